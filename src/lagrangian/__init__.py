@@ -1,0 +1,38 @@
+"""lagrangian: equations of motion by Lagrange's method, from energies or components.
+
+>>> import lagrangian
+>>> system = lagrangian.load("pendulum")
+>>> system.equations_of_motion().equations
+Matrix([[L**2*m*theta_ddot + L*g*m*sin(theta)]])
+"""
+
+from sympy import cos, exp, sin, sqrt, tan
+
+from .derivation.equations import EquationsOfMotion, LoadContribution
+from .errors import DerivationError, LagrangianError, ModelError
+from .model.examples import example_names as examples
+from .model.model import Model
+from .model.reader import parse_model, read_model
+from .system import System, SystemBuilder, load
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "DerivationError",
+    "EquationsOfMotion",
+    "LagrangianError",
+    "LoadContribution",
+    "Model",
+    "ModelError",
+    "System",
+    "SystemBuilder",
+    "cos",
+    "examples",
+    "exp",
+    "load",
+    "parse_model",
+    "read_model",
+    "sin",
+    "sqrt",
+    "tan",
+]

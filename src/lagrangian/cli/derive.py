@@ -1,0 +1,36 @@
+"""`lagrangian derive MODEL`: energies, equations of motion, generalized forces, matrices."""
+
+from __future__ import annotations
+
+from enum import Enum
+from typing import Annotated
+
+import typer
+
+from ..output.json import derivation_document
+from ..output.latex import derivation_latex
+from ..output.text import derivation_text
+from . import app
+from .common import load_system, print_json
+
+
+class Format(str, Enum):
+    text = "text"
+    latex = "latex"
+    json = "json"
+
+
+@app.command()
+def derive(
+    model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
+    format: Annotated[Format, typer.Option("--format", "-f", help="Output format.")] = Format.text,
+    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+) -> None:
+    """Derive the equations of motion by Lagrange's method."""
+    eom = load_system(model, set_).equations_of_motion()
+    if format is Format.json:
+        print_json(derivation_document(eom))
+    elif format is Format.latex:
+        typer.echo(derivation_latex(eom), nl=False)
+    else:
+        typer.echo(derivation_text(eom), nl=False)

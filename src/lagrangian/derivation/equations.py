@@ -1,0 +1,83 @@
+"""The equations of motion, in the convention M(q, t) q_ddot + Phi_q^T lambda = f(q, q_dot, t)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..model.model import Model
+from ..model.notation import latex_symbol_names
+
+
+@dataclass(frozen=True)
+class LoadContribution:
+    """What one load gives to one coordinate's generalized force (N or N m)."""
+
+    load: str
+    coordinate: str
+    expression: sp.Expr
+
+
+@dataclass(frozen=True)
+class EquationsOfMotion:
+    """Equations of motion M q_ddot + Phi_q^T lambda = f, with the energies they came from.
+
+    ``mass_matrix`` is W = d^2L/dq_dot^2 (n x n), ``forcing`` f (n x 1) collects generalized
+    forces, potential, velocity-product and explicit-time terms. With constraints,
+    ``constraint_jacobian`` is Phi_q (or A), one ``multipliers`` entry per constraint, and the
+    acceleration-level constraint reads Phi_q q_ddot = ``acceleration_rhs``.
+    """
+
+    model: Model
+    kinetic_energy: sp.Expr
+    potential_energy: sp.Expr
+    dissipation: sp.Expr
+    mass_matrix: sp.ImmutableMatrix
+    forcing: sp.ImmutableMatrix
+    generalized_forces: sp.ImmutableMatrix
+    load_contributions: tuple[LoadContribution, ...]
+    constraint_jacobian: sp.ImmutableMatrix
+    velocity_bias: sp.ImmutableMatrix
+    acceleration_rhs: sp.ImmutableMatrix
+    multipliers: sp.ImmutableMatrix
+    accelerations: sp.ImmutableMatrix | None
+
+    @property
+    def coordinates(self) -> sp.ImmutableMatrix:
+        return sp.ImmutableMatrix(self.model.q)
+
+    @property
+    def velocities(self) -> sp.ImmutableMatrix:
+        return sp.ImmutableMatrix(self.model.q_dot)
+
+    @property
+    def coordinate_accelerations(self) -> sp.ImmutableMatrix:
+        return sp.ImmutableMatrix(self.model.q_ddot)
+
+    @property
+    def constraint_names(self) -> tuple[str, ...]:
+        return tuple(c.name for c in self.model.constraints)
+
+    @property
+    def lagrangian(self) -> sp.Expr:
+        """L = T - V (J)."""
+        return self.kinetic_energy - self.potential_energy
+
+    @property
+    def equations(self) -> sp.ImmutableMatrix:
+        """One expression per coordinate that equals zero: M q_ddot + Phi_q^T lambda - f."""
+        lhs = self.mass_matrix * self.coordinate_accelerations
+        if self.multipliers.shape[0]:
+            lhs = lhs + self.constraint_jacobian.T * self.multipliers
+        return sp.ImmutableMatrix(lhs - self.forcing)
+
+    def _repr_latex_(self) -> str:
+        names = latex_symbol_names(self.model)
+        rows = []
+        for coordinate, equation in zip(self.model.coordinates, self.equations, strict=True):
+            rows.append(
+                rf"{sp.latex(coordinate.symbol)}:\quad & "
+                rf"{sp.latex(equation, symbol_names=names)} = 0"
+            )
+        return r"$\begin{aligned}" + r"\\ ".join(rows) + r"\end{aligned}$"

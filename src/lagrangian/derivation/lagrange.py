@@ -1,0 +1,174 @@
+"""Lagrange's equations, d/dt(dL/dq_dot) - dL/dq = Q, in the form M q_ddot + Phi_q^T lambda = f.
+
+Structure is used instead of generic time differentiation: each particle and body contributes
+M += m J^T J and f -= m J^T a_rest (its velocity Jacobian J and the acceleration at q_ddot = 0),
+which is exactly the Euler-Lagrange operator applied to its 1/2 m v.v. A user-given L(q, q_dot, t)
+goes through the general formula W q_ddot = dL/dq - (d^2L/dq_dot dq) q_dot - d^2L/dq_dot dt.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..model.model import Model, multiplier_name
+from .constraints import constraint_terms
+from .equations import EquationsOfMotion
+from .kinematics import jacobian_row, time_rate
+from .regularity import check_regularity
+from .virtual_work import generalized_forces, load_contributions
+
+# Above this size a symbolic solve for q_ddot swells; users get the implicit form only.
+SYMBOLIC_SOLVE_MAX_UNKNOWNS = 3
+SYMBOLIC_SOLVE_MAX_OPS = 400
+
+
+class _Accumulator:
+    """Collects terms of M and f and adds each entry once (repeated Add is quadratic)."""
+
+    def __init__(self, n: int):
+        self.n = n
+        self.mass = [[[] for _ in range(n)] for _ in range(n)]
+        self.forcing = [[] for _ in range(n)]
+
+    def inertia(self, mass: sp.Expr, jacobian: list[list[sp.Expr]], rest: list[sp.Expr]) -> None:
+        """Add m J^T J to M and -m J^T a_rest to f for J (rows: components, cols: coordinates)."""
+        n = self.n
+        for i in range(n):
+            column_i = [row[i] for row in jacobian]
+            if not any(c != 0 for c in column_i):
+                continue
+            for j in range(i, n):
+                dot = sp.Add(*(a * row[j] for a, row in zip(column_i, jacobian, strict=True)
+                               if a != 0 and row[j] != 0))
+                if dot != 0:
+                    self.mass[i][j].append(mass * dot)
+            projected = sp.Add(*(a * r for a, r in zip(column_i, rest, strict=True)
+                                 if a != 0 and r != 0))
+            if projected != 0:
+                self.forcing[i].append(-mass * projected)
+
+    def matrices(self) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
+        n = self.n
+        mass = [[sp.S.Zero] * n for _ in range(n)]
+        for i in range(n):
+            for j in range(i, n):
+                mass[i][j] = mass[j][i] = sp.Add(*self.mass[i][j])
+        forcing = [sp.Add(*terms) for terms in self.forcing]
+        return sp.ImmutableMatrix(mass), sp.ImmutableMatrix(n, 1, forcing)
+
+
+def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
+    """Form the equations of motion of ``model`` by Lagrange's method (units: SI)."""
+    q, q_dot, t = model.q, model.q_dot, model.time
+    n = len(q)
+    acc = _Accumulator(n)
+    kinetic_terms: list[sp.Expr] = []
+    potential_terms: list[sp.Expr] = [model.potential_energy]
+    dissipation_terms: list[sp.Expr] = [model.dissipation]
+
+    def translate(mass: sp.Expr, position) -> None:
+        jacobian = [jacobian_row(component, q) for component in position]
+        velocity = [time_rate(component, q, q_dot, t) for component in position]
+        rest = [time_rate(v, q, q_dot, t) for v in velocity]
+        acc.inertia(mass, jacobian, rest)
+        kinetic_terms.append(sp.Rational(1, 2) * mass * sp.Add(*(v**2 for v in velocity)))
+
+    for particle in model.particles:
+        translate(particle.mass, particle.position)
+    for body in model.bodies:
+        translate(body.mass, body.position)
+        omega = time_rate(body.angle, q, q_dot, t)
+        acc.inertia(body.inertia, [jacobian_row(body.angle, q)], [time_rate(omega, q, q_dot, t)])
+        kinetic_terms.append(sp.Rational(1, 2) * body.inertia * omega**2)
+
+    if model.gravity is not None:
+        g, direction = model.gravity.magnitude, model.gravity.direction
+        for item in (*model.particles, *model.bodies):
+            height = sp.Add(*(d * r for d, r in zip(direction, item.position, strict=True)
+                              if d != 0))
+            potential_terms.append(-item.mass * g * height)
+    for spring in model.springs:
+        potential_terms.append(
+            sp.Rational(1, 2) * spring.stiffness * (spring.length - spring.rest_length) ** 2
+        )
+    for damper in model.dampers:
+        dissipation_terms.append(sp.Rational(1, 2) * damper.coefficient * damper.rate**2)
+
+    # The user's T and V go through the general Euler-Lagrange formula.
+    user_lagrangian = model.kinetic_energy - model.potential_energy
+    if user_lagrangian != 0:
+        _general_lagrangian(acc, user_lagrangian, q, q_dot, t)
+    component_potential = sp.Add(*potential_terms[1:])
+    if component_potential != 0:
+        for i, d in enumerate(jacobian_row(component_potential, q)):
+            if d != 0:
+                acc.forcing[i].append(-d)
+
+    contributions = load_contributions(model)
+    Q = generalized_forces(model, contributions)
+    for i, value in enumerate(Q):
+        if value != 0:
+            acc.forcing[i].append(value)
+    mass_matrix, forcing = acc.matrices()
+
+    jacobian, bias, gamma = constraint_terms(model)
+    multipliers = sp.ImmutableMatrix(
+        len(model.constraints), 1, [sp.Symbol(multiplier_name(c.name)) for c in model.constraints]
+    )
+    if check:
+        check_regularity(model, mass_matrix, jacobian)
+    return EquationsOfMotion(
+        model=model,
+        kinetic_energy=sp.Add(model.kinetic_energy, *kinetic_terms),
+        potential_energy=sp.Add(*potential_terms),
+        dissipation=sp.Add(*dissipation_terms),
+        mass_matrix=mass_matrix,
+        forcing=forcing,
+        generalized_forces=sp.ImmutableMatrix(n, 1, Q),
+        load_contributions=tuple(contributions),
+        constraint_jacobian=jacobian,
+        velocity_bias=bias,
+        acceleration_rhs=gamma,
+        multipliers=multipliers,
+        accelerations=_solve_small(mass_matrix, forcing, jacobian, gamma),
+    )
+
+
+def _general_lagrangian(acc: _Accumulator, L: sp.Expr, q, q_dot, t) -> None:
+    """W q_ddot = dL/dq - (d^2L/dq_dot dq) q_dot - d^2L/dq_dot dt, added term by term."""
+    momenta = jacobian_row(L, q_dot)
+    forces = jacobian_row(L, q)
+    for i, p in enumerate(momenta):
+        if forces[i] != 0:
+            acc.forcing[i].append(forces[i])
+        if p == 0:
+            continue
+        # W is symmetric: only its upper triangle is accumulated.
+        for j, w in enumerate(jacobian_row(p, q_dot)[i:], start=i):
+            if w != 0:
+                acc.mass[i][j].append(w)
+        rate = time_rate(p, q, q_dot, t)
+        if rate != 0:
+            acc.forcing[i].append(-rate)
+
+
+def _solve_small(mass_matrix, forcing, jacobian, gamma) -> sp.ImmutableMatrix | None:
+    n, m = mass_matrix.shape[0], jacobian.shape[0]
+    if n + m > SYMBOLIC_SOLVE_MAX_UNKNOWNS:
+        return None
+    if sp.count_ops(mass_matrix) + sp.count_ops(forcing) > SYMBOLIC_SOLVE_MAX_OPS:
+        return None
+    if m:
+        system = sp.Matrix(sp.BlockMatrix([[mass_matrix, jacobian.T],
+                                           [jacobian, sp.zeros(m, m)]]))
+        rhs = sp.Matrix.vstack(sp.Matrix(forcing), sp.Matrix(gamma))
+    else:
+        system, rhs = sp.Matrix(mass_matrix), sp.Matrix(forcing)
+    try:
+        solution = system.LUsolve(rhs)
+    except (ValueError, ZeroDivisionError, sp.matrices.exceptions.NonInvertibleMatrixError):
+        return None
+    if any(value.has(sp.nan, sp.zoo) for value in solution):
+        return None
+    # Small by the guard above, so a rational cancellation is cheap and much more readable.
+    return sp.ImmutableMatrix(n, 1, [sp.factor_terms(sp.cancel(v)) for v in solution[:n]])

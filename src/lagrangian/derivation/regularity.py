@@ -1,0 +1,106 @@
+"""Checks that the equations can be solved for the accelerations (and multipliers).
+
+A structural test finds coordinates whose velocity T does not contain; a numeric rank test at
+random states (probabilistic: generic rank holds almost everywhere) finds the rest, and names
+a redundant constraint.
+"""
+
+from __future__ import annotations
+
+import random
+
+import numpy as np
+import sympy as sp
+
+from ..errors import DerivationError
+from ..model.model import Model
+
+
+def random_state(model: Model, seed: int = 12345) -> dict[sp.Symbol, sp.Float]:
+    """A random substitution for parameters without value, coordinates, velocities and time."""
+    rng = random.Random(seed)
+    values: dict[sp.Symbol, sp.Float] = {}
+    for p in model.parameters:
+        value = p.value if p.value is not None else rng.uniform(0.6, 1.7)
+        values[p.symbol] = sp.Float(value)
+    for c in model.coordinates:
+        values[c.symbol] = sp.Float(rng.uniform(-1.3, 1.3) + (c.initial or 0.0))
+        values[c.velocity] = sp.Float(rng.uniform(-1.0, 1.0))
+    values[model.time] = sp.Float(rng.uniform(0.1, 1.0))
+    return values
+
+
+def numeric_matrix(matrix: sp.MatrixBase, values: dict) -> np.ndarray:
+    """Evaluate a symbolic matrix at a point by substitution (no compilation)."""
+    out = np.empty(matrix.shape)
+    for (i, j), entry in np.ndenumerate(np.empty(matrix.shape)):
+        value = matrix[i, j].xreplace(values)
+        out[i, j] = float(value.evalf()) if not value.is_Number else float(value)
+    return out
+
+
+def check_regularity(model: Model, mass_matrix: sp.MatrixBase, jacobian: sp.MatrixBase) -> None:
+    """Raise DerivationError naming the coordinate or constraint that makes the system singular."""
+    n, m = mass_matrix.shape[0], jacobian.shape[0]
+    names = [c.name for c in model.coordinates]
+    missing = [names[i] for i in range(n) if all(mass_matrix[i, j] == 0 for j in range(n))]
+    if missing and not m:
+        raise DerivationError(_missing_message(missing))
+    values = random_state(model)
+    try:
+        M = numeric_matrix(mass_matrix, values)
+        A = numeric_matrix(jacobian, values) if m else np.zeros((0, n))
+    except (TypeError, ValueError):
+        return  # not numerically evaluable (e.g. complex at this point): leave it to the solver
+    if not (np.all(np.isfinite(M)) and np.all(np.isfinite(A))):
+        return
+    if m:
+        _check_constraints(model, A)
+        system = np.block([[M, A.T], [A, np.zeros((m, m))]])
+    else:
+        system = M
+    if _rank(system) < system.shape[0]:
+        if missing:
+            raise DerivationError(_missing_message(missing))
+        null = np.linalg.svd(system)[2][-1][:n]
+        involved = [names[i] for i in np.flatnonzero(np.abs(null) > 1e-6 * np.abs(null).max())]
+        raise DerivationError(
+            "the mass matrix W = d^2L/dq_dot^2 is singular"
+            + (" on the constraints" if m else "")
+            + f": the accelerations of {', '.join(involved)} cannot be solved for "
+            "(T does not determine them independently); check the kinetic energy"
+        )
+
+
+def _missing_message(missing: list[str]) -> str:
+    listed = ", ".join(f"'{name}'" for name in missing)
+    return (
+        f"singular mass matrix: the kinetic energy does not contain the velocity of {listed}, "
+        "so its equation has no acceleration; give it inertia (a mass, a body or a T term) or "
+        "remove the coordinate"
+    )
+
+
+def _check_constraints(model: Model, A: np.ndarray) -> None:
+    kept: list[np.ndarray] = []
+    for constraint, row in zip(model.constraints, A, strict=True):
+        candidate = np.array(kept + [row])
+        if _rank(candidate) < len(candidate):
+            others = ", ".join(c.name for c in model.constraints[: len(kept)]) or "none"
+            if not np.any(row):
+                reason = "its Jacobian is zero"
+            else:
+                reason = f"it depends on the constraints before it ({others})"
+            raise DerivationError(
+                f"redundant constraint '{constraint.name}': {reason}; "
+                "remove it so that there is exactly one multiplier per independent constraint"
+            )
+        kept.append(row)
+
+
+def _rank(matrix: np.ndarray) -> int:
+    if matrix.size == 0:
+        return 0
+    singular = np.linalg.svd(matrix, compute_uv=False)
+    scale = max(singular.max(), 1.0)
+    return int(np.sum(singular > 1e-9 * scale))

@@ -1,0 +1,31 @@
+"""Errors a user can meet, each naming where the problem is and what is wrong."""
+
+from __future__ import annotations
+
+
+class LagrangianError(Exception):
+    """Base class for every error the library raises on bad input (CLI exit status 2)."""
+
+
+class ModelError(LagrangianError):
+    """A model (file or builder) is invalid: names the source, the field and the problem."""
+
+    def __init__(self, message: str, *, field: str | None = None, source: str | None = None):
+        self.message = message
+        self.field = field
+        self.source = source
+        super().__init__(self.__str__())
+
+    def __str__(self) -> str:
+        where = ": ".join(part for part in (self.source, self.field) if part)
+        return f"{where}: {self.message}" if where else self.message
+
+    def located(self, source: str | None = None, field: str | None = None) -> ModelError:
+        """The same error with a source file and/or field filled in where missing."""
+        return ModelError(
+            self.message, field=self.field or field, source=self.source or source
+        )
+
+
+class DerivationError(LagrangianError):
+    """The model is well formed but its equations cannot be formed (singular mass matrix, ...)."""

@@ -1,0 +1,499 @@
+"""Build a :class:`Model` step by step from Python (sympy expressions, numbers or strings).
+
+Strings are parsed with the model-file grammar; sympy expressions may use the symbols this
+builder returns, or ``dynamicsymbols`` of the same names (``q(t)`` and ``q(t).diff(t)``).
+"""
+
+from __future__ import annotations
+
+import keyword
+import re
+from collections.abc import Iterable, Sequence
+
+import sympy as sp
+
+from ..errors import ModelError
+from .expressions import RESERVED, parse_expression
+from .model import (
+    TIME,
+    Body,
+    Constraint,
+    Coordinate,
+    Damper,
+    Gravity,
+    Model,
+    Parameter,
+    Particle,
+    PointForce,
+    Spring,
+    Torque,
+    Vector,
+    acceleration_name,
+    multiplier_name,
+    velocity_name,
+)
+
+_IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+_ZERO: Vector = (sp.S.Zero, sp.S.Zero, sp.S.Zero)
+
+
+class ModelBuilder:
+    """Mutable shell that validates each piece as it is added and builds an immutable Model."""
+
+    def __init__(self, name: str = "", description: str = "", *, source: str | None = None):
+        self.name = name
+        self.description = description
+        self.source = source
+        self._coordinates: list[Coordinate] = []
+        self._parameters: list[Parameter] = []
+        self._definitions: list[tuple[str, sp.Expr]] = []
+        self._names: dict[str, sp.Expr] = {"t": TIME}
+        self._kinetic: list[sp.Expr] = []
+        self._potential: list[sp.Expr] = []
+        self._dissipation: list[sp.Expr] = []
+        self._gravity: Gravity | None = None
+        self._particles: list[Particle] = []
+        self._bodies: list[Body] = []
+        self._springs: list[Spring] = []
+        self._dampers: list[Damper] = []
+        self._loads: list[PointForce | Torque] = []
+        self._generalized: dict[str, list[sp.Expr]] = {}
+        self._constraints: list[Constraint] = []
+        self._component_names: set[str] = set()
+
+    # -- declarations ---------------------------------------------------------------------
+
+    def coordinate(
+        self,
+        name: str,
+        unit: str = "m",
+        *,
+        initial: float | None = None,
+        rate: float | None = None,
+        range: tuple[float, float] | None = None,
+        field: str | None = None,
+    ) -> sp.Symbol:
+        """Declare a generalized coordinate; returns its symbol (its velocity is ``name_dot``)."""
+        field = field or f"coordinates.{name}"
+        self._declare(name, field)
+        for derived in (velocity_name(name), acceleration_name(name)):
+            self._declare(derived, field)
+        symbol, velocity = sp.Symbol(name), sp.Symbol(velocity_name(name))
+        coordinate = Coordinate(
+            name, symbol, velocity, sp.Symbol(acceleration_name(name)), unit,
+            _optional_float(initial, f"{field}.initial", self.source),
+            _optional_float(rate, f"{field}.rate", self.source),
+            _range(range, f"{field}.range", self.source),
+        )
+        self._coordinates.append(coordinate)
+        self._names[name] = symbol
+        self._names[velocity_name(name)] = velocity
+        return symbol
+
+    def parameter(
+        self, name: str, value: float | None = None, unit: str | None = None, *,
+        field: str | None = None,
+    ) -> sp.Symbol:
+        """Declare a named constant (SI value, or None to keep it symbolic); returns its symbol."""
+        field = field or f"parameters.{name}"
+        self._declare(name, field)
+        symbol = sp.Symbol(name)
+        self._parameters.append(
+            Parameter(name, symbol, _optional_float(value, field, self.source), unit)
+        )
+        self._names[name] = symbol
+        return symbol
+
+    def define(self, name: str, expression: object, *, field: str | None = None) -> sp.Expr:
+        """A named sub-expression, usable in everything added after it; returns its value."""
+        field = field or f"definitions.{name}"
+        value = self.expression(expression, field)
+        self._declare(name, field)
+        self._definitions.append((name, value))
+        self._names[name] = value
+        return value
+
+    def velocity(self, coordinate: sp.Symbol | str) -> sp.Symbol:
+        """The velocity symbol q_dot of a declared coordinate."""
+        return self._coordinate(str(coordinate), "velocity").velocity
+
+    # -- energies -------------------------------------------------------------------------
+
+    def add_kinetic_energy(self, T: object, *, field: str = "energy.T") -> ModelBuilder:
+        """Add a kinetic-energy term T(q, q_dot, t) in J."""
+        self._kinetic.append(self.expression(T, field))
+        return self
+
+    def add_potential_energy(self, V: object, *, field: str = "energy.V") -> ModelBuilder:
+        """Add a potential-energy term V(q, t) in J (may depend on velocities: generalized potential)."""
+        self._potential.append(self.expression(V, field))
+        return self
+
+    def add_dissipation(self, D: object, *, field: str = "energy.D") -> ModelBuilder:
+        """Add a Rayleigh dissipation term D(q, q_dot, t) in W; Q_i = -dD/dq_dot_i."""
+        self._dissipation.append(self.expression(D, field))
+        return self
+
+    # -- components -----------------------------------------------------------------------
+
+    def set_gravity(
+        self, g: object, direction: Sequence[object] = (0, -1), *, field: str = "gravity"
+    ) -> ModelBuilder:
+        """Uniform gravity of magnitude g (m/s^2) along ``direction`` (normalized here)."""
+        magnitude = self.expression(g, f"{field}.g")
+        vector = self.vector(direction, f"{field}.direction")
+        if any(component.free_symbols for component in vector):
+            raise self._error("the direction must be numbers", f"{field}.direction")
+        norm = sp.sqrt(sum(c**2 for c in vector))
+        if norm == 0:
+            raise self._error("the direction is the zero vector", f"{field}.direction")
+        self._gravity = Gravity(magnitude, tuple(c / norm for c in vector))
+        return self
+
+    def add_particle(
+        self, name: str, mass: object, position: Sequence[object], *, field: str | None = None
+    ) -> ModelBuilder:
+        """A point mass (kg) at position r(q, t) (m)."""
+        field = field or f"particle '{name}'"
+        self._component(name, field)
+        self._particles.append(
+            Particle(
+                name,
+                self.expression(mass, f"{field}.mass", velocities=False),
+                self.vector(position, f"{field}.position", velocities=False),
+            )
+        )
+        return self
+
+    def add_body(
+        self, name: str, mass: object, inertia: object, position: Sequence[object], angle: object,
+        *, field: str | None = None,
+    ) -> ModelBuilder:
+        """A planar rigid body: mass (kg), inertia about its centre of mass (kg m^2), centre, angle."""
+        field = field or f"body '{name}'"
+        self._component(name, field)
+        self._bodies.append(
+            Body(
+                name,
+                self.expression(mass, f"{field}.mass", velocities=False),
+                self.expression(inertia, f"{field}.inertia", velocities=False),
+                self.vector(position, f"{field}.position", velocities=False),
+                self.expression(angle, f"{field}.angle", velocities=False),
+            )
+        )
+        return self
+
+    def point(self, reference: object, *, field: str = "point") -> Vector:
+        """Resolve a point: a particle or body name (its centre), a vector, or (body, offset)."""
+        if isinstance(reference, str):
+            for particle in self._particles:
+                if particle.name == reference:
+                    return particle.position
+            for body in self._bodies:
+                if body.name == reference:
+                    return body.position
+            names = [p.name for p in self._particles] + [b.name for b in self._bodies]
+            import difflib
+
+            close = difflib.get_close_matches(reference, names, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise self._error(
+                f"'{reference}' is not a particle or body (declare it before use){hint}", field
+            )
+        if isinstance(reference, dict):
+            unknown = set(reference) - {"body", "offset"}
+            if unknown or "body" not in reference:
+                raise self._error(
+                    "a body point is a table {body = \"name\", offset = [x, y]}"
+                    + (f"; unknown key '{sorted(unknown)[0]}'" if unknown else ""),
+                    field,
+                )
+            return self.body_point(reference["body"], reference.get("offset", (0, 0)), field=field)
+        return self.vector(reference, field, velocities=False)
+
+    def body_point(
+        self, body: str, offset: Sequence[object], *, field: str = "point"
+    ) -> Vector:
+        """The point fixed in a planar body at ``offset`` (m, in the body's frame)."""
+        for candidate in self._bodies:
+            if candidate.name == body:
+                dx, dy, dz = self.vector(offset, f"{field}.offset", velocities=False)
+                c, s = sp.cos(candidate.angle), sp.sin(candidate.angle)
+                x, y, z = candidate.position
+                return (x + c * dx - s * dy, y + s * dx + c * dy, z + dz)
+        raise self._error(f"'{body}' is not a body (declare it before use)", f"{field}.body")
+
+    def add_spring(
+        self, name: str, stiffness: object, rest_length: object = 0, *, length: object = None,
+        between: Sequence[object] | None = None, field: str | None = None,
+    ) -> ModelBuilder:
+        """A linear spring, V = 1/2 k (length - rest_length)^2; give ``length`` or ``between``."""
+        field = field or f"spring '{name}'"
+        self._component(name, field)
+        extent = self._extent(length, between, "length", field)
+        self._springs.append(
+            Spring(
+                name,
+                self.expression(stiffness, f"{field}.stiffness", velocities=False),
+                self.expression(rest_length, f"{field}.rest_length", velocities=False),
+                extent,
+            )
+        )
+        return self
+
+    def add_damper(
+        self, name: str, coefficient: object, *, rate: object = None,
+        between: Sequence[object] | None = None, field: str | None = None,
+    ) -> ModelBuilder:
+        """A linear viscous damper, D = 1/2 c rate^2; give ``rate`` or ``between`` (two points)."""
+        field = field or f"damper '{name}'"
+        self._component(name, field)
+        if (rate is None) == (between is None):
+            raise self._error("give exactly one of 'rate' or 'between'", field)
+        if rate is not None:
+            value = self.expression(rate, f"{field}.rate")
+        else:
+            value = self._time_derivative(self._extent(None, between, "rate", field))
+        self._dampers.append(
+            Damper(name, self.expression(coefficient, f"{field}.coefficient", velocities=False),
+                   value)
+        )
+        return self
+
+    def add_force(
+        self, name: str, point: object, force: Sequence[object], *, field: str | None = None
+    ) -> ModelBuilder:
+        """A force (N) at a point; enters by virtual work, Q_i = F . dr/dq_i."""
+        field = field or f"load '{name}'"
+        self._component(name, field)
+        where = self.point(point, field=f"{field}.point")
+        self._require_coordinate_dependence(where, name, f"{field}.point", "point")
+        self._loads.append(PointForce(name, where, self.vector(force, f"{field}.force")))
+        return self
+
+    def add_torque(
+        self, name: str, torque: object, angle: object, *, field: str | None = None
+    ) -> ModelBuilder:
+        """A torque (N m) turning through angle theta(q); Q_i = tau dtheta/dq_i."""
+        field = field or f"load '{name}'"
+        self._component(name, field)
+        if isinstance(angle, str) and any(b.name == angle for b in self._bodies):
+            turned = next(b.angle for b in self._bodies if b.name == angle)
+        else:
+            turned = self.expression(angle, f"{field}.angle", velocities=False)
+        self._require_coordinate_dependence((turned,), name, f"{field}.angle", "angle")
+        self._loads.append(Torque(name, self.expression(torque, f"{field}.torque"), turned))
+        return self
+
+    def add_generalized_force(
+        self, coordinate: sp.Symbol | str, Q: object, *, field: str | None = None
+    ) -> ModelBuilder:
+        """A generalized force given directly on one coordinate (N or N m)."""
+        name = str(coordinate)
+        field = field or f"generalized_forces.{name}"
+        self._coordinate(name, field)
+        self._generalized.setdefault(name, []).append(self.expression(Q, field))
+        return self
+
+    def add_constraint(
+        self, name: str, *, holonomic: object = None, velocity: object = None,
+        field: str | None = None,
+    ) -> ModelBuilder:
+        """A constraint Phi(q, t) = 0 (holonomic) or A(q, t) q_dot + b(q, t) = 0 (velocity)."""
+        field = field or f"constraint '{name}'"
+        if not isinstance(name, str) or not _IDENTIFIER.match(name):
+            raise self._error(f"constraint name {name!r} must be an identifier", f"{field}.name")
+        self._component(name, field)
+        if (holonomic is None) == (velocity is None):
+            raise self._error("give exactly one of 'holonomic' or 'velocity'", field)
+        if holonomic is not None:
+            expression = self.expression(holonomic, f"{field}.holonomic", velocities=False)
+            kind = "holonomic"
+        else:
+            expression = self.expression(velocity, f"{field}.velocity")
+            velocities = [c.velocity for c in self._coordinates]
+            if not expression.free_symbols & set(velocities):
+                raise self._error(
+                    "a velocity constraint must contain at least one velocity (q_dot); "
+                    "write a constraint on positions as 'holonomic'", f"{field}.velocity",
+                )
+            for v in velocities:
+                if expression.diff(v).free_symbols & set(velocities):
+                    raise self._error(
+                        "a velocity constraint must be linear in the velocities",
+                        f"{field}.velocity",
+                    )
+            kind = "velocity"
+        if not expression.free_symbols & set(self._all_state_symbols()):
+            raise self._error("the constraint does not involve any coordinate", field)
+        self._constraints.append(Constraint(name, kind, expression))
+        return self
+
+    # -- expressions ----------------------------------------------------------------------
+
+    def expression(self, value: object, field: str, *, velocities: bool = True) -> sp.Expr:
+        """Turn a string, number or sympy expression into a validated sympy expression."""
+        if isinstance(value, sp.Basic):
+            expr = self._adopt(value, field)
+        else:
+            expr = parse_expression(value, self._names, field=field, source=self.source)
+        if not isinstance(expr, sp.Expr):
+            raise self._error("expected a scalar expression", field)
+        if not velocities:
+            used = expr.free_symbols & {c.velocity for c in self._coordinates}
+            if used:
+                raise self._error(
+                    f"may not depend on velocities (found {sorted(map(str, used))[0]})", field
+                )
+        return expr
+
+    def vector(
+        self, values: Sequence[object], field: str, *, velocities: bool = True
+    ) -> Vector:
+        """A 2- or 3-component vector of expressions (a planar one gets z = 0)."""
+        if isinstance(values, str | bytes) or not isinstance(values, Sequence | sp.MatrixBase):
+            raise self._error("expected a vector: a list of 2 or 3 components", field)
+        items = list(values)
+        if len(items) not in (2, 3):
+            raise self._error(f"expected 2 or 3 components, got {len(items)}", field)
+        parsed = [
+            self.expression(v, f"{field}[{i}]", velocities=velocities) for i, v in enumerate(items)
+        ]
+        if len(parsed) == 2:
+            parsed.append(sp.S.Zero)
+        return tuple(parsed)
+
+    def _adopt(self, value: sp.Basic, field: str) -> sp.Expr:
+        replacements: dict[sp.Basic, sp.Basic] = {}
+        for derivative in value.atoms(sp.Derivative):
+            base = derivative.expr
+            if (
+                isinstance(base, sp.core.function.AppliedUndef)
+                and str(base.func) in self._names
+                and derivative.variables == (TIME,)
+            ):
+                replacements[derivative] = self.velocity(str(base.func))
+            else:
+                raise self._error(f"unsupported derivative {derivative}", field)
+        value = value.xreplace(replacements)
+        for applied in value.atoms(sp.core.function.AppliedUndef):
+            name = str(applied.func)
+            if name in self._names and applied.args == (TIME,):
+                replacements[applied] = self._names[name]
+            else:
+                raise self._error(f"unknown function {applied}", field)
+        value = value.xreplace(replacements)
+        declared = set(self._names.values())
+        for symbol in value.free_symbols:
+            if symbol not in declared:
+                raise self._error(
+                    f"unknown symbol '{symbol}': declare it with coordinate() or parameter()",
+                    field,
+                )
+        return value
+
+    # -- build ----------------------------------------------------------------------------
+
+    def build_model(self) -> Model:
+        """Validate the whole and return the immutable Model."""
+        if not self._coordinates:
+            raise self._error("a model needs at least one generalized coordinate", "coordinates")
+        return Model(
+            name=self.name or "Unnamed model",
+            description=self.description,
+            coordinates=tuple(self._coordinates),
+            parameters=tuple(self._parameters),
+            definitions=tuple(self._definitions),
+            kinetic_energy=sp.Add(*self._kinetic),
+            potential_energy=sp.Add(*self._potential),
+            dissipation=sp.Add(*self._dissipation),
+            gravity=self._gravity,
+            particles=tuple(self._particles),
+            bodies=tuple(self._bodies),
+            springs=tuple(self._springs),
+            dampers=tuple(self._dampers),
+            loads=tuple(self._loads),
+            generalized_forces=tuple((k, sp.Add(*v)) for k, v in self._generalized.items()),
+            constraints=tuple(self._constraints),
+            source=self.source,
+        )
+
+    # -- helpers --------------------------------------------------------------------------
+
+    def _error(self, message: str, field: str | None) -> ModelError:
+        return ModelError(message, field=field, source=self.source)
+
+    def _declare(self, name: str, field: str) -> None:
+        if not isinstance(name, str) or not _IDENTIFIER.match(name) or keyword.iskeyword(name):
+            raise self._error(f"{name!r} is not a valid name (letters, digits, '_')", field)
+        if name in RESERVED:
+            raise self._error(f"'{name}' is reserved (a function, constant or time)", field)
+        if name in self._names:
+            raise self._error(f"'{name}' is declared twice", field)
+        if name.startswith("lambda_"):
+            raise self._error(f"'{name}': names starting 'lambda_' are reserved for multipliers",
+                              field)
+
+    def _component(self, name: str, field: str) -> None:
+        if not isinstance(name, str) or not name:
+            raise self._error("every component needs a non-empty name", f"{field}.name")
+        if name in self._component_names:
+            raise self._error(f"the name '{name}' is used twice", f"{field}.name")
+        self._component_names.add(name)
+
+    def _coordinate(self, name: str, field: str) -> Coordinate:
+        for c in self._coordinates:
+            if c.name == name:
+                return c
+        raise self._error(f"'{name}' is not a declared coordinate", field)
+
+    def _all_state_symbols(self) -> Iterable[sp.Symbol]:
+        for c in self._coordinates:
+            yield c.symbol
+            yield c.velocity
+
+    def _extent(self, value, between, what: str, field: str) -> sp.Expr:
+        if (value is None) == (between is None):
+            raise self._error(f"give exactly one of '{what}' or 'between'", field)
+        if value is not None:
+            return self.expression(value, f"{field}.{what}", velocities=False)
+        if isinstance(between, str) or not isinstance(between, Sequence) or len(between) != 2:
+            raise self._error("'between' takes exactly two points", f"{field}.between")
+        a = self.point(between[0], field=f"{field}.between[0]")
+        b = self.point(between[1], field=f"{field}.between[1]")
+        return sp.sqrt(sum((ai - bi) ** 2 for ai, bi in zip(a, b, strict=True)))
+
+    def _time_derivative(self, expr: sp.Expr) -> sp.Expr:
+        return sum(
+            (expr.diff(c.symbol) * c.velocity for c in self._coordinates), expr.diff(TIME)
+        )
+
+    def _require_coordinate_dependence(self, values, name, field, what) -> None:
+        coordinates = {c.symbol for c in self._coordinates}
+        if not any(v.free_symbols & coordinates for v in values):
+            raise self._error(
+                f"the {what} of load '{name}' does not depend on any coordinate, so the load "
+                "does no virtual work; attach it to a moving point", field,
+            )
+
+
+def _optional_float(value: object, field: str, source: str | None) -> float | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float | sp.Number):
+        raise ModelError(f"expected a number, got {value!r}", field=field, source=source)
+    return float(value)
+
+
+def _range(value, field: str, source: str | None) -> tuple[float, float] | None:
+    if value is None:
+        return None
+    if not isinstance(value, Sequence) or len(value) != 2:
+        raise ModelError("expected [lower, upper]", field=field, source=source)
+    lower, upper = (_optional_float(v, field, source) for v in value)
+    if not lower < upper:
+        raise ModelError("lower must be below upper", field=field, source=source)
+    return (lower, upper)
+
+
+__all__ = ["ModelBuilder", "multiplier_name"]

@@ -1,0 +1,51 @@
+"""Built-in example models, shipped as model files (TOML) beside this module."""
+
+from __future__ import annotations
+
+import tomllib
+from importlib import resources
+from pathlib import Path
+
+from ...errors import ModelError
+
+
+def _files() -> dict[str, Path]:
+    folder = resources.files(__package__)
+    return {
+        Path(entry.name).stem: Path(str(entry))
+        for entry in folder.iterdir()
+        if entry.name.endswith(".toml")
+    }
+
+
+def example_names() -> list[str]:
+    """Names of the built-in examples, in the order the course introduces them."""
+    files = _files()
+    return sorted(files, key=lambda name: (_order(files[name]), name))
+
+
+def example_path(name: str) -> Path:
+    """Path of a built-in example's model file."""
+    files = _files()
+    if name not in files:
+        import difflib
+
+        close = difflib.get_close_matches(name, list(files), n=1)
+        hint = f"; did you mean '{close[0]}'?" if close else ""
+        raise ModelError(f"no such file or built-in example '{name}'{hint} "
+                         "(`lagrangian examples` lists them)")
+    return files[name]
+
+
+def example_summary(name: str) -> dict[str, str]:
+    """{'name': ..., 'title': ..., 'description': ...} of a built-in example."""
+    data = tomllib.loads(example_path(name).read_text(encoding="utf-8"))
+    return {"name": name, "title": data.get("name", name),
+            "description": data.get("description", "")}
+
+
+def _order(path: Path) -> int:
+    head = path.read_text(encoding="utf-8").splitlines()[:1]
+    if head and head[0].startswith("# order:"):
+        return int(head[0].split(":")[1])
+    return 1000

@@ -1,0 +1,199 @@
+"""What the user describes: an immutable mechanical model in generalized coordinates.
+
+Every expression is a sympy expression in the coordinate symbols ``q``, velocity
+symbols ``q_dot``, parameters and time ``t`` (definitions already substituted).
+Vectors are 3-tuples; planar models have a zero third component.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+TIME = sp.Symbol("t")
+
+Vector = tuple[sp.Expr, sp.Expr, sp.Expr]
+
+
+def velocity_name(coordinate: str) -> str:
+    return f"{coordinate}_dot"
+
+
+def acceleration_name(coordinate: str) -> str:
+    return f"{coordinate}_ddot"
+
+
+def multiplier_name(constraint: str) -> str:
+    return f"lambda_{constraint}"
+
+
+@dataclass(frozen=True)
+class Coordinate:
+    """A generalized coordinate q with its velocity symbol q_dot; unit as declared (SI)."""
+
+    name: str
+    symbol: sp.Symbol
+    velocity: sp.Symbol
+    acceleration: sp.Symbol
+    unit: str = "m"
+    initial: float | None = None
+    rate: float | None = None
+    range: tuple[float, float] | None = None
+
+    @property
+    def is_angle(self) -> bool:
+        return self.unit in ("rad", "radian", "deg", "degree", "rev", "")
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A named constant; ``value`` in SI units, or None for a purely symbolic one."""
+
+    name: str
+    symbol: sp.Symbol
+    value: float | None = None
+    unit: str | None = None
+
+
+@dataclass(frozen=True)
+class Particle:
+    """A point mass m (kg) at position r(q, t) (m)."""
+
+    name: str
+    mass: sp.Expr
+    position: Vector
+
+
+@dataclass(frozen=True)
+class Body:
+    """A planar rigid body: mass (kg), inertia about its centre of mass (kg m^2), position, angle."""
+
+    name: str
+    mass: sp.Expr
+    inertia: sp.Expr
+    position: Vector
+    angle: sp.Expr
+
+
+@dataclass(frozen=True)
+class Spring:
+    """A linear spring: V = 1/2 k (length - rest_length)^2, in J."""
+
+    name: str
+    stiffness: sp.Expr
+    rest_length: sp.Expr
+    length: sp.Expr
+
+
+@dataclass(frozen=True)
+class Damper:
+    """A linear viscous damper: Rayleigh dissipation D = 1/2 c rate^2, in W."""
+
+    name: str
+    coefficient: sp.Expr
+    rate: sp.Expr
+
+
+@dataclass(frozen=True)
+class PointForce:
+    """A force F (N) applied at point r(q, t): virtual work F . dr."""
+
+    name: str
+    point: Vector
+    force: Vector
+
+
+@dataclass(frozen=True)
+class Torque:
+    """A torque tau (N m) turning through angle theta(q, t): virtual work tau d(theta)."""
+
+    name: str
+    torque: sp.Expr
+    angle: sp.Expr
+
+
+Load = PointForce | Torque
+
+
+@dataclass(frozen=True)
+class Gravity:
+    """Uniform gravity of magnitude g (m/s^2) along the unit vector ``direction``."""
+
+    magnitude: sp.Expr
+    direction: Vector
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """Phi(q, t) = 0 (``kind='holonomic'``) or A(q, t) q_dot + b(q, t) = 0 (``kind='velocity'``)."""
+
+    name: str
+    kind: str
+    expression: sp.Expr
+
+
+@dataclass(frozen=True)
+class Model:
+    """A complete mechanical model: coordinates, parameters, energies and components."""
+
+    name: str
+    coordinates: tuple[Coordinate, ...]
+    parameters: tuple[Parameter, ...] = ()
+    definitions: tuple[tuple[str, sp.Expr], ...] = ()
+    kinetic_energy: sp.Expr = sp.S.Zero
+    potential_energy: sp.Expr = sp.S.Zero
+    dissipation: sp.Expr = sp.S.Zero
+    gravity: Gravity | None = None
+    particles: tuple[Particle, ...] = ()
+    bodies: tuple[Body, ...] = ()
+    springs: tuple[Spring, ...] = ()
+    dampers: tuple[Damper, ...] = ()
+    loads: tuple[Load, ...] = ()
+    generalized_forces: tuple[tuple[str, sp.Expr], ...] = ()
+    constraints: tuple[Constraint, ...] = ()
+    description: str = ""
+    source: str | None = None
+    time: sp.Symbol = field(default=TIME)
+
+    @property
+    def q(self) -> tuple[sp.Symbol, ...]:
+        return tuple(c.symbol for c in self.coordinates)
+
+    @property
+    def q_dot(self) -> tuple[sp.Symbol, ...]:
+        return tuple(c.velocity for c in self.coordinates)
+
+    @property
+    def q_ddot(self) -> tuple[sp.Symbol, ...]:
+        return tuple(c.acceleration for c in self.coordinates)
+
+    @property
+    def parameter_values(self) -> dict[sp.Symbol, float]:
+        """Parameters that have a numeric value, symbol -> SI value."""
+        return {p.symbol: p.value for p in self.parameters if p.value is not None}
+
+    def coordinate(self, name: str) -> Coordinate:
+        for c in self.coordinates:
+            if c.name == name:
+                return c
+        raise KeyError(name)
+
+    def parameter(self, name: str) -> Parameter:
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def with_parameter_values(self, values: dict[str, float]) -> Model:
+        """A copy with some parameter values replaced (SI units)."""
+        from dataclasses import replace
+
+        unknown = set(values) - {p.name for p in self.parameters}
+        if unknown:
+            raise KeyError(sorted(unknown)[0])
+        parameters = tuple(
+            replace(p, value=float(values[p.name])) if p.name in values else p
+            for p in self.parameters
+        )
+        return replace(self, parameters=parameters)

@@ -1,0 +1,195 @@
+"""Read a model file (TOML) into a :class:`Model`, naming file, table and key on every error."""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Callable, Mapping
+from pathlib import Path
+
+from ..errors import ModelError
+from .builder import ModelBuilder
+from .model import Model
+from .units import check_unit, to_si
+
+TOP_LEVEL = {
+    "name", "description", "coordinates", "parameters", "definitions", "energy", "gravity",
+    "particles", "bodies", "springs", "dampers", "loads", "generalized_forces", "constraints",
+}
+COMPONENT_KEYS = {
+    "particles": ({"name", "mass", "position"}, set()),
+    "bodies": ({"name", "mass", "inertia", "position", "angle"}, set()),
+    "springs": ({"name", "stiffness"}, {"rest_length", "length", "between"}),
+    "dampers": ({"name", "coefficient"}, {"rate", "between"}),
+    "loads": ({"name"}, {"point", "force", "torque", "angle"}),
+    "constraints": ({"name"}, {"holonomic", "velocity"}),
+}
+
+
+def read_model(path: str | Path) -> Model:
+    """Load a TOML model file."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ModelError("no such file", source=str(path)) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ModelError(f"cannot read the file ({exc})", source=str(path)) from None
+    return parse_model(text, source=str(path))
+
+
+def parse_model(text: str, *, source: str = "<model>") -> Model:
+    """Parse the text of a TOML model file."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelError(f"invalid TOML: {exc}", source=source) from None
+    return model_from_mapping(data, source=source)
+
+
+def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
+    """Build a Model from the already-parsed TOML tables."""
+    _known_keys(data, TOP_LEVEL, None, source)
+    name = _string(data.get("name", ""), "name", source)
+    description = _string(data.get("description", ""), "description", source)
+    builder = ModelBuilder(name, description, source=source)
+
+    coordinates = _table(data, "coordinates", source, required=True)
+    for key, spec in coordinates.items():
+        field = f"coordinates.{key}"
+        if isinstance(spec, str):
+            builder.coordinate(key, check_unit(spec, field, source), field=field)
+        elif isinstance(spec, Mapping):
+            _known_keys(spec, {"unit", "initial", "rate", "range"}, field, source)
+            unit = check_unit(_string(spec.get("unit", "m"), f"{field}.unit", source),
+                              f"{field}.unit", source)
+            builder.coordinate(
+                key, unit, initial=spec.get("initial"), rate=spec.get("rate"),
+                range=spec.get("range"), field=field,
+            )
+        else:
+            raise ModelError("expected a unit string or a table {unit, initial, rate}",
+                             field=field, source=source)
+
+    for key, spec in _table(data, "parameters", source).items():
+        field = f"parameters.{key}"
+        if isinstance(spec, Mapping):
+            _known_keys(spec, {"value", "unit"}, field, source)
+            unit = spec.get("unit")
+            if unit is not None:
+                unit = check_unit(_string(unit, f"{field}.unit", source), f"{field}.unit", source)
+            value = spec.get("value")
+            if value is not None and unit is not None:
+                value = to_si(value, unit, f"{field}.value", source)
+            builder.parameter(key, value, unit, field=field)
+        else:
+            builder.parameter(key, spec, field=field)
+
+    for key, text in _table(data, "definitions", source).items():
+        builder.define(key, text, field=f"definitions.{key}")
+
+    energy = _table(data, "energy", source)
+    _known_keys(energy, {"T", "V", "D"}, "energy", source)
+    adders: dict[str, Callable] = {
+        "T": builder.add_kinetic_energy,
+        "V": builder.add_potential_energy,
+        "D": builder.add_dissipation,
+    }
+    for key, text in energy.items():
+        adders[key](text, field=f"energy.{key}")
+
+    if "gravity" in data:
+        gravity = _table(data, "gravity", source)
+        _known_keys(gravity, {"g", "direction"}, "gravity", source)
+        if "g" not in gravity:
+            raise ModelError("missing key 'g'", field="gravity", source=source)
+        builder.set_gravity(gravity["g"], gravity.get("direction", [0, -1]))
+
+    for index, item in _components(data, "particles", source):
+        field = f"particles[{index}]"
+        builder.add_particle(item["name"], item["mass"], item["position"], field=field)
+    for index, item in _components(data, "bodies", source):
+        field = f"bodies[{index}]"
+        builder.add_body(item["name"], item["mass"], item["inertia"], item["position"],
+                         item["angle"], field=field)
+    for index, item in _components(data, "springs", source):
+        builder.add_spring(
+            item["name"], item["stiffness"], item.get("rest_length", 0),
+            length=item.get("length"), between=item.get("between"), field=f"springs[{index}]",
+        )
+    for index, item in _components(data, "dampers", source):
+        builder.add_damper(
+            item["name"], item["coefficient"], rate=item.get("rate"),
+            between=item.get("between"), field=f"dampers[{index}]",
+        )
+    for index, item in _components(data, "loads", source):
+        field = f"loads[{index}]"
+        has_force = "point" in item or "force" in item
+        has_torque = "torque" in item or "angle" in item
+        if has_force and has_torque or not (has_force or has_torque):
+            raise ModelError("give either 'point' and 'force', or 'torque' and 'angle'",
+                             field=field, source=source)
+        if has_force:
+            for key in ("point", "force"):
+                if key not in item:
+                    raise ModelError(f"missing key '{key}'", field=field, source=source)
+            builder.add_force(item["name"], item["point"], item["force"], field=field)
+        else:
+            for key in ("torque", "angle"):
+                if key not in item:
+                    raise ModelError(f"missing key '{key}'", field=field, source=source)
+            builder.add_torque(item["name"], item["torque"], item["angle"], field=field)
+
+    for key, text in _table(data, "generalized_forces", source).items():
+        builder.add_generalized_force(key, text, field=f"generalized_forces.{key}")
+
+    for index, item in _components(data, "constraints", source):
+        builder.add_constraint(
+            item["name"], holonomic=item.get("holonomic"), velocity=item.get("velocity"),
+            field=f"constraints[{index}]",
+        )
+    return builder.build_model()
+
+
+def _table(data: Mapping, key: str, source: str, *, required: bool = False) -> Mapping:
+    if key not in data:
+        if required:
+            raise ModelError(f"missing table [{key}]", field=key, source=source)
+        return {}
+    value = data[key]
+    if not isinstance(value, Mapping):
+        raise ModelError(f"expected a table [{key}]", field=key, source=source)
+    return value
+
+
+def _components(data: Mapping, key: str, source: str):
+    items = data.get(key, [])
+    if not isinstance(items, list):
+        raise ModelError(f"expected an array of tables [[{key}]]", field=key, source=source)
+    required, optional = COMPONENT_KEYS[key]
+    for index, item in enumerate(items):
+        field = f"{key}[{index}]"
+        if not isinstance(item, Mapping):
+            raise ModelError("expected a table", field=field, source=source)
+        _known_keys(item, required | optional, field, source)
+        missing = sorted(required - set(item), key=lambda k: (k != "name", k))
+        if missing:
+            raise ModelError(f"missing key '{missing[0]}'", field=field, source=source)
+        _string(item["name"], f"{field}.name", source)
+        yield index, item
+
+
+def _known_keys(table: Mapping, allowed: set[str], field: str | None, source: str) -> None:
+    import difflib
+
+    for key in table:
+        if key not in allowed:
+            close = difflib.get_close_matches(key, sorted(allowed), n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            where = f"{field}.{key}" if field else key
+            raise ModelError(f"unknown key '{key}'{hint}", field=where, source=source)
+
+
+def _string(value: object, field: str, source: str) -> str:
+    if not isinstance(value, str):
+        raise ModelError(f"expected a string, got {value!r}", field=field, source=source)
+    return value

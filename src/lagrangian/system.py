@@ -1,0 +1,124 @@
+"""The user-facing System: a thin stateful shell over an immutable Model and pure functions.
+
+Like MuJoCo's model/data split, the Model is fixed; what is derived from it is cached here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import replace
+from pathlib import Path
+
+import sympy as sp
+
+from .analysis.forces import ForceReport, evaluate_generalized_forces
+from .derivation.equations import EquationsOfMotion
+from .derivation.lagrange import derive
+from .errors import ModelError
+from .model.builder import ModelBuilder
+from .model.examples import example_path
+from .model.model import Model
+from .model.notation import latex_symbol_names
+from .model.reader import read_model
+
+
+class System:
+    """A mechanical system described in generalized coordinates.
+
+    >>> import lagrangian
+    >>> pendulum = lagrangian.load("pendulum")          # a built-in example, or a path
+    >>> pendulum.equations_of_motion().mass_matrix
+    Matrix([[L**2*m]])
+    """
+
+    def __init__(self, model: Model):
+        if not isinstance(model, Model):
+            raise TypeError("System(model) takes a lagrangian Model; use load() or SystemBuilder")
+        self._model = model
+        self._equations: EquationsOfMotion | None = None
+
+    @property
+    def model(self) -> Model:
+        return self._model
+
+    @property
+    def name(self) -> str:
+        return self._model.name
+
+    @property
+    def coordinates(self) -> tuple[sp.Symbol, ...]:
+        return self._model.q
+
+    @property
+    def velocities(self) -> tuple[sp.Symbol, ...]:
+        return self._model.q_dot
+
+    @property
+    def parameters(self) -> dict[str, float | None]:
+        """Parameter name -> SI value (None for symbolic-only parameters)."""
+        return {p.name: p.value for p in self._model.parameters}
+
+    def symbol(self, name: str) -> sp.Symbol:
+        """The sympy symbol of a coordinate, velocity or parameter, by name."""
+        for c in self._model.coordinates:
+            if name in (c.name, c.velocity.name, c.acceleration.name):
+                return {c.name: c.symbol, c.velocity.name: c.velocity,
+                        c.acceleration.name: c.acceleration}[name]
+        for p in self._model.parameters:
+            if p.name == name:
+                return p.symbol
+        raise KeyError(name)
+
+    def with_parameters(self, **values: float) -> System:
+        """A copy of the system with some parameter values replaced (SI units)."""
+        try:
+            return System(self._model.with_parameter_values(values))
+        except KeyError as exc:
+            raise ModelError(f"'{exc.args[0]}' is not a parameter of this model",
+                             field="parameters") from None
+
+    def equations_of_motion(self) -> EquationsOfMotion:
+        """M q_ddot + Phi_q^T lambda = f by Lagrange's method (derived once, then cached)."""
+        if self._equations is None:
+            self._equations = derive(self._model)
+        return self._equations
+
+    def generalized_forces_at(
+        self, configuration: Mapping[str, float], parameters: Mapping[str, float] | None = None
+    ) -> ForceReport:
+        """Each generalized force, and each load's part of it, at a configuration (SI)."""
+        return evaluate_generalized_forces(self.equations_of_motion(), configuration, parameters)
+
+    def __repr__(self) -> str:
+        names = ", ".join(c.name for c in self._model.coordinates)
+        return f"System({self._model.name!r}, coordinates=[{names}])"
+
+    def _repr_latex_(self) -> str:
+        eom = self.equations_of_motion()
+        names = latex_symbol_names(self._model)
+        return rf"$L = {sp.latex(eom.lagrangian, symbol_names=names)}$"
+
+
+class SystemBuilder(ModelBuilder):
+    """Describe a system from Python; ``build()`` returns a :class:`System`.
+
+    >>> import lagrangian
+    >>> b = lagrangian.SystemBuilder("Pendulum")
+    >>> theta = b.coordinate("theta", unit="rad")
+    >>> m, L, g = b.parameter("m", 1.0), b.parameter("L", 0.5), b.parameter("g", 9.81)
+    >>> _ = b.set_gravity(g, (0, -1)).add_particle("bob", m, (L*lagrangian.sin(theta), -L*lagrangian.cos(theta)))
+    >>> b.build().equations_of_motion().forcing
+    Matrix([[-L*g*m*sin(theta)]])
+    """
+
+    def build(self) -> System:
+        return System(self.build_model())
+
+
+def load(path_or_example: str | Path) -> System:
+    """Load a model file (TOML), or a built-in example by name (see ``examples()``)."""
+    path = Path(path_or_example)
+    if path.exists() or path.suffix == ".toml" or len(path.parts) > 1:
+        return System(read_model(path))
+    model = read_model(example_path(str(path_or_example)))
+    return System(replace(model, source=f"example:{path_or_example}"))

@@ -1,4 +1,4 @@
-"""Numeric functions compiled once from the symbolic equations (numpy backend).
+"""Numeric functions compiled once from the symbolic equations (generated C, or numpy).
 
 Every function takes q and q_dot of shape (..., n) and t broadcastable to the batch shape, and
 returns arrays with that leading batch shape: one state or many at once.
@@ -7,7 +7,9 @@ returns arrays with that leading batch shape: one state or many at once.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+import warnings
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 import sympy as sp
@@ -18,15 +20,16 @@ from ..errors import ModelError
 
 @dataclass(frozen=True)
 class NumericSystem:
-    """Mass matrix, forcing, constraint terms and energy as numeric callables (SI units)."""
+    """Mass matrix, forcing, constraint terms and energy as numeric callables (SI units).
+
+    ``backend`` is "c" (generated C, compiled once and cached) or "numpy" (lambdify).
+    """
 
     coordinates: tuple[str, ...]
     constraint_names: tuple[str, ...]
     constraint_kinds: tuple[str, ...]
     parameters: dict[str, float]
-    _evaluate: Callable
-    _energy: Callable
-    _residual: Callable
+    _kernel: _NumpyKernel | _CKernel
 
     @property
     def n(self) -> int:
@@ -36,18 +39,25 @@ class NumericSystem:
     def m(self) -> int:
         return len(self.constraint_names)
 
-    def _parts(self, q, q_dot, t):
+    @property
+    def backend(self) -> str:
+        return self._kernel.backend
+
+    def _flat(self, q, q_dot, t):
+        """Contiguous (N, n), (N, n), (N,) arrays for the kernel, and the batch shape."""
         q, q_dot, batch = _batch(q, q_dot, self.n)
-        t = np.broadcast_to(np.asarray(t, dtype=float), batch)
-        entries = self._evaluate(*np.moveaxis(q, -1, 0), *np.moveaxis(q_dot, -1, 0), t)
+        count = int(np.prod(batch, dtype=np.int64))
+        t = np.broadcast_to(np.asarray(t, dtype=float), batch).reshape(count)
+        return (np.ascontiguousarray(q.reshape(count, self.n)),
+                np.ascontiguousarray(q_dot.reshape(count, self.n)),
+                np.ascontiguousarray(t), batch)
+
+    def _parts(self, q, q_dot, t):
+        Q, V, T, batch = self._flat(q, q_dot, t)
+        mass, forcing, jacobian, gamma = self._kernel.parts(Q, V, T)
         n, m = self.n, self.m
-        flat = np.stack([np.broadcast_to(np.asarray(e, dtype=float), batch) for e in entries],
-                        axis=-1)
-        mass = flat[..., : n * n].reshape(batch + (n, n))
-        forcing = flat[..., n * n: n * n + n]
-        jacobian = flat[..., n * n + n: n * n + n + m * n].reshape(batch + (m, n))
-        gamma = flat[..., n * n + n + m * n:]
-        return mass, forcing, jacobian, gamma
+        return (mass.reshape(batch + (n, n)), forcing.reshape(batch + (n,)),
+                jacobian.reshape(batch + (m, n)), gamma.reshape(batch + (m,)))
 
     def mass_matrix(self, q, q_dot, t=0.0) -> np.ndarray:
         """M(q, t), shape (..., n, n), in kg, kg m or kg m^2 per entry."""
@@ -67,39 +77,104 @@ class NumericSystem:
 
     def constraint_residual(self, q, q_dot, t=0.0) -> np.ndarray:
         """Phi(q, t) for holonomic constraints, A q_dot + b for velocity ones; shape (..., m)."""
-        q, q_dot, batch = _batch(q, q_dot, self.n)
-        t = np.broadcast_to(np.asarray(t, dtype=float), batch)
-        values = self._residual(*np.moveaxis(q, -1, 0), *np.moveaxis(q_dot, -1, 0), t)
-        return np.stack([np.broadcast_to(np.asarray(v, dtype=float), batch) for v in values],
-                        axis=-1) if self.m else np.zeros(batch + (0,))
+        Q, V, T, batch = self._flat(q, q_dot, t)
+        return self._kernel.residual(Q, V, T).reshape(batch + (self.m,))
 
     def energy(self, q, q_dot, t=0.0) -> np.ndarray:
         """Total mechanical energy T + V in J, shape (...)."""
-        q, q_dot, batch = _batch(q, q_dot, self.n)
-        t = np.broadcast_to(np.asarray(t, dtype=float), batch)
-        value = self._energy(*np.moveaxis(q, -1, 0), *np.moveaxis(q_dot, -1, 0), t)
-        return np.broadcast_to(np.asarray(value, dtype=float), batch).copy()
+        Q, V, T, batch = self._flat(q, q_dot, t)
+        return self._kernel.energy(Q, V, T).reshape(batch)
 
     def accelerations(self, q, q_dot, t=0.0) -> tuple[np.ndarray, np.ndarray]:
         """Solve [[M, Phi_q^T], [Phi_q, 0]] [q_ddot; lambda] = [f; gamma]: (q_ddot, lambda)."""
-        mass, forcing, jacobian, gamma = self._parts(q, q_dot, t)
-        n, m = self.n, self.m
-        if not m:
-            return np.linalg.solve(mass, forcing[..., None])[..., 0], forcing[..., :0]
-        batch = mass.shape[:-2]
-        system = np.zeros(batch + (n + m, n + m))
-        system[..., :n, :n] = mass
-        system[..., :n, n:] = np.swapaxes(jacobian, -1, -2)
-        system[..., n:, :n] = jacobian
-        rhs = np.concatenate([forcing, gamma], axis=-1)
-        solution = np.linalg.solve(system, rhs[..., None])[..., 0]
-        return solution[..., :n], solution[..., n:]
+        Q, V, T, batch = self._flat(q, q_dot, t)
+        q_ddot, multipliers = self._kernel.accelerations(Q, V, T)
+        return q_ddot.reshape(batch + (self.n,)), multipliers.reshape(batch + (self.m,))
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """First-order right-hand side for y = [q, q_dot]; always returns a fresh array."""
+        return self._kernel.rhs(t, y)
+
+
+class _NumpyKernel:
+    """lambdify'd functions over flat batches; the fallback that needs no compiler."""
+
+    backend = "numpy"
+
+    def __init__(self, n: int, m: int, evaluate: Callable, energy: Callable, residual: Callable):
+        self.n, self.m = n, m
+        self._evaluate, self._energy, self._residual = evaluate, energy, residual
+
+    def _columns(self, Q, V):
+        return *Q.T, *V.T
+
+    def parts(self, Q, V, T):
+        count, n, m = len(T), self.n, self.m
+        entries = self._evaluate(*self._columns(Q, V), T)
+        flat = np.empty((count, len(entries)))
+        for i, e in enumerate(entries):
+            flat[:, i] = e
+        return (flat[:, : n * n].reshape(count, n, n), flat[:, n * n: n * n + n],
+                flat[:, n * n + n: n * n + n + m * n].reshape(count, m, n),
+                flat[:, n * n + n + m * n:])
+
+    def residual(self, Q, V, T):
+        values = self._residual(*self._columns(Q, V), T)
+        out = np.empty((len(T), self.m))
+        for i, v in enumerate(values):
+            out[:, i] = v
+        return out
+
+    def energy(self, Q, V, T):
+        out = np.empty(len(T))
+        out[:] = self._energy(*self._columns(Q, V), T)
+        return out
+
+    def accelerations(self, Q, V, T):
+        mass, forcing, jacobian, gamma = self.parts(Q, V, T)
+        n, m = self.n, self.m
+        if not m:
+            return np.linalg.solve(mass, forcing[..., None])[..., 0], forcing[..., :0]
+        system = np.zeros((len(T), n + m, n + m))
+        system[:, :n, :n] = mass
+        system[:, :n, n:] = np.swapaxes(jacobian, -1, -2)
+        system[:, n:, :n] = jacobian
+        rhs = np.concatenate([forcing, gamma], axis=-1)
+        solution = np.linalg.solve(system, rhs[..., None])[..., 0]
+        return solution[:, :n], solution[:, n:]
+
+    def rhs(self, t, y):
+        y = np.asarray(y, dtype=float)
+        if y.shape != (2 * self.n,):
+            raise ValueError(f"y must hold {2 * self.n} numbers [q, q_dot]")
         n = self.n
-        q_ddot, _ = self.accelerations(y[:n], y[n:], t)
-        return np.concatenate([y[n:], q_ddot])
+        q_ddot, _ = self.accelerations(y[None, :n], y[None, n:], np.array([float(t)]))
+        return np.concatenate([y[n:], q_ddot[0]])
+
+
+class _CKernel:
+    """Generated C (see codegen.py / template.c): batch loops and the linear solve run in C."""
+
+    backend = "c"
+
+    def __init__(self, module, parameter_values: np.ndarray):
+        self.module = module
+        self.parameter_values = np.ascontiguousarray(parameter_values, dtype=float)
+        self.parameter_values.flags.writeable = False
+        # partial is a C callable: rhs(t, y) costs one C call plus the work.
+        self.rhs = partial(module.rhs, self.parameter_values)
+
+    def parts(self, Q, V, T):
+        return self.module.parts(Q, V, T, self.parameter_values)
+
+    def residual(self, Q, V, T):
+        return self.module.residual(Q, V, T, self.parameter_values)
+
+    def energy(self, Q, V, T):
+        return self.module.energy(Q, V, T, self.parameter_values)
+
+    def accelerations(self, Q, V, T):
+        return self.module.accelerations(Q, V, T, self.parameter_values)
 
 
 def _batch(q, q_dot, n: int):
@@ -129,10 +204,41 @@ def parameter_substitution(
     return values
 
 
-def numeric(eom: EquationsOfMotion, parameters: Mapping[str, float] | None = None) -> NumericSystem:
-    """Compile the equations once (common-subexpression elimination, numpy backend)."""
+BACKENDS = ("auto", "c", "numpy")
+
+# Generated C per equations object: cse + printing is the slow part of a C build.
+_SOURCES: dict[int, tuple[EquationsOfMotion, object]] = {}
+
+
+def _generated(eom: EquationsOfMotion):
+    from .codegen import generate
+
+    hit = _SOURCES.get(id(eom))
+    if hit is not None and hit[0] is eom:
+        return hit[1]
+    source = generate(eom)
+    if len(_SOURCES) >= 16:
+        _SOURCES.pop(next(iter(_SOURCES)))
+    _SOURCES[id(eom)] = (eom, source)
+    return source
+
+
+def _c_kernel(eom: EquationsOfMotion, values: dict) -> _CKernel:
+    from . import compiled
+    from .codegen import CodegenError
+
+    if not compiled.available():
+        raise compiled.BackendUnavailable("no C compiler or Python headers found")
+    try:
+        source = _generated(eom)
+    except CodegenError as exc:
+        raise compiled.BackendUnavailable(f"the equations cannot be written in C: {exc}") from None
+    module = compiled.load(source)
+    return _CKernel(module, np.array([float(values[p.symbol]) for p in eom.model.parameters]))
+
+
+def _numpy_kernel(eom: EquationsOfMotion, values: dict) -> _NumpyKernel:
     model = eom.model
-    values = parameter_substitution(eom, parameters)
     args = [*model.q, *model.q_dot, model.time]
 
     def numeric_list(exprs):
@@ -140,16 +246,53 @@ def numeric(eom: EquationsOfMotion, parameters: Mapping[str, float] | None = Non
 
     entries = numeric_list([*eom.mass_matrix, *eom.forcing, *eom.constraint_jacobian,
                             *eom.acceleration_rhs])
-    residuals = numeric_list([
-        c.expression for c in model.constraints
-    ])
+    residuals = numeric_list([c.expression for c in model.constraints])
     energy = (eom.kinetic_energy + eom.potential_energy).xreplace(values)
+    return _NumpyKernel(
+        len(model.q), len(model.constraints),
+        sp.lambdify(args, entries, modules="numpy", cse=True),
+        sp.lambdify(args, energy, modules="numpy", cse=True),
+        sp.lambdify(args, residuals, modules="numpy", cse=True),
+    )
+
+
+def numeric(
+    eom: EquationsOfMotion, parameters: Mapping[str, float] | None = None, backend: str = "auto"
+) -> NumericSystem:
+    """Compile the equations once (common-subexpression elimination) into numeric functions.
+
+    backend: "c" (generated C; raises BackendUnavailable without a working compiler), "numpy"
+    (lambdify, needs no compiler) or "auto" (C when a compiler works, else numpy).
+    """
+    if backend not in BACKENDS:
+        raise ValueError(f"backend must be one of {', '.join(BACKENDS)}, not {backend!r}")
+    model = eom.model
+    values = parameter_substitution(eom, parameters)
+    kernel = None
+    if backend in ("auto", "c"):
+        from .compiled import BackendUnavailable
+
+        try:
+            kernel = _c_kernel(eom, values)
+        except BackendUnavailable as exc:
+            if backend == "c":
+                raise
+            if compiled_was_expected():
+                warnings.warn(f"C backend unavailable, using numpy: {exc}", RuntimeWarning,
+                              stacklevel=2)
+    if kernel is None:
+        kernel = _numpy_kernel(eom, values)
     return NumericSystem(
         coordinates=tuple(c.name for c in model.coordinates),
         constraint_names=tuple(c.name for c in model.constraints),
         constraint_kinds=tuple(c.kind for c in model.constraints),
         parameters={str(k): float(v) for k, v in values.items()},
-        _evaluate=sp.lambdify(args, entries, modules="numpy", cse=True),
-        _energy=sp.lambdify(args, energy, modules="numpy", cse=True),
-        _residual=sp.lambdify(args, residuals, modules="numpy", cse=True),
+        _kernel=kernel,
     )
+
+
+def compiled_was_expected() -> bool:
+    """A compiler is present, so a failure to use it is worth a warning."""
+    from . import compiled
+
+    return compiled.available()

@@ -1,0 +1,138 @@
+"""C source for a model's numeric functions: M, f, Phi_q, gamma, energy and residuals.
+
+Generated once from the symbolic equations with common-subexpression elimination; parameters
+stay runtime inputs (an array ``p``), so one compiled module serves every parameter value.
+The linear solve of M q_ddot = f (or the KKT system) and a DOP853 integrator are C code in
+``template.c``, appended after the generated functions (see ``compiled.py``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import sympy as sp
+from sympy.codegen.rewriting import create_expand_pow_optimization, optimize
+from sympy.printing.c import C99CodePrinter
+
+from ..derivation.equations import EquationsOfMotion
+
+TEMPLATE = Path(__file__).with_name("template.c")
+
+# x**2 .. x**4 as products: pow() is a library call at -O2 without fast-math.
+_EXPAND_POW = create_expand_pow_optimization(4)
+
+
+class CodegenError(Exception):
+    """The equations use a function the C printer cannot express (the numpy backend can)."""
+
+
+@dataclass(frozen=True)
+class GeneratedSource:
+    """The C source of one model's numeric functions, and the names of its runtime parameters."""
+
+    source: str
+    parameters: tuple[str, ...]
+    n: int
+    m: int
+
+
+class _Printer(C99CodePrinter):
+    """C99 with exact doubles (repr round-trips) and a record of unsupported functions."""
+
+    def _print_Float(self, expr):
+        return repr(float(expr))
+
+    def _print_Rational(self, expr):
+        return f"({float(expr.p)!r}/{float(expr.q)!r})"
+
+    def _print_Integer(self, expr):
+        return f"{float(expr)!r}"
+
+
+def _block(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: _Printer) -> str:
+    """C statements computing ``targets[i] = exprs[i]`` with shared subexpressions hoisted."""
+    exprs = [sp.sympify(e) for e in exprs]  # safe: already sympy objects
+    replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), optimizations="basic")
+    lines = []
+    for symbol, value in replacements:
+        lines.append(f"    const double {symbol} = {printer.doprint(optimize(value, [_EXPAND_POW]))};")
+    for target, value in zip(targets, reduced, strict=True):
+        lines.append(f"    {target} = {printer.doprint(optimize(value, [_EXPAND_POW]))};")
+    return "\n".join(lines)
+
+
+def generate(eom: EquationsOfMotion) -> GeneratedSource:
+    """The C functions lg_parts, lg_energy and lg_residual for these equations."""
+    model = eom.model
+    n, m = len(model.q), len(model.constraints)
+    parameters = tuple(p.name for p in model.parameters)
+    # Rename every symbol to a C identifier nobody's model can clash with.
+    rename: dict[sp.Symbol, sp.Symbol] = {}
+    for i, (q, v) in enumerate(zip(model.q, model.q_dot, strict=True)):
+        rename[q] = sp.Symbol(f"q[{i}]")
+        rename[v] = sp.Symbol(f"v[{i}]")
+    for i, p in enumerate(model.parameters):
+        rename[p.symbol] = sp.Symbol(f"p[{i}]")
+    rename[model.time] = sp.Symbol("t")
+
+    def c_exprs(exprs):
+        out = []
+        for e in exprs:
+            e = sp.sympify(e)  # safe: sympy objects
+            unknown = e.free_symbols - set(rename)
+            if unknown:
+                raise CodegenError(f"unknown symbols {sorted(map(str, unknown))} in the equations")
+            out.append(e.xreplace(rename))
+        return out
+
+    printer = _Printer()
+    parts = c_exprs([*eom.mass_matrix, *eom.forcing, *eom.constraint_jacobian,
+                     *eom.acceleration_rhs])
+    targets = ([f"M[{i}]" for i in range(n * n)] + [f"f[{i}]" for i in range(n)]
+               + [f"J[{i}]" for i in range(m * n)] + [f"g[{i}]" for i in range(m)])
+    energy = c_exprs([eom.kinetic_energy + eom.potential_energy])
+    residual = c_exprs([c.expression for c in model.constraints])
+    signature = "(const double *restrict q, const double *restrict v, double t, " \
+                "const double *restrict p"
+    body = [
+        f"/* lagrangian: generated C for model {model.name!r} ({n} coordinates, {m} constraints) */",
+        f"#define LG_N {n}",
+        f"#define LG_M {m}",
+        f"#define LG_NP {len(parameters)}",
+        "#define PY_SSIZE_T_CLEAN",
+        "#include <Python.h>",  # before any standard header, as Python's docs require
+        "#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION",
+        "#include <numpy/arrayobject.h>",
+        "#include <math.h>",
+        "",
+        f"static void lg_parts{signature}, double *restrict M, double *restrict f, "
+        "double *restrict J, double *restrict g)",
+        "{",
+        "    (void)q; (void)v; (void)t; (void)p; (void)J; (void)g;",
+        _block(parts, targets, printer),
+        "}",
+        "",
+        f"static double lg_energy{signature})",
+        "{",
+        "    (void)q; (void)v; (void)t; (void)p;",
+        "    double e;",
+        _block(energy, ["e"], printer),
+        "    return e;",
+        "}",
+        "",
+        f"static void lg_residual{signature}, double *restrict r)",
+        "{",
+        "    (void)q; (void)v; (void)t; (void)p; (void)r;",
+        _block(residual, [f"r[{i}]" for i in range(m)], printer) if m else "",
+        "}",
+        "",
+    ]
+    unsupported = printer._not_supported
+    if unsupported:
+        names = sorted({type(e).__name__ if not isinstance(e, sp.Basic) else str(e.func)
+                        for e in unsupported})
+        raise CodegenError(f"no C translation for {', '.join(names)}")
+    source = "\n".join(body) + "\n" + TEMPLATE.read_text()
+    return GeneratedSource(source=source, parameters=parameters, n=n, m=m)

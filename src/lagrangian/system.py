@@ -89,6 +89,18 @@ class System:
         """Each generalized force, and each load's part of it, at a configuration (SI)."""
         return evaluate_generalized_forces(self.equations_of_motion(), configuration, parameters)
 
+    # ---- numerics (issue 4, speed): compiled numeric functions --------------------------------
+    def numeric(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"):
+        """M, f, Phi_q, gamma, energy and the ODE right-hand side as batched numeric functions.
+
+        backend "c" (generated C, compiled once and cached), "numpy", or "auto" (C if a compiler
+        works). Parameters (SI) override the model's values.
+        """
+        from .numerics.functions import numeric
+
+        return numeric(self.equations_of_motion(), parameters, backend=backend)
+    # ---- end numerics -------------------------------------------------------------------------
+
     def __repr__(self) -> str:
         names = ", ".join(c.name for c in self._model.coordinates)
         return f"System({self._model.name!r}, coordinates=[{names}])"

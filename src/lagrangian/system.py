@@ -89,6 +89,40 @@ class System:
         """Each generalized force, and each load's part of it, at a configuration (SI)."""
         return evaluate_generalized_forces(self.equations_of_motion(), configuration, parameters)
 
+    # -- simulation (issue 4): thin delegation to numerics.simulate ---------------------------
+
+    def simulate(
+        self,
+        t_end: float,
+        *,
+        initial: Mapping[str, float] | None = None,
+        method: str = "DOP853",
+        rtol: float = 1e-9,
+        atol: float = 1e-9,
+        samples: int = 1001,
+        stop_when: str | None = None,
+        progress=None,
+    ):
+        """Integrate the equations of motion to ``t_end`` (s); returns a Simulation.
+
+        ``initial`` overrides the model's initial/rate values (SI: rad, m, rad/s, m/s; 't' sets
+        the start time); ``stop_when`` is a condition such as "theta < 0" that ends the run.
+        Constrained models are kept on Phi = 0 by projection (see docs/simulation.md).
+        """
+        from .numerics.functions import numeric
+        from .numerics.simulate import simulate
+        from .simulation import Simulation
+
+        cache = self.__dict__.setdefault("_simulation_numeric", {})
+        if "system" not in cache:  # compiled once per System (parameters are fixed in it)
+            cache["system"] = numeric(self.equations_of_motion())
+        result = simulate(self.equations_of_motion(), t_end, initial=initial, method=method,
+                          rtol=rtol, atol=atol, samples=samples, stop_when=stop_when,
+                          progress=progress, system=cache["system"])
+        return Simulation(result, self._model)
+
+    # -- end simulation ----------------------------------------------------------------------
+
     # ---- numerics (issue 4, speed): compiled numeric functions --------------------------------
     def numeric(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"):
         """M, f, Phi_q, gamma, energy and the ODE right-hand side as batched numeric functions.

@@ -1,0 +1,247 @@
+"""Animation of the mechanism: particles as dots, bodies as bars, springs as zigzags (GIF/HTML).
+
+Positions come from the model (particle and body positions, body angles); a spring is drawn
+between its two end points when they can be recovered from its length (the model keeps only
+the length of a spring given by ``between``), otherwise it is left out.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import sympy as sp
+
+from ..errors import ModelError
+from ..model.model import Model
+from ..numerics.simulate import SimulationResult
+from .files import atomic_write
+
+ANIMATION_FORMATS = (".gif", ".html")
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """Compiled geometry: callables of (q, q_dot, t) arrays giving points in the plane (m)."""
+
+    particle_names: tuple[str, ...]
+    body_names: tuple[str, ...]
+    spring_names: tuple[str, ...]
+    _particles: object
+    _bodies: object
+    _springs: object
+
+    def frame(self, q: np.ndarray, v: np.ndarray, t: np.ndarray):
+        """Batched positions: particles (k, P, 2), bar ends (k, B, 2, 2), springs (k, S, 2, 2)."""
+        k = len(t)
+
+        def stack(f, count, shape):
+            if not count:
+                return np.zeros((k, 0) + shape)
+            values = [np.broadcast_to(np.asarray(x, dtype=float), (k,)) for x in f(*q.T, *v.T, t)]
+            return np.stack(values, axis=-1).reshape((k, count) + shape)
+
+        particles = stack(self._particles, len(self.particle_names), (2,))
+        raw = stack(self._bodies, len(self.body_names), (4,))  # x, y, angle, half length
+        c, s = np.cos(raw[..., 2]), np.sin(raw[..., 2])
+        half = raw[..., 3]
+        centre = raw[..., :2]
+        offset = np.stack([c * half, s * half], axis=-1)
+        bars = np.stack([centre - offset, centre + offset], axis=-2)
+        springs = stack(self._springs, len(self.spring_names), (2, 2))
+        return particles, bars, springs
+
+
+def mechanism(model: Model, parameters: dict[str, float]) -> Mechanism:
+    """Compile the drawable geometry of ``model`` once (parameters by name, SI)."""
+    values = {p.symbol: sp.Float(parameters[p.name]) for p in model.parameters
+              if p.name in parameters}
+    args = [*model.q, *model.q_dot, model.time]
+
+    def compile_(exprs):
+        exprs = [sp.sympify(e).xreplace(values) for e in exprs]
+        return sp.lambdify(args, exprs, modules="numpy") if exprs else None
+
+    particles = [e for p in model.particles for e in p.position[:2]]
+    bodies = []
+    for body in model.bodies:
+        mass, inertia = body.mass.xreplace(values), body.inertia.xreplace(values)
+        # Drawn as the uniform bar of the same mass and inertia: length sqrt(12 I / m).
+        half = sp.sqrt(3 * inertia / mass) if mass != 0 else sp.S.Zero
+        bodies.extend([body.position[0], body.position[1], body.angle, half])
+    ends = spring_end_points(model, values)
+    springs = [e for name in ends for point in ends[name] for e in point[:2]]
+    return Mechanism(
+        particle_names=tuple(p.name for p in model.particles),
+        body_names=tuple(b.name for b in model.bodies),
+        spring_names=tuple(ends),
+        _particles=compile_(particles), _bodies=compile_(bodies), _springs=compile_(springs),
+    )
+
+
+def spring_end_points(model: Model, values: dict) -> dict[str, tuple]:
+    """Spring name -> (point A, point B) where the length equals |A - B| at sampled states.
+
+    Candidates are the origin and the particle and body centres; failing a pair, one moving
+    candidate and a fixed anchor found by least squares. Springs matching neither are skipped.
+    """
+    candidates = [(0, 0, 0)] + [p.position for p in model.particles] + \
+        [b.position for b in model.bodies]
+    args = [*model.q, *model.q_dot, model.time]
+    rng = np.random.default_rng(7)
+    samples = rng.uniform(-1.0, 1.0, size=(6, len(args)))
+
+    def sample(expr):
+        f = sp.lambdify(args, sp.sympify(expr).xreplace(values), modules="numpy")
+        with np.errstate(all="ignore"):
+            return np.array([float(np.real(f(*row))) for row in samples])
+
+    try:
+        points = [np.stack([sample(c) for c in point], axis=-1) for point in candidates]
+    except (TypeError, ValueError, ZeroDivisionError):
+        return {}
+    found = {}
+    for spring in model.springs:
+        try:
+            length = sample(spring.length)
+        except (TypeError, ValueError, ZeroDivisionError):
+            continue
+        if not np.all(np.isfinite(length)):
+            continue
+        scale = 1.0 + np.max(np.abs(length))
+        match = None
+        for i, a in enumerate(points):
+            for j in range(i + 1, len(points)):
+                distance = np.linalg.norm(a - points[j], axis=-1)
+                if np.allclose(distance, np.abs(length), rtol=1e-9, atol=1e-12 * scale):
+                    match = (candidates[i], candidates[j])
+                    break
+            if match:
+                break
+        if match is None:
+            match = _fixed_anchor(points, candidates, length)
+        if match is not None:
+            found[spring.name] = match
+    return found
+
+
+def _fixed_anchor(points, candidates, length):
+    for point, expr in zip(points[1:], candidates[1:], strict=True):
+        # |P - A|^2 = L^2  <=>  2 P.A - c = |P|^2 - L^2 with c = |A|^2 (linear in A, c)
+        matrix = np.column_stack([2 * point, -np.ones(len(point))])
+        rhs = np.sum(point**2, axis=-1) - length**2
+        solution, *_ = np.linalg.lstsq(matrix, rhs, rcond=None)
+        anchor, c = solution[:3], solution[3]
+        if np.allclose(matrix @ solution, rhs, atol=1e-9 * (1 + np.max(np.abs(rhs)))) and \
+                abs(c - anchor @ anchor) < 1e-9 * (1 + abs(c)):
+            return (tuple(sp.Float(x) for x in anchor), expr)
+    return None
+
+
+def _zigzag(a: np.ndarray, b: np.ndarray, turns: int = 8, width: float = 0.06):
+    """Points of a zigzag from a to b (width relative to its length, with straight ends)."""
+    d = b - a
+    length = np.hypot(*d)
+    if length == 0:
+        return np.array([a, b])
+    u = d / length
+    normal = np.array([-u[1], u[0]])
+    s = np.concatenate([[0, 0.1], 0.1 + 0.8 * (np.arange(1, 2 * turns) / (2 * turns)), [0.9, 1]])
+    side = np.zeros_like(s)
+    side[2:-2] = np.where(np.arange(len(s) - 4) % 2 == 0, 1.0, -1.0)
+    return a + np.outer(s * length, u) + np.outer(side * width * max(length, 0.05), normal)
+
+
+def animation_frames(result: SimulationResult, fps: int = 25, max_frames: int = 250):
+    """Frame times: real time at ``fps``, at most ``max_frames`` frames over the run."""
+    t0, t1 = float(result.t[0]), float(result.t[-1])
+    count = int(min(max_frames, max(2, round((t1 - t0) * fps) + 1)))
+    return np.linspace(t0, t1, count)
+
+
+def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25,
+                        max_frames: int = 250):
+    """A matplotlib FuncAnimation of the mechanism over the run (planar x-y view)."""
+    from matplotlib.animation import FuncAnimation
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    geometry = mechanism(model, result.parameters)
+    times = animation_frames(result, fps, max_frames)
+    q = np.column_stack([np.interp(times, result.t, result.q[:, i])
+                         for i in range(result.q.shape[1])])
+    v = np.column_stack([np.interp(times, result.t, result.q_dot[:, i])
+                         for i in range(result.q.shape[1])])
+    particles, bars, springs = geometry.frame(q, v, times)
+    if not (particles.size or bars.size or springs.size):
+        raise ModelError("nothing to animate: the model has no particles or bodies "
+                         "(it is given by its energies only)", field="--animate")
+    everything = np.concatenate([particles.reshape(-1, 2), bars.reshape(-1, 2),
+                                 springs.reshape(-1, 2), [[0.0, 0.0]]])
+    everything = everything[np.all(np.isfinite(everything), axis=1)]
+    low, high = everything.min(axis=0), everything.max(axis=0)
+    pad = 0.1 * max(float(np.max(high - low)), 1e-3)
+
+    figure = Figure(figsize=(5, 5), dpi=80)
+    FigureCanvasAgg(figure)
+    ax = figure.add_subplot()
+    ax.set_xlim(low[0] - pad, high[0] + pad)
+    ax.set_ylim(low[1] - pad, high[1] + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.plot([0], [0], marker="+", color="grey")
+    spring_lines = [ax.plot([], [], color="tab:green", linewidth=1)[0] for _ in geometry.spring_names]
+    bar_lines = [ax.plot([], [], color="tab:blue", linewidth=4, solid_capstyle="round")[0]
+                 for _ in geometry.body_names]
+    dots = ax.plot([], [], "o", color="tab:red", markersize=10)[0]
+    clock = ax.text(0.02, 0.95, "", transform=ax.transAxes)
+    ax.set_title(result.model_name)
+
+    def draw(k):
+        for line, (a, b) in zip(spring_lines, springs[k], strict=True):
+            zig = _zigzag(a, b)
+            line.set_data(zig[:, 0], zig[:, 1])
+        for line, ends in zip(bar_lines, bars[k], strict=True):
+            line.set_data(ends[:, 0], ends[:, 1])
+        dots.set_data(particles[k][:, 0], particles[k][:, 1])
+        clock.set_text(f"t = {times[k]:.2f} s")
+        return [*spring_lines, *bar_lines, dots, clock]
+
+    return FuncAnimation(figure, draw, frames=len(times), interval=1000 / fps, blit=False)
+
+
+def write_animation(result: SimulationResult, model: Model, path: str | Path, *, fps: int = 25,
+                    max_frames: int = 250, protect: tuple[Path, ...] = ()) -> Path:
+    """Write the animation as GIF (Pillow) or as HTML with a player, atomically."""
+    _check_suffix(path)
+    animation = mechanism_animation(result, model, fps=fps, max_frames=max_frames)
+    return save_animation(animation, path, fps=fps, protect=protect)
+
+
+def save_animation(animation, path: str | Path, *, fps: int = 25,
+                   protect: tuple[Path, ...] = ()) -> Path:
+    """Save a built animation as .gif or .html, through a temporary file and a rename."""
+    path = _check_suffix(path)
+    if path.suffix.lower() == ".html":
+        return atomic_write(path, animation.to_jshtml(fps=fps), protect=protect)
+    from matplotlib.animation import PillowWriter
+
+    handle, temporary = tempfile.mkstemp(suffix=".gif")
+    os.close(handle)
+    try:
+        animation.save(temporary, writer=PillowWriter(fps=fps))
+        data = Path(temporary).read_bytes()
+    finally:
+        os.unlink(temporary)
+    return atomic_write(path, data, protect=protect)
+
+
+def _check_suffix(path: str | Path) -> Path:
+    path = Path(path)
+    if path.suffix.lower() not in ANIMATION_FORMATS:
+        raise ModelError(f"cannot write {path}: use a .gif or .html file name", field="--animate")
+    return path

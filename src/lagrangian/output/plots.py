@@ -1,0 +1,79 @@
+"""Time-history plots of a simulation: coordinates, energy (and multipliers) against time."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ModelError
+from ..numerics.simulate import SimulationResult
+from .files import atomic_write
+
+
+def time_history_figure(result: SimulationResult, units: dict[str, str] | None = None):
+    """A matplotlib Figure: coordinates (one panel per unit), energy T + V, multipliers.
+
+    Built without pyplot, so it works headless; in Jupyter the Figure shows itself.
+    """
+    from matplotlib.figure import Figure
+
+    units = units or {}
+    groups: dict[str, list[int]] = {}
+    for i, name in enumerate(result.coordinates):
+        groups.setdefault(units.get(name, ""), []).append(i)
+    panels = len(groups) + 1 + (1 if result.constraint_names else 0)
+    figure = Figure(figsize=(8, 2.4 * panels + 0.6), layout="constrained")
+    axes = figure.subplots(panels, 1, sharex=True, squeeze=False)[:, 0]
+    for ax, (unit, indices) in zip(axes, groups.items(), strict=False):
+        for i in indices:
+            ax.plot(result.t, result.q[:, i], label=result.coordinates[i])
+        ax.set_ylabel(f"coordinate ({unit})" if unit else "coordinate")
+        ax.legend(loc="upper right", fontsize="small")
+    ax = axes[len(groups)]
+    if result.energy_conserved and len(result.energy):
+        # Conserved: the change is what matters, so draw E - E0 rather than E near a big offset.
+        ax.plot(result.t, result.energy - result.energy[0], color="black")
+        ax.set_ylabel("E - E0 (J)")
+        ax.set_title(f"energy T + V, E0 = {result.energy[0]:.6g} J, relative drift "
+                     f"{result.energy_drift:.1e}", fontsize="small")
+    else:
+        ax.plot(result.t, result.energy, color="black")
+        ax.set_ylabel("energy T + V (J)")
+    if np.any(result.power != 0):
+        power_axis = ax.twinx()
+        power_axis.plot(result.t, result.power, color="tab:red", linewidth=0.8)
+        power_axis.set_ylabel("power of loads (W)", color="tab:red")
+    if result.constraint_names:
+        ax = axes[-1]
+        for i, name in enumerate(result.constraint_names):
+            ax.plot(result.t, result.multipliers[:, i], label=f"lambda_{name}")
+        ax.set_ylabel("multiplier")
+        ax.legend(loc="upper right", fontsize="small")
+    axes[-1].set_xlabel("t (s)")
+    status = "" if result.completed else f" ({result.status})"
+    figure.suptitle(f"{result.model_name}{status}")
+    return figure
+
+
+def write_plot(result: SimulationResult, path: str | Path, *, units: dict[str, str] | None = None,
+               protect: tuple[Path, ...] = ()) -> Path:
+    """Draw the time history and write it as PNG (or SVG/PDF by suffix), atomically."""
+    _check_suffix(path)
+    return save_figure(time_history_figure(result, units), path, protect=protect)
+
+
+def save_figure(figure, path: str | Path, *, protect: tuple[Path, ...] = ()) -> Path:
+    """Write a figure (format by suffix) through a temporary file and a rename."""
+    path = _check_suffix(path)
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format=path.suffix.lower().lstrip("."), dpi=110)
+    return atomic_write(path, buffer.getvalue(), protect=protect)
+
+
+def _check_suffix(path: str | Path) -> Path:
+    path = Path(path)
+    if path.suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise ModelError(f"cannot write {path}: use a .png, .svg or .pdf file name", field="--plot")
+    return path

@@ -1,0 +1,530 @@
+"""Verdicts on a hand derivation, with diagnoses in the seed's own terms (module 7, section 07).
+
+Each item of the user's answer (T, V, D, Q[q], equation[q], multipliers) is compared with the
+Lagrange derivation by probabilistic identity testing (see :mod:`.equivalence`). A wrong item
+gets one diagnosis code and the corrected item; ``equation_wrong`` is also the fallback for an
+item that is wrong in a way no more specific diagnosis names.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..derivation.equations import EquationsOfMotion
+from ..derivation.kinematics import time_rate
+from ..derivation.virtual_work import DISSIPATION_LOAD, GIVEN_LOAD
+from ..model.answer import Answer
+from ..model.expressions import format_expression as fmt
+from ..model.model import Damper, Model, PointForce, Torque
+from ..model.units import generalized_force_unit
+from . import equivalence as eq
+from .units import answer_unit_issues
+
+CODES = (
+    "potential_sign", "potential_datum", "kinetic_factor", "kinetic_term",
+    "generalized_force_missing", "generalized_force_projection",
+    "reaction_in_minimal_coordinates", "multiplier_count", "equation_wrong",
+    "equation_equivalent", "units_mismatch",
+)
+STATUSES = ("correct", "equivalent", "wrong", "note")
+
+
+@dataclass(frozen=True)
+class Finding:
+    """The verdict on one item; ``code`` is None when correct, ``expected`` our version."""
+
+    item: str
+    status: str
+    code: str | None
+    message: str
+    expected: str | None = None
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    """All findings on an answer; the verdict is 'correct' unless some item is wrong."""
+
+    model: str
+    answer: str
+    findings: tuple[Finding, ...]
+
+    @property
+    def verdict(self) -> str:
+        return "incorrect" if any(f.status == "wrong" for f in self.findings) else "correct"
+
+    @property
+    def correct(self) -> bool:
+        return self.verdict == "correct"
+
+    def codes(self, item: str | None = None) -> list[str]:
+        return [f.code for f in self.findings if f.code and (item is None or f.item == item)]
+
+    def __repr__(self) -> str:
+        lines = [f"CheckReport({self.verdict})"]
+        lines += [f"  {f.item}: {f.status}" + (f" [{f.code}]" if f.code else "") + f" {f.message}"
+                  for f in self.findings]
+        return "\n".join(lines)
+
+
+# -- energy parts, to name a missing term ------------------------------------------------
+
+
+def kinetic_parts(model: Model) -> list[tuple[str, sp.Expr]]:
+    """Each component's share of T: 1/2 m v^2 of a particle, 1/2 m v_G^2 and 1/2 I w^2 of a body."""
+    q, q_dot, t = model.q, model.q_dot, model.time
+    half = sp.Rational(1, 2)
+    parts = []
+
+    def speed2(position):
+        return sp.Add(*(time_rate(r, q, q_dot, t) ** 2 for r in position))
+
+    for particle in model.particles:
+        parts.append((f"translational energy 1/2 m v^2 of particle '{particle.name}'",
+                      half * particle.mass * speed2(particle.position)))
+    for body in model.bodies:
+        parts.append((f"translational energy 1/2 m v_G^2 of body '{body.name}'",
+                      half * body.mass * speed2(body.position)))
+        omega = time_rate(body.angle, q, q_dot, t)
+        if omega != 0:
+            parts.append((f"rotational energy 1/2 I w^2 of body '{body.name}'",
+                          half * body.inertia * omega**2))
+    if model.kinetic_energy != 0:
+        parts.append(("kinetic energy given in the model ([energy] T)", model.kinetic_energy))
+    return [(label, value) for label, value in parts if value != 0]
+
+
+def potential_parts(model: Model) -> list[tuple[str, sp.Expr]]:
+    """Each source of V: gravity of each particle and body, each spring, the model's V."""
+    parts = []
+    if model.gravity is not None:
+        g, direction = model.gravity.magnitude, model.gravity.direction
+        for item in (*model.particles, *model.bodies):
+            height = sp.Add(*(d * r for d, r in zip(direction, item.position, strict=True)))
+            if height.free_symbols & set(model.q):
+                parts.append((f"gravity potential of '{item.name}'", -item.mass * g * height))
+    for spring in model.springs:
+        parts.append((f"potential of spring '{spring.name}'",
+                      sp.Rational(1, 2) * spring.stiffness * (spring.length - spring.rest_length) ** 2))
+    if model.potential_energy != 0:
+        parts.append(("potential given in the model ([energy] V)", model.potential_energy))
+    return parts
+
+
+# -- the checker -------------------------------------------------------------------------
+
+
+def check_answer(eom: EquationsOfMotion, answer: Answer) -> CheckReport:
+    """Compare every item of ``answer`` with the Lagrange derivation ``eom``."""
+    model = eom.model
+    foreign = set().union(*(symbols for _, symbols in answer.foreign)) if answer.foreign else set()
+    points = eq.random_points(model, foreign)
+    checker = _Checker(eom, answer, points)
+    findings: list[Finding] = []
+    if answer.kinetic_energy is not None:
+        findings += checker.kinetic(answer.kinetic_energy)
+    if answer.potential_energy is not None:
+        findings += checker.potential(answer.potential_energy)
+    if answer.dissipation is not None:
+        findings += checker.dissipation(answer.dissipation)
+    for name, value in answer.generalized_forces:
+        findings += checker.generalized_force(name, value)
+    if answer.equations:
+        findings += checker.equations()
+    if answer.multiplier_count is not None or answer.multiplier_names is not None:
+        findings += checker.multipliers()
+    findings += checker.units()
+    return CheckReport(model.name, answer.source, tuple(findings))
+
+
+class _Checker:
+    def __init__(self, eom: EquationsOfMotion, answer: Answer, points: eq.Points):
+        self.eom = eom
+        self.model = eom.model
+        self.answer = answer
+        self.points = points
+        self.names = [c.name for c in self.model.coordinates]
+
+    # T ---------------------------------------------------------------------------------
+
+    def kinetic(self, T_user: sp.Expr) -> list[Finding]:
+        T = self.eom.kinetic_energy
+        expected = fmt(T)
+        unknown = self._unknown_names("T", "T")
+        if unknown:
+            return unknown
+        if eq.identical(T_user, T, self.points):
+            return [Finding("T", "correct", None, "T matches.", None)]
+        parts = kinetic_parts(self.model)
+        for label, part in parts:
+            if len(parts) > 1 and eq.identical(T_user, T - part, self.points):
+                return [Finding("T", "wrong", "kinetic_term",
+                                f"T is missing the {label}: {fmt(eq.display(part))}.", expected)]
+        if not eq.zero(T, self.points) and eq.constant_in_state(T_user / T, self.points):
+            factor = eq.display(sp.cancel(T_user / T))
+            hint = ""
+            if factor == 2:
+                hint = " (a forgotten 1/2?)"
+            elif factor.free_symbols and any(str(s).startswith(("m", "M")) for s in factor.free_symbols):
+                hint = " (a missing mass?)"
+            return [Finding("T", "wrong", "kinetic_factor",
+                            f"T is {fmt(factor)} times the kinetic energy{hint}: every term of "
+                            "T = sum 1/2 m v^2 + 1/2 I w^2 carries 1/2 and its mass or inertia.",
+                            expected)]
+        for label, part in parts:
+            if eq.identical(T_user, T + part, self.points):
+                return [Finding("T", "wrong", "kinetic_term",
+                                f"T counts the {label} twice: {fmt(eq.display(part))}.", expected)]
+        difference = eq.display(T_user - T)
+        return [Finding("T", "wrong", "kinetic_term",
+                        f"T has a wrong or extra term: yours minus ours is {fmt(difference)}.",
+                        expected)]
+
+    # V ---------------------------------------------------------------------------------
+
+    def potential(self, V_user: sp.Expr) -> list[Finding]:
+        V = self.eom.potential_energy
+        expected = fmt(V)
+        unknown = self._unknown_names("V", "V")
+        if unknown:
+            return unknown
+        if eq.identical(V_user, V, self.points):
+            return [Finding("V", "correct", None, "V matches.", None)]
+        if eq.constant_in_state(V_user - V, self.points):
+            offset = eq.display(V_user - V)
+            return [Finding("V", "equivalent", "potential_datum",
+                            f"V differs from ours only by the constant {fmt(offset)}: another "
+                            "datum, which is fine (only dV/dq enters the equations).", expected)]
+        rises = ("Does V increase as the body rises? Take V positive upward (V = m g h) "
+                 "and be consistent with the datum.")
+        if eq.constant_in_state(V_user + V, self.points):
+            return [Finding("V", "wrong", "potential_sign", f"V has the wrong sign. {rises}",
+                            expected)]
+        parts = potential_parts(self.model)
+        if len(parts) > 1:
+            for label, part in parts:
+                if eq.constant_in_state(V_user - (V - 2 * part), self.points):
+                    return [Finding("V", "wrong", "potential_sign",
+                                    f"the {label} has the wrong sign (it should be "
+                                    f"{fmt(eq.display(part))}). {rises}", expected)]
+        for label, part in parts:
+            if eq.constant_in_state(V_user - (V - part), self.points):
+                return [Finding("V", "wrong", "equation_wrong",
+                                f"V is missing the {label}: {fmt(eq.display(part))}.", expected)]
+        difference = eq.display(V_user - V)
+        return [Finding("V", "wrong", "equation_wrong",
+                        f"V differs from ours by {fmt(difference)} (not a constant).", expected)]
+
+    # D ---------------------------------------------------------------------------------
+
+    def dissipation(self, D_user: sp.Expr) -> list[Finding]:
+        D = self.eom.dissipation
+        unknown = self._unknown_names("D", "D")
+        if unknown:
+            return unknown
+        if eq.identical(D_user, D, self.points):
+            return [Finding("D", "correct", None, "D matches.", None)]
+        difference = eq.display(D_user - D)
+        return [Finding("D", "wrong", "equation_wrong",
+                        f"the dissipation function differs from ours by {fmt(difference)}; "
+                        "D = sum 1/2 c (rate)^2.", fmt(D))]
+
+    # Q ---------------------------------------------------------------------------------
+
+    def generalized_force(self, name: str, Q_user: sp.Expr) -> list[Finding]:
+        item = f"Q[{name}]"
+        i = self.names.index(name)
+        coordinate = self.model.coordinates[i]
+        Q = self.eom.generalized_forces[i]
+        expected = fmt(Q)
+        foreign = self.answer.foreign_symbols(item)
+        if foreign:
+            listed = ", ".join(sorted(map(str, foreign)))
+            stripped = Q_user.xreplace({s: 0 for s in foreign})
+            rest = (" Without them your Q matches ours." if eq.identical(stripped, Q, self.points)
+                    else "")
+            if not self.model.constraints:
+                return [Finding(item, "wrong", "reaction_in_minimal_coordinates",
+                                f"{item} contains {listed}, which the model does not have: ideal "
+                                "reactions do no virtual work, so in minimal coordinates they "
+                                f"vanish; leave them out.{rest}", expected)]
+            return [Finding(item, "wrong", "equation_wrong",
+                            f"{item} contains {listed}, which the model does not have: constraint "
+                            "reactions enter as multipliers (Phi_q^T lambda), not as generalized "
+                            f"forces.{rest}", expected)]
+        if eq.identical(Q_user, Q, self.points):
+            return [Finding(item, "correct", None, f"{item} matches.", None)]
+        V = self.eom.potential_energy
+        V_user = self.answer.potential_energy if self.answer.potential_energy is not None else 0
+        dV, dV_user = V.diff(coordinate.symbol), sp.sympify(V_user).diff(coordinate.symbol)
+        if dV != 0 and eq.identical(Q_user - dV_user, Q - dV, self.points):
+            return [Finding(item, "equivalent", "equation_equivalent",
+                            f"{item} includes the conservative force -dV/d{name} = "
+                            f"{fmt(eq.display(-dV))}; fine as long as V leaves it out.", expected)]
+        contributions = [(c.load, c.expression) for c in self.eom.load_contributions
+                         if c.coordinate == name]
+        unit = generalized_force_unit(coordinate.unit)
+        for load, part in contributions:
+            if eq.identical(Q_user, Q - part, self.points):
+                return [Finding(item, "wrong", "generalized_force_missing",
+                                f"the load '{load}' is missing: it does virtual work "
+                                f"dW = ({fmt(eq.display(part))}) d{name} on {name} ({unit}). "
+                                "Did you do virtual work for every non-potential load?", expected)]
+        if len(contributions) > 1 and eq.zero(Q_user, self.points):
+            listed = "; ".join(f"'{load}': {fmt(eq.display(p))}" for load, p in contributions)
+            return [Finding(item, "wrong", "generalized_force_missing",
+                            f"every load is missing; by virtual work they give {listed}.",
+                            expected)]
+        suspect = self._mis_projected(Q_user, Q, contributions)
+        if suspect is not None:
+            load, part = suspect
+            return [Finding(item, "wrong", "generalized_force_projection",
+                            self._projection_message(load, part, name, Q_user - (Q - part)),
+                            expected)]
+        difference = eq.display(Q_user - Q)
+        if not contributions:
+            message = (f"no load does virtual work on {name}, so {item} = 0 (potential forces "
+                       f"belong in V); yours minus ours is {fmt(difference)}.")
+        else:
+            message = f"{item} differs from ours by {fmt(difference)}."
+        return [Finding(item, "wrong", "equation_wrong", message, expected)]
+
+    def _mis_projected(self, Q_user, Q, contributions):
+        """The load whose contribution the user replaced by something else (same magnitudes)."""
+        if len(contributions) == 1:
+            return contributions[0]
+        parameters = {p.symbol for p in self.model.parameters}
+        for load, part in contributions:
+            yours = sp.sympify(Q_user - (Q - part))
+            if eq.zero(yours, self.points):
+                continue
+            if (yours.free_symbols & parameters) == (part.free_symbols & parameters):
+                return load, part
+        return None
+
+    def _projection_message(self, load_name: str, part: sp.Expr, name: str,
+                            yours: sp.Expr) -> str:
+        q = self.model.coordinate(name).symbol
+        load = next((item for item in self.model.loads if item.name == load_name), None)
+        damper = next((d for d in self.model.dampers if d.name == load_name), None)
+        tail = (f"so its generalized force is {fmt(eq.display(part))}; yours is "
+                f"{fmt(eq.display(yours))} (sin for cos, lever arm or sign?).")
+        if isinstance(load, PointForce):
+            dr = ", ".join(fmt(eq.display(r.diff(q))) for r in _planar(load.point))
+            force = ", ".join(fmt(f) for f in _planar(load.force))
+            return (f"the load '{load_name}' is projected wrongly: its point moves by "
+                    f"dr = dr/d{name} d{name} = ({dr}) d{name}, and dW = F . dr with "
+                    f"F = ({force}), {tail}")
+        if isinstance(load, Torque):
+            return (f"the torque '{load_name}' is projected wrongly: it turns through "
+                    f"d(angle) = ({fmt(eq.display(load.angle.diff(q)))}) d{name}, {tail}")
+        if isinstance(damper, Damper):
+            return (f"the damper '{load_name}' is projected wrongly: Q = -c (rate) d(rate)/"
+                    f"d{name}_dot with rate = {fmt(damper.rate)}, {tail}")
+        what = {DISSIPATION_LOAD: "the dissipation D", GIVEN_LOAD: "the given generalized force"}
+        return f"{what.get(load_name, repr(load_name))} is projected wrongly, {tail}"
+
+    # equations -------------------------------------------------------------------------
+
+    def equations(self) -> list[Finding]:
+        eom, model = self.eom, self.model
+        ours = list(eom.equations)
+        given = dict(self.answer.equations)
+        multipliers = list(eom.multipliers)
+        foreign = set().union(*(self.answer.foreign_symbols(f"equation[{n}]") for n in given)) \
+            if given else set()
+        findings: list[Finding] = []
+        if not model.constraints and foreign:
+            for name, value in given.items():
+                item = f"equation[{name}]"
+                extra = self.answer.foreign_symbols(item)
+                if not extra:
+                    continue
+                i = self.names.index(name)
+                stripped = value.xreplace({s: 0 for s in extra})
+                rest = (" Without them the equation matches ours."
+                        if self._multiple(stripped, ours[i]) is not None else "")
+                listed = ", ".join(sorted(map(str, extra)))
+                findings.append(Finding(
+                    item, "wrong", "reaction_in_minimal_coordinates",
+                    f"the equation contains {listed}, which the model does not have: do ideal "
+                    "reactions do any virtual work? In minimal coordinates they vanish; leave "
+                    f"them out.{rest}", self._expected(i)))
+            done = {f.item for f in findings}
+            given = {n: v for n, v in given.items() if f"equation[{n}]" not in done}
+        user_multipliers = sorted(
+            {s for v in given.values() for s in v.free_symbols if s in set(multipliers)} | foreign,
+            key=str) if model.constraints else []
+        if model.constraints and len(user_multipliers) != len(multipliers):
+            findings.append(Finding(
+                "multipliers", "wrong", "multiplier_count",
+                f"your equations use {len(user_multipliers)} multiplier(s) "
+                f"({', '.join(map(str, user_multipliers)) or 'none'}) for "
+                f"{len(multipliers)} constraint(s) ({', '.join(eom.constraint_names)}). "
+                "Is there one lambda per constraint?",
+                ", ".join(map(str, multipliers))))
+            # Judge the equations with the user's multipliers left as they are.
+        set_equivalent = False
+        if given and len(given) == len(ours) and (not model.constraints
+                                                   or len(user_multipliers) == len(multipliers)):
+            set_equivalent = self._same_motion([given[n] for n in self.names], user_multipliers)
+        for name, value in given.items():
+            i = self.names.index(name)
+            item = f"equation[{name}]"
+            mapped = value.xreplace(dict(zip(user_multipliers, multipliers, strict=False))) \
+                if model.constraints and len(user_multipliers) == len(multipliers) else value
+            factor = self._multiple(mapped, ours[i])
+            if factor is not None and factor == 1:
+                findings.append(Finding(item, "correct", None, "the equation matches ours.", None))
+            elif factor is not None:
+                findings.append(Finding(
+                    item, "equivalent", "equation_equivalent",
+                    f"your equation is ours multiplied by {fmt(factor)}: equivalent.",
+                    self._expected(i)))
+            elif set_equivalent:
+                findings.append(Finding(
+                    item, "equivalent", "equation_equivalent",
+                    "your equations are an invertible combination of ours: they give the same "
+                    "accelerations.", self._expected(i)))
+            else:
+                findings.append(Finding(item, "wrong", "equation_wrong",
+                                        self._difference_message(mapped, ours[i]),
+                                        self._expected(i)))
+        return findings
+
+    def _expected(self, i: int) -> str:
+        eom = self.eom
+        lhs = (eom.mass_matrix * eom.coordinate_accelerations)[i]
+        if eom.multipliers.shape[0]:
+            lhs += (eom.constraint_jacobian.T * eom.multipliers)[i]
+        return f"{fmt(lhs)} = {fmt(eom.forcing[i])}"
+
+    def _multiple(self, user: sp.Expr, ours: sp.Expr) -> sp.Expr | None:
+        """c when user == c * ours with c independent of the state (a rescaling), else None."""
+        if eq.identical(user, ours, self.points):
+            return sp.S.One
+        accelerations = [a for a in self.model.q_ddot if ours.has(a)]
+        for a in accelerations:
+            c_ours = ours.diff(a)
+            if eq.zero(c_ours, self.points):
+                continue
+            ratio = user.diff(a) / c_ours
+            if eq.zero(ratio, self.points):
+                return None
+            if eq.identical(user, ratio * ours, self.points):
+                if eq.constant_in_state(ratio, self.points):
+                    return eq.display(sp.cancel(ratio)) if eq._small(ratio) else ratio
+                return eq.display(ratio)
+            return None
+        return None
+
+    def _difference_message(self, user: sp.Expr, ours: sp.Expr) -> str:
+        """Name the term that differs, after scaling the user's equation like ours."""
+        scale = sp.S.One
+        for a in self.model.q_ddot:
+            c_ours = ours.diff(a)
+            if ours.has(a) and not eq.zero(c_ours, self.points):
+                c_user = user.diff(a)
+                if not eq.zero(c_user, self.points):
+                    scale = c_user / c_ours
+                    if eq._small(scale):
+                        scale = sp.cancel(scale)
+                break
+        difference = eq.display(sp.expand(user / scale - ours)) if eq._small(user) \
+            else user / scale - ours
+        extra_terms, missing_terms = [], []
+        if eq._small(user) and eq._small(ours):
+            mine = set(sp.Add.make_args(sp.expand(user / scale)))
+            theirs = set(sp.Add.make_args(sp.expand(ours)))
+            extra_terms = [fmt(t) for t in mine - theirs]
+            missing_terms = [fmt(t) for t in theirs - mine]
+        scaled = "" if scale == 1 else f" (after dividing yours by {fmt(scale)})"
+        detail = ""
+        if missing_terms and len(missing_terms) <= 3:
+            detail += f" Ours has {', '.join(missing_terms)}"
+            detail += f" where yours has {', '.join(extra_terms)}." if extra_terms else \
+                " which yours lacks."
+        elif extra_terms and len(extra_terms) <= 3:
+            detail += f" Yours has the extra term(s) {', '.join(extra_terms)}."
+        return (f"the equation differs from ours{scaled} by the term {fmt(difference)}."
+                + detail)
+
+    def _same_motion(self, user: list[sp.Expr], user_multipliers: list[sp.Symbol]) -> bool:
+        """Both sets give the same accelerations at random states (solved numerically)."""
+        eom = self.eom
+        unknowns = list(self.model.q_ddot) + list(user_multipliers)
+        if not eq.is_linear(user, unknowns, self.points):
+            return False
+        A_u, b_u = eq.linear_system(user, unknowns)
+        A, b = eq.linear_system(list(eom.equations), list(self.model.q_ddot) + list(eom.multipliers))
+        m = len(eom.multipliers)
+        if m:
+            phi, gamma = eom.constraint_jacobian, eom.acceleration_rhs
+            extra_rows = sp.Matrix(phi).row_join(sp.zeros(m, m))
+            A_u = A_u.col_join(extra_rows)
+            b_u = b_u.col_join(-sp.Matrix(gamma))
+            A = A.col_join(extra_rows)
+            b = b.col_join(-sp.Matrix(gamma))
+        n = len(self.names)
+        mine = eq.solve_at_points(A_u, b_u, self.points, count=n)
+        theirs = eq.solve_at_points(A, b, self.points, count=n)
+        usable = [(x, y) for x, y in zip(mine, theirs, strict=True) if y is not None]
+        if not usable or any(x is None for x, _ in usable):
+            return False
+        return all(eq.close(a, b) for x, y in usable for a, b in zip(x, y, strict=True))
+
+    # multipliers -----------------------------------------------------------------------
+
+    def multipliers(self) -> list[Finding]:
+        m = len(self.model.constraints)
+        count = self.answer.multiplier_count
+        if count is None:
+            count = len(self.answer.multiplier_names or ())
+        expected = ", ".join(str(s) for s in self.eom.multipliers) or "none"
+        if count == m:
+            return [Finding("multipliers", "correct", None,
+                            f"{m} multiplier(s), one per constraint.", None)]
+        listed = ", ".join(self.eom.constraint_names) or "none"
+        return [Finding("multipliers", "wrong", "multiplier_count",
+                        f"{count} multiplier(s) for {m} constraint(s) ({listed}). Is there one "
+                        "lambda per constraint? Add exactly one for each constraint equation.",
+                        expected)]
+
+    # units -----------------------------------------------------------------------------
+
+    def units(self) -> list[Finding]:
+        answer = self.answer
+        items: list[tuple[str, sp.Expr, str | None, str]] = []
+        if answer.kinetic_energy is not None:
+            items.append(("T", answer.kinetic_energy, "J", "an energy"))
+        if answer.potential_energy is not None:
+            items.append(("V", answer.potential_energy, "J", "an energy"))
+        if answer.dissipation is not None:
+            items.append(("D", answer.dissipation, "W", "a power"))
+        for name, value in answer.generalized_forces:
+            unit = generalized_force_unit(self.model.coordinate(name).unit)
+            items.append((f"Q[{name}]", value, unit, f"energy per unit of {name}"))
+        for name, value in answer.equations:
+            items.append((f"equation[{name}]", value, None, ""))
+        unknown = {s: None for _, symbols in answer.foreign for s in symbols}
+        issues = answer_unit_issues(self.model, items, unknown)
+        return [Finding(issue.item, "wrong", "units_mismatch", issue.message, None)
+                for issue in issues]
+
+    def _unknown_names(self, item: str, label: str) -> list[Finding]:
+        foreign = self.answer.foreign_symbols(item)
+        if not foreign:
+            return []
+        listed = ", ".join(sorted(map(str, foreign)))
+        return [Finding(item, "wrong", "equation_wrong",
+                        f"{label} uses {listed}, which the model does not declare.",
+                        fmt(self.eom.kinetic_energy if item == "T" else
+                            self.eom.potential_energy if item == "V" else self.eom.dissipation))]
+
+
+def _planar(vector):
+    return vector[:2] if vector[2] == 0 else vector
+
+
+__all__ = ["CODES", "CheckReport", "Finding", "check_answer", "kinetic_parts", "potential_parts"]

@@ -1,0 +1,313 @@
+"""An independent derivation by Newton-Euler, compared with Lagrange coordinate by coordinate.
+
+Free bodies: each particle and planar body obeys m a_G = F + R and I alpha = M_G + M_R, with
+a_G and alpha from the positions as functions of time differentiated twice (sympy's own d/dt,
+not the Lagrange kinematics), every applied force an explicit vector (gravity m g, spring
+tension k (l - l0) along the unit vector between its ends, damper force, loads), and unknown
+reactions R. Ideal reactions do no virtual work, so projecting onto the virtual displacements
+dr/dq_i eliminates them (with constraints, the multiplier terms Phi_q^T lambda remain, the same
+on both sides):
+
+    E_i = sum_b [(m a_G - F) . dr_G/dq_i + (I alpha - M_G) dangle/dq_i]
+
+which must equal Lagrange's (M q_ddot - f)_i identically. The reaction on each body is then
+R = m a_G - F (and M_R = I alpha - M_G about its centre of mass), with q_ddot solved from E.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..derivation.equations import EquationsOfMotion
+from ..errors import DerivationError
+from ..model.expressions import format_expression as fmt
+from ..model.model import Model, PointForce, Torque
+from . import equivalence as eq
+
+SYMBOLIC_REACTIONS_MAX_UNKNOWNS = 3
+
+
+@dataclass(frozen=True)
+class CoordinateAgreement:
+    """Newton-Euler vs Lagrange on one coordinate; ``difference`` = E_NE - E_Lagrange."""
+
+    coordinate: str
+    agree: bool
+    difference: str | None
+    newton_euler: sp.Expr
+
+
+@dataclass(frozen=True)
+class Reaction:
+    """The resultant reaction on one body (the 'joint' is named after the body it acts on):
+    force components (N) and, for a rigid body, the moment about its centre of mass (N m)."""
+
+    joint: str
+    labels: tuple[str, ...]
+    components: tuple[sp.Expr, ...]
+
+    def _repr_latex_(self) -> str:
+        rows = [rf"{label} &= {sp.latex(value)}" for label, value in zip(self.labels,
+                                                                       self.components,
+                                                                       strict=True)]
+        return r"$\begin{aligned}" + r"\\ ".join(rows) + r"\end{aligned}$"
+
+
+@dataclass(frozen=True)
+class CrosscheckReport:
+    """Whether Newton-Euler and Lagrange agree on every coordinate, with the reactions found."""
+
+    model: str
+    coordinates: tuple[CoordinateAgreement, ...]
+    reactions: tuple[Reaction, ...]
+    notes: tuple[str, ...]
+
+    @property
+    def agree(self) -> bool:
+        return all(c.agree for c in self.coordinates)
+
+    def reaction(self, joint: str) -> Reaction:
+        for r in self.reactions:
+            if r.joint == joint:
+                return r
+        raise KeyError(joint)
+
+    def __repr__(self) -> str:
+        lines = [f"CrosscheckReport(agree={self.agree})"]
+        lines += [f"  {c.coordinate}: {'agree' if c.agree else 'differ by ' + str(c.difference)}"
+                  for c in self.coordinates]
+        lines += [f"  reaction on {r.joint}: " + ", ".join(
+            f"{label} = {fmt(v)}" for label, v in zip(r.labels, r.components, strict=True))
+            for r in self.reactions]
+        return "\n".join(lines)
+
+
+@dataclass
+class _FreeBody:
+    name: str
+    mass: sp.Expr
+    position: tuple
+    acceleration: list
+    angle: sp.Expr | None = None
+    inertia: sp.Expr = sp.S.Zero
+    angular_acceleration: sp.Expr = sp.S.Zero
+    force: list | None = None
+    moment: sp.Expr = sp.S.Zero
+
+
+def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
+    """Derive by Newton-Euler and compare with ``eom`` (Lagrange) coordinate by coordinate."""
+    model = eom.model
+    if model.kinetic_energy != 0:
+        raise DerivationError(
+            "Newton-Euler needs the inertia as particles and bodies, but this model gives T as "
+            "an expression ([energy] T): there is no free body to draw (build it from "
+            "[[particles]]/[[bodies]], e.g. the example 'ladder_pendulum')")
+    if not model.particles and not model.bodies:
+        raise DerivationError("Newton-Euler needs at least one particle or body")
+    q, t = model.q, model.time
+    n = len(q)
+    points = eq.random_points(model)
+    to_time = {c.symbol: sp.Function(c.name)(t) for c in model.coordinates}
+
+    def second_derivative(expr: sp.Expr) -> sp.Expr:
+        """d^2/dt^2 with q -> q(t), then back to the plain symbols q, q_dot, q_ddot."""
+        moving = expr.xreplace(to_time).diff(t, 2)
+        back = {}
+        for c in model.coordinates:
+            f = to_time[c.symbol]
+            back[f.diff(t, 2)] = c.acceleration
+        moving = moving.xreplace(back)
+        moving = moving.xreplace({to_time[c.symbol].diff(t): c.velocity for c in model.coordinates})
+        return moving.xreplace({f: s for s, f in to_time.items()})
+
+    bodies: list[_FreeBody] = []
+    for particle in model.particles:
+        bodies.append(_FreeBody(particle.name, particle.mass, particle.position,
+                                [second_derivative(r) for r in particle.position],
+                                force=[sp.S.Zero] * 3))
+    for body in model.bodies:
+        bodies.append(_FreeBody(body.name, body.mass, body.position,
+                                [second_derivative(r) for r in body.position], body.angle,
+                                body.inertia, second_derivative(body.angle), [sp.S.Zero] * 3))
+
+    # Virtual work of the applied forces, per coordinate; loads that cannot be put on a free
+    # body are still projected, but then the reactions cannot be reported.
+    work = [[] for _ in range(n)]
+    notes: list[str] = []
+    unattributed: list[str] = []
+
+    def project(force, point) -> None:
+        for i, qi in enumerate(q):
+            dr = [r.diff(qi) for r in point]
+            work[i].append(sp.Add(*(f * d for f, d in zip(force, dr, strict=True))))
+
+    if model.gravity is not None:
+        g, direction = model.gravity.magnitude, model.gravity.direction
+        for fb in bodies:
+            weight = [fb.mass * g * d for d in direction]
+            fb.force = [a + b for a, b in zip(fb.force, weight, strict=True)]
+            project(weight, fb.position)
+    for load in model.loads:
+        if isinstance(load, PointForce):
+            project(load.force, load.point)
+            holder = _holder(load.point, bodies, model, points)
+            if holder is None:
+                unattributed.append(load.name)
+                continue
+            holder.force = [a + b for a, b in zip(holder.force, load.force, strict=True)]
+            if holder.angle is not None:
+                s = [p - r for p, r in zip(load.point, holder.position, strict=True)]
+                holder.moment += s[0] * load.force[1] - s[1] * load.force[0]
+        elif isinstance(load, Torque):
+            for i, qi in enumerate(q):
+                work[i].append(load.torque * load.angle.diff(qi))
+            holder = next((fb for fb in bodies if fb.angle is not None
+                           and eq.identical(fb.angle, load.angle, points)), None)
+            if holder is None:
+                unattributed.append(load.name)
+                continue
+            holder.moment += load.torque
+    for spring in model.springs:
+        unattributed.append(spring.name)
+        tension = spring.stiffness * (spring.length - spring.rest_length)
+        ends = _separation(spring.length)
+        for i, qi in enumerate(q):
+            if ends is not None:  # force -k (l - l0) d/|d| on one end, the opposite on the other
+                work[i].append(sp.Add(*(-tension * d / spring.length * d.diff(qi) for d in ends)))
+            else:  # a spring along its own length coordinate
+                work[i].append(-tension * spring.length.diff(qi))
+    for damper in model.dampers:
+        unattributed.append(damper.name)
+        # Force -c l_dot along the line, projected by dl/dq_i = d(l_dot)/d(q_dot_i).
+        for i, c in enumerate(model.coordinates):
+            work[i].append(-damper.coefficient * damper.rate * damper.rate.diff(c.velocity))
+    given = []
+    if model.potential_energy != 0:
+        given.append("[energy] V")
+        for i, qi in enumerate(q):
+            work[i].append(-model.potential_energy.diff(qi))
+    if model.dissipation != 0:
+        given.append("[energy] D")
+        for i, c in enumerate(model.coordinates):
+            work[i].append(-model.dissipation.diff(c.velocity))
+    for name, value in model.generalized_forces:
+        given.append(f"[generalized_forces] {name}")
+        work[[c.name for c in model.coordinates].index(name)].append(value)
+    if given:
+        notes.append("taken as given generalized forces (no force vector in the model): "
+                     + ", ".join(given))
+        unattributed += given
+
+    newton_euler = []
+    for i, qi in enumerate(q):
+        terms = []
+        for fb in bodies:
+            terms += [fb.mass * a * r.diff(qi) for a, r in zip(fb.acceleration, fb.position,
+                                                               strict=True) if r.has(qi)]
+            if fb.angle is not None and fb.angle.has(qi):
+                terms.append(fb.inertia * fb.angular_acceleration * fb.angle.diff(qi))
+        newton_euler.append(sp.Add(*terms) - sp.Add(*work[i]))
+
+    lagrange = list(eom.mass_matrix * eom.coordinate_accelerations - eom.forcing)
+    agreements = []
+    for c, ne, la in zip(model.coordinates, newton_euler, lagrange, strict=True):
+        same = eq.identical(ne, la, points)
+        difference = None if same else fmt(eq.display(sp.expand(ne - la)) if eq._small(ne - la)
+                                           else ne - la)
+        agreements.append(CoordinateAgreement(c.name, same, difference, ne))
+
+    reactions: tuple[Reaction, ...] = ()
+    if unattributed:
+        notes.append("reactions not reported: the forces of "
+                     + ", ".join(f"'{u}'" for u in unattributed)
+                     + " cannot be placed on a free body from the model")
+    else:
+        reactions = _reactions(eom, bodies, newton_euler, notes)
+    return CrosscheckReport(model.name, tuple(agreements), reactions, tuple(notes))
+
+
+def _holder(point, bodies: list[_FreeBody], model: Model, points: eq.Points) -> _FreeBody | None:
+    """The particle at ``point``, or the body that ``point`` moves rigidly with."""
+    for fb in bodies:
+        if fb.angle is None and all(eq.identical(a, b, points)
+                                    for a, b in zip(point, fb.position, strict=True)):
+            return fb
+    q, q_dot = model.q, model.q_dot
+    for fb in bodies:
+        if fb.angle is None:
+            continue
+        s = [p - r for p, r in zip(point, fb.position, strict=True)]
+        rate = [sp.Add(*(si.diff(qi) * vi for qi, vi in zip(q, q_dot, strict=True))) + si.diff(model.time)
+                for si in s]
+        omega = sp.Add(*(fb.angle.diff(qi) * vi for qi, vi in zip(q, q_dot, strict=True))) \
+            + fb.angle.diff(model.time)
+        # A point fixed in a planar body: ds/dt = omega k x s.
+        if (eq.identical(rate[0], -omega * s[1], points) and eq.identical(rate[1], omega * s[0], points)
+                and eq.zero(rate[2], points)):
+            return fb
+    return None
+
+
+def _separation(length: sp.Expr):
+    """The components d of a length written sqrt(d_x^2 + d_y^2 + ...) (spring 'between')."""
+    if isinstance(length, sp.Pow) and length.exp == sp.S.Half:
+        squares = sp.Add.make_args(length.base)
+        if all(isinstance(s, sp.Pow) and s.exp == 2 for s in squares):
+            return [s.base for s in squares]
+    return None
+
+
+def _reactions(eom: EquationsOfMotion, bodies: list[_FreeBody], newton_euler: list[sp.Expr],
+               notes: list[str]) -> tuple[Reaction, ...]:
+    model = eom.model
+    n, m = len(model.q), eom.multipliers.shape[0]
+    solution: dict[sp.Symbol, sp.Expr] = {}
+    if n + m <= SYMBOLIC_REACTIONS_MAX_UNKNOWNS:
+        residual = sp.Matrix(newton_euler)
+        if m:
+            residual += eom.constraint_jacobian.T * eom.multipliers
+        unknowns = list(model.q_ddot) + list(eom.multipliers)
+        A, b = eq.linear_system(list(residual), list(model.q_ddot) + list(eom.multipliers))
+        if m:
+            A = A.col_join(sp.Matrix(eom.constraint_jacobian).row_join(sp.zeros(m, m)))
+            b = b.col_join(-sp.Matrix(eom.acceleration_rhs))
+        try:
+            values = A.LUsolve(-b)
+            solution = {u: sp.cancel(v) for u, v in zip(unknowns, values, strict=True)}
+            # A solved form this large reads worse than the accelerations themselves.
+            if any(sp.count_ops(v) > 2 * eq.SMALL for v in solution.values()):
+                solution = {}
+        except (ValueError, ZeroDivisionError, sp.matrices.exceptions.NonInvertibleMatrixError):
+            solution = {}
+    if not solution:
+        notes.append("reactions are given in terms of the accelerations"
+                     + (" and multipliers" if m else "") + " (their solved form is too large)")
+    planar = all(fb.position[2] == 0 and fb.acceleration[2] == 0 and fb.force[2] == 0
+                 for fb in bodies)
+    reactions = []
+    for fb in bodies:
+        force = [fb.mass * a - f for a, f in zip(fb.acceleration, fb.force, strict=True)]
+        labels = ["R_x", "R_y", "R_z"]
+        components = force[:2] if planar else force
+        labels = labels[:len(components)]
+        if fb.angle is not None:
+            components.append(fb.inertia * fb.angular_acceleration - fb.moment)
+            labels.append("M_z")
+        values = tuple(_tidy(v.xreplace(solution)) for v in components)
+        reactions.append(Reaction(fb.name, tuple(labels), values))
+    return tuple(reactions)
+
+
+def _tidy(expr: sp.Expr) -> sp.Expr:
+    if not eq._small(expr):
+        return expr
+    try:
+        return sp.factor(sp.trigsimp(sp.cancel(expr)))
+    except Exception:  # noqa: BLE001 - tidying only costs readability
+        return expr
+
+
+__all__ = ["CoordinateAgreement", "CrosscheckReport", "Reaction", "crosscheck"]

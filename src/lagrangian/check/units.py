@@ -1,0 +1,272 @@
+"""Dimensional analysis of a model (and of a user's answer) with pint.
+
+Each symbol gets the dimension of its declared unit (q_dot: unit/s, q_ddot: unit/s^2, t: s).
+Radians are dimensionless, so sin(theta) is fine, while a generalized force on an angle still
+has to be an energy per radian (N m) and on a length a force (N). A parameter without a unit
+has an unknown dimension and the terms containing it are not judged.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..model.expressions import format_expression
+from ..model.model import Model, PointForce, multiplier_name
+from ..model.units import generalized_force_unit, registry
+
+ENERGY = "J"
+POWER = "W"
+
+
+@dataclass(frozen=True)
+class UnitIssue:
+    """One dimensionally inconsistent term: where it is, the term, and what is wrong."""
+
+    item: str
+    term: str
+    message: str
+
+
+@dataclass(frozen=True)
+class UnitsReport:
+    """Every inconsistent term of a model; ``consistent`` when there is none."""
+
+    model: str
+    issues: tuple[UnitIssue, ...]
+    unchecked: tuple[str, ...]  # parameters without a unit (terms with them are not judged)
+
+    @property
+    def consistent(self) -> bool:
+        return not self.issues
+
+
+def quantity(unit: str | None):
+    """A pint quantity of magnitude 1 in base units, or None for an unknown unit."""
+    if unit is None:
+        return None
+    ureg = registry()
+    if unit in ("", "1"):
+        return ureg.Quantity(1)
+    try:
+        return ureg.Quantity(1, unit.replace("^", "**")).to_base_units()
+    except Exception:  # noqa: BLE001 - pint raises many types for an unparsable unit
+        return None
+
+
+def symbol_units(model: Model) -> dict[sp.Symbol, object]:
+    """Symbol -> unit quantity (None: unknown) for parameters, coordinates and their rates."""
+    ureg = registry()
+    second = ureg.Quantity(1, "s")
+    units: dict[sp.Symbol, object] = {model.time: second}
+    for p in model.parameters:
+        units[p.symbol] = quantity(p.unit)
+    for c in model.coordinates:
+        q = quantity(c.unit if c.unit else "")
+        units[c.symbol] = q
+        units[c.velocity] = None if q is None else q / second
+        units[c.acceleration] = None if q is None else q / second**2
+    for constraint in model.constraints:
+        units[sp.Symbol(multiplier_name(constraint.name))] = None
+    return units
+
+
+def describe(q) -> str:
+    if q is None:
+        return "unknown units"
+    if q.dimensionless:
+        return "no units (dimensionless)"
+    text = f"{q.units:~C}"
+    return text.replace("**", "^")
+
+
+class DimensionChecker:
+    """Walks a sympy expression, returning its dimension and collecting inconsistencies."""
+
+    def __init__(self, units: Mapping[sp.Symbol, object]):
+        self.units = units
+        self.issues: list[UnitIssue] = []
+        self._one = registry().Quantity(1)
+
+    def check(self, item: str, expression: sp.Expr, expected: str | None = None,
+              what: str = "") -> None:
+        """Record every inconsistent term of ``expression``; with ``expected``, every term whose
+        dimension differs from it (``what`` names the expected quantity, e.g. 'an energy')."""
+        target = quantity(expected) if expected is not None else None
+        terms = sp.Add.make_args(expression) if target is not None else (expression,)
+        for term in terms:
+            if term.is_Number:
+                continue  # a bare number is an SI value of whatever the item needs
+            dim = self.dimension(term, item)
+            if target is not None and dim is not None and not _same(dim, target):
+                label = what or f"in {expected}"
+                self.issues.append(UnitIssue(
+                    item, format_expression(term),
+                    f"{item} must be {label} ({_named(expected, target)}), but the term "
+                    f"{format_expression(term)} has {describe(dim)}"))
+
+    def dimension(self, expr: sp.Expr, item: str):
+        if expr.is_Number or expr in (sp.pi, sp.E) or expr.is_NumberSymbol:
+            return self._one
+        if isinstance(expr, sp.Symbol):
+            return self.units.get(expr)
+        if isinstance(expr, sp.Add):
+            # Bare numbers added to a term take its units (SI values), so they are not judged.
+            dims = [(term, self.dimension(term, item)) for term in expr.args if not term.is_Number]
+            known = [(term, d) for term, d in dims if d is not None]
+            if not known:
+                return None
+            groups: list[list] = []
+            for term, d in known:
+                for group in groups:
+                    if _same(group[0][1], d):
+                        group.append((term, d))
+                        break
+                else:
+                    groups.append([(term, d)])
+            if len(groups) > 1:
+                groups.sort(key=len, reverse=True)
+                major = groups[0][0][1]
+                for group in groups[1:]:
+                    for term, d in group:
+                        self.issues.append(UnitIssue(
+                            item, format_expression(term),
+                            f"in {item}, the term {format_expression(term)} has {describe(d)} "
+                            f"where the other terms of {format_expression(expr)} have "
+                            f"{describe(major)}"))
+                return major
+            return None if len(known) < len(dims) else known[0][1]
+        if isinstance(expr, sp.Mul):
+            result = self._one
+            for factor in expr.args:
+                d = self.dimension(factor, item)
+                if d is None:
+                    return None
+                result = result * d
+            return result
+        if isinstance(expr, sp.Pow):
+            base, exponent = expr.args
+            b = self.dimension(base, item)
+            if exponent.is_Number:
+                return None if b is None else b ** float(exponent)
+            self._dimensionless(exponent, item, "an exponent", expr)
+            if b is not None and not b.dimensionless:
+                self._issue(item, base, b, f"the base of {format_expression(expr)} "
+                            "with a symbolic exponent")
+            return self._one
+        if isinstance(expr, sp.Abs):
+            return self.dimension(expr.args[0], item)
+        if isinstance(expr, sp.sign):
+            self.dimension(expr.args[0], item)
+            return self._one
+        if isinstance(expr, sp.atan2):
+            a, b = (self.dimension(arg, item) for arg in expr.args)
+            if a is not None and b is not None and not _same(a, b):
+                self.issues.append(UnitIssue(
+                    item, format_expression(expr),
+                    f"in {item}, the two arguments of {format_expression(expr)} have "
+                    f"{describe(a)} and {describe(b)}"))
+            return self._one
+        if isinstance(expr, sp.Function):
+            for arg in expr.args:
+                self._dimensionless(arg, item, f"the argument of {expr.func.__name__}", expr)
+            return self._one
+        return None
+
+    def _dimensionless(self, arg: sp.Expr, item: str, role: str, whole: sp.Expr) -> None:
+        d = self.dimension(arg, item)
+        if d is not None and not d.dimensionless:
+            self._issue(item, arg, d, f"{role} in {format_expression(whole)}")
+
+    def _issue(self, item: str, term: sp.Expr, d, role: str) -> None:
+        self.issues.append(UnitIssue(
+            item, format_expression(term),
+            f"in {item}, {role} must be dimensionless, but {format_expression(term)} has "
+            f"{describe(d)}"))
+
+
+def _named(expected: str, target) -> str:
+    if not expected:
+        return describe(target)
+    base = describe(target)
+    return expected if base == expected else f"{expected} = {base}"
+
+
+def _same(a, b) -> bool:
+    return a.dimensionality == b.dimensionality
+
+
+def check_model_units(model: Model) -> UnitsReport:
+    """Every dimensionally inconsistent term of the model: T, V, D, components, loads, Q."""
+    checker = DimensionChecker(symbol_units(model))
+    c = checker.check
+    if model.kinetic_energy != 0:
+        c("T", model.kinetic_energy, ENERGY, "an energy")
+    if model.potential_energy != 0:
+        c("V", model.potential_energy, ENERGY, "an energy")
+    if model.dissipation != 0:
+        c("D", model.dissipation, POWER, "a power (Rayleigh dissipation)")
+    if model.gravity is not None:
+        c("gravity.g", model.gravity.magnitude, "m/s^2", "an acceleration")
+    for particle in model.particles:
+        where = f"particles[{particle.name}]"
+        c(f"{where}.mass", particle.mass, "kg", "a mass")
+        for axis, component in zip("xyz", particle.position, strict=True):
+            c(f"{where}.position.{axis}", component, "m", "a length")
+    for body in model.bodies:
+        where = f"bodies[{body.name}]"
+        c(f"{where}.mass", body.mass, "kg", "a mass")
+        c(f"{where}.inertia", body.inertia, "kg*m^2", "a moment of inertia")
+        for axis, component in zip("xyz", body.position, strict=True):
+            c(f"{where}.position.{axis}", component, "m", "a length")
+        c(f"{where}.angle", body.angle, "", "an angle")
+    for spring in model.springs:
+        where = f"springs[{spring.name}]"
+        c(f"{where}.stiffness", spring.stiffness, None)
+        c(f"{where}.potential", sp.Rational(1, 2) * spring.stiffness
+          * (spring.length - spring.rest_length) ** 2, ENERGY, "an energy")
+    for damper in model.dampers:
+        where = f"dampers[{damper.name}]"
+        c(f"{where}.dissipation", sp.Rational(1, 2) * damper.coefficient * damper.rate**2,
+          POWER, "a power")
+    for load in model.loads:
+        where = f"loads[{load.name}]"
+        if isinstance(load, PointForce):
+            for axis, component in zip("xyz", load.point, strict=True):
+                c(f"{where}.point.{axis}", component, "m", "a length")
+            for axis, component in zip("xyz", load.force, strict=True):
+                c(f"{where}.force.{axis}", component, "N", "a force")
+        else:
+            c(f"{where}.torque", load.torque, "N*m", "a torque")
+            c(f"{where}.angle", load.angle, "", "an angle")
+    for name, value in model.generalized_forces:
+        coordinate = model.coordinate(name)
+        c(f"Q[{name}]", value, generalized_force_unit(coordinate.unit),
+          f"energy per unit of {name}")
+    for constraint in model.constraints:
+        c(f"constraints[{constraint.name}]", constraint.expression, None)
+    unchecked = tuple(p.name for p in model.parameters if p.unit is None)
+    return UnitsReport(model.name, _unique(checker.issues), unchecked)
+
+
+def answer_unit_issues(model: Model, items: list[tuple[str, sp.Expr, str | None, str]],
+                       extra: Mapping[sp.Symbol, object] | None = None) -> list[UnitIssue]:
+    """Unit issues of a user's items: (item, expression, expected unit or None, what)."""
+    units = symbol_units(model)
+    units.update(extra or {})
+    checker = DimensionChecker(units)
+    for item, expression, expected, what in items:
+        checker.check(item, expression, expected, what)
+    return list(_unique(checker.issues))
+
+
+def _unique(issues: list[UnitIssue]) -> tuple[UnitIssue, ...]:
+    seen, out = set(), []
+    for issue in issues:
+        key = (issue.item, issue.term, issue.message)
+        if key not in seen:
+            seen.add(key)
+            out.append(issue)
+    return tuple(out)

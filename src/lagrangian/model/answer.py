@@ -1,0 +1,207 @@
+"""A user's hand derivation (ANSWER.toml) read in the model-file grammar, to be checked.
+
+Tables: ``[energy]`` T, V, D; ``[generalized_forces]`` one entry per coordinate;
+``[equations]`` one entry per coordinate, ``"lhs = rhs"`` or an expression equal to zero;
+``[multipliers]`` ``count`` or ``names``. Names that the model does not know (a reaction force
+``N``, a tension ``T_rod``) are kept as *foreign symbols*, so the checker can say why they do
+not belong, instead of failing to parse.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import sympy as sp
+
+from ..errors import ModelError
+from .expressions import CONSTANTS, FUNCTIONS, parse_expression
+from .model import Model, multiplier_name
+
+TABLES = ("energy", "generalized_forces", "equations", "multipliers")
+_FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+@dataclass(frozen=True)
+class Answer:
+    """The items a user derived by hand; each expression is sympy, None where not given."""
+
+    source: str
+    kinetic_energy: sp.Expr | None = None
+    potential_energy: sp.Expr | None = None
+    dissipation: sp.Expr | None = None
+    generalized_forces: tuple[tuple[str, sp.Expr], ...] = ()
+    equations: tuple[tuple[str, sp.Expr], ...] = ()
+    multiplier_count: int | None = None
+    multiplier_names: tuple[str, ...] | None = None
+    # item ("T", "Q[theta]", "equation[x]") -> names the model does not declare
+    foreign: tuple[tuple[str, frozenset[sp.Symbol]], ...] = field(default=())
+
+    def foreign_symbols(self, item: str) -> frozenset[sp.Symbol]:
+        return dict(self.foreign).get(item, frozenset())
+
+    @property
+    def is_empty(self) -> bool:
+        return (self.kinetic_energy is None and self.potential_energy is None
+                and self.dissipation is None and not self.generalized_forces
+                and not self.equations and self.multiplier_count is None
+                and self.multiplier_names is None)
+
+
+def answer_names(model: Model) -> dict[str, sp.Expr]:
+    """Every name an answer may use: parameters, coordinates with _dot/_ddot, definitions, t,
+    and the multipliers lambda_<constraint>."""
+    names: dict[str, sp.Expr] = {"t": model.time}
+    for p in model.parameters:
+        names[p.name] = p.symbol
+    for c in model.coordinates:
+        names[c.name] = c.symbol
+        names[c.velocity.name] = c.velocity
+        names[c.acceleration.name] = c.acceleration
+    for name, value in model.definitions:
+        names[name] = value
+    for constraint in model.constraints:
+        name = multiplier_name(constraint.name)
+        names[name] = sp.Symbol(name)
+    return names
+
+
+def read_answer(path: str | Path, model: Model) -> Answer:
+    """Read ANSWER.toml against ``model``; errors name the file and the key."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ModelError("no such file", source=str(path)) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ModelError(f"cannot read the file ({exc})", source=str(path)) from None
+    return parse_answer(text, model, source=str(path))
+
+
+def parse_answer(text: str, model: Model, *, source: str = "<answer>") -> Answer:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelError(f"invalid TOML: {exc}", source=source) from None
+    return answer_from_mapping(data, model, source=source)
+
+
+def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>") -> Answer:
+    _known(data, TABLES, None, source)
+    names = answer_names(model)
+    coordinates = [c.name for c in model.coordinates]
+    foreign: dict[str, frozenset[sp.Symbol]] = {}
+
+    def expression(value: object, field: str, item: str) -> sp.Expr:
+        if isinstance(value, str):
+            extra = _foreign_names(value, names, field, source)
+            if extra:
+                foreign[item] = foreign.get(item, frozenset()) | set(extra.values())
+            scope = {**names, **extra}
+        else:
+            scope = names
+        return parse_expression(value, scope, field=field, source=source)
+
+    energy = _table(data, "energy", source)
+    _known(energy, ("T", "V", "D"), "energy", source)
+    values = {key: expression(energy[key], f"energy.{key}", key) for key in energy}
+
+    forces = _table(data, "generalized_forces", source)
+    _known(forces, coordinates, "generalized_forces", source, what="coordinate")
+    generalized = tuple(
+        (name, expression(forces[name], f"generalized_forces.{name}", f"Q[{name}]"))
+        for name in coordinates if name in forces
+    )
+
+    table = _table(data, "equations", source)
+    _known(table, coordinates, "equations", source, what="coordinate")
+    equations = []
+    for name in coordinates:
+        if name not in table:
+            continue
+        field, item = f"equations.{name}", f"equation[{name}]"
+        value = table[name]
+        if isinstance(value, str) and "=" in value:
+            sides = value.split("=")
+            if len(sides) != 2 or any(s[-1:] in "<>!" for s in sides[:1]) or not sides[1].strip():
+                raise ModelError(f"an equation is 'lhs = rhs' or one expression equal to zero, "
+                                 f"got {value!r}", field=field, source=source)
+            equations.append((name, expression(sides[0], field, item)
+                              - expression(sides[1], field, item)))
+        else:
+            equations.append((name, expression(value, field, item)))
+
+    count, multiplier_names = None, None
+    multipliers = _table(data, "multipliers", source)
+    _known(multipliers, ("count", "names"), "multipliers", source)
+    if "count" in multipliers:
+        count = multipliers["count"]
+        if isinstance(count, bool) or not isinstance(count, int) or count < 0:
+            raise ModelError(f"expected a whole number >= 0, got {count!r}",
+                             field="multipliers.count", source=source)
+    if "names" in multipliers:
+        listed = multipliers["names"]
+        if not isinstance(listed, list) or not all(isinstance(n, str) for n in listed):
+            raise ModelError("expected a list of names", field="multipliers.names", source=source)
+        multiplier_names = tuple(listed)
+        if count is not None and count != len(listed):
+            raise ModelError(f"count = {count} but {len(listed)} names are listed",
+                             field="multipliers", source=source)
+
+    return Answer(
+        source=source,
+        kinetic_energy=values.get("T"),
+        potential_energy=values.get("V"),
+        dissipation=values.get("D"),
+        generalized_forces=generalized,
+        equations=tuple(equations),
+        multiplier_count=count,
+        multiplier_names=multiplier_names,
+        foreign=tuple(sorted(foreign.items())),
+    )
+
+
+def _foreign_names(text: str, names: Mapping[str, sp.Expr], field: str,
+                   source: str) -> dict[str, sp.Symbol]:
+    """Plain identifiers in ``text`` that the model does not declare (never called functions).
+
+    Syntax and grammar errors are left for the grammar parser to report.
+    """
+    try:
+        tree = ast.parse(text.replace("^", "**").strip(), mode="eval")
+    except (SyntaxError, ValueError, RecursionError, MemoryError):
+        return {}
+    called = {id(node.func) for node in ast.walk(tree) if isinstance(node, ast.Call)}
+    extra: dict[str, sp.Symbol] = {}
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Name) or id(node) in called:
+            continue
+        name = node.id
+        if name in names or name in CONSTANTS or name in FUNCTIONS:
+            continue
+        if not _FOREIGN.match(name):
+            raise ModelError(f"'{name}' is not a valid name", field=field, source=source)
+        extra[name] = sp.Symbol(name)
+    return extra
+
+
+def _table(data: Mapping, key: str, source: str) -> Mapping:
+    value = data.get(key, {})
+    if not isinstance(value, Mapping):
+        raise ModelError(f"expected a table [{key}]", field=key, source=source)
+    return value
+
+
+def _known(table: Mapping, allowed, field: str | None, source: str, what: str = "key") -> None:
+    import difflib
+
+    for key in table:
+        if key not in allowed:
+            close = difflib.get_close_matches(key, list(allowed), n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            where = f"{field}.{key}" if field else key
+            raise ModelError(f"unknown {what} '{key}'{hint}", field=where, source=source)

@@ -135,6 +135,36 @@ class System:
         return numeric(self.equations_of_motion(), parameters, backend=backend)
     # ---- end numerics -------------------------------------------------------------------------
 
+    # -- checking a hand derivation (issue 5): check, crosscheck, check_units --------------------
+
+    def check(self, answer):
+        """Verdicts and diagnoses on a hand derivation: a path to ANSWER.toml, or an Answer.
+
+        Returns a CheckReport (``verdict``, ``findings`` with item, status, code, message,
+        expected); items written differently but equivalently are accepted.
+        """
+        from .check.diagnose import check_answer
+        from .model.answer import Answer, read_answer
+
+        if not isinstance(answer, Answer):
+            answer = read_answer(answer, self._model)
+        return check_answer(self.equations_of_motion(), answer)
+
+    def crosscheck(self):
+        """Newton-Euler (free bodies, reactions eliminated) vs Lagrange, coordinate by
+        coordinate, with the reaction force on each body (N; moment about the centre, N m)."""
+        from .check.newton_euler import crosscheck
+
+        return crosscheck(self.equations_of_motion())
+
+    def check_units(self):
+        """Every dimensionally inconsistent term of the model (T, V: J; D: W; Q: J per unit of q)."""
+        from .check.units import check_model_units
+
+        return check_model_units(self._model)
+
+    # -- end of checking ---------------------------------------------------------------------------
+
     def __repr__(self) -> str:
         names = ", ".join(c.name for c in self._model.coordinates)
         return f"System({self._model.name!r}, coordinates=[{names}])"

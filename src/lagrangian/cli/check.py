@@ -1,0 +1,73 @@
+"""`lagrangian check MODEL ANSWER.toml`, `lagrangian crosscheck MODEL`, `lagrangian units MODEL`.
+
+check exits 0 when the answer is correct, 1 when it is not, 2 when a file cannot be read
+(crosscheck: 1 when the derivations disagree; units: 1 when a term is inconsistent).
+SystemExit(1) rather than typer.Exit(1): the app runs with standalone_mode=False, where click
+returns an Exit's code instead of raising it, and the status would be lost.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from ..output.check import (
+    check_document,
+    check_text,
+    crosscheck_document,
+    crosscheck_text,
+    units_document,
+    units_text,
+)
+from . import app
+from .common import load_system, print_json
+
+_MODEL = Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")]
+_SET = Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")]
+_JSON = Annotated[bool, typer.Option("--json", help="Print JSON.")]
+
+
+@app.command()
+def check(
+    model: _MODEL,
+    answer: Annotated[str, typer.Argument(help="Your derivation: ANSWER.toml ([energy] T, V; "
+                                                "[generalized_forces]; [equations]; [multipliers]).")],
+    set_: _SET = [],  # noqa: B006
+    json_: _JSON = False,
+) -> None:
+    """Check a hand derivation (T, V, Q, equations, multipliers) and diagnose each mistake."""
+    system = load_system(model, set_)
+    report = system.check(answer)
+    if json_:
+        print_json(check_document(report))
+    else:
+        typer.echo(check_text(report), nl=False)
+    if not report.correct:
+        raise SystemExit(1)
+
+
+@app.command()
+def crosscheck(model: _MODEL, set_: _SET = [], json_: _JSON = False) -> None:  # noqa: B006
+    """Derive again by Newton-Euler (free bodies, reactions eliminated) and compare with Lagrange."""
+    system = load_system(model, set_)
+    report = system.crosscheck()
+    if json_:
+        print_json(crosscheck_document(report))
+    else:
+        typer.echo(crosscheck_text(report), nl=False)
+    if not report.agree:
+        raise SystemExit(1)
+
+
+@app.command()
+def units(model: _MODEL, json_: _JSON = False) -> None:
+    """Check the model for dimensional consistency; print every inconsistent term."""
+    system = load_system(model)
+    report = system.check_units()
+    if json_:
+        print_json(units_document(report))
+    else:
+        typer.echo(units_text(report), nl=False)
+    if not report.consistent:
+        raise SystemExit(1)

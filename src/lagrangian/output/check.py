@@ -1,0 +1,84 @@
+"""Text and JSON of the checking reports: check (findings), crosscheck (Newton-Euler), units."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..check.diagnose import CheckReport
+from ..check.newton_euler import CrosscheckReport
+from ..check.units import UnitsReport
+from ..model.expressions import format_expression as fmt
+
+_MARK = {"correct": "ok", "equivalent": "equivalent", "wrong": "WRONG", "note": "note"}
+
+
+def check_document(report: CheckReport) -> dict[str, Any]:
+    """The `check --json` document (a public contract)."""
+    return {
+        "verdict": report.verdict,
+        "findings": [
+            {"item": f.item, "status": f.status, "code": f.code, "message": f.message,
+             "expected": f.expected}
+            for f in report.findings
+        ],
+    }
+
+
+def check_text(report: CheckReport) -> str:
+    lines = [f"Checking {report.answer} against {report.model}"]
+    if not report.findings:
+        lines.append("  (the answer has no items to check)")
+    for f in report.findings:
+        code = f" [{f.code}]" if f.code else ""
+        lines.append(f"  {f.item}: {_MARK.get(f.status, f.status)}{code}")
+        lines.append(f"      {f.message}")
+        if f.expected is not None and f.status != "correct":
+            lines.append(f"      expected: {f.expected}")
+    lines.append(f"verdict: {report.verdict}")
+    return "\n".join(lines) + "\n"
+
+
+def crosscheck_document(report: CrosscheckReport) -> dict[str, Any]:
+    """The `crosscheck --json` document (a public contract)."""
+    return {
+        "agree": report.agree,
+        "coordinates": {c.coordinate: {"agree": c.agree, "difference": c.difference}
+                        for c in report.coordinates},
+        "reactions": [{"joint": r.joint, "components": [fmt(v) for v in r.components]}
+                      for r in report.reactions],
+    }
+
+
+def crosscheck_text(report: CrosscheckReport) -> str:
+    lines = [f"Newton-Euler vs Lagrange: {report.model}"]
+    for c in report.coordinates:
+        state = "agree" if c.agree else f"DIFFER by {c.difference}"
+        lines.append(f"  {c.coordinate}: {state}")
+    if report.reactions:
+        lines.append("reactions (resultant on each body; moment about its centre of mass):")
+        for r in report.reactions:
+            lines.append(f"  {r.joint}:")
+            lines += [f"      {label} = {fmt(value)}"
+                      for label, value in zip(r.labels, r.components, strict=True)]
+    lines += [f"note: {note}" for note in report.notes]
+    lines.append("agree" if report.agree else "disagree")
+    return "\n".join(lines) + "\n"
+
+
+def units_document(report: UnitsReport) -> dict[str, Any]:
+    return {
+        "consistent": report.consistent,
+        "issues": [{"item": i.item, "term": i.term, "message": i.message} for i in report.issues],
+        "unchecked_parameters": list(report.unchecked),
+    }
+
+
+def units_text(report: UnitsReport) -> str:
+    lines = [f"Units of {report.model}"]
+    lines += [f"  {issue.message}" for issue in report.issues]
+    if report.unchecked:
+        lines.append("note: parameters without a unit are not judged: "
+                     + ", ".join(report.unchecked))
+    lines.append("consistent" if report.consistent
+                 else f"{len(report.issues)} inconsistent term(s)")
+    return "\n".join(lines) + "\n"

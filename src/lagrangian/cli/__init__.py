@@ -21,6 +21,7 @@ from . import check as _check  # noqa: E402,F401
 from . import derive as _derive  # noqa: E402,F401
 from . import examples as _examples  # noqa: E402,F401
 from . import forces as _forces  # noqa: E402,F401
+from . import simulate as _simulate  # noqa: E402,F401
 
 
 def main(argv: list[str] | None = None) -> int:

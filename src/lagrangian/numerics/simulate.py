@@ -369,7 +369,10 @@ def _integrate_compiled(system, t_span, y0, rtol, atol, grid) -> _Run | None:
     if result.success:
         return _Run(t, y, "finished", STATUS_MESSAGES["finished"], steps, int(result.nfev))
     reached = float(t[-1]) if len(t) else t_span[0]
-    return _Run(t, y, "failed", f"{result.message} (stopped at t = {reached:.9g} s)", steps,
+    message = str(result.message).rstrip(".")
+    if "t =" not in message:
+        message += f" (stopped at t = {reached:.9g} s)"
+    return _Run(t, y, "failed", message, steps,
                 int(result.nfev))
 
 
@@ -394,7 +397,7 @@ def _integrate_steps(fun, t0, y0, t_end, grid, method, rtol, atol, event, drift,
                 failure = solver.step()
                 if solver.status == "failed":
                     status = "failed"
-                    message = (f"{failure or 'the step failed'} "
+                    message = (f"{(failure or 'the step failed').rstrip('.')} "
                                f"(stopped at t = {solver.t:.9g} s)")
                     break
                 if not np.all(np.isfinite(solver.y)):

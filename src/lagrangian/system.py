@@ -5,7 +5,7 @@ Like MuJoCo's model/data split, the Model is fixed; what is derived from it is c
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
 
@@ -134,6 +134,48 @@ class System:
 
         return numeric(self.equations_of_motion(), parameters, backend=backend)
     # ---- end numerics -------------------------------------------------------------------------
+
+    # -- analysis: equilibria, linearization and modes (issue 3) --------------------------------
+
+    def _static_functions(self):
+        """Compiled functions at rest, built once per System (parameters are fixed per System)."""
+        from .analysis.linearization import StaticFunctions
+
+        cached = getattr(self, "_static_cache", None)
+        if cached is None:
+            cached = self._static_cache = StaticFunctions(self.equations_of_motion())
+        return cached
+
+    def equilibria(self):
+        """Configurations of rest, f(q, 0) = Phi_q^T lambda with Phi(q) = 0, each with its stability."""
+        from .analysis.modes import equilibria_of
+
+        return equilibria_of(self._static_functions())
+
+    def linearize(self, about: Mapping[str, float] | None = None, inputs: Sequence[str] = (), *,
+                  symbolic: bool = False):
+        """Linear model M, C, K and state-space A, B (x = [q; q_dot]) about an equilibrium.
+
+        ``about`` maps coordinate names to SI values (the others are solved for); without it the
+        equilibrium nearest the initial values is used. ``inputs`` name parameters, loads or
+        coordinates (a generalized force). ``symbolic=True`` gives exact M, C, K of a small
+        unconstrained model with the parameters kept as symbols.
+        """
+        if symbolic:
+            from .analysis.linearization import symbolic_linear_model
+
+            return symbolic_linear_model(self.equations_of_motion(), dict(about or {}))
+        from .analysis.modes import linearize_about
+
+        return linearize_about(self._static_functions(), about, tuple(inputs))
+
+    def modes(self, about: Mapping[str, float] | None = None):
+        """Natural frequencies (rad/s), damping ratios and mode shapes about an equilibrium."""
+        from .analysis.modes import modes_about
+
+        return modes_about(self._static_functions(), about)
+
+    # -- end of analysis ---------------------------------------------------------------------------
 
     # -- checking a hand derivation (issue 5): check, crosscheck, check_units --------------------
 

@@ -1,0 +1,400 @@
+"""Linearization about an equilibrium: M dq_ddot + C dq_dot + K dq = B du, and x_dot = A x + B u.
+
+From M(q) q_ddot + Phi_q^T lambda = f(q, q_dot, t) at rest (q_dot = 0, q_ddot = 0, lambda0):
+M = M(q0) (the dM/dq q_ddot terms vanish because q_ddot = 0), C = -df/dq_dot (dissipation plus
+gyroscopic), K = -df/dq + sum_c lambda0_c d(Phi_q,c)/dq (the constraint Hessian), all evaluated
+numerically from symbolic Jacobians compiled once: no symbolic inversion, no simplify.
+With holonomic constraints the matrices are projected on the null space of Phi_q at q0, spanned
+by the independent coordinates (dq = N z); velocity constraints restrict only the velocities.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy as sp
+
+from ..derivation.equations import EquationsOfMotion
+from ..derivation.kinematics import jacobian_row
+from ..errors import DerivationError, ModelError
+from ..model.model import Model
+from ..numerics.functions import parameter_substitution
+
+# Relative singular-value threshold for the rank of the constraint Jacobian.
+RANK_TOLERANCE = 1e-9
+
+
+# -- numeric functions at rest ------------------------------------------------------------------
+
+
+class StaticFunctions:
+    """M, f, K0 = -df/dq, C = -df/dq_dot, Phi_q, its q-derivatives and the static constraint
+    residuals, all at q_dot = 0, compiled once (one lambdify with cse) and batched over q."""
+
+    def __init__(self, eom: EquationsOfMotion, parameters: Mapping[str, float] | None = None):
+        model = eom.model
+        self.model = model
+        self.eom = eom
+        q, q_dot, t = model.q, model.q_dot, model.time
+        n, m = len(q), len(model.constraints)
+        self.n, self.m = n, m
+        values = parameter_substitution(eom, parameters)
+        self.parameters = {str(k): float(v) for k, v in values.items()}
+        at_rest = {v: sp.S.Zero for v in q_dot}
+
+        forcing = [sp.sympify(e) for e in eom.forcing]
+        forcing_at_rest = [e.xreplace(at_rest) for e in forcing]
+        stiffness = [[-d for d in jacobian_row(e, q)] for e in forcing_at_rest]
+        damping = [[-d.xreplace(at_rest) for d in _linear_velocity_row(e, q_dot)]
+                   for e in forcing]
+        jacobian = [[sp.sympify(e).xreplace(at_rest) for e in eom.constraint_jacobian.row(i)]
+                    for i in range(m)]
+        hessians = [[jacobian_row(e, q) for e in row] for row in jacobian]
+        # At rest a holonomic constraint reads Phi(q) = 0, a velocity one b(q) = 0.
+        static = []
+        for c in model.constraints:
+            residual = c.expression if c.kind == "holonomic" else c.expression.xreplace(at_rest)
+            if residual != 0:
+                static.append((c.name, residual))
+        self.static_names = tuple(name for name, _ in static)
+        static_jacobian = [jacobian_row(e, q) for _, e in static]
+        self.depends_on = frozenset(
+            s for e in [*forcing_at_rest, *(e for _, e in static)] for s in e.free_symbols
+        )
+        rest = [*eom.mass_matrix, *forcing_at_rest, *_flat(damping), *(e for _, e in static)]
+        if any(t in sp.sympify(e).free_symbols for e in rest):
+            raise ModelError("the equations at rest depend on time t explicitly, so the model has "
+                             "no fixed equilibrium to analyse", field="equilibria")
+
+        mass = [sp.sympify(e).xreplace(at_rest) for e in eom.mass_matrix]
+        entries = [*mass, *forcing_at_rest, *_flat(stiffness), *_flat(damping), *_flat(jacobian),
+                   *_flat(_flat(hessians)), *(e for _, e in static), *_flat(static_jacobian)]
+        entries = [sp.sympify(e).xreplace(values) for e in entries]
+        self._layout = [("mass", (n, n)), ("forcing", (n,)), ("stiffness", (n, n)),
+                        ("damping", (n, n)), ("jacobian", (m, n)), ("hessians", (m, n, n)),
+                        ("static", (len(static),)), ("static_jacobian", (len(static), n))]
+        self._function = sp.lambdify([*q, t], entries, modules="numpy", cse=True)
+
+    def evaluate(self, q: np.ndarray, t: float = 0.0) -> dict[str, np.ndarray]:
+        """Every matrix at configurations q of shape (..., n), at rest and time t."""
+        q = np.asarray(q, dtype=float)
+        batch = q.shape[:-1]
+        raw = self._function(*np.moveaxis(q, -1, 0), np.broadcast_to(float(t), batch))
+        flat = [np.broadcast_to(np.asarray(e, dtype=float), batch) for e in raw]
+        out, start = {}, 0
+        for name, shape in self._layout:
+            size = int(np.prod(shape))
+            block = flat[start:start + size]
+            start += size
+            stacked = np.stack(block, axis=-1) if block else np.zeros(batch + (0,))
+            out[name] = stacked.reshape(batch + shape)
+        return out
+
+
+def _linear_velocity_row(expr: sp.Expr, q_dot: Sequence[sp.Symbol]) -> list[sp.Expr]:
+    """d expr / d q_dot_j, only for velocities the expression contains."""
+    present = expr.free_symbols
+    return [expr.diff(v) if v in present else sp.S.Zero for v in q_dot]
+
+
+def _flat(rows):
+    return [x for row in rows for x in row]
+
+
+# -- the equilibrium equations ------------------------------------------------------------------
+
+
+def static_residual(values: dict[str, np.ndarray], multipliers: np.ndarray) -> np.ndarray:
+    """[f(q, 0) - Phi_q^T lambda; Phi(q)] (forces, then constraint residuals), shape (..., n + s)."""
+    force = values["forcing"] - np.einsum("...cn,...c->...n", values["jacobian"], multipliers)
+    return np.concatenate([force, values["static"]], axis=-1)
+
+
+def total_stiffness(values: dict[str, np.ndarray], multipliers: np.ndarray) -> np.ndarray:
+    """K = -df/dq + sum_c lambda_c d(Phi_q,c)/dq, in user coordinates (n x n)."""
+    return values["stiffness"] + np.einsum("...c,...cij->...ij", multipliers, values["hessians"])
+
+
+# -- the linear model ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class LinearModel:
+    """M z_ddot + C z_dot + K z = B_q u about an equilibrium, and x_dot = A x + B u, x = [z; z_dot].
+
+    ``coordinates`` name z: all coordinates of an unconstrained model, else the independent ones
+    kept by the projection (dq = basis @ z in the user's ``user_coordinates``). Units SI.
+    """
+
+    equilibrium: dict[str, float]
+    multipliers: dict[str, float]
+    coordinates: tuple[str, ...]
+    user_coordinates: tuple[str, ...]
+    basis: np.ndarray
+    mass_matrix: np.ndarray
+    damping_matrix: np.ndarray
+    stiffness_matrix: np.ndarray
+    A: np.ndarray
+    B: np.ndarray
+    inputs: tuple[str, ...] = ()
+    input_matrix: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    velocity_constraints: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    full_mass_matrix: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    full_damping_matrix: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    full_stiffness_matrix: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+
+    @property
+    def M(self) -> np.ndarray:
+        return self.mass_matrix
+
+    @property
+    def C(self) -> np.ndarray:
+        return self.damping_matrix
+
+    @property
+    def K(self) -> np.ndarray:
+        return self.stiffness_matrix
+
+    @property
+    def gyroscopic_matrix(self) -> np.ndarray:
+        """G = (C - C^T)/2: the skew, energy-neutral part of C."""
+        return (self.damping_matrix - self.damping_matrix.T) / 2
+
+    @property
+    def dissipation_matrix(self) -> np.ndarray:
+        """(C + C^T)/2: the symmetric, energy-removing part of C."""
+        return (self.damping_matrix + self.damping_matrix.T) / 2
+
+    @property
+    def constrained(self) -> bool:
+        return self.coordinates != self.user_coordinates or self.velocity_constraints.size > 0
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        return (*self.coordinates, *(f"{c}_dot" for c in self.coordinates))
+
+    def state_space(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(A, B, C, D) with the whole state as output: ``scipy.signal.StateSpace(*lm.state_space())``
+        or ``control.ss(*lm.state_space())``."""
+        size = self.A.shape[0]
+        return self.A, self.B, np.eye(size), np.zeros((size, self.B.shape[1]))
+
+    def __repr__(self) -> str:
+        about = ", ".join(f"{k}={v:.6g}" for k, v in self.equilibrium.items())
+        return (f"LinearModel(about {about}; coordinates={list(self.coordinates)}, "
+                f"inputs={list(self.inputs)})\nM =\n{self.mass_matrix}\nC =\n"
+                f"{self.damping_matrix}\nK =\n{self.stiffness_matrix}")
+
+
+def independent_basis(jacobian: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Null-space basis N of the constraint Jacobian (n x p) with an identity on the independent
+    coordinates; returns (N, indices of the independent coordinates).
+
+    The rank comes from the singular values; the dependent coordinates are the pivots of a
+    column-pivoted QR (the best-conditioned choice), so dq = N z never divides by a small pivot.
+    """
+    import scipy.linalg
+
+    m, n = jacobian.shape
+    if m == 0:
+        return np.eye(n), np.arange(n)
+    singular = np.linalg.svd(jacobian, compute_uv=False)
+    rank = int(np.sum(singular > RANK_TOLERANCE * max(singular[0], 1e-300)))
+    _, _, pivots = scipy.linalg.qr(jacobian, pivoting=True, mode="economic")
+    dependent = np.sort(pivots[:rank])
+    independent = np.array([i for i in range(n) if i not in set(dependent)], dtype=int)
+    basis = np.zeros((n, n - rank))
+    basis[independent, np.arange(n - rank)] = 1.0
+    if rank:
+        # J_d dq_d + J_i dq_i = 0 in the least-squares sense (redundant rows allowed).
+        solution = np.linalg.lstsq(jacobian[:, dependent], -jacobian[:, independent], rcond=None)[0]
+        basis[dependent, :] = solution
+    return basis, independent
+
+
+def null_space(matrix: np.ndarray) -> np.ndarray:
+    """Orthonormal null-space basis (SVD) of a k x p matrix."""
+    p = matrix.shape[1]
+    if matrix.shape[0] == 0:
+        return np.eye(p)
+    _, singular, vt = np.linalg.svd(matrix)
+    rank = int(np.sum(singular > RANK_TOLERANCE * max(singular[0] if singular.size else 0, 1e-300)))
+    return vt[rank:].T
+
+
+def linear_model_at(
+    functions: StaticFunctions,
+    q0: np.ndarray,
+    multipliers: np.ndarray,
+    t: float = 0.0,
+    *,
+    inputs: Sequence[str] = (),
+    input_columns: np.ndarray | None = None,
+) -> LinearModel:
+    """The linear model at a known equilibrium (q0, lambda0), from the compiled functions."""
+    model = functions.model
+    values = functions.evaluate(np.asarray(q0, dtype=float), t)
+    n = functions.n
+    mass, damping = values["mass"], values["damping"]
+    stiffness = total_stiffness(values, multipliers)
+    kinds = [c.kind for c in model.constraints]
+    holonomic = [i for i, k in enumerate(kinds) if k == "holonomic"]
+    velocity = [i for i, k in enumerate(kinds) if k != "holonomic"]
+    basis, independent = independent_basis(values["jacobian"][holonomic])
+    names = tuple(c.name for c in model.coordinates)
+    reduced = tuple(names[i] for i in independent)
+    Mr = basis.T @ mass @ basis
+    Cr = basis.T @ damping @ basis
+    Kr = basis.T @ stiffness @ basis
+    p = basis.shape[1]
+    G = values["jacobian"][velocity] @ basis
+    Nv = null_space(G)
+    reduced_mass = Nv.T @ Mr @ Nv
+    try:
+        projector = Nv @ np.linalg.solve(reduced_mass, Nv.T)
+    except np.linalg.LinAlgError:
+        raise DerivationError("the mass matrix is singular at this equilibrium; "
+                              "the linear model has no state-space form") from None
+    columns = np.zeros((n, 0)) if input_columns is None else np.asarray(input_columns, float)
+    Br = basis.T @ columns
+    A = np.block([[np.zeros((p, p)), np.eye(p)], [-projector @ Kr, -projector @ Cr]])
+    B = np.vstack([np.zeros((p, columns.shape[1])), projector @ Br])
+    return LinearModel(
+        equilibrium={name: float(v) for name, v in zip(names, q0, strict=True)},
+        multipliers={c.name: float(v) for c, v in zip(model.constraints, multipliers,
+                                                      strict=True)},
+        coordinates=reduced,
+        user_coordinates=names,
+        basis=basis,
+        mass_matrix=Mr,
+        damping_matrix=Cr,
+        stiffness_matrix=Kr,
+        A=A,
+        B=B,
+        inputs=tuple(inputs),
+        input_matrix=Br,
+        velocity_constraints=G,
+        full_mass_matrix=mass,
+        full_damping_matrix=damping,
+        full_stiffness_matrix=stiffness,
+    )
+
+
+# -- inputs -------------------------------------------------------------------------------------
+
+
+def input_columns(
+    eom: EquationsOfMotion, q0: np.ndarray, inputs: Sequence[str],
+    parameters: Mapping[str, float] | None = None, t: float = 0.0,
+) -> np.ndarray:
+    """df/du at rest for each named input (n x r).
+
+    An input is a parameter (df/dp), a load (df/dp for the one parameter its force or torque
+    contains, e.g. cart_pendulum's ``push`` -> F), or a coordinate (a generalized force on it).
+    """
+    model = eom.model
+    n = len(model.q)
+    columns = np.zeros((n, len(inputs)))
+    values = parameter_substitution(eom, parameters)
+    at_rest = {v: sp.S.Zero for v in model.q_dot}
+    point = {s: sp.Float(float(v)) for s, v in zip(model.q, q0, strict=True)}
+    point[model.time] = sp.Float(float(t))
+    names = [c.name for c in model.coordinates]
+    for k, name in enumerate(inputs):
+        symbol = _input_parameter(model, name)
+        if symbol is None:
+            columns[names.index(name), k] = 1.0
+            continue
+        for i, f in enumerate(eom.forcing):
+            if symbol in f.free_symbols:
+                d = f.diff(symbol).xreplace(at_rest).xreplace(values).xreplace(point)
+                columns[i, k] = float(sp.N(d))
+    return columns
+
+
+def _input_parameter(model: Model, name: str) -> sp.Symbol | None:
+    """The parameter an input name stands for; None for a generalized force on a coordinate."""
+    for p in model.parameters:
+        if p.name == name:
+            return p.symbol
+    for load in model.loads:
+        if load.name == name:
+            magnitude = load.force if hasattr(load, "force") else (load.torque,)
+            symbols = {s for e in magnitude for s in sp.sympify(e).free_symbols}
+            owned = sorted((p for p in model.parameters if p.symbol in symbols),
+                           key=lambda p: p.name)
+            if len(owned) != 1:
+                listed = ", ".join(p.name for p in owned) or "none"
+                raise ModelError(
+                    f"load '{name}' must contain exactly one parameter to serve as an input "
+                    f"(it has: {listed}); name the parameter instead", field="inputs")
+            return owned[0].symbol
+    if name in {c.name for c in model.coordinates}:
+        return None
+    known = [p.name for p in model.parameters] + [ld.name for ld in model.loads] + \
+        [c.name for c in model.coordinates]
+    raise ModelError(f"'{name}' is not a parameter, load or coordinate of this model "
+                     f"(inputs may be any of: {', '.join(known)})", field="inputs")
+
+
+# -- symbolic linear matrices for small models ------------------------------------------------
+
+SYMBOLIC_MAX_COORDINATES = 6
+
+
+@dataclass(frozen=True)
+class SymbolicLinearModel:
+    """M, C, K as sympy matrices at an equilibrium, parameters kept as symbols."""
+
+    coordinates: tuple[str, ...]
+    equilibrium: dict[str, sp.Expr]
+    mass_matrix: sp.ImmutableMatrix
+    damping_matrix: sp.ImmutableMatrix
+    stiffness_matrix: sp.ImmutableMatrix
+
+    def _repr_latex_(self) -> str:
+        parts = [rf"{name} = {sp.latex(m)}" for name, m in
+                 (("M", self.mass_matrix), ("C", self.damping_matrix),
+                  ("K", self.stiffness_matrix))]
+        return "$" + r",\quad ".join(parts) + "$"
+
+
+def symbolic_linear_model(eom: EquationsOfMotion, about: Mapping[str, object]) -> SymbolicLinearModel:
+    """Exact M, C, K of a small unconstrained model at the configuration ``about``."""
+    model = eom.model
+    n = len(model.q)
+    if model.constraints:
+        raise ModelError("symbolic linear matrices are available for unconstrained models only; "
+                         "use the numeric linearize() for constrained ones", field="about")
+    if n > SYMBOLIC_MAX_COORDINATES:
+        raise ModelError(f"symbolic linear matrices are limited to {SYMBOLIC_MAX_COORDINATES} "
+                         f"coordinates (this model has {n}); use the numeric linearize()",
+                         field="about")
+    point = {}
+    for c in model.coordinates:
+        value = about.get(c.name, c.initial or 0)
+        point[c.symbol] = _exact(value)
+    at_rest = {v: sp.S.Zero for v in model.q_dot}
+    forcing = [sp.sympify(e) for e in eom.forcing]
+    K = [[-d.xreplace(point) for d in jacobian_row(e.xreplace(at_rest), model.q)]
+         for e in forcing]
+    C = [[-d.xreplace(at_rest).xreplace(point) for d in _linear_velocity_row(e, model.q_dot)]
+         for e in forcing]
+    M = eom.mass_matrix.xreplace(point)
+    return SymbolicLinearModel(
+        coordinates=tuple(c.name for c in model.coordinates),
+        equilibrium={c.name: point[c.symbol] for c in model.coordinates},
+        mass_matrix=sp.ImmutableMatrix(M),
+        damping_matrix=sp.ImmutableMatrix(C),
+        stiffness_matrix=sp.ImmutableMatrix(K),
+    )
+
+
+def _exact(value: object) -> sp.Expr:
+    """A float near a simple multiple of pi or a rational becomes exact (sin(pi) is then 0)."""
+    if isinstance(value, sp.Basic):
+        return value
+    number = float(value)  # type: ignore[arg-type]
+    return sp.nsimplify(number, [sp.pi], tolerance=1e-12, rational=False)

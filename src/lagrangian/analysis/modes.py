@@ -1,0 +1,284 @@
+"""Natural frequencies, damping ratios and mode shapes of a linear model about an equilibrium.
+
+Undamped, non-gyroscopic models solve the symmetric K phi = omega^2 M phi; models with damping,
+gyroscopic coupling, circulatory stiffness or velocity constraints solve the quadratic
+eigenproblem through its first-order (state-space) form. Each mode comes from a pair of
+eigenvalues s1, s2: natural frequency sqrt(s1 s2) (rad/s), damping ratio -(s1 + s2) / (2 sqrt|s1 s2|),
+growth rate max Re s (1/s, > 0 when the mode grows). A pair with s1 s2 <= 0 (a rigid-body or
+divergent mode) has zero frequency.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .linearization import LinearModel
+
+# Eigenvalues smaller than this fraction of the largest are zero (rigid-body modes).
+ZERO_TOLERANCE = 1e-6
+# omega^2 smaller than this fraction of the largest counts as zero in the symmetric problem.
+ZERO_SQUARED_TOLERANCE = 1e-10
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One mode: frequency (rad/s), damping ratio, growth rate (1/s) and its shape.
+
+    ``shape`` is real, in the user's coordinates, scaled so that the first component of largest
+    magnitude is +1; ``complex_shape`` keeps the phases of a damped or gyroscopic mode.
+    """
+
+    frequency: float
+    damping_ratio: float | None
+    growth_rate: float
+    shape: dict[str, float]
+    complex_shape: tuple[complex, ...]
+    eigenvalues: tuple[complex, ...]
+
+    @property
+    def frequency_hz(self) -> float:
+        return self.frequency / (2 * math.pi)
+
+    @property
+    def period(self) -> float | None:
+        """2 pi / frequency in s; None for a zero-frequency (rigid-body or divergent) mode."""
+        return 2 * math.pi / self.frequency if self.frequency > 0 else None
+
+    @property
+    def kind(self) -> str:
+        """'oscillating', 'rigid-body', 'divergent' (grows without oscillating) or 'overdamped'."""
+        if self.frequency > 0:
+            return "overdamped" if (self.damping_ratio or 0) >= 1 and all(
+                abs(s.imag) == 0 for s in self.eigenvalues) else "oscillating"
+        return "divergent" if self.growth_rate > 0 else "rigid-body"
+
+    def __repr__(self) -> str:
+        shape = ", ".join(f"{k}={v:.4g}" for k, v in self.shape.items())
+        zeta = "None" if self.damping_ratio is None else f"{self.damping_ratio:.4g}"
+        return (f"Mode({self.frequency:.6g} rad/s, zeta={zeta}, growth={self.growth_rate:.4g} 1/s; "
+                f"{shape})")
+
+
+@dataclass(frozen=True)
+class ModalAnalysis:
+    """The modes of a linear model, in ascending frequency, with the model they came from."""
+
+    model_name: str
+    linear_model: LinearModel
+    modes: tuple[Mode, ...]
+    stable: bool
+
+    @property
+    def equilibrium(self) -> dict[str, float]:
+        return self.linear_model.equilibrium
+
+    @property
+    def coordinates(self) -> tuple[str, ...]:
+        return self.linear_model.coordinates
+
+    @property
+    def mass_matrix(self) -> np.ndarray:
+        return self.linear_model.mass_matrix
+
+    @property
+    def damping_matrix(self) -> np.ndarray:
+        return self.linear_model.damping_matrix
+
+    @property
+    def stiffness_matrix(self) -> np.ndarray:
+        return self.linear_model.stiffness_matrix
+
+    @property
+    def natural_frequencies(self) -> np.ndarray:
+        """Each mode's frequency in rad/s, ascending."""
+        return np.array([m.frequency for m in self.modes])
+
+    @property
+    def mode_shapes(self) -> np.ndarray:
+        """Columns: each mode's real shape in the user's coordinates."""
+        names = self.linear_model.user_coordinates
+        return np.array([[m.shape[n] for m in self.modes] for n in names]).reshape(len(names), -1)
+
+    def __iter__(self):
+        return iter(self.modes)
+
+    def __len__(self) -> int:
+        return len(self.modes)
+
+    def __getitem__(self, index: int) -> Mode:
+        return self.modes[index]
+
+    def __repr__(self) -> str:
+        about = ", ".join(f"{k}={v:.6g}" for k, v in self.equilibrium.items())
+        lines = [f"Modes of {self.model_name!r} about {about} "
+                 f"({'stable' if self.stable else 'unstable'}):"]
+        lines += [f"  {i}. {m!r}" for i, m in enumerate(self.modes, 1)]
+        return "\n".join(lines)
+
+
+def modal_analysis(linear: LinearModel, model_name: str = "") -> ModalAnalysis:
+    """Modes of ``linear``: symmetric eigenproblem when it applies, state-space otherwise."""
+    if _symmetric_undamped(linear):
+        modes = _symmetric_modes(linear)
+    else:
+        modes = _state_space_modes(linear)
+    modes = tuple(sorted(modes, key=lambda m: (m.frequency, -m.growth_rate)))
+    stable = not any(m.growth_rate > 0 for m in modes)
+    return ModalAnalysis(model_name, linear, modes, stable)
+
+
+def is_stable(linear: LinearModel) -> bool:
+    """True when no mode of the linear model grows (rigid-body modes are neutral)."""
+    return modal_analysis(linear).stable
+
+
+# -- the two eigenproblems ----------------------------------------------------------------------
+
+
+def _symmetric_undamped(linear: LinearModel) -> bool:
+    K, C = linear.stiffness_matrix, linear.damping_matrix
+    scale = max(np.abs(K).max(initial=0.0), 1e-300)
+    return (linear.velocity_constraints.size == 0 and not np.any(C)
+            and np.allclose(K, K.T, rtol=0, atol=1e-10 * scale))
+
+
+def _symmetric_modes(linear: LinearModel) -> list[Mode]:
+    import scipy.linalg
+
+    M = (linear.mass_matrix + linear.mass_matrix.T) / 2
+    K = (linear.stiffness_matrix + linear.stiffness_matrix.T) / 2
+    if K.shape[0] == 0:
+        return []
+    squared, vectors = scipy.linalg.eigh(K, M)
+    zero = ZERO_SQUARED_TOLERANCE * max(np.abs(squared).max(), 1e-300)
+    modes = []
+    for w2, vector in zip(squared, vectors.T, strict=True):
+        if abs(w2) <= zero:
+            frequency, growth, pair = 0.0, 0.0, (0j, 0j)
+        elif w2 > 0:
+            frequency, growth = math.sqrt(w2), 0.0
+            pair = (1j * frequency, -1j * frequency)
+        else:
+            frequency, growth = 0.0, math.sqrt(-w2)
+            pair = (complex(growth), complex(-growth))
+        modes.append(_mode(linear, vector.astype(complex), frequency, 0.0, growth, pair))
+    return modes
+
+
+def _state_space_modes(linear: LinearModel) -> list[Mode]:
+    import scipy.linalg
+
+    A = linear.A
+    p = linear.mass_matrix.shape[0]
+    if A.shape[0] == 0:
+        return []
+    values, vectors = scipy.linalg.eig(A)
+    scale = max(np.abs(values).max(), 1e-300)
+    tolerance = ZERO_TOLERANCE * scale
+    values = np.where(np.abs(values.real) <= tolerance, 1j * values.imag, values)
+    values = np.where(np.abs(values.imag) <= tolerance, values.real + 0j, values)
+    modes: list[Mode] = []
+    real = []
+    for k, s in enumerate(values):
+        if s.imag > 0:
+            modes.append(_pair_mode(linear, vectors[:p, k], s, np.conj(s)))
+        elif s.imag == 0:
+            real.append(k)
+    # Real eigenvalues pair up by the likeness of their displacement shapes.
+    while real:
+        k = real.pop(0)
+        if not real:
+            modes.append(_pair_mode(linear, vectors[:p, k], values[k], None))
+            break
+        likeness = [_likeness(vectors[:p, k], vectors[:p, j]) for j in real]
+        j = real.pop(int(np.argmax(likeness)))
+        dominant = k if values[k].real >= values[j].real else j
+        modes.append(_pair_mode(linear, vectors[:p, dominant], values[k], values[j]))
+    return modes
+
+
+def _pair_mode(linear: LinearModel, vector: np.ndarray, s1: complex, s2: complex | None) -> Mode:
+    if s2 is None:  # a lone real eigenvalue (velocity constraints make the count odd)
+        growth = float(s1.real)
+        return _mode(linear, vector, 0.0, 0.0 if growth == 0 else None, growth, (s1,))
+    product = float((s1 * s2).real)
+    total = float((s1 + s2).real)
+    growth = float(max(s1.real, s2.real))
+    if product > 0:
+        frequency = math.sqrt(product)
+        zeta: float | None = -total / (2 * frequency)
+    else:
+        frequency = 0.0
+        zeta = -total / (2 * math.sqrt(-product)) if product < 0 else (0.0 if total == 0 else None)
+    return _mode(linear, vector, frequency, zeta, growth, (s1, s2))
+
+
+def _mode(linear: LinearModel, vector: np.ndarray, frequency: float, zeta: float | None,
+          growth: float, eigenvalues) -> Mode:
+    shape = normalized_shape(linear.basis @ vector)
+    names = linear.user_coordinates
+    return Mode(
+        frequency=float(frequency),
+        damping_ratio=None if zeta is None else float(zeta) + 0.0,
+        growth_rate=float(growth) + 0.0,
+        shape={n: _clean(v.real) for n, v in zip(names, shape, strict=True)},
+        complex_shape=tuple(complex(v) for v in shape),
+        eigenvalues=tuple(complex(s) for s in eigenvalues),
+    )
+
+
+def normalized_shape(vector: np.ndarray) -> np.ndarray:
+    """Scale so that the first component of largest magnitude is exactly +1."""
+    vector = np.asarray(vector, dtype=complex)
+    magnitude = np.abs(vector)
+    if not magnitude.size or magnitude.max() == 0:
+        return vector
+    reference = int(np.flatnonzero(magnitude >= magnitude.max() * (1 - 1e-9))[0])
+    shape = vector / vector[reference]
+    shape[reference] = 1.0
+    return shape
+
+
+def _likeness(a: np.ndarray, b: np.ndarray) -> float:
+    na, nb = np.linalg.norm(a), np.linalg.norm(b)
+    if na == 0 or nb == 0:
+        return 1.0 if na == nb else 0.0
+    return float(abs(np.vdot(a, b)) / (na * nb))
+
+
+def _clean(value: float) -> float:
+    value = float(value)
+    return 0.0 if abs(value) < 1e-12 else value
+
+
+# -- from equations of motion to equilibria, linear models and modes ------------------------------
+
+
+def equilibria_of(functions, *, t: float = 0.0):
+    """Every equilibrium found, with its linear stability."""
+    from .equilibria import find_equilibria
+    from .linearization import linear_model_at
+
+    def stability(q, multipliers) -> bool:
+        return is_stable(linear_model_at(functions, q, multipliers, t))
+
+    return find_equilibria(functions, t=t, stability=stability)
+
+
+def linearize_about(functions, about=None, inputs=(), *, t: float = 0.0) -> LinearModel:
+    """The linear model about the equilibrium ``about`` (or the one nearest the initial values)."""
+    from .equilibria import resolve_equilibrium
+    from .linearization import input_columns, linear_model_at
+
+    q0, multipliers = resolve_equilibrium(functions, about, t=t)
+    columns = input_columns(functions.eom, q0, list(inputs), functions.parameters, t) \
+        if inputs else None
+    return linear_model_at(functions, q0, multipliers, t, inputs=inputs, input_columns=columns)
+
+
+def modes_about(functions, about=None, *, t: float = 0.0) -> ModalAnalysis:
+    """Modes about the equilibrium ``about`` (or the one nearest the initial values)."""
+    return modal_analysis(linearize_about(functions, about, t=t), functions.model.name)

@@ -147,9 +147,16 @@ class _NumpyKernel:
         y = np.asarray(y, dtype=float)
         if y.shape != (2 * self.n,):
             raise ValueError(f"y must hold {2 * self.n} numbers [q, q_dot]")
-        n = self.n
-        q_ddot, _ = self.accelerations(y[None, :n], y[None, n:], np.array([float(t)]))
-        return np.concatenate([y[n:], q_ddot[0]])
+        n, m = self.n, self.m
+        # One state: scalar lambdify call and a small solve, no batch machinery.
+        entries = np.array(self._evaluate(*y, float(t)), dtype=float)
+        mass = entries[: n * n].reshape(n, n)
+        forcing = entries[n * n: n * n + n]
+        if m:
+            jacobian = entries[n * n + n: n * n + n + m * n].reshape(m, n)
+            mass = np.block([[mass, jacobian.T], [jacobian, np.zeros((m, m))]])
+            forcing = np.concatenate([forcing, entries[n * n + n + m * n:]])
+        return np.concatenate([y[n:], np.linalg.solve(mass, forcing)[:n]])
 
 
 class _CKernel:

@@ -87,7 +87,7 @@ class _Solver:
             values = self.functions.evaluate(q, self.t)
             residual = static_residual(values, lam)
             jacobian = self._jacobian(values, lam)[..., self._columns(free)]
-            step = -np.einsum("...ij,...j->...i", np.linalg.pinv(jacobian, rcond=1e-12), residual)
+            step = _newton_step(jacobian, residual)
             dq = np.zeros_like(q)
             dq[..., free] = step[..., :k]
             # A full Newton step can jump across the configuration space: limit its size.
@@ -117,6 +117,33 @@ class _Solver:
         top = np.concatenate([-stiffness, -jac_t], axis=-1)
         bottom = np.concatenate([static_q, np.zeros(batch + (s, m))], axis=-1)
         return np.concatenate([top, bottom], axis=-2)
+
+
+def _newton_step(jacobian: np.ndarray, residual: np.ndarray) -> np.ndarray:
+    """-J^+ r for each point: an LU solve where J is square and regular, else the minimum-norm
+    least-squares step (neutral directions do not move, redundant equations are fine)."""
+    rows, columns = jacobian.shape[-2:]
+    if rows == columns:
+        try:
+            step = -np.linalg.solve(jacobian, residual[..., None])[..., 0]
+            if np.all(np.isfinite(step)):
+                return step
+        except np.linalg.LinAlgError:
+            pass
+        batch = jacobian.reshape(-1, rows, columns)
+        flat = residual.reshape(-1, rows)
+        steps = np.empty_like(flat)
+        for i, (matrix, r) in enumerate(zip(batch, flat, strict=True)):
+            try:
+                steps[i] = -np.linalg.solve(matrix, r)
+                if np.all(np.isfinite(steps[i])) and \
+                        np.linalg.cond(matrix) < 1e12:
+                    continue
+            except np.linalg.LinAlgError:
+                pass
+            steps[i] = -np.linalg.pinv(matrix, rcond=1e-12) @ r
+        return steps.reshape(residual.shape[:-1] + (columns,))
+    return -np.einsum("...ij,...j->...i", np.linalg.pinv(jacobian, rcond=1e-12), residual)
 
 
 def initial_multipliers(values: dict[str, np.ndarray]) -> np.ndarray:

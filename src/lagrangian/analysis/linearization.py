@@ -24,6 +24,7 @@ from ..numerics.functions import parameter_substitution
 
 # Relative singular-value threshold for the rank of the constraint Jacobian.
 RANK_TOLERANCE = 1e-9
+CSE_MIN_OPERATIONS = 2000
 
 
 # -- numeric functions at rest ------------------------------------------------------------------
@@ -44,18 +45,20 @@ class StaticFunctions:
         self.parameters = {str(k): float(v) for k, v in values.items()}
         at_rest = {v: sp.S.Zero for v in q_dot}
 
-        forcing = [sp.sympify(e) for e in eom.forcing]
+        # Parameter values go in first: differentiating numbers is much cheaper than symbols.
+        forcing = [sp.sympify(e).xreplace(values) for e in eom.forcing]
         forcing_at_rest = [e.xreplace(at_rest) for e in forcing]
         stiffness = [[-d for d in jacobian_row(e, q)] for e in forcing_at_rest]
         damping = [[-d.xreplace(at_rest) for d in _linear_velocity_row(e, q_dot)]
                    for e in forcing]
-        jacobian = [[sp.sympify(e).xreplace(at_rest) for e in eom.constraint_jacobian.row(i)]
-                    for i in range(m)]
+        jacobian = [[sp.sympify(e).xreplace(values).xreplace(at_rest)
+                     for e in eom.constraint_jacobian.row(i)] for i in range(m)]
         hessians = [[jacobian_row(e, q) for e in row] for row in jacobian]
         # At rest a holonomic constraint reads Phi(q) = 0, a velocity one b(q) = 0.
         static = []
         for c in model.constraints:
-            residual = c.expression if c.kind == "holonomic" else c.expression.xreplace(at_rest)
+            residual = c.expression.xreplace(values)
+            residual = residual if c.kind == "holonomic" else residual.xreplace(at_rest)
             if residual != 0:
                 static.append((c.name, residual))
         self.static_names = tuple(name for name, _ in static)
@@ -63,34 +66,60 @@ class StaticFunctions:
         self.depends_on = frozenset(
             s for e in [*forcing_at_rest, *(e for _, e in static)] for s in e.free_symbols
         )
-        rest = [*eom.mass_matrix, *forcing_at_rest, *_flat(damping), *(e for _, e in static)]
+        mass = [sp.sympify(e).xreplace(values).xreplace(at_rest) for e in eom.mass_matrix]
+        rest = [*mass, *forcing_at_rest, *_flat(damping), *(e for _, e in static)]
         if any(t in sp.sympify(e).free_symbols for e in rest):
             raise ModelError("the equations at rest depend on time t explicitly, so the model has "
                              "no fixed equilibrium to analyse", field="equilibria")
 
-        mass = [sp.sympify(e).xreplace(at_rest) for e in eom.mass_matrix]
         entries = [*mass, *forcing_at_rest, *_flat(stiffness), *_flat(damping), *_flat(jacobian),
                    *_flat(_flat(hessians)), *(e for _, e in static), *_flat(static_jacobian)]
-        entries = [sp.sympify(e).xreplace(values) for e in entries]
+        entries = [sp.sympify(e) for e in entries]
         self._layout = [("mass", (n, n)), ("forcing", (n,)), ("stiffness", (n, n)),
                         ("damping", (n, n)), ("jacobian", (m, n)), ("hessians", (m, n, n)),
                         ("static", (len(static),)), ("static_jacobian", (len(static), n))]
-        self._function = sp.lambdify([*q, t], entries, modules="numpy", cse=True)
+        # Only entries that vary with q (or t) are compiled; constants (most of a big sparse
+        # model's K and C) are stored once.
+        self._constants = np.zeros(len(entries))
+        varying = []
+        for i, e in enumerate(entries):
+            if e.free_symbols:
+                varying.append(i)
+            else:
+                self._constants[i] = _real(e)
+        self._varying = np.array(varying, dtype=int)
+        compiled = [entries[i] for i in varying]
+        # Common-subexpression elimination pays for big expressions only (it costs more than it
+        # saves on a large sparse linear model).
+        large = sum(sp.count_ops(e) for e in compiled) > CSE_MIN_OPERATIONS
+        self._function = sp.lambdify([*q, t], compiled, modules="numpy", cse=large) \
+            if varying else None
 
     def evaluate(self, q: np.ndarray, t: float = 0.0) -> dict[str, np.ndarray]:
         """Every matrix at configurations q of shape (..., n), at rest and time t."""
         q = np.asarray(q, dtype=float)
         batch = q.shape[:-1]
-        raw = self._function(*np.moveaxis(q, -1, 0), np.broadcast_to(float(t), batch))
-        flat = [np.broadcast_to(np.asarray(e, dtype=float), batch) for e in raw]
+        flat = np.empty(batch + self._constants.shape)
+        flat[...] = self._constants
+        if self._function is not None:
+            raw = self._function(*np.moveaxis(q, -1, 0), np.broadcast_to(float(t), batch))
+            for i, value in zip(self._varying, raw, strict=True):
+                flat[..., i] = value
         out, start = {}, 0
         for name, shape in self._layout:
             size = int(np.prod(shape))
-            block = flat[start:start + size]
+            out[name] = flat[..., start:start + size].reshape(batch + shape)
             start += size
-            stacked = np.stack(block, axis=-1) if block else np.zeros(batch + (0,))
-            out[name] = stacked.reshape(batch + shape)
         return out
+
+
+def _real(value: sp.Expr) -> float:
+    if value.is_Number:
+        return float(value)
+    number = complex(sp.N(value))
+    if abs(number.imag) > 1e-12 * max(1.0, abs(number.real)):
+        raise ModelError(f"the value {value} is not real", field="parameters")
+    return number.real
 
 
 def _linear_velocity_row(expr: sp.Expr, q_dot: Sequence[sp.Symbol]) -> list[sp.Expr]:

@@ -19,8 +19,10 @@ app = typer.Typer(
 # Each command lives in its own module and registers itself on `app` when imported.
 from . import check as _check  # noqa: E402,F401
 from . import derive as _derive  # noqa: E402,F401
+from . import equilibria as _equilibria  # noqa: E402,F401
 from . import examples as _examples  # noqa: E402,F401
 from . import forces as _forces  # noqa: E402,F401
+from . import modes as _modes  # noqa: E402,F401
 from . import simulate as _simulate  # noqa: E402,F401
 
 

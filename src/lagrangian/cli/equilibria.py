@@ -1,0 +1,25 @@
+"""`lagrangian equilibria MODEL [--set k=2] [--json]`: configurations of rest and their stability."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from ..output.modes import equilibria_document, equilibria_text
+from . import app
+from .common import load_system, print_json
+
+
+@app.command()
+def equilibria(
+    model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
+    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+) -> None:
+    """Find the equilibria (forces balance at rest, with the constraints) and their stability."""
+    found = load_system(model, set_).equilibria()
+    if json_:
+        print_json(equilibria_document(found))
+    else:
+        typer.echo(equilibria_text(found), nl=False)

@@ -1,0 +1,69 @@
+"""`lagrangian modes MODEL [--about theta=0] [--json] [--plot modes.png]`: natural frequencies."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ..errors import ModelError
+from ..output.modes import modes_document, modes_text, write_mode_plot
+from . import app
+from .common import assignments, load_system, print_json, state_assignments
+
+# "pi", "-pi/2", "2*pi", "0.5pi": multiples of pi are common equilibria of angles.
+_PI = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)?)\s*\*?\s*pi\s*(?:/\s*(\d+\.?\d*))?\s*$")
+
+
+@app.command()
+def modes(
+    model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
+    about: Annotated[list[str], typer.Option("--about", help="Equilibrium: COORDINATE=VALUE (pi, 180deg, 0.5m); others are solved for.")] = [],  # noqa: B006
+    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+    plot: Annotated[Path | None, typer.Option("--plot", help="Draw the mode shapes to a PNG file.")] = None,
+) -> None:
+    """Linearize about an equilibrium: M, C, K, natural frequencies, damping and mode shapes."""
+    system = load_system(model, set_)
+    names = [c.name for c in system.model.coordinates]
+    pairs = assignments(about, "--about")
+    for name, _ in pairs:
+        if name not in names:
+            import difflib
+
+            close = difflib.get_close_matches(name, names, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise ModelError(f"'{name}' is not a coordinate of this model{hint}", field="--about")
+    point = state_assignments(system, [f"{n}={_expand_pi(v)}" for n, v in pairs], "--about")
+    try:
+        analysis = system.modes(about=point or None)
+    except ModelError as exc:
+        if exc.field != "about":
+            raise
+        raise ModelError(exc.message, field="--about", source=exc.source) from None
+    if plot is not None:
+        if plot.suffix.lower() != ".png":
+            raise ModelError(f"the plot is written as PNG; name the file *.png (got '{plot}')",
+                             field="--plot")
+        inputs = (Path(model),) if Path(model).exists() else ()
+        write_mode_plot(analysis, plot, protect=inputs)
+    if json_:
+        print_json(modes_document(analysis))
+    else:
+        typer.echo(modes_text(analysis), nl=False)
+        if plot is not None:
+            typer.echo(f"Mode shapes drawn to {plot}")
+
+
+def _expand_pi(text: str) -> str:
+    """'pi/2' -> '1.5707963267948966'; anything else unchanged (units are read later)."""
+    match = _PI.match(text)
+    if not match:
+        return text
+    factor = float(match.group(1)) if match.group(1) not in ("", "+", "-") else \
+        (-1.0 if match.group(1) == "-" else 1.0)
+    divisor = float(match.group(2)) if match.group(2) else 1.0
+    return repr(factor * math.pi / divisor)

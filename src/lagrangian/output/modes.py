@@ -1,0 +1,218 @@
+"""Reports of equilibria and modes: JSON documents (public contracts), text, and the mode-shape plot."""
+
+from __future__ import annotations
+
+import io
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..analysis.equilibria import Equilibria
+from ..analysis.modes import ModalAnalysis, Mode
+from ..errors import ModelError
+from .files import atomic_write
+
+# The plot shows at most this many modes (the lowest), in a grid of at most PLOT_COLUMNS columns.
+PLOT_MAX_MODES = 12
+PLOT_COLUMNS = 3
+PANEL_INCHES = (4.0, 3.0)
+PLOT_DPI = 100
+
+
+# -- equilibria ---------------------------------------------------------------------------------
+
+
+def equilibria_document(found: Equilibria) -> dict[str, Any]:
+    """The `equilibria --json` document."""
+    items = []
+    for e in found:
+        item: dict[str, Any] = {"coordinates": dict(e.coordinates), "stable": e.stable}
+        if found.constraints:
+            item["multipliers"] = dict(e.multipliers)
+        items.append(item)
+    return {"equilibria": items}
+
+
+def equilibria_text(found: Equilibria) -> str:
+    lines = [f"Equilibria of {found.model_name}", "=" * (14 + len(found.model_name))]
+    if not len(found):
+        lines.append("No equilibrium found: the generalized forces at rest never balance.")
+        return "\n".join(lines) + "\n"
+    for i, e in enumerate(found, 1):
+        where = ", ".join(f"{k} = {_number(v)}" for k, v in e.coordinates.items())
+        lines.append(f"{i}. {where}   {'stable' if e.stable else 'unstable'}")
+        if e.multipliers:
+            reactions = ", ".join(f"lambda_{k} = {_number(v)}" for k, v in e.multipliers.items())
+            lines.append(f"   multipliers: {reactions}")
+    neutral = found[0].neutral
+    if neutral:
+        lines += ["", f"Any value of {', '.join(neutral)} is also an equilibrium "
+                      "(the equations at rest do not contain it); the model's initial value is shown."]
+    return "\n".join(lines) + "\n"
+
+
+# -- modes --------------------------------------------------------------------------------------
+
+
+def modes_document(analysis: ModalAnalysis) -> dict[str, Any]:
+    """The `modes --json` document; matrices in the coordinates listed under `coordinates`."""
+    linear = analysis.linear_model
+    return {
+        "equilibrium": dict(linear.equilibrium),
+        "stable": analysis.stable,
+        "coordinates": list(linear.coordinates),
+        "mass_matrix": _rows(linear.mass_matrix),
+        "damping_matrix": _rows(linear.damping_matrix),
+        "stiffness_matrix": _rows(linear.stiffness_matrix),
+        "modes": [mode_document(m) for m in analysis.modes],
+    }
+
+
+def mode_document(mode: Mode) -> dict[str, Any]:
+    return {
+        "frequency": mode.frequency,
+        "frequency_hz": mode.frequency_hz,
+        "period": mode.period,
+        "damping_ratio": mode.damping_ratio,
+        "growth_rate": mode.growth_rate,
+        "shape": dict(mode.shape),
+    }
+
+
+def modes_text(analysis: ModalAnalysis) -> str:
+    linear = analysis.linear_model
+    title = f"Modes of {analysis.model_name}"
+    lines = [title, "=" * len(title)]
+    about = ", ".join(f"{k} = {_number(v)}" for k, v in linear.equilibrium.items())
+    lines.append(f"About the equilibrium {about} "
+                 f"({'stable' if analysis.stable else 'unstable'})")
+    if linear.multipliers:
+        lines.append("Multipliers: " + ", ".join(f"lambda_{k} = {_number(v)}"
+                                                 for k, v in linear.multipliers.items()))
+    if linear.coordinates != linear.user_coordinates:
+        lines.append(f"Matrices in the independent coordinates ({', '.join(linear.coordinates)}); "
+                     "shapes in all coordinates.")
+    lines.append("")
+    for label, matrix in (("Mass matrix M", linear.mass_matrix),
+                          ("Damping matrix C (dissipation + gyroscopic)", linear.damping_matrix),
+                          ("Stiffness matrix K", linear.stiffness_matrix)):
+        lines.append(f"{label}:")
+        lines += _matrix_lines(matrix, linear.coordinates)
+        lines.append("")
+    if not analysis.modes:
+        lines.append("No modes: the model has no degree of freedom left.")
+        return "\n".join(lines) + "\n"
+    names = linear.user_coordinates
+    header = f"{'mode':>4}  {'omega [rad/s]':>13}  {'f [Hz]':>10}  {'period [s]':>10}  " \
+             f"{'zeta':>8}  {'growth [1/s]':>12}  " + "  ".join(f"{n:>9}" for n in names)
+    lines += ["Modes (ascending frequency; shapes scaled so the largest component is +1):",
+              header]
+    for i, m in enumerate(analysis.modes, 1):
+        period = "-" if m.period is None else _number(m.period)
+        zeta = "-" if m.damping_ratio is None else _number(m.damping_ratio)
+        shape = "  ".join(f"{_number(m.shape[n]):>9}" for n in names)
+        lines.append(f"{i:>4}  {_number(m.frequency):>13}  {_number(m.frequency_hz):>10}  "
+                     f"{period:>10}  {zeta:>8}  {_number(m.growth_rate):>12}  {shape}  "
+                     f"{_kind_note(m)}".rstrip())
+    return "\n".join(lines) + "\n"
+
+
+def _kind_note(mode: Mode) -> str:
+    kind = mode.kind
+    if kind == "divergent":
+        return "(unstable: grows without oscillating)"
+    if kind == "rigid-body":
+        return "(rigid-body: zero frequency)"
+    if mode.growth_rate > 0:
+        return "(unstable: growing oscillation)"
+    if kind == "overdamped":
+        return "(overdamped)"
+    return ""
+
+
+# -- the mode-shape plot ------------------------------------------------------------------------
+
+
+def mode_plot_size(mode_count: int) -> tuple[int, int]:
+    """Pixel size (width, height) of the mode-shape plot for this many modes."""
+    shown = max(1, min(mode_count, PLOT_MAX_MODES))
+    columns = min(PLOT_COLUMNS, shown)
+    rows = math.ceil(shown / columns)
+    return (round(PANEL_INCHES[0] * columns * PLOT_DPI), round(PANEL_INCHES[1] * rows * PLOT_DPI))
+
+
+def mode_shape_figure(analysis: ModalAnalysis):
+    """A matplotlib Figure with one panel per mode (the lowest twelve): the shape per coordinate."""
+    from matplotlib.figure import Figure
+
+    modes = analysis.modes[:PLOT_MAX_MODES]
+    if not modes:
+        raise ModelError("there are no modes to plot (no degree of freedom)", field="--plot")
+    width, height = mode_plot_size(len(modes))
+    figure = Figure(figsize=(width / PLOT_DPI, height / PLOT_DPI), dpi=PLOT_DPI,
+                    layout="constrained")
+    columns = min(PLOT_COLUMNS, len(modes))
+    rows = math.ceil(len(modes) / columns)
+    axes = figure.subplots(rows, columns, squeeze=False).ravel()
+    names = list(analysis.linear_model.user_coordinates)
+    positions = np.arange(len(names))
+    for i, (ax, mode) in enumerate(zip(axes, modes, strict=False), 1):
+        values = [mode.shape[n] for n in names]
+        if len(names) <= 12:
+            ax.bar(positions, values, color=["tab:blue" if v >= 0 else "tab:red" for v in values])
+            ax.set_xticks(positions, names, fontsize=8)
+        else:  # a chain of many coordinates reads better as a line
+            ax.plot(positions + 1, values, marker=".", color="tab:blue")
+            ax.set_xlabel("coordinate number", fontsize=8)
+        ax.axhline(0.0, color="black", linewidth=0.6)
+        ax.set_ylim(-1.15, 1.15)
+        ax.set_title(f"mode {i}: {_title(mode)}", fontsize=9)
+        ax.tick_params(labelsize=8)
+    for ax in axes[len(modes):]:
+        ax.set_visible(False)
+    figure.suptitle(f"Mode shapes of {analysis.model_name}", fontsize=10)
+    return figure
+
+
+def write_mode_plot(analysis: ModalAnalysis, path: str | Path, *,
+                    protect: tuple[Path, ...] = ()) -> Path:
+    """Draw the mode shapes to a PNG file (written atomically, never over an input file)."""
+    figure = mode_shape_figure(analysis)
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=PLOT_DPI)
+    return atomic_write(path, buffer.getvalue(), protect=protect)
+
+
+def _title(mode: Mode) -> str:
+    if mode.frequency > 0:
+        text = f"{mode.frequency:.4g} rad/s ({mode.frequency_hz:.4g} Hz)"
+        if mode.damping_ratio:
+            text += f", zeta {mode.damping_ratio:.3g}"
+        return text
+    if mode.growth_rate > 0:
+        return f"unstable, grows at {mode.growth_rate:.4g} 1/s"
+    return "rigid-body (0 rad/s)"
+
+
+# -- helpers ------------------------------------------------------------------------------------
+
+
+def _rows(matrix: np.ndarray) -> list[list[float]]:
+    return [[float(v) + 0.0 for v in row] for row in np.asarray(matrix, dtype=float)]
+
+
+def _number(value: float) -> str:
+    value = float(value)
+    if value == 0:
+        return "0"
+    return f"{value:.6g}"
+
+
+def _matrix_lines(matrix: np.ndarray, names) -> list[str]:
+    width = max([9, *(len(n) for n in names)])
+    lines = ["  " + " " * width + "  " + "  ".join(f"{n:>{width}}" for n in names)]
+    for name, row in zip(names, np.asarray(matrix), strict=True):
+        lines.append(f"  {name:>{width}}  " + "  ".join(f"{_number(v):>{width}}" for v in row))
+    return lines

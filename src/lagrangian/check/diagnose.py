@@ -135,7 +135,13 @@ def check_answer(eom: EquationsOfMotion, answer: Answer) -> CheckReport:
     if answer.multiplier_count is not None or answer.multiplier_names is not None:
         findings += checker.multipliers()
     findings += checker.units()
-    return CheckReport(model.name, answer.source, tuple(findings))
+    unique, seen = [], set()
+    for finding in findings:  # one multiplier_count finding, whichever item raised it first
+        key = (finding.item, finding.code) if finding.code == "multiplier_count" else id(finding)
+        if key not in seen:
+            seen.add(key)
+            unique.append(finding)
+    return CheckReport(model.name, answer.source, tuple(unique))
 
 
 class _Checker:
@@ -150,7 +156,7 @@ class _Checker:
 
     def kinetic(self, T_user: sp.Expr) -> list[Finding]:
         T = self.eom.kinetic_energy
-        expected = fmt(T)
+        expected = fmt(eq.display(T))
         unknown = self._unknown_names("T", "T")
         if unknown:
             return unknown
@@ -185,7 +191,7 @@ class _Checker:
 
     def potential(self, V_user: sp.Expr) -> list[Finding]:
         V = self.eom.potential_energy
-        expected = fmt(V)
+        expected = fmt(eq.display(V))
         unknown = self._unknown_names("V", "V")
         if unknown:
             return unknown
@@ -237,7 +243,7 @@ class _Checker:
         i = self.names.index(name)
         coordinate = self.model.coordinates[i]
         Q = self.eom.generalized_forces[i]
-        expected = fmt(Q)
+        expected = fmt(eq.display(Q))
         foreign = self.answer.foreign_symbols(item)
         if foreign:
             listed = ", ".join(sorted(map(str, foreign)))
@@ -398,7 +404,7 @@ class _Checker:
         lhs = (eom.mass_matrix * eom.coordinate_accelerations)[i]
         if eom.multipliers.shape[0]:
             lhs += (eom.constraint_jacobian.T * eom.multipliers)[i]
-        return f"{fmt(lhs)} = {fmt(eom.forcing[i])}"
+        return f"{fmt(eq.display(lhs))} = {fmt(eq.display(eom.forcing[i]))}"
 
     def _multiple(self, user: sp.Expr, ours: sp.Expr) -> sp.Expr | None:
         """c when user == c * ours with c independent of the state (a rescaling), else None."""
@@ -437,8 +443,8 @@ class _Checker:
         if eq._small(user) and eq._small(ours):
             mine = set(sp.Add.make_args(sp.expand(user / scale)))
             theirs = set(sp.Add.make_args(sp.expand(ours)))
-            extra_terms = [fmt(t) for t in mine - theirs]
-            missing_terms = [fmt(t) for t in theirs - mine]
+            extra_terms = sorted(fmt(t) for t in mine - theirs)
+            missing_terms = sorted(fmt(t) for t in theirs - mine)
         scaled = "" if scale == 1 else f" (after dividing yours by {fmt(scale)})"
         detail = ""
         if missing_terms and len(missing_terms) <= 3:

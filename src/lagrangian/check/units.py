@@ -15,7 +15,7 @@ import sympy as sp
 
 from ..model.expressions import format_expression
 from ..model.model import Model, PointForce, multiplier_name
-from ..model.units import generalized_force_unit, registry
+from ..model.units import generalized_force_unit, is_angle_unit, registry
 
 ENERGY = "J"
 POWER = "W"
@@ -64,7 +64,8 @@ def symbol_units(model: Model) -> dict[sp.Symbol, object]:
     for p in model.parameters:
         units[p.symbol] = quantity(p.unit)
     for c in model.coordinates:
-        q = quantity(c.unit if c.unit else "")
+        # Radians are dimensionless: sin(theta) is fine and theta_dot is 1/s.
+        q = quantity("" if is_angle_unit(c.unit) or not c.unit else c.unit)
         units[c.symbol] = q
         units[c.velocity] = None if q is None else q / second
         units[c.acceleration] = None if q is None else q / second**2
@@ -129,6 +130,15 @@ class DimensionChecker:
             if len(groups) > 1:
                 groups.sort(key=len, reverse=True)
                 major = groups[0][0][1]
+                if len(groups[0]) == len(groups[1]):  # no majority: name every group
+                    listed = "; ".join(
+                        ", ".join(format_expression(term) for term, _ in group)
+                        + f" ({describe(group[0][1])})" for group in groups)
+                    self.issues.append(UnitIssue(
+                        item, format_expression(expr),
+                        f"in {item}, the terms of {format_expression(expr)} do not share units: "
+                        f"{listed}"))
+                    return None
                 for group in groups[1:]:
                     for term, d in group:
                         self.issues.append(UnitIssue(

@@ -1,0 +1,76 @@
+"""Dimensional analysis of models: T, V in J, D in W, Q in J per unit of q, trig args pure."""
+
+from __future__ import annotations
+
+import pytest
+
+import lagrangian
+from lagrangian.check.units import check_model_units
+
+BAD = """
+name = "Bad units"
+[coordinates]
+theta = "rad"
+x = "m"
+[parameters]
+m = { value = 1.0, unit = "kg" }
+L = { value = 0.5, unit = "m" }
+g = { value = 9.81, unit = "m/s^2" }
+k = { value = 10.0, unit = "N/m" }
+c = { value = 0.2, unit = "N*s/m" }
+F = { value = 3.0, unit = "N" }
+[energy]
+T = "1/2*m*L^2*theta_dot^2 + 1/2*m*x_dot^2"
+V = "-m*g*L*cos(theta) + 1/2*k*x^2 + m*g*sin(L)"
+D = "1/2*c*x_dot"
+[[loads]]
+name = "push"
+torque = "F"
+angle = "theta"
+[generalized_forces]
+x = "F*L"
+theta = "F*L"
+"""
+
+
+@pytest.fixture(scope="module")
+def bad():
+    return lagrangian.parse_model(BAD, source="bad.toml")
+
+
+def test_every_inconsistent_term_is_named(bad):
+    report = check_model_units(bad)
+    assert not report.consistent
+    by_item = {}
+    for issue in report.issues:
+        by_item.setdefault(issue.item, []).append(issue)
+    # sin(L): a length inside a trig function, and m g sin(L) is a force, not an energy.
+    assert any("the argument of sin" in i.message and i.term == "L" for i in by_item["V"])
+    assert any(i.term == "g*m*sin(L)" for i in by_item["V"])
+    assert [i.term for i in by_item["D"]] == ["c*x_dot/2"]
+    assert "a power" in by_item["D"][0].message
+    assert [i.item for i in report.issues if i.item.startswith("loads")] == ["loads[push].torque"]
+    # Q on a length must be a force (N); F*L is N m. Q on an angle is N m: F*L is right.
+    assert "Q[x]" in by_item and "Q[theta]" not in by_item
+    assert "N" in by_item["Q[x]"][0].message
+
+
+def test_examples_are_consistent():
+    for name in lagrangian.examples():
+        report = lagrangian.load(name).check_units()
+        assert report.consistent, (name, report.issues)
+
+
+def test_parameters_without_units_are_not_judged():
+    model = lagrangian.parse_model("""
+[coordinates]
+x = "m"
+[parameters]
+m = 1.0
+k = { value = 2.0, unit = "N/m" }
+[energy]
+T = "1/2*m*x_dot^2"
+V = "1/2*k*x^2"
+""")
+    report = check_model_units(model)
+    assert report.consistent and report.unchecked == ("m",)

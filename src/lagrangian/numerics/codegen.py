@@ -50,16 +50,28 @@ class _Printer(C99CodePrinter):
     def _print_Integer(self, expr):
         return f"{float(expr)!r}"
 
+    def _print_sign(self, expr):  # sympy's sign(0) = 0, as numpy's
+        x = self._print(expr.args[0])
+        return f"((double)(({x}) > 0) - (double)(({x}) < 0))"
+
+    def _print_Heaviside(self, expr):  # H(0) = 1/2, sympy's default
+        x = self._print(expr.args[0])
+        return f"(({x}) > 0 ? 1.0 : (({x}) < 0 ? 0.0 : 0.5))"
+
 
 def _block(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: _Printer) -> str:
     """C statements computing ``targets[i] = exprs[i]`` with shared subexpressions hoisted."""
     exprs = [sp.sympify(e) for e in exprs]  # safe: already sympy objects
     replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), optimizations="basic")
+    statements = [(f"const double {symbol}", value) for symbol, value in replacements]
+    statements += list(zip(targets, reduced, strict=True))
     lines = []
-    for symbol, value in replacements:
-        lines.append(f"    const double {symbol} = {printer.doprint(optimize(value, [_EXPAND_POW]))};")
-    for target, value in zip(targets, reduced, strict=True):
-        lines.append(f"    {target} = {printer.doprint(optimize(value, [_EXPAND_POW]))};")
+    for target, value in statements:
+        try:
+            code = printer.doprint(optimize(value, [_EXPAND_POW]))
+        except (NotImplementedError, TypeError, ValueError) as exc:
+            raise CodegenError(str(exc).splitlines()[0]) from None
+        lines.append(f"    {target} = {code};")
     return "\n".join(lines)
 
 

@@ -6,8 +6,8 @@ returns arrays with that leading batch shape: one state or many at once.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
 import warnings
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import partial
 
@@ -15,7 +15,7 @@ import numpy as np
 import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
-from ..errors import ModelError
+from ..errors import DerivationError, ModelError
 
 
 @dataclass(frozen=True)
@@ -288,7 +288,11 @@ def numeric(
                 warnings.warn(f"C backend unavailable, using numpy: {exc}", RuntimeWarning,
                               stacklevel=2)
     if kernel is None:
-        kernel = _numpy_kernel(eom, values)
+        try:
+            kernel = _numpy_kernel(eom, values)
+        except NotImplementedError as exc:  # sympy's printers: e.g. a leftover Derivative
+            raise DerivationError("the equations cannot be evaluated numerically: "
+                                  + str(exc).splitlines()[0]) from None
     return NumericSystem(
         coordinates=tuple(c.name for c in model.coordinates),
         constraint_names=tuple(c.name for c in model.constraints),

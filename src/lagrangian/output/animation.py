@@ -197,6 +197,10 @@ def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25
     spring_lines = [ax.plot([], [], color="tab:green", linewidth=1)[0] for _ in geometry.spring_names]
     bar_lines = [ax.plot([], [], color="tab:blue", linewidth=4, solid_capstyle="round")[0]
                  for _ in geometry.body_names]
+    # Each particle leaves a short trail (its last second) so the motion reads in one frame.
+    trails = [ax.plot([], [], color="tab:red", alpha=0.35, linewidth=1)[0]
+              for _ in geometry.particle_names]
+    trail_length = max(1, int(fps))
     dots = ax.plot([], [], "o", color="tab:red", markersize=10)[0]
     clock = ax.text(0.02, 0.95, "", transform=ax.transAxes)
     ax.set_title(result.model_name)
@@ -207,9 +211,12 @@ def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25
             line.set_data(zig[:, 0], zig[:, 1])
         for line, ends in zip(bar_lines, bars[k], strict=True):
             line.set_data(ends[:, 0], ends[:, 1])
+        for i, line in enumerate(trails):
+            path = particles[max(0, k - trail_length): k + 1, i]
+            line.set_data(path[:, 0], path[:, 1])
         dots.set_data(particles[k][:, 0], particles[k][:, 1])
         clock.set_text(f"t = {times[k]:.2f} s")
-        return [*spring_lines, *bar_lines, dots, clock]
+        return [*spring_lines, *bar_lines, *trails, dots, clock]
 
     return FuncAnimation(figure, draw, frames=len(times), interval=1000 / fps, blit=False)
 

@@ -123,3 +123,22 @@ def test_bad_arguments_are_rejected():
         integrate_fast(system, (0, 1), np.zeros(2), rtol=1e-6, atol=1e-6, t_eval=np.array([0.5, 0.2]))
     with pytest.raises(ValueError, match="rtol must be positive"):
         integrate_fast(system, (0, 1), np.zeros(2), rtol=0.0, atol=1e-6)
+
+
+def test_ctrl_c_stops_the_compiled_loop_and_keeps_what_was_computed():
+    import _thread
+    import threading
+
+    system = lagrangian.load("double_pendulum").numeric(backend="c")
+    timer = threading.Timer(0.2, _thread.interrupt_main)  # what Ctrl-C does to the main thread
+    timer.start()
+    try:
+        result = integrate_fast(system, (0.0, 1e6), np.array([1.0, 0.5, 0.0, 0.0]), rtol=1e-12,
+                                atol=1e-12)
+    finally:
+        timer.cancel()
+    assert not result.success
+    assert result.message.startswith("Interrupted at t = ")
+    assert 0.0 < result.t[-1] < 1e6 and len(result.t) == len(result.y) > 100
+    energy = system.energy(result.y[:, :2], result.y[:, 2:])
+    assert np.max(np.abs(energy - energy[0])) / abs(energy[0]) < 1e-8  # a valid partial run

@@ -238,3 +238,31 @@ V = "-(m1 + m2)*g*l1*cos(theta1) - m2*g*l2*cos(theta2)"
 ''')
     assert report.verdict == "correct", report
     assert [f.status for f in report.findings] == ["correct", "correct"]
+
+
+def _slider_crank_equations(transform):
+    from check_helpers import system
+
+    from lagrangian.model.expressions import format_expression
+
+    s = system("slider_crank")
+    equations = transform(list(s.equations_of_motion().equations), s)
+    lines = [f'{c.name} = "{format_expression(e)}"'
+             for c, e in zip(s.model.coordinates, equations, strict=True)]
+    return "[equations]\n" + "\n".join(lines) + "\n[multipliers]\ncount = 2\n"
+
+
+def test_slider_crank_equations_times_minus_three_are_accepted():
+    report = check_text("slider_crank", _slider_crank_equations(lambda e, s: [-3 * x for x in e]))
+    assert report.verdict == "correct", report
+    assert report.codes() == ["equation_equivalent"] * 3
+
+
+def test_slider_crank_spring_left_out_of_the_slider_equation():
+    def drop_spring(equations, s):
+        return equations[:2] + [equations[2].subs(s.symbol("k"), 0)]
+
+    report = check_text("slider_crank", _slider_crank_equations(drop_spring))
+    assert [f.status for f in report.findings[:2]] == ["correct", "correct"]
+    x = finding(report, "equation[x]")
+    assert x.code == "equation_wrong" and "k*(-x + x0)" in x.message

@@ -371,6 +371,12 @@ class _Checker:
                 "Is there one lambda per constraint?",
                 ", ".join(map(str, multipliers))))
             # Judge the equations with the user's multipliers left as they are.
+        # The user's own multiplier names (a tension T_rod) stand for ours, in order.
+        renaming: dict[sp.Symbol, sp.Symbol] = {}
+        if model.constraints and len(user_multipliers) == len(multipliers):
+            free = [s for s in multipliers if s not in user_multipliers]
+            renaming = dict(zip([s for s in user_multipliers if s not in multipliers], free,
+                                strict=True))
         set_equivalent = False
         if given and len(given) == len(ours) and (not model.constraints
                                                    or len(user_multipliers) == len(multipliers)):
@@ -378,8 +384,7 @@ class _Checker:
         for name, value in given.items():
             i = self.names.index(name)
             item = f"equation[{name}]"
-            mapped = value.xreplace(dict(zip(user_multipliers, multipliers, strict=False))) \
-                if model.constraints and len(user_multipliers) == len(multipliers) else value
+            mapped = value.xreplace(renaming)
             factor = self._multiple(mapped, ours[i])
             if factor is not None and factor == 1:
                 findings.append(Finding(item, "correct", None, "the equation matches ours.", None))

@@ -136,7 +136,7 @@ class DimensionChecker:
                         + f" ({describe(group[0][1])})" for group in groups)
                     self.issues.append(UnitIssue(
                         item, format_expression(expr),
-                        f"in {item}, the terms of {format_expression(expr)} do not share units: "
+                        f"in {item}, the terms{_of(expr)} do not share units: "
                         f"{listed}"))
                     return None
                 for group in groups[1:]:
@@ -144,8 +144,7 @@ class DimensionChecker:
                         self.issues.append(UnitIssue(
                             item, format_expression(term),
                             f"in {item}, the term {format_expression(term)} has {describe(d)} "
-                            f"where the other terms of {format_expression(expr)} have "
-                            f"{describe(major)}"))
+                            f"where the other terms{_of(expr)} have {describe(major)}"))
                 return major
             return None if len(known) < len(dims) else known[0][1]
         if isinstance(expr, sp.Mul):
@@ -195,6 +194,12 @@ class DimensionChecker:
             item, format_expression(term),
             f"in {item}, {role} must be dimensionless, but {format_expression(term)} has "
             f"{describe(d)}"))
+
+
+def _of(expr: sp.Expr) -> str:
+    """' of <expr>' when short enough to read in a message."""
+    text = format_expression(expr)
+    return f" of {text}" if len(text) <= 80 else ""
 
 
 def _named(expected: str, target) -> str:

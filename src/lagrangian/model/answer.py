@@ -152,7 +152,7 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
             raise ModelError(f"count = {count} but {len(listed)} names are listed",
                              field="multipliers", source=source)
 
-    return Answer(
+    answer = Answer(
         source=source,
         kinetic_energy=values.get("T"),
         potential_energy=values.get("V"),
@@ -161,8 +161,12 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
         equations=tuple(equations),
         multiplier_count=count,
         multiplier_names=multiplier_names,
-        foreign=tuple(sorted(foreign.items())),
+        foreign=tuple(sorted(foreign.items(), key=lambda kv: kv[0])),
     )
+    if answer.is_empty:
+        raise ModelError("the answer has nothing to check: give [energy] T/V/D, "
+                         "[generalized_forces], [equations] or [multipliers]", source=source)
+    return answer
 
 
 def _foreign_names(text: str, names: Mapping[str, sp.Expr], field: str,

@@ -486,8 +486,6 @@ class _DriftControl:
 
     def project(self, q, v, t, inverse_metric=None, tolerance=0.0):
         """The nearest state (in the metric) with Phi = 0 and J q_dot + b = 0."""
-        s = self.system
-        n = s.n
         phi, velocity, jacobian = self.residuals(q, v, t)
         for _ in range(12):
             if not phi.size or np.max(np.abs(phi)) <= tolerance:

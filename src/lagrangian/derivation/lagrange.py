@@ -13,13 +13,15 @@ import sympy as sp
 from ..model.model import Model, multiplier_name
 from .constraints import constraint_terms
 from .equations import EquationsOfMotion
-from .kinematics import jacobian_row, time_rate
+from .kinematics import Differentiator
 from .regularity import check_regularity
 from .virtual_work import generalized_forces, load_contributions
 
 # Above this size a symbolic solve for q_ddot swells; users get the implicit form only.
 SYMBOLIC_SOLVE_MAX_UNKNOWNS = 3
-SYMBOLIC_SOLVE_MAX_OPS = 400
+SYMBOLIC_SOLVE_MAX_OPS = 200
+# cancel() is superlinear in expression size: past this the closed form is not worth showing.
+SYMBOLIC_SOLUTION_MAX_OPS = 1500
 
 
 class _Accumulator:
@@ -62,13 +64,19 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
     q, q_dot, t = model.q, model.q_dot, model.time
     n = len(q)
     acc = _Accumulator(n)
+    d = Differentiator()
+    jacobian_row, time_rate = d.row, d.rate
     kinetic_terms: list[sp.Expr] = []
     potential_terms: list[sp.Expr] = [model.potential_energy]
     dissipation_terms: list[sp.Expr] = [model.dissipation]
 
     def translate(mass: sp.Expr, position) -> None:
         jacobian = [jacobian_row(component, q) for component in position]
-        velocity = [time_rate(component, q, q_dot, t) for component in position]
+        # v = J q_dot + dr/dt, reusing J rather than differentiating r again.
+        velocity = [
+            sp.Add(*(j * v for j, v in zip(row, q_dot, strict=True) if j != 0), d(component, t))
+            for row, component in zip(jacobian, position, strict=True)
+        ]
         rest = [time_rate(v, q, q_dot, t) for v in velocity]
         acc.inertia(mass, jacobian, rest)
         kinetic_terms.append(sp.Rational(1, 2) * mass * sp.Add(*(v**2 for v in velocity)))
@@ -97,12 +105,12 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
     # The user's T and V go through the general Euler-Lagrange formula.
     user_lagrangian = model.kinetic_energy - model.potential_energy
     if user_lagrangian != 0:
-        _general_lagrangian(acc, user_lagrangian, q, q_dot, t)
+        _general_lagrangian(acc, d, user_lagrangian, q, q_dot, t)
     component_potential = sp.Add(*potential_terms[1:])
     if component_potential != 0:
-        for i, d in enumerate(jacobian_row(component_potential, q)):
-            if d != 0:
-                acc.forcing[i].append(-d)
+        for i, gradient in enumerate(jacobian_row(component_potential, q)):
+            if gradient != 0:
+                acc.forcing[i].append(-gradient)
 
     contributions = load_contributions(model)
     Q = generalized_forces(model, contributions)
@@ -134,8 +142,9 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
     )
 
 
-def _general_lagrangian(acc: _Accumulator, L: sp.Expr, q, q_dot, t) -> None:
+def _general_lagrangian(acc: _Accumulator, d: Differentiator, L: sp.Expr, q, q_dot, t) -> None:
     """W q_ddot = dL/dq - (d^2L/dq_dot dq) q_dot - d^2L/dq_dot dt, added term by term."""
+    jacobian_row, time_rate = d.row, d.rate
     momenta = jacobian_row(L, q_dot)
     forces = jacobian_row(L, q)
     for i, p in enumerate(momenta):
@@ -169,6 +178,8 @@ def _solve_small(mass_matrix, forcing, jacobian, gamma) -> sp.ImmutableMatrix | 
     except (ValueError, ZeroDivisionError, sp.matrices.exceptions.NonInvertibleMatrixError):
         return None
     if any(value.has(sp.nan, sp.zoo) for value in solution):
+        return None
+    if sp.count_ops(solution) > SYMBOLIC_SOLUTION_MAX_OPS:
         return None
     # Small by the guard above, so a rational cancellation is cheap and much more readable.
     return sp.ImmutableMatrix(n, 1, [sp.factor_terms(sp.cancel(v)) for v in solution[:n]])

@@ -7,6 +7,7 @@ a redundant constraint.
 
 from __future__ import annotations
 
+import math
 import random
 
 import numpy as np
@@ -30,12 +31,57 @@ def random_state(model: Model, seed: int = 12345) -> dict[sp.Symbol, sp.Float]:
     return values
 
 
+_FUNCTIONS = {
+    sp.sin: math.sin, sp.cos: math.cos, sp.tan: math.tan, sp.exp: math.exp, sp.log: math.log,
+    sp.asin: math.asin, sp.acos: math.acos, sp.atan: math.atan, sp.sinh: math.sinh,
+    sp.cosh: math.cosh, sp.tanh: math.tanh, sp.Abs: abs,
+}
+
+
+class _Evaluator:
+    """Float evaluation of sympy trees with shared sub-expressions evaluated once.
+
+    One evaluation at one point does not pay for compiling (lambdify) the whole matrix.
+    """
+
+    def __init__(self, values: dict):
+        self.memo = {symbol: float(value) for symbol, value in values.items()}
+
+    def __call__(self, expr: sp.Basic) -> float:
+        found = self.memo.get(expr)
+        if found is not None:
+            return found
+        if expr.is_Number:
+            value = float(expr)
+        elif expr.is_Add:
+            value = math.fsum(self(a) for a in expr.args)
+        elif expr.is_Mul:
+            value = math.prod(self(a) for a in expr.args)
+        elif expr.is_Pow:
+            value = self(expr.args[0]) ** self(expr.args[1])
+        elif expr.func in _FUNCTIONS:
+            value = _FUNCTIONS[expr.func](*(self(a) for a in expr.args))
+        elif expr.func is sp.atan2:
+            value = math.atan2(self(expr.args[0]), self(expr.args[1]))
+        else:
+            symbols = {k: sp.Float(v) for k, v in self.memo.items() if isinstance(k, sp.Symbol)}
+            value = complex(expr.xreplace(symbols).evalf())
+            if abs(value.imag) > 1e-12 * max(1.0, abs(value.real)):
+                raise ValueError("not real")
+            value = value.real
+        if isinstance(value, complex):
+            raise ValueError("not real")
+        self.memo[expr] = value
+        return value
+
+
 def numeric_matrix(matrix: sp.MatrixBase, values: dict) -> np.ndarray:
-    """Evaluate a symbolic matrix at a point by substitution (no compilation)."""
+    """Evaluate a symbolic matrix at a point (floats; raises ValueError if not real)."""
+    evaluate = _Evaluator(values)
     out = np.empty(matrix.shape)
-    for (i, j), entry in np.ndenumerate(np.empty(matrix.shape)):
-        value = matrix[i, j].xreplace(values)
-        out[i, j] = float(value.evalf()) if not value.is_Number else float(value)
+    for i in range(matrix.rows):
+        for j in range(matrix.cols):
+            out[i, j] = evaluate(matrix[i, j])
     return out
 
 
@@ -50,7 +96,7 @@ def check_regularity(model: Model, mass_matrix: sp.MatrixBase, jacobian: sp.Matr
     try:
         M = numeric_matrix(mass_matrix, values)
         A = numeric_matrix(jacobian, values) if m else np.zeros((0, n))
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, ZeroDivisionError, OverflowError):
         return  # not numerically evaluable (e.g. complex at this point): leave it to the solver
     if not (np.all(np.isfinite(M)) and np.all(np.isfinite(A))):
         return

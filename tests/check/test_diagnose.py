@@ -266,3 +266,17 @@ def test_slider_crank_spring_left_out_of_the_slider_equation():
     assert [f.status for f in report.findings[:2]] == ["correct", "correct"]
     x = finding(report, "equation[x]")
     assert x.code == "equation_wrong" and "k*(-x + x0)" in x.message
+
+
+def test_parallel_axis_double_count_is_a_kinetic_term():
+    # I about the pin (m L^2/3) and the centre's translation as well: translation counted twice.
+    report = check_text("virtual_work_link",
+                        '[energy]\nT = "1/2*(m*L^2/3)*theta_dot^2 + 1/2*m*(L/2)^2*theta_dot^2"\n')
+    t = finding(report, "T")
+    assert t.code == "kinetic_term"
+    assert "counts the translational energy 1/2 m v_G^2 of body 'link' twice" in t.message
+
+
+def test_a_missing_mass_is_said_so():
+    t = finding(check_text("pendulum", '[energy]\nT = "1/2*L^2*theta_dot^2"\n'), "T")
+    assert t.code == "kinetic_factor" and "a missing mass m?" in t.message

@@ -167,25 +167,32 @@ class _Checker:
             if len(parts) > 1 and eq.identical(T_user, T - part, self.points):
                 return [Finding("T", "wrong", "kinetic_term",
                                 f"T is missing the {label}: {fmt(eq.display(part))}.", expected)]
+        for label, part in parts:
+            if len(parts) > 1 and eq.identical(T_user, T + part, self.points):
+                return [Finding("T", "wrong", "kinetic_term",
+                                f"T counts the {label} twice: {fmt(eq.display(part))}.", expected)]
         if not eq.zero(T, self.points) and eq.constant_in_state(T_user / T, self.points):
             factor = eq.display(sp.cancel(T_user / T))
             hint = ""
             if factor == 2:
                 hint = " (a forgotten 1/2?)"
-            elif factor.free_symbols and any(str(s).startswith(("m", "M")) for s in factor.free_symbols):
-                hint = " (a missing mass?)"
+            elif (1 / factor).free_symbols and (1 / factor).free_symbols <= self._masses():
+                hint = f" (a missing mass {fmt(1 / factor)}?)"
             return [Finding("T", "wrong", "kinetic_factor",
                             f"T is {fmt(factor)} times the kinetic energy{hint}: every term of "
                             "T = sum 1/2 m v^2 + 1/2 I w^2 carries 1/2 and its mass or inertia.",
                             expected)]
-        for label, part in parts:
-            if eq.identical(T_user, T + part, self.points):
-                return [Finding("T", "wrong", "kinetic_term",
-                                f"T counts the {label} twice: {fmt(eq.display(part))}.", expected)]
         difference = eq.display(T_user - T)
         return [Finding("T", "wrong", "kinetic_term",
                         f"T has a wrong or extra term: yours minus ours is {fmt(difference)}.",
                         expected)]
+
+    def _masses(self) -> set[sp.Symbol]:
+        """Parameters that are masses: in kg, or in a particle's or body's mass."""
+        masses = {p.symbol for p in self.model.parameters if (p.unit or "").strip() == "kg"}
+        for item in (*self.model.particles, *self.model.bodies):
+            masses |= item.mass.free_symbols
+        return masses
 
     # V ---------------------------------------------------------------------------------
 
@@ -362,7 +369,9 @@ class _Checker:
         user_multipliers = sorted(
             {s for v in given.values() for s in v.free_symbols if s in set(multipliers)} | foreign,
             key=str) if model.constraints else []
-        if model.constraints and len(user_multipliers) != len(multipliers):
+        # Only a full set of equations shows how many multipliers the user has.
+        if (model.constraints and len(given) == len(ours)
+                and len(user_multipliers) != len(multipliers)):
             findings.append(Finding(
                 "multipliers", "wrong", "multiplier_count",
                 f"your equations use {len(user_multipliers)} multiplier(s) "

@@ -42,6 +42,12 @@ class UnitsReport:
     def consistent(self) -> bool:
         return not self.issues
 
+    def __repr__(self) -> str:
+        if self.consistent:
+            return f"UnitsReport({self.model!r}: consistent)"
+        return "\n".join([f"UnitsReport({self.model!r}: {len(self.issues)} inconsistent term(s))"]
+                         + [f"  {issue.message}" for issue in self.issues])
+
 
 def quantity(unit: str | None):
     """A pint quantity of magnitude 1 in base units, or None for an unknown unit."""

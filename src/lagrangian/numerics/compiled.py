@@ -110,7 +110,11 @@ def load(generated: GeneratedSource) -> ModuleType:
     if not path.exists():
         if sys.platform == "win32":
             raise BackendUnavailable("the C backend is not supported on Windows yet")
-        _compile(generated.source, name, path)
+        try:
+            _compile(generated.source, name, path)
+        except OSError as exc:
+            raise BackendUnavailable(f"cannot write the compiled-module cache {path.parent}: "
+                                     f"{exc.strerror or exc} (set LAGRANGIAN_CACHE)") from None
     spec = importlib.util.spec_from_file_location(name, path)
     if spec is None or spec.loader is None:
         raise BackendUnavailable(f"cannot load {path}")

@@ -211,3 +211,26 @@ def test_columns_are_named_as_documented():
     assert list(result.columns()) == [
         "t", "theta", "phi", "x", "theta_dot", "phi_dot", "x_dot", "energy",
         "lambda_loop_y", "lambda_loop_x", "residual_loop_y", "residual_loop_x", "power"]
+
+
+def test_ctrl_c_in_the_compiled_loop_keeps_what_was_computed(monkeypatch):
+    """A run that looks long (a clock that jumps 10 s a reading) goes in pieces with progress."""
+    import lagrangian.numerics.simulate as module
+
+    if run("double_pendulum", 0.1, samples=3).backend != "compiled":
+        pytest.skip("no compiled integration loop here (no C compiler)")
+    clock = iter(range(0, 10**6, 10))
+    monkeypatch.setattr(module.time, "perf_counter", lambda: float(next(clock)))
+    reached = []
+
+    def progress(t):
+        reached.append(t)
+        if t > 3:
+            raise KeyboardInterrupt
+
+    result = run("double_pendulum", 10, samples=1001, progress=progress)
+    assert result.backend == "compiled" and result.status == "interrupted"
+    assert len(reached) > 3 and 3 < result.t[-1] < 4
+    assert np.allclose(np.diff(result.t), 0.01)  # the samples computed so far, none repeated
+    whole = run("double_pendulum", 10, samples=1001)
+    np.testing.assert_allclose(result.q, whole.q[: len(result.t)], atol=1e-7)

@@ -298,7 +298,7 @@ def simulate(
     started = time.perf_counter()
     run = None
     if fast and not m and method == "DOP853" and event is None:
-        run = _integrate_compiled(system, (t0, t_end), y0, rtol, atol, grid)
+        run = _integrate_compiled(system, (t0, t_end), y0, rtol, atol, grid, progress)
     backend = "compiled" if run is not None else "scipy"
     if run is None:
         fun = _rhs(system)
@@ -354,26 +354,64 @@ def _rhs(system: NumericSystem) -> Callable[[float, np.ndarray], np.ndarray]:
     return rhs
 
 
-def _integrate_compiled(system, t_span, y0, rtol, atol, grid) -> _Run | None:
-    """The compiled integration loop of numerics.fast when it is there; None to fall back."""
+def _integrate_compiled(system, t_span, y0, rtol, atol, grid, progress=None) -> _Run | None:
+    """The compiled integration loop of numerics.fast when it is there; None to fall back.
+
+    With a ``progress`` callback the run goes in pieces between output samples (a first short
+    piece times the loop; the rest in one call when it will take under a second), so a long run
+    can report progress; Ctrl-C inside the C loop keeps the states computed so far.
+    """
     try:
         from .fast import integrate_fast
     except ImportError:
         return None
-    result = integrate_fast(system, t_span, y0, rtol=rtol, atol=atol, t_eval=grid)
-    if result is None:
-        return None
-    t = np.asarray(result.t, dtype=float)
-    y = np.asarray(result.y, dtype=float).reshape(len(t), -1)
-    steps = getattr(result, "steps", getattr(result, "nsteps", None))
-    if result.success:
-        return _Run(t, y, "finished", STATUS_MESSAGES["finished"], steps, int(result.nfev))
-    reached = float(t[-1]) if len(t) else t_span[0]
-    message = str(result.message).rstrip(".")
-    if "t =" not in message:
-        message += f" (stopped at t = {reached:.9g} s)"
-    return _Run(t, y, "failed", message, steps,
-                int(result.nfev))
+    pieces = [(0, len(grid) - 1)]
+    if progress is not None and len(grid) > 2:
+        first = max(1, (len(grid) - 1) // 100)
+        pieces = [(0, first), (first, len(grid) - 1)]
+    ts, ys, nfev, steps = [], [], 0, 0
+    y_start = y0
+    status, message = "finished", STATUS_MESSAGES["finished"]
+    while pieces:
+        a, b = pieces.pop(0)
+        began = time.perf_counter()
+        result = integrate_fast(system, (float(grid[a]), float(grid[b])), y_start, rtol=rtol,
+                                atol=atol, t_eval=grid[a:b + 1])
+        if result is None:
+            return None
+        t = np.asarray(result.t, dtype=float)
+        y = np.asarray(result.y, dtype=float).reshape(len(t), -1)
+        skip = 1 if ts and len(t) and t[0] == ts[-1][-1] else 0
+        ts.append(t[skip:])
+        ys.append(y[skip:])
+        nfev += int(result.nfev)
+        piece_steps = getattr(result, "steps", getattr(result, "nsteps", None))
+        steps = None if piece_steps is None or steps is None else steps + int(piece_steps)
+        if not result.success:
+            text = str(result.message).rstrip(".")
+            status = "interrupted" if text.lower().startswith("interrupted") else "failed"
+            reached = float(t[-1]) if len(t) else float(grid[a])
+            message = text if "t =" in text else f"{text} (stopped at t = {reached:.9g} s)"
+            break
+        if progress is not None:
+            try:
+                progress(float(t[-1]))
+            except KeyboardInterrupt:
+                if not pieces:  # the run was complete already
+                    break
+                status = "interrupted"
+                message = f"interrupted by the user (Ctrl-C) at t = {float(t[-1]):.9g} s"
+                break
+            spent = time.perf_counter() - began
+            remaining = float(grid[-1] - grid[b])
+            if len(pieces) == 1 and a == 0 and \
+                    spent * remaining / max(float(grid[b] - grid[a]), 1e-300) > 1.0:
+                # about 50 pieces, so the bar moves and Ctrl-C is answered between them
+                _, last = pieces.pop(0)
+                bounds = np.unique(np.linspace(b, last, 51).round().astype(int))
+                pieces = list(zip(bounds[:-1], bounds[1:], strict=True))
+        y_start = y[-1]
+    return _Run(np.concatenate(ts), np.concatenate(ys), status, message, steps, nfev)
 
 
 def _integrate_steps(fun, t0, y0, t_end, grid, method, rtol, atol, event, drift, progress) -> _Run:

@@ -21,6 +21,8 @@ MAX_ITERATIONS = 80
 RESIDUAL_TOLERANCE = 1e-9
 # Relative distance below which two equilibria are one.
 SAME_TOLERANCE = 1e-6
+# A given equilibrium may be off by this much (relative) in the given coordinates: refined.
+ACCEPT_MOVE = 1e-6
 
 
 @dataclass(frozen=True)
@@ -300,22 +302,29 @@ def resolve_equilibrium(
     scale = force_scale(functions, points, t)
     solver = _Solver(functions, t, scale)
     limit = np.where(periodic, 1.0, np.maximum(np.abs(high - low) / 4, 1e-12))
+    everything = np.ones(len(names), bool)
     lam = initial_multipliers(functions.evaluate(q, t))
+
+    def polished(q_start, lam_start):
+        """Newton with every coordinate free; accepted if the given values barely move."""
+        q2, lam2, ok2 = solver.solve(q_start[None], lam_start[None], everything, limit)
+        moved = np.abs(q2[0] - q)[given]
+        if ok2[0] and np.all(moved <= ACCEPT_MOVE * (1 + np.abs(q[given]))):
+            return q2[0], lam2[0]
+        return None
+
     q1, lam1, ok = solver.solve(q[None], lam[None], ~given, limit)
+    candidates = [(q1[0], lam1[0])]
     if not ok[0] and (~given).any():
-        # Try the other starting points for the coordinates not given, nearest first.
+        # Other starting values for the coordinates not given, nearest first.
         lams = initial_multipliers(functions.evaluate(points, t))
         qs, ls, oks = solver.solve(points, lams, ~given, limit)
-        if oks.any():
-            candidates = np.flatnonzero(oks)
-            best = candidates[np.argmin([_distance(qs[i], q, periodic) for i in candidates])]
-            q1, lam1, ok = qs[best][None], ls[best][None], np.array([True])
-    if ok[0]:
-        # Polish with every coordinate free; accept if the given values barely move.
-        q2, lam2, ok2 = solver.solve(q1, lam1, np.ones(len(names), bool), limit)
-        if ok2[0] and np.all(np.abs(q2[0] - q)[given] <= 1e-6 * (1 + np.abs(q[given]))):
-            return q2[0], lam2[0]
-        return q1[0], lam1[0]
+        order = sorted(np.flatnonzero(oks), key=lambda i: _distance(qs[i], q, periodic))
+        candidates += [(qs[i], ls[i]) for i in order[:5]]
+    for q_start, lam_start in candidates:
+        result = polished(q_start, lam_start)
+        if result is not None:
+            return result
     residual = solver.residual(q1[0], lam1[0])
     worst = int(np.argmax(np.abs(residual)))
     what = names[worst] if worst < len(names) else \

@@ -46,18 +46,18 @@ class StaticFunctions:
         at_rest = {v: sp.S.Zero for v in q_dot}
 
         # Parameter values go in first: differentiating numbers is much cheaper than symbols.
-        forcing = [sp.sympify(e).xreplace(values) for e in eom.forcing]
+        forcing = [_floats(sp.sympify(e).xreplace(values)) for e in eom.forcing]
         forcing_at_rest = [e.xreplace(at_rest) for e in forcing]
         stiffness = [[-d for d in jacobian_row(e, q)] for e in forcing_at_rest]
         damping = [[-d.xreplace(at_rest) for d in _linear_velocity_row(e, q_dot)]
                    for e in forcing]
-        jacobian = [[sp.sympify(e).xreplace(values).xreplace(at_rest)
+        jacobian = [[_floats(sp.sympify(e).xreplace(values).xreplace(at_rest))
                      for e in eom.constraint_jacobian.row(i)] for i in range(m)]
         hessians = [[jacobian_row(e, q) for e in row] for row in jacobian]
         # At rest a holonomic constraint reads Phi(q) = 0, a velocity one b(q) = 0.
         static = []
         for c in model.constraints:
-            residual = c.expression.xreplace(values)
+            residual = _floats(c.expression.xreplace(values))
             residual = residual if c.kind == "holonomic" else residual.xreplace(at_rest)
             if residual != 0:
                 static.append((c.name, residual))
@@ -66,7 +66,8 @@ class StaticFunctions:
         self.depends_on = frozenset(
             s for e in [*forcing_at_rest, *(e for _, e in static)] for s in e.free_symbols
         )
-        mass = [sp.sympify(e).xreplace(values).xreplace(at_rest) for e in eom.mass_matrix]
+        mass = [_floats(sp.sympify(e).xreplace(values).xreplace(at_rest))
+                for e in eom.mass_matrix]
         rest = [*mass, *forcing_at_rest, *_flat(damping), *(e for _, e in static)]
         if any(t in sp.sympify(e).free_symbols for e in rest):
             raise ModelError("the equations at rest depend on time t explicitly, so the model has "
@@ -111,6 +112,13 @@ class StaticFunctions:
             out[name] = flat[..., start:start + size].reshape(batch + shape)
             start += size
         return out
+
+
+def _floats(expr: sp.Expr) -> sp.Expr:
+    """Exact numbers too big for machine integers (from floats made exact) become floats."""
+    big = {a: sp.Float(a) for a in expr.atoms(sp.Rational)
+           if not (a.is_Integer and abs(a) < 2**31) and not (abs(a.p) < 2**31 and a.q < 2**31)}
+    return expr.xreplace(big) if big else expr
 
 
 def _real(value: sp.Expr) -> float:

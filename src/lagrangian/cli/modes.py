@@ -18,10 +18,13 @@ from .common import assignments, load_system, print_json, state_assignments
 _PI = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)?)\s*\*?\s*pi\s*(?:/\s*(\d+\.?\d*))?\s*$")
 
 
+ABOUT_HELP = "Equilibrium: COORDINATE=VALUE (pi, 180deg, 0.5m); the others are solved for."
+
+
 @app.command()
 def modes(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
-    about: Annotated[list[str], typer.Option("--about", help="Equilibrium: COORDINATE=VALUE (pi, 180deg, 0.5m); others are solved for.")] = [],  # noqa: B006
+    about: Annotated[list[str], typer.Option("--about", help=ABOUT_HELP)] = [],  # noqa: B006
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option("--plot", help="Draw the mode shapes to a PNG file.")] = None,

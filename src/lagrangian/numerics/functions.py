@@ -44,8 +44,15 @@ class NumericSystem:
         return self._kernel.backend
 
     def _flat(self, q, q_dot, t):
-        """Contiguous (N, n), (N, n), (N,) arrays for the kernel, and the batch shape."""
-        q, q_dot, batch = _batch(q, q_dot, self.n)
+        """(N, n), (N, n), (N,) float arrays for the kernel, and the batch shape."""
+        n = self.n
+        q, q_dot = np.asarray(q, dtype=float), np.asarray(q_dot, dtype=float)
+        if q.shape == q_dot.shape and q.shape[-1:] == (n,) and np.ndim(t) == 0:
+            # the common case (same shapes, one time): no broadcasting machinery
+            batch = q.shape[:-1]
+            Q, V = q.reshape(-1, n), q_dot.reshape(-1, n)
+            return Q, V, np.full(len(Q), float(t)), batch
+        q, q_dot, batch = _batch(q, q_dot, n)
         count = int(np.prod(batch, dtype=np.int64))
         t = np.broadcast_to(np.asarray(t, dtype=float), batch).reshape(count)
         return (np.ascontiguousarray(q.reshape(count, self.n)),

@@ -94,7 +94,8 @@ def test_step_limit_keeps_the_partial_result():
     assert not result.success
     assert result.message.startswith("Reached the limit of 10 steps at t = ")
     assert len(result.t) == 11 and 0 < result.t[-1] < 10.0
-    assert result.nfev == 2 + 12 * 10 + 12 * (result.nfev - 2 - 120) // 12  # 12 calls a step
+    # two calls to start (f0, initial step), then 12 a step attempt (rejected ones included)
+    assert (result.nfev - 2) % 12 == 0 and result.nfev >= 2 + 12 * 10
 
 
 def test_singular_mass_matrix_on_the_way_stops_with_the_time_reached():

@@ -131,9 +131,38 @@ def _real(value: sp.Expr) -> float:
 
 
 def _linear_velocity_row(expr: sp.Expr, q_dot: Sequence[sp.Symbol]) -> list[sp.Expr]:
-    """d expr / d q_dot_j, only for velocities the expression contains."""
-    present = expr.free_symbols
-    return [expr.diff(v) if v in present else sp.S.Zero for v in q_dot]
+    """d expr / d q_dot_j, for use at q_dot = 0.
+
+    Terms at least quadratic in the velocities (centripetal, Coriolis) have no slope at rest, so
+    they are dropped before differentiating: a big model's forcing is mostly such terms.
+    """
+    velocities = frozenset(q_dot)
+    degrees: dict[sp.Basic, int] = {}
+    kept = [term for term in sp.Add.make_args(expr)
+            if _lowest_velocity_degree(term, velocities, degrees) < 2]
+    linear = sp.Add(*kept)
+    present = linear.free_symbols
+    return [linear.diff(v) if v in present else sp.S.Zero for v in q_dot]
+
+
+def _lowest_velocity_degree(expr: sp.Basic, velocities: frozenset, memo: dict) -> int:
+    """A lower bound on the degree in the velocities of every term of ``expr`` (0 if unsure)."""
+    if expr in memo:
+        return memo[expr]
+    if expr in velocities:
+        degree = 1
+    elif not (expr.free_symbols & velocities):
+        degree = 0
+    elif expr.is_Mul:
+        degree = sum(_lowest_velocity_degree(a, velocities, memo) for a in expr.args)
+    elif expr.is_Add:
+        degree = min(_lowest_velocity_degree(a, velocities, memo) for a in expr.args)
+    elif expr.is_Pow and expr.exp.is_Integer and expr.exp > 0:
+        degree = int(expr.exp) * _lowest_velocity_degree(expr.base, velocities, memo)
+    else:
+        degree = 0  # a function of a velocity: no claim
+    memo[expr] = degree
+    return degree
 
 
 def _flat(rows):

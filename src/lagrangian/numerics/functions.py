@@ -43,6 +43,11 @@ class NumericSystem:
     def backend(self) -> str:
         return self._kernel.backend
 
+    def __repr__(self) -> str:
+        constraints = f", constraints={list(self.constraint_names)}" if self.m else ""
+        return (f"NumericSystem(coordinates={list(self.coordinates)}{constraints}, "
+                f"backend={self.backend!r})")
+
     def _flat(self, q, q_dot, t):
         """(N, n), (N, n), (N,) float arrays for the kernel, and the batch shape."""
         n = self.n

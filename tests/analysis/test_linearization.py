@@ -128,3 +128,32 @@ def test_thirty_dof_linearization_avoids_symbolic_inversion(monkeypatch):
     expected = np.sqrt(9.81 + 2 * 2.0 * (1 - np.cos(k * np.pi / n)))
     np.testing.assert_allclose(analysis.natural_frequencies, expected, rtol=1e-10)
     assert lm.A.shape == (2 * n, 2 * n)
+
+
+@pytest.mark.slow
+def test_thirty_link_pendulum_against_its_known_linear_matrices(monkeypatch):
+    """n unit masses on n unit links: M_ij = n - max(i, j) (0-based), K = diag(g (n - i))."""
+    n, g = 30, 9.81
+    b = SystemBuilder("30-link pendulum")
+    b.set_gravity(b.parameter("g", g, "m/s^2"), (0, -1))
+    x = y = 0
+    thetas = [b.coordinate(f"theta{i}", unit="rad") for i in range(n)]
+    for i, theta in enumerate(thetas):
+        x, y = x + lagrangian.sin(theta), y - lagrangian.cos(theta)
+        b.add_particle(f"bob{i}", 1.0, (x, y))
+    system = b.build()
+    system.equations_of_motion()
+
+    def forbidden(*args, **kwargs):
+        raise AssertionError("symbolic inversion or simplification in linearize")
+
+    monkeypatch.setattr(sp, "simplify", forbidden)
+    monkeypatch.setattr(sp.MatrixBase, "inv", forbidden)
+    monkeypatch.setattr(sp.MatrixBase, "LUsolve", forbidden)
+    lm = system.linearize(about={t.name: 0.0 for t in thetas})
+    i = np.arange(n)
+    mass = (n - np.maximum.outer(i, i)).astype(float)
+    stiffness = np.diag(g * (n - i).astype(float))
+    np.testing.assert_allclose(lm.M, mass, rtol=1e-12)
+    np.testing.assert_allclose(lm.K, stiffness, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(lm.C, 0)

@@ -280,3 +280,18 @@ def test_parallel_axis_double_count_is_a_kinetic_term():
 def test_a_missing_mass_is_said_so():
     t = finding(check_text("pendulum", '[energy]\nT = "1/2*L^2*theta_dot^2"\n'), "T")
     assert t.code == "kinetic_factor" and "a missing mass m?" in t.message
+
+
+def test_numbers_in_place_of_parameters_are_compared_at_the_model_values():
+    # Worked example 2 with its numbers: Q = 100 N x 0.5 m x cos(theta).
+    report = check_text("virtual_work_link", '[generalized_forces]\ntheta = "100*0.5*cos(theta)"\n')
+    assert report.verdict == "correct", report
+    assert "model's parameter values" in finding(report, "Q[theta]").message
+    report = check_text("pendulum", '[energy]\nV = "-m*9.81*L*cos(theta)"\n')
+    assert finding(report, "V").status == "correct"
+    wrong = check_text("pendulum", '[energy]\nV = "9.81*0.5*cos(theta)"\n')
+    assert finding(wrong, "V").code == "potential_sign"
+    # Plain factors like 1/2 are not numbers standing in for parameters: a missing m is wrong
+    # even though the model's m is 1 kg.
+    missing_m = check_text("pendulum", '[energy]\nT = "1/2*L^2*theta_dot^2"\n')
+    assert finding(missing_m, "T").code == "kinetic_factor"

@@ -8,7 +8,7 @@ item that is wrong in a way no more specific diagnosis names.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import sympy as sp
 
@@ -121,17 +121,24 @@ def check_answer(eom: EquationsOfMotion, answer: Answer) -> CheckReport:
     foreign = set().union(*(symbols for _, symbols in answer.foreign)) if answer.foreign else set()
     points = eq.random_points(model, foreign)
     checker = _Checker(eom, answer, points)
+    numeric = _NumericItems(model, eq.random_points(model, foreign, model_values=True), checker)
     findings: list[Finding] = []
     if answer.kinetic_energy is not None:
-        findings += checker.kinetic(answer.kinetic_energy)
+        findings += numeric.run(checker.kinetic, [answer.kinetic_energy], [eom.kinetic_energy],
+                                answer.kinetic_energy)
     if answer.potential_energy is not None:
-        findings += checker.potential(answer.potential_energy)
+        findings += numeric.run(checker.potential, [answer.potential_energy],
+                                [eom.potential_energy], answer.potential_energy)
     if answer.dissipation is not None:
-        findings += checker.dissipation(answer.dissipation)
+        findings += numeric.run(checker.dissipation, [answer.dissipation], [eom.dissipation],
+                                answer.dissipation)
     for name, value in answer.generalized_forces:
-        findings += checker.generalized_force(name, value)
+        i = [c.name for c in model.coordinates].index(name)
+        findings += numeric.run(checker.generalized_force, [value],
+                                [eom.generalized_forces[i]], name, value)
     if answer.equations:
-        findings += checker.equations()
+        findings += numeric.run(checker.equations, [v for _, v in answer.equations],
+                                list(eom.equations))
     if answer.multiplier_count is not None or answer.multiplier_names is not None:
         findings += checker.multipliers()
     findings += checker.units()
@@ -142,6 +149,31 @@ def check_answer(eom: EquationsOfMotion, answer: Answer) -> CheckReport:
             seen.add(key)
             unique.append(finding)
     return CheckReport(model.name, answer.source, tuple(unique))
+
+
+class _NumericItems:
+    """Items that write numbers in place of parameters (9.81 for g) are compared at the
+    model's parameter values instead of at random ones, and the finding says so."""
+
+    NOTE = " (compared at the model's parameter values: numbers stand in for parameters)"
+
+    def __init__(self, model: Model, points: eq.Points, checker: _Checker):
+        self.valued = {p.symbol for p in model.parameters if p.value is not None}
+        self.points = points
+        self.checker = checker
+
+    def run(self, method, yours: list[sp.Expr], ours: list[sp.Expr], *args) -> list[Finding]:
+        yours = [sp.sympify(e) for e in yours]  # safe: sympy objects or numbers, not text
+        used = set().union(*(e.free_symbols for e in yours))
+        needed = set().union(*(sp.sympify(e).free_symbols for e in ours)) & self.valued
+        if not needed - used or not any(_measured(e) for e in yours):
+            return method(*args)
+        saved, self.checker.points = self.checker.points, self.points
+        try:
+            findings = method(*args)
+        finally:
+            self.checker.points = saved
+        return [replace(f, message=f.message.rstrip() + self.NOTE) for f in findings]
 
 
 class _Checker:
@@ -492,7 +524,8 @@ class _Checker:
         usable = [(x, y) for x, y in zip(mine, theirs, strict=True) if y is not None]
         if not usable or any(x is None for x, _ in usable):
             return False
-        return all(eq.close(a, b) for x, y in usable for a, b in zip(x, y, strict=True))
+        return all(eq.close(a, b, self.points.tolerance)
+                   for x, y in usable for a, b in zip(x, y, strict=True))
 
     # multipliers -----------------------------------------------------------------------
 
@@ -528,6 +561,8 @@ class _Checker:
         for name, value in answer.equations:
             items.append((f"equation[{name}]", value, None, ""))
         unknown = {s: None for _, symbols in answer.foreign for s in symbols}
+        # A number standing for a measured value (9.81) carries no unit to judge.
+        items = [item for item in items if not _measured(item[1])]
         issues = answer_unit_issues(self.model, items, unknown)
         return [Finding(issue.item, "wrong", "units_mismatch", issue.message, None)
                 for issue in issues]
@@ -541,6 +576,16 @@ class _Checker:
                         f"{label} uses {listed}, which the model does not declare.",
                         fmt(self.eom.kinetic_energy if item == "T" else
                             self.eom.potential_energy if item == "V" else self.eom.dissipation))]
+
+
+def _measured(expr: sp.Expr) -> bool:
+    """Contains a number that looks like a measured value (9.81, 0.35, 50), not a plain
+    factor such as 1/2, 2 or 1/12 that derivations write anyway."""
+    for number in expr.atoms(sp.Rational):
+        p, q = abs(number.p), number.q
+        if p > 12 or q > 12:
+            return True
+    return bool(expr.atoms(sp.Float))
 
 
 def _planar(vector):

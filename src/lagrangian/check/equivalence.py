@@ -19,6 +19,7 @@ from ..model.model import Model
 
 DIGITS = 30
 TOLERANCE = mpmath.mpf(10) ** -18  # relative: rounding at 30 digits leaves ~1e-28
+FLOAT_TOLERANCE = mpmath.mpf(10) ** -12  # model values are floats (pi/6 vs 0.5235987755982988)
 SMALL = 120  # expressions with fewer operations than this may be simplified for display
 
 
@@ -29,6 +30,7 @@ class Points:
     symbols: tuple[sp.Symbol, ...]
     values: tuple[tuple[mpmath.mpf, ...], ...]
     groups: tuple[tuple[int, ...], ...]
+    tolerance: mpmath.mpf = TOLERANCE  # looser where model values (16-digit floats) are used
 
     def evaluate(self, expressions: Sequence[sp.Expr]) -> list[list[mpmath.mpc]]:
         """values[point][expression], each expression compiled once (mpmath, 30 digits)."""
@@ -49,9 +51,10 @@ class Points:
 
 
 def random_points(model: Model, extra: Iterable[sp.Symbol] = (), *, count: int = 6,
-                  groups: int = 2, seed: int = 2718) -> Points:
+                  groups: int = 2, seed: int = 2718, model_values: bool = False) -> Points:
     """``count`` points per group: within a group the parameters are fixed and the state
-    (q, q_dot, q_ddot, t, multipliers, extra symbols) varies."""
+    (q, q_dot, q_ddot, t, multipliers, extra symbols) varies. ``model_values``: parameters
+    that have a value keep it (for answers that write numbers in place of parameters)."""
     rng = random.Random(seed)
     parameters = [p.symbol for p in model.parameters]
     state: list[sp.Symbol] = []
@@ -66,25 +69,29 @@ def random_points(model: Model, extra: Iterable[sp.Symbol] = (), *, count: int =
     with mpmath.workdps(DIGITS):
         for _ in range(groups):
             fixed = [mpmath.mpf(rng.uniform(0.6, 1.8)) for _ in parameters]
+            if model_values:
+                fixed = [mpmath.mpf(repr(p.value)) if p.value is not None else value
+                         for p, value in zip(model.parameters, fixed, strict=True)]
             members = []
             for _ in range(count):
                 members.append(len(values))
                 values.append(tuple(fixed + [mpmath.mpf(rng.uniform(-1.2, 1.2)) for _ in state]))
             index_groups.append(tuple(members))
-    return Points(symbols, tuple(values), tuple(index_groups))
+    tolerance = FLOAT_TOLERANCE if model_values else TOLERANCE
+    return Points(symbols, tuple(values), tuple(index_groups), tolerance)
 
 
-def close(a, b) -> bool:
-    """Equal to within rounding at 30 digits (nan never equals)."""
+def close(a, b, tolerance=TOLERANCE) -> bool:
+    """Equal to within rounding (nan never equals)."""
     if mpmath.isnan(a.real) or mpmath.isnan(b.real):
         return False
     scale = max(mpmath.mpf(1), abs(a), abs(b))
-    return abs(a - b) <= TOLERANCE * scale
+    return abs(a - b) <= tolerance * scale
 
 
-def all_close(values) -> bool:
+def all_close(values, tolerance=TOLERANCE) -> bool:
     values = list(values)
-    return all(close(v, values[0]) for v in values[1:])
+    return all(close(v, values[0], tolerance) for v in values[1:])
 
 
 def identical(a: sp.Expr, b: sp.Expr, points: Points) -> bool:
@@ -93,20 +100,20 @@ def identical(a: sp.Expr, b: sp.Expr, points: Points) -> bool:
     if difference == 0:
         return True
     rows = points.evaluate([a, b])
-    return all(close(row[0], row[1]) for row in rows)
+    return all(close(row[0], row[1], points.tolerance) for row in rows)
 
 
 def constant_in_state(expression: sp.Expr, points: Points) -> bool:
     """True when ``expression`` depends on parameters only (same value across a group)."""
     rows = points.evaluate([expression])
-    return all(all_close(rows[i][0] for i in group) for group in points.groups)
+    return all(all_close((rows[i][0] for i in group), points.tolerance) for group in points.groups)
 
 
 def zero(expression: sp.Expr, points: Points) -> bool:
     if expression == 0:
         return True
     rows = points.evaluate([expression])
-    return all(close(row[0], mpmath.mpc(0)) for row in rows)
+    return all(close(row[0], mpmath.mpc(0), points.tolerance) for row in rows)
 
 
 def display(expression: sp.Expr) -> sp.Expr:

@@ -26,30 +26,11 @@ from . import modes as _modes  # noqa: E402,F401
 from . import simulate as _simulate  # noqa: E402,F401
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Console entry point: run the app, turning library errors into exit status 2."""
+def main(argv: list[str] | None = None) -> None:
+    """Console entry point: usage errors exit 2 (click's standalone mode); library errors
+    (bad model, bad values, singular system) print one line and exit 2 as well."""
     try:
-        app(args=argv, prog_name="lagrangian", standalone_mode=False)
-    except LagrangianError as exc:
+        app(args=argv, prog_name="lagrangian")
+    except (LagrangianError, FileExistsError) as exc:
         typer.echo(f"error: {exc}", err=True)
-        return _exit(2)
-    except FileExistsError as exc:
-        typer.echo(f"error: {exc}", err=True)
-        return _exit(2)
-    except typer.Exit as exc:
-        return _exit(exc.exit_code)
-    except (typer.Abort, KeyboardInterrupt):
-        typer.echo("aborted", err=True)
-        return _exit(130)
-    except Exception as exc:  # click usage errors carry their own exit code
-        import click
-
-        if isinstance(exc, click.ClickException):
-            exc.show()
-            return _exit(exc.exit_code)
-        raise
-    return _exit(0)
-
-
-def _exit(code: int | None) -> int:
-    sys.exit(int(code or 0))
+        sys.exit(2)

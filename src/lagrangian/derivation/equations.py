@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import sympy as sp
 
@@ -41,7 +42,15 @@ class EquationsOfMotion:
     velocity_bias: sp.ImmutableMatrix
     acceleration_rhs: sp.ImmutableMatrix
     multipliers: sp.ImmutableMatrix
-    accelerations: sp.ImmutableMatrix | None
+
+    @cached_property
+    def accelerations(self) -> sp.ImmutableMatrix | None:
+        """q_ddot solved symbolically (with the multipliers eliminated), or None where the
+        closed form would be too large to be useful; computed on first use."""
+        from .solve import solve_accelerations
+
+        return solve_accelerations(self.mass_matrix, self.forcing, self.constraint_jacobian,
+                                   self.acceleration_rhs)
 
     @property
     def coordinates(self) -> sp.ImmutableMatrix:

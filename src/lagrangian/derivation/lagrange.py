@@ -17,11 +17,6 @@ from .kinematics import Differentiator
 from .regularity import check_regularity
 from .virtual_work import generalized_forces, load_contributions
 
-# Above this size a symbolic solve for q_ddot swells; users get the implicit form only.
-SYMBOLIC_SOLVE_MAX_UNKNOWNS = 3
-SYMBOLIC_SOLVE_MAX_OPS = 200
-# cancel() is superlinear in expression size: past this the closed form is not worth showing.
-SYMBOLIC_SOLUTION_MAX_OPS = 1500
 
 
 class _Accumulator:
@@ -138,7 +133,6 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
         velocity_bias=bias,
         acceleration_rhs=gamma,
         multipliers=multipliers,
-        accelerations=_solve_small(mass_matrix, forcing, jacobian, gamma),
     )
 
 
@@ -159,27 +153,3 @@ def _general_lagrangian(acc: _Accumulator, d: Differentiator, L: sp.Expr, q, q_d
         rate = time_rate(p, q, q_dot, t)
         if rate != 0:
             acc.forcing[i].append(-rate)
-
-
-def _solve_small(mass_matrix, forcing, jacobian, gamma) -> sp.ImmutableMatrix | None:
-    n, m = mass_matrix.shape[0], jacobian.shape[0]
-    if n + m > SYMBOLIC_SOLVE_MAX_UNKNOWNS:
-        return None
-    if sp.count_ops(mass_matrix) + sp.count_ops(forcing) > SYMBOLIC_SOLVE_MAX_OPS:
-        return None
-    if m:
-        system = sp.Matrix(sp.BlockMatrix([[mass_matrix, jacobian.T],
-                                           [jacobian, sp.zeros(m, m)]]))
-        rhs = sp.Matrix.vstack(sp.Matrix(forcing), sp.Matrix(gamma))
-    else:
-        system, rhs = sp.Matrix(mass_matrix), sp.Matrix(forcing)
-    try:
-        solution = system.LUsolve(rhs)
-    except (ValueError, ZeroDivisionError, sp.matrices.exceptions.NonInvertibleMatrixError):
-        return None
-    if any(value.has(sp.nan, sp.zoo) for value in solution):
-        return None
-    if sp.count_ops(solution) > SYMBOLIC_SOLUTION_MAX_OPS:
-        return None
-    # Small by the guard above, so a rational cancellation is cheap and much more readable.
-    return sp.ImmutableMatrix(n, 1, [sp.factor_terms(sp.cancel(v)) for v in solution[:n]])

@@ -310,7 +310,7 @@ def resolve_equilibrium(
         q2, lam2, ok2 = solver.solve(q_start[None], lam_start[None], everything, limit)
         moved = np.abs(q2[0] - q)[given]
         if ok2[0] and np.all(moved <= ACCEPT_MOVE * (1 + np.abs(q[given]))):
-            return q2[0], lam2[0]
+            return np.vectorize(_clean)(q2[0]), lam2[0]
         return None
 
     q1, lam1, ok = solver.solve(q[None], lam[None], ~given, limit)
@@ -325,19 +325,39 @@ def resolve_equilibrium(
         result = polished(q_start, lam_start)
         if result is not None:
             return result
-    residual = solver.residual(q1[0], lam1[0])
-    worst = int(np.argmax(np.abs(residual)))
-    what = names[worst] if worst < len(names) else \
-        f"constraint '{functions.static_names[worst - len(names)]}'"
     given_text = ", ".join(f"{n}={about[n]:.6g}" for n in names if n in about)
     hint = ""
     nearby = solver.solve(q[None], lam[None], np.ones(len(names), bool), limit)
     if nearby[2][0]:
         near = ", ".join(f"{n}={_clean(v):.6g}" for n, v in zip(names, nearby[0][0], strict=True))
         hint = f"; the nearest equilibrium is at {near}"
-    raise ModelError(
-        f"{given_text} is not an equilibrium: the forces at rest do not balance "
-        f"(residual {residual[worst]:.4g} on {what}){hint}", field=option)
+    raise ModelError(f"{given_text} is not an equilibrium: "
+                     f"{_why_not(functions, q, ~given, t)}{hint}", field=option)
+
+
+def _why_not(functions: StaticFunctions, q: np.ndarray, free: np.ndarray, t: float) -> str:
+    """Which balance fails at q: first meet the constraints moving only the free coordinates,
+    then report the largest unbalanced generalized force (or the violated constraint)."""
+    names = [c.name for c in functions.model.coordinates]
+    q = q.copy()
+    for _ in range(50):
+        values = functions.evaluate(q, t)
+        if not values["static"].size:
+            break
+        step = -np.linalg.pinv(values["static_jacobian"][:, free], rcond=1e-12) @ values["static"]
+        q[free] += step
+        if np.all(np.abs(step) <= 1e-14 * (1 + np.abs(q[free]))):
+            break
+    values = functions.evaluate(q, t)
+    if values["static"].size:
+        worst = int(np.argmax(np.abs(values["static"])))
+        if abs(values["static"][worst]) > 1e-9 * (1 + np.abs(q).max()):
+            return (f"it violates constraint '{functions.static_names[worst]}' "
+                    f"(residual {values['static'][worst]:.4g})")
+    force = static_residual(values, initial_multipliers(values))[: len(names)]
+    worst = int(np.argmax(np.abs(force)))
+    return (f"the forces at rest do not balance (residual {force[worst]:.4g} on "
+            f"{names[worst]})")
 
 
 # -- helpers ------------------------------------------------------------------------------------

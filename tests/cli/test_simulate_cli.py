@@ -131,3 +131,12 @@ def test_console_script_runs_simulate():
     summary = json.loads(done.stdout)
     # y = a t^2 / 2 with a = (m1 - m2) g / (m1 + m2 + I/R^2) = 9.81/6
     assert summary["final_state"]["y"] == pytest.approx(9.81 / 12, rel=1e-8)
+
+
+def test_nothing_to_animate_is_refused_before_the_run(capsys, tmp_path):
+    plot = tmp_path / "run.png"
+    code, out, err = cli(capsys, "pendulum", "--t-end", "1", "--plot", plot, "--animate",
+                         tmp_path / "run.gif")
+    assert code == 2 and out == "" and not plot.exists()
+    assert err == ("error: --animate: nothing to animate: the model has no particles or bodies "
+                   "(it is given by its energies only)\n")

@@ -35,6 +35,7 @@ def simulate(
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
     from ..output.animation import _check_suffix as check_animation
+    from ..output.animation import check_animatable
     from ..output.plots import _check_suffix as check_plot
     from ..output.tables import TABLE_FORMATS
 
@@ -53,6 +54,7 @@ def simulate(
         check_plot(plot)
     if animate is not None:
         check_animation(animate)
+        check_animatable(system.model)
     inputs = (Path(model),) if Path(model).exists() else ()
     for path in (out, plot, animate):
         if path is not None and inputs and path.exists() and path.resolve() == inputs[0].resolve():

@@ -162,6 +162,13 @@ def animation_frames(result: SimulationResult, fps: int = 25, max_frames: int = 
     return np.linspace(t0, t1, count)
 
 
+def check_animatable(model: Model) -> None:
+    """Refuse a model with nothing to draw (given by its energies only)."""
+    if not (model.particles or model.bodies):
+        raise ModelError("nothing to animate: the model has no particles or bodies "
+                         "(it is given by its energies only)", field="--animate")
+
+
 def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25,
                         max_frames: int = 250):
     """A matplotlib FuncAnimation of the mechanism over the run (planar x-y view)."""
@@ -169,6 +176,7 @@ def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    check_animatable(model)
     geometry = mechanism(model, result.parameters)
     times = animation_frames(result, fps, max_frames)
     q = np.column_stack([np.interp(times, result.t, result.q[:, i])
@@ -176,16 +184,16 @@ def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25
     v = np.column_stack([np.interp(times, result.t, result.q_dot[:, i])
                          for i in range(result.q.shape[1])])
     particles, bars, springs = geometry.frame(q, v, times)
-    if not (particles.size or bars.size or springs.size):
-        raise ModelError("nothing to animate: the model has no particles or bodies "
-                         "(it is given by its energies only)", field="--animate")
     everything = np.concatenate([particles.reshape(-1, 2), bars.reshape(-1, 2),
                                  springs.reshape(-1, 2), [[0.0, 0.0]]])
     everything = everything[np.all(np.isfinite(everything), axis=1)]
     low, high = everything.min(axis=0), everything.max(axis=0)
-    pad = 0.1 * max(float(np.max(high - low)), 1e-3)
+    # A square view around the motion, so a mechanism moving along one line is not squashed.
+    half = 0.55 * max(float(np.max(high - low)), 1e-3)
+    centre = (low + high) / 2
+    low, high, pad = centre - half, centre + half, 0.0
 
-    figure = Figure(figsize=(5, 5), dpi=80)
+    figure = Figure(figsize=(5, 5), dpi=80, layout="constrained")
     FigureCanvasAgg(figure)
     ax = figure.add_subplot()
     ax.set_xlim(low[0] - pad, high[0] + pad)

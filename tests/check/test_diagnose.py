@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 from check_helpers import check_file, check_text, finding
 
+import lagrangian
 from lagrangian.check.diagnose import CODES
 
 # -- potential energy ---------------------------------------------------------------------
@@ -295,3 +296,32 @@ def test_numbers_in_place_of_parameters_are_compared_at_the_model_values():
     # even though the model's m is 1 kg.
     missing_m = check_text("pendulum", '[energy]\nT = "1/2*L^2*theta_dot^2"\n')
     assert finding(missing_m, "T").code == "kinetic_factor"
+
+
+@pytest.mark.parametrize("name", lagrangian.examples())
+def test_every_example_accepts_its_own_derivation_and_rejects_a_changed_one(name):
+    from lagrangian.model.answer import answer_from_mapping
+    from lagrangian.model.expressions import format_expression
+
+    s = lagrangian.load(name)
+    eom, model = s.equations_of_motion(), s.model
+    names = [c.name for c in model.coordinates]
+    data = {
+        "energy": {"T": format_expression(eom.kinetic_energy),
+                   "V": format_expression(eom.potential_energy)},
+        "equations": {n: format_expression(-2 * e) for n, e in zip(names, eom.equations,
+                                                                    strict=True)},
+    }
+    if model.constraints:
+        data["multipliers"] = {"count": len(model.constraints)}
+    report = s.check(answer_from_mapping(data, model))
+    assert report.verdict == "correct", report
+    # The first equation with its velocity-independent forcing doubled is wrong.
+    changed = dict(data["equations"])
+    first = eom.equations[0]
+    extra = -eom.forcing[0].xreplace({v: 0 for v in model.q_dot})
+    if extra == 0:
+        extra = eom.mass_matrix[0, 0] * model.q[0]  # a spring that is not there
+    changed[names[0]] = format_expression(-2 * (first + extra))
+    wrong = s.check(answer_from_mapping({**data, "equations": changed}, model))
+    assert finding(wrong, f"equation[{names[0]}]").code == "equation_wrong", wrong

@@ -8,6 +8,7 @@ a parameter that happens to be 0 (a load switched off) must not hide a mistake.
 
 from __future__ import annotations
 
+import functools
 import random
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -116,12 +117,21 @@ def zero(expression: sp.Expr, points: Points) -> bool:
     return all(close(row[0], mpmath.mpc(0), points.tolerance) for row in rows)
 
 
+SIMPLIFY_MAX_OPS = 40  # display only: simplify costs ~0.1-1 s beyond this
+
+
+@functools.lru_cache(maxsize=512)
 def display(expression: sp.Expr) -> sp.Expr:
     """A readable form for messages: simplified only when small (never on large ones)."""
-    if not _small(expression):
+    expression = sp.sympify(expression)  # safe: a sympy object or a number
+    if sp.count_ops(expression) > SIMPLIFY_MAX_OPS:
         return expression
+    angles = {f.args[0] for f in expression.atoms(sp.sin, sp.cos, sp.tan)}
     try:
-        simpler = sp.factor_terms(sp.simplify(expression))
+        if len(angles) > 1:  # trigsimp over several angles is where simplify spends seconds
+            simpler = sp.factor_terms(sp.cancel(expression))
+        else:
+            simpler = sp.factor_terms(sp.simplify(expression))
     except Exception:  # noqa: BLE001 - a failed simplification only costs readability
         return expression
     return simpler if sp.count_ops(simpler) <= sp.count_ops(expression) else expression

@@ -122,6 +122,8 @@ def test_charged_particle_cyclotron_frequency():
     circle = np.array(oscillating[0].complex_shape)
     assert abs(circle[0]) == pytest.approx(abs(circle[1]))
     assert abs(circle[1].real) == pytest.approx(0, abs=1e-12)
+    # x = cos(w t), y = Re(i e^{i w t}) = -sin(w t): a positive charge circles clockwise about +B.
+    assert np.angle(circle[1] / circle[0]) == pytest.approx(math.pi / 2)
     assert analysis.stable
 
 

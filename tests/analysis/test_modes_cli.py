@@ -50,6 +50,12 @@ def test_modes_text_report(capsys):
     assert "Stiffness matrix K" in out
 
 
+def test_complex_mode_phases_in_text(capsys):
+    code, out, _ = run(capsys, "modes", "charged_particle")
+    assert code == 0
+    assert "mode 2: x 1 at +0.0 deg, y 1 at +90.0 deg" in out
+
+
 def test_inverted_pendulum_about_pi(capsys):
     code, out, _ = run(capsys, "modes", "cart_pendulum", "--about", "theta=pi", "--json")
     assert code == 0

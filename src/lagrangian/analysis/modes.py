@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import DerivationError
 from .linearization import LinearModel
 
 # Eigenvalues smaller than this fraction of the largest are zero (rigid-body modes).
@@ -152,7 +153,11 @@ def _symmetric_modes(linear: LinearModel) -> list[Mode]:
     K = (linear.stiffness_matrix + linear.stiffness_matrix.T) / 2
     if K.shape[0] == 0:
         return []
-    squared, vectors = scipy.linalg.eigh(K, M)
+    try:
+        squared, vectors = scipy.linalg.eigh(K, M)
+    except np.linalg.LinAlgError:
+        raise DerivationError("the mass matrix is not positive definite at this equilibrium "
+                              "(is the kinetic energy complete and positive?)") from None
     zero = ZERO_SQUARED_TOLERANCE * max(np.abs(squared).max(), 1e-300)
     modes = []
     for w2, vector in zip(squared, vectors.T, strict=True):

@@ -116,6 +116,16 @@ def modes_text(analysis: ModalAnalysis) -> str:
         lines.append(f"{i:>4}  {_number(m.frequency):>13}  {_number(m.frequency_hz):>10}  "
                      f"{period:>10}  {zeta:>8}  {_number(m.growth_rate):>12}  {shape}  "
                      f"{_kind_note(m)}".rstrip())
+    complex_modes = [(i, m) for i, m in enumerate(analysis.modes, 1)
+                     if any(abs(v.imag) > 1e-9 for v in m.complex_shape)]
+    if complex_modes:
+        lines += ["", "Complex modes (gyroscopic or non-proportional damping): the shape above is "
+                      "the snapshot when the reference coordinate peaks;",
+                  "amplitude and phase of each coordinate:"]
+        for i, m in complex_modes:
+            parts = ", ".join(f"{n} {abs(v):.4g} at {math.degrees(np.angle(v)):+.1f} deg"
+                              for n, v in zip(names, m.complex_shape, strict=True))
+            lines.append(f"  mode {i}: {parts}")
     return "\n".join(lines) + "\n"
 
 

@@ -180,15 +180,18 @@ class System:
     # -- checking a hand derivation (issue 5): check, crosscheck, check_units --------------------
 
     def check(self, answer):
-        """Verdicts and diagnoses on a hand derivation: a path to ANSWER.toml, or an Answer.
+        """Verdicts and diagnoses on a hand derivation: a path to ANSWER.toml, its tables as a
+        dict ({"energy": {"V": "..."}}), or an Answer.
 
         Returns a CheckReport (``verdict``, ``findings`` with item, status, code, message,
         expected); items written differently but equivalently are accepted.
         """
         from .check.diagnose import check_answer
-        from .model.answer import Answer, read_answer
+        from .model.answer import Answer, answer_from_mapping, read_answer
 
-        if not isinstance(answer, Answer):
+        if isinstance(answer, Mapping):
+            answer = answer_from_mapping(answer, self._model, source="<answer>")
+        elif not isinstance(answer, Answer):
             answer = read_answer(answer, self._model)
         return check_answer(self.equations_of_motion(), answer)
 

@@ -325,3 +325,10 @@ def test_every_example_accepts_its_own_derivation_and_rejects_a_changed_one(name
     changed[names[0]] = format_expression(-2 * (first + extra))
     wrong = s.check(answer_from_mapping({**data, "equations": changed}, model))
     assert finding(wrong, f"equation[{names[0]}]").code == "equation_wrong", wrong
+
+
+def test_python_api_takes_the_tables_as_a_dict():
+    report = lagrangian.load("pendulum").check({"energy": {"V": "m*g*L*cos(theta)"}})
+    assert report.codes() == ["potential_sign"] and not report.correct
+    with pytest.raises(lagrangian.ModelError, match="unknown key 'U'"):
+        lagrangian.load("pendulum").check({"energy": {"U": "0"}})

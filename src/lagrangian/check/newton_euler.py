@@ -27,6 +27,7 @@ from ..model.model import Model, PointForce, Torque
 from . import equivalence as eq
 
 SYMBOLIC_REACTIONS_MAX_UNKNOWNS = 3
+SOLVED_MAX_OPS = 60  # beyond this, reactions read better in terms of the accelerations
 
 
 @dataclass(frozen=True)
@@ -278,7 +279,7 @@ def _reactions(eom: EquationsOfMotion, bodies: list[_FreeBody], newton_euler: li
             values = A.LUsolve(-b)
             solution = {u: sp.cancel(v) for u, v in zip(unknowns, values, strict=True)}
             # A solved form this large reads worse than the accelerations themselves.
-            if any(sp.count_ops(v) > 2 * eq.SMALL for v in solution.values()):
+            if any(sp.count_ops(v) > SOLVED_MAX_OPS for v in solution.values()):
                 solution = {}
         except (ValueError, ZeroDivisionError, sp.matrices.exceptions.NonInvertibleMatrixError):
             solution = {}

@@ -91,3 +91,32 @@ def test_reaction_repr_and_difference_strings():
     report = system("ladder_pendulum").crosscheck()
     assert "agree=True" in repr(report)
     assert all(isinstance(format_expression(v), str) for v in report.reactions[0].components)
+
+
+def test_double_pendulum_reactions_in_terms_of_accelerations():
+    s = system("double_pendulum")
+    report = s.crosscheck()
+    assert any("in terms of the accelerations" in note for note in report.notes)
+    names = ("theta1", "theta2", "theta1_dot", "theta2_dot", "theta1_ddot", "theta2_ddot",
+             "l1", "l2", "m2", "g")
+    t1, t2, w1, w2, a1, a2, l1, l2, m2, g = (s.symbol(n) for n in names)
+    R_x, R_y = s.crosscheck().reaction("bob2").components
+    # m2 a = R + m2 g with a the second time derivative of (l1 sin t1 + l2 sin t2, ...).
+    a_x = l1 * (a1 * sp.cos(t1) - w1**2 * sp.sin(t1)) + l2 * (a2 * sp.cos(t2) - w2**2 * sp.sin(t2))
+    assert sp.expand(R_x - m2 * a_x) == 0
+    assert R_y.has(a1, a2, g)
+
+
+def test_elastic_pendulum_spring_between_two_points():
+    # A spring 'between' the pivot and the bob: its tension along the unit vector between them.
+    from lagrangian import SystemBuilder
+
+    b = SystemBuilder("Elastic pendulum")
+    r, th = b.coordinate("r", unit="m"), b.coordinate("theta", unit="rad")
+    m, g, k, l0 = (b.parameter(n, v, u) for n, v, u in
+                   (("m", 1.0, "kg"), ("g", 9.81, "m/s^2"), ("k", 50.0, "N/m"), ("l0", 0.4, "m")))
+    b.set_gravity(g, (0, -1)).add_particle("bob", m, (r * sp.sin(th), -r * sp.cos(th)))
+    b.add_spring("spring", k, l0, between=[(0, 0), "bob"])
+    b.add_damper("damper", 0.3, between=[(0, 0), "bob"])
+    report = b.build().crosscheck()
+    assert report.agree, report

@@ -174,10 +174,12 @@ def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
     for spring in model.springs:
         unattributed.append(spring.name)
         tension = spring.stiffness * (spring.length - spring.rest_length)
-        ends = _separation(spring.length)
+        squared = _squared_separation(spring.length)
         for i, qi in enumerate(q):
-            if ends is not None:  # force -k (l - l0) d/|d| on one end, the opposite on the other
-                work[i].append(sp.Add(*(-tension * d / spring.length * d.diff(qi) for d in ends)))
+            if squared is not None:
+                # Force -k (l - l0) d/|d| on one end along d = r_a - r_b and the opposite on the
+                # other: virtual work -k (l - l0)/l d.(dd/dq_i) = -k (l - l0)/l * 1/2 d|d|^2/dq_i.
+                work[i].append(-tension / spring.length * squared.diff(qi) / 2)
             else:  # a spring along its own length coordinate
                 work[i].append(-tension * spring.length.diff(qi))
     for damper in model.dampers:
@@ -252,12 +254,10 @@ def _holder(point, bodies: list[_FreeBody], model: Model, points: eq.Points) -> 
     return None
 
 
-def _separation(length: sp.Expr):
-    """The components d of a length written sqrt(d_x^2 + d_y^2 + ...) (spring 'between')."""
+def _squared_separation(length: sp.Expr) -> sp.Expr | None:
+    """|d|^2 for a length written sqrt(|d|^2), as a spring 'between' two points is."""
     if isinstance(length, sp.Pow) and length.exp == sp.S.Half:
-        squares = sp.Add.make_args(length.base)
-        if all(isinstance(s, sp.Pow) and s.exp == 2 for s in squares):
-            return [s.base for s in squares]
+        return length.base
     return None
 
 

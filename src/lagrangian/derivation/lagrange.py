@@ -8,6 +8,8 @@ goes through the general formula W q_ddot = dL/dq - (d^2L/dq_dot dq) q_dot - d^2
 
 from __future__ import annotations
 
+from collections import defaultdict
+
 import sympy as sp
 
 from ..model.model import Model, multiplier_name
@@ -15,43 +17,79 @@ from .constraints import constraint_terms
 from .equations import EquationsOfMotion
 from .kinematics import Differentiator
 from .regularity import check_regularity
+from .trig import combine_terms, combined_terms
 from .virtual_work import generalized_forces, load_contributions
 
 
 
 class _Accumulator:
-    """Collects terms of M and f and adds each entry once (repeated Add is quadratic)."""
+    """Collects the terms of M and f, grouped by shape, and adds each entry once.
+
+    A chain repeats the same column products for every body further out; grouping term -> list
+    of coefficients (masses) forms each product once and gives the textbook (m1 + m2) l1^2.
+    """
 
     def __init__(self, n: int):
         self.n = n
-        self.mass = [[[] for _ in range(n)] for _ in range(n)]
-        self.forcing = [[] for _ in range(n)]
+        self.mass = [[defaultdict(list) for _ in range(n)] for _ in range(n)]
+        self.forcing = [defaultdict(list) for _ in range(n)]
+        self._dots: dict[tuple, sp.Expr] = {}
+        self._products: dict[tuple[sp.Expr, sp.Expr], sp.Expr] = {}
+
+    def add_force(self, i: int, expr: sp.Expr) -> None:
+        self.forcing[i][expr].append(sp.S.One)
+
+    def add_mass(self, i: int, j: int, expr: sp.Expr) -> None:
+        self.mass[i][j][expr].append(sp.S.One)
+
+    def _dot(self, column_i: tuple, column_j: tuple) -> sp.Expr:
+        key = (column_i, column_j)
+        found = self._dots.get(key)
+        if found is None:
+            terms = [a * b for a, b in zip(column_i, column_j, strict=True) if a != 0 and b != 0]
+            found = self._dots[key] = combine_terms(terms)
+        return found
+
+    def _projection(self, column: tuple, vector: list[sp.Expr]) -> list[sp.Expr]:
+        """column . vector distributed term by term (memoized products), then tidied."""
+        terms = []
+        for a, v in zip(column, vector, strict=True):
+            if a == 0 or v == 0:
+                continue
+            for term in sp.Add.make_args(v):
+                key = (a, term)
+                product = self._products.get(key)
+                if product is None:
+                    product = self._products[key] = a * term
+                terms.append(product)
+        return combined_terms(terms)
 
     def inertia(self, mass: sp.Expr, jacobian: list[list[sp.Expr]], rest: list[sp.Expr]) -> None:
         """Add m J^T J to M and -m J^T a_rest to f for J (rows: components, cols: coordinates)."""
         n = self.n
+        columns = [tuple(row[i] for row in jacobian) for i in range(n)]
         for i in range(n):
-            column_i = [row[i] for row in jacobian]
-            if not any(c != 0 for c in column_i):
+            if not any(c != 0 for c in columns[i]):
                 continue
             for j in range(i, n):
-                dot = sp.Add(*(a * row[j] for a, row in zip(column_i, jacobian, strict=True)
-                               if a != 0 and row[j] != 0))
+                dot = self._dot(columns[i], columns[j])
                 if dot != 0:
-                    self.mass[i][j].append(mass * dot)
-            projected = sp.Add(*(a * r for a, r in zip(column_i, rest, strict=True)
-                                 if a != 0 and r != 0))
-            if projected != 0:
-                self.forcing[i].append(-mass * projected)
+                    self.mass[i][j][dot].append(mass)
+            for term in self._projection(columns[i], rest):
+                self.forcing[i][term].append(-mass)
 
     def matrices(self) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
         n = self.n
         mass = [[sp.S.Zero] * n for _ in range(n)]
         for i in range(n):
             for j in range(i, n):
-                mass[i][j] = mass[j][i] = sp.Add(*self.mass[i][j])
-        forcing = [sp.Add(*terms) for terms in self.forcing]
+                mass[i][j] = mass[j][i] = _collect(self.mass[i][j])
+        forcing = [_collect(terms) for terms in self.forcing]
         return sp.ImmutableMatrix(mass), sp.ImmutableMatrix(n, 1, forcing)
+
+
+def _collect(groups: dict[sp.Expr, list[sp.Expr]]) -> sp.Expr:
+    return sp.Add(*(term * sp.Add(*coefficients) for term, coefficients in groups.items()))
 
 
 def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
@@ -105,13 +143,13 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
     if component_potential != 0:
         for i, gradient in enumerate(jacobian_row(component_potential, q)):
             if gradient != 0:
-                acc.forcing[i].append(-gradient)
+                acc.add_force(i, -gradient)
 
     contributions = load_contributions(model)
     Q = generalized_forces(model, contributions)
     for i, value in enumerate(Q):
         if value != 0:
-            acc.forcing[i].append(value)
+            acc.add_force(i, value)
     mass_matrix, forcing = acc.matrices()
 
     jacobian, bias, gamma = constraint_terms(model)
@@ -143,13 +181,13 @@ def _general_lagrangian(acc: _Accumulator, d: Differentiator, L: sp.Expr, q, q_d
     forces = jacobian_row(L, q)
     for i, p in enumerate(momenta):
         if forces[i] != 0:
-            acc.forcing[i].append(forces[i])
+            acc.add_force(i, forces[i])
         if p == 0:
             continue
         # W is symmetric: only its upper triangle is accumulated.
         for j, w in enumerate(jacobian_row(p, q_dot)[i:], start=i):
             if w != 0:
-                acc.mass[i][j].append(w)
+                acc.add_mass(i, j, w)
         rate = time_rate(p, q, q_dot, t)
         if rate != 0:
-            acc.forcing[i].append(-rate)
+            acc.add_force(i, -rate)

@@ -59,9 +59,33 @@ class _Printer(C99CodePrinter):
         return f"(({x}) > 0 ? 1.0 : (({x}) < 0 ? 0.0 : 0.5))"
 
 
+def _is_angle_pair(e) -> bool:
+    return isinstance(e, (sp.sin, sp.cos)) and isinstance(e.args[0], sp.Add) and len(e.args[0].args) == 2
+
+
+def _split_angle_pair(e):
+    a, b = e.args[0].args
+    if isinstance(e, sp.sin):
+        return sp.sin(a) * sp.cos(b) + sp.cos(a) * sp.sin(b)
+    return sp.cos(a) * sp.cos(b) - sp.sin(a) * sp.sin(b)
+
+
+def _trig_calls(exprs) -> int:
+    return len(set().union(*(e.atoms(sp.sin, sp.cos) for e in exprs))) if exprs else 0
+
+
+def _fewer_trig_calls(exprs: list[sp.Expr]) -> list[sp.Expr]:
+    """sin/cos(a ± b) by the addition theorems where that leaves fewer distinct trig calls.
+
+    A chain with absolute angles has cos(q_i - q_j) for every pair: n^2 calls become 2n.
+    """
+    split = [e.replace(_is_angle_pair, _split_angle_pair) for e in exprs]
+    return split if _trig_calls(split) < _trig_calls(exprs) else exprs
+
+
 def _block(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: _Printer) -> str:
     """C statements computing ``targets[i] = exprs[i]`` with shared subexpressions hoisted."""
-    exprs = [sp.sympify(e) for e in exprs]  # safe: already sympy objects
+    exprs = _fewer_trig_calls([sp.sympify(e) for e in exprs])  # safe: already sympy objects
     replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), optimizations="basic")
     statements = [(f"const double {symbol}", value) for symbol, value in replacements]
     statements += list(zip(targets, reduced, strict=True))

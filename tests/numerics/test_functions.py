@@ -271,3 +271,20 @@ def test_generated_source_has_no_symbolic_inverse_and_shares_subexpressions():
     calls = re.findall(r"\b(?:sin|cos)\([^()]*\)", parts)
     assert calls and len(calls) == len(set(calls))  # cse: each trig call computed once
     assert functions_module.BACKENDS == ("auto", "c", "numpy")
+
+
+def test_angle_sums_are_split_only_when_that_saves_trig_calls():
+    import sympy as sp
+
+    from lagrangian.numerics.codegen import _fewer_trig_calls
+
+    a, b, c, w, t, phi = sp.symbols("a b c w t phi")
+    chain = [sp.cos(a - b), sp.cos(a - c), sp.cos(b - c), sp.sin(a - b), sp.sin(b - c), sp.sin(a - c)]
+    split = _fewer_trig_calls(chain)  # 6 calls -> sin and cos of a, b, c
+    assert {e for s in split for e in s.atoms(sp.sin, sp.cos)} == {
+        sp.sin(a), sp.cos(a), sp.sin(b), sp.cos(b), sp.sin(c), sp.cos(c)}
+    values = {a: 0.3, b: -1.2, c: 2.5}
+    for original, rewritten in zip(chain, split, strict=True):
+        assert float(rewritten.subs(values)) == pytest.approx(float(original.subs(values)), abs=1e-15)
+    drive = [sp.sin(w * t + phi)]  # one call; splitting would make it four
+    assert _fewer_trig_calls(drive) == drive

@@ -31,8 +31,8 @@ _JSON = Annotated[bool, typer.Option("--json", help="Print JSON.")]
 @app.command()
 def check(
     model: _MODEL,
-    answer: Annotated[str, typer.Argument(help="Your derivation: ANSWER.toml ([energy] T, V; "
-                                                "[generalized_forces]; [equations]; [multipliers]).")],
+    answer: Annotated[str, typer.Argument(help="Your derivation, ANSWER.toml: tables energy (T, V, "
+                                                "D), generalized_forces, equations, multipliers.")],
     set_: _SET = [],  # noqa: B006
     json_: _JSON = False,
 ) -> None:

@@ -278,13 +278,16 @@ def test_angle_sums_are_split_only_when_that_saves_trig_calls():
 
     from lagrangian.numerics.codegen import _fewer_trig_calls
 
-    a, b, c, w, t, phi = sp.symbols("a b c w t phi")
-    chain = [sp.cos(a - b), sp.cos(a - c), sp.cos(b - c), sp.sin(a - b), sp.sin(b - c), sp.sin(a - c)]
-    split = _fewer_trig_calls(chain)  # 6 calls -> sin and cos of a, b, c
+    angles = sp.symbols("a b c d")
+    w, t, phi = sp.symbols("w t phi")
+    pairs = [(x, y) for i, x in enumerate(angles) for y in angles[i + 1:]]
+    chain = [f(x - y) for x, y in pairs for f in (sp.sin, sp.cos)]
+    split = _fewer_trig_calls(chain)  # 12 calls -> sin and cos of a, b, c, d
     assert {e for s in split for e in s.atoms(sp.sin, sp.cos)} == {
-        sp.sin(a), sp.cos(a), sp.sin(b), sp.cos(b), sp.sin(c), sp.cos(c)}
-    values = {a: 0.3, b: -1.2, c: 2.5}
+        f(x) for x in angles for f in (sp.sin, sp.cos)}
+    values = dict(zip(angles, (0.3, -1.2, 2.5, 0.7), strict=True))
     for original, rewritten in zip(chain, split, strict=True):
         assert float(rewritten.subs(values)) == pytest.approx(float(original.subs(values)), abs=1e-15)
+    assert _fewer_trig_calls(chain[:6]) == chain[:6]  # a, b, c: 6 calls either way, left alone
     drive = [sp.sin(w * t + phi)]  # one call; splitting would make it four
     assert _fewer_trig_calls(drive) == drive

@@ -288,6 +288,6 @@ def test_angle_sums_are_split_only_when_that_saves_trig_calls():
     values = dict(zip(angles, (0.3, -1.2, 2.5, 0.7), strict=True))
     for original, rewritten in zip(chain, split, strict=True):
         assert float(rewritten.subs(values)) == pytest.approx(float(original.subs(values)), abs=1e-15)
-    assert _fewer_trig_calls(chain[:6]) == chain[:6]  # a, b, c: 6 calls either way, left alone
+    assert _fewer_trig_calls(chain[:6]) == chain[:6]  # only pairs with a: 6 calls, 8 if split
     drive = [sp.sin(w * t + phi)]  # one call; splitting would make it four
     assert _fewer_trig_calls(drive) == drive

@@ -88,6 +88,15 @@ class _Accumulator:
         return sp.ImmutableMatrix(mass), sp.ImmutableMatrix(n, 1, forcing)
 
 
+def _quadratic_form(mass: sp.MatrixBase, q_dot) -> sp.Expr:
+    """1/2 q_dot^T M q_dot written entry by entry (M symmetric)."""
+    n = len(q_dot)
+    terms = [sp.Rational(1, 2) * mass[i, i] * q_dot[i] ** 2 for i in range(n) if mass[i, i] != 0]
+    terms += [mass[i, j] * q_dot[i] * q_dot[j] for i in range(n) for j in range(i + 1, n)
+              if mass[i, j] != 0]
+    return sp.Add(*terms)
+
+
 def _collect(groups: dict[sp.Expr, list[sp.Expr]]) -> sp.Expr:
     return sp.Add(*(term * sp.Add(*coefficients) for term, coefficients in groups.items()))
 
@@ -106,13 +115,17 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
     def translate(mass: sp.Expr, position) -> None:
         jacobian = [jacobian_row(component, q) for component in position]
         # v = J q_dot + dr/dt, reusing J rather than differentiating r again.
+        moving = [d(component, t) for component in position]
         velocity = [
-            sp.Add(*(j * v for j, v in zip(row, q_dot, strict=True) if j != 0), d(component, t))
-            for row, component in zip(jacobian, position, strict=True)
+            sp.Add(*(j * v for j, v in zip(row, q_dot, strict=True) if j != 0), r_t)
+            for row, r_t in zip(jacobian, moving, strict=True)
         ]
         rest = [time_rate(v, q, q_dot, t) for v in velocity]
         acc.inertia(mass, jacobian, rest)
-        kinetic_terms.append(sp.Rational(1, 2) * mass * sp.Add(*(v**2 for v in velocity)))
+        # T = 1/2 q_dot^T M q_dot (from the tidied M) + what a moving support adds.
+        for v, r_t in zip(velocity, moving, strict=True):
+            if r_t != 0:
+                kinetic_terms.append(mass * (v - r_t) * r_t + sp.Rational(1, 2) * mass * r_t**2)
 
     for particle in model.particles:
         translate(particle.mass, particle.position)
@@ -120,7 +133,13 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
         translate(body.mass, body.position)
         omega = time_rate(body.angle, q, q_dot, t)
         acc.inertia(body.inertia, [jacobian_row(body.angle, q)], [time_rate(omega, q, q_dot, t)])
-        kinetic_terms.append(sp.Rational(1, 2) * body.inertia * omega**2)
+        spin = d(body.angle, t)
+        if spin != 0:
+            kinetic_terms.append(body.inertia * (omega - spin) * spin
+                                 + sp.Rational(1, 2) * body.inertia * spin**2)
+    if model.particles or model.bodies:
+        component_mass, _ = acc.matrices()
+        kinetic_terms.append(_quadratic_form(component_mass, q_dot))
 
     if model.gravity is not None:
         g, direction = model.gravity.magnitude, model.gravity.direction

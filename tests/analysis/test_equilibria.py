@@ -162,3 +162,16 @@ def test_link_pulled_by_its_tip_force():
     # About theta = pi/2 it swings like a pendulum in the field F: omega^2 = F L / (m L^2 / 3).
     (mode,) = system.modes(about={"theta": math.pi / 2}).modes
     assert mode.frequency == pytest.approx(math.sqrt(3 * 100.0 / (1.0 * 0.5)))
+
+
+def test_four_bar_rests_on_both_assembly_branches():
+    found = lagrangian.load("four_bar").equilibria()
+    a, b, c, d = 0.1, 0.35, 0.3, 0.3
+    assert len(found) == 2 and all(e.stable for e in found)
+    branches = set()
+    for e in found:
+        t1, t2, t3 = (e.coordinates[n] for n in ("theta1", "theta2", "theta3"))
+        assert a * math.cos(t1) + b * math.cos(t2) - c * math.cos(t3) - d == pytest.approx(0, abs=1e-12)
+        assert a * math.sin(t1) + b * math.sin(t2) - c * math.sin(t3) == pytest.approx(0, abs=1e-12)
+        branches.add(t3 > 0)  # open (rocker up) and crossed (rocker down) assembly
+    assert branches == {True, False}

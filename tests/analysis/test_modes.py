@@ -233,7 +233,8 @@ def test_free_mass_with_damper_is_rigid_body_and_json_has_no_nan():
 
 @pytest.mark.parametrize("name", ["pendulum", "two_mass", "double_pendulum", "cartesian_pendulum",
                                   "cart_pendulum", "damped_oscillator", "charged_particle",
-                                  "bead_on_hoop", "slider_crank", "virtual_work_link"])
+                                  "bead_on_hoop", "slider_crank", "virtual_work_link",
+                                  "four_bar"])
 def test_every_mode_report_is_finite_json_in_ascending_frequency(name):
     document = modes_document(lagrangian.load(name).modes())
     text = json.dumps(document, allow_nan=False)
@@ -269,3 +270,51 @@ def test_tilted_gravity_uses_the_mass_matrix_at_the_equilibrium():
 
     expected = np.sqrt(scipy.linalg.eigh(stiffness, mass, eigvals_only=True))
     np.testing.assert_allclose(analysis.natural_frequencies, expected, rtol=1e-12)
+
+
+def test_four_bar_against_the_energy_method():
+    """Along the mechanism V(theta1) and T = 1/2 m_eff theta1_dot^2; at rest omega^2 = V'' / m_eff.
+    The loop is closed numerically for each crank angle: no multiplier, no projection."""
+    analysis = lagrangian.load("four_bar").modes()
+    a, b, c, d = 0.1, 0.35, 0.3, 0.3
+    m1, m2, m3, k, g = 0.2, 0.5, 0.4, 2.0, 9.81
+    start = np.array([analysis.equilibrium[n] for n in ("theta2", "theta3")])
+
+    def close(t1):
+        t = start.copy()
+        for _ in range(50):
+            t2, t3 = t
+            residual = np.array([a * math.cos(t1) + b * math.cos(t2) - c * math.cos(t3) - d,
+                                 a * math.sin(t1) + b * math.sin(t2) - c * math.sin(t3)])
+            jacobian = np.array([[-b * math.sin(t2), c * math.sin(t3)],
+                                 [b * math.cos(t2), -c * math.cos(t3)]])
+            t = t - np.linalg.solve(jacobian, residual)
+        return t
+
+    def centres(t1):
+        t2, t3 = close(t1)
+        return np.array([[a / 2 * math.cos(t1), a / 2 * math.sin(t1)],
+                         [a * math.cos(t1) + b / 2 * math.cos(t2),
+                          a * math.sin(t1) + b / 2 * math.sin(t2)],
+                         [d + c / 2 * math.cos(t3), c / 2 * math.sin(t3)]]), np.array([t1, t2, t3])
+
+    masses = np.array([m1, m2, m3])
+    inertias = masses * np.array([a, b, c]) ** 2 / 12
+
+    def potential(t1):
+        r, _ = centres(t1)
+        return k * t1**2 / 2 + g * masses @ r[:, 1]
+
+    t1, h = analysis.equilibrium["theta1"], 1e-4
+    slope = (potential(t1 + h) - potential(t1 - h)) / (2 * h)
+    curvature = (potential(t1 + h) - 2 * potential(t1) + potential(t1 - h)) / h**2
+    (r_plus, angles_plus), (r_minus, angles_minus) = centres(t1 + h), centres(t1 - h)
+    velocity = (r_plus - r_minus) / (2 * h)
+    rate = (angles_plus - angles_minus) / (2 * h)
+    m_eff = masses @ np.sum(velocity**2, axis=1) + inertias @ rate**2
+    assert abs(slope) < 1e-6 * abs(curvature)  # it is an equilibrium along the mechanism
+    (mode,) = analysis.modes
+    assert mode.frequency**2 == pytest.approx(curvature / m_eff, rel=1e-6)
+    # The shape follows the loop: (1, dtheta2/dtheta1, dtheta3/dtheta1).
+    np.testing.assert_allclose([mode.shape[n] for n in ("theta1", "theta2", "theta3")], rate,
+                               rtol=1e-6)

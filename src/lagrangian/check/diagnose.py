@@ -411,7 +411,6 @@ class _Checker:
                 f"{len(multipliers)} constraint(s) ({', '.join(eom.constraint_names)}). "
                 "Is there one lambda per constraint?",
                 ", ".join(map(str, multipliers))))
-            # Judge the equations with the user's multipliers left as they are.
         # The user's own multiplier names (a tension T_rod) stand for ours, in order.
         renaming: dict[sp.Symbol, sp.Symbol] = {}
         if model.constraints and len(user_multipliers) == len(multipliers):
@@ -453,7 +452,8 @@ class _Checker:
         return f"{fmt(eq.display(lhs))} = {fmt(eq.display(eom.forcing[i]))}"
 
     def _multiple(self, user: sp.Expr, ours: sp.Expr) -> sp.Expr | None:
-        """c when user == c * ours with c independent of the state (a rescaling), else None."""
+        """c when user == c * ours (a rescaling; c may depend on the state, like cos(theta),
+        and is then shown so the user sees where it vanishes), else None."""
         if eq.identical(user, ours, self.points):
             return sp.S.One
         accelerations = [a for a in self.model.q_ddot if ours.has(a)]

@@ -283,8 +283,8 @@ def resolve_equilibrium(
     if not about:
         found = find_equilibria(functions, t=t)
         if not len(found):
-            raise ModelError("no equilibrium found (the generalized forces at rest never "
-                             "balance); give a configuration with --about", field=option)
+            raise ModelError("no equilibrium found (the forces at rest balanced at none of the "
+                             "configurations searched); give one with --about", field=option)
         q_all = np.array([[e.coordinates[n] for n in names] for e in found])
         distance = [_distance(qi, initial, periodic) for qi in q_all]
         best = int(np.argmin(distance))

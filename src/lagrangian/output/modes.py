@@ -38,7 +38,8 @@ def equilibria_document(found: Equilibria) -> dict[str, Any]:
 def equilibria_text(found: Equilibria) -> str:
     lines = [f"Equilibria of {found.model_name}", "=" * (14 + len(found.model_name))]
     if not len(found):
-        lines.append("No equilibrium found: the generalized forces at rest never balance.")
+        lines.append("No equilibrium found: at none of the configurations searched (from many "
+                     "starting points over the coordinates' ranges) do the forces at rest balance.")
         return "\n".join(lines) + "\n"
     for i, e in enumerate(found, 1):
         where = ", ".join(f"{k} = {_number(v)}" for k, v in e.coordinates.items())
@@ -91,6 +92,9 @@ def modes_text(analysis: ModalAnalysis) -> str:
     if linear.multipliers:
         lines.append("Multipliers: " + ", ".join(f"lambda_{k} = {_number(v)}"
                                                  for k, v in linear.multipliers.items()))
+    if linear.velocity_constraints.size:
+        lines.append("Velocity constraints restrict the motion, not the configuration: the state "
+                     "keeps only velocities that satisfy them.")
     if linear.coordinates != linear.user_coordinates:
         lines.append(f"Matrices in the independent coordinates ({', '.join(linear.coordinates)}); "
                      "shapes in all coordinates.")

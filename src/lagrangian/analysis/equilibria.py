@@ -284,7 +284,7 @@ def resolve_equilibrium(
         found = find_equilibria(functions, t=t)
         if not len(found):
             raise ModelError("no equilibrium found (the forces at rest balanced at none of the "
-                             "configurations searched); give one with --about", field=option)
+                             "configurations searched); give one with --about")
         q_all = np.array([[e.coordinates[n] for n in names] for e in found])
         distance = [_distance(qi, initial, periodic) for qi in q_all]
         best = int(np.argmin(distance))

@@ -318,3 +318,23 @@ def test_four_bar_against_the_energy_method():
     # The shape follows the loop: (1, dtheta2/dtheta1, dtheta3/dtheta1).
     np.testing.assert_allclose([mode.shape[n] for n in ("theta1", "theta2", "theta3")], rate,
                                rtol=1e-6)
+
+
+def test_gyroscopic_stabilization_in_a_rotating_frame():
+    """An isotropic oscillator (omega0 = sqrt(k/m)) seen from a frame turning at Omega > omega0:
+    the centrifugal term makes K negative definite, yet the Coriolis coupling keeps it stable,
+    with frequencies Omega -+ omega0. K - omega^2 M alone would call it unstable."""
+    m, k, spin = 1.0, 1.0, 3.0
+    b = SystemBuilder("oscillator in a rotating frame")
+    x, y = b.coordinate("x", unit="m"), b.coordinate("y", unit="m")
+    xd, yd = b.velocity(x), b.velocity(y)
+    b.add_kinetic_energy(m / 2 * ((xd - spin * y) ** 2 + (yd + spin * x) ** 2))
+    b.add_potential_energy(k / 2 * (x**2 + y**2))
+    analysis = b.build().modes()
+    np.testing.assert_allclose(analysis.stiffness_matrix, (k - m * spin**2) * np.eye(2))
+    np.testing.assert_allclose(analysis.linear_model.gyroscopic_matrix,
+                               [[0, -2 * m * spin], [2 * m * spin, 0]])
+    assert analysis.stable
+    np.testing.assert_allclose(analysis.natural_frequencies,
+                               [spin - math.sqrt(k / m), spin + math.sqrt(k / m)], rtol=1e-12)
+    assert all(mode.growth_rate == 0 for mode in analysis)

@@ -51,7 +51,6 @@ def agree(n: int) -> bool:
     rng = random.Random(n)
     M1, f1 = n_link.ours(n)
     M2, f2 = n_link.sympy_kanes_method(n)
-    t = me.dynamicsymbols._t
     values, values2 = {}, {}
     for i in range(1, n + 1):
         th, w = rng.uniform(-2, 2), rng.uniform(-2, 2)
@@ -94,8 +93,10 @@ def main() -> None:
                 skip[name] = True  # larger n would only take longer
         def cell(value):
             return f"{value:.3f}" if value is not None else f"> {args.limit:.0f}"
-        def ratio(value):
+
+        def ratio(value, ours=ours):
             return f"{value / ours:.0f}x" if value is not None and ours else "-"
+
         print(f"{n:>3}  {cell(ours):>9}  {cell(row['lagrange']):>12}  {cell(row['kane']):>9}  "
               f"{ratio(row['lagrange']):>13}  {ratio(row['kane']):>9}", flush=True)
     for n in [int(s) for s in args.ours_only.split(",") if s]:

@@ -227,7 +227,8 @@ class SystemBuilder(ModelBuilder):
     >>> b = lagrangian.SystemBuilder("Pendulum")
     >>> theta = b.coordinate("theta", unit="rad")
     >>> m, L, g = b.parameter("m", 1.0), b.parameter("L", 0.5), b.parameter("g", 9.81)
-    >>> _ = b.set_gravity(g, (0, -1)).add_particle("bob", m, (L*lagrangian.sin(theta), -L*lagrangian.cos(theta)))
+    >>> bob = (L * lagrangian.sin(theta), -L * lagrangian.cos(theta))
+    >>> _ = b.set_gravity(g, (0, -1)).add_particle("bob", m, bob)
     >>> b.build().equations_of_motion().forcing
     Matrix([[-L*g*m*sin(theta)]])
     """

@@ -37,8 +37,8 @@ def test_reads_the_documented_format():
 
 
 def test_parameter_units_are_converted_to_si():
-    model = parse_model(PENDULUM.replace('m = { value = 1.0, unit = "kg" }',
-                                         'm = { value = 500, unit = "g" }\nalpha = { value = 30, unit = "deg" }'))
+    grams = 'm = { value = 500, unit = "g" }\nalpha = { value = 30, unit = "deg" }'
+    model = parse_model(PENDULUM.replace('m = { value = 1.0, unit = "kg" }', grams))
     assert model.parameter("m").value == pytest.approx(0.5)
     assert model.parameter("alpha").value == pytest.approx(sp.pi.evalf() / 6)
 
@@ -59,7 +59,8 @@ def test_definitions_are_usable_after_their_definition():
 @pytest.mark.parametrize(
     ("change", "message"),
     [
-        (("[energy]", "[energy]\nW = \"m\""), "bad.toml: energy.W: unknown key 'W'"),
+        (("[energy]", "[energy]\nW = \"m\""),
+         "bad.toml: energy.W: unknown key 'W'"),
         (("name =", "nme = 1\nname ="), "bad.toml: nme: unknown key 'nme'; did you mean 'name'?"),
         (('V = "-m*g*L*cos(theta)"', 'V = "-m*g*Ln*cos(theta)"'),
          "bad.toml: energy.V: unknown name 'Ln'; did you mean 'L'?"),
@@ -70,9 +71,11 @@ def test_definitions_are_usable_after_their_definition():
         (('V = "-m*g*L*cos(theta)"', 'V = "2**99999"'),
          "bad.toml: energy.V: the exponent 99999 is too large (at most 1000)"),
         (('unit = "kg"', 'unit = "kilofoo"'), "bad.toml: parameters.m.unit: unknown unit 'kilofoo'"),
-        (("initial = 0.3", 'initial = "x"'), "bad.toml: coordinates.theta.initial: expected a number, got 'x'"),
+        (("initial = 0.3", 'initial = "x"'),
+         "bad.toml: coordinates.theta.initial: expected a number, got 'x'"),
         (("g = 9.81", "g = 9.81\ntheta = 1"), "bad.toml: parameters.theta: 'theta' is declared twice"),
-        (("g = 9.81", "g = 9.81\nsin = 1"), "bad.toml: parameters.sin: 'sin' is reserved (a function, constant or time)"),
+        (("g = 9.81", "g = 9.81\nsin = 1"),
+         "bad.toml: parameters.sin: 'sin' is reserved (a function, constant or time)"),
     ],
 )
 def test_errors_name_file_field_and_problem(change, message):
@@ -95,7 +98,8 @@ def test_component_errors():
         "bad.toml: particles[0].position: expected 2 or 3 components, got 1"
     assert error(base + '[[particles]]\nname = "p"\nposition = ["x", 0]') == \
         "bad.toml: particles[0]: missing key 'mass'"
-    assert error(base + '[[particles]]\nname = "p"\nmass = "m"\nposition = ["x", 0]\ncolour = 1') == \
+    extra = '[[particles]]\nname = "p"\nmass = "m"\nposition = ["x", 0]\ncolour = 1'
+    assert error(base + extra) == \
         "bad.toml: particles[0].colour: unknown key 'colour'"
     assert error(base + '[[particles]]\nname = "p"\nmass = "m"\nposition = ["x_dot", 0]') == \
         "bad.toml: particles[0].position[0]: may not depend on velocities (found x_dot)"
@@ -104,7 +108,8 @@ def test_component_errors():
     assert error(base + '[[loads]]\nname = "F"\npoint = [1, 0]\nforce = [1, 0]') == (
         "bad.toml: loads[0].point: the point of load 'F' does not depend on any coordinate, so the "
         "load does no virtual work; attach it to a moving point")
-    assert error(base + '[[loads]]\nname = "F"\npoint = ["x", 0]') == "bad.toml: loads[0]: missing key 'force'"
+    assert error(base + '[[loads]]\nname = "F"\npoint = ["x", 0]') == \
+        "bad.toml: loads[0]: missing key 'force'"
     assert error(base + '[[constraints]]\nname = "c"\nvelocity = "x_dot^2"') == \
         "bad.toml: constraints[0].velocity: a velocity constraint must be linear in the velocities"
     assert error(base + '[[constraints]]\nname = "c"\nholonomic = "x_dot"') == \

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from enum import Enum
+from enum import StrEnum
 from typing import Annotated
 
 import typer
@@ -14,7 +14,7 @@ from . import app
 from .common import load_system, print_json
 
 
-class Format(str, Enum):
+class Format(StrEnum):
     text = "text"
     latex = "latex"
     json = "json"

@@ -62,6 +62,12 @@ class Differentiator:
             return sp.cos(expr.args[0]) * self(expr.args[0], x)
         elif isinstance(expr, sp.cos):
             return -sp.sin(expr.args[0]) * self(expr.args[0], x)
+        elif isinstance(expr, sp.Abs):
+            # Model symbols carry no 'real' assumption, so sympy would answer with re()/im();
+            # every model quantity is real, where d|u| = sign(u) du.
+            return sp.sign(expr.args[0]) * self(expr.args[0], x)
+        elif isinstance(expr, sp.sign):
+            return sp.S.Zero  # almost everywhere
         return expr.diff(x)
 
     def row(self, expr: sp.Expr, variables: Sequence[sp.Symbol]) -> list[sp.Expr]:

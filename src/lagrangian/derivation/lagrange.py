@@ -21,7 +21,6 @@ from .trig import combine_terms, combined_terms
 from .virtual_work import generalized_forces, load_contributions
 
 
-
 class _Accumulator:
     """Collects the terms of M and f, grouped by shape, and adds each entry once.
 

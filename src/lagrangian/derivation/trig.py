@@ -38,7 +38,7 @@ def combine_angle_differences(expr: sp.Expr) -> sp.Expr:
     """Apply the identities above to the terms of an Add (other expressions are returned)."""
     if not expr.is_Add:
         return expr
-    return combine_terms(expr.args)  # noqa: the list form is combined_terms
+    return combine_terms(expr.args)
 
 
 def combine_terms(terms: Sequence[sp.Expr]) -> sp.Expr:

@@ -1,0 +1,12 @@
+"""The examples in the public docstrings run and print what they say."""
+
+import doctest
+
+import lagrangian
+import lagrangian.system
+
+
+def test_public_docstring_examples():
+    for module in (lagrangian, lagrangian.system):
+        failures, _ = doctest.testmod(module, raiseonerror=False)
+        assert failures == 0, module.__name__

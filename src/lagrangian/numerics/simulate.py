@@ -31,6 +31,9 @@ METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 _IN_PLACE = {"DOP853", "RK45", "RK23"}
 _DRIFT_IN_PLACE = 1e-12
 _DRIFT_RESTART = 1e-10
+# A restarted multistep solver begins again at order 1 with small steps; restarting it more
+# often than this many steps keeps it at low order for ever (BDF then crawls).
+_STEPS_BETWEEN_RESTARTS = 50
 
 STATUS_MESSAGES = {
     "finished": "reached the end time",
@@ -514,6 +517,7 @@ class _DriftControl:
         self.velocity_bias = velocity_bias
         self.holonomic = np.array([k == "holonomic" for k in system.constraint_kinds])
         self.nfev = 0
+        self.steps_since_restart = 0
 
     def residuals(self, q, v, t):
         s = self.system
@@ -570,8 +574,12 @@ class _DriftControl:
         phi, velocity, _ = self.residuals(y[:n], y[n:], solver.t)
         worst = np.max(np.abs(np.concatenate([phi, velocity])), initial=0.0)
         in_place = type(solver).__name__ in _IN_PLACE
+        self.steps_since_restart += 1
         if worst <= (_DRIFT_IN_PLACE if in_place else _DRIFT_RESTART):
             return solver
+        if not in_place and self.steps_since_restart < _STEPS_BETWEEN_RESTARTS:
+            return solver
+        self.steps_since_restart = 0
         q, v = self.project(y[:n], y[n:], solver.t, tolerance=1e-15)
         y_new = np.concatenate([q, v])
         if in_place:

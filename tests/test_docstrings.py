@@ -8,5 +8,5 @@ import lagrangian.system
 
 def test_public_docstring_examples():
     for module in (lagrangian, lagrangian.system):
-        failures, _ = doctest.testmod(module, raiseonerror=False)
+        failures, _ = doctest.testmod(module)
         assert failures == 0, module.__name__

@@ -178,7 +178,10 @@ def mode_shape_figure(analysis: ModalAnalysis):
             ax.bar(positions, values, color=["tab:blue" if v >= 0 else "tab:red" for v in values])
             ax.set_xticks(positions, names, fontsize=8)
         else:  # a chain of many coordinates reads better as a line
+            from matplotlib.ticker import MaxNLocator
+
             ax.plot(positions + 1, values, marker=".", color="tab:blue")
+            ax.xaxis.set_major_locator(MaxNLocator(integer=True))
             ax.set_xlabel("coordinate number", fontsize=8)
         ax.axhline(0.0, color="black", linewidth=0.6)
         ax.set_ylim(-1.15, 1.15)
@@ -186,7 +189,10 @@ def mode_shape_figure(analysis: ModalAnalysis):
         ax.tick_params(labelsize=8)
     for ax in axes[len(modes):]:
         ax.set_visible(False)
-    figure.suptitle(f"Mode shapes of {analysis.model_name}", fontsize=10)
+    title = f"Mode shapes of {analysis.model_name}"
+    if len(analysis.modes) > len(modes):
+        title += f" (lowest {len(modes)} of {len(analysis.modes)} modes)"
+    figure.suptitle(title, fontsize=10)
     return figure
 
 

@@ -157,3 +157,12 @@ def test_thirty_link_pendulum_against_its_known_linear_matrices(monkeypatch):
     np.testing.assert_allclose(lm.M, mass, rtol=1e-12)
     np.testing.assert_allclose(lm.K, stiffness, rtol=1e-12, atol=1e-9)
     np.testing.assert_allclose(lm.C, 0)
+
+
+def test_about_values_must_be_numbers():
+    system = lagrangian.load("pendulum")
+    assert system.modes(about={"theta": sp.pi})[0].growth_rate == pytest.approx(math.sqrt(9.81 / 0.5))
+    with pytest.raises(ModelError, match="the value of 'theta' must be a number in SI units"):
+        system.linearize(about={"theta": "pi"})
+    with pytest.raises(ModelError, match="'phi' is not a coordinate of this model"):
+        system.linearize(about={"phi": 0.0})

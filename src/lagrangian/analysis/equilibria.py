@@ -277,6 +277,12 @@ def resolve_equilibrium(
             close = difflib.get_close_matches(name, names, n=1)
             hint = f"; did you mean '{close[0]}'?" if close else ""
             raise ModelError(f"'{name}' is not a coordinate of this model{hint}", field=option)
+    for name, value in about.items():
+        try:
+            about[name] = float(value)  # numbers, numpy or sympy numbers (sympy.pi)
+        except (TypeError, ValueError):
+            raise ModelError(f"the value of '{name}' must be a number in SI units (radians for "
+                             f"angles, e.g. math.pi), got {value!r}", field=option) from None
     low, high, _ = coordinate_spans(model)
     periodic = periodic_coordinates(functions, t)
     initial = np.array([c.initial or 0.0 for c in model.coordinates], float)

@@ -13,6 +13,7 @@ from .errors import DerivationError, LagrangianError, ModelError
 from .model.examples import example_names as examples
 from .model.model import Model
 from .model.reader import parse_model, read_model
+from .simulation import Simulation
 from .system import System, SystemBuilder, load
 
 __version__ = "0.1.0"
@@ -25,6 +26,7 @@ __all__ = [
     "Model",
     "ModelError",
     "System",
+    "Simulation",
     "SystemBuilder",
     "cos",
     "examples",

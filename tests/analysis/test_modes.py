@@ -338,3 +338,10 @@ def test_gyroscopic_stabilization_in_a_rotating_frame():
     np.testing.assert_allclose(analysis.natural_frequencies,
                                [spin - math.sqrt(k / m), spin + math.sqrt(k / m)], rtol=1e-12)
     assert all(mode.growth_rate == 0 for mode in analysis)
+
+
+@pytest.mark.parametrize("c", [4e-7, 4.0, 0.4, 40.0])
+def test_damping_ratio_from_tiny_to_critical_to_heavy(c):
+    (mode,) = lagrangian.load("damped_oscillator").with_parameters(c=c).modes().modes
+    assert mode.frequency == pytest.approx(2.0, rel=1e-6)
+    assert mode.damping_ratio == pytest.approx(c / (2 * math.sqrt(4.0 * 1.0)), rel=1e-6)

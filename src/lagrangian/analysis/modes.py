@@ -20,6 +20,8 @@ from .linearization import LinearModel
 
 # Eigenvalues smaller than this fraction of the largest are zero (rigid-body modes).
 ZERO_TOLERANCE = 1e-6
+# Real or imaginary parts smaller than this fraction of the largest eigenvalue are round-off.
+ROUND_OFF_TOLERANCE = 1e-10
 # omega^2 smaller than this fraction of the largest counts as zero in the symmetric problem.
 ZERO_SQUARED_TOLERANCE = 1e-10
 
@@ -182,9 +184,11 @@ def _state_space_modes(linear: LinearModel) -> list[Mode]:
         return []
     values, vectors = scipy.linalg.eig(A)
     scale = max(np.abs(values).max(), 1e-300)
-    tolerance = ZERO_TOLERANCE * scale
-    values = np.where(np.abs(values.real) <= tolerance, 1j * values.imag, values)
-    values = np.where(np.abs(values.imag) <= tolerance, values.real + 0j, values)
+    # Defective zero eigenvalues (rigid-body modes) scatter by ~sqrt(eps); others by ~eps.
+    values = np.where(np.abs(values) <= ZERO_TOLERANCE * scale, 0j, values)
+    noise = ROUND_OFF_TOLERANCE * scale
+    values = np.where(np.abs(values.real) <= noise, 1j * values.imag, values)
+    values = np.where(np.abs(values.imag) <= noise, values.real + 0j, values)
     modes: list[Mode] = []
     real = []
     for k, s in enumerate(values):

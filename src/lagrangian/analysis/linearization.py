@@ -19,6 +19,7 @@ import sympy as sp
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import jacobian_row
 from ..errors import DerivationError, ModelError
+from ..model.expressions import as_expression
 from ..model.model import Model
 from ..numerics.functions import parameter_substitution
 
@@ -46,12 +47,12 @@ class StaticFunctions:
         at_rest = {v: sp.S.Zero for v in q_dot}
 
         # Parameter values go in first: differentiating numbers is much cheaper than symbols.
-        forcing = [_floats(sp.sympify(e).xreplace(values)) for e in eom.forcing]
+        forcing = [_floats(as_expression(e).xreplace(values)) for e in eom.forcing]
         forcing_at_rest = [e.xreplace(at_rest) for e in forcing]
         stiffness = [[-d for d in jacobian_row(e, q)] for e in forcing_at_rest]
         damping = [[-d.xreplace(at_rest) for d in _linear_velocity_row(e, q_dot)]
                    for e in forcing]
-        jacobian = [[_floats(sp.sympify(e).xreplace(values).xreplace(at_rest))
+        jacobian = [[_floats(as_expression(e).xreplace(values).xreplace(at_rest))
                      for e in eom.constraint_jacobian.row(i)] for i in range(m)]
         hessians = [[jacobian_row(e, q) for e in row] for row in jacobian]
         # At rest a holonomic constraint reads Phi(q) = 0, a velocity one b(q) = 0.
@@ -66,16 +67,16 @@ class StaticFunctions:
         self.depends_on = frozenset(
             s for e in [*forcing_at_rest, *(e for _, e in static)] for s in e.free_symbols
         )
-        mass = [_floats(sp.sympify(e).xreplace(values).xreplace(at_rest))
+        mass = [_floats(as_expression(e).xreplace(values).xreplace(at_rest))
                 for e in eom.mass_matrix]
         rest = [*mass, *forcing_at_rest, *_flat(damping), *(e for _, e in static)]
-        if any(t in sp.sympify(e).free_symbols for e in rest):
+        if any(t in as_expression(e).free_symbols for e in rest):
             raise ModelError("the equations at rest depend on time t explicitly, so the model has "
                              "no fixed equilibrium to analyse", field="equilibria")
 
         entries = [*mass, *forcing_at_rest, *_flat(stiffness), *_flat(damping), *_flat(jacobian),
                    *_flat(_flat(hessians)), *(e for _, e in static), *_flat(static_jacobian)]
-        entries = [sp.sympify(e) for e in entries]
+        entries = [as_expression(e) for e in entries]
         self._layout = [("mass", (n, n)), ("forcing", (n,)), ("stiffness", (n, n)),
                         ("damping", (n, n)), ("jacobian", (m, n)), ("hessians", (m, n, n)),
                         ("static", (len(static),)), ("static_jacobian", (len(static), n))]
@@ -388,7 +389,7 @@ def _input_parameter(model: Model, name: str) -> sp.Symbol | None:
     for load in model.loads:
         if load.name == name:
             magnitude = load.force if hasattr(load, "force") else (load.torque,)
-            symbols = {s for e in magnitude for s in sp.sympify(e).free_symbols}
+            symbols = {s for e in magnitude for s in as_expression(e).free_symbols}
             owned = sorted((p for p in model.parameters if p.symbol in symbols),
                            key=lambda p: p.name)
             if len(owned) != 1:
@@ -443,7 +444,7 @@ def symbolic_linear_model(eom: EquationsOfMotion, about: Mapping[str, object]) -
         value = about.get(c.name, c.initial or 0)
         point[c.symbol] = _exact(value)
     at_rest = {v: sp.S.Zero for v in model.q_dot}
-    forcing = [sp.sympify(e) for e in eom.forcing]
+    forcing = [as_expression(e) for e in eom.forcing]
     K = [[-d.xreplace(point) for d in jacobian_row(e.xreplace(at_rest), model.q)]
          for e in forcing]
     C = [[-d.xreplace(at_rest).xreplace(point) for d in _linear_velocity_row(e, model.q_dot)]

@@ -16,6 +16,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import time_rate
 from ..derivation.virtual_work import DISSIPATION_LOAD, GIVEN_LOAD
 from ..model.answer import Answer
+from ..model.expressions import as_expression
 from ..model.expressions import format_expression as fmt
 from ..model.model import Damper, Model, PointForce, Torque
 from ..model.units import generalized_force_unit
@@ -163,9 +164,9 @@ class _NumericItems:
         self.checker = checker
 
     def run(self, method, yours: list[sp.Expr], ours: list[sp.Expr], *args) -> list[Finding]:
-        yours = [sp.sympify(e) for e in yours]  # safe: sympy objects or numbers, not text
+        yours = [as_expression(e) for e in yours]
         used = set().union(*(e.free_symbols for e in yours))
-        needed = set().union(*(sp.sympify(e).free_symbols for e in ours)) & self.valued
+        needed = set().union(*(as_expression(e).free_symbols for e in ours)) & self.valued
         if not needed - used or not any(_measured(e) for e in yours):
             return method(*args)
         saved, self.checker.points = self.checker.points, self.points
@@ -302,7 +303,7 @@ class _Checker:
             return [Finding(item, "correct", None, f"{item} matches.", None)]
         V = self.eom.potential_energy
         V_user = self.answer.potential_energy if self.answer.potential_energy is not None else 0
-        dV, dV_user = V.diff(coordinate.symbol), sp.sympify(V_user).diff(coordinate.symbol)
+        dV, dV_user = V.diff(coordinate.symbol), as_expression(V_user).diff(coordinate.symbol)
         if dV != 0 and eq.identical(Q_user - dV_user, Q - dV, self.points):
             return [Finding(item, "equivalent", "equation_equivalent",
                             f"{item} includes the conservative force -dV/d{name} = "
@@ -341,7 +342,7 @@ class _Checker:
             return contributions[0]
         parameters = {p.symbol for p in self.model.parameters}
         for load, part in contributions:
-            yours = sp.sympify(Q_user - (Q - part))
+            yours = as_expression(Q_user - (Q - part))
             if eq.zero(yours, self.points):
                 continue
             if (yours.free_symbols & parameters) == (part.free_symbols & parameters):

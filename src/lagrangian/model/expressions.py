@@ -245,8 +245,18 @@ class _GrammarPrinter(StrPrinter):
 _PRINTER = _GrammarPrinter({"order": None})
 
 
+def as_expression(value: object) -> sp.Basic:
+    """A sympy object or a Python number as a sympy object.
+
+    Strings are refused: user text goes through :func:`parse_expression` only.
+    """
+    if isinstance(value, sp.Basic):
+        return value
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise TypeError(f"expected a sympy object or a number, got {type(value).__name__}")
+    return sp.Integer(value) if isinstance(value, int) else sp.Float(value)
+
+
 def format_expression(expr: sp.Expr) -> str:
     """Format a sympy expression as a string of the model-file grammar."""
-    if isinstance(expr, int | float):
-        expr = sp.sympify(expr)  # safe: a Python number, not user text
-    return _PRINTER.doprint(expr)
+    return _PRINTER.doprint(as_expression(expr))

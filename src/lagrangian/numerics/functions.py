@@ -16,6 +16,7 @@ import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, ModelError
+from ..model.expressions import as_expression
 
 
 @dataclass(frozen=True)
@@ -261,7 +262,7 @@ def _numpy_kernel(eom: EquationsOfMotion, values: dict) -> _NumpyKernel:
     args = [*model.q, *model.q_dot, model.time]
 
     def numeric_list(exprs):
-        return [sp.sympify(e).xreplace(values) for e in exprs]  # safe: sympy objects
+        return [as_expression(e).xreplace(values) for e in exprs]
 
     entries = numeric_list([*eom.mass_matrix, *eom.forcing, *eom.constraint_jacobian,
                             *eom.acceleration_rhs])

@@ -21,7 +21,7 @@ from scipy import integrate, optimize
 
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
-from ..model.expressions import parse_expression
+from ..model.expressions import as_expression, parse_expression
 from ..model.model import Model
 from .functions import NumericSystem, numeric, parameter_substitution
 
@@ -236,7 +236,7 @@ def energy_is_conserved(eom: EquationsOfMotion) -> bool:
         return False
     terms = [eom.kinetic_energy, eom.potential_energy, *eom.mass_matrix, *eom.forcing,
              *(c.expression for c in model.constraints)]
-    return not any(t in sp.sympify(e).free_symbols for e in terms)
+    return not any(t in as_expression(e).free_symbols for e in terms)
 
 
 def simulate(
@@ -594,12 +594,12 @@ class _DriftControl:
 # -- small compiled helpers --------------------------------------------------------------------
 
 def _lambdify_rows(args, matrix, values) -> Callable:
-    exprs = [sp.sympify(e).xreplace(values) for e in matrix]
+    exprs = [as_expression(e).xreplace(values) for e in matrix]
     return sp.lambdify(args, exprs, modules="numpy", cse=True)
 
 
 def _lambdify_scalar(args, expr, values) -> Callable:
-    f = sp.lambdify(args, sp.sympify(expr).xreplace(values), modules="numpy")
+    f = sp.lambdify(args, as_expression(expr).xreplace(values), modules="numpy")
 
     def event(q, v, t):
         return float(f(*q, *v, t))

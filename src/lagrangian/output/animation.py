@@ -16,6 +16,7 @@ import numpy as np
 import sympy as sp
 
 from ..errors import ModelError
+from ..model.expressions import as_expression
 from ..model.model import Model
 from ..numerics.simulate import SimulationResult
 from .files import atomic_write
@@ -62,7 +63,7 @@ def mechanism(model: Model, parameters: dict[str, float]) -> Mechanism:
     args = [*model.q, *model.q_dot, model.time]
 
     def compile_(exprs):
-        exprs = [sp.sympify(e).xreplace(values) for e in exprs]
+        exprs = [as_expression(e).xreplace(values) for e in exprs]
         return sp.lambdify(args, exprs, modules="numpy") if exprs else None
 
     particles = [e for p in model.particles for e in p.position[:2]]
@@ -95,7 +96,7 @@ def spring_end_points(model: Model, values: dict) -> dict[str, tuple]:
     samples = rng.uniform(-1.0, 1.0, size=(6, len(args)))
 
     def sample(expr):
-        f = sp.lambdify(args, sp.sympify(expr).xreplace(values), modules="numpy")
+        f = sp.lambdify(args, as_expression(expr).xreplace(values), modules="numpy")
         with np.errstate(all="ignore"):
             return np.array([float(np.real(f(*row))) for row in samples])
 

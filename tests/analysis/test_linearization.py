@@ -166,3 +166,36 @@ def test_about_values_must_be_numbers():
         system.linearize(about={"theta": "pi"})
     with pytest.raises(ModelError, match="'phi' is not a coordinate of this model"):
         system.linearize(about={"phi": 0.0})
+
+
+def test_double_pendulum_state_matrix_agrees_with_sympy_mechanics():
+    """An independent derivation: sympy.physics.mechanics LagrangesMethod.linearize."""
+    from sympy.physics.mechanics import (
+        LagrangesMethod,
+        Lagrangian,
+        Particle,
+        Point,
+        ReferenceFrame,
+        dynamicsymbols,
+    )
+
+    q1, q2 = dynamicsymbols("q1 q2")
+    u1, u2 = dynamicsymbols("q1 q2", 1)
+    m1, m2, l1, l2, g = sp.symbols("m1 m2 l1 l2 g")
+    frame, origin = ReferenceFrame("N"), Point("O")
+    origin.set_vel(frame, 0)
+    p1 = origin.locatenew("P1", l1 * sp.sin(q1) * frame.x - l1 * sp.cos(q1) * frame.y)
+    p2 = p1.locatenew("P2", l2 * sp.sin(q2) * frame.x - l2 * sp.cos(q2) * frame.y)
+    for point in (p1, p2):
+        point.set_vel(frame, point.pos_from(origin).dt(frame))
+    bob1, bob2 = Particle("bob1", p1, m1), Particle("bob2", p2, m2)
+    bob1.potential_energy = m1 * g * p1.pos_from(origin).dot(frame.y)
+    bob2.potential_energy = m2 * g * p2.pos_from(origin).dot(frame.y)
+    method = LagrangesMethod(Lagrangian(frame, bob1, bob2), [q1, q2])
+    method.form_lagranges_equations()
+    point = {q1: 0, q2: 0, u1: 0, u2: 0, u1.diff(): 0, u2.diff(): 0}
+    A, _, _ = method.linearize(q_ind=[q1, q2], qd_ind=[u1, u2], A_and_B=True, op_point=point)
+    values = {m1: 1.0, m2: 1.0, l1: 1.0, l2: 1.0, g: 9.81}
+    expected = np.array(A.subs(values), dtype=float)
+    ours = lagrangian.load("double_pendulum").linearize(about={"theta1": 0, "theta2": 0})
+    np.testing.assert_allclose(ours.A, expected, atol=1e-12)

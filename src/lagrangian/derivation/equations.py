@@ -31,7 +31,8 @@ class EquationsOfMotion:
     """
 
     model: Model
-    kinetic_energy: sp.Expr
+    kinetic_terms: tuple[sp.Expr, ...]
+    component_mass_matrix: sp.ImmutableMatrix | None
     potential_energy: sp.Expr
     dissipation: sp.Expr
     mass_matrix: sp.ImmutableMatrix
@@ -42,6 +43,20 @@ class EquationsOfMotion:
     velocity_bias: sp.ImmutableMatrix
     acceleration_rhs: sp.ImmutableMatrix
     multipliers: sp.ImmutableMatrix
+
+    @cached_property
+    def kinetic_energy(self) -> sp.Expr:
+        """T in J: 1/2 q_dot^T M q_dot of the particles and bodies (from the tidied M), their
+        moving-support terms, and the user's own T. Formed on first use."""
+        terms = list(self.kinetic_terms)
+        mass, q_dot = self.component_mass_matrix, self.model.q_dot
+        if mass is not None:
+            n = len(q_dot)
+            terms += [sp.Rational(1, 2) * mass[i, i] * q_dot[i] ** 2
+                      for i in range(n) if mass[i, i] != 0]
+            terms += [mass[i, j] * q_dot[i] * q_dot[j]
+                      for i in range(n) for j in range(i + 1, n) if mass[i, j] != 0]
+        return sp.Add(*terms)
 
     @cached_property
     def accelerations(self) -> sp.ImmutableMatrix | None:

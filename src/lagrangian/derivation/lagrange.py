@@ -17,7 +17,7 @@ from .constraints import constraint_terms
 from .equations import EquationsOfMotion
 from .kinematics import Differentiator
 from .regularity import check_regularity
-from .trig import combine_terms, combined_terms
+from .trig import combined_terms, parts, product
 from .virtual_work import generalized_forces, load_contributions
 
 
@@ -33,35 +33,31 @@ class _Accumulator:
         self.mass = [[defaultdict(list) for _ in range(n)] for _ in range(n)]
         self.forcing = [defaultdict(list) for _ in range(n)]
         self._dots: dict[tuple, sp.Expr] = {}
-        self._products: dict[tuple[sp.Expr, sp.Expr], sp.Expr] = {}
+        self._collected: dict[tuple[int, int], sp.Expr] = {}  # M entries already summed
 
     def add_force(self, i: int, expr: sp.Expr) -> None:
         self.forcing[i][expr].append(sp.S.One)
 
     def add_mass(self, i: int, j: int, expr: sp.Expr) -> None:
         self.mass[i][j][expr].append(sp.S.One)
+        self._collected.pop((i, j), None)
 
     def _dot(self, column_i: tuple, column_j: tuple) -> sp.Expr:
         key = (column_i, column_j)
         found = self._dots.get(key)
         if found is None:
-            terms = [a * b for a, b in zip(column_i, column_j, strict=True) if a != 0 and b != 0]
-            found = self._dots[key] = combine_terms(terms)
+            found = self._dots[key] = sp.Add(*combined_terms(
+                product(parts(x), parts(y))
+                for a, b in zip(column_i, column_j, strict=True) if a != 0 and b != 0
+                for x in sp.Add.make_args(a) for y in sp.Add.make_args(b)))
         return found
 
     def _projection(self, column: tuple, vector: list[sp.Expr]) -> list[sp.Expr]:
-        """column . vector distributed term by term (memoized products), then tidied."""
-        terms = []
-        for a, v in zip(column, vector, strict=True):
-            if a == 0 or v == 0:
-                continue
-            for term in sp.Add.make_args(v):
-                key = (a, term)
-                product = self._products.get(key)
-                if product is None:
-                    product = self._products[key] = a * term
-                terms.append(product)
-        return combined_terms(terms)
+        """column . vector distributed term by term, then tidied (no intermediate products)."""
+        return combined_terms(
+            product(parts(x), parts(term))
+            for a, v in zip(column, vector, strict=True) if a != 0 and v != 0
+            for x in sp.Add.make_args(a) for term in sp.Add.make_args(v))
 
     def inertia(self, mass: sp.Expr, jacobian: list[list[sp.Expr]], rest: list[sp.Expr]) -> None:
         """Add m J^T J to M and -m J^T a_rest to f for J (rows: components, cols: coordinates)."""
@@ -74,30 +70,28 @@ class _Accumulator:
                 dot = self._dot(columns[i], columns[j])
                 if dot != 0:
                     self.mass[i][j][dot].append(mass)
+                    self._collected.pop((i, j), None)
             for term in self._projection(columns[i], rest):
                 self.forcing[i][term].append(-mass)
 
-    def matrices(self) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
+    def mass_matrix(self) -> sp.ImmutableMatrix:
         n = self.n
         mass = [[sp.S.Zero] * n for _ in range(n)]
         for i in range(n):
             for j in range(i, n):
-                mass[i][j] = mass[j][i] = _collect(self.mass[i][j])
-        forcing = [_collect(terms) for terms in self.forcing]
-        return sp.ImmutableMatrix(mass), sp.ImmutableMatrix(n, 1, forcing)
+                entry = self._collected.get((i, j))
+                if entry is None:
+                    entry = self._collected[(i, j)] = _collect(self.mass[i][j])
+                mass[i][j] = mass[j][i] = entry
+        return sp.ImmutableMatrix(mass)
 
-
-def _quadratic_form(mass: sp.MatrixBase, q_dot) -> sp.Expr:
-    """1/2 q_dot^T M q_dot written entry by entry (M symmetric)."""
-    n = len(q_dot)
-    terms = [sp.Rational(1, 2) * mass[i, i] * q_dot[i] ** 2 for i in range(n) if mass[i, i] != 0]
-    terms += [mass[i, j] * q_dot[i] * q_dot[j] for i in range(n) for j in range(i + 1, n)
-              if mass[i, j] != 0]
-    return sp.Add(*terms)
+    def forcing_vector(self) -> sp.ImmutableMatrix:
+        return sp.ImmutableMatrix(self.n, 1, [_collect(terms) for terms in self.forcing])
 
 
 def _collect(groups: dict[sp.Expr, list[sp.Expr]]) -> sp.Expr:
-    return sp.Add(*(term * sp.Add(*coefficients) for term, coefficients in groups.items()))
+    return sp.Add(*(term if coefficients == [sp.S.One] else term * sp.Add(*coefficients)
+                    for term, coefficients in groups.items()))
 
 
 def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
@@ -136,9 +130,7 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
         if spin != 0:
             kinetic_terms.append(body.inertia * (omega - spin) * spin
                                  + sp.Rational(1, 2) * body.inertia * spin**2)
-    if model.particles or model.bodies:
-        component_mass, _ = acc.matrices()
-        kinetic_terms.append(_quadratic_form(component_mass, q_dot))
+    component_mass = acc.mass_matrix() if model.particles or model.bodies else None
 
     if model.gravity is not None:
         g, direction = model.gravity.magnitude, model.gravity.direction
@@ -168,7 +160,7 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
     for i, value in enumerate(Q):
         if value != 0:
             acc.add_force(i, value)
-    mass_matrix, forcing = acc.matrices()
+    mass_matrix, forcing = acc.mass_matrix(), acc.forcing_vector()
 
     jacobian, bias, gamma = constraint_terms(model)
     multipliers = sp.ImmutableMatrix(
@@ -178,7 +170,8 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
         check_regularity(model, mass_matrix, jacobian)
     return EquationsOfMotion(
         model=model,
-        kinetic_energy=sp.Add(model.kinetic_energy, *kinetic_terms),
+        kinetic_terms=(model.kinetic_energy, *kinetic_terms),
+        component_mass_matrix=component_mass,
         potential_energy=sp.Add(*potential_terms),
         dissipation=sp.Add(*dissipation_terms),
         mass_matrix=mass_matrix,

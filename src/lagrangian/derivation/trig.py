@@ -5,96 +5,125 @@ these rules turn them into the textbook l1 l2 cos(a - b) without trigsimp's sear
 
     c sin(a) sin(b) + c cos(a) cos(b) -> c cos(a - b)   (and c sin(a)^2 + c cos(a)^2 -> c)
     c sin(a) cos(b) - c cos(a) sin(b) -> c sin(a - b)
+    c X - c X -> 0
+
+Terms are handled as decomposed products (coefficient, other factors, sin and cos arguments):
+a product of two terms is formed by merging tuples, and a sympy Mul is built only for a term
+that is left over, since building sympy objects is what costs.
 """
 
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from functools import lru_cache
 
 import sympy as sp
 
+Parts = tuple[sp.Expr, tuple, tuple, tuple]  # coefficient, other factors, sin args, cos args
+_KEY = sp.default_sort_key  # canonical order, for what is printed
+# Factor tuples are only compared with each other within one run, so any consistent order will
+# do: sympy caches each object's hash, while sort keys cost a cache lookup each.
+_FAST = hash
+
 
 @lru_cache(maxsize=1 << 16)
-def _split(term: sp.Expr):
-    """(rest, sorted sin arguments, sorted cos arguments) when the term has exactly two trig
-    factors, else None."""
-    sins, coss, rest = [], [], []
+def parts(term: sp.Expr) -> Parts:
+    """Decompose a product into (numeric coefficient, other factors, sin args, cos args)."""
+    coefficient = sp.S.One
+    rest, sins, coss = [], [], []
     for factor in sp.Mul.make_args(term):
+        if factor.is_Number:
+            coefficient = coefficient * factor
+            continue
         base, exponent = factor.as_base_exp()
         if isinstance(base, sp.sin | sp.cos) and exponent.is_Integer and 0 < exponent <= 2:
             target = sins if isinstance(base, sp.sin) else coss
             target.extend([base.args[0]] * int(exponent))
         else:
             rest.append(factor)
-    if len(sins) + len(coss) != 2:
-        return None
-    key = sp.default_sort_key  # cached per expression, unlike sp.ordered's full comparison
-    return sp.Mul(*rest), tuple(sorted(sins, key=key)), tuple(sorted(coss, key=key))
+    return (coefficient, tuple(sorted(rest, key=_FAST)), tuple(sorted(sins, key=_FAST)),
+            tuple(sorted(coss, key=_FAST)))
+
+
+def product(a: Parts, b: Parts) -> Parts:
+    """The parts of the product of two decomposed terms."""
+    return (a[0] * b[0], _merge(a[1], b[1]), _merge(a[2], b[2]), _merge(a[3], b[3]))
+
+
+def _merge(x: tuple, y: tuple) -> tuple:
+    if not x:
+        return y
+    if not y:
+        return x
+    return tuple(sorted(x + y, key=_FAST))
+
+
+@lru_cache(maxsize=1 << 16)
+def build(item: Parts) -> sp.Expr:
+    coefficient, rest, sins, coss = item
+    return sp.Mul(coefficient, *rest, *(sp.sin(a) for a in sins), *(sp.cos(a) for a in coss))
 
 
 def combine_angle_differences(expr: sp.Expr) -> sp.Expr:
     """Apply the identities above to the terms of an Add (other expressions are returned)."""
     if not expr.is_Add:
         return expr
-    return combine_terms(expr.args)
+    return sp.Add(*combined_terms(parts(term) for term in expr.args))
 
 
 def combine_terms(terms: Sequence[sp.Expr]) -> sp.Expr:
     """The sum of ``terms`` with the identities above applied between them."""
-    return sp.Add(*combined_terms(terms))
+    return sp.Add(*combined_terms(parts(term) for term in terms))
 
 
-def combined_terms(terms: Sequence[sp.Expr]) -> list[sp.Expr]:
-    """``terms`` with the identities above applied between them (a list of terms)."""
-    terms = list(terms)
-    parsed = [_split(term) for term in terms]
-    index: dict[tuple, list[int]] = defaultdict(list)
-    for k, item in enumerate(parsed):
-        if item is not None:
-            index[item].append(k)
-    used = [False] * len(terms)
+def combined_terms(items: Iterable[Parts]) -> list[sp.Expr]:
+    """Decomposed terms with the identities above applied between them (a list of terms)."""
+    items = list(items)
+    index: dict[Parts, list[int]] = defaultdict(list)
+    for k, item in enumerate(items):
+        index[item].append(k)
+    used = [False] * len(items)
     combined = []
-    for k, item in enumerate(parsed):
-        if item is None or used[k]:
+    for k, item in enumerate(items):
+        if used[k]:
             continue
-        rest, sins, coss = item
-        partner, replacement = None, None
+        coefficient, rest, sins, coss = item
+        partner = _take(index, (-coefficient, rest, sins, coss), used, k)
+        if partner is not None:  # exact cancellation
+            used[k] = used[partner] = True
+            continue
+        if len(sins) + len(coss) != 2:
+            continue
+        replacement = None
         if len(sins) == 2:  # c sin a sin b + c cos a cos b
-            partner = _take(index, (rest, (), sins), used, k)
+            partner = _take(index, (coefficient, rest, (), sins), used, k)
             if partner is not None:
-                replacement = _difference(rest, sp.cos, *sins)
+                replacement = _difference(coefficient, rest, sp.cos, *sins)
         elif len(sins) == 1:  # c sin a cos b - c cos a sin b
             a, b = sins[0], coss[0]
             if a != b:
-                partner = _take(index, (_negated(rest), (b,), (a,)), used, k)
+                partner = _take(index, (-coefficient, rest, (b,), (a,)), used, k)
                 if partner is not None:
-                    replacement = _difference(rest, sp.sin, a, b)
+                    replacement = _difference(coefficient, rest, sp.sin, a, b)
         if partner is not None:
             used[k] = used[partner] = True
             combined.append(replacement)
-    combined.extend(term for term, done in zip(terms, used, strict=True) if not done)
+    combined.extend(build(item) for item, done in zip(items, used, strict=True) if not done)
     return combined
 
 
 # Chains meet the same pairs again for every body further out: build each result once.
 @lru_cache(maxsize=1 << 16)
-def _difference(rest: sp.Expr, function, a: sp.Expr, b: sp.Expr) -> sp.Expr:
+def _difference(coefficient, rest: tuple, function, a: sp.Expr, b: sp.Expr) -> sp.Expr:
     # sympy's trig eval spends milliseconds looking for multiples of pi; the sign is the only
     # canonicalisation an angle difference needs, so it is done here and eval is skipped.
     if a == b:
-        return rest * function(sp.S.Zero)
-    sign = 1
-    if sp.default_sort_key(b) < sp.default_sort_key(a):  # write the difference in sorted order
+        return sp.Mul(coefficient, *rest, function(sp.S.Zero))
+    if _KEY(b) < _KEY(a):  # write the difference in sorted order
         a, b = b, a
-        sign = -1 if function is sp.sin else 1
-    return sign * rest * function(a - b, evaluate=False)
-
-
-@lru_cache(maxsize=1 << 16)
-def _negated(expr: sp.Expr) -> sp.Expr:
-    return -expr
+        coefficient = -coefficient if function is sp.sin else coefficient
+    return sp.Mul(coefficient, *rest, function(a - b, evaluate=False))
 
 
 def _take(index, key, used, exclude):

@@ -2,7 +2,7 @@
 
 Run:  python benchmarks/bench_derive.py [--max-n 16] [--limit 60] [--ours-n 30]
 
-Each anchor runs in a child process under a time limit (a run that exceeds it is reported as
+Each run is a child process under a time limit (best of three where a run takes under 5 s) (a run that exceeds it is reported as
 "> limit"). Before timing, the three results are checked to agree numerically at a random state.
 """
 
@@ -31,7 +31,21 @@ def _timed(name: str, n: int, queue) -> None:
 
 
 def run(name: str, n: int, limit: float) -> float | None:
-    """Wall time of one derivation in a fresh process (so caches do not help), or None."""
+    """Best wall time of up to three derivations, each in a fresh process (so caches do not
+    help), repeated only while a run takes under 5 s (the same rule for every library)."""
+    best = None
+    for _ in range(3):
+        elapsed = run_once(name, n, limit)
+        if elapsed is None:
+            return best
+        best = elapsed if best is None else min(best, elapsed)
+        if elapsed > 5.0:
+            break
+    return best
+
+
+def run_once(name: str, n: int, limit: float) -> float | None:
+    """Wall time of one derivation in a fresh process, or None past the time limit."""
     context = mp.get_context("fork")
     queue = context.Queue()
     process = context.Process(target=_timed, args=(name, n, queue))

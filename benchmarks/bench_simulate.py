@@ -17,31 +17,22 @@ system, so it is wrapped with .copy() (the unwrapped run is shown too, to docume
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 import timeit
+from pathlib import Path
 
 import numpy as np
 import sympy as sp
 from scipy.integrate import solve_ivp
 
-import lagrangian
+import lagrangian  # noqa: F401
 from lagrangian.numerics.fast import integrate_fast
 
+sys.path.insert(0, str(Path(__file__).parent))
+from n_link import build_lagrangian  # noqa: E402  (the same model as bench_derive)
+
 G = 9.81
-
-
-def build_lagrangian(n: int) -> lagrangian.System:
-    """The n-link pendulum with lagrangian's SystemBuilder (absolute angles theta_i)."""
-    b = lagrangian.SystemBuilder(f"{n}-link pendulum")
-    g = b.parameter("g", G)
-    x, y = sp.S.Zero, sp.S.Zero
-    for i in range(1, n + 1):
-        theta = b.coordinate(f"theta{i}", unit="rad")
-        mass, length = b.parameter(f"m{i}", 1.0), b.parameter(f"l{i}", 1.0)
-        x, y = x + length * sp.sin(theta), y - length * sp.cos(theta)
-        b.add_particle(f"bob{i}", mass, (x, y))
-    b.set_gravity(g, (0, -1))
-    return b.build()
 
 
 def kane_model(n: int):

@@ -21,6 +21,7 @@ import sympy as sp
 from ..errors import ModelError
 from .expressions import CONSTANTS, FUNCTIONS, parse_expression
 from .model import Model, multiplier_name
+from .reader import read_text_file
 
 TABLES = ("energy", "generalized_forces", "equations", "multipliers")
 _FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
@@ -72,14 +73,7 @@ def answer_names(model: Model) -> dict[str, sp.Expr]:
 
 def read_answer(path: str | Path, model: Model) -> Answer:
     """Read ANSWER.toml against ``model``; errors name the file and the key."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ModelError("no such file", source=str(path)) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ModelError(f"cannot read the file ({exc})", source=str(path)) from None
-    return parse_answer(text, model, source=str(path))
+    return parse_answer(read_text_file(path), model, source=str(path))
 
 
 def parse_answer(text: str, model: Model, *, source: str = "<answer>") -> Answer:

@@ -25,16 +25,19 @@ COMPONENT_KEYS = {
 }
 
 
-def read_model(path: str | Path) -> Model:
-    """Load a TOML model file."""
-    path = Path(path)
+def read_text_file(path: str | Path) -> str:
+    """The text of a user's input file; a missing or unreadable file is a ModelError naming it."""
     try:
-        text = path.read_text(encoding="utf-8")
+        return Path(path).read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ModelError("no such file", source=str(path)) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ModelError(f"cannot read the file ({exc})", source=str(path)) from None
-    return parse_model(text, source=str(path))
+
+
+def read_model(path: str | Path) -> Model:
+    """Load a TOML model file."""
+    return parse_model(read_text_file(path), source=str(path))
 
 
 def parse_model(text: str, *, source: str = "<model>") -> Model:

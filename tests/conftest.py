@@ -24,3 +24,17 @@ def cli(capsys):
         return CliResult(code, captured.out, captured.err)
 
     return run
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _compiled_module_cache(tmp_path_factory):
+    """Compiled C modules of the test run go to a fresh cache, never the user's."""
+    import os
+
+    previous = os.environ.get("LAGRANGIAN_CACHE")
+    os.environ["LAGRANGIAN_CACHE"] = str(tmp_path_factory.mktemp("lagrangian-cache"))
+    yield
+    if previous is None:
+        os.environ.pop("LAGRANGIAN_CACHE", None)
+    else:
+        os.environ["LAGRANGIAN_CACHE"] = previous

@@ -57,6 +57,8 @@ def test_same_steps_and_answers_as_scipy_dop853(t_eval):
     np.testing.assert_allclose(ours.y, scipy.y.T, rtol=1e-6, atol=1e-6)
     if t_eval is not None:
         assert ours.nfev == scipy.nfev  # dense output costs 3 extra calls per step, as in scipy
+    else:
+        assert ours.steps == len(scipy.t) - 1  # every accepted step is recorded
 
 
 def test_backward_in_time_matches_scipy():

@@ -25,6 +25,7 @@ class FastResult:
     nfev: int
     success: bool
     message: str
+    steps: int = 0  # accepted steps
 
 
 _MESSAGES = {
@@ -73,7 +74,8 @@ def integrate_fast(
         steps = np.diff(t_eval)
         if (t1 >= t0 and np.any(steps <= 0)) or (t1 < t0 and np.any(steps >= 0)):
             raise ValueError("values in t_eval are not properly sorted")
-    t, y, nfev, status, t_reached = kernel.module.dop853(
+    t, y, nfev, steps, status, t_reached = kernel.module.dop853(
         kernel.parameter_values, t0, t1, y0, float(rtol), float(atol), t_eval, int(max_steps))
     message = _MESSAGES[status].format(max_steps=max_steps, t=t_reached)
-    return FastResult(t=t, y=y, nfev=int(nfev), success=status == 0, message=message)
+    return FastResult(t=t, y=y, nfev=int(nfev), success=status == 0, message=message,
+                      steps=int(steps))

@@ -141,7 +141,7 @@ static int lg_push(lg_trace *o, double t, const double *y)
  * Called without the GIL; takes it back every 256 steps to notice Ctrl-C. */
 static int lg_dop853(const double *p, double t0, double t1, const double *y0, double rtol, double atol,
                      const double *te, npy_intp ne, long long max_steps, lg_trace *out,
-                     long long *nfev, double *t_reached, PyThreadState **save)
+                     long long *nfev, long long *accepted, double *t_reached, PyThreadState **save)
 {
     double K[16][LG_S], y[LG_S], ynew[LG_S], tmp[LG_S], f[LG_S], F[7][LG_S];
     const double dir = (t1 >= t0) ? 1.0 : -1.0;
@@ -150,6 +150,7 @@ static int lg_dop853(const double *p, double t0, double t1, const double *y0, do
     npy_intp ie = 0;
     memcpy(y, y0, sizeof y);
     *nfev = 0;
+    *accepted = 0;
     *t_reached = t0;
     (*nfev)++;
     if (lg_rhs(t, y, p, f)) return LG_SINGULAR;
@@ -287,6 +288,7 @@ static int lg_dop853(const double *p, double t0, double t1, const double *y0, do
         memcpy(y, ynew, sizeof y);
         memcpy(f, K[12], sizeof f);
         *t_reached = t;
+        (*accepted)++;
         if (dir * (t - t1) >= 0) return LG_DONE;
     }
 }
@@ -440,7 +442,8 @@ static PyObject *py_rhs(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     return dy;
 }
 
-/* dop853(P, t0, t1, y0, rtol, atol, t_eval or None, max_steps) -> (t, y, nfev, status, t_reached) */
+/* dop853(P, t0, t1, y0, rtol, atol, t_eval or None, max_steps)
+ *   -> (t, y, nfev, accepted steps, status, t_reached) */
 static PyObject *py_dop853(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     if (nargs != 8) {
@@ -461,13 +464,13 @@ static PyObject *py_dop853(PyObject *self, PyObject *const *args, Py_ssize_t nar
         if (!te) { Py_DECREF(P); Py_DECREF(y0); return NULL; }
     }
     lg_trace out = {NULL, NULL, 0, 0};
-    long long nfev = 0;
+    long long nfev = 0, accepted = 0;
     double t_reached = t0;
     int status;
     PyThreadState *save = PyEval_SaveThread();
     status = lg_dop853((const double *)PyArray_DATA(P), t0, t1, (const double *)PyArray_DATA(y0), rtol, atol,
                        te ? (const double *)PyArray_DATA(te) : NULL, te ? PyArray_SIZE(te) : 0,
-                       max_steps, &out, &nfev, &t_reached, &save);
+                       max_steps, &out, &nfev, &accepted, &t_reached, &save);
     PyEval_RestoreThread(save);
     if (status == LG_INTERRUPTED) PyErr_Clear();  /* Ctrl-C: keep what was computed */
     Py_DECREF(P); Py_DECREF(y0); Py_XDECREF(te);
@@ -479,7 +482,7 @@ static PyObject *py_dop853(PyObject *self, PyObject *const *args, Py_ssize_t nar
     free(out.t);
     free(out.y);
     if (!T || !Y) { Py_XDECREF(T); Py_XDECREF(Y); return NULL; }
-    return Py_BuildValue("(NNLid)", T, Y, nfev, status, t_reached);
+    return Py_BuildValue("(NNLLid)", T, Y, nfev, accepted, status, t_reached);
 }
 
 static PyMethodDef lg_methods[] = {
@@ -490,7 +493,7 @@ static PyMethodDef lg_methods[] = {
      "(Q, V, T, P) -> (q_ddot, lambda)"},
     {"rhs", (PyCFunction)(void (*)(void))py_rhs, METH_FASTCALL, "(P, t, y) -> [q_dot, q_ddot]"},
     {"dop853", (PyCFunction)(void (*)(void))py_dop853, METH_FASTCALL,
-     "(P, t0, t1, y0, rtol, atol, t_eval, max_steps) -> (t, y, nfev, status, t_reached)"},
+     "(P, t0, t1, y0, rtol, atol, t_eval, max_steps) -> (t, y, nfev, steps, status, t_reached)"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -105,8 +105,19 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
     potential_terms: list[sp.Expr] = [model.potential_energy]
     dissipation_terms: list[sp.Expr] = [model.dissipation]
 
+    gravity = model.gravity
+
     def translate(mass: sp.Expr, position) -> None:
         jacobian = [jacobian_row(component, q) for component in position]
+        if gravity is not None:
+            # Weight m g d enters as its virtual work m g d . dr/dq_i, grouped by shape like the
+            # inertia terms (so a chain shows (m1 + m2) g l1 sin(theta1)); V still shows -m g h.
+            for i in range(n):
+                lever = sp.Add(*(dc * row[i] for dc, row in zip(gravity.direction, jacobian,
+                                                                 strict=True)
+                                 if dc != 0 and row[i] != 0))
+                if lever != 0:
+                    acc.forcing[i][gravity.magnitude * lever].append(mass)
         # v = J q_dot + dr/dt, reusing J rather than differentiating r again.
         moving = [d(component, t) for component in position]
         velocity = [
@@ -132,16 +143,17 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
                                  + sp.Rational(1, 2) * body.inertia * spin**2)
     component_mass = acc.mass_matrix() if model.particles or model.bodies else None
 
-    if model.gravity is not None:
-        g, direction = model.gravity.magnitude, model.gravity.direction
+    if gravity is not None:
+        g, direction = gravity.magnitude, gravity.direction
         for item in (*model.particles, *model.bodies):
             height = sp.Add(*(d * r for d, r in zip(direction, item.position, strict=True)
                               if d != 0))
             potential_terms.append(-item.mass * g * height)
-    for spring in model.springs:
-        potential_terms.append(
-            sp.Rational(1, 2) * spring.stiffness * (spring.length - spring.rest_length) ** 2
-        )
+    spring_terms = [
+        sp.Rational(1, 2) * spring.stiffness * (spring.length - spring.rest_length) ** 2
+        for spring in model.springs
+    ]
+    potential_terms.extend(spring_terms)
     for damper in model.dampers:
         dissipation_terms.append(sp.Rational(1, 2) * damper.coefficient * damper.rate**2)
 
@@ -149,9 +161,9 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
     user_lagrangian = model.kinetic_energy - model.potential_energy
     if user_lagrangian != 0:
         _general_lagrangian(acc, d, user_lagrangian, q, q_dot, t)
-    component_potential = sp.Add(*potential_terms[1:])
-    if component_potential != 0:
-        for i, gradient in enumerate(jacobian_row(component_potential, q)):
+    spring_potential = sp.Add(*spring_terms)
+    if spring_potential != 0:
+        for i, gradient in enumerate(jacobian_row(spring_potential, q)):
             if gradient != 0:
                 acc.add_force(i, -gradient)
 

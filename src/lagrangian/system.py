@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
+from functools import cached_property
 from pathlib import Path
 
 import sympy as sp
@@ -35,7 +36,6 @@ class System:
         if not isinstance(model, Model):
             raise TypeError("System(model) takes a lagrangian Model; use load() or SystemBuilder")
         self._model = model
-        self._equations: EquationsOfMotion | None = None
 
     @property
     def model(self) -> Model:
@@ -79,9 +79,11 @@ class System:
 
     def equations_of_motion(self) -> EquationsOfMotion:
         """M q_ddot + Phi_q^T lambda = f by Lagrange's method (derived once, then cached)."""
-        if self._equations is None:
-            self._equations = derive(self._model)
         return self._equations
+
+    @cached_property
+    def _equations(self) -> EquationsOfMotion:
+        return derive(self._model)
 
     def generalized_forces_at(
         self, configuration: Mapping[str, float], parameters: Mapping[str, float] | None = None
@@ -89,7 +91,7 @@ class System:
         """Each generalized force, and each load's part of it, at a configuration (SI)."""
         return evaluate_generalized_forces(self.equations_of_motion(), configuration, parameters)
 
-    # -- simulation (issue 4): thin delegation to numerics.simulate ---------------------------
+    # -- simulation -------------------------------------------------------------------------------
 
     def simulate(
         self,
@@ -109,48 +111,49 @@ class System:
         the start time); ``stop_when`` is a condition such as "theta < 0" that ends the run.
         Constrained models are kept on Phi = 0 by projection (see docs/simulation.md).
         """
-        from .numerics.functions import numeric
         from .numerics.simulate import simulate
         from .simulation import Simulation
 
-        cache = self.__dict__.setdefault("_simulation_numeric", {})
-        if "system" not in cache:  # compiled once per System (parameters are fixed in it)
-            cache["system"] = numeric(self.equations_of_motion())
         result = simulate(self.equations_of_motion(), t_end, initial=initial, method=method,
                           rtol=rtol, atol=atol, samples=samples, stop_when=stop_when,
-                          progress=progress, system=cache["system"])
+                          progress=progress, system=self._numeric)
         return Simulation(result, self._model)
 
-    # -- end simulation ----------------------------------------------------------------------
+    # -- compiled numeric functions -------------------------------------------------------------
 
-    # ---- numerics (issue 4, speed): compiled numeric functions --------------------------------
     def numeric(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"):
         """M, f, Phi_q, gamma, energy and the ODE right-hand side as batched numeric functions.
 
         backend "c" (generated C, compiled once and cached), "numpy", or "auto" (C if a compiler
         works). Parameters (SI) override the model's values.
         """
+        if parameters is None and backend == "auto":
+            return self._numeric
         from .numerics.functions import numeric
 
         return numeric(self.equations_of_motion(), parameters, backend=backend)
-    # ---- end numerics -------------------------------------------------------------------------
 
-    # -- analysis: equilibria, linearization and modes (issue 3) --------------------------------
+    @cached_property
+    def _numeric(self):
+        """The default numeric system, compiled once per System (its parameters are fixed)."""
+        from .numerics.functions import numeric
 
+        return numeric(self.equations_of_motion())
+
+    # -- equilibria, linearization and modes -----------------------------------------------------
+
+    @cached_property
     def _static_functions(self):
         """Compiled functions at rest, built once per System (parameters are fixed per System)."""
         from .analysis.linearization import StaticFunctions
 
-        cached = getattr(self, "_static_cache", None)
-        if cached is None:
-            cached = self._static_cache = StaticFunctions(self.equations_of_motion())
-        return cached
+        return StaticFunctions(self.equations_of_motion())
 
     def equilibria(self):
         """Configurations of rest, f(q, 0) = Phi_q^T lambda with Phi(q) = 0, each with its stability."""
         from .analysis.modes import equilibria_of
 
-        return equilibria_of(self._static_functions())
+        return equilibria_of(self._static_functions)
 
     def linearize(self, about: Mapping[str, float] | None = None, inputs: Sequence[str] = (), *,
                   symbolic: bool = False):
@@ -167,17 +170,15 @@ class System:
             return symbolic_linear_model(self.equations_of_motion(), dict(about or {}))
         from .analysis.modes import linearize_about
 
-        return linearize_about(self._static_functions(), about, tuple(inputs))
+        return linearize_about(self._static_functions, about, tuple(inputs))
 
     def modes(self, about: Mapping[str, float] | None = None):
         """Natural frequencies (rad/s), damping ratios and mode shapes about an equilibrium."""
         from .analysis.modes import modes_about
 
-        return modes_about(self._static_functions(), about)
+        return modes_about(self._static_functions, about)
 
-    # -- end of analysis ---------------------------------------------------------------------------
-
-    # -- checking a hand derivation (issue 5): check, crosscheck, check_units --------------------
+    # -- checking a hand derivation: check, crosscheck, check_units --------------------------------
 
     def check(self, answer):
         """Verdicts and diagnoses on a hand derivation: a path to ANSWER.toml, its tables as a
@@ -207,8 +208,6 @@ class System:
         from .check.units import check_model_units
 
         return check_model_units(self._model)
-
-    # -- end of checking ---------------------------------------------------------------------------
 
     def __repr__(self) -> str:
         names = ", ".join(c.name for c in self._model.coordinates)

@@ -16,6 +16,7 @@ from ..errors import ModelError
 from .expressions import RESERVED, parse_expression
 from .model import (
     TIME,
+    Attachment,
     Body,
     Constraint,
     Coordinate,
@@ -230,13 +231,14 @@ class ModelBuilder:
         """A linear spring, V = 1/2 k (length - rest_length)^2; give ``length`` or ``between``."""
         field = field or f"spring '{name}'"
         self._component(name, field)
-        extent = self._extent(length, between, "length", field)
+        extent, ends = self._extent(length, between, "length", field)
         self._springs.append(
             Spring(
                 name,
                 self.expression(stiffness, f"{field}.stiffness", velocities=False),
                 self.expression(rest_length, f"{field}.rest_length", velocities=False),
                 extent,
+                ends,
             )
         )
         return self
@@ -250,13 +252,15 @@ class ModelBuilder:
         self._component(name, field)
         if (rate is None) == (between is None):
             raise self._error("give exactly one of 'rate' or 'between'", field)
+        ends = None
         if rate is not None:
             value = self.expression(rate, f"{field}.rate")
         else:
-            value = self._time_derivative(self._extent(None, between, "rate", field))
+            extent, ends = self._extent(None, between, "rate", field)
+            value = self._time_derivative(extent)
         self._dampers.append(
             Damper(name, self.expression(coefficient, f"{field}.coefficient", velocities=False),
-                   value)
+                   value, ends)
         )
         return self
 
@@ -452,16 +456,29 @@ class ModelBuilder:
             yield c.symbol
             yield c.velocity
 
-    def _extent(self, value, between, what: str, field: str) -> sp.Expr:
+    def _extent(self, value, between, what: str, field: str):
+        """(length expression, end attachments or None) of a spring or damper."""
         if (value is None) == (between is None):
             raise self._error(f"give exactly one of '{what}' or 'between'", field)
         if value is not None:
-            return self.expression(value, f"{field}.{what}", velocities=False)
+            return self.expression(value, f"{field}.{what}", velocities=False), None
         if isinstance(between, str) or not isinstance(between, Sequence) or len(between) != 2:
             raise self._error("'between' takes exactly two points", f"{field}.between")
-        a = self.point(between[0], field=f"{field}.between[0]")
-        b = self.point(between[1], field=f"{field}.between[1]")
-        return sp.sqrt(sum((ai - bi) ** 2 for ai, bi in zip(a, b, strict=True)))
+        ends = tuple(
+            Attachment(self.point(reference, field=f"{field}.between[{k}]"),
+                       self._attached_body(reference))
+            for k, reference in enumerate(between)
+        )
+        a, b = ends[0].point, ends[1].point
+        return sp.sqrt(sum((ai - bi) ** 2 for ai, bi in zip(a, b, strict=True))), ends
+
+    def _attached_body(self, reference: object) -> str | None:
+        """The particle or body a point reference is fixed to (None for a plain vector)."""
+        if isinstance(reference, str):
+            return reference
+        if isinstance(reference, dict):
+            return reference.get("body")
+        return None
 
     def _time_derivative(self, expr: sp.Expr) -> sp.Expr:
         return sum(

@@ -77,22 +77,40 @@ class Body:
 
 
 @dataclass(frozen=True)
+class Attachment:
+    """Where a two-point element (spring, damper) ends: the point, and the particle or body it
+    is fixed to (None for a point given as a vector: the ground or a prescribed point)."""
+
+    point: Vector
+    body: str | None = None
+
+
+@dataclass(frozen=True)
 class Spring:
-    """A linear spring: V = 1/2 k (length - rest_length)^2, in J."""
+    """A linear spring: V = 1/2 k (length - rest_length)^2, in J.
+
+    ``ends`` holds its two attachments when it was given ``between`` two points (its length is
+    then their distance), None when only its length was given.
+    """
 
     name: str
     stiffness: sp.Expr
     rest_length: sp.Expr
     length: sp.Expr
+    ends: tuple[Attachment, Attachment] | None = None
 
 
 @dataclass(frozen=True)
 class Damper:
-    """A linear viscous damper: Rayleigh dissipation D = 1/2 c rate^2, in W."""
+    """A linear viscous damper: Rayleigh dissipation D = 1/2 c rate^2, in W.
+
+    ``ends`` as for a spring: set when it was given ``between`` two points.
+    """
 
     name: str
     coefficient: sp.Expr
     rate: sp.Expr
+    ends: tuple[Attachment, Attachment] | None = None
 
 
 @dataclass(frozen=True)

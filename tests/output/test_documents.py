@@ -84,3 +84,13 @@ def test_jupyter_display_is_latex():
     assert system._repr_latex_().startswith("$L = ")
     latex = system.equations_of_motion()._repr_latex_()
     assert latex.startswith("$") and r"\ddot{\theta}" in latex
+
+
+def test_jupyter_display_of_modes_and_forces():
+    modes = lagrangian.load("two_mass").modes()._repr_latex_()
+    assert modes.startswith("$\\begin{array}") and modes.endswith("$")
+    assert "1 & 1 & 0.159155 & 0 & 0 & 1 & 1" in modes  # omega = 1 rad/s, shape (1, 1)
+    assert "2 & 1.73205" in modes and "& 1 & -1" in modes
+    forces = lagrangian.load("virtual_work_link").generalized_forces_at(
+        {"theta": 0.5235987755982988})._repr_latex_()
+    assert "Q_{\\theta} &= 43.3013" in forces and "\\mathrm{N\\,m}" in forces

@@ -21,6 +21,18 @@ class ForceReport:
     contributions: tuple[tuple[str, str, float], ...]
     units: dict[str, str]
 
+    def _repr_latex_(self) -> str:
+        """Jupyter: each Q_i with its unit and each load's part of it."""
+        rows = []
+        for name, value in self.generalized_forces.items():
+            parts = ", ".join(rf"\text{{{load}}}: {part:.6g}"
+                              for load, coordinate, part in self.contributions
+                              if coordinate == name)
+            unit = self.units[name].replace("*", r"\,")
+            rows.append(rf"Q_{{{sp.latex(sp.Symbol(name))}}} &= {value:.6g}\ \mathrm{{{unit}}}"
+                        + (rf" && ({parts})" if parts else ""))
+        return r"$\begin{aligned}" + r" \\ ".join(rows) + r"\end{aligned}$"
+
 
 def state_values(
     eom: EquationsOfMotion, at: Mapping[str, float], parameters: Mapping[str, float] | None = None,

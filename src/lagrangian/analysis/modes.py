@@ -14,6 +14,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import sympy as sp
 
 from ..errors import DerivationError
 from .linearization import LinearModel
@@ -113,6 +114,23 @@ class ModalAnalysis:
 
     def __getitem__(self, index: int) -> Mode:
         return self.modes[index]
+
+    def _repr_latex_(self) -> str:
+        """Jupyter: a table of frequency (rad/s), f (Hz), damping ratio and shape per mode."""
+        names = self.linear_model.user_coordinates
+        heads = " & ".join(sp.latex(sp.Symbol(n)) for n in names)
+        rows = []
+        for i, m in enumerate(self.modes, 1):
+            zeta = "-" if m.damping_ratio is None else f"{m.damping_ratio:.4g}"
+            shape = " & ".join(f"{m.shape[n]:.4g}" for n in names)
+            rows.append(f"{i} & {m.frequency:.6g} & {m.frequency_hz:.6g} & {zeta} & "
+                        f"{m.growth_rate:.4g} & {shape}")
+        columns = "r" * (5 + len(names))
+        state = "stable" if self.stable else "unstable"
+        return (rf"$\begin{{array}}{{{columns}}}"
+                rf"\text{{mode}} & \omega\ [\mathrm{{rad/s}}] & f\ [\mathrm{{Hz}}] & \zeta"
+                rf" & \sigma\ [1/\mathrm{{s}}] & {heads} \\ \hline "
+                + r" \\ ".join(rows) + rf"\end{{array}}\quad\text{{({state})}}$")
 
     def __repr__(self) -> str:
         about = ", ".join(f"{k}={v:.6g}" for k, v in self.equilibrium.items())

@@ -12,6 +12,10 @@ on both sides):
 
 which must equal Lagrange's (M q_ddot - f)_i identically. The reaction on each body is then
 R = m a_G - F (and M_R = I alpha - M_G about its centre of mass), with q_ddot solved from E.
+
+A spring or damper given ``between`` two points acts on the particles or bodies at its ends,
+equal and opposite (on a body also with its moment about G from the end's offset); one given by
+its length only still enters the virtual work, but then no reactions are reported.
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ import sympy as sp
 from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError
 from ..model.expressions import format_expression as fmt
-from ..model.model import Model, PointForce, Torque
+from ..model.model import Attachment, Model, PointForce, Torque
 from . import equivalence as eq
 
 SYMBOLIC_REACTIONS_MAX_UNKNOWNS = 3
@@ -113,6 +117,12 @@ def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
     points = eq.random_points(model)
     to_time = {c.symbol: sp.Function(c.name)(t) for c in model.coordinates}
 
+    def first_derivative(expr: sp.Expr) -> sp.Expr:
+        """d/dt with q -> q(t), then back to the plain symbols q, q_dot."""
+        moving = expr.xreplace(to_time).diff(t)
+        moving = moving.xreplace({to_time[c.symbol].diff(t): c.velocity for c in model.coordinates})
+        return moving.xreplace({f: s for s, f in to_time.items()})
+
     def second_derivative(expr: sp.Expr) -> sp.Expr:
         """d^2/dt^2 with q -> q(t), then back to the plain symbols q, q_dot, q_ddot."""
         moving = expr.xreplace(to_time).diff(t, 2)
@@ -151,6 +161,27 @@ def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
             weight = [fb.mass * g * d for d in direction]
             fb.force = [a + b for a, b in zip(fb.force, weight, strict=True)]
             project(weight, fb.position)
+    def place(force, point, holder: _FreeBody | None) -> None:
+        """Add ``force`` acting at ``point`` to ``holder``: force, and moment about G for a body."""
+        holder.force = [a + b for a, b in zip(holder.force, force, strict=True)]
+        if holder.angle is not None:
+            s = [p - r for p, r in zip(point, holder.position, strict=True)]
+            holder.moment += s[0] * force[1] - s[1] * force[0]
+
+    def attach(force, end: Attachment) -> bool:
+        """Put ``force`` on the free body ``end`` is fixed to; False when there is none to find."""
+        project(force, end.point)
+        if end.body is not None:
+            holder = next((fb for fb in bodies if fb.name == end.body), None)
+        elif any(c.has(*q) for c in end.point):  # a moving point given as a vector
+            holder = _holder(end.point, bodies, model, points)
+        else:  # the ground (or a prescribed point): its reaction is not asked for
+            return True
+        if holder is None:
+            return False
+        place(force, end.point, holder)
+        return True
+
     for load in model.loads:
         if isinstance(load, PointForce):
             project(load.force, load.point)
@@ -158,10 +189,7 @@ def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
             if holder is None:
                 unattributed.append(load.name)
                 continue
-            holder.force = [a + b for a, b in zip(holder.force, load.force, strict=True)]
-            if holder.angle is not None:
-                s = [p - r for p, r in zip(load.point, holder.position, strict=True)]
-                holder.moment += s[0] * load.force[1] - s[1] * load.force[0]
+            place(load.force, load.point, holder)
         elif isinstance(load, Torque):
             for i, qi in enumerate(q):
                 work[i].append(load.torque * load.angle.diff(qi))
@@ -172,6 +200,13 @@ def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
                 continue
             holder.moment += load.torque
     for spring in model.springs:
+        if spring.ends is not None:
+            # Tension k (l - l0) pulls each end towards the other along u = (r_a - r_b)/l.
+            a, b, u, length = _line(spring.ends)
+            tension = spring.stiffness * (length - spring.rest_length)
+            if not _pull(attach, a, b, [-tension * c for c in u]):
+                unattributed.append(spring.name)
+            continue
         unattributed.append(spring.name)
         tension = spring.stiffness * (spring.length - spring.rest_length)
         squared = _squared_separation(spring.length)
@@ -183,6 +218,15 @@ def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
             else:  # a spring along its own length coordinate
                 work[i].append(-tension * spring.length.diff(qi))
     for damper in model.dampers:
+        if damper.ends is not None:
+            # -c l_dot along u on end a, with l_dot = u . d(r_a - r_b)/dt (own time derivative).
+            a, b, u, _ = _line(damper.ends)
+            separation_rate = [first_derivative(pa - pb)
+                               for pa, pb in zip(a.point, b.point, strict=True)]
+            rate = sp.Add(*(ui * di for ui, di in zip(u, separation_rate, strict=True)))
+            if not _pull(attach, a, b, [-damper.coefficient * rate * c for c in u]):
+                unattributed.append(damper.name)
+            continue
         unattributed.append(damper.name)
         # Force -c l_dot along the line, projected by dl/dq_i = d(l_dot)/d(q_dot_i).
         for i, c in enumerate(model.coordinates):
@@ -254,6 +298,21 @@ def _holder(point, bodies: list[_FreeBody], model: Model, points: eq.Points) -> 
     return None
 
 
+def _line(ends: tuple[Attachment, Attachment]):
+    """(end a, end b, unit vector from b to a, distance) of a two-point element."""
+    a, b = ends
+    d = [pa - pb for pa, pb in zip(a.point, b.point, strict=True)]
+    length = sp.sqrt(sp.Add(*(c**2 for c in d)))
+    return a, b, [c / length for c in d], length
+
+
+def _pull(attach, a: Attachment, b: Attachment, force_on_a: list) -> bool:
+    """Apply ``force_on_a`` at end a and its opposite at end b; True when both are placed."""
+    placed_a = attach(force_on_a, a)
+    placed_b = attach([-c for c in force_on_a], b)
+    return placed_a and placed_b
+
+
 def _squared_separation(length: sp.Expr) -> sp.Expr | None:
     """|d|^2 for a length written sqrt(|d|^2), as a spring 'between' two points is."""
     if isinstance(length, sp.Pow) and length.exp == sp.S.Half:
@@ -305,6 +364,14 @@ def _reactions(eom: EquationsOfMotion, bodies: list[_FreeBody], newton_euler: li
 def _tidy(expr: sp.Expr) -> sp.Expr:
     if not eq._small(expr):
         return expr
+    radicals = [power for power in expr.atoms(sp.Pow) if not power.exp.is_integer]
+    if radicals:
+        # A spring between two points brings its length sqrt(|d|^2): trigsimp and cancel on
+        # the whole term are slow and multiply the roots out, so only the radicands are tidied.
+        try:
+            return expr.xreplace({r: sp.Pow(sp.trigsimp(r.base), r.exp) for r in radicals})
+        except Exception:  # noqa: BLE001 - tidying only costs readability
+            return expr
     try:
         return sp.factor(sp.trigsimp(sp.cancel(expr)))
     except Exception:  # noqa: BLE001 - tidying only costs readability

@@ -1,8 +1,10 @@
-"""Animation of the mechanism: particles as dots, bodies as bars, springs as zigzags (GIF/HTML).
+"""Animation of the mechanism: particles as dots, bodies as bars, springs as zigzags and
+dampers as dashpots (GIF/HTML).
 
-Positions come from the model (particle and body positions, body angles); a spring is drawn
-between its two end points when they can be recovered from its length (the model keeps only
-the length of a spring given by ``between``), otherwise it is left out.
+Positions come from the model (particle and body positions, body angles). A spring or damper
+given ``between`` two points is drawn between its kept ends, exactly. A spring given by its
+length only is drawn between end points guessed from that length (see ``spring_end_points``),
+or left out when none fit; a damper given by its rate only is left out.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ import os
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import sympy as sp
@@ -24,6 +27,16 @@ from .files import atomic_write
 ANIMATION_FORMATS = (".gif", ".html")
 
 
+class Frame(NamedTuple):
+    """Batched positions (m) at k instants: particles (k, P, 2), bar ends (k, B, 2, 2), spring
+    ends (k, S, 2, 2), damper ends (k, D, 2, 2)."""
+
+    particles: np.ndarray
+    bars: np.ndarray
+    springs: np.ndarray
+    dampers: np.ndarray
+
+
 @dataclass(frozen=True)
 class Mechanism:
     """Compiled geometry: callables of (q, q_dot, t) arrays giving points in the plane (m)."""
@@ -34,9 +47,11 @@ class Mechanism:
     _particles: object
     _bodies: object
     _springs: object
+    damper_names: tuple[str, ...] = ()
+    _dampers: object = None
 
-    def frame(self, q: np.ndarray, v: np.ndarray, t: np.ndarray):
-        """Batched positions: particles (k, P, 2), bar ends (k, B, 2, 2), springs (k, S, 2, 2)."""
+    def frame(self, q: np.ndarray, v: np.ndarray, t: np.ndarray) -> Frame:
+        """Batched positions of everything drawn, for states q, v (k, n) at times t (k,)."""
         k = len(t)
 
         def stack(f, count, shape):
@@ -53,7 +68,8 @@ class Mechanism:
         offset = np.stack([c * half, s * half], axis=-1)
         bars = np.stack([centre - offset, centre + offset], axis=-2)
         springs = stack(self._springs, len(self.spring_names), (2, 2))
-        return particles, bars, springs
+        dampers = stack(self._dampers, len(self.damper_names), (2, 2))
+        return Frame(particles, bars, springs, dampers)
 
 
 def mechanism(model: Model, parameters: dict[str, float]) -> Mechanism:
@@ -75,20 +91,39 @@ def mechanism(model: Model, parameters: dict[str, float]) -> Mechanism:
         bodies.extend([body.position[0], body.position[1], body.angle, half])
     ends = spring_end_points(model, values)
     springs = [e for name in ends for point in ends[name] for e in point[:2]]
+    damper_ends = {d.name: (d.ends[0].point, d.ends[1].point) for d in model.dampers
+                   if d.ends is not None}
+    dampers = [e for name in damper_ends for point in damper_ends[name] for e in point[:2]]
     return Mechanism(
         particle_names=tuple(p.name for p in model.particles),
         body_names=tuple(b.name for b in model.bodies),
         spring_names=tuple(ends),
         _particles=compile_(particles), _bodies=compile_(bodies), _springs=compile_(springs),
+        damper_names=tuple(damper_ends), _dampers=compile_(dampers),
     )
 
 
 def spring_end_points(model: Model, values: dict) -> dict[str, tuple]:
-    """Spring name -> (point A, point B) where the length equals |A - B| at sampled states.
+    """Spring name -> (point A, point B), in the model's order.
 
-    Candidates are the origin and the particle and body centres; failing a pair, one moving
-    candidate and a fixed anchor found by least squares. Springs matching neither are skipped.
+    A spring given ``between`` two points has its kept ends. For one given by its length only,
+    A and B are guessed where the length equals |A - B| at sampled states: candidates are the
+    origin and the particle and body centres; failing a pair, one moving candidate and a fixed
+    anchor found by least squares. Springs matching neither are skipped.
     """
+    guessed = _guessed_end_points(model, [s for s in model.springs if s.ends is None], values)
+    found = {}
+    for spring in model.springs:
+        if spring.ends is not None:
+            found[spring.name] = (spring.ends[0].point, spring.ends[1].point)
+        elif spring.name in guessed:
+            found[spring.name] = guessed[spring.name]
+    return found
+
+
+def _guessed_end_points(model: Model, springs: list, values: dict) -> dict[str, tuple]:
+    if not springs:
+        return {}
     candidates = [(0, 0, 0)] + [p.position for p in model.particles] + \
         [b.position for b in model.bodies]
     args = [*model.q, *model.q_dot, model.time]
@@ -105,7 +140,7 @@ def spring_end_points(model: Model, values: dict) -> dict[str, tuple]:
     except (TypeError, ValueError, ZeroDivisionError):
         return {}
     found = {}
-    for spring in model.springs:
+    for spring in springs:
         try:
             length = sample(spring.length)
         except (TypeError, ValueError, ZeroDivisionError):
@@ -156,6 +191,24 @@ def _zigzag(a: np.ndarray, b: np.ndarray, turns: int = 8, width: float = 0.06):
     return a + np.outer(s * length, u) + np.outer(side * width * max(length, 0.05), normal)
 
 
+def _dashpot(a: np.ndarray, b: np.ndarray, width: float = 0.08):
+    """Points of a dashpot from a to b: rod, open cylinder, piston plate, rod (NaN-separated)."""
+    d = b - a
+    length = np.hypot(*d)
+    if length == 0:
+        return np.array([a, b])
+    u = d / length
+    n = np.array([-u[1], u[0]]) * width * max(length, 0.05)
+
+    def at(s: float) -> np.ndarray:  # the point a fraction s of the way from a to b
+        return a + s * d
+
+    gap = np.full(2, np.nan)  # a NaN breaks the line between the pieces
+    cylinder = [at(0.65) + n, at(0.35) + n, at(0.35) - n, at(0.65) - n]
+    piston = [at(0.55) + 0.8 * n, at(0.55) - 0.8 * n]
+    return np.array([a, at(0.35), gap, *cylinder, gap, *piston, gap, at(0.55), b])
+
+
 def animation_frames(result: SimulationResult, fps: int = 25, max_frames: int = 250):
     """Frame times: real time at ``fps``, at most ``max_frames`` frames over the run."""
     t0, t1 = float(result.t[0]), float(result.t[-1])
@@ -184,9 +237,9 @@ def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25
                          for i in range(result.q.shape[1])])
     v = np.column_stack([np.interp(times, result.t, result.q_dot[:, i])
                          for i in range(result.q.shape[1])])
-    particles, bars, springs = geometry.frame(q, v, times)
+    particles, bars, springs, dampers = geometry.frame(q, v, times)
     everything = np.concatenate([particles.reshape(-1, 2), bars.reshape(-1, 2),
-                                 springs.reshape(-1, 2), [[0.0, 0.0]]])
+                                 springs.reshape(-1, 2), dampers.reshape(-1, 2), [[0.0, 0.0]]])
     everything = everything[np.all(np.isfinite(everything), axis=1)]
     low, high = everything.min(axis=0), everything.max(axis=0)
     # A square view around the motion, so a mechanism moving along one line is not squashed.
@@ -204,6 +257,8 @@ def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25
     ax.set_ylabel("y (m)")
     ax.plot([0], [0], marker="+", color="grey")
     spring_lines = [ax.plot([], [], color="tab:green", linewidth=1)[0] for _ in geometry.spring_names]
+    damper_lines = [ax.plot([], [], color="tab:purple", linewidth=1.5)[0]
+                    for _ in geometry.damper_names]
     bar_lines = [ax.plot([], [], color="tab:blue", linewidth=4, solid_capstyle="round")[0]
                  for _ in geometry.body_names]
     # Each particle leaves a short trail (its last second) so the motion reads in one frame.
@@ -218,6 +273,9 @@ def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25
         for line, (a, b) in zip(spring_lines, springs[k], strict=True):
             zig = _zigzag(a, b)
             line.set_data(zig[:, 0], zig[:, 1])
+        for line, (a, b) in zip(damper_lines, dampers[k], strict=True):
+            pot = _dashpot(a, b)
+            line.set_data(pot[:, 0], pot[:, 1])
         for line, ends in zip(bar_lines, bars[k], strict=True):
             line.set_data(ends[:, 0], ends[:, 1])
         for i, line in enumerate(trails):
@@ -225,7 +283,7 @@ def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25
             line.set_data(path[:, 0], path[:, 1])
         dots.set_data(particles[k][:, 0], particles[k][:, 1])
         clock.set_text(f"t = {times[k]:.2f} s")
-        return [*spring_lines, *bar_lines, *trails, dots, clock]
+        return [*spring_lines, *damper_lines, *bar_lines, *trails, dots, clock]
 
     return FuncAnimation(figure, draw, frames=len(times), interval=1000 / fps, blit=False)
 

@@ -112,3 +112,8 @@ def test_singular_model_exits_2(cli, tmp_path):
 
 def test_usage_error_exit_code(cli):
     assert cli("derive").code == 2
+
+
+def test_non_finite_option_values_exit_2(cli):
+    result = cli("forces", "virtual_work_link", "--set", "F=1e400")
+    assert result.code == 2 and result.err.strip() == "error: --set F: '1e400' is not a finite number"

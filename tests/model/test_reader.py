@@ -127,3 +127,13 @@ def test_every_builtin_example_loads_and_derives():
     for name in lagrangian.examples():
         eom = lagrangian.load(name).equations_of_motion()
         assert eom.mass_matrix.shape[0] == len(eom.model.coordinates)
+
+
+def test_non_finite_numbers_are_refused():
+    assert error(PENDULUM.replace("g = 9.81", "g = 1e400")) == \
+        "bad.toml: parameters.g: the number inf is not finite"
+    assert error(PENDULUM.replace('m = { value = 1.0, unit = "kg" }',
+                                  'm = { value = 1e999, unit = "kg" }')) == \
+        "bad.toml: parameters.m.value: the number inf is not finite"
+    assert error(PENDULUM.replace("initial = 0.3", "initial = nan")) == \
+        "bad.toml: coordinates.theta.initial: the number nan is not finite"

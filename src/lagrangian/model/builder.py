@@ -7,6 +7,7 @@ builder returns, or ``dynamicsymbols`` of the same names (``q(t)`` and ``q(t).di
 from __future__ import annotations
 
 import keyword
+import math
 import re
 from collections.abc import Iterable, Sequence
 
@@ -499,6 +500,8 @@ def _optional_float(value: object, field: str, source: str | None) -> float | No
         return None
     if isinstance(value, bool) or not isinstance(value, int | float | sp.Number):
         raise ModelError(f"expected a number, got {value!r}", field=field, source=source)
+    if not math.isfinite(float(value)):
+        raise ModelError(f"the number {value!r} is not finite", field=field, source=source)
     return float(value)
 
 

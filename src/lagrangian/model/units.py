@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import math
 import re
 
 from ..errors import ModelError
@@ -47,6 +48,8 @@ def to_si(value: float, unit: str | None, field: str, source: str | None = None)
     """Convert a number in ``unit`` to SI base units (angles to radians)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ModelError(f"expected a number, got {value!r}", field=field, source=source)
+    if not math.isfinite(value):
+        raise ModelError(f"the number {value!r} is not finite", field=field, source=source)
     if not unit or unit == "1":
         return float(value)
     parsed = _unit(unit)
@@ -65,6 +68,8 @@ def parse_quantity(text: str, expected_unit: str | None, field: str) -> float:
         raise ModelError(f"expected a number with an optional unit (like 30deg), got {text!r}",
                          field=field)
     number, unit = float(match.group(1)), (match.group(2) or "").strip()
+    if not math.isfinite(number):
+        raise ModelError(f"{text!r} is not a finite number", field=field)
     if not unit:
         return number
     parsed = _unit(unit)

@@ -161,7 +161,8 @@ def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
             weight = [fb.mass * g * d for d in direction]
             fb.force = [a + b for a, b in zip(fb.force, weight, strict=True)]
             project(weight, fb.position)
-    def place(force, point, holder: _FreeBody | None) -> None:
+
+    def place(force, point, holder: _FreeBody) -> None:
         """Add ``force`` acting at ``point`` to ``holder``: force, and moment about G for a body."""
         holder.force = [a + b for a, b in zip(holder.force, force, strict=True)]
         if holder.angle is not None:

@@ -137,3 +137,10 @@ def test_non_finite_numbers_are_refused():
         "bad.toml: parameters.m.value: the number inf is not finite"
     assert error(PENDULUM.replace("initial = 0.3", "initial = nan")) == \
         "bad.toml: coordinates.theta.initial: the number nan is not finite"
+
+
+def test_unreadable_unit_strings_are_refused():
+    assert error(PENDULUM.replace('unit = "kg"', 'unit = "sin("')) == \
+        "bad.toml: parameters.m.unit: unknown unit 'sin('"
+    assert error(PENDULUM.replace('theta = { unit = "rad"', 'theta = { unit = "m/(s"')) == \
+        "bad.toml: coordinates.theta.unit: unknown unit 'm/(s'"

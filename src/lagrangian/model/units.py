@@ -21,13 +21,10 @@ def registry():
 
 
 def _unit(text: str):
-    import pint
-
-    ureg = registry()
+    """The pint unit of ``text``, or None when pint cannot read it."""
     try:
-        return ureg.Unit(text.replace("^", "**").replace("·", "*"))
-    except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError, ValueError,
-            AttributeError, TypeError, SyntaxError, AssertionError):
+        return registry().Unit(text.replace("^", "**").replace("·", "*"))
+    except Exception:  # pint's parser raises many kinds (tokenize, syntax, lookup): all mean "not a unit"
         return None
 
 

@@ -21,7 +21,7 @@ import sympy as sp
 from ..errors import ModelError
 from .expressions import CONSTANTS, FUNCTIONS, parse_expression
 from .model import Model, multiplier_name
-from .reader import read_text_file
+from .reader import check_known_keys, read_text_file
 
 TABLES = ("energy", "generalized_forces", "equations", "multipliers")
 _FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
@@ -85,7 +85,7 @@ def parse_answer(text: str, model: Model, *, source: str = "<answer>") -> Answer
 
 
 def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>") -> Answer:
-    _known(data, TABLES, None, source)
+    check_known_keys(data, TABLES, None, source)
     names = answer_names(model)
     coordinates = [c.name for c in model.coordinates]
     foreign: dict[str, frozenset[sp.Symbol]] = {}
@@ -101,18 +101,18 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
         return parse_expression(value, scope, field=field, source=source)
 
     energy = _table(data, "energy", source)
-    _known(energy, ("T", "V", "D"), "energy", source)
+    check_known_keys(energy, ("T", "V", "D"), "energy", source)
     values = {key: expression(energy[key], f"energy.{key}", key) for key in energy}
 
     forces = _table(data, "generalized_forces", source)
-    _known(forces, coordinates, "generalized_forces", source, what="coordinate")
+    check_known_keys(forces, coordinates, "generalized_forces", source, what="coordinate")
     generalized = tuple(
         (name, expression(forces[name], f"generalized_forces.{name}", f"Q[{name}]"))
         for name in coordinates if name in forces
     )
 
     table = _table(data, "equations", source)
-    _known(table, coordinates, "equations", source, what="coordinate")
+    check_known_keys(table, coordinates, "equations", source, what="coordinate")
     equations = []
     for name in coordinates:
         if name not in table:
@@ -131,7 +131,7 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
 
     count, multiplier_names = None, None
     multipliers = _table(data, "multipliers", source)
-    _known(multipliers, ("count", "names"), "multipliers", source)
+    check_known_keys(multipliers, ("count", "names"), "multipliers", source)
     if "count" in multipliers:
         count = multipliers["count"]
         if isinstance(count, bool) or not isinstance(count, int) or count < 0:
@@ -192,14 +192,3 @@ def _table(data: Mapping, key: str, source: str) -> Mapping:
     if not isinstance(value, Mapping):
         raise ModelError(f"expected a table [{key}]", field=key, source=source)
     return value
-
-
-def _known(table: Mapping, allowed, field: str | None, source: str, what: str = "key") -> None:
-    import difflib
-
-    for key in table:
-        if key not in allowed:
-            close = difflib.get_close_matches(key, list(allowed), n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            where = f"{field}.{key}" if field else key
-            raise ModelError(f"unknown {what} '{key}'{hint}", field=where, source=source)

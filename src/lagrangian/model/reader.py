@@ -51,7 +51,7 @@ def parse_model(text: str, *, source: str = "<model>") -> Model:
 
 def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
     """Build a Model from the already-parsed TOML tables."""
-    _known_keys(data, TOP_LEVEL, None, source)
+    check_known_keys(data, TOP_LEVEL, None, source)
     name = _string(data.get("name", ""), "name", source)
     description = _string(data.get("description", ""), "description", source)
     builder = ModelBuilder(name, description, source=source)
@@ -62,7 +62,7 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
         if isinstance(spec, str):
             builder.coordinate(key, check_unit(spec, field, source), field=field)
         elif isinstance(spec, Mapping):
-            _known_keys(spec, {"unit", "initial", "rate", "range"}, field, source)
+            check_known_keys(spec, {"unit", "initial", "rate", "range"}, field, source)
             unit = check_unit(_string(spec.get("unit", "m"), f"{field}.unit", source),
                               f"{field}.unit", source)
             builder.coordinate(
@@ -76,7 +76,7 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
     for key, spec in _table(data, "parameters", source).items():
         field = f"parameters.{key}"
         if isinstance(spec, Mapping):
-            _known_keys(spec, {"value", "unit"}, field, source)
+            check_known_keys(spec, {"value", "unit"}, field, source)
             unit = spec.get("unit")
             if unit is not None:
                 unit = check_unit(_string(unit, f"{field}.unit", source), f"{field}.unit", source)
@@ -91,7 +91,7 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
         builder.define(key, text, field=f"definitions.{key}")
 
     energy = _table(data, "energy", source)
-    _known_keys(energy, {"T", "V", "D"}, "energy", source)
+    check_known_keys(energy, {"T", "V", "D"}, "energy", source)
     adders: dict[str, Callable] = {
         "T": builder.add_kinetic_energy,
         "V": builder.add_potential_energy,
@@ -102,7 +102,7 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
 
     if "gravity" in data:
         gravity = _table(data, "gravity", source)
-        _known_keys(gravity, {"g", "direction"}, "gravity", source)
+        check_known_keys(gravity, {"g", "direction"}, "gravity", source)
         if "g" not in gravity:
             raise ModelError("missing key 'g'", field="gravity", source=source)
         builder.set_gravity(gravity["g"], gravity.get("direction", [0, -1]))
@@ -173,7 +173,7 @@ def _components(data: Mapping, key: str, source: str):
         field = f"{key}[{index}]"
         if not isinstance(item, Mapping):
             raise ModelError("expected a table", field=field, source=source)
-        _known_keys(item, required | optional, field, source)
+        check_known_keys(item, required | optional, field, source)
         missing = sorted(required - set(item), key=lambda k: (k != "name", k))
         if missing:
             raise ModelError(f"missing key '{missing[0]}'", field=field, source=source)
@@ -181,7 +181,10 @@ def _components(data: Mapping, key: str, source: str):
         yield index, item
 
 
-def _known_keys(table: Mapping, allowed: set[str], field: str | None, source: str) -> None:
+def check_known_keys(
+    table: Mapping, allowed, field: str | None, source: str, what: str = "key"
+) -> None:
+    """Unknown keys are errors (never silently ignored), with the nearest valid one suggested."""
     import difflib
 
     for key in table:
@@ -189,7 +192,7 @@ def _known_keys(table: Mapping, allowed: set[str], field: str | None, source: st
             close = difflib.get_close_matches(key, sorted(allowed), n=1)
             hint = f"; did you mean '{close[0]}'?" if close else ""
             where = f"{field}.{key}" if field else key
-            raise ModelError(f"unknown key '{key}'{hint}", field=where, source=source)
+            raise ModelError(f"unknown {what} '{key}'{hint}", field=where, source=source)
 
 
 def _string(value: object, field: str, source: str) -> str:

@@ -8,8 +8,13 @@ from lagrangian.cli import main
 
 
 class CliResult:
+    """Exit status and captured output of one CLI run; unpacks as (code, out, err)."""
+
     def __init__(self, code: int, out: str, err: str):
         self.code, self.out, self.err = code, out, err
+
+    def __iter__(self):
+        return iter((self.code, self.out, self.err))
 
 
 @pytest.fixture

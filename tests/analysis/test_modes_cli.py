@@ -8,21 +8,13 @@ import struct
 
 import pytest
 
-from lagrangian.cli import main
 from lagrangian.output.modes import mode_plot_size
 
 MODE_KEYS = {"frequency", "frequency_hz", "period", "damping_ratio", "growth_rate", "shape"}
 
 
-def run(capsys, *args):
-    with pytest.raises(SystemExit) as exit_info:
-        main(list(args))
-    captured = capsys.readouterr()
-    return exit_info.value.code, captured.out, captured.err
-
-
-def test_modes_json_contract_for_worked_example_3(capsys):
-    code, out, _ = run(capsys, "modes", "two_mass", "--json")
+def test_modes_json_contract_for_worked_example_3(cli):
+    code, out, _ = cli("modes", "two_mass", "--json")
     assert code == 0
     document = json.loads(out)
     assert set(document) == {"equilibrium", "stable", "mass_matrix", "damping_matrix",
@@ -43,21 +35,21 @@ def test_modes_json_contract_for_worked_example_3(capsys):
     assert second["shape"] == pytest.approx({"x1": 1.0, "x2": -1.0})
 
 
-def test_modes_text_report(capsys):
-    code, out, _ = run(capsys, "modes", "pendulum")
+def test_modes_text_report(cli):
+    code, out, _ = cli("modes", "pendulum")
     assert code == 0
     assert "4.42945" in out and "1.4185" in out  # rad/s and period in s (1.41850)
     assert "Stiffness matrix K" in out
 
 
-def test_complex_mode_phases_in_text(capsys):
-    code, out, _ = run(capsys, "modes", "charged_particle")
+def test_complex_mode_phases_in_text(cli):
+    code, out, _ = cli("modes", "charged_particle")
     assert code == 0
     assert "mode 2: x 1 at +0.0 deg, y 1 at +90.0 deg" in out
 
 
-def test_inverted_pendulum_about_pi(capsys):
-    code, out, _ = run(capsys, "modes", "cart_pendulum", "--about", "theta=pi", "--json")
+def test_inverted_pendulum_about_pi(cli):
+    code, out, _ = cli("modes", "cart_pendulum", "--about", "theta=pi", "--json")
     assert code == 0
     document = json.loads(out)
     assert document["equilibrium"]["theta"] == pytest.approx(math.pi)
@@ -67,16 +59,16 @@ def test_inverted_pendulum_about_pi(capsys):
     assert growing[0]["growth_rate"] == pytest.approx(math.sqrt(9.81 * 2.5 / (2.0 * 0.6)))
 
 
-def test_about_in_degrees_and_set(capsys):
-    code, out, _ = run(capsys, "modes", "pendulum", "--about", "theta=180deg", "--set", "L=2m",
+def test_about_in_degrees_and_set(cli):
+    code, out, _ = cli("modes", "pendulum", "--about", "theta=180deg", "--set", "L=2m",
                        "--json")
     assert code == 0
     (mode,) = json.loads(out)["modes"]
     assert mode["growth_rate"] == pytest.approx(math.sqrt(9.81 / 2.0))
 
 
-def test_constrained_modes_json_names_the_independent_coordinates(capsys):
-    code, out, _ = run(capsys, "modes", "cartesian_pendulum", "--json")
+def test_constrained_modes_json_names_the_independent_coordinates(cli):
+    code, out, _ = cli("modes", "cartesian_pendulum", "--json")
     document = json.loads(out)
     assert code == 0
     assert document["coordinates"] == ["x"]
@@ -86,13 +78,13 @@ def test_constrained_modes_json_names_the_independent_coordinates(capsys):
     assert mode["shape"] == {"x": 1.0, "y": 0.0}
 
 
-def test_equilibria_json_shows_the_pitchfork(capsys):
-    code, out, _ = run(capsys, "equilibria", "bead_on_hoop", "--set", "Omega=3", "--json")
+def test_equilibria_json_shows_the_pitchfork(cli):
+    code, out, _ = cli("equilibria", "bead_on_hoop", "--set", "Omega=3", "--json")
     assert code == 0
     below = json.loads(out)["equilibria"]
     assert [(e["coordinates"]["theta"], e["stable"]) for e in below] == \
         [(0.0, True), (pytest.approx(math.pi), False)]
-    code, out, _ = run(capsys, "equilibria", "bead_on_hoop", "--set", "Omega=6", "--json")
+    code, out, _ = cli("equilibria", "bead_on_hoop", "--set", "Omega=6", "--json")
     above = json.loads(out)["equilibria"]
     side = math.acos(9.81 / (0.5 * 36))
     assert [e["coordinates"]["theta"] for e in above] == \
@@ -101,15 +93,15 @@ def test_equilibria_json_shows_the_pitchfork(capsys):
     assert all(set(e) == {"coordinates", "stable"} for e in above)
 
 
-def test_equilibria_text_with_multipliers(capsys):
-    code, out, _ = run(capsys, "equilibria", "cartesian_pendulum")
+def test_equilibria_text_with_multipliers(cli):
+    code, out, _ = cli("equilibria", "cartesian_pendulum")
     assert code == 0
     assert "stable" in out and "lambda_rod = 9.81" in out
 
 
-def test_mode_shape_plot_is_a_png_of_the_stated_size(capsys, tmp_path):
+def test_mode_shape_plot_is_a_png_of_the_stated_size(cli, tmp_path):
     target = tmp_path / "modes.png"
-    code, out, _ = run(capsys, "modes", "double_pendulum", "--about", "theta1=0",
+    code, out, _ = cli("modes", "double_pendulum", "--about", "theta1=0",
                        "--about", "theta2=0", "--plot", str(target))
     assert code == 0 and "drawn to" in out
     data = target.read_bytes()
@@ -120,12 +112,12 @@ def test_mode_shape_plot_is_a_png_of_the_stated_size(capsys, tmp_path):
     assert mode_plot_size(50) == (1200, 1200)
 
 
-def test_plot_never_overwrites_the_model_file(capsys, tmp_path):
+def test_plot_never_overwrites_the_model_file(cli, tmp_path):
     from lagrangian.model.examples import example_path
 
     model = tmp_path / "pendulum.png"
     model.write_bytes(open(example_path("pendulum"), "rb").read())
-    code, _, err = run(capsys, "modes", str(model), "--plot", str(model))
+    code, _, err = cli("modes", str(model), "--plot", str(model))
     assert code == 2 and "refusing to overwrite" in err
 
 
@@ -145,8 +137,8 @@ def test_plot_never_overwrites_the_model_file(capsys, tmp_path):
         (["equilibria", "pendulum", "--set", "Q=1"], "'Q' is not a parameter"),
     ],
 )
-def test_bad_input_exits_with_status_2(capsys, args, message):
-    code, out, err = run(capsys, *args)
+def test_bad_input_exits_with_status_2(cli, args, message):
+    code, out, err = cli(*args)
     assert code == 2
     assert message in err
     assert "Traceback" not in err and out == ""

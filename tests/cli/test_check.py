@@ -7,20 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from lagrangian.cli import main
-
 ANSWERS = Path(__file__).parents[1] / "check" / "answers"
 
 
-def run(capsys, *args):
-    with pytest.raises(SystemExit) as exit_info:
-        main(list(args))
-    out = capsys.readouterr()
-    return exit_info.value.code, out.out, out.err
-
-
-def test_check_wrong_potential_exits_1_with_the_contract(capsys):
-    code, out, _ = run(capsys, "check", "pendulum", str(ANSWERS / "pendulum_wrong_potential.toml"),
+def test_check_wrong_potential_exits_1_with_the_contract(cli):
+    code, out, _ = cli("check", "pendulum", str(ANSWERS / "pendulum_wrong_potential.toml"),
                        "--json")
     assert code == 1
     document = json.loads(out)
@@ -35,14 +26,14 @@ def test_check_wrong_potential_exits_1_with_the_contract(capsys):
     assert t["code"] is None and t["expected"] is None
 
 
-def test_check_correct_answer_exits_0(capsys):
-    code, out, _ = run(capsys, "check", "pendulum", str(ANSWERS / "pendulum_other_datum.toml"))
+def test_check_correct_answer_exits_0(cli):
+    code, out, _ = cli("check", "pendulum", str(ANSWERS / "pendulum_other_datum.toml"))
     assert code == 0
     assert "potential_datum" in out and out.rstrip().endswith("verdict: correct")
 
 
-def test_check_misprojected_load_text(capsys):
-    code, out, _ = run(capsys, "check", "virtual_work_link", str(ANSWERS / "link_misprojected.toml"))
+def test_check_misprojected_load_text(cli):
+    code, out, _ = cli("check", "virtual_work_link", str(ANSWERS / "link_misprojected.toml"))
     assert code == 1
     assert "Q[theta]: WRONG [generalized_force_projection]" in out
     assert "expected: F*L*cos(theta)" in out
@@ -52,28 +43,28 @@ def test_check_misprojected_load_text(capsys):
     ("missing.toml", "no such file"),
     ("unknown_key.toml", "unknown key 'W'"),
 ])
-def test_check_unreadable_answer_exits_2(capsys, tmp_path, answer, message):
+def test_check_unreadable_answer_exits_2(cli, tmp_path, answer, message):
     (tmp_path / "unknown_key.toml").write_text('[energy]\nW = "m"\n')
-    code, out, err = run(capsys, "check", "pendulum", str(tmp_path / answer))
+    code, out, err = cli("check", "pendulum", str(tmp_path / answer))
     assert code == 2 and out == ""
     assert err.startswith("error: ") and message in err and answer in err
     assert "Traceback" not in err
 
 
-def test_check_injection_exits_2(capsys, tmp_path):
+def test_check_injection_exits_2(cli, tmp_path):
     path = tmp_path / "evil.toml"
     path.write_text("[energy]\nV = \"__import__('os').system('echo hacked')\"\n")
-    code, out, err = run(capsys, "check", "pendulum", str(path))
+    code, out, err = cli("check", "pendulum", str(path))
     assert code == 2 and "hacked" not in out and "evil.toml: energy.V" in err
 
 
-def test_check_bad_model_exits_2(capsys):
-    code, _, err = run(capsys, "check", "no_such_model", str(ANSWERS / "pendulum_other_datum.toml"))
+def test_check_bad_model_exits_2(cli):
+    code, _, err = cli("check", "no_such_model", str(ANSWERS / "pendulum_other_datum.toml"))
     assert code == 2 and "no such file or built-in example" in err
 
 
-def test_crosscheck_json_contract(capsys):
-    code, out, _ = run(capsys, "crosscheck", "ladder_pendulum", "--json")
+def test_crosscheck_json_contract(cli):
+    code, out, _ = cli("crosscheck", "ladder_pendulum", "--json")
     assert code == 0
     document = json.loads(out)
     assert document == {
@@ -85,14 +76,14 @@ def test_crosscheck_json_contract(capsys):
     }
 
 
-def test_crosscheck_text_and_refusal(capsys):
-    code, out, _ = run(capsys, "crosscheck", "rolling_disk")
+def test_crosscheck_text_and_refusal(cli):
+    code, out, _ = cli("crosscheck", "rolling_disk")
     assert code == 0 and "x: agree" in out and "R_y = sqrt(3)*g*m/2" in out
-    code, _, err = run(capsys, "crosscheck", "pendulum")
+    code, _, err = cli("crosscheck", "pendulum")
     assert code == 2 and "[energy] T" in err
 
 
-def test_units_lists_every_inconsistent_term(capsys, tmp_path):
+def test_units_lists_every_inconsistent_term(cli, tmp_path):
     path = tmp_path / "bad.toml"
     path.write_text("""
 [coordinates]
@@ -104,12 +95,12 @@ k = { value = 2.0, unit = "N/m" }
 T = "1/2*m*x_dot"
 V = "1/2*k*x^2 + k*x"
 """)
-    code, out, _ = run(capsys, "units", str(path))
+    code, out, _ = cli("units", str(path))
     assert code == 1
     assert "m*x_dot/2" in out and "k*x has" in out and "2 inconsistent term(s)" in out
-    code, out, _ = run(capsys, "units", str(path), "--json")
+    code, out, _ = cli("units", str(path), "--json")
     document = json.loads(out)
     assert document["consistent"] is False
     assert [i["term"] for i in document["issues"]] == ["m*x_dot/2", "k*x"]
-    code, out, _ = run(capsys, "units", "slider_crank")
+    code, out, _ = cli("units", "slider_crank")
     assert code == 0 and out.rstrip().endswith("consistent")

@@ -137,6 +137,23 @@ static int lg_push(lg_trace *o, double t, const double *y)
     return 0;
 }
 
+/* Runge-Kutta stages first..last-1 of a DOP853 step from (t, y) with step h: K[s] = f(t + c_s h,
+ * y + h sum_j a_sj K[j]). Nonzero when the mass matrix is singular on the way. */
+static int lg_stages(int first, int last, double t, double h, const double *y, const double *p,
+                     double K[16][LG_S], double *tmp, long long *nfev)
+{
+    for (int s = first; s < last; s++) {
+        for (int i = 0; i < LG_S; i++) {
+            double acc = 0.0;
+            for (int j = 0; j < s; j++) acc += DOP_A[s][j] * K[j][i];
+            tmp[i] = y[i] + h * acc;
+        }
+        (*nfev)++;
+        if (lg_rhs(t + DOP_C[s] * h, tmp, p, K[s])) return 1;
+    }
+    return 0;
+}
+
 /* Integrate from t0 to t1; records every step (te == NULL) or the dense output at te[0..ne).
  * Called without the GIL; takes it back every 256 steps to notice Ctrl-C. */
 static int lg_dop853(const double *p, double t0, double t1, const double *y0, double rtol, double atol,
@@ -205,15 +222,7 @@ static int lg_dop853(const double *p, double t0, double t1, const double *y0, do
             h = t_new - t;
             h_abs = fabs(h);
             memcpy(K[0], f, sizeof f);
-            for (int s = 1; s < 12; s++) {
-                for (int i = 0; i < LG_S; i++) {
-                    double acc = 0.0;
-                    for (int j = 0; j < s; j++) acc += DOP_A[s][j] * K[j][i];
-                    tmp[i] = y[i] + h * acc;
-                }
-                (*nfev)++;
-                if (lg_rhs(t + DOP_C[s] * h, tmp, p, K[s])) return LG_SINGULAR;
-            }
+            if (lg_stages(1, 12, t, h, y, p, K, tmp, nfev)) return LG_SINGULAR;
             for (int i = 0; i < LG_S; i++) {
                 double acc = 0.0;
                 for (int j = 0; j < 12; j++) acc += DOP_B[j] * K[j][i];
@@ -247,15 +256,7 @@ static int lg_dop853(const double *p, double t0, double t1, const double *y0, do
             int dense = 0;
             while (ie < ne && dir * (te[ie] - t_new) <= 0) {
                 if (!dense) {  /* three extra stages and the 7th-order interpolant, as scipy */
-                    for (int s = 13; s < 16; s++) {
-                        for (int i = 0; i < LG_S; i++) {
-                            double acc = 0.0;
-                            for (int j = 0; j < s; j++) acc += DOP_A[s][j] * K[j][i];
-                            tmp[i] = y[i] + h * acc;
-                        }
-                        (*nfev)++;
-                        if (lg_rhs(t + DOP_C[s] * h, tmp, p, K[s])) return LG_SINGULAR;
-                    }
+                    if (lg_stages(13, 16, t, h, y, p, K, tmp, nfev)) return LG_SINGULAR;
                     for (int i = 0; i < LG_S; i++) {
                         double dy = ynew[i] - y[i];
                         F[0][i] = dy;

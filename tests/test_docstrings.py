@@ -3,10 +3,10 @@
 import doctest
 
 import lagrangian
-import lagrangian.system
+import lagrangian.api.system
 
 
 def test_public_docstring_examples():
-    for module in (lagrangian, lagrangian.system):
+    for module in (lagrangian, lagrangian.api.system):
         failures, _ = doctest.testmod(module)
         assert failures == 0, module.__name__

@@ -8,13 +8,21 @@ Matrix([[L**2*m*theta_ddot + L*g*m*sin(theta)]])
 
 from sympy import cos, exp, sin, sqrt, tan
 
-from .derivation.equations import EquationsOfMotion, LoadContribution
-from .errors import DerivationError, LagrangianError, ModelError
-from .model.examples import example_names as examples
-from .model.model import Model
-from .model.reader import parse_model, read_model
-from .simulation import Simulation
-from .system import System, SystemBuilder, load
+from .api import (
+    DerivationError,
+    EquationsOfMotion,
+    LagrangianError,
+    LoadContribution,
+    Model,
+    ModelError,
+    Simulation,
+    System,
+    SystemBuilder,
+    examples,
+    load,
+    parse_model,
+    read_model,
+)
 
 __version__ = "0.1.0"
 

@@ -9,7 +9,7 @@ from typing import Any
 
 from ..errors import ModelError
 from ..model.units import parse_quantity
-from ..system import System, load
+from ..api.system import System, load
 
 
 def load_system(model: str, settings: Iterable[str] = ()) -> System:

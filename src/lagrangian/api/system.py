@@ -12,15 +12,15 @@ from pathlib import Path
 
 import sympy as sp
 
-from .analysis.forces import ForceReport, evaluate_generalized_forces
-from .derivation.equations import EquationsOfMotion
-from .derivation.lagrange import derive
-from .errors import ModelError
-from .model.builder import ModelBuilder
-from .model.examples import example_path
-from .model.model import Model
-from .model.notation import latex_symbol_names
-from .model.reader import read_model
+from ..analysis.forces import ForceReport, evaluate_generalized_forces
+from ..derivation.equations import EquationsOfMotion
+from ..derivation.lagrange import derive
+from ..errors import ModelError
+from ..model.builder import ModelBuilder
+from ..model.examples import example_path
+from ..model.model import Model
+from ..model.notation import latex_symbol_names
+from ..model.reader import read_model
 
 
 class System:
@@ -111,8 +111,8 @@ class System:
         the start time); ``stop_when`` is a condition such as "theta < 0" that ends the run.
         Constrained models are kept on Phi = 0 by projection (see docs/simulation.md).
         """
-        from .numerics.simulate import simulate
-        from .simulation import Simulation
+        from ..numerics.simulate import simulate
+        from ..simulation import Simulation
 
         result = simulate(self.equations_of_motion(), t_end, initial=initial, method=method,
                           rtol=rtol, atol=atol, samples=samples, stop_when=stop_when,
@@ -129,14 +129,14 @@ class System:
         """
         if parameters is None and backend == "auto":
             return self._numeric
-        from .numerics.functions import numeric
+        from ..numerics.functions import numeric
 
         return numeric(self.equations_of_motion(), parameters, backend=backend)
 
     @cached_property
     def _numeric(self):
         """The default numeric system, compiled once per System (its parameters are fixed)."""
-        from .numerics.functions import numeric
+        from ..numerics.functions import numeric
 
         return numeric(self.equations_of_motion())
 
@@ -145,13 +145,13 @@ class System:
     @cached_property
     def _static_functions(self):
         """Compiled functions at rest, built once per System (parameters are fixed per System)."""
-        from .analysis.linearization import StaticFunctions
+        from ..analysis.linearization import StaticFunctions
 
         return StaticFunctions(self.equations_of_motion())
 
     def equilibria(self):
         """Configurations of rest, f(q, 0) = Phi_q^T lambda with Phi(q) = 0, each with its stability."""
-        from .analysis.modes import equilibria_of
+        from ..analysis.modes import equilibria_of
 
         return equilibria_of(self._static_functions)
 
@@ -165,16 +165,16 @@ class System:
         unconstrained model with the parameters kept as symbols.
         """
         if symbolic:
-            from .analysis.linearization import symbolic_linear_model
+            from ..analysis.linearization import symbolic_linear_model
 
             return symbolic_linear_model(self.equations_of_motion(), dict(about or {}))
-        from .analysis.modes import linearize_about
+        from ..analysis.modes import linearize_about
 
         return linearize_about(self._static_functions, about, tuple(inputs))
 
     def modes(self, about: Mapping[str, float] | None = None):
         """Natural frequencies (rad/s), damping ratios and mode shapes about an equilibrium."""
-        from .analysis.modes import modes_about
+        from ..analysis.modes import modes_about
 
         return modes_about(self._static_functions, about)
 
@@ -187,8 +187,8 @@ class System:
         Returns a CheckReport (``verdict``, ``findings`` with item, status, code, message,
         expected); items written differently but equivalently are accepted.
         """
-        from .check.diagnose import check_answer
-        from .model.answer import Answer, answer_from_mapping, read_answer
+        from ..check.diagnose import check_answer
+        from ..model.answer import Answer, answer_from_mapping, read_answer
 
         if isinstance(answer, Mapping):
             answer = answer_from_mapping(answer, self._model, source="<answer>")
@@ -199,13 +199,13 @@ class System:
     def crosscheck(self):
         """Newton-Euler (free bodies, reactions eliminated) vs Lagrange, coordinate by
         coordinate, with the reaction force on each body (N; moment about the centre, N m)."""
-        from .check.newton_euler import crosscheck
+        from ..check.newton_euler import crosscheck
 
         return crosscheck(self.equations_of_motion())
 
     def check_units(self):
         """Every dimensionally inconsistent term of the model (T, V: J; D: W; Q: J per unit of q)."""
-        from .check.units import check_model_units
+        from ..check.units import check_model_units
 
         return check_model_units(self._model)
 

@@ -7,9 +7,9 @@ import sys
 from collections.abc import Iterable
 from typing import Any
 
+from ..api.system import System, load
 from ..errors import ModelError
 from ..model.units import parse_quantity
-from ..api.system import System, load
 
 
 def load_system(model: str, settings: Iterable[str] = ()) -> System:

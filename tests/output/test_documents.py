@@ -7,8 +7,8 @@ import sympy as sp
 
 import lagrangian
 from lagrangian.model.expressions import parse_expression
-from lagrangian.output.json import derivation_document, forces_document
-from lagrangian.output.latex import derivation_latex
+from lagrangian.output.derivation import derivation_document, derivation_latex
+from lagrangian.output.forces import forces_document
 
 DERIVE_KEYS = {"name", "convention", "coordinates", "parameters", "kinetic_energy",
                "potential_energy", "dissipation", "lagrangian", "generalized_forces",

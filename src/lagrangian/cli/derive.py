@@ -7,9 +7,7 @@ from typing import Annotated
 
 import typer
 
-from ..output.json import derivation_document
-from ..output.latex import derivation_latex
-from ..output.text import derivation_text
+from ..output.derivation import derivation_document, derivation_latex, derivation_text
 from . import app
 from .common import load_system, print_json
 

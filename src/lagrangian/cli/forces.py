@@ -6,8 +6,7 @@ from typing import Annotated
 
 import typer
 
-from ..output.json import forces_document
-from ..output.text import forces_text
+from ..output.forces import forces_document, forces_text
 from . import app
 from .common import load_system, print_json, state_assignments
 

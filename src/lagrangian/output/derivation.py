@@ -1,0 +1,170 @@
+"""The derivation (`derive`): text for a terminal, the JSON document, and LaTeX for a paper.
+
+Text and JSON write expressions in the model-file grammar (readable, copyable, and read back by
+``parse_expression``); LaTeX uses the model's symbol names.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import sympy as sp
+
+from ..derivation.equations import EquationsOfMotion
+from ..model.expressions import format_expression as fmt
+from ..model.notation import latex_symbol_names
+from ..model.units import generalized_force_unit
+
+CONVENTION = "M q_ddot + Phi_q^T lambda = forcing"
+
+
+# -- text ---------------------------------------------------------------------------------------
+
+
+def derivation_text(eom: EquationsOfMotion) -> str:
+    model = eom.model
+    lines = [model.name, "=" * len(model.name)]
+    coordinates = ", ".join(f"{c.name} [{c.unit or '1'}]" for c in model.coordinates)
+    lines += [f"Coordinates: {coordinates}", ""]
+    lines += [f"T = {fmt(eom.kinetic_energy)}", f"V = {fmt(eom.potential_energy)}"]
+    if eom.dissipation != 0:
+        lines.append(f"D = {fmt(eom.dissipation)}")
+    lines += [f"L = T - V = {fmt(eom.lagrangian)}", ""]
+
+    lines.append("Equations of motion, d/dt(dL/dq_dot) - dL/dq = Q"
+                 + (" - Phi_q^T lambda" if model.constraints else "") + ":")
+    for c, row, f in zip(model.coordinates, _rows(eom), eom.forcing, strict=True):
+        lines.append(f"  [{c.name}]  {row} = {fmt(f)}")
+    lines.append("")
+
+    lines.append("Generalized forces (virtual work, delta W = Q . delta q):")
+    for c, total in zip(model.coordinates, eom.generalized_forces, strict=True):
+        unit = generalized_force_unit(c.unit)
+        lines.append(f"  Q[{c.name}] = {fmt(total)}   [{unit}]")
+        for part in eom.load_contributions:
+            if part.coordinate == c.name:
+                lines.append(f"      from {part.load}: {fmt(part.expression)}")
+    lines.append("")
+
+    lines.append("Mass matrix M:")
+    for i in range(eom.mass_matrix.rows):
+        lines.append("  [" + ", ".join(fmt(v) for v in eom.mass_matrix.row(i)) + "]")
+    lines.append("Forcing f:")
+    for c, f in zip(model.coordinates, eom.forcing, strict=True):
+        lines.append(f"  {c.name}: {fmt(f)}")
+
+    if model.constraints:
+        lines += ["", f"Constraints ({len(model.constraints)}, one multiplier each):"]
+        for k, constraint in enumerate(model.constraints):
+            lines.append(f"  {constraint.name} ({constraint.kind}): {fmt(constraint.expression)}"
+                         f" = 0   multiplier {eom.multipliers[k]}")
+        lines.append("Constraint Jacobian Phi_q:")
+        for i in range(eom.constraint_jacobian.rows):
+            lines.append("  [" + ", ".join(fmt(v) for v in eom.constraint_jacobian.row(i)) + "]")
+        lines.append("Acceleration level, Phi_q q_ddot = gamma:")
+        for constraint, gamma in zip(model.constraints, eom.acceleration_rhs, strict=True):
+            lines.append(f"  {constraint.name}: gamma = {fmt(gamma)}")
+
+    if eom.accelerations is not None:
+        lines += ["", "Accelerations:"]
+        for c, a in zip(model.coordinates, eom.accelerations, strict=True):
+            lines.append(f"  {c.acceleration} = {fmt(a)}")
+    lines += ["", "Convention: M q_ddot + Phi_q^T lambda = f"]
+    return "\n".join(lines) + "\n"
+
+
+def _rows(eom: EquationsOfMotion) -> list[str]:
+    """Left-hand sides sum_j M_ij q_ddot_j + sum_k Phi_ki lambda_k as text."""
+    model = eom.model
+    rows = []
+    for i in range(len(model.coordinates)):
+        terms = []
+        for j, c in enumerate(model.coordinates):
+            entry = eom.mass_matrix[i, j]
+            if entry != 0:
+                terms.append(f"({fmt(entry)})*{c.acceleration}" if entry.is_Add
+                             else f"{fmt(entry * c.acceleration)}")
+        for k in range(eom.multipliers.rows):
+            entry = eom.constraint_jacobian[k, i]
+            if entry != 0:
+                terms.append(f"({fmt(entry)})*{eom.multipliers[k]}" if entry.is_Add
+                             else fmt(entry * eom.multipliers[k]))
+        rows.append(" + ".join(terms) if terms else "0")
+    return rows
+
+
+# -- JSON ---------------------------------------------------------------------------------------
+
+
+def derivation_document(eom: EquationsOfMotion) -> dict[str, Any]:
+    """The `derive --format json` document."""
+    model = eom.model
+    names = [c.name for c in model.coordinates]
+    text = fmt
+    document: dict[str, Any] = {
+        "name": model.name,
+        "convention": CONVENTION,
+        "coordinates": names,
+        "parameters": {p.name: p.value for p in model.parameters},
+        "kinetic_energy": text(eom.kinetic_energy),
+        "potential_energy": text(eom.potential_energy),
+        "dissipation": text(eom.dissipation),
+        "lagrangian": text(eom.lagrangian),
+        "generalized_forces": {n: text(v) for n, v in zip(names, eom.generalized_forces,
+                                                           strict=True)},
+        "load_contributions": [
+            {"load": c.load, "coordinate": c.coordinate, "expression": text(c.expression)}
+            for c in eom.load_contributions
+        ],
+        "mass_matrix": [[text(v) for v in eom.mass_matrix.row(i)]
+                        for i in range(eom.mass_matrix.rows)],
+        "forcing": [text(v) for v in eom.forcing],
+        "equations": {n: text(v) for n, v in zip(names, eom.equations, strict=True)},
+        "accelerations": {
+            n: (text(v) if eom.accelerations is not None else None)
+            for n, v in zip(names, eom.accelerations if eom.accelerations is not None
+                            else [None] * len(names), strict=True)
+        },
+    }
+    if model.constraints:
+        document["constraints"] = {
+            "names": [c.name for c in model.constraints],
+            "kinds": [c.kind for c in model.constraints],
+            "multipliers": [str(s) for s in eom.multipliers],
+            "jacobian": [[text(v) for v in eom.constraint_jacobian.row(i)]
+                         for i in range(eom.constraint_jacobian.rows)],
+            "acceleration_rhs": [text(v) for v in eom.acceleration_rhs],
+        }
+    return document
+
+
+# -- LaTeX --------------------------------------------------------------------------------------
+
+
+def derivation_latex(eom: EquationsOfMotion) -> str:
+    """A self-contained LaTeX fragment (amsmath) ready to paste into a paper."""
+    model = eom.model
+    names = latex_symbol_names(model)
+
+    def tex(expr) -> str:
+        return sp.latex(expr, symbol_names=names)
+
+    lines = [f"% {model.name}: equations of motion by Lagrange's method",
+             r"% Convention: M \ddot{q} + \Phi_q^T \lambda = f", r"\begin{align}"]
+    lines.append(rf"T &= {tex(eom.kinetic_energy)} \\")
+    lines.append(rf"V &= {tex(eom.potential_energy)} \\")
+    if eom.dissipation != 0:
+        lines.append(rf"D &= {tex(eom.dissipation)} \\")
+    lines.append(rf"L &= T - V = {tex(eom.lagrangian)} \\")
+    for c, total in zip(model.coordinates, eom.generalized_forces, strict=True):
+        lines.append(rf"Q_{{{tex(c.symbol)}}} &= {tex(total)} \\")
+    for c, equation in zip(model.coordinates, eom.equations, strict=True):
+        lines.append(rf"0 &= {tex(equation)} && \text{{({c.name})}} \\")
+    lines.append(rf"M &= {tex(eom.mass_matrix)} \\")
+    lines.append(rf"f &= {tex(eom.forcing)}")
+    if model.constraints:
+        lines[-1] += r" \\"
+        lines.append(rf"\Phi_q &= {tex(eom.constraint_jacobian)} \\")
+        lines.append(rf"\gamma &= {tex(eom.acceleration_rhs)}")
+    lines.append(r"\end{align}")
+    return "\n".join(lines) + "\n"

@@ -20,12 +20,5 @@ class ModelError(LagrangianError):
         where = ": ".join(part for part in (self.source, self.field) if part)
         return f"{where}: {self.message}" if where else self.message
 
-    def located(self, source: str | None = None, field: str | None = None) -> ModelError:
-        """The same error with a source file and/or field filled in where missing."""
-        return ModelError(
-            self.message, field=self.field or field, source=self.source or source
-        )
-
-
 class DerivationError(LagrangianError):
     """The model is well formed but its equations cannot be formed (singular mass matrix, ...)."""

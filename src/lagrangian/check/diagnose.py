@@ -29,7 +29,6 @@ CODES = (
     "reaction_in_minimal_coordinates", "multiplier_count", "equation_wrong",
     "equation_equivalent", "units_mismatch",
 )
-STATUSES = ("correct", "equivalent", "wrong", "note")
 
 
 @dataclass(frozen=True)

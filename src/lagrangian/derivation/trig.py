@@ -15,7 +15,7 @@ that is left over, since building sympy objects is what costs.
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from functools import lru_cache
 
 import sympy as sp
@@ -63,18 +63,6 @@ def _merge(x: tuple, y: tuple) -> tuple:
 def build(item: Parts) -> sp.Expr:
     coefficient, rest, sins, coss = item
     return sp.Mul(coefficient, *rest, *(sp.sin(a) for a in sins), *(sp.cos(a) for a in coss))
-
-
-def combine_angle_differences(expr: sp.Expr) -> sp.Expr:
-    """Apply the identities above to the terms of an Add (other expressions are returned)."""
-    if not expr.is_Add:
-        return expr
-    return sp.Add(*combined_terms(parts(term) for term in expr.args))
-
-
-def combine_terms(terms: Sequence[sp.Expr]) -> sp.Expr:
-    """The sum of ``terms`` with the identities above applied between them."""
-    return sp.Add(*combined_terms(parts(term) for term in terms))
 
 
 def combined_terms(items: Iterable[Parts]) -> list[sp.Expr]:

@@ -288,14 +288,6 @@ def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25
     return FuncAnimation(figure, draw, frames=len(times), interval=1000 / fps, blit=False)
 
 
-def write_animation(result: SimulationResult, model: Model, path: str | Path, *, fps: int = 25,
-                    max_frames: int = 250, protect: tuple[Path, ...] = ()) -> Path:
-    """Write the animation as GIF (Pillow) or as HTML with a player, atomically."""
-    _check_suffix(path)
-    animation = mechanism_animation(result, model, fps=fps, max_frames=max_frames)
-    return save_animation(animation, path, fps=fps, protect=protect)
-
-
 def save_animation(animation, path: str | Path, *, fps: int = 25,
                    protect: tuple[Path, ...] = ()) -> Path:
     """Save a built animation as .gif or .html, through a temporary file and a rename."""

@@ -57,13 +57,6 @@ def time_history_figure(result: SimulationResult, units: dict[str, str] | None =
     return figure
 
 
-def write_plot(result: SimulationResult, path: str | Path, *, units: dict[str, str] | None = None,
-               protect: tuple[Path, ...] = ()) -> Path:
-    """Draw the time history and write it as PNG (or SVG/PDF by suffix), atomically."""
-    _check_suffix(path)
-    return save_figure(time_history_figure(result, units), path, protect=protect)
-
-
 def save_figure(figure, path: str | Path, *, protect: tuple[Path, ...] = ()) -> Path:
     """Write a figure (format by suffix) through a temporary file and a rename."""
     path = _check_suffix(path)

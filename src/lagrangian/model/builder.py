@@ -13,7 +13,7 @@ from collections.abc import Iterable, Sequence
 
 import sympy as sp
 
-from ..errors import ModelError
+from ..errors import ModelError, did_you_mean
 from .expressions import RESERVED, parse_expression
 from .model import (
     TIME,
@@ -195,13 +195,8 @@ class ModelBuilder:
                 if body.name == reference:
                     return body.position
             names = [p.name for p in self._particles] + [b.name for b in self._bodies]
-            import difflib
-
-            close = difflib.get_close_matches(reference, names, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            raise self._error(
-                f"'{reference}' is not a particle or body (declare it before use){hint}", field
-            )
+            raise self._error(f"'{reference}' is not a particle or body (declare it before use)"
+                              f"{did_you_mean(reference, names)}", field)
         if isinstance(reference, dict):
             unknown = set(reference) - {"body", "offset"}
             if unknown or "body" not in reference:

@@ -7,14 +7,13 @@ grammar; nothing is ever evaluated as Python.
 from __future__ import annotations
 
 import ast
-import difflib
 import math
 from collections.abc import Mapping
 
 import sympy as sp
 from sympy.printing.str import StrPrinter
 
-from ..errors import ModelError
+from ..errors import ModelError, did_you_mean
 
 FUNCTIONS: dict[str, tuple[object, int]] = {
     "sin": (sp.sin, 1),
@@ -160,9 +159,7 @@ class _Converter:
         if name in FUNCTIONS:
             raise self.fail(f"'{name}' is a function: call it as {name}(...)")
         known = list(self.names) + list(CONSTANTS)
-        close = difflib.get_close_matches(name, known, n=1)
-        hint = f"; did you mean '{close[0]}'?" if close else ""
-        raise self.fail(f"unknown name '{name}'{hint}")
+        raise self.fail(f"unknown name '{name}'{did_you_mean(name, known)}")
 
     def _binary(self, node: ast.BinOp, depth: int) -> sp.Expr:
         op = type(node.op)
@@ -199,9 +196,7 @@ class _Converter:
             raise self.fail(f"only the functions {', '.join(FUNCTIONS)} can be called")
         name = node.func.id
         if name not in FUNCTIONS:
-            close = difflib.get_close_matches(name, list(FUNCTIONS), n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            raise self.fail(f"unknown function '{name}'{hint}")
+            raise self.fail(f"unknown function '{name}'{did_you_mean(name, FUNCTIONS)}")
         if node.keywords:
             raise self.fail(f"{name}() takes no keyword arguments")
         function, arity = FUNCTIONS[name]

@@ -6,7 +6,7 @@ import tomllib
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
-from ..errors import ModelError
+from ..errors import ModelError, did_you_mean
 from .builder import ModelBuilder
 from .model import Model
 from .units import check_unit, to_si
@@ -185,12 +185,9 @@ def check_known_keys(
     table: Mapping, allowed, field: str | None, source: str, what: str = "key"
 ) -> None:
     """Unknown keys are errors (never silently ignored), with the nearest valid one suggested."""
-    import difflib
-
     for key in table:
         if key not in allowed:
-            close = difflib.get_close_matches(key, sorted(allowed), n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
+            hint = did_you_mean(key, sorted(allowed))
             where = f"{field}.{key}" if field else key
             raise ModelError(f"unknown {what} '{key}'{hint}", field=where, source=source)
 

@@ -6,7 +6,7 @@ import tomllib
 from importlib import resources
 from pathlib import Path
 
-from ...errors import ModelError
+from ...errors import ModelError, did_you_mean
 
 
 def _files() -> dict[str, Path]:
@@ -28,11 +28,7 @@ def example_path(name: str) -> Path:
     """Path of a built-in example's model file."""
     files = _files()
     if name not in files:
-        import difflib
-
-        close = difflib.get_close_matches(name, list(files), n=1)
-        hint = f"; did you mean '{close[0]}'?" if close else ""
-        raise ModelError(f"no such file or built-in example '{name}'{hint} "
+        raise ModelError(f"no such file or built-in example '{name}'{did_you_mean(name, files)} "
                          "(`lagrangian examples` lists them)")
     return files[name]
 

@@ -14,7 +14,9 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.model import Model
-from .linearization import StaticFunctions, static_residual, total_stiffness
+from ..model.values import State, resolve_state
+from ..numerics.static import StaticFunctions
+from .linearization import static_residual, total_stiffness
 
 MAX_ITERATIONS = 80
 # Residual relative to the force scale of the model at which Newton has converged.
@@ -181,7 +183,7 @@ def starting_points(model: Model, free: np.ndarray) -> np.ndarray:
     coordinates, a scrambled Sobol sequence beyond)."""
     low, high, _ = coordinate_spans(model)
     n = len(model.coordinates)
-    initial = np.array([c.initial or 0.0 for c in model.coordinates], float)
+    initial = resolve_state(model).q_array()  # the model's initial values
     points = [initial, np.where(free, 0.0, initial)]
     k = int(free.sum())
     if k:
@@ -262,35 +264,23 @@ def find_equilibria(
 
 
 def resolve_equilibrium(
-    functions: StaticFunctions, about: Mapping[str, float] | None, *, t: float = 0.0,
+    functions: StaticFunctions, about: Mapping[str, float] | State | None, *, t: float = 0.0,
     option: str = "about",
 ) -> tuple[np.ndarray, np.ndarray]:
     """The equilibrium (q, lambda) given by ``about`` (checked to be one; coordinates not given
     are solved for), or, without ``about``, the equilibrium nearest the model's initial values."""
     model = functions.model
     names = [c.name for c in model.coordinates]
-    about = dict(about or {})
-    for name in about:
-        if name not in names:
-            import difflib
-
-            close = difflib.get_close_matches(name, names, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            raise ModelError(f"'{name}' is not a coordinate of this model{hint}", field=option)
-    for name, value in about.items():
-        try:
-            about[name] = float(value)  # numbers, numpy or sympy numbers (sympy.pi)
-        except (TypeError, ValueError):
-            raise ModelError(f"the value of '{name}' must be a number in SI units (radians for "
-                             f"angles, e.g. math.pi), got {value!r}", field=option) from None
+    state = resolve_state(model, about, field=option, velocities=False, time=False)
+    about = {n: q for n, q in zip(names, state.q, strict=True) if n in state.given}
     low, high, _ = coordinate_spans(model)
     periodic = periodic_coordinates(functions, t)
-    initial = np.array([c.initial or 0.0 for c in model.coordinates], float)
+    initial = resolve_state(model).q_array()  # the model's initial values
     if not about:
         found = find_equilibria(functions, t=t)
         if not len(found):
             raise ModelError("no equilibrium found (the forces at rest balanced at none of the "
-                             "configurations searched); give one with --about")
+                             "configurations searched); name one to analyse about")
         q_all = np.array([[e.coordinates[n] for n in names] for e in found])
         distance = [_distance(qi, initial, periodic) for qi in q_all]
         best = int(np.argmin(distance))

@@ -10,6 +10,7 @@ import sympy as sp
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
 from ..model.units import generalized_force_unit
+from ..model.values import ParameterValues, State, resolve_parameters, resolve_state
 
 
 @dataclass(frozen=True)
@@ -34,57 +35,30 @@ class ForceReport:
         return r"$\begin{aligned}" + r" \\ ".join(rows) + r"\end{aligned}$"
 
 
-def state_values(
-    eom: EquationsOfMotion, at: Mapping[str, float], parameters: Mapping[str, float] | None = None,
-    *, needed: set[sp.Symbol] | None = None,
-) -> tuple[dict[sp.Symbol, float], dict[str, float]]:
-    """Numeric values for every symbol: ``at`` (coordinates, velocities, t), then the model's
-    initial values and rates, then 0; parameters from the model, overridden by ``parameters``.
-    Returns (symbol -> value, the configuration as name -> value)."""
-    model = eom.model
-    parameters = dict(parameters or {})
-    known = {c.name for c in model.coordinates} | {c.velocity.name for c in model.coordinates}
-    known.add("t")
-    for name in at:
-        if name not in known:
-            raise ModelError(f"'{name}' is not a coordinate, velocity or t of this model",
-                             field="--at")
-    for name in parameters:
-        if name not in {p.name for p in model.parameters}:
-            raise ModelError(f"'{name}' is not a parameter of this model", field="--set")
-    values: dict[sp.Symbol, float] = {}
-    configuration: dict[str, float] = {}
-    for c in model.coordinates:
-        values[c.symbol] = float(at.get(c.name, c.initial or 0.0))
-        configuration[c.name] = values[c.symbol]
-        values[c.velocity] = float(at.get(c.velocity.name, c.rate or 0.0))
-        if c.velocity.name in at or (needed and c.velocity in needed):
-            configuration[c.velocity.name] = values[c.velocity]
-    values[model.time] = float(at.get("t", 0.0))
-    if "t" in at or (needed and model.time in needed):
-        configuration["t"] = values[model.time]
-    for p in model.parameters:
-        value = parameters.get(p.name, p.value)
-        if value is not None:
-            values[p.symbol] = float(value)
-    return values, configuration
-
-
 def evaluate_generalized_forces(
-    eom: EquationsOfMotion, at: Mapping[str, float], parameters: Mapping[str, float] | None = None
+    eom: EquationsOfMotion, at: Mapping[str, float] | State,
+    parameters: Mapping[str, float] | ParameterValues | None = None,
 ) -> ForceReport:
     """Evaluate Q_i and every load's contribution to it at the configuration ``at`` (SI)."""
     model = eom.model
     needed: set[sp.Symbol] = set()
     for contribution in eom.load_contributions:
         needed |= contribution.expression.free_symbols
-    values, configuration = state_values(eom, at, parameters, needed=needed)
+    state = resolve_state(model, at, field="configuration")
+    values: dict[sp.Symbol, float] = state.symbol_values(model)
+    values.update(resolve_parameters(model, parameters, require=False).symbol_values(model))
     missing = sorted(str(s) for s in needed if s not in values)
     if missing:
-        raise ModelError(
-            f"parameter '{missing[0]}' has no value; give one with --set {missing[0]}=...",
-            field="parameters",
-        )
+        raise ModelError(f"parameter '{missing[0]}' has no value; give one",
+                         field=f"parameters.{missing[0]}")
+    # The report names q always, q_dot and t where they were given or the forces contain them.
+    configuration = {}
+    for c, q, v in zip(model.coordinates, state.q, state.q_dot, strict=True):
+        configuration[c.name] = q
+        if c.velocity.name in state.given or c.velocity in needed:
+            configuration[c.velocity.name] = v
+    if "t" in state.given or model.time in needed:
+        configuration["t"] = state.t
     totals = {c.name: 0.0 for c in model.coordinates}
     contributions = []
     for contribution in eom.load_contributions:

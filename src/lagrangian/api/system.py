@@ -15,7 +15,6 @@ import sympy as sp
 from ..analysis.forces import ForceReport, evaluate_generalized_forces
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
-from ..errors import ModelError
 from ..model.builder import ModelBuilder
 from ..model.examples import example_path
 from ..model.model import Model
@@ -71,11 +70,7 @@ class System:
 
     def with_parameters(self, **values: float) -> System:
         """A copy of the system with some parameter values replaced (SI units)."""
-        try:
-            return System(self._model.with_parameter_values(values))
-        except KeyError as exc:
-            raise ModelError(f"'{exc.args[0]}' is not a parameter of this model",
-                             field="parameters") from None
+        return System(self._model.with_parameter_values(values))
 
     def equations_of_motion(self) -> EquationsOfMotion:
         """M q_ddot + Phi_q^T lambda = f by Lagrange's method (derived once, then cached)."""
@@ -145,7 +140,7 @@ class System:
     @cached_property
     def _static_functions(self):
         """Compiled functions at rest, built once per System (parameters are fixed per System)."""
-        from ..analysis.linearization import StaticFunctions
+        from ..numerics.static import StaticFunctions
 
         return StaticFunctions(self.equations_of_motion())
 

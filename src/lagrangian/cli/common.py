@@ -10,6 +10,7 @@ from typing import Any
 from ..api.system import System, load
 from ..errors import ModelError
 from ..model.units import parse_quantity
+from ..model.values import state_units, unknown_name
 
 
 def load_system(model: str, settings: Iterable[str] = ()) -> System:
@@ -32,14 +33,11 @@ def parameter_values(system: System, settings: Iterable[str]) -> dict[str, float
 
 def state_assignments(system: System, settings: Iterable[str], option: str) -> dict[str, float]:
     """Read NAME=VALUE[unit] options for coordinates (e.g. 30deg), velocities and t."""
-    units: dict[str, str | None] = {"t": "s"}
-    for c in system.model.coordinates:
-        units[c.name] = c.unit
-        units[c.velocity.name] = None if not c.unit else f"({c.unit})/s"
+    units = state_units(system.model)
     values = {}
     for name, text in assignments(settings, option):
         if name not in units:
-            raise _unknown(name, list(units), option, "coordinate, velocity or t")
+            raise unknown_name(name, units, "coordinate, velocity or t", option)
         values[name] = parse_quantity(text, units[name], f"{option} {name}")
     return values
 

@@ -186,11 +186,6 @@ class Model:
     def q_ddot(self) -> tuple[sp.Symbol, ...]:
         return tuple(c.acceleration for c in self.coordinates)
 
-    @property
-    def parameter_values(self) -> dict[sp.Symbol, float]:
-        """Parameters that have a numeric value, symbol -> SI value."""
-        return {p.symbol: p.value for p in self.parameters if p.value is not None}
-
     def coordinate(self, name: str) -> Coordinate:
         for c in self.coordinates:
             if c.name == name:
@@ -204,14 +199,12 @@ class Model:
         raise KeyError(name)
 
     def with_parameter_values(self, values: dict[str, float]) -> Model:
-        """A copy with some parameter values replaced (SI units)."""
+        """A copy with some parameter values replaced (SI units); unknown names are refused."""
         from dataclasses import replace
 
-        unknown = set(values) - {p.name for p in self.parameters}
-        if unknown:
-            raise KeyError(sorted(unknown)[0])
-        parameters = tuple(
-            replace(p, value=float(values[p.name])) if p.name in values else p
-            for p in self.parameters
-        )
+        from .values import resolve_parameters
+
+        resolved = resolve_parameters(self, values, require=False)
+        parameters = tuple(replace(p, value=v) if p.name in values else p
+                           for p, v in zip(self.parameters, resolved.values, strict=True))
         return replace(self, parameters=parameters)

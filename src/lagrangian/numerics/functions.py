@@ -12,11 +12,12 @@ from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
-import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
-from ..errors import DerivationError, ModelError
+from ..errors import DerivationError
 from ..model.expressions import as_expression
+from ..model.values import ParameterValues, resolve_parameters
+from .lambdified import numpy_function
 
 
 @dataclass(frozen=True)
@@ -206,24 +207,6 @@ def _batch(q, q_dot, n: int):
     return np.broadcast_to(q, batch + (n,)), np.broadcast_to(q_dot, batch + (n,)), batch
 
 
-def parameter_substitution(
-    eom: EquationsOfMotion, parameters: Mapping[str, float] | None = None
-) -> dict[sp.Symbol, sp.Float]:
-    """Parameter symbol -> value (model values overridden by ``parameters``); all must be set."""
-    overrides = dict(parameters or {})
-    values = {}
-    for p in eom.model.parameters:
-        value = overrides.pop(p.name, p.value)
-        if value is None:
-            raise ModelError(f"parameter '{p.name}' has no value; give one (--set {p.name}=...)",
-                             field=f"parameters.{p.name}")
-        values[p.symbol] = sp.Float(float(value))
-    if overrides:
-        raise ModelError(f"'{sorted(overrides)[0]}' is not a parameter of this model",
-                         field="parameters")
-    return values
-
-
 BACKENDS = ("auto", "c", "numpy")
 
 # Generated C per equations object: cse + printing is the slow part of a C build.
@@ -268,16 +251,13 @@ def _numpy_kernel(eom: EquationsOfMotion, values: dict) -> _NumpyKernel:
                             *eom.acceleration_rhs])
     residuals = numeric_list([c.expression for c in model.constraints])
     energy = (eom.kinetic_energy + eom.potential_energy).xreplace(values)
-    return _NumpyKernel(
-        len(model.q), len(model.constraints),
-        sp.lambdify(args, entries, modules="numpy", cse=True),
-        sp.lambdify(args, energy, modules="numpy", cse=True),
-        sp.lambdify(args, residuals, modules="numpy", cse=True),
-    )
+    return _NumpyKernel(len(model.q), len(model.constraints), numpy_function(args, entries),
+                        numpy_function(args, energy), numpy_function(args, residuals))
 
 
 def numeric(
-    eom: EquationsOfMotion, parameters: Mapping[str, float] | None = None, backend: str = "auto"
+    eom: EquationsOfMotion, parameters: Mapping[str, float] | ParameterValues | None = None,
+    backend: str = "auto",
 ) -> NumericSystem:
     """Compile the equations once (common-subexpression elimination) into numeric functions.
 
@@ -287,7 +267,7 @@ def numeric(
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {', '.join(BACKENDS)}, not {backend!r}")
     model = eom.model
-    values = parameter_substitution(eom, parameters)
+    values = resolve_parameters(model, parameters).symbol_values(model)
     kernel = None
     if backend in ("auto", "c"):
         from .compiled import BackendUnavailable

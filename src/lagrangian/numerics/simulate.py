@@ -23,7 +23,8 @@ from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
 from ..model.expressions import as_expression, parse_expression
 from ..model.model import Model
-from .functions import NumericSystem, numeric, parameter_substitution
+from ..model.values import resolve_parameters, resolve_state
+from .functions import NumericSystem, numeric
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 # Explicit Runge-Kutta solvers keep only (y, f) between steps, so a projected state can be put
@@ -211,23 +212,6 @@ class SimulationResult:
 
 # -- the integration ---------------------------------------------------------------------------
 
-def initial_state(model: Model, initial: Mapping[str, float] | None = None
-                  ) -> tuple[float, np.ndarray, np.ndarray]:
-    """(t0, q0, q_dot0) from the model's initial/rate values, overridden by ``initial`` (SI)."""
-    values = dict(initial or {})
-    t0 = float(values.pop("t", 0.0))
-    q0, v0 = [], []
-    for c in model.coordinates:
-        q0.append(float(values.pop(c.name, c.initial if c.initial is not None else 0.0)))
-        v0.append(float(values.pop(c.velocity.name, c.rate if c.rate is not None else 0.0)))
-    if values:
-        known = [c.name for c in model.coordinates] + [c.velocity.name for c in model.coordinates]
-        name = sorted(values)[0]
-        raise ModelError(f"'{name}' is not a coordinate or velocity of this model "
-                         f"(known: {', '.join(known)})", field="initial")
-    return t0, np.array(q0), np.array(v0)
-
-
 def energy_is_conserved(eom: EquationsOfMotion) -> bool:
     """No dissipation, no non-conservative loads, no explicit time dependence."""
     model = eom.model
@@ -270,7 +254,8 @@ def simulate(
             raise ModelError(f"{name} must be a positive number, got {value}", field=name)
     if int(samples) < 2:
         raise ModelError(f"samples must be at least 2, got {samples}", field="samples")
-    t0, q0, v0 = initial_state(model, initial)
+    start = resolve_state(model, initial, field="initial", what="coordinate or velocity (or t)")
+    t0, q0, v0 = start.t, start.q_array(), start.q_dot_array()
     if not (math.isfinite(t_end) and t_end > t0):
         raise ModelError(f"the end time ({t_end} s) must be after the start time ({t0} s)",
                          field="t_end")
@@ -279,7 +264,7 @@ def simulate(
 
     # Everything numeric is compiled here, once, before the loop.
     system = system if system is not None else numeric(eom, parameters)
-    values = parameter_substitution(eom, parameters)
+    values = resolve_parameters(model, parameters).symbol_values(model)
     args = [*model.q, *model.q_dot, model.time]
     n, m = system.n, system.m
     drift = _DriftControl(system, _lambdify_rows(args, eom.velocity_bias, values)) if m else None
@@ -288,9 +273,9 @@ def simulate(
 
     projected: dict[str, tuple[float, float]] = {}
     if drift is not None:
-        given = {name: bool(initial and name in initial) for name in _state_names(model)}
+        given = {name: name in start.given for name in start.names}
         q_new, v_new = drift.project_initial(q0, v0, t0, given)
-        for name, old, new in zip(_state_names(model), np.concatenate([q0, v0]),
+        for name, old, new in zip(start.names, np.concatenate([q0, v0]),
                                   np.concatenate([q_new, v_new]), strict=True):
             if abs(new - old) > 1e-12 * max(1.0, abs(old)):
                 projected[name] = (float(old), float(new))

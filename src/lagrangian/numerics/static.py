@@ -1,0 +1,155 @@
+"""The equations at rest as numbers: M, f, -df/dq, -df/dq_dot, Phi_q and its q-derivatives.
+
+What equilibria, linearization and modes evaluate (analysis/), at q_dot = 0, batched over many
+configurations q; compiled once per set of parameter values.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import sympy as sp
+
+from ..derivation.equations import EquationsOfMotion
+from ..derivation.kinematics import jacobian_row
+from ..errors import ModelError
+from ..model.expressions import as_expression
+from ..model.values import ParameterValues, resolve_parameters
+from .lambdified import numpy_function
+
+
+class StaticFunctions:
+    """M, f, K0 = -df/dq, C = -df/dq_dot, Phi_q, its q-derivatives and the static constraint
+    residuals, all at q_dot = 0, compiled once (numerics.lambdified) and batched over q."""
+
+    def __init__(self, eom: EquationsOfMotion,
+                 parameters: Mapping[str, float] | ParameterValues | None = None):
+        model = eom.model
+        self.model = model
+        self.eom = eom
+        q, q_dot, t = model.q, model.q_dot, model.time
+        n, m = len(q), len(model.constraints)
+        self.n, self.m = n, m
+        values = resolve_parameters(model, parameters).symbol_values(model)
+        self.parameters = {str(k): float(v) for k, v in values.items()}
+        at_rest = {v: sp.S.Zero for v in q_dot}
+
+        # Parameter values go in first: differentiating numbers is much cheaper than symbols.
+        forcing = [_floats(as_expression(e).xreplace(values)) for e in eom.forcing]
+        forcing_at_rest = [e.xreplace(at_rest) for e in forcing]
+        stiffness = [[-d for d in jacobian_row(e, q)] for e in forcing_at_rest]
+        damping = [[-d.xreplace(at_rest) for d in linear_velocity_row(e, q_dot)]
+                   for e in forcing]
+        jacobian = [[_floats(as_expression(e).xreplace(values).xreplace(at_rest))
+                     for e in eom.constraint_jacobian.row(i)] for i in range(m)]
+        hessians = [[jacobian_row(e, q) for e in row] for row in jacobian]
+        # At rest a holonomic constraint reads Phi(q) = 0, a velocity one b(q) = 0.
+        static = []
+        for c in model.constraints:
+            residual = _floats(c.expression.xreplace(values))
+            residual = residual if c.kind == "holonomic" else residual.xreplace(at_rest)
+            if residual != 0:
+                static.append((c.name, residual))
+        self.static_names = tuple(name for name, _ in static)
+        static_jacobian = [jacobian_row(e, q) for _, e in static]
+        self.depends_on = frozenset(
+            s for e in [*forcing_at_rest, *(e for _, e in static)] for s in e.free_symbols
+        )
+        mass = [_floats(as_expression(e).xreplace(values).xreplace(at_rest))
+                for e in eom.mass_matrix]
+        rest = [*mass, *forcing_at_rest, *_flat(damping), *(e for _, e in static)]
+        if any(t in as_expression(e).free_symbols for e in rest):
+            raise ModelError("the equations at rest depend on time t explicitly, so the model has "
+                             "no fixed equilibrium to analyse", field="equilibria")
+
+        entries = [*mass, *forcing_at_rest, *_flat(stiffness), *_flat(damping), *_flat(jacobian),
+                   *_flat(_flat(hessians)), *(e for _, e in static), *_flat(static_jacobian)]
+        entries = [as_expression(e) for e in entries]
+        self._layout = [("mass", (n, n)), ("forcing", (n,)), ("stiffness", (n, n)),
+                        ("damping", (n, n)), ("jacobian", (m, n)), ("hessians", (m, n, n)),
+                        ("static", (len(static),)), ("static_jacobian", (len(static), n))]
+        # Only entries that vary with q (or t) are compiled; constants (most of a big sparse
+        # model's K and C) are stored once.
+        self._constants = np.zeros(len(entries))
+        varying = []
+        for i, e in enumerate(entries):
+            if e.free_symbols:
+                varying.append(i)
+            else:
+                self._constants[i] = _real(e)
+        self._varying = np.array(varying, dtype=int)
+        compiled = [entries[i] for i in varying]
+        self._function = numpy_function([*q, t], compiled) if varying else None
+
+    def evaluate(self, q: np.ndarray, t: float = 0.0) -> dict[str, np.ndarray]:
+        """Every matrix at configurations q of shape (..., n), at rest and time t."""
+        q = np.asarray(q, dtype=float)
+        batch = q.shape[:-1]
+        flat = np.empty(batch + self._constants.shape)
+        flat[...] = self._constants
+        if self._function is not None:
+            raw = self._function(*np.moveaxis(q, -1, 0), np.broadcast_to(float(t), batch))
+            for i, value in zip(self._varying, raw, strict=True):
+                flat[..., i] = value
+        out, start = {}, 0
+        for name, shape in self._layout:
+            size = int(np.prod(shape))
+            out[name] = flat[..., start:start + size].reshape(batch + shape)
+            start += size
+        return out
+
+
+def _floats(expr: sp.Expr) -> sp.Expr:
+    """Exact numbers too big for machine integers (from floats made exact) become floats."""
+    big = {a: sp.Float(a) for a in expr.atoms(sp.Rational)
+           if not (a.is_Integer and abs(a) < 2**31) and not (abs(a.p) < 2**31 and a.q < 2**31)}
+    return expr.xreplace(big) if big else expr
+
+
+def _real(value: sp.Expr) -> float:
+    if value.is_Number:
+        return float(value)
+    number = complex(sp.N(value))
+    if abs(number.imag) > 1e-12 * max(1.0, abs(number.real)):
+        raise ModelError(f"the value {value} is not real", field="parameters")
+    return number.real
+
+
+def linear_velocity_row(expr: sp.Expr, q_dot: Sequence[sp.Symbol]) -> list[sp.Expr]:
+    """d expr / d q_dot_j, for use at q_dot = 0.
+
+    Terms at least quadratic in the velocities (centripetal, Coriolis) have no slope at rest, so
+    they are dropped before differentiating: a big model's forcing is mostly such terms.
+    """
+    velocities = frozenset(q_dot)
+    degrees: dict[sp.Basic, int] = {}
+    kept = [term for term in sp.Add.make_args(expr)
+            if _lowest_velocity_degree(term, velocities, degrees) < 2]
+    linear = sp.Add(*kept)
+    present = linear.free_symbols
+    return [linear.diff(v) if v in present else sp.S.Zero for v in q_dot]
+
+
+def _lowest_velocity_degree(expr: sp.Basic, velocities: frozenset, memo: dict) -> int:
+    """A lower bound on the degree in the velocities of every term of ``expr`` (0 if unsure)."""
+    if expr in memo:
+        return memo[expr]
+    if expr in velocities:
+        degree = 1
+    elif not (expr.free_symbols & velocities):
+        degree = 0
+    elif expr.is_Mul:
+        degree = sum(_lowest_velocity_degree(a, velocities, memo) for a in expr.args)
+    elif expr.is_Add:
+        degree = min(_lowest_velocity_degree(a, velocities, memo) for a in expr.args)
+    elif expr.is_Pow and expr.exp.is_Integer and expr.exp > 0:
+        degree = int(expr.exp) * _lowest_velocity_degree(expr.base, velocities, memo)
+    else:
+        degree = 0  # a function of a velocity: no claim
+    memo[expr] = degree
+    return degree
+
+
+def _flat(rows):
+    return [x for row in rows for x in row]

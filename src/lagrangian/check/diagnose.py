@@ -58,6 +58,11 @@ class CheckReport:
     def correct(self) -> bool:
         return self.verdict == "correct"
 
+    @property
+    def passed(self) -> bool:
+        """The check passed: every item is correct or equivalent (the same as ``correct``)."""
+        return self.correct
+
     def codes(self, item: str | None = None) -> list[str]:
         return [f.code for f in self.findings if f.code and (item is None or f.item == item)]
 
@@ -466,7 +471,7 @@ class _Checker:
                 return None
             if eq.identical(user, ratio * ours, self.points):
                 if eq.constant_in_state(ratio, self.points):
-                    return eq.display(sp.cancel(ratio)) if eq._small(ratio) else ratio
+                    return eq.display(sp.cancel(ratio)) if eq.is_small(ratio) else ratio
                 return eq.display(ratio)
             return None
         return None
@@ -480,13 +485,13 @@ class _Checker:
                 c_user = user.diff(a)
                 if not eq.zero(c_user, self.points):
                     scale = c_user / c_ours
-                    if eq._small(scale):
+                    if eq.is_small(scale):
                         scale = sp.cancel(scale)
                 break
-        difference = eq.display(sp.expand(user / scale - ours)) if eq._small(user) \
+        difference = eq.display(sp.expand(user / scale - ours)) if eq.is_small(user) \
             else user / scale - ours
         extra_terms, missing_terms = [], []
-        if eq._small(user) and eq._small(ours):
+        if eq.is_small(user) and eq.is_small(ours):
             mine = set(sp.Add.make_args(sp.expand(user / scale)))
             theirs = set(sp.Add.make_args(sp.expand(ours)))
             extra_terms = sorted(fmt(t) for t in mine - theirs)

@@ -97,7 +97,7 @@ def all_close(values, tolerance=TOLERANCE) -> bool:
 
 def identical(a: sp.Expr, b: sp.Expr, points: Points) -> bool:
     """a == b identically (at every random point)."""
-    difference = sp.expand(a - b) if _small(a) and _small(b) else a - b
+    difference = sp.expand(a - b) if is_small(a) and is_small(b) else a - b
     if difference == 0:
         return True
     rows = points.evaluate([a, b])
@@ -137,7 +137,8 @@ def display(expression: sp.Expr) -> sp.Expr:
     return simpler if sp.count_ops(simpler) <= sp.count_ops(expression) else expression
 
 
-def _small(expression: sp.Expr) -> bool:
+def is_small(expression: sp.Expr) -> bool:
+    """Small enough (fewer than SMALL operations) to expand or simplify for a message."""
     return sp.count_ops(expression) < SMALL
 
 

@@ -73,6 +73,11 @@ class CrosscheckReport:
     def agree(self) -> bool:
         return all(c.agree for c in self.coordinates)
 
+    @property
+    def passed(self) -> bool:
+        """The crosscheck passed: the two derivations agree on every coordinate (``agree``)."""
+        return self.agree
+
     def reaction(self, joint: str) -> Reaction:
         for r in self.reactions:
             if r.joint == joint:
@@ -105,6 +110,31 @@ class _FreeBody:
 def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
     """Derive by Newton-Euler and compare with ``eom`` (Lagrange) coordinate by coordinate."""
     model = eom.model
+    _require_free_bodies(model)
+    points = eq.random_points(model)
+    clock = _Clock(model)
+    bodies = _free_bodies(model, clock)
+    forces = _AppliedForces(model, bodies, points)
+    forces.add_gravity()
+    forces.add_loads()
+    forces.add_springs()
+    forces.add_dampers(clock)
+    forces.add_given_generalized_forces()
+    newton_euler = _projected_equations(model, bodies, forces.work)
+    agreements = _compare(eom, newton_euler, points)
+    notes = forces.notes
+    reactions: tuple[Reaction, ...] = ()
+    if forces.unattributed:
+        notes.append("reactions not reported: the forces of "
+                     + ", ".join(f"'{u}'" for u in forces.unattributed)
+                     + " cannot be placed on a free body from the model")
+    else:
+        reactions = _reactions(eom, bodies, newton_euler, notes)
+    return CrosscheckReport(model.name, agreements, reactions, tuple(notes))
+
+
+def _require_free_bodies(model: Model) -> None:
+    """Newton-Euler draws free bodies: the inertia must come as particles and bodies."""
     if model.kinetic_energy != 0:
         raise DerivationError(
             "Newton-Euler needs the inertia as particles and bodies, but this model gives T as "
@@ -112,169 +142,203 @@ def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
             "[[particles]]/[[bodies]], e.g. the example 'ladder_pendulum')")
     if not model.particles and not model.bodies:
         raise DerivationError("Newton-Euler needs at least one particle or body")
-    q, t = model.q, model.time
-    n = len(q)
-    points = eq.random_points(model)
-    to_time = {c.symbol: sp.Function(c.name)(t) for c in model.coordinates}
 
-    def first_derivative(expr: sp.Expr) -> sp.Expr:
-        """d/dt with q -> q(t), then back to the plain symbols q, q_dot."""
-        moving = expr.xreplace(to_time).diff(t)
-        moving = moving.xreplace({to_time[c.symbol].diff(t): c.velocity for c in model.coordinates})
-        return moving.xreplace({f: s for s, f in to_time.items()})
 
-    def second_derivative(expr: sp.Expr) -> sp.Expr:
-        """d^2/dt^2 with q -> q(t), then back to the plain symbols q, q_dot, q_ddot."""
-        moving = expr.xreplace(to_time).diff(t, 2)
-        back = {}
-        for c in model.coordinates:
-            f = to_time[c.symbol]
-            back[f.diff(t, 2)] = c.acceleration
-        moving = moving.xreplace(back)
-        moving = moving.xreplace({to_time[c.symbol].diff(t): c.velocity for c in model.coordinates})
-        return moving.xreplace({f: s for s, f in to_time.items()})
+class _Clock:
+    """Time derivatives by sympy's own d/dt (q -> q(t)), independent of the Lagrange kinematics,
+    written back in the plain symbols q, q_dot, q_ddot."""
 
-    bodies: list[_FreeBody] = []
-    for particle in model.particles:
-        bodies.append(_FreeBody(particle.name, particle.mass, particle.position,
-                                [second_derivative(r) for r in particle.position],
-                                force=[sp.S.Zero] * 3))
-    for body in model.bodies:
-        bodies.append(_FreeBody(body.name, body.mass, body.position,
-                                [second_derivative(r) for r in body.position], body.angle,
-                                body.inertia, second_derivative(body.angle), [sp.S.Zero] * 3))
+    def __init__(self, model: Model):
+        self.model = model
+        self.to_time = {c.symbol: sp.Function(c.name)(model.time) for c in model.coordinates}
+        self.velocities = {self.to_time[c.symbol].diff(model.time): c.velocity
+                           for c in model.coordinates}
+        self.accelerations = {self.to_time[c.symbol].diff(model.time, 2): c.acceleration
+                              for c in model.coordinates}
+        self.back = {f: s for s, f in self.to_time.items()}
 
-    # Virtual work of the applied forces, per coordinate; loads that cannot be put on a free
-    # body are still projected, but then the reactions cannot be reported.
-    work = [[] for _ in range(n)]
-    notes: list[str] = []
-    unattributed: list[str] = []
+    def first(self, expr: sp.Expr) -> sp.Expr:
+        """d/dt of an expression in q (and t)."""
+        moving = expr.xreplace(self.to_time).diff(self.model.time)
+        return moving.xreplace(self.velocities).xreplace(self.back)
 
-    def project(force, point) -> None:
-        for i, qi in enumerate(q):
+    def second(self, expr: sp.Expr) -> sp.Expr:
+        """d^2/dt^2 of an expression in q (and t)."""
+        moving = expr.xreplace(self.to_time).diff(self.model.time, 2)
+        return moving.xreplace(self.accelerations).xreplace(self.velocities).xreplace(self.back)
+
+
+def _free_bodies(model: Model, clock: _Clock) -> list[_FreeBody]:
+    """One free body per particle and rigid body, with its accelerations a_G (and alpha)."""
+    bodies = [_FreeBody(particle.name, particle.mass, particle.position,
+                        [clock.second(r) for r in particle.position], force=[sp.S.Zero] * 3)
+              for particle in model.particles]
+    bodies += [_FreeBody(body.name, body.mass, body.position,
+                         [clock.second(r) for r in body.position], body.angle, body.inertia,
+                         clock.second(body.angle), [sp.S.Zero] * 3)
+               for body in model.bodies]
+    return bodies
+
+
+class _AppliedForces:
+    """The applied forces: their virtual work per coordinate, and each force put on the free
+    body it acts on. Loads that cannot be put on a free body are still projected, but then the
+    reactions cannot be reported (they are listed in ``unattributed``)."""
+
+    def __init__(self, model: Model, bodies: list[_FreeBody], points: eq.Points):
+        self.model, self.bodies, self.points = model, bodies, points
+        self.work: list[list[sp.Expr]] = [[] for _ in model.q]
+        self.notes: list[str] = []
+        self.unattributed: list[str] = []
+
+    def project(self, force, point) -> None:
+        """The virtual work F . dr/dq_i of ``force`` acting at ``point``."""
+        for i, qi in enumerate(self.model.q):
             dr = [r.diff(qi) for r in point]
-            work[i].append(sp.Add(*(f * d for f, d in zip(force, dr, strict=True))))
+            self.work[i].append(sp.Add(*(f * d for f, d in zip(force, dr, strict=True))))
 
-    if model.gravity is not None:
-        g, direction = model.gravity.magnitude, model.gravity.direction
-        for fb in bodies:
-            weight = [fb.mass * g * d for d in direction]
-            fb.force = [a + b for a, b in zip(fb.force, weight, strict=True)]
-            project(weight, fb.position)
-
-    def place(force, point, holder: _FreeBody) -> None:
+    def place(self, force, point, holder: _FreeBody) -> None:
         """Add ``force`` acting at ``point`` to ``holder``: force, and moment about G for a body."""
         holder.force = [a + b for a, b in zip(holder.force, force, strict=True)]
         if holder.angle is not None:
             s = [p - r for p, r in zip(point, holder.position, strict=True)]
             holder.moment += s[0] * force[1] - s[1] * force[0]
 
-    def attach(force, end: Attachment) -> bool:
+    def attach(self, force, end: Attachment) -> bool:
         """Put ``force`` on the free body ``end`` is fixed to; False when there is none to find."""
-        project(force, end.point)
+        self.project(force, end.point)
         if end.body is not None:
-            holder = next((fb for fb in bodies if fb.name == end.body), None)
-        elif any(c.has(*q) for c in end.point):  # a moving point given as a vector
-            holder = _holder(end.point, bodies, model, points)
+            holder = next((fb for fb in self.bodies if fb.name == end.body), None)
+        elif any(c.has(*self.model.q) for c in end.point):  # a moving point given as a vector
+            holder = _holder(end.point, self.bodies, self.model, self.points)
         else:  # the ground (or a prescribed point): its reaction is not asked for
             return True
         if holder is None:
             return False
-        place(force, end.point, holder)
+        self.place(force, end.point, holder)
         return True
 
-    for load in model.loads:
-        if isinstance(load, PointForce):
-            project(load.force, load.point)
-            holder = _holder(load.point, bodies, model, points)
-            if holder is None:
-                unattributed.append(load.name)
-                continue
-            place(load.force, load.point, holder)
-        elif isinstance(load, Torque):
-            for i, qi in enumerate(q):
-                work[i].append(load.torque * load.angle.diff(qi))
-            holder = next((fb for fb in bodies if fb.angle is not None
-                           and eq.identical(fb.angle, load.angle, points)), None)
-            if holder is None:
-                unattributed.append(load.name)
-                continue
-            holder.moment += load.torque
-    for spring in model.springs:
-        if spring.ends is not None:
-            # Tension k (l - l0) pulls each end towards the other along u = (r_a - r_b)/l.
-            a, b, u, length = _line(spring.ends)
-            tension = spring.stiffness * (length - spring.rest_length)
-            if not _pull(attach, a, b, [-tension * c for c in u]):
-                unattributed.append(spring.name)
-            continue
-        unattributed.append(spring.name)
-        tension = spring.stiffness * (spring.length - spring.rest_length)
-        squared = _squared_separation(spring.length)
-        for i, qi in enumerate(q):
-            if squared is not None:
-                # Force -k (l - l0) d/|d| on one end along d = r_a - r_b and the opposite on the
-                # other: virtual work -k (l - l0)/l d.(dd/dq_i) = -k (l - l0)/l * 1/2 d|d|^2/dq_i.
-                work[i].append(-tension / spring.length * squared.diff(qi) / 2)
-            else:  # a spring along its own length coordinate
-                work[i].append(-tension * spring.length.diff(qi))
-    for damper in model.dampers:
-        if damper.ends is not None:
-            # -c l_dot along u on end a, with l_dot = u . d(r_a - r_b)/dt (own time derivative).
-            a, b, u, _ = _line(damper.ends)
-            separation_rate = [first_derivative(pa - pb)
-                               for pa, pb in zip(a.point, b.point, strict=True)]
-            rate = sp.Add(*(ui * di for ui, di in zip(u, separation_rate, strict=True)))
-            if not _pull(attach, a, b, [-damper.coefficient * rate * c for c in u]):
-                unattributed.append(damper.name)
-            continue
-        unattributed.append(damper.name)
-        # Force -c l_dot along the line, projected by dl/dq_i = d(l_dot)/d(q_dot_i).
-        for i, c in enumerate(model.coordinates):
-            work[i].append(-damper.coefficient * damper.rate * damper.rate.diff(c.velocity))
-    given = []
-    if model.potential_energy != 0:
-        given.append("[energy] V")
-        for i, qi in enumerate(q):
-            work[i].append(-model.potential_energy.diff(qi))
-    if model.dissipation != 0:
-        given.append("[energy] D")
-        for i, c in enumerate(model.coordinates):
-            work[i].append(-model.dissipation.diff(c.velocity))
-    for name, value in model.generalized_forces:
-        given.append(f"[generalized_forces] {name}")
-        work[[c.name for c in model.coordinates].index(name)].append(value)
-    if given:
-        notes.append("taken as given generalized forces (no force vector in the model): "
-                     + ", ".join(given))
-        unattributed += given
+    def pull(self, a: Attachment, b: Attachment, force_on_a: list) -> bool:
+        """Apply ``force_on_a`` at end a and its opposite at end b; True when both are placed."""
+        placed_a = self.attach(force_on_a, a)
+        placed_b = self.attach([-c for c in force_on_a], b)
+        return placed_a and placed_b
 
-    newton_euler = []
-    for i, qi in enumerate(q):
+    def add_gravity(self) -> None:
+        """The weight m g of every free body, at its centre of mass."""
+        if self.model.gravity is None:
+            return
+        g, direction = self.model.gravity.magnitude, self.model.gravity.direction
+        for fb in self.bodies:
+            weight = [fb.mass * g * d for d in direction]
+            fb.force = [a + b for a, b in zip(fb.force, weight, strict=True)]
+            self.project(weight, fb.position)
+
+    def add_loads(self) -> None:
+        """Point forces (N) and torques (N m) on the body they act on."""
+        for load in self.model.loads:
+            if isinstance(load, PointForce):
+                self.project(load.force, load.point)
+                holder = _holder(load.point, self.bodies, self.model, self.points)
+                if holder is None:
+                    self.unattributed.append(load.name)
+                    continue
+                self.place(load.force, load.point, holder)
+            elif isinstance(load, Torque):
+                for i, qi in enumerate(self.model.q):
+                    self.work[i].append(load.torque * load.angle.diff(qi))
+                holder = next((fb for fb in self.bodies if fb.angle is not None
+                               and eq.identical(fb.angle, load.angle, self.points)), None)
+                if holder is None:
+                    self.unattributed.append(load.name)
+                    continue
+                holder.moment += load.torque
+
+    def add_springs(self) -> None:
+        """Tension k (l - l0) (N) along each spring, on the ends it joins."""
+        for spring in self.model.springs:
+            if spring.ends is not None:
+                # Tension k (l - l0) pulls each end towards the other along u = (r_a - r_b)/l.
+                a, b, u, length = _line(spring.ends)
+                tension = spring.stiffness * (length - spring.rest_length)
+                if not self.pull(a, b, [-tension * c for c in u]):
+                    self.unattributed.append(spring.name)
+                continue
+            self.unattributed.append(spring.name)
+            tension = spring.stiffness * (spring.length - spring.rest_length)
+            squared = _squared_separation(spring.length)
+            for i, qi in enumerate(self.model.q):
+                if squared is not None:
+                    # Force -k (l - l0) d/|d| on one end along d = r_a - r_b and the opposite on
+                    # the other: virtual work -k (l - l0)/l d.(dd/dq_i) = -k (l - l0)/l * 1/2
+                    # d|d|^2/dq_i.
+                    self.work[i].append(-tension / spring.length * squared.diff(qi) / 2)
+                else:  # a spring along its own length coordinate
+                    self.work[i].append(-tension * spring.length.diff(qi))
+
+    def add_dampers(self, clock: _Clock) -> None:
+        """Force -c l_dot (N) along each damper, on the ends it joins."""
+        for damper in self.model.dampers:
+            if damper.ends is not None:
+                # -c l_dot along u on end a, with l_dot = u . d(r_a - r_b)/dt (own time derivative).
+                a, b, u, _ = _line(damper.ends)
+                separation_rate = [clock.first(pa - pb)
+                                   for pa, pb in zip(a.point, b.point, strict=True)]
+                rate = sp.Add(*(ui * di for ui, di in zip(u, separation_rate, strict=True)))
+                if not self.pull(a, b, [-damper.coefficient * rate * c for c in u]):
+                    self.unattributed.append(damper.name)
+                continue
+            self.unattributed.append(damper.name)
+            # Force -c l_dot along the line, projected by dl/dq_i = d(l_dot)/d(q_dot_i).
+            for i, c in enumerate(self.model.coordinates):
+                self.work[i].append(-damper.coefficient * damper.rate * damper.rate.diff(c.velocity))
+
+    def add_given_generalized_forces(self) -> None:
+        """V, D and generalized forces the model gives directly: no force vector to place."""
+        model, given = self.model, []
+        if model.potential_energy != 0:
+            given.append("[energy] V")
+            for i, qi in enumerate(model.q):
+                self.work[i].append(-model.potential_energy.diff(qi))
+        if model.dissipation != 0:
+            given.append("[energy] D")
+            for i, c in enumerate(model.coordinates):
+                self.work[i].append(-model.dissipation.diff(c.velocity))
+        for name, value in model.generalized_forces:
+            given.append(f"[generalized_forces] {name}")
+            self.work[[c.name for c in model.coordinates].index(name)].append(value)
+        if given:
+            self.notes.append("taken as given generalized forces (no force vector in the model): "
+                              + ", ".join(given))
+            self.unattributed += given
+
+
+def _projected_equations(model: Model, bodies: list[_FreeBody],
+                         work: list[list[sp.Expr]]) -> list[sp.Expr]:
+    """E_i = sum_b [m a_G . dr_G/dq_i + I alpha dangle/dq_i] - (virtual work of the forces)_i."""
+    equations = []
+    for i, qi in enumerate(model.q):
         terms = []
         for fb in bodies:
             terms += [fb.mass * a * r.diff(qi) for a, r in zip(fb.acceleration, fb.position,
                                                                strict=True) if r.has(qi)]
             if fb.angle is not None and fb.angle.has(qi):
                 terms.append(fb.inertia * fb.angular_acceleration * fb.angle.diff(qi))
-        newton_euler.append(sp.Add(*terms) - sp.Add(*work[i]))
+        equations.append(sp.Add(*terms) - sp.Add(*work[i]))
+    return equations
 
+
+def _compare(eom: EquationsOfMotion, newton_euler: list[sp.Expr],
+             points: eq.Points) -> tuple[CoordinateAgreement, ...]:
+    """Each E_i against Lagrange's (M q_ddot - f)_i, identically (at random points)."""
     lagrange = list(eom.mass_matrix * eom.coordinate_accelerations - eom.forcing)
     agreements = []
-    for c, ne, la in zip(model.coordinates, newton_euler, lagrange, strict=True):
+    for c, ne, la in zip(eom.model.coordinates, newton_euler, lagrange, strict=True):
         same = eq.identical(ne, la, points)
-        difference = None if same else fmt(eq.display(sp.expand(ne - la)) if eq._small(ne - la)
+        difference = None if same else fmt(eq.display(sp.expand(ne - la)) if eq.is_small(ne - la)
                                            else ne - la)
         agreements.append(CoordinateAgreement(c.name, same, difference, ne))
-
-    reactions: tuple[Reaction, ...] = ()
-    if unattributed:
-        notes.append("reactions not reported: the forces of "
-                     + ", ".join(f"'{u}'" for u in unattributed)
-                     + " cannot be placed on a free body from the model")
-    else:
-        reactions = _reactions(eom, bodies, newton_euler, notes)
-    return CrosscheckReport(model.name, tuple(agreements), reactions, tuple(notes))
+    return tuple(agreements)
 
 
 def _holder(point, bodies: list[_FreeBody], model: Model, points: eq.Points) -> _FreeBody | None:
@@ -305,13 +369,6 @@ def _line(ends: tuple[Attachment, Attachment]):
     d = [pa - pb for pa, pb in zip(a.point, b.point, strict=True)]
     length = sp.sqrt(sp.Add(*(c**2 for c in d)))
     return a, b, [c / length for c in d], length
-
-
-def _pull(attach, a: Attachment, b: Attachment, force_on_a: list) -> bool:
-    """Apply ``force_on_a`` at end a and its opposite at end b; True when both are placed."""
-    placed_a = attach(force_on_a, a)
-    placed_b = attach([-c for c in force_on_a], b)
-    return placed_a and placed_b
 
 
 def _squared_separation(length: sp.Expr) -> sp.Expr | None:
@@ -363,7 +420,7 @@ def _reactions(eom: EquationsOfMotion, bodies: list[_FreeBody], newton_euler: li
 
 
 def _tidy(expr: sp.Expr) -> sp.Expr:
-    if not eq._small(expr):
+    if not eq.is_small(expr):
         return expr
     radicals = [power for power in expr.atoms(sp.Pow) if not power.exp.is_integer]
     if radicals:

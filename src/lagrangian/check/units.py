@@ -42,6 +42,11 @@ class UnitsReport:
     def consistent(self) -> bool:
         return not self.issues
 
+    @property
+    def passed(self) -> bool:
+        """The units check passed: no inconsistent term (the same as ``consistent``)."""
+        return self.consistent
+
     def __repr__(self) -> str:
         if self.consistent:
             return f"UnitsReport({self.model!r}: consistent)"

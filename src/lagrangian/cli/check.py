@@ -43,7 +43,7 @@ def check(
         print_json(check_document(report))
     else:
         typer.echo(check_text(report), nl=False)
-    if not report.correct:
+    if not report.passed:
         raise SystemExit(1)
 
 
@@ -56,7 +56,7 @@ def crosscheck(model: _MODEL, set_: _SET = [], json_: _JSON = False) -> None:  #
         print_json(crosscheck_document(report))
     else:
         typer.echo(crosscheck_text(report), nl=False)
-    if not report.agree:
+    if not report.passed:
         raise SystemExit(1)
 
 
@@ -69,5 +69,5 @@ def units(model: _MODEL, json_: _JSON = False) -> None:
         print_json(units_document(report))
     else:
         typer.echo(units_text(report), nl=False)
-    if not report.consistent:
+    if not report.passed:
         raise SystemExit(1)

@@ -24,6 +24,7 @@ from . import examples as _examples  # noqa: E402,F401
 from . import forces as _forces  # noqa: E402,F401
 from . import modes as _modes  # noqa: E402,F401
 from . import simulate as _simulate  # noqa: E402,F401
+from .common import in_flags  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -32,5 +33,6 @@ def main(argv: list[str] | None = None) -> None:
     try:
         app(args=argv, prog_name="lagrangian")
     except (LagrangianError, FileExistsError) as exc:
-        typer.echo(f"error: {exc}", err=True)
+        typer.echo(f"error: {in_flags(exc) if isinstance(exc, LagrangianError) else exc}",
+                   err=True)
         sys.exit(2)

@@ -4,13 +4,42 @@ from __future__ import annotations
 
 import json
 import sys
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 from ..api.system import System, load
-from ..errors import ModelError
+from ..errors import LagrangianError, ModelError
 from ..model.units import parse_quantity
-from ..model.values import state_units, unknown_name
+from ..model.values import state_units
+
+# The CLI's name for each Python field the library names in its errors (ModelError.field):
+# the one place where the library's words meet the command line's flags.
+FLAG_OF_FIELD = {
+    "parameters": "--set",
+    "configuration": "--at",
+    "about": "--about",
+    "initial": "--initial",
+    "t_end": "--t-end",
+    "stop_when": "--stop-when",
+    "method": "--method",
+    "rtol": "--rtol",
+    "atol": "--atol",
+    "samples": "--samples",
+    "table": "--out",
+    "plot": "--plot",
+    "animation": "--animate",
+}
+
+
+def in_flags(error: LagrangianError) -> LagrangianError:
+    """The library's error with its Python field (``parameters.m``) named by the flag that gave
+    it (``--set m``); errors in a file (with a source) keep the file's own field names."""
+    if not isinstance(error, ModelError) or error.source or not error.field:
+        return error
+    head, _, rest = error.field.partition(".")
+    if head not in FLAG_OF_FIELD:
+        return error
+    return ModelError(error.message, field=f"{FLAG_OF_FIELD[head]} {rest}".strip())
 
 
 def load_system(model: str, settings: Iterable[str] = ()) -> System:
@@ -20,29 +49,29 @@ def load_system(model: str, settings: Iterable[str] = ()) -> System:
     return system.with_parameters(**values) if values else system
 
 
-def parameter_values(system: System, settings: Iterable[str]) -> dict[str, float]:
-    """Read --set NAME=VALUE[unit] options against the model's parameters."""
-    parameters = {p.name: p for p in system.model.parameters}
-    values = {}
-    for name, text in assignments(settings, "--set"):
-        if name not in parameters:
-            raise _unknown(name, list(parameters), "--set", "parameter")
-        values[name] = parse_quantity(text, parameters[name].unit, f"--set {name}")
-    return values
+def parameter_values(system: System, settings: Iterable[str]) -> dict[str, float | str]:
+    """Read --set NAME=VALUE[unit] options in SI units (names are judged by the library)."""
+    units = {p.name: p.unit for p in system.model.parameters}
+    return quantities(assignments(settings, "--set"), units, "--set")
 
 
-def state_assignments(system: System, settings: Iterable[str], option: str) -> dict[str, float]:
-    """Read NAME=VALUE[unit] options for coordinates (e.g. 30deg), velocities and t."""
-    units = state_units(system.model)
-    values = {}
-    for name, text in assignments(settings, option):
-        if name not in units:
-            raise unknown_name(name, units, "coordinate, velocity or t", option)
-        values[name] = parse_quantity(text, units[name], f"{option} {name}")
-    return values
+def state_assignments(system: System, settings: Iterable[str], option: str
+                      ) -> dict[str, float | str]:
+    """Read NAME=VALUE[unit] options for coordinates (e.g. 30deg), velocities and t, in SI
+    units (names are judged by the library)."""
+    return quantities(assignments(settings, option), state_units(system.model), option)
+
+
+def quantities(pairs: Iterable[tuple[str, str]], units: Mapping[str, str | None], option: str
+               ) -> dict[str, float | str]:
+    """Each value in SI units by the unit of its name. A name without a unit here is passed on
+    as written: the library refuses it by name (with a suggestion), so the CLI need not judge."""
+    return {name: parse_quantity(text, units[name], f"{option} {name}") if name in units else text
+            for name, text in pairs}
 
 
 def assignments(settings: Iterable[str], option: str) -> list[tuple[str, str]]:
+    """NAME=VALUE options as (name, value text) pairs."""
     pairs = []
     for setting in settings:
         name, sep, value = setting.partition("=")
@@ -50,14 +79,6 @@ def assignments(settings: Iterable[str], option: str) -> list[tuple[str, str]]:
             raise ModelError(f"expected NAME=VALUE, got {setting!r}", field=option)
         pairs.append((name.strip(), value.strip()))
     return pairs
-
-
-def _unknown(name: str, known: list[str], option: str, what: str) -> ModelError:
-    import difflib
-
-    close = difflib.get_close_matches(name, known, n=1)
-    hint = f"; did you mean '{close[0]}'?" if close else ""
-    return ModelError(f"'{name}' is not a {what} of this model{hint}", field=option)
 
 
 def print_json(document: Any) -> None:

@@ -163,7 +163,7 @@ def mode_shape_figure(analysis: ModalAnalysis):
 
     modes = analysis.modes[:PLOT_MAX_MODES]
     if not modes:
-        raise ModelError("there are no modes to plot (no degree of freedom)", field="--plot")
+        raise ModelError("there are no modes to plot (no degree of freedom)", field="plot")
     width, height = mode_plot_size(len(modes))
     figure = Figure(figsize=(width / PLOT_DPI, height / PLOT_DPI), dpi=PLOT_DPI,
                     layout="constrained")
@@ -199,6 +199,9 @@ def mode_shape_figure(analysis: ModalAnalysis):
 def write_mode_plot(analysis: ModalAnalysis, path: str | Path, *,
                     protect: tuple[Path, ...] = ()) -> Path:
     """Draw the mode shapes to a PNG file (written atomically, never over an input file)."""
+    if Path(path).suffix.lower() != ".png":
+        raise ModelError(f"the plot is written as PNG; name the file *.png (got '{path}')",
+                         field="plot")
     figure = mode_shape_figure(analysis)
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=PLOT_DPI)

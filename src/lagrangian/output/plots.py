@@ -11,6 +11,8 @@ from ..errors import ModelError
 from ..numerics.simulate import SimulationResult
 from .files import atomic_write
 
+PLOT_FORMATS = (".png", ".svg", ".pdf")
+
 
 def time_history_figure(result: SimulationResult, units: dict[str, str] | None = None):
     """A matplotlib Figure: coordinates (one panel per unit), energy T + V, multipliers.
@@ -59,14 +61,19 @@ def time_history_figure(result: SimulationResult, units: dict[str, str] | None =
 
 def save_figure(figure, path: str | Path, *, protect: tuple[Path, ...] = ()) -> Path:
     """Write a figure (format by suffix) through a temporary file and a rename."""
-    path = _check_suffix(path)
+    path = check_plot_path(path)
     buffer = io.BytesIO()
     figure.savefig(buffer, format=path.suffix.lower().lstrip("."), dpi=110)
     return atomic_write(path, buffer.getvalue(), protect=protect)
 
 
-def _check_suffix(path: str | Path) -> Path:
+def check_plot_path(path: str | Path) -> Path:
+    """The path of a plot, refused unless it names a format we write (.png, .svg, .pdf)."""
     path = Path(path)
-    if path.suffix.lower() not in (".png", ".svg", ".pdf"):
-        raise ModelError(f"cannot write {path}: use a .png, .svg or .pdf file name", field="--plot")
+    if path.suffix.lower() not in PLOT_FORMATS:
+        raise ModelError(f"cannot write {path}: use a .png, .svg or .pdf file name", field="plot")
     return path
+
+
+# Until cli/simulate.py and simulation.py import check_plot_path.
+_check_suffix = check_plot_path

@@ -30,14 +30,19 @@ def csv_text(result: SimulationResult) -> str:
     return "\n".join(lines) + "\n"
 
 
+def check_table_path(path: str | Path) -> Path:
+    """The path of a table, refused unless it names a format we write (.csv, .parquet)."""
+    path = Path(path)
+    if path.suffix.lower() not in TABLE_FORMATS:
+        raise ModelError(f"cannot write {path}: use a .csv or .parquet file name", field="table")
+    return path
+
+
 def write_table(result: SimulationResult, path: str | Path, *, protect: tuple[Path, ...] = ()
                 ) -> Path:
     """Write CSV (``.csv``) or Parquet (``.parquet``) atomically; never over a protected file."""
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in TABLE_FORMATS:
-        raise ModelError(f"cannot write {path}: use a .csv or .parquet file name", field="--out")
-    if suffix == ".csv":
+    path = check_table_path(path)
+    if path.suffix.lower() == ".csv":
         return atomic_write(path, csv_text(result), protect=protect)
     buffer = io.BytesIO()
     result_frame(result).to_parquet(buffer, index=False)

@@ -199,12 +199,12 @@ def main() -> None:
     Q, V = rng.uniform(-np.pi, np.pi, (10_000, 2)), rng.uniform(-3, 3, (10_000, 2))
     print("| function | one batched call (ms) | 10,000 single calls (ms) | ratio |")
     print("|---|---|---|---|")
-    for name in ("accelerations", "mass_matrix", "energy"):
+    for name in ("accelerations_and_multipliers", "mass_matrix", "energy"):
         fn = getattr(ours, name)
         batched, values = best_of(lambda fn=fn: fn(Q, V), repeat * 3)
         singles, loop = best_of(lambda fn=fn: [fn(Q[i], V[i]) for i in range(len(Q))], 3)
-        assert np.allclose(np.asarray(values if name != "accelerations" else values[0]),
-                           np.asarray([v if name != "accelerations" else v[0] for v in loop]))
+        assert np.allclose(np.asarray(values if name != "accelerations_and_multipliers" else values[0]),
+                           np.asarray([v if name != "accelerations_and_multipliers" else v[0] for v in loop]))
         print(f"| {name} | {batched * 1e3:.3f} | {singles * 1e3:.1f} | {singles / batched:.0f}× |")
 
 

@@ -53,7 +53,8 @@ def test_c_backend_agrees_with_numpy_on_every_example(name):
         a, b = getattr(fast, function)(q, q_dot, t), getattr(slow, function)(q, q_dot, t)
         assert a.shape == b.shape
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12, err_msg=function)
-    for a, b in zip(fast.accelerations(q, q_dot, t), slow.accelerations(q, q_dot, t), strict=True):
+    for a, b in zip(fast.accelerations_and_multipliers(q, q_dot, t),
+                    slow.accelerations_and_multipliers(q, q_dot, t), strict=True):
         np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9)
     y = np.concatenate([q[0, 0], q_dot[0, 0]])
     np.testing.assert_allclose(fast.rhs(t, y), slow.rhs(t, y), rtol=1e-9, atol=1e-9)
@@ -89,9 +90,9 @@ def test_pendulum_acceleration_and_parameters_reuse_the_compiled_module():
     # parameters are runtime inputs of the generated C: one module serves both
     assert short._kernel.module is long._kernel.module
     theta = np.linspace(-3, 3, 13)[:, None]
-    q_ddot, _ = short.accelerations(theta, np.zeros_like(theta))
+    q_ddot, _ = short.accelerations_and_multipliers(theta, np.zeros_like(theta))
     np.testing.assert_allclose(q_ddot[:, 0], -9.81 / 0.5 * np.sin(theta[:, 0]), rtol=1e-13, atol=1e-14)
-    q_ddot, _ = long.accelerations(theta, np.zeros_like(theta))
+    q_ddot, _ = long.accelerations_and_multipliers(theta, np.zeros_like(theta))
     np.testing.assert_allclose(q_ddot[:, 0], -9.81 / 2.0 * np.sin(theta[:, 0]), rtol=1e-13, atol=1e-14)
 
 
@@ -102,7 +103,7 @@ def test_constrained_multipliers_cartesian_pendulum():
     fast, slow = system.numeric(backend="c"), system.numeric(backend="numpy")
     rng = np.random.default_rng(3)
     q, q_dot = rng.uniform(-1, 1, (50, fast.n)), rng.uniform(-1, 1, (50, fast.n))
-    a, b = fast.accelerations(q, q_dot), slow.accelerations(q, q_dot)
+    a, b = fast.accelerations_and_multipliers(q, q_dot), slow.accelerations_and_multipliers(q, q_dot)
     assert a[1].shape == (50, 1)
     np.testing.assert_allclose(a[0], b[0], rtol=1e-10, atol=1e-10)
     np.testing.assert_allclose(a[1], b[1], rtol=1e-10, atol=1e-10)
@@ -119,14 +120,14 @@ def test_batch_equals_loop_of_single_states(backend):
     rng = np.random.default_rng(11)
     q, q_dot = rng.uniform(-3, 3, (5, 4, 2)), rng.uniform(-3, 3, (5, 4, 2))
     t = rng.uniform(0, 1, (5, 1))  # broadcast against the (5, 4) batch
-    batch_q_ddot, _ = numeric_system.accelerations(q, q_dot, t)
+    batch_q_ddot, _ = numeric_system.accelerations_and_multipliers(q, q_dot, t)
     batch_mass = numeric_system.mass_matrix(q, q_dot, t)
     batch_energy = numeric_system.energy(q, q_dot, t)
     assert batch_q_ddot.shape == (5, 4, 2) and batch_mass.shape == (5, 4, 2, 2)
     assert batch_energy.shape == (5, 4)
     for i in range(5):
         for j in range(4):
-            single, _ = numeric_system.accelerations(q[i, j], q_dot[i, j], t[i, 0])
+            single, _ = numeric_system.accelerations_and_multipliers(q[i, j], q_dot[i, j], t[i, 0])
             assert single.shape == (2,)
             np.testing.assert_array_equal(batch_q_ddot[i, j], single)
             np.testing.assert_array_equal(batch_mass[i, j], numeric_system.mass_matrix(q[i, j], q_dot[i, j]))
@@ -187,9 +188,10 @@ def test_singular_mass_matrix_raises_linalg_error(backend):
     if backend == "c" and not compiled.available():
         pytest.skip("no C compiler")
     numeric_system = singular_at_zero().numeric(backend=backend)
-    assert numeric_system.accelerations([1.0], [1.0])[0] == pytest.approx([-1.0])  # -s_dot^2/s
+    q_ddot = numeric_system.accelerations_and_multipliers([1.0], [1.0])[0]
+    assert q_ddot == pytest.approx([-1.0])  # -s_dot^2/s
     with pytest.raises(np.linalg.LinAlgError):
-        numeric_system.accelerations([[1.0], [0.0]], [[1.0], [1.0]])
+        numeric_system.accelerations_and_multipliers([[1.0], [0.0]], [[1.0], [1.0]])
     with pytest.raises(np.linalg.LinAlgError):
         numeric_system.rhs(0.0, [0.0, 1.0])
 
@@ -197,7 +199,7 @@ def test_singular_mass_matrix_raises_linalg_error(backend):
 @needs_c
 def test_empty_batch_and_unwritable_cache(monkeypatch, tmp_path):
     numeric_system = lagrangian.load("double_pendulum").numeric(backend="c")
-    q_ddot, multipliers = numeric_system.accelerations(np.zeros((0, 2)), np.zeros((0, 2)))
+    q_ddot, multipliers = numeric_system.accelerations_and_multipliers(np.zeros((0, 2)), np.zeros((0, 2)))
     assert q_ddot.shape == (0, 2) and multipliers.shape == (0, 0)
     assert numeric_system.energy(np.zeros((0, 2)), np.zeros((0, 2))).shape == (0,)
     blocked = tmp_path / "file"

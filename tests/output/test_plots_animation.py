@@ -44,7 +44,7 @@ def test_html_animation_has_a_player_and_one_image_per_frame(tmp_path):
     run.animate(tmp_path / "run.html", fps=10)
     html = (tmp_path / "run.html").read_text()
     assert "<script" in html and "animation" in html.lower()
-    assert html.count("frames[") >= 5 == len(animation_frames(run.result, fps=10))
+    assert html.count("frames[") >= 5 == len(animation_frames(run, fps=10))
 
 
 def test_springs_given_by_length_only_are_drawn_between_guessed_end_points():

@@ -20,6 +20,8 @@ from ..model.examples import example_path
 from ..model.model import Model
 from ..model.notation import latex_symbol_names
 from ..model.reader import read_model
+from ..model.values import State
+from ..numerics.events import StopCondition
 
 
 class System:
@@ -92,12 +94,12 @@ class System:
         self,
         t_end: float,
         *,
-        initial: Mapping[str, float] | None = None,
+        initial: Mapping[str, float] | State | None = None,
         method: str = "DOP853",
         rtol: float = 1e-9,
         atol: float = 1e-9,
         samples: int = 1001,
-        stop_when: str | None = None,
+        stop_when: str | StopCondition | None = None,
         progress=None,
     ):
         """Integrate the equations of motion to ``t_end`` (s); returns a Simulation.
@@ -106,13 +108,19 @@ class System:
         the start time); ``stop_when`` is a condition such as "theta < 0" that ends the run.
         Constrained models are kept on Phi = 0 by projection (see docs/simulation.md).
         """
-        from ..numerics.simulate import simulate
+        from ..model.values import resolve_state
+        from ..numerics.simulate import SaveAt, StepControl, parse_stop_condition, simulate
         from ..simulation import Simulation
 
-        result = simulate(self.equations_of_motion(), t_end, initial=initial, method=method,
-                          rtol=rtol, atol=atol, samples=samples, stop_when=stop_when,
-                          progress=progress, system=self._numeric)
-        return Simulation(result, self._model)
+        start = resolve_state(self._model, initial, field="initial")
+        step_control = StepControl(method, rtol, atol)
+        save_at = SaveAt(samples)
+        stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) \
+            else stop_when
+        result = simulate(self.equations_of_motion(), t_end, initial=start,
+                          step_control=step_control, save_at=save_at, stop=stop,
+                          progress=progress, functions=self._numeric)
+        return Simulation.of(result)
 
     # -- compiled numeric functions -------------------------------------------------------------
 

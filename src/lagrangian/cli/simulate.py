@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 from pathlib import Path
@@ -12,7 +11,9 @@ import typer
 
 from ..errors import ModelError
 from ..model.units import parse_quantity
-from ..numerics.simulate import METHODS, parse_stop_condition
+from ..model.values import resolve_state
+from ..numerics.simulate import METHODS, SaveAt, StepControl, parse_stop_condition
+from ..output.simulation import projection_warning, simulation_document, simulation_text
 from . import app
 from .common import load_system, print_json, state_assignments
 
@@ -34,26 +35,24 @@ def simulate(
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
-    from ..output.animation import _check_suffix as check_animation
-    from ..output.animation import check_animatable
-    from ..output.plots import _check_suffix as check_plot
-    from ..output.tables import TABLE_FORMATS
+    from ..output.animation import check_animatable, check_animation_path
+    from ..output.plots import check_plot_path
+    from ..output.tables import check_table_path
 
     system = load_system(model, set_)
     end = parse_quantity(t_end, "s", "--t-end")
-    start_values = state_assignments(system, initial, "--initial")
-    if method not in METHODS:
-        raise ModelError(f"unknown method '{method}'; choose one of {', '.join(METHODS)}",
-                         field="--method")
-    # Check everything the user typed before spending time on the integration.
-    if stop_when is not None:
-        parse_stop_condition(stop_when, system.model)
-    if out is not None and out.suffix.lower() not in TABLE_FORMATS:
-        raise ModelError(f"cannot write {out}: use a .csv or .parquet file name", field="--out")
+    # Everything the user typed is checked (by the library) before the integration starts.
+    start = resolve_state(system.model, state_assignments(system, initial, "--initial"),
+                          field="initial")
+    step_control = StepControl(method, rtol, atol)
+    save_at = SaveAt(samples)
+    stop = parse_stop_condition(stop_when, system.model) if stop_when is not None else None
+    if out is not None:
+        check_table_path(out)
     if plot is not None:
-        check_plot(plot)
+        check_plot_path(plot)
     if animate is not None:
-        check_animation(animate)
+        check_animation_path(animate)
         check_animatable(system.model)
     inputs = (Path(model),) if Path(model).exists() else ()
     for path in (out, plot, animate):
@@ -62,15 +61,13 @@ def simulate(
 
     with _Progress(end) as progress:
         simulation = system.simulate(
-            end, initial=start_values, method=method, rtol=rtol, atol=atol, samples=samples,
-            stop_when=stop_when, progress=progress.update,
+            end, initial=start, method=step_control.method,
+            rtol=step_control.rtol, atol=step_control.atol, samples=save_at.samples,
+            stop_when=stop, progress=progress.update,
         )
-    result = simulation.result
-    if result.projected_initial_state:
-        changes = ", ".join(f"{name} {given:.12g} -> {used:.12g}"
-                            for name, (given, used) in result.projected_initial_state.items())
-        typer.echo("warning: the initial state violates the constraints; projected onto them: "
-                   + changes, err=True)
+    warning = projection_warning(simulation)
+    if warning:
+        typer.echo(warning, err=True)
 
     written = {}
     if out is not None:
@@ -83,18 +80,16 @@ def simulate(
         written["animate"] = str(animate)
 
     if json_:
-        document = _finite(result.summary())
-        document["outputs"] = written
-        print_json(document)
+        print_json(simulation_document(simulation, written))
     else:
-        typer.echo(_summary_text(result, written), nl=False)
-    if result.status == "failed":
+        typer.echo(simulation_text(simulation, written), nl=False)
+    if simulation.status == "failed":
         saved = f"; partial result saved to {', '.join(written.values())}" if written else ""
-        typer.echo(f"error: integration failed: {result.message}{saved}", err=True)
+        typer.echo(f"error: integration failed: {simulation.message}{saved}", err=True)
         raise SystemExit(1)  # not typer.Exit: click swallows its code outside standalone mode
-    if result.status == "interrupted":
+    if simulation.status == "interrupted":
         saved = f"; partial result saved to {', '.join(written.values())}" if written else ""
-        typer.echo(f"{result.message}{saved}", err=True)
+        typer.echo(f"{simulation.message}{saved}", err=True)
         raise SystemExit(130)
 
 
@@ -132,30 +127,3 @@ class _Progress:
         if self.bar is not None:
             self.bar.stop()
         return False
-
-
-def _finite(value):
-    """JSON has no NaN/inf: such numbers become null."""
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_finite(v) for v in value]
-    return value
-
-
-def _summary_text(result, written: dict[str, str]) -> str:
-    lines = [f"{result.model_name}: {result.message} "
-             f"({result.method}, rtol {result.rtol:g}, atol {result.atol:g}, {result.backend})"]
-    steps = f"{result.steps} steps, " if result.steps is not None else ""
-    lines.append(f"  {steps}{result.nfev} right-hand-side calls, wall time {result.wall_time:.3g} s")
-    state = ", ".join(f"{k} = {v:.9g}" for k, v in result.final_state.items())
-    lines.append(f"  final state: {state}")
-    if result.energy_drift is not None:
-        lines.append(f"  relative energy drift: {result.energy_drift:.2e}")
-    if result.max_residual is not None:
-        lines.append(f"  largest constraint residual: {result.max_residual:.2e}")
-    for path in written.values():
-        lines.append(f"  wrote {path}")
-    return "\n".join(lines) + "\n"

@@ -99,7 +99,7 @@ class NumericSystem:
         Q, V, T, batch = self._flat(q, q_dot, t)
         return self._kernel.energy(Q, V, T).reshape(batch)
 
-    def accelerations(self, q, q_dot, t=0.0) -> tuple[np.ndarray, np.ndarray]:
+    def accelerations_and_multipliers(self, q, q_dot, t=0.0) -> tuple[np.ndarray, np.ndarray]:
         """Solve [[M, Phi_q^T], [Phi_q, 0]] [q_ddot; lambda] = [f; gamma]: (q_ddot, lambda)."""
         Q, V, T, batch = self._flat(q, q_dot, t)
         q_ddot, multipliers = self._kernel.accelerations(Q, V, T)

@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model.model import Model
 from ..numerics.geometry import mechanism
-from ..numerics.simulate import SimulationResult
+from ..numerics.result import SimulationResult
 from .files import atomic_write
 
 ANIMATION_FORMATS = (".gif", ".html")
@@ -65,7 +65,7 @@ def check_animatable(model: Model) -> None:
     """Refuse a model with nothing to draw (given by its energies only)."""
     if not (model.particles or model.bodies):
         raise ModelError("nothing to animate: the model has no particles or bodies "
-                         "(it is given by its energies only)", field="--animate")
+                         "(it is given by its energies only)", field="animation")
 
 
 def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25,
@@ -136,7 +136,7 @@ def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25
 def save_animation(animation, path: str | Path, *, fps: int = 25,
                    protect: tuple[Path, ...] = ()) -> Path:
     """Save a built animation as .gif or .html, through a temporary file and a rename."""
-    path = _check_suffix(path)
+    path = check_animation_path(path)
     if path.suffix.lower() == ".html":
         return atomic_write(path, animation.to_jshtml(fps=fps), protect=protect)
     from matplotlib.animation import PillowWriter
@@ -151,8 +151,9 @@ def save_animation(animation, path: str | Path, *, fps: int = 25,
     return atomic_write(path, data, protect=protect)
 
 
-def _check_suffix(path: str | Path) -> Path:
+def check_animation_path(path: str | Path) -> Path:
+    """The path, if it names a .gif or .html file."""
     path = Path(path)
     if path.suffix.lower() not in ANIMATION_FORMATS:
-        raise ModelError(f"cannot write {path}: use a .gif or .html file name", field="--animate")
+        raise ModelError(f"cannot write {path}: use a .gif or .html file name", field="animation")
     return path

@@ -1,0 +1,132 @@
+"""What a simulation returns: the sampled trajectory, its energy and constraint residuals, and
+how the run went (status, steps, wall time). Its text and JSON forms are in output/simulation.py.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.model import Model
+from ..model.values import State
+from .options import StepControl
+
+STATUS_MESSAGES = {
+    "finished": "reached the end time",
+    "stopped": "stopped by the stop condition",
+    "interrupted": "interrupted",
+    "failed": "integration failed",
+}
+
+
+@dataclass(frozen=True, repr=False)
+class SimulationResult:
+    """Sampled trajectory t (s), q, q_dot, energy T + V (J), power of non-conservative loads
+    Q . q_dot (W), multipliers lambda and constraint residuals, with run statistics."""
+
+    model: Model
+    coordinates: tuple[str, ...]
+    constraint_names: tuple[str, ...]
+    parameters: dict[str, float]
+    t: np.ndarray
+    q: np.ndarray
+    q_dot: np.ndarray
+    energy: np.ndarray
+    power: np.ndarray
+    multipliers: np.ndarray
+    residuals: np.ndarray
+    step_control: StepControl
+    status: str
+    message: str
+    steps: int | None
+    nfev: int
+    wall_time: float
+    backend: str
+    energy_conserved: bool
+    t_end: float
+    stop_when: str | None = None
+    projected_initial_state: dict[str, tuple[float, float]] = field(default_factory=dict)
+    kinetic_energy: np.ndarray | None = None
+
+    @property
+    def model_name(self) -> str:
+        return self.model.name
+
+    @property
+    def method(self) -> str:
+        return self.step_control.method
+
+    @property
+    def rtol(self) -> float:
+        return self.step_control.rtol
+
+    @property
+    def atol(self) -> float:
+        return self.step_control.atol
+
+    @property
+    def completed(self) -> bool:
+        """True when the run reached its end time or its stop condition."""
+        return self.status in ("finished", "stopped")
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """Named columns: t, <q>, <q>_dot, energy, lambda_<c>, residual_<c>, power."""
+        out: dict[str, np.ndarray] = {"t": self.t}
+        for i, name in enumerate(self.coordinates):
+            out[name] = self.q[:, i]
+        for i, name in enumerate(self.coordinates):
+            out[f"{name}_dot"] = self.q_dot[:, i]
+        out["energy"] = self.energy
+        for i, name in enumerate(self.constraint_names):
+            out[f"lambda_{name}"] = self.multipliers[:, i]
+        for i, name in enumerate(self.constraint_names):
+            out[f"residual_{name}"] = self.residuals[:, i]
+        out["power"] = self.power
+        return out
+
+    @property
+    def last_state(self) -> State:
+        """The state at the last sample."""
+        return State(self.coordinates, tuple(float(x) for x in self.q[-1]),
+                     tuple(float(x) for x in self.q_dot[-1]), float(self.t[-1]))
+
+    @property
+    def final_state(self) -> dict[str, float]:
+        """t, then q, then q_dot at the last sample, by name."""
+        state = {"t": float(self.t[-1])}
+        for i, name in enumerate(self.coordinates):
+            state[name] = float(self.q[-1, i])
+        for i, name in enumerate(self.coordinates):
+            state[f"{name}_dot"] = float(self.q_dot[-1, i])
+        return state
+
+    @property
+    def energy_drift(self) -> float | None:
+        """max |E - E0| / |E0| where energy should be conserved, else None (max T if E0 = 0)."""
+        if not self.energy_conserved or len(self.energy) == 0:
+            return None
+        change = float(np.max(np.abs(self.energy - self.energy[0])))
+        scale = abs(float(self.energy[0]))
+        if self.kinetic_energy is not None and len(self.kinetic_energy):
+            # E0 = 0 (a body starting at rest at the potential's zero): relative to the largest T
+            largest_t = float(np.max(np.abs(self.kinetic_energy)))
+            if scale <= 1e-9 * largest_t:
+                scale = largest_t
+        return change / scale if scale > 0 else 0.0
+
+    @property
+    def max_residual(self) -> float | None:
+        """Largest |Phi| (holonomic) or |A q_dot + b| (velocity) over the samples, else None."""
+        if not self.constraint_names or len(self.t) == 0:
+            return None
+        return float(np.max(np.abs(self.residuals)))
+
+    def __repr__(self) -> str:
+        parts = [f"{self.status}", f"t = {self.t[0]:g}..{self.t[-1]:g} s", f"{len(self.t)} samples",
+                 f"{self.method}"]
+        if self.energy_drift is not None:
+            parts.append(f"energy drift {self.energy_drift:.1e}")
+        if self.max_residual is not None:
+            parts.append(f"max residual {self.max_residual:.1e}")
+        return f"{type(self).__name__}({self.model_name!r}: {', '.join(parts)})"

@@ -1,0 +1,74 @@
+"""The architecture of docs/architecture.md, checked: the layer order (import-linter's contracts
+in pyproject.toml), no private helper shared across packages, and a library that speaks Python
+(its errors name Python fields, never command-line flags)."""
+
+from __future__ import annotations
+
+import ast
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "src" / "lagrangian"
+FLAG = re.compile(r"(?:^|[\s(`'\"])--[a-z]")
+
+
+def _modules():
+    for path in sorted(PACKAGE.rglob("*.py")):
+        yield path, ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+
+
+def _package_of(path: Path) -> tuple[str, ...]:
+    return path.relative_to(PACKAGE).parent.parts
+
+
+def test_import_contracts_hold():
+    """model -> derivation -> numerics -> analysis -> check -> output -> api -> cli: no stage
+    imports a later one, and only the CLI imports typer, click or rich."""
+    executable = Path(sys.executable).with_name("lint-imports")
+    command = str(executable) if executable.exists() else shutil.which("lint-imports")
+    assert command, "lint-imports is missing: install the test extra, pip install -e '.[test]'"
+    process = subprocess.run([command, "--no-cache"], cwd=ROOT, capture_output=True, text=True)
+    assert process.returncode == 0, process.stdout + process.stderr
+
+
+def test_no_private_name_is_imported_from_another_package():
+    """A helper shared between packages is public (no leading underscore) in its own layer."""
+    offences = []
+    for path, tree in _modules():
+        here = _package_of(path)
+        for node in ast.walk(tree):
+            if not isinstance(node, ast.ImportFrom) or node.level == 0:
+                continue
+            # `from .x` resolves in this package, each further dot climbs one level.
+            base = here[: len(here) - (node.level - 1)]
+            target = base + tuple(node.module.split(".")) if node.module else base
+            if target[:1] == here[:1]:
+                continue
+            offences += [f"{path.relative_to(ROOT)}:{node.lineno} imports {alias.name}"
+                         for alias in node.names if alias.name.startswith("_")]
+    assert not offences, "\n".join(offences)
+
+
+def _error_strings(call: ast.Call):
+    for argument in [*call.args, *(k.value for k in call.keywords)]:
+        for node in ast.walk(argument):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str):
+                yield node.lineno, node.value
+
+
+def test_library_errors_name_python_fields_not_flags():
+    """Outside cli/, no error message or field names a command-line flag (--at, --set, ...):
+    the CLI maps Python fields to its flags in one table (cli/common.py, FLAG_OF_FIELD)."""
+    offences = []
+    for path, tree in _modules():
+        if _package_of(path)[:1] == ("cli",):
+            continue
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", "").endswith("Error"):
+                offences += [f"{path.relative_to(ROOT)}:{line}: {text!r}"
+                             for line, text in _error_strings(node) if FLAG.search(text)]
+    assert not offences, "\n".join(offences)

@@ -16,10 +16,10 @@ pytestmark = pytest.mark.skipif(not compiled.available(), reason="no C compiler 
 
 def test_large_amplitude_pendulum_period_matches_the_elliptic_integral():
     """T = 4 sqrt(L/g) K(sin(theta0/2)) for theta0 = 170 deg, to 1e-8 relative."""
-    system = lagrangian.load("pendulum").numeric(backend="c")
+    functions = lagrangian.load("pendulum").numeric(backend="c")
     L, g, theta0 = 0.5, 9.81, np.radians(170.0)
     period = 4 * np.sqrt(L / g) * ellipk(np.sin(theta0 / 2) ** 2)  # scipy's K takes m = k^2
-    result = integrate_fast(system, (0.0, period), np.array([theta0, 0.0]), rtol=1e-12, atol=1e-12,
+    result = integrate_fast(functions, (0.0, period), np.array([theta0, 0.0]), rtol=1e-12, atol=1e-12,
                             t_eval=np.array([0.0, period / 2, period]))
     assert result.success, result.message
     np.testing.assert_allclose(result.t, [0.0, period / 2, period])
@@ -36,19 +36,19 @@ def test_large_amplitude_pendulum_period_matches_the_elliptic_integral():
     ((1.2, -0.6, 0.0, 2.0), 1e-12),  # chaotic: at 1e-10 scipy's DOP853 drifts 1.7e-9 too
 ])
 def test_double_pendulum_conserves_energy_over_ten_seconds(y0, tolerance):
-    system = lagrangian.load("double_pendulum").numeric(backend="c")
-    result = integrate_fast(system, (0.0, 10.0), np.array(y0), rtol=tolerance, atol=tolerance)
+    functions = lagrangian.load("double_pendulum").numeric(backend="c")
+    result = integrate_fast(functions, (0.0, 10.0), np.array(y0), rtol=tolerance, atol=tolerance)
     assert result.success and result.t[-1] == 10.0
-    energy = system.energy(result.y[:, :2], result.y[:, 2:])
+    energy = functions.energy(result.y[:, :2], result.y[:, 2:])
     assert np.max(np.abs(energy - energy[0])) / abs(energy[0]) < 1e-9
 
 
 @pytest.mark.parametrize("t_eval", [None, np.linspace(0.0, 5.0, 51)])
 def test_same_steps_and_answers_as_scipy_dop853(t_eval):
-    system = lagrangian.load("double_pendulum").numeric(backend="c")
+    functions = lagrangian.load("double_pendulum").numeric(backend="c")
     y0 = np.array([1.0, 0.5, 0.0, 0.0])
-    ours = integrate_fast(system, (0.0, 5.0), y0, rtol=1e-9, atol=1e-9, t_eval=t_eval)
-    scipy = solve_ivp(system.rhs, (0.0, 5.0), y0, method="DOP853", rtol=1e-9, atol=1e-9, t_eval=t_eval)
+    ours = integrate_fast(functions, (0.0, 5.0), y0, rtol=1e-9, atol=1e-9, t_eval=t_eval)
+    scipy = solve_ivp(functions.rhs, (0.0, 5.0), y0, method="DOP853", rtol=1e-9, atol=1e-9, t_eval=t_eval)
     assert isinstance(ours, FastResult) and ours.success
     # the same method and error control: step for step the same run
     assert abs(ours.nfev - scipy.nfev) <= 0.02 * scipy.nfev
@@ -62,10 +62,10 @@ def test_same_steps_and_answers_as_scipy_dop853(t_eval):
 
 
 def test_backward_in_time_matches_scipy():
-    system = lagrangian.load("pendulum").numeric(backend="c")
+    functions = lagrangian.load("pendulum").numeric(backend="c")
     y0 = np.array([2.0, 0.5])
-    ours = integrate_fast(system, (3.0, 0.0), y0, rtol=1e-10, atol=1e-10)
-    scipy = solve_ivp(system.rhs, (3.0, 0.0), y0, method="DOP853", rtol=1e-10, atol=1e-10)
+    ours = integrate_fast(functions, (3.0, 0.0), y0, rtol=1e-10, atol=1e-10)
+    scipy = solve_ivp(functions.rhs, (3.0, 0.0), y0, method="DOP853", rtol=1e-10, atol=1e-10)
     assert ours.success and ours.t[-1] == 0.0 and np.all(np.diff(ours.t) < 0)
     np.testing.assert_allclose(ours.y[-1], scipy.y[:, -1], rtol=1e-7, atol=1e-8)
 
@@ -75,9 +75,9 @@ def test_harmonic_oscillator_closed_form():
     x = b.coordinate("x")
     m, k = b.parameter("m", 2.0), b.parameter("k", 8.0)
     b.add_kinetic_energy(m * b.velocity(x) ** 2 / 2).add_potential_energy(k * x**2 / 2)
-    system = b.build().numeric(backend="c")
+    functions = b.build().numeric(backend="c")
     t = np.linspace(0.0, 10.0, 201)
-    result = integrate_fast(system, (0.0, 10.0), np.array([0.1, 0.0]), rtol=1e-11, atol=1e-13, t_eval=t)
+    result = integrate_fast(functions, (0.0, 10.0), np.array([0.1, 0.0]), rtol=1e-11, atol=1e-13, t_eval=t)
     np.testing.assert_allclose(result.y[:, 0], 0.1 * np.cos(2.0 * t), atol=1e-10)
     np.testing.assert_allclose(result.y[:, 1], -0.2 * np.sin(2.0 * t), atol=1e-10)
 
@@ -90,8 +90,8 @@ def test_not_used_for_constrained_models_or_without_the_c_backend():
 
 
 def test_step_limit_keeps_the_partial_result():
-    system = lagrangian.load("double_pendulum").numeric(backend="c")
-    result = integrate_fast(system, (0.0, 10.0), np.array([1.0, 0.5, 0.0, 0.0]), rtol=1e-10,
+    functions = lagrangian.load("double_pendulum").numeric(backend="c")
+    result = integrate_fast(functions, (0.0, 10.0), np.array([1.0, 0.5, 0.0, 0.0]), rtol=1e-10,
                             atol=1e-10, max_steps=10)
     assert not result.success
     assert result.message.startswith("Reached the limit of 10 steps at t = ")
@@ -105,8 +105,8 @@ def test_singular_mass_matrix_on_the_way_stops_with_the_time_reached():
     b = lagrangian.SystemBuilder("bead through the singular point")
     s = b.coordinate("s")
     b.add_particle("bead", b.parameter("m", 1.0), (s**2, 0))
-    system = b.build().numeric(backend="c")
-    result = integrate_fast(system, (0.0, 5.0), np.array([1.0, -1.0]), rtol=1e-8, atol=1e-8)
+    functions = b.build().numeric(backend="c")
+    result = integrate_fast(functions, (0.0, 5.0), np.array([1.0, -1.0]), rtol=1e-8, atol=1e-8)
     assert not result.success
     assert "at t = " in result.message
     assert ("Singular" in result.message) or ("step size" in result.message)
@@ -117,31 +117,31 @@ def test_singular_mass_matrix_on_the_way_stops_with_the_time_reached():
 
 
 def test_bad_arguments_are_rejected():
-    system = lagrangian.load("pendulum").numeric(backend="c")
+    functions = lagrangian.load("pendulum").numeric(backend="c")
     with pytest.raises(ValueError, match="y0 must hold 2 numbers"):
-        integrate_fast(system, (0, 1), np.zeros(3), rtol=1e-6, atol=1e-6)
+        integrate_fast(functions, (0, 1), np.zeros(3), rtol=1e-6, atol=1e-6)
     with pytest.raises(ValueError, match="not within t_span"):
-        integrate_fast(system, (0, 1), np.zeros(2), rtol=1e-6, atol=1e-6, t_eval=np.array([2.0]))
+        integrate_fast(functions, (0, 1), np.zeros(2), rtol=1e-6, atol=1e-6, t_eval=np.array([2.0]))
     with pytest.raises(ValueError, match="not properly sorted"):
-        integrate_fast(system, (0, 1), np.zeros(2), rtol=1e-6, atol=1e-6, t_eval=np.array([0.5, 0.2]))
+        integrate_fast(functions, (0, 1), np.zeros(2), rtol=1e-6, atol=1e-6, t_eval=np.array([0.5, 0.2]))
     with pytest.raises(ValueError, match="rtol must be positive"):
-        integrate_fast(system, (0, 1), np.zeros(2), rtol=0.0, atol=1e-6)
+        integrate_fast(functions, (0, 1), np.zeros(2), rtol=0.0, atol=1e-6)
 
 
 def test_ctrl_c_stops_the_compiled_loop_and_keeps_what_was_computed():
     import _thread
     import threading
 
-    system = lagrangian.load("double_pendulum").numeric(backend="c")
+    functions = lagrangian.load("double_pendulum").numeric(backend="c")
     timer = threading.Timer(0.2, _thread.interrupt_main)  # what Ctrl-C does to the main thread
     timer.start()
     try:
-        result = integrate_fast(system, (0.0, 1e6), np.array([1.0, 0.5, 0.0, 0.0]), rtol=1e-12,
+        result = integrate_fast(functions, (0.0, 1e6), np.array([1.0, 0.5, 0.0, 0.0]), rtol=1e-12,
                                 atol=1e-12)
     finally:
         timer.cancel()
     assert not result.success
     assert result.message.startswith("Interrupted at t = ")
     assert 0.0 < result.t[-1] < 1e6 and len(result.t) == len(result.y) > 100
-    energy = system.energy(result.y[:, :2], result.y[:, 2:])
+    energy = functions.energy(result.y[:, :2], result.y[:, 2:])
     assert np.max(np.abs(energy - energy[0])) / abs(energy[0]) < 1e-8  # a valid partial run

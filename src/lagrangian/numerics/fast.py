@@ -39,7 +39,7 @@ _MESSAGES = {
 
 
 def integrate_fast(
-    system: NumericSystem,
+    functions: NumericSystem,
     t_span: tuple[float, float],
     y0: np.ndarray,
     *,
@@ -54,13 +54,13 @@ def integrate_fast(
     Returns None for constrained systems and without the C backend; a failure (step size
     underflow, singular M, Ctrl-C) returns the states up to the time reached, success False.
     """
-    kernel = system._kernel
-    if system.m or getattr(kernel, "backend", None) != "c":
+    kernel = functions._kernel
+    if functions.m or getattr(kernel, "backend", None) != "c":
         return None
     t0, t1 = (float(v) for v in t_span)
     y0 = np.ascontiguousarray(y0, dtype=float)
-    if y0.shape != (2 * system.n,):
-        raise ValueError(f"y0 must hold {2 * system.n} numbers [q, q_dot], not shape {y0.shape}")
+    if y0.shape != (2 * functions.n,):
+        raise ValueError(f"y0 must hold {2 * functions.n} numbers [q, q_dot], not shape {y0.shape}")
     if not (np.isfinite(t0) and np.isfinite(t1)):
         raise ValueError("t_span must be finite")
     if not (rtol > 0 and atol >= 0):

@@ -149,12 +149,12 @@ class _NumpyKernel:
         n, m = self.n, self.m
         if not m:
             return np.linalg.solve(mass, forcing[..., None])[..., 0], forcing[..., :0]
-        system = np.zeros((len(T), n + m, n + m))
-        system[:, :n, :n] = mass
-        system[:, :n, n:] = np.swapaxes(jacobian, -1, -2)
-        system[:, n:, :n] = jacobian
+        kkt = np.zeros((len(T), n + m, n + m))  # [[M, Phi_q^T], [Phi_q, 0]]
+        kkt[:, :n, :n] = mass
+        kkt[:, :n, n:] = np.swapaxes(jacobian, -1, -2)
+        kkt[:, n:, :n] = jacobian
         rhs = np.concatenate([forcing, gamma], axis=-1)
-        solution = np.linalg.solve(system, rhs[..., None])[..., 0]
+        solution = np.linalg.solve(kkt, rhs[..., None])[..., 0]
         return solution[:, :n], solution[:, n:]
 
     def rhs(self, t, y):

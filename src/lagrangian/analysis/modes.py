@@ -279,33 +279,3 @@ def _likeness(a: np.ndarray, b: np.ndarray) -> float:
 def _clean(value: float) -> float:
     value = float(value)
     return 0.0 if abs(value) < 1e-12 else value
-
-
-# -- from equations of motion to equilibria, linear models and modes ------------------------------
-
-
-def equilibria_of(functions, *, t: float = 0.0):
-    """Every equilibrium found, with its linear stability."""
-    from .equilibria import find_equilibria
-    from .linearization import linear_model_at
-
-    def stability(q, multipliers) -> bool:
-        return is_stable(linear_model_at(functions, q, multipliers, t))
-
-    return find_equilibria(functions, t=t, stability=stability)
-
-
-def linearize_about(functions, about=None, inputs=(), *, t: float = 0.0) -> LinearModel:
-    """The linear model about the equilibrium ``about`` (or the one nearest the initial values)."""
-    from .equilibria import resolve_equilibrium
-    from .linearization import input_columns, linear_model_at
-
-    q0, multipliers = resolve_equilibrium(functions, about, t=t)
-    columns = input_columns(functions.eom, q0, list(inputs), functions.parameters, t) \
-        if inputs else None
-    return linear_model_at(functions, q0, multipliers, t, inputs=inputs, input_columns=columns)
-
-
-def modes_about(functions, about=None, *, t: float = 0.0) -> ModalAnalysis:
-    """Modes about the equilibrium ``about`` (or the one nearest the initial values)."""
-    return modal_analysis(linearize_about(functions, about, t=t), functions.model.name)

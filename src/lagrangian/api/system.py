@@ -12,16 +12,33 @@ from pathlib import Path
 
 import sympy as sp
 
+from ..analysis.equilibria import Equilibria, find_equilibria, resolve_equilibrium
 from ..analysis.forces import ForceReport, evaluate_generalized_forces
+from ..analysis.linearization import (
+    LinearModel,
+    SymbolicLinearModel,
+    input_columns,
+    linear_model_at,
+    symbolic_linear_model,
+)
+from ..analysis.modes import ModalAnalysis, is_stable, modal_analysis
+from ..check.diagnose import CheckReport, check_answer
+from ..check.newton_euler import CrosscheckReport, crosscheck
+from ..check.units import UnitsReport, check_model_units
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
+from ..model.answer import Answer, answer_from_mapping, read_answer
 from ..model.builder import ModelBuilder
 from ..model.examples import example_path
 from ..model.model import Model
 from ..model.notation import latex_symbol_names
 from ..model.reader import read_model
-from ..model.values import State
+from ..model.values import State, resolve_state
 from ..numerics.events import StopCondition
+from ..numerics.functions import NumericSystem, numeric
+from ..numerics.simulate import SaveAt, StepControl, parse_stop_condition, simulate
+from ..numerics.static import StaticFunctions
+from ..simulation import Simulation
 
 
 class System:
@@ -101,17 +118,13 @@ class System:
         samples: int = 1001,
         stop_when: str | StopCondition | None = None,
         progress=None,
-    ):
+    ) -> Simulation:
         """Integrate the equations of motion to ``t_end`` (s); returns a Simulation.
 
         ``initial`` overrides the model's initial/rate values (SI: rad, m, rad/s, m/s; 't' sets
         the start time); ``stop_when`` is a condition such as "theta < 0" that ends the run.
         Constrained models are kept on Phi = 0 by projection (see docs/simulation.md).
         """
-        from ..model.values import resolve_state
-        from ..numerics.simulate import SaveAt, StepControl, parse_stop_condition, simulate
-        from ..simulation import Simulation
-
         start = resolve_state(self._model, initial, field="initial")
         step_control = StepControl(method, rtol, atol)
         save_at = SaveAt(samples)
@@ -124,7 +137,8 @@ class System:
 
     # -- compiled numeric functions -------------------------------------------------------------
 
-    def numeric(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"):
+    def numeric(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"
+                ) -> NumericSystem:
         """M, f, Phi_q, gamma, energy and the ODE right-hand side as batched numeric functions.
 
         backend "c" (generated C, compiled once and cached), "numpy", or "auto" (C if a compiler
@@ -132,34 +146,31 @@ class System:
         """
         if parameters is None and backend == "auto":
             return self._numeric
-        from ..numerics.functions import numeric
-
         return numeric(self.equations_of_motion(), parameters, backend=backend)
 
     @cached_property
-    def _numeric(self):
+    def _numeric(self) -> NumericSystem:
         """The default numeric system, compiled once per System (its parameters are fixed)."""
-        from ..numerics.functions import numeric
-
         return numeric(self.equations_of_motion())
 
     # -- equilibria, linearization and modes -----------------------------------------------------
 
     @cached_property
-    def _static_functions(self):
+    def _static_functions(self) -> StaticFunctions:
         """Compiled functions at rest, built once per System (parameters are fixed per System)."""
-        from ..numerics.static import StaticFunctions
-
         return StaticFunctions(self.equations_of_motion())
 
-    def equilibria(self):
+    def equilibria(self) -> Equilibria:
         """Configurations of rest, f(q, 0) = Phi_q^T lambda with Phi(q) = 0, each with its stability."""
-        from ..analysis.modes import equilibria_of
+        functions = self._static_functions
 
-        return equilibria_of(self._static_functions)
+        def stable(q, multipliers) -> bool:
+            return is_stable(linear_model_at(functions, q, multipliers))
+
+        return find_equilibria(functions, stability=stable)
 
     def linearize(self, about: Mapping[str, float] | None = None, inputs: Sequence[str] = (), *,
-                  symbolic: bool = False):
+                  symbolic: bool = False) -> LinearModel | SymbolicLinearModel:
         """Linear model M, C, K and state-space A, B (x = [q; q_dot]) about an equilibrium.
 
         ``about`` maps coordinate names to SI values (the others are solved for); without it the
@@ -168,48 +179,39 @@ class System:
         unconstrained model with the parameters kept as symbols.
         """
         if symbolic:
-            from ..analysis.linearization import symbolic_linear_model
-
             return symbolic_linear_model(self.equations_of_motion(), dict(about or {}))
-        from ..analysis.modes import linearize_about
+        functions = self._static_functions
+        q, multipliers = resolve_equilibrium(functions, about)
+        inputs = tuple(inputs)
+        columns = input_columns(functions.eom, q, inputs, functions.parameters) if inputs else None
+        return linear_model_at(functions, q, multipliers, inputs=inputs, input_columns=columns)
 
-        return linearize_about(self._static_functions, about, tuple(inputs))
-
-    def modes(self, about: Mapping[str, float] | None = None):
+    def modes(self, about: Mapping[str, float] | None = None) -> ModalAnalysis:
         """Natural frequencies (rad/s), damping ratios and mode shapes about an equilibrium."""
-        from ..analysis.modes import modes_about
-
-        return modes_about(self._static_functions, about)
+        return modal_analysis(self.linearize(about), self._model.name)
 
     # -- checking a hand derivation: check, crosscheck, check_units --------------------------------
 
-    def check(self, answer):
+    def check(self, answer) -> CheckReport:
         """Verdicts and diagnoses on a hand derivation: a path to ANSWER.toml, its tables as a
         dict ({"energy": {"V": "..."}}), or an Answer.
 
         Returns a CheckReport (``verdict``, ``findings`` with item, status, code, message,
         expected); items written differently but equivalently are accepted.
         """
-        from ..check.diagnose import check_answer
-        from ..model.answer import Answer, answer_from_mapping, read_answer
-
         if isinstance(answer, Mapping):
             answer = answer_from_mapping(answer, self._model, source="<answer>")
         elif not isinstance(answer, Answer):
             answer = read_answer(answer, self._model)
         return check_answer(self.equations_of_motion(), answer)
 
-    def crosscheck(self):
+    def crosscheck(self) -> CrosscheckReport:
         """Newton-Euler (free bodies, reactions eliminated) vs Lagrange, coordinate by
         coordinate, with the reaction force on each body (N; moment about the centre, N m)."""
-        from ..check.newton_euler import crosscheck
-
         return crosscheck(self.equations_of_motion())
 
-    def check_units(self):
+    def check_units(self) -> UnitsReport:
         """Every dimensionally inconsistent term of the model (T, V: J; D: W; Q: J per unit of q)."""
-        from ..check.units import check_model_units
-
         return check_model_units(self._model)
 
     def __repr__(self) -> str:

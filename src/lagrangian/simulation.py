@@ -57,7 +57,7 @@ class Simulation(SimulationResult):
 
         if path is not None:
             check_animation_path(path)
-        animation = mechanism_animation(self, self.model, fps=fps, max_frames=max_frames)
+        animation = mechanism_animation(self, fps=fps, max_frames=max_frames)
         if path is not None:
             save_animation(animation, path, fps=fps, protect=self._inputs())
         return animation

@@ -163,13 +163,13 @@ def coordinate_spans(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
                if p.value is not None and p.unit in ("m", "meter", "metre")]
     length = max([*lengths, 0.1])
     low, high, periodic = [], [], []
-    for c in model.coordinates:
+    initial = resolve_state(model).q  # the model's initial values
+    for c, centre in zip(model.coordinates, initial, strict=True):
         if c.range is not None:
             lo, hi = c.range
         elif c.is_angle:
             lo, hi = -np.pi, np.pi
         else:
-            centre = c.initial or 0.0
             half = 2.0 * max(length, abs(centre))
             lo, hi = centre - half, centre + half
         low.append(lo)

@@ -68,15 +68,14 @@ def check_animatable(model: Model) -> None:
                          "(it is given by its energies only)", field="animation")
 
 
-def mechanism_animation(result: SimulationResult, model: Model, *, fps: int = 25,
-                        max_frames: int = 250):
+def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: int = 250):
     """A matplotlib FuncAnimation of the mechanism over the run (planar x-y view)."""
     from matplotlib.animation import FuncAnimation
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    check_animatable(model)
-    geometry = mechanism(model, result.parameters)
+    check_animatable(result.model)
+    geometry = mechanism(result.model, result.parameters)
     times = animation_frames(result, fps, max_frames)
     q = np.column_stack([np.interp(times, result.t, result.q[:, i])
                          for i in range(result.q.shape[1])])

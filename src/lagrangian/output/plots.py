@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError
-from ..numerics.simulate import SimulationResult
+from ..numerics.result import SimulationResult
 from .files import atomic_write
 
 PLOT_FORMATS = (".png", ".svg", ".pdf")
@@ -73,7 +73,3 @@ def check_plot_path(path: str | Path) -> Path:
     if path.suffix.lower() not in PLOT_FORMATS:
         raise ModelError(f"cannot write {path}: use a .png, .svg or .pdf file name", field="plot")
     return path
-
-
-# Until cli/simulate.py and simulation.py import check_plot_path.
-_check_suffix = check_plot_path

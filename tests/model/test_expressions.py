@@ -54,7 +54,7 @@ def test_printer_round_trips(expr):
         ("m[0]", "model.toml: energy.T: indexing ('[...]') is not allowed (in 'm[0]')"),
         ("thetta*m", "model.toml: energy.T: unknown name 'thetta'; did you mean 'theta'?"),
         ("9**9**9", "model.toml: energy.T: the exponent 387420489 is too large (at most 1000)"),
-        ("10**400", "model.toml: energy.T: the power is too large a number"),
+        ("10**400", "model.toml: energy.T: the power '10**400' is too large a number (beyond 1e300)"),
         ("sin(theta, L)", "model.toml: energy.T: sin() takes 1 argument(s), got 2"),
         ("cosh", "model.toml: energy.T: 'cosh' is a function: call it as cosh(...)"),
         ("lambda: 1", "model.toml: energy.T: lambda is not allowed (in 'lambda: 1')"),
@@ -63,7 +63,7 @@ def test_printer_round_trips(expr):
         ("'text'", "model.toml: energy.T: only numbers are allowed as constants, got 'text'"),
         ("m % 2", "model.toml: energy.T: the operator '%' is not allowed (in 'm % 2')"),
         ("m/0", "model.toml: energy.T: division by zero in 'm/0'"),
-        ("m +", "model.toml: energy.T: cannot parse 'm +': invalid syntax"),
+        ("m +", "model.toml: energy.T: cannot parse 'm +' at column 4: the expression ends too early"),
         ("", "model.toml: energy.T: the expression is empty"),
         ("open('f')", "model.toml: energy.T: unknown function 'open'"),
     ],
@@ -87,4 +87,4 @@ def test_deep_nesting_is_refused_not_crashing():
     with pytest.raises(ModelError):
         parse("(" * 300 + "m" + ")" * 300)
     with pytest.raises(ModelError, match="longer than"):
-        parse("m+" * 20000 + "m")
+        parse("m+" * 60000 + "m")

@@ -9,9 +9,7 @@ not belong, instead of failing to parse.
 
 from __future__ import annotations
 
-import ast
 import re
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,9 +17,9 @@ from pathlib import Path
 import sympy as sp
 
 from ..errors import ModelError
-from .expressions import CONSTANTS, FUNCTIONS, parse_expression
+from .expressions import CONSTANTS, FUNCTIONS, parse_expression, plain_names
 from .model import Model, multiplier_name
-from .reader import check_known_keys, read_text_file
+from .reader import check_known_keys, load_toml, read_text_file
 
 TABLES = ("energy", "generalized_forces", "equations", "multipliers")
 _FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
@@ -77,11 +75,7 @@ def read_answer(path: str | Path, model: Model) -> Answer:
 
 
 def parse_answer(text: str, model: Model, *, source: str = "<answer>") -> Answer:
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ModelError(f"invalid TOML: {exc}", source=source) from None
-    return answer_from_mapping(data, model, source=source)
+    return answer_from_mapping(load_toml(text, source), model, source=source)
 
 
 def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>") -> Answer:
@@ -169,16 +163,8 @@ def _foreign_names(text: str, names: Mapping[str, sp.Expr], field: str,
 
     Syntax and grammar errors are left for the grammar parser to report.
     """
-    try:
-        tree = ast.parse(text.replace("^", "**").strip(), mode="eval")
-    except (SyntaxError, ValueError, RecursionError, MemoryError):
-        return {}
-    called = {id(node.func) for node in ast.walk(tree) if isinstance(node, ast.Call)}
     extra: dict[str, sp.Symbol] = {}
-    for node in ast.walk(tree):
-        if not isinstance(node, ast.Name) or id(node) in called:
-            continue
-        name = node.id
+    for name in plain_names(text):
         if name in names or name in CONSTANTS or name in FUNCTIONS:
             continue
         if not _FOREIGN.match(name):

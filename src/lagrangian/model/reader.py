@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import tomllib
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -42,11 +43,43 @@ def read_model(path: str | Path) -> Model:
 
 def parse_model(text: str, *, source: str = "<model>") -> Model:
     """Parse the text of a TOML model file."""
+    return model_from_mapping(load_toml(text, source), source=source)
+
+
+class _TinyNumber(ValueError):
+    """A TOML float whose digits are not zero but whose value underflows to 0.0."""
+
+
+def _toml_float(text: str) -> float:
+    value = float(text)
+    if abs(value) < 1e-300 and any(d in "123456789" for d in text.lower().partition("e")[0]):
+        raise _TinyNumber(text)
+    return value
+
+
+def load_toml(text: str, source: str) -> dict:
+    """The tables of a TOML document; a number too small for a float (1e-400) is refused,
+    never read as 0."""
     try:
-        data = tomllib.loads(text)
+        return tomllib.loads(text, parse_float=_toml_float)
     except tomllib.TOMLDecodeError as exc:
         raise ModelError(f"invalid TOML: {exc}", source=source) from None
-    return model_from_mapping(data, source=source)
+    except _TinyNumber as exc:
+        raise ModelError(f"the number {exc} is too small (below 1e-300, it would be read as 0): "
+                         f"write 0 or a larger number", field=_line_of(text, str(exc)),
+                         source=source) from None
+    except ValueError:  # an integer of more than 4300 digits
+        raise ModelError("invalid TOML: a number has far too many digits", source=source) \
+            from None
+
+
+def _line_of(text: str, literal: str) -> str | None:
+    """'line N (key)' of the first occurrence of a number literal, for the message."""
+    for number, line in enumerate(text.splitlines(), 1):
+        if re.search(rf"(?<![\w.]){re.escape(literal)}(?![\w.])", line):
+            key = re.match(r"\s*([\w.\"'-]+)\s*=", line)
+            return f"line {number}" + (f" ({key.group(1)})" if key else "")
+    return None
 
 
 def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:

@@ -10,6 +10,10 @@ from ..errors import ModelError
 
 _ANGLE_UNITS = {"rad", "radian", "radians", "deg", "degree", "degrees", "rev", "revolution"}
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z_µ°][\w*/^ .µ°-]*)?\s*$")
+MAX_UNIT_LENGTH = 200
+MAX_UNIT_EXPONENT = 100
+_UNIT_TOKEN = re.compile(r"\s*(?:(?P<number>(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+                         r"|(?P<name>[A-Za-z_µ°][A-Za-z0-9_µ°]*)|(?P<op>\*\*|[*/^()·.-]))")
 
 
 @functools.cache
@@ -20,8 +24,77 @@ def registry():
     return pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
 
 
+def unit_syntax_problem(text: str) -> str | None:
+    """Why ``text`` cannot be a unit before the unit library reads it (pint evaluates powers
+    and numbers in a unit string: 'kg*9^9^9' would take minutes), or None.
+
+    Powers must be plain numbers of at most MAX_UNIT_EXPONENT in size (m^2, s^-1, m^(1/2)),
+    never towers; numbers stay below 1e300.
+    """
+    if len(text) > MAX_UNIT_LENGTH:
+        return f"a unit is at most {MAX_UNIT_LENGTH} characters long"
+    tokens = []
+    position = 0
+    stripped = text.rstrip()
+    while position < len(stripped):
+        match = _UNIT_TOKEN.match(stripped, position)
+        if match is None or match.end() == position:
+            return None  # pint reports characters it does not know as an unknown unit
+        tokens.append((match.lastgroup, match.group(match.lastgroup)))
+        position = match.end()
+    depth = 0
+    index = 0
+    while index < len(tokens):
+        kind, value = tokens[index]
+        if kind == "op" and value == "(":
+            depth += 1
+            if depth > 20:
+                return "the unit is nested too deeply"
+        elif kind == "op" and value == ")":
+            depth -= 1
+        elif kind == "number" and not float(value) < 1e300:
+            return f"the number {value} is too large"
+        elif kind == "op" and value in ("^", "**"):
+            index, problem = _unit_exponent(tokens, index + 1)
+            if problem:
+                return problem
+            continue
+        index += 1
+    return None
+
+
+def _unit_exponent(tokens, index):
+    """Read the exponent after '^': [sign] number or '(' [sign] number [/ number] ')'."""
+    values = []
+    closing = index < len(tokens) and tokens[index] == ("op", "(")
+    if closing:
+        index += 1
+    if index < len(tokens) and tokens[index] in (("op", "-"),):
+        index += 1
+    while index < len(tokens) and tokens[index][0] == "number":
+        values.append(float(tokens[index][1]))
+        index += 1
+        if closing and index < len(tokens) and tokens[index] == ("op", "/"):
+            index += 1
+            continue
+        break
+    if not values:
+        return index, "a power in a unit must be a plain number (like m^2 or s^-1)"
+    if closing:
+        if index >= len(tokens) or tokens[index] != ("op", ")"):
+            return index, "a power in a unit must be a plain number (like m^2 or m^(1/2))"
+        index += 1
+    if any(abs(v) > MAX_UNIT_EXPONENT for v in values):
+        return index, f"the power is too large (at most {MAX_UNIT_EXPONENT})"
+    if index < len(tokens) and tokens[index] in (("op", "^"), ("op", "**")):
+        return index, "powers of powers are not allowed in a unit"
+    return index, None
+
+
 def _unit(text: str):
     """The pint unit of ``text``, or None when pint cannot read it."""
+    if unit_syntax_problem(text):
+        return None
     try:
         return registry().Unit(text.replace("^", "**").replace("·", "*"))
     except Exception:  # pint's parser raises many kinds (tokenize, syntax, lookup): all mean "not a unit"
@@ -32,9 +105,18 @@ def check_unit(text: str, field: str, source: str | None) -> str:
     """Validate a unit string (pint syntax, e.g. 'kg', 'N*m', 'm/s^2'); returns it unchanged."""
     if text in ("", "1"):
         return text
+    if re.fullmatch(r"[A-Za-z0-9_*/^ .()µ°·-]+", text):
+        problem = unit_syntax_problem(text)
+        if problem:
+            raise ModelError(f"unit {_short(text)}: {problem}", field=field, source=source)
     if not re.fullmatch(r"[A-Za-z0-9_*/^ .()µ°·-]+", text) or _unit(text) is None:
-        raise ModelError(f"unknown unit '{text}'", field=field, source=source)
+        raise ModelError(f"unknown unit {_short(text)}", field=field, source=source)
     return text
+
+
+def _short(text: str) -> str:
+    """A unit string for a one-line message (cut when long)."""
+    return f"'{text}'" if len(text) <= 60 else f"'{text[:28]}...{text[-28:]}'"
 
 
 def is_angle_unit(unit: str | None) -> bool:
@@ -51,8 +133,20 @@ def to_si(value: float, unit: str | None, field: str, source: str | None = None)
         return float(value)
     parsed = _unit(unit)
     if parsed is None:
-        raise ModelError(f"unknown unit '{unit}'", field=field, source=source)
-    return float(registry().Quantity(value, parsed).to_base_units().magnitude)
+        raise ModelError(f"unknown unit {_short(unit)}", field=field, source=source)
+    return _finite_si(registry().Quantity(value, parsed), f"{value!r} {unit}", field, source)
+
+
+def _finite_si(quantity, text: str, field: str, source: str | None = None) -> float:
+    """The SI magnitude of ``quantity``, refused when the conversion overflows (1e308 pi)."""
+    try:
+        value = float(quantity.to_base_units().magnitude)
+    except (OverflowError, ZeroDivisionError, ValueError):
+        value = math.inf
+    if not math.isfinite(value):
+        raise ModelError(f"{text!r} is not a finite number in SI units", field=field,
+                         source=source)
+    return value
 
 
 def parse_quantity(text: str, expected_unit: str | None, field: str) -> float:
@@ -67,11 +161,17 @@ def parse_quantity(text: str, expected_unit: str | None, field: str) -> float:
     number, unit = float(match.group(1)), (match.group(2) or "").strip()
     if not math.isfinite(number):
         raise ModelError(f"{text!r} is not a finite number", field=field)
+    if number == 0 and any(d in "123456789" for d in match.group(1).lower().partition("e")[0]):
+        raise ModelError(f"{text!r} is too small for a floating-point number (it would be "
+                         f"read as 0)", field=field)
     if not unit:
         return number
+    problem = unit_syntax_problem(unit)
+    if problem:
+        raise ModelError(f"unit {_short(unit)}: {problem}", field=field)
     parsed = _unit(unit)
     if parsed is None:
-        raise ModelError(f"unknown unit '{unit}' in {text!r}", field=field)
+        raise ModelError(f"unknown unit {_short(unit)} in {text!r}", field=field)
     quantity = registry().Quantity(number, parsed)
     if expected_unit and expected_unit != "1":
         target = _unit(expected_unit)
@@ -79,7 +179,7 @@ def parse_quantity(text: str, expected_unit: str | None, field: str) -> float:
             raise ModelError(
                 f"{text!r} is not in units compatible with '{expected_unit}'", field=field
             )
-    return float(quantity.to_base_units().magnitude)
+    return _finite_si(quantity, text, field)
 
 
 def generalized_force_unit(coordinate_unit: str | None) -> str:

@@ -72,3 +72,14 @@ def test_library_errors_name_python_fields_not_flags():
                 offences += [f"{path.relative_to(ROOT)}:{line}: {text!r}"
                              for line, text in _error_strings(node) if FLAG.search(text)]
     assert not offences, "\n".join(offences)
+
+
+def test_one_public_face():
+    """lagrangian re-exports every name of lagrangian.api.__all__, and each one exists."""
+    import lagrangian
+    import lagrangian.api
+
+    assert set(lagrangian.api.__all__) <= set(lagrangian.__all__)
+    for name in lagrangian.__all__:
+        assert getattr(lagrangian, name) is not None, name
+    assert not (PACKAGE / "system.py").exists()  # the facade lives in api/ only

@@ -1,28 +1,63 @@
 """The public face of lagrangian: load a model or build one, then ask the System.
 
-Everything a user needs is importable from here (and from ``lagrangian`` itself).
+Everything a user needs is importable from here (and from ``lagrangian`` itself): the entry
+points, the values a System takes, the results it returns and the errors it raises.
 """
 
+from ..analysis.equilibria import Equilibria, Equilibrium
+from ..analysis.forces import ForceReport
+from ..analysis.linearization import LinearModel, SymbolicLinearModel
+from ..analysis.modes import ModalAnalysis, Mode
+from ..check.diagnose import CheckReport, Finding
+from ..check.newton_euler import CoordinateAgreement, CrosscheckReport, Reaction
+from ..check.units import UnitIssue, UnitsReport
 from ..derivation.equations import EquationsOfMotion, LoadContribution
 from ..errors import DerivationError, LagrangianError, ModelError
+from ..model.answer import Answer
 from ..model.examples import example_names as examples
 from ..model.model import Model
 from ..model.reader import parse_model, read_model
+from ..model.values import ParameterValues, State
+from ..numerics.functions import NumericSystem
+from ..numerics.result import SimulationResult
 from ..simulation import Simulation
 from .system import System, SystemBuilder, load
 
 __all__ = [
-    "DerivationError",
-    "EquationsOfMotion",
-    "LagrangianError",
-    "LoadContribution",
-    "Model",
-    "ModelError",
-    "Simulation",
+    # entry points
     "System",
     "SystemBuilder",
     "examples",
     "load",
     "parse_model",
     "read_model",
+    # what a System is made of and takes
+    "Answer",
+    "Model",
+    "ParameterValues",
+    "State",
+    # what it returns
+    "CheckReport",
+    "CoordinateAgreement",
+    "CrosscheckReport",
+    "Equilibria",
+    "Equilibrium",
+    "EquationsOfMotion",
+    "Finding",
+    "ForceReport",
+    "LinearModel",
+    "LoadContribution",
+    "ModalAnalysis",
+    "Mode",
+    "NumericSystem",
+    "Reaction",
+    "Simulation",
+    "SimulationResult",
+    "SymbolicLinearModel",
+    "UnitIssue",
+    "UnitsReport",
+    # what it raises
+    "DerivationError",
+    "LagrangianError",
+    "ModelError",
 ]

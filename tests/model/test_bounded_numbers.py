@@ -108,9 +108,9 @@ def test_long_inputs_are_quoted_as_a_window_around_the_fault():
     message = refusal(text)
     assert message == ("cannot parse '...+ m + m + m + m + m + m + m + >>>) + theta' "
                        "at column 12001: unexpected ')'")
-    text = "m*" * 4000 + "m % 2 + " + "m*" * 4000 + "m"
+    text = "m*" * 4000 + "m % 2 + " + "m*" * 4000 + "m"  # no parse error: a forbidden operator
     assert refusal(text) == ("the operator '%' is not allowed (in "
-                             "'...m*m*m*m*m*m*m*m*m*m*m*m*m*m*m>>>% 2 + m*m*m*m*m*m*m*m*m*m*m*...')")
+                             "'...m*m*m*m*m*m*m*m*m*m*m*m*m*m*m >>>% 2 + m*m*m*m*m*m*m*m*m*m*m*m*...')")
 
 
 def test_no_python_warning_leaks(recwarn):

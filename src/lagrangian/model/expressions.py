@@ -9,7 +9,6 @@ its exact value would be too large or too costly.
 
 from __future__ import annotations
 
-import difflib
 import keyword
 import math
 import re
@@ -18,7 +17,7 @@ from collections.abc import Mapping
 import sympy as sp
 from sympy.printing.str import StrPrinter
 
-from ..errors import ModelError
+from ..errors import ModelError, did_you_mean
 from .printing import MemoizedPrinting
 
 FUNCTIONS: dict[str, tuple[object, int]] = {
@@ -457,15 +456,11 @@ def _check_names(tree: _Node, names: Mapping[str, sp.Expr], text: str, fail) -> 
             if name in FUNCTIONS:
                 raise fail(f"'{name}' is a function: call it as {name}(...)")
             known = list(names) + list(CONSTANTS)
-            close = difflib.get_close_matches(name, known, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            raise fail(f"unknown name '{name}'{hint}")
+            raise fail(f"unknown name '{name}'{did_you_mean(name, known)}")
         if node.kind == "call":
             name = node.value
             if name not in FUNCTIONS:
-                close = difflib.get_close_matches(name, list(FUNCTIONS), n=1)
-                hint = f"; did you mean '{close[0]}'?" if close else ""
-                raise fail(f"unknown function '{name}'{hint}")
+                raise fail(f"unknown function '{name}'{did_you_mean(name, FUNCTIONS)}")
             arity = FUNCTIONS[name][1]
             if len(node.children) != arity:
                 raise fail(f"{name}() takes {arity} argument(s), got {len(node.children)}")

@@ -83,3 +83,15 @@ def test_one_public_face():
     for name in lagrangian.__all__:
         assert getattr(lagrangian, name) is not None, name
     assert not (PACKAGE / "system.py").exists()  # the facade lives in api/ only
+
+
+def test_expressions_become_numbers_in_one_place():
+    """Only numerics/lambdified.py calls sympy's lambdify; only errors.py suggests names."""
+    calls: dict[str, set[str]] = {"lambdify": set(), "get_close_matches": set()}
+    for path, tree in _modules():
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call):
+                name = getattr(node.func, "attr", getattr(node.func, "id", ""))
+                if name in calls:
+                    calls[name].add(path.relative_to(PACKAGE).as_posix())
+    assert calls == {"lambdify": {"numerics/lambdified.py"}, "get_close_matches": {"errors.py"}}

@@ -17,6 +17,7 @@ import mpmath
 import sympy as sp
 
 from ..model.model import Model
+from ..numerics.lambdified import mpmath_function
 
 DIGITS = 30
 TOLERANCE = mpmath.mpf(10) ** -18  # relative: rounding at 30 digits leaves ~1e-28
@@ -40,7 +41,7 @@ class Points:
         if missing:
             raise ValueError(f"no random values for {sorted(map(str, missing))}")
         with mpmath.workdps(DIGITS):
-            function = sp.lambdify(self.symbols, exprs, modules="mpmath")
+            function = mpmath_function(self.symbols, exprs)
             rows = []
             for point in self.values:
                 try:

@@ -29,6 +29,12 @@ def numpy_function(args: Sequence[sp.Symbol], exprs: sp.Expr | Sequence[sp.Expr]
     return sp.lambdify(list(args), items if many else items[0], modules="numpy", cse=cse)
 
 
+def mpmath_function(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr]) -> Callable:
+    """One mpmath function of ``args`` returning the list ``exprs``, evaluated at mpmath's
+    working precision (the checks' random points); no cse."""
+    return sp.lambdify(list(args), [as_expression(e) for e in exprs], modules="mpmath")
+
+
 class StateFunction:
     """Expressions in q, q_dot and t (parameter values put in) as one numpy function.
 

@@ -12,6 +12,10 @@ def did_you_mean(name: str, known: Iterable[str]) -> str:
     return f"; did you mean '{close[0]}'?" if close else ""
 
 
+# control characters as escapes (a newline as \n), so every message stays one line
+_ONE_LINE = {code: repr(chr(code))[1:-1] for code in (*range(32), 127)}
+
+
 class LagrangianError(Exception):
     """Base class for every error the library raises on bad input (CLI exit status 2)."""
 
@@ -27,7 +31,8 @@ class ModelError(LagrangianError):
 
     def __str__(self) -> str:
         where = ": ".join(part for part in (self.source, self.field) if part)
-        return f"{where}: {self.message}" if where else self.message
+        text = f"{where}: {self.message}" if where else self.message
+        return text.translate(_ONE_LINE)  # a TOML key or value may hold a newline
 
 class DerivationError(LagrangianError):
     """The model is well formed but its equations cannot be formed (singular mass matrix, ...)."""

@@ -115,8 +115,8 @@ def check_unit(text: str, field: str, source: str | None) -> str:
 
 
 def _short(text: str) -> str:
-    """A unit string for a one-line message (cut when long)."""
-    return f"'{text}'" if len(text) <= 60 else f"'{text[:28]}...{text[-28:]}'"
+    """A unit string for a one-line message (cut when long, control characters escaped)."""
+    return repr(text) if len(text) <= 60 else repr(f"{text[:28]}...{text[-28:]}")
 
 
 def is_angle_unit(unit: str | None) -> bool:
@@ -144,7 +144,7 @@ def _finite_si(quantity, text: str, field: str, source: str | None = None) -> fl
     except (OverflowError, ZeroDivisionError, ValueError):
         value = math.inf
     if not math.isfinite(value):
-        raise ModelError(f"{text!r} is not a finite number in SI units", field=field,
+        raise ModelError(f"{_short(text)} is not a finite number in SI units", field=field,
                          source=source)
     return value
 

@@ -177,6 +177,14 @@ V = "m*theta"
          "(below 1e-300, it would be read as 0): write 0 or a larger number"),
         (("m = 1.0", "m = 1" + "0" * 5000), "bad.toml: invalid TOML: a number has far too many "
          "digits"),
+        (("m = 1.0", "m = 1" + "0" * 400), "bad.toml: parameters.m: the number is too large for a "
+         "floating-point number"),  # an OverflowError traceback (fuzzing find)
+        (("m = 1.0", 'm = { value = 1' + "0" * 400 + ', unit = "kg" }'), "bad.toml: "
+         "parameters.m.value: the number is too large for a floating-point number"),
+        (('theta = { unit = "rad" }', 'theta = { unit = "rad", initial = 1' + "0" * 400 + " }"),
+         "bad.toml: coordinates.theta.initial: the number is too large for a floating-point number"),
+        (('unit = "rad"', 'unit = "\\n"'), "bad.toml: coordinates.theta.unit: unknown unit "
+         "'\\n'"),  # was a message of two lines (fuzzing find)
         (('unit = "rad"', 'unit = "(-pi)^(1e300)"'), "bad.toml: coordinates.theta.unit: unit "
          "'(-pi)^(1e300)': the power is too large (at most 100)"),
         (("m = 1.0", 'm = { value = 1e308, unit = "pi" }'), "bad.toml: parameters.m.value: "

@@ -495,9 +495,14 @@ def _optional_float(value: object, field: str, source: str | None) -> float | No
         return None
     if isinstance(value, bool) or not isinstance(value, int | float | sp.Number):
         raise ModelError(f"expected a number, got {value!r}", field=field, source=source)
-    if not math.isfinite(float(value)):
+    try:
+        number = float(value)
+    except OverflowError:  # an integer beyond 1.8e308
+        raise ModelError("the number is too large for a floating-point number", field=field,
+                         source=source) from None
+    if not math.isfinite(number):
         raise ModelError(f"the number {value!r} is not finite", field=field, source=source)
-    return float(value)
+    return number
 
 
 def _range(value, field: str, source: str | None) -> tuple[float, float] | None:

@@ -127,7 +127,12 @@ def to_si(value: float, unit: str | None, field: str, source: str | None = None)
     """Convert a number in ``unit`` to SI base units (angles to radians)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ModelError(f"expected a number, got {value!r}", field=field, source=source)
-    if not math.isfinite(value):
+    try:
+        finite = math.isfinite(value)
+    except OverflowError:  # an integer beyond 1.8e308
+        raise ModelError("the number is too large for a floating-point number", field=field,
+                         source=source) from None
+    if not finite:
         raise ModelError(f"the number {value!r} is not finite", field=field, source=source)
     if not unit or unit == "1":
         return float(value)

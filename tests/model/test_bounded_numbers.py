@@ -8,7 +8,7 @@ import sympy as sp
 
 from lagrangian.errors import ModelError
 from lagrangian.model.answer import parse_answer
-from lagrangian.model.expressions import parse_expression
+from lagrangian.model.expressions import format_expression, parse_expression
 from lagrangian.model.reader import parse_model
 from lagrangian.model.units import check_unit, parse_quantity
 
@@ -213,3 +213,14 @@ def test_answer_files_are_bounded_like_models():
     # a foreign name in a long flat sum is still found (it once needed Python's parser)
     answer = parse_answer('[energy]\nV = "' + "m*theta + " * 2000 + 'N*theta"', model)
     assert answer.foreign_symbols("V") == {sp.Symbol("N")}
+
+
+def test_nesting_is_limited_to_what_sympy_can_still_print():
+    # sympy's printer spends about five frames per level: depth 199 was accepted, then
+    # `str` of it died with RecursionError (fuzzing find)
+    deep = "sin(" * 99 + "theta" + ")" * 99
+    expr = parse_expression(deep, NAMES)
+    assert parse_expression(format_expression(expr), NAMES) == expr
+    assert refusal("sin(" * 100 + "theta" + ")" * 100) == "the expression is nested too deeply"
+    assert refusal("-" * 5000 + "theta") == "the expression is nested too deeply"
+    assert refusal("2^" * 5000 + "2") == "the expression is nested too deeply"

@@ -41,7 +41,7 @@ CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}
 RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"t"}
 
 MAX_LENGTH = 100_000
-MAX_DEPTH = 200  # nesting (parentheses, calls, powers, signs); flat sums and products are free
+MAX_DEPTH = 100  # nesting (parentheses, calls, powers, signs); flat sums and products are free
 MAX_EXPONENT = 1000
 MAX_NUMBER_DIGITS = 300  # every number's size is below 10**300 (and a literal above 10**-300)
 MAX_EXACT_DIGITS = 1000  # numerator and denominator of an exact rational

@@ -157,6 +157,31 @@ def test_values_with_units_are_bounded_after_conversion(text, message):
     assert str(info.value) == message
 
 
+@pytest.mark.parametrize(
+    ("text", "value"),
+    [("pi/2", 1.5707963267948966), ("-pi/4 rad", -0.7853981633974483), ("pi", 3.141592653589793),
+     ("3*pi/4 deg", 0.041123351671205656), ("30deg", 0.5235987755982988)],
+)
+def test_values_may_be_constant_expressions_of_pi(text, value):
+    assert parse_quantity(text, "rad", "--about theta") == value
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("pi/0", "--about theta: division by zero in 'pi/0'"),  # a ZeroDivisionError traceback
+        ("sqrt(-1)", "--about theta: 'sqrt(-1)' is not a real number"),
+        ("exp(exp(10))", "--about theta: the value of 'exp(exp(10))' is too large a number "
+                         "(beyond 1e300)"),
+        ("abc", "--about theta: expected a number with an optional unit (like 30deg), got 'abc'"),
+    ],
+)
+def test_constant_expressions_in_values_are_bounded(text, message):
+    with pytest.raises(ModelError) as info:
+        parse_quantity(text, "rad", "--about theta")
+    assert str(info.value) == message
+
+
 # -- whole files ---------------------------------------------------------------------------
 
 MODEL = """

@@ -155,20 +155,22 @@ def _finite_si(quantity, text: str, field: str, source: str | None = None) -> fl
 
 
 def parse_quantity(text: str, expected_unit: str | None, field: str) -> float:
-    """Read '30deg', '0.5 m' or '2' as an SI number, checking it matches ``expected_unit``.
+    """Read '30deg', '0.5 m', '2', 'pi/2' or '3*pi/4 rad' as an SI number, checking it matches
+    ``expected_unit``.
 
-    A bare number is taken as SI (radians for an angle).
+    A bare number is taken as SI (radians for an angle); the number may be a constant
+    expression of the model grammar (numbers and pi), bounded like any expression.
     """
     match = _QUANTITY.match(text)
-    if not match:
-        raise ModelError(f"expected a number with an optional unit (like 30deg), got {text!r}",
-                         field=field)
-    number, unit = float(match.group(1)), (match.group(2) or "").strip()
-    if not math.isfinite(number):
-        raise ModelError(f"{text!r} is not a finite number", field=field)
-    if number == 0 and any(d in "123456789" for d in match.group(1).lower().partition("e")[0]):
-        raise ModelError(f"{text!r} is too small for a floating-point number (it would be "
-                         f"read as 0)", field=field)
+    if match:
+        number, unit = float(match.group(1)), (match.group(2) or "").strip()
+        if not math.isfinite(number):
+            raise ModelError(f"{_short(text)} is not a finite number", field=field)
+        if number == 0 and any(d in "123456789" for d in match.group(1).lower().partition("e")[0]):
+            raise ModelError(f"{_short(text)} is too small for a floating-point number (it would "
+                             f"be read as 0)", field=field)
+    else:
+        number, unit = _constant_quantity(text, field)
     if not unit:
         return number
     problem = unit_syntax_problem(unit)
@@ -176,15 +178,33 @@ def parse_quantity(text: str, expected_unit: str | None, field: str) -> float:
         raise ModelError(f"unit {_short(unit)}: {problem}", field=field)
     parsed = _unit(unit)
     if parsed is None:
-        raise ModelError(f"unknown unit {_short(unit)} in {text!r}", field=field)
+        raise ModelError(f"unknown unit {_short(unit)} in {_short(text)}", field=field)
     quantity = registry().Quantity(number, parsed)
     if expected_unit and expected_unit != "1":
         target = _unit(expected_unit)
         if target is not None and quantity.dimensionality != (1 * target).dimensionality:
             raise ModelError(
-                f"{text!r} is not in units compatible with '{expected_unit}'", field=field
+                f"{_short(text)} is not in units compatible with '{expected_unit}'", field=field
             )
     return _finite_si(quantity, text, field)
+
+
+_UNIT_TAIL = re.compile(r"^(.*?\S)\s+([A-Za-z_µ°][\w*/^.µ°-]*)\s*$", re.DOTALL)
+
+
+def _constant_quantity(text: str, field: str) -> tuple[float, str]:
+    """'pi/2' or '3*pi/4 rad': a constant expression and an optional unit after a space."""
+    from .expressions import parse_expression, plain_names
+
+    head, unit = text.strip(), ""
+    split = _UNIT_TAIL.match(head)
+    if split and split.group(2) != "pi" and _unit(split.group(2)) is not None:
+        head, unit = split.group(1), split.group(2)
+    if not head or set(plain_names(head)) - {"pi"}:
+        raise ModelError(f"expected a number with an optional unit (like 30deg), got "
+                         f"{_short(text)}", field=field)
+    value = parse_expression(head, {}, field=field)
+    return float(value.evalf()), unit
 
 
 def generalized_force_unit(coordinate_unit: str | None) -> str:

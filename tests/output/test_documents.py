@@ -12,7 +12,8 @@ from lagrangian.output.forces import forces_document
 
 DERIVE_KEYS = {"name", "convention", "coordinates", "parameters", "kinetic_energy",
                "potential_energy", "dissipation", "lagrangian", "generalized_forces",
-               "load_contributions", "mass_matrix", "forcing", "equations", "accelerations"}
+               "load_contributions", "mass_matrix", "forcing", "equations", "accelerations",
+               "accelerations_note"}
 
 
 def names_of(eom):
@@ -55,6 +56,9 @@ def test_derive_document_keys_and_expressions_read_back(name):
 def test_large_models_report_null_accelerations():
     document = derivation_document(lagrangian.load("slider_crank").equations_of_motion())
     assert document["accelerations"] == {"theta": None, "phi": None, "x": None}
+    assert document["accelerations_note"] == (
+        "not solved symbolically: 5 unknowns (more than 3); the equations are given in the "
+        "implicit form M q_ddot = f")
 
 
 def test_forces_document_contract():

@@ -59,13 +59,22 @@ class EquationsOfMotion:
         return sp.Add(*terms)
 
     @cached_property
-    def accelerations(self) -> sp.ImmutableMatrix | None:
-        """q_ddot solved symbolically (with the multipliers eliminated), or None where the
-        closed form would be too large to be useful; computed on first use."""
+    def _symbolic_accelerations(self):
         from .solve import solve_accelerations
 
         return solve_accelerations(self.mass_matrix, self.forcing, self.constraint_jacobian,
                                    self.acceleration_rhs)
+
+    @property
+    def accelerations(self) -> sp.ImmutableMatrix | None:
+        """q_ddot solved symbolically (with the multipliers eliminated), or None where the solve
+        would exceed its budget (see ``accelerations_note``); computed on first use."""
+        return self._symbolic_accelerations.accelerations
+
+    @property
+    def accelerations_note(self) -> str | None:
+        """Why ``accelerations`` is None (None when they were solved)."""
+        return self._symbolic_accelerations.note
 
     @property
     def coordinates(self) -> sp.ImmutableMatrix:
@@ -91,10 +100,17 @@ class EquationsOfMotion:
     @property
     def equations(self) -> sp.ImmutableMatrix:
         """One expression per coordinate that equals zero: M q_ddot + Phi_q^T lambda - f."""
-        lhs = self.mass_matrix * self.coordinate_accelerations
-        if self.multipliers.shape[0]:
-            lhs = lhs + self.constraint_jacobian.T * self.multipliers
-        return sp.ImmutableMatrix(lhs - self.forcing)
+        # Summed term by term in one Add per row: the matrix product and subtraction build and
+        # flatten every partial sum again (2.6 s for the 30-link pendulum, against 0.1 s).
+        M, A, f = self.mass_matrix, self.constraint_jacobian, self.forcing
+        q_ddot, multipliers = self.model.q_ddot, self.multipliers
+        rows = []
+        for i in range(M.rows):
+            terms = [M[i, j] * a for j, a in enumerate(q_ddot) if M[i, j] != 0]
+            terms += [A[k, i] * multipliers[k] for k in range(A.rows) if A[k, i] != 0]
+            terms += [-term for term in sp.Add.make_args(f[i])]
+            rows.append(sp.Add(*terms))
+        return sp.ImmutableMatrix(M.rows, 1, rows)
 
     def _repr_latex_(self) -> str:
         names = latex_symbol_names(self.model)

@@ -8,11 +8,9 @@ from __future__ import annotations
 
 from typing import Any
 
-import sympy as sp
-
 from ..derivation.equations import EquationsOfMotion
 from ..model.expressions import format_expression as fmt
-from ..model.notation import latex_symbol_names
+from ..model.notation import latex_printer
 from ..model.units import generalized_force_unit
 
 CONVENTION = "M q_ddot + Phi_q^T lambda = forcing"
@@ -69,6 +67,8 @@ def derivation_text(eom: EquationsOfMotion) -> str:
         lines += ["", "Accelerations:"]
         for c, a in zip(model.coordinates, eom.accelerations, strict=True):
             lines.append(f"  {c.acceleration} = {fmt(a)}")
+    elif eom.accelerations_note:
+        lines += ["", f"Accelerations: {eom.accelerations_note}"]
     lines += ["", "Convention: M q_ddot + Phi_q^T lambda = f"]
     return "\n".join(lines) + "\n"
 
@@ -125,6 +125,7 @@ def derivation_document(eom: EquationsOfMotion) -> dict[str, Any]:
             for n, v in zip(names, eom.accelerations if eom.accelerations is not None
                             else [None] * len(names), strict=True)
         },
+        "accelerations_note": eom.accelerations_note,
     }
     if model.constraints:
         document["constraints"] = {
@@ -144,10 +145,7 @@ def derivation_document(eom: EquationsOfMotion) -> dict[str, Any]:
 def derivation_latex(eom: EquationsOfMotion) -> str:
     """A self-contained LaTeX fragment (amsmath) ready to paste into a paper."""
     model = eom.model
-    names = latex_symbol_names(model)
-
-    def tex(expr) -> str:
-        return sp.latex(expr, symbol_names=names)
+    tex = latex_printer(model)
 
     lines = [f"% {model.name}: equations of motion by Lagrange's method",
              r"% Convention: M \ddot{q} + \Phi_q^T \lambda = f", r"\begin{align}"]

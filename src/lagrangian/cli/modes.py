@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-import re
 from pathlib import Path
 from typing import Annotated
 
@@ -11,11 +9,7 @@ import typer
 
 from ..output.modes import modes_document, modes_text, write_mode_plot
 from . import app
-from .common import assignments, load_system, print_json, state_assignments
-
-# "pi", "-pi/2", "2*pi", "0.5pi": multiples of pi are common equilibria of angles.
-_PI = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)?)\s*\*?\s*pi\s*(?:/\s*(\d+\.?\d*))?\s*$")
-
+from .common import load_system, print_json, state_assignments
 
 ABOUT_HELP = "Equilibrium: COORDINATE=VALUE (pi, 180deg, 0.5m); the others are solved for."
 
@@ -30,8 +24,7 @@ def modes(
 ) -> None:
     """Linearize about an equilibrium: M, C, K, natural frequencies, damping and mode shapes."""
     system = load_system(model, set_)
-    pairs = assignments(about, "--about")
-    point = state_assignments(system, [f"{n}={_expand_pi(v)}" for n, v in pairs], "--about")
+    point = state_assignments(system, about, "--about")
     analysis = system.modes(about=point or None)
     if plot is not None:
         inputs = (Path(model),) if Path(model).exists() else ()
@@ -43,13 +36,3 @@ def modes(
         if plot is not None:
             typer.echo(f"Mode shapes drawn to {plot}")
 
-
-def _expand_pi(text: str) -> str:
-    """'pi/2' -> '1.5707963267948966'; anything else unchanged (units are read later)."""
-    match = _PI.match(text)
-    if not match:
-        return text
-    factor = float(match.group(1)) if match.group(1) not in ("", "+", "-") else \
-        (-1.0 if match.group(1) == "-" else 1.0)
-    divisor = float(match.group(2)) if match.group(2) else 1.0
-    return repr(factor * math.pi / divisor)

@@ -40,7 +40,7 @@ FUNCTIONS: dict[str, tuple[object, int]] = {
 CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}
 RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"t"}
 
-MAX_LENGTH = 100_000
+MAX_LENGTH = 50_000  # parsing and converting stay under about 1 s
 MAX_DEPTH = 100  # nesting (parentheses, calls, powers, signs); flat sums and products are free
 MAX_EXPONENT = 1000
 MAX_NUMBER_DIGITS = 300  # every number's size is below 10**300 (and a literal above 10**-300)

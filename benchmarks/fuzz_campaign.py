@@ -5,8 +5,9 @@ and the JSON output, with counts.
 
 Inputs are drawn at random (unlike the test suite's fixed CI budget, tests/fuzz): expressions,
 numbers, unit strings and values with units, whole model files (from the grammar and mutated
-built-in examples) read, and model files derived to JSON through the CLI. Each must be accepted,
-or refused with the project's own one-line error; a refusal should take under 1 s. Reports
+built-in examples) and answer files read, and model files derived to JSON through the CLI.
+Each must be accepted, or refused with the project's own one-line error; a refusal should take
+under 1 s. Reports
 inputs tried, accepted, refusals by kind, failures (tracebacks, time-outs) with their input,
 the slowest refusal and the refusals over 1 s.
 """
@@ -24,11 +25,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "fuzz"))
 
 from fuzz_inputs import (  # noqa: E402
     Tally,
+    answer_files,
     derive_json,
     expressions,
     model_files,
     number_texts,
     quantities,
+    read_answer_text,
     read_expression,
     read_model_text,
     run_input,
@@ -45,7 +48,8 @@ TARGETS = {
     "number": (0.05, 10.0),
     "unit": (0.05, 10.0),
     "quantity": (0.05, 10.0),
-    "model file (read)": (0.35, 20.0),
+    "answer file (read)": (0.05, 20.0),
+    "model file (read)": (0.30, 20.0),
     "model file (derive --format json)": (0.10, 60.0),
 }
 SLOW_REFUSAL = 1.0
@@ -71,11 +75,14 @@ def campaign(inputs: int, minutes: float, progress: bool = True) -> dict:
             return lambda: parse_quantity(text, "m", "--set x")
         if target == "model file (read)":
             return lambda: read_model_text(text)
+        if target == "answer file (read)":
+            return lambda: read_answer_text(text)
         return lambda: derive_json(text, folder)
 
     strategies = {
         "expression": expressions(), "number": number_texts(), "unit": unit_strings(),
         "quantity": quantities(), "model file (read)": model_files(),
+        "answer file (read)": answer_files(),
         "model file (derive --format json)": model_files(),
     }
     # each target repeated by its weight: a uniform pick among 100 (hypothesis favours small

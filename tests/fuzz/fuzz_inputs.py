@@ -7,6 +7,7 @@ each input must meet: accepted, or refused with the project's own error, within 
 from __future__ import annotations
 
 import contextlib
+import functools
 import io
 import json
 import re
@@ -67,7 +68,12 @@ def number_texts() -> st.SearchStrategy[str]:
 def expressions(names: list[str] | None = None) -> st.SearchStrategy[str]:
     """Expression text from the grammar (with wrong arities, unknown names and hostile
     constants mixed in), and grammar text with junk spliced in."""
-    names = names or NAMES
+    return _expressions(tuple(names or NAMES))
+
+
+@functools.cache  # building the recursive strategy costs more than drawing from it
+def _expressions(names: tuple[str, ...]) -> st.SearchStrategy[str]:
+    names = list(names)
     leaves = st.one_of(
         st.sampled_from(names), number_texts(), st.just("pi"),
         st.sampled_from(UNKNOWN_NAMES), st.sampled_from(HOSTILE_EXPRESSIONS),
@@ -208,6 +214,42 @@ def mutated_examples(draw) -> str:
 
 def model_files() -> st.SearchStrategy[str]:
     return st.one_of(grammar_models(), mutated_examples())
+
+
+@st.composite
+def answer_files(draw) -> str:
+    """A hand derivation (ANSWER.toml) for the pendulum example, with hostile expressions,
+    equations with several '=' and wrong multiplier counts."""
+    names = ["theta", "theta_dot", "theta_ddot", "m", "L", "g", "t", "N", "T_rod"]
+    lines = ["[energy]"]
+    for key in draw(st.sets(st.sampled_from(["T", "V", "D", "X"]), min_size=1)):
+        lines.append(f"{key} = {_toml_string(draw(expressions(names)))}")
+    if draw(st.booleans()):
+        lhs, rhs = draw(expressions(names)), draw(expressions(names))
+        sep = draw(st.sampled_from([" = ", "=", " == ", " <= ", " = = "]))
+        lines += ["[equations]", f"theta = {_toml_string(lhs + sep + rhs)}"]
+    if draw(st.booleans()):
+        count = draw(st.sampled_from(["0", "1", "-1", "1e3", "true", '"x"', "99999999999999999999"]))
+        lines += ["[multipliers]", f"count = {count}"]
+    return "\n".join(lines) + "\n"
+
+
+def read_answer_text(text: str) -> None:
+    from lagrangian.model.answer import parse_answer
+
+    parse_answer(text, _pendulum(), source="ANSWER.toml")
+
+
+def _pendulum():
+    global _PENDULUM
+    if _PENDULUM is None:
+        from lagrangian.model.reader import parse_model
+
+        _PENDULUM = parse_model(EXAMPLE_TEXTS["pendulum"], source="pendulum.toml")
+    return _PENDULUM
+
+
+_PENDULUM = None
 
 
 # -- the contract ----------------------------------------------------------------------------

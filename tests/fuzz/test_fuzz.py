@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import pytest
 from fuzz_inputs import (
+    answer_files,
     derive_json,
     expressions,
     model_files,
     number_texts,
     quantities,
+    read_answer_text,
     read_expression,
     read_model_text,
     run_input,
@@ -58,6 +60,12 @@ def test_unit_strings_and_values_with_units(unit, quantity):
 @given(model_files())
 def test_model_files_read(text):
     check(run_input(lambda: read_model_text(text), 10.0), text)
+
+
+@fuzz(200)
+@given(answer_files())
+def test_answer_files_read(text):
+    check(run_input(lambda: read_answer_text(text), 10.0), text)
 
 
 @pytest.fixture(scope="module")

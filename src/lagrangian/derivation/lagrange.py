@@ -2,7 +2,9 @@
 
 Structure is used instead of generic time differentiation: each particle and body contributes
 M += m J^T J and f -= m J^T a_rest (its velocity Jacobian J and the acceleration at q_ddot = 0),
-which is exactly the Euler-Lagrange operator applied to its 1/2 m v.v. A user-given L(q, q_dot, t)
+which is exactly the Euler-Lagrange operator applied to its 1/2 m v.v for a constant m; a mass or
+inertia that depends on q or t adds 1/2 dm/dq_i v.v - m_dot v.J_i to f (and g dm/dq_i d.r to the
+weight), so the equations stay those of the printed L. A user-given L(q, q_dot, t)
 goes through the general formula W q_ddot = dL/dq - (d^2L/dq_dot dq) q_dot - d^2L/dq_dot dt.
 """
 
@@ -107,9 +109,31 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
 
     gravity = model.gravity
 
+    def varying_inertia(inertia: sp.Expr, jacobian, velocity) -> None:
+        """The Euler-Lagrange operator on 1/2 m v.v is m J_i.a + m_dot v.J_i - 1/2 dm/dq_i v.v:
+        for m(q, t) f_i gets the last two terms, which m J^T J and m J^T a_rest leave out (the
+        same with I and omega for a body's rotation)."""
+        gradient = jacobian_row(inertia, q)
+        rate = time_rate(inertia, q, q_dot, t)
+        if rate == 0 and all(g == 0 for g in gradient):
+            return
+        speed_squared = sp.Add(*(v**2 for v in velocity if v != 0))
+        for i in range(n):
+            projection = sp.Add(*(row[i] * v for row, v in zip(jacobian, velocity, strict=True)
+                                  if row[i] != 0 and v != 0))
+            term = sp.expand(gradient[i] * speed_squared / 2 - rate * projection)
+            if term != 0:
+                acc.add_force(i, term)
+
     def translate(mass: sp.Expr, position) -> None:
         jacobian = [jacobian_row(component, q) for component in position]
         if gravity is not None:
+            # With a mass that depends on q, -dV/dq_i of V = -m g d.r also has g dm/dq_i d.r.
+            height = sp.Add(*(dc * r for dc, r in zip(gravity.direction, position, strict=True)
+                              if dc != 0))
+            for i, gradient in enumerate(jacobian_row(mass, q)):
+                if gradient != 0 and height != 0:
+                    acc.add_force(i, gravity.magnitude * gradient * height)
             # Weight m g d enters as its virtual work m g d . dr/dq_i, grouped by shape like the
             # inertia terms (so a chain shows (m1 + m2) g l1 sin(theta1)); V still shows -m g h.
             for i in range(n):
@@ -126,6 +150,7 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
         ]
         rest = [time_rate(v, q, q_dot, t) for v in velocity]
         acc.inertia(mass, jacobian, rest)
+        varying_inertia(mass, jacobian, velocity)
         # T = 1/2 q_dot^T M q_dot (from the tidied M) + what a moving support adds.
         for v, r_t in zip(velocity, moving, strict=True):
             if r_t != 0:
@@ -136,7 +161,9 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
     for body in model.bodies:
         translate(body.mass, body.position)
         omega = time_rate(body.angle, q, q_dot, t)
-        acc.inertia(body.inertia, [jacobian_row(body.angle, q)], [time_rate(omega, q, q_dot, t)])
+        turning = [jacobian_row(body.angle, q)]
+        acc.inertia(body.inertia, turning, [time_rate(omega, q, q_dot, t)])
+        varying_inertia(body.inertia, turning, [omega])
         spin = d(body.angle, t)
         if spin != 0:
             kinetic_terms.append(body.inertia * (omega - spin) * spin

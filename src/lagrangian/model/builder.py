@@ -62,6 +62,11 @@ class ModelBuilder:
         self._generalized: dict[str, list[sp.Expr]] = {}
         self._constraints: list[Constraint] = []
         self._component_names: set[str] = set()
+        # Every vector given, in order: (field, components, what it places: "particle", "body"
+        # or None). The first particle or body position fixes the model's dimension; every
+        # vector must match it.
+        self._vectors: list[tuple[str, int, str | None]] = []
+        self._gravity_field: str | None = None
 
     # -- declarations ---------------------------------------------------------------------
 
@@ -139,16 +144,25 @@ class ModelBuilder:
     # -- components -----------------------------------------------------------------------
 
     def set_gravity(
-        self, g: object, direction: Sequence[object] = (0, -1), *, field: str = "gravity"
+        self, g: object, direction: Sequence[object] | None = None, *, field: str = "gravity"
     ) -> ModelBuilder:
-        """Uniform gravity of magnitude g (m/s^2) along ``direction`` (normalized here)."""
-        magnitude = self.expression(g, f"{field}.g")
+        """Uniform gravity of magnitude g (m/s^2) along ``direction`` (normalized here; default
+        (0, -1) in a planar model). Both may be expressions in parameters (an incline angle)."""
+        magnitude = self._parameter_expression(g, f"{field}.g")
+        self._gravity_field = field
+        if direction is None:
+            self._gravity = Gravity(magnitude, (sp.S.Zero, -sp.S.One, sp.S.Zero))
+            return self
         vector = self.vector(direction, f"{field}.direction")
-        if any(component.free_symbols for component in vector):
-            raise self._error("the direction must be numbers", f"{field}.direction")
-        norm = sp.sqrt(sum(c**2 for c in vector))
-        if norm == 0:
+        for i, component in enumerate(vector):
+            self._parameter_expression(component, f"{field}.direction[{i}]")
+        squared = sp.Add(*(c**2 for c in vector))
+        if squared.free_symbols:
+            # sin(a)^2 + cos(a)^2 and the like: small, parameters only, so trigsimp is cheap.
+            squared = sp.trigsimp(squared)
+        if squared == 0 or self._zero_at_values(squared):
             raise self._error("the direction is the zero vector", f"{field}.direction")
+        norm = sp.sqrt(squared)
         self._gravity = Gravity(magnitude, tuple(c / norm for c in vector))
         return self
 
@@ -162,7 +176,8 @@ class ModelBuilder:
             Particle(
                 name,
                 self.expression(mass, f"{field}.mass", velocities=False),
-                self.vector(position, f"{field}.position", velocities=False),
+                self.vector(position, f"{field}.position", velocities=False,
+                            places="particle"),
             )
         )
         return self
@@ -179,7 +194,7 @@ class ModelBuilder:
                 name,
                 self.expression(mass, f"{field}.mass", velocities=False),
                 self.expression(inertia, f"{field}.inertia", velocities=False),
-                self.vector(position, f"{field}.position", velocities=False),
+                self.vector(position, f"{field}.position", velocities=False, places="body"),
                 self.expression(angle, f"{field}.angle", velocities=False),
             )
         )
@@ -348,14 +363,18 @@ class ModelBuilder:
         return expr
 
     def vector(
-        self, values: Sequence[object], field: str, *, velocities: bool = True
+        self, values: Sequence[object], field: str, *, velocities: bool = True,
+        places: str | None = None,
     ) -> Vector:
-        """A 2- or 3-component vector of expressions (a planar one gets z = 0)."""
+        """A 2- or 3-component vector of expressions (a planar one gets z = 0); its number of
+        components must be the model's (``places``: "particle" or "body" it positions)."""
         if isinstance(values, str | bytes) or not isinstance(values, Sequence | sp.MatrixBase):
             raise self._error("expected a vector: a list of 2 or 3 components", field)
         items = list(values)
         if len(items) not in (2, 3):
             raise self._error(f"expected 2 or 3 components, got {len(items)}", field)
+        self._vectors.append((field, len(items), places))
+        self._check_dimensions()
         parsed = [
             self.expression(v, f"{field}[{i}]", velocities=velocities) for i, v in enumerate(items)
         ]
@@ -398,6 +417,7 @@ class ModelBuilder:
         """Validate the whole and return the immutable Model."""
         if not self._coordinates:
             raise self._error("a model needs at least one generalized coordinate", "coordinates")
+        self._check_dimensions()
         return Model(
             name=self.name or "Unnamed model",
             description=self.description,
@@ -419,6 +439,50 @@ class ModelBuilder:
         )
 
     # -- helpers --------------------------------------------------------------------------
+
+    def dimension(self) -> int | None:
+        """2 (planar) or 3: the components of the first particle or body position (of the first
+        vector where there are none); None before any vector."""
+        placing = [n for _, n, places in self._vectors if places]
+        if placing:
+            return placing[0]
+        return self._vectors[0][1] if self._vectors else None
+
+    def _check_dimensions(self) -> None:
+        dimension = self.dimension()
+        if dimension is None:
+            return
+        what = "a planar" if dimension == 2 else "a 3D"
+        for field, n, places in self._vectors:
+            if n != dimension:
+                raise self._error(f"{n} components in {what} model", field)
+            if places == "body" and n == 3:
+                raise self._error("3 components: a body is planar (it turns about z); "
+                                  "give its position as [x, y]", field)
+        if dimension == 3 and self._gravity is not None and self._gravity_field is not None \
+                and not any(f == f"{self._gravity_field}.direction" for f, _, _ in self._vectors):
+            raise self._error("give the direction of gravity in a 3D model (3 components)",
+                              f"{self._gravity_field}.direction")
+
+    def _parameter_expression(self, value: object, field: str) -> sp.Expr:
+        """An expression in parameters only (not coordinates, velocities or time)."""
+        expr = self.expression(value, field)
+        state = {c.symbol for c in self._coordinates} | {c.velocity for c in self._coordinates}
+        used = expr.free_symbols & (state | {TIME})
+        if used:
+            raise self._error(
+                f"may depend on parameters only (found {sorted(map(str, used))[0]})", field)
+        return expr
+
+    def _zero_at_values(self, expr: sp.Expr) -> bool:
+        """True where every symbol of ``expr`` is a parameter with a value that makes it 0."""
+        values = {p.symbol: p.value for p in self._parameters if p.value is not None}
+        if not expr.free_symbols <= set(values):
+            return False
+        try:
+            return abs(complex(expr.xreplace(values))) < 1e-300
+        except (TypeError, ValueError):
+            return False
 
     def _error(self, message: str, field: str | None) -> ModelError:
         return ModelError(message, field=field, source=self.source)

@@ -138,7 +138,7 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
         check_known_keys(gravity, {"g", "direction"}, "gravity", source)
         if "g" not in gravity:
             raise ModelError("missing key 'g'", field="gravity", source=source)
-        builder.set_gravity(gravity["g"], gravity.get("direction", [0, -1]))
+        builder.set_gravity(gravity["g"], gravity.get("direction"))
 
     for index, item in _components(data, "particles", source):
         field = f"particles[{index}]"

@@ -76,8 +76,7 @@ def cli_time(path: Path, fmt: str, repeat: int) -> float:
     for _ in range(repeat):
         start = time.perf_counter()
         result = subprocess.run([sys.executable, "-m", "lagrangian", "derive", str(path),
-                                 "--format", fmt], stdout=subprocess.PIPE,
-                                stderr=subprocess.PIPE, check=False)
+                                 "--format", fmt], capture_output=True, check=False)
         times.append(time.perf_counter() - start)
         if result.returncode != 0 or not result.stdout:
             raise SystemExit(f"derive failed on {path} ({fmt}): {result.stderr.decode()}")

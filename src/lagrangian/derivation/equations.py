@@ -97,6 +97,66 @@ class EquationsOfMotion:
         """L = T - V (J)."""
         return self.kinetic_energy - self.potential_energy
 
+    # -- what is conserved, and the work that changes it --------------------------------------
+
+    @cached_property
+    def jacobi_integral(self) -> sp.Expr:
+        """h = q_dot . dL/dq_dot - L (J); T + V when T is quadratic in q_dot and V has no q_dot."""
+        L, q_dot = self.lagrangian, self.model.q_dot
+        return sp.Add(*(v * L.diff(v) for v in q_dot if v in L.free_symbols)) - L
+
+    @cached_property
+    def power(self) -> sp.Expr:
+        """dh/dt along a motion (W): sum Q_i q_dot_i of the non-potential loads (dampers and
+        dissipation included) - dL/dt (explicit time) + lambda . b of constraints that move
+        (Phi_q q_dot + b = 0); in the multiplier symbols where there are constraints."""
+        q_dot, t = self.model.q_dot, self.model.time
+        terms = [Q * v for Q, v in zip(self.generalized_forces, q_dot, strict=True) if Q != 0]
+        if t in self.lagrangian.free_symbols:
+            terms.append(-self.lagrangian.diff(t))
+        terms += [lam * b for lam, b in zip(self.multipliers, self.velocity_bias, strict=True)
+                  if b != 0]
+        return sp.Add(*terms)
+
+    @cached_property
+    def invariant_kind(self) -> str:
+        """'energy' (T + V is conserved), 'jacobi_integral' (h is, while T + V is not) or
+        'work_balance' (h changes by the work of the loads: h(t) - h(0) - int P dt = 0)."""
+        if sp.expand(self.power) != 0:
+            return "work_balance"
+        if sp.expand(self.jacobi_integral - self.kinetic_energy - self.potential_energy) == 0:
+            return "energy"
+        return "jacobi_integral"
+
+    @property
+    def invariant(self) -> sp.Expr:
+        """The monitored quantity (J): T + V for 'energy', the Jacobi integral h otherwise."""
+        if self.invariant_kind == "energy":
+            return self.kinetic_energy + self.potential_energy
+        return self.jacobi_integral
+
+    # -- statics ----------------------------------------------------------------------------
+
+    @property
+    def has_inertia(self) -> bool:
+        """False for a mechanism with no mass, inertia or T at all (statics only)."""
+        return any(x != 0 for x in self.mass_matrix)
+
+    @property
+    def coordinates_without_inertia(self) -> tuple[str, ...]:
+        """Coordinates whose row of M is zero (no acceleration in their equation)."""
+        M = self.mass_matrix
+        return tuple(c.name for i, c in enumerate(self.model.coordinates)
+                     if all(M[i, j] == 0 for j in range(M.cols)))
+
+    @cached_property
+    def static_conditions(self) -> sp.ImmutableMatrix:
+        """Q_i - dV/dq_i at rest (q_dot = 0), one per coordinate: with Phi_q^T lambda on the
+        left, the equilibrium conditions of virtual work (delta W = 0 for every admissible
+        delta q)."""
+        rest = {v: sp.S.Zero for v in self.model.q_dot}
+        return sp.ImmutableMatrix(self.forcing.rows, 1, [f.xreplace(rest) for f in self.forcing])
+
     @property
     def equations(self) -> sp.ImmutableMatrix:
         """One expression per coordinate that equals zero: M q_ddot + Phi_q^T lambda - f."""

@@ -90,6 +90,10 @@ def check_regularity(model: Model, mass_matrix: sp.MatrixBase, jacobian: sp.Matr
     n, m = mass_matrix.shape[0], jacobian.shape[0]
     names = [c.name for c in model.coordinates]
     missing = [names[i] for i in range(n) if all(mass_matrix[i, j] == 0 for j in range(n))]
+    if len(missing) == n:
+        # No inertia at all: a mechanism for statics (virtual work needs none); only the
+        # commands that integrate or linearize in time refuse it (require_inertia).
+        return
     if missing and not m:
         raise DerivationError(_missing_message(missing))
     values = random_state(model)
@@ -150,3 +154,16 @@ def _rank(matrix: np.ndarray) -> int:
     singular = np.linalg.svd(matrix, compute_uv=False)
     scale = max(singular.max(), 1.0)
     return int(np.sum(singular > 1e-9 * scale))
+
+
+def require_inertia(eom, what: str) -> None:
+    """Raise DerivationError when ``what`` (e.g. 'simulate') needs accelerations the model
+    cannot give: coordinates without mass, inertia or T."""
+    missing = eom.coordinates_without_inertia
+    if missing:
+        listed = ", ".join(f"'{name}'" for name in missing)
+        raise DerivationError(
+            f"{what} needs inertia: the model has no mass, inertia or kinetic energy for "
+            f"{listed} (a statics model: derive, forces, equilibria, check and statics work "
+            "without it)"
+        )

@@ -71,6 +71,9 @@ def solve_accelerations(
     """q_ddot = N / det from [[M, Phi_q^T], [Phi_q, 0]] [q_ddot; lambda] = [f; gamma], when the
     solve stays within the budget (None and a note otherwise)."""
     n, m = mass_matrix.shape[0], jacobian.shape[0]
+    if all(x == 0 for x in mass_matrix):
+        return SymbolicAccelerations(None, "none: the model has no inertia (statics: the "
+                                     "equations are the equilibrium conditions 0 = f)")
     if n + m > SYMBOLIC_SOLVE_MAX_UNKNOWNS:
         return SymbolicAccelerations(
             None, f"not solved symbolically: {n + m} unknowns (more than "

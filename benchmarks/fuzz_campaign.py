@@ -99,6 +99,9 @@ def campaign(inputs: int, minutes: float, progress: bool = True) -> dict:
         text = data.draw(strategies[target])
         outcome = run_input(runner(target, text), TARGETS[target][1])
         tallies[target].add(target, text, outcome)
+        if not outcome.ok and progress:
+            print(f"FAILURE {target}: {outcome.status} {outcome.kind} {outcome.message[:300]} "
+                  f"on {text[:1000]!r}", file=sys.stderr, flush=True)
         if outcome.status == "refused" and outcome.seconds > SLOW_REFUSAL:
             slow.append((outcome.seconds, f"{target}: {text[:200]}", outcome.message[:200]))
         total = sum(t.tried for t in tallies.values())

@@ -335,3 +335,64 @@ def test_particles_alone_need_no_shortcut_terms():
     eom = derive(b.build_model())
     assert eom.forcing[0] == 0
     assert isinstance(b.build_model().particles[0], Particle)
+
+
+BEAD_3D = """
+name = "Bead on a spinning hoop, in the inertial frame"
+[coordinates]
+theta = "rad"
+[parameters]
+m = 0.1
+R = 0.5
+g = 9.81
+Omega = 6.0
+[gravity]
+g = "g"
+direction = [0, 0, -1]
+[[particles]]
+name = "bead"
+mass = "m"
+position = ["R*sin(theta)*cos(Omega*t)", "R*sin(theta)*sin(Omega*t)", "-R*cos(theta)"]
+"""
+
+
+def test_bead_on_a_spinning_hoop_in_3d_reads_as_in_the_rotating_frame():
+    """sin^2(Omega t) + cos^2(Omega t) is recognized inside longer products, so the inertial
+    description prints the rotating-frame T, M and f, with no t left."""
+    import lagrangian
+
+    inertial = derive(parse_model(BEAD_3D))
+    rotating = derive(lagrangian.load("bead_on_hoop").model)
+    s = symbols(inertial.model)
+    assert inertial.mass_matrix == sp.Matrix([[s["R"] ** 2 * s["m"]]])
+    assert sp.expand(inertial.forcing[0] - rotating.forcing[0]) == 0
+    assert sp.expand(inertial.kinetic_energy - rotating.kinetic_energy) == 0
+    assert inertial.model.time not in inertial.lagrangian.free_symbols
+    assert inertial.invariant_kind == "jacobi_integral"
+
+
+def test_a_damper_between_two_masses_on_a_line_is_c_times_the_relative_velocity():
+    model = parse_model(BASE_LINE + '[[dampers]]\nname = "d"\ncoefficient = "c"\n'
+                        'between = ["a", "b"]\n')
+    eom = derive(model)
+    s = symbols(model)
+    assert eom.generalized_forces[0] == -s["c"] * (s["x1_dot"] - s["x2_dot"])
+    assert sp.expand(eom.dissipation - s["c"] * (s["x1_dot"] - s["x2_dot"]) ** 2 / 2) == 0
+
+
+BASE_LINE = """
+[coordinates]
+x1 = "m"
+x2 = "m"
+[parameters]
+m = 1.0
+c = 0.5
+[[particles]]
+name = "a"
+mass = "m"
+position = ["x1", 0]
+[[particles]]
+name = "b"
+mass = "m"
+position = ["x2", 0]
+"""

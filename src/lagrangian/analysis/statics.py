@@ -20,6 +20,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
 from ..model.model import Model
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state, unknown_name
+from ..numerics.lambdified import numpy_function
 
 _RANK_TOLERANCE = 1e-9
 _RESIDUAL_TOLERANCE = 1e-8
@@ -139,15 +140,20 @@ def _configuration(model: Model, state: State, known: Mapping) -> tuple[np.ndarr
     if unknown:
         raise ModelError(f"parameter '{unknown[0]}' has no value; give one",
                          field=f"parameters.{unknown[0]}")
-    residual = sp.lambdify([symbols], list(phi), "numpy")
-    jacobian = sp.lambdify([symbols], phi.jacobian([symbols[i] for i in free]), "numpy")
+    residual_of = numpy_function(symbols, list(phi))
+    jacobian_of = numpy_function(symbols, list(phi.jacobian([symbols[i] for i in free])))
+
+    def residual(q):
+        return np.array(residual_of(*q), dtype=float)
+
     for _ in range(50):
-        r = np.array(residual(q), dtype=float)
+        r = residual(q)
         if np.abs(r).max() < 1e-13:
             break
-        step, *_ = np.linalg.lstsq(np.array(jacobian(q), dtype=float), -r, rcond=None)
+        jacobian = np.array(jacobian_of(*q), dtype=float).reshape(len(r), len(free))
+        step, *_ = np.linalg.lstsq(jacobian, -r, rcond=None)
         q[free] += step
-    if np.abs(np.array(residual(q), dtype=float)).max() > 1e-9:
+    if np.abs(residual(q)).max() > 1e-9:
         raise ModelError("the constraints cannot be satisfied with the coordinates given; "
                          "give a configuration the mechanism can take", field="configuration")
     return q, tuple(model.coordinates[i].name for i in free)

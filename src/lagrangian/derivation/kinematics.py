@@ -57,7 +57,13 @@ class Differentiator:
         if expr.is_Pow:
             base, exponent = expr.args
             if x not in self.free_symbols(exponent):
-                return exponent * base ** (exponent - 1) * self(base, x)
+                inner = self(base, x)
+                if inner.is_Add:
+                    # sqrt(u) with u = (x1 - x2)^2 + ...: 1/2 * (2 x1 - 2 x2) is written
+                    # (x1 - x2), not (2*x1 - 2*x2)/2 (sympy spreads a number over a sum).
+                    content, inner = inner.primitive()
+                    return exponent * content * base ** (exponent - 1) * inner
+                return exponent * base ** (exponent - 1) * inner
         elif isinstance(expr, sp.sin):
             return sp.cos(expr.args[0]) * self(expr.args[0], x)
         elif isinstance(expr, sp.cos):
@@ -83,7 +89,10 @@ class Differentiator:
         velocity-product (centripetal, Coriolis) and explicit-time part of the acceleration.
         """
         present = self.free_symbols(expr)
-        terms = [self(expr, qi) * vi for qi, vi in zip(q, q_dot, strict=True) if qi in present]
+        # Distributed over each partial derivative that is a sum, so a velocity-product term
+        # stays a sum of products (which the trig identities work on term by term).
+        terms = [term * vi for qi, vi in zip(q, q_dot, strict=True) if qi in present
+                 for term in sp.Add.make_args(self(expr, qi))]
         if t in present:
             terms.append(self(expr, t))
         return sp.Add(*terms)

@@ -151,10 +151,18 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
         rest = [time_rate(v, q, q_dot, t) for v in velocity]
         acc.inertia(mass, jacobian, rest)
         varying_inertia(mass, jacobian, velocity)
-        # T = 1/2 q_dot^T M q_dot (from the tidied M) + what a moving support adds.
+        # T = 1/2 q_dot^T M q_dot (from the tidied M) + what a moving support adds,
+        # m (J q_dot).r_t + 1/2 m r_t.r_t, tidied like M (sin^2 + cos^2 of a spin angle).
+        half = parts(sp.Rational(1, 2))
+        items = []
         for v, r_t in zip(velocity, moving, strict=True):
-            if r_t != 0:
-                kinetic_terms.append(mass * (v - r_t) * r_t + sp.Rational(1, 2) * mass * r_t**2)
+            if r_t == 0:
+                continue
+            moved = [parts(y) for y in sp.Add.make_args(r_t)]
+            items += [product(parts(x), y) for x in sp.Add.make_args(v - r_t) for y in moved]
+            items += [product(half, product(x, y)) for x in moved for y in moved]
+        if items:
+            kinetic_terms.extend(mass * term for term in combined_terms(items))
 
     for particle in model.particles:
         translate(particle.mass, particle.position)
@@ -188,11 +196,17 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
     user_lagrangian = model.kinetic_energy - model.potential_energy
     if user_lagrangian != 0:
         _general_lagrangian(acc, d, user_lagrangian, q, q_dot, t)
-    spring_potential = sp.Add(*spring_terms)
-    if spring_potential != 0:
-        for i, gradient in enumerate(jacobian_row(spring_potential, q)):
-            if gradient != 0:
-                acc.add_force(i, -gradient)
+    for spring in model.springs:
+        # -dV/dq_i of V = 1/2 k s^2 (s = length - rest length), in the textbook form
+        # -k s ds/dq_i (and -1/2 dk/dq_i s^2 for a stiffness that depends on q).
+        stretch = spring.length - spring.rest_length
+        for i, (rate, stiffening) in enumerate(zip(jacobian_row(stretch, q),
+                                                    jacobian_row(spring.stiffness, q),
+                                                    strict=True)):
+            if rate != 0:
+                acc.add_force(i, -spring.stiffness * stretch * rate)
+            if stiffening != 0:
+                acc.add_force(i, -stiffening * stretch**2 / 2)
 
     contributions = load_contributions(model)
     Q = generalized_forces(model, contributions)

@@ -67,7 +67,7 @@ def build(item: Parts) -> sp.Expr:
 
 def combined_terms(items: Iterable[Parts]) -> list[sp.Expr]:
     """Decomposed terms with the identities above applied between them (a list of terms)."""
-    items = list(items)
+    items = _pythagorean(list(items))
     index: dict[Parts, list[int]] = defaultdict(list)
     for k, item in enumerate(items):
         index[item].append(k)
@@ -99,6 +99,40 @@ def combined_terms(items: Iterable[Parts]) -> list[sp.Expr]:
             combined.append(replacement)
     combined.extend(build(item) for item, done in zip(items, used, strict=True) if not done)
     return combined
+
+
+def _pythagorean(items: list[Parts]) -> list[Parts]:
+    """c X sin(a)^2 + c X cos(a)^2 -> c X where X holds other sines and cosines too (a point
+    spinning about an axis: sin^2(Omega t) + cos^2(Omega t)), repeated while pairs are found.
+    Terms with two trig factors are left to the pair rules of combined_terms."""
+    while True:
+        index: dict[Parts, list[int]] = defaultdict(list)
+        for k, item in enumerate(items):
+            index[item].append(k)
+        used = [False] * len(items)
+        merged = []
+        for k, (coefficient, rest, sins, coss) in enumerate(items):
+            if used[k] or len(sins) + len(coss) <= 2:
+                continue
+            for a in dict.fromkeys(sins):
+                if sins.count(a) < 2:
+                    continue
+                fewer = _without_pair(sins, a)
+                partner = _take(index, (coefficient, rest, fewer, _merge(coss, (a, a))), used, k)
+                if partner is not None:
+                    used[k] = used[partner] = True
+                    merged.append((coefficient, rest, fewer, coss))
+                    break
+        if not merged:
+            return items
+        items = merged + [item for item, done in zip(items, used, strict=True) if not done]
+
+
+def _without_pair(factors: tuple, a: sp.Expr) -> tuple:
+    out = list(factors)
+    out.remove(a)
+    out.remove(a)
+    return tuple(out)
 
 
 # Chains meet the same pairs again for every body further out: build each result once.

@@ -48,8 +48,10 @@ def point_force_projection(load: PointForce, q) -> list[sp.Expr]:
 
 
 def damper_forces(damper: Damper, q_dot) -> list[sp.Expr]:
-    """Q_i = -dD/dq_dot_i with D = 1/2 c rate^2."""
-    return [-damper.coefficient * damper.rate * d for d in jacobian_row(damper.rate, q_dot)]
+    """Q_i = -dD/dq_dot_i = -c rate d(rate)/dq_dot_i with D = 1/2 c rate^2."""
+    # rate * d(rate) first: for a rate (a - b).(a_dot - b_dot)/|a - b| the two 1/|a - b|
+    # factors then meet and cancel against (a - b)^2 (c * rate * d leaves the quotient).
+    return [-damper.coefficient * (damper.rate * d) for d in jacobian_row(damper.rate, q_dot)]
 
 
 def generalized_forces(model: Model, contributions: list[LoadContribution]) -> list[sp.Expr]:

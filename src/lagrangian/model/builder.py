@@ -268,7 +268,11 @@ class ModelBuilder:
             value = self.expression(rate, f"{field}.rate")
         else:
             extent, ends = self._extent(None, between, "rate", field)
-            value = self._time_derivative(extent)
+            # d|a - b|/dt = (a - b).(a_dot - b_dot) / |a - b|: a 1-D chain gets x1_dot - x2_dot
+            # instead of the derivative of sqrt((x1 - x2)^2).
+            a, b = ends[0].point, ends[1].point
+            value = sp.Add(*((ai - bi) * self._time_derivative(ai - bi)
+                             for ai, bi in zip(a, b, strict=True) if ai != bi)) / extent
         self._dampers.append(
             Damper(name, self.expression(coefficient, f"{field}.coefficient", velocities=False),
                    value, ends)

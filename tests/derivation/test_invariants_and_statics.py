@@ -162,3 +162,41 @@ holonomic = "(x - r*cos(theta))^2 + (r*sin(theta))^2 - l^2"
     s = symbols(model)
     assert not eom.has_inertia
     assert sp.expand(eom.static_conditions[1] + s["k"] * (s["x"] - s["x0"])) == 0
+
+
+def test_time_dependence_at_rest_is_decided_by_value():
+    model = parse_model("""
+[coordinates]
+x = "m"
+[parameters]
+m = 1.0
+k = 4.0
+W = 3.0
+[energy]
+T = "m*x_dot^2/2"
+V = "k*(sin(W*t)^2 + cos(W*t)^2)*x^2/2 + x*t*x_dot"
+""")
+    eom = derive(model)
+    assert model.time in eom.forcing[0].free_symbols  # t is there by form ...
+    assert eom.rest_is_time_invariant  # ... but not by value
+    assert not eom_of("support_pendulum").rest_is_time_invariant
+    assert eom_of("bead_on_hoop").rest_is_time_invariant
+    # V = x t x_dot is a generalized potential with explicit t: h changes by -dL/dt = x x_dot
+    assert eom.invariant_kind == "work_balance"
+
+
+def test_an_identity_in_t_is_no_explicit_time_for_the_invariant():
+    model = parse_model("""
+[coordinates]
+x = "m"
+[parameters]
+m = 1.0
+k = 4.0
+W = 3.0
+[energy]
+T = "m*x_dot^2/2"
+V = "k*(1 + sin(2*W*t) - 2*sin(W*t)*cos(W*t))*x^2/2"
+""")
+    eom = derive(model)
+    assert eom.power != 0  # by form
+    assert eom.invariant_kind == "energy"  # by value

@@ -122,9 +122,13 @@ class EquationsOfMotion:
     def invariant_kind(self) -> str:
         """'energy' (T + V is conserved), 'jacobi_integral' (h is, while T + V is not) or
         'work_balance' (h changes by the work of the loads: h(t) - h(0) - int P dt = 0)."""
-        if sp.expand(self.power) != 0:
+        from .regularity import vanishes
+
+        # By value, not by form: sin^2(Omega t) + cos^2(Omega t) left in L is no explicit t.
+        if sp.expand(self.power) != 0 and not vanishes(self.power, self.model):
             return "work_balance"
-        if sp.expand(self.jacobi_integral - self.kinetic_energy - self.potential_energy) == 0:
+        difference = self.jacobi_integral - self.kinetic_energy - self.potential_energy
+        if sp.expand(difference) == 0 or vanishes(difference, self.model):
             return "energy"
         return "jacobi_integral"
 
@@ -148,6 +152,16 @@ class EquationsOfMotion:
         M = self.mass_matrix
         return tuple(c.name for i, c in enumerate(self.model.coordinates)
                      if all(M[i, j] == 0 for j in range(M.cols)))
+
+    @cached_property
+    def rest_is_time_invariant(self) -> bool:
+        """Whether M and f at rest (q_dot = 0) do not change with t, decided by value at random
+        states and several times (a rotating frame written with Omega t may still be)."""
+        from .regularity import independent_of_time
+
+        rest = {v: sp.S.Zero for v in self.model.q_dot}
+        return independent_of_time([*self.mass_matrix, *(f.xreplace(rest) for f in self.forcing)],
+                                   self.model)
 
     @cached_property
     def static_conditions(self) -> sp.ImmutableMatrix:

@@ -167,3 +167,57 @@ def require_inertia(eom, what: str) -> None:
             f"{listed} (a statics model: derive, forces, equilibria, check and statics work "
             "without it)"
         )
+
+
+def vanishes(expr: sp.Expr, model: Model, samples: int = 4) -> bool:
+    """expr == 0 at random states, parameters, times and multipliers (a probabilistic identity
+    test: a nonzero analytic expression is almost never zero at a random point); False where
+    it cannot be evaluated."""
+    if expr == 0:
+        return True
+    others = sorted(expr.free_symbols, key=str)
+    scale = 0.0
+    values = []
+    for seed in range(samples):
+        point = _random_point(model, others, seed=1000 + seed)
+        try:
+            values.append(_Evaluator(point)(expr))
+            scale = max(scale, *(abs(float(v)) for v in point.values()))
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+            return False
+    return all(abs(v) <= 1e-9 * max(1.0, scale) for v in values)
+
+
+def independent_of_time(exprs, model: Model, samples: int = 3) -> bool:
+    """Each expression takes the same value at several times for random other values: it does
+    not change with t, whatever its form (sin^2(Omega t) + cos^2(Omega t) does not)."""
+    t = model.time
+    if not any(t in e.free_symbols for e in exprs):
+        return True
+    for seed in range(samples):
+        point = _random_point(model, set().union(*(e.free_symbols for e in exprs)),
+                              seed=2000 + seed)
+        try:
+            seen = []
+            for time in (0.0, 0.37, 1.9, 7.3):
+                point[t] = sp.Float(time)
+                evaluate = _Evaluator(point)
+                seen.append([evaluate(e) for e in exprs])
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+            return False
+        reference = seen[0]
+        for row in seen[1:]:
+            for a, b in zip(reference, row, strict=True):
+                if abs(a - b) > 1e-9 * max(1.0, abs(a), abs(b)):
+                    return False
+    return True
+
+
+def _random_point(model: Model, symbols, seed: int) -> dict[sp.Symbol, sp.Float]:
+    """Random values for every symbol (parameters too: an identity must hold for all values)."""
+    rng = random.Random(seed)
+    point = {s: sp.Float(rng.uniform(0.4, 1.6)) for s in sorted(symbols, key=str)}
+    for c in model.coordinates:
+        point[c.symbol] = sp.Float(rng.uniform(-1.3, 1.3))
+        point[c.velocity] = sp.Float(rng.uniform(-1.0, 1.0))
+    return point

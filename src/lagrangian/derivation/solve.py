@@ -16,6 +16,7 @@ import random
 import time
 from dataclasses import dataclass
 
+import numpy as np
 import sympy as sp
 from sympy.polys.domains import ZZ
 from sympy.polys.rings import PolyRing, sring
@@ -207,6 +208,12 @@ def _verified(mass_matrix, forcing, jacobian, gamma, solution) -> bool:
         try:
             M = sp.Matrix(mass_matrix.xreplace(values)).evalf()
             f = sp.Matrix(forcing.xreplace(values)).evalf()
+            kkt = sp.Matrix(sp.BlockMatrix([[M, jacobian.T], [jacobian, sp.zeros(m, m)]])) \
+                if m else M
+            # A pivot that is zero only through sin^2 + cos^2 = 1 leaves a matrix that is
+            # singular in value: the residual test alone would accept 1/(1e-17).
+            if np.linalg.cond(np.array(kkt.xreplace(values).evalf(), dtype=complex)) > 1e10:
+                return False
             a = sp.Matrix([v.xreplace(values) for v in solution]).evalf()
             residual = f - M * a
             scale = max([abs(complex(x)) for x in (*f, *(M * a))] + [1e-300])

@@ -9,12 +9,15 @@ Every figure is the best wall time of --repeat runs (default 3):
 - "CLI" columns: `python -m lagrangian derive FILE --format F > /dev/null` in a fresh process:
   interpreter start-up, imports, reading the file, the derivation, the symbolic accelerations
   (attempted under their budget), formatting and writing the output.
-- "in-process": the same steps after the imports (read, derive, format one format), in one
-  already-running Python process, so start-up is excluded.
+- "read", "derive", "text": the same steps after the imports, timed one by one in a fresh
+  process: reading the file (which builds the unit registry), the derivation (mass matrix,
+  forcing, generalized forces, constraint terms, the regularity check), and the text output
+  (which includes the symbolic accelerations, attempted under their budget).
 - "Kane": sympy.physics.mechanics.models.n_link_pendulum_on_cart(n) (KanesMethod, the same
   model, links from the upward vertical, a force on the cart) in a fresh process; "in-process"
   is the call alone (it forms kanes_equations, the mass matrix and forcing), "process" adds
   start-up and `import sympy.physics.mechanics`. Kane prints nothing; ours prints everything.
+  "Kane call/derive" compares the derivations alone; "Kane proc/CLI text" whole processes.
 
 Before timing, our accelerations M^-1 f (from the model file) are checked to equal Kane's
 (mass_matrix_full, forcing_full with u = q_dot) at a random state for n = 1, 2 and 5.
@@ -46,14 +49,17 @@ from lagrangian.output.derivation import derivation_text, derivation_document, d
 import json
 path, fmt = sys.argv[1], sys.argv[2]
 start = time.perf_counter()
-eom = derive(read_model(path))
+model = read_model(path)
+read = time.perf_counter()
+eom = derive(model)
+derived = time.perf_counter()
 if fmt == "json":
     out = json.dumps(derivation_document(eom), indent=2)
 elif fmt == "latex":
     out = derivation_latex(eom)
 else:
     out = derivation_text(eom)
-print(time.perf_counter() - start)
+print(read - start, derived - read, time.perf_counter() - derived)
 """
 
 _KANE = r"""
@@ -83,10 +89,13 @@ def cli_time(path: Path, fmt: str, repeat: int) -> float:
     return _best(times)
 
 
-def in_process_time(path: Path, fmt: str, repeat: int) -> float:
-    return _best([float(subprocess.run([sys.executable, "-c", _IN_PROCESS, str(path), fmt],
-                                       capture_output=True, text=True, check=True).stdout)
-                  for _ in range(repeat)])
+def in_process_times(path: Path, fmt: str, repeat: int) -> tuple[float, float, float]:
+    """(read the file, derive, format) seconds after the imports, each the best of ``repeat``
+    fresh processes (reading includes building the unit registry)."""
+    runs = [[float(x) for x in subprocess.run(
+        [sys.executable, "-c", _IN_PROCESS, str(path), fmt], capture_output=True, text=True,
+        check=True).stdout.split()] for _ in range(repeat)]
+    return tuple(min(run[k] for run in runs) for k in range(3))
 
 
 def kane_times(n: int, repeat: int) -> tuple[float, float]:
@@ -160,31 +169,34 @@ def main() -> None:
             print(f"check n={n}: our accelerations equal KanesMethod's: {agree(n, folder)}")
         print("\nn-link pendulum on a cart (sympy n_link_pendulum_on_cart)")
         header = (f"{'n':>3} | {'CLI text':>8} {'CLI json':>8} {'CLI latex':>9} | "
-                  f"{'in-proc text':>12} | {'Kane call':>9} {'Kane proc':>9} | "
-                  f"{'Kane call / ours in-proc':>24}")
+                  f"{'read':>6} {'derive':>7} {'text':>6} | {'Kane call':>9} {'Kane proc':>9} | "
+                  f"{'Kane call/derive':>16} {'Kane proc/CLI text':>18}")
         print(header + "\n" + "-" * len(header))
         for n in sizes(args.cart):
             path = folder / f"cart_{n}.toml"
             path.write_text(model_files.n_link_pendulum_on_cart(n))
             cli = {fmt: cli_time(path, fmt, args.repeat) for fmt in FORMATS}
-            inner = in_process_time(path, "text", args.repeat)
+            read, derived, text = in_process_times(path, "text", args.repeat)
             call, process = kane_times(n, args.repeat)
-            results["cart"].append({"n": n, "cli": cli, "in_process_text": inner,
-                                    "kane_call": call, "kane_process": process})
+            results["cart"].append({"n": n, "cli": cli, "read": read, "derive": derived,
+                                    "format_text": text, "kane_call": call,
+                                    "kane_process": process})
             print(f"{n:>3} | {cli['text']:>8.2f} {cli['json']:>8.2f} {cli['latex']:>9.2f} | "
-                  f"{inner:>12.3f} | {call:>9.3f} {process:>9.2f} | {call / inner:>23.1f}x",
-                  flush=True)
+                  f"{read:>6.3f} {derived:>7.3f} {text:>6.3f} | {call:>9.3f} {process:>9.2f} | "
+                  f"{call / derived:>15.1f}x {process / cli['text']:>17.2f}x", flush=True)
         print("\nn-link pendulum")
-        header = f"{'n':>3} | {'CLI text':>8} {'CLI json':>8} {'CLI latex':>9} | {'in-proc text':>12}"
+        header = (f"{'n':>3} | {'CLI text':>8} {'CLI json':>8} {'CLI latex':>9} | "
+                  f"{'read':>6} {'derive':>7} {'text':>6}")
         print(header + "\n" + "-" * len(header))
         for n in sizes(args.chain):
             path = folder / f"chain_{n}.toml"
             path.write_text(model_files.n_link_pendulum(n))
             cli = {fmt: cli_time(path, fmt, args.repeat) for fmt in FORMATS}
-            inner = in_process_time(path, "text", args.repeat)
-            results["chain"].append({"n": n, "cli": cli, "in_process_text": inner})
+            read, derived, text = in_process_times(path, "text", args.repeat)
+            results["chain"].append({"n": n, "cli": cli, "read": read, "derive": derived,
+                                     "format_text": text})
             print(f"{n:>3} | {cli['text']:>8.2f} {cli['json']:>8.2f} {cli['latex']:>9.2f} | "
-                  f"{inner:>12.3f}", flush=True)
+                  f"{read:>6.3f} {derived:>7.3f} {text:>6.3f}", flush=True)
     print(f"\nload average {os.getloadavg()[0]:.2f} at the end")
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1))

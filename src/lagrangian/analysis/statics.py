@@ -19,6 +19,7 @@ import sympy as sp
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
 from ..model.model import Model
+from ..model.units import generalized_force_unit
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state, unknown_name
 from ..numerics.lambdified import numpy_function
 
@@ -41,6 +42,7 @@ class StaticsReport:
     reactions: dict[str, float]
     shares: tuple[tuple[str, str, float], ...]
     units: dict[str, str]
+    force_units: dict[str, str]
     residual: float
 
     def _repr_latex_(self) -> str:
@@ -124,7 +126,9 @@ def solve_statics(
     shares = _shares(eom, values, reactions, jacobian)
     configuration = {c.name: float(v) for c, v in zip(model.coordinates, q, strict=True)}
     units = {name: _unit(model, name) for name in unknowns}
-    return StaticsReport(configuration, found, solved, reactions, shares, units, residual)
+    force_units = {c.name: generalized_force_unit(c.unit) for c in model.coordinates}
+    return StaticsReport(configuration, found, solved, reactions, shares, units, force_units,
+                         residual)
 
 
 def _configuration(model: Model, state: State, known: Mapping) -> tuple[np.ndarray, tuple]:

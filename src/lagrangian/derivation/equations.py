@@ -106,14 +106,19 @@ class EquationsOfMotion:
         return sp.Add(*(v * L.diff(v) for v in q_dot if v in L.free_symbols)) - L
 
     @cached_property
+    def explicit_time_power(self) -> sp.Expr:
+        """-dL/dt (W): what explicit time in L (a moving support, I(t)) adds to dh/dt."""
+        t = self.model.time
+        return -self.lagrangian.diff(t) if t in self.lagrangian.free_symbols else sp.S.Zero
+
+    @cached_property
     def power(self) -> sp.Expr:
         """dh/dt along a motion (W): sum Q_i q_dot_i of the non-potential loads (dampers and
         dissipation included) - dL/dt (explicit time) + lambda . b of constraints that move
         (Phi_q q_dot + b = 0); in the multiplier symbols where there are constraints."""
-        q_dot, t = self.model.q_dot, self.model.time
+        q_dot = self.model.q_dot
         terms = [Q * v for Q, v in zip(self.generalized_forces, q_dot, strict=True) if Q != 0]
-        if t in self.lagrangian.free_symbols:
-            terms.append(-self.lagrangian.diff(t))
+        terms.append(self.explicit_time_power)
         terms += [lam * b for lam, b in zip(self.multipliers, self.velocity_bias, strict=True)
                   if b != 0]
         return sp.Add(*terms)

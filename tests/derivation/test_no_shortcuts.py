@@ -235,18 +235,23 @@ def random_models(draw):
     for name, value in PARAMETERS.items():
         b.parameter(name, value)
 
+    # planar models with bodies, or 3D ones of particles only (a body is planar)
+    dimension = draw(st.sampled_from([2, 2, 3]))
+
     def position():  # each component moves with q (a load needs a moving point)
         return [" + ".join([draw(st.sampled_from(TERMS[:-2]))]
                            + draw(st.lists(st.sampled_from(TERMS), max_size=1)))
-                for _ in range(2)]
+                for _ in range(dimension)]
 
     if draw(st.booleans()):
-        b.set_gravity("g", draw(st.sampled_from([(0, -1), (1, -2)])))
-    points: list[object] = [[0, 0]]
+        directions = [(0, -1), (1, -2), ("sin(a)", "-cos(a)")] if dimension == 2 else \
+            [(0, 0, -1), (1, "b", -2)]
+        b.set_gravity("g", draw(st.sampled_from(directions)))
+    points: list[object] = [[0] * dimension]
     for i in range(draw(st.integers(1, 2))):
         b.add_particle(f"p{i}", draw(st.sampled_from(MASSES)), position())
         points.append(f"p{i}")
-    for i in range(draw(st.integers(0, 1))):
+    for i in range(draw(st.integers(0, 1 if dimension == 2 else 0))):
         b.add_body(f"b{i}", draw(st.sampled_from(MASSES)), draw(st.sampled_from(INERTIAS)),
                    position(), draw(st.sampled_from(ANGLES)))
         points.append({"body": f"b{i}", "offset": [draw(st.sampled_from(["a", "0.5"])), "c"]})
@@ -268,7 +273,7 @@ def random_models(draw):
     for i in range(draw(st.integers(0, 2))):
         if draw(st.booleans()):
             point = draw(st.sampled_from(points[1:]))
-            force = [draw(st.sampled_from(FORCE_TERMS)) for _ in range(2)]
+            force = [draw(st.sampled_from(FORCE_TERMS)) for _ in range(dimension)]
             b.add_force(f"f{i}", point, force)
         else:
             b.add_torque(f"tau{i}", draw(st.sampled_from(FORCE_TERMS)),

@@ -159,6 +159,7 @@ def main() -> None:
     parser.add_argument("--chain", default="1-30", help="n of the plain n-link pendulum")
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--json", help="also write the measurements to this file")
+    parser.add_argument("--markdown", help="also write the tables of docs/benchmarks.md here")
     args = parser.parse_args()
     results: dict[str, list] = {"cart": [], "chain": []}
     print(f"python {sys.version.split()[0]}, {os.cpu_count()} cores, "
@@ -200,6 +201,29 @@ def main() -> None:
     print(f"\nload average {os.getloadavg()[0]:.2f} at the end")
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1))
+    if args.markdown:
+        Path(args.markdown).write_text(markdown(results))
+
+
+def markdown(results: dict) -> str:
+    """The two tables of docs/benchmarks.md."""
+    lines = ["| n | CLI text (s) | CLI JSON (s) | CLI LaTeX (s) | read / derive / text in-process (s) "
+             "| KanesMethod call (s) | KanesMethod process (s) | Kane call ÷ our derive "
+             "| Kane process ÷ our CLI text |", "|---" * 9 + "|"]
+    for row in results["cart"]:
+        cli = row["cli"]
+        lines.append(f"| {row['n']} | {cli['text']:.2f} | {cli['json']:.2f} | {cli['latex']:.2f} "
+                     f"| {row['read']:.3f} / {row['derive']:.3f} / {row['format_text']:.3f} "
+                     f"| {row['kane_call']:.3f} | {row['kane_process']:.2f} "
+                     f"| {row['kane_call'] / row['derive']:.0f}× "
+                     f"| {row['kane_process'] / cli['text']:.1f}× |")
+    lines += ["", "| n | CLI text (s) | CLI JSON (s) | CLI LaTeX (s) "
+              "| read / derive / text in-process (s) |", "|---" * 5 + "|"]
+    for row in results["chain"]:
+        cli = row["cli"]
+        lines.append(f"| {row['n']} | {cli['text']:.2f} | {cli['json']:.2f} | {cli['latex']:.2f} "
+                     f"| {row['read']:.3f} / {row['derive']:.3f} / {row['format_text']:.3f} |")
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":

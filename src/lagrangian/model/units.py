@@ -41,32 +41,41 @@ def unit_syntax_problem(text: str) -> str | None:
         return f"a unit is at most {MAX_UNIT_LENGTH} characters long"
     tokens = []
     position = 0
-    stripped = text.rstrip()
+    stripped = _pint_text(text).rstrip()
     while position < len(stripped):
         match = _UNIT_TOKEN.match(stripped, position)
         if match is None or match.end() == position:
-            return None  # pint reports characters it does not know as an unknown unit
+            return f"{stripped[position:].lstrip()[:1]!r} cannot appear in a unit"
         tokens.append((match.lastgroup, match.group(match.lastgroup)))
         position = match.end()
-    depth = 0
+    powered = [False]  # per open parenthesis: does the group hold a power already?
     index = 0
     while index < len(tokens):
         kind, value = tokens[index]
         if kind == "op" and value == "(":
-            depth += 1
-            if depth > 20:
+            powered.append(False)
+            if len(powered) > 20:
                 return "the unit is nested too deeply"
-        elif kind == "op" and value == ")":
-            depth -= 1
+        elif kind == "op" and value == ")" and len(powered) > 1:
+            inner = powered.pop()
+            powered[-1] = powered[-1] or inner
+            if inner and tokens[index + 1:index + 2] == [("op", "**")]:
+                return "powers of powers are not allowed in a unit"
         elif kind == "number" and not float(value) < 1e300:
             return f"the number {value} is too large"
-        elif kind == "op" and value in ("^", "**"):
+        elif kind == "op" and value == "**":
             index, problem = _unit_exponent(tokens, index + 1)
             if problem:
                 return problem
+            powered[-1] = True
             continue
         index += 1
     return None
+
+
+def _pint_text(text: str) -> str:
+    """A unit string as the unit library reads it ('·' multiplies, '^' raises)."""
+    return text.replace("^", "**").replace("·", "*")
 
 
 def _unit_exponent(tokens, index):
@@ -92,7 +101,7 @@ def _unit_exponent(tokens, index):
         index += 1
     if any(abs(v) > MAX_UNIT_EXPONENT for v in values):
         return index, f"the power is too large (at most {MAX_UNIT_EXPONENT})"
-    if index < len(tokens) and tokens[index] in (("op", "^"), ("op", "**")):
+    if index < len(tokens) and tokens[index] == ("op", "**"):
         return index, "powers of powers are not allowed in a unit"
     return index, None
 
@@ -102,7 +111,7 @@ def _unit(text: str):
     if unit_syntax_problem(text):
         return None
     try:
-        return registry().Unit(text.replace("^", "**").replace("·", "*"))
+        return registry().Unit(_pint_text(text))
     except Exception:  # pint's parser raises many kinds (tokenize, syntax, lookup): all mean "not a unit"
         return None
 

@@ -9,7 +9,8 @@ built-in examples) and answer files read, and model files derived to JSON throug
 Each must be accepted, or refused with the project's own one-line error; a refusal should take
 under 1 s. Reports
 inputs tried, accepted, refusals by kind, failures (tracebacks, time-outs) with their input,
-the slowest refusal and the refusals over 1 s.
+the slowest refusal and the refusals over 1 s (each timed twice: a pause of the machine is not
+a slow refusal).
 """
 
 from __future__ import annotations
@@ -63,6 +64,7 @@ def campaign(inputs: int, minutes: float, progress: bool = True) -> dict:
     folder = Path(tempfile.mkdtemp(prefix="lagrangian-fuzz-"))
     tallies = {target: Tally() for target in TARGETS}
     slow: list[tuple[float, str, str]] = []
+    retimed: list[float] = []  # refusals over 1 s that took under 1 s when run again
     deadline = time.monotonic() + 60 * minutes
     started = time.monotonic()
 
@@ -103,7 +105,14 @@ def campaign(inputs: int, minutes: float, progress: bool = True) -> dict:
             print(f"FAILURE {target}: {outcome.status} {outcome.kind} {outcome.message[:300]} "
                   f"on {text[:1000]!r}", file=sys.stderr, flush=True)
         if outcome.status == "refused" and outcome.seconds > SLOW_REFUSAL:
-            slow.append((outcome.seconds, f"{target}: {text[:200]}", outcome.message[:200]))
+            # timed again at once: a pause of the machine (other work, garbage collection) is
+            # not a slow refusal
+            again = run_input(runner(target, text), TARGETS[target][1])
+            if again.seconds > SLOW_REFUSAL:
+                slow.append((min(outcome.seconds, again.seconds), f"{target}: {text[:200]}",
+                             outcome.message[:200]))
+            else:
+                retimed.append(outcome.seconds)
         total = sum(t.tried for t in tallies.values())
         if progress and total % 1000 == 0:
             failures = sum(len(t.failures) for t in tallies.values())
@@ -114,10 +123,10 @@ def campaign(inputs: int, minutes: float, progress: bool = True) -> dict:
         one()
     except _Stop:
         pass
-    return _report(tallies, slow, time.monotonic() - started)
+    return _report(tallies, slow, retimed, time.monotonic() - started)
 
 
-def _report(tallies: dict[str, Tally], slow, seconds: float) -> dict:
+def _report(tallies: dict[str, Tally], slow, retimed, seconds: float) -> dict:
     refusals: dict[str, int] = {}
     for tally in tallies.values():
         for kind, count in tally.refusals.items():
@@ -139,6 +148,8 @@ def _report(tallies: dict[str, Tally], slow, seconds: float) -> dict:
         "slowest_accept": {"seconds": round(slowest_accept[0], 3), "input": slowest_accept[1]},
         "refusals_over_1s": [{"seconds": round(s, 3), "input": i, "message": m}
                              for s, i, m in sorted(slow, reverse=True)[:20]],
+        "refusals_over_1s_only_once": {"count": len(retimed),
+                                       "max_seconds": round(max(retimed, default=0.0), 3)},
         "failure_examples": [{"target": target, "input": text[:2000], "what": what[:500]}
                              for tally in tallies.values()
                              for target, text, what in tally.failures[:10]],

@@ -207,6 +207,25 @@ def linear_model_at(
     )
 
 
+def is_statically_stable(functions: StaticFunctions, q0: np.ndarray, multipliers: np.ndarray,
+                         t: float = 0.0) -> bool:
+    """For a mechanism without inertia: a strict minimum of the potential on the constraints
+    (the stiffness K, reduced to the admissible displacements, positive definite)."""
+    values = functions.evaluate(np.asarray(q0, dtype=float), t)
+    stiffness = total_stiffness(values, multipliers)
+    kinds = [c.kind for c in functions.model.constraints]
+    holonomic = [i for i, k in enumerate(kinds) if k == "holonomic"]
+    velocity = [i for i, k in enumerate(kinds) if k != "holonomic"]
+    basis, _ = independent_basis(values["jacobian"][holonomic])
+    admissible = basis @ null_space(values["jacobian"][velocity] @ basis)
+    reduced = admissible.T @ stiffness @ admissible
+    symmetric = (reduced + reduced.T) / 2
+    if symmetric.size == 0:
+        return False
+    scale = max(float(np.abs(symmetric).max()), 1e-300)
+    return bool(np.all(np.linalg.eigvalsh(symmetric) > 1e-10 * scale))
+
+
 # -- inputs -------------------------------------------------------------------------------------
 
 

@@ -101,7 +101,9 @@ def solve_statics(
                                  "magnitude that virtual work can solve for", field="solve_for")
             A[i, j] = _real(coefficient)
         b[i] = -_real(condition.xreplace({x: 0 for x in columns}))
-    size = max(np.abs(A).max(initial=0.0), np.abs(b).max(initial=0.0), 1e-300)
+    # A coefficient of 6e-17 is cos(pi/2) in floating point, not a lever: compared with the
+    # other coefficients, and at least with 1 (SI magnitudes of real mechanisms are far above).
+    size = max(np.abs(A).max(initial=0.0), np.abs(b).max(initial=0.0), 1.0)
     idle = [unknowns[j] for j in range(len(unknowns))
             if np.abs(A[:, j]).max(initial=0.0) <= 1e-12 * size]
     if idle:

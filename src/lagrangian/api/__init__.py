@@ -8,6 +8,7 @@ from ..analysis.equilibria import Equilibria, Equilibrium
 from ..analysis.forces import ForceReport
 from ..analysis.linearization import LinearModel, SymbolicLinearModel
 from ..analysis.modes import ModalAnalysis, Mode
+from ..analysis.statics import StaticsReport
 from ..check.diagnose import CheckReport, Finding
 from ..check.newton_euler import CoordinateAgreement, CrosscheckReport, Reaction
 from ..check.units import UnitIssue, UnitsReport
@@ -53,6 +54,7 @@ __all__ = [
     "Reaction",
     "Simulation",
     "SimulationResult",
+    "StaticsReport",
     "SymbolicLinearModel",
     "UnitIssue",
     "UnitsReport",

@@ -18,15 +18,18 @@ from ..analysis.linearization import (
     LinearModel,
     SymbolicLinearModel,
     input_columns,
+    is_statically_stable,
     linear_model_at,
     symbolic_linear_model,
 )
 from ..analysis.modes import ModalAnalysis, is_stable, modal_analysis
+from ..analysis.statics import StaticsReport, solve_statics
 from ..check.diagnose import CheckReport, check_answer
 from ..check.newton_euler import CrosscheckReport, crosscheck
 from ..check.units import UnitsReport, check_model_units
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
+from ..derivation.regularity import require_inertia
 from ..model.answer import Answer, answer_from_mapping, read_answer
 from ..model.builder import ModelBuilder
 from ..model.examples import example_path
@@ -105,6 +108,16 @@ class System:
         """Each generalized force, and each load's part of it, at a configuration (SI)."""
         return evaluate_generalized_forces(self.equations_of_motion(), configuration, parameters)
 
+    def statics(
+        self, configuration: Mapping[str, float], solve_for: str | Sequence[str],
+        parameters: Mapping[str, float] | None = None,
+    ) -> StaticsReport:
+        """The load magnitudes (parameters ``solve_for``, entering Q linearly) that hold the
+        mechanism at rest at ``configuration`` (SI; coordinates not given follow the
+        constraints), by virtual work delta W = 0, with each load's share and the reactions."""
+        unknowns = [solve_for] if isinstance(solve_for, str) else list(solve_for)
+        return solve_statics(self.equations_of_motion(), configuration, unknowns, parameters)
+
     # -- simulation -------------------------------------------------------------------------------
 
     def simulate(
@@ -125,6 +138,7 @@ class System:
         the start time); ``stop_when`` is a condition such as "theta < 0" that ends the run.
         Constrained models are kept on Phi = 0 by projection (see docs/simulation.md).
         """
+        require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
         step_control = StepControl(method, rtol, atol)
         save_at = SaveAt(samples)
@@ -163,8 +177,11 @@ class System:
     def equilibria(self) -> Equilibria:
         """Configurations of rest, f(q, 0) = Phi_q^T lambda with Phi(q) = 0, each with its stability."""
         functions = self._static_functions
+        statics = not self.equations_of_motion().has_inertia
 
         def stable(q, multipliers) -> bool:
+            if statics:  # no inertia: stable where the potential has a minimum
+                return is_statically_stable(functions, q, multipliers)
             return is_stable(linear_model_at(functions, q, multipliers))
 
         return find_equilibria(functions, stability=stable)
@@ -188,6 +205,7 @@ class System:
 
     def modes(self, about: Mapping[str, float] | None = None) -> ModalAnalysis:
         """Natural frequencies (rad/s), damping ratios and mode shapes about an equilibrium."""
+        require_inertia(self.equations_of_motion(), "modes")
         return modal_analysis(self.linearize(about), self._model.name)
 
     # -- checking a hand derivation: check, crosscheck, check_units --------------------------------

@@ -142,6 +142,20 @@ def _require_free_bodies(model: Model) -> None:
             "[[particles]]/[[bodies]], e.g. the example 'ladder_pendulum')")
     if not model.particles and not model.bodies:
         raise DerivationError("Newton-Euler needs at least one particle or body")
+    # F = m a and M = I alpha hold for a constant mass and inertia only; Lagrange's equations
+    # of the printed L have m_dot and dm/dq terms that Newton-Euler would not reproduce.
+    changing = set(model.q) | {model.time}
+    for kind, item, quantity, value in (
+        *(("particle", p, "mass", p.mass) for p in model.particles),
+        *(("body", b, "mass", b.mass) for b in model.bodies),
+        *(("body", b, "inertia", b.inertia) for b in model.bodies),
+    ):
+        found = sorted(str(s) for s in value.free_symbols & changing)
+        if found:
+            raise DerivationError(
+                f"Newton-Euler (F = m a, M = I alpha) does not model {quantity} that changes "
+                f"with {found[0]}: the {quantity} of {kind} '{item.name}' is {value}, so "
+                "crosscheck cannot check this model (derive gives its Euler-Lagrange equations)")
 
 
 class _Clock:

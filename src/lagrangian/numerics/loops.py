@@ -61,7 +61,7 @@ def integrate_compiled(functions: NumericSystem, t_span: tuple[float, float], y0
         if result is None:
             return None
         t = np.asarray(result.t, dtype=float)
-        y = np.asarray(result.y, dtype=float).reshape(len(t), -1)
+        y = np.asarray(result.y, dtype=float).reshape(len(t), len(y_start))
         skip = 1 if ts and len(t) and t[0] == ts[-1][-1] else 0
         ts.append(t[skip:])
         ys.append(y[skip:])
@@ -92,6 +92,8 @@ def integrate_compiled(functions: NumericSystem, t_span: tuple[float, float], y0
                 bounds = np.unique(np.linspace(b, last, 51).round().astype(int))
                 pieces = list(zip(bounds[:-1], bounds[1:], strict=True))
         y_start = y[-1]
+    if not any(len(piece) for piece in ts):  # failed at the first step: keep the start
+        ts, ys = [grid[:1].astype(float)], [np.asarray(y0, dtype=float)[None, :]]
     return LoopRun(np.concatenate(ts), np.concatenate(ys), status, message, steps, nfev,
                    "compiled")
 

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from ..errors import ModelError
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+MAX_SAMPLES = 10_000_000  # about 1 GB of results for a small model
 
 
 @dataclass(frozen=True)
@@ -45,3 +46,7 @@ class SaveAt:
         if isinstance(self.samples, bool) or not isinstance(self.samples, int) or \
                 self.samples < 2:
             raise ModelError(f"samples must be at least 2, got {self.samples}", field="samples")
+        if self.samples > MAX_SAMPLES:
+            # refused up front: each sample holds q, q_dot, energy, power, ... (1e12 was 7 TiB)
+            raise ModelError(f"samples must be at most {MAX_SAMPLES:,}, got {self.samples:,}",
+                             field="samples")

@@ -105,7 +105,7 @@ def check_regularity(model: Model, mass_matrix: sp.MatrixBase, jacobian: sp.Matr
     if not (np.all(np.isfinite(M)) and np.all(np.isfinite(A))):
         return
     if m:
-        _check_constraints(model, A)
+        _check_constraints(model, A, jacobian)
         system = np.block([[M, A.T], [A, np.zeros((m, m))]])
     else:
         system = M
@@ -131,12 +131,21 @@ def _missing_message(missing: list[str]) -> str:
     )
 
 
-def _check_constraints(model: Model, A: np.ndarray) -> None:
+def _check_constraints(model: Model, A: np.ndarray, jacobian: sp.MatrixBase) -> None:
     kept: list[np.ndarray] = []
-    for constraint, row in zip(model.constraints, A, strict=True):
+    for index, (constraint, row) in enumerate(zip(model.constraints, A, strict=True)):
         candidate = np.array(kept + [row])
         if _rank(candidate) < len(candidate):
             others = ", ".join(c.name for c in model.constraints[: len(kept)]) or "none"
+            contradiction = _contradiction(model, jacobian, index) if np.any(row) else None
+            if contradiction is not None:
+                value, involved = contradiction
+                where = " and ".join(f"'{name}'" for name in involved)
+                raise DerivationError(
+                    f"inconsistent constraints: where {where} hold{'s' if len(involved) == 1 else ''}"
+                    f", '{constraint.name}' equals {value:.6g}, never 0; correct or remove one of "
+                    "them"
+                )
             if not np.any(row):
                 reason = "its Jacobian is zero"
             else:
@@ -146,6 +155,43 @@ def _check_constraints(model: Model, A: np.ndarray) -> None:
                 "remove it so that there is exactly one multiplier per independent constraint"
             )
         kept.append(row)
+
+
+def _contradiction(model: Model, jacobian: sp.MatrixBase, index: int
+                   ) -> tuple[float, list[str]] | None:
+    """The constant value of constraint ``index`` where those before it hold (and their
+    names), when the
+    constraints can never hold together (x - 1 = 0 and x - 2 = 0); None when it is merely
+    redundant.
+
+    Its Jacobian row is a combination a of theirs, so Phi_k - a . Phi has no gradient; when a
+    and that difference are the same at two random states, and the difference is not 0, Phi_k
+    equals that constant wherever the others are 0. Only constraints of one kind are compared
+    (a holonomic Phi and a velocity A q_dot + b are not the same kind of quantity).
+    """
+    constraints = model.constraints[: index + 1]
+    found = []
+    for seed in (12345, 54321):
+        values = random_state(model, seed)
+        try:
+            rows = numeric_matrix(jacobian[: index + 1, :], values)
+            evaluate = _Evaluator(values)
+            phi = np.array([evaluate(c.expression) for c in constraints])
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+            return None
+        if not (np.all(np.isfinite(rows)) and np.all(np.isfinite(phi))):
+            return None
+        combination = np.linalg.lstsq(rows[:index].T, rows[index], rcond=None)[0]
+        found.append((combination, float(phi[index] - combination @ phi[:index])))
+    (a1, c1), (a2, c2) = found
+    involved = [c for c, a in zip(constraints, a1, strict=False) if abs(a) > 1e-9]
+    if {c.kind for c in involved} != {constraints[index].kind}:
+        return None
+    scale = max(1.0, abs(c1), *(abs(v) for v in a1))
+    if np.allclose(a1, a2, rtol=1e-9, atol=1e-12) and abs(c1 - c2) <= 1e-9 * scale \
+            and abs(c1) > 1e-9 * scale:
+        return c1, [c.name for c in involved]
+    return None
 
 
 def _rank(matrix: np.ndarray) -> int:

@@ -1,22 +1,37 @@
-"""Which quantity a run should conserve, asked of the symbolic equations once per run.
+"""Which quantity a run should conserve, asked of the symbolic equations once per run, and
+the work that changes it.
 
-For now the total energy T + V: conserved when nothing dissipates, no non-conservative load
-acts and nothing depends on t explicitly. (A Jacobi integral or a work balance would cover
-more models; this is the one place to change.)
+The derivation decides (EquationsOfMotion.invariant_kind, by value): "energy" (T + V), the
+"jacobi_integral" h = q_dot . dL/dq_dot - L (conserved when L has no explicit t and no load does
+work: a rotating frame, a charged particle), or a "work_balance" h(t) - h(0) - int P dt = 0 with
+P the power of the loads that do work, dissipation, explicit time and moving constraints.
 """
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..derivation.equations import EquationsOfMotion
-from ..model.expressions import as_expression
+
+INVARIANTS = ("energy", "jacobi_integral", "work_balance")
+
+
+def invariant_kind(eom: EquationsOfMotion) -> str:
+    """'energy', 'jacobi_integral' or 'work_balance' (see the module docstring)."""
+    return eom.invariant_kind
 
 
 def energy_is_conserved(eom: EquationsOfMotion) -> bool:
-    """No dissipation, no non-conservative loads, no explicit time dependence."""
-    model = eom.model
-    t = model.time
-    if eom.dissipation != 0 or any(Q != 0 for Q in eom.generalized_forces):
-        return False
-    terms = [eom.kinetic_energy, eom.potential_energy, *eom.mass_matrix, *eom.forcing,
-             *(c.expression for c in model.constraints)]
-    return not any(t in as_expression(e).free_symbols for e in terms)
+    """T + V itself is conserved (the published ``energy_conserved``)."""
+    return eom.invariant_kind == "energy"
+
+
+def cumulative_work(t: np.ndarray, power: np.ndarray) -> np.ndarray:
+    """int_t0^t P dt at every sample (J): Simpson's rule on the saved samples (trapezoids for
+    fewer than three), so the balance closes to the integration and sampling accuracy."""
+    if len(t) < 3:
+        steps = np.diff(t) * (power[1:] + power[:-1]) / 2 if len(t) > 1 else np.zeros(0)
+        return np.concatenate([[0.0], np.cumsum(steps)])
+    from scipy.integrate import cumulative_simpson
+
+    return cumulative_simpson(power, x=t, initial=0.0)

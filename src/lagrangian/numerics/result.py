@@ -23,7 +23,12 @@ STATUS_MESSAGES = {
 @dataclass(frozen=True, repr=False)
 class SimulationResult:
     """Sampled trajectory t (s), q, q_dot, energy T + V (J), power of non-conservative loads
-    Q . q_dot (W), multipliers lambda and constraint residuals, with run statistics."""
+    Q . q_dot (W), multipliers lambda and constraint residuals, with run statistics.
+
+    ``invariant`` names the monitored quantity: "energy" (T + V), "jacobi_integral" (h, in
+    ``invariant_values``) or "work_balance" (h - h0 - ``work``, the work int P dt done on the
+    system by loads, dissipation, explicit time and moving constraints).
+    """
 
     model: Model
     coordinates: tuple[str, ...]
@@ -48,6 +53,9 @@ class SimulationResult:
     stop_when: str | None = None
     projected_initial_state: dict[str, tuple[float, float]] = field(default_factory=dict)
     kinetic_energy: np.ndarray | None = None
+    invariant: str = "energy"
+    invariant_values: np.ndarray | None = None
+    work: np.ndarray | None = None
 
     @property
     def model_name(self) -> str:
@@ -83,7 +91,42 @@ class SimulationResult:
         for i, name in enumerate(self.constraint_names):
             out[f"residual_{name}"] = self.residuals[:, i]
         out["power"] = self.power
+        if self.invariant == "jacobi_integral" and self.invariant_values is not None:
+            out["jacobi_integral"] = self.invariant_values
+        elif self.invariant == "work_balance" and self.balance is not None:
+            out["work_balance"] = self.balance
         return out
+
+    @property
+    def balance(self) -> np.ndarray | None:
+        """What should stay zero (J): I - I0 for a conserved I, h - h0 - int P dt for a work
+        balance; None before the quantity is known."""
+        values = self.invariant_values if self.invariant_values is not None else self.energy
+        if values is None or len(values) == 0:
+            return None
+        change = values - values[0]
+        if self.invariant == "work_balance":
+            if self.work is None:
+                return None
+            change = change - self.work
+        return change
+
+    @property
+    def invariant_drift(self) -> float | None:
+        """max |balance| relative to the size of the quantity (|I0|, or the largest T, or the
+        largest work done, whichever is largest where I0 is near 0)."""
+        balance = self.balance
+        if balance is None:
+            return None
+        values = self.invariant_values if self.invariant_values is not None else self.energy
+        scale = abs(float(values[0]))
+        others = [float(np.max(np.abs(x))) for x in (self.kinetic_energy, self.work)
+                  if x is not None and len(x)]
+        if others and scale <= 1e-9 * max(others):
+            scale = max(others)
+        if self.invariant == "work_balance" and others:
+            scale = max([scale, *others])
+        return float(np.max(np.abs(balance))) / scale if scale > 0 else 0.0
 
     @property
     def last_state(self) -> State:

@@ -22,7 +22,7 @@ from ..model.values import ParameterValues, State, resolve_parameters, resolve_s
 from .drift import DriftControl
 from .events import StopCondition, parse_stop_condition
 from .functions import NumericSystem, numeric
-from .invariants import energy_is_conserved
+from .invariants import cumulative_work, energy_is_conserved, invariant_kind
 from .lambdified import StateFunction
 from .loops import LoopRun, integrate_compiled, integrate_steps
 from .options import METHODS, SaveAt, StepControl
@@ -91,6 +91,7 @@ def simulate(
         residuals = functions.constraint_residual(q, q_dot, t)
     else:
         multipliers = residuals = np.zeros((len(t), 0))
+    kind, invariant, work = _invariant(eom, substitution, t, q, q_dot, energy, power, multipliers)
     return SimulationResult(
         model=model, coordinates=functions.coordinates,
         constraint_names=functions.constraint_names, parameters=dict(functions.parameters),
@@ -99,8 +100,29 @@ def simulate(
         steps=run.steps, nfev=run.nfev, wall_time=wall, backend=run.backend,
         energy_conserved=energy_is_conserved(eom), t_end=float(t_end),
         stop_when=stop.text if stop else None, projected_initial_state=projected,
-        kinetic_energy=kinetic,
+        kinetic_energy=kinetic, invariant=kind, invariant_values=invariant, work=work,
     )
+
+
+def _invariant(eom, substitution, t, q, q_dot, energy, power, multipliers):
+    """(kind, the monitored quantity on the samples, the work done on the system up to each
+    sample or None): T + V, the Jacobi integral h, or h with int P dt for a work balance, where
+    P = Q . q_dot - dL/dt + lambda . b (b: the velocity bias of moving constraints)."""
+    kind = invariant_kind(eom)
+    if kind == "energy":
+        return kind, energy, None
+    model = eom.model
+    values = StateFunction(model, [eom.jacobi_integral], substitution)(q, q_dot, t)[:, 0]
+    if kind == "jacobi_integral":
+        return kind, values, None
+    supplied = np.array(power, dtype=float)
+    if eom.explicit_time_power != 0:
+        supplied = supplied + StateFunction(model, [eom.explicit_time_power],
+                                            substitution)(q, q_dot, t)[:, 0]
+    if multipliers.shape[1] and any(b != 0 for b in eom.velocity_bias):
+        bias = StateFunction(model, eom.velocity_bias, substitution)(q, q_dot, t)
+        supplied = supplied + np.einsum("kc,kc->k", multipliers, bias)
+    return kind, values, cumulative_work(t, supplied)
 
 
 def _integrate(functions, y0, grid, step_control, event, drift, progress, compiled) -> LoopRun:

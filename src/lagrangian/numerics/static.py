@@ -13,6 +13,7 @@ import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import jacobian_row
+from ..derivation.regularity import independent_of_time
 from ..errors import ModelError
 from ..model.expressions import as_expression
 from ..model.values import ParameterValues, resolve_parameters
@@ -59,13 +60,18 @@ class StaticFunctions:
         mass = [_floats(as_expression(e).xreplace(values).xreplace(at_rest))
                 for e in eom.mass_matrix]
         rest = [*mass, *forcing_at_rest, *_flat(damping), *(e for _, e in static)]
-        if any(t in as_expression(e).free_symbols for e in rest):
+        by_form = any(t in as_expression(e).free_symbols for e in rest)
+        # Decided by value: t written as sin^2(Omega t) + cos^2(Omega t) changes nothing.
+        if by_form and not independent_of_time([as_expression(e) for e in rest], model):
             raise ModelError("the equations at rest depend on time t explicitly, so the model has "
                              "no fixed equilibrium to analyse", field="equilibria")
 
         entries = [*mass, *forcing_at_rest, *_flat(stiffness), *_flat(damping), *_flat(jacobian),
                    *_flat(_flat(hessians)), *(e for _, e in static), *_flat(static_jacobian)]
         entries = [as_expression(e) for e in entries]
+        if by_form:  # the same values at every t, so at t = 0
+            entries = [e.xreplace({t: sp.S.Zero}) for e in entries]
+            self.depends_on = self.depends_on - {t}
         self._layout = [("mass", (n, n)), ("forcing", (n,)), ("stiffness", (n, n)),
                         ("damping", (n, n)), ("jacobian", (m, n)), ("hessians", (m, n, n)),
                         ("static", (len(static),)), ("static_jacobian", (len(static), n))]

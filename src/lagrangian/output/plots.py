@@ -10,6 +10,7 @@ import numpy as np
 from ..errors import ModelError
 from ..numerics.result import SimulationResult
 from .files import atomic_write
+from .simulation import INVARIANT_WORDS
 
 PLOT_FORMATS = (".png", ".svg", ".pdf")
 
@@ -34,15 +35,27 @@ def time_history_figure(result: SimulationResult, units: dict[str, str] | None =
         ax.set_ylabel(f"coordinate ({unit})" if unit else "coordinate")
         ax.legend(loc="upper right", fontsize="small")
     ax = axes[len(groups)]
+    balance = result.balance
     if result.energy_conserved and len(result.energy):
         # Conserved: the change is what matters, so draw E - E0 rather than E near a big offset.
         ax.plot(result.t, result.energy - result.energy[0], color="black")
         ax.set_ylabel("E - E0 (J)")
         ax.set_title(f"energy T + V, E0 = {result.energy[0]:.6g} J, relative drift "
                      f"{result.energy_drift:.1e}", fontsize="small")
+    elif result.invariant == "jacobi_integral" and balance is not None and len(balance):
+        # h is what is conserved (T + V is not): draw h - h0.
+        ax.plot(result.t, balance, color="black")
+        ax.set_ylabel("h - h0 (J)")
+        ax.set_title(f"{INVARIANT_WORDS[result.invariant]}, relative drift "
+                     f"{result.invariant_drift:.1e}", fontsize="small")
     else:
+        # The energy changes (by the work of the loads): draw it, and say how well the work
+        # balance h - h0 - int P dt closes.
         ax.plot(result.t, result.energy, color="black")
         ax.set_ylabel("energy T + V (J)")
+        if result.invariant == "work_balance" and result.invariant_drift is not None:
+            ax.set_title(f"{INVARIANT_WORDS[result.invariant]}, relative drift "
+                         f"{result.invariant_drift:.1e}", fontsize="small")
     if np.any(result.power != 0):
         power_axis = ax.twinx()
         power_axis.plot(result.t, result.power, color="tab:red", linewidth=0.8)

@@ -7,6 +7,13 @@ import math
 
 from ..numerics.result import SimulationResult
 
+# What each monitored quantity is, in the text summary and the plot's title.
+INVARIANT_WORDS = {
+    "energy": "energy T + V",
+    "jacobi_integral": "Jacobi integral h = q_dot . dL/dq_dot - L",
+    "work_balance": "work balance h - h0 - int P dt",
+}
+
 
 def simulation_summary(result: SimulationResult) -> dict:
     """JSON-ready summary: final state, steps, wall time, drift, largest residual."""
@@ -29,6 +36,8 @@ def simulation_summary(result: SimulationResult) -> dict:
         "wall_time_s": result.wall_time,
         "energy_conserved": result.energy_conserved,
         "relative_energy_drift": result.energy_drift,
+        "invariant": result.invariant,
+        "relative_invariant_drift": result.invariant_drift,
         "max_constraint_residual": result.max_residual,
         "projected_initial_state": {
             name: {"given": given, "used": used}
@@ -54,6 +63,9 @@ def simulation_text(result: SimulationResult, written: dict[str, str]) -> str:
     lines.append(f"  final state: {state}")
     if result.energy_drift is not None:
         lines.append(f"  relative energy drift: {result.energy_drift:.2e}")
+    elif result.invariant_drift is not None:
+        lines.append(f"  {INVARIANT_WORDS[result.invariant]}, relative drift: "
+                     f"{result.invariant_drift:.2e}")
     if result.max_residual is not None:
         lines.append(f"  largest constraint residual: {result.max_residual:.2e}")
     for path in written.values():

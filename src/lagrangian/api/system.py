@@ -208,6 +208,48 @@ class System:
         require_inertia(self.equations_of_motion(), "modes")
         return modal_analysis(self.linearize(about), self._model.name)
 
+    # -- parameter studies and ensembles (Dask; see docs/sweeps.md) -------------------------------
+
+    def sweep(self, vary: Mapping[str, Sequence[float]] | None = None, compute: str = "modes", *,
+              sample: Mapping[str, str] | None = None, members: int = 0, seed: int = 0,
+              t_end: float | None = None, method: str = "DOP853", rtol: float = 1e-9,
+              atol: float = 1e-9, samples: int = 201, stop_when: str | None = None,
+              trajectories: bool = False, out: str | Path | None = None, resume: bool = False,
+              scheduler: str | None = None, client=None, workers: int | None = None,
+              chunk_size: int | None = None, progress=None):
+        """A parameter study or ensemble as an xarray Dataset, one dimension per varied name.
+
+        ``vary`` maps parameters (and, for ``compute="simulate"``, coordinates and velocities)
+        to their values (SI); ``compute`` is "modes" (frequency, damping_ratio, growth_rate,
+        stable about the equilibrium System.modes uses), "equilibria" (each one found and its
+        stability, along ``equilibrium``) or "simulate" (per member: final state, extremes,
+        energy drift, stop time; ``trajectories=True`` adds the states on the time grid).
+        ``sample`` draws ``members`` values per name from 'normal(mean, std)' or
+        'uniform(low, high)'. Runs on Dask: a LocalCluster of one process per core by default,
+        ``scheduler`` an address of a running one, ``client`` a dask Client. A failing point is
+        NaN with its reason in ``status``. With ``out`` (*.nc or *.zarr) the chunks are kept as
+        they finish and ``resume=True`` continues an interrupted study.
+        """
+        from ..analysis.sweep import SimulationOptions, make_study
+        from ..errors import ModelError
+        from .sweep import run_study
+
+        eom = self.equations_of_motion()
+        require_inertia(eom, "simulate" if compute == "simulate" else "modes")
+        options = None
+        if compute == "simulate":
+            if t_end is None:
+                raise ModelError("a simulation study needs t_end (s)", field="t_end")
+            step = StepControl(method, rtol, atol)  # checks the method and tolerances
+            SaveAt(samples)
+            if stop_when is not None:
+                parse_stop_condition(stop_when, self._model)
+            options = SimulationOptions(float(t_end), step.method, step.rtol, step.atol,
+                                        int(samples), stop_when, bool(trajectories))
+        study = make_study(eom, compute, vary or {}, sample, members, seed, options, chunk_size)
+        return run_study(study, out=out, resume=resume, scheduler=scheduler, client=client,
+                         workers=workers, progress=progress)
+
     # -- checking a hand derivation: check, crosscheck, check_units --------------------------------
 
     def check(self, answer) -> CheckReport:

@@ -1,0 +1,237 @@
+"""Running a study on Dask: chunks as tasks on a dask.distributed cluster, results kept as they
+finish so that an interrupted study can be resumed.
+
+By default a LocalCluster with one single-threaded worker process per core is started and
+closed around the study; ``scheduler`` (an address, tcp://host:8786) uses a running cluster, so a
+study can go to many machines; ``client`` uses a dask Client the caller owns (tests run an
+in-process one). Each finished chunk is written to a directory of per-chunk files beside the
+output (``<out>.partial``) before the next is awaited; tasks are retried by the scheduler when
+a worker dies. Dask is imported only here, when a study runs.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import shutil
+import uuid
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.sweep import NOT_COMPUTED, Study, evaluate_chunk, layout
+from ..errors import ModelError
+from ..output.sweep import check_study_path, study_dataset, write_study
+
+# Tasks of a chunk whose worker died are run again this many times before the study gives up.
+RETRIES = 3
+
+
+def chunk_task(study: Study, start: int, stop: int) -> dict[str, np.ndarray]:
+    """What runs on a worker: one chunk's arrays (the compiled functions are cached per process)."""
+    return evaluate_chunk(study, start, stop)
+
+
+def with_compiled_module(study: Study) -> Study:
+    """For an ensemble: build the model's C module once here (into the on-disk cache), and give
+    the workers its source so they load it instead of building it."""
+    if study.compute != "simulate":
+        return study
+    from ..numerics import compiled
+    from ..numerics.codegen import CodegenError, generate
+
+    if not compiled.available():
+        return study
+    try:
+        generated = generate(study.eom)
+        compiled.load(generated)
+    except (CodegenError, compiled.BackendUnavailable):
+        return study
+    return replace(study, generated=generated)
+
+
+class PartialStore:
+    """Per-chunk .npz files and the study's key in a directory: what finished, kept on disk."""
+
+    def __init__(self, directory: Path, study: Study):
+        self.directory = Path(directory)
+        self.study = study
+
+    def open(self, resume: bool) -> set[int]:
+        """The chunk starts already done (resume), after checking they belong to this study."""
+        manifest = self.directory / "study.json"
+        if resume and manifest.exists():
+            stored = json.loads(manifest.read_text())
+            if stored.get("key") != self.study.key:
+                raise ModelError(f"{self.directory} holds a different study (other model, grid or "
+                                 f"options); run without resume to start again", field="resume")
+            return {int(p.stem.split("-")[1]) for p in self.directory.glob("chunk-*.npz")}
+        if self.directory.exists():
+            shutil.rmtree(self.directory)
+        self.directory.mkdir(parents=True)
+        manifest.write_text(json.dumps({"key": self.study.key, "compute": self.study.compute,
+                                        "points": self.study.size}))
+        return set()
+
+    def write(self, start: int, arrays: dict[str, np.ndarray]) -> None:
+        final = self.directory / f"chunk-{start}.npz"
+        temporary = self.directory / f".chunk-{start}.tmp.npz"
+        saved = {k: (np.asarray(v).astype(str) if k == "status" else v) for k, v in arrays.items()}
+        np.savez(temporary, **saved)
+        os.replace(temporary, final)
+
+    def read(self, start: int) -> dict[str, np.ndarray]:
+        with np.load(self.directory / f"chunk-{start}.npz", allow_pickle=False) as data:
+            return {k: data[k] for k in data.files}
+
+    def remove(self) -> None:
+        shutil.rmtree(self.directory, ignore_errors=True)
+
+
+def assemble(study: Study, pieces: dict[int, dict[str, np.ndarray]]):
+    """The flat arrays of all points from the chunks done; points not done are NaN with status
+    'not computed'. Extra dimensions that differ by chunk (the equilibrium count) are padded."""
+    extra = {}
+    for arrays in pieces.values():
+        for name, array in arrays.items():
+            shape = np.shape(array)[1:]
+            extra[name] = tuple(max(a, b) for a, b in zip(extra.get(name, shape), shape,
+                                                            strict=True))
+    names = layout(study)
+    out = {}
+    for name in names:
+        shape = extra.get(name)
+        if shape is None:  # nothing finished: the sizes the study would have had
+            shape = _default_extra(study, names[name][0])
+        out[name] = np.full((study.size, *shape), np.nan)
+    out["status"] = np.full(study.size, NOT_COMPUTED, dtype=object)
+    for start, arrays in pieces.items():
+        for name, array in arrays.items():
+            array = np.asarray(array)
+            index = (slice(start, start + len(array)), *(slice(0, s) for s in array.shape[1:]))
+            out[name][index] = array
+    return out
+
+
+def _default_extra(study: Study, dims: tuple[str, ...]) -> tuple[int, ...]:
+    n = len(study.model.coordinates)
+    sizes = {"mode": n, "coordinate": n, "equilibrium": 1, "state": 2 * n,
+             "time": study.simulation.samples if study.simulation else 1}
+    return tuple(sizes[d] for d in dims)
+
+
+def run_study(
+    study: Study,
+    *,
+    out: str | Path | None = None,
+    resume: bool = False,
+    scheduler: str | None = None,
+    client=None,
+    workers: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    protect: tuple[Path, ...] = (),
+):
+    """Run every chunk of ``study`` on Dask and return its Dataset (written to ``out`` if given).
+
+    ``progress(points_done, points_total)`` is called as chunks finish. On KeyboardInterrupt
+    what finished is written to ``out`` (status 'not computed' elsewhere) and kept in
+    ``<out>.partial``; ``resume=True`` continues from there.
+    """
+    if out is not None:
+        check_study_path(out)
+    study = with_compiled_module(study)
+    store = None
+    done: set[int] = set()
+    if out is not None:
+        out = Path(out)
+        store = PartialStore(out.with_name(out.name + ".partial"), study)
+        done = store.open(resume)
+    elif resume:
+        raise ModelError("resume needs the output path the study writes to", field="resume")
+    pieces: dict[int, dict[str, np.ndarray]] = {start: store.read(start) for start in done} \
+        if store else {}
+    todo = [(a, b) for a, b in study.chunks if a not in done]
+    finished = sum(b - a for a, b in study.chunks if a in done)
+    if progress is not None:
+        progress(finished, study.size)
+    try:
+        if todo:
+            with _cluster(scheduler, client, workers) as dask_client:
+                finished = _run_chunks(dask_client, study, todo, pieces, store, finished,
+                                       progress)
+    except KeyboardInterrupt:
+        if out is not None:
+            done_points = sum(len(p["status"]) for p in pieces.values())
+            write_study(study_dataset(study, assemble(study, pieces), done_points), out,
+                        protect=protect)
+        raise
+    dataset = study_dataset(study, assemble(study, pieces))
+    if out is not None:
+        write_study(dataset, out, protect=protect)
+        store.remove()
+    return dataset
+
+
+def _run_chunks(client, study, todo, pieces, store, finished, progress) -> int:
+    from dask.distributed import as_completed
+
+    shared = client.scatter(study, broadcast=True)
+    # Keys new for each run: a resumed study must not meet the cancelled tasks of the last one.
+    run = uuid.uuid4().hex[:8]
+    futures = {}
+    for start, stop in todo:
+        future = client.submit(chunk_task, shared, start, stop, pure=False, retries=RETRIES,
+                               key=f"lagrangian-chunk-{start}-{run}")
+        futures[future] = start
+    try:
+        for future in as_completed(list(futures)):
+            arrays = future.result()
+            start = futures[future]
+            pieces[start] = arrays
+            if store is not None:
+                store.write(start, arrays)
+            finished += len(arrays["status"])
+            if progress is not None:
+                progress(finished, study.size)
+    finally:
+        for future in futures:
+            if not future.done():
+                future.cancel()
+    return finished
+
+
+class _cluster:
+    """The dask Client to use: the caller's, one connected to ``scheduler``, or a LocalCluster
+    started here (one single-threaded worker process per core) and closed afterwards."""
+
+    def __init__(self, scheduler, client, workers):
+        self.scheduler, self.client, self.workers = scheduler, client, workers
+        self.owned = []
+
+    def __enter__(self):
+        if self.client is not None:
+            return self.client
+        from dask.distributed import Client, LocalCluster
+
+        if self.scheduler:
+            try:
+                client = Client(self.scheduler, timeout="10s")
+            except (OSError, TimeoutError) as exc:
+                raise ModelError(f"cannot reach the Dask scheduler at {self.scheduler}: {exc}",
+                                 field="scheduler") from None
+            self.owned = [client]
+            return client
+        workers = self.workers or os.cpu_count() or 1
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=":0", silence_logs=logging.ERROR)
+        client = Client(cluster)
+        self.owned = [client, cluster]
+        return client
+
+    def __exit__(self, *exc):
+        for thing in self.owned:
+            thing.close()
+        return False

@@ -1,0 +1,280 @@
+"""A study's results as an xarray Dataset, its files (NetCDF or Zarr), plot and JSON summary.
+
+One dimension per varied name (and ``member`` for an ensemble); ``status`` says 'ok' or why a
+point is missing (its numbers are NaN). xarray is imported here, on the sweep path only.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import shutil
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.sweep import NOT_COMPUTED, OK, Study, layout
+from ..errors import ModelError
+from .files import atomic_write
+
+STUDY_FORMATS = (".nc", ".zarr")
+PLOT_DPI = 120
+
+DESCRIPTIONS = {
+    "frequency": ("rad/s", "natural frequency of each mode, ascending"),
+    "damping_ratio": ("1", "damping ratio of each mode"),
+    "growth_rate": ("1/s", "largest real part of the mode's eigenvalues (> 0: it grows)"),
+    "stable": ("1", "1 when no mode grows (linear stability), 0 when one does"),
+    "equilibrium": ("SI", "the equilibrium the modes are about (System.modes' choice)"),
+    "configuration": ("SI", "each equilibrium found, in the coordinates' units"),
+    "shape": ("1", "mode shape, first component of largest magnitude +1"),
+    "count": ("1", "number of equilibria found"),
+    "final": ("SI", "state at the last sample"),
+    "minimum": ("SI", "smallest value of each state component over the samples"),
+    "maximum": ("SI", "largest value of each state component over the samples"),
+    "t_final": ("s", "time of the last sample"),
+    "energy_drift": ("1", "max |E - E0| / |E0| where the energy is conserved"),
+    "stop_time": ("s", "time the stop condition fired (NaN: it did not)"),
+    "trajectory": ("SI", "state on the common time grid"),
+    "status": ("", "'ok', or why the point has no numbers"),
+}
+
+
+def check_study_path(path: str | Path) -> Path:
+    """The output file of a study: *.nc (NetCDF through h5netcdf) or *.zarr (a Zarr store)."""
+    path = Path(path)
+    if path.suffix.lower() not in STUDY_FORMATS:
+        raise ModelError(f"a study is written as NetCDF (*.nc) or Zarr (*.zarr), not '{path}'",
+                         field="out")
+    return path
+
+
+def check_study_plot_path(path: str | Path) -> Path:
+    path = Path(path)
+    if path.suffix.lower() != ".png":
+        raise ModelError(f"the plot is written as PNG; name the file *.png (got '{path}')",
+                         field="plot")
+    return path
+
+
+def study_dataset(study: Study, arrays: Mapping[str, np.ndarray], finished: int | None = None):
+    """The Dataset of a study from the flat arrays of every point (rows in flat point order)."""
+    import xarray as xr
+
+    model = study.model
+    coordinates = [c.name for c in model.coordinates]
+    units = {p.name: p.unit for p in model.parameters}
+    units.update({c.name: c.unit for c in model.coordinates})
+    units.update({c.velocity.name: f"({c.unit})/s" if c.unit else None
+                  for c in model.coordinates})
+    coords: dict[str, object] = {}
+    for name, values in study.axes:
+        coords[name] = (name, np.asarray(values, float), {"units": units.get(name) or ""})
+    if study.draws:
+        coords["member"] = ("member", np.arange(len(study.draws[0][1])))
+        for name, values in study.draws:
+            coords[name] = ("member", np.asarray(values, float), {"units": units.get(name) or ""})
+    data_vars = {}
+    extra_sizes = {}
+    for name, (extra, _) in layout(study).items():
+        array = np.asarray(arrays[name], float)
+        for d, size in zip(extra, array.shape[1:], strict=True):
+            extra_sizes[d] = size
+        unit, text = DESCRIPTIONS[name]
+        data_vars[name] = ((*study.dims, *extra), array.reshape(*study.shape, *array.shape[1:]),
+                           {"units": unit, "description": text})
+    status = np.asarray(arrays["status"]).astype(str)
+    data_vars["status"] = (study.dims, status.reshape(study.shape),
+                           {"description": DESCRIPTIONS["status"][1]})
+    if "mode" in extra_sizes:
+        coords["mode"] = ("mode", np.arange(1, extra_sizes["mode"] + 1))
+    if "coordinate" in extra_sizes:
+        coords["coordinate"] = ("coordinate", np.array(coordinates))
+    if "equilibrium" in extra_sizes:
+        coords["equilibrium"] = ("equilibrium", np.arange(extra_sizes["equilibrium"]))
+    if "state" in extra_sizes:
+        coords["state"] = ("state", np.array([*coordinates, *(f"{c}_dot" for c in coordinates)]))
+    if "time" in extra_sizes:
+        options = study.simulation
+        coords["time"] = ("time", np.linspace(0.0, options.t_end, options.samples), {"units": "s"})
+    attrs = {"model": model.name, "compute": study.compute, "points": study.size,
+             "finished": study.size if finished is None else int(finished),
+             "failed": int(np.sum((status != OK) & (status != NOT_COMPUTED)))}
+    if study.simulation is not None:
+        options = study.simulation
+        attrs.update({"t_end": options.t_end, "method": options.method, "rtol": options.rtol,
+                      "atol": options.atol, "stop_when": options.stop_when or ""})
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def write_study(dataset, path: str | Path, *, protect: tuple[Path, ...] = ()) -> Path:
+    """NetCDF (h5netcdf) for *.nc, a Zarr store for *.zarr; written beside and moved into place,
+    so a half-written file never replaces a good one."""
+    path = check_study_path(path)
+    for guarded in protect:
+        if path.exists() and guarded.exists() and path.resolve() == guarded.resolve():
+            raise FileExistsError(f"{path}: refusing to overwrite an input file")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    temporary = path.with_name(f".{path.name}.tmp")
+    _remove(temporary)
+    if path.suffix.lower() == ".nc":
+        dataset.to_netcdf(temporary, engine="h5netcdf")
+    else:
+        # Zarr format 2: fixed-width text (status) and consolidated metadata are in its spec.
+        dataset.to_zarr(temporary, mode="w", consolidated=True, zarr_format=2)
+    _remove(path)
+    os.replace(temporary, path)
+    return path
+
+
+def read_study(path: str | Path):
+    """A study written by ``write_study``, loaded into memory."""
+    import xarray as xr
+
+    path = Path(path)
+    if path.suffix.lower() == ".zarr":
+        return xr.open_zarr(path).load()
+    with xr.open_dataset(path, engine="h5netcdf") as dataset:
+        return dataset.load()
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir():
+        shutil.rmtree(path)
+    elif path.exists():
+        path.unlink()
+
+
+def study_summary(dataset) -> dict:
+    """JSON-ready: what was computed over which grid, how many points failed and why, and the
+    range of the main result."""
+    status = np.asarray(dataset["status"].values).astype(str).ravel()
+    reasons: dict[str, int] = {}
+    for s in status:
+        if s != OK:
+            reasons[s] = reasons.get(s, 0) + 1
+    dims = {d: int(dataset.sizes[d]) for d in dataset["status"].dims}
+    summary = {"model": dataset.attrs.get("model"), "compute": dataset.attrs.get("compute"),
+               "dimensions": dims, "points": int(status.size),
+               "ok": int(np.sum(status == OK)), "missing": reasons}
+    main = {"modes": "frequency", "equilibria": "count", "simulate": "energy_drift"}
+    name = main.get(str(dataset.attrs.get("compute")))
+    if name in dataset:
+        values = np.asarray(dataset[name].values, float)
+        finite = values[np.isfinite(values)]
+        summary[name] = ({"min": float(finite.min()), "max": float(finite.max())}
+                         if finite.size else None)
+    if "stable" in dataset and dataset.attrs.get("compute") == "modes":
+        stable = np.asarray(dataset["stable"].values, float)
+        summary["stable_points"] = int(np.sum(stable == 1))
+        summary["unstable_points"] = int(np.sum(stable == 0))
+    return summary
+
+
+def study_text(dataset, path: Path | None = None) -> str:
+    s = study_summary(dataset)
+    dims = " x ".join(f"{d} {n}" for d, n in s["dimensions"].items())
+    lines = [f"{s['compute']} of {s['model']!r} over {dims}: {s['ok']} of {s['points']} "
+             f"points computed"]
+    for reason, count in s["missing"].items():
+        lines.append(f"  {count} missing: {reason}")
+    for key in ("frequency", "count", "energy_drift"):
+        if s.get(key):
+            lines.append(f"  {key}: {s[key]['min']:.6g} .. {s[key]['max']:.6g}")
+    if "stable_points" in s:
+        lines.append(f"  stable at {s['stable_points']} points, unstable at "
+                     f"{s['unstable_points']}")
+    if path is not None:
+        lines.append(f"Written to {path}")
+    return "\n".join(lines) + "\n"
+
+
+def study_figure(dataset):
+    """Frequencies against the (first) varied parameter, a line per mode and per value of a
+    second; for two or more varied parameters also a stability map over the first two. For
+    equilibria: each equilibrium's coordinates, stable solid, unstable hollow; for an ensemble
+    the spread of the final states."""
+    from matplotlib.figure import Figure
+
+    compute = dataset.attrs.get("compute")
+    dims = [d for d in dataset["status"].dims]
+    figure = Figure(figsize=(8, 5), layout="constrained")
+    if compute == "simulate":
+        ax = figure.subplots()
+        final = dataset["final"]
+        for state in final["state"].values[: len(final["state"]) // 2]:
+            values = np.asarray(final.sel(state=state).values, float).ravel()
+            ax.hist(values[np.isfinite(values)], bins=60, alpha=0.6, label=str(state))
+        ax.set_xlabel("final value (SI)")
+        ax.set_ylabel("members")
+        ax.legend(fontsize="small")
+        return figure
+    x = dims[0]
+    others = dims[1:]
+    if compute == "equilibria":
+        ax = figure.subplots()
+        eq = dataset["configuration"]
+        stable = dataset["stable"]
+        reduce = {d: 0 for d in others}
+        eq, stable = eq.isel(reduce), stable.isel(reduce)
+        xs = dataset[x].values
+        for c in eq["coordinate"].values:
+            for k in eq["equilibrium"].values:
+                y = np.asarray(eq.sel(coordinate=c, equilibrium=k).values, float)
+                s = np.asarray(stable.sel(equilibrium=k).values, float)
+                ax.plot(xs[s == 1], y[s == 1], "o", color="C0", ms=4)
+                ax.plot(xs[s == 0], y[s == 0], "o", mfc="none", color="C3", ms=4)
+            ax.set_ylabel(f"equilibrium {c}")
+        ax.set_xlabel(_label(dataset, x))
+        ax.set_title("equilibria: stable filled, unstable hollow")
+        return figure
+    panels = 2 if others else 1
+    axes = figure.subplots(1, panels, squeeze=False)[0]
+    ax = axes[0]
+    frequency = dataset["frequency"]
+    series = [{}] if not others else [{others[0]: i} for i in range(dataset.sizes[others[0]])]
+    rest = {d: 0 for d in others[1:]}
+    for j, selection in enumerate(series):
+        sub = frequency.isel({**selection, **rest})
+        for k in sub["mode"].values:
+            label = f"mode {k}" + (f", {others[0]}={dataset[others[0]].values[j]:.4g}"
+                                   if selection else "")
+            ax.plot(dataset[x].values, np.asarray(sub.sel(mode=k).values, float),
+                    color=f"C{j % 10}", ls=["-", "--", ":", "-."][(k - 1) % 4],
+                    label=label if len(series) * len(sub["mode"]) <= 12 else None)
+    ax.set_xlabel(_label(dataset, x))
+    ax.set_ylabel("natural frequency (rad/s)")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize="small")
+    if others:
+        ax2 = axes[1]
+        stable = dataset["stable"].isel(rest)
+        y = others[0]
+        grid = np.asarray(stable.transpose(y, x).values, float)
+        ax2.pcolormesh(dataset[x].values, dataset[y].values, grid, cmap="RdYlGn", vmin=0, vmax=1,
+                       shading="nearest")
+        ax2.set_xlabel(_label(dataset, x))
+        ax2.set_ylabel(_label(dataset, y))
+        ax2.set_title("stable (green) / unstable (red)")
+    else:
+        growth = np.asarray(dataset["growth_rate"].max("mode").values, float)
+        unstable = growth > 0
+        if unstable.any():
+            ax.fill_between(dataset[x].values, 0, 1, where=unstable, alpha=0.15, color="C3",
+                            transform=ax.get_xaxis_transform(), label="unstable")
+            ax.legend(fontsize="small")
+    return figure
+
+
+def _label(dataset, name: str) -> str:
+    unit = dataset[name].attrs.get("units")
+    return f"{name} ({unit})" if unit else name
+
+
+def write_study_plot(dataset, path: str | Path, *, protect: tuple[Path, ...] = ()) -> Path:
+    """Draw the study (study_figure) to a PNG file, atomically, never over an input file."""
+    path = check_study_plot_path(path)
+    buffer = io.BytesIO()
+    study_figure(dataset).savefig(buffer, format="png", dpi=PLOT_DPI)
+    return atomic_write(path, buffer.getvalue(), protect=protect)

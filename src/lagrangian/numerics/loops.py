@@ -12,7 +12,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import integrate, optimize
 
 from .drift import DriftControl
 from .functions import NumericSystem
@@ -103,6 +102,10 @@ def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y
                     event: Callable | None = None, drift: DriftControl | None = None,
                     progress: Callable[[float], None] | None = None) -> LoopRun:
     """Step a scipy OdeSolver by hand: dense output onto the grid, events, projection, Ctrl-C."""
+    # scipy is imported where it is used: at module level it cost every command (derive
+    # included) half a second of start-up.
+    from scipy import integrate
+
     solver_class = getattr(integrate, step.method)
 
     def start(t, y, first_step=None):
@@ -183,5 +186,7 @@ def _crossing(event, dense, t_old: float, t_new: float, n: int) -> float:
 
     if g(t_old) >= 0:
         return t_old
+    from scipy import optimize
+
     return float(optimize.brentq(g, t_old, t_new, xtol=1e-15 * max(1.0, abs(t_new)),
                                  rtol=4 * np.finfo(float).eps, maxiter=200))

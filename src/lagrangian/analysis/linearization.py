@@ -265,7 +265,8 @@ def _input_parameter(model: Model, name: str) -> sp.Symbol | None:
             return p.symbol
     for load in model.loads:
         if load.name == name:
-            magnitude = load.force if hasattr(load, "force") else (load.torque,)
+            magnitude = (load.force if hasattr(load, "force") else
+                         load.moment if hasattr(load, "moment") else (load.torque,))
             symbols = {s for e in magnitude for s in as_expression(e).free_symbols}
             owned = sorted((p for p in model.parameters if p.symbol in symbols),
                            key=lambda p: p.name)

@@ -188,7 +188,7 @@ def _shares(eom, values, reactions, jacobian) -> tuple[tuple[str, str, float], .
         add(spring.name, [-energy.diff(x) for x in q])
     gravity = model.gravity
     if gravity is not None:
-        for item in (*model.particles, *model.bodies):
+        for item in (*model.particles, *model.bodies, *model.rigid_bodies):
             height = sp.Add(*(d * r for d, r in zip(gravity.direction, item.position,
                                                     strict=True)))
             energy = -item.mass * gravity.magnitude * height

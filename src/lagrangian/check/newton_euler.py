@@ -140,6 +140,13 @@ def _require_free_bodies(model: Model) -> None:
             "Newton-Euler needs the inertia as particles and bodies, but this model gives T as "
             "an expression ([energy] T): there is no free body to draw (build it from "
             "[[particles]]/[[bodies]], e.g. the example 'ladder_pendulum')")
+    if model.rigid_bodies:
+        # Euler's equations and 3D joint reactions are not drawn yet: refuse rather than
+        # compare a derivation that leaves the bodies in space out.
+        raise DerivationError(
+            "Newton-Euler is not available yet for bodies in space (3D rigid bodies: "
+            f"{', '.join(b.name for b in model.rigid_bodies)}); the Lagrange derivation of "
+            "`derive` is checked against sympy.physics.mechanics in the tests")
     if not model.particles and not model.bodies:
         raise DerivationError("Newton-Euler needs at least one particle or body")
     # F = m a and M = I alpha hold for a constant mass and inertia only; Lagrange's equations

@@ -15,6 +15,7 @@ import sympy as sp
 
 from ..model.expressions import format_expression
 from ..model.model import Model, PointForce, multiplier_name
+from ..model.rotations import Moment
 from ..model.units import generalized_force_unit, is_angle_unit, registry
 
 ENERGY = "J"
@@ -248,6 +249,17 @@ def check_model_units(model: Model) -> UnitsReport:
         for axis, component in zip("xyz", body.position, strict=True):
             c(f"{where}.position.{axis}", component, "m", "a length")
         c(f"{where}.angle", body.angle, "", "an angle")
+    for rigid in model.rigid_bodies:
+        where = f"bodies[{rigid.name}]"
+        c(f"{where}.mass", rigid.mass, "kg", "a mass")
+        for i, row in enumerate(rigid.inertia):
+            for j, entry in enumerate(row[i:], start=i):
+                c(f"{where}.inertia[{i}][{j}]", entry, "kg*m^2", "a moment of inertia")
+        for axis, component in zip("xyz", rigid.position, strict=True):
+            c(f"{where}.position.{axis}", component, "m", "a length")
+        for i, row in enumerate(rigid.rotation):  # direction cosines: angles inside
+            for j, entry in enumerate(row):
+                c(f"{where}.rotation[{i}][{j}]", entry, "", "a direction cosine")
     for spring in model.springs:
         where = f"springs[{spring.name}]"
         c(f"{where}.stiffness", spring.stiffness, None)
@@ -264,6 +276,9 @@ def check_model_units(model: Model) -> UnitsReport:
                 c(f"{where}.point.{axis}", component, "m", "a length")
             for axis, component in zip("xyz", load.force, strict=True):
                 c(f"{where}.force.{axis}", component, "N", "a force")
+        elif isinstance(load, Moment):
+            for axis, component in zip("xyz", load.moment, strict=True):
+                c(f"{where}.moment.{axis}", component, "N*m", "a moment")
         else:
             c(f"{where}.torque", load.torque, "N*m", "a torque")
             c(f"{where}.angle", load.angle, "", "an angle")

@@ -19,6 +19,7 @@ from .constraints import constraint_terms
 from .equations import EquationsOfMotion
 from .kinematics import Differentiator
 from .regularity import check_regularity
+from .rigid_bodies import rotational_equations, rotational_kinetic_energy
 from .trig import combined_terms, parts, product
 from .virtual_work import generalized_forces, load_contributions
 
@@ -176,11 +177,24 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
         if spin != 0:
             kinetic_terms.append(body.inertia * (omega - spin) * spin
                                  + sp.Rational(1, 2) * body.inertia * spin**2)
-    component_mass = acc.mass_matrix() if model.particles or model.bodies else None
+    for rigid in model.rigid_bodies:
+        translate(rigid.mass, rigid.position)
+    component_mass = (acc.mass_matrix() if model.particles or model.bodies or model.rigid_bodies
+                      else None)
+    for rigid in model.rigid_bodies:
+        # 1/2 omega^T I omega by the general formula written with omega's structure (after
+        # component_mass, which holds only 1/2 m v.v: the printed T shows this term as written).
+        kinetic_terms.append(rotational_kinetic_energy(rigid))
+        rotation_mass, rotation_forcing = rotational_equations(rigid, q, q_dot, t, d)
+        for (i, j), entry in rotation_mass.items():
+            acc.add_mass(i, j, entry)
+        for i, entry in enumerate(rotation_forcing):
+            if entry != 0:
+                acc.add_force(i, entry)
 
     if gravity is not None:
         g, direction = gravity.magnitude, gravity.direction
-        for item in (*model.particles, *model.bodies):
+        for item in (*model.particles, *model.bodies, *model.rigid_bodies):
             height = sp.Add(*(d * r for d, r in zip(direction, item.position, strict=True)
                               if d != 0))
             potential_terms.append(-item.mass * g * height)

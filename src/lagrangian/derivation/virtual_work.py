@@ -5,8 +5,10 @@ from __future__ import annotations
 import sympy as sp
 
 from ..model.model import Damper, Model, PointForce, Torque
+from ..model.rotations import Moment
 from .equations import LoadContribution
 from .kinematics import jacobian_row
+from .rigid_bodies import moment_projection
 
 DISSIPATION_LOAD = "dissipation"
 GIVEN_LOAD = "generalized_forces"
@@ -28,6 +30,8 @@ def load_contributions(model: Model) -> list[LoadContribution]:
             add(load.name, point_force_projection(load, q))
         elif isinstance(load, Torque):
             add(load.name, [load.torque * d for d in jacobian_row(load.angle, q)])
+        elif isinstance(load, Moment):
+            add(load.name, moment_projection(load, q_dot))
     for damper in model.dampers:
         add(damper.name, damper_forces(damper, q_dot))
     if model.dissipation != 0:

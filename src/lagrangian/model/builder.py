@@ -34,6 +34,7 @@ from .model import (
     multiplier_name,
     velocity_name,
 )
+from .rotations import GROUND, Frame, Moment, RigidBody, RotationReader
 
 _IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _ZERO: Vector = (sp.S.Zero, sp.S.Zero, sp.S.Zero)
@@ -56,6 +57,8 @@ class ModelBuilder:
         self._gravity: Gravity | None = None
         self._particles: list[Particle] = []
         self._bodies: list[Body] = []
+        self._rigid_bodies: list[RigidBody] = []
+        self._frames: dict = {}  # 3D body name -> its rotations.Frame, for joints on it
         self._springs: list[Spring] = []
         self._dampers: list[Damper] = []
         self._loads: list[PointForce | Torque] = []
@@ -200,16 +203,119 @@ class ModelBuilder:
         )
         return self
 
+    def add_rigid_body(
+        self, name: str, mass: object, inertia: object, *, position: Sequence[object] | None = None,
+        rotation: Sequence | None = None, origin: Sequence[object] | None = None,
+        center: Sequence[object] | None = None, parent: str | None = None,
+        joint: dict | None = None, field: str | None = None,
+    ) -> ModelBuilder:
+        """A rigid body in space: mass (kg), inertia about its centre of mass in body axes
+        (kg m^2; [Ixx, Iyy, Izz] or a symmetric 3x3), oriented by a body-fixed ``rotation``
+        sequence [[axis, angle], ...] or by a ``joint`` on its ``parent`` (or on the ground).
+
+        Where: ``position`` (its centre of mass, world, m), or ``origin`` (its body frame, world)
+        with ``center`` (the centre of mass from the origin, body axes); a body on a joint has
+        its origin at the joint and may give ``center``.
+        """
+        field = field or f"body '{name}'"
+        self._component(name, field)
+        self._vectors.append((field, 3, "rigid body"))
+        self._check_dimensions()
+        reader = self._rotation_reader()
+        given = {k for k, v in (("position", position), ("rotation", rotation),
+                                ("origin", origin), ("center", center), ("joint", joint))
+                 if v is not None}
+        if parent is not None:
+            if parent == name:
+                raise self._error(f"body '{name}' is its own parent (a cycle)", f"{field}.parent")
+            frame = self._frames.get(parent)
+            if frame is None:
+                names = list(self._frames)
+                raise self._error(f"no body '{parent}' to attach to (declare the parent first)"
+                                  f"{did_you_mean(parent, names)}", f"{field}.parent")
+            if joint is None:
+                raise self._error("a body with a parent needs a 'joint'", f"{field}.joint")
+            for key in sorted(given & {"position", "rotation", "origin"}):
+                raise self._error(f"'{key}' comes from the joint on '{parent}': give the joint "
+                                  "instead", f"{field}.{key}")
+        else:
+            frame = GROUND
+            if joint is not None:
+                for key in sorted(given & {"position", "rotation", "origin"}):
+                    raise self._error(f"'{key}' comes from the joint (on the ground): give one "
+                                      "or the other", f"{field}.{key}")
+            elif (position is None) == (origin is None):
+                raise self._error("give the centre of mass 'position' or the body's 'origin' "
+                                  "(with 'center')", field)
+            if position is not None and center is not None:
+                raise self._error("'center' is measured from 'origin': give 'origin' with it, "
+                                  "or 'position' alone", f"{field}.center")
+        if joint is not None:
+            frame = reader.joint(frame, joint, f"{field}.joint")
+        else:
+            start = position if position is not None else origin
+            key = "position" if position is not None else "origin"
+            frame = Frame(self.vector(start, f"{field}.{key}", velocities=False,
+                                      places="rigid body"), frame.rotation,
+                          frame.angular_velocity)
+            if rotation is not None:
+                frame = reader.sequence(frame, rotation, f"{field}.rotation")
+        offset = (self.vector(center, f"{field}.center", velocities=False)
+                  if center is not None else (sp.S.Zero,) * 3)
+        values = {p.symbol: p.value for p in self._parameters if p.value is not None}
+        body = RigidBody(
+            name,
+            self.expression(mass, f"{field}.mass", velocities=False),
+            reader.inertia(inertia, f"{field}.inertia", values),
+            tuple(o + sum((r * c for r, c in zip(row, offset, strict=True)), sp.S.Zero)
+                  for o, row in zip(frame.origin, frame.rotation, strict=True)),
+            frame.rotation, frame.origin, frame.angular_velocity, parent,
+        )
+        self._frames[name] = frame
+        self._rigid_bodies.append(body)
+        return self
+
+    def add_moment(
+        self, name: str, body: str, moment: Sequence[object], *, axes: str = "world",
+        field: str | None = None,
+    ) -> ModelBuilder:
+        """A moment (N m) on a rigid body, in world or body axes; Q_i = M . d omega/d q_dot_i."""
+        field = field or f"load '{name}'"
+        self._component(name, field)
+        target = next((b for b in self._rigid_bodies if b.name == body), None)
+        if target is None:
+            raise self._error(f"'{body}' is not a 3D body (declare it before use)"
+                              f"{did_you_mean(str(body), [b.name for b in self._rigid_bodies])}",
+                              f"{field}.body")
+        if axes not in ("world", "body"):
+            raise self._error(f"axes must be 'world' or 'body', not {axes!r}", f"{field}.axes")
+        omega = (target.world_angular_velocity() if axes == "world"
+                 else target.angular_velocity)
+        self._require_coordinate_dependence(
+            [e for row in target.rotation for e in row], name, f"{field}.body", "rotation")
+        self._loads.append(Moment(name, body, self.vector(moment, f"{field}.moment"), axes, omega))
+        return self
+
+    def _rotation_reader(self) -> RotationReader:
+        def angle(value, field):
+            return self.expression(value, field, velocities=False)
+
+        def vector(value, field):
+            return self.vector(value, field, velocities=False)
+
+        return RotationReader(angle, vector, self._time_derivative, self.source)
+
     def point(self, reference: object, *, field: str = "point") -> Vector:
         """Resolve a point: a particle or body name (its centre), a vector, or (body, offset)."""
         if isinstance(reference, str):
             for particle in self._particles:
                 if particle.name == reference:
                     return particle.position
-            for body in self._bodies:
+            for body in (*self._bodies, *self._rigid_bodies):
                 if body.name == reference:
                     return body.position
-            names = [p.name for p in self._particles] + [b.name for b in self._bodies]
+            names = [p.name for p in self._particles] + [b.name for b in self._bodies] + \
+                [b.name for b in self._rigid_bodies]
             raise self._error(f"'{reference}' is not a particle or body (declare it before use)"
                               f"{did_you_mean(reference, names)}", field)
         if isinstance(reference, dict):
@@ -220,13 +326,19 @@ class ModelBuilder:
                     + (f"; unknown key '{sorted(unknown)[0]}'" if unknown else ""),
                     field,
                 )
-            return self.body_point(reference["body"], reference.get("offset", (0, 0)), field=field)
+            return self.body_point(reference["body"], reference.get("offset"), field=field)
         return self.vector(reference, field, velocities=False)
 
     def body_point(
         self, body: str, offset: Sequence[object], *, field: str = "point"
     ) -> Vector:
-        """The point fixed in a planar body at ``offset`` (m, in the body's frame)."""
+        """The point fixed in a body at ``offset`` (m, in the body's axes; from a planar body's
+        centre of mass, from a 3D body's origin)."""
+        for candidate in self._rigid_bodies:
+            if candidate.name == body:
+                offset = (0, 0, 0) if offset is None else offset
+                return candidate.point(self.vector(offset, f"{field}.offset", velocities=False))
+        offset = (0, 0) if offset is None else offset
         for candidate in self._bodies:
             if candidate.name == body:
                 dx, dy, dz = self.vector(offset, f"{field}.offset", velocities=False)
@@ -296,6 +408,9 @@ class ModelBuilder:
         """A torque (N m) turning through angle theta(q); Q_i = tau dtheta/dq_i."""
         field = field or f"load '{name}'"
         self._component(name, field)
+        if isinstance(angle, str) and any(b.name == angle for b in self._rigid_bodies):
+            raise self._error(f"'{angle}' is a 3D body: put a moment on it "
+                              "({name, body, moment = [Mx, My, Mz]})", f"{field}.angle")
         if isinstance(angle, str) and any(b.name == angle for b in self._bodies):
             turned = next(b.angle for b in self._bodies if b.name == angle)
         else:
@@ -434,6 +549,7 @@ class ModelBuilder:
             gravity=self._gravity,
             particles=tuple(self._particles),
             bodies=tuple(self._bodies),
+            rigid_bodies=tuple(self._rigid_bodies),
             springs=tuple(self._springs),
             dampers=tuple(self._dampers),
             loads=tuple(self._loads),

@@ -8,8 +8,12 @@ Vectors are 3-tuples; planar models have a zero third component.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import sympy as sp
+
+if TYPE_CHECKING:
+    from .rotations import RigidBody
 
 TIME = sp.Symbol("t")
 
@@ -173,6 +177,8 @@ class Model:
     description: str = ""
     source: str | None = None
     time: sp.Symbol = field(default=TIME)
+    # Bodies in space (model/rotations.py); their moments (rotations.Moment) are in ``loads``.
+    rigid_bodies: tuple[RigidBody, ...] = ()
 
     @property
     def q(self) -> tuple[sp.Symbol, ...]:

@@ -18,10 +18,11 @@ TOP_LEVEL = {
 }
 COMPONENT_KEYS = {
     "particles": ({"name", "mass", "position"}, set()),
-    "bodies": ({"name", "mass", "inertia", "position", "angle"}, set()),
+    "bodies": ({"name", "mass", "inertia"},
+               {"position", "angle", "rotation", "origin", "center", "parent", "joint"}),
     "springs": ({"name", "stiffness"}, {"rest_length", "length", "between"}),
     "dampers": ({"name", "coefficient"}, {"rate", "between"}),
-    "loads": ({"name"}, {"point", "force", "torque", "angle"}),
+    "loads": ({"name"}, {"point", "force", "torque", "angle", "body", "moment", "axes"}),
     "constraints": ({"name"}, {"holonomic", "velocity"}),
 }
 
@@ -143,8 +144,20 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
     for index, item in _components(data, "particles", source):
         field = f"particles[{index}]"
         builder.add_particle(item["name"], item["mass"], item["position"], field=field)
-    for index, item in _components(data, "bodies", source):
+    for index, item in tree_order(list(_components(data, "bodies", source)), source):
         field = f"bodies[{index}]"
+        if is_spatial_body(item):
+            builder.add_rigid_body(
+                item["name"], item["mass"], item["inertia"], position=item.get("position"),
+                rotation=item.get("rotation"), origin=item.get("origin"),
+                center=item.get("center"), parent=item.get("parent"), joint=item.get("joint"),
+                field=field)
+            continue
+        for key in ("position", "angle"):
+            if key not in item:
+                raise ModelError(f"missing key '{key}' (a planar body has 'position' and "
+                                 "'angle'; a 3D body 'rotation' or 'joint')", field=field,
+                                 source=source)
         builder.add_body(item["name"], item["mass"], item["inertia"], item["position"],
                          item["angle"], field=field)
     for index, item in _components(data, "springs", source):
@@ -161,10 +174,17 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
         field = f"loads[{index}]"
         has_force = "point" in item or "force" in item
         has_torque = "torque" in item or "angle" in item
-        if has_force and has_torque or not (has_force or has_torque):
-            raise ModelError("give either 'point' and 'force', or 'torque' and 'angle'",
-                             field=field, source=source)
-        if has_force:
+        has_moment = "moment" in item or "body" in item or "axes" in item
+        if has_force + has_torque + has_moment != 1:
+            raise ModelError("give either 'point' and 'force', 'torque' and 'angle', or "
+                             "'body' and 'moment'", field=field, source=source)
+        if has_moment:
+            for key in ("body", "moment"):
+                if key not in item:
+                    raise ModelError(f"missing key '{key}'", field=field, source=source)
+            builder.add_moment(item["name"], _string(item["body"], f"{field}.body", source),
+                               item["moment"], axes=item.get("axes", "world"), field=field)
+        elif has_force:
             for key in ("point", "force"):
                 if key not in item:
                     raise ModelError(f"missing key '{key}'", field=field, source=source)
@@ -184,6 +204,47 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
             field=f"constraints[{index}]",
         )
     return builder.build_model()
+
+
+SPATIAL_BODY_KEYS = ("rotation", "origin", "center", "parent", "joint")
+
+
+def is_spatial_body(item: Mapping) -> bool:
+    """A body in space (3D keys, or an inertia given as a list) rather than a planar one."""
+    return any(key in item for key in SPATIAL_BODY_KEYS) or isinstance(item.get("inertia"), list)
+
+
+def tree_order(items: list[tuple[int, Mapping]], source: str) -> list[tuple[int, Mapping]]:
+    """Bodies with every parent before its children (file order otherwise); a missing parent
+    or a cycle is named with the body's field."""
+    names = {item["name"]: (index, item) for index, item in items}
+    placed: set[str] = set()
+    ordered: list[tuple[int, Mapping]] = []
+
+    def place(index: int, item: Mapping, path: list[str]) -> None:
+        name = item["name"]
+        if name in placed:
+            return
+        parent = item.get("parent")
+        if parent is not None:
+            field = f"bodies[{index}].parent"
+            _string(parent, field, source)
+            if parent in path or parent == name:
+                cycle = " -> ".join([*path[path.index(parent):], name, parent]) \
+                    if parent in path else f"{name} -> {name}"
+                raise ModelError(f"the bodies' parents form a cycle ({cycle}): a kinematic tree "
+                                 "ends at the ground", field=field, source=source)
+            if parent not in names:
+                raise ModelError(f"no body named '{parent}'"
+                                 f"{did_you_mean(parent, sorted(names))}", field=field,
+                                 source=source)
+            place(*names[parent], [*path, name])
+        placed.add(name)
+        ordered.append((index, item))
+
+    for index, item in items:
+        place(index, item, [])
+    return ordered
 
 
 def _table(data: Mapping, key: str, source: str, *, required: bool = False) -> Mapping:

@@ -1,0 +1,293 @@
+"""Rigid bodies in space: rotation sequences, joints, inertia tensors, and their validation.
+
+A body's orientation is the rotation matrix R (body axes -> world axes, so the columns of R are
+the body axes written in the world). It comes from a body-fixed rotation sequence of named axes
+(z-x-z Euler angles: R = Rz(phi) Rx(theta) Rz(psi)) or from a joint on a parent body
+(R = R_parent R_joint). The angular velocity is composed along the same chain, exactly as
+omega~ = R^T R_dot in body axes (rad/s), without differentiating R:
+
+    omega_child = R_step^T omega_parent + alpha_dot u      (one rotation by alpha about u)
+
+which keeps the components short (no sin^2 + cos^2 left to cancel).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..errors import ModelError, did_you_mean
+from .model import Vector
+
+Matrix3 = tuple[Vector, Vector, Vector]
+
+AXES: dict[str, Vector] = {
+    "x": (sp.S.One, sp.S.Zero, sp.S.Zero),
+    "y": (sp.S.Zero, sp.S.One, sp.S.Zero),
+    "z": (sp.S.Zero, sp.S.Zero, sp.S.One),
+}
+JOINT_TYPES = ("revolute", "prismatic", "spherical", "fixed")
+JOINT_KEYS = {
+    "revolute": ({"type", "axis", "angle"}, {"at"}),
+    "prismatic": ({"type", "axis", "distance"}, {"at"}),
+    "spherical": ({"type", "rotation"}, {"at"}),
+    "fixed": ({"type"}, {"at", "rotation"}),
+}
+_IDENTITY: Matrix3 = (AXES["x"], AXES["y"], AXES["z"])
+_ZERO: Vector = (sp.S.Zero, sp.S.Zero, sp.S.Zero)
+
+
+@dataclass(frozen=True)
+class RigidBody:
+    """A rigid body in space: mass (kg), inertia tensor about its centre of mass in body axes
+    (kg m^2), centre of mass r (m, world axes), rotation R (body -> world), origin of its body
+    frame (m, world) and angular velocity omega in body axes (rad/s, linear in q_dot)."""
+
+    name: str
+    mass: sp.Expr
+    inertia: Matrix3
+    position: Vector
+    rotation: Matrix3
+    origin: Vector
+    angular_velocity: Vector
+    parent: str | None = None
+
+    def world_angular_velocity(self) -> Vector:
+        """omega in world axes, R omega_body (rad/s)."""
+        return apply(self.rotation, self.angular_velocity)
+
+    def point(self, offset: Vector) -> Vector:
+        """The point fixed at ``offset`` (body axes, from the body's origin), in the world (m)."""
+        return add(self.origin, apply(self.rotation, offset))
+
+
+@dataclass(frozen=True)
+class Moment:
+    """A moment M (N m) on a rigid body; virtual work M . delta(phi), so Q_i = M . d omega/d q_dot_i
+    with omega in the axes M is given in (``axes``: "world" or "body")."""
+
+    name: str
+    body: str
+    moment: Vector
+    axes: str
+    angular_velocity: Vector
+
+
+# -- small 3-vector algebra on sympy expressions ----------------------------------------------
+
+def apply(matrix: Matrix3, vector: Vector) -> Vector:
+    return tuple(sp.Add(*(a * v for a, v in zip(row, vector, strict=True) if a != 0 and v != 0))
+                 for row in matrix)
+
+
+def apply_transpose(matrix: Matrix3, vector: Vector) -> Vector:
+    return apply(transpose(matrix), vector)
+
+
+def transpose(matrix: Matrix3) -> Matrix3:
+    return tuple(tuple(matrix[i][j] for i in range(3)) for j in range(3))
+
+
+def compose(a: Matrix3, b: Matrix3) -> Matrix3:
+    columns = [apply(a, tuple(b[i][j] for i in range(3))) for j in range(3)]
+    return tuple(tuple(columns[j][i] for j in range(3)) for i in range(3))
+
+
+def add(a: Vector, b: Vector) -> Vector:
+    return tuple(x + y for x, y in zip(a, b, strict=True))
+
+
+def axis_rotation(axis: Vector, angle: sp.Expr) -> Matrix3:
+    """The rotation by ``angle`` about the unit vector ``axis`` (Rodrigues)."""
+    c, s = sp.cos(angle), sp.sin(angle)
+    named = next((k for k, v in AXES.items() if v == tuple(axis)), None)
+    if named == "x":
+        return ((1, 0, 0), (0, c, -s), (0, s, c))
+    if named == "y":
+        return ((c, 0, s), (0, 1, 0), (-s, 0, c))
+    if named == "z":
+        return ((c, -s, 0), (s, c, 0), (0, 0, 1))
+    x, y, z = axis
+    v = 1 - c
+    return ((c + x * x * v, x * y * v - z * s, x * z * v + y * s),
+            (y * x * v + z * s, c + y * y * v, y * z * v - x * s),
+            (z * x * v - y * s, z * y * v + x * s, c + z * z * v))
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A body frame on the way down a tree: origin (world), R (body -> world), omega (body)."""
+
+    origin: Vector
+    rotation: Matrix3
+    angular_velocity: Vector
+
+
+GROUND = Frame(_ZERO, _IDENTITY, _ZERO)
+
+
+def rotate(frame: Frame, axis: Vector, angle: sp.Expr, rate: sp.Expr) -> Frame:
+    """The frame turned by ``angle`` about its own ``axis`` (body-fixed); rate = d(angle)/dt."""
+    step = axis_rotation(axis, angle)
+    omega = add(apply_transpose(step, frame.angular_velocity),
+                tuple(rate * a for a in axis))
+    return Frame(frame.origin, compose(frame.rotation, step), omega)
+
+
+def translate(frame: Frame, offset: Vector) -> Frame:
+    """The frame moved by ``offset`` given in its own axes."""
+    return Frame(add(frame.origin, apply(frame.rotation, offset)), frame.rotation,
+                 frame.angular_velocity)
+
+
+# -- reading the user's description -----------------------------------------------------------
+
+class RotationReader:
+    """Turns the user's rotation sequences, joints and inertia into frames, naming each field.
+
+    ``expression(value, field)`` parses an angle or length in q and t (no velocities);
+    ``vector(value, field)`` a 3-vector; ``rate(expr)`` is d/dt along the motion.
+    """
+
+    def __init__(self, expression: Callable, vector: Callable, rate: Callable,
+                 source: str | None):
+        self.expression, self.vector, self.rate, self.source = expression, vector, rate, source
+
+    def error(self, message: str, field: str) -> ModelError:
+        return ModelError(message, field=field, source=self.source)
+
+    def axis(self, value: object, field: str) -> Vector:
+        """A named axis ('x', 'y', 'z', '-x', ...) or a 3-vector (normalized); never zero."""
+        if isinstance(value, str):
+            name = value.strip().lower()
+            sign = -1 if name.startswith("-") else 1
+            name = name.lstrip("+-")
+            if name not in AXES:
+                raise self.error(f"unknown axis '{value}': use x, y or z (or a 3-component "
+                                 f"vector){did_you_mean(name, list(AXES))}", field)
+            return tuple(sign * a for a in AXES[name])
+        vector = self.vector(value, field)
+        squared = sp.Add(*(c**2 for c in vector))
+        if squared.free_symbols:
+            raise self.error("a joint axis must be numbers (a direction fixed in the parent)",
+                             field)
+        if squared == 0:
+            raise self.error("the axis has zero length", field)
+        norm = sp.sqrt(squared)
+        return tuple(c / norm for c in vector)
+
+    def sequence(self, frame: Frame, value: object, field: str) -> Frame:
+        """Apply a body-fixed rotation sequence [[axis, angle], ...] to ``frame``."""
+        if isinstance(value, str) or not isinstance(value, Sequence) or not value:
+            raise self.error('a rotation is a list of [axis, angle] pairs, e.g. '
+                             '[["z", "phi"], ["x", "theta"], ["z", "psi"]]', field)
+        previous = None
+        for k, step in enumerate(value):
+            where = f"{field}[{k}]"
+            if isinstance(step, str) or not isinstance(step, Sequence) or len(step) != 2:
+                raise self.error('each rotation step is a pair [axis, angle], e.g. ["z", "phi"]',
+                                 where)
+            axis = self.axis(step[0], f"{where}[0]")
+            if previous is not None and (axis == previous
+                                         or axis == tuple(-a for a in previous)):
+                raise self.error(
+                    f"two rotations about the same axis in a row ({step[0]} after "
+                    f"{value[k - 1][0]}) are one rotation: a sequence needs a different axis "
+                    "next (z-x-z, z-y-x, ...)", where)
+            previous = axis
+            angle = self.expression(step[1], f"{where}[1]")
+            frame = rotate(frame, axis, angle, self.rate(angle))
+        return frame
+
+    def joint(self, parent: Frame, value: object, field: str) -> Frame:
+        """The child frame of a joint on ``parent`` (``at``: the joint in parent axes)."""
+        if not isinstance(value, Mapping):
+            raise self.error('a joint is a table {type = "revolute", axis = "z", angle = "q"}',
+                             field)
+        kind = value.get("type")
+        if kind not in JOINT_TYPES:
+            raise self.error(f"unknown joint type {kind!r}: use one of "
+                             f"{', '.join(JOINT_TYPES)}{did_you_mean(str(kind), JOINT_TYPES)}",
+                             f"{field}.type")
+        required, optional = JOINT_KEYS[kind]
+        for key in value:
+            if key not in required | optional:
+                raise self.error(f"unknown key '{key}' for a {kind} joint"
+                                 f"{did_you_mean(key, sorted(required | optional))}",
+                                 f"{field}.{key}")
+        for key in sorted(required - set(value)):
+            raise self.error(f"missing key '{key}' for a {kind} joint", field)
+        frame = parent
+        if "at" in value:
+            frame = translate(frame, self.vector(value["at"], f"{field}.at"))
+        if kind == "revolute":
+            axis = self.axis(value["axis"], f"{field}.axis")
+            angle = self.expression(value["angle"], f"{field}.angle")
+            frame = rotate(frame, axis, angle, self.rate(angle))
+        elif kind == "prismatic":
+            axis = self.axis(value["axis"], f"{field}.axis")
+            distance = self.expression(value["distance"], f"{field}.distance")
+            frame = translate(frame, tuple(distance * a for a in axis))
+        elif "rotation" in value:
+            frame = self.sequence(frame, value["rotation"], f"{field}.rotation")
+        return frame
+
+    def inertia(self, value: object, field: str, values: Mapping[sp.Symbol, float]) -> Matrix3:
+        """Principal [Ixx, Iyy, Izz] or a symmetric 3x3 tensor (kg m^2), about the centre of mass
+        in body axes; positive definite with each principal moment at most the sum of the
+        other two, checked wherever the parameters have values."""
+        if isinstance(value, str) or not isinstance(value, Sequence) or len(value) != 3:
+            raise self.error("the inertia of a 3D body is [Ixx, Iyy, Izz] (principal) or a "
+                             "3x3 table of rows [[Ixx, Ixy, Ixz], [Ixy, Iyy, Iyz], "
+                             "[Ixz, Iyz, Izz]]", field)
+        rows = [isinstance(v, Sequence) and not isinstance(v, str) for v in value]
+        if not any(rows):
+            diagonal = [self.expression(v, f"{field}[{i}]") for i, v in enumerate(value)]
+            tensor = tuple(tuple(diagonal[i] if i == j else sp.S.Zero for j in range(3))
+                           for i in range(3))
+        else:
+            if not all(rows) or any(len(v) != 3 for v in value):
+                raise self.error("a full inertia tensor has 3 rows of 3 entries", field)
+            tensor = tuple(tuple(self.expression(v, f"{field}[{i}][{j}]")
+                                 for j, v in enumerate(row)) for i, row in enumerate(value))
+            for i in range(3):
+                for j in range(i + 1, 3):
+                    if sp.expand(tensor[i][j] - tensor[j][i]) != 0:
+                        raise self.error(
+                            f"the inertia tensor is not symmetric: entry [{i}][{j}] = "
+                            f"{tensor[i][j]} but [{j}][{i}] = {tensor[j][i]}", field)
+        self._check_inertia_values(tensor, field, values)
+        return tensor
+
+    def _check_inertia_values(self, tensor: Matrix3, field: str,
+                              values: Mapping[sp.Symbol, float]) -> None:
+        numbers = []
+        for row in tensor:
+            for entry in row:
+                if not entry.free_symbols <= set(values):
+                    return  # symbolic: decided only where every parameter has a value
+                try:
+                    numbers.append(float(entry.xreplace(dict(values))))
+                except (TypeError, ValueError):
+                    return
+        import numpy as np
+
+        matrix = np.array(numbers).reshape(3, 3)
+        moments = np.linalg.eigvalsh(matrix)
+        if not all(math.isfinite(m) for m in moments) or moments[0] <= 0:
+            raise self.error(
+                "the inertia tensor is not positive definite (principal moments "
+                f"{', '.join(f'{m:.6g}' for m in moments)} kg m^2; each must be > 0)", field)
+        tolerance = 1e-9 * float(moments[-1])
+        if moments[0] + moments[1] < moments[2] - tolerance:
+            raise self.error(
+                "the principal moments break the triangle inequality I1 + I2 >= I3 "
+                f"({moments[0]:.6g} + {moments[1]:.6g} < {moments[2]:.6g} kg m^2): no body "
+                "has this inertia", field)
+
+
+__all__ = ["AXES", "GROUND", "Frame", "Moment", "RigidBody", "RotationReader", "apply",
+           "axis_rotation", "compose", "rotate", "translate", "transpose"]

@@ -230,7 +230,7 @@ def layout(study: Study) -> dict[str, tuple[tuple[str, ...], str]]:
         return {"configuration": (("equilibrium", "coordinate"), "f8"),
                 "stable": (("equilibrium",), "f8"), "count": ((), "f8")}
     out = {"final": (("state",), "f8"), "minimum": (("state",), "f8"),
-           "maximum": (("state",), "f8"), "t_final": ((), "f8"), "energy_drift": ((), "f8"),
+           "maximum": (("state",), "f8"), "t_final": ((), "f8"), "invariant_drift": ((), "f8"),
            "stop_time": ((), "f8")}
     if study.simulation.trajectories:
         out["trajectory"] = (("time", "state"), "f8")
@@ -520,10 +520,15 @@ class _SimulationFunctions:
 
 def _prepare_simulation(study: Study):
     from ..numerics import compiled
+    from ..numerics.invariants import energy_is_conserved
 
     module = None
+    # The compiled loop where it applies: no constraints (no projection), no stop condition
+    # (no event location) and T + V the invariant (the module evaluates it); otherwise each
+    # member is the single-point simulation itself.
     fast = (study.generated is not None and study.eom.model.constraints == ()
-            and study.simulation.stop_when is None and study.simulation.method == "DOP853")
+            and study.simulation.stop_when is None and study.simulation.method == "DOP853"
+            and energy_is_conserved(study.eom))
     if fast:
         try:
             module = compiled.load(study.generated)
@@ -550,7 +555,7 @@ def _simulation_chunk(study, functions: _SimulationFunctions, values, count):
         except Exception as exc:
             out["status"][i] = _reason(exc)
             continue
-        t, y, energy, status, message, stop_time = run
+        t, y, drift, status, message, stop_time = run
         if status == "failed":
             out["status"][i] = message
             continue
@@ -558,7 +563,7 @@ def _simulation_chunk(study, functions: _SimulationFunctions, values, count):
         out["minimum"][i] = y.min(axis=0)
         out["maximum"][i] = y.max(axis=0)
         out["t_final"][i] = t[-1]
-        out["energy_drift"][i] = np.nan if energy is None else energy
+        out["invariant_drift"][i] = np.nan if drift is None else drift
         out["stop_time"][i] = np.nan if stop_time is None else stop_time
         if options.trajectories:
             out["trajectory"][i, : len(t)] = y
@@ -568,7 +573,7 @@ def _simulation_chunk(study, functions: _SimulationFunctions, values, count):
 
 
 def _simulate_member(study, functions, parameters, state):
-    """(t, y, energy drift or None, status, message, stop time or None) of one member."""
+    """(t, y, invariant drift or None, status, message, stop time or None) of one member."""
     options = study.simulation
     model = study.model
     if functions.module is not None:
@@ -583,14 +588,11 @@ def _simulate_member(study, functions, parameters, state):
                                                  options.rtol, options.atol)
         if status != 0:
             return t, y, None, "failed", f"integration failed at t = {reached:.9g} s", None
-        drift = None
-        if _energy_conserved(study):
-            n = len(model.coordinates)
-            q, v = np.ascontiguousarray(y[:, :n]), np.ascontiguousarray(y[:, n:])
-            energy = functions.module.energy(q, v, t, vector)
-            kinetic = energy - functions.module.energy(q, np.zeros_like(v), t, vector)
-            drift = _drift(energy, kinetic)
-        return t, y, drift, "finished", "", None
+        n = len(model.coordinates)
+        q, v = np.ascontiguousarray(y[:, :n]), np.ascontiguousarray(y[:, n:])
+        energy = functions.module.energy(q, v, t, vector)
+        kinetic = energy - functions.module.energy(q, np.zeros_like(v), t, vector)
+        return t, y, _drift(energy, kinetic), "finished", "", None
     from ..numerics.options import SaveAt, StepControl
     from ..numerics.simulate import parse_stop_condition, simulate
 
@@ -600,23 +602,12 @@ def _simulate_member(study, functions, parameters, state):
                       save_at=SaveAt(options.samples), stop=stop)
     y = np.concatenate([result.q, result.q_dot], axis=1)
     stop_time = float(result.t[-1]) if result.status == "stopped" else None
-    return result.t, y, result.energy_drift, result.status, result.message, stop_time
-
-
-_CONSERVED: dict[int, bool] = {}
-
-
-def _energy_conserved(study: Study) -> bool:
-    from ..numerics.invariants import energy_is_conserved
-
-    key = id(study.eom)
-    if key not in _CONSERVED:
-        _CONSERVED[key] = energy_is_conserved(study.eom)
-    return _CONSERVED[key]
+    return result.t, y, result.invariant_drift, result.status, result.message, stop_time
 
 
 def _drift(energy: np.ndarray, kinetic: np.ndarray) -> float:
-    """max |E - E0| / |E0| (relative to the largest T when E0 = 0), as SimulationResult."""
+    """max |E - E0| / |E0| (relative to the largest T when E0 = 0), as SimulationResult's
+    invariant_drift for the energy."""
     change = float(np.max(np.abs(energy - energy[0])))
     scale = abs(float(energy[0]))
     largest_t = float(np.max(np.abs(kinetic)))

@@ -178,8 +178,9 @@ def run_study(
 def _run_chunks(client, study, todo, pieces, store, finished, progress) -> int:
     from dask.distributed import as_completed
 
-    shared = client.scatter(study, broadcast=True)
-    # Keys new for each run: a resumed study must not meet the cancelled tasks of the last one.
+    # Keys new for each run (hash=False for the scattered study too): a study run again or
+    # resumed must not meet the data and tasks the last run is still releasing.
+    shared = client.scatter(study, broadcast=True, hash=False)
     run = uuid.uuid4().hex[:8]
     futures = {}
     for start, stop in todo:

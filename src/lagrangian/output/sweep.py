@@ -34,7 +34,8 @@ DESCRIPTIONS = {
     "minimum": ("SI", "smallest value of each state component over the samples"),
     "maximum": ("SI", "largest value of each state component over the samples"),
     "t_final": ("s", "time of the last sample"),
-    "energy_drift": ("1", "max |E - E0| / |E0| where the energy is conserved"),
+    "invariant_drift": ("1", "largest change of the monitored invariant (T + V, the Jacobi "
+                        "integral or the work balance) relative to its size"),
     "stop_time": ("s", "time the stop condition fired (NaN: it did not)"),
     "trajectory": ("SI", "state on the common time grid"),
     "status": ("", "'ok', or why the point has no numbers"),
@@ -103,8 +104,9 @@ def study_dataset(study: Study, arrays: Mapping[str, np.ndarray], finished: int 
              "failed": int(np.sum((status != OK) & (status != NOT_COMPUTED)))}
     if study.simulation is not None:
         options = study.simulation
-        attrs.update({"t_end": options.t_end, "method": options.method, "rtol": options.rtol,
-                      "atol": options.atol, "stop_when": options.stop_when or ""})
+        attrs.update({"invariant": study.eom.invariant_kind, "t_end": options.t_end,
+                      "method": options.method, "rtol": options.rtol, "atol": options.atol,
+                      "stop_when": options.stop_when or ""})
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 
@@ -158,7 +160,7 @@ def study_summary(dataset) -> dict:
     summary = {"model": dataset.attrs.get("model"), "compute": dataset.attrs.get("compute"),
                "dimensions": dims, "points": int(status.size),
                "ok": int(np.sum(status == OK)), "missing": reasons}
-    main = {"modes": "frequency", "equilibria": "count", "simulate": "energy_drift"}
+    main = {"modes": "frequency", "equilibria": "count", "simulate": "invariant_drift"}
     name = main.get(str(dataset.attrs.get("compute")))
     if name in dataset:
         values = np.asarray(dataset[name].values, float)
@@ -179,7 +181,7 @@ def study_text(dataset, path: Path | None = None) -> str:
              f"points computed"]
     for reason, count in s["missing"].items():
         lines.append(f"  {count} missing: {reason}")
-    for key in ("frequency", "count", "energy_drift"):
+    for key in ("frequency", "count", "invariant_drift"):
         if s.get(key):
             lines.append(f"  {key}: {s[key]['min']:.6g} .. {s[key]['max']:.6g}")
     if "stable_points" in s:

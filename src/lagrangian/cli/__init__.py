@@ -29,11 +29,36 @@ from .common import in_flags  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Console entry point: usage errors exit 2 (click's standalone mode); library errors
-    (bad model, bad values, singular system) print one line and exit 2 as well."""
+    """Console entry point. Every bad input ends with one line `error: ...` and exit status 2:
+    the library's errors (bad model, bad values, singular system), the command line's own
+    (unknown option, bad or missing value: typer's 6-line box before) and files that cannot be
+    written."""
     try:
-        app(args=argv, prog_name="lagrangian")
-    except (LagrangianError, FileExistsError) as exc:
-        typer.echo(f"error: {in_flags(exc) if isinstance(exc, LagrangianError) else exc}",
-                   err=True)
-        sys.exit(2)
+        code = app(args=argv, prog_name="lagrangian", standalone_mode=False)
+    except LagrangianError as exc:
+        _fail(str(in_flags(exc)))
+    except typer.Abort:  # end of input or Ctrl-C at a prompt
+        _fail("aborted", 130)
+    except typer.TyperException as exc:  # click's usage errors
+        if type(exc).__name__ == "NoArgsIsHelpError":  # bare `lagrangian`: the help, as before
+            typer.echo(exc.format_message(), err=True)
+            sys.exit(2)
+        _fail(_usage_message(exc))
+    except OSError as exc:  # a file that passed the checks but could not be written after all
+        where = f"{exc.filename}: " if exc.filename else ""
+        _fail(f"{where}{exc.strerror or exc}")
+    sys.exit(code if isinstance(code, int) else 0)  # as click's standalone mode did
+
+
+def _usage_message(exc: typer.TyperException) -> str:
+    """click's message on one line, with the command to ask for help."""
+    message = " ".join(exc.format_message().split()).rstrip(".")
+    message = message[:1].lower() + message[1:]
+    context = getattr(exc, "ctx", None)
+    command = context.command_path if context is not None else "lagrangian"
+    return f"{message} (see '{command} --help')"
+
+
+def _fail(message: str, code: int = 2) -> None:
+    typer.echo(f"error: {message}", err=True)
+    sys.exit(code)

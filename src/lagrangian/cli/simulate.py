@@ -9,10 +9,10 @@ from typing import Annotated
 
 import typer
 
-from ..errors import ModelError
 from ..model.units import parse_quantity
 from ..model.values import resolve_state
 from ..numerics.simulate import METHODS, SaveAt, StepControl, parse_stop_condition
+from ..output.files import check_output_path, partial_path
 from ..output.simulation import projection_warning, simulation_document, simulation_text
 from . import app
 from .common import load_system, print_json, state_assignments
@@ -55,9 +55,9 @@ def simulate(
         check_animation_path(animate)
         check_animatable(system.model)
     inputs = (Path(model),) if Path(model).exists() else ()
-    for path in (out, plot, animate):
-        if path is not None and inputs and path.exists() and path.resolve() == inputs[0].resolve():
-            raise ModelError(f"{path}: refusing to overwrite the input model file", field="output")
+    for path, field in ((out, "table"), (plot, "plot"), (animate, "animation")):
+        if path is not None:  # writable, not a directory, not the model: before the run
+            check_output_path(path, field, inputs=inputs)
 
     with _Progress(end) as progress:
         simulation = system.simulate(
@@ -69,15 +69,19 @@ def simulate(
     if warning:
         typer.echo(warning, err=True)
 
+    # a partial result (failed or interrupted run) never replaces an existing file
+    partial = simulation.status in ("failed", "interrupted")
     written = {}
     if out is not None:
-        written["out"] = str(simulation.save(out))
+        written["out"] = str(simulation.save(partial_path(out) if partial else out))
     if plot is not None:
-        simulation.plot(plot)
-        written["plot"] = str(plot)
+        target = partial_path(plot) if partial else plot
+        simulation.plot(target)
+        written["plot"] = str(target)
     if animate is not None:
-        simulation.animate(animate)
-        written["animate"] = str(animate)
+        target = partial_path(animate) if partial else animate
+        simulation.animate(target)
+        written["animate"] = str(target)
 
     if json_:
         print_json(simulation_document(simulation, written))

@@ -102,8 +102,8 @@ class SimulationResult:
         """What should stay zero (J): I - I0 for a conserved I, h - h0 - int P dt for a work
         balance; None before the quantity is known."""
         values = self.invariant_values if self.invariant_values is not None else self.energy
-        if values is None or len(values) == 0:
-            return None
+        if values is None or len(values) == 0 or not np.all(np.isfinite(values)):
+            return None  # none (a run that failed on an overflow has an infinite energy)
         change = values - values[0]
         if self.invariant == "work_balance":
             if self.work is None:
@@ -147,7 +147,8 @@ class SimulationResult:
     @property
     def energy_drift(self) -> float | None:
         """max |E - E0| / |E0| where energy should be conserved, else None (max T if E0 = 0)."""
-        if not self.energy_conserved or len(self.energy) == 0:
+        if not self.energy_conserved or len(self.energy) == 0 or \
+                not np.all(np.isfinite(self.energy)):  # a run failed on an overflow
             return None
         change = float(np.max(np.abs(self.energy - self.energy[0])))
         scale = abs(float(self.energy[0]))

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Mapping
+from dataclasses import replace
 
 import numpy as np
 
@@ -80,6 +81,8 @@ def simulate(
     run = _integrate(functions, y0, grid, step_control, event, drift, progress,
                      compiled_loop and not functions.m and event is None)
     wall = time.perf_counter() - began
+    if run.status == "failed":
+        run = replace(run, message=_explain_failure(functions, run))
 
     t, q, q_dot = run.t, run.y[:, :functions.n], run.y[:, functions.n:]
     energy = functions.energy(q, q_dot, t)
@@ -134,6 +137,32 @@ def _integrate(functions, y0, grid, step_control, event, drift, progress, compil
             return run
     return integrate_steps(_rhs(functions), float(grid[0]), y0, float(grid[-1]), grid,
                            step_control, event, drift, progress)
+
+
+_TOO_LARGE = 1e100  # beyond this a step of any size overflows somewhere in the loop
+
+
+def _explain_failure(functions: NumericSystem, run: LoopRun) -> str:
+    """The loop's message, with why from the last state kept: a state or an acceleration too
+    large for floating point (g = 1e308, theta_dot = 1e300) makes every step size fail."""
+    if "singular" in run.message.lower():
+        return run.message
+    n, t, y = functions.n, float(run.t[-1]), run.y[-1]
+    names = [*functions.coordinates, *(f"{c}_dot" for c in functions.coordinates)]
+    for name, value in zip(names, y, strict=True):
+        if not abs(value) < _TOO_LARGE:
+            return (f"{run.message}: {name} = {value:.3g} there is too large to integrate "
+                    "(check the parameters and initial values)")
+    try:
+        with np.errstate(all="ignore"):
+            q_ddot, _ = functions.accelerations_and_multipliers(y[:n], y[n:], t)
+    except (np.linalg.LinAlgError, ValueError, ZeroDivisionError, OverflowError):
+        return run.message
+    for name, value in zip(functions.coordinates, np.ravel(q_ddot), strict=True):
+        if not abs(value) < _TOO_LARGE:
+            return (f"{run.message}: the acceleration of {name} is {value:.3g} there, too large "
+                    "to integrate (check the parameters and initial values)")
+    return run.message
 
 
 def _project_start(drift: DriftControl, start: State):

@@ -1,0 +1,203 @@
+"""Hostile command lines (issue 14): one line `error: ...` and the right exit status, never a
+traceback; a failed integration keeps its partial result and says where and why."""
+
+from __future__ import annotations
+
+import pytest
+
+SINGULAR_AT_ZERO = """
+[coordinates]
+x = { unit = "m", initial = 0.0, rate = 1.0 }
+[energy]
+T = "x^2*x_dot^2"
+"""
+
+QUARTIC = """
+[coordinates]
+x = { unit = "m", initial = 0.0, rate = 0.0 }
+[energy]
+T = "x_dot^4"
+"""
+
+
+def one_line(err: str) -> str:
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    return lines[0]
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        # a traceback: "cannot reshape array of size 0" (the C loop failed at the first step)
+        (("--set", "g=1e308"), "error: integration failed: Required step size is less than "
+         "spacing between numbers at t = 0 s: the acceleration of theta is -5.91e+307 there, too "
+         "large to integrate (check the parameters and initial values); partial result saved to "
+         "{out}"),
+        (("--initial", "theta_dot=1e300"), "error: integration failed: Required step size is "
+         "less than spacing between numbers at t = 0 s: theta_dot = 1e+300 there is too large to "
+         "integrate (check the parameters and initial values); partial result saved to {out}"),
+    ],
+)
+def test_a_run_failing_at_the_first_step_keeps_the_start_and_says_why(cli, tmp_path, args,
+                                                                      message):
+    out = tmp_path / "run.csv"
+    code, _, err = cli("simulate", "pendulum", "--t-end", "1", *args, "--out", str(out))
+    assert code == 1
+    assert one_line(err) == message.format(out=out)
+    rows = out.read_text().splitlines()
+    assert rows[0].startswith("t,theta,theta_dot") and rows[1].startswith("0.0,0.3,")
+
+
+@pytest.mark.parametrize(("text", "name"), [(SINGULAR_AT_ZERO, "x2"), (QUARTIC, "x4")])
+def test_a_mass_matrix_singular_at_the_start_is_named(cli, tmp_path, text, name):
+    # M = 2 x^2 and 12 x_dot^2: both zero at the start
+    model = tmp_path / f"{name}.toml"
+    model.write_text(text)
+    code, _, err = cli("simulate", str(model), "--t-end", "1")
+    assert code == 1
+    assert one_line(err) == "error: integration failed: Singular mass matrix at t = 0 s"
+
+
+def test_a_sample_count_beyond_memory_is_refused_up_front(cli):
+    code, out, err = cli("simulate", "pendulum", "--t-end", "1", "--samples", "1000000000000")
+    assert code == 2 and out == ""
+    assert one_line(err) == ("error: --samples: samples must be at most 10,000,000, "
+                             "got 1,000,000,000,000")
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (("modes", "pendulum", "--about", "theta=pi/0"),
+         "error: --about theta: division by zero in 'pi/0'"),  # a ZeroDivisionError traceback
+        (("simulate", "pendulum", "--t-end", "1", "--stop-when", "log(-1) > theta"),
+         "error: --stop-when: 'log(-1)' is not a real number"),  # the real part was used
+        (("simulate", "pendulum", "--t-end", "1", "--stop-when", "theta > 1.0000001^1000"),
+         "error: --stop-when: the exact value of '1.0000001^1000' has about 7000 digits (at most "
+         "1000): write it as a decimal number (about 1.0001)"),
+        (("forces", "pendulum", "--at", "theta=1 rad*9^9^9"),
+         "error: --at theta: unit 'rad*9^9^9': powers of powers are not allowed in a unit"),
+        (("forces", "pendulum", "--at", "theta=1e308pi"),  # units after the finiteness check
+         "error: --at theta: '1e308pi' is not a finite number in SI units"),
+    ],
+)
+def test_hostile_values_on_the_command_line(cli, args, message):
+    code, out, err = cli(*args)
+    assert code == 2 and out == ""
+    assert one_line(err) == message
+
+
+CONSTRAINED = """
+[coordinates]
+x = { unit = "m", initial = 1.0 }
+y = { unit = "m", initial = 0.0 }
+[energy]
+T = "1/2*(x_dot^2 + y_dot^2)"
+[[constraints]]
+name = "one"
+FIRST
+[[constraints]]
+name = "two"
+SECOND
+"""
+
+
+@pytest.mark.parametrize(
+    ("first", "second", "message"),
+    [
+        # x = 1 and x = 2 cannot both hold: once called "redundant"
+        ('holonomic = "x - 1"', 'holonomic = "x - 2"', "error: inconsistent constraints: where "
+         "'one' holds, 'two' equals -1, never 0; correct or remove one of them"),
+        ('velocity = "x_dot - 1"', 'velocity = "x_dot - 2"', "error: inconsistent constraints: "
+         "where 'one' holds, 'two' equals -1, never 0; correct or remove one of them"),
+        # 2x - 2 = 0 says again what x - 1 = 0 says
+        ('holonomic = "x - 1"', 'holonomic = "2*x - 2"', "error: redundant constraint 'two': it "
+         "depends on the constraints before it (one); remove it so that there is exactly one "
+         "multiplier per independent constraint"),
+    ],
+)
+def test_inconsistent_constraints_are_told_from_redundant_ones(cli, tmp_path, first, second,
+                                                               message):
+    model = tmp_path / "constrained.toml"
+    model.write_text(CONSTRAINED.replace("FIRST", first).replace("SECOND", second))
+    code, out, err = cli("derive", str(model))
+    assert code == 2 and out == ""
+    assert one_line(err) == message
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        # the command line's own errors were a 5-6 line box from the CLI framework
+        (("derive", "pendulum", "--format", "xml"), "error: invalid value for '--format' / '-f': "
+         "Value error, 'xml' is not one of 'text', 'latex', 'json' (see 'lagrangian derive "
+         "--help')"),
+        (("simulate", "pendulum"), "error: missing option '--t-end' (see 'lagrangian simulate "
+         "--help')"),
+        (("simulate", "pendulum", "--t-end", "1", "--samples", "abc"), "error: invalid value for "
+         "'--samples': Input should be a valid integer, unable to parse string as an integer "
+         "(see 'lagrangian simulate --help')"),
+        (("nosuch",), "error: no such command 'nosuch' (see 'lagrangian --help')"),
+        (("derive",), "error: missing argument 'model' (see 'lagrangian derive --help')"),
+    ],
+)
+def test_command_line_errors_are_one_line(cli, args, message):
+    code, out, err = cli(*args)
+    assert code == 2 and out == ""
+    assert one_line(err) == message
+
+
+def test_output_paths_are_checked_before_the_run(cli, tmp_path):
+    folder = tmp_path / "run.csv"
+    folder.mkdir()
+    code, out, err = cli("simulate", "pendulum", "--t-end", "1", "--out", str(folder))
+    assert code == 2 and out == ""
+    assert one_line(err) == f"error: --out: cannot write {folder}: it is a directory"
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    # was "[Errno 17] File exists: 'afile'" after the run (29 s of animation lost)
+    code, out, err = cli("simulate", "pendulum", "--t-end", "1", "--plot", str(afile / "run.png"))
+    assert code == 2 and out == ""
+    assert one_line(err) == (f"error: --plot: cannot write {afile / 'run.png'}: {afile} is a "
+                             "file, not a directory")
+    shapes = tmp_path / "shapes.png"
+    shapes.mkdir()
+    code, out, err = cli("modes", "pendulum", "--plot", str(shapes))
+    assert code == 2 and out == ""
+    assert one_line(err) == f"error: --plot: cannot write {shapes}: it is a directory"
+
+
+def test_a_read_only_directory_is_refused_before_the_run(cli, tmp_path, monkeypatch):
+    import os
+
+    from lagrangian.output import files
+
+    folder = tmp_path / "locked"
+    folder.mkdir()
+    # what a read-only directory answers (root could write into one, so it is simulated)
+    monkeypatch.setattr(files.os, "access",
+                        lambda path, mode: os.path.abspath(path) != str(folder))
+    code, out, err = cli("simulate", "double_pendulum", "--t-end", "1", "--animate",
+                         str(folder / "run.gif"))
+    assert code == 2 and out == ""
+    assert one_line(err) == (f"error: --animate: cannot write {folder / 'run.gif'}: the "
+                             f"directory {folder} is not writable")
+    code, out, err = cli("simulate", "pendulum", "--t-end", "1", "--out",
+                         str(folder / "new" / "run.csv"))
+    assert one_line(err) == (f"error: --out: cannot write {folder / 'new' / 'run.csv'}: "
+                             f"{folder / 'new'} cannot be created: {folder} is not writable")
+
+
+def test_a_partial_result_never_replaces_an_existing_file(cli, tmp_path):
+    model = tmp_path / "x2.toml"
+    model.write_text(SINGULAR_AT_ZERO)
+    table = tmp_path / "run.csv"
+    table.write_text("a good result\n")
+    code, _, err = cli("simulate", str(model), "--t-end", "1", "--out", str(table))
+    assert code == 1
+    partial = tmp_path / "run.partial.csv"
+    assert one_line(err) == ("error: integration failed: Singular mass matrix at t = 0 s; "
+                             f"partial result saved to {partial}")
+    assert table.read_text() == "a good result\n"
+    assert partial.read_text().splitlines()[1] == "0.0,0.0,1.0,0.0,0.0"

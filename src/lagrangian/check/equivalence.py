@@ -175,7 +175,7 @@ def solve_at_points(A: sp.Matrix, b: sp.Matrix, points: Points, count: int | Non
                     solutions.append(None)
                     continue
                 u = mpmath.lu_solve(matrix, rhs)
-            except (ZeroDivisionError, ValueError):
+            except (ZeroDivisionError, ValueError, TypeError):  # mpmath's singular cases
                 solutions.append(None)
                 continue
             values = [u[i] for i in range(n_cols)]

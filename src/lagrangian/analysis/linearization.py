@@ -69,6 +69,9 @@ class LinearModel:
     full_mass_matrix: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     full_damping_matrix: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     full_stiffness_matrix: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    # About a steady motion (analysis/steady.py): velocity name -> its constant rate; empty
+    # about an equilibrium.
+    steady: dict[str, float] = field(default_factory=dict)
 
     @property
     def M(self) -> np.ndarray:

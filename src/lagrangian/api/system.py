@@ -24,6 +24,7 @@ from ..analysis.linearization import (
 )
 from ..analysis.modes import ModalAnalysis, is_stable, modal_analysis
 from ..analysis.statics import StaticsReport, solve_statics
+from ..analysis.steady import steady_linear_model
 from ..check.diagnose import CheckReport, check_answer
 from ..check.newton_euler import CrosscheckReport, crosscheck
 from ..check.units import UnitsReport, check_model_units
@@ -187,14 +188,24 @@ class System:
         return find_equilibria(functions, stability=stable)
 
     def linearize(self, about: Mapping[str, float] | None = None, inputs: Sequence[str] = (), *,
-                  symbolic: bool = False) -> LinearModel | SymbolicLinearModel:
+                  symbolic: bool = False, steady: Mapping[str, float] | None = None,
+                  ) -> LinearModel | SymbolicLinearModel:
         """Linear model M, C, K and state-space A, B (x = [q; q_dot]) about an equilibrium.
 
         ``about`` maps coordinate names to SI values (the others are solved for); without it the
         equilibrium nearest the initial values is used. ``inputs`` name parameters, loads or
         coordinates (a generalized force). ``symbolic=True`` gives exact M, C, K of a small
-        unconstrained model with the parameters kept as symbols.
+        unconstrained model with the parameters kept as symbols. ``steady`` linearizes about a
+        steady motion instead: cyclic coordinates turning at constant rates, e.g.
+        ``steady={"psi_dot": 10}`` (rad/s), the rest at ``about`` (the others solved for).
         """
+        if steady:
+            from ..errors import ModelError
+
+            if symbolic or inputs:
+                raise ModelError("about a steady motion the linear model is numeric and has "
+                                 "no inputs yet", field="steady")
+            return steady_linear_model(self.equations_of_motion(), about, steady)
         if symbolic:
             return symbolic_linear_model(self.equations_of_motion(), dict(about or {}))
         functions = self._static_functions
@@ -203,10 +214,12 @@ class System:
         columns = input_columns(functions.eom, q, inputs, functions.parameters) if inputs else None
         return linear_model_at(functions, q, multipliers, inputs=inputs, input_columns=columns)
 
-    def modes(self, about: Mapping[str, float] | None = None) -> ModalAnalysis:
-        """Natural frequencies (rad/s), damping ratios and mode shapes about an equilibrium."""
+    def modes(self, about: Mapping[str, float] | None = None, *,
+              steady: Mapping[str, float] | None = None) -> ModalAnalysis:
+        """Natural frequencies (rad/s), damping ratios and mode shapes about an equilibrium, or
+        about a steady motion (``steady``: velocity name -> constant rate)."""
         require_inertia(self.equations_of_motion(), "modes")
-        return modal_analysis(self.linearize(about), self._model.name)
+        return modal_analysis(self.linearize(about, steady=steady), self._model.name)
 
     # -- parameter studies and ensembles (Dask; see docs/sweeps.md) -------------------------------
 

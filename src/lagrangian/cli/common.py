@@ -18,6 +18,7 @@ FLAG_OF_FIELD = {
     "parameters": "--set",
     "configuration": "--at",
     "about": "--about",
+    "steady": "--steady",
     "solve_for": "--solve-for",
     "initial": "--initial",
     "t_end": "--t-end",

@@ -12,12 +12,15 @@ from . import app
 from .common import load_system, print_json, state_assignments
 
 ABOUT_HELP = "Equilibrium: COORDINATE=VALUE (pi, 180deg, 0.5m); the others are solved for."
+STEADY_HELP = ("Steady motion: a cyclic coordinate's constant rate, NAME_dot=VALUE (psi_dot=10, "
+               "rad/s); linearize about it instead of an equilibrium.")
 
 
 @app.command()
 def modes(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
     about: Annotated[list[str], typer.Option("--about", help=ABOUT_HELP)] = [],  # noqa: B006
+    steady: Annotated[list[str], typer.Option("--steady", help=STEADY_HELP)] = [],  # noqa: B006
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option("--plot", help="Draw the mode shapes to a PNG file.")] = None,
@@ -25,7 +28,8 @@ def modes(
     """Linearize about an equilibrium: M, C, K, natural frequencies, damping and mode shapes."""
     system = load_system(model, set_)
     point = state_assignments(system, about, "--about")
-    analysis = system.modes(about=point or None)
+    rates = state_assignments(system, steady, "--steady")
+    analysis = system.modes(about=point or None, steady=rates or None)
     if plot is not None:
         inputs = (Path(model),) if Path(model).exists() else ()
         write_mode_plot(analysis, plot, protect=inputs)

@@ -62,6 +62,7 @@ def modes_document(analysis: ModalAnalysis) -> dict[str, Any]:
     linear = analysis.linear_model
     return {
         "equilibrium": dict(linear.equilibrium),
+        **({"steady": dict(linear.steady)} if linear.steady else {}),
         "stable": analysis.stable,
         "coordinates": list(linear.coordinates),
         "mass_matrix": _rows(linear.mass_matrix),
@@ -87,8 +88,13 @@ def modes_text(analysis: ModalAnalysis) -> str:
     title = f"Modes of {analysis.model_name}"
     lines = [title, "=" * len(title)]
     about = ", ".join(f"{k} = {_number(v)}" for k, v in linear.equilibrium.items())
-    lines.append(f"About the equilibrium {about} "
-                 f"({'stable' if analysis.stable else 'unstable'})")
+    if linear.steady:
+        rates = ", ".join(f"{k} = {_number(v)}" for k, v in linear.steady.items())
+        lines.append(f"About the steady motion {about} with {rates} "
+                     f"({'stable' if analysis.stable else 'unstable'})")
+    else:
+        lines.append(f"About the equilibrium {about} "
+                     f"({'stable' if analysis.stable else 'unstable'})")
     if linear.multipliers:
         lines.append("Multipliers: " + ", ".join(f"lambda_{k} = {_number(v)}"
                                                  for k, v in linear.multipliers.items()))

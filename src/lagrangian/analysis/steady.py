@@ -1,0 +1,169 @@
+"""Linearization about steady motion: cyclic coordinates turning at constant rates.
+
+A relative equilibrium (a sleeping or precessing top, a spinning satellite) has q_ddot = 0 with
+some velocities non-zero: the cyclic coordinates q_c (absent from M and f) turn at constant rates
+Omega_c while the others stay at q0. About it, M dq_ddot + C dq_dot + K dq = 0 with
+M = M(q0), C = -df/dq_dot and K = -df/dq at (q0, q_dot0) (the dM/dq q_ddot terms vanish since
+q_ddot0 = 0); C now holds the gyroscopic coupling of the spin. Units SI (rad/s for the rates).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..derivation.equations import EquationsOfMotion
+from ..derivation.kinematics import Differentiator
+from ..errors import DerivationError, ModelError, did_you_mean
+from ..model.expressions import as_expression
+from ..model.model import velocity_name
+from ..model.values import ParameterValues, resolve_parameters
+from ..numerics.lambdified import StateFunction
+from .linearization import LinearModel
+
+FIELD = "steady"
+# q_ddot smaller than this (relative to the rates squared) is a steady motion.
+BALANCE_TOLERANCE = 1e-8
+
+
+def steady_rates(eom: EquationsOfMotion, steady: Mapping[str, float]) -> dict[int, float]:
+    """Coordinate index -> constant rate for names like ``psi_dot`` (rad/s or m/s)."""
+    model = eom.model
+    velocities = {velocity_name(c.name): i for i, c in enumerate(model.coordinates)}
+    rates = {}
+    for name, value in steady.items():
+        if name not in velocities:
+            hint = did_you_mean(name, list(velocities))
+            if name in {c.name for c in model.coordinates}:
+                hint = f"; give the rate of '{name}' as {velocity_name(name)}=VALUE"
+            raise ModelError(f"'{name}' is not a velocity of this model{hint}",
+                             field=f"{FIELD}.{name}")
+        try:
+            rate = float(value)
+        except (TypeError, ValueError):
+            raise ModelError(f"expected a number, got {value!r}", field=f"{FIELD}.{name}") \
+                from None
+        if not np.isfinite(rate):
+            raise ModelError("the rate must be finite", field=f"{FIELD}.{name}")
+        rates[velocities[name]] = rate
+    if not rates:
+        raise ModelError("name at least one steady rate (e.g. psi_dot=10)", field=FIELD)
+    return rates
+
+
+def steady_linear_model(
+    eom: EquationsOfMotion, about: Mapping[str, float] | None, steady: Mapping[str, float],
+    parameters: Mapping[str, float] | ParameterValues | None = None,
+) -> LinearModel:
+    """The linear model about the steady motion with the given rates (``steady``: velocity
+    name -> rate) at the configuration ``about`` (other non-cyclic coordinates solved for)."""
+    model = eom.model
+    if model.constraints:
+        raise ModelError("linearization about steady motion takes unconstrained models for now "
+                         f"(this one has constraints: "
+                         f"{', '.join(c.name for c in model.constraints)})", field=FIELD)
+    rates = steady_rates(eom, steady)
+    names = [c.name for c in model.coordinates]
+    n = len(names)
+    about = dict(about or {})
+    for name in about:
+        if name not in names:
+            raise ModelError(f"'{name}' is not a coordinate{did_you_mean(name, names)}",
+                             field=f"about.{name}")
+    values = resolve_parameters(model, parameters).symbol_values(model)
+    q, q_dot, t = model.q, model.q_dot, model.time
+    forcing = [as_expression(e).xreplace(values) for e in eom.forcing]
+    mass = [as_expression(e).xreplace(values) for e in eom.mass_matrix]
+    if any(t in e.free_symbols for e in (*forcing, *mass)):
+        raise ModelError("the equations depend on time t explicitly, so there is no steady "
+                         "motion to linearize about", field=FIELD)
+    d = Differentiator()
+    cyclic = sorted(rates)
+    stiffness = [-d(e, x) for e in forcing for x in q]
+    damping = [-d(e, v) for e in forcing for v in q_dot]
+    drift = [d(e, q[c]) for c in cyclic for e in (*forcing, *mass)]
+    function = StateFunction(model, [*mass, *forcing, *stiffness, *damping, *drift])
+
+    def evaluate(qv, vv):
+        out = function.at(qv, vv, 0.0)
+        parts = np.split(out, np.cumsum([n * n, n, n * n, n * n]))
+        return (parts[0].reshape(n, n), parts[1], parts[2].reshape(n, n),
+                parts[3].reshape(n, n), parts[4])
+
+    q0 = np.array([about.get(c.name, c.initial if c.initial is not None else 0.0)
+                   for c in model.coordinates], dtype=float)
+    v0 = np.zeros(n)
+    for i, rate in rates.items():
+        v0[i] = rate
+    free = [i for i in range(n) if names[i] not in about and i not in rates]
+    scale = 1.0 + max(abs(r) for r in rates.values()) ** 2
+
+    def accelerations(qv):
+        M, f, *_ = evaluate(qv, v0)
+        return np.linalg.lstsq(M, f, rcond=None)[0]
+
+    if free:
+        import scipy.optimize
+
+        def residual(x):
+            trial = q0.copy()
+            trial[free] = x
+            return accelerations(trial) / scale
+
+        solution = scipy.optimize.least_squares(residual, q0[free], xtol=1e-14, ftol=1e-14,
+                                                gtol=1e-14)
+        q0[free] = solution.x
+    M, f, K, C, dependence = evaluate(q0, v0)
+    try:
+        q_ddot = np.linalg.solve(M, f)
+    except np.linalg.LinAlgError:
+        raise DerivationError("the mass matrix is singular on this steady motion (a gimbal-lock "
+                              "configuration of the rotation sequence?); the linear model has "
+                              "no state-space form") from None
+    if np.max(np.abs(q_ddot), initial=0.0) > BALANCE_TOLERANCE * scale:
+        moving = ", ".join(f"{names[i]}_ddot = {q_ddot[i]:.6g}" for i in range(n)
+                           if abs(q_ddot[i]) > BALANCE_TOLERANCE * scale)
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in zip(names, q0, strict=True))
+        raise ModelError(f"not a steady motion: at {where} with "
+                         f"{', '.join(f'{velocity_name(names[i])} = {r:g}' for i, r in rates.items())}"
+                         f" the accelerations are not zero ({moving}); give other rates or "
+                         "configuration", field=FIELD)
+    # A cyclic coordinate appears in neither M nor f; checked here and at nearby states.
+    rng = np.random.default_rng(0)
+    for trial in range(3):
+        if trial:
+            qv = q0 + rng.uniform(-0.3, 0.3, n)
+            vv = v0 + rng.uniform(-1.0, 1.0, n)
+            dependence = evaluate(qv, vv)[4]
+        blocks = dependence.reshape(len(cyclic), -1)
+        for k, i in enumerate(cyclic):
+            size = max(1.0, float(np.abs(M).max()) * scale)
+            if np.max(np.abs(blocks[k]), initial=0.0) > 1e-9 * size:
+                raise ModelError(
+                    f"'{names[i]}' is not cyclic: the equations of motion depend on it, so it "
+                    "cannot turn at a constant rate in a steady motion (choose coordinates in "
+                    "which the spin angle is absent from L)", field=f"{FIELD}.{names[i]}_dot")
+    A = np.block([[np.zeros((n, n)), np.eye(n)],
+                  [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    return LinearModel(
+        equilibrium={name: float(v) for name, v in zip(names, q0, strict=True)},
+        multipliers={},
+        coordinates=tuple(names),
+        user_coordinates=tuple(names),
+        basis=np.eye(n),
+        mass_matrix=M,
+        damping_matrix=C,
+        stiffness_matrix=K,
+        A=A,
+        B=np.zeros((2 * n, 0)),
+        input_matrix=np.zeros((n, 0)),
+        velocity_constraints=np.zeros((0, n)),
+        full_mass_matrix=M,
+        full_damping_matrix=C,
+        full_stiffness_matrix=K,
+        steady={velocity_name(names[i]): float(r) for i, r in sorted(rates.items())},
+    )
+
+
+__all__ = ["steady_linear_model", "steady_rates"]

@@ -269,7 +269,7 @@ class ModelBuilder:
             reader.inertia(inertia, f"{field}.inertia", values),
             tuple(o + sum((r * c for r, c in zip(row, offset, strict=True)), sp.S.Zero)
                   for o, row in zip(frame.origin, frame.rotation, strict=True)),
-            frame.rotation, frame.origin, frame.angular_velocity, parent,
+            frame.rotation, frame.origin, frame.angular_velocity, parent, frame.singularities,
         )
         self._frames[name] = frame
         self._rigid_bodies.append(body)

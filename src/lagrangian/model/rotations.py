@@ -54,6 +54,9 @@ class RigidBody:
     origin: Vector
     angular_velocity: Vector
     parent: str | None = None
+    # Each three-angle sequence on the way to this body: (its description, the angle names, the
+    # determinant of the map from the angle rates to omega, zero at gimbal lock).
+    singularities: tuple[tuple[str, tuple[str, ...], sp.Expr], ...] = ()
 
     def world_angular_velocity(self) -> Vector:
         """omega in world axes, R omega_body (rad/s)."""
@@ -124,6 +127,7 @@ class Frame:
     origin: Vector
     rotation: Matrix3
     angular_velocity: Vector
+    singularities: tuple[tuple[str, tuple[str, ...], sp.Expr], ...] = ()
 
 
 GROUND = Frame(_ZERO, _IDENTITY, _ZERO)
@@ -134,13 +138,13 @@ def rotate(frame: Frame, axis: Vector, angle: sp.Expr, rate: sp.Expr) -> Frame:
     step = axis_rotation(axis, angle)
     omega = add(apply_transpose(step, frame.angular_velocity),
                 tuple(rate * a for a in axis))
-    return Frame(frame.origin, compose(frame.rotation, step), omega)
+    return Frame(frame.origin, compose(frame.rotation, step), omega, frame.singularities)
 
 
 def translate(frame: Frame, offset: Vector) -> Frame:
     """The frame moved by ``offset`` given in its own axes."""
     return Frame(add(frame.origin, apply(frame.rotation, offset)), frame.rotation,
-                 frame.angular_velocity)
+                 frame.angular_velocity, frame.singularities)
 
 
 # -- reading the user's description -----------------------------------------------------------
@@ -185,6 +189,7 @@ class RotationReader:
             raise self.error('a rotation is a list of [axis, angle] pairs, e.g. '
                              '[["z", "phi"], ["x", "theta"], ["z", "psi"]]', field)
         previous = None
+        steps = []
         for k, step in enumerate(value):
             where = f"{field}[{k}]"
             if isinstance(step, str) or not isinstance(step, Sequence) or len(step) != 2:
@@ -199,7 +204,19 @@ class RotationReader:
                     "next (z-x-z, z-y-x, ...)", where)
             previous = axis
             angle = self.expression(step[1], f"{where}[1]")
+            steps.append((str(step[0]), axis, angle))
             frame = rotate(frame, axis, angle, self.rate(angle))
+        if len(steps) == 3:
+            # omega = R3^T R2^T u1 a1' + R3^T u2 a2' + u3 a3': the rates are lost where
+            # det[R2(a2)^T u1, u2, u3] = 0 (sin a2 for z-x-z, cos a2 for z-y-x).
+            (n1, u1, _), (n2, u2, a2), (n3, u3, _) = steps
+            first = apply_transpose(axis_rotation(u2, a2), u1)
+            cross = (u2[1] * u3[2] - u2[2] * u3[1], u2[2] * u3[0] - u2[0] * u3[2],
+                     u2[0] * u3[1] - u2[1] * u3[0])
+            determinant = sp.expand(sp.Add(*(a * b for a, b in zip(first, cross, strict=True))))
+            names = tuple(str(a) for _, _, a in steps)
+            frame = Frame(frame.origin, frame.rotation, frame.angular_velocity,
+                          (*frame.singularities, (f"{n1}-{n2}-{n3}", names, determinant)))
         return frame
 
     def joint(self, parent: Frame, value: object, field: str) -> Frame:
@@ -289,5 +306,30 @@ class RotationReader:
                 "has this inertia", field)
 
 
-__all__ = ["AXES", "GROUND", "Frame", "Moment", "RigidBody", "RotationReader", "apply",
+def gimbal_lock(bodies: Sequence[RigidBody], point: Mapping[sp.Symbol, float],
+                tolerance: float = 1e-3) -> str | None:
+    """A sentence naming the rotation sequence at (or within ``tolerance`` of) its singular
+    configuration at ``point`` (values of q and the parameters), None where there is none."""
+    seen = set()
+    for body in bodies:
+        for label, names, determinant in body.singularities:
+            if (label, names) in seen:
+                continue
+            seen.add((label, names))
+            try:
+                value = float(determinant.xreplace(dict(point)))
+            except (TypeError, ValueError):
+                continue
+            if abs(value) < tolerance:
+                angles = ", ".join(names)
+                where = ", ".join(f"{s} = {float(v):.6g}" for s, v in point.items()
+                                  if s in determinant.free_symbols)
+                return (f"gimbal lock: the {label} angles ({angles}) of body '{body.name}' are at "
+                        f"their singular configuration ({where}, where {determinant} = 0: the "
+                        "first and last axes line up and the rates are lost); choose a rotation "
+                        "sequence whose singular configuration the motion avoids")
+    return None
+
+
+__all__ = ["AXES", "GROUND", "Frame", "Moment", "RigidBody", "RotationReader", "apply", "gimbal_lock",
            "axis_rotation", "compose", "rotate", "translate", "transpose"]

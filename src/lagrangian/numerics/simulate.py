@@ -19,6 +19,7 @@ import numpy as np
 
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
+from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state
 from .drift import DriftControl
 from .events import StopCondition, parse_stop_condition
@@ -83,6 +84,11 @@ def simulate(
     wall = time.perf_counter() - began
     if run.status == "failed":
         run = replace(run, message=_explain_failure(functions, run))
+    if run.status == "failed" and model.rigid_bodies:  # an Euler-angle singularity, named
+        where = {**substitution, **dict(zip(model.q, run.y[-1][:functions.n], strict=True))}
+        lock = gimbal_lock(model.rigid_bodies, where)
+        if lock:
+            run = replace(run, message=f"{run.message}: {lock}")
 
     t, q, q_dot = run.t, run.y[:, :functions.n], run.y[:, functions.n:]
     energy = functions.energy(q, q_dot, t)

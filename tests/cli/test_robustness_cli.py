@@ -201,3 +201,74 @@ def test_a_partial_result_never_replaces_an_existing_file(cli, tmp_path):
                              f"partial result saved to {partial}")
     assert table.read_text() == "a good result\n"
     assert partial.read_text().splitlines()[1] == "0.0,0.0,1.0,0.0,0.0"
+
+
+INDEFINITE = """
+[coordinates]
+x = { unit = "m", initial = 0.5 }
+y = { unit = "m", initial = 0.5 }
+[energy]
+T = "1/2*x_dot^2 - 1/2*y_dot^2"
+V = "1/2*x^2 + 1/2*y^2"
+"""
+
+NAN_IN_V = """
+[coordinates]
+x = { unit = "m", initial = 0.5 }
+[parameters]
+k = -1.0
+[energy]
+T = "1/2*x_dot^2"
+V = "sqrt(k)*x^2"
+"""
+
+
+@pytest.mark.parametrize(
+    ("args", "warning"),
+    [
+        # M = m L^2 = -0.25: simulated with exit 0 and no word before
+        (("pendulum", "--set", "m=-1"), "warning: the kinetic energy is not positive at the "
+         "initial state (the mass matrix has the eigenvalue -0.25): T < 0 for some velocities, so "
+         "the motion is not physical"),
+        (("double_pendulum", "--set", "m1=-1"), "warning: particle 'bob1' has a negative mass (-1)"),
+    ],
+)
+def test_a_negative_mass_is_warned_about_in_derive_and_simulate(cli, args, warning):
+    code, out, err = cli("derive", *args)
+    assert code == 0 and out
+    assert one_line(err) == warning
+    code, out, err = cli("simulate", *args, "--t-end", "0.1")
+    assert err.splitlines()[0] == warning
+
+
+def test_an_indefinite_kinetic_energy_is_warned_about(cli, tmp_path):
+    model = tmp_path / "indefinite.toml"
+    model.write_text(INDEFINITE)
+    code, out, err = cli("simulate", str(model), "--t-end", "1")
+    assert code == 0
+    assert one_line(err) == ("warning: the kinetic energy is not positive at the initial state "
+                             "(the mass matrix has the eigenvalue -1): T < 0 for some "
+                             "velocities, so the motion is not physical")
+
+
+def test_the_analysis_refuses_what_it_cannot_get_right(cli):
+    code, out, err = cli("modes", "pendulum", "--set", "m=-1")
+    assert code == 2 and out == ""
+    assert one_line(err) == ("error: the mass matrix is not positive definite at this "
+                             "equilibrium (is the kinetic energy complete and positive?)")
+
+
+def test_a_nan_in_v_is_a_potential_energy_problem(cli, tmp_path):
+    model = tmp_path / "nan.toml"
+    model.write_text(NAN_IN_V)
+    code, out, err = cli("simulate", str(model), "--t-end", "1")
+    assert code == 1
+    assert one_line(err) == ("error: integration failed: Required step size is less than "
+                             "spacing between numbers at t = 0 s: the potential energy V is not "
+                             "a real number there (NaN: a square root or logarithm of a negative "
+                             "value?)")
+    code, out, err = cli("modes", str(model))
+    assert code == 2  # was "--set: the value 2.0*I is not real", naming a flag not given
+    assert one_line(err) == ("error: the potential energy V or a load (the stiffness) is not a "
+                             "real number with these parameter values (a value 2.0*I): a square "
+                             "root or logarithm of a negative value?")

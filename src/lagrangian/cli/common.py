@@ -7,7 +7,11 @@ import sys
 from collections.abc import Iterable, Mapping
 from typing import Any
 
+import typer
+
 from ..api.system import System, load
+from ..derivation.equations import EquationsOfMotion
+from ..derivation.regularity import physical_warnings
 from ..errors import LagrangianError, ModelError
 from ..model.units import parse_quantity
 from ..model.values import state_units
@@ -81,6 +85,13 @@ def assignments(settings: Iterable[str], option: str) -> list[tuple[str, str]]:
             raise ModelError(f"expected NAME=VALUE, got {setting!r}", field=option)
         pairs.append((name.strip(), value.strip()))
     return pairs
+
+
+def warn_if_unphysical(eom: EquationsOfMotion) -> None:
+    """One line `warning: ...` on stderr for each thing that makes a well-formed model
+    physically meaningless (a negative mass, a kinetic energy that is not positive)."""
+    for warning in physical_warnings(eom.model, eom.mass_matrix):
+        typer.echo(f"warning: {warning}", err=True)
 
 
 def print_json(document: Any) -> None:

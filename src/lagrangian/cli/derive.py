@@ -9,7 +9,7 @@ import typer
 
 from ..output.derivation import derivation_document, derivation_latex, derivation_text
 from . import app
-from .common import load_system, print_json
+from .common import load_system, print_json, warn_if_unphysical
 
 
 class Format(StrEnum):
@@ -26,6 +26,7 @@ def derive(
 ) -> None:
     """Derive the equations of motion by Lagrange's method."""
     eom = load_system(model, set_).equations_of_motion()
+    warn_if_unphysical(eom)
     if format is Format.json:
         print_json(derivation_document(eom))
     elif format is Format.latex:

@@ -7,7 +7,9 @@ from typing import Annotated
 
 import typer
 
+from ..output.files import check_output_path
 from ..output.modes import modes_document, modes_text, write_mode_plot
+from ..output.plots import check_plot_path
 from . import app
 from .common import load_system, print_json, state_assignments
 
@@ -28,10 +30,12 @@ def modes(
     """Linearize about an equilibrium: M, C, K, natural frequencies, damping and mode shapes."""
     system = load_system(model, set_)
     point = state_assignments(system, about, "--about")
+    inputs = (Path(model),) if Path(model).exists() else ()
+    if plot is not None:  # before the analysis: a path that cannot be written costs nothing
+        check_output_path(check_plot_path(plot), "plot", inputs=inputs)
     rates = state_assignments(system, steady, "--steady")
     analysis = system.modes(about=point or None, steady=rates or None)
     if plot is not None:
-        inputs = (Path(model),) if Path(model).exists() else ()
         write_mode_plot(analysis, plot, protect=inputs)
     if json_:
         print_json(modes_document(analysis))

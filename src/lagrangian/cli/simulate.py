@@ -15,7 +15,7 @@ from ..numerics.simulate import METHODS, SaveAt, StepControl, parse_stop_conditi
 from ..output.files import check_output_path, partial_path
 from ..output.simulation import projection_warning, simulation_document, simulation_text
 from . import app
-from .common import load_system, print_json, state_assignments
+from .common import load_system, print_json, state_assignments, warn_if_unphysical
 
 
 @app.command()
@@ -40,6 +40,7 @@ def simulate(
     from ..output.tables import check_table_path
 
     system = load_system(model, set_)
+    warn_if_unphysical(system.equations_of_motion())
     end = parse_quantity(t_end, "s", "--t-end")
     # Everything the user typed is checked (by the library) before the integration starts.
     start = resolve_state(system.model, state_assignments(system, initial, "--initial"),

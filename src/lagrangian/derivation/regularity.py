@@ -267,3 +267,48 @@ def _random_point(model: Model, symbols, seed: int) -> dict[sp.Symbol, sp.Float]
         point[c.symbol] = sp.Float(rng.uniform(-1.3, 1.3))
         point[c.velocity] = sp.Float(rng.uniform(-1.0, 1.0))
     return point
+
+
+def physical_warnings(model: Model, mass_matrix: sp.MatrixBase) -> list[str]:
+    """What makes a well-formed model physically meaningless, one line each: a negative mass
+    or moment of inertia, or a kinetic energy that is not positive (a mass matrix with a
+    negative eigenvalue) at the initial state. Parameters without a value are not judged."""
+    warnings = []
+    values: dict[sp.Symbol, float] = {p.symbol: p.value for p in model.parameters
+                                      if p.value is not None}
+    for kind, items in (("particle", model.particles), ("body", model.bodies)):
+        for item in items:
+            for what, expr in (("mass", item.mass), ("moment of inertia",
+                                                     getattr(item, "inertia", None))):
+                value = _constant_value(expr, values)
+                if value is not None and value < 0:
+                    warnings.append(f"{kind} '{item.name}' has a negative {what} ({value:.6g})")
+    state = dict(values)
+    state[model.time] = 0.0
+    for c in model.coordinates:
+        state[c.symbol] = c.initial if c.initial is not None else 0.0
+        state[c.velocity] = c.rate if c.rate is not None else 0.0
+    if mass_matrix.shape[0] and not warnings:
+        try:
+            M = numeric_matrix(mass_matrix, state)
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError, KeyError):
+            return warnings
+        if np.all(np.isfinite(M)):
+            eigenvalues = np.linalg.eigvalsh((M + M.T) / 2)
+            if eigenvalues.min() < -1e-9 * max(1.0, float(np.abs(eigenvalues).max())):
+                warnings.append(
+                    "the kinetic energy is not positive at the initial state (the mass matrix has "
+                    f"the eigenvalue {eigenvalues.min():.6g}): T < 0 for some velocities, "
+                    "so the motion is not physical")
+    return warnings
+
+
+def _constant_value(expr: object, values: dict[sp.Symbol, float]) -> float | None:
+    """A mass or inertia as a number with the parameters' values; None where it is not one."""
+    if not isinstance(expr, sp.Expr):
+        return None
+    try:
+        value = expr.xreplace({s: sp.Float(v) for s, v in values.items()})
+        return float(value) if not value.free_symbols else None
+    except (TypeError, ValueError, OverflowError):
+        return None

@@ -164,11 +164,29 @@ def _explain_failure(functions: NumericSystem, run: LoopRun) -> str:
             q_ddot, _ = functions.accelerations_and_multipliers(y[:n], y[n:], t)
     except (np.linalg.LinAlgError, ValueError, ZeroDivisionError, OverflowError):
         return run.message
-    for name, value in zip(functions.coordinates, np.ravel(q_ddot), strict=True):
+    q_ddot = np.ravel(q_ddot)
+    if np.any(np.isnan(q_ddot)):
+        return f"{run.message}: {_undefined_part(functions, y[:n], y[n:], t)}"
+    for name, value in zip(functions.coordinates, q_ddot, strict=True):
         if not abs(value) < _TOO_LARGE:
             return (f"{run.message}: the acceleration of {name} is {value:.3g} there, too large "
                     "to integrate (check the parameters and initial values)")
     return run.message
+
+
+def _undefined_part(functions: NumericSystem, q: np.ndarray, q_dot: np.ndarray, t: float) -> str:
+    """Which part of the model is NaN at a state: T (its mass matrix), V or the forces."""
+    with np.errstate(all="ignore"):
+        potential = functions.energy(q, np.zeros_like(q_dot), t)
+        mass = functions.mass_matrix(q, q_dot, t)
+    if not np.all(np.isfinite(mass)):  # first: T at q_dot = 0 enters the energy below
+        what = "the kinetic energy T (its mass matrix)"
+    elif not np.all(np.isfinite(potential)):
+        what = "the potential energy V"
+    else:
+        what = "the generalized forces"
+    return (f"{what} is not a real number there (NaN: a square root or logarithm of a negative "
+            "value?)")
 
 
 def _project_start(drift: DriftControl, start: State):

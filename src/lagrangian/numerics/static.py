@@ -78,12 +78,13 @@ class StaticFunctions:
         # Only entries that vary with q (or t) are compiled; constants (most of a big sparse
         # model's K and C) are stored once.
         self._constants = np.zeros(len(entries))
+        parts = [name for name, shape in self._layout for _ in range(int(np.prod(shape)))]
         varying = []
         for i, e in enumerate(entries):
             if e.free_symbols:
                 varying.append(i)
             else:
-                self._constants[i] = _real(e)
+                self._constants[i] = _real(e, parts[i])
         self._varying = np.array(varying, dtype=int)
         compiled = [entries[i] for i in varying]
         self._function = numpy_function([*q, t], compiled) if varying else None
@@ -113,12 +114,27 @@ def _floats(expr: sp.Expr) -> sp.Expr:
     return expr.xreplace(big) if big else expr
 
 
-def _real(value: sp.Expr) -> float:
-    if value.is_Number:
+# The part of the model each block of the equations at rest comes from, for messages.
+_SOURCES = {
+    "mass": "the kinetic energy T (its mass matrix)",
+    "forcing": "the potential energy V or a load (the forces at rest)",
+    "stiffness": "the potential energy V or a load (the stiffness)",
+    "damping": "the dissipation D or a damper (the damping)",
+    "jacobian": "a constraint (its Jacobian)",
+    "hessians": "a constraint (its curvature)",
+    "static": "the potential energy V or a load (the forces at rest)",
+    "static_jacobian": "the potential energy V or a load (the stiffness)",
+}
+
+
+def _real(value: sp.Expr, part: str) -> float:
+    if value.is_Number and value.is_finite:
         return float(value)
     number = complex(sp.N(value))
-    if abs(number.imag) > 1e-12 * max(1.0, abs(number.real)):
-        raise ModelError(f"the value {value} is not real", field="parameters")
+    if abs(number.imag) > 1e-12 * max(1.0, abs(number.real)) or not np.isfinite(number.real):
+        raise ModelError(f"{_SOURCES.get(part, 'the model')} is not a real number with these "
+                         f"parameter values (a value {value}): a square root or logarithm of a "
+                         "negative value?")
     return number.real
 
 

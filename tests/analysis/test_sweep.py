@@ -204,3 +204,22 @@ def test_ensemble_of_a_damped_model_monitors_its_work_balance(client):
         np.testing.assert_allclose(ds["final"][i], [*one.q[-1], *one.q_dot[-1]], rtol=1e-12)
         assert float(ds["invariant_drift"][i]) == pytest.approx(one.invariant_drift, rel=1e-9)
     assert ds.attrs["invariant"] != "energy"
+
+
+def test_modes_where_lengths_and_masses_enter_the_search(client):
+    """Double pendulum over l1 (a length: the search spans change) and m2 (enters m g): each
+    point equals System.modes; at l1 = l2 = 1, m1 = m2 the frequencies are
+    sqrt((2 -+ sqrt 2) g / l)."""
+    pendulum = lagrangian.load("double_pendulum")
+    lengths, masses = [0.5, 1.0], [1.0, 3.0]
+    ds = pendulum.sweep({"l1": lengths, "m2": masses}, compute="modes", client=client,
+                        chunk_size=3)
+    for (i, l1), (j, m2) in itertools.product(enumerate(lengths), enumerate(masses)):
+        one = pendulum.with_parameters(l1=l1, m2=m2).modes()
+        np.testing.assert_allclose(ds["frequency"][i, j], one.natural_frequencies, rtol=1e-10)
+        np.testing.assert_allclose(ds["equilibrium"][i, j], list(one.equilibrium.values()),
+                                   atol=1e-9)
+    g = 9.81
+    np.testing.assert_allclose(ds["frequency"].sel(l1=1.0, m2=1.0),
+                               np.sqrt([(2 - math.sqrt(2)) * g, (2 + math.sqrt(2)) * g]),
+                               rtol=1e-10)

@@ -118,6 +118,7 @@ class Study:
     generated: object = None  # the C source of the model's module (numerics/codegen.py)
     chunk_size: int = 1000
     key: str = field(default="", compare=False)
+    functions_key: str = field(default="", compare=False)
 
     @property
     def model(self):
@@ -206,7 +207,13 @@ def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence
                                        [(n, v.tobytes()) for n, v in axes],
                                        [(n, v.tobytes()) for n, v in draws],
                                        simulation, chunk_size))).hexdigest()[:20]
-    return Study(eom, compute, tuple(axes), tuple(draws), simulation, None, int(chunk_size), key)
+    simulation_kind = None if simulation is None else (simulation.method, simulation.stop_when)
+    functions_key = hashlib.sha256(pickle.dumps((model.name, str(eom.lagrangian),
+                                                 str(eom.forcing), str(eom.mass_matrix),
+                                                 compute == "simulate", simulation_kind))
+                                   ).hexdigest()[:20]
+    return Study(eom, compute, tuple(axes), tuple(draws), simulation, None, int(chunk_size), key,
+                 functions_key)
 
 
 def _known(name: str, allowed: set, parameters: set, what: str, where: str) -> None:
@@ -243,8 +250,10 @@ _PREPARED: dict[str, object] = {}
 
 
 def prepared(study: Study):
-    """The compiled functions a chunk needs, built once per process and study."""
-    hit = _PREPARED.get(study.key)
+    """The compiled functions a chunk needs, built once per process and model (every study of
+    the same equations shares them)."""
+    key = study.functions_key
+    hit = _PREPARED.get(key)
     if hit is None:
         if study.compute == "simulate":
             hit = _prepare_simulation(study)
@@ -252,7 +261,7 @@ def prepared(study: Study):
             hit = ParametricStaticFunctions(study.eom)
         if len(_PREPARED) > 8:
             _PREPARED.pop(next(iter(_PREPARED)))
-        _PREPARED[study.key] = hit
+        _PREPARED[key] = hit
     return hit
 
 
@@ -334,16 +343,21 @@ def _modes_batched(study, parametric, vectors, out) -> np.ndarray:
     count, n = len(vectors), parametric.n
     lengths = [i for i, p in enumerate(model.parameters)
                if p.unit in ("m", "meter", "metre")]
-    # The search spans depend on the length parameters only: one search set per distinct set.
-    keys = np.round(vectors[:, lengths], 15) if lengths else np.zeros((count, 0))
-    unique, group = np.unique(keys, axis=0, return_inverse=True)
+    # The search sees the parameters of the forces at rest and, through its spans, the
+    # lengths: it runs once per distinct set of those, in groups of equal spans.
+    search = sorted(set(parametric.search_parameters) | set(lengths))
+    distinct, back = np.unique(vectors[:, search], axis=0, return_inverse=True)
+    back = np.asarray(back).ravel()
+    representatives = vectors[np.unique(back, return_index=True)[1]]
+    spans = [search.index(i) for i in lengths]
+    _, group = np.unique(distinct[:, spans], axis=0, return_inverse=True)
     group = np.asarray(group).ravel()
-    q_star = np.full((count, n), np.nan)
-    for g in range(len(unique)):
+    found_q = np.full((len(distinct), n), np.nan)
+    for g in range(group.max() + 1 if len(group) else 0):
         members = np.flatnonzero(group == g)
-        first = vectors[members[0]]
-        view = parametric.at(first)
-        q_star[members] = _nearest_equilibria(parametric, view, vectors[members])
+        view = parametric.at(representatives[members[0]])
+        found_q[members] = _nearest_equilibria(parametric, view, representatives[members])
+    q_star = found_q[back]
     found = np.all(np.isfinite(q_star), axis=-1)
     values = parametric.evaluate(np.where(found[:, None], q_star, 0.0), vectors)
     M, K, C = values["mass"], values["stiffness"], values["damping"]

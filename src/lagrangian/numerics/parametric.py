@@ -67,6 +67,13 @@ class ParametricStaticFunctions:
         self._layout = [("mass", (n, n)), ("forcing", (n,)), ("stiffness", (n, n)),
                         ("damping", (n, n)), ("jacobian", (m, n)), ("hessians", (m, n, n)),
                         ("static", (len(static),)), ("static_jacobian", (len(static), n))]
+        # The parameters the search for equilibria sees (forces and constraints at rest): points
+        # that agree in these have the same equilibria, whatever their masses.
+        search = [*forcing_at_rest, *_flat(stiffness), *_flat(jacobian), *_flat(_flat(hessians)),
+                  *(e for _, e in static), *_flat(static_jacobian)]
+        present = set().union(*(as_expression(e).free_symbols for e in search)) if search else set()
+        self.search_parameters = tuple(i for i, p in enumerate(model.parameters)
+                                       if p.symbol in present)
         self._constants = np.zeros(len(entries))
         varying = []
         for i, e in enumerate(entries):
@@ -84,17 +91,21 @@ class ParametricStaticFunctions:
         q = np.asarray(q, dtype=float)
         parameters = np.asarray(parameters, dtype=float)
         batch = np.broadcast_shapes(q.shape[:-1], parameters.shape[:-1])
-        flat = np.empty(batch + self._constants.shape)
-        flat[...] = self._constants
+        # Entry-major: each entry is one contiguous write (a strided column write of a big
+        # batch costs more than the arithmetic).
+        flat = np.empty(self._constants.shape + batch)
+        flat[...] = self._constants.reshape(self._constants.shape + (1,) * len(batch))
         if self._function is not None:
             raw = self._function(*np.moveaxis(q, -1, 0), np.broadcast_to(float(t), batch),
                                  *np.moveaxis(parameters, -1, 0))
             for i, value in zip(self._varying, raw, strict=True):
-                flat[..., i] = value
+                flat[i] = value
         out, start = {}, 0
         for name, shape in self._layout:
             size = int(np.prod(shape))
-            out[name] = flat[..., start:start + size].reshape(batch + shape)
+            block = flat[start:start + size].reshape(shape + batch)
+            out[name] = np.moveaxis(block, tuple(range(len(shape))),
+                                    tuple(range(len(batch), len(batch) + len(shape))))
             start += size
         return out
 

@@ -1,0 +1,130 @@
+"""Parameter studies and ensembles on Dask: wall times, scaling and the gain over a plain loop.
+
+Run:  python benchmarks/bench_sweep.py [--quick]
+
+  1. a 10^5-point modes sweep of the two-mass system (examples/two_mass.toml), twice: over
+     k x k_c (1000 x 100: every point searches its own equilibrium) and over k x m (1000 x 100:
+     the masses do not enter the forces at rest, so the search runs once per k); each timed
+     end to end through System.sweep with its default LocalCluster (2 worker processes here,
+     started and closed inside the timing) and again on a cluster already running;
+  2. 10^4 ten-second double-pendulum simulations (DOP853, rtol = atol = 1e-9, 201 samples,
+     theta1 ~ uniform(-1, 1), theta2 ~ uniform(-1, 1)): end to end with the default cluster;
+  3. the speed-up from one worker process to two (clusters already running; the 10^5-point
+     k x k_c sweep and 2,000 ensemble members);
+  4. the time per point against a plain Python loop of the single-point API:
+     system.with_parameters(k=..., k_c=...).modes() and
+     system.simulate(10, initial={...}) per member.
+Times are wall-clock seconds, best of ``--repeat`` runs (1 by default: the cluster start-up is
+part of what a user waits for). The machine may be shared: see docs/benchmarks.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import time
+
+import numpy as np
+
+import lagrangian
+
+
+def _cluster(workers: int):
+    from dask.distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                           dashboard_address=":0", silence_logs=logging.ERROR)
+    return Client(cluster), cluster
+
+
+def _timed(function, repeat: int = 1) -> float:
+    best = float("inf")
+    for _ in range(repeat):
+        began = time.perf_counter()
+        function()
+        best = min(best, time.perf_counter() - began)
+    return best
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--quick", action="store_true", help="10x fewer points")
+    parser.add_argument("--repeat", type=int, default=1)
+    args = parser.parse_args()
+    scale = 10 if args.quick else 1
+    two_mass = lagrangian.load("two_mass")
+    pendulum = lagrangian.load("double_pendulum")
+    k = np.linspace(10, 100, 1000 // scale)
+    second = np.linspace(1, 10, 100)
+    points = len(k) * len(second)
+    members = 10_000 // scale
+    ensemble = {"sample": {"theta1": "uniform(-1, 1)", "theta2": "uniform(-1, 1)"},
+                "members": members, "t_end": 10.0, "samples": 201}
+    rows = []
+    print(f"cores: {os.cpu_count()}")
+
+    # 1-2: end to end, the default cluster started and closed by System.sweep
+    t = _timed(lambda: two_mass.sweep({"k": k, "k_c": second}, compute="modes"), args.repeat)
+    rows.append((f"modes, two_mass, k x k_c = {points:,} points, default cluster", t, points))
+    t = _timed(lambda: two_mass.sweep({"k": k, "m": second}, compute="modes"), args.repeat)
+    rows.append((f"modes, two_mass, k x m = {points:,} points, default cluster", t, points))
+    t = _timed(lambda: pendulum.sweep(compute="simulate", **ensemble), args.repeat)
+    rows.append((f"simulate, double pendulum, {members:,} x 10 s, default cluster", t, members))
+
+    # 3: clusters already running: one worker, then two
+    few = {**ensemble, "members": 2000 // scale}
+    scaling = {}
+    for workers in (1, 2):
+        client, cluster = _cluster(workers)
+        try:
+            two_mass.sweep({"k": k[:2], "k_c": second[:2]}, client=client)  # warm the workers
+            pendulum.sweep(compute="simulate", client=client, **{**few, "members": 2})
+            a = _timed(lambda c=client: two_mass.sweep({"k": k, "k_c": second}, client=c),
+                       args.repeat)
+            b = _timed(lambda c=client: pendulum.sweep(compute="simulate", client=c, **few),
+                       args.repeat)
+        finally:
+            client.close()
+            cluster.close()
+        scaling[workers] = (a, b)
+        rows.append((f"modes, k x k_c = {points:,} points, running cluster of {workers}", a,
+                     points))
+        rows.append((f"simulate, {few['members']:,} x 10 s, running cluster of {workers}", b,
+                     few["members"]))
+
+    # 4: a plain Python loop of the single-point API
+    loop_points = 20
+    values = list(zip(np.linspace(10, 100, loop_points), np.linspace(1, 10, loop_points),
+                      strict=True))
+    t_modes = _timed(lambda: [two_mass.with_parameters(k=float(a), k_c=float(b)).modes()
+                              for a, b in values])
+    rng = np.random.default_rng(0)
+    starts = rng.uniform(-1, 1, (loop_points, 2))
+    pendulum.simulate(10.0, samples=201)  # compile once, as the sweep does
+    t_sim = _timed(lambda: [pendulum.simulate(10.0, samples=201, initial={
+        "theta1": float(a), "theta2": float(b)}) for a, b in starts])
+    rows.append((f"loop of System.with_parameters(...).modes(), {loop_points} points", t_modes,
+                 loop_points))
+    rows.append((f"loop of System.simulate(10 s), {loop_points} members", t_sim, loop_points))
+
+    print()
+    print("| what | wall (s) | per point (ms) |")
+    print("|---|---:|---:|")
+    for what, seconds, count in rows:
+        print(f"| {what} | {seconds:.2f} | {1e3 * seconds / count:.3f} |")
+    print()
+    for label, index in (("modes 10^5 (k x k_c)", 0), ("simulate", 1)):
+        one, two = scaling[1][index], scaling[2][index]
+        print(f"speed-up 1 -> 2 workers, {label}: {one / two:.2f}x")
+    per_point_sweep = rows[0][1] / rows[0][2]
+    print(f"modes per point: loop {1e3 * t_modes / loop_points:.2f} ms, sweep "
+          f"{1e3 * per_point_sweep:.4f} ms end to end: "
+          f"{(t_modes / loop_points) / per_point_sweep:.0f}x")
+    per_member = rows[2][1] / rows[2][2]
+    print(f"simulate per member: loop {1e3 * t_sim / loop_points:.2f} ms, sweep "
+          f"{1e3 * per_member:.3f} ms end to end: {(t_sim / loop_points) / per_member:.1f}x")
+
+
+if __name__ == "__main__":
+    main()

@@ -223,3 +223,25 @@ def test_modes_where_lengths_and_masses_enter_the_search(client):
     np.testing.assert_allclose(ds["frequency"].sel(l1=1.0, m2=1.0),
                                np.sqrt([(2 - math.sqrt(2)) * g, (2 + math.sqrt(2)) * g]),
                                rtol=1e-10)
+
+
+def test_modes_about_a_named_equilibrium_show_the_pitchfork(client):
+    """About the bottom of the hoop: omega^2 = g/R - Omega^2 below the pitchfork, growth rate
+    sqrt(Omega^2 - g/R) above it (the bottom turns unstable at Omega^2 = g/R)."""
+    bead = lagrangian.load("bead_on_hoop")
+    g, R = 9.81, 0.5
+    omegas = np.array([0.0, 2.0, 4.0, 5.0, 8.0])
+    ds = bead.sweep({"Omega": omegas}, compute="modes", about={"theta": 0.0}, client=client)
+    below = omegas**2 < g / R
+    np.testing.assert_allclose(ds["frequency"][below, 0], np.sqrt(g / R - omegas[below]**2),
+                               rtol=1e-10)
+    np.testing.assert_allclose(ds["growth_rate"][~below, 0], np.sqrt(omegas[~below]**2 - g / R),
+                               rtol=1e-10)
+    np.testing.assert_array_equal(ds["stable"], below.astype(float))
+    one = bead.with_parameters(Omega=5.0).modes(about={"theta": 0.0})
+    assert float(ds["growth_rate"][3, 0]) == pytest.approx(one.modes[0].growth_rate, rel=1e-12)
+    # a configuration that is not an equilibrium is a status, not a crash
+    ds = bead.sweep({"Omega": [2.0, 3.0]}, compute="modes", about={"theta": 0.3}, client=client)
+    assert all("not an equilibrium" in s for s in ds["status"].values)
+    with pytest.raises(ModelError, match="about"):
+        bead.sweep({"Omega": [2.0]}, compute="equilibria", about={"theta": 0.0})

@@ -119,6 +119,7 @@ class Study:
     chunk_size: int = 1000
     key: str = field(default="", compare=False)
     functions_key: str = field(default="", compare=False)
+    about: tuple[tuple[str, float], ...] = ()  # modes: the equilibrium, as System.modes(about)
 
     @property
     def model(self):
@@ -159,7 +160,8 @@ class Study:
 def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence[float]],
                sample: Mapping[str, str | Distribution] | None = None, members: int = 0,
                seed: int = 0, simulation: SimulationOptions | None = None,
-               chunk_size: int | None = None) -> Study:
+               chunk_size: int | None = None,
+               about: Mapping[str, float] | None = None) -> Study:
     """Check the names and values of a study and draw its ensemble (seeded)."""
     model = eom.model
     if compute not in COMPUTES:
@@ -193,6 +195,14 @@ def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence
         if not isinstance(distribution, Distribution):
             distribution = parse_distribution(distribution, field=f"sample.{name}")
         draws.append((name, distribution.draw(rng, int(members))))
+    if about and compute != "modes":
+        raise ModelError("about names the equilibrium of a modes study", field="about")
+    about_values = ()
+    if about:
+        given = resolve_state(model, about, field="about", velocities=False, time=False)
+        about_values = tuple((c.name, float(v)) for c, v in zip(model.coordinates, given.q,
+                                                                 strict=True)
+                             if c.name in given.given)
     if not axes and not draws:
         raise ModelError("nothing varies: give at least one name with its values", field="vary")
     if compute == "simulate" and simulation is None:
@@ -206,14 +216,14 @@ def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence
     key = hashlib.sha256(pickle.dumps((model.name, str(eom.lagrangian), compute,
                                        [(n, v.tobytes()) for n, v in axes],
                                        [(n, v.tobytes()) for n, v in draws],
-                                       simulation, chunk_size))).hexdigest()[:20]
+                                       simulation, chunk_size, about_values))).hexdigest()[:20]
     simulation_kind = None if simulation is None else (simulation.method, simulation.stop_when)
     functions_key = hashlib.sha256(pickle.dumps((model.name, str(eom.lagrangian),
                                                  str(eom.forcing), str(eom.mass_matrix),
                                                  compute == "simulate", simulation_kind))
                                    ).hexdigest()[:20]
     return Study(eom, compute, tuple(axes), tuple(draws), simulation, None, int(chunk_size), key,
-                 functions_key)
+                 functions_key, about_values)
 
 
 def _known(name: str, allowed: set, parameters: set, what: str, where: str) -> None:
@@ -306,7 +316,8 @@ def _modes_chunk(study, parametric: ParametricStaticFunctions, values, count):
     out = _empty(study, count, {"mode": n, "coordinate": n})
     vectors = _parameter_vectors(parametric, values, count)
     todo = np.arange(count)
-    if parametric.m == 0 and not parametric.static_names:
+    about = dict(study.about) or None
+    if parametric.m == 0 and not parametric.static_names and about is None:
         try:
             with np.errstate(all="ignore"):
                 todo = _modes_batched(study, parametric, vectors, out)
@@ -315,7 +326,7 @@ def _modes_chunk(study, parametric: ParametricStaticFunctions, values, count):
     for i in todo:
         try:
             view = parametric.at(vectors[i])
-            q, lam = resolve_equilibrium(view, None)
+            q, lam = resolve_equilibrium(view, about)
             analysis = modal_analysis(linear_model_at(view, q, lam))
         except Exception as exc:  # a failing point is recorded, the study goes on
             out["status"][i] = _reason(exc)

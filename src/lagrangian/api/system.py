@@ -229,12 +229,13 @@ class System:
               atol: float = 1e-9, samples: int = 201, stop_when: str | None = None,
               trajectories: bool = False, out: str | Path | None = None, resume: bool = False,
               scheduler: str | None = None, client=None, workers: int | None = None,
-              chunk_size: int | None = None, progress=None):
+              chunk_size: int | None = None, progress=None,
+              about: Mapping[str, float] | None = None):
         """A parameter study or ensemble as an xarray Dataset, one dimension per varied name.
 
         ``vary`` maps parameters (and, for ``compute="simulate"``, coordinates and velocities)
         to their values (SI); ``compute`` is "modes" (frequency, damping_ratio, growth_rate,
-        stable about the equilibrium System.modes uses), "equilibria" (each one found and its
+        stable about the equilibrium System.modes(about) uses), "equilibria" (each one and its
         stability, along ``equilibrium``) or "simulate" (per member: final state, extremes,
         energy drift, stop time; ``trajectories=True`` adds the states on the time grid).
         ``sample`` draws ``members`` values per name from 'normal(mean, std)' or
@@ -259,7 +260,8 @@ class System:
                 parse_stop_condition(stop_when, self._model)
             options = SimulationOptions(float(t_end), step.method, step.rtol, step.atol,
                                         int(samples), stop_when, bool(trajectories))
-        study = make_study(eom, compute, vary or {}, sample, members, seed, options, chunk_size)
+        study = make_study(eom, compute, vary or {}, sample, members, seed, options, chunk_size,
+                           about)
         return run_study(study, out=out, resume=resume, scheduler=scheduler, client=client,
                          workers=workers, progress=progress)
 

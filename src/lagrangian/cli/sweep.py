@@ -15,7 +15,7 @@ from ..errors import LagrangianError, ModelError
 from ..model.units import parse_quantity
 from ..model.values import state_units
 from . import app
-from .common import assignments, in_flags, load_system, print_json
+from .common import assignments, in_flags, load_system, print_json, state_assignments
 
 # The library's field -> this command's flag (before the shared table of common.py).
 SWEEP_FLAGS = {
@@ -23,6 +23,7 @@ SWEEP_FLAGS = {
     "compute": "--compute", "t_end": "--t-end", "out": "--out", "plot": "--plot",
     "resume": "--resume", "scheduler": "--scheduler", "stop_when": "--stop-when",
     "method": "--method", "rtol": "--rtol", "atol": "--atol", "initial": "--vary",
+    "about": "--about",
 }
 VARY_HELP = ("A varied name and its values: NAME=START:STOP:COUNT (COUNT evenly spaced values, "
              "both ends included), NAME=V1,V2,... or NAME=VALUE; units as in --set (0deg:90deg:19).")
@@ -52,19 +53,20 @@ def sweep(
     workers: Annotated[int | None, typer.Option("--workers", help="Worker processes of the local cluster (default: one per core).")] = None,  # noqa: E501
     resume: Annotated[bool, typer.Option("--resume", help="Continue an interrupted study writing to the same --out.")] = False,  # noqa: E501
     chunk_size: Annotated[int | None, typer.Option("--chunk-size", help="Points per task.")] = None,
+    about: Annotated[list[str], typer.Option("--about", help="modes: the equilibrium, COORDINATE=VALUE (theta=0); default: the one nearest the initial values, as `lagrangian modes`.")] = [],  # noqa: B006,E501
 ) -> None:
     """Evaluate modes, equilibria or simulations over a grid of parameters (and ensembles)."""
     try:
         _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_end,
              time_samples, method, rtol, atol, stop_when, trajectories, scheduler, workers,
-             resume, chunk_size)
+             resume, chunk_size, about)
     except ModelError as exc:
         raise _flagged(exc) from None
 
 
 def _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_end,
          time_samples, method, rtol, atol, stop_when, trajectories, scheduler, workers, resume,
-         chunk_size):
+         chunk_size, about):
     from ..output.sweep import check_study_path, check_study_plot_path, study_summary, study_text
 
     system = load_system(model, set_)
@@ -73,6 +75,7 @@ def _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_
     grid = {name: grid_values(text, units.get(name), f"vary.{name}")
             for name, text in assignments(vary, "--vary")}
     draws = dict(assignments(sample, "--sample"))
+    point = state_assignments(system, about, "--about")
     end = parse_quantity(t_end, "s", "t_end") if t_end is not None else None
     if out is not None:
         check_study_path(out)
@@ -96,7 +99,7 @@ def _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_
                 method=method, rtol=rtol, atol=atol, samples=time_samples,
                 stop_when=stop_when, trajectories=trajectories, out=out, resume=resume,
                 scheduler=scheduler, workers=workers, chunk_size=chunk_size,
-                progress=progress.update)
+                progress=progress.update, about=point or None)
         except KeyboardInterrupt:
             progress.close()
             where = (f"; what finished is in {out}, continue with --resume" if out is not None

@@ -100,6 +100,7 @@ def study_dataset(study: Study, arrays: Mapping[str, np.ndarray], finished: int 
         options = study.simulation
         coords["time"] = ("time", np.linspace(0.0, options.t_end, options.samples), {"units": "s"})
     attrs = {"model": model.name, "compute": study.compute, "points": study.size,
+             "about": ", ".join(f"{k}={v:.6g}" for k, v in study.about),
              "finished": study.size if finished is None else int(finished),
              "failed": int(np.sum((status != OK) & (status != NOT_COMPUTED)))}
     if study.simulation is not None:
@@ -231,26 +232,38 @@ def study_figure(dataset):
         ax.set_xlabel(_label(dataset, x))
         ax.set_title("equilibria: stable filled, unstable hollow")
         return figure
-    panels = 2 if others else 1
-    axes = figure.subplots(1, panels, squeeze=False)[0]
-    ax = axes[0]
-    frequency = dataset["frequency"]
+    growth = np.asarray(dataset["growth_rate"].values, float)
+    grows = bool(np.any(growth[np.isfinite(growth)] > 0))
+    panels = 1 + int(grows) + int(bool(others))
+    figure.set_size_inches(8, 3.2 * panels + 0.4)
+    axes = figure.subplots(panels, 1, squeeze=False)[:, 0]
     series = [{}] if not others else [{others[0]: i} for i in range(dataset.sizes[others[0]])]
     rest = {d: 0 for d in others[1:]}
-    for j, selection in enumerate(series):
-        sub = frequency.isel({**selection, **rest})
-        for k in sub["mode"].values:
-            label = f"mode {k}" + (f", {others[0]}={dataset[others[0]].values[j]:.4g}"
-                                   if selection else "")
-            ax.plot(dataset[x].values, np.asarray(sub.sel(mode=k).values, float),
-                    color=f"C{j % 10}", ls=["-", "--", ":", "-."][(k - 1) % 4],
-                    label=label if len(series) * len(sub["mode"]) <= 12 else None)
-    ax.set_xlabel(_label(dataset, x))
-    ax.set_ylabel("natural frequency (rad/s)")
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize="small")
+    for ax, name, label in ((axes[0], "frequency", "natural frequency (rad/s)"),
+                            *(((axes[1], "growth_rate", "growth rate (1/s)"),) if grows else ())):
+        variable = dataset[name]
+        for j, selection in enumerate(series):
+            sub = variable.isel({**selection, **rest})
+            for k in sub["mode"].values:
+                text = f"mode {k}" + (f", {others[0]}={dataset[others[0]].values[j]:.4g}"
+                                      if selection else "")
+                ax.plot(dataset[x].values, np.asarray(sub.sel(mode=k).values, float),
+                        color=f"C{j % 10}", ls=["-", "--", ":", "-."][(k - 1) % 4],
+                        label=text if len(series) * len(sub["mode"]) <= 12 else None)
+        ax.set_xlabel(_label(dataset, x))
+        ax.set_ylabel(label)
+        if name == "frequency" and ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize="small")
+        if not others:
+            unstable = np.asarray(dataset["stable"].values, float) == 0
+            if unstable.any():
+                ax.fill_between(dataset[x].values, 0, 1, where=unstable, alpha=0.12,
+                                color="C3", transform=ax.get_xaxis_transform(),
+                                label="unstable" if name == "frequency" else None)
+    if not others and axes[0].get_legend_handles_labels()[0]:
+        axes[0].legend(fontsize="small")
     if others:
-        ax2 = axes[1]
+        ax2 = axes[-1]
         stable = dataset["stable"].isel(rest)
         y = others[0]
         grid = np.asarray(stable.transpose(y, x).values, float)
@@ -259,13 +272,9 @@ def study_figure(dataset):
         ax2.set_xlabel(_label(dataset, x))
         ax2.set_ylabel(_label(dataset, y))
         ax2.set_title("stable (green) / unstable (red)")
-    else:
-        growth = np.asarray(dataset["growth_rate"].max("mode").values, float)
-        unstable = growth > 0
-        if unstable.any():
-            ax.fill_between(dataset[x].values, 0, 1, where=unstable, alpha=0.15, color="C3",
-                            transform=ax.get_xaxis_transform(), label="unstable")
-            ax.legend(fontsize="small")
+    about = dataset.attrs.get("about")
+    axes[0].set_title(f"modes about {about}" if about else
+                      "modes about the equilibrium nearest the initial values")
     return figure
 
 

@@ -149,6 +149,9 @@ def _error(text):
     ('rotation = [["z", "phi"], ["x", "theta"], ["z", "psi"]]', 'rotation = "zxz"',
      "bodies[0].rotation", "list of [axis, angle] pairs"),
     ('inertia = ["A", "A", "C"]', 'inertia = ["A", "C"]', "bodies[0].inertia", "[Ixx, Iyy, Izz]"),
+    ('["x", "theta"]', '[1, "theta"]', "bodies[0].rotation[1][0]", "an axis is x, y or z"),
+    ('center = [0, 0, "l"]', 'center = [0, 0, "l"]\nangle = "phi"', "bodies[0].angle",
+     "'angle' is for a planar body"),
 ])
 def test_bad_3d_bodies_are_named(old, new, field, words):
     assert old in TOP

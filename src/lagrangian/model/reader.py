@@ -147,6 +147,9 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
     for index, item in tree_order(list(_components(data, "bodies", source)), source):
         field = f"bodies[{index}]"
         if is_spatial_body(item):
+            if "angle" in item:
+                raise ModelError("'angle' is for a planar body; a 3D body turns by 'rotation' "
+                                 "or by its 'joint'", field=f"{field}.angle", source=source)
             builder.add_rigid_body(
                 item["name"], item["mass"], item["inertia"], position=item.get("position"),
                 rotation=item.get("rotation"), origin=item.get("origin"),

@@ -173,6 +173,9 @@ class RotationReader:
                 raise self.error(f"unknown axis '{value}': use x, y or z (or a 3-component "
                                  f"vector){did_you_mean(name, list(AXES))}", field)
             return tuple(sign * a for a in AXES[name])
+        if not isinstance(value, Sequence):
+            raise self.error(f"an axis is x, y or z (or -x, ...) or a 3-component vector, not "
+                             f"{value!r}", field)
         vector = self.vector(value, field)
         squared = sp.Add(*(c**2 for c in vector))
         if squared.free_symbols:

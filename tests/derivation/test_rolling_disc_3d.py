@@ -102,3 +102,28 @@ def test_rolling_disc_accelerations_and_contact_forces():
                      for s2, v2 in zip(system.model.q, system.model.q_dot, strict=True))
             force = VALUES["m"] * float(a.xreplace(accelerations).xreplace(state))
             assert force == pytest.approx(-multipliers.ravel()[axis], rel=1e-9, abs=1e-9)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("factor", [0.9, 0.99, 1.01, 1.1])
+def test_upright_rolling_disc_is_stable_exactly_above_the_critical_speed(factor):
+    import math
+
+    from lagrangian.errors import ModelError
+
+    system = _our_disc()
+    r, g = VALUES["r"], VALUES["g"]
+    speed = factor * math.sqrt(g * r / 3)
+    about = {"yaw": 0, "lean": 0, "x": 0, "y": 0, "spin": 0}
+    analysis = system.modes(about=about, steady={"spin_dot": speed / r, "x_dot": speed})
+    assert analysis.stable == (factor > 1)
+    # the lean-yaw mode of a thin uniform disc: s^2 = 4 g/(5 r) (1 - 3 v^2/(g r))
+    s2 = 4 * g / (5 * r) * (1 - 3 * speed**2 / (g * r))
+    if s2 > 0:
+        assert max(m.growth_rate for m in analysis.modes) == pytest.approx(math.sqrt(s2),
+                                                                             rel=1e-7)
+    else:
+        assert max(m.frequency for m in analysis.modes) == pytest.approx(math.sqrt(-s2),
+                                                                           rel=1e-7)
+    with pytest.raises(ModelError, match="break constraint 'roll_x'"):
+        system.modes(about=about, steady={"spin_dot": speed / r, "x_dot": 2 * speed})

@@ -5,6 +5,12 @@ some velocities non-zero: the cyclic coordinates q_c (absent from M and f) turn 
 Omega_c while the others stay at q0. About it, M dq_ddot + C dq_dot + K dq = 0 with
 M = M(q0), C = -df/dq_dot and K = -df/dq at (q0, q_dot0) (the dM/dq q_ddot terms vanish since
 q_ddot0 = 0); C now holds the gyroscopic coupling of the spin. Units SI (rad/s for the rates).
+
+With constraints A(q) q_dot + b(q) = 0 (velocity or holonomic at velocity level) and their
+multipliers lambda0 on the steady motion, K gains d(A^T lambda0)/dq and the perturbations keep
+G dq_dot + H dq = 0 (G = A(q0), H = d(A q_dot + b)/dq at the steady state): the multipliers'
+perturbation is eliminated with that constraint differentiated once, which adds one neutral
+(zero) eigenvalue per constraint to the state matrix.
 """
 
 from __future__ import annotations
@@ -12,6 +18,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
+import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import Differentiator
@@ -59,10 +66,6 @@ def steady_linear_model(
     """The linear model about the steady motion with the given rates (``steady``: velocity
     name -> rate) at the configuration ``about`` (other non-cyclic coordinates solved for)."""
     model = eom.model
-    if model.constraints:
-        raise ModelError("linearization about steady motion takes unconstrained models for now "
-                         f"(this one has constraints: "
-                         f"{', '.join(c.name for c in model.constraints)})", field=FIELD)
     rates = steady_rates(eom, steady)
     names = [c.name for c in model.coordinates]
     n = len(names)
@@ -75,21 +78,40 @@ def steady_linear_model(
     q, q_dot, t = model.q, model.q_dot, model.time
     forcing = [as_expression(e).xreplace(values) for e in eom.forcing]
     mass = [as_expression(e).xreplace(values) for e in eom.mass_matrix]
-    if any(t in e.free_symbols for e in (*forcing, *mass)):
+    k = len(model.constraints)
+    jacobian = [as_expression(e).xreplace(values) for e in eom.constraint_jacobian]
+    bias = [as_expression(e).xreplace(values) for e in eom.velocity_bias]
+    gamma = [as_expression(e).xreplace(values) for e in eom.acceleration_rhs]
+    if any(t in e.free_symbols for e in (*forcing, *mass, *jacobian, *bias)):
         raise ModelError("the equations depend on time t explicitly, so there is no steady "
                          "motion to linearize about", field=FIELD)
     d = Differentiator()
     cyclic = sorted(rates)
     stiffness = [-d(e, x) for e in forcing for x in q]
     damping = [-d(e, v) for e in forcing for v in q_dot]
-    drift = [d(e, q[c]) for c in cyclic for e in (*forcing, *mass)]
-    function = StateFunction(model, [*mass, *forcing, *stiffness, *damping, *drift])
+    drift = [d(e, q[c]) for c in cyclic for e in (*forcing, *mass, *jacobian, *bias)]
+    level = [sp.Add(*(jacobian[c * n + j] * q_dot[j] for j in range(n)), bias[c])
+             for c in range(k)]  # A q_dot + b
+    level_slope = [d(e, x) for e in level for x in q]
+    jacobian_slope = [d(e, x) for e in jacobian for x in q]
+    sizes = [n * n, n, n * n, n * n, k * n, k, k, k * n, k * n * n]
+    function = StateFunction(model, [*mass, *forcing, *stiffness, *damping, *jacobian, *gamma,
+                                     *level, *level_slope, *jacobian_slope, *drift])
 
     def evaluate(qv, vv):
-        out = function.at(qv, vv, 0.0)
-        parts = np.split(out, np.cumsum([n * n, n, n * n, n * n]))
-        return (parts[0].reshape(n, n), parts[1], parts[2].reshape(n, n),
-                parts[3].reshape(n, n), parts[4])
+        parts = np.split(function.at(qv, vv, 0.0), np.cumsum(sizes))
+        return {"M": parts[0].reshape(n, n), "f": parts[1], "K": parts[2].reshape(n, n),
+                "C": parts[3].reshape(n, n), "A": parts[4].reshape(k, n), "gamma": parts[5],
+                "level": parts[6], "H": parts[7].reshape(k, n),
+                "dA": parts[8].reshape(k, n, n), "drift": parts[9]}
+
+    def solve(values):
+        """(q_ddot, lambda) of M q_ddot + A^T lambda = f, A q_ddot = gamma."""
+        M, A = values["M"], values["A"]
+        system = np.block([[M, A.T], [A, np.zeros((k, k))]])
+        right = np.concatenate([values["f"], values["gamma"]])
+        solution = np.linalg.lstsq(system, right, rcond=None)[0]
+        return solution[:n], solution[n:]
 
     q0 = np.array([about.get(c.name, c.initial if c.initial is not None else 0.0)
                    for c in model.coordinates], dtype=float)
@@ -100,8 +122,7 @@ def steady_linear_model(
     scale = 1.0 + max(abs(r) for r in rates.values()) ** 2
 
     def accelerations(qv):
-        M, f, *_ = evaluate(qv, v0)
-        return np.linalg.lstsq(M, f, rcond=None)[0]
+        return solve(evaluate(qv, v0))[0]
 
     if free:
         import scipy.optimize
@@ -114,9 +135,19 @@ def steady_linear_model(
         solution = scipy.optimize.least_squares(residual, q0[free], xtol=1e-14, ftol=1e-14,
                                                 gtol=1e-14)
         q0[free] = solution.x
-    M, f, K, C, dependence = evaluate(q0, v0)
+    at = evaluate(q0, v0)
+    M, C, G, H = at["M"], at["C"], at["A"], at["H"]
+    for c, value in enumerate(at["level"]):
+        if abs(value) > BALANCE_TOLERANCE * scale:
+            raise ModelError(f"the steady rates break constraint '{model.constraints[c].name}' "
+                             f"(A q_dot + b = {value:.6g} there): give rates that satisfy it",
+                             field=FIELD)
     try:
-        q_ddot = np.linalg.solve(M, f)
+        np.linalg.cholesky(M)
+        q_ddot, multipliers = solve(at)
+        K = at["K"] + np.einsum("c,cij->ij", multipliers, at["dA"])
+        inverse = np.linalg.inv(M)
+        S = np.linalg.inv(G @ inverse @ G.T) if k else np.zeros((0, 0))
     except np.linalg.LinAlgError:
         raise DerivationError("the mass matrix is singular on this steady motion (a gimbal-lock "
                               "configuration of the rotation sequence?); the linear model has "
@@ -124,31 +155,36 @@ def steady_linear_model(
     if np.max(np.abs(q_ddot), initial=0.0) > BALANCE_TOLERANCE * scale:
         moving = ", ".join(f"{names[i]}_ddot = {q_ddot[i]:.6g}" for i in range(n)
                            if abs(q_ddot[i]) > BALANCE_TOLERANCE * scale)
-        where = ", ".join(f"{k} = {v:.6g}" for k, v in zip(names, q0, strict=True))
+        where = ", ".join(f"{name} = {v:.6g}" for name, v in zip(names, q0, strict=True))
         raise ModelError(f"not a steady motion: at {where} with "
                          f"{', '.join(f'{velocity_name(names[i])} = {r:g}' for i, r in rates.items())}"
                          f" the accelerations are not zero ({moving}); give other rates or "
                          "configuration", field=FIELD)
     # A cyclic coordinate appears in neither M nor f; checked here and at nearby states.
     rng = np.random.default_rng(0)
+    dependence = at["drift"]
     for trial in range(3):
         if trial:
             qv = q0 + rng.uniform(-0.3, 0.3, n)
             vv = v0 + rng.uniform(-1.0, 1.0, n)
-            dependence = evaluate(qv, vv)[4]
+            dependence = evaluate(qv, vv)["drift"]
         blocks = dependence.reshape(len(cyclic), -1)
-        for k, i in enumerate(cyclic):
+        for row, i in enumerate(cyclic):
             size = max(1.0, float(np.abs(M).max()) * scale)
-            if np.max(np.abs(blocks[k]), initial=0.0) > 1e-9 * size:
+            if np.max(np.abs(blocks[row]), initial=0.0) > 1e-9 * size:
                 raise ModelError(
                     f"'{names[i]}' is not cyclic: the equations of motion depend on it, so it "
                     "cannot turn at a constant rate in a steady motion (choose coordinates in "
                     "which the spin angle is absent from L)", field=f"{FIELD}.{names[i]}_dot")
+    # dq_ddot = M^-1 P (-C dq_dot - K dq) - M^-1 G^T S H dq_dot, P = 1 - G^T S G M^-1: the
+    # multipliers' perturbation keeps d/dt (G dq_dot + H dq) = 0.
+    P = np.eye(n) - G.T @ S @ G @ inverse
     A = np.block([[np.zeros((n, n)), np.eye(n)],
-                  [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+                  [-inverse @ P @ K, -inverse @ P @ C - inverse @ G.T @ S @ H]])
     return LinearModel(
         equilibrium={name: float(v) for name, v in zip(names, q0, strict=True)},
-        multipliers={},
+        multipliers={c.name: float(v) for c, v in zip(model.constraints, multipliers,
+                                                      strict=True)},
         coordinates=tuple(names),
         user_coordinates=tuple(names),
         basis=np.eye(n),
@@ -158,7 +194,7 @@ def steady_linear_model(
         A=A,
         B=np.zeros((2 * n, 0)),
         input_matrix=np.zeros((n, 0)),
-        velocity_constraints=np.zeros((0, n)),
+        velocity_constraints=G if k else np.zeros((0, n)),
         full_mass_matrix=M,
         full_damping_matrix=C,
         full_stiffness_matrix=K,

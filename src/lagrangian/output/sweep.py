@@ -204,15 +204,7 @@ def study_figure(dataset):
     dims = [d for d in dataset["status"].dims]
     figure = Figure(figsize=(8, 5), layout="constrained")
     if compute == "simulate":
-        ax = figure.subplots()
-        final = dataset["final"]
-        for state in final["state"].values[: len(final["state"]) // 2]:
-            values = np.asarray(final.sel(state=state).values, float).ravel()
-            ax.hist(values[np.isfinite(values)], bins=60, alpha=0.6, label=str(state))
-        ax.set_xlabel("final value (SI)")
-        ax.set_ylabel("members")
-        ax.legend(fontsize="small")
-        return figure
+        return _ensemble_figure(figure, dataset, dims)
     x = dims[0]
     others = dims[1:]
     if compute == "equilibria":
@@ -275,6 +267,45 @@ def study_figure(dataset):
     about = dataset.attrs.get("about")
     axes[0].set_title(f"modes about {about}" if about else
                       "modes about the equilibrium nearest the initial values")
+    return figure
+
+
+def _ensemble_figure(figure, dataset, dims):
+    """One panel per coordinate: with trajectories the median and the 5-95 % band of the members
+    against time, else a histogram of the final values; a colour per value of the grid."""
+    final = dataset["final"]
+    coordinates = list(final["state"].values[: len(final["state"]) // 2])
+    grid_dims = [d for d in dims if d != "member"]
+    combos = [{}]
+    for d in grid_dims:
+        combos = [{**c, d: i} for c in combos for i in range(dataset.sizes[d])]
+    combos = combos[:6]
+    figure.set_size_inches(8, 2.8 * len(coordinates) + 0.4)
+    axes = figure.subplots(len(coordinates), 1, squeeze=False)[:, 0]
+    for ax, name in zip(axes, coordinates, strict=True):
+        for j, combo in enumerate(combos):
+            label = ", ".join(f"{d}={dataset[d].values[i]:.4g}" for d, i in combo.items()) or None
+            if "trajectory" in dataset:
+                values = np.asarray(dataset["trajectory"].isel(combo).sel(state=name)
+                                    .transpose(..., "time").values, float)
+                values = values.reshape(-1, values.shape[-1])
+                t = dataset["time"].values
+                with np.errstate(all="ignore"):
+                    low, mid, high = np.nanpercentile(values, [5, 50, 95], axis=0)
+                ax.fill_between(t, low, high, color=f"C{j}", alpha=0.25)
+                ax.plot(t, mid, color=f"C{j}", label=label)
+                ax.set_xlabel("t (s)")
+            else:
+                values = np.asarray(final.isel(combo).sel(state=name).values, float).ravel()
+                ax.hist(values[np.isfinite(values)], bins=60, alpha=0.6, color=f"C{j}",
+                        label=label)
+                ax.set_xlabel(f"final {name}")
+        ax.set_ylabel(name if "trajectory" in dataset else "members")
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize="small")
+    members = dataset.sizes.get("member", 1)
+    axes[0].set_title(f"{members} members: median and 5-95 % band" if "trajectory" in dataset
+                      else f"final state of {members} members")
     return figure
 
 

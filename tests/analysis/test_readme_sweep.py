@@ -1,0 +1,57 @@
+"""The README's sweep section shows real output: its commands re-run on an in-process Dask
+scheduler print what the README shows, and its Python example runs."""
+
+from __future__ import annotations
+
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+
+README = Path(__file__).resolve().parents[2] / "README.md"
+distributed = pytest.importorskip("dask.distributed")
+
+
+def section() -> str:
+    text = README.read_text(encoding="utf-8")
+    match = re.search(r"<!-- BEGIN sweep -->(.*?)<!-- END sweep -->", text, re.S)
+    assert match, "README.md lacks the sweep section"
+    return match.group(1)
+
+
+def commands() -> list[tuple[list[str], str]]:
+    """(arguments, the output shown) of each `$ lagrangian sweep ...` line."""
+    found = []
+    for block in re.findall(r"```console\n(.*?)```", section(), re.S):
+        for piece in re.split(r"^\$ ", block, flags=re.M)[1:]:
+            line, _, output = piece.partition("\n")
+            found.append((shlex.split(line)[1:], output))
+    return found
+
+
+@pytest.fixture(scope="module")
+def client():
+    with distributed.Client(processes=False, n_workers=1, threads_per_worker=2,
+                            dashboard_address=":0") as c:
+        yield c
+
+
+@pytest.mark.parametrize("index", [pytest.param(0, marks=pytest.mark.slow), 1,
+                                   pytest.param(2, marks=pytest.mark.slow)])
+def test_console_output_is_current(cli, client, index, tmp_path, monkeypatch):
+    args, shown = commands()[index]
+    monkeypatch.chdir(tmp_path)
+    code, out, err = cli(*args, "--scheduler", client.scheduler.address)
+    assert code == 0, err
+    assert out == shown
+
+
+def test_python_example_runs(client, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code = re.findall(r"```python\n(.*?)```", section(), re.S)[0]
+    # The README's script starts a local cluster; here it runs on the test's in-process one.
+    code = code.replace('compute="modes")', 'compute="modes", client=client)')
+    exec(compile(code, "README.md", "exec"), {"client": client})  # noqa: S102 (our own docs)
+    assert "[2.23606798 2.44948974 2.64575131]" in capsys.readouterr().out
+    assert (tmp_path / "study.nc").exists()

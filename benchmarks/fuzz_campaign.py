@@ -121,8 +121,13 @@ def campaign(inputs: int, minutes: float, progress: bool = True) -> dict:
 
     try:
         one()
-    except _Stop:
-        pass
+    except KeyboardInterrupt:
+        pass  # report what was tried
+    except BaseException:  # noqa: BLE001
+        # past the time limit hypothesis replays the stopping input and calls it flaky; the
+        # counts are complete all the same
+        if time.monotonic() <= deadline:
+            raise
     return _report(tallies, slow, retimed, time.monotonic() - started)
 
 

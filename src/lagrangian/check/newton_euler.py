@@ -13,6 +13,11 @@ on both sides):
 which must equal Lagrange's (M q_ddot - f)_i identically. The reaction on each body is then
 R = m a_G - F (and M_R = I alpha - M_G about its centre of mass), with q_ddot solved from E.
 
+A body in space obeys Euler's equations in body axes, I alpha + omega x I omega = M_G, with
+omega from omega~ = R^T R_dot by sympy's own d/dt of its rotation matrix (not the model's
+composed omega); its rotational part of E_i is (I alpha + omega x I omega - M_G) . d omega/d q_dot_i.
+Reactions are not reported for bodies in space yet.
+
 A spring or damper given ``between`` two points acts on the particles or bodies at its ends,
 equal and opposite (on a body also with its moment about G from the end's offset); one given by
 its length only still enters the virtual work, but then no reactions are reported.
@@ -28,6 +33,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError
 from ..model.expressions import format_expression as fmt
 from ..model.model import Attachment, Model, PointForce, Torque
+from ..model.rotations import Moment
 from . import equivalence as eq
 
 SYMBOLIC_REACTIONS_MAX_UNKNOWNS = 3
@@ -105,6 +111,13 @@ class _FreeBody:
     angular_acceleration: sp.Expr = sp.S.Zero
     force: list | None = None
     moment: sp.Expr = sp.S.Zero
+    # a body in space: R (body -> world), I (body axes), omega and alpha (body axes), the moment
+    # about G (world axes)
+    rotation: sp.Matrix | None = None
+    body_inertia: sp.Matrix | None = None
+    omega: list | None = None
+    alpha: list | None = None
+    moment3: list | None = None
 
 
 def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
@@ -128,6 +141,11 @@ def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
         notes.append("reactions not reported: the forces of "
                      + ", ".join(f"'{u}'" for u in forces.unattributed)
                      + " cannot be placed on a free body from the model")
+    elif model.rigid_bodies:
+        notes.append("reactions not reported: bodies in space ("
+                     + ", ".join(f"'{b.name}'" for b in model.rigid_bodies)
+                     + ") are checked by Euler's equations, their joint reactions are not "
+                     "solved for yet")
     else:
         reactions = _reactions(eom, bodies, newton_euler, notes)
     return CrosscheckReport(model.name, agreements, reactions, tuple(notes))
@@ -140,14 +158,7 @@ def _require_free_bodies(model: Model) -> None:
             "Newton-Euler needs the inertia as particles and bodies, but this model gives T as "
             "an expression ([energy] T): there is no free body to draw (build it from "
             "[[particles]]/[[bodies]], e.g. the example 'ladder_pendulum')")
-    if model.rigid_bodies:
-        # Euler's equations and 3D joint reactions are not drawn yet: refuse rather than
-        # compare a derivation that leaves the bodies in space out.
-        raise DerivationError(
-            "Newton-Euler is not available yet for bodies in space (3D rigid bodies: "
-            f"{', '.join(b.name for b in model.rigid_bodies)}); the Lagrange derivation of "
-            "`derive` is checked against sympy.physics.mechanics in the tests")
-    if not model.particles and not model.bodies:
+    if not model.particles and not model.bodies and not model.rigid_bodies:
         raise DerivationError("Newton-Euler needs at least one particle or body")
     # F = m a and M = I alpha hold for a constant mass and inertia only; Lagrange's equations
     # of the printed L have m_dot and dm/dq terms that Newton-Euler would not reproduce.
@@ -183,6 +194,14 @@ class _Clock:
         moving = expr.xreplace(self.to_time).diff(self.model.time)
         return moving.xreplace(self.velocities).xreplace(self.back)
 
+    def first_with_velocities(self, expr: sp.Expr) -> sp.Expr:
+        """d/dt of an expression in q, q_dot (and t), written with q_ddot."""
+        to_time = dict(self.to_time)
+        to_time.update({c.velocity: self.to_time[c.symbol].diff(self.model.time)
+                        for c in self.model.coordinates})
+        moving = expr.xreplace(to_time).diff(self.model.time)
+        return moving.xreplace(self.accelerations).xreplace(self.velocities).xreplace(self.back)
+
     def second(self, expr: sp.Expr) -> sp.Expr:
         """d^2/dt^2 of an expression in q (and t)."""
         moving = expr.xreplace(self.to_time).diff(self.model.time, 2)
@@ -198,6 +217,16 @@ def _free_bodies(model: Model, clock: _Clock) -> list[_FreeBody]:
                          [clock.second(r) for r in body.position], body.angle, body.inertia,
                          clock.second(body.angle), [sp.S.Zero] * 3)
                for body in model.bodies]
+    for rigid in model.rigid_bodies:
+        R = sp.Matrix(rigid.rotation)
+        rate = R.applyfunc(clock.first)
+        skew = R.T * rate  # omega~ in body axes
+        omega = [skew[2, 1], skew[0, 2], skew[1, 0]]
+        bodies.append(_FreeBody(rigid.name, rigid.mass, rigid.position,
+                                [clock.second(r) for r in rigid.position], force=[sp.S.Zero] * 3,
+                                rotation=R, body_inertia=sp.Matrix(rigid.inertia), omega=omega,
+                                alpha=[clock.first_with_velocities(w) for w in omega],
+                                moment3=[sp.S.Zero] * 3))
     return bodies
 
 
@@ -221,7 +250,12 @@ class _AppliedForces:
     def place(self, force, point, holder: _FreeBody) -> None:
         """Add ``force`` acting at ``point`` to ``holder``: force, and moment about G for a body."""
         holder.force = [a + b for a, b in zip(holder.force, force, strict=True)]
-        if holder.angle is not None:
+        if holder.rotation is not None:
+            s = [p - r for p, r in zip(point, holder.position, strict=True)]
+            arm = (s[1] * force[2] - s[2] * force[1], s[2] * force[0] - s[0] * force[2],
+                   s[0] * force[1] - s[1] * force[0])
+            holder.moment3 = [a + b for a, b in zip(holder.moment3, arm, strict=True)]
+        elif holder.angle is not None:
             s = [p - r for p, r in zip(point, holder.position, strict=True)]
             holder.moment += s[0] * force[1] - s[1] * force[0]
 
@@ -265,6 +299,15 @@ class _AppliedForces:
                     self.unattributed.append(load.name)
                     continue
                 self.place(load.force, load.point, holder)
+            elif isinstance(load, Moment):
+                holder = next(fb for fb in self.bodies if fb.name == load.body)
+                world = list(holder.rotation * sp.Matrix(load.moment)) \
+                    if load.axes == "body" else list(load.moment)
+                omega = list(holder.rotation * sp.Matrix(holder.omega))  # world axes
+                for i, c in enumerate(self.model.coordinates):
+                    self.work[i].append(sp.Add(*(m * w.diff(c.velocity)
+                                                 for m, w in zip(world, omega, strict=True))))
+                holder.moment3 = [a + b for a, b in zip(holder.moment3, world, strict=True)]
             elif isinstance(load, Torque):
                 for i, qi in enumerate(self.model.q):
                     self.work[i].append(load.torque * load.angle.diff(qi))
@@ -345,6 +388,14 @@ def _projected_equations(model: Model, bodies: list[_FreeBody],
                                                                strict=True) if r.has(qi)]
             if fb.angle is not None and fb.angle.has(qi):
                 terms.append(fb.inertia * fb.angular_acceleration * fb.angle.diff(qi))
+            if fb.rotation is not None:
+                # (I alpha + omega x I omega - M_G) . d omega/d q_dot_i, in body axes; the
+                # applied moments' part is in ``work`` (M . d omega/d q_dot_i).
+                I, w = fb.body_inertia, sp.Matrix(fb.omega)
+                euler = I * sp.Matrix(fb.alpha) + w.cross(I * w)
+                velocity = model.q_dot[i]
+                terms += [e * wk.diff(velocity) for e, wk in zip(euler, fb.omega, strict=True)
+                          if wk.has(velocity)]
         equations.append(sp.Add(*terms) - sp.Add(*work[i]))
     return equations
 
@@ -365,10 +416,17 @@ def _compare(eom: EquationsOfMotion, newton_euler: list[sp.Expr],
 def _holder(point, bodies: list[_FreeBody], model: Model, points: eq.Points) -> _FreeBody | None:
     """The particle at ``point``, or the body that ``point`` moves rigidly with."""
     for fb in bodies:
-        if fb.angle is None and all(eq.identical(a, b, points)
+        if fb.angle is None and fb.rotation is None and all(eq.identical(a, b, points)
                                     for a, b in zip(point, fb.position, strict=True)):
             return fb
     q, q_dot = model.q, model.q_dot
+    for fb in bodies:  # a point fixed in a body in space: R^T (point - G) is constant
+        if fb.rotation is None:
+            continue
+        local = fb.rotation.T * sp.Matrix([p - r for p, r in zip(point, fb.position,
+                                                                 strict=True)])
+        if all(eq.zero(c.diff(qi), points) for c in local for qi in q):
+            return fb
     for fb in bodies:
         if fb.angle is None:
             continue

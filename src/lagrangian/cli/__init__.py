@@ -14,9 +14,14 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    # click's plain help: rich's help formatter alone doubles the start-up of `--help`
+    rich_markup_mode=None,
+    context_settings={"max_content_width": 100},
 )
 
-# Each command lives in its own module and registers itself on `app` when imported.
+# Each command lives in its own module and registers itself on `app` when imported. The modules
+# import sympy, scipy, matplotlib and pandas inside the commands, never at the top: `--help` and
+# `examples` start in a fraction of a second (tests/cli/test_startup.py).
 from . import check as _check  # noqa: E402,F401
 from . import derive as _derive  # noqa: E402,F401
 from . import equilibria as _equilibria  # noqa: E402,F401

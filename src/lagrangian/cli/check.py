@@ -12,14 +12,6 @@ from typing import Annotated
 
 import typer
 
-from ..output.check import (
-    check_document,
-    check_text,
-    crosscheck_document,
-    crosscheck_text,
-    units_document,
-    units_text,
-)
 from . import app
 from .common import load_system, print_json
 
@@ -37,6 +29,8 @@ def check(
     json_: _JSON = False,
 ) -> None:
     """Check a hand derivation (T, V, Q, equations, multipliers) and diagnose each mistake."""
+    from ..output.check import check_document, check_text
+
     system = load_system(model, set_)
     report = system.check(answer)
     if json_:
@@ -50,6 +44,8 @@ def check(
 @app.command()
 def crosscheck(model: _MODEL, set_: _SET = [], json_: _JSON = False) -> None:  # noqa: B006
     """Derive again by Newton-Euler (free bodies, reactions eliminated) and compare with Lagrange."""
+    from ..output.check import crosscheck_document, crosscheck_text
+
     system = load_system(model, set_)
     report = system.crosscheck()
     if json_:
@@ -63,6 +59,8 @@ def crosscheck(model: _MODEL, set_: _SET = [], json_: _JSON = False) -> None:  #
 @app.command()
 def units(model: _MODEL, json_: _JSON = False) -> None:
     """Check the model for dimensional consistency; print every inconsistent term."""
+    from ..output.check import units_document, units_text
+
     system = load_system(model)
     report = system.check_units()
     if json_:

@@ -5,16 +5,18 @@ from __future__ import annotations
 import json
 import sys
 from collections.abc import Iterable, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
-from ..api.system import System, load
-from ..derivation.equations import EquationsOfMotion
-from ..derivation.regularity import physical_warnings
 from ..errors import LagrangianError, ModelError
-from ..model.units import parse_quantity
-from ..model.values import state_units
+
+if TYPE_CHECKING:
+    from ..api.system import System
+    from ..derivation.equations import EquationsOfMotion
+
+# sympy, scipy and pint are imported inside the functions that need them, so that
+# `lagrangian --help` and `lagrangian examples` start in a fraction of a second.
 
 # The CLI's name for each Python field the library names in its errors (ModelError.field):
 # the one place where the library's words meet the command line's flags.
@@ -50,6 +52,8 @@ def in_flags(error: LagrangianError) -> LagrangianError:
 
 def load_system(model: str, settings: Iterable[str] = ()) -> System:
     """The system of a model file or built-in example, with --set overrides applied."""
+    from ..api.system import load
+
     system = load(model)
     values = parameter_values(system, settings)
     return system.with_parameters(**values) if values else system
@@ -65,6 +69,8 @@ def state_assignments(system: System, settings: Iterable[str], option: str
                       ) -> dict[str, float | str]:
     """Read NAME=VALUE[unit] options for coordinates (e.g. 30deg), velocities and t, in SI
     units (names are judged by the library)."""
+    from ..model.values import state_units
+
     return quantities(assignments(settings, option), state_units(system.model), option)
 
 
@@ -72,6 +78,8 @@ def quantities(pairs: Iterable[tuple[str, str]], units: Mapping[str, str | None]
                ) -> dict[str, float | str]:
     """Each value in SI units by the unit of its name. A name without a unit here is passed on
     as written: the library refuses it by name (with a suggestion), so the CLI need not judge."""
+    from ..model.units import parse_quantity
+
     return {name: parse_quantity(text, units[name], f"{option} {name}") if name in units else text
             for name, text in pairs}
 
@@ -90,6 +98,8 @@ def assignments(settings: Iterable[str], option: str) -> list[tuple[str, str]]:
 def warn_if_unphysical(eom: EquationsOfMotion) -> None:
     """One line `warning: ...` on stderr for each thing that makes a well-formed model
     physically meaningless (a negative mass, a kinetic energy that is not positive)."""
+    from ..derivation.regularity import physical_warnings
+
     for warning in physical_warnings(eom.model, eom.mass_matrix):
         typer.echo(f"warning: {warning}", err=True)
 

@@ -7,7 +7,6 @@ from typing import Annotated
 
 import typer
 
-from ..output.derivation import derivation_document, derivation_latex, derivation_text
 from . import app
 from .common import load_system, print_json, warn_if_unphysical
 
@@ -25,6 +24,8 @@ def derive(
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
 ) -> None:
     """Derive the equations of motion by Lagrange's method."""
+    from ..output.derivation import derivation_document, derivation_latex, derivation_text
+
     eom = load_system(model, set_).equations_of_motion()
     warn_if_unphysical(eom)
     if format is Format.json:

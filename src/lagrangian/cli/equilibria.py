@@ -6,7 +6,6 @@ from typing import Annotated
 
 import typer
 
-from ..output.modes import equilibria_document, equilibria_text
 from . import app
 from .common import load_system, print_json
 
@@ -18,6 +17,8 @@ def equilibria(
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Find the equilibria (forces balance at rest, with the constraints) and their stability."""
+    from ..output.modes import equilibria_document, equilibria_text
+
     found = load_system(model, set_).equilibria()
     if json_:
         print_json(equilibria_document(found))

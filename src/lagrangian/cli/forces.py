@@ -6,7 +6,6 @@ from typing import Annotated
 
 import typer
 
-from ..output.forces import forces_document, forces_text
 from . import app
 from .common import load_system, print_json, state_assignments
 
@@ -19,6 +18,8 @@ def forces(
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Evaluate each generalized force, and each load's contribution, at a configuration."""
+    from ..output.forces import forces_document, forces_text
+
     system = load_system(model, set_)
     report = system.generalized_forces_at(state_assignments(system, at, "--at"))
     if json_:

@@ -7,9 +7,6 @@ from typing import Annotated
 
 import typer
 
-from ..output.files import check_output_path
-from ..output.modes import modes_document, modes_text, write_mode_plot
-from ..output.plots import check_plot_path
 from . import app
 from .common import load_system, print_json, state_assignments
 
@@ -28,6 +25,10 @@ def modes(
     plot: Annotated[Path | None, typer.Option("--plot", help="Draw the mode shapes to a PNG file.")] = None,
 ) -> None:
     """Linearize about an equilibrium: M, C, K, natural frequencies, damping and mode shapes."""
+    from ..output.files import check_output_path
+    from ..output.modes import modes_document, modes_text, write_mode_plot
+    from ..output.plots import check_plot_path
+
     system = load_system(model, set_)
     point = state_assignments(system, about, "--about")
     inputs = (Path(model),) if Path(model).exists() else ()

@@ -9,11 +9,7 @@ from typing import Annotated
 
 import typer
 
-from ..model.units import parse_quantity
-from ..model.values import resolve_state
-from ..numerics.simulate import METHODS, SaveAt, StepControl, parse_stop_condition
-from ..output.files import check_output_path, partial_path
-from ..output.simulation import projection_warning, simulation_document, simulation_text
+from ..numerics.options import METHODS  # light: the names only, no scipy
 from . import app
 from .common import load_system, print_json, state_assignments, warn_if_unphysical
 
@@ -35,8 +31,13 @@ def simulate(
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
+    from ..model.units import parse_quantity
+    from ..model.values import resolve_state
+    from ..numerics.simulate import SaveAt, StepControl, parse_stop_condition
     from ..output.animation import check_animatable, check_animation_path
+    from ..output.files import check_output_path, partial_path
     from ..output.plots import check_plot_path
+    from ..output.simulation import projection_warning, simulation_document, simulation_text
     from ..output.tables import check_table_path
 
     system = load_system(model, set_)

@@ -6,7 +6,6 @@ from typing import Annotated
 
 import typer
 
-from ..output.statics import statics_document, statics_text
 from . import app
 from .common import load_system, print_json, state_assignments
 
@@ -23,6 +22,8 @@ def statics(
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Find the load magnitudes that hold the mechanism at rest in a configuration (delta W = 0)."""
+    from ..output.statics import statics_document, statics_text
+
     system = load_system(model, set_)
     names = [name.strip() for item in solve_for for name in item.split(",") if name.strip()]
     report = system.statics(state_assignments(system, at, "--at"), names)

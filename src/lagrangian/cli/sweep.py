@@ -12,8 +12,6 @@ from typing import Annotated
 import typer
 
 from ..errors import LagrangianError, ModelError
-from ..model.units import parse_quantity
-from ..model.values import state_units
 from . import app
 from .common import assignments, in_flags, load_system, print_json, state_assignments
 
@@ -67,6 +65,8 @@ def sweep(
 def _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_end,
          time_samples, method, rtol, atol, stop_when, trajectories, scheduler, workers, resume,
          chunk_size, about):
+    from ..model.units import parse_quantity
+    from ..model.values import state_units
     from ..output.sweep import check_study_path, check_study_plot_path, study_summary, study_text
 
     system = load_system(model, set_)
@@ -123,6 +123,8 @@ def _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_
 def grid_values(text: str, unit: str | None, field: str) -> list[float]:
     """START:STOP:COUNT (evenly spaced, both ends), V1,V2,... or one VALUE, each with its unit."""
     import numpy as np
+
+    from ..model.units import parse_quantity
 
     if ":" in text:
         parts = text.split(":")

@@ -113,3 +113,19 @@ def test_cli_modes_about_steady_spin(cli):
     assert document["steady"] == {"psi_dot": 40.0} and document["stable"] is False
     code, _, err = cli("modes", "sleeping_top", "--steady", "spin_dot=3")
     assert code == 2 and err.startswith("error: --steady spin_dot:") and "psi_dot" in err
+
+
+def test_equilibria_of_a_top_and_gimbal_lock_kept_apart(cli):
+    found = lagrangian.load("sleeping_top").equilibria()
+    states = {(round(e.coordinates["a"], 6), round(e.coordinates["b"], 6)): e.stable
+              for e in found}
+    assert states[(0.0, 0.0)] is False  # upright at rest: falls
+    assert states[(round(math.pi, 6), 0.0)] is True  # hanging below the pivot
+    # a = b = +-pi/2 balances only because x-y-z angles lock there (cos b = 0): listed apart
+    assert all(abs(abs(p["b"]) - math.pi / 2) < 1e-9 for p in found.singular)
+    assert found.singular
+    code, out, _ = cli("equilibria", "heavy_top", "--json")
+    document = json.loads(out)
+    assert code == 0 and document["equilibria"] == []
+    assert sorted(round(p["theta"], 6) for p in document["gimbal_lock"]) == [0.0,
+                                                                            round(math.pi, 6)]

@@ -11,9 +11,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
+import sympy as sp
 
 from ..errors import ModelError
 from ..model.model import Model
+from ..model.rotations import gimbal_lock
 from ..model.values import State, resolve_state
 from ..numerics.static import StaticFunctions
 from .linearization import static_residual, total_stiffness
@@ -50,6 +52,9 @@ class Equilibria:
     coordinates: tuple[str, ...]
     constraints: tuple[str, ...]
     equilibria: tuple[Equilibrium, ...]
+    # Configurations of rest where a body's rotation sequence is singular (gimbal lock): the
+    # forces balance only because the angles lose a direction there, so no stability is claimed.
+    singular: tuple[dict[str, float], ...] = ()
 
     def __iter__(self):
         return iter(self.equilibria)
@@ -241,9 +246,16 @@ def find_equilibria(
     lam = initial_multipliers(functions.evaluate(points, t))
     q, lam, converged = solver.solve(points, lam, free, limit)
     found: list[tuple[np.ndarray, np.ndarray]] = []
+    singular: list[np.ndarray] = []
+    values = {sp.Symbol(k): v for k, v in functions.parameters.items()}
     for qi, li in zip(q[converged], lam[converged], strict=True):
         qi = _wrap(qi, periodic, low)
         if not _inside(qi, low, high, model, periodic):
+            continue
+        if model.rigid_bodies and gimbal_lock(
+                model.rigid_bodies, {**values, **dict(zip(model.q, qi, strict=True))}, 1e-6):
+            if not any(_same(qi, other, periodic, low, high) for other in singular):
+                singular.append(qi)
             continue
         if any(_same(qi, other, periodic, low, high) for other, _ in found):
             continue
@@ -260,7 +272,10 @@ def find_equilibria(
         )
         for qi, li in found
     )
-    return Equilibria(model.name, names, tuple(c.name for c in model.constraints), equilibria)
+    singular.sort(key=lambda item: tuple(np.round(item, 9)))
+    return Equilibria(model.name, names, tuple(c.name for c in model.constraints), equilibria,
+                      tuple({n: _clean(v) for n, v in zip(names, qi, strict=True)}
+                            for qi in singular))
 
 
 def resolve_equilibrium(

@@ -32,12 +32,14 @@ def equilibria_document(found: Equilibria) -> dict[str, Any]:
         if found.constraints:
             item["multipliers"] = dict(e.multipliers)
         items.append(item)
+    if found.singular:  # only for bodies in space whose angles lock somewhere at rest
+        return {"equilibria": items, "gimbal_lock": [dict(point) for point in found.singular]}
     return {"equilibria": items}
 
 
 def equilibria_text(found: Equilibria) -> str:
     lines = [f"Equilibria of {found.model_name}", "=" * (14 + len(found.model_name))]
-    if not len(found):
+    if not len(found) and not found.singular:
         lines.append("No equilibrium found: at none of the configurations searched (from many "
                      "starting points over the coordinates' ranges) do the forces at rest balance.")
         return "\n".join(lines) + "\n"
@@ -47,7 +49,12 @@ def equilibria_text(found: Equilibria) -> str:
         if e.multipliers:
             reactions = ", ".join(f"lambda_{k} = {_number(v)}" for k, v in e.multipliers.items())
             lines.append(f"   multipliers: {reactions}")
-    neutral = found[0].neutral
+    if found.singular:
+        where = "; ".join(", ".join(f"{k} = {_number(v)}" for k, v in point.items())
+                          for point in found.singular)
+        lines += ["", f"Also at rest where a rotation sequence is singular (gimbal lock), its "
+                      f"stability not decided in these coordinates: {where}"]
+    neutral = found[0].neutral if len(found) else ()
     if neutral:
         lines += ["", f"Any value of {', '.join(neutral)} is also an equilibrium "
                       "(the equations at rest do not contain it); the model's initial value is shown."]

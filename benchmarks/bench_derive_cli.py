@@ -4,7 +4,9 @@ model files, through the command line in every format, with sympy's KanesMethod 
 Run:  python benchmarks/bench_derive_cli.py [--cart 1-10] [--chain 1-30] [--repeat 3]
 
 Model files are written by benchmarks/model_files.py into a temporary folder (nothing is kept).
-Every figure is the best wall time of --repeat runs (default 3):
+Every figure is the best of --repeat runs (default 3); wall times, with the CPU time (user +
+system) of the process in brackets where a whole process is timed, since on a shared machine the
+wall time also counts the time a process waits for a CPU:
 
 - "CLI" columns: `python -m lagrangian derive FILE --format F > /dev/null` in a fresh process:
   interpreter start-up, imports, reading the file, the derivation, the symbolic accelerations
@@ -29,6 +31,7 @@ import argparse
 import json
 import os
 import random
+import resource
 import subprocess
 import sys
 import tempfile
@@ -77,16 +80,30 @@ def _best(times: list[float]) -> float:
     return min(times)
 
 
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def cli_time(path: Path, fmt: str, repeat: int) -> float:
-    times = []
+    """Best wall time of the whole `derive` process; its CPU time goes to CPU_TIMES."""
+    times, cpu = [], []
     for _ in range(repeat):
+        before = _children_cpu()
         start = time.perf_counter()
         result = subprocess.run([sys.executable, "-m", "lagrangian", "derive", str(path),
                                  "--format", fmt], capture_output=True, check=False)
         times.append(time.perf_counter() - start)
+        cpu.append(_children_cpu() - before)
         if result.returncode != 0 or not result.stdout:
             raise SystemExit(f"derive failed on {path} ({fmt}): {result.stderr.decode()}")
+    CPU_TIMES[(str(path), fmt)] = min(cpu)
     return _best(times)
+
+
+# (model file, format) -> best CPU time (user + system) of the derive process, seconds: on a
+# shared machine it does not count the time the process waited for a CPU.
+CPU_TIMES: dict[tuple[str, str], float] = {}
 
 
 def in_process_times(path: Path, fmt: str, repeat: int) -> tuple[float, float, float]:
@@ -100,13 +117,16 @@ def in_process_times(path: Path, fmt: str, repeat: int) -> tuple[float, float, f
 
 def kane_times(n: int, repeat: int) -> tuple[float, float]:
     """(in-process call, whole process) seconds, best of ``repeat``."""
-    calls, processes = [], []
+    calls, processes, cpu = [], [], []
     for _ in range(repeat):
+        before = _children_cpu()
         start = time.perf_counter()
         out = subprocess.run([sys.executable, "-c", _KANE, str(n)], capture_output=True,
                              text=True, check=True).stdout
         processes.append(time.perf_counter() - start)
+        cpu.append(_children_cpu() - before)
         calls.append(float(out))
+    CPU_TIMES[("kane", str(n))] = min(cpu)
     return _best(calls), _best(processes)
 
 
@@ -179,9 +199,11 @@ def main() -> None:
             cli = {fmt: cli_time(path, fmt, args.repeat) for fmt in FORMATS}
             read, derived, text = in_process_times(path, "text", args.repeat)
             call, process = kane_times(n, args.repeat)
-            results["cart"].append({"n": n, "cli": cli, "read": read, "derive": derived,
-                                    "format_text": text, "kane_call": call,
-                                    "kane_process": process})
+            cpu = {fmt: CPU_TIMES[(str(path), fmt)] for fmt in FORMATS}
+            results["cart"].append({"n": n, "cli": cli, "cli_cpu": cpu, "read": read,
+                                    "derive": derived, "format_text": text, "kane_call": call,
+                                    "kane_process": process,
+                                    "kane_process_cpu": CPU_TIMES[("kane", str(n))]})
             print(f"{n:>3} | {cli['text']:>8.2f} {cli['json']:>8.2f} {cli['latex']:>9.2f} | "
                   f"{read:>6.3f} {derived:>7.3f} {text:>6.3f} | {call:>9.3f} {process:>9.2f} | "
                   f"{call / derived:>15.1f}x {process / cli['text']:>17.2f}x", flush=True)
@@ -194,8 +216,9 @@ def main() -> None:
             path.write_text(model_files.n_link_pendulum(n))
             cli = {fmt: cli_time(path, fmt, args.repeat) for fmt in FORMATS}
             read, derived, text = in_process_times(path, "text", args.repeat)
-            results["chain"].append({"n": n, "cli": cli, "read": read, "derive": derived,
-                                     "format_text": text})
+            cpu = {fmt: CPU_TIMES[(str(path), fmt)] for fmt in FORMATS}
+            results["chain"].append({"n": n, "cli": cli, "cli_cpu": cpu, "read": read,
+                                     "derive": derived, "format_text": text})
             print(f"{n:>3} | {cli['text']:>8.2f} {cli['json']:>8.2f} {cli['latex']:>9.2f} | "
                   f"{read:>6.3f} {derived:>7.3f} {text:>6.3f}", flush=True)
     print(f"\nload average {os.getloadavg()[0]:.2f} at the end")
@@ -207,21 +230,25 @@ def main() -> None:
 
 def markdown(results: dict) -> str:
     """The two tables of docs/benchmarks.md."""
-    lines = ["| n | CLI text (s) | CLI JSON (s) | CLI LaTeX (s) | read / derive / text in-process (s) "
-             "| KanesMethod call (s) | KanesMethod process (s) | Kane call ÷ our derive "
-             "| Kane process ÷ our CLI text |", "|---" * 9 + "|"]
+    def pair(row, fmt):
+        return f"{row['cli'][fmt]:.2f} ({row['cli_cpu'][fmt]:.2f})"
+
+    lines = ["| n | CLI text, s: wall (CPU) | CLI JSON | CLI LaTeX | read / derive / text "
+             "in-process (s) | KanesMethod call (s) | KanesMethod process: wall (CPU) "
+             "| Kane call ÷ our derive | Kane process ÷ our CLI text (CPU) |", "|---" * 9 + "|"]
     for row in results["cart"]:
-        cli = row["cli"]
-        lines.append(f"| {row['n']} | {cli['text']:.2f} | {cli['json']:.2f} | {cli['latex']:.2f} "
+        lines.append(f"| {row['n']} | {pair(row, 'text')} | {pair(row, 'json')} "
+                     f"| {pair(row, 'latex')} "
                      f"| {row['read']:.3f} / {row['derive']:.3f} / {row['format_text']:.3f} "
-                     f"| {row['kane_call']:.3f} | {row['kane_process']:.2f} "
+                     f"| {row['kane_call']:.3f} "
+                     f"| {row['kane_process']:.2f} ({row['kane_process_cpu']:.2f}) "
                      f"| {row['kane_call'] / row['derive']:.0f}× "
-                     f"| {row['kane_process'] / cli['text']:.1f}× |")
-    lines += ["", "| n | CLI text (s) | CLI JSON (s) | CLI LaTeX (s) "
+                     f"| {row['kane_process_cpu'] / row['cli_cpu']['text']:.1f}× |")
+    lines += ["", "| n | CLI text, s: wall (CPU) | CLI JSON | CLI LaTeX "
               "| read / derive / text in-process (s) |", "|---" * 5 + "|"]
     for row in results["chain"]:
-        cli = row["cli"]
-        lines.append(f"| {row['n']} | {cli['text']:.2f} | {cli['json']:.2f} | {cli['latex']:.2f} "
+        lines.append(f"| {row['n']} | {pair(row, 'text')} | {pair(row, 'json')} "
+                     f"| {pair(row, 'latex')} "
                      f"| {row['read']:.3f} / {row['derive']:.3f} / {row['format_text']:.3f} |")
     return "\n".join(lines) + "\n"
 

@@ -25,7 +25,7 @@ from ..derivation.kinematics import Differentiator
 from ..errors import DerivationError, ModelError, did_you_mean
 from ..model.expressions import as_expression
 from ..model.model import velocity_name
-from ..model.values import ParameterValues, resolve_parameters
+from ..model.values import ParameterValues, resolve_parameters, resolve_state
 from ..numerics.lambdified import StateFunction
 from .linearization import LinearModel
 
@@ -69,11 +69,8 @@ def steady_linear_model(
     rates = steady_rates(eom, steady)
     names = [c.name for c in model.coordinates]
     n = len(names)
-    about = dict(about or {})
-    for name in about:
-        if name not in names:
-            raise ModelError(f"'{name}' is not a coordinate{did_you_mean(name, names)}",
-                             field=f"about.{name}")
+    state = resolve_state(model, about, field="about", velocities=False, time=False)
+    about = {name: v for name, v in zip(names, state.q, strict=True) if name in state.given}
     values = resolve_parameters(model, parameters).symbol_values(model)
     q, q_dot, t = model.q, model.q_dot, model.time
     forcing = [as_expression(e).xreplace(values) for e in eom.forcing]
@@ -94,16 +91,21 @@ def steady_linear_model(
              for c in range(k)]  # A q_dot + b
     level_slope = [d(e, x) for e in level for x in q]
     jacobian_slope = [d(e, x) for e in jacobian for x in q]
-    sizes = [n * n, n, n * n, n * n, k * n, k, k, k * n, k * n * n]
+    # Holonomic constraints hold at position level too: Phi(q0) = 0 on the steady motion.
+    positions = [c.expression.xreplace(values) for c in model.constraints
+                 if c.kind == "holonomic"]
+    sizes = [n * n, n, n * n, n * n, k * n, k, k, k * n, k * n * n, len(cyclic) * (n * n + n
+                                                                            + k * n + k)]
     function = StateFunction(model, [*mass, *forcing, *stiffness, *damping, *jacobian, *gamma,
-                                     *level, *level_slope, *jacobian_slope, *drift])
+                                     *level, *level_slope, *jacobian_slope, *drift,
+                                     *positions])
 
     def evaluate(qv, vv):
         parts = np.split(function.at(qv, vv, 0.0), np.cumsum(sizes))
         return {"M": parts[0].reshape(n, n), "f": parts[1], "K": parts[2].reshape(n, n),
                 "C": parts[3].reshape(n, n), "A": parts[4].reshape(k, n), "gamma": parts[5],
                 "level": parts[6], "H": parts[7].reshape(k, n),
-                "dA": parts[8].reshape(k, n, n), "drift": parts[9]}
+                "dA": parts[8].reshape(k, n, n), "drift": parts[9], "Phi": parts[10]}
 
     def solve(values):
         """(q_ddot, lambda) of M q_ddot + A^T lambda = f, A q_ddot = gamma."""
@@ -121,22 +123,24 @@ def steady_linear_model(
     free = [i for i in range(n) if names[i] not in about and i not in rates]
     scale = 1.0 + max(abs(r) for r in rates.values()) ** 2
 
-    def accelerations(qv):
-        return solve(evaluate(qv, v0))[0]
-
     if free:
         import scipy.optimize
 
         def residual(x):
             trial = q0.copy()
             trial[free] = x
-            return accelerations(trial) / scale
+            values_at = evaluate(trial, v0)
+            return np.concatenate([solve(values_at)[0] / scale, values_at["Phi"]])
 
         solution = scipy.optimize.least_squares(residual, q0[free], xtol=1e-14, ftol=1e-14,
                                                 gtol=1e-14)
         q0[free] = solution.x
     at = evaluate(q0, v0)
     M, C, G, H = at["M"], at["C"], at["A"], at["H"]
+    if np.max(np.abs(at["Phi"]), initial=0.0) > 1e-9:
+        raise ModelError("the configuration does not satisfy the holonomic constraints "
+                         f"(largest residual {np.max(np.abs(at['Phi'])):.3g}); give 'about' "
+                         "values on them", field="about")
     for c, value in enumerate(at["level"]):
         if abs(value) > BALANCE_TOLERANCE * scale:
             raise ModelError(f"the steady rates break constraint '{model.constraints[c].name}' "

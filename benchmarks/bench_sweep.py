@@ -15,7 +15,10 @@ Run:  python benchmarks/bench_sweep.py [--quick]
      system.with_parameters(k=..., k_c=...).modes() and
      system.simulate(10, initial={...}) per member.
 Times are wall-clock seconds, best of ``--repeat`` runs (1 by default: the cluster start-up is
-part of what a user waits for). The machine may be shared: see docs/benchmarks.md.
+part of what a user waits for), with the CPU seconds every process of the run used (this one,
+the workers it started, and for a running cluster its workers, from psutil): on a machine
+shared with other work the CPU time is the steadier figure. The load average is printed before
+and after. See docs/benchmarks.md.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import resource
 import time
 
 import numpy as np
@@ -31,19 +35,52 @@ import lagrangian
 
 
 def _cluster(workers: int):
+    """A running cluster set up as System.sweep sets up its own (api/sweep.py)."""
+    import dask
     from dask.distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=":0", silence_logs=logging.ERROR)
+    from lagrangian.api.sweep import WORKER_ENVIRONMENT
+
+    with dask.config.set(WORKER_ENVIRONMENT):
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=":0", silence_logs=logging.ERROR)
     return Client(cluster), cluster
 
 
-def _timed(function, repeat: int = 1) -> float:
+CPU = {"last": 0.0}
+
+
+def _cpu_here() -> float:
+    """CPU seconds of this process and of its children that have ended (a default cluster)."""
+    total = 0.0
+    for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN):
+        usage = resource.getrusage(who)
+        total += usage.ru_utime + usage.ru_stime
+    return total
+
+
+def _cpu_workers(client) -> float:
+    if client is None:
+        return 0.0
+
+    def used() -> float:
+        import psutil
+
+        times = psutil.Process().cpu_times()
+        return times.user + times.system
+
+    return sum(client.run(used).values())
+
+
+def _timed(function, repeat: int = 1, client=None) -> float:
+    """Best wall time of ``repeat`` runs; CPU["last"]: the CPU seconds of the last run."""
     best = float("inf")
     for _ in range(repeat):
+        cpu, workers = _cpu_here(), _cpu_workers(client)
         began = time.perf_counter()
         function()
         best = min(best, time.perf_counter() - began)
+        CPU["last"] = _cpu_here() - cpu + _cpu_workers(client) - workers
     return best
 
 
@@ -62,15 +99,18 @@ def main() -> None:
     ensemble = {"sample": {"theta1": "uniform(-1, 1)", "theta2": "uniform(-1, 1)"},
                 "members": members, "t_end": 10.0, "samples": 201}
     rows = []
-    print(f"cores: {os.cpu_count()}")
+    print(f"cores: {os.cpu_count()}, load average before: {os.getloadavg()}")
 
     # 1-2: end to end, the default cluster started and closed by System.sweep
     t = _timed(lambda: two_mass.sweep({"k": k, "k_c": second}, compute="modes"), args.repeat)
-    rows.append((f"modes, two_mass, k x k_c = {points:,} points, default cluster", t, points))
+    rows.append((f"modes, two_mass, k x k_c = {points:,} points, default cluster", t, points,
+                 CPU["last"]))
     t = _timed(lambda: two_mass.sweep({"k": k, "m": second}, compute="modes"), args.repeat)
-    rows.append((f"modes, two_mass, k x m = {points:,} points, default cluster", t, points))
+    rows.append((f"modes, two_mass, k x m = {points:,} points, default cluster", t, points,
+                 CPU["last"]))
     t = _timed(lambda: pendulum.sweep(compute="simulate", **ensemble), args.repeat)
-    rows.append((f"simulate, double pendulum, {members:,} x 10 s, default cluster", t, members))
+    rows.append((f"simulate, double pendulum, {members:,} x 10 s, default cluster", t, members,
+                 CPU["last"]))
 
     # 3: clusters already running: one worker, then two
     few = {**ensemble, "members": 2000 // scale}
@@ -81,17 +121,19 @@ def main() -> None:
             two_mass.sweep({"k": k[:2], "k_c": second[:2]}, client=client)  # warm the workers
             pendulum.sweep(compute="simulate", client=client, **{**few, "members": 2})
             a = _timed(lambda c=client: two_mass.sweep({"k": k, "k_c": second}, client=c),
-                       args.repeat)
+                       args.repeat, client)
+            cpu_a = CPU["last"]
             b = _timed(lambda c=client: pendulum.sweep(compute="simulate", client=c, **few),
-                       args.repeat)
+                       args.repeat, client)
+            cpu_b = CPU["last"]
         finally:
             client.close()
             cluster.close()
         scaling[workers] = (a, b)
         rows.append((f"modes, k x k_c = {points:,} points, running cluster of {workers}", a,
-                     points))
+                     points, cpu_a))
         rows.append((f"simulate, {few['members']:,} x 10 s, running cluster of {workers}", b,
-                     few["members"]))
+                     few["members"], cpu_b))
 
     # 4: a plain Python loop of the single-point API
     loop_points = 20
@@ -99,21 +141,26 @@ def main() -> None:
                       strict=True))
     t_modes = _timed(lambda: [two_mass.with_parameters(k=float(a), k_c=float(b)).modes()
                               for a, b in values])
+    cpu_modes = CPU["last"]
     rng = np.random.default_rng(0)
     starts = rng.uniform(-1, 1, (loop_points, 2))
     pendulum.simulate(10.0, samples=201)  # compile once, as the sweep does
     t_sim = _timed(lambda: [pendulum.simulate(10.0, samples=201, initial={
         "theta1": float(a), "theta2": float(b)}) for a, b in starts])
+    cpu_sim = CPU["last"]
     rows.append((f"loop of System.with_parameters(...).modes(), {loop_points} points", t_modes,
-                 loop_points))
-    rows.append((f"loop of System.simulate(10 s), {loop_points} members", t_sim, loop_points))
+                 loop_points, cpu_modes))
+    rows.append((f"loop of System.simulate(10 s), {loop_points} members", t_sim, loop_points,
+                 cpu_sim))
 
     print()
-    print("| what | wall (s) | per point (ms) |")
-    print("|---|---:|---:|")
-    for what, seconds, count in rows:
-        print(f"| {what} | {seconds:.2f} | {1e3 * seconds / count:.3f} |")
+    print("| what | wall (s) | wall per point (ms) | CPU (s) | CPU per point (ms) |")
+    print("|---|---:|---:|---:|---:|")
+    for what, seconds, count, cpu in rows:
+        print(f"| {what} | {seconds:.2f} | {1e3 * seconds / count:.3f} | {cpu:.1f} | "
+              f"{1e3 * cpu / count:.3f} |")
     print()
+    print(f"load average after: {os.getloadavg()}")
     for label, index in (("modes 10^5 (k x k_c)", 0), ("simulate", 1)):
         one, two = scaling[1][index], scaling[2][index]
         print(f"speed-up 1 -> 2 workers, {label}: {one / two:.2f}x")

@@ -25,6 +25,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "fuzz"))
 
 from fuzz_inputs import (  # noqa: E402
+    EXAMPLE_TEXTS,
     Tally,
     answer_files,
     derive_json,
@@ -41,7 +42,7 @@ from fuzz_inputs import (  # noqa: E402
 from hypothesis import HealthCheck, Phase, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
-from lagrangian.model.units import check_unit, parse_quantity  # noqa: E402
+from lagrangian.model.units import check_unit, parse_quantity, registry  # noqa: E402
 
 # share of the inputs per target, and each input's time limit (a hang, not a slow refusal)
 TARGETS = {
@@ -62,6 +63,10 @@ class _Stop(Exception):
 
 def campaign(inputs: int, minutes: float, progress: bool = True) -> dict:
     folder = Path(tempfile.mkdtemp(prefix="lagrangian-fuzz-"))
+    # one-time set-up (pint's registry, sympy's caches: seconds on a busy machine) is not an
+    # input's time
+    registry()
+    derive_json(EXAMPLE_TEXTS["double_pendulum"], folder)
     tallies = {target: Tally() for target in TARGETS}
     slow: list[tuple[float, str, str]] = []
     retimed: list[float] = []  # refusals over 1 s that took under 1 s when run again

@@ -37,7 +37,9 @@ from ..model.examples import example_path
 from ..model.model import Model
 from ..model.notation import latex_symbol_names
 from ..model.reader import read_model
+from ..model.urdf import read_urdf
 from ..model.values import State, resolve_state
+from ..numerics.dynamics import Dynamics
 from ..numerics.events import StopCondition
 from ..numerics.functions import NumericSystem, numeric
 from ..numerics.simulate import SaveAt, StepControl, parse_stop_condition, simulate
@@ -167,6 +169,13 @@ class System:
     def _numeric(self) -> NumericSystem:
         """The default numeric system, compiled once per System (its parameters are fixed)."""
         return numeric(self.equations_of_motion())
+
+    def dynamics(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"
+                 ) -> Dynamics:
+        """M(q), bias C q_dot + g, g(q), inverse and forward dynamics and the energies, batched
+        over leading axes (q of shape (n,) or (N, n)); a generalized force tau acts on top of
+        the model's own loads (numerics/dynamics.py)."""
+        return Dynamics(self.numeric(parameters, backend))
 
     # -- equilibria, linearization and modes -----------------------------------------------------
 
@@ -316,9 +325,16 @@ class SystemBuilder(ModelBuilder):
         return System(self.build_model())
 
 
-def load(path_or_example: str | Path) -> System:
-    """Load a model file (TOML), or a built-in example by name (see ``examples()``)."""
+def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None) -> System:
+    """Load a model file (TOML), a robot (URDF: ``lock`` freezes joints by name, rad or m), or
+    a built-in example by name (see ``examples()``)."""
     path = Path(path_or_example)
+    if path.suffix.lower() == ".urdf":
+        return System(read_urdf(path, lock))
+    if lock:
+        from ..errors import ModelError
+
+        raise ModelError("only a URDF model has joints to lock", field="lock")
     if path.exists() or path.suffix == ".toml" or len(path.parts) > 1:
         return System(read_model(path))
     model = read_model(example_path(str(path_or_example)))

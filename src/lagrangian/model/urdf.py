@@ -1,0 +1,310 @@
+"""Robot arms from URDF: joints become the kinematic tree of 3D bodies, links their inertia.
+
+URDF is read by yourdfpy (meshes, visual and collision elements are never loaded). Each
+revolute, continuous or prismatic joint that is neither locked nor a mimic is a coordinate named
+after it (rad or m); its actuator is the generalized force ``tau_<joint>`` (N m, or N for a
+prismatic joint), a parameter of value 0. Gravity is g = 9.81 m/s^2 along -z. A link's frame is
+
+    R_child = R_parent R_origin(rpy) R_axis(angle),  x_child = x_parent + R_parent xyz (+ d axis)
+
+and its inertial (mass, tensor about the centre of mass in the inertial frame, that frame's
+origin and rpy) becomes a rigid body whose inertia is turned into link axes, I = R I' R^T.
+Joint damping and friction (<dynamics>) are ignored, as Pinocchio does: M, C q_dot and g are
+the rigid-body terms a controller needs.
+"""
+
+from __future__ import annotations
+
+import io
+import keyword
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import replace
+
+import numpy as np
+import sympy as sp
+
+from ..errors import ModelError, did_you_mean
+from .builder import ModelBuilder
+from .expressions import RESERVED
+from .model import Model
+from .reader import read_text_file
+from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
+
+MOVABLE = ("revolute", "continuous", "prismatic")
+SUPPORTED = (*MOVABLE, "fixed")
+GRAVITY = 9.81  # m/s^2, along -z
+# Entries of a rotation within this of 0 or +-1 are taken as exact: cos(pi/2) = 6e-17 in a
+# URDF's rpy would otherwise keep every product it enters.
+_SNAP = 1e-14
+
+
+def read_urdf(path, lock: Mapping[str, float] | None = None) -> Model:
+    """Load a URDF file as a model; ``lock`` freezes joints at values (rad or m) by name."""
+    return parse_urdf(read_text_file(path), source=str(path), lock=lock)
+
+
+def parse_urdf(text: str, *, source: str = "<urdf>",
+               lock: Mapping[str, float] | None = None) -> Model:
+    """The model of a URDF document (see the module docstring for what each element becomes)."""
+    robot = _parse(text, source)
+    return _Tree(robot, source).model(dict(lock or {}))
+
+
+def _parse(text: str, source: str):
+    from lxml import etree
+
+    data = text.encode("utf-8")
+    try:
+        etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True))
+    except etree.XMLSyntaxError as exc:
+        raise ModelError(f"not well-formed XML ({exc})", source=source) from None
+    import yourdfpy
+
+    try:
+        urdf = yourdfpy.URDF.load(io.BytesIO(data), build_scene_graph=False, load_meshes=False,
+                                  load_collision_meshes=False, build_collision_scene_graph=False)
+    except Exception as exc:  # yourdfpy's own errors are plain exceptions of many kinds
+        raise ModelError(f"not a URDF robot ({type(exc).__name__}: {exc})",
+                         source=source) from None
+    return urdf.robot
+
+
+def _number(x: float) -> sp.Expr:
+    x = float(x)
+    if not math.isfinite(x):
+        raise ValueError(x)
+    if abs(x) < _SNAP:
+        return sp.S.Zero
+    if abs(x - round(x)) < _SNAP and abs(x) < 1e6:
+        return sp.Integer(round(x))
+    return sp.Float(x)
+
+
+def _matrix(a) -> tuple:
+    return tuple(tuple(_number(v) for v in row) for row in np.asarray(a, dtype=float))
+
+
+def _vector(a) -> tuple:
+    return tuple(_number(v) for v in np.asarray(a, dtype=float))
+
+
+def identifier(name: str) -> str:
+    """A joint name as a coordinate name of the model grammar (letters, digits, _)."""
+    text = re.sub(r"\W", "_", name)
+    if not text or not text[0].isalpha():
+        text = "q_" + text
+    if text in RESERVED or keyword.iskeyword(text) or text in ("g", "t"):
+        text = text + "_joint"
+    return text
+
+
+class _Tree:
+    def __init__(self, robot, source: str):
+        self.source = source
+        self.links = {link.name: link for link in robot.links}
+        self.joints = list(robot.joints)
+        self.by_name = {j.name: j for j in self.joints}
+        self.name = robot.name or "URDF robot"
+
+    def error(self, message: str, field: str | None = None) -> ModelError:
+        return ModelError(message, field=field, source=self.source)
+
+    def _check_tree(self) -> tuple[str, dict[str, list]]:
+        parent_of: dict[str, object] = {}
+        children: dict[str, list] = {}
+        for joint in self.joints:
+            where = f"joint '{joint.name}'"
+            if joint.type not in SUPPORTED:
+                raise self.error(
+                    f"{joint.type} joints are not supported yet (use revolute, continuous, "
+                    "prismatic or fixed)" if joint.type in ("floating", "planar")
+                    else f"unknown joint type {joint.type!r} (use revolute, continuous, "
+                    f"prismatic or fixed){did_you_mean(str(joint.type), SUPPORTED)}", where)
+            for role, link in (("parent", joint.parent), ("child", joint.child)):
+                if link not in self.links:
+                    raise self.error(f"no link '{link}' for its {role}"
+                                     f"{did_you_mean(str(link), list(self.links))}", where)
+            if joint.child in parent_of:
+                raise self.error(
+                    f"link '{joint.child}' is the child of joints '{parent_of[joint.child].name}' "
+                    f"and '{joint.name}': a closed loop (URDF describes trees only)", where)
+            parent_of[joint.child] = joint
+            children.setdefault(joint.parent, []).append(joint)
+        roots = [name for name in self.links if name not in parent_of]
+        if len(roots) != 1:
+            if not roots:
+                raise self.error("every link is the child of a joint: a closed loop "
+                                 "(URDF describes trees only)")
+            raise self.error(f"the links form {len(roots)} separate trees (roots "
+                             f"{', '.join(repr(r) for r in roots)}); a robot has one root link")
+        reached, stack = set(), [roots[0]]
+        while stack:
+            link = stack.pop()
+            reached.add(link)
+            stack += [j.child for j in children.get(link, [])]
+        if len(reached) != len(self.links):
+            lost = next(j for j in self.joints if j.child not in reached)
+            raise self.error("its links form a closed loop, unreachable from the root link "
+                             f"'{roots[0]}' (URDF describes trees only)", f"joint '{lost.name}'")
+        return roots[0], children
+
+    def model(self, lock: dict[str, float]) -> Model:
+        root, children = self._check_tree()
+        order = []  # joints from the root down, depth first in document order
+        stack = list(reversed(children.get(root, [])))
+        while stack:
+            joint = stack.pop()
+            order.append(joint)
+            stack += list(reversed(children.get(joint.child, [])))
+        movable = [j.name for j in order if j.type in MOVABLE]
+        for name, value in lock.items():
+            if name not in self.by_name:
+                raise ModelError(f"no joint '{name}' in {self.source}"
+                                 f"{did_you_mean(str(name), movable)}", field=f"lock.{name}")
+            if self.by_name[name].type not in MOVABLE:
+                raise ModelError(f"joint '{name}' is {self.by_name[name].type}: only revolute, "
+                                 "continuous and prismatic joints can be locked",
+                                 field=f"lock.{name}")
+            if self.by_name[name].mimic is not None:
+                raise ModelError(f"joint '{name}' mimics '{self.by_name[name].mimic.joint}': "
+                                 "lock that one instead", field=f"lock.{name}")
+            try:
+                lock[name] = float(value)
+            except (TypeError, ValueError):
+                raise ModelError(f"the value {value!r} is not a number",
+                                 field=f"lock.{name}") from None
+            if not math.isfinite(lock[name]):
+                raise ModelError(f"the value {value!r} is not finite", field=f"lock.{name}")
+
+        builder = ModelBuilder(self.name, f"Robot '{self.name}' read from URDF "
+                               f"({len(order)} joints, {len(self.links)} links).",
+                               source=self.source)
+        g = builder.parameter("g", GRAVITY, "m/s^2")
+        builder.set_gravity(g, (0, 0, -1))
+        names: dict[str, str] = {}
+        taken = {"g"}
+        for joint in order:
+            if joint.type not in MOVABLE or joint.name in lock or joint.mimic is not None:
+                continue
+            name = identifier(joint.name)
+            while name in taken or f"tau_{name}" in taken:
+                name += "_"
+            taken |= {name, f"tau_{name}"}
+            names[joint.name] = name
+            unit = "m" if joint.type == "prismatic" else "rad"
+            limit = joint.limit if joint.type != "continuous" else None
+            span = None
+            initial = 0.0
+            if limit is not None and limit.lower is not None and limit.upper is not None \
+                    and limit.lower < limit.upper:
+                span = (float(limit.lower), float(limit.upper))
+                if not span[0] <= 0.0 <= span[1]:
+                    initial = 0.5 * (span[0] + span[1])
+            field = f"joint '{joint.name}'"
+            builder.coordinate(name, unit, initial=initial, rate=0.0, range=span, field=field)
+            tau = builder.parameter(f"tau_{name}", 0.0, "N" if unit == "m" else "N*m",
+                                    field=field)
+            builder.add_generalized_force(name, tau, field=field)
+        if not names:
+            raise self.error("no joint left to move: a model needs at least one revolute, "
+                             "continuous or prismatic joint that is not locked")
+        position = self._positions(lock, names)
+        bodies = self._bodies(root, order, position)
+        model = builder.build_model()
+        return replace(model, rigid_bodies=tuple(bodies))
+
+    def _positions(self, lock: dict[str, float], names: dict[str, str]):
+        """Each movable joint's position (angle or distance) and rate as expressions in q."""
+        values: dict[str, tuple[sp.Expr, sp.Expr]] = {}
+
+        def value(joint, path=()):
+            if joint.name in values:
+                return values[joint.name]
+            if joint.name in names:
+                symbol = sp.Symbol(names[joint.name])
+                values[joint.name] = (symbol, sp.Symbol(names[joint.name] + "_dot"))
+            elif joint.name in lock:
+                values[joint.name] = (_number(lock[joint.name]), sp.S.Zero)
+            else:  # a mimic joint: multiplier * master + offset
+                mimic = joint.mimic
+                master = self.by_name.get(mimic.joint)
+                field = f"joint '{joint.name}'.mimic"
+                if master is None:
+                    raise self.error(f"mimics no joint '{mimic.joint}'"
+                                     f"{did_you_mean(str(mimic.joint), list(self.by_name))}",
+                                     field)
+                if master.type not in MOVABLE or master.name in path:
+                    raise self.error(f"mimics '{mimic.joint}', which is "
+                                     + ("a cycle of mimics" if master.name in path
+                                        else f"a {master.type} joint"), field)
+                angle, rate = value(master, (*path, joint.name))
+                k = _number(mimic.multiplier if mimic.multiplier is not None else 1.0)
+                offset = _number(mimic.offset or 0.0)
+                values[joint.name] = (k * angle + offset, k * rate)
+            return values[joint.name]
+
+        return value
+
+    def _bodies(self, root: str, order, position) -> list[RigidBody]:
+        frames: dict[str, Frame] = {root: GROUND}
+        parents: dict[str, str | None] = {root: None}
+        for joint in order:
+            frame = frames[joint.parent]
+            if joint.origin is not None:
+                origin = np.asarray(joint.origin, dtype=float)
+                frame = translate(frame, _vector(origin[:3, 3]))
+                frame = _turned(frame, _matrix(origin[:3, :3]))
+            if joint.type in MOVABLE:
+                axis = np.asarray(joint.axis if joint.axis is not None else (1, 0, 0), float)
+                norm = float(np.linalg.norm(axis))
+                if not math.isfinite(norm) or norm == 0:
+                    raise self.error("the axis has zero length", f"joint '{joint.name}'.axis")
+                axis = _vector(axis / norm)
+                angle, rate = position(joint)
+                if joint.type == "prismatic":
+                    frame = translate(frame, tuple(angle * a for a in axis))
+                else:
+                    frame = rotate(frame, axis, angle, rate)
+            frames[joint.child] = frame
+            parents[joint.child] = joint.parent
+        bodies = []
+        for name, frame in frames.items():
+            link = self.links[name]
+            inertial = link.inertial
+            if inertial is None or not inertial.mass:
+                continue
+            field = f"link '{name}'.inertial"
+            mass = float(inertial.mass)
+            tensor = np.asarray(inertial.inertia if inertial.inertia is not None
+                                else np.zeros((3, 3)), dtype=float)
+            if not math.isfinite(mass) or mass < 0:
+                raise self.error(f"the mass {mass} is negative or not finite", field)
+            if not np.all(np.isfinite(tensor)):
+                raise self.error("the inertia tensor has an entry that is not finite", field)
+            where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
+                               dtype=float)
+            turn = where[:3, :3]
+            tensor = turn @ tensor @ turn.T  # about the centre of mass, in link axes
+            if np.linalg.eigvalsh(0.5 * (tensor + tensor.T))[0] < -1e-12 * max(
+                    1.0, float(np.abs(tensor).max())):
+                raise self.error("the inertia tensor is not positive semidefinite", field)
+            center = apply(frame.rotation, _vector(where[:3, 3]))
+            position_ = tuple(o + c for o, c in zip(frame.origin, center, strict=True))
+            moving = any(e.free_symbols for e in (*position_, *frame.angular_velocity))
+            if not moving:
+                continue  # fixed to the ground: no kinetic energy, a constant potential
+            bodies.append(RigidBody(name, _number(mass), _matrix(0.5 * (tensor + tensor.T)),
+                                    position_, frame.rotation, frame.origin,
+                                    frame.angular_velocity, parents[name]))
+        return bodies
+
+
+def _turned(frame: Frame, rotation) -> Frame:
+    """The frame turned by a constant rotation (given in its own axes)."""
+    return Frame(frame.origin, compose(frame.rotation, rotation),
+                 apply_transpose(rotation, frame.angular_velocity), frame.singularities)
+
+
+__all__ = ["identifier", "parse_urdf", "read_urdf"]

@@ -1,0 +1,93 @@
+"""Rigid-body dynamics in a controller's words: M(q), C(q, q_dot) q_dot + g(q), inverse and
+forward dynamics, energies, batched over leading axes.
+
+With the equations M q_ddot = f(q, q_dot) (f holds every force of the model: gravity, springs,
+dampers, its loads), a generalized force tau applied on top gives M q_ddot = f + tau, so
+
+    bias b(q, q_dot) = C q_dot + g = -f,   g(q) = -f(q, 0),   tau = M q_ddot + b,
+    q_ddot = M^-1 (tau - b).
+
+For a URDF arm the actuator parameters tau_<joint> are 0, so f holds gravity and the velocity
+terms only. Units SI (rad or m per coordinate; N m or N for tau; J for energies).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ModelError
+from .functions import NumericSystem
+
+
+class Dynamics:
+    """Batched dynamics functions over one NumericSystem (compiled C where available)."""
+
+    def __init__(self, functions: NumericSystem):
+        if functions.m:
+            raise ModelError("dynamics in joint space needs a model without constraints "
+                             f"(this one has {functions.m}: {', '.join(functions.constraint_names)})")
+        self.functions = functions
+
+    @property
+    def coordinates(self) -> tuple[str, ...]:
+        return self.functions.coordinates
+
+    @property
+    def n(self) -> int:
+        return self.functions.n
+
+    def _vector(self, value, field: str) -> np.ndarray:
+        array = np.asarray(value, dtype=float)
+        if array.ndim == 0 or array.shape[-1] != self.n:
+            shape = "()" if array.ndim == 0 else str(array.shape)
+            raise ModelError(f"expected {self.n} values ({', '.join(self.coordinates)}) along "
+                             f"the last axis, got shape {shape}", field=field)
+        return array
+
+    def _state(self, q, v=None):
+        q = self._vector(q, "q")
+        v = np.zeros_like(q) if v is None else self._vector(v, "v")
+        batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
+        return np.broadcast_to(q, batch + (self.n,)), np.broadcast_to(v, batch + (self.n,))
+
+    def mass_matrix(self, q) -> np.ndarray:
+        """M(q), shape (..., n, n) (kg, kg m or kg m^2 per entry)."""
+        q, v = self._state(q)
+        return self.functions.mass_matrix(q, v)
+
+    def bias_forces(self, q, v) -> np.ndarray:
+        """C(q, q_dot) q_dot + g(q) = -f(q, q_dot), shape (..., n)."""
+        return -self.functions.forcing(*self._state(q, v))
+
+    def gravity(self, q) -> np.ndarray:
+        """g(q) = -f(q, 0): the generalized forces that hold the arm at rest, shape (..., n)."""
+        return -self.functions.forcing(*self._state(q))
+
+    def inverse_dynamics(self, q, v, a) -> np.ndarray:
+        """tau = M(q) a + C(q, q_dot) q_dot + g(q), shape (..., n)."""
+        q, v = self._state(q, v)
+        a = self._vector(a, "a")
+        mass, forcing = self.functions._parts(q, v, 0.0)[:2]
+        return np.einsum("...ij,...j->...i", mass, a) - forcing
+
+    def forward_dynamics(self, q, v, tau) -> np.ndarray:
+        """q_ddot = M(q)^-1 (tau - C(q, q_dot) q_dot - g(q)), shape (..., n)."""
+        q, v = self._state(q, v)
+        tau = self._vector(tau, "tau")
+        mass, forcing = self.functions._parts(q, v, 0.0)[:2]
+        rhs = np.broadcast_to(forcing + tau, np.broadcast_shapes(forcing.shape, tau.shape))
+        batch = np.broadcast_shapes(mass.shape[:-2], rhs.shape[:-1])
+        mass = np.broadcast_to(mass, batch + (self.n, self.n))
+        return np.linalg.solve(mass, np.broadcast_to(rhs, batch + (self.n,))[..., None])[..., 0]
+
+    def potential_energy(self, q) -> np.ndarray:
+        """V(q) in J, shape (...)."""
+        return self.functions.energy(*self._state(q))
+
+    def kinetic_energy(self, q, v) -> np.ndarray:
+        """T(q, q_dot) = (T + V)(q, q_dot) - V(q) in J, shape (...)."""
+        q, v = self._state(q, v)
+        return self.functions.energy(q, v) - self.functions.energy(q, np.zeros_like(v))
+
+
+__all__ = ["Dynamics"]

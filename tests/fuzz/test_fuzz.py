@@ -33,6 +33,14 @@ def fuzz(examples: int) -> settings:
                     print_blob=True, suppress_health_check=list(HealthCheck))
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _set_up_once():
+    """pint's registry is built once (seconds on a busy machine), not in an input's time."""
+    from lagrangian.model.units import registry
+
+    registry()
+
+
 def check(outcome, text):
     assert outcome.ok, f"{outcome.status} on {text!r}: {outcome.kind} {outcome.message}"
 

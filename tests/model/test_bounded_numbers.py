@@ -254,3 +254,18 @@ def test_nesting_is_limited_to_what_sympy_can_still_print():
     assert refusal("sin(" * 100 + "theta" + ")" * 100) == "the expression is nested too deeply"
     assert refusal("-" * 5000 + "theta") == "the expression is nested too deeply"
     assert refusal("2^" * 5000 + "2") == "the expression is nested too deeply"
+
+
+def test_a_model_of_500_coordinates_reads():
+    # a chain of 500 masses and springs: T and V are flat sums of 500 terms (refused as
+    # "nested too deeply" beyond 200 terms before)
+    n = 500
+    text = ("[coordinates]\n" + "".join(f'x{i} = "m"\n' for i in range(n))
+            + "[parameters]\nm = 1.0\nk = 2.0\n[energy]\n"
+            + 'T = "' + " + ".join(f"1/2*m*x{i}_dot^2" for i in range(n)) + '"\n'
+            + 'V = "' + " + ".join(f"1/2*k*(x{i} - x{i + 1})^2" for i in range(n - 1)) + '"\n')
+    model = parse_model(text)
+    assert len(model.coordinates) == n
+    x = [c.symbol for c in model.coordinates]
+    k = sp.Symbol("k")
+    assert model.potential_energy == sum(k * (x[i] - x[i + 1]) ** 2 / 2 for i in range(n - 1))

@@ -92,7 +92,7 @@ def test_flat_sums_and_products_of_any_length_parse():
     # 500 coordinates and a T of 500 terms: the nesting limit counts depth, not length
     names = {f"x{i}_dot": sp.Symbol(f"x{i}_dot") for i in range(500)} | {"m": m}
     T = " + ".join(f"1/2*m*x{i}_dot^2" for i in range(500))
-    assert parse_expression(T, names) == sum(m * names[f"x{i}_dot"] ** 2 for i in range(500)) / 2
+    assert parse_expression(T, names) == sp.Add(*(m * names[f"x{i}_dot"] ** 2 / 2 for i in range(500)))
     product = "*".join(f"x{i}_dot" for i in range(500))
     assert parse_expression(product, names) == sp.Mul(*(names[f"x{i}_dot"] for i in range(500)))
     assert parse_expression("m - " * 3000 + "m", NAMES) == -2999 * m
@@ -268,4 +268,4 @@ def test_a_model_of_500_coordinates_reads():
     assert len(model.coordinates) == n
     x = [c.symbol for c in model.coordinates]
     k = sp.Symbol("k")
-    assert model.potential_energy == sum(k * (x[i] - x[i + 1]) ** 2 / 2 for i in range(n - 1))
+    assert model.potential_energy == sp.Add(*(k * (x[i] - x[i + 1]) ** 2 / 2 for i in range(n - 1)))

@@ -24,6 +24,7 @@ app = typer.Typer(
 # `examples` start in a fraction of a second (tests/cli/test_startup.py).
 from . import check as _check  # noqa: E402,F401
 from . import derive as _derive  # noqa: E402,F401
+from . import dynamics as _dynamics  # noqa: E402,F401
 from . import equilibria as _equilibria  # noqa: E402,F401
 from . import examples as _examples  # noqa: E402,F401
 from . import forces as _forces  # noqa: E402,F401

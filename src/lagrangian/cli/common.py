@@ -36,6 +36,7 @@ FLAG_OF_FIELD = {
     "table": "--out",
     "plot": "--plot",
     "animation": "--animate",
+    "lock": "--lock",
 }
 
 
@@ -50,11 +51,15 @@ def in_flags(error: LagrangianError) -> LagrangianError:
     return ModelError(error.message, field=f"{FLAG_OF_FIELD[head]} {rest}".strip())
 
 
-def load_system(model: str, settings: Iterable[str] = ()) -> System:
-    """The system of a model file or built-in example, with --set overrides applied."""
+def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = ()) -> System:
+    """The system of a model file or built-in example, with --set overrides applied (and a
+    URDF's joints frozen by --lock NAME=VALUE)."""
     from ..api.system import load
+    from ..model.units import parse_quantity
 
-    system = load(model)
+    locked = {name: parse_quantity(text, None, f"--lock {name}")
+              for name, text in assignments(lock, "--lock")}
+    system = load(model, lock=locked) if locked else load(model)
     values = parameter_values(system, settings)
     return system.with_parameters(**values) if values else system
 

@@ -1,0 +1,65 @@
+"""`lagrangian dynamics MODEL --q 0.1,0.2 --v 0,1 [--a ... | --tau ...]`: M, bias, gravity,
+inverse or forward dynamics and the energies at one state."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from ..errors import ModelError
+from ..model.units import parse_quantity
+from . import app
+from .common import load_system, print_json
+
+LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
+
+
+def _vector(text: str | None, n: int, flag: str, default: list[float]) -> list[float]:
+    """A comma-separated vector in the model's coordinate order (each entry may carry a unit)."""
+    if text is None:
+        return default
+    parts = [p.strip() for p in text.split(",")]
+    if len(parts) != n:
+        raise ModelError(f"expected {n} comma-separated values, got {len(parts)}", field=flag)
+    return [parse_quantity(p, None, flag) for p in parts]
+
+
+@app.command()
+def dynamics(
+    model: Annotated[str, typer.Argument(help="Model file (TOML or URDF) or built-in example name.")],
+    q: Annotated[str | None, typer.Option("--q", help="Coordinates, comma-separated in the model's order (default: the initial values).")] = None,  # noqa: E501
+    v: Annotated[str | None, typer.Option("--v", help="Velocities, comma-separated (default: the initial rates).")] = None,  # noqa: E501
+    a: Annotated[str | None, typer.Option("--a", help="Accelerations: print the inverse dynamics tau.")] = None,  # noqa: E501
+    tau: Annotated[str | None, typer.Option("--tau", help="Generalized forces on top of the model's loads: print the forward dynamics q_ddot.")] = None,  # noqa: E501
+    lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
+    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+) -> None:
+    """Mass matrix, bias forces C q_dot + g, gravity, inverse or forward dynamics, energies."""
+    from ..output.dynamics import dynamics_document, dynamics_text
+
+    if a is not None and tau is not None:
+        raise ModelError("--a (inverse dynamics) and --tau (forward dynamics) ask for two "
+                         "things; give one")
+    system = load_system(model, set_, lock)
+    coordinates = system.model.coordinates
+    n = len(coordinates)
+    qs = _vector(q, n, "--q", [c.initial or 0.0 for c in coordinates])
+    vs = _vector(v, n, "--v", [c.rate or 0.0 for c in coordinates])
+    f = system.dynamics()
+    values = {"q": qs, "v": vs, "mass_matrix": f.mass_matrix(qs),
+              "bias_forces": f.bias_forces(qs, vs), "gravity": f.gravity(qs)}
+    if a is not None:
+        values["a"] = _vector(a, n, "--a", [])
+        values["inverse_dynamics"] = f.inverse_dynamics(qs, vs, values["a"])
+    if tau is not None:
+        values["tau"] = _vector(tau, n, "--tau", [])
+        values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"])
+    values["kinetic_energy"] = f.kinetic_energy(qs, vs)
+    values["potential_energy"] = f.potential_energy(qs)
+    names = [c.name for c in coordinates]
+    if json_:
+        print_json(dynamics_document(names, values))
+    else:
+        typer.echo(dynamics_text(names, values), nl=False)

@@ -148,10 +148,16 @@ def main() -> None:
     t_sim = _timed(lambda: [pendulum.simulate(10.0, samples=201, initial={
         "theta1": float(a), "theta2": float(b)}) for a, b in starts])
     cpu_sim = CPU["last"]
+    lengths = rng.uniform(0.9, 1.1, loop_points)
+    t_sim_p = _timed(lambda: [pendulum.with_parameters(l1=float(a)).simulate(10.0, samples=201)
+                              for a in lengths])
+    cpu_sim_p = CPU["last"]
     rows.append((f"loop of System.with_parameters(...).modes(), {loop_points} points", t_modes,
                  loop_points, cpu_modes))
     rows.append((f"loop of System.simulate(10 s), {loop_points} members", t_sim, loop_points,
                  cpu_sim))
+    rows.append((f"loop of System.with_parameters(l1=...).simulate(10 s), {loop_points} members",
+                 t_sim_p, loop_points, cpu_sim_p))
 
     print()
     print("| what | wall (s) | wall per point (ms) | CPU (s) | CPU per point (ms) |")
@@ -170,7 +176,9 @@ def main() -> None:
           f"{(t_modes / loop_points) / per_point_sweep:.0f}x")
     per_member = rows[2][1] / rows[2][2]
     print(f"simulate per member: loop {1e3 * t_sim / loop_points:.2f} ms, sweep "
-          f"{1e3 * per_member:.3f} ms end to end: {(t_sim / loop_points) / per_member:.1f}x")
+          f"{1e3 * per_member:.3f} ms end to end: {(t_sim / loop_points) / per_member:.1f}x; "
+          f"with a parameter changed per member: loop {1e3 * t_sim_p / loop_points:.2f} ms, "
+          f"{(t_sim_p / loop_points) / per_member:.1f}x")
 
 
 if __name__ == "__main__":

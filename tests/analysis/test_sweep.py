@@ -245,3 +245,16 @@ def test_modes_about_a_named_equilibrium_show_the_pitchfork(client):
     assert all("not an equilibrium" in s for s in ds["status"].values)
     with pytest.raises(ModelError, match="about"):
         bead.sweep({"Omega": [2.0]}, compute="equilibria", about={"theta": 0.0})
+
+
+def test_a_parameter_without_value_must_be_given_or_varied(client):
+    builder = lagrangian.SystemBuilder("Spring")
+    x = builder.coordinate("x", unit="m")
+    m, k = builder.parameter("m", 2.0), builder.parameter("k", None)
+    builder.add_particle("bob", m, (x, 0))
+    builder.add_potential_energy(k * x**2 / 2)
+    system = builder.build()
+    with pytest.raises(ModelError, match="'k' has no value"):
+        system.sweep({"m": [1.0, 2.0]})
+    ds = system.sweep({"k": [2.0, 8.0]}, client=client)
+    np.testing.assert_allclose(ds["frequency"][:, 0], [1.0, 2.0], rtol=1e-12)

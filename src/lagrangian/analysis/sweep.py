@@ -203,6 +203,11 @@ def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence
         about_values = tuple((c.name, float(v)) for c, v in zip(model.coordinates, given.q,
                                                                  strict=True)
                              if c.name in given.given)
+    varied = {n for n, _ in axes} | {n for n, _ in draws}
+    for p in model.parameters:
+        if p.value is None and p.name not in varied:
+            raise ModelError(f"parameter '{p.name}' has no value; give one or vary it",
+                             field=f"parameters.{p.name}")
     if not axes and not draws:
         raise ModelError("nothing varies: give at least one name with its values", field="vary")
     if compute == "simulate" and simulation is None:
@@ -300,7 +305,9 @@ def _reason(exc: BaseException) -> str:
 
 def _parameter_vectors(parametric: ParametricStaticFunctions, values: Mapping[str, np.ndarray],
                        count: int) -> np.ndarray:
-    base = parametric.parameter_vector({})
+    # A parameter without a value is varied (make_study checked): its column is filled below.
+    base = np.array([np.nan if p.value is None else float(p.value)
+                     for p in parametric.model.parameters])
     vectors = np.tile(base, (count, 1))
     for i, name in enumerate(parametric.parameter_names):
         if name in values:

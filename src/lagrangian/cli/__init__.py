@@ -23,6 +23,7 @@ app = typer.Typer(
 # import sympy, scipy, matplotlib and pandas inside the commands, never at the top: `--help` and
 # `examples` start in a fraction of a second (tests/cli/test_startup.py).
 from . import check as _check  # noqa: E402,F401
+from . import codegen as _codegen  # noqa: E402,F401
 from . import derive as _derive  # noqa: E402,F401
 from . import dynamics as _dynamics  # noqa: E402,F401
 from . import equilibria as _equilibria  # noqa: E402,F401

@@ -1,0 +1,52 @@
+"""`lagrangian codegen MODEL --lang c --out DIR`: standalone C99 (.c and .h) of the dynamics."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ..errors import ModelError
+from . import app
+from .common import load_system
+
+LANGUAGES = ("c",)
+
+
+@app.command()
+def codegen(
+    model: Annotated[str, typer.Argument(help="Model file (TOML or URDF) or built-in example name.")],
+    out: Annotated[str, typer.Option("--out", help="Directory for <name>.c and <name>.h.")],
+    lang: Annotated[str, typer.Option("--lang", help="Language: c (C99, libm only).")] = "c",
+    name: Annotated[str | None, typer.Option("--name", help="Prefix of the functions and files (default: from the model's name).")] = None,  # noqa: E501
+    lock: Annotated[list[str], typer.Option("--lock", help="URDF: freeze a joint, NAME=VALUE.")] = [],  # noqa: B006
+    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+) -> None:
+    """Write M(q), bias C q_dot + g, gravity, inverse and forward dynamics and the energies as
+    standalone C (no Python, no allocation, libm only) for embedding in a controller."""
+    from ..numerics.codegen import CodegenError
+    from ..numerics.standalone import c_prefix, standalone_c
+
+    if lang.lower() not in LANGUAGES:
+        raise ModelError(f"unknown language {lang!r}: use c", field="--lang")
+    if name is not None and c_prefix(name) != name:
+        raise ModelError(f"{name!r} is not a C identifier (letters, digits, _; a letter first)",
+                         field="--name")
+    directory = Path(out)
+    if directory.exists() and not directory.is_dir():
+        raise ModelError("exists and is not a directory", field=f"--out {out}")
+    system = load_system(model, set_, lock)
+    if any(v is None for v in system.parameters.values()):
+        missing = [k for k, v in system.parameters.items() if v is None]
+        raise ModelError(f"parameters without a value: {', '.join(missing)} (give them with --set)",
+                         field="--set")
+    try:
+        code = standalone_c(system.equations_of_motion(), system.parameters, name)
+    except CodegenError as exc:
+        raise ModelError(f"cannot write C: {exc}", field="--lang") from None
+    directory.mkdir(parents=True, exist_ok=True)
+    for suffix, text in ((".h", code.header), (".c", code.source)):
+        path = directory / f"{code.prefix}{suffix}"
+        path.write_text(text, encoding="utf-8")
+        typer.echo(f"wrote {path}")

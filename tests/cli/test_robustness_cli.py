@@ -298,3 +298,15 @@ def test_derive_survives_towers_and_long_rational_exponents_of_coordinates(cli, 
     assert code == 0 and err == ""
     # no closed form is claimed (the implicit M q_ddot = f stands)
     assert json.loads(out)["accelerations"] == {"x": None, "y": None}
+
+
+def test_a_mass_near_overflow_is_judged_without_a_traceback(cli, tmp_path):
+    # campaign find: M + M^T overflowed and the eigenvalue solver did not converge
+    model = tmp_path / "heavy.toml"
+    model.write_text('[coordinates]\nq = { unit = "rad" }\n[parameters]\nm = -1e308\n'
+                     '[energy]\nT = "1/2*m*q_dot^2"\n')
+    code, out, err = cli("derive", str(model))
+    assert code == 0
+    assert one_line(err) == ("warning: the kinetic energy is not positive at the initial state "
+                             "(the mass matrix has the eigenvalue -1e+308): T < 0 for some "
+                             "velocities, so the motion is not physical")

@@ -293,8 +293,12 @@ def physical_warnings(model: Model, mass_matrix: sp.MatrixBase) -> list[str]:
             M = numeric_matrix(mass_matrix, state)
         except (TypeError, ValueError, ZeroDivisionError, OverflowError, KeyError):
             return warnings
-        if np.all(np.isfinite(M)):
-            eigenvalues = np.linalg.eigvalsh((M + M.T) / 2)
+        try:
+            with np.errstate(all="ignore"):
+                eigenvalues = np.linalg.eigvalsh(0.5 * M + 0.5 * M.T)  # M + M.T may overflow
+        except (np.linalg.LinAlgError, ValueError):  # entries near overflow (m = 1e308)
+            return warnings
+        if np.all(np.isfinite(eigenvalues)):
             if eigenvalues.min() < -1e-9 * max(1.0, float(np.abs(eigenvalues).max())):
                 warnings.append(
                     "the kinetic energy is not positive at the initial state (the mass matrix has "

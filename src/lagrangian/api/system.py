@@ -37,7 +37,7 @@ from ..model.examples import example_path
 from ..model.model import Model
 from ..model.notation import latex_symbol_names
 from ..model.reader import read_model
-from ..model.urdf import read_urdf
+from ..model.urdf import example_urdf, read_urdf
 from ..model.values import State, resolve_state
 from ..numerics.dynamics import Dynamics
 from ..numerics.events import StopCondition
@@ -331,6 +331,9 @@ def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None
     path = Path(path_or_example)
     if path.suffix.lower() == ".urdf":
         return System(read_urdf(path, lock))
+    urdf = None if path.exists() else example_urdf(str(path_or_example))
+    if urdf is not None:
+        return System(replace(read_urdf(urdf, lock), source=f"example:{path_or_example}"))
     if lock:
         from ..errors import ModelError
 

@@ -21,6 +21,7 @@ import math
 import re
 from collections.abc import Mapping
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import sympy as sp
@@ -43,6 +44,14 @@ _SNAP = 1e-14
 def read_urdf(path, lock: Mapping[str, float] | None = None) -> Model:
     """Load a URDF file as a model; ``lock`` freezes joints at values (rad or m) by name."""
     return parse_urdf(read_text_file(path), source=str(path), lock=lock)
+
+
+def example_urdf(name: str):
+    """The path of a built-in URDF example (``two_link_arm``), or None."""
+    from importlib import resources
+
+    entry = resources.files("lagrangian.model.examples") / f"{name}.urdf"
+    return Path(str(entry)) if re.fullmatch(r"\w+", name) and entry.is_file() else None
 
 
 def parse_urdf(text: str, *, source: str = "<urdf>",
@@ -79,6 +88,10 @@ def _number(x: float) -> sp.Expr:
         return sp.S.Zero
     if abs(x - round(x)) < _SNAP and abs(x) < 1e6:
         return sp.Integer(round(x))
+    text = repr(x)
+    if len(text) <= 8 and "e" not in text:
+        # the short decimal the file wrote (0.4 -> 2/5): exact, and printed equations stay short
+        return sp.Rational(text)
     return sp.Float(x)
 
 
@@ -307,4 +320,4 @@ def _turned(frame: Frame, rotation) -> Frame:
                  apply_transpose(rotation, frame.angular_velocity), frame.singularities)
 
 
-__all__ = ["identifier", "parse_urdf", "read_urdf"]
+__all__ = ["example_urdf", "identifier", "parse_urdf", "read_urdf"]

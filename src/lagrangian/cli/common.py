@@ -36,6 +36,7 @@ FLAG_OF_FIELD = {
     "table": "--out",
     "plot": "--plot",
     "animation": "--animate",
+    "view": "--view",
     "lock": "--lock",
 }
 

@@ -27,14 +27,16 @@ def simulate(
     out: Annotated[Path | None, typer.Option("--out", help="Write the table: .csv or .parquet.")] = None,
     plot: Annotated[Path | None, typer.Option("--plot", help="Plot coordinates and energy: .png (.svg, .pdf).")] = None,  # noqa: E501
     animate: Annotated[Path | None, typer.Option("--animate", help="Animate the mechanism: .gif or .html.")] = None,  # noqa: E501
+    view: Annotated[str | None, typer.Option("--view", help="Viewpoint of the animation of bodies in space: AZIMUTH,ELEVATION in degrees (default 45,35.26: isometric).")] = None,  # noqa: E501
     stop_when: Annotated[str | None, typer.Option("--stop-when", help="Stop when a condition turns true, e.g. \"theta < 0\".")] = None,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
+    from ..errors import ModelError
     from ..model.units import parse_quantity
     from ..model.values import resolve_state
     from ..numerics.simulate import SaveAt, StepControl, parse_stop_condition
-    from ..output.animation import check_animatable, check_animation_path
+    from ..output.animation import check_animatable, check_animation_path, check_view
     from ..output.files import check_output_path, partial_path
     from ..output.plots import check_plot_path
     from ..output.simulation import projection_warning, simulation_document, simulation_text
@@ -56,6 +58,10 @@ def simulate(
     if animate is not None:
         check_animation_path(animate)
         check_animatable(system.model)
+    if view is not None:
+        check_view(view)
+        if animate is None:
+            raise ModelError("a viewpoint is only used with --animate", field="view")
     inputs = (Path(model),) if Path(model).exists() else ()
     for path, field in ((out, "table"), (plot, "plot"), (animate, "animation")):
         if path is not None:  # writable, not a directory, not the model: before the run
@@ -82,7 +88,7 @@ def simulate(
         written["plot"] = str(target)
     if animate is not None:
         target = partial_path(animate) if partial else animate
-        simulation.animate(target)
+        simulation.animate(target, view=view)
         written["animate"] = str(target)
 
     if json_:

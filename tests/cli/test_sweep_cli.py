@@ -85,6 +85,7 @@ def test_ensemble(cli, scheduler, tmp_path):
     (["--compute", "simulate", "--vary", "x1=0,1", "--t-end", "1", "--method", "Euler"],
      "--method"),
     ([], "--vary"),
+    (["--vary", "k=1,2", "--scheduler", "notanaddress"], "--scheduler"),
 ])
 def test_bad_input_one_line_naming_the_flag(cli, args, flag, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)

@@ -575,7 +575,6 @@ def _simulation_chunk(study, functions: _SimulationFunctions, values, count):
     model = study.model
     options = study.simulation
     n = len(model.coordinates)
-    names = [*(c.name for c in model.coordinates), *(c.velocity.name for c in model.coordinates)]
     out = _empty(study, count, {"state": 2 * n, "time": options.samples})
     parameter_names = set(functions.names)
     for i in range(count):
@@ -600,7 +599,6 @@ def _simulation_chunk(study, functions: _SimulationFunctions, values, count):
         if options.trajectories:
             out["trajectory"][i, : len(t)] = y
         out["status"][i] = OK if status in ("finished", "stopped") else status
-    del names
     return out
 
 

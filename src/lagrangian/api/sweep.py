@@ -228,7 +228,7 @@ class _cluster:
         if self.scheduler:
             try:
                 client = Client(self.scheduler, timeout="10s")
-            except (OSError, TimeoutError) as exc:
+            except (OSError, TimeoutError, ValueError) as exc:  # unreachable, or no address
                 raise ModelError(f"cannot reach the Dask scheduler at {self.scheduler}: {exc}",
                                  field="scheduler") from None
             self.owned = [client]

@@ -270,3 +270,9 @@ def test_wrong_state_length_is_named(tmp_path):
     f = lagrangian.load(write(tmp_path, TWO_LINK)).dynamics()
     with pytest.raises(ModelError, match="expected 2 values"):
         f.mass_matrix([0.1, 0.2, 0.3])
+
+
+def test_two_link_arm_agrees_with_the_newton_euler_crosscheck():
+    # an independent, force-based derivation of the same URDF bodies
+    report = lagrangian.load("two_link_arm").crosscheck()
+    assert report.passed

@@ -54,7 +54,7 @@ def relative(ours, theirs) -> float:
     return float(np.max(np.abs(ours - theirs)) / max(np.max(np.abs(theirs)), 1e-300))
 
 
-def bench(name: str, backend: str, states: int) -> None:
+def bench(name: str, backend: str, states: int, timing: bool = True) -> None:
     import pinocchio as pin
 
     relpath, lock = ROBOTS[name]
@@ -98,6 +98,8 @@ def bench(name: str, backend: str, states: int) -> None:
           f"{sum(e.count_ops() for e in eom.mass_matrix) + sum(e.count_ops() for e in eom.forcing)}")
     print("  max relative error vs Pinocchio over", states, "states:",
           ", ".join(f"{k} {e:.1e}" for k, e in errors.items()))
+    if not timing:
+        return
     q0, v0, a0, t0 = q[0], v[0], a[0], tau[0]
     rows = [("mass matrix / crba", lambda: f.mass_matrix(q0), lambda: pin.crba(model, data, q0)),
             ("inverse dyn / rnea", lambda: f.inverse_dynamics(q0, v0, a0),
@@ -128,9 +130,10 @@ def main() -> None:
     parser.add_argument("robots", nargs="*", default=["ur5", "panda", "xarm7"])
     parser.add_argument("--backend", default="auto", choices=("auto", "c", "numpy"))
     parser.add_argument("--states", type=int, default=100)
+    parser.add_argument("--accuracy-only", action="store_true", help="skip the timings")
     args = parser.parse_args()
     for name in args.robots:
-        bench(name, args.backend, args.states)
+        bench(name, args.backend, args.states, not args.accuracy_only)
 
 
 if __name__ == "__main__":

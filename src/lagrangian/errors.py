@@ -7,9 +7,23 @@ from collections.abc import Iterable
 
 
 def did_you_mean(name: str, known: Iterable[str]) -> str:
-    """"; did you mean 'x'?" naming the known name closest to ``name``, or "" when none is close."""
-    close = difflib.get_close_matches(name, list(known), n=1)
+    """"; did you mean 'x'?" naming the known name closest to ``name``, or "" when none is close.
+    A name that differs only in case ('l' for 'L') is the closest of all."""
+    known = list(known)
+    same_but_case = [k for k in known if k.lower() == name.lower()]
+    close = same_but_case or difflib.get_close_matches(name, known, n=1)
     return f"; did you mean '{close[0]}'?" if close else ""
+
+
+def did_you_mean_or_list(name: str, known: Iterable[str], most: int = 24) -> str:
+    """The hint of did_you_mean, or when no name is close, the valid names themselves
+    ("; expected one of: a, b, c"), so an error never leaves a user guessing."""
+    known = list(known)
+    hint = did_you_mean(name, known)
+    if hint or not known:
+        return hint
+    shown = ", ".join(known[:most]) + (", ..." if len(known) > most else "")
+    return f"; expected one of: {shown}"
 
 
 # control characters as escapes (a newline as \n), so every message stays one line

@@ -133,7 +133,7 @@ def test_bad_requests_are_named():
     assert error(eom, ["F", "G"]) == (
         "solve_for: too many unknowns: 'F' and 'G' for 1 equilibrium conditions; solve for "
         "fewer")
-    assert error(eom, ["Q"]) == "solve_for: 'Q' is not a parameter of this model"
+    assert error(eom, ["Q"]) == "solve_for: 'Q' is not a parameter of this model; expected one of: F, G, L, tau"
     assert error(eom, ["F"]) == (
         "parameters.G: parameter 'G' has no value; give one (or solve for it)")
     assert error(eom, []) == "solve_for: give at least one parameter to solve for"
@@ -142,7 +142,7 @@ def test_bad_requests_are_named():
         "solve_for: 'G' does not enter the generalized forces linearly, so it is not a load "
         "magnitude that virtual work can solve for")
     assert error(eom, ["F"], at={"phi": 1.0}) == (
-        "configuration: 'phi' is not a coordinate or t of this model")
+        "configuration: 'phi' is not a coordinate or t of this model; expected one of: theta, t")
 
 
 def test_dependent_unknowns_and_too_few_unknowns_are_named():

@@ -212,7 +212,11 @@ def test_crosscheck_json_reports_the_reactions_of_a_model_with_springs():
     assert document["coordinates"] == {n: {"agree": True, "difference": None}
                                        for n in ("theta", "x", "y")}
     assert [r["joint"] for r in document["reactions"]] == ["mass", "rod"]
-    assert [set(r) for r in document["reactions"]] == [{"joint", "components"}] * 2
+    # the first published keys, and the labelled ones added beside them (the rod has a moment)
+    assert [set(r) for r in document["reactions"]] == [
+        {"joint", "components", "body", "force"},
+        {"joint", "components", "body", "force", "moment"}]
+    assert [r["body"] for r in document["reactions"]] == ["mass", "rod"]
     assert [len(r["components"]) for r in document["reactions"]] == [2, 3]
     assert all(isinstance(c, str) and "k1" in c for c in document["reactions"][1]["components"][:2])
 
@@ -258,3 +262,18 @@ def test_a_spring_end_on_no_body_leaves_the_reactions_out():
     assert report.agree, report
     assert report.reactions == ()
     assert any("'loose'" in note and "not reported" in note for note in report.notes)
+
+
+def test_crosscheck_json_labels_the_rolling_disk_contact_reaction_by_axis():
+    """x_ddot = g/3 down a 30 deg slope: friction m g/6 up the slope (force x), normal
+    m g cos 30 (force y), and its moment about the centre -m g R/6 (moment z)."""
+    s = system("rolling_disk")
+    m, g, R = (s.symbol(n) for n in "mgR")
+    (disk,) = crosscheck_document(s.crosscheck())["reactions"]
+    assert disk["body"] == disk["joint"] == "disk"
+    labelled = [disk["force"]["x"], disk["force"]["y"], disk["moment"]["z"]]
+    assert labelled == disk["components"]
+    names = {str(x): x for x in (m, g, R)}
+    expected = (-m * g / 6, sp.sqrt(3) * m * g / 2, -m * g * R / 6)
+    assert all(sp.simplify(sp.sympify(text, locals=names) - value) == 0
+               for text, value in zip(labelled, expected, strict=True))

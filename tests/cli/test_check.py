@@ -72,7 +72,11 @@ def test_crosscheck_json_contract(cli):
         "coordinates": {"theta": {"agree": True, "difference": None}},
         "reactions": [{"joint": "bob", "components": [
             "-m*(L*theta_dot**2 + g*cos(theta))*sin(theta)",
-            "m*(L*theta_dot**2 + g*cos(theta))*cos(theta)"]}],
+            "m*(L*theta_dot**2 + g*cos(theta))*cos(theta)"],
+            # added beside the first published keys: what "joint" holds, components by axis
+            "body": "bob", "force": {
+                "x": "-m*(L*theta_dot**2 + g*cos(theta))*sin(theta)",
+                "y": "m*(L*theta_dot**2 + g*cos(theta))*cos(theta)"}}],
     }
 
 

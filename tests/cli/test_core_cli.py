@@ -81,7 +81,7 @@ def test_forces_units_on_values(cli):
          "error: --at theta: '0.5m' is not in units compatible with 'rad'"),
         (("forces", "pendulum", "--at", "theta"), "error: --at: expected NAME=VALUE, got 'theta'"),
         (("forces", "pendulum", "--set", "q=1"),
-         "error: --set: 'q' is not a parameter of this model"),
+         "error: --set: 'q' is not a parameter of this model; expected one of: m, L, g"),
         (("forces", "pendulum", "--at", "theta=abc"),
          "error: --at theta: expected a number with an optional unit (like 30deg), got 'abc'"),
     ],

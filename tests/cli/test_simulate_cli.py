@@ -78,7 +78,7 @@ def test_parameters_and_units_on_the_command_line(capsys, tmp_path):
 
 @pytest.mark.parametrize(("args", "message"), [
     (["--initial", "phi=1"], "error: --initial: 'phi' is not a coordinate, velocity or t of this "
-                             "model"),
+                             "model; expected one of: theta, theta_dot, t"),
     (["--initial", "thetta=1"], "error: --initial: 'thetta' is not a coordinate, velocity or t of "
                                 "this model; did you mean 'theta'?"),
     (["--stop-when", "theta <"], "error: --stop-when: the right side of 'theta <' is empty"),
@@ -90,7 +90,7 @@ def test_parameters_and_units_on_the_command_line(capsys, tmp_path):
     (["--out", "run.xlsx"], "error: --out: cannot write run.xlsx: use a .csv or .parquet file name"),
     (["--animate", "run.mp4"], "error: --animate: cannot write run.mp4: use a .gif or .html file "
                                "name"),
-    (["--set", "q=1"], "error: --set: 'q' is not a parameter of this model"),
+    (["--set", "q=1"], "error: --set: 'q' is not a parameter of this model; expected one of: m, L, g"),
 ])
 def test_bad_input_exits_with_status_2(capsys, args, message):
     code, out, err = cli(capsys, "pendulum", "--t-end", "1", *args)

@@ -98,7 +98,7 @@ def test_statics_text_names_the_coordinates_found_from_the_constraints(cli, file
 
 @pytest.mark.parametrize("args, message", [
     (["--at", "theta=40deg", "--solve-for", "G"],
-     "error: --solve-for: 'G' is not a parameter of this model\n"),
+     "error: --solve-for: 'G' is not a parameter of this model; expected one of: F, L, tau\n"),
     (["--at", "theta=40deg"], "error: --solve-for: give at least one parameter to solve for\n"),
     (["--at", "theta=40deg", "--solve-for", "F,tau"],
      "error: --solve-for: too many unknowns: 'F' and 'tau' for 1 equilibrium conditions; solve "
@@ -107,7 +107,7 @@ def test_statics_text_names_the_coordinates_found_from_the_constraints(cli, file
      "error: --solve-for: 'F' does no virtual work in this configuration (it is not in Q), so "
      "the equilibrium cannot fix it\n"),
     (["--at", "phi=1", "--solve-for", "tau"],
-     "error: --at: 'phi' is not a coordinate or t of this model\n"),
+     "error: --at: 'phi' is not a coordinate or t of this model; expected one of: theta, t\n"),
 ])
 def test_bad_statics_requests(cli, files, args, message):
     link, _ = files

@@ -60,7 +60,7 @@ def test_definitions_are_usable_after_their_definition():
     ("change", "message"),
     [
         (("[energy]", "[energy]\nW = \"m\""),
-         "bad.toml: energy.W: unknown key 'W'"),
+         "bad.toml: energy.W: unknown key 'W'; expected one of: D, T, V"),
         (("name =", "nme = 1\nname ="), "bad.toml: nme: unknown key 'nme'; did you mean 'name'?"),
         (('V = "-m*g*L*cos(theta)"', 'V = "-m*g*Ln*cos(theta)"'),
          "bad.toml: energy.V: unknown name 'Ln'; did you mean 'L'?"),
@@ -100,7 +100,7 @@ def test_component_errors():
         "bad.toml: particles[0]: missing key 'mass'"
     extra = '[[particles]]\nname = "p"\nmass = "m"\nposition = ["x", 0]\ncolour = 1'
     assert error(base + extra) == \
-        "bad.toml: particles[0].colour: unknown key 'colour'"
+        "bad.toml: particles[0].colour: unknown key 'colour'; expected one of: mass, name, position"
     assert error(base + '[[particles]]\nname = "p"\nmass = "m"\nposition = ["x_dot", 0]') == \
         "bad.toml: particles[0].position[0]: may not depend on velocities (found x_dot)"
     assert error(base + '[[springs]]\nname = "s"\nstiffness = 1\nbetween = ["p", [0, 0]]') == \

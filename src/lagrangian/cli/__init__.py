@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from typing import Annotated
 
 import typer
 
@@ -18,6 +19,23 @@ app = typer.Typer(
     rich_markup_mode=None,
     context_settings={"max_content_width": 100},
 )
+
+
+
+def _version(show: bool) -> None:
+    if show:
+        import lagrangian
+
+        typer.echo(f"lagrangian {lagrangian.__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(version: Annotated[bool, typer.Option(
+        "--version", help="Print the version and exit.", callback=_version,
+        is_eager=True)] = False) -> None:
+    """Derive, check, analyse and simulate equations of motion by Lagrange's method."""
+
 
 # Each command lives in its own module and registers itself on `app` when imported. The modules
 # import sympy, scipy, matplotlib and pandas inside the commands, never at the top: `--help` and

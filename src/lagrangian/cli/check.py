@@ -13,10 +13,10 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import load_system, print_json
+from .common import SET_HELP, load_system, print_json
 
 _MODEL = Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")]
-_SET = Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")]
+_SET = Annotated[list[str], typer.Option("--set", help=SET_HELP)]
 _JSON = Annotated[bool, typer.Option("--json", help="Print JSON.")]
 
 

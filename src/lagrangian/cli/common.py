@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import sys
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
@@ -40,6 +41,8 @@ FLAG_OF_FIELD = {
     "lock": "--lock",
 }
 
+SET_HELP = "Override a parameter: NAME=VALUE; repeat, or join with commas (m=2,L=0.5)."
+
 
 def in_flags(error: LagrangianError) -> LagrangianError:
     """The library's error with its Python field (``parameters.m``) named by the flag that gave
@@ -68,7 +71,7 @@ def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = 
 def parameter_values(system: System, settings: Iterable[str]) -> dict[str, float | str]:
     """Read --set NAME=VALUE[unit] options in SI units (names are judged by the library)."""
     units = {p.name: p.unit for p in system.model.parameters}
-    return quantities(assignments(settings, "--set"), units, "--set")
+    return quantities(assignments(comma_separated(settings), "--set"), units, "--set")
 
 
 def state_assignments(system: System, settings: Iterable[str], option: str
@@ -77,7 +80,8 @@ def state_assignments(system: System, settings: Iterable[str], option: str
     units (names are judged by the library)."""
     from ..model.values import state_units
 
-    return quantities(assignments(settings, option), state_units(system.model), option)
+    return quantities(assignments(comma_separated(settings), option), state_units(system.model),
+                      option)
 
 
 def quantities(pairs: Iterable[tuple[str, str]], units: Mapping[str, str | None], option: str
@@ -88,6 +92,15 @@ def quantities(pairs: Iterable[tuple[str, str]], units: Mapping[str, str | None]
 
     return {name: parse_quantity(text, units[name], f"{option} {name}") if name in units else text
             for name, text in pairs}
+
+
+def comma_separated(settings: Iterable[str]) -> list[str]:
+    """`--at x=0.1,x_dot=2` as `--at x=0.1 --at x_dot=2`: split at each comma that a NAME=
+    follows (a comma inside a value, as in 1,5, stays where it is and is refused as a number)."""
+    return [part for setting in settings for part in _NEXT_ASSIGNMENT.split(setting)]
+
+
+_NEXT_ASSIGNMENT = re.compile(r",(?=\s*[A-Za-z_][A-Za-z0-9_]*\s*=)")
 
 
 def assignments(settings: Iterable[str], option: str) -> list[tuple[str, str]]:

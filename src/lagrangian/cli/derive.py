@@ -7,8 +7,9 @@ from typing import Annotated
 
 import typer
 
+from ..errors import ModelError
 from . import app
-from .common import load_system, print_json, warn_if_unphysical
+from .common import SET_HELP, load_system, print_json, warn_if_unphysical
 
 
 class Format(StrEnum):
@@ -21,14 +22,17 @@ class Format(StrEnum):
 def derive(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
     format: Annotated[Format, typer.Option("--format", "-f", help="Output format.")] = Format.text,
-    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    json_: Annotated[bool, typer.Option("--json", help="Print JSON (as --format json, the flag of every other command).")] = False,  # noqa: E501
+    set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
 ) -> None:
     """Derive the equations of motion by Lagrange's method."""
     from ..output.derivation import derivation_document, derivation_latex, derivation_text
 
     eom = load_system(model, set_).equations_of_motion()
     warn_if_unphysical(eom)
-    if format is Format.json:
+    if json_ and format is Format.latex:
+        raise ModelError("--json and --format latex ask for two formats; give one", field="--format")
+    if json_ or format is Format.json:
         print_json(derivation_document(eom))
     elif format is Format.latex:
         typer.echo(derivation_latex(eom), nl=False)

@@ -7,13 +7,13 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import load_system, print_json
+from .common import SET_HELP, load_system, print_json
 
 
 @app.command()
 def equilibria(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
-    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Find the equilibria (forces balance at rest, with the constraints) and their stability."""

@@ -7,14 +7,14 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import load_system, print_json, state_assignments
+from .common import SET_HELP, load_system, print_json, state_assignments
 
 
 @app.command()
 def forces(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
-    at: Annotated[list[str], typer.Option("--at", help="Configuration: NAME=VALUE (30deg, 0.5m).")] = [],  # noqa: B006
-    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    at: Annotated[list[str], typer.Option("--at", help="Configuration: NAME=VALUE (30deg, 0.5m); repeat, or join with commas.")] = [],  # noqa: B006,E501
+    set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Evaluate each generalized force, and each load's contribution, at a configuration."""

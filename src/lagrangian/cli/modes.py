@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import load_system, print_json, state_assignments
+from .common import SET_HELP, load_system, print_json, state_assignments
 
 ABOUT_HELP = "Equilibrium: COORDINATE=VALUE (pi, 180deg, 0.5m); the others are solved for."
 STEADY_HELP = ("Steady motion: a cyclic coordinate's constant rate, NAME_dot=VALUE (psi_dot=10, "
@@ -20,7 +20,7 @@ def modes(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
     about: Annotated[list[str], typer.Option("--about", help=ABOUT_HELP)] = [],  # noqa: B006
     steady: Annotated[list[str], typer.Option("--steady", help=STEADY_HELP)] = [],  # noqa: B006
-    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option("--plot", help="Draw the mode shapes to a PNG file.")] = None,
 ) -> None:

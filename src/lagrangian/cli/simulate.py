@@ -11,15 +11,15 @@ import typer
 
 from ..numerics.options import METHODS  # light: the names only, no scipy
 from . import app
-from .common import load_system, print_json, state_assignments, warn_if_unphysical
+from .common import SET_HELP, load_system, print_json, state_assignments, warn_if_unphysical
 
 
 @app.command()
 def simulate(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
     t_end: Annotated[str, typer.Option("--t-end", help="End time (s, or with a unit: 500ms).")],
-    initial: Annotated[list[str], typer.Option("--initial", help="Initial value: NAME=VALUE (theta=30deg, theta_dot=0, t=0); default: the model's initial/rate.")] = [],  # noqa: B006,E501
-    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    initial: Annotated[list[str], typer.Option("--initial", help="Initial value: NAME=VALUE (theta=30deg, theta_dot=0, t=0); default: the model's initial/rate; repeat, or separate by commas.")] = [],  # noqa: B006,E501
+    set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     method: Annotated[str, typer.Option("--method", help=f"Integrator: {', '.join(METHODS)}.")] = "DOP853",
     rtol: Annotated[float, typer.Option("--rtol", help="Relative tolerance.")] = 1e-9,
     atol: Annotated[float, typer.Option("--atol", help="Absolute tolerance.")] = 1e-9,

@@ -7,7 +7,7 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import load_system, print_json, state_assignments
+from .common import SET_HELP, load_system, print_json, state_assignments
 
 AT_HELP = "Configuration: NAME=VALUE (40deg, 0.5m); coordinates not given follow the constraints."
 SOLVE_HELP = "Parameter to find (a load magnitude); repeat or separate by commas."
@@ -18,7 +18,7 @@ def statics(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
     at: Annotated[list[str], typer.Option("--at", help=AT_HELP)] = [],  # noqa: B006
     solve_for: Annotated[list[str], typer.Option("--solve-for", help=SOLVE_HELP)] = [],  # noqa: B006
-    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Find the load magnitudes that hold the mechanism at rest in a configuration (delta W = 0)."""

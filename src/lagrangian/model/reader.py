@@ -7,7 +7,7 @@ import tomllib
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
-from ..errors import ModelError, did_you_mean
+from ..errors import ModelError, did_you_mean, did_you_mean_or_list
 from .builder import ModelBuilder
 from .model import Model
 from .units import check_unit, to_si
@@ -284,7 +284,7 @@ def check_known_keys(
     """Unknown keys are errors (never silently ignored), with the nearest valid one suggested."""
     for key in table:
         if key not in allowed:
-            hint = did_you_mean(key, sorted(allowed))
+            hint = did_you_mean_or_list(key, sorted(allowed))
             where = f"{field}.{key}" if field else key
             raise ModelError(f"unknown {what} '{key}'{hint}", field=where, source=source)
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from ..errors import ModelError, did_you_mean
+from ..errors import ModelError, did_you_mean_or_list
 from .model import Model, velocity_name
 
 
@@ -161,9 +161,10 @@ def resolve_parameters(
 
 
 def unknown_name(name: str, known: Iterable[str], what: str, field: str | None) -> ModelError:
-    """"'x' is not a <what> of this model; did you mean 'y'?" (the hint when one is close)."""
-    return ModelError(f"'{name}' is not a {what} of this model{did_you_mean(name, known)}",
-                      field=field)
+    """"'x' is not a <what> of this model; did you mean 'y'?" (the hint when one is close, else
+    the valid names)."""
+    return ModelError(f"'{name}' is not a {what} of this model"
+                      f"{did_you_mean_or_list(name, known)}", field=field)
 
 
 def state_units(model: Model) -> dict[str, str | None]:

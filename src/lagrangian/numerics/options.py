@@ -25,6 +25,10 @@ class StepControl:
     max_step: float = math.inf
 
     def __post_init__(self):
+        # any case is accepted (rk45, dop853), and kept in scipy's spelling
+        canonical = {name.lower(): name for name in METHODS}
+        if isinstance(self.method, str) and self.method.lower() in canonical:
+            object.__setattr__(self, "method", canonical[self.method.lower()])
         if self.method not in METHODS:
             raise ModelError(f"unknown method '{self.method}'; choose one of {', '.join(METHODS)}",
                              field="method")

@@ -44,9 +44,22 @@ def crosscheck_document(report: CrosscheckReport) -> dict[str, Any]:
         "agree": report.agree,
         "coordinates": {c.coordinate: {"agree": c.agree, "difference": c.difference}
                         for c in report.coordinates},
-        "reactions": [{"joint": r.joint, "components": [fmt(v) for v in r.components]}
+        # "joint" and "components" as first published; "body" names what the key holds (the
+        # body the resultant acts on), "force" and "moment" label each component by its axis
+        "reactions": [{"joint": r.joint, "components": [fmt(v) for v in r.components],
+                       "body": r.joint, **_labelled(r)}
                       for r in report.reactions],
     }
+
+
+def _labelled(reaction) -> dict[str, dict[str, str]]:
+    """{"force": {"x": R_x, "y": R_y[, "z": R_z]}[, "moment": {"z": M_z}]} (N; N m about the
+    centre of mass), from the report's labels R_x ... M_z."""
+    groups: dict[str, dict[str, str]] = {}
+    for label, value in zip(reaction.labels, reaction.components, strict=True):
+        kind, _, axis = label.partition("_")
+        groups.setdefault({"R": "force", "M": "moment"}.get(kind, kind), {})[axis] = fmt(value)
+    return groups
 
 
 def crosscheck_text(report: CrosscheckReport) -> str:

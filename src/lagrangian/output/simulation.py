@@ -74,11 +74,17 @@ def simulation_text(result: SimulationResult, written: dict[str, str]) -> str:
 
 
 def projection_warning(result: SimulationResult) -> str | None:
-    """The warning when the initial state had to be moved onto the constraints, else None."""
-    if not result.projected_initial_state:
+    """The warning when the initial state had to be moved onto the constraints, else None.
+
+    A move within the integrator's own error per step (atol + rtol |value|, tenfold) is the
+    rounding of a state given to a dozen digits, not a violation: no warning for it."""
+    control = result.step_control
+    moved = {name: (given, used) for name, (given, used) in result.projected_initial_state.items()
+             if abs(used - given) > 10 * (control.atol + control.rtol * abs(given))}
+    if not moved:
         return None
     changes = ", ".join(f"{name} {given:.12g} -> {used:.12g}"
-                        for name, (given, used) in result.projected_initial_state.items())
+                        for name, (given, used) in moved.items())
     return "warning: the initial state violates the constraints; projected onto them: " + changes
 
 

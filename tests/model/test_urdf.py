@@ -230,6 +230,10 @@ def test_mimic_and_lock(tmp_path):
     q = 0.4
     height = 1.0 * 0.3 * np.sin(q) + 0.5 * (0.6 * np.sin(q) + 0.2 * np.sin(q + 2 * q + 0.1))
     assert f.potential_energy([q]) == pytest.approx(9.81 * height, rel=1e-12)
+    # locking the mimic joint (the Panda's second finger) freezes it at its own value
+    frozen = lagrangian.load(write(tmp_path, text), lock={"j2": 0.25}).dynamics()
+    height = 1.0 * 0.3 * np.sin(q) + 0.5 * (0.6 * np.sin(q) + 0.2 * np.sin(q + 0.25))
+    assert frozen.potential_energy([q]) == pytest.approx(9.81 * height, rel=1e-12)
     locked = lagrangian.load(write(tmp_path, TWO_LINK), lock={"elbow": np.pi / 2})
     assert [c.name for c in locked.model.coordinates] == ["shoulder"]
     m = locked.dynamics().mass_matrix([0.2])

@@ -180,9 +180,7 @@ class _Tree:
                 raise ModelError(f"joint '{name}' is {self.by_name[name].type}: only revolute, "
                                  "continuous and prismatic joints can be locked",
                                  field=f"lock.{name}")
-            if self.by_name[name].mimic is not None:
-                raise ModelError(f"joint '{name}' mimics '{self.by_name[name].mimic.joint}': "
-                                 "lock that one instead", field=f"lock.{name}")
+            # a locked mimic joint (the Panda's second finger) is frozen at its own value
             try:
                 lock[name] = float(value)
             except (TypeError, ValueError):

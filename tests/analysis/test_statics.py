@@ -133,7 +133,8 @@ def test_bad_requests_are_named():
     assert error(eom, ["F", "G"]) == (
         "solve_for: too many unknowns: 'F' and 'G' for 1 equilibrium conditions; solve for "
         "fewer")
-    assert error(eom, ["Q"]) == "solve_for: 'Q' is not a parameter of this model; expected one of: F, G, L, tau"
+    assert error(eom, ["Q"]) == ("solve_for: 'Q' is not a parameter of this model; expected one of: "
+                                 "F, G, L, tau")
     assert error(eom, ["F"]) == (
         "parameters.G: parameter 'G' has no value; give one (or solve for it)")
     assert error(eom, []) == "solve_for: give at least one parameter to solve for"

@@ -18,16 +18,42 @@ CONVENTION = "M q_ddot + Phi_q^T lambda = forcing"
 
 # -- text ---------------------------------------------------------------------------------------
 
+# The letters the text labels its lines with, and the words used instead when the model has a
+# parameter or coordinate of that name (a length L beside "L = T - V", a mass M beside "Mass
+# matrix M"), so that a reader never takes one for the other.
+_LETTER_LABELS = {
+    "T": ("T", "Kinetic energy"),
+    "V": ("V", "Potential energy"),
+    "D": ("D", "Dissipation function"),
+    "L": ("L = T - V", "Lagrangian T - V"),
+    "M": ("Mass matrix M", "Mass matrix"),
+    "f": ("Forcing f", "Forcing"),
+}
+
+
+def _labels(model) -> dict[str, str]:
+    names = {p.name for p in model.parameters} | {c.name for c in model.coordinates}
+    labels = {letter: words if letter in names else short
+              for letter, (short, words) in _LETTER_LABELS.items()}
+    if names & {"T", "V"}:  # "T - V" would name them too
+        labels["L"] = "Lagrangian (kinetic less potential energy)"
+    labels["convention"] = ("M q_ddot + Phi_q^T lambda = f" if not names & {"M", "f"} else
+                            "(mass matrix) q_ddot + Phi_q^T lambda = (forcing)")
+    return labels
+
+
 
 def derivation_text(eom: EquationsOfMotion) -> str:
     model = eom.model
     lines = [model.name, "=" * len(model.name)]
     coordinates = ", ".join(f"{c.name} [{c.unit or '1'}]" for c in model.coordinates)
     lines += [f"Coordinates: {coordinates}", ""]
-    lines += [f"T = {fmt(eom.kinetic_energy)}", f"V = {fmt(eom.potential_energy)}"]
+    label = _labels(model)
+    lines += [f"{label['T']} = {fmt(eom.kinetic_energy)}",
+              f"{label['V']} = {fmt(eom.potential_energy)}"]
     if eom.dissipation != 0:
-        lines.append(f"D = {fmt(eom.dissipation)}")
-    lines += [f"L = T - V = {fmt(eom.lagrangian)}", ""]
+        lines.append(f"{label['D']} = {fmt(eom.dissipation)}")
+    lines += [f"{label['L']} = {fmt(eom.lagrangian)}", ""]
 
     lines.append("Equations of motion, d/dt(dL/dq_dot) - dL/dq = Q"
                  + (" - Phi_q^T lambda" if model.constraints else "") + ":")
@@ -44,10 +70,10 @@ def derivation_text(eom: EquationsOfMotion) -> str:
                 lines.append(f"      from {part.load}: {fmt(part.expression)}")
     lines.append("")
 
-    lines.append("Mass matrix M:")
+    lines.append(f"{label['M']}:")
     for i in range(eom.mass_matrix.rows):
         lines.append("  [" + ", ".join(fmt(v) for v in eom.mass_matrix.row(i)) + "]")
-    lines.append("Forcing f:")
+    lines.append(f"{label['f']}:")
     for c, f in zip(model.coordinates, eom.forcing, strict=True):
         lines.append(f"  {c.name}: {fmt(f)}")
 
@@ -69,7 +95,7 @@ def derivation_text(eom: EquationsOfMotion) -> str:
             lines.append(f"  {c.acceleration} = {fmt(a)}")
     elif eom.accelerations_note:
         lines += ["", f"Accelerations: {eom.accelerations_note}"]
-    lines += ["", "Convention: M q_ddot + Phi_q^T lambda = f"]
+    lines += ["", f"Convention: {label['convention']}"]
     return "\n".join(lines) + "\n"
 
 

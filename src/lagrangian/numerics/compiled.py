@@ -1,7 +1,9 @@
-"""Compile generated C into a Python extension module, cached on disk by a hash of its source.
+"""Compile generated C into a Python extension module, cached on disk by a hash of the
+equations (load_keyed) or of its source (load).
 
 The cache lives in ``$LAGRANGIAN_CACHE``, else ``$XDG_CACHE_HOME/lagrangian``, else
-``~/.cache/lagrangian``; a repeat run (any process) loads the module without compiling.
+``~/.cache/lagrangian``; a repeat run (any process) loads the module without generating C and
+without a compiler: the key is computed from the equations before any code is generated.
 Extension modules (not ctypes) because a ctypes call costs microseconds, METH_FASTCALL ~0.1 us.
 """
 
@@ -16,6 +18,7 @@ import subprocess
 import sys
 import sysconfig
 import tempfile
+from collections.abc import Callable
 from functools import lru_cache
 from pathlib import Path
 from types import ModuleType
@@ -34,6 +37,10 @@ class BackendUnavailable(LagrangianError):
     """The compiled (C) backend cannot be used here: no compiler, no headers, or a failed build."""
 
 
+class CompilerMissing(BackendUnavailable):
+    """No C compiler to build with: none on PATH, or $CC names a program that is not there."""
+
+
 def cache_dir() -> Path:
     """Where compiled modules are kept (created on first use)."""
     if os.environ.get("LAGRANGIAN_CACHE"):
@@ -43,8 +50,13 @@ def cache_dir() -> Path:
 
 
 def find_compiler() -> list[str] | None:
-    """The C compiler command ($CC, Python's own CC, or cc/gcc/clang on PATH), or None."""
-    candidates = [os.environ.get("CC"), sysconfig.get_config_var("CC"), "cc", "gcc", "clang"]
+    """The C compiler command ($CC, Python's own CC, or cc/gcc/clang on PATH), or None.
+    A $CC that names no program is None too (never silently another compiler)."""
+    if os.environ.get("CC", "").strip():
+        words = shlex.split(os.environ["CC"])
+        found = shutil.which(words[0]) if words else None
+        return [found, *words[1:]] if found else None
+    candidates = [sysconfig.get_config_var("CC"), "cc", "gcc", "clang"]
     for candidate in candidates:
         if not candidate:
             continue
@@ -77,10 +89,20 @@ def _run_compiler(command: list[str]) -> subprocess.CompletedProcess:
     return subprocess.run(command, capture_output=True, text=True, timeout=600)
 
 
-def _compile(source: str, name: str, target: Path) -> None:
+def check_compiler() -> list[str]:
+    """The compiler command, or CompilerMissing saying why there is none."""
     compiler = find_compiler()
-    if compiler is None:
-        raise BackendUnavailable("no C compiler found (set CC, or install gcc or clang)")
+    if compiler is not None:
+        return compiler
+    cc = os.environ.get("CC", "").strip()
+    if cc:
+        raise CompilerMissing(f"CC={cc!r} names no program on PATH (unset CC, or point it at gcc "
+                              "or clang)")
+    raise CompilerMissing("no C compiler found (set CC, or install gcc or clang)")
+
+
+def _compile(source: str, name: str, target: Path) -> None:
+    compiler = check_compiler()
     includes = [f"-I{d}" for d in _include_dirs()]
     extra = ["-undefined", "dynamic_lookup"] if sys.platform == "darwin" else []
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -94,8 +116,10 @@ def _compile(source: str, name: str, target: Path) -> None:
         except (OSError, subprocess.SubprocessError) as exc:
             raise BackendUnavailable(f"the C compiler could not run: {exc}") from None
         if done.returncode != 0:
-            raise BackendUnavailable("compiling the generated C failed:\n"
-                                     + (done.stderr or done.stdout)[-2000:])
+            cc = os.environ.get("CC", "").strip()
+            who = f"the C compiler CC={cc!r}" if cc else f"the C compiler {compiler[0]}"
+            raise BackendUnavailable(f"compiling the generated C failed ({who}):\n"
+                                     + (done.stderr or done.stdout or "no output")[-2000:])
         shutil.copyfile(c_file, target.with_suffix(".c"))  # kept for inspection
         os.replace(built, target)  # atomic: a concurrent process sees all or nothing
 
@@ -129,6 +153,61 @@ def load(generated: GeneratedSource) -> ModuleType:
             spec.loader.exec_module(module)
         except ImportError:
             raise BackendUnavailable(f"cannot load the compiled module {path}: {exc}") from None
+    _LOADED[name] = module
+    return module
+
+
+@lru_cache(maxsize=1)
+def _generator_key() -> str:
+    """The code generator itself (codegen.py, template.c): a new generator is a new module."""
+    here = Path(__file__).parent
+    return hashlib.sha256(b"".join((here / f).read_bytes() for f in ("codegen.py", "template.c"))
+                          ).hexdigest()
+
+
+def keyed_module_name(key: str) -> str:
+    """lg_<hash of the equations' key, the generator, compiler flags, Python and numpy>."""
+    text = "\n".join((_platform_key(), _generator_key(), key))
+    return f"lg_{hashlib.sha256(text.encode()).hexdigest()[:24]}"
+
+
+def load_keyed(key: str, make_source: Callable[[], GeneratedSource]) -> ModuleType:
+    """The compiled module for the equations with this key: in memory, else from the on-disk
+    cache (no C generated, no compiler needed), else ``make_source()`` generated and built now."""
+    name = keyed_module_name(key)
+    if name in _LOADED:
+        return _LOADED[name]
+    suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
+    path = cache_dir() / f"{name}{suffix}"
+    if path.exists():
+        spec = importlib.util.spec_from_file_location(name, path)
+        if spec is not None and spec.loader is not None:
+            module = importlib.util.module_from_spec(spec)
+            try:
+                spec.loader.exec_module(module)
+            except ImportError:  # a stale or foreign file: built again below
+                path.unlink(missing_ok=True)
+            else:
+                _LOADED[name] = module
+                return module
+    if sys.platform == "win32":
+        raise BackendUnavailable("the C backend is not supported on Windows yet")
+    check_compiler()  # before generating C: without a compiler it would be wasted
+    _include_dirs()
+    generated = make_source()
+    try:
+        _compile(generated.source, name, path)
+    except OSError as exc:
+        raise BackendUnavailable(f"cannot write the compiled-module cache {path.parent}: "
+                                 f"{exc.strerror or exc} (set LAGRANGIAN_CACHE)") from None
+    spec = importlib.util.spec_from_file_location(name, path)
+    if spec is None or spec.loader is None:
+        raise BackendUnavailable(f"cannot load {path}")
+    module = importlib.util.module_from_spec(spec)
+    try:
+        spec.loader.exec_module(module)
+    except ImportError as exc:
+        raise BackendUnavailable(f"cannot load the compiled module {path}: {exc}") from None
     _LOADED[name] = module
     return module
 

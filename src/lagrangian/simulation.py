@@ -51,18 +51,18 @@ class Simulation(SimulationResult):
         return figure
 
     def animate(self, path: str | Path | None = None, *, fps: int = 25, max_frames: int = 250,
-                view: tuple[float, float] | str | None = None):
+                view: tuple[float, float] | str | None = None, progress=None):
         """The mechanism moving: a matplotlib animation, also written to ``path`` (.gif or
         .html with a player) when given. Bodies in space are seen from ``view`` = (azimuth,
         elevation) in degrees (default isometric). In Jupyter,
-        ``HTML(sim.animate().to_jshtml())``."""
+        ``HTML(sim.animate().to_jshtml())``. ``progress(frame, frames)`` follows a GIF's writing."""
         from .output.animation import check_animation_path, mechanism_animation, save_animation
 
         if path is not None:
             check_animation_path(path)
         animation = mechanism_animation(self, fps=fps, max_frames=max_frames, view=view)
         if path is not None:
-            save_animation(animation, path, fps=fps, protect=self._inputs())
+            save_animation(animation, path, fps=fps, protect=self._inputs(), progress=progress)
         return animation
 
     def summary(self) -> dict:

@@ -142,3 +142,14 @@ def test_a_model_without_particles_or_bodies_cannot_be_animated(tmp_path):
     with pytest.raises(ModelError, match="use a .gif or .html file name"):
         lagrangian.load("double_pendulum").simulate(0.1, samples=3).animate(tmp_path / "x.mp4")
     assert not (tmp_path / "run.gif").exists()
+
+
+def test_writing_a_gif_reports_each_frame_for_a_progress_bar(tmp_path):
+    """1 s at 10 frames a second: 11 frames, reported 0..10 of 11, in order."""
+    run = lagrangian.load("ladder_pendulum").simulate(1.0, samples=101)
+    seen = []
+    run.animate(tmp_path / "run.gif", fps=10, progress=lambda frame, frames: seen.append(
+        (frame, frames)))
+    with Image.open(tmp_path / "run.gif") as gif:
+        assert gif.n_frames == 11
+    assert seen == [(k, 11) for k in range(11)]

@@ -88,7 +88,8 @@ def simulate(
         written["plot"] = str(target)
     if animate is not None:
         target = partial_path(animate) if partial else animate
-        simulation.animate(target, view=view)
+        with _FrameProgress() as frames:
+            simulation.animate(target, view=view, progress=frames.update)
         written["animate"] = str(target)
 
     if json_:
@@ -134,6 +135,37 @@ class _Progress:
             self.bar.start()
             self.task = self.bar.add_task("simulate", total=self.t_end)
         self.bar.update(self.task, completed=t)
+
+    def __exit__(self, *exc):
+        if self.bar is not None:
+            self.bar.stop()
+        return False
+
+
+class _FrameProgress:
+    """A rich progress bar on a terminal (stderr) while the animation's frames are written."""
+
+    def __init__(self):
+        self.enabled = sys.stderr.isatty()
+        self.bar = None
+        self.task = None
+
+    def __enter__(self):
+        return self
+
+    def update(self, frame: int, frames: int) -> None:
+        if not self.enabled:
+            return
+        if self.bar is None:
+            from rich.console import Console
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+            self.bar = Progress(TextColumn("animating"), BarColumn(), MofNCompleteColumn(),
+                                TextColumn("frames"), console=Console(stderr=True),
+                                transient=True)
+            self.bar.start()
+            self.task = self.bar.add_task("animate", total=frames)
+        self.bar.update(self.task, completed=frame + 1)
 
     def __exit__(self, *exc):
         if self.bar is not None:

@@ -254,8 +254,9 @@ def _space_animation(result, geometry, times, q, v, view, fps):
 
 
 def save_animation(animation, path: str | Path, *, fps: int = 25,
-                   protect: tuple[Path, ...] = ()) -> Path:
-    """Save a built animation as .gif or .html, through a temporary file and a rename."""
+                   protect: tuple[Path, ...] = (), progress=None) -> Path:
+    """Save a built animation as .gif or .html, through a temporary file and a rename.
+    ``progress(frame, frames)`` is called as each GIF frame is written (for a progress bar)."""
     path = check_animation_path(path)
     if path.suffix.lower() == ".html":
         return atomic_write(path, animation.to_jshtml(fps=fps), protect=protect)
@@ -264,7 +265,7 @@ def save_animation(animation, path: str | Path, *, fps: int = 25,
     handle, temporary = tempfile.mkstemp(suffix=".gif")
     os.close(handle)
     try:
-        animation.save(temporary, writer=PillowWriter(fps=fps))
+        animation.save(temporary, writer=PillowWriter(fps=fps), progress_callback=progress)
         data = Path(temporary).read_bytes()
     finally:
         os.unlink(temporary)

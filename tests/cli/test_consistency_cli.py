@@ -78,7 +78,8 @@ def test_four_bar_starts_quietly_and_a_wrong_start_still_warns(cli):
     """The example's own start is consistent to a dozen digits (5e-10, below the solver's
     tolerance): no warning. A start moved off the linkage is projected back, with a warning."""
     quiet = cli("simulate", "four_bar", "--t-end", "0.05", "--samples", "11")
-    assert quiet.code == 0 and quiet.err == ""
+    assert quiet.code == 0 and "warning" not in quiet.err  # (a machine with no C compiler
+    # adds its one-line note there)
     moved = cli("simulate", "four_bar", "--t-end", "0.05", "--samples", "11", "--initial",
                 "theta2=0.8")
     assert moved.code == 0

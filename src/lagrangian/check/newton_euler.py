@@ -16,7 +16,12 @@ R = m a_G - F (and M_R = I alpha - M_G about its centre of mass), with q_ddot so
 A body in space obeys Euler's equations in body axes, I alpha + omega x I omega = M_G, with
 omega from omega~ = R^T R_dot by sympy's own d/dt of its rotation matrix (not the model's
 composed omega); its rotational part of E_i is (I alpha + omega x I omega - M_G) . d omega/d q_dot_i.
-Reactions are not reported for bodies in space yet.
+The reaction at a body in space's joint (its origin J: a pivot, a joint on its parent, or the
+body's own reference point) is what its parent or the ground exerts on it and on every body it
+carries: summed over that subtree, R_J = sum (m a_G - F) and, about J in world axes,
+M_J = sum [(r_G - r_J) x (m a_G - F) + R (I alpha + omega x I omega) - M_G]. For a free body
+on a rolling contact (no joint), that is the contact force (its moment about J from the contact
+point's arm).
 
 A spring or damper given ``between`` two points acts on the particles or bodies at its ends,
 equal and opposite (on a body also with its moment about G from the end's offset); one given by
@@ -53,7 +58,9 @@ class CoordinateAgreement:
 @dataclass(frozen=True)
 class Reaction:
     """The resultant reaction on one body (the 'joint' is named after the body it acts on):
-    force components (N) and, for a rigid body, the moment about its centre of mass (N m)."""
+    force components (N) and, for a rigid body, the moment about its centre of mass (N m).
+    For a body in space: the force and moment (about its joint, world axes x, y, z) at its
+    joint, on it and the bodies it carries."""
 
     joint: str
     labels: tuple[str, ...]
@@ -141,12 +148,13 @@ def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
         notes.append("reactions not reported: the forces of "
                      + ", ".join(f"'{u}'" for u in forces.unattributed)
                      + " cannot be placed on a free body from the model")
-    elif model.rigid_bodies:
-        notes.append("reactions not reported: bodies in space ("
-                     + ", ".join(f"'{b.name}'" for b in model.rigid_bodies)
-                     + ") are checked by Euler's equations, their joint reactions are not "
-                     "solved for yet")
     else:
+        if model.rigid_bodies:
+            notes.append("bodies in space ("
+                         + ", ".join(f"'{b.name}'" for b in model.rigid_bodies)
+                         + ") are checked by Euler's equations; the reaction at each one's joint "
+                         "is the force and moment (about the joint, world axes) that its parent "
+                         "or the ground exerts on it and the bodies it carries")
         reactions = _reactions(eom, bodies, newton_euler, notes)
     return CrosscheckReport(model.name, agreements, reactions, tuple(notes))
 
@@ -462,7 +470,9 @@ def _reactions(eom: EquationsOfMotion, bodies: list[_FreeBody], newton_euler: li
     model = eom.model
     n, m = len(model.q), eom.multipliers.shape[0]
     solution: dict[sp.Symbol, sp.Expr] = {}
-    if n + m <= SYMBOLIC_REACTIONS_MAX_UNKNOWNS:
+    # Bodies in space: solving for q_ddot and tidying with trig identities takes minutes (the
+    # rotation's trigonometry), so their reactions stay in terms of the accelerations.
+    if n + m <= SYMBOLIC_REACTIONS_MAX_UNKNOWNS and not model.rigid_bodies:
         residual = sp.Matrix(newton_euler)
         if m:
             residual += eom.constraint_jacobian.T * eom.multipliers
@@ -482,10 +492,12 @@ def _reactions(eom: EquationsOfMotion, bodies: list[_FreeBody], newton_euler: li
     if not solution:
         notes.append("reactions are given in terms of the accelerations"
                      + (" and multipliers" if m else "") + " (their solved form is too large)")
-    planar = all(fb.position[2] == 0 and fb.acceleration[2] == 0 and fb.force[2] == 0
-                 for fb in bodies)
+    planar = not model.rigid_bodies and all(
+        fb.position[2] == 0 and fb.acceleration[2] == 0 and fb.force[2] == 0 for fb in bodies)
     reactions = []
     for fb in bodies:
+        if fb.rotation is not None:
+            continue  # a body in space: at its joint, below
         force = [fb.mass * a - f for a, f in zip(fb.acceleration, fb.force, strict=True)]
         labels = ["R_x", "R_y", "R_z"]
         components = force[:2] if planar else force
@@ -495,7 +507,37 @@ def _reactions(eom: EquationsOfMotion, bodies: list[_FreeBody], newton_euler: li
             labels.append("M_z")
         values = tuple(_tidy(v.xreplace(solution)) for v in components)
         reactions.append(Reaction(fb.name, tuple(labels), values))
+    for body, force, moment in _joint_reactions(model, bodies):
+        values = tuple(v.xreplace(solution) for v in (*force, *moment))
+        reactions.append(Reaction(body, ("R_x", "R_y", "R_z", "M_x", "M_y", "M_z"), values))
     return tuple(reactions)
+
+
+def _joint_reactions(model: Model, bodies: list[_FreeBody]):
+    """(body, R_J, M_J) at each body in space's joint J (its origin): the sums over the subtree
+    it heads of m a_G - F (N) and, about J in world axes, (r_G - r_J) x (m a_G - F) +
+    R (I alpha + omega x I omega) - M_G (N m)."""
+    free = {fb.name: fb for fb in bodies}
+    children: dict[str | None, list[str]] = {}
+    for body in model.rigid_bodies:
+        children.setdefault(body.parent, []).append(body.name)
+
+    def subtree(name: str) -> list[str]:
+        return [name] + [d for child in children.get(name, []) for d in subtree(child)]
+
+    for body in model.rigid_bodies:
+        joint = sp.Matrix(body.origin)
+        force, moment = sp.zeros(3, 1), sp.zeros(3, 1)
+        for name in subtree(body.name):
+            fb = free[name]
+            inertial = sp.Matrix([fb.mass * a - f for a, f in zip(fb.acceleration, fb.force,
+                                                                  strict=True)])
+            I, w = fb.body_inertia, sp.Matrix(fb.omega)
+            spin = fb.rotation * (I * sp.Matrix(fb.alpha) + w.cross(I * w))
+            force += inertial
+            moment += (sp.Matrix(fb.position) - joint).cross(inertial) + spin \
+                - sp.Matrix(fb.moment3)
+        yield body.name, list(force), list(moment)
 
 
 def _tidy(expr: sp.Expr) -> sp.Expr:

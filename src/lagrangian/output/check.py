@@ -68,7 +68,12 @@ def crosscheck_text(report: CrosscheckReport) -> str:
         state = "agree" if c.agree else f"DIFFER by {c.difference}"
         lines.append(f"  {c.coordinate}: {state}")
     if report.reactions:
-        lines.append("reactions (resultant on each body; moment about its centre of mass):")
+        spatial = any("M_x" in r.labels for r in report.reactions)
+        lines.append("reactions (resultant on each body; moment about its centre of mass):"
+                     if not spatial else
+                     "reactions (resultant on each body, moment about its centre of mass; a body "
+                     "in space: at its joint, on it and the bodies it carries, moment about the "
+                     "joint, world axes):")
         for r in report.reactions:
             lines.append(f"  {r.joint}:")
             lines += [f"      {label} = {fmt(value)}"

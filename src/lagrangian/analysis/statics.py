@@ -18,6 +18,7 @@ import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
+from ..model.expressions import as_expression
 from ..model.model import Model
 from ..model.units import generalized_force_unit
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state, unknown_name
@@ -175,7 +176,7 @@ def _shares(eom, values, reactions, jacobian) -> tuple[tuple[str, str, float], .
 
     def add(source: str, gradient: Sequence[sp.Expr]) -> None:
         for name, value in zip(names, gradient, strict=True):
-            number = _real(sp.sympify(value).xreplace(values)) if value != 0 else 0.0
+            number = _real(as_expression(value).xreplace(values)) if value != 0 else 0.0
             if number != 0.0:
                 out.append((source, name, _clean(number)))
 
@@ -227,7 +228,7 @@ def _unit(model: Model, name: str) -> str:
 
 
 def _real(expr: sp.Expr) -> float:
-    value = complex(sp.sympify(expr).evalf())
+    value = complex(as_expression(expr).evalf())
     if abs(value.imag) > 1e-12 * max(1.0, abs(value.real)):
         raise ModelError(f"the value of {expr} is not real at this configuration",
                          field="configuration")

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from lagrangian.api.simulation import Simulation
 from lagrangian.cli import main
-from lagrangian.simulation import Simulation
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 WALL = re.compile(r"wall time [0-9.e+-]+ s")

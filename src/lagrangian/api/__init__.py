@@ -21,7 +21,7 @@ from ..model.reader import parse_model, read_model
 from ..model.values import ParameterValues, State
 from ..numerics.functions import NumericSystem
 from ..numerics.result import SimulationResult
-from ..simulation import Simulation
+from .simulation import Simulation
 from .system import System, SystemBuilder, load
 
 __all__ = [

@@ -44,7 +44,7 @@ from ..numerics.events import StopCondition
 from ..numerics.functions import NumericSystem, numeric
 from ..numerics.simulate import SaveAt, StepControl, parse_stop_condition, simulate
 from ..numerics.static import StaticFunctions
-from ..simulation import Simulation
+from .simulation import Simulation
 
 
 class System:

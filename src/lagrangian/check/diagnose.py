@@ -451,7 +451,7 @@ class _Checker:
 
     def _expected(self, i: int) -> str:
         eom = self.eom
-        lhs = (eom.mass_matrix * eom.coordinate_accelerations)[i]
+        lhs = (eom.mass_matrix * eom.acceleration_symbols)[i]
         if eom.multipliers.shape[0]:
             lhs += (eom.constraint_jacobian.T * eom.multipliers)[i]
         return f"{fmt(eq.display(lhs))} = {fmt(eq.display(eom.forcing[i]))}"

@@ -411,7 +411,7 @@ def _projected_equations(model: Model, bodies: list[_FreeBody],
 def _compare(eom: EquationsOfMotion, newton_euler: list[sp.Expr],
              points: eq.Points) -> tuple[CoordinateAgreement, ...]:
     """Each E_i against Lagrange's (M q_ddot - f)_i, identically (at random points)."""
-    lagrange = list(eom.mass_matrix * eom.coordinate_accelerations - eom.forcing)
+    lagrange = list(eom.mass_matrix * eom.acceleration_symbols - eom.forcing)
     agreements = []
     for c, ne, la in zip(eom.model.coordinates, newton_euler, lagrange, strict=True):
         same = eq.identical(ne, la, points)

@@ -85,7 +85,7 @@ class EquationsOfMotion:
         return sp.ImmutableMatrix(self.model.q_dot)
 
     @property
-    def coordinate_accelerations(self) -> sp.ImmutableMatrix:
+    def acceleration_symbols(self) -> sp.ImmutableMatrix:
         return sp.ImmutableMatrix(self.model.q_ddot)
 
     @property

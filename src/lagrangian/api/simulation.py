@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import fields
 from pathlib import Path
 
-from .numerics.result import SimulationResult
+from ..numerics.result import SimulationResult
 
 
 class Simulation(SimulationResult):
@@ -30,20 +30,20 @@ class Simulation(SimulationResult):
     def to_pandas(self):
         """A pandas DataFrame with the columns t, <q>, <q>_dot, energy, lambda_*, residual_*,
         power."""
-        from .output.tables import result_frame
+        from ..output.tables import result_frame
 
         return result_frame(self)
 
     def save(self, path: str | Path) -> Path:
         """Write the table as CSV or Parquet (by suffix), atomically."""
-        from .output.tables import write_table
+        from ..output.tables import write_table
 
         return write_table(self, path, protect=self._inputs())
 
     def plot(self, path: str | Path | None = None):
         """Coordinates, energy (and multipliers) against time; a matplotlib Figure, also
         written to ``path`` (PNG, SVG or PDF) when given."""
-        from .output.plots import save_figure, time_history_figure
+        from ..output.plots import save_figure, time_history_figure
 
         figure = time_history_figure(self, {c.name: c.unit for c in self.model.coordinates})
         if path is not None:
@@ -56,7 +56,7 @@ class Simulation(SimulationResult):
         .html with a player) when given. Bodies in space are seen from ``view`` = (azimuth,
         elevation) in degrees (default isometric). In Jupyter,
         ``HTML(sim.animate().to_jshtml())``. ``progress(frame, frames)`` follows a GIF's writing."""
-        from .output.animation import check_animation_path, mechanism_animation, save_animation
+        from ..output.animation import check_animation_path, mechanism_animation, save_animation
 
         if path is not None:
             check_animation_path(path)
@@ -67,7 +67,7 @@ class Simulation(SimulationResult):
 
     def summary(self) -> dict:
         """JSON-ready summary: final state, steps, wall time, energy drift, largest residual."""
-        from .output.simulation import simulation_summary
+        from ..output.simulation import simulation_summary
 
         return simulation_summary(self)
 

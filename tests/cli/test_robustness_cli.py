@@ -310,3 +310,21 @@ def test_a_mass_near_overflow_is_judged_without_a_traceback(cli, tmp_path):
     assert one_line(err) == ("warning: the kinetic energy is not positive at the initial state "
                              "(the mass matrix has the eigenvalue -1e+308): T < 0 for some "
                              "velocities, so the motion is not physical")
+
+
+
+def test_a_model_too_deep_for_sympy_is_one_line_not_a_traceback(monkeypatch, capsys):
+    # A chain of ~1500 bodies nests its positions deeper than sympy can recurse (seen with a
+    # real model file, 30 s to build); the CLI's backstop names it in one line.
+    from lagrangian.api.system import System
+    from lagrangian.cli import main
+
+    def too_deep(self):
+        raise RecursionError("maximum recursion depth exceeded")
+
+    monkeypatch.setattr(System, "equations_of_motion", too_deep)
+    with pytest.raises(SystemExit) as stop:
+        main(["derive", "pendulum"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: the model is nested too deeply") and err.count("\n") == 1

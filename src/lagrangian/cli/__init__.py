@@ -70,6 +70,11 @@ def main(argv: list[str] | None = None) -> None:
             typer.echo(exc.format_message(), err=True)
             sys.exit(2)
         _fail(_usage_message(exc))
+    except RecursionError:  # sympy recurses once per level of nesting (a chain of ~1000 bodies)
+        _fail("the model is nested too deeply for the symbolic engine (Python's recursion limit): "
+              "split the chain, or use fewer bodies in one tree")
+    except MemoryError:
+        _fail("the model needs more memory than this machine has")
     except OSError as exc:  # a file that passed the checks but could not be written after all
         where = f"{exc.filename}: " if exc.filename else ""
         _fail(f"{where}{exc.strerror or exc}")

@@ -224,29 +224,37 @@ def tree_order(items: list[tuple[int, Mapping]], source: str) -> list[tuple[int,
     placed: set[str] = set()
     ordered: list[tuple[int, Mapping]] = []
 
-    def place(index: int, item: Mapping, path: list[str]) -> None:
-        name = item["name"]
-        if name in placed:
-            return
-        parent = item.get("parent")
-        if parent is not None:
+    def place(index: int, item: Mapping) -> None:
+        # Walk up to a placed body or the ground, then place the chain from the top down:
+        # iterative, so a chain of thousands of bodies is no recursion-depth traceback.
+        chain: list[tuple[int, Mapping]] = []
+        on_chain: set[str] = set()
+        while item["name"] not in placed:
+            name = item["name"]
+            chain.append((index, item))
+            on_chain.add(name)
+            parent = item.get("parent")
+            if parent is None:
+                break
             field = f"bodies[{index}].parent"
             _string(parent, field, source)
-            if parent in path or parent == name:
-                cycle = " -> ".join([*path[path.index(parent):], name, parent]) \
-                    if parent in path else f"{name} -> {name}"
+            if parent in on_chain:
+                path = [entry["name"] for _, entry in chain]
+                cycle = " -> ".join([*path[path.index(parent):], parent]) \
+                    if parent != name else f"{name} -> {name}"
                 raise ModelError(f"the bodies' parents form a cycle ({cycle}): a kinematic tree "
                                  "ends at the ground", field=field, source=source)
             if parent not in names:
                 raise ModelError(f"no body named '{parent}'"
                                  f"{did_you_mean(parent, sorted(names))}", field=field,
                                  source=source)
-            place(*names[parent], [*path, name])
-        placed.add(name)
-        ordered.append((index, item))
+            index, item = names[parent]
+        for entry in reversed(chain):
+            placed.add(entry[1]["name"])
+            ordered.append(entry)
 
     for index, item in items:
-        place(index, item, [])
+        place(index, item)
     return ordered
 
 

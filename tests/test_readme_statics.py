@@ -5,33 +5,9 @@ import math
 import re
 from pathlib import Path
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+from statics_models import SLIDER_CRANK as CRANK
 
-CRANK = """
-[coordinates]
-theta = { unit = "rad", initial = 0.7 }
-phi = { unit = "rad", initial = 0.2 }
-x = { unit = "m", initial = 0.37 }
-[parameters]
-r = { value = 0.1, unit = "m" }
-l = { value = 0.3, unit = "m" }
-tau = { value = 12.0, unit = "N*m" }
-P = { unit = "N" }
-[[loads]]
-name = "crank_torque"
-torque = "tau"
-angle = "theta"
-[[loads]]
-name = "piston_force"
-point = ["x", 0]
-force = ["P", 0]
-[[constraints]]
-name = "loop_y"
-holonomic = "r*sin(theta) - l*sin(phi)"
-[[constraints]]
-name = "loop_x"
-holonomic = "x - r*cos(theta) - l*cos(phi)"
-"""
+README = Path(__file__).resolve().parents[1] / "README.md"
 
 
 def section() -> str:

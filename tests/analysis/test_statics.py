@@ -10,33 +10,7 @@ from lagrangian.analysis.statics import solve_statics
 from lagrangian.derivation.lagrange import derive
 from lagrangian.errors import ModelError
 from lagrangian.model.reader import parse_model
-
-SLIDER_CRANK = """
-name = "Massless slider-crank: piston force against a crank torque"
-[coordinates]
-theta = { unit = "rad", initial = 0.7 }
-phi = { unit = "rad", initial = 0.2 }
-x = { unit = "m", initial = 0.37 }
-[parameters]
-r = { value = 0.1, unit = "m" }
-l = { value = 0.3, unit = "m" }
-tau = { value = 12.0, unit = "N*m" }
-P = { unit = "N" }
-[[loads]]
-name = "crank_torque"
-torque = "tau"
-angle = "theta"
-[[loads]]
-name = "piston_force"
-point = ["x", 0]
-force = ["P", 0]
-[[constraints]]
-name = "loop_y"
-holonomic = "r*sin(theta) - l*sin(phi)"
-[[constraints]]
-name = "loop_x"
-holonomic = "x - r*cos(theta) - l*cos(phi)"
-"""
+from statics_models import SLIDER_CRANK
 
 
 @pytest.mark.parametrize("degrees", [15, 40, 90, 135])

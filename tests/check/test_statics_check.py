@@ -6,33 +6,7 @@ from __future__ import annotations
 import pytest
 
 from lagrangian.cli import main
-
-CRANK = """
-name = "Massless slider-crank"
-[coordinates]
-theta = { unit = "rad", initial = 0.7 }
-phi = { unit = "rad", initial = 0.2 }
-x = { unit = "m", initial = 0.37 }
-[parameters]
-r = { value = 0.1, unit = "m" }
-l = { value = 0.3, unit = "m" }
-tau = { value = 12.0, unit = "N*m" }
-P = { unit = "N" }
-[[loads]]
-name = "crank_torque"
-torque = "tau"
-angle = "theta"
-[[loads]]
-name = "piston_force"
-point = ["x", 0]
-force = ["P", 0]
-[[constraints]]
-name = "loop_y"
-holonomic = "r*sin(theta) - l*sin(phi)"
-[[constraints]]
-name = "loop_x"
-holonomic = "x - r*cos(theta) - l*cos(phi)"
-"""
+from statics_models import SLIDER_CRANK as CRANK
 
 # By hand: Q = (tau, 0, P) from delta W = tau delta theta + P delta x, and Phi_q^T lambda with
 # Phi_q = [[r cos(theta), -l cos(phi), 0], [r sin(theta), l sin(phi), 1]]; no inertia, so

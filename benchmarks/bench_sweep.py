@@ -118,8 +118,11 @@ def main() -> None:
     for workers in (1, 2):
         client, cluster = _cluster(workers)
         try:
-            two_mass.sweep({"k": k[:2], "k_c": second[:2]}, client=client)  # warm the workers
-            pendulum.sweep(compute="simulate", client=client, **{**few, "members": 2})
+            # warm every worker (one chunk per point here, so each worker gets some): a warm-up
+            # of one chunk would leave the second worker to build its functions inside the timing
+            two_mass.sweep({"k": k[:4], "k_c": second[:4]}, client=client, chunk_size=1)
+            pendulum.sweep(compute="simulate", client=client, chunk_size=1,
+                           **{**few, "members": 8})
             a = _timed(lambda c=client: two_mass.sweep({"k": k, "k_c": second}, client=c),
                        args.repeat, client)
             cpu_a = CPU["last"]

@@ -49,7 +49,8 @@ def test_models_that_hung_derive_and_print_in_every_format_quickly(text):
     eom = derive(parse_model(text))
     for render in (derivation_text, derivation_document, derivation_latex):
         assert render(eom)
-    assert time.perf_counter() - start < 10  # were over 5 minutes of CPU each
+    # a hang guard, not a speed test (speed lives in benchmarks/): these took over 5 minutes
+    assert time.perf_counter() - start < 60
     if eom.accelerations is None:
         assert eom.accelerations_note.startswith("not solved symbolically: ")
 

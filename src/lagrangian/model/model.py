@@ -13,7 +13,9 @@ from typing import TYPE_CHECKING
 import sympy as sp
 
 if TYPE_CHECKING:
+    from .contacts import RollingContact
     from .rotations import RigidBody
+    from .tree import KinematicTree
 
 TIME = sp.Symbol("t")
 
@@ -179,6 +181,11 @@ class Model:
     time: sp.Symbol = field(default=TIME)
     # Bodies in space (model/rotations.py); their moments (rotations.Moment) are in ``loads``.
     rigid_bodies: tuple[RigidBody, ...] = ()
+    # Rolling contacts (model/contacts.py); their constraints are in ``constraints``.
+    contacts: tuple[RollingContact, ...] = ()
+    # A robot read from URDF keeps its tree in numbers (model/tree.py) for recursive dynamics;
+    # not part of the model's identity (equal models with and without it are equal).
+    kinematic_tree: KinematicTree | None = field(default=None, compare=False, repr=False)
 
     @property
     def q(self) -> tuple[sp.Symbol, ...]:

@@ -32,6 +32,7 @@ from .expressions import RESERVED
 from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
+from .tree import KinematicTree, TreeJoint
 
 MOVABLE = ("revolute", "continuous", "prismatic")
 SUPPORTED = (*MOVABLE, "fixed")
@@ -222,9 +223,10 @@ class _Tree:
             raise self.error("no joint left to move: a model needs at least one revolute, "
                              "continuous or prismatic joint that is not locked")
         position = self._positions(lock, names)
-        bodies = self._bodies(root, order, position)
+        bodies = tuple(self._bodies(root, order, position))
         model = builder.build_model()
-        return replace(model, rigid_bodies=tuple(bodies))
+        tree = self._tree(root, order, position, names, bodies)
+        return replace(model, rigid_bodies=bodies, kinematic_tree=tree)
 
     def _positions(self, lock: dict[str, float], names: dict[str, str]):
         """Each movable joint's position (angle or distance) and rate as expressions in q."""
@@ -310,6 +312,96 @@ class _Tree:
                                     position_, frame.rotation, frame.origin,
                                     frame.angular_velocity, parents[name]))
         return bodies
+
+
+    def _tree(self, root: str, order, position, names: dict[str, str], bodies) -> KinematicTree:
+        """The same robot as numbers for the recursive algorithms (model/tree.py)."""
+        index = {joint: i for i, joint in enumerate(names)}
+        coordinate = {symbol: index[joint] for joint, symbol in names.items()}
+        anchor = {root: (-1, np.eye(3), np.zeros(3))}  # link -> (moving body, R, t in it)
+        joints: list[dict] = []
+        for joint in order:
+            body, turn, shift = anchor[joint.parent]
+            origin = np.eye(4) if joint.origin is None else np.asarray(joint.origin, float)
+            rotation = _snapped(turn @ _snapped(origin[:3, :3]))
+            translation = shift + turn @ _snapped(origin[:3, 3])
+            if joint.type not in MOVABLE:
+                anchor[joint.child] = (body, rotation, translation)
+                continue
+            axis = np.asarray(joint.axis if joint.axis is not None else (1, 0, 0), float)
+            axis = _snapped(axis / float(np.linalg.norm(axis)))
+            angle = position(joint)[0]
+            if angle.free_symbols:  # k q + offset with one coordinate q
+                (symbol,) = angle.free_symbols
+                k = float(angle.diff(symbol))
+                offset = float(angle.subs(symbol, 0))
+                joints.append(dict(name=joint.name, parent=body, kind=_KIND[joint.type],
+                                   rotation=rotation, translation=translation, axis=axis,
+                                   coordinate=coordinate[str(symbol)], multiplier=k,
+                                   offset=offset))
+                anchor[joint.child] = (len(joints) - 1, np.eye(3), np.zeros(3))
+            else:  # locked, or a mimic of a locked joint: a fixed joint at that value
+                theta = float(angle)
+                if joint.type == "prismatic":
+                    anchor[joint.child] = (body, rotation, translation + rotation @ axis * theta)
+                else:
+                    anchor[joint.child] = (body, rotation @ _axis_rotation(axis, theta),
+                                           translation)
+        inertias = [[0.0, np.zeros(3), np.zeros((3, 3))] for _ in joints]
+        for name, (body, turn, shift) in anchor.items():
+            inertial = self.links[name].inertial
+            if body < 0 or inertial is None or not inertial.mass:
+                continue
+            mass = float(inertial.mass)
+            where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
+                               dtype=float)
+            tensor = np.asarray(inertial.inertia if inertial.inertia is not None
+                                else np.zeros((3, 3)), dtype=float)
+            tensor = 0.5 * (tensor + tensor.T)
+            tensor = turn @ (_snapped(where[:3, :3]) @ tensor @ _snapped(where[:3, :3]).T) @ turn.T
+            center = shift + turn @ _snapped(where[:3, 3])
+            # about the body's origin: J_O = I_C + m (|c|^2 1 - c c^T), h = m c
+            inertias[body][0] += mass
+            inertias[body][1] += mass * center
+            inertias[body][2] += tensor + mass * (center @ center * np.eye(3)
+                                                  - np.outer(center, center))
+
+        def vector(a):
+            return tuple(float(x) for x in a)
+
+        def matrix(a):
+            return tuple(vector(row) for row in a)
+
+        return KinematicTree(
+            joints=tuple(TreeJoint(
+                name=j["name"], parent=j["parent"], kind=j["kind"], rotation=matrix(j["rotation"]),
+                translation=vector(j["translation"]), axis=vector(j["axis"]),
+                coordinate=j["coordinate"], multiplier=j["multiplier"], offset=j["offset"],
+                mass=m, first_moment=vector(h), inertia=matrix(0.5 * (J + J.T)))
+                for j, (m, h, J) in zip(joints, inertias, strict=True)),
+            coordinates=tuple(names.values()), gravity_parameter="g",
+            gravity_direction=(0.0, 0.0, -1.0),
+            actuators=tuple(f"tau_{name}" for name in names.values()),
+            rigid_bodies=tuple(bodies))
+
+
+_KIND = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
+
+
+def _snapped(a) -> np.ndarray:
+    """Entries within _SNAP of an integer made that integer (as _number does for the symbols)."""
+    a = np.array(a, dtype=float)
+    near = np.abs(a - np.round(a)) < _SNAP
+    a[near] = np.round(a[near])
+    return a
+
+
+def _axis_rotation(axis, angle: float) -> np.ndarray:
+    """Rot(u, angle) by Rodrigues' formula."""
+    x = np.asarray(axis, float)
+    cross = np.array([[0, -x[2], x[1]], [x[2], 0, -x[0]], [-x[1], x[0], 0]])
+    return math.cos(angle) * np.eye(3) + math.sin(angle) * cross \
+        + (1 - math.cos(angle)) * np.outer(x, x)
 
 
 def _turned(frame: Frame, rotation) -> Frame:

@@ -495,6 +495,9 @@ static PyMethodDef lg_methods[] = {
     {"rhs", (PyCFunction)(void (*)(void))py_rhs, METH_FASTCALL, "(P, t, y) -> [q_dot, q_ddot]"},
     {"dop853", (PyCFunction)(void (*)(void))py_dop853, METH_FASTCALL,
      "(P, t0, t1, y0, rtol, atol, t_eval, max_steps) -> (t, y, nfev, steps, status, t_reached)"},
+#ifdef LG_EXTRA_METHODS
+    LG_EXTRA_METHODS /* more functions of a generated module (recursive.py) */
+#endif
     {NULL, NULL, 0, NULL},
 };
 

@@ -1,0 +1,747 @@
+"""Recursive rigid-body dynamics of a robot's kinematic tree (model/tree.py) as generated C.
+
+Instead of expanding the equations of motion (whose size grows much faster than the number of
+bodies), the generated code keeps the recursions over the tree, unrolled body by body with the
+joint axes, placements and inertias as numbers (zeros and ones folded away, common terms
+shared):
+
+- inverse dynamics by recursive Newton-Euler: tau = M(q) a + C(q, q_dot) q_dot + g(q);
+- the mass matrix by the composite-rigid-body algorithm;
+- forward dynamics q_ddot = M^-1 (tau - b) by Cholesky (M is symmetric positive definite);
+- kinetic energy 1/2 sum (m v.v + 2 v.(w x h) + w.J_O w), potential energy m g height.
+
+Units SI. Gravity g (a runtime parameter) along the tree's direction; each coordinate's actuator
+parameter tau_<joint> acts as a load, as in the symbolic equations (b = C q_dot + g - tau_p).
+The same functions are written as standalone C99 (standalone.py) and, with the Python bindings
+below and template.c, as a compiled module cached by compiled.py (a key of the tree's numbers,
+taken before any code is generated).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ModelError
+from ..model.model import Model
+from ..model.tree import KinematicTree
+from ..model.values import resolve_parameters
+
+Term = float | str  # a number, or the C name of a value computed before
+
+
+class _Emitter:
+    """Straight-line C with constants folded and equal operations computed once (value
+    numbering): x*0, x*1, x+0 vanish, so a z axis or an identity placement costs nothing."""
+
+    def __init__(self):
+        self.lines: list[tuple[str, str, tuple[str, ...]]] = []
+        self.memo: dict[tuple, str] = {}
+        self.negated: dict[str, str] = {}  # name of -x -> name of x
+
+    def _new(self, key: tuple, text: str, deps: tuple) -> str:
+        hit = self.memo.get(key)
+        if hit is not None:
+            return hit
+        name = f"t{len(self.lines)}"
+        self.lines.append((name, text, tuple(d for d in deps if isinstance(d, str))))
+        self.memo[key] = name
+        return name
+
+    @staticmethod
+    def text(x: Term) -> str:
+        if isinstance(x, str):
+            return x
+        return repr(float(x)) if x >= 0 else f"({float(x)!r})"
+
+    def neg(self, a: Term) -> Term:
+        if not isinstance(a, str):
+            return -a + 0.0
+        if a in self.negated:
+            return self.negated[a]
+        name = self._new(("-", a), f"-{a}", (a,))
+        self.negated[name] = a
+        return name
+
+    def add(self, a: Term, b: Term) -> Term:
+        if not isinstance(a, str) and not isinstance(b, str):
+            return a + b
+        if not isinstance(a, str) and a == 0:
+            return b
+        if not isinstance(b, str) and b == 0:
+            return a
+        if isinstance(b, str) and b in self.negated:
+            return self.sub(a, self.negated[b])
+        if isinstance(a, str) and a in self.negated:
+            return self.sub(b, self.negated[a])
+        x, y = sorted((a, b), key=repr)
+        return self._new(("+", x, y), f"{self.text(x)} + {self.text(y)}", (x, y))
+
+    def sub(self, a: Term, b: Term) -> Term:
+        if not isinstance(a, str) and not isinstance(b, str):
+            return a - b
+        if not isinstance(b, str) and b == 0:
+            return a
+        if not isinstance(a, str) and a == 0:
+            return self.neg(b)
+        if a == b:
+            return 0.0
+        if isinstance(b, str) and b in self.negated:
+            return self.add(a, self.negated[b])
+        return self._new(("-", a, b), f"{self.text(a)} - {self.text(b)}", (a, b))
+
+    def mul(self, a: Term, b: Term) -> Term:
+        if not isinstance(a, str) and not isinstance(b, str):
+            return a * b
+        if not isinstance(a, str):
+            a, b = b, a  # the constant second
+        if not isinstance(b, str):
+            if b == 0:
+                return 0.0
+            if b == 1:
+                return a
+            if b == -1:
+                return self.neg(a)
+            if a in self.negated:
+                return self.mul(self.negated[a], -b)
+            return self._new(("*", a, b), f"{a} * {self.text(b)}", (a,))
+        if a in self.negated:
+            return self.neg(self.mul(self.negated[a], b))
+        if b in self.negated:
+            return self.neg(self.mul(a, self.negated[b]))
+        x, y = sorted((a, b))
+        return self._new(("*", x, y), f"{x} * {y}", (x, y))
+
+    def call(self, function: str, a: Term) -> Term:
+        if not isinstance(a, str):
+            return float(getattr(np, function)(a))
+        return self._new((function, a), f"{function}({a})", (a,))
+
+    # -- 3-vectors and 3x3 matrices of terms ----------------------------------------------------
+
+    def sum(self, terms) -> Term:
+        total: Term = 0.0
+        for t in terms:
+            total = self.add(total, t)
+        return total
+
+    def dot(self, a, b) -> Term:
+        return self.sum(self.mul(x, y) for x, y in zip(a, b, strict=True))
+
+    def vadd(self, a, b):
+        return [self.add(x, y) for x, y in zip(a, b, strict=True)]
+
+    def scale(self, s: Term, a):
+        return [self.mul(s, x) for x in a]
+
+    def cross(self, a, b):
+        return [self.sub(self.mul(a[1], b[2]), self.mul(a[2], b[1])),
+                self.sub(self.mul(a[2], b[0]), self.mul(a[0], b[2])),
+                self.sub(self.mul(a[0], b[1]), self.mul(a[1], b[0]))]
+
+    def apply(self, R, x):
+        return [self.dot(row, x) for row in R]
+
+    def apply_transpose(self, R, x):
+        return [self.dot([R[0][i], R[1][i], R[2][i]], x) for i in range(3)]
+
+    def matmul(self, A, B):
+        return [[self.dot(A[i], [B[0][j], B[1][j], B[2][j]]) for j in range(3)]
+                for i in range(3)]
+
+    def body(self, outputs: list[tuple[str, Term]], indent: str = "    ") -> str:
+        """The C statements computing ``target = term`` for each output (dead temporaries
+        dropped)."""
+        live = {t for _, t in outputs if isinstance(t, str)}
+        keep = []
+        for name, text, deps in reversed(self.lines):
+            if name in live:
+                keep.append((name, text))
+                live.update(deps)
+        statements = [f"{indent}const double {name} = {text};" for name, text in reversed(keep)]
+        statements += [f"{indent}{target} = {self.text(term)};" for target, term in outputs]
+        return "\n".join(statements)
+
+
+class _Layout:
+    """Where each input of the generated code lives: q[i], v[i], a[i], p[k]."""
+
+    def __init__(self, tree: KinematicTree, parameters: tuple[str, ...]):
+        self.tree = tree
+        index = {name: k for k, name in enumerate(parameters)}
+        missing = [name for name in (tree.gravity_parameter, *tree.actuators) if name not in index]
+        if missing:
+            raise ModelError(f"the tree's parameters {missing} are not the model's")
+        self.gravity = f"p[{index[tree.gravity_parameter]}]"
+        self.actuators = [f"p[{index[name]}]" for name in tree.actuators]
+        self.n = len(tree.coordinates)
+
+
+def _rotation(E: _Emitter, joint, c: Term, s: Term):
+    """Rot(u, theta) = c 1 + s [u]x + (1 - c) u u^T as terms (c = cos, s = sin theta)."""
+    u = joint.axis
+    one_minus_c = E.sub(1.0, c)
+    R = [[E.mul(one_minus_c, u[i] * u[j]) for j in range(3)] for i in range(3)]
+    for i in range(3):
+        # along a coordinate axis the diagonal entry is exactly 1, not c + (1 - c)
+        R[i][i] = 1.0 if abs(u[i]) == 1.0 else E.add(c, R[i][i])
+    cross = ((0, 1, -u[2]), (0, 2, u[1]), (1, 0, u[2]), (1, 2, -u[0]), (2, 0, -u[1]),
+             (2, 1, u[0]))
+    for i, j, k in cross:
+        R[i][j] = E.add(R[i][j], E.mul(s, k))
+    return R
+
+
+def _kinematics(E: _Emitter, tree: KinematicTree, q):
+    """Each body's rotation R (body -> parent axes) and origin p (in its parent), as terms."""
+    placements = []
+    for joint in tree.joints:
+        theta = E.add(E.mul(q[joint.coordinate], joint.multiplier), joint.offset)
+        R0 = [list(row) for row in joint.rotation]
+        if joint.kind == "revolute":
+            R = E.matmul(R0, _rotation(E, joint, E.call("cos", theta), E.call("sin", theta)))
+            p = list(joint.translation)
+        else:
+            R = R0
+            p = E.vadd(joint.translation, E.scale(theta, E.apply(R0, joint.axis)))
+        placements.append((R, p))
+    return placements
+
+
+def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a):
+    """Recursive Newton-Euler: the generalized forces tau_i (N m or N) for q, q_dot, q_ddot,
+    minus each actuator parameter (the model's own load)."""
+    placements = _kinematics(E, tree, q)
+    g = layout.gravity
+    up = [E.mul(g, -d) for d in tree.gravity_direction]  # the ground accelerates up by g
+    w, dw, acc, f, n = [], [], [], [], []
+    for i, joint in enumerate(tree.joints):
+        R, p = placements[i]
+        if joint.parent < 0:
+            wl, dwl, al = [0.0] * 3, [0.0] * 3, up
+        else:
+            wl, dwl, al = w[joint.parent], dw[joint.parent], acc[joint.parent]
+        u = list(joint.axis)
+        rate = E.mul(v[joint.coordinate], joint.multiplier)
+        accel = E.mul(a[joint.coordinate], joint.multiplier)
+        w_in = E.apply_transpose(R, wl)
+        dw_in = E.apply_transpose(R, dwl)
+        origin = E.vadd(al, E.vadd(E.cross(dwl, p), E.cross(wl, E.cross(wl, p))))
+        a_i = E.apply_transpose(R, origin)
+        if joint.kind == "revolute":
+            w_i = E.vadd(w_in, E.scale(rate, u))
+            dw_i = E.vadd(dw_in, E.vadd(E.cross(w_in, E.scale(rate, u)), E.scale(accel, u)))
+        else:
+            w_i, dw_i = w_in, dw_in
+            a_i = E.vadd(a_i, E.vadd(E.scale(2.0, E.cross(w_i, E.scale(rate, u))),
+                                     E.scale(accel, u)))
+        w.append(w_i)
+        dw.append(dw_i)
+        acc.append(a_i)
+        m, h, J = joint.mass, list(joint.first_moment), [list(r) for r in joint.inertia]
+        # about the body's origin: f = m a + dw x h + w x (w x h), n = J dw + w x J w + h x a
+        f.append(E.vadd(E.scale(m, a_i), E.vadd(E.cross(dw_i, h), E.cross(w_i, E.cross(w_i, h)))))
+        n.append(E.vadd(E.vadd(E.apply(J, dw_i), E.cross(w_i, E.apply(J, w_i))),
+                        E.cross(h, a_i)))
+    tau_full: list[Term] = [0.0] * len(tree.joints)
+    for i in reversed(range(len(tree.joints))):
+        joint = tree.joints[i]
+        tau_full[i] = E.dot(joint.axis, n[i] if joint.kind == "revolute" else f[i])
+        if joint.parent >= 0:
+            R, p = placements[i]
+            force = E.apply(R, f[i])
+            f[joint.parent] = E.vadd(f[joint.parent], force)
+            n[joint.parent] = E.vadd(n[joint.parent],
+                                     E.vadd(E.apply(R, n[i]), E.cross(p, force)))
+    tau: list[Term] = [0.0] * layout.n
+    for i, joint in enumerate(tree.joints):
+        tau[joint.coordinate] = E.add(tau[joint.coordinate], E.mul(tau_full[i], joint.multiplier))
+    return [E.sub(t, actuator) for t, actuator in zip(tau, layout.actuators, strict=True)]
+
+
+def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
+    """Composite-rigid-body algorithm: M (lower triangle, row-major entries i >= j)."""
+    placements = _kinematics(E, tree, q)
+    nb = len(tree.joints)
+    mass = [j.mass for j in tree.joints]
+    h = [list(j.first_moment) for j in tree.joints]
+    J = [[list(r) for r in j.inertia] for j in tree.joints]
+    full = {}
+    for i in reversed(range(nb)):
+        joint = tree.joints[i]
+        u = list(joint.axis)
+        if joint.kind == "revolute":  # unit rate about u: f = u x h, n = J u
+            force, moment = E.cross(u, h[i]), E.apply(J[i], u)
+        else:  # unit rate along u: f = m u, n = h x u
+            force, moment = E.scale(mass[i], u), E.cross(h[i], u)
+        full[i, i] = E.dot(u, moment if joint.kind == "revolute" else force)
+        k = i
+        while tree.joints[k].parent >= 0:
+            R, p = placements[k]
+            force = E.apply(R, force)
+            moment = E.vadd(E.apply(R, moment), E.cross(p, force))
+            k = tree.joints[k].parent
+            ancestor = tree.joints[k]
+            full[i, k] = E.dot(ancestor.axis, moment if ancestor.kind == "revolute" else force)
+        parent = joint.parent
+        if parent >= 0:  # the composite inertia of body i, moved into its parent's axes
+            R, p = placements[i]
+            hr = E.apply(R, h[i])
+            A = [E.apply(R, [J[i][0][c], J[i][1][c], J[i][2][c]]) for c in range(3)]  # columns
+            RJRt = [[None] * 3 for _ in range(3)]
+            for r in range(3):
+                for c in range(r, 3):
+                    RJRt[r][c] = RJRt[c][r] = E.dot([A[0][r], A[1][r], A[2][r]], R[c])
+            ph = E.dot(p, hr)
+            pp = E.dot(p, p)
+            for r in range(3):
+                for c in range(r, 3):
+                    # J' = R J R^T + m (|p|^2 1 - p p^T) + 2 (p.h) 1 - p h^T - h p^T
+                    shift = E.sub(E.neg(E.mul(mass[i], E.mul(p[r], p[c]))),
+                                  E.add(E.mul(p[r], hr[c]), E.mul(hr[r], p[c])))
+                    if r == c:
+                        shift = E.add(shift, E.add(E.mul(mass[i], pp), E.mul(2.0, ph)))
+                    entry = E.add(J[parent][r][c], E.add(RJRt[r][c], shift))
+                    J[parent][r][c] = J[parent][c][r] = entry
+            h[parent] = E.vadd(h[parent], E.vadd(hr, E.scale(mass[i], p)))
+            mass[parent] = mass[parent] + mass[i]
+    entries = {}
+    for (i, k), value in full.items():
+        a, b = tree.joints[i], tree.joints[k]
+        for (r, c, x) in ((a.coordinate, b.coordinate, value),) + (
+                ((b.coordinate, a.coordinate, value),) if i != k else ()):
+            if r >= c:
+                entries[r, c] = E.add(entries.get((r, c), 0.0),
+                                      E.mul(x, a.multiplier * b.multiplier))
+    return entries
+
+
+def _velocities(E: _Emitter, tree: KinematicTree, q, v):
+    placements = _kinematics(E, tree, q)
+    w, vel = [], []
+    for i, joint in enumerate(tree.joints):
+        R, p = placements[i]
+        wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
+                                                                 vel[joint.parent])
+        rate = E.mul(v[joint.coordinate], joint.multiplier)
+        w_i = E.apply_transpose(R, wl)
+        v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
+        if joint.kind == "revolute":
+            w_i = E.vadd(w_i, E.scale(rate, joint.axis))
+        else:
+            v_i = E.vadd(v_i, E.scale(rate, joint.axis))
+        w.append(w_i)
+        vel.append(v_i)
+    return w, vel
+
+
+def _kinetic_energy(E: _Emitter, tree: KinematicTree, q, v) -> Term:
+    """T = sum 1/2 m v.v + v.(w x h) + 1/2 w.J_O w (J)."""
+    w, vel = _velocities(E, tree, q, v)
+    terms = []
+    for joint, w_i, v_i in zip(tree.joints, w, vel, strict=True):
+        twice = E.add(E.mul(joint.mass, E.dot(v_i, v_i)),
+                      E.add(E.mul(2.0, E.dot(v_i, E.cross(w_i, list(joint.first_moment)))),
+                            E.dot(w_i, E.apply([list(r) for r in joint.inertia], w_i))))
+        terms.append(twice)
+    return E.mul(E.sum(terms), 0.5)
+
+
+def _potential_energy(E: _Emitter, tree: KinematicTree, layout: _Layout, q) -> Term:
+    """V = g sum (m height of the origin + up.h), up in each body's axes (J)."""
+    placements = _kinematics(E, tree, q)
+    up_world = [-d + 0.0 for d in tree.gravity_direction]
+    up, height, terms = [], [], []
+    for i, joint in enumerate(tree.joints):
+        R, p = placements[i]
+        up_l, height_l = (up_world, 0.0) if joint.parent < 0 else (up[joint.parent],
+                                                                   height[joint.parent])
+        up.append(E.apply_transpose(R, up_l))
+        height.append(E.add(height_l, E.dot(up_l, p)))
+        terms.append(E.add(E.mul(joint.mass, height[i]), E.dot(up[i], list(joint.first_moment))))
+    return E.mul(E.sum(terms), layout.gravity)
+
+
+def _inputs(name: str, n: int) -> list[str]:
+    return [f"{name}[{i}]" for i in range(n)]
+
+
+def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix: str,
+                       storage: str = "static ") -> str:
+    """C99 functions <prefix>_mass_matrix, _bias_forces, _gravity, _inverse_dynamics,
+    _forward_dynamics, _kinetic_energy, _potential_energy (the standalone API)."""
+    layout = _Layout(tree, parameters)
+    n = layout.n
+    q, v, a = _inputs("q", n), _inputs("v", n), _inputs("a", n)
+    zeros = [0.0] * n
+    P, S = prefix, storage
+    R = "const double *restrict"
+    sections = []
+
+    def function(signature: str, E: _Emitter, outputs, extra: str = "") -> None:
+        sections.append(f"{S}{signature}\n{{\n    (void)p;\n{E.body(outputs)}\n{extra}}}\n")
+
+    E = _Emitter()
+    entries = _mass_matrix(E, tree, layout, q)
+    outputs = []
+    for r in range(n):
+        for c in range(r + 1):
+            outputs.append((f"M[{r * n + c}]", entries.get((r, c), 0.0)))
+    mirror = "".join(f"    M[{c * n + r}] = M[{r * n + c}];\n"
+                     for r in range(n) for c in range(r))
+    function(f"void {P}_mass_matrix({R} q, {R} p, double *restrict M)", E, outputs, mirror)
+    for name, args, rates, accels in (
+            ("inverse_dynamics", f"{R} q, {R} v, {R} a, {R} p, double *restrict tau", v, a),
+            ("bias_forces", f"{R} q, {R} v, {R} p, double *restrict tau", v, zeros),
+            ("gravity", f"{R} q, {R} p, double *restrict tau", zeros, zeros)):
+        E = _Emitter()
+        tau = _inverse_dynamics(E, tree, layout, q, rates, accels)
+        function(f"void {P}_{name}({args})", E, [(f"tau[{i}]", t) for i, t in enumerate(tau)])
+    E = _Emitter()
+    function(f"double {P}_kinetic_energy({R} q, {R} v, {R} p)", E,
+             [("double T", _kinetic_energy(E, tree, q, v))], "    return T;\n")
+    E = _Emitter()
+    function(f"double {P}_potential_energy({R} q, {R} p)", E,
+             [("double V", _potential_energy(E, tree, layout, q))], "    return V;\n")
+    sections.append(f"""/* q_ddot = M^-1 (tau - b): Cholesky M = L L^T on the stack; -1 where M is not
+   positive definite (a massless branch), else 0. */
+{S}int {P}_forward_dynamics({R} q, {R} v, {R} tau, {R} p, double *restrict qdd)
+{{
+    double L[{n * n}], b[{n}];
+    {P}_mass_matrix(q, p, L);
+    {P}_bias_forces(q, v, p, b);
+    for (int i = 0; i < {n}; i++) qdd[i] = tau[i] - b[i];
+    for (int j = 0; j < {n}; j++) {{
+        double d = L[j * {n} + j];
+        for (int k = 0; k < j; k++) d -= L[j * {n} + k] * L[j * {n} + k];
+        if (!(d > 0.0)) return -1;
+        d = sqrt(d);
+        L[j * {n} + j] = d;
+        const double inv = 1.0 / d;
+        for (int i = j + 1; i < {n}; i++) {{
+            double s = L[i * {n} + j];
+            for (int k = 0; k < j; k++) s -= L[i * {n} + k] * L[j * {n} + k];
+            L[i * {n} + j] = s * inv;
+        }}
+    }}
+    for (int i = 0; i < {n}; i++) {{
+        double s = qdd[i];
+        for (int k = 0; k < i; k++) s -= L[i * {n} + k] * qdd[k];
+        qdd[i] = s / L[i * {n} + i];
+    }}
+    for (int i = {n} - 1; i >= 0; i--) {{
+        double s = qdd[i];
+        for (int k = i + 1; k < {n}; k++) s -= L[k * {n} + i] * qdd[k];
+        qdd[i] = s / L[i * {n} + i];
+    }}
+    return 0;
+}}
+""")
+    return "\n".join(sections)
+
+
+# -- the compiled module ---------------------------------------------------------------------------
+
+_BINDINGS = r"""
+/* ---- batched bindings: each input (..., N) or (N,), outputs shaped like the largest ---- */
+enum { RT_MASS, RT_BIAS, RT_GRAVITY, RT_INVERSE, RT_FORWARD, RT_KINETIC, RT_POTENTIAL };
+static const char *rt_names[] = {"q", "v", "third"};
+
+static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int kind)
+{
+    PyArrayObject *in[3] = {NULL, NULL, NULL}, *P = NULL;
+    PyObject *out = NULL;
+    npy_intp step[3] = {0, 0, 0};
+    if (nargs != nin + 1) {
+        PyErr_Format(PyExc_TypeError, "expected %d arguments", nin + 1);
+        return NULL;
+    }
+    int base = 0;
+    for (int i = 0; i < nin; i++) {
+        in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
+        if (!in[i]) goto done;
+        int nd = PyArray_NDIM(in[i]);
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != LG_N) {
+            PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
+                         i == 2 ? (kind == RT_FORWARD ? "tau" : "a") : rt_names[i], LG_N);
+            goto done;
+        }
+        if (PyArray_SIZE(in[i]) > PyArray_SIZE(in[base])) base = i;
+    }
+    npy_intp count = PyArray_SIZE(in[base]) / LG_N;
+    int nd = PyArray_NDIM(in[base]);
+    for (int i = 0; i < nin; i++) {
+        if (PyArray_SIZE(in[i]) == LG_N && PyArray_NDIM(in[i]) == 1) {
+            step[i] = count > 1 ? 0 : LG_N;
+            continue;
+        }
+        if (PyArray_NDIM(in[i]) != nd
+            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), nd * sizeof(npy_intp))) {
+            PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
+            goto done;
+        }
+        step[i] = LG_N;
+    }
+    P = lg_doubles(args[nin], LG_NP, "parameters");
+    if (!P) goto done;
+    npy_intp dims[NPY_MAXDIMS];
+    memcpy(dims, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
+    int od = nd - 1;
+    if (kind == RT_MASS) { dims[od++] = LG_N; dims[od++] = LG_N; }
+    else if (kind != RT_KINETIC && kind != RT_POTENTIAL) dims[od++] = LG_N;
+    out = PyArray_SimpleNew(od, dims, NPY_DOUBLE);
+    if (!out) goto done;
+    const double *x0 = (const double *)PyArray_DATA(in[0]);
+    const double *x1 = nin > 1 ? (const double *)PyArray_DATA(in[1]) : NULL;
+    const double *x2 = nin > 2 ? (const double *)PyArray_DATA(in[2]) : NULL;
+    const double *p = (const double *)PyArray_DATA(P);
+    double *y = (double *)PyArray_DATA((PyArrayObject *)out);
+    npy_intp failed = -1;
+    NPY_BEGIN_THREADS_DEF;
+    if (count > 16) NPY_BEGIN_THREADS;
+    for (npy_intp k = 0; k < count; k++) {
+        const double *a0 = x0 + k * step[0], *a1 = x1 + k * step[1], *a2 = x2 + k * step[2];
+        switch (kind) {
+        case RT_MASS: rt_mass_matrix(a0, p, y + k * LG_N * LG_N); break;
+        case RT_BIAS: rt_bias_forces(a0, a1, p, y + k * LG_N); break;
+        case RT_GRAVITY: rt_gravity(a0, p, y + k * LG_N); break;
+        case RT_INVERSE: rt_inverse_dynamics(a0, a1, a2, p, y + k * LG_N); break;
+        case RT_FORWARD:
+            if (rt_forward_dynamics(a0, a1, a2, p, y + k * LG_N) && failed < 0) failed = k;
+            break;
+        case RT_KINETIC: y[k] = rt_kinetic_energy(a0, a1, p); break;
+        case RT_POTENTIAL: y[k] = rt_potential_energy(a0, p); break;
+        }
+    }
+    if (count > 16) NPY_END_THREADS;
+    if (failed >= 0) {
+        PyErr_Format(lg_LinAlgError, "the mass matrix is not positive definite (state %zd)",
+                     (Py_ssize_t)failed);
+        Py_CLEAR(out);
+    }
+done:
+    for (int i = 0; i < 3; i++) Py_XDECREF(in[i]);
+    Py_XDECREF(P);
+    return out;
+}
+
+#define RT_WRAP(name, nin, kind) \
+    static PyObject *rt_py_##name(PyObject *self, PyObject *const *args, Py_ssize_t nargs) \
+    { (void)self; return rt_batch(args, nargs, nin, kind); }
+RT_WRAP(mass_matrix, 1, RT_MASS)
+RT_WRAP(bias_forces, 2, RT_BIAS)
+RT_WRAP(gravity, 1, RT_GRAVITY)
+RT_WRAP(inverse_dynamics, 3, RT_INVERSE)
+RT_WRAP(forward_dynamics, 3, RT_FORWARD)
+RT_WRAP(kinetic_energy, 2, RT_KINETIC)
+RT_WRAP(potential_energy, 1, RT_POTENTIAL)
+"""
+
+_DECLARE = "\n".join(
+    f"static PyObject *rt_py_{name}(PyObject *, PyObject *const *, Py_ssize_t);"
+    for name in ("mass_matrix", "bias_forces", "gravity", "inverse_dynamics", "forward_dynamics",
+                 "kinetic_energy", "potential_energy"))
+
+_METHODS = " ".join(
+    f'{{"{name}", (PyCFunction)(void (*)(void))rt_py_{name}, METH_FASTCALL, "{doc}"}},'
+    for name, doc in (("mass_matrix", "(Q, P) -> M"), ("bias_forces", "(Q, V, P) -> b"),
+                      ("gravity", "(Q, P) -> g"), ("inverse_dynamics", "(Q, V, A, P) -> tau"),
+                      ("forward_dynamics", "(Q, V, TAU, P) -> q_ddot"),
+                      ("kinetic_energy", "(Q, V, P) -> T"), ("potential_energy", "(Q, P) -> V")))
+
+
+def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
+    """The compiled module's C: the recursive functions, lg_parts/lg_energy/lg_residual for
+    template.c (simulation, accelerations), and batched bindings for each function."""
+    from .codegen import TEMPLATE, GeneratedSource
+
+    n = len(tree.coordinates)
+    source = "\n".join([
+        f"/* lagrangian: recursive dynamics of a tree of {len(tree.joints)} bodies, {n} "
+        "coordinates */",
+        f"#define LG_N {n}",
+        "#define LG_M 0",
+        f"#define LG_NP {len(parameters)}",
+        "#define PY_SSIZE_T_CLEAN",
+        "#include <Python.h>",
+        "#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION",
+        "#include <numpy/arrayobject.h>",
+        "#include <math.h>",
+        "",
+        dynamics_functions(tree, parameters, "rt"),
+        """
+static void lg_parts(const double *restrict q, const double *restrict v, double t,
+                     const double *restrict p, double *restrict M, double *restrict f,
+                     double *restrict J, double *restrict g)
+{
+    (void)t; (void)J; (void)g;
+    rt_mass_matrix(q, p, M);
+    rt_bias_forces(q, v, p, f);
+    for (int i = 0; i < LG_N; i++) f[i] = -f[i];
+}
+
+static double lg_energy(const double *restrict q, const double *restrict v, double t,
+                        const double *restrict p)
+{
+    (void)t;
+    return rt_kinetic_energy(q, v, p) + rt_potential_energy(q, p);
+}
+
+static void lg_residual(const double *restrict q, const double *restrict v, double t,
+                        const double *restrict p, double *restrict r)
+{
+    (void)q; (void)v; (void)t; (void)p; (void)r;
+}
+""",
+        _DECLARE,
+        f"#define LG_EXTRA_METHODS {_METHODS}",
+        TEMPLATE.read_text(),
+        _BINDINGS,
+    ])
+    return GeneratedSource(source=source, parameters=parameters, n=n, m=0)
+
+
+@lru_cache(maxsize=1)
+def _generator_key() -> str:
+    return hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+
+
+def tree_key(tree: KinematicTree, parameters: tuple[str, ...]) -> str:
+    """What the generated module is a function of: the tree's numbers (exact reprs) and the
+    parameters' order, and this generator."""
+    return "\n".join(["recursive", _generator_key(), repr(parameters), repr(tree)])
+
+
+def applicable_tree(model: Model) -> KinematicTree | None:
+    """The model's kinematic tree when it describes the model's whole dynamics (a robot read
+    from URDF and not edited since: only its rigid bodies, gravity and the actuator forces),
+    else None, so that nothing else a model holds is ever left out."""
+    tree = model.kinematic_tree
+    if tree is None:
+        return None
+    if (model.particles or model.bodies or model.springs or model.dampers or model.loads
+            or model.constraints or model.definitions
+            or model.kinetic_energy != 0 or model.potential_energy != 0
+            or model.dissipation != 0):
+        return None
+    if model.rigid_bodies != tree.rigid_bodies:
+        return None
+    if tuple(c.name for c in model.coordinates) != tree.coordinates:
+        return None
+    names = {p.name: p.symbol for p in model.parameters}
+    if tree.gravity_parameter not in names or any(a not in names for a in tree.actuators):
+        return None
+    gravity = model.gravity
+    if gravity is None or gravity.magnitude != names[tree.gravity_parameter] or \
+            tuple(float(d) for d in gravity.direction) != tree.gravity_direction:
+        return None
+    expected = {c: ((names[a]),) for c, a in zip(tree.coordinates, tree.actuators, strict=True)}
+    given: dict[str, tuple] = {}
+    for coordinate, force in model.generalized_forces:
+        given[coordinate] = given.get(coordinate, ()) + (force,)
+    if given != expected:
+        return None
+    return tree
+
+
+class RecursiveDynamics:
+    """Compiled recursive dynamics of a tree, batched over leading axes (SI units).
+
+    Every input is (..., n) (or (n,), broadcast against the others); outputs keep the batch
+    shape. ``functions`` (lazy) is the NumericSystem over the same module (simulation).
+    """
+
+    backend = "recursive"
+
+    def __init__(self, model: Model, tree: KinematicTree,
+                 parameters: Mapping[str, float] | None = None):
+        from . import compiled
+
+        names = tuple(p.name for p in model.parameters)
+        values = resolve_parameters(model, parameters)
+        self.model = model
+        self.tree = tree
+        self.coordinates = tree.coordinates
+        self.n = len(tree.coordinates)
+        self.parameters = {name: float(v) for name, v in zip(names, values.values, strict=True)}
+        self.parameter_values = np.array(list(self.parameters.values()), dtype=float)
+        self.parameter_values.flags.writeable = False
+        self.module = compiled.load_keyed(tree_key(tree, names),
+                                          lambda: module_source(tree, names))
+        P = self.parameter_values
+        m = self.module
+        # The fast path: one C call each, the parameters bound here.
+        self._mass, self._bias, self._gravity = m.mass_matrix, m.bias_forces, m.gravity
+        self._inverse, self._forward = m.inverse_dynamics, m.forward_dynamics
+        self._kinetic, self._potential = m.kinetic_energy, m.potential_energy
+        self._P = P
+
+    def _call(self, function, *arrays):
+        try:
+            return function(*arrays, self._P)
+        except np.linalg.LinAlgError:
+            raise
+        except ValueError as exc:
+            if "batch shapes" in str(exc):  # broadcast in numpy, then one C call
+                arrays = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in arrays))
+                return function(*(np.ascontiguousarray(x) for x in arrays), self._P)
+            field = str(exc).split(":")[0]
+            raise ModelError(f"expected {self.n} values ({', '.join(self.coordinates)}) "
+                             "along the last axis", field=field) from None
+
+    def mass_matrix(self, q):
+        """M(q), shape (..., n, n)."""
+        try:
+            return self._mass(q, self._P)
+        except ValueError:
+            return self._call(self._mass, q)
+
+    def bias_forces(self, q, v):
+        """C(q, q_dot) q_dot + g(q), shape (..., n)."""
+        try:
+            return self._bias(q, v, self._P)
+        except ValueError:
+            return self._call(self._bias, q, v)
+
+    def gravity(self, q):
+        """g(q), shape (..., n)."""
+        try:
+            return self._gravity(q, self._P)
+        except ValueError:
+            return self._call(self._gravity, q)
+
+    def inverse_dynamics(self, q, v, a):
+        """tau = M a + C q_dot + g, shape (..., n)."""
+        try:
+            return self._inverse(q, v, a, self._P)
+        except ValueError:
+            return self._call(self._inverse, q, v, a)
+
+    def forward_dynamics(self, q, v, tau):
+        """q_ddot = M^-1 (tau - C q_dot - g), shape (..., n)."""
+        try:
+            return self._forward(q, v, tau, self._P)
+        except ValueError:
+            return self._call(self._forward, q, v, tau)
+
+    def kinetic_energy(self, q, v):
+        """T in J, shape (...)."""
+        try:
+            return self._kinetic(q, v, self._P)
+        except ValueError:
+            return self._call(self._kinetic, q, v)
+
+    def potential_energy(self, q):
+        """V in J, shape (...)."""
+        try:
+            return self._potential(q, self._P)
+        except ValueError:
+            return self._call(self._potential, q)
+
+
+__all__ = ["RecursiveDynamics", "applicable_tree", "dynamics_functions", "module_source",
+           "tree_key"]

@@ -39,7 +39,7 @@ from ..model.notation import latex_symbol_names
 from ..model.reader import read_model
 from ..model.urdf import example_urdf, read_urdf
 from ..model.values import State, resolve_state
-from ..numerics.dynamics import Dynamics
+from ..numerics.dynamics import model_dynamics, recursive_dynamics
 from ..numerics.events import StopCondition
 from ..numerics.functions import NumericSystem, numeric
 from ..numerics.simulate import SaveAt, StepControl, parse_stop_condition, simulate
@@ -163,19 +163,31 @@ class System:
         """
         if parameters is None and backend == "auto":
             return self._numeric
+        fast = recursive_dynamics(self.model, parameters, backend)  # a URDF tree: no derivation
+        if fast is not None:
+            return fast.numeric_system()
         return numeric(self.equations_of_motion(), parameters, backend=backend)
 
     @cached_property
     def _numeric(self) -> NumericSystem:
         """The default numeric system, compiled once per System (its parameters are fixed)."""
-        return numeric(self.equations_of_motion())
+        fast = self._recursive
+        return fast.numeric_system() if fast is not None else numeric(self.equations_of_motion())
 
-    def dynamics(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"
-                 ) -> Dynamics:
+    @cached_property
+    def _recursive(self):
+        """Recursive dynamics of a URDF tree in generated C, or None (numerics/dynamics.py)."""
+        return recursive_dynamics(self.model)
+
+    def dynamics(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"):
         """M(q), bias C q_dot + g, g(q), inverse and forward dynamics and the energies, batched
         over leading axes (q of shape (n,) or (N, n)); a generalized force tau acts on top of
-        the model's own loads (numerics/dynamics.py)."""
-        return Dynamics(self.numeric(parameters, backend))
+        the model's own loads (numerics/dynamics.py). A URDF robot runs recursive algorithms in
+        generated C (numerics/recursive.py), the other models their derived equations."""
+        if parameters is None and backend == "auto" and self._recursive is not None:
+            return self._recursive
+        return model_dynamics(self.model, lambda: self.numeric(parameters, backend),
+                              parameters, backend)
 
     # -- equilibria, linearization and modes -----------------------------------------------------
 

@@ -9,13 +9,20 @@ dampers, its loads), a generalized force tau applied on top gives M q_ddot = f +
 
 For a URDF arm the actuator parameters tau_<joint> are 0, so f holds gravity and the velocity
 terms only. Units SI (rad or m per coordinate; N m or N for tau; J for energies).
+
+A robot read from URDF (a tree of rigid bodies on revolute, prismatic and fixed joints, nothing
+added) is evaluated by recursive algorithms in generated C instead (recursive.py), without
+deriving its equations: ``model_dynamics`` picks that path wherever it applies.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
+
 import numpy as np
 
 from ..errors import ModelError
+from ..model.model import Model
 from .functions import NumericSystem
 
 
@@ -90,4 +97,34 @@ class Dynamics:
         return self.functions.energy(q, v) - self.functions.energy(q, np.zeros_like(v))
 
 
-__all__ = ["Dynamics"]
+def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = None,
+                       backend: str = "auto"):
+    """The compiled recursive dynamics of a URDF tree (recursive.RecursiveDynamics), or None
+    where they do not apply: not a bare tree, backend "numpy", no compiler (backend "auto"),
+    or a mass matrix that is not positive definite (the symbolic path names the joints)."""
+    from .compiled import BackendUnavailable
+    from .recursive import RecursiveDynamics, applicable_tree
+
+    if backend not in ("auto", "c"):
+        return None
+    tree = applicable_tree(model)
+    if tree is None:
+        return None
+    try:
+        dynamics = RecursiveDynamics(model, tree, parameters)
+    except BackendUnavailable:
+        if backend == "c":
+            raise
+        return None
+    return dynamics if dynamics.regular() else None
+
+
+def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
+                   parameters: Mapping[str, float] | None = None, backend: str = "auto"):
+    """Recursive dynamics where they apply, else Dynamics over ``symbolic()`` (the numeric
+    functions of the derived equations)."""
+    fast = recursive_dynamics(model, parameters, backend)
+    return fast if fast is not None else Dynamics(symbolic())
+
+
+__all__ = ["Dynamics", "model_dynamics", "recursive_dynamics"]

@@ -680,6 +680,27 @@ class RecursiveDynamics:
         self._kinetic, self._potential = m.kinetic_energy, m.potential_energy
         self._P = P
 
+    def regular(self) -> bool:
+        """Whether M is positive definite at a few random states (a massless branch is not)."""
+        rng = np.random.default_rng(0)
+        try:
+            np.linalg.cholesky(self.mass_matrix(rng.uniform(-np.pi, np.pi, (3, self.n))))
+        except np.linalg.LinAlgError:
+            return False
+        return True
+
+    def numeric_system(self):
+        """The NumericSystem over this module (M, f = -b, energy, accelerations, rhs), as the
+        symbolic path gives it; simulation uses it."""
+        from .functions import NumericSystem, _CKernel
+
+        return NumericSystem(coordinates=self.coordinates, constraint_names=(),
+                             constraint_kinds=(), parameters=dict(self.parameters),
+                             _kernel=_CKernel(self.module, self.parameter_values))
+
+    def __repr__(self) -> str:
+        return f"RecursiveDynamics(coordinates={list(self.coordinates)})"
+
     def _call(self, function, *arrays):
         try:
             return function(*arrays, self._P)

@@ -149,6 +149,27 @@ def test_ensemble_equals_serial_simulations(client, tmp_path):
     assert np.all(np.abs(ds["theta1"].values - 0.3) < 0.05)
 
 
+def test_ensemble_loads_the_cached_module_without_generating_c(client, monkeypatch):
+    """A second study of the same equations finds the compiled module by the equations' key:
+    no C is generated again (that cost seconds per process for larger models)."""
+    from lagrangian.numerics import codegen, compiled
+
+    if not compiled.available():
+        pytest.skip("no C compiler")
+    pendulum = lagrangian.load("double_pendulum")
+    first = pendulum.sweep(compute="simulate", t_end=0.5, samples=3,
+                           sample={"theta1": "uniform(0.1, 0.2)"}, members=2, client=client)
+
+    def refuse(eom):
+        raise AssertionError("C generated again for equations already compiled")
+
+    monkeypatch.setattr(codegen, "generate", refuse)
+    again = pendulum.sweep(compute="simulate", t_end=0.5, samples=3,
+                           sample={"theta1": "uniform(0.1, 0.2)"}, members=2, client=client)
+    assert again.equals(first)
+    assert list(again["status"].values) == ["ok", "ok"]
+
+
 def test_stop_condition_time_per_member(client):
     pendulum = lagrangian.load("pendulum")
     ds = pendulum.sweep({"theta": [0.2, 0.5]}, compute="simulate", t_end=3.0, samples=31,

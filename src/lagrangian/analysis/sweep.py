@@ -115,7 +115,7 @@ class Study:
     axes: tuple[tuple[str, np.ndarray], ...]
     draws: tuple[tuple[str, np.ndarray], ...] = ()
     simulation: SimulationOptions | None = None
-    generated: object = None  # the C source of the model's module (numerics/codegen.py)
+    compiled_key: str | None = None  # the compiled module's cache key (numerics/compiled.py)
     chunk_size: int = 1000
     key: str = field(default="", compare=False)
     functions_key: str = field(default="", compare=False)
@@ -552,19 +552,21 @@ class _SimulationFunctions:
 
 def _prepare_simulation(study: Study):
     from ..numerics import compiled
+    from ..numerics.codegen import CodegenError, generate
     from ..numerics.invariants import energy_is_conserved
 
     module = None
     # The compiled loop where it applies: no constraints (no projection), no stop condition
     # (no event location) and T + V the invariant (the module evaluates it); otherwise each
     # member is the single-point simulation itself.
-    fast = (study.generated is not None and study.eom.model.constraints == ()
+    fast = (study.compiled_key is not None and study.eom.model.constraints == ()
             and study.simulation.stop_when is None and study.simulation.method == "DOP853"
             and energy_is_conserved(study.eom))
     if fast:
         try:
-            module = compiled.load(study.generated)
-        except compiled.BackendUnavailable:
+            # from the on-disk cache the caller filled; a worker on another machine builds it
+            module = compiled.load_keyed(study.compiled_key, lambda: generate(study.eom))
+        except (compiled.BackendUnavailable, CodegenError):
             module = None
     model = study.model
     defaults = np.array([np.nan if p.value is None else float(p.value) for p in model.parameters])

@@ -44,21 +44,22 @@ def chunk_task(study: Study, start: int, stop: int) -> dict[str, np.ndarray]:
 
 
 def with_compiled_module(study: Study) -> Study:
-    """For an ensemble: build the model's C module once here (into the on-disk cache), and give
-    the workers its source so they load it instead of building it."""
+    """For an ensemble: build the model's C module once here, into the on-disk cache keyed by
+    the equations (no C generated on a hit), so the workers load it instead of building it."""
     if study.compute != "simulate":
         return study
     from ..numerics import compiled
     from ..numerics.codegen import CodegenError, generate
+    from ..numerics.functions import equations_key
 
     if not compiled.available():
         return study
+    key = equations_key(study.eom)
     try:
-        generated = generate(study.eom)
-        compiled.load(generated)
+        compiled.load_keyed(key, lambda: generate(study.eom))
     except (CodegenError, compiled.BackendUnavailable):
         return study
-    return replace(study, generated=generated)
+    return replace(study, compiled_key=key)
 
 
 class PartialStore:

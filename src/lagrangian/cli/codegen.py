@@ -26,7 +26,7 @@ def codegen(
     """Write M(q), bias C q_dot + g, gravity, inverse and forward dynamics and the energies as
     standalone C (no Python, no allocation, libm only) for embedding in a controller."""
     from ..numerics.codegen import CodegenError
-    from ..numerics.standalone import c_prefix, standalone_c
+    from ..numerics.standalone import c_prefix, standalone_for
 
     if lang.lower() not in LANGUAGES:
         raise ModelError(f"unknown language {lang!r}: use c", field="--lang")
@@ -42,7 +42,7 @@ def codegen(
         raise ModelError(f"parameters without a value: {', '.join(missing)} (give them with --set)",
                          field="--set")
     try:
-        code = standalone_c(system.equations_of_motion(), system.parameters, name)
+        code = standalone_for(system.model, system.equations_of_motion, system.parameters, name)
     except CodegenError as exc:
         raise ModelError(f"cannot write C: {exc}", field="--lang") from None
     directory.mkdir(parents=True, exist_ok=True)

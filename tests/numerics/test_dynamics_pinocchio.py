@@ -41,10 +41,11 @@ ARM = """<?xml version="1.0"?>
 
 
 @pytest.mark.slow
-def test_spatial_arm_matches_pinocchio(tmp_path):
+@pytest.mark.parametrize("backend", ["numpy", "auto"])  # derived equations; recursive C
+def test_spatial_arm_matches_pinocchio(tmp_path, backend):
     path = tmp_path / "spatial.urdf"
     path.write_text(ARM)
-    f = lagrangian.load(path).dynamics(backend="numpy")
+    f = lagrangian.load(path).dynamics(backend=backend)
     model = pin.buildModelFromXML(ARM)
     data = model.createData()
     assert model.nq == f.n == 3

@@ -16,6 +16,7 @@ perturbation is eliminated with that constraint differentiated once, which adds 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
@@ -34,8 +35,11 @@ FIELD = "steady"
 BALANCE_TOLERANCE = 1e-8
 
 
-def steady_rates(eom: EquationsOfMotion, steady: Mapping[str, float]) -> dict[int, float]:
-    """Coordinate index -> constant rate for names like ``psi_dot`` (rad/s or m/s)."""
+def steady_rates(eom: EquationsOfMotion, steady: Mapping[str, float | str],
+                 parameters: Mapping[str, float] | ParameterValues | None = None,
+                 ) -> dict[int, float]:
+    """Coordinate index -> constant rate for names like ``psi_dot`` (rad/s or m/s); a rate may
+    be an expression in the parameters (``"-v/rR"``), read with the model grammar."""
     model = eom.model
     velocities = {velocity_name(c.name): i for i, c in enumerate(model.coordinates)}
     rates = {}
@@ -46,6 +50,8 @@ def steady_rates(eom: EquationsOfMotion, steady: Mapping[str, float]) -> dict[in
                 hint = f"; give the rate of '{name}' as {velocity_name(name)}=VALUE"
             raise ModelError(f"'{name}' is not a velocity of this model{hint}",
                              field=f"{FIELD}.{name}")
+        if isinstance(value, str):
+            value = _parameter_value(model, value, f"{FIELD}.{name}", parameters)
         try:
             rate = float(value)
         except (TypeError, ValueError):
@@ -59,61 +65,126 @@ def steady_rates(eom: EquationsOfMotion, steady: Mapping[str, float]) -> dict[in
     return rates
 
 
-def steady_linear_model(
-    eom: EquationsOfMotion, about: Mapping[str, float] | None, steady: Mapping[str, float],
-    parameters: Mapping[str, float] | ParameterValues | None = None,
-) -> LinearModel:
-    """The linear model about the steady motion with the given rates (``steady``: velocity
-    name -> rate) at the configuration ``about`` (other non-cyclic coordinates solved for)."""
-    model = eom.model
-    rates = steady_rates(eom, steady)
-    names = [c.name for c in model.coordinates]
-    n = len(names)
-    state = resolve_state(model, about, field="about", velocities=False, time=False)
-    about = {name: v for name, v in zip(names, state.q, strict=True) if name in state.given}
-    values = resolve_parameters(model, parameters).symbol_values(model)
-    q, q_dot, t = model.q, model.q_dot, model.time
-    forcing = [as_expression(e).xreplace(values) for e in eom.forcing]
-    mass = [as_expression(e).xreplace(values) for e in eom.mass_matrix]
-    k = len(model.constraints)
-    jacobian = [as_expression(e).xreplace(values) for e in eom.constraint_jacobian]
-    bias = [as_expression(e).xreplace(values) for e in eom.velocity_bias]
-    gamma = [as_expression(e).xreplace(values) for e in eom.acceleration_rhs]
-    if any(t in e.free_symbols for e in (*forcing, *mass, *jacobian, *bias)):
-        raise ModelError("the equations depend on time t explicitly, so there is no steady "
-                         "motion to linearize about", field=FIELD)
-    d = Differentiator()
-    cyclic = sorted(rates)
-    stiffness = [-d(e, x) for e in forcing for x in q]
-    damping = [-d(e, v) for e in forcing for v in q_dot]
-    drift = [d(e, q[c]) for c in cyclic for e in (*forcing, *mass, *jacobian, *bias)]
-    level = [sp.Add(*(jacobian[c * n + j] * q_dot[j] for j in range(n)), bias[c])
-             for c in range(k)]  # A q_dot + b
-    level_slope = [d(e, x) for e in level for x in q]
-    jacobian_slope = [d(e, x) for e in jacobian for x in q]
-    # Holonomic constraints hold at position level too: Phi(q0) = 0 on the steady motion.
-    positions = [c.expression.xreplace(values) for c in model.constraints
-                 if c.kind == "holonomic"]
-    sizes = [n * n, n, n * n, n * n, k * n, k, k, k * n, k * n * n, len(cyclic) * (n * n + n
-                                                                            + k * n + k)]
-    function = StateFunction(model, [*mass, *forcing, *stiffness, *damping, *jacobian, *gamma,
-                                     *level, *level_slope, *jacobian_slope, *drift,
-                                     *positions])
+def _parameter_value(model, text: str, field: str, parameters) -> float:
+    """The value of an expression in the model's parameters (at their values)."""
+    from ..model.expressions import parse_expression
 
-    def evaluate(qv, vv):
-        parts = np.split(function.at(qv, vv, 0.0), np.cumsum(sizes))
+    names = {p.name: p.symbol for p in model.parameters}
+    expr = parse_expression(text, names, field=field)
+    values = resolve_parameters(model, parameters).symbol_values(model)
+    try:
+        return float(expr.xreplace(values))
+    except (TypeError, ValueError):
+        raise ModelError(f"'{text}' has no value (a parameter without a value?)",
+                         field=field) from None
+
+
+class SteadyFunctions:
+    """M, f, their slopes -df/dq and -df/dq_dot, the constraints A, gamma, A q_dot + b, its
+    slope H, dA/dq and the holonomic residuals, compiled once at given parameter values."""
+
+    def __init__(self, eom: EquationsOfMotion, values: Mapping[sp.Symbol, float]):
+        model = eom.model
+        self.model = model
+        q, q_dot, t = model.q, model.q_dot, model.time
+        n = self.n = len(q)
+        k = self.k = len(model.constraints)
+        forcing = [as_expression(e).xreplace(values) for e in eom.forcing]
+        mass = [as_expression(e).xreplace(values) for e in eom.mass_matrix]
+        jacobian = [as_expression(e).xreplace(values) for e in eom.constraint_jacobian]
+        bias = [as_expression(e).xreplace(values) for e in eom.velocity_bias]
+        gamma = [as_expression(e).xreplace(values) for e in eom.acceleration_rhs]
+        if any(t in e.free_symbols for e in (*forcing, *mass, *jacobian, *bias)):
+            raise ModelError("the equations depend on time t explicitly, so there is no "
+                             "steady motion to linearize about", field=FIELD)
+        d = Differentiator()
+        stiffness = [-d(e, x) for e in forcing for x in q]
+        damping = [-d(e, v) for e in forcing for v in q_dot]
+        level = [sp.Add(*(jacobian[c * n + j] * q_dot[j] for j in range(n)), bias[c])
+                 for c in range(k)]  # A q_dot + b
+        level_slope = [d(e, x) for e in level for x in q]
+        jacobian_slope = [d(e, x) for e in jacobian for x in q]
+        # Holonomic constraints hold at position level too: Phi(q0) = 0 on the steady motion.
+        self.holonomic = [i for i, c in enumerate(model.constraints) if c.kind == "holonomic"]
+        positions = [model.constraints[i].expression.xreplace(values) for i in self.holonomic]
+        self.sizes = [n * n, n, n * n, n * n, k * n, k, k, k * n, k * n * n]
+        self.function = StateFunction(model, [*mass, *forcing, *stiffness, *damping, *jacobian,
+                                              *gamma, *level, *level_slope, *jacobian_slope,
+                                              *positions])
+
+    def evaluate(self, qv, vv) -> dict[str, np.ndarray]:
+        n, k = self.n, self.k
+        parts = np.split(self.function.at(qv, vv, 0.0), np.cumsum(self.sizes))
         return {"M": parts[0].reshape(n, n), "f": parts[1], "K": parts[2].reshape(n, n),
                 "C": parts[3].reshape(n, n), "A": parts[4].reshape(k, n), "gamma": parts[5],
                 "level": parts[6], "H": parts[7].reshape(k, n),
-                "dA": parts[8].reshape(k, n, n), "drift": parts[9], "Phi": parts[10]}
+                "dA": parts[8].reshape(k, n, n), "Phi": parts[9]}
 
-    def solve(values):
+    def solve(self, values) -> tuple[np.ndarray, np.ndarray]:
         """(q_ddot, lambda) of M q_ddot + A^T lambda = f, A q_ddot = gamma."""
+        n, k = self.n, self.k
         M, A = values["M"], values["A"]
         system = np.block([[M, A.T], [A, np.zeros((k, k))]])
         right = np.concatenate([values["f"], values["gamma"]])
         solution = np.linalg.lstsq(system, right, rcond=None)[0]
         return solution[:n], solution[n:]
+
+
+# The compiled functions of the last few (equations, parameter values): a speed sweep or a
+# benchmark-form fit linearizes the same equations many times.
+_FUNCTIONS: dict[tuple, tuple[EquationsOfMotion, SteadyFunctions]] = {}
+
+
+def steady_functions(eom: EquationsOfMotion,
+                     parameters: Mapping[str, float] | ParameterValues | None = None,
+                     ) -> SteadyFunctions:
+    """The compiled steady-motion functions of ``eom`` at these parameter values (cached)."""
+    values = resolve_parameters(eom.model, parameters).symbol_values(eom.model)
+    key = (id(eom), tuple(sorted((str(s), float(v)) for s, v in values.items())))
+    found = _FUNCTIONS.get(key)
+    if found is not None and found[0] is eom:
+        return found[1]
+    functions = SteadyFunctions(eom, values)
+    if len(_FUNCTIONS) >= 4:
+        _FUNCTIONS.pop(next(iter(_FUNCTIONS)))
+    _FUNCTIONS[key] = (eom, functions)
+    return functions
+
+
+@dataclass(frozen=True)
+class SteadyPoint:
+    """The steady motion (q0, q_dot0) with the multipliers on it, and the linearized terms:
+    M dq_ddot + C dq_dot + K dq + G^T dlambda = dQ, G dq_dot + H dq = 0 (SI units)."""
+
+    q: np.ndarray
+    q_dot: np.ndarray
+    multipliers: np.ndarray
+    M: np.ndarray
+    C: np.ndarray
+    K: np.ndarray
+    G: np.ndarray
+    H: np.ndarray
+    holonomic: tuple[int, ...]
+    rates: dict[int, float]
+
+
+def steady_point(
+    eom: EquationsOfMotion, about: Mapping[str, float] | None, steady: Mapping[str, float | str],
+    parameters: Mapping[str, float] | ParameterValues | None = None,
+) -> SteadyPoint:
+    """The steady motion with the given rates (``steady``: velocity name -> rate, a number or
+    an expression in the parameters) at the configuration ``about`` (other non-cyclic
+    coordinates solved for), checked, with its linearized terms."""
+    model = eom.model
+    rates = steady_rates(eom, steady, parameters)
+    names = [c.name for c in model.coordinates]
+    n = len(names)
+    state = resolve_state(model, about, field="about", velocities=False, time=False)
+    about = {name: v for name, v in zip(names, state.q, strict=True) if name in state.given}
+    functions = steady_functions(eom, parameters)
+    k = functions.k
+    evaluate, solve = functions.evaluate, functions.solve
+    cyclic = sorted(rates)
 
     q0 = np.array([about.get(c.name, c.initial if c.initial is not None else 0.0)
                    for c in model.coordinates], dtype=float)
@@ -149,13 +220,11 @@ def steady_linear_model(
     try:
         np.linalg.cholesky(M)
         q_ddot, multipliers = solve(at)
-        K = at["K"] + np.einsum("c,cij->ij", multipliers, at["dA"])
-        inverse = np.linalg.inv(M)
-        S = np.linalg.inv(G @ inverse @ G.T) if k else np.zeros((0, 0))
     except np.linalg.LinAlgError:
         raise DerivationError("the mass matrix is singular on this steady motion (a gimbal-lock "
                               "configuration of the rotation sequence?); the linear model has "
                               "no state-space form") from None
+    K = at["K"] + np.einsum("c,cij->ij", multipliers, at["dA"])
     if np.max(np.abs(q_ddot), initial=0.0) > BALANCE_TOLERANCE * scale:
         moving = ", ".join(f"{names[i]}_ddot = {q_ddot[i]:.6g}" for i in range(n)
                            if abs(q_ddot[i]) > BALANCE_TOLERANCE * scale)
@@ -164,30 +233,59 @@ def steady_linear_model(
                          f"{', '.join(f'{velocity_name(names[i])} = {r:g}' for i, r in rates.items())}"
                          f" the accelerations are not zero ({moving}); give other rates or "
                          "configuration", field=FIELD)
-    # A cyclic coordinate appears in neither M nor f; checked here and at nearby states.
+    # A cyclic coordinate appears in neither M, f nor the constraints: the same values with it
+    # shifted, checked here and at nearby states (no derivatives needed).
     rng = np.random.default_rng(0)
-    dependence = at["drift"]
+    keys = ("M", "f", "A", "level")
+    size = max(1.0, float(np.abs(M).max()) * scale)
     for trial in range(3):
+        qv, vv = q0, v0
         if trial:
             qv = q0 + rng.uniform(-0.3, 0.3, n)
             vv = v0 + rng.uniform(-1.0, 1.0, n)
-            dependence = evaluate(qv, vv)["drift"]
-        blocks = dependence.reshape(len(cyclic), -1)
-        for row, i in enumerate(cyclic):
-            size = max(1.0, float(np.abs(M).max()) * scale)
-            if np.max(np.abs(blocks[row]), initial=0.0) > 1e-9 * size:
+        base = evaluate(qv, vv)
+        for i in cyclic:
+            shifted = qv.copy()
+            shifted[i] += 0.7
+            other = evaluate(shifted, vv)
+            change = max(float(np.max(np.abs(other[key] - base[key]), initial=0.0))
+                         for key in keys)
+            if change > 1e-9 * size:
                 raise ModelError(
                     f"'{names[i]}' is not cyclic: the equations of motion depend on it, so it "
                     "cannot turn at a constant rate in a steady motion (choose coordinates in "
                     "which the spin angle is absent from L)", field=f"{FIELD}.{names[i]}_dot")
+    return SteadyPoint(q0, v0, multipliers, M, C, K, G if k else np.zeros((0, n)),
+                       H if k else np.zeros((0, n)), tuple(functions.holonomic), rates)
+
+
+def steady_linear_model(
+    eom: EquationsOfMotion, about: Mapping[str, float] | None, steady: Mapping[str, float | str],
+    parameters: Mapping[str, float] | ParameterValues | None = None,
+) -> LinearModel:
+    """The linear model about the steady motion with the given rates (``steady``: velocity
+    name -> rate) at the configuration ``about`` (other non-cyclic coordinates solved for)."""
+    model = eom.model
+    names = [c.name for c in model.coordinates]
+    n = len(names)
+    point = steady_point(eom, about, steady, parameters)
+    M, C, K, G, H = point.M, point.C, point.K, point.G, point.H
+    k = G.shape[0]
+    try:
+        inverse = np.linalg.inv(M)
+        S = np.linalg.inv(G @ inverse @ G.T) if k else np.zeros((0, 0))
+    except np.linalg.LinAlgError:
+        raise DerivationError("the mass matrix is singular on this steady motion (a gimbal-lock "
+                              "configuration of the rotation sequence?); the linear model has "
+                              "no state-space form") from None
     # dq_ddot = M^-1 P (-C dq_dot - K dq) - M^-1 G^T S H dq_dot, P = 1 - G^T S G M^-1: the
     # multipliers' perturbation keeps d/dt (G dq_dot + H dq) = 0.
     P = np.eye(n) - G.T @ S @ G @ inverse
     A = np.block([[np.zeros((n, n)), np.eye(n)],
                   [-inverse @ P @ K, -inverse @ P @ C - inverse @ G.T @ S @ H]])
     return LinearModel(
-        equilibrium={name: float(v) for name, v in zip(names, q0, strict=True)},
-        multipliers={c.name: float(v) for c, v in zip(model.constraints, multipliers,
+        equilibrium={name: float(v) for name, v in zip(names, point.q, strict=True)},
+        multipliers={c.name: float(v) for c, v in zip(model.constraints, point.multipliers,
                                                       strict=True)},
         coordinates=tuple(names),
         user_coordinates=tuple(names),
@@ -202,8 +300,9 @@ def steady_linear_model(
         full_mass_matrix=M,
         full_damping_matrix=C,
         full_stiffness_matrix=K,
-        steady={velocity_name(names[i]): float(r) for i, r in sorted(rates.items())},
+        steady={velocity_name(names[i]): float(r) for i, r in sorted(point.rates.items())},
     )
 
 
-__all__ = ["steady_linear_model", "steady_rates"]
+__all__ = ["SteadyFunctions", "SteadyPoint", "steady_functions", "steady_linear_model", "steady_point",
+           "steady_rates"]

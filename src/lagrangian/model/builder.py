@@ -14,6 +14,14 @@ from collections.abc import Iterable, Sequence
 import sympy as sp
 
 from ..errors import ModelError, did_you_mean
+from .contacts import (
+    RollingContact,
+    contact_velocity,
+    dot,
+    ground_tangents,
+    identically_zero,
+    wheel_down_direction,
+)
 from .expressions import RESERVED, parse_expression
 from .model import (
     TIME,
@@ -34,8 +42,10 @@ from .model import (
     multiplier_name,
     velocity_name,
 )
-from .rotations import GROUND, Frame, Moment, RigidBody, RotationReader
+from .rotations import GROUND, Frame, Moment, RigidBody, RotationReader, apply
 
+# A rolling contact's velocity coefficients are trigsimp'd only below this op count (cheap).
+TIDY_LIMIT = 40
 _IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _ZERO: Vector = (sp.S.Zero, sp.S.Zero, sp.S.Zero)
 
@@ -64,6 +74,7 @@ class ModelBuilder:
         self._loads: list[PointForce | Torque] = []
         self._generalized: dict[str, list[sp.Expr]] = {}
         self._constraints: list[Constraint] = []
+        self._contacts: list[RollingContact] = []
         self._component_names: set[str] = set()
         # Every vector given, in order: (field, components, what it places: "particle", "body"
         # or None). The first particle or body position fixes the model's dimension; every
@@ -257,7 +268,7 @@ class ModelBuilder:
             key = "position" if position is not None else "origin"
             frame = Frame(self.vector(start, f"{field}.{key}", velocities=False,
                                       places="rigid body"), frame.rotation,
-                          frame.angular_velocity)
+                          frame.angular_velocity, (), frame.world_angular_velocity)
             if rotation is not None:
                 frame = reader.sequence(frame, rotation, f"{field}.rotation")
         offset = (self.vector(center, f"{field}.center", velocities=False)
@@ -463,6 +474,114 @@ class ModelBuilder:
         self._constraints.append(Constraint(name, kind, expression))
         return self
 
+    def add_rolling_contact(
+        self, name: str, body: str, radius: object, axle: object, *,
+        normal: Sequence[object] | None = None, field: str | None = None,
+    ) -> ModelBuilder:
+        """A knife-edge wheel rolling without slipping on the ground plane r . n = 0.
+
+        ``body``: a 3D body whose origin is the wheel's centre; ``radius`` (m, > 0); ``axle``
+        in body axes ("y" or a 3-vector); ``normal``: the ground's unit normal (numbers,
+        pointing out of the ground; default against gravity, else +z). Adds the velocity
+        constraints ``<name>_friction_<t>`` along the two ground tangents (the friction on the
+        wheel along t is -lambda) and, where the contact height r_C . n is not identically
+        zero in these coordinates, the holonomic ``<name>_normal`` (normal force -lambda).
+        """
+        field = field or f"contact '{name}'"
+        if not isinstance(name, str) or not _IDENTIFIER.match(name):
+            raise self._error(f"contact name {name!r} must be an identifier", f"{field}.name")
+        self._component(name, field)
+        target = next((b for b in self._rigid_bodies if b.name == body), None)
+        if target is None:
+            planar = any(b.name == body for b in self._bodies)
+            hint = (" (a rolling contact needs a body in space: give it 'rotation' or a "
+                    "'joint')" if planar else did_you_mean(str(body),
+                                                             [b.name for b in self._rigid_bodies]))
+            raise self._error(f"'{body}' is not a 3D body (declare it before the contact)"
+                              f"{hint}", f"{field}.body")
+        r = self._parameter_expression(radius, f"{field}.radius")
+        if r.is_number and not r.is_positive or self._nonpositive_at_values(r):
+            raise self._error(f"the radius must be positive (it is {r})", f"{field}.radius")
+        reader = self._rotation_reader()
+        a_body = reader.axis(axle, f"{field}.axle")
+        if any(c.free_symbols for c in a_body):
+            raise self._error("the axle must be numbers (a direction fixed in the body)",
+                              f"{field}.axle")
+        n = self._ground_normal(normal, f"{field}.normal")
+        frame = self._frames[body]
+        omega = frame.world_angular_velocity
+        if omega is None:
+            omega = target.world_angular_velocity()
+        reference = {c.symbol: (c.initial or 0.0) for c in self._coordinates}
+        reference |= {p.symbol: p.value for p in self._parameters if p.value is not None}
+        a = apply(target.rotation, a_body)
+        down = wheel_down_direction(a, n, reference)
+        arm = tuple(r * c for c in down)
+        centre = target.origin
+        contact = tuple(g + c for g, c in zip(centre, arm, strict=True))
+        v_centre = tuple(self._time_derivative(c) for c in centre)
+        slip = contact_velocity(v_centre, omega, arm)
+        tangents, labels = ground_tangents([float(c) for c in n])
+        names = []
+        for t, label in zip(tangents, labels, strict=True):
+            constraint = f"{name}_friction_{label}"
+            self._component(constraint, field)
+            self._constraints.append(Constraint(constraint, "velocity",
+                                                self._tidy_velocity_row(dot(slip, t))))
+            names.append(constraint)
+        height = dot(contact, n)
+        values = {p.symbol: p.value for p in self._parameters}
+        flat = identically_zero(height, [c.symbol for c in self._coordinates], values)
+        if not flat:
+            constraint = f"{name}_normal"
+            self._component(constraint, field)
+            self._constraints.append(Constraint(constraint, "holonomic", height))
+            names.append(constraint)
+        self._contacts.append(RollingContact(name, body, r, a_body, n, tangents, contact,
+                                             tuple(names), not flat))
+        return self
+
+    def _tidy_velocity_row(self, expr: sp.Expr) -> sp.Expr:
+        """sum_j A_j(q) q_dot_j with each short A_j trigsimp'd (the sin^2 + cos^2 that omega x
+        arm leaves); long ones are kept as they come (no simplify on long expressions)."""
+        velocities = [c.velocity for c in self._coordinates]
+        rest = expr.xreplace({v: 0 for v in velocities})
+        terms = [rest] if rest != 0 else []
+        for v in velocities:
+            coefficient = expr.diff(v)  # expr is linear in the velocities
+            if coefficient == 0:
+                continue
+            if sp.count_ops(coefficient) <= TIDY_LIMIT:
+                coefficient = sp.trigsimp(sp.expand(coefficient))
+            terms.append(coefficient * v)
+        return sp.Add(*terms)
+
+    def _ground_normal(self, normal, field: str) -> Vector:
+        if normal is None:
+            if self._gravity is not None:
+                direction = self._gravity.direction
+                if not all(c.is_number for c in direction):
+                    raise self._error("gravity's direction depends on parameters: give the "
+                                      "ground's 'normal' as numbers", field)
+                return tuple(sp.nsimplify(-c) if c.is_Rational else -c for c in direction)
+            return (sp.S.Zero, sp.S.Zero, sp.S.One)
+        vector = self.vector(normal, field)
+        if any(c.free_symbols for c in vector):
+            raise self._error("the ground normal must be numbers", field)
+        squared = sp.Add(*(c**2 for c in vector))
+        if squared == 0:
+            raise self._error("the ground normal is the zero vector", field)
+        return tuple(c / sp.sqrt(squared) for c in vector)
+
+    def _nonpositive_at_values(self, expr: sp.Expr) -> bool:
+        values = {p.symbol: p.value for p in self._parameters if p.value is not None}
+        if not expr.free_symbols or not expr.free_symbols <= set(values):
+            return False
+        try:
+            return float(expr.xreplace(values)) <= 0
+        except (TypeError, ValueError):
+            return False
+
     # -- expressions ----------------------------------------------------------------------
 
     def expression(self, value: object, field: str, *, velocities: bool = True) -> sp.Expr:
@@ -556,6 +675,7 @@ class ModelBuilder:
             generalized_forces=tuple((k, sp.Add(*v)) for k, v in self._generalized.items()),
             constraints=tuple(self._constraints),
             source=self.source,
+            contacts=tuple(self._contacts),
         )
 
     # -- helpers --------------------------------------------------------------------------

@@ -15,6 +15,7 @@ from .units import check_unit, to_si
 TOP_LEVEL = {
     "name", "description", "coordinates", "parameters", "definitions", "energy", "gravity",
     "particles", "bodies", "springs", "dampers", "loads", "generalized_forces", "constraints",
+    "contacts",
 }
 COMPONENT_KEYS = {
     "particles": ({"name", "mass", "position"}, set()),
@@ -24,6 +25,7 @@ COMPONENT_KEYS = {
     "dampers": ({"name", "coefficient"}, {"rate", "between"}),
     "loads": ({"name"}, {"point", "force", "torque", "angle", "body", "moment", "axes"}),
     "constraints": ({"name"}, {"holonomic", "velocity"}),
+    "contacts": ({"name", "body", "radius", "axle"}, {"normal"}),
 }
 
 
@@ -201,6 +203,11 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
     for key, text in _table(data, "generalized_forces", source).items():
         builder.add_generalized_force(key, text, field=f"generalized_forces.{key}")
 
+    for index, item in _components(data, "contacts", source):
+        field = f"contacts[{index}]"
+        builder.add_rolling_contact(item["name"], _string(item["body"], f"{field}.body", source),
+                                    item["radius"], item["axle"], normal=item.get("normal"),
+                                    field=field)
     for index, item in _components(data, "constraints", source):
         builder.add_constraint(
             item["name"], holonomic=item.get("holonomic"), velocity=item.get("velocity"),

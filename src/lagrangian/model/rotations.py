@@ -128,9 +128,13 @@ class Frame:
     rotation: Matrix3
     angular_velocity: Vector
     singularities: tuple[tuple[str, tuple[str, ...], sp.Expr], ...] = ()
+    # omega in world axes, composed step by step (omega_parent + alpha_dot R u) so that no
+    # sin^2 + cos^2 of a spin angle is left to cancel, as R omega_body would leave (rolling
+    # contacts use it); None where it was not followed.
+    world_angular_velocity: Vector | None = None
 
 
-GROUND = Frame(_ZERO, _IDENTITY, _ZERO)
+GROUND = Frame(_ZERO, _IDENTITY, _ZERO, (), _ZERO)
 
 
 def rotate(frame: Frame, axis: Vector, angle: sp.Expr, rate: sp.Expr) -> Frame:
@@ -138,13 +142,17 @@ def rotate(frame: Frame, axis: Vector, angle: sp.Expr, rate: sp.Expr) -> Frame:
     step = axis_rotation(axis, angle)
     omega = add(apply_transpose(step, frame.angular_velocity),
                 tuple(rate * a for a in axis))
-    return Frame(frame.origin, compose(frame.rotation, step), omega, frame.singularities)
+    world = None
+    if frame.world_angular_velocity is not None:
+        world = add(frame.world_angular_velocity,
+                    tuple(rate * a for a in apply(frame.rotation, axis)))
+    return Frame(frame.origin, compose(frame.rotation, step), omega, frame.singularities, world)
 
 
 def translate(frame: Frame, offset: Vector) -> Frame:
     """The frame moved by ``offset`` given in its own axes."""
     return Frame(add(frame.origin, apply(frame.rotation, offset)), frame.rotation,
-                 frame.angular_velocity, frame.singularities)
+                 frame.angular_velocity, frame.singularities, frame.world_angular_velocity)
 
 
 # -- reading the user's description -----------------------------------------------------------
@@ -179,8 +187,11 @@ class RotationReader:
         vector = self.vector(value, field)
         squared = sp.Add(*(c**2 for c in vector))
         if squared.free_symbols:
-            raise self.error("a joint axis must be numbers (a direction fixed in the parent)",
-                             field)
+            # parameters only (a steering axis tilted by an angle lambda): fixed in the parent
+            if any(self.rate(c) != 0 for c in vector):
+                raise self.error("a joint axis must be fixed in the parent (numbers or "
+                                 "parameters, not coordinates or time)", field)
+            squared = sp.trigsimp(squared)  # sin(a)^2 + cos(a)^2: short, parameters only
         if squared == 0:
             raise self.error("the axis has zero length", field)
         norm = sp.sqrt(squared)
@@ -219,7 +230,8 @@ class RotationReader:
             determinant = sp.expand(sp.Add(*(a * b for a, b in zip(first, cross, strict=True))))
             names = tuple(str(a) for _, _, a in steps)
             frame = Frame(frame.origin, frame.rotation, frame.angular_velocity,
-                          (*frame.singularities, (f"{n1}-{n2}-{n3}", names, determinant)))
+                          (*frame.singularities, (f"{n1}-{n2}-{n3}", names, determinant)),
+                          frame.world_angular_velocity)
         return frame
 
     def joint(self, parent: Frame, value: object, field: str) -> Frame:

@@ -4,7 +4,9 @@ Structure is used instead of generic time differentiation: each particle and bod
 M += m J^T J and f -= m J^T a_rest (its velocity Jacobian J and the acceleration at q_ddot = 0),
 which is exactly the Euler-Lagrange operator applied to its 1/2 m v.v for a constant m; a mass or
 inertia that depends on q or t adds 1/2 dm/dq_i v.v - m_dot v.J_i to f (and g dm/dq_i d.r to the
-weight), so the equations stay those of the printed L. A user-given L(q, q_dot, t)
+weight), so the equations stay those of the printed L. A rigid body in space with constant
+inertia and no explicit t whose expanded kinematics would be large goes through its Jacobians
+instead, unexpanded (body_jacobians.py). A user-given L(q, q_dot, t)
 goes through the general formula W q_ddot = dL/dq - (d^2L/dq_dot dq) q_dot - d^2L/dq_dot dt.
 """
 
@@ -15,6 +17,7 @@ from collections import defaultdict
 import sympy as sp
 
 from ..model.model import Model, multiplier_name
+from .body_jacobians import jacobian_equations, takes_jacobian_form
 from .constraints import constraint_terms
 from .equations import EquationsOfMotion
 from .kinematics import Differentiator
@@ -97,12 +100,21 @@ def _collect(groups: dict[sp.Expr, list[sp.Expr]]) -> sp.Expr:
                     for term, coefficients in groups.items()))
 
 
-def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
-    """Form the equations of motion of ``model`` by Lagrange's method (units: SI)."""
+def derive(model: Model, *, check: bool = True,
+           jacobian_form: bool | None = None) -> EquationsOfMotion:
+    """Form the equations of motion of ``model`` by Lagrange's method (units: SI).
+
+    ``jacobian_form``: derive the scleronomic rigid bodies of constant inertia through their
+    Jacobians, unexpanded (True), term by term (False), or by the size of their expanded
+    kinematics (None; see body_jacobians.py). Every other body takes the term-by-term path.
+    """
     q, q_dot, t = model.q, model.q_dot, model.time
     n = len(q)
     acc = _Accumulator(n)
     d = Differentiator()
+    sizes: dict = {}
+    unexpanded = {k for k, rigid in enumerate(model.rigid_bodies)
+                  if takes_jacobian_form(rigid, q, t, d, sizes, jacobian_form)}
     jacobian_row, time_rate = d.row, d.rate
     kinetic_terms: list[sp.Expr] = []
     potential_terms: list[sp.Expr] = [model.potential_energy]
@@ -177,11 +189,24 @@ def derive(model: Model, *, check: bool = True) -> EquationsOfMotion:
         if spin != 0:
             kinetic_terms.append(body.inertia * (omega - spin) * spin
                                  + sp.Rational(1, 2) * body.inertia * spin**2)
-    for rigid in model.rigid_bodies:
-        translate(rigid.mass, rigid.position)
+    for k, rigid in enumerate(model.rigid_bodies):
+        if k not in unexpanded:
+            translate(rigid.mass, rigid.position)
     component_mass = (acc.mass_matrix() if model.particles or model.bodies or model.rigid_bodies
                       else None)
-    for rigid in model.rigid_bodies:
+    for k, rigid in enumerate(model.rigid_bodies):
+        if k in unexpanded:
+            # M, f and the weight through the body's Jacobians; its T is printed as
+            # 1/2 m v.v + 1/2 omega^T I omega (component_mass holds none of it).
+            rigid_mass, rigid_forcing, kinetic = jacobian_equations(rigid, q, q_dot, t,
+                                                                     gravity, d)
+            kinetic_terms.append(kinetic)
+            for (i, j), entry in rigid_mass.items():
+                acc.add_mass(i, j, entry)
+            for i, entry in enumerate(rigid_forcing):
+                if entry != 0:
+                    acc.add_force(i, entry)
+            continue
         # 1/2 omega^T I omega by the general formula written with omega's structure (after
         # component_mass, which holds only 1/2 m v.v: the printed T shows this term as written).
         kinetic_terms.append(rotational_kinetic_energy(rigid))

@@ -17,6 +17,7 @@ from typing import NamedTuple
 import numpy as np
 import sympy as sp
 
+from ..model.expressions import as_expression
 from ..model.model import Model
 from ..model.values import ParameterValues, resolve_parameters
 from .lambdified import StateFunction
@@ -24,12 +25,15 @@ from .lambdified import StateFunction
 
 class Frame(NamedTuple):
     """Batched positions (m) at k instants: particles (k, P, 2), bar ends (k, B, 2, 2), spring
-    ends (k, S, 2, 2), damper ends (k, D, 2, 2)."""
+    ends (k, S, 2, 2), damper ends (k, D, 2, 2), rod ends (k, R, 2, 2: anchor, point) and
+    pivots (k, V, 2: fixed or driven supports)."""
 
     particles: np.ndarray
     bars: np.ndarray
     springs: np.ndarray
     dampers: np.ndarray
+    rods: np.ndarray | None = None
+    pivots: np.ndarray | None = None
 
 
 class SpaceFrame(NamedTuple):
@@ -50,6 +54,8 @@ class SpaceFrame(NamedTuple):
     bars: np.ndarray
     springs: np.ndarray
     dampers: np.ndarray
+    rods: np.ndarray | None = None
+    pivots: np.ndarray | None = None
 
 
 ISOMETRIC_VIEW = (45.0, float(np.degrees(np.arctan(1 / np.sqrt(2)))))  # azimuth, elevation (deg)
@@ -89,6 +95,13 @@ class Mechanism:
     link_count: int = 0
     _space: StateFunction | None = None  # particles, bodies in space, links, springs, dampers
     _inertia: StateFunction | None = None  # each body in space's inertia tensor, row by row
+    # The mechanism as a user sketches it (see ``sketch``): rods, pivots, blocks, rolling bodies.
+    rod_count: int = 0
+    pivot_count: int = 0
+    _rods: StateFunction | None = None  # rod ends then pivots, 3 components each
+    blocks: tuple[tuple[int, tuple[float, float]], ...] = ()  # particle index, unit track
+    rolling: tuple[tuple[int, float, tuple[float, float]], ...] = ()  # body, radius, normal
+    gravity: tuple[float, float] | None = None  # unit direction of gravity in the plane
 
     def space_frame(self, q: np.ndarray, v: np.ndarray, t: np.ndarray) -> SpaceFrame:
         """Batched 3D geometry for states q, v (k, n) at times t (k,), bodies in space included."""
@@ -112,8 +125,9 @@ class Mechanism:
         bars = np.concatenate([bars2, np.zeros(bars2.shape[:-1] + (1,))], axis=-1)
         springs = parts[3].reshape(k, -1, 2, 3)
         dampers = parts[4].reshape(k, -1, 2, 3)
+        rods, pivots = self._rods_and_pivots(q, v, t)
         return SpaceFrame(particles, origins, rotations, centres, half, principal, links, bars,
-                          springs, dampers)
+                          springs, dampers, rods, pivots)
 
     def _frame_space(self, q, v, t) -> np.ndarray:
         if self._space is None:
@@ -136,7 +150,17 @@ class Mechanism:
         bars = np.stack([centre - offset, centre + offset], axis=-2)
         springs = stack(self._springs, len(self.spring_names), (2, 2))
         dampers = stack(self._dampers, len(self.damper_names), (2, 2))
-        return Frame(particles, bars, springs, dampers)
+        rods, pivots = self._rods_and_pivots(q, v, t)
+        return Frame(particles, bars, springs, dampers, rods[..., :2], pivots[..., :2])
+
+    def _rods_and_pivots(self, q, v, t) -> tuple[np.ndarray, np.ndarray]:
+        """Rod ends (k, R, 2, 3) and pivots (k, V, 3), in 3D."""
+        k = len(t)
+        if self._rods is None:
+            return np.zeros((k, 0, 2, 3)), np.zeros((k, 0, 3))
+        flat = self._rods(q, v, t)
+        rods = flat[:, :self.rod_count * 6].reshape(k, -1, 2, 3)
+        return rods, flat[:, self.rod_count * 6:].reshape(k, -1, 3)
 
 
 def mechanism(model: Model, parameters: Mapping[str, float | None] | ParameterValues | None = None
@@ -165,6 +189,9 @@ def mechanism(model: Model, parameters: Mapping[str, float | None] | ParameterVa
     space = {}
     if model.rigid_bodies:
         space = _space_geometry(model, ends, damper_ends, compile_)
+    drawn = sketch(model, values)
+    rod_exprs = [e for pair in drawn.rods for point in pair for e in point] + \
+        [e for point in drawn.pivots for e in point]
     return Mechanism(
         particle_names=tuple(p.name for p in model.particles),
         body_names=tuple(b.name for b in model.bodies),
@@ -172,6 +199,9 @@ def mechanism(model: Model, parameters: Mapping[str, float | None] | ParameterVa
         damper_names=tuple(damper_ends),
         _particles=compile_(particles), _bodies=compile_(bodies), _springs=compile_(springs),
         _dampers=compile_(dampers), **space,
+        rod_count=len(drawn.rods), pivot_count=len(drawn.pivots),
+        _rods=compile_(rod_exprs) if rod_exprs else None, blocks=drawn.blocks,
+        rolling=drawn.rolling, gravity=drawn.gravity,
     )
 
 
@@ -270,3 +300,215 @@ def _fixed_anchor(points, candidates, length):
                 abs(c - anchor @ anchor) < 1e-9 * (1 + abs(c)):
             return (tuple(sp.Float(x) for x in anchor), expr)
     return None
+
+
+class Sketch(NamedTuple):
+    """The mechanism as a user sketches it (see ``sketch``): rods as (anchor, point) and pivots
+    as 3-vectors of expressions; blocks as (particle index, unit track direction); rolling
+    bodies as (body index, radius rho (m), unit normal n from the surface to the centre); the
+    unit direction of gravity in the plane, if any."""
+
+    rods: tuple[tuple[tuple, tuple], ...] = ()
+    pivots: tuple[tuple, ...] = ()
+    blocks: tuple[tuple[int, tuple[float, float]], ...] = ()
+    rolling: tuple[tuple[int, float, tuple[float, float]], ...] = ()
+    gravity: tuple[float, float] | None = None
+
+
+_SKETCH_SAMPLES = 8
+
+
+def sketch(model: Model, values: Mapping[sp.Symbol, sp.Expr]) -> Sketch:
+    """What a user draws besides the masses, found from the model's structure:
+
+    - a rod from a point's pivot: the part of its position (particle, body centre) without one
+      of its coordinates, when that part holds no coordinate and the point stays at a fixed
+      distance from it (pivot + l (sin q, -cos q); a driven support x_s(t) + ...);
+    - a rod between two points of different owners (particles, body centres, bar ends) that
+      stay at a fixed non-zero distance in every configuration (the double pendulum's second
+      rod, a cart and its pendulum), unless both lie on one body's bar (one per pair of owners);
+    - pivots: those anchors, and bar ends that do not move with the coordinates;
+    - blocks: particles moving along a straight line (a cart, a slider), with the line;
+    - rolling bodies: a body whose centre moves along a line while a constraint keeps the point
+      at distance rho below it (along the normal) from slipping: v.d + rho omega = 0.
+
+    Decided at random configurations (q, t in [-1, 1]): the structure holds at every
+    configuration, so it holds at these; nothing is fitted to a run. Bodies in space are drawn
+    from their joints already (``_space_geometry``) and take no part.
+    """
+    gravity = None
+    if model.gravity is not None:
+        try:
+            g = np.array([float(as_expression(c).xreplace(values))
+                          for c in model.gravity.direction[:2]])
+            if np.hypot(*g) > 0:
+                gravity = tuple(float(c) for c in g / np.hypot(*g))
+        except (TypeError, ValueError):
+            gravity = None
+    points, owners = [], []  # 3-vectors; owner: ("particle", i) or ("body", j)
+    for i, particle in enumerate(model.particles):
+        points.append(tuple((*particle.position, 0, 0, 0)[:3]))
+        owners.append(("particle", i))
+    bar_ends = {}
+    for j, body in enumerate(model.bodies):
+        centre = tuple((*body.position, 0, 0, 0)[:3])
+        points.append(centre)
+        owners.append(("body", j))
+        mass, inertia = body.mass.xreplace(values), body.inertia.xreplace(values)
+        half = sp.sqrt(3 * inertia / mass) if mass != 0 else sp.S.Zero
+        if half != 0:
+            direction = (sp.cos(body.angle), sp.sin(body.angle), 0)
+            ends = []
+            for sign in (-1, 1):
+                ends.append(len(points))
+                points.append(tuple(c + sign * half * u for c, u in zip(centre, direction,
+                                                                         strict=True)))
+                owners.append(("body", j))
+            bar_ends[j] = tuple(ends)
+    coordinates = set(model.q)
+    # Pivot candidates: a point's position without the terms holding one of its coordinates.
+    candidates = []  # (point index, anchor)
+    for index, (point, owner) in enumerate(zip(points, owners, strict=True)):
+        if owner[0] == "body" and index != _centre_index(owners, index):
+            continue  # bar ends follow their centre
+        held = set().union(*(as_expression(c).free_symbols for c in point)) & coordinates
+        for q in (c for c in model.q if c in held):
+            anchor = tuple(sp.Add(*(term for term in sp.Add.make_args(sp.expand(c))
+                                    if q not in term.free_symbols)) for c in point)
+            if not set().union(*(as_expression(c).free_symbols for c in anchor)) & coordinates:
+                candidates.append((index, anchor))
+    n = len(model.q)
+    rng = np.random.default_rng(11)
+    samples = rng.uniform(-1.0, 1.0, size=(_SKETCH_SAMPLES, 2 * n + 1))
+    q_s, v_s, t_s = samples[:, :n], samples[:, n:2 * n], samples[:, -1]
+    exprs = [c for point in points for c in point] + \
+        [c for _, anchor in candidates for c in anchor]
+    try:
+        with np.errstate(all="ignore"):
+            flat = StateFunction(model, exprs, values)(q_s, v_s, t_s)
+    except (TypeError, ValueError, ZeroDivisionError, NameError, KeyError):
+        return Sketch(gravity=gravity)
+    at = flat.reshape(_SKETCH_SAMPLES, -1, 3)  # (samples, points then anchors, 3)
+    where, anchors_at = at[:, :len(points)], at[:, len(points):]
+    scale = 1.0 + float(np.nanmax(np.abs(at))) if np.isfinite(at).any() else 1.0
+    tolerance = 1e-9 * scale
+
+    def fixed_distance(a: np.ndarray, b: np.ndarray) -> bool:
+        d = np.linalg.norm(a - b, axis=-1)
+        return bool(np.all(np.isfinite(d)) and np.ptp(d) <= tolerance and d.min() > tolerance)
+
+    def still(a: np.ndarray) -> bool:
+        return bool(np.all(np.isfinite(a)) and np.ptp(a, axis=0).max() <= tolerance)
+
+    def on_bar(a: np.ndarray, j: int) -> bool:
+        """a lies on body j's bar at every sample."""
+        e0, e1 = where[:, bar_ends[j][0]], where[:, bar_ends[j][1]]
+        u = e1 - e0
+        s = np.clip(np.sum((a - e0) * u, axis=-1) / np.maximum(np.sum(u * u, axis=-1), 1e-300),
+                    0, 1)
+        return bool(np.all(np.linalg.norm(e0 + s[:, None] * u - a, axis=-1) <= tolerance))
+
+    def same_bar(a: np.ndarray, b: np.ndarray) -> bool:
+        return any(on_bar(a, j) and on_bar(b, j) for j in bar_ends)
+
+    rods, pivots, pivots_at = [], [], []
+
+    def add_pivot(expr: tuple, value: np.ndarray) -> None:
+        if not any(np.all(np.abs(value - seen) <= tolerance) for seen in pivots_at):
+            pivots.append(expr)
+            pivots_at.append(value)
+
+    rooted = set()
+    for (index, anchor), value in zip(candidates, np.moveaxis(anchors_at, 1, 0), strict=True):
+        if index in rooted or not fixed_distance(where[:, index], value):
+            continue
+        rooted.add(index)
+        add_pivot(anchor, value)
+        if not same_bar(value, where[:, index]):
+            rods.append((anchor, points[index]))
+    for ends in bar_ends.values():
+        for e in ends:
+            if still(where[:, e]):
+                add_pivot(points[e], where[:, e])
+    best = {}  # (owner, owner) -> (distance, i, j): the shortest fixed distance between them
+    for i in range(len(points)):
+        for j in range(i + 1, len(points)):
+            if owners[i] == owners[j] or (still(where[:, i]) and still(where[:, j])):
+                continue
+            if fixed_distance(where[:, i], where[:, j]) and \
+                    not same_bar(where[:, i], where[:, j]):
+                key = (owners[i], owners[j])
+                distance = float(np.linalg.norm(where[0, i] - where[0, j]))
+                if key not in best or distance < best[key][0]:
+                    best[key] = (distance, i, j)
+    rods += [(points[i], points[j]) for _, i, j in best.values()]
+    blocks = []
+    if not model.rigid_bodies:
+        for i in range(len(model.particles)):
+            direction = _line_direction(where[:, i], tolerance)
+            if direction is not None:
+                blocks.append((i, direction))
+    rolling = [] if model.rigid_bodies else _rolling_bodies(model, values, points, owners,
+                                                             where, samples, tolerance)
+    return Sketch(tuple(rods), tuple(pivots), tuple(blocks), tuple(rolling), gravity)
+
+
+def _centre_index(owners: list, index: int) -> int:
+    """The index of the first point of this point's owner (a body's centre)."""
+    return owners.index(owners[index])
+
+
+def _line_direction(path: np.ndarray, tolerance: float) -> tuple[float, float] | None:
+    """The unit direction (in the plane) of a point that moves along a straight line, or None."""
+    if not np.all(np.isfinite(path)) or np.any(np.abs(path[:, 2]) > tolerance):
+        return None
+    centred = path[:, :2] - path[:, :2].mean(axis=0)
+    _, spread, axes = np.linalg.svd(centred, full_matrices=False)
+    if spread[0] <= tolerance or spread[1] > 1e-9 * spread[0]:
+        return None
+    d = axes[0] if axes[0][np.argmax(np.abs(axes[0]))] > 0 else -axes[0]
+    return (float(d[0]), float(d[1]))
+
+
+def _rolling_bodies(model, values, points, owners, where, samples, tolerance) -> list:
+    """Bodies rolling without slipping on a straight surface: (body index, rho, normal)."""
+    if not model.bodies or not model.constraints:
+        return []
+    n = len(model.q)
+    q, v, t = samples[:, :n], samples[:, n:2 * n], samples[:, -1]
+    found = []
+    for j, body in enumerate(model.bodies):
+        direction = _line_direction(where[:, owners.index(("body", j))], tolerance)
+        if direction is None:
+            continue
+        d = np.array(direction)
+        rows = [sp.diff(c, x) for c in body.position[:2] for x in model.q] + \
+            [sp.diff(body.angle, x) for x in model.q]
+        for constraint in model.constraints:
+            speeds = model.q_dot if constraint.kind == "velocity" else model.q
+            rows_c = [sp.diff(constraint.expression, x) for x in speeds]
+            try:
+                with np.errstate(all="ignore"):
+                    at = StateFunction(model, rows + rows_c, values)(q, v, t)
+            except (TypeError, ValueError, ZeroDivisionError, NameError, KeyError):
+                continue
+            jp = at[:, :2 * n].reshape(-1, 2, n)
+            slide = np.einsum("i,sin->sn", d, jp)  # d . dP/dq
+            turn = at[:, 2 * n:3 * n]  # d angle / dq
+            a = at[:, 3 * n:]
+            radii = []
+            for s in range(len(a)):
+                basis = np.column_stack([slide[s], turn[s]])
+                if not np.all(np.isfinite(basis)) or not np.all(np.isfinite(a[s])):
+                    break
+                (alpha, gamma), *_ = np.linalg.lstsq(basis, a[s], rcond=None)
+                if abs(alpha) <= 1e-12 or np.linalg.norm(basis @ [alpha, gamma] - a[s]) > \
+                        1e-9 * (1 + np.linalg.norm(a[s])) or not np.any(turn[s]):
+                    break
+                radii.append(gamma / alpha)  # rho: v . d + rho omega = 0
+            if len(radii) == len(a) and np.ptp(radii) <= 1e-9 * (1 + abs(radii[0])) and \
+                    abs(radii[0]) > tolerance:
+                normal = (-d[1], d[0])  # the contact is at centre - rho n
+                found.append((j, float(radii[0]), (float(normal[0]), float(normal[1]))))
+                break
+    return found

@@ -9,6 +9,9 @@ there is left out); nothing here evaluates an expression.
 
 from __future__ import annotations
 
+import base64
+import html
+import io
 import os
 import tempfile
 from pathlib import Path
@@ -91,7 +94,6 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
                         view: object = None):
     """A matplotlib FuncAnimation of the mechanism over the run (planar x-y view; a model with
     bodies in space is seen from ``view`` = (azimuth, elevation) in degrees)."""
-    from matplotlib.animation import FuncAnimation
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -105,37 +107,86 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
                          for i in range(result.q.shape[1])])
     if geometry.rigid_body_names:
         return _space_animation(result, geometry, times, q, v, view, fps)
-    particles, bars, springs, dampers = geometry.frame(q, v, times)
-    everything = np.concatenate([particles.reshape(-1, 2), bars.reshape(-1, 2),
-                                 springs.reshape(-1, 2), dampers.reshape(-1, 2), [[0.0, 0.0]]])
+    frame = geometry.frame(q, v, times)
+    particles, bars, springs, dampers = frame.particles, frame.bars, frame.springs, frame.dampers
+    rolling = {j: (radius, np.array(normal)) for j, radius, normal in geometry.rolling}
+    # A rolling body's reach is its wheel, not its bar of the same inertia.
+    wheels = [bars[:, j].mean(axis=1)[:, None, :] + abs(radius) * np.array(
+        [[1, 0], [-1, 0], [0, 1], [0, -1]]) for j, (radius, _) in rolling.items()]
+    everything = np.concatenate([particles.reshape(-1, 2), np.delete(bars, list(rolling), axis=1)
+                                 .reshape(-1, 2), springs.reshape(-1, 2), dampers.reshape(-1, 2),
+                                 frame.rods.reshape(-1, 2), frame.pivots.reshape(-1, 2),
+                                 *(w.reshape(-1, 2) for w in wheels), [[0.0, 0.0]]])
     everything = everything[np.all(np.isfinite(everything), axis=1)]
     low, high = everything.min(axis=0), everything.max(axis=0)
     # A square view around the motion, so a mechanism moving along one line is not squashed.
-    half = 0.55 * max(float(np.max(high - low)), 1e-3)
+    half = 0.6 * max(float(np.max(high - low)), 1e-3)
+    if geometry.blocks:  # room for the blocks drawn around their particles (a 0.12 span box)
+        block_paths = particles[:, [i for i, _ in geometry.blocks]].reshape(-1, 2)
+        low = np.minimum(low, block_paths.min(axis=0) - 0.08 * 2 * half)
+        high = np.maximum(high, block_paths.max(axis=0) + 0.08 * 2 * half)
+        half = max(half, 0.5 * float(np.max(high - low)))
     centre = (low + high) / 2
-    low, high, pad = centre - half, centre + half, 0.0
+    low, high = centre - half, centre + half
+    span = 2 * half
 
     figure = Figure(figsize=(5, 5), dpi=80, layout="constrained")
     FigureCanvasAgg(figure)
     ax = figure.add_subplot()
-    ax.set_xlim(low[0] - pad, high[0] + pad)
-    ax.set_ylim(low[1] - pad, high[1] + pad)
+    ax.set_xlim(low[0], high[0])
+    ax.set_ylim(low[1], high[1])
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.plot([0], [0], marker="+", color="grey")
+    if geometry.gravity is not None:
+        _gravity_arrow(ax, geometry.gravity)
+    gravity = None if geometry.gravity is None else np.array(geometry.gravity)
+    # Still surfaces: each block's track and each rolling body's ground, with hatching.
+    block_size = np.array([0.12, 0.07]) * span  # along, across the track
+    for i, direction in geometry.blocks:
+        d = np.array(direction)
+        n = np.array([-d[1], d[0]])
+        if gravity is not None and abs(gravity @ n) > 1e-9:
+            n = n if gravity @ n < 0 else -n  # the track is under the block (against gravity)
+            offset = block_size[1] / 2
+        else:
+            offset = 0.0  # along gravity (or none): a guide through the block
+        path = particles[:, i] @ d
+        base = particles[0, i] - (particles[0, i] @ d) * d - offset * n
+        _surface(ax, base, d, -n if offset else None, path.min() - block_size[0],
+                 path.max() + block_size[0], span)
+    for j, (radius, normal) in rolling.items():
+        d = np.array([normal[1], -normal[0]])
+        contact = bars[:, j].mean(axis=1) - radius * normal  # centre - rho n
+        path = contact @ d
+        base = contact[0] - (contact[0] @ d) * d
+        _surface(ax, base, d, -np.sign(radius) * normal, path.min() - 2 * abs(radius),
+                 path.max() + 2 * abs(radius), span)
     spring_lines = [ax.plot([], [], color="tab:green", linewidth=1)[0] for _ in geometry.spring_names]
     damper_lines = [ax.plot([], [], color="tab:purple", linewidth=1.5)[0]
                     for _ in geometry.damper_names]
-    bar_lines = [ax.plot([], [], color="tab:blue", linewidth=4, solid_capstyle="round")[0]
-                 for _ in geometry.body_names]
+    rod_lines = [ax.plot([], [], color="black", linewidth=2, solid_capstyle="round",
+                         label="rod")[0] for _ in range(geometry.rod_count)]
+    bar_lines = {j: ax.plot([], [], color="tab:blue", linewidth=4, solid_capstyle="round",
+                            label="bar")[0]
+                 for j in range(len(geometry.body_names)) if j not in rolling}
+    wheel_lines = {j: ax.plot([], [], color="tab:blue", linewidth=2, label="wheel")[0]
+                   for j in rolling}
+    pivot_marks = ax.plot([], [], "^", color="0.45", markersize=13, label="pivot")[0]
+    hinges = ax.plot([], [], "o", color="white", markeredgecolor="black", markersize=5)[0]
+    blocks = [ax.fill([], [], facecolor="tab:red", edgecolor="black", linewidth=1,
+                      label="block")[0] for _ in geometry.blocks]
+    block_of = {i for i, _ in geometry.blocks}
+    free = [i for i in range(len(geometry.particle_names)) if i not in block_of]
     # Each particle leaves a short trail (its last second) so the motion reads in one frame.
-    trails = [ax.plot([], [], color="tab:red", alpha=0.35, linewidth=1)[0]
-              for _ in geometry.particle_names]
+    trails = [ax.plot([], [], color="tab:red", alpha=0.35, linewidth=1)[0] for _ in free]
     trail_length = max(1, int(fps))
-    dots = ax.plot([], [], "o", color="tab:red", markersize=10)[0]
+    dots = ax.plot([], [], "o", color="tab:red", markersize=10, label="particles")[0]
     clock = ax.text(0.02, 0.95, "", transform=ax.transAxes)
     ax.set_title(result.model_name)
+    angles = np.linspace(0, 2 * np.pi, 41)
+    circle = np.column_stack([np.cos(angles), np.sin(angles)])
 
     def draw(k):
         for line, (a, b) in zip(spring_lines, springs[k], strict=True):
@@ -144,16 +195,66 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
         for line, (a, b) in zip(damper_lines, dampers[k], strict=True):
             pot = _dashpot(a, b)
             line.set_data(pot[:, 0], pot[:, 1])
-        for line, ends in zip(bar_lines, bars[k], strict=True):
+        for line, ends in zip(rod_lines, frame.rods[k], strict=True):
             line.set_data(ends[:, 0], ends[:, 1])
-        for i, line in enumerate(trails):
+        for j, line in bar_lines.items():
+            line.set_data(bars[k, j, :, 0], bars[k, j, :, 1])
+        for j, line in wheel_lines.items():
+            # The rim, and a spoke along the body's x axis so the turning shows.
+            radius = abs(rolling[j][0])
+            middle, end = bars[k, j].mean(axis=0), bars[k, j, 1]
+            spoke = middle + radius * (end - middle) / max(np.hypot(*(end - middle)), 1e-300)
+            rim = middle + radius * circle
+            line.set_data([*rim[:, 0], np.nan, middle[0], spoke[0]],
+                          [*rim[:, 1], np.nan, middle[1], spoke[1]])
+        pivot_marks.set_data(frame.pivots[k][:, 0], frame.pivots[k][:, 1])
+        hinges.set_data(frame.pivots[k][:, 0], frame.pivots[k][:, 1])
+        for patch, (i, direction) in zip(blocks, geometry.blocks, strict=True):
+            patch.set_xy(_box(particles[k, i], np.array(direction), block_size))
+        for line, i in zip(trails, free, strict=True):
             path = particles[max(0, k - trail_length): k + 1, i]
             line.set_data(path[:, 0], path[:, 1])
-        dots.set_data(particles[k][:, 0], particles[k][:, 1])
+        dots.set_data(particles[k, free, 0], particles[k, free, 1])
         clock.set_text(f"t = {times[k]:.2f} s")
-        return [*spring_lines, *damper_lines, *bar_lines, *trails, dots, clock]
+        return [*spring_lines, *damper_lines, *rod_lines, *bar_lines.values(),
+                *wheel_lines.values(), *blocks, *trails, dots, pivot_marks, hinges, clock]
 
-    return FuncAnimation(figure, draw, frames=len(times), interval=1000 / fps, blit=False)
+    return _animation(figure, draw, times, fps)
+
+
+def _box(centre: np.ndarray, d: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Corners of a box centred at ``centre`` with its length along unit ``d``."""
+    n = np.array([-d[1], d[0]])
+    a, b = size[0] / 2 * d, size[1] / 2 * n
+    return np.array([centre - a - b, centre + a - b, centre + a + b, centre - a + b])
+
+
+def _surface(ax, base: np.ndarray, d: np.ndarray, inside: np.ndarray | None, start: float,
+             stop: float, span: float) -> None:
+    """A fixed line base + s d for s in [start, stop], hatched on the side ``inside`` (the
+    ground's side; None: a bare guide line)."""
+    ends = np.array([base + start * d, base + stop * d])
+    ax.plot(ends[:, 0], ends[:, 1], color="0.3", linewidth=1.5, label="surface")
+    if inside is None:
+        return
+    step = 0.03 * span
+    marks = np.arange(start, stop, step)
+    tick = 0.025 * span * (inside - 0.6 * d)
+    xs = np.column_stack([base[0] + marks * d[0], base[0] + marks * d[0] + tick[0],
+                          np.full(len(marks), np.nan)]).ravel()
+    ys = np.column_stack([base[1] + marks * d[1], base[1] + marks * d[1] + tick[1],
+                          np.full(len(marks), np.nan)]).ravel()
+    ax.plot(xs, ys, color="0.5", linewidth=0.8)
+
+
+def _gravity_arrow(ax, direction: tuple[float, float]) -> None:
+    """A small arrow in the corner showing which way gravity pulls (an incline reads)."""
+    start = np.array([0.92, 0.9]) - 0.05 * np.array(direction)
+    end = start + 0.08 * np.array(direction)
+    ax.annotate("", xy=end, xytext=start, xycoords="axes fraction",
+                arrowprops={"arrowstyle": "-|>", "color": "0.4"})
+    ax.text(*(start + np.array([-0.04, 0.0])), "g", transform=ax.transAxes, color="0.4",
+            ha="center", va="center")
 
 
 # The 12 edges of a box, as pairs of corners (signs of the half extents along its three axes).
@@ -164,7 +265,6 @@ _EDGES = [(a, b) for a in range(8) for b in range(a + 1, 8)
 
 def _space_animation(result, geometry, times, q, v, view, fps):
     """The 3D mechanism projected on the screen seen from ``view`` (azimuth, elevation)."""
-    from matplotlib.animation import FuncAnimation
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -250,14 +350,175 @@ def _space_animation(result, geometry, times, q, v, view, fps):
         return [*boxes, *links, *bars, *spring_lines, *damper_lines,
                 *(line for triad in axes for line in triad), dots, clock]
 
-    return FuncAnimation(figure, draw, frames=len(times), interval=1000 / fps, blit=False)
+    return _animation(figure, draw, times, fps)
+
+
+def _animation(figure, draw, times: np.ndarray, fps: int):
+    """Wrap a figure and its per-frame ``draw(k)`` (returning the artists it changed)."""
+    from matplotlib.animation import FuncAnimation
+
+    class MechanismAnimation(FuncAnimation):
+        """A matplotlib FuncAnimation that also renders its frames fast (``frame_images``: one
+        full draw of the still parts, then only the moving artists per frame) and whose
+        ``to_jshtml`` is a self-contained player (no remote font or script)."""
+
+        def draw(self, k: int) -> list:
+            """Put frame k on the figure; the artists it moved."""
+            self._draw_was_started = True  # drawn: matplotlib need not warn when it is deleted
+            return draw(k)
+
+        def frame_images(self, *, dpi: float | None = None, progress=None):
+            self._draw_was_started = True
+            return _frame_images(figure, draw, len(times), dpi=dpi, progress=progress)
+
+        def to_jshtml(self, fps=None, embed_frames=True, default_mode=None):
+            return player_html(self.frame_images(dpi=HTML_DPI), fps=fps or self.fps,
+                               times=times, title=self.title)
+
+        def _repr_html_(self):
+            return self.to_jshtml()
+
+    animation = MechanismAnimation(figure, draw, frames=len(times), interval=1000 / fps,
+                                   blit=False)
+    animation.fps = fps
+    animation.times = times
+    animation.title = figure.axes[0].get_title()
+    return animation
+
+
+# The HTML player's frames are drawn smaller than the GIF's (80 dpi, 400 px): a page of
+# many embedded images stays small.
+HTML_DPI = 64
+# Colours in the GIF's shared palette (the drawing has a dozen colours and their antialiasing).
+GIF_COLOURS = 64
+
+
+def _frame_images(figure, draw, count: int, *, dpi: float | None = None, progress=None):
+    """RGB frames (H, W, 3) uint8: the still parts (axes, ticks, labels) are drawn once and
+    restored as a background; each frame draws only the artists ``draw(k)`` moves (blitting).
+    ``progress(frame, frames)`` is called after each frame."""
+    canvas = figure.canvas
+    if dpi is not None:
+        figure.set_dpi(dpi)
+    moving = draw(0)
+    for artist in moving:
+        artist.set_animated(True)  # left out of the full draw: the background
+    try:
+        canvas.draw()
+        background = canvas.copy_from_bbox(figure.bbox)
+        for k in range(count):
+            canvas.restore_region(background)
+            for artist in draw(k):
+                artist.axes.draw_artist(artist)
+            yield np.asarray(canvas.buffer_rgba())[..., :3].copy()
+            if progress is not None:
+                progress(k, count)
+    finally:
+        for artist in moving:
+            artist.set_animated(False)
+
+
+def _palette_frames(frames) -> list:
+    """The frames as palette images sharing one palette (taken from a few spread frames), so
+    the GIF needs no per-frame quantization search and its colours do not flicker."""
+    from PIL import Image
+
+    frames = list(frames)
+    picks = sorted({0, len(frames) // 3, 2 * len(frames) // 3, len(frames) - 1})
+    mosaic = Image.fromarray(np.concatenate([frames[i] for i in picks], axis=0))
+    palette = mosaic.quantize(colors=GIF_COLOURS, method=Image.Quantize.MEDIANCUT)
+    return [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE)
+            for f in frames]
+
+
+def gif_bytes(frames, fps: float) -> bytes:
+    """An endlessly looping GIF of the RGB frames at ``fps``."""
+    images = _palette_frames(frames)
+    buffer = io.BytesIO()
+    images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:],
+                   duration=round(1000 / fps), loop=0)
+    return buffer.getvalue()
+
+
+def player_html(frames, *, fps: float, times: np.ndarray, title: str = "") -> str:
+    """A self-contained HTML page that plays the RGB frames: play/pause, step, a slider and
+    the time; every image is embedded (palette PNG, base64) and nothing is loaded from
+    elsewhere, so it works offline."""
+    images = _palette_frames(frames)
+    encoded = []
+    for image in images:
+        buffer = io.BytesIO()
+        image.save(buffer, format="PNG", optimize=True)
+        encoded.append(base64.b64encode(buffer.getvalue()).decode("ascii"))
+    lines = "\n".join(f'frames[{k}] = "data:image/png;base64,{data}";'
+                      for k, data in enumerate(encoded))
+    stamps = ", ".join(f"{t:.3f}" for t in times[:len(encoded)])
+    return _PLAYER.format(title=html.escape(title or "animation"), frames=lines,
+                          times=stamps, count=len(encoded), last=len(encoded) - 1,
+                          interval=round(1000 / fps))
+
+
+_PLAYER = """<!DOCTYPE html>
+<html><head><meta charset="utf-8"><title>{title}</title></head>
+<body style="font-family: sans-serif">
+<div class="lagrangian-animation">
+<img id="frame" alt="{title}" style="display: block">
+<div>
+<button id="back" title="previous frame">&#9664;&#9664;</button>
+<button id="play" title="play / pause">&#9654;</button>
+<button id="next" title="next frame">&#9654;&#9654;</button>
+<input id="slider" type="range" min="0" max="{last}" value="0" style="width: 60%">
+<span id="clock"></span>
+<label><input id="loop" type="checkbox" checked> loop</label>
+</div>
+</div>
+<script>
+// The animation's frames, embedded: this page needs nothing from the network.
+var frames = new Array({count});
+{frames}
+var times = [{times}];
+var k = 0, timer = null;
+var img = document.getElementById("frame"), slider = document.getElementById("slider");
+var play = document.getElementById("play"), clock = document.getElementById("clock");
+function show(i) {{
+  k = (i + frames.length) % frames.length;
+  img.src = frames[k]; slider.value = k; clock.textContent = "t = " + times[k].toFixed(2) + " s";
+}}
+function stop() {{ clearInterval(timer); timer = null; play.innerHTML = "&#9654;"; }}
+function tick() {{
+  if (k == frames.length - 1 && !document.getElementById("loop").checked) {{ stop(); return; }}
+  show(k + 1);
+}}
+play.onclick = function () {{
+  if (timer) {{ stop(); return; }}
+  timer = setInterval(tick, {interval}); play.innerHTML = "&#10074;&#10074;";
+}};
+document.getElementById("back").onclick = function () {{ stop(); show(k - 1); }};
+document.getElementById("next").onclick = function () {{ stop(); show(k + 1); }};
+slider.oninput = function () {{ stop(); show(parseInt(slider.value)); }};
+show(0);
+</script>
+</body></html>
+"""
 
 
 def save_animation(animation, path: str | Path, *, fps: int = 25,
                    protect: tuple[Path, ...] = (), progress=None) -> Path:
-    """Save a built animation as .gif or .html, through a temporary file and a rename.
-    ``progress(frame, frames)`` is called as each GIF frame is written (for a progress bar)."""
+    """Save a built animation as .gif or .html (a self-contained player), through a temporary
+    file and a rename. ``progress(frame, frames)`` is called as each frame is drawn."""
     path = check_animation_path(path)
+    if not hasattr(animation, "frame_images"):  # any other matplotlib animation
+        return _save_with_matplotlib(animation, path, fps=fps, protect=protect,
+                                     progress=progress)
+    if path.suffix.lower() == ".html":
+        frames = animation.frame_images(dpi=HTML_DPI, progress=progress)
+        page = player_html(frames, fps=fps, times=animation.times, title=animation.title)
+        return atomic_write(path, page, protect=protect)
+    return atomic_write(path, gif_bytes(animation.frame_images(progress=progress), fps),
+                        protect=protect)
+
+
+def _save_with_matplotlib(animation, path: Path, *, fps, protect, progress) -> Path:
     if path.suffix.lower() == ".html":
         return atomic_write(path, animation.to_jshtml(fps=fps), protect=protect)
     from matplotlib.animation import PillowWriter

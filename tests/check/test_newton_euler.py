@@ -213,9 +213,12 @@ def test_crosscheck_json_reports_the_reactions_of_a_model_with_springs():
                                        for n in ("theta", "x", "y")}
     assert [r["joint"] for r in document["reactions"]] == ["mass", "rod"]
     # the first published keys, and the labelled ones added beside them (the rod has a moment)
+    # and their values at the initial state (N, N m), labelled the same way
     assert [set(r) for r in document["reactions"]] == [
-        {"joint", "components", "body", "force"},
-        {"joint", "components", "body", "force", "moment"}]
+        {"joint", "components", "body", "force", "at_initial_state"},
+        {"joint", "components", "body", "force", "moment", "at_initial_state"}]
+    assert [set(r["at_initial_state"]) for r in document["reactions"]] == [
+        {"force"}, {"force", "moment"}]
     assert [r["body"] for r in document["reactions"]] == ["mass", "rod"]
     assert [len(r["components"]) for r in document["reactions"]] == [2, 3]
     assert all(isinstance(c, str) and "k1" in c for c in document["reactions"][1]["components"][:2])

@@ -32,13 +32,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
 import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
-from ..errors import DerivationError
+from ..errors import DerivationError, LagrangianError
 from ..model.expressions import format_expression as fmt
 from ..model.model import Attachment, Model, PointForce, Torque
 from ..model.rotations import Moment
+from ..model.values import resolve_parameters, resolve_state
 from . import equivalence as eq
 
 SYMBOLIC_REACTIONS_MAX_UNKNOWNS = 3
@@ -65,6 +67,9 @@ class Reaction:
     joint: str
     labels: tuple[str, ...]
     components: tuple[sp.Expr, ...]
+    # N and N m at the model's initial state, the accelerations and multipliers from the
+    # equations of motion there; None where a parameter has no value or M is singular there
+    at_initial_state: tuple[float, ...] | None = None
 
     def _repr_latex_(self) -> str:
         rows = [rf"{label} &= {sp.latex(value)}" for label, value in zip(self.labels,
@@ -155,8 +160,52 @@ def crosscheck(eom: EquationsOfMotion) -> CrosscheckReport:
                          + ") are checked by Euler's equations; the reaction at each one's joint "
                          "is the force and moment (about the joint, world axes) that its parent "
                          "or the ground exerts on it and the bodies it carries")
-        reactions = _reactions(eom, bodies, newton_euler, notes)
+        reactions = _at_initial_state(eom, _reactions(eom, bodies, newton_euler, notes))
     return CrosscheckReport(model.name, agreements, reactions, tuple(notes))
+
+
+def _at_initial_state(eom: EquationsOfMotion, reactions: tuple[Reaction, ...]
+                      ) -> tuple[Reaction, ...]:
+    """Each reaction's value at the initial state: q, q_dot, t and the parameters substituted,
+    [[M, Phi_q^T], [Phi_q, 0]] [q_ddot; lambda] = [f; gamma] solved there by numpy. A reaction
+    in space on the accelerations runs to thousands of characters; its numbers still read."""
+    model = eom.model
+    if not reactions:
+        return reactions
+    try:
+        parameters = resolve_parameters(model).symbol_values(model)
+    except LagrangianError:
+        return reactions  # a parameter without a value
+    values = {**parameters, **{s: sp.Float(v)
+                               for s, v in resolve_state(model).symbol_values(model).items()}}
+
+    def number(matrix) -> np.ndarray:
+        return np.array([[float(e.xreplace(values)) for e in row]
+                         for row in sp.Matrix(matrix).tolist()], dtype=float).reshape(
+                             sp.Matrix(matrix).shape)
+
+    n, m = len(model.q), eom.multipliers.shape[0]
+    try:
+        M, f = number(eom.mass_matrix), number(eom.forcing).ravel()
+        A = number(eom.constraint_jacobian) if m else np.zeros((0, n))
+        gamma = number(eom.acceleration_rhs).ravel() if m else np.zeros(0)
+        K = np.block([[M, A.T], [A, np.zeros((m, m))]])
+        solved = np.linalg.solve(K, np.concatenate([f, gamma]))
+    except (TypeError, ValueError, np.linalg.LinAlgError):
+        return reactions  # symbols left (no value) or singular at this state
+    if not np.all(np.isfinite(solved)):
+        return reactions
+    values.update({s: sp.Float(v) for s, v in zip([*model.q_ddot, *eom.multipliers], solved,
+                                                   strict=True)})
+    out = []
+    for r in reactions:
+        try:
+            numbers = tuple(float(c.xreplace(values)) for c in r.components)
+        except (TypeError, ValueError):
+            out.append(r)
+            continue
+        out.append(Reaction(r.joint, r.labels, r.components, numbers))
+    return tuple(out)
 
 
 def _require_free_bodies(model: Model) -> None:

@@ -47,9 +47,33 @@ def crosscheck_document(report: CrosscheckReport) -> dict[str, Any]:
         # "joint" and "components" as first published; "body" names what the key holds (the
         # body the resultant acts on), "force" and "moment" label each component by its axis
         "reactions": [{"joint": r.joint, "components": [fmt(v) for v in r.components],
-                       "body": r.joint, **_labelled(r)}
+                       "body": r.joint, **_labelled(r), **_at_initial_state(r)}
                       for r in report.reactions],
     }
+
+
+def _at_initial_state(reaction) -> dict[str, dict[str, dict[str, float]]]:
+    """{"at_initial_state": {"force": {"x": N, ...}, "moment": {...}}} where it is known."""
+    if reaction.at_initial_state is None:
+        return {}
+    groups: dict[str, dict[str, float]] = {}
+    for label, value in zip(reaction.labels, reaction.at_initial_state, strict=True):
+        kind, _, axis = label.partition("_")
+        groups.setdefault({"R": "force", "M": "moment"}.get(kind, kind), {})[axis] = value
+    return {"at_initial_state": groups}
+
+
+# A reaction longer than this (characters) is printed by its value at the initial state.
+READABLE_REACTION = 240
+
+
+def _reaction_line(label: str, value, number: float | None) -> str:
+    text = fmt(value)
+    unit = "N m" if label.startswith("M") else "N"
+    if len(text) <= READABLE_REACTION or number is None:
+        return f"      {label} = {text}"
+    return (f"      {label} = {number:.6g} {unit} at the initial state (its expression, "
+            f"{len(text)} characters, is in --json)")
 
 
 def _labelled(reaction) -> dict[str, dict[str, str]]:
@@ -76,8 +100,10 @@ def crosscheck_text(report: CrosscheckReport) -> str:
                      "joint, world axes):")
         for r in report.reactions:
             lines.append(f"  {r.joint}:")
-            lines += [f"      {label} = {fmt(value)}"
-                      for label, value in zip(r.labels, r.components, strict=True)]
+            numbers = r.at_initial_state or (None,) * len(r.labels)
+            lines += [_reaction_line(label, value, number)
+                      for label, value, number in zip(r.labels, r.components, numbers,
+                                                      strict=True)]
     lines += [f"note: {note}" for note in report.notes]
     lines.append("agree" if report.agree else "disagree")
     return "\n".join(lines) + "\n"

@@ -249,6 +249,9 @@ def speed_form(
         raise ModelError(f"the reduced equations are not of the form C = C0 + v C1, K = K0 + "
                          f"v K1 + v^2 K2 in the speed '{speed}' (misfit {error:.3g}); are all "
                          "steady rates proportional to it?", field="speed")
+    # round-off in place of an exact zero (C1[0, 0] of the bicycle is 1e-14 of C1's size)
+    C1, K0, K2 = (np.where(np.abs(X) < 1e-13 * max(float(np.abs(X).max()), 1e-300), 0.0, X)
+                  for X in (C1, K0, K2))
     size_C = max(float(np.abs(C1).max()), 1e-300)
     size_K = max(float(np.abs(K0).max()), float(np.abs(K2).max()), 1e-300)
     C0 = np.where(np.abs(C0) < 1e-12 * size_C, 0.0, C0)

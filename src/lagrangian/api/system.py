@@ -23,6 +23,7 @@ from ..analysis.linearization import (
     symbolic_linear_model,
 )
 from ..analysis.modes import ModalAnalysis, is_stable, modal_analysis
+from ..analysis.speed_form import SpeedForm, SpeedSweep, speed_form, speed_sweep
 from ..analysis.statics import StaticsReport, solve_statics
 from ..analysis.steady import steady_linear_model
 from ..check.diagnose import CheckReport, check_answer
@@ -241,6 +242,21 @@ class System:
         about a steady motion (``steady``: velocity name -> constant rate)."""
         require_inertia(self.equations_of_motion(), "modes")
         return modal_analysis(self.linearize(about, steady=steady), self._model.name)
+
+    def speed_form(self, steady: Mapping[str, float | str], speed: str, keep: Sequence[str],
+                   *, about: Mapping[str, float] | None = None) -> SpeedForm:
+        """The reduced linear equations of the ``keep`` coordinates about steady motion at the
+        speed parameter ``speed``, in the form M q'' + v C1 q' + (g K0 + v^2 K2) q = f
+        (analysis/speed_form.py); ``steady`` gives each steady rate as an expression in the
+        parameters, e.g. {"x_dot": "v", "thetaR_dot": "-v/rR", "thetaF_dot": "-v/rF"}."""
+        return speed_form(self.equations_of_motion(), about, steady, speed, keep)
+
+    def speed_sweep(self, steady: Mapping[str, float | str], speed: str, keep: Sequence[str],
+                    speeds: Sequence[float], *, about: Mapping[str, float] | None = None,
+                    ) -> SpeedSweep:
+        """Eigenvalues (1/s) of the reduced equations at each speed, and the speeds where their
+        real parts cross zero (a bicycle's weave and capsize speeds) with the stable range."""
+        return speed_sweep(self.speed_form(steady, speed, keep, about=about), speeds)
 
     # -- parameter studies and ensembles (Dask; see docs/sweeps.md) -------------------------------
 

@@ -49,6 +49,7 @@ from . import examples as _examples  # noqa: E402,F401
 from . import forces as _forces  # noqa: E402,F401
 from . import modes as _modes  # noqa: E402,F401
 from . import simulate as _simulate  # noqa: E402,F401
+from . import speeds as _speeds  # noqa: E402,F401
 from . import statics as _statics  # noqa: E402,F401
 from . import sweep as _sweep  # noqa: E402,F401
 from .common import in_flags  # noqa: E402

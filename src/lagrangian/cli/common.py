@@ -39,6 +39,8 @@ FLAG_OF_FIELD = {
     "animation": "--animate",
     "view": "--view",
     "lock": "--lock",
+    "keep": "--keep",
+    "speed": "--speed",
 }
 
 SET_HELP = "Override a parameter: NAME=VALUE; repeat, or join with commas (m=2,L=0.5)."

@@ -1,0 +1,73 @@
+"""`lagrangian speeds MODEL --speed v --steady x_dot=v,... --keep phi,delta`: the reduced linear
+equations about steady motion in the benchmark form, and their eigenvalues against speed."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from . import app
+from .common import SET_HELP, assignments, comma_separated, load_system, print_json
+
+STEADY_HELP = ("A steady rate, NAME_dot=EXPRESSION in the parameters (x_dot=v, "
+               "thetaR_dot=-v/rR); repeat or join with commas.")
+KEEP_HELP = "The coordinates whose equations are kept (phi,delta); the rest are eliminated."
+
+
+def steady_settings(settings: list[str], option: str = "--steady") -> dict[str, str]:
+    """NAME_dot=TEXT pairs, the text left to the library (a number or an expression in the
+    parameters)."""
+    return dict(assignments(comma_separated(settings), option))
+
+
+@app.command()
+def speeds(
+    model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
+    speed: Annotated[str, typer.Option("--speed", help="The parameter that is the forward "
+                                       "speed (m/s), e.g. v.")],
+    steady: Annotated[list[str], typer.Option("--steady", help=STEADY_HELP)],
+    keep: Annotated[list[str], typer.Option("--keep", help=KEEP_HELP)],
+    about: Annotated[list[str], typer.Option("--about", help="Configuration of the steady "
+                                             "motion, COORDINATE=VALUE (the rest solved for).")
+                     ] = [],  # noqa: B006
+    lowest: Annotated[float, typer.Option("--from", help="Lowest speed of the sweep.")] = 0.0,
+    highest: Annotated[float, typer.Option("--to", help="Highest speed of the sweep.")] = 10.0,
+    points: Annotated[int, typer.Option("--points", help="Speeds in the sweep.")] = 101,
+    set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
+    json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+    plot: Annotated[Path | None, typer.Option("--plot", help="Draw the eigenvalues against "
+                                              "speed (.png, .svg, .pdf).")] = None,
+) -> None:
+    """M q'' + v C1 q' + (g K0 + v^2 K2) q = f about steady motion, and a speed sweep with the
+    speeds where the eigenvalues' real parts cross zero (weave, capsize)."""
+    from ..errors import ModelError
+    from ..output.files import check_output_path
+    from ..output.plots import check_plot_path
+    from ..output.speed_form import speed_form_document, speed_form_text, write_speed_plot
+    from .common import state_assignments
+
+    system = load_system(model, set_)
+    inputs = (Path(model),) if Path(model).exists() else ()
+    if plot is not None:
+        check_output_path(check_plot_path(plot), "plot", inputs=inputs)
+    if not (points >= 2 and highest > lowest):
+        raise ModelError("the sweep needs --to above --from and --points of at least 2",
+                         field="--points")
+    point = state_assignments(system, about, "--about")
+    kept = [name.strip() for setting in keep for name in setting.split(",") if name.strip()]
+    form = system.speed_form(steady_settings(steady), speed, kept, about=point or None)
+    import numpy as np
+
+    from ..analysis.speed_form import speed_sweep
+
+    sweep = speed_sweep(form, np.linspace(lowest, highest, points))
+    if plot is not None:
+        write_speed_plot(form, sweep, plot, protect=inputs)
+    if json_:
+        print_json(speed_form_document(system.model.name, form, sweep))
+    else:
+        typer.echo(speed_form_text(system.model.name, form, sweep), nl=False)
+        if plot is not None:
+            typer.echo(f"Eigenvalues against speed drawn to {plot}")

@@ -75,3 +75,21 @@ def test_outputs_never_overwrite_the_model_file(tmp_path):
     assert model.read_text() == source and png.read_text() == source
     with pytest.raises(ModelError, match="use a .csv or .parquet file name"):
         run.save(tmp_path / "run.xlsx")
+
+
+@pytest.mark.parametrize("name", ["slider_crank", "double_pendulum"])
+def test_legends_sit_outside_the_panels_and_hide_no_curve(name, tmp_path):
+    run = lagrangian.load(name).simulate(0.5, samples=51)
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    figure = run.plot(tmp_path / "run.png")
+    canvas = FigureCanvasAgg(figure)
+    canvas.draw()  # the layout is final
+    renderer = canvas.get_renderer()
+    legends = [ax.get_legend() for ax in figure.axes if ax.get_legend() is not None]
+    assert legends
+    for legend in legends:
+        box = legend.get_window_extent(renderer)
+        assert box.width > 0 and box.x1 <= figure.bbox.x1 + 1  # on the page
+        for ax in figure.axes:  # over no panel's plotting area
+            assert not box.overlaps(ax.get_window_extent(renderer))

@@ -33,7 +33,7 @@ def time_history_figure(result: SimulationResult, units: dict[str, str] | None =
         for i in indices:
             ax.plot(result.t, result.q[:, i], label=result.coordinates[i])
         ax.set_ylabel(f"coordinate ({unit})" if unit else "coordinate")
-        ax.legend(loc="upper right", fontsize="small")
+        _legend_outside(ax)
     ax = axes[len(groups)]
     balance = result.balance
     if result.energy_conserved and len(result.energy):
@@ -65,11 +65,17 @@ def time_history_figure(result: SimulationResult, units: dict[str, str] | None =
         for i, name in enumerate(result.constraint_names):
             ax.plot(result.t, result.multipliers[:, i], label=f"lambda_{name}")
         ax.set_ylabel("multiplier")
-        ax.legend(loc="upper right", fontsize="small")
+        _legend_outside(ax)
     axes[-1].set_xlabel("t (s)")
     status = "" if result.completed else f" ({result.status})"
     figure.suptitle(f"{result.model_name}{status}")
     return figure
+
+
+def _legend_outside(ax) -> None:
+    """The legend to the right of the panel, outside it, so it hides no curve (constrained
+    layout narrows the panels to make room)."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize="small")
 
 
 def save_figure(figure, path: str | Path, *, protect: tuple[Path, ...] = ()) -> Path:

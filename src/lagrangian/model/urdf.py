@@ -263,6 +263,10 @@ class _Tree:
     def _bodies(self, root: str, order, position) -> list[RigidBody]:
         frames: dict[str, Frame] = {root: GROUND}
         parents: dict[str, str | None] = {root: None}
+        # whether a link moves: some joint above it has a coordinate in its position (asked of
+        # the joints, never of the frames: free_symbols walks a deep chain's shared subtrees
+        # as a tree, minutes at 30 links)
+        moves: dict[str, bool] = {root: False}
         for joint in order:
             frame = frames[joint.parent]
             if joint.origin is not None:
@@ -282,6 +286,8 @@ class _Tree:
                     frame = rotate(frame, axis, angle, rate)
             frames[joint.child] = frame
             parents[joint.child] = joint.parent
+            moves[joint.child] = moves[joint.parent] or (
+                joint.type in MOVABLE and bool(position(joint)[0].free_symbols))
         bodies = []
         for name, frame in frames.items():
             link = self.links[name]
@@ -305,8 +311,7 @@ class _Tree:
                 raise self.error("the inertia tensor is not positive semidefinite", field)
             center = apply(frame.rotation, _vector(where[:3, 3]))
             position_ = tuple(o + c for o, c in zip(frame.origin, center, strict=True))
-            moving = any(e.free_symbols for e in (*position_, *frame.angular_velocity))
-            if not moving:
+            if not moves[name]:
                 continue  # fixed to the ground: no kinetic energy, a constant potential
             bodies.append(RigidBody(name, _number(mass), _matrix(0.5 * (tensor + tensor.T)),
                                     position_, frame.rotation, frame.origin,

@@ -22,10 +22,10 @@ def test_python_example_runs(capsys):
 
 
 @pytest.mark.parametrize("line", [
-    "  [theta1]  l1**2*theta1_ddot*(m1 + m2) + l1*l2*m2*theta2_ddot*cos(theta1 - theta2) = "
+    "  [theta1]  l1**2*(m1 + m2)*theta1_ddot + l1*l2*m2*theta2_ddot*cos(theta1 - theta2) = "
     "-g*l1*(m1 + m2)*sin(theta1) - l1*l2*m2*theta2_dot**2*sin(theta1 - theta2)",
-    "T = l1**2*theta1_dot**2*(m1 + m2)/2 + l1*l2*m2*theta1_dot*theta2_dot*cos(theta1 - theta2) "
-    "+ l2**2*m2*theta2_dot**2/2",
+    "T = (l1**2*theta1_dot**2*(m1 + m2) + 2*l1*l2*m2*theta1_dot*theta2_dot*cos(theta1 - theta2) "
+    "+ l2**2*m2*theta2_dot**2)/2",
 ])
 def test_console_lines_are_real_output(cli, line):
     assert line in core_section()

@@ -17,6 +17,7 @@ import mpmath
 import sympy as sp
 
 from ..model.model import Model
+from ..model.readable import readable
 from ..numerics.lambdified import mpmath_function
 
 DIGITS = 30
@@ -125,8 +126,9 @@ SIMPLIFY_MAX_OPS = 40  # display only: simplify costs ~0.1-1 s beyond this
 def display(expression: sp.Expr) -> sp.Expr:
     """A readable form for messages: simplified only when small (never on large ones)."""
     expression = sp.sympify(expression)  # safe: a sympy object or a number
+    grouped = readable(expression)  # by products of the rates, as derive prints (equal)
     if sp.count_ops(expression) > SIMPLIFY_MAX_OPS:
-        return expression
+        return grouped
     angles = {f.args[0] for f in expression.atoms(sp.sin, sp.cos, sp.tan)}
     try:
         if len(angles) > 1:  # trigsimp over several angles is where simplify spends seconds
@@ -134,8 +136,8 @@ def display(expression: sp.Expr) -> sp.Expr:
         else:
             simpler = sp.factor_terms(sp.simplify(expression))
     except Exception:  # noqa: BLE001 - a failed simplification only costs readability
-        return expression
-    return simpler if sp.count_ops(simpler) <= sp.count_ops(expression) else expression
+        return grouped
+    return simpler if sp.count_ops(simpler) < sp.count_ops(grouped) else grouped
 
 
 def is_small(expression: sp.Expr) -> bool:

@@ -8,12 +8,38 @@ from __future__ import annotations
 
 from typing import Any
 
+import sympy as sp
+
 from ..derivation.equations import EquationsOfMotion
-from ..model.expressions import format_expression as fmt
+from ..model.expressions import format_expression
 from ..model.notation import latex_printer
+from ..model.readable import readable, readable_matrix
 from ..model.units import generalized_force_unit
 
 CONVENTION = "M q_ddot + Phi_q^T lambda = forcing"
+
+
+class _Display:
+    """The readable form of the derivation's expressions (model/readable.py: equal to the
+    derived ones, grouped by products of the rates), as text in the model-file grammar."""
+
+    def __init__(self, eom: EquationsOfMotion):
+        model = eom.model
+        self.rates = frozenset([*model.q_dot, *model.q_ddot, *eom.multipliers])
+        self.ranges = {c.symbol: tuple(c.range) for c in model.coordinates if c.range}
+
+    def form(self, expr) -> sp.Expr:
+        return readable(expr, self.rates, self.ranges)
+
+    def lagrangian(self, eom: EquationsOfMotion) -> sp.Expr:
+        """L = T - V from the readable T and V (grouping L again would repeat T's work)."""
+        return self.form(eom.kinetic_energy) - self.form(eom.potential_energy)
+
+    def matrix(self, matrix) -> sp.ImmutableMatrix:
+        return readable_matrix(matrix, self.rates, self.ranges)
+
+    def __call__(self, expr) -> str:
+        return format_expression(self.form(expr))
 
 
 # -- text ---------------------------------------------------------------------------------------
@@ -45,6 +71,7 @@ def _labels(model) -> dict[str, str]:
 
 def derivation_text(eom: EquationsOfMotion) -> str:
     model = eom.model
+    fmt = _Display(eom)
     lines = [model.name, "=" * len(model.name)]
     coordinates = ", ".join(f"{c.name} [{c.unit or '1'}]" for c in model.coordinates)
     lines += [f"Coordinates: {coordinates}", ""]
@@ -53,11 +80,11 @@ def derivation_text(eom: EquationsOfMotion) -> str:
               f"{label['V']} = {fmt(eom.potential_energy)}"]
     if eom.dissipation != 0:
         lines.append(f"{label['D']} = {fmt(eom.dissipation)}")
-    lines += [f"{label['L']} = {fmt(eom.lagrangian)}", ""]
+    lines += [f"{label['L']} = {format_expression(fmt.lagrangian(eom))}", ""]
 
     lines.append("Equations of motion, d/dt(dL/dq_dot) - dL/dq = Q"
                  + (" - Phi_q^T lambda" if model.constraints else "") + ":")
-    for c, row, f in zip(model.coordinates, _rows(eom), eom.forcing, strict=True):
+    for c, row, f in zip(model.coordinates, _rows(eom, fmt), eom.forcing, strict=True):
         lines.append(f"  [{c.name}]  {row} = {fmt(f)}")
     lines.append("")
 
@@ -99,24 +126,41 @@ def derivation_text(eom: EquationsOfMotion) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _rows(eom: EquationsOfMotion) -> list[str]:
+def _rows(eom: EquationsOfMotion, fmt: _Display) -> list[str]:
     """Left-hand sides sum_j M_ij q_ddot_j + sum_k Phi_ki lambda_k as text."""
     model = eom.model
     rows = []
     for i in range(len(model.coordinates)):
         terms = []
         for j, c in enumerate(model.coordinates):
-            entry = eom.mass_matrix[i, j]
-            if entry != 0:
-                terms.append(f"({fmt(entry)})*{c.acceleration}" if entry.is_Add
-                             else f"{fmt(entry * c.acceleration)}")
+            terms.append(_product_text(fmt.form(eom.mass_matrix[i, j]), c.acceleration))
         for k in range(eom.multipliers.rows):
-            entry = eom.constraint_jacobian[k, i]
-            if entry != 0:
-                terms.append(f"({fmt(entry)})*{eom.multipliers[k]}" if entry.is_Add
-                             else fmt(entry * eom.multipliers[k]))
-        rows.append(" + ".join(terms) if terms else "0")
+            terms.append(_product_text(fmt.form(eom.constraint_jacobian[k, i]),
+                                       eom.multipliers[k]))
+        text = ""
+        for term in filter(None, terms):
+            if not text:
+                text = term
+            elif term.startswith("-"):
+                text += " - " + term[1:]
+            else:
+                text += " + " + term
+        rows.append(text or "0")
     return rows
+
+
+def _product_text(coefficient: sp.Expr, unknown: sp.Symbol) -> str:
+    """coefficient*unknown as text, the sum in parentheses ('' for a zero coefficient)."""
+    if coefficient == 0:
+        return ""
+    if coefficient.is_Add:
+        negated = -coefficient
+        if sp.count_ops(negated) < sp.count_ops(coefficient) and not negated.is_Add:
+            return "-" + format_expression(negated * unknown)
+        return f"({format_expression(coefficient)})*{unknown}"
+    if coefficient.is_Mul and any(factor.is_Add for factor in coefficient.args):
+        return f"{format_expression(coefficient)}*{unknown}"  # the unknown after the sum
+    return format_expression(coefficient * unknown)
 
 
 # -- JSON ---------------------------------------------------------------------------------------
@@ -126,7 +170,7 @@ def derivation_document(eom: EquationsOfMotion) -> dict[str, Any]:
     """The `derive --format json` document."""
     model = eom.model
     names = [c.name for c in model.coordinates]
-    text = fmt
+    text = _Display(eom)
     document: dict[str, Any] = {
         "name": model.name,
         "convention": CONVENTION,
@@ -135,7 +179,7 @@ def derivation_document(eom: EquationsOfMotion) -> dict[str, Any]:
         "kinetic_energy": text(eom.kinetic_energy),
         "potential_energy": text(eom.potential_energy),
         "dissipation": text(eom.dissipation),
-        "lagrangian": text(eom.lagrangian),
+        "lagrangian": format_expression(text.lagrangian(eom)),
         "generalized_forces": {n: text(v) for n, v in zip(names, eom.generalized_forces,
                                                            strict=True)},
         "load_contributions": [
@@ -171,7 +215,12 @@ def derivation_document(eom: EquationsOfMotion) -> dict[str, Any]:
 def derivation_latex(eom: EquationsOfMotion) -> str:
     """A self-contained LaTeX fragment (amsmath) ready to paste into a paper."""
     model = eom.model
-    tex = latex_printer(model)
+    printer = latex_printer(model)
+    display = _Display(eom)
+
+    def tex(expr) -> str:
+        form = display.matrix(expr) if isinstance(expr, sp.MatrixBase) else display.form(expr)
+        return printer(form)
 
     lines = [f"% {model.name}: equations of motion by Lagrange's method",
              r"% Convention: M \ddot{q} + \Phi_q^T \lambda = f", r"\begin{align}"]
@@ -179,7 +228,7 @@ def derivation_latex(eom: EquationsOfMotion) -> str:
     lines.append(rf"V &= {tex(eom.potential_energy)} \\")
     if eom.dissipation != 0:
         lines.append(rf"D &= {tex(eom.dissipation)} \\")
-    lines.append(rf"L &= T - V = {tex(eom.lagrangian)} \\")
+    lines.append(rf"L &= T - V = {printer(display.lagrangian(eom))} \\")
     for c, total in zip(model.coordinates, eom.generalized_forces, strict=True):
         lines.append(rf"Q_{{{tex(c.symbol)}}} &= {tex(total)} \\")
     for c, equation in zip(model.coordinates, eom.equations, strict=True):

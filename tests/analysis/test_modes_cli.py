@@ -10,7 +10,8 @@ import pytest
 
 from lagrangian.output.modes import mode_plot_size
 
-MODE_KEYS = {"frequency", "frequency_hz", "period", "damping_ratio", "growth_rate", "shape"}
+MODE_KEYS = {"frequency", "frequency_hz", "period", "damping_ratio", "growth_rate", "shape",
+             "amplitude", "phase"}
 
 
 def test_modes_json_contract_for_worked_example_3(cli):

@@ -87,7 +87,21 @@ def mode_document(mode: Mode) -> dict[str, Any]:
         "damping_ratio": mode.damping_ratio,
         "growth_rate": mode.growth_rate,
         "shape": dict(mode.shape),
+        **mode_phases(mode),
     }
+
+
+def mode_phases(mode: Mode) -> dict[str, dict[str, float]]:
+    """Amplitude and phase (rad, in (-pi, pi]) of each coordinate in the complex shape: the
+    coordinate moves as amplitude * e^(growth t) * cos(omega_d t + phase), the reference
+    coordinate (largest, +1) at phase 0; a real mode's negative components are at phase pi."""
+    names = list(mode.shape)
+    amplitude, phase = {}, {}
+    for name, value in zip(names, mode.complex_shape, strict=True):
+        amplitude[name] = float(abs(value))
+        angle = float(np.angle(value)) + 0.0 if abs(value) > 0 else 0.0
+        phase[name] = math.pi if angle <= -math.pi + 1e-12 else angle  # -1 - 0j: pi, not -pi
+    return {"amplitude": amplitude, "phase": phase}
 
 
 def modes_text(analysis: ModalAnalysis) -> str:
@@ -197,6 +211,9 @@ def mode_shape_figure(analysis: ModalAnalysis):
             ax.xaxis.set_major_locator(MaxNLocator(integer=True))
             ax.set_xlabel("coordinate number", fontsize=8)
         ax.axhline(0.0, color="black", linewidth=0.6)
+        if _is_complex(mode):
+            _draw_motion(ax, mode, positions if len(names) <= 12 else positions + 1,
+                         bars=len(names) <= 12)
         ax.set_ylim(-1.15, 1.15)
         ax.set_title(f"mode {i}: {_title(mode)}", fontsize=9)
         ax.tick_params(labelsize=8)
@@ -207,6 +224,49 @@ def mode_shape_figure(analysis: ModalAnalysis):
         title += f" (lowest {len(modes)} of {len(analysis.modes)} modes)"
     figure.suptitle(title, fontsize=10)
     return figure
+
+
+# A complex mode is drawn over one period as this many snapshots of Re(shape e^(i theta)).
+MOTION_SNAPSHOTS = 8
+
+
+def _is_complex(mode: Mode) -> bool:
+    return any(abs(v.imag) > 1e-9 for v in mode.complex_shape)
+
+
+def mode_snapshots(mode: Mode, count: int = MOTION_SNAPSHOTS) -> tuple[np.ndarray, np.ndarray]:
+    """Phases theta_k = 2 pi k / count over one period and the shapes Re(shape e^(i theta_k))
+    (count, coordinates): the mode's motion, its growth or decay left out."""
+    theta = 2 * np.pi * np.arange(count) / count
+    shape = np.array(mode.complex_shape)
+    return theta, np.real(shape[None, :] * np.exp(1j * theta)[:, None])
+
+
+def _draw_motion(ax, mode: Mode, positions: np.ndarray, bars: bool) -> None:
+    """A complex (gyroscopic, non-proportionally damped) mode moves its coordinates out of step.
+    Bars: over each coordinate's bar, its motion Re(a e^(i theta)) over one period (theta from
+    0 at the bar's left to 2 pi at its right), so the phase shifts show. Many coordinates: the
+    shape at snapshots over one period, coloured by phase (a wave along a chain)."""
+    if bars:
+        theta = np.linspace(0, 2 * np.pi, 49)
+        for position, value in zip(positions, mode.complex_shape, strict=True):
+            ax.plot(position + 0.8 * (theta / (2 * np.pi) - 0.5),
+                    np.real(value * np.exp(1j * theta)), color="tab:orange", linewidth=1.4,
+                    label="motion")
+            if abs(value) > 0:
+                ax.text(position, -1.08, f"{math.degrees(np.angle(value)):+.0f}°", ha="center",
+                        fontsize=7, color="tab:orange")
+        ax.text(0.02, 0.03, "orange: each coordinate over one period", transform=ax.transAxes,
+                fontsize=7, color="0.35")
+        return
+    from matplotlib import colormaps
+
+    theta, snapshots = mode_snapshots(mode)
+    colours = colormaps["twilight"](theta / (2 * np.pi))
+    for snapshot, colour in zip(snapshots, colours, strict=True):
+        ax.plot(positions, snapshot, color=colour, linewidth=0.9, alpha=0.8, label="snapshot")
+    ax.text(0.02, 0.03, f"{len(theta)} snapshots over one period", transform=ax.transAxes,
+            fontsize=7, color="0.35")
 
 
 def write_mode_plot(analysis: ModalAnalysis, path: str | Path, *,

@@ -146,7 +146,7 @@ def test_html_player_is_offline_and_small(tmp_path):
     page = (tmp_path / "run.html").read_text()
     assert not re.search(r"https?://", page)
     assert not re.search(r"""(src|href)\s*=\s*["'](?!data:)""", page)  # nothing linked
-    assert page.count("data:image/png;base64,") == len(animation.times) == 126
+    assert page.count("data:image/png;base64,") == len(animation.times) == 101  # 20 a second
     assert len(page.encode()) < 1_000_000
 
 

@@ -50,7 +50,7 @@ class Simulation(SimulationResult):
             save_figure(figure, path, protect=self._inputs())
         return figure
 
-    def animate(self, path: str | Path | None = None, *, fps: int = 25, max_frames: int = 250,
+    def animate(self, path: str | Path | None = None, *, fps: int = 20, max_frames: int = 250,
                 view: tuple[float, float] | str | None = None, progress=None):
         """The mechanism moving: a matplotlib animation, also written to ``path`` (.gif or
         .html with a player) when given. Bodies in space are seen from ``view`` = (azimuth,

@@ -94,9 +94,20 @@ def test_recursive_equals_the_derived_equations_on_a_branched_tree(tree):
                                    err_msg=name)
 
 
+@pytest.fixture(scope="module")
+def no_mimic(tmp_path_factory):
+    """The tree with its mimic joint locked: forward dynamics by the articulated-body
+    algorithm (with the mimic, by Cholesky of M)."""
+    path = tmp_path_factory.mktemp("tree") / "turret.urdf"
+    path.write_text(TREE)
+    return lagrangian.load(path, lock={"grip": 0.01, "wrist": -0.3})
+
+
 @needs_c
-def test_laws_of_the_recursive_functions(tree):
-    f = tree.dynamics()
+@pytest.mark.parametrize("which", ["tree", "no_mimic"])
+def test_laws_of_the_recursive_functions(which, request):
+    f = request.getfixturevalue(which).dynamics()
+    assert isinstance(f, RecursiveDynamics)
     n = f.n
     q, v, a, _ = states(n, count=4, seed=11)
     mass = f.mass_matrix(q)
@@ -121,8 +132,12 @@ def test_laws_of_the_recursive_functions(tree):
 
     np.testing.assert_allclose((energy(h) - energy(-h)) / (2 * h), np.einsum("ki,ki->k", v, tau),
                                rtol=1e-6, atol=1e-7)
-    # forward dynamics undoes inverse dynamics, q of shape (n,) broadcast against a batch
+    # forward dynamics (articulated-body algorithm or Cholesky) undoes inverse dynamics
+    # (Newton-Euler), and equals M^-1 (tau - b) solved here
     np.testing.assert_allclose(f.forward_dynamics(q, v, tau), a, rtol=1e-9, atol=1e-10)
+    solved = np.linalg.solve(mass, (tau - f.bias_forces(q, v))[..., None])[..., 0]
+    np.testing.assert_allclose(solved, a, rtol=1e-9, atol=1e-10)
+    # q of shape (n,) broadcast against a batch
     one = f.bias_forces(q[0], v)
     np.testing.assert_allclose(one, f.bias_forces(np.broadcast_to(q[0], v.shape), v), rtol=1e-15)
     assert f.mass_matrix(q.reshape(2, 2, n)).shape == (2, 2, n, n)

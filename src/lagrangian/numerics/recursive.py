@@ -7,7 +7,8 @@ shared):
 
 - inverse dynamics by recursive Newton-Euler: tau = M(q) a + C(q, q_dot) q_dot + g(q);
 - the mass matrix by the composite-rigid-body algorithm;
-- forward dynamics q_ddot = M^-1 (tau - b) by Cholesky (M is symmetric positive definite);
+- forward dynamics by the articulated-body algorithm, O(n) (or, with mimic joints, Cholesky
+  of M: q_ddot = M^-1 (tau - b));
 - kinetic energy 1/2 sum (m v.v + 2 v.(w x h) + w.J_O w), potential energy m g height.
 
 Units SI. Gravity g (a runtime parameter) along the tree's direction; each coordinate's actuator
@@ -115,6 +116,15 @@ class _Emitter:
             return self.neg(self.mul(a, self.negated[b]))
         x, y = sorted((a, b))
         return self._new(("*", x, y), f"{x} * {y}", (x, y))
+
+    def div(self, a: Term, b: Term) -> Term:
+        if not isinstance(b, str):
+            if b == 0:
+                raise ZeroDivisionError("a joint moves nothing (massless subtree)")
+            return self.mul(a, 1.0 / b)
+        if not isinstance(a, str) and a == 0:
+            return 0.0
+        return self._new(("/", a, b), f"{self.text(a)} / {b}", (a, b))
 
     def call(self, function: str, a: Term) -> Term:
         if not isinstance(a, str):
@@ -320,6 +330,137 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
     return entries
 
 
+def _articulated(tree: KinematicTree) -> bool:
+    """Whether the articulated-body algorithm applies: each coordinate drives one joint, as
+    its angle or distance (no mimic joint)."""
+    used = [j.coordinate for j in tree.joints]
+    return len(set(used)) == len(used) and all(j.multiplier == 1.0 for j in tree.joints)
+
+
+def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, tau):
+    """Articulated-body algorithm (Featherstone): q_ddot for q, q_dot and tau (on top of the
+    actuator parameters), O(n). Spatial vectors in body axes about the body's origin: motion
+    (w, v), force (n, f); inertia blocks [[A, B], [B^T, C]] with n = A w + B v, f = B^T w + C v."""
+    placements = _kinematics(E, tree, q)
+    nb = len(tree.joints)
+    w, vel, c, A, B, C, pn, pf = [], [], [], [], [], [], [], []
+    for i, joint in enumerate(tree.joints):
+        R, p = placements[i]
+        u = list(joint.axis)
+        rate = v[joint.coordinate]
+        wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
+                                                                 vel[joint.parent])
+        w_i = E.apply_transpose(R, wl)
+        v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
+        su = E.scale(rate, u)
+        if joint.kind == "revolute":
+            w_i = E.vadd(w_i, su)
+            c.append((E.cross(w_i, su), E.cross(v_i, su)))  # (w, v) x S q_dot
+        else:
+            v_i = E.vadd(v_i, su)
+            c.append(([0.0] * 3, E.cross(w_i, su)))
+        w.append(w_i)
+        vel.append(v_i)
+        m, h, J = joint.mass, list(joint.first_moment), [list(r) for r in joint.inertia]
+        # the rigid body's inertia: A = J_O, B = [h]x, C = m 1
+        A.append([row[:] for row in J])
+        B.append([[0.0, E.neg(h[2]), h[1]], [h[2], 0.0, E.neg(h[0])],
+                  [E.neg(h[1]), h[0], 0.0]])
+        C.append([[m if r == k else 0.0 for k in range(3)] for r in range(3)])
+        # bias force (w, v) x* (I (w, v)): n0 = J w + h x v, f0 = m v + w x h
+        n0 = E.vadd(E.apply(J, w_i), E.cross(h, v_i))
+        f0 = E.vadd(E.scale(m, v_i), E.cross(w_i, h))
+        pn.append(E.vadd(E.cross(w_i, n0), E.cross(v_i, f0)))
+        pf.append(E.cross(w_i, f0))
+    U, D, uu = [None] * nb, [None] * nb, [None] * nb
+    for i in reversed(range(nb)):
+        joint = tree.joints[i]
+        u = list(joint.axis)
+        if joint.kind == "revolute":  # U = IA S: the first column block times u
+            Un = E.apply(A[i], u)
+            Uf = E.apply_transpose(B[i], u)
+            drive_n, drive_f = u, [0.0] * 3
+        else:
+            Un = E.apply(B[i], u)
+            Uf = E.apply(C[i], u)
+            drive_n, drive_f = [0.0] * 3, u
+        U[i] = (Un, Uf)
+        D[i] = E.add(E.dot(drive_n, Un), E.dot(drive_f, Uf))
+        effort = E.add(tau[joint.coordinate], layout.actuators[joint.coordinate])
+        uu[i] = E.sub(effort, E.add(E.dot(drive_n, pn[i]), E.dot(drive_f, pf[i])))
+        parent = joint.parent
+        if parent < 0:
+            continue
+        R, p = placements[i]
+        inv = E.div(1.0, D[i])
+        Uns, Ufs = E.scale(inv, Un), E.scale(inv, Uf)
+        # Ia = IA - U U^T / D, pa = pA + Ia c + U u / D
+        Aa = [[E.sub(A[i][r][k], E.mul(Un[r], Uns[k])) for k in range(3)] for r in range(3)]
+        Ba = [[E.sub(B[i][r][k], E.mul(Un[r], Ufs[k])) for k in range(3)] for r in range(3)]
+        Ca = [[E.sub(C[i][r][k], E.mul(Uf[r], Ufs[k])) for k in range(3)] for r in range(3)]
+        cw, cv = c[i]
+        Bt = [[Ba[k][r] for k in range(3)] for r in range(3)]
+        an = E.vadd(pn[i], E.vadd(E.vadd(E.apply(Aa, cw), E.apply(Ba, cv)), E.scale(uu[i], Uns)))
+        af = E.vadd(pf[i], E.vadd(E.vadd(E.apply(Bt, cw), E.apply(Ca, cv)), E.scale(uu[i], Ufs)))
+        # into the parent: rotate (R X R^T), then move the reference point by p
+        Ar, Br, Cr = _sandwich(E, R, Aa, True), _sandwich(E, R, Ba, False), _sandwich(E, R, Ca, True)
+        P = [[0.0, E.neg(p[2]), p[1]], [p[2], 0.0, E.neg(p[0])], [E.neg(p[1]), p[0], 0.0]]
+        K = E.matmul(P, Cr)  # [p]x C
+        PBt = E.matmul(P, [[Br[k][r] for k in range(3)] for r in range(3)])  # [p]x B^T
+        KP = E.matmul(K, P)
+        for r in range(3):
+            for k in range(r, 3):
+                # A_P = A + [p]x B^T + ([p]x B^T)^T - [p]x C [p]x
+                entry = E.add(Ar[r][k], E.sub(E.add(PBt[r][k], PBt[k][r]), KP[r][k]))
+                A[parent][r][k] = E.add(A[parent][r][k], entry)
+                if k != r:
+                    A[parent][k][r] = A[parent][r][k]
+                C[parent][r][k] = E.add(C[parent][r][k], Cr[r][k])
+                if k != r:
+                    C[parent][k][r] = C[parent][r][k]
+        for r in range(3):
+            for k in range(3):  # B_P = B + [p]x C
+                B[parent][r][k] = E.add(B[parent][r][k], E.add(Br[r][k], K[r][k]))
+        force = E.apply(R, af)
+        pf[parent] = E.vadd(pf[parent], force)
+        pn[parent] = E.vadd(pn[parent], E.vadd(E.apply(R, an), E.cross(p, force)))
+    up = [E.mul(layout.gravity, -d) for d in tree.gravity_direction]
+    acc_w, acc_v = [None] * nb, [None] * nb
+    qdd: list[Term] = [0.0] * layout.n
+    for i, joint in enumerate(tree.joints):
+        R, p = placements[i]
+        if joint.parent < 0:
+            aw_l, av_l = [0.0] * 3, up
+        else:
+            aw_l, av_l = acc_w[joint.parent], acc_v[joint.parent]
+        cw, cv = c[i]
+        aw = E.vadd(E.apply_transpose(R, aw_l), cw)
+        av = E.vadd(E.apply_transpose(R, E.vadd(av_l, E.cross(aw_l, p))), cv)
+        Un, Uf = U[i]
+        x = E.div(E.sub(uu[i], E.add(E.dot(Un, aw), E.dot(Uf, av))), D[i])
+        qdd[joint.coordinate] = x
+        if joint.kind == "revolute":
+            aw = E.vadd(aw, E.scale(x, joint.axis))
+        else:
+            av = E.vadd(av, E.scale(x, joint.axis))
+        acc_w[i], acc_v[i] = aw, av
+    return qdd
+
+
+def _sandwich(E: _Emitter, R, X, symmetric: bool):
+    """R X R^T (only the upper triangle computed when X is symmetric)."""
+    RX = E.matmul(R, X)
+    out = [[None] * 3 for _ in range(3)]
+    for r in range(3):
+        for k in range(3):
+            if symmetric and k < r:
+                continue
+            out[r][k] = E.dot(RX[r], R[k])
+            if symmetric:
+                out[k][r] = out[r][k]
+    return out
+
+
 def _velocities(E: _Emitter, tree: KinematicTree, q, v):
     placements = _kinematics(E, tree, q)
     w, vel = [], []
@@ -407,7 +548,25 @@ def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix:
     E = _Emitter()
     function(f"double {P}_potential_energy({R} q, {R} p)", E,
              [("double V", _potential_energy(E, tree, layout, q))], "    return V;\n")
-    sections.append(f"""/* q_ddot = M^-1 (tau - b): Cholesky M = L L^T on the stack; -1 where M is not
+    qdd = None
+    if _articulated(tree):
+        E = _Emitter()
+        try:
+            qdd = _forward_dynamics(E, tree, layout, q, v, _inputs("tau", n))
+        except ZeroDivisionError:  # singular: Cholesky says so at run time
+            qdd = None
+    if qdd is not None:
+        check = "".join(f"    if (!isfinite(qdd[{i}])) return -1;\n" for i in range(n))
+        function(f"int {P}_forward_dynamics({R} q, {R} v, {R} tau, {R} p, double *restrict qdd)",
+                 E, [(f"qdd[{i}]", x) for i, x in enumerate(qdd)], check + "    return 0;\n")
+    else:
+        sections.append(_cholesky_forward(P, S, R, n))
+    return "\n".join(sections)
+
+
+def _cholesky_forward(P: str, S: str, R: str, n: int) -> str:
+    """Forward dynamics by Cholesky of M (a tree with mimic joints)."""
+    return f"""/* q_ddot = M^-1 (tau - b): Cholesky M = L L^T on the stack; -1 where M is not
    positive definite (a massless branch), else 0. */
 {S}int {P}_forward_dynamics({R} q, {R} v, {R} tau, {R} p, double *restrict qdd)
 {{
@@ -440,8 +599,7 @@ def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix:
     }}
     return 0;
 }}
-""")
-    return "\n".join(sections)
+"""
 
 
 # -- the compiled module ---------------------------------------------------------------------------

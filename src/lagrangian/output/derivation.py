@@ -65,7 +65,26 @@ def _labels(model) -> dict[str, str]:
         labels["L"] = "Lagrangian (kinetic less potential energy)"
     labels["convention"] = ("M q_ddot + Phi_q^T lambda = f" if not names & {"M", "f"} else
                             "(mass matrix) q_ddot + Phi_q^T lambda = (forcing)")
+    # Lagrange's equations name L and Q: written out when the model uses either letter.
+    lagrangian = ("L" if "L" not in names else "(T - V)" if not names & {"T", "V"}
+                  else "(Lagrangian)")
+    force = "Q" if "Q" not in names else "(generalized force)"
+    labels["equations"] = (f"Equations of motion, d/dt(d{lagrangian}/dq_dot) - d{lagrangian}/dq"
+                           f" = {force}")
     return labels
+
+
+# LaTeX: the letters of the labels, set in another alphabet when the model has a symbol of
+# that name (a length L is not the Lagrangian \mathcal{L}).
+_LATEX_LETTERS = {"T": r"\mathcal{T}", "V": r"\mathcal{V}", "D": r"\mathcal{D}",
+                  "L": r"\mathcal{L}", "Q": r"\mathcal{Q}", "M": r"\mathbf{M}",
+                  "f": r"\mathbf{f}"}
+
+
+def _latex_letters(model) -> dict[str, str]:
+    names = {p.name for p in model.parameters} | {c.name for c in model.coordinates}
+    return {letter: (other if letter in names else letter)
+            for letter, other in _LATEX_LETTERS.items()}
 
 
 
@@ -82,8 +101,7 @@ def derivation_text(eom: EquationsOfMotion) -> str:
         lines.append(f"{label['D']} = {fmt(eom.dissipation)}")
     lines += [f"{label['L']} = {format_expression(fmt.lagrangian(eom))}", ""]
 
-    lines.append("Equations of motion, d/dt(dL/dq_dot) - dL/dq = Q"
-                 + (" - Phi_q^T lambda" if model.constraints else "") + ":")
+    lines.append(label["equations"] + (" - Phi_q^T lambda" if model.constraints else "") + ":")
     for c, row, f in zip(model.coordinates, _rows(eom, fmt), eom.forcing, strict=True):
         lines.append(f"  [{c.name}]  {row} = {fmt(f)}")
     lines.append("")
@@ -222,19 +240,21 @@ def derivation_latex(eom: EquationsOfMotion) -> str:
         form = display.matrix(expr) if isinstance(expr, sp.MatrixBase) else display.form(expr)
         return printer(form)
 
+    k = _latex_letters(model)
     lines = [f"% {model.name}: equations of motion by Lagrange's method",
-             r"% Convention: M \ddot{q} + \Phi_q^T \lambda = f", r"\begin{align}"]
-    lines.append(rf"T &= {tex(eom.kinetic_energy)} \\")
-    lines.append(rf"V &= {tex(eom.potential_energy)} \\")
+             rf"% Convention: {k['M']} \ddot{{q}} + \Phi_q^T \lambda = {k['f']}",
+             r"\begin{align}"]
+    lines.append(rf"{k['T']} &= {tex(eom.kinetic_energy)} \\")
+    lines.append(rf"{k['V']} &= {tex(eom.potential_energy)} \\")
     if eom.dissipation != 0:
-        lines.append(rf"D &= {tex(eom.dissipation)} \\")
-    lines.append(rf"L &= T - V = {printer(display.lagrangian(eom))} \\")
+        lines.append(rf"{k['D']} &= {tex(eom.dissipation)} \\")
+    lines.append(rf"{k['L']} &= {k['T']} - {k['V']} = {printer(display.lagrangian(eom))} \\")
     for c, total in zip(model.coordinates, eom.generalized_forces, strict=True):
-        lines.append(rf"Q_{{{tex(c.symbol)}}} &= {tex(total)} \\")
+        lines.append(rf"{k['Q']}_{{{tex(c.symbol)}}} &= {tex(total)} \\")
     for c, equation in zip(model.coordinates, eom.equations, strict=True):
         lines.append(rf"0 &= {tex(equation)} && \text{{({c.name})}} \\")
-    lines.append(rf"M &= {tex(eom.mass_matrix)} \\")
-    lines.append(rf"f &= {tex(eom.forcing)}")
+    lines.append(rf"{k['M']} &= {tex(eom.mass_matrix)} \\")
+    lines.append(rf"{k['f']} &= {tex(eom.forcing)}")
     if model.constraints:
         lines[-1] += r" \\"
         lines.append(rf"\Phi_q &= {tex(eom.constraint_jacobian)} \\")

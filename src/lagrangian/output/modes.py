@@ -126,9 +126,12 @@ def modes_text(analysis: ModalAnalysis) -> str:
         lines.append(f"Matrices in the independent coordinates ({', '.join(linear.coordinates)}); "
                      "shapes in all coordinates.")
     lines.append("")
-    for label, matrix in (("Mass matrix M", linear.mass_matrix),
-                          ("Damping matrix C (dissipation + gyroscopic)", linear.damping_matrix),
-                          ("Stiffness matrix K", linear.stiffness_matrix)):
+    # A coordinate named M, C or K labels rows and columns: the matrices then lose their letter.
+    letter = {n: ("" if n in linear.user_coordinates else f" {n}") for n in "MCK"}
+    for label, matrix in ((f"Mass matrix{letter['M']}", linear.mass_matrix),
+                          (f"Damping matrix{letter['C']} (dissipation + gyroscopic)",
+                           linear.damping_matrix),
+                          (f"Stiffness matrix{letter['K']}", linear.stiffness_matrix)):
         lines.append(f"{label}:")
         lines += _matrix_lines(matrix, linear.coordinates)
         lines.append("")

@@ -27,6 +27,24 @@ COMPONENT_KEYS = {
     "constraints": ({"name"}, {"holonomic", "velocity"}),
     "contacts": ({"name", "body", "radius", "axle"}, {"normal"}),
 }
+COORDINATE_KEYS = {"unit", "initial", "rate", "range"}  # a coordinate given as a table
+PARAMETER_KEYS = {"value", "unit"}  # a parameter given as a table
+ENERGY_KEYS = {"T", "V", "D"}
+GRAVITY_KEYS = ({"g"}, {"direction"})
+
+
+def model_file_schema() -> dict[str, tuple[frozenset[str], frozenset[str]]]:
+    """Every key the reader accepts: table -> (required keys, optional keys); "" is the file's
+    top level. The README's table of model-file keys is checked against it."""
+    optional_top = TOP_LEVEL - {"coordinates"}
+    schema = {"": (frozenset({"coordinates"}), frozenset(optional_top)),
+              "coordinates.<name>": (frozenset(), frozenset(COORDINATE_KEYS)),
+              "parameters.<name>": (frozenset(), frozenset(PARAMETER_KEYS)),
+              "energy": (frozenset(), frozenset(ENERGY_KEYS)),
+              "gravity": (frozenset(GRAVITY_KEYS[0]), frozenset(GRAVITY_KEYS[1]))}
+    for table, (required, optional) in COMPONENT_KEYS.items():
+        schema[table] = (frozenset(required), frozenset(optional))
+    return schema
 
 
 def read_text_file(path: str | Path) -> str:
@@ -98,7 +116,7 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
         if isinstance(spec, str):
             builder.coordinate(key, check_unit(spec, field, source), field=field)
         elif isinstance(spec, Mapping):
-            check_known_keys(spec, {"unit", "initial", "rate", "range"}, field, source)
+            check_known_keys(spec, COORDINATE_KEYS, field, source)
             unit = check_unit(_string(spec.get("unit", "m"), f"{field}.unit", source),
                               f"{field}.unit", source)
             builder.coordinate(
@@ -112,7 +130,7 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
     for key, spec in _table(data, "parameters", source).items():
         field = f"parameters.{key}"
         if isinstance(spec, Mapping):
-            check_known_keys(spec, {"value", "unit"}, field, source)
+            check_known_keys(spec, PARAMETER_KEYS, field, source)
             unit = spec.get("unit")
             if unit is not None:
                 unit = check_unit(_string(unit, f"{field}.unit", source), f"{field}.unit", source)
@@ -127,7 +145,7 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
         builder.define(key, text, field=f"definitions.{key}")
 
     energy = _table(data, "energy", source)
-    check_known_keys(energy, {"T", "V", "D"}, "energy", source)
+    check_known_keys(energy, ENERGY_KEYS, "energy", source)
     adders: dict[str, Callable] = {
         "T": builder.add_kinetic_energy,
         "V": builder.add_potential_energy,
@@ -138,7 +156,7 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
 
     if "gravity" in data:
         gravity = _table(data, "gravity", source)
-        check_known_keys(gravity, {"g", "direction"}, "gravity", source)
+        check_known_keys(gravity, GRAVITY_KEYS[0] | GRAVITY_KEYS[1], "gravity", source)
         if "g" not in gravity:
             raise ModelError("missing key 'g'", field="gravity", source=source)
         builder.set_gravity(gravity["g"], gravity.get("direction"))

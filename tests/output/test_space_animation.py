@@ -129,3 +129,26 @@ def test_cli_view_flag(capsys, tmp_path):
     assert code == 2 and err.startswith("error: --view: expected AZIMUTH,ELEVATION")
     code, out, err = cli(capsys, "heavy_top", "--t-end", "0.1", "--view", "60,10")
     assert code == 2 and err == "error: --view: a viewpoint is only used with --animate\n"
+
+
+def test_a_rolling_wheel_is_drawn_as_its_rim_touching_the_ground():
+    """The coin (radius r, axle = body y): its rim is a circle of radius r about the centre in
+    the plane normal to R e_y, and its lowest point touches the ground z = 0."""
+    run = lagrangian.load("rolling_coin").simulate(0.5, samples=26)
+    geometry = mechanism(run.model, run.parameters)
+    r = {p.name: p.value for p in run.model.parameters}["r"]
+    (body, radius, axle, normal), = geometry.wheels
+    assert radius == r and axle == (0.0, 1.0, 0.0) and normal == (0.0, 0.0, 1.0)
+    space = geometry.space_frame(run.q, run.q_dot, run.t)
+    rims, contacts = geometry.wheel_frame(space)
+    centre = space.origins[:, body]
+    assert np.allclose(np.linalg.norm(rims[:, 0] - centre[:, None], axis=-1), r, rtol=1e-12)
+    world_axle = space.rotations[:, body] @ np.array(axle)
+    assert np.allclose(np.einsum("kpi,ki->kp", rims[:, 0] - centre[:, None], world_axle), 0,
+                       atol=1e-12)
+    assert np.allclose(contacts[:, 0, 2], 0.0, atol=1e-9)  # on the ground (the constraint)
+    assert np.allclose(rims[:, 0, :, 2].min(axis=1), contacts[:, 0, 2], atol=1e-3 * r)
+    frames = run.animate(fps=10)
+    frames.draw(len(frames.times) - 1)
+    labels = {line.get_label() for line in frames._fig.axes[0].get_lines()}
+    assert {"ground", "wheel", "track"} <= labels

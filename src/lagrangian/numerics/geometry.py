@@ -102,6 +102,9 @@ class Mechanism:
     blocks: tuple[tuple[int, tuple[float, float]], ...] = ()  # particle index, unit track
     rolling: tuple[tuple[int, float, tuple[float, float]], ...] = ()  # body, radius, normal
     gravity: tuple[float, float] | None = None  # unit direction of gravity in the plane
+    # Rolling contacts of bodies in space: (body index, radius (m), axle (body axes), ground
+    # normal (world)), the ground being the plane r . n = 0 (model/contacts.py).
+    wheels: tuple[tuple[int, float, tuple[float, ...], tuple[float, ...]], ...] = ()
 
     def space_frame(self, q: np.ndarray, v: np.ndarray, t: np.ndarray) -> SpaceFrame:
         """Batched 3D geometry for states q, v (k, n) at times t (k,), bodies in space included."""
@@ -128,6 +131,28 @@ class Mechanism:
         rods, pivots = self._rods_and_pivots(q, v, t)
         return SpaceFrame(particles, origins, rotations, centres, half, principal, links, bars,
                           springs, dampers, rods, pivots)
+
+    def wheel_frame(self, space: SpaceFrame, points: int = 41) -> tuple[np.ndarray, np.ndarray]:
+        """Each rolling wheel's rim (k, W, points, 3) and contact point (k, W, 3) in the world:
+        with a = R axle and d = -(n - (n.a) a)/|n - (n.a) a| (down in the wheel's plane), the
+        contact is r_C = r_G + r d and the rim r_G + r (cos s d + sin s a x d)."""
+        k = len(space.origins)
+        if not self.wheels:
+            return np.zeros((k, 0, points, 3)), np.zeros((k, 0, 3))
+        index = [w[0] for w in self.wheels]
+        radius = np.array([w[1] for w in self.wheels])[None, :, None]
+        axle = np.einsum("kbij,bj->kbi", space.rotations[:, index],
+                         np.array([w[2] for w in self.wheels]))
+        normal = np.array([w[3] for w in self.wheels])[None]
+        down = -(normal - np.sum(normal * axle, axis=-1, keepdims=True) * axle)
+        down /= np.maximum(np.linalg.norm(down, axis=-1, keepdims=True), 1e-300)
+        side = np.cross(axle, down)
+        centre = space.origins[:, index]
+        contact = centre + radius * down
+        s = np.linspace(0, 2 * np.pi, points)[None, None, :, None]
+        rim = centre[:, :, None] + radius[..., None] * (np.cos(s) * down[:, :, None] +
+                                                        np.sin(s) * side[:, :, None])
+        return rim, contact
 
     def _frame_space(self, q, v, t) -> np.ndarray:
         if self._space is None:
@@ -188,7 +213,7 @@ def mechanism(model: Model, parameters: Mapping[str, float | None] | ParameterVa
     dampers = [e for name in damper_ends for point in damper_ends[name] for e in point[:2]]
     space = {}
     if model.rigid_bodies:
-        space = _space_geometry(model, ends, damper_ends, compile_)
+        space = _space_geometry(model, ends, damper_ends, compile_, values)
     drawn = sketch(model, values)
     rod_exprs = [e for pair in drawn.rods for point in pair for e in point] + \
         [e for point in drawn.pivots for e in point]
@@ -205,7 +230,8 @@ def mechanism(model: Model, parameters: Mapping[str, float | None] | ParameterVa
     )
 
 
-def _space_geometry(model: Model, ends: Mapping, damper_ends: Mapping, compile_) -> dict:
+def _space_geometry(model: Model, ends: Mapping, damper_ends: Mapping, compile_,
+                    values: Mapping) -> dict:
     """The 3D expressions of a model with bodies in space, as Mechanism's keyword arguments."""
     by_name = {b.name: b for b in model.rigid_bodies}
     exprs = [e for p in model.particles for e in (*p.position, 0, 0, 0)[:3]]
@@ -224,7 +250,18 @@ def _space_geometry(model: Model, ends: Mapping, damper_ends: Mapping, compile_)
             links += 1
     for table in (ends, damper_ends):
         exprs += [e for name in table for point in table[name] for e in (*point, 0, 0, 0)[:3]]
-    return {"rigid_body_names": tuple(by_name), "link_count": links,
+    names = list(by_name)
+    wheels = []
+    for contact in model.contacts:
+        try:
+            radius = float(as_expression(contact.radius).xreplace(values))
+            axle = tuple(float(as_expression(c).xreplace(values)) for c in contact.axle)
+            normal = tuple(float(as_expression(c).xreplace(values)) for c in contact.normal)
+        except (TypeError, ValueError):
+            continue  # a symbolic radius or direction: the wheel is not drawn
+        if contact.body in by_name:
+            wheels.append((names.index(contact.body), radius, axle, normal))
+    return {"rigid_body_names": tuple(by_name), "link_count": links, "wheels": tuple(wheels),
             "_space": compile_(exprs), "_inertia": compile_(inertia)}
 
 

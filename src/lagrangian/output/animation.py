@@ -291,8 +291,11 @@ def _space_animation(result, geometry, times, q, v, view, fps):
         np.swapaxes(space.rotations, -1, -2) * length[..., None, None]  # (k, B, axis, 3)
     corners = space.centres[..., None, :] + np.einsum(
         "cj,kbij->kbci", _CORNERS, space.principal_axes * space.half_extents[..., None, :])
+    rims, contacts = geometry.wheel_frame(space)
+    grid = _ground_grid(geometry, contacts)
     everything = np.concatenate([
-        space.particles.reshape(-1, 3), space.centres.reshape(-1, 3), tips.reshape(-1, 3),
+        rims.reshape(-1, 3), grid.reshape(-1, 3), space.particles.reshape(-1, 3),
+        space.centres.reshape(-1, 3), tips.reshape(-1, 3),
         corners.reshape(-1, 3), space.links.reshape(-1, 3), space.bars.reshape(-1, 3),
         space.rods.reshape(-1, 3),
         space.springs.reshape(-1, 3), space.dampers.reshape(-1, 3), [[0.0, 0.0, 0.0]]])
@@ -316,6 +319,15 @@ def _space_animation(result, geometry, times, q, v, view, fps):
         end = project(unit * 0.3 * half)
         ax.plot([0, end[0]], [0, end[1]], color="grey", linewidth=0.8)
     ax.plot([0], [0], marker="+", color="grey")
+    if len(grid):  # the ground the wheels roll on, still
+        flat_grid = project(grid.reshape(-1, 3)).reshape(len(grid), 2, 2)
+        pieces = np.concatenate([flat_grid, np.full((len(grid), 1, 2), np.nan)], axis=1)
+        ax.plot(pieces[..., 0].ravel(), pieces[..., 1].ravel(), color="0.75", linewidth=0.7,
+                label="ground")
+    tracks = [ax.plot([], [], color="tab:brown", alpha=0.6, linewidth=1, label="track")[0]
+              for _ in geometry.wheels]
+    wheel_lines = [ax.plot([], [], color="tab:blue", linewidth=2, label="wheel")[0]
+                   for _ in geometry.wheels]
     boxes = [ax.plot([], [], color="0.55", linewidth=0.8)[0] for _ in geometry.rigid_body_names]
     links = [ax.plot([], [], color="black", linewidth=2.5, solid_capstyle="round")[0]
              for _ in range(space.links.shape[1])]
@@ -344,6 +356,11 @@ def _space_animation(result, geometry, times, q, v, view, fps):
         for line, ends in zip(bars, space.bars[k], strict=True):
             flat_ends = project(ends)
             line.set_data(flat_ends[:, 0], flat_ends[:, 1])
+        for w, (line, track) in enumerate(zip(wheel_lines, tracks, strict=True)):
+            rim = project(rims[k, w])
+            line.set_data(rim[:, 0], rim[:, 1])
+            trace = project(contacts[: k + 1, w])  # where it has touched the ground so far
+            track.set_data(trace[:, 0], trace[:, 1])
         for line, ends in zip(rods, space.rods[k], strict=True):
             flat_ends = project(ends)
             line.set_data(flat_ends[:, 0], flat_ends[:, 1])
@@ -361,7 +378,7 @@ def _space_animation(result, geometry, times, q, v, view, fps):
         flat_particles = project(space.particles[k])
         dots.set_data(flat_particles[:, 0], flat_particles[:, 1])
         clock.set_text(f"{times[k]:.2f}")
-        return [*boxes, *links, *bars, *rods, *spring_lines, *damper_lines,
+        return [*tracks, *wheel_lines, *boxes, *links, *bars, *rods, *spring_lines, *damper_lines,
                 *(line for triad in axes for line in triad), dots, clock]
 
     return _animation(figure, draw, times, fps)
@@ -514,6 +531,34 @@ show(0);
 </script>
 </body></html>
 """
+
+
+def _ground_grid(geometry, contacts: np.ndarray, lines: int = 7) -> np.ndarray:
+    """Segments (G, 2, 3) of a square grid on the ground plane r . n = 0 around where the
+    wheels touch it over the run (a wheel's diameter of margin)."""
+    if not geometry.wheels:
+        return np.zeros((0, 2, 3))
+    n = np.array(geometry.wheels[0][3], dtype=float)
+    helper = np.eye(3)[int(np.argmin(np.abs(n)))]
+    t1 = helper - (helper @ n) * n
+    t1 /= np.linalg.norm(t1)
+    t2 = np.cross(n, t1)
+    flat = contacts.reshape(-1, 3)
+    flat = flat[np.all(np.isfinite(flat), axis=1)]
+    if not len(flat):
+        return np.zeros((0, 2, 3))
+    margin = 2 * max(w[1] for w in geometry.wheels)
+    a, b = flat @ t1, flat @ t2
+    middle = np.array([(a.min() + a.max()) / 2, (b.min() + b.max()) / 2])
+    half = max(a.max() - a.min(), b.max() - b.min()) / 2 + margin
+    ticks = np.linspace(-half, half, lines)
+    segments = []
+    for x in ticks:
+        segments.append([(middle[0] + x) * t1 + (middle[1] - half) * t2,
+                         (middle[0] + x) * t1 + (middle[1] + half) * t2])
+        segments.append([(middle[0] - half) * t1 + (middle[1] + x) * t2,
+                         (middle[0] + half) * t1 + (middle[1] + x) * t2])
+    return np.array(segments)
 
 
 def save_animation(animation, path: str | Path, *, fps: int = 25,

@@ -154,3 +154,18 @@ def test_the_notebook_player_is_self_contained_too():
     animation = lagrangian.load("slider_crank").simulate(0.3, samples=31).animate(fps=10)
     page = animation.to_jshtml()
     assert not re.search(r"https?://", page) and page.count("data:image/png;base64,") == 4
+
+
+def test_a_rod_held_by_a_constraint_is_drawn_from_its_pivot():
+    """The Cartesian pendulum: x^2 + y^2 - L^2 = 0 ties the bob to the origin by a rod of L."""
+    run = lagrangian.load("cartesian_pendulum").simulate(0.5, samples=51)
+    animation = mechanism_animation(run, fps=10)
+    for k in (0, 5):
+        t = animation.times[k]
+        bob = [np.interp(t, run.t, run["x"]), np.interp(t, run.t, run["y"])]
+        rod, = drawn(animation, k, "rod")
+        assert rod == pytest.approx(np.array([[0, 0], bob]), abs=1e-12)
+        assert np.hypot(*bob) == pytest.approx(0.5, rel=1e-6)  # the constraint holds
+    # a constraint that is not a distance draws no rod (the slider-crank's loop closure)
+    slider = lagrangian.load("slider_crank")
+    assert mechanism(slider.model, slider.parameters).rod_count == 0

@@ -479,6 +479,39 @@ def sketch(model: Model, values: Mapping[sp.Symbol, sp.Expr]) -> Sketch:
                 if key not in best or distance < best[key][0]:
                     best[key] = (distance, i, j)
     rods += [(points[i], points[j]) for _, i, j in best.values()]
+    # A rod held by a constraint rather than by the coordinates: Phi = c (|P - A|^2 - L^2)
+    # (the Cartesian pendulum's x^2 + y^2 - L^2), A the origin or another point.
+    holonomic = [c.expression for c in model.constraints if c.kind == "holonomic"]
+    if holonomic:
+        try:
+            with np.errstate(all="ignore"):
+                phi = StateFunction(model, holonomic, values)(q_s, v_s, t_s)
+        except (TypeError, ValueError, ZeroDivisionError, NameError, KeyError):
+            phi = np.full((_SKETCH_SAMPLES, 0), np.nan)
+        origin = (sp.S.Zero,) * 3
+        anchors = [(origin, np.zeros((_SKETCH_SAMPLES, 3)), None)] + \
+            [(points[j], where[:, j], owners[j]) for j in range(len(points))]
+        for column in phi.T:
+            if not np.all(np.isfinite(column)):
+                continue
+            for i, point in enumerate(points):
+                found = False
+                for anchor, value, owner in anchors:
+                    if owner == owners[i]:
+                        continue
+                    squared = np.sum((where[:, i] - value) ** 2, axis=-1)
+                    basis = np.column_stack([squared, -np.ones_like(squared)])
+                    (c, c_length2), *_ = np.linalg.lstsq(basis, column, rcond=None)
+                    if abs(c) > 1e-12 and c_length2 / c > tolerance and np.allclose(
+                            basis @ [c, c_length2], column,
+                            atol=1e-9 * (1 + np.max(np.abs(column)))) and np.ptp(squared) > 0:
+                        rods.append((anchor, point))
+                        if owner is None:
+                            add_pivot(anchor, value)
+                        found = True
+                        break
+                if found:
+                    break
     blocks = []
     if not model.rigid_bodies:
         for i in range(len(model.particles)):

@@ -137,6 +137,12 @@ def test_laws_of_the_recursive_functions(which, request):
     np.testing.assert_allclose(f.forward_dynamics(q, v, tau), a, rtol=1e-9, atol=1e-10)
     solved = np.linalg.solve(mass, (tau - f.bias_forces(q, v))[..., None])[..., 0]
     np.testing.assert_allclose(solved, a, rtol=1e-9, atol=1e-10)
+    # a batch (two states per vector operation, an odd one alone) equals one call per state
+    for name, args in [("mass_matrix", (q[:3],)), ("inverse_dynamics", (q[:3], v[:3], a[:3])),
+                       ("forward_dynamics", (q[:3], v[:3], tau[:3])),
+                       ("kinetic_energy", (q[:3], v[:3]))]:
+        one_by_one = [getattr(f, name)(*(x[k] for x in args)) for k in range(3)]
+        np.testing.assert_allclose(getattr(f, name)(*args), one_by_one, rtol=1e-14, atol=0)
     # q of shape (n,) broadcast against a batch
     one = f.bias_forces(q[0], v)
     np.testing.assert_allclose(one, f.bias_forces(np.broadcast_to(q[0], v.shape), v), rtol=1e-15)

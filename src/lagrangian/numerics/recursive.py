@@ -7,8 +7,11 @@ shared):
 
 - inverse dynamics by recursive Newton-Euler: tau = M(q) a + C(q, q_dot) q_dot + g(q);
 - the mass matrix by the composite-rigid-body algorithm;
-- forward dynamics by the articulated-body algorithm, O(n) (or, with mimic joints, Cholesky
-  of M: q_ddot = M^-1 (tau - b));
+- forward dynamics by the articulated-body algorithm, O(n), or M = L L^T, whichever takes
+  fewer operations (Cholesky only with mimic joints);
+- sin and cos of each joint angle once, by inline kernels (fdlibm's polynomials after a
+  three-part reduction by pi/2, libm beyond |x| = 1e5): a libm call costs as much as the rest
+  of the mass matrix of a 7-joint arm;
 - kinetic energy 1/2 sum (m v.v + 2 v.(w x h) + w.J_O w), potential energy m g height.
 
 Units SI. Gravity g (a runtime parameter) along the tree's direction; each coordinate's actuator
@@ -126,9 +129,26 @@ class _Emitter:
             return 0.0
         return self._new(("/", a, b), f"{self.text(a)} / {b}", (a, b))
 
+    def sincos(self, a: Term) -> tuple[Term, Term]:
+        """sin a and cos a from one lg_sincos call (the C preamble's inline kernels)."""
+        if not isinstance(a, str):
+            return float(np.sin(a)), float(np.cos(a))
+        pair = self._new(("sincos", a), f"lg_sincos({a}, &@s, &@c)", (a,))
+        names = []
+        for part in "sc":
+            name = f"{pair}{part}"
+            if ("part", name) not in self.memo:
+                self.lines.append((name, None, (pair,)))
+                self.memo[("part", name)] = name
+            names.append(name)
+        return names[0], names[1]
+
     def call(self, function: str, a: Term) -> Term:
         if not isinstance(a, str):
-            return float(getattr(np, function)(a))
+            value = float(getattr(np, function)(a)) if function != "sqrt" or a >= 0 else np.nan
+            if not np.isfinite(value):
+                raise ZeroDivisionError(f"{function}({a})")
+            return value
         return self._new((function, a), f"{function}({a})", (a,))
 
     # -- 3-vectors and 3x3 matrices of terms ----------------------------------------------------
@@ -163,18 +183,48 @@ class _Emitter:
         return [[self.dot(A[i], [B[0][j], B[1][j], B[2][j]]) for j in range(3)]
                 for i in range(3)]
 
-    def body(self, outputs: list[tuple[str, Term]], indent: str = "    ") -> str:
+    def count(self, outputs: list[tuple[str, Term]]) -> int:
+        """How many operations ``body(outputs)`` performs (its statements)."""
+        return self.body(outputs).count(";")
+
+    def body(self, outputs: list[tuple[str, Term]], indent: str = "    ",
+             vector: bool = False) -> str:
         """The C statements computing ``target = term`` for each output (dead temporaries
-        dropped)."""
+        dropped). ``vector``: values that depend on q, v, a or tau are lg_v4 (four states),
+        the others (parameters, numbers) stay double."""
         live = {t for _, t in outputs if isinstance(t, str)}
         keep = []
         for name, text, deps in reversed(self.lines):
             if name in live:
-                keep.append((name, text))
+                keep.append((name, text, deps))
                 live.update(deps)
-        statements = [f"{indent}const double {name} = {text};" for name, text in reversed(keep)]
-        statements += [f"{indent}{target} = {self.text(term)};" for target, term in outputs]
+        lanes: set[str] = set()
+        statements = []
+        for name, text, deps in reversed(keep):
+            if vector and any(d in lanes or d.split("[")[0] in _STATE for d in deps):
+                lanes.add(name)
+            kind = "lg_v4" if name in lanes else "double"
+            if text is None:  # one of a sincos pair, declared with it
+                continue
+            if text.startswith("lg_sincos("):
+                call = "lg_vsincos(" if name in lanes else "lg_sincos("
+                statements.append(f"{indent}{kind} {name}s, {name}c; "
+                                  + text.replace("lg_sincos(", call).replace("@s", f"{name}s")
+                                  .replace("@c", f"{name}c") + ";")
+            elif vector and name in lanes:
+                statements.append(f"{indent}const lg_v4 {name} = "
+                                  + text.replace("sqrt(", "lg_vsqrt(") + ";")
+            else:
+                statements.append(f"{indent}const double {name} = {text};")
+        for target, term in outputs:
+            value = self.text(term)
+            if vector and not (term in lanes or value.split("[")[0] in _STATE):
+                value = f"LG_V4({value})"
+            statements.append(f"{indent}{target} = {value};")
         return "\n".join(statements)
+
+
+_STATE = {"q", "v", "a", "tau"}  # the inputs that differ between the four states of a batch
 
 
 class _Layout:
@@ -213,7 +263,8 @@ def _kinematics(E: _Emitter, tree: KinematicTree, q):
         theta = E.add(E.mul(q[joint.coordinate], joint.multiplier), joint.offset)
         R0 = [list(row) for row in joint.rotation]
         if joint.kind == "revolute":
-            R = E.matmul(R0, _rotation(E, joint, E.call("cos", theta), E.call("sin", theta)))
+            sin, cos = E.sincos(theta)
+            R = E.matmul(R0, _rotation(E, joint, cos, sin))
             p = list(joint.translation)
         else:
             R = R0
@@ -511,17 +562,45 @@ def _inputs(name: str, n: int) -> list[str]:
     return [f"{name}[{i}]" for i in range(n)]
 
 
+_SINCOS = r"""
+/* sin and cos of x (fdlibm's kernels on [-pi/4, pi/4] after a three-part reduction by pi/2;
+   libm beyond |x| = 1e5 and for NaN): within an ulp or two, no library call. */
+static inline void lg_sincos(double x, double *sine, double *cosine)
+{
+    if (!(fabs(x) < 1.0e5)) { *sine = sin(x); *cosine = cos(x); return; }
+    const double n = (x * 6.36619772367581382433e-01 + 6755399441055744.0) - 6755399441055744.0;
+    const double r = ((x - n * 1.57079632673412561417e+00) - n * 6.07710050630396597660e-11)
+                     - n * 2.02226624871116645580e-21;
+    const double z = r * r;
+    const double s = r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03
+        + z * (-1.98412698298579493134e-04 + z * (2.75573137070700676789e-06
+        + z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
+    const double c = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02
+        + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05
+        + z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09
+        + z * -1.13596475577881948265e-11)))));
+    const double turn[4] = {s, c, -s, -c};
+    const long k = (long)n;
+    *sine = turn[k & 3];
+    *cosine = turn[(k + 1) & 3];
+}
+"""
+
+
 def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix: str,
-                       storage: str = "static ") -> str:
+                       storage: str = "static ", vector: bool = False) -> str:
     """C99 functions <prefix>_mass_matrix, _bias_forces, _gravity, _inverse_dynamics,
-    _forward_dynamics, _kinetic_energy, _potential_energy (the standalone API)."""
+    _forward_dynamics, _kinetic_energy, _potential_energy (the standalone API); with
+    ``vector``, also <prefix>4_<name> on two states at once (GCC/Clang vector extensions, for
+    the compiled module's batches)."""
     layout = _Layout(tree, parameters)
     n = layout.n
     q, v, a = _inputs("q", n), _inputs("v", n), _inputs("a", n)
     zeros = [0.0] * n
     P, S = prefix, storage
     R = "const double *restrict"
-    sections = []
+    sections = [_SINCOS]
+    straight = []  # (name, inputs, emitter, [(output index, term)]) for the vector variants
 
     def function(signature: str, E: _Emitter, outputs, extra: str = "") -> None:
         sections.append(f"{S}{signature}\n{{\n    (void)p;\n{E.body(outputs)}\n{extra}}}\n")
@@ -531,37 +610,140 @@ def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix:
     outputs = []
     for r in range(n):
         for c in range(r + 1):
-            outputs.append((f"M[{r * n + c}]", entries.get((r, c), 0.0)))
+            outputs.append((r * n + c, entries.get((r, c), 0.0)))
     mirror = "".join(f"    M[{c * n + r}] = M[{r * n + c}];\n"
                      for r in range(n) for c in range(r))
-    function(f"void {P}_mass_matrix({R} q, {R} p, double *restrict M)", E, outputs, mirror)
-    for name, args, rates, accels in (
-            ("inverse_dynamics", f"{R} q, {R} v, {R} a, {R} p, double *restrict tau", v, a),
-            ("bias_forces", f"{R} q, {R} v, {R} p, double *restrict tau", v, zeros),
-            ("gravity", f"{R} q, {R} p, double *restrict tau", zeros, zeros)):
+    function(f"void {P}_mass_matrix({R} q, {R} p, double *restrict M)", E,
+             [(f"M[{k}]", t) for k, t in outputs], mirror)
+    straight.append(("mass_matrix", ("q",), E, outputs))
+    for name, args, rates, accels, inputs in (
+            ("inverse_dynamics", f"{R} q, {R} v, {R} a, {R} p, double *restrict tau", v, a,
+             ("q", "v", "a")),
+            ("bias_forces", f"{R} q, {R} v, {R} p, double *restrict tau", v, zeros, ("q", "v")),
+            ("gravity", f"{R} q, {R} p, double *restrict tau", zeros, zeros, ("q",))):
         E = _Emitter()
         tau = _inverse_dynamics(E, tree, layout, q, rates, accels)
         function(f"void {P}_{name}({args})", E, [(f"tau[{i}]", t) for i, t in enumerate(tau)])
+        straight.append((name, inputs, E, list(enumerate(tau))))
     E = _Emitter()
-    function(f"double {P}_kinetic_energy({R} q, {R} v, {R} p)", E,
-             [("double T", _kinetic_energy(E, tree, q, v))], "    return T;\n")
+    T = _kinetic_energy(E, tree, q, v)
+    function(f"double {P}_kinetic_energy({R} q, {R} v, {R} p)", E, [("double T", T)],
+             "    return T;\n")
+    straight.append(("kinetic_energy", ("q", "v"), E, [(0, T)]))
     E = _Emitter()
-    function(f"double {P}_potential_energy({R} q, {R} p)", E,
-             [("double V", _potential_energy(E, tree, layout, q))], "    return V;\n")
-    qdd = None
+    V = _potential_energy(E, tree, layout, q)
+    function(f"double {P}_potential_energy({R} q, {R} p)", E, [("double V", V)],
+             "    return V;\n")
+    straight.append(("potential_energy", ("q",), E, [(0, V)]))
+    # forward dynamics: the articulated-body algorithm or M = L L^T straight-line (M and b
+    # sharing their kinematics), whichever takes fewer operations; loops for a big M
+    candidates = []
+    tau_in = _inputs("tau", n)
     if _articulated(tree):
         E = _Emitter()
         try:
-            qdd = _forward_dynamics(E, tree, layout, q, v, _inputs("tau", n))
-        except ZeroDivisionError:  # singular: Cholesky says so at run time
-            qdd = None
+            qdd = _forward_dynamics(E, tree, layout, q, v, tau_in)
+            candidates.append((E.count([(f"qdd[{i}]", x) for i, x in enumerate(qdd)]), E, qdd))
+        except ZeroDivisionError:  # a joint that moves no mass: singular at every state
+            pass
+    if n <= 24:
+        E = _Emitter()
+        try:
+            mass = _mass_matrix(E, tree, layout, q)
+            bias = _inverse_dynamics(E, tree, layout, q, v, zeros)
+            qdd = _cholesky_solve(E, mass, [E.sub(t, b) for t, b in zip(tau_in, bias, strict=True)])
+            candidates.append((E.count([(f"qdd[{i}]", x) for i, x in enumerate(qdd)]), E, qdd))
+        except ZeroDivisionError:
+            pass
+    qdd = None
+    if candidates:
+        _, E, qdd = min(candidates, key=lambda c: c[0])
     if qdd is not None:
         check = "".join(f"    if (!isfinite(qdd[{i}])) return -1;\n" for i in range(n))
         function(f"int {P}_forward_dynamics({R} q, {R} v, {R} tau, {R} p, double *restrict qdd)",
                  E, [(f"qdd[{i}]", x) for i, x in enumerate(qdd)], check + "    return 0;\n")
+        straight.append(("forward_dynamics", ("q", "v", "tau"), E, list(enumerate(qdd))))
     else:
         sections.append(_cholesky_forward(P, S, R, n))
+    if vector:
+        sections.append(_VECTOR)
+        for name, inputs, E, outs in straight:
+            body = E.body([(f"out[{k}]", t) for k, t in outs], vector=True)
+            if name == "mass_matrix":
+                body += "\n" + "".join(f"    out[{c * n + r}] = out[{r * n + c}];\n"
+                                        for r in range(n) for c in range(r))
+            args = ", ".join(f"const lg_v4 *restrict {x}" for x in inputs)
+            sections.append(f"static void {P}4_{name}({args}, {R} p, lg_v4 *restrict out)\n"
+                            f"{{\n    (void)p;\n{body}\n}}\n")
     return "\n".join(sections)
+
+
+_VECTOR = r"""
+/* Two states at once: each operation on 2 lanes (one SSE2 instruction; wider vectors
+   without -mavx are split through memory by the compiler, slower than scalar code). */
+#define LG_LANES 2
+typedef double lg_v4 __attribute__((vector_size(16)));
+#define LG_V4(x) ((lg_v4){0.0, 0.0} + (x))
+
+static inline lg_v4 lg_vsqrt(lg_v4 x)
+{
+    lg_v4 r = {sqrt(x[0]), sqrt(x[1])};
+    return r;
+}
+
+static inline void lg_vsincos(lg_v4 x, lg_v4 *sine, lg_v4 *cosine)
+{
+    if (!(fabs(x[0]) < 1.0e5 && fabs(x[1]) < 1.0e5)) {
+        for (int l = 0; l < LG_LANES; l++) {
+            double s, c;
+            lg_sincos(x[l], &s, &c);
+            (*sine)[l] = s;
+            (*cosine)[l] = c;
+        }
+        return;
+    }
+    const lg_v4 n = (x * 6.36619772367581382433e-01 + 6755399441055744.0) - 6755399441055744.0;
+    const lg_v4 r = ((x - n * 1.57079632673412561417e+00) - n * 6.07710050630396597660e-11)
+                    - n * 2.02226624871116645580e-21;
+    const lg_v4 z = r * r;
+    const lg_v4 s = r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03
+        + z * (-1.98412698298579493134e-04 + z * (2.75573137070700676789e-06
+        + z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
+    const lg_v4 c = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02
+        + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05
+        + z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09
+        + z * -1.13596475577881948265e-11)))));
+    for (int l = 0; l < LG_LANES; l++) {
+        const double turn[4] = {s[l], c[l], -s[l], -c[l]};
+        const long k = (long)n[l];
+        (*sine)[l] = turn[k & 3];
+        (*cosine)[l] = turn[(k + 1) & 3];
+    }
+}
+"""
+
+
+def _cholesky_solve(E: _Emitter, mass: dict, rhs: list) -> list:
+    """x with M x = rhs by M = L L^T, straight-line (zeros of M, e.g. between two branches of
+    the tree, fold away); M given by its lower triangle."""
+    n = len(rhs)
+    L: dict = {}
+    inverse = []
+    for j in range(n):
+        d = E.sub(mass.get((j, j), 0.0), E.sum(E.mul(L[j, k], L[j, k]) for k in range(j)))
+        inverse.append(E.div(1.0, E.call("sqrt", d)))
+        for i in range(j + 1, n):
+            e = E.sub(mass.get((i, j), 0.0), E.sum(E.mul(L[i, k], L[j, k]) for k in range(j)))
+            L[i, j] = E.mul(e, inverse[j])
+        L[j, j] = E.div(1.0, inverse[j])
+    y = []
+    for i in range(n):
+        y.append(E.mul(E.sub(rhs[i], E.sum(E.mul(L[i, k], y[k]) for k in range(i))), inverse[i]))
+    x = [0.0] * n
+    for i in reversed(range(n)):
+        x[i] = E.mul(E.sub(y[i], E.sum(E.mul(L[k, i], x[k]) for k in range(i + 1, n))),
+                     inverse[i])
+    return x
 
 
 def _cholesky_forward(P: str, S: str, R: str, n: int) -> str:
@@ -661,7 +843,36 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     npy_intp failed = -1;
     NPY_BEGIN_THREADS_DEF;
     if (count > 16) NPY_BEGIN_THREADS;
-    for (npy_intp k = 0; k < count; k++) {
+    const int size = kind == RT_MASS ? LG_N * LG_N
+                     : (kind == RT_KINETIC || kind == RT_POTENTIAL) ? 1 : LG_N;
+    npy_intp k = 0;
+    /* LG_LANES states at a time through the vector variants, the rest one by one */
+    for (; k + LG_LANES <= count && (kind != RT_FORWARD || RT_VECTOR_FORWARD); k += LG_LANES) {
+        lg_v4 in[3][LG_N], out4[LG_N * LG_N];
+        for (int j = 0; j < nin; j++) {
+            const double *x = j == 0 ? x0 : j == 1 ? x1 : x2;
+            for (int l = 0; l < LG_LANES; l++)
+                for (int i = 0; i < LG_N; i++) in[j][i][l] = x[(k + l) * step[j] + i];
+        }
+        switch (kind) {
+        case RT_MASS: rt4_mass_matrix(in[0], p, out4); break;
+        case RT_BIAS: rt4_bias_forces(in[0], in[1], p, out4); break;
+        case RT_GRAVITY: rt4_gravity(in[0], p, out4); break;
+        case RT_INVERSE: rt4_inverse_dynamics(in[0], in[1], in[2], p, out4); break;
+#if RT_VECTOR_FORWARD
+        case RT_FORWARD: rt4_forward_dynamics(in[0], in[1], in[2], p, out4); break;
+#endif
+        case RT_KINETIC: rt4_kinetic_energy(in[0], in[1], p, out4); break;
+        case RT_POTENTIAL: rt4_potential_energy(in[0], p, out4); break;
+        }
+        for (int l = 0; l < LG_LANES; l++)
+            for (int i = 0; i < size; i++) {
+                const double x = out4[i][l];
+                y[(k + l) * size + i] = x;
+                if (kind == RT_FORWARD && !isfinite(x) && failed < 0) failed = k + l;
+            }
+    }
+    for (; k < count; k++) {
         const double *a0 = x0 + k * step[0], *a1 = x1 + k * step[1], *a2 = x2 + k * step[2];
         switch (kind) {
         case RT_MASS: rt_mass_matrix(a0, p, y + k * LG_N * LG_N); break;
@@ -718,6 +929,7 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
     from .codegen import TEMPLATE, GeneratedSource
 
     n = len(tree.coordinates)
+    functions = dynamics_functions(tree, parameters, "rt", vector=True)
     source = "\n".join([
         f"/* lagrangian: recursive dynamics of a tree of {len(tree.joints)} bodies, {n} "
         "coordinates */",
@@ -730,7 +942,7 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
         "#include <numpy/arrayobject.h>",
         "#include <math.h>",
         "",
-        dynamics_functions(tree, parameters, "rt"),
+        functions,
         """
 static void lg_parts(const double *restrict q, const double *restrict v, double t,
                      const double *restrict p, double *restrict M, double *restrict f,
@@ -757,6 +969,7 @@ static void lg_residual(const double *restrict q, const double *restrict v, doub
 """,
         _DECLARE,
         f"#define LG_EXTRA_METHODS {_METHODS}",
+        "#define RT_VECTOR_FORWARD " + ("1" if "rt4_forward_dynamics" in functions else "0"),
         TEMPLATE.read_text(),
         _BINDINGS,
     ])

@@ -407,7 +407,12 @@ def _animation(figure, draw, times: np.ndarray, fps: int):
                                times=times, title=self.title)
 
         def _repr_html_(self):
-            return self.to_jshtml()
+            # As matplotlib: shown inline only where rcParams["animation.html"] asks for it.
+            from matplotlib import rcParams
+
+            if rcParams["animation.html"] == "jshtml":
+                return self.to_jshtml()
+            return super()._repr_html_()
 
     animation = MechanismAnimation(figure, draw, frames=len(times), interval=1000 / fps,
                                    blit=False)

@@ -5,7 +5,9 @@ A spring or damper given ``between`` two points has its kept ends, exactly. A sp
 length only gets end points guessed from that length (see ``spring_end_points``), or none when
 none fit; a damper given by its rate only has none. output/animation.py draws what this gives.
 Bodies in space (model/rotations.py) give their frames in 3D (``Mechanism.space_frame``), drawn
-after ``view_projection`` from a chosen viewpoint.
+after ``view_projection`` from a chosen viewpoint, and their rolling wheels' rims and contact
+points (``Mechanism.wheel_frame``). ``sketch`` finds what a user would draw besides the masses
+(rods, pivots, blocks on tracks, wheels on surfaces) from the model's structure.
 """
 
 from __future__ import annotations

@@ -1,10 +1,15 @@
-"""Animation of the mechanism: particles as dots, bodies as bars, springs as zigzags and
-dampers as dashpots (GIF/HTML). Bodies in space are drawn in 3D seen from a viewpoint (azimuth,
+"""Animation of the mechanism as a user sketches it: particles as dots, rods from their pivots
+(hinges) and between linked points, carts and sliders as blocks on their tracks, bodies as bars
+(a rolling body as a wheel on its surface), springs as zigzags and dampers as dashpots (GIF or a
+self-contained HTML player). Bodies in space are drawn in 3D seen from a viewpoint (azimuth,
 elevation): each as its body axes (x red, y green, z blue), the wire box of the same mass and
-inertia, and lines from its joint to its centre of mass and from its parent's joint to its own.
+inertia, lines from its joint to its centre of mass and from its parent's joint to its own, and a
+wheel on a rolling contact as its rim over a ground grid.
 
-It draws the positions numerics/geometry.py computes (a spring or damper with no ends found
-there is left out); nothing here evaluates an expression.
+It draws the positions numerics/geometry.py computes (its ``sketch`` finds the rods, pivots,
+blocks and wheels from the model's structure; a spring or damper with no ends found there is
+left out); nothing here evaluates an expression. Frames are rendered by blitting: the still
+parts once, the moving artists per frame.
 """
 
 from __future__ import annotations

@@ -13,6 +13,7 @@ import lagrangian
 from lagrangian.derivation.body_jacobians import takes_jacobian_form
 from lagrangian.derivation.kinematics import Differentiator
 from lagrangian.derivation.lagrange import derive
+from lagrangian.derivation.regularity import numeric_matrix
 from lagrangian.model.builder import ModelBuilder
 from lagrangian.output.derivation import derivation_latex, derivation_text
 
@@ -79,11 +80,12 @@ def _kane_chain(n):
 
 
 def _values(eom, point):
+    """M and f at a point, in floats (each shared sub-expression evaluated once)."""
     values = point | {p.symbol: p.value for p in eom.model.parameters}
-    return (np.array(eom.mass_matrix.xreplace(values), dtype=float),
-            np.array(eom.forcing.xreplace(values), dtype=float).ravel())
+    return numeric_matrix(eom.mass_matrix, values), numeric_matrix(eom.forcing, values).ravel()
 
 
+@pytest.mark.slow
 def test_three_body_chain_jacobian_form_agrees_with_term_by_term_and_kane():
     model = _chain(3)
     unexpanded, expanded = derive(model, jacobian_form=True), derive(model, jacobian_form=False)
@@ -110,6 +112,17 @@ def test_deep_chain_takes_the_jacobian_form_by_size_and_shallow_bodies_stay_expa
     taken = [takes_jacobian_form(b, model.q, model.time, d, sizes) for b in model.rigid_bodies]
     # the first bodies' expanded kinematics is short (textbook form), the deeper ones' is not
     assert taken[:2] == [False, False] and taken[-2:] == [True, True]
+
+
+def test_two_body_chain_is_the_same_in_both_forms():
+    model = _chain(2)
+    unexpanded, expanded = derive(model, jacobian_form=True), derive(model, jacobian_form=False)
+    rng = random.Random(3)
+    for _ in range(3):
+        point = {x: rng.uniform(-2.5, 2.5) for x in (*model.q, *model.q_dot)}
+        for mine, theirs in zip(_values(unexpanded, point), _values(expanded, point),
+                                strict=True):
+            assert mine == pytest.approx(theirs, rel=1e-12, abs=1e-12)
 
 
 @pytest.mark.slow
@@ -194,3 +207,34 @@ def test_unexpanded_equations_print_and_evaluate():
     numeric = lagrangian.System(_chain(4)).numeric(backend="numpy")
     M = numeric.mass_matrix(np.full(4, 0.2), np.full(4, 0.1))
     assert np.allclose(M, M.T) and np.all(np.linalg.eigvalsh(M) > 0)
+
+
+@pytest.mark.slow
+def test_spherical_prismatic_and_revolute_joints_agree_in_both_forms():
+    """A body on a spherical joint (z-x-z), a slider along its axis and an arm on a revolute
+    joint about a skew axis, full inertia tensor with products of inertia: the Jacobian form
+    and the term-by-term form give the same M and f (gravity and a spring on the slider)."""
+    b = ModelBuilder("mixed joints")
+    for name in ("phi", "theta", "psi", "s", "beta"):
+        b.coordinate(name, "m" if name == "s" else "rad")
+    for name, value in (("g", 9.81), ("k", 40.0), ("m", 1.3), ("M", 0.7)):
+        b.parameter(name, value)
+    b.set_gravity("g", (0, 0, -1))
+    b.add_rigid_body("base", "m", [0.3, 0.2, 0.15], parent=None, center=[0.1, 0, -0.4],
+                     joint={"type": "spherical",
+                            "rotation": [["z", "phi"], ["x", "theta"], ["z", "psi"]]})
+    b.add_rigid_body("slider", "M", [[0.02, 0.003, 0], [0.003, 0.025, -0.002], [0, -0.002, 0.015]],
+                     parent="base", joint={"type": "prismatic", "axis": "z", "distance": "s",
+                                           "at": [0, 0.1, -0.8]}, center=[0, 0, -0.1])
+    b.add_rigid_body("arm", 0.5, [0.01, 0.02, 0.02], parent="slider",
+                     joint={"type": "revolute", "axis": [1, 1, 0], "angle": "beta",
+                            "at": [0, 0, -0.2]}, center=[0.3, 0, 0])
+    b.add_spring("slide", "k", 0.1, length="s")
+    model = b.build_model()
+    unexpanded, expanded = derive(model, jacobian_form=True), derive(model, jacobian_form=False)
+    rng = random.Random(17)
+    for _ in range(3):
+        point = {x: rng.uniform(0.2, 1.3) for x in (*model.q, *model.q_dot)}
+        for mine, theirs in zip(_values(unexpanded, point), _values(expanded, point),
+                                strict=True):
+            assert mine == pytest.approx(theirs, rel=1e-11, abs=1e-11)

@@ -1,19 +1,30 @@
 """URDF arms against Pinocchio: relative error and speed of M, bias, gravity, inverse and
-forward dynamics and energies, per call and in batches of 10^4 states.
+forward dynamics and energies, per call and in batches of 10^4 states, and the time from a URDF
+file to compiled functions (cold and from the cache).
 
-    python benchmarks/bench_urdf.py [ur5|panda|xarm7 ...] [--backend c|numpy] [--states 100]
+    python benchmarks/bench_urdf.py [ur5|panda|xarm7 ...] [--states 100] [--symbolic numpy|c]
 
 Needs the bench extra (pin, example-robot-data). The Panda's finger joints are locked at 0.
-Build time: URDF -> derived equations -> numeric functions, in this process (cold, no cache of
-the generated source). Per-call times: one state through the Python API (ours) and through
-Pinocchio's Python bindings (crba, rnea, aba), best of 5 runs of many calls. Batch: one call on
-10^4 states (ours) against a Python loop of 10^4 Pinocchio calls.
+Default: ``arm.dynamics()``, the recursive algorithms in generated C (numerics/recursive.py);
+``--symbolic`` times the derived equations instead (numpy or C backend).
+
+- Build: ``lagrangian.load(urdf, lock=...)`` then ``.dynamics()`` and a first call, in a fresh
+  process (interpreter start and ``import lagrangian, yourdfpy`` reported apart), first with an
+  empty cache (cold: C generated and compiled), then again with the cache it filled (warm).
+- Per call: one state through the Python API and through Pinocchio's Python bindings (crba,
+  rnea, aba), interleaved in one process, best of 7 runs of 2000 calls.
+- Batch: one call on 10^4 states (ours) against a Python loop of 10^4 Pinocchio calls (best
+  of 3 each).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -28,6 +39,19 @@ ROBOTS = {
     "xarm7": ("xarm_description/urdf/xarm7.urdf", {}),
 }
 
+BUILD = """
+import json, sys, time
+t0 = time.perf_counter()
+import lagrangian, yourdfpy
+t1 = time.perf_counter()
+arm = lagrangian.load(sys.argv[1], lock=json.loads(sys.argv[2]))
+f = arm.dynamics()
+n = f.n
+f.forward_dynamics([0.1] * n, [0.0] * n, [0.0] * n)
+t2 = time.perf_counter()
+print(json.dumps({"import": t1 - t0, "build": t2 - t1, "kind": type(f).__name__}))
+"""
+
 
 def robots_folder() -> Path:
     import pinocchio
@@ -39,7 +63,11 @@ def robots_folder() -> Path:
     sys.exit("example-robot-data not found (pip install example-robot-data)")
 
 
-def best(function, repeat=5, number=200) -> float:
+def load_average() -> str:
+    return " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def best(function, repeat=7, number=2000) -> float:
     times = []
     for _ in range(repeat):
         start = time.perf_counter()
@@ -49,22 +77,51 @@ def best(function, repeat=5, number=200) -> float:
     return min(times)
 
 
+def side_by_side(mine, theirs, repeat=7, number=2000) -> tuple[float, float]:
+    """Best per-call times, the two measured in alternation (the same load for both)."""
+    ours, pins = [], []
+    for _ in range(repeat):
+        ours.append(best(mine, 1, number))
+        pins.append(best(theirs, 1, number))
+    return min(ours), min(pins)
+
+
 def relative(ours, theirs) -> float:
     ours, theirs = np.asarray(ours), np.asarray(theirs)
     return float(np.max(np.abs(ours - theirs)) / max(np.max(np.abs(theirs)), 1e-300))
 
 
-def bench(name: str, backend: str, states: int, timing: bool = True) -> None:
+def build_times(path: Path, lock: dict) -> tuple[dict, dict]:
+    """A fresh process with an empty cache (cold), then another with the cache it filled."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, LAGRANGIAN_CACHE=cache)
+        runs = []
+        for _ in range(2):
+            done = subprocess.run([sys.executable, "-c", BUILD, str(path), json.dumps(lock)],
+                                  env=env, capture_output=True, text=True, check=True)
+            runs.append(json.loads(done.stdout.strip().splitlines()[-1]))
+    return runs[0], runs[1]
+
+
+def bench(name: str, symbolic: str | None, states: int, timing: bool = True) -> None:
     import pinocchio as pin
 
     relpath, lock = ROBOTS[name]
     path = robots_folder() / relpath
-    start = time.perf_counter()
     arm = lagrangian.load(path, lock=lock)
-    eom = arm.equations_of_motion()
-    derived = time.perf_counter() - start
-    f = arm.dynamics(backend=backend)
-    built = time.perf_counter() - start
+    if symbolic:
+        from lagrangian.numerics.dynamics import Dynamics
+
+        start = time.perf_counter()
+        f = Dynamics(arm.numeric(backend=symbolic))
+        print(f"\n{name}: derived equations, {symbolic} backend, derive + build "
+              f"{time.perf_counter() - start:.1f} s")
+    else:
+        f = arm.dynamics()
+        cold, warm = build_times(path, lock)
+        print(f"\n{name}: {cold['kind']}; URDF -> compiled functions: cold {cold['build']:.2f} s, "
+              f"from the cache {warm['build']:.2f} s (fresh processes; import lagrangian + "
+              f"yourdfpy {warm['import']:.2f} s apart); load average {load_average()}")
     model = pin.buildModelFromUrdf(str(path))
     if lock:
         locked = [model.getJointId(j) for j in lock]
@@ -93,27 +150,26 @@ def bench(name: str, backend: str, states: int, timing: bool = True) -> None:
                   "V": pin.computePotentialEnergy(model, data, q[k])}
         for key in errors:
             errors[key] = max(errors[key], relative(ours[key][k], theirs[key]))
-    print(f"\n{name}: n = {n}, backend {f.functions.backend}; derive {derived:.1f} s, "
-          f"numeric functions {built - derived:.1f} s, eom ops "
-          f"{sum(e.count_ops() for e in eom.mass_matrix) + sum(e.count_ops() for e in eom.forcing)}")
-    print("  max relative error vs Pinocchio over", states, "states:",
-          ", ".join(f"{k} {e:.1e}" for k, e in errors.items()))
+    print(f"  n = {n}; max relative error vs Pinocchio over {states} states: "
+          + ", ".join(f"{k} {e:.1e}" for k, e in errors.items()))
     if not timing:
         return
-    q0, v0, a0, t0 = q[0], v[0], a[0], tau[0]
+    q0, v0, a0, t0 = q[0].copy(), v[0].copy(), a[0].copy(), tau[0].copy()
     rows = [("mass matrix / crba", lambda: f.mass_matrix(q0), lambda: pin.crba(model, data, q0)),
             ("inverse dyn / rnea", lambda: f.inverse_dynamics(q0, v0, a0),
              lambda: pin.rnea(model, data, q0, v0, a0)),
             ("forward dyn / aba", lambda: f.forward_dynamics(q0, v0, t0),
              lambda: pin.aba(model, data, q0, v0, t0))]
-    print("  per call (us): ours, Pinocchio, ratio pin/ours")
+    print(f"  per call (us): ours, Pinocchio, ratio pin/ours; load average {load_average()}")
+    number = 2000 if not symbolic else 20
     for label, mine, theirs in rows:
-        t_ours, t_pin = best(mine), best(theirs)
-        print(f"    {label:<20} {t_ours * 1e6:9.1f} {t_pin * 1e6:9.1f} {t_pin / t_ours:7.2f}")
+        t_ours, t_pin = side_by_side(mine, theirs, number=number)
+        print(f"    {label:<20} {t_ours * 1e6:9.2f} {t_pin * 1e6:9.2f} {t_pin / t_ours:7.2f}")
     big = 10_000
     Q = rng.uniform(-1, 1, (big, n))
     V, A, TAU = (rng.uniform(-1, 1, (big, n)) for _ in range(3))
-    print(f"  batch of {big} (ms): ours one call, Pinocchio Python loop, ratio")
+    print(f"  batch of {big} (ms): ours one call, Pinocchio Python loop, ratio; "
+          f"load average {load_average()}")
     for label, mine, theirs in [
             ("mass matrix", lambda: f.mass_matrix(Q),
              lambda: [pin.crba(model, data, x) for x in Q]),
@@ -121,19 +177,20 @@ def bench(name: str, backend: str, states: int, timing: bool = True) -> None:
              lambda: [pin.rnea(model, data, x, y, z) for x, y, z in zip(Q, V, A, strict=True)]),
             ("forward dyn", lambda: f.forward_dynamics(Q, V, TAU),
              lambda: [pin.aba(model, data, x, y, z) for x, y, z in zip(Q, V, TAU, strict=True)])]:
-        t_ours, t_pin = best(mine, 3, 1), best(theirs, 3, 1)
-        print(f"    {label:<20} {t_ours * 1e3:9.1f} {t_pin * 1e3:9.1f} {t_pin / t_ours:7.2f}")
+        t_ours, t_pin = side_by_side(mine, theirs, 3, 1)
+        print(f"    {label:<20} {t_ours * 1e3:9.2f} {t_pin * 1e3:9.2f} {t_pin / t_ours:7.1f}")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("robots", nargs="*", default=["ur5", "panda", "xarm7"])
-    parser.add_argument("--backend", default="auto", choices=("auto", "c", "numpy"))
+    parser.add_argument("--symbolic", choices=("c", "numpy"),
+                        help="time the derived equations with this backend instead")
     parser.add_argument("--states", type=int, default=100)
     parser.add_argument("--accuracy-only", action="store_true", help="skip the timings")
     args = parser.parse_args()
     for name in args.robots:
-        bench(name, args.backend, args.states, not args.accuracy_only)
+        bench(name, args.symbolic, args.states, not args.accuracy_only)
 
 
 if __name__ == "__main__":

@@ -169,3 +169,18 @@ def test_a_rod_held_by_a_constraint_is_drawn_from_its_pivot():
     # a constraint that is not a distance draws no rod (the slider-crank's loop closure)
     slider = lagrangian.load("slider_crank")
     assert mechanism(slider.model, slider.parameters).rod_count == 0
+
+
+def test_a_link_pinned_at_its_end_is_drawn_from_the_pivot_whatever_its_angle_reference():
+    """virtual_work_link: centre L/2 (sin th, -cos th), angle th (from the downward vertical,
+    not along the link): the uniform bar of inertia m L^2 / 12 reaches the pivot, so it is drawn
+    from the origin to the tip L (sin th, -cos th), with no separate rod."""
+    run = lagrangian.load("virtual_work_link").simulate(0.3, samples=31)
+    animation = mechanism_animation(run, fps=10)
+    length = 0.5
+    for k in (0, 3):
+        th = np.interp(animation.times[k], run.t, run["theta"])
+        bar, = drawn(animation, k, "bar")
+        assert bar == pytest.approx(np.array([[0, 0], length * np.array(
+            [np.sin(th), -np.cos(th)])]), abs=1e-12)
+        assert drawn(animation, k, "rod") == []

@@ -104,6 +104,7 @@ class Mechanism:
     blocks: tuple[tuple[int, tuple[float, float]], ...] = ()  # particle index, unit track
     rolling: tuple[tuple[int, float, tuple[float, float]], ...] = ()  # body, radius, normal
     gravity: tuple[float, float] | None = None  # unit direction of gravity in the plane
+    aimed: tuple[tuple[int, int], ...] = ()  # (body, pivot): bar drawn from the pivot
     # Rolling contacts of bodies in space: (body index, radius (m), axle (body axes), ground
     # normal (world)), the ground being the plane r . n = 0 (model/contacts.py).
     wheels: tuple[tuple[int, float, tuple[float, ...], tuple[float, ...]], ...] = ()
@@ -178,6 +179,8 @@ class Mechanism:
         springs = stack(self._springs, len(self.spring_names), (2, 2))
         dampers = stack(self._dampers, len(self.damper_names), (2, 2))
         rods, pivots = self._rods_and_pivots(q, v, t)
+        for j, p in self.aimed:  # pinned at one end: from the pivot through the centre
+            bars[:, j] = np.stack([pivots[:, p, :2], 2 * centre[:, j] - pivots[:, p, :2]], axis=1)
         return Frame(particles, bars, springs, dampers, rods[..., :2], pivots[..., :2])
 
     def _rods_and_pivots(self, q, v, t) -> tuple[np.ndarray, np.ndarray]:
@@ -228,7 +231,7 @@ def mechanism(model: Model, parameters: Mapping[str, float | None] | ParameterVa
         _dampers=compile_(dampers), **space,
         rod_count=len(drawn.rods), pivot_count=len(drawn.pivots),
         _rods=compile_(rod_exprs) if rod_exprs else None, blocks=drawn.blocks,
-        rolling=drawn.rolling, gravity=drawn.gravity,
+        rolling=drawn.rolling, gravity=drawn.gravity, aimed=drawn.aimed,
     )
 
 
@@ -352,6 +355,7 @@ class Sketch(NamedTuple):
     blocks: tuple[tuple[int, tuple[float, float]], ...] = ()
     rolling: tuple[tuple[int, float, tuple[float, float]], ...] = ()
     gravity: tuple[float, float] | None = None
+    aimed: tuple[tuple[int, int], ...] = ()  # (body index, pivot index): a link pinned at an end
 
 
 _SKETCH_SAMPLES = 8
@@ -362,7 +366,9 @@ def sketch(model: Model, values: Mapping[sp.Symbol, sp.Expr]) -> Sketch:
 
     - a rod from a point's pivot: the part of its position (particle, body centre) without one
       of its coordinates, when that part holds no coordinate and the point stays at a fixed
-      distance from it (pivot + l (sin q, -cos q); a driven support x_s(t) + ...);
+      distance from it (pivot + l (sin q, -cos q); a driven support x_s(t) + ...); a body whose
+      bar of the same inertia reaches that pivot is a link pinned at its end, its bar drawn from
+      the pivot through its centre (``aimed``), whatever its angle is measured from;
     - a rod between two points of different owners (particles, body centres, bar ends) that
       stay at a fixed non-zero distance in every configuration (the double pendulum's second
       rod, a cart and its pendulum), unless both lie on one body's bar (one per pair of owners);
@@ -452,18 +458,29 @@ def sketch(model: Model, values: Mapping[sp.Symbol, sp.Expr]) -> Sketch:
 
     rods, pivots, pivots_at = [], [], []
 
-    def add_pivot(expr: tuple, value: np.ndarray) -> None:
-        if not any(np.all(np.abs(value - seen) <= tolerance) for seen in pivots_at):
-            pivots.append(expr)
-            pivots_at.append(value)
+    def add_pivot(expr: tuple, value: np.ndarray) -> int:
+        for i, seen in enumerate(pivots_at):
+            if np.all(np.abs(value - seen) <= tolerance):
+                return i
+        pivots.append(expr)
+        pivots_at.append(value)
+        return len(pivots) - 1
 
     rooted = set()
+    aimed = []  # (body, pivot): a link pinned at one end, its bar drawn from the pivot
     for (index, anchor), value in zip(candidates, np.moveaxis(anchors_at, 1, 0), strict=True):
         if index in rooted or not fixed_distance(where[:, index], value):
             continue
         rooted.add(index)
-        add_pivot(anchor, value)
-        if not same_bar(value, where[:, index]):
+        pivot = add_pivot(anchor, value)
+        owner = owners[index]
+        if owner[0] == "body" and owner[1] in bar_ends and np.allclose(
+                np.linalg.norm(where[:, bar_ends[owner[1]][1]] - where[:, index], axis=-1),
+                np.linalg.norm(value - where[:, index], axis=-1), rtol=0, atol=tolerance):
+            # The uniform bar of this inertia reaches the pivot: a link pinned at its end,
+            # drawn along pivot -> centre whatever the body's angle is measured from.
+            aimed.append((owner[1], pivot))
+        elif not same_bar(value, where[:, index]):
             rods.append((anchor, points[index]))
     for ends in bar_ends.values():
         for e in ends:
@@ -522,7 +539,8 @@ def sketch(model: Model, values: Mapping[sp.Symbol, sp.Expr]) -> Sketch:
                 blocks.append((i, direction))
     rolling = [] if model.rigid_bodies else _rolling_bodies(model, values, points, owners,
                                                              where, samples, tolerance)
-    return Sketch(tuple(rods), tuple(pivots), tuple(blocks), tuple(rolling), gravity)
+    return Sketch(tuple(rods), tuple(pivots), tuple(blocks), tuple(rolling), gravity,
+                  tuple(aimed))
 
 
 def _centre_index(owners: list, index: int) -> int:

@@ -249,7 +249,9 @@ def check_model_units(model: Model) -> UnitsReport:
         for axis, component in zip("xyz", body.position, strict=True):
             c(f"{where}.position.{axis}", component, "m", "a length")
         c(f"{where}.angle", body.angle, "", "an angle")
-    for rigid in model.rigid_bodies:
+    # A robot read from URDF: its lengths, masses and inertias are SI numbers by the format
+    # (m, kg, kg m^2), multiplied by sines of the joint angles; no symbol with a unit to judge.
+    for rigid in model.rigid_bodies if model.kinematic_tree is None else ():
         where = f"bodies[{rigid.name}]"
         c(f"{where}.mass", rigid.mass, "kg", "a mass")
         for i, row in enumerate(rigid.inertia):

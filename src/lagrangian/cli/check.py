@@ -13,10 +13,11 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import SET_HELP, load_system, print_json
+from .common import LOCK_HELP, SET_HELP, load_system, print_json
 
 _MODEL = Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")]
 _SET = Annotated[list[str], typer.Option("--set", help=SET_HELP)]
+_LOCK = Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)]
 _JSON = Annotated[bool, typer.Option("--json", help="Print JSON.")]
 
 
@@ -26,12 +27,13 @@ def check(
     answer: Annotated[str, typer.Argument(help="Your derivation, ANSWER.toml: tables energy (T, V, "
                                                 "D), generalized_forces, equations, multipliers.")],
     set_: _SET = [],  # noqa: B006
+    lock: _LOCK = [],  # noqa: B006
     json_: _JSON = False,
 ) -> None:
     """Check a hand derivation (T, V, Q, equations, multipliers) and diagnose each mistake."""
     from ..output.check import check_document, check_text
 
-    system = load_system(model, set_)
+    system = load_system(model, set_, lock)
     report = system.check(answer)
     if json_:
         print_json(check_document(report))
@@ -42,11 +44,12 @@ def check(
 
 
 @app.command()
-def crosscheck(model: _MODEL, set_: _SET = [], json_: _JSON = False) -> None:  # noqa: B006
+def crosscheck(model: _MODEL, set_: _SET = [], lock: _LOCK = [],  # noqa: B006
+               json_: _JSON = False) -> None:
     """Derive again by Newton-Euler (free bodies, reactions eliminated) and compare with Lagrange."""
     from ..output.check import crosscheck_document, crosscheck_text
 
-    system = load_system(model, set_)
+    system = load_system(model, set_, lock)
     report = system.crosscheck()
     if json_:
         print_json(crosscheck_document(report))
@@ -57,11 +60,11 @@ def crosscheck(model: _MODEL, set_: _SET = [], json_: _JSON = False) -> None:  #
 
 
 @app.command()
-def units(model: _MODEL, json_: _JSON = False) -> None:
+def units(model: _MODEL, lock: _LOCK = [], json_: _JSON = False) -> None:  # noqa: B006
     """Check the model for dimensional consistency; print every inconsistent term."""
     from ..output.check import units_document, units_text
 
-    system = load_system(model)
+    system = load_system(model, (), lock)
     report = system.check_units()
     if json_:
         print_json(units_document(report))

@@ -44,6 +44,7 @@ FLAG_OF_FIELD = {
 }
 
 SET_HELP = "Override a parameter: NAME=VALUE; repeat, or join with commas (m=2,L=0.5)."
+LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
 
 
 def in_flags(error: LagrangianError) -> LagrangianError:

@@ -9,7 +9,7 @@ import typer
 
 from ..errors import ModelError
 from . import app
-from .common import SET_HELP, load_system, print_json, warn_if_unphysical
+from .common import LOCK_HELP, SET_HELP, load_system, print_json, warn_if_unphysical
 
 
 class Format(StrEnum):
@@ -24,11 +24,12 @@ def derive(
     format: Annotated[Format, typer.Option("--format", "-f", help="Output format.")] = Format.text,
     json_: Annotated[bool, typer.Option("--json", help="Print JSON (as --format json, the flag of every other command).")] = False,  # noqa: E501
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
+    lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
 ) -> None:
     """Derive the equations of motion by Lagrange's method."""
     from ..output.derivation import derivation_document, derivation_latex, derivation_text
 
-    eom = load_system(model, set_).equations_of_motion()
+    eom = load_system(model, set_, lock).equations_of_motion()
     warn_if_unphysical(eom)
     if json_ and format is Format.latex:
         raise ModelError("--json and --format latex ask for two formats; give one", field="--format")

@@ -7,19 +7,20 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import SET_HELP, load_system, print_json
+from .common import LOCK_HELP, SET_HELP, load_system, print_json
 
 
 @app.command()
 def equilibria(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
+    lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Find the equilibria (forces balance at rest, with the constraints) and their stability."""
     from ..output.modes import equilibria_document, equilibria_text
 
-    found = load_system(model, set_).equilibria()
+    found = load_system(model, set_, lock).equilibria()
     if json_:
         print_json(equilibria_document(found))
     else:

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import SET_HELP, load_system, print_json, state_assignments
+from .common import LOCK_HELP, SET_HELP, load_system, print_json, state_assignments
 
 ABOUT_HELP = "Equilibrium: COORDINATE=VALUE (pi, 180deg, 0.5m); the others are solved for."
 STEADY_HELP = ("Steady motion: a cyclic coordinate's constant rate, NAME_dot=VALUE (psi_dot=10, "
@@ -21,6 +21,7 @@ def modes(
     about: Annotated[list[str], typer.Option("--about", help=ABOUT_HELP)] = [],  # noqa: B006
     steady: Annotated[list[str], typer.Option("--steady", help=STEADY_HELP)] = [],  # noqa: B006
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
+    lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option("--plot", help="Draw the mode shapes to a PNG file.")] = None,
 ) -> None:
@@ -29,7 +30,7 @@ def modes(
     from ..output.modes import modes_document, modes_text, write_mode_plot
     from ..output.plots import check_plot_path
 
-    system = load_system(model, set_)
+    system = load_system(model, set_, lock)
     point = state_assignments(system, about, "--about")
     inputs = (Path(model),) if Path(model).exists() else ()
     if plot is not None:  # before the analysis: a path that cannot be written costs nothing

@@ -11,7 +11,7 @@ import typer
 
 from ..numerics.options import METHODS  # light: the names only, no scipy
 from . import app
-from .common import SET_HELP, load_system, print_json, state_assignments, warn_if_unphysical
+from .common import LOCK_HELP, SET_HELP, load_system, print_json, state_assignments, warn_if_unphysical
 
 
 @app.command()
@@ -20,6 +20,7 @@ def simulate(
     t_end: Annotated[str, typer.Option("--t-end", help="End time (s, or with a unit: 500ms).")],
     initial: Annotated[list[str], typer.Option("--initial", help="Initial value: NAME=VALUE (theta=30deg, theta_dot=0, t=0); default: the model's initial/rate; repeat, or separate by commas.")] = [],  # noqa: B006,E501
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
+    lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     method: Annotated[str, typer.Option("--method", help=f"Integrator: {', '.join(METHODS)}.")] = "DOP853",
     rtol: Annotated[float, typer.Option("--rtol", help="Relative tolerance.")] = 1e-9,
     atol: Annotated[float, typer.Option("--atol", help="Absolute tolerance.")] = 1e-9,
@@ -42,7 +43,7 @@ def simulate(
     from ..output.simulation import projection_warning, simulation_document, simulation_text
     from ..output.tables import check_table_path
 
-    system = load_system(model, set_)
+    system = load_system(model, set_, lock)
     warn_if_unphysical(system.equations_of_motion())
     end = parse_quantity(t_end, "s", "--t-end")
     # Everything the user typed is checked (by the library) before the integration starts.

@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import SET_HELP, assignments, comma_separated, load_system, print_json
+from .common import LOCK_HELP, SET_HELP, assignments, comma_separated, load_system, print_json
 
 STEADY_HELP = ("A steady rate, NAME_dot=EXPRESSION in the parameters (x_dot=v, "
                "thetaR_dot=-v/rR); repeat or join with commas.")
@@ -36,6 +36,7 @@ def speeds(
     highest: Annotated[float, typer.Option("--to", help="Highest speed of the sweep.")] = 10.0,
     points: Annotated[int, typer.Option("--points", help="Speeds in the sweep.")] = 101,
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
+    lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option("--plot", help="Draw the eigenvalues against "
                                               "speed (.png, .svg, .pdf).")] = None,
@@ -48,7 +49,7 @@ def speeds(
     from ..output.speed_form import speed_form_document, speed_form_text, write_speed_plot
     from .common import state_assignments
 
-    system = load_system(model, set_)
+    system = load_system(model, set_, lock)
     inputs = (Path(model),) if Path(model).exists() else ()
     if plot is not None:
         check_output_path(check_plot_path(plot), "plot", inputs=inputs)

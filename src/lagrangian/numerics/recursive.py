@@ -36,6 +36,7 @@ from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters
 
 Term = float | str  # a number, or the C name of a value computed before
+VECTOR_LIMIT = 16  # coordinates up to which batches run two states per vector operation
 
 
 class _Emitter:
@@ -846,6 +847,7 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     const int size = kind == RT_MASS ? LG_N * LG_N
                      : (kind == RT_KINETIC || kind == RT_POTENTIAL) ? 1 : LG_N;
     npy_intp k = 0;
+#if RT_VECTOR
     /* LG_LANES states at a time through the vector variants, the rest one by one */
     for (; k + LG_LANES <= count && (kind != RT_FORWARD || RT_VECTOR_FORWARD); k += LG_LANES) {
         lg_v4 in[3][LG_N], out4[LG_N * LG_N];
@@ -872,6 +874,7 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
                 if (kind == RT_FORWARD && !isfinite(x) && failed < 0) failed = k + l;
             }
     }
+#endif
     for (; k < count; k++) {
         const double *a0 = x0 + k * step[0], *a1 = x1 + k * step[1], *a2 = x2 + k * step[2];
         switch (kind) {
@@ -929,7 +932,9 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
     from .codegen import TEMPLATE, GeneratedSource
 
     n = len(tree.coordinates)
-    functions = dynamics_functions(tree, parameters, "rt", vector=True)
+    # two-state vector variants for batches of arms; a long chain's code is big enough that
+    # compiling it twice costs minutes, so there the batch runs the scalar functions
+    functions = dynamics_functions(tree, parameters, "rt", vector=n <= VECTOR_LIMIT)
     source = "\n".join([
         f"/* lagrangian: recursive dynamics of a tree of {len(tree.joints)} bodies, {n} "
         "coordinates */",
@@ -970,6 +975,7 @@ static void lg_residual(const double *restrict q, const double *restrict v, doub
         _DECLARE,
         f"#define LG_EXTRA_METHODS {_METHODS}",
         "#define RT_VECTOR_FORWARD " + ("1" if "rt4_forward_dynamics" in functions else "0"),
+        "#define RT_VECTOR " + ("1" if "rt4_mass_matrix" in functions else "0"),
         TEMPLATE.read_text(),
         _BINDINGS,
     ])

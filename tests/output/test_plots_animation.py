@@ -35,6 +35,8 @@ def test_gif_holds_distinct_frames_of_the_moving_mechanism(tmp_path):
         last = np.asarray(gif.convert("RGB")).copy()
         end = red_centroid(gif)
     assert np.mean(np.any(first != last, axis=-1)) > 0.002
+    # the shared palette keeps the white background white (not a near-white neighbour)
+    assert tuple(first[2, 2]) == tuple(last[2, 2]) == (255, 255, 255)
     # the bobs fall: their centroid moves by several pixels between first and last frame
     assert np.linalg.norm(end - start) > 5
 

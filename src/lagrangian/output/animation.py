@@ -468,6 +468,15 @@ def _palette_frames(frames) -> list:
     picks = sorted({0, len(frames) // 3, 2 * len(frames) // 3, len(frames) - 1})
     mosaic = Image.fromarray(np.concatenate([frames[i] for i in picks], axis=0))
     palette = mosaic.quantize(colors=GIF_COLOURS, method=Image.Quantize.MEDIANCUT)
+    # Pillow maps a colour to a palette entry through a coarse lookup, so pure white landed on
+    # a near-white neighbour (an off-white background): an entry within 12 levels of a more
+    # used one becomes that one.
+    entries = np.array(palette.getpalette()[:3 * GIF_COLOURS]).reshape(-1, 3)
+    used = np.array(palette.histogram()[:len(entries)])
+    for a in np.argsort(-used, kind="stable"):
+        near = (used < used[a]) & (np.abs(entries - entries[a]).max(axis=1) <= 12)
+        entries[near] = entries[a]
+    palette.putpalette([int(c) for c in entries.ravel()])
     return [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE)
             for f in frames]
 

@@ -278,7 +278,10 @@ class ModelBuilder:
             name,
             self.expression(mass, f"{field}.mass", velocities=False),
             reader.inertia(inertia, f"{field}.inertia", values),
-            tuple(o + sum((r * c for r, c in zip(row, offset, strict=True)), sp.S.Zero)
+            # zero offsets skipped: 0 * (a deep rotation product) makes sympy ask is_finite
+            # of the whole tree (a tenth of a second per body down a chain)
+            tuple(o + sum((r * c for r, c in zip(row, offset, strict=True) if c != 0),
+                          sp.S.Zero)
                   for o, row in zip(frame.origin, frame.rotation, strict=True)),
             frame.rotation, frame.origin, frame.angular_velocity, parent, frame.singularities,
         )

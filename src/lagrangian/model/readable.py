@@ -13,8 +13,10 @@ What a person checking a hand derivation expects to see:
   its sign.
 
 Cost is bounded: the heavy steps (expansion, trig identities) run only on coefficients below
-``COEFFICIENT_BUDGET`` nodes, and the grouping gives up past ``MAX_MONOMIALS`` rate products,
-returning the tidied expression. Nothing here calls ``simplify``.
+``COEFFICIENT_BUDGET`` nodes (400 in an expression of at most ``SMALL_EXPRESSION`` nodes and
+``SMALL_ANGLES`` angles), and
+the grouping gives up past ``MAX_MONOMIALS`` rate products, returning the tidied expression.
+Nothing here calls ``simplify``.
 """
 
 from __future__ import annotations
@@ -26,6 +28,9 @@ from sympy.core.mul import _keep_coeff
 from sympy.simplify.fu import TR10i
 
 COEFFICIENT_BUDGET = 160  # nodes of a coefficient above which only cheap steps run
+SMALL_EXPRESSION = 1500  # nodes of a whole expression whose coefficients get a budget of 400
+SMALL_ANGLES = 3  # ... and at most this many distinct trig arguments
+_SMALL_BUDGET = 400
 MAX_MONOMIALS = 400  # rate products per expression above which no grouping is attempted
 MAX_PULLED_TERMS = 40  # terms of a sum above which no common factor is pulled out of it
 _CACHE_LIMIT = 50_000
@@ -279,18 +284,18 @@ def _collected(expr: sp.Expr) -> sp.Expr:
     return sp.Add(*(sp.factor_terms(sp.Add(*c)) * _product(m) for m, c in groups.items()))
 
 
-def compact(coefficient: sp.Expr) -> sp.Expr:
+def compact(coefficient: sp.Expr, budget: int = COEFFICIENT_BUDGET) -> sp.Expr:
     """The shortest (sympy count_ops) of a few equal forms of a coefficient free of the rates:
     as given, common factors out, and, when small, expanded with the trig identities applied
     and like terms collected."""
     if coefficient.is_Atom or not isinstance(coefficient, sp.Expr):
         return coefficient
-    key = ("compact", coefficient)
+    key = ("compact", coefficient, budget)
     found = _cache.get(key)
     if found is not None:
         return found
     options = [coefficient]
-    small = _size(coefficient, COEFFICIENT_BUDGET + 1) <= COEFFICIENT_BUDGET
+    small = _size(coefficient, budget + 1) <= budget
     if coefficient.is_Add:
         # sympy's factor_terms recurses through the whole tree: on small coefficients only.
         options.append(sp.factor_terms(coefficient) if small
@@ -299,7 +304,7 @@ def compact(coefficient: sp.Expr) -> sp.Expr:
         try:
             expanded = sp.expand(coefficient, trig=False, log=False, power_exp=False,
                                  power_base=False)
-            if _size(expanded, 4 * COEFFICIENT_BUDGET) < 4 * COEFFICIENT_BUDGET:
+            if _size(expanded, 4 * budget) < 4 * budget:
                 identities = expanded
                 if _trig_candidates(expanded):
                     angles = {f.args[0] for f in expanded.atoms(*_TRIG)}
@@ -342,11 +347,18 @@ def readable(expr: sp.Expr, rates: Iterable[sp.Symbol] | None = None,
     if tidied.is_Mul and any(f.is_Pow and f.exp.is_negative and not f.base.is_Number
                              for f in tidied.args):
         numerator, denominator = sp.fraction(tidied)
+    # A small expression in few angles (a two-link arm's solved acceleration) affords larger
+    # coefficients; the identities' cost grows with the angles (the bicycle's M: 1 s an entry).
+    budget = COEFFICIENT_BUDGET
+    if _size(tidied, SMALL_EXPRESSION + 1) <= SMALL_EXPRESSION and len(
+            {f.args[0] for f in tidied.atoms(*_TRIG)}) <= SMALL_ANGLES:
+        budget = _SMALL_BUDGET
     if denominator is not sp.S.One:
-        result = _grouped(numerator, generators) / _grouped(denominator, generators)
+        result = (_grouped(numerator, generators, budget)
+                  / _grouped(denominator, generators, budget))
         result = _shortest([result, tidied])
     else:
-        result = _grouped(tidied, generators)
+        result = _grouped(tidied, generators, budget)
     return _remember(key, result)
 
 
@@ -382,7 +394,8 @@ def _pull_common(terms: list[sp.Expr], keep: frozenset = frozenset()) -> sp.Expr
     return _keep_coeff(sp.Rational(scale), front * inner) if scale != 1 else front * inner
 
 
-def _grouped(expr: sp.Expr, generators: frozenset) -> sp.Expr:
+def _grouped(expr: sp.Expr, generators: frozenset, budget: int = COEFFICIENT_BUDGET
+             ) -> sp.Expr:
     if expr.is_Atom:
         return expr
     contains = _Contains(generators)
@@ -398,15 +411,15 @@ def _grouped(expr: sp.Expr, generators: frozenset) -> sp.Expr:
                     whole[m] = term
                 groups.setdefault(m, []).extend(c)
     except _TooMany:
-        return _shortest([compact(expr), expr])
+        return _shortest([compact(expr, budget), expr])
     if list(groups) == [()]:
-        simpler = compact(expr)
+        simpler = compact(expr, budget)
         return expr if simpler is expr else _shortest([simpler, expr])
-    free = compact(sp.Add(*groups.pop((), [])))
+    free = compact(sp.Add(*groups.pop((), [])), budget)
     rate_terms = []
     for m, c in groups.items():
         coefficient = sp.Add(*c)
-        simpler = compact(coefficient)
+        simpler = compact(coefficient, budget)
         rate_terms.append(whole[m] if m in whole and simpler is coefficient
                           else simpler * _product(m))
     if len(rate_terms) > MAX_PULLED_TERMS:  # a long sum stays flat: its terms are the reading

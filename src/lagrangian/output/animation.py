@@ -19,6 +19,7 @@ import html
 import io
 import os
 import tempfile
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -503,7 +504,8 @@ def player_html(frames, *, fps: float, times: np.ndarray, title: str = "") -> st
     lines = "\n".join(f'frames[{k}] = "data:image/png;base64,{data}";'
                       for k, data in enumerate(encoded))
     stamps = ", ".join(f"{t:.3f}" for t in times[:len(encoded)])
-    return _PLAYER.format(title=html.escape(title or "animation"), frames=lines,
+    return _PLAYER.format(id=f"lagrangian-{uuid.uuid4().hex[:12]}",
+                          title=html.escape(title or "animation"), frames=lines,
                           times=stamps, count=len(encoded), last=len(encoded) - 1,
                           interval=round(1000 / fps))
 
@@ -511,42 +513,45 @@ def player_html(frames, *, fps: float, times: np.ndarray, title: str = "") -> st
 _PLAYER = """<!DOCTYPE html>
 <html><head><meta charset="utf-8"><title>{title}</title></head>
 <body style="font-family: sans-serif">
-<div class="lagrangian-animation">
-<img id="frame" alt="{title}" style="display: block">
+<div class="lagrangian-animation" id="{id}">
+<img id="{id}-frame" alt="{title}" style="display: block">
 <div>
-<button id="back" title="previous frame">&#9664;&#9664;</button>
-<button id="play" title="play / pause">&#9654;</button>
-<button id="next" title="next frame">&#9654;&#9654;</button>
-<input id="slider" type="range" min="0" max="{last}" value="0" style="width: 60%">
-<span id="clock"></span>
-<label><input id="loop" type="checkbox" checked> loop</label>
+<button id="{id}-back" title="previous frame">&#9664;&#9664;</button>
+<button id="{id}-play" title="play / pause">&#9654;</button>
+<button id="{id}-next" title="next frame">&#9654;&#9654;</button>
+<input id="{id}-slider" type="range" min="0" max="{last}" value="0" style="width: 60%">
+<span id="{id}-clock"></span>
+<label><input id="{id}-loop" type="checkbox" checked> loop</label>
 </div>
 </div>
 <script>
-// The animation's frames, embedded: this page needs nothing from the network.
+(function () {{
+// The animation's frames, embedded: this page needs nothing from the network. Ids carry a
+// prefix of their own, so several players on one page (a notebook) stay apart.
 var frames = new Array({count});
 {frames}
 var times = [{times}];
 var k = 0, timer = null;
-var img = document.getElementById("frame"), slider = document.getElementById("slider");
-var play = document.getElementById("play"), clock = document.getElementById("clock");
+function part(name) {{ return document.getElementById("{id}-" + name); }}
+var img = part("frame"), slider = part("slider"), play = part("play"), clock = part("clock");
 function show(i) {{
   k = (i + frames.length) % frames.length;
   img.src = frames[k]; slider.value = k; clock.textContent = "t = " + times[k].toFixed(2) + " s";
 }}
 function stop() {{ clearInterval(timer); timer = null; play.innerHTML = "&#9654;"; }}
 function tick() {{
-  if (k == frames.length - 1 && !document.getElementById("loop").checked) {{ stop(); return; }}
+  if (k == frames.length - 1 && !part("loop").checked) {{ stop(); return; }}
   show(k + 1);
 }}
 play.onclick = function () {{
   if (timer) {{ stop(); return; }}
   timer = setInterval(tick, {interval}); play.innerHTML = "&#10074;&#10074;";
 }};
-document.getElementById("back").onclick = function () {{ stop(); show(k - 1); }};
-document.getElementById("next").onclick = function () {{ stop(); show(k + 1); }};
+part("back").onclick = function () {{ stop(); show(k - 1); }};
+part("next").onclick = function () {{ stop(); show(k + 1); }};
 slider.oninput = function () {{ stop(); show(parseInt(slider.value)); }};
 show(0);
+}})();
 </script>
 </body></html>
 """

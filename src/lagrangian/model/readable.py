@@ -128,7 +128,10 @@ def _rewrite(node: sp.Expr, ranges) -> sp.Expr:
             inner, power = base.args
             if _negative_first(inner):
                 inner = -inner
-            return _absolute(inner, ranges) ** (power / 2 * exponent.p)
+            new_exponent = power / 2 * exponent.p
+            if _even(new_exponent):
+                return inner**new_exponent  # |u|^(2j) = u^(2j)
+            return _absolute(inner, ranges) ** new_exponent
         return node
     if isinstance(node, sp.Abs):
         sign = _sign_over_ranges(node.args[0], ranges)
@@ -342,6 +345,14 @@ def readable(expr: sp.Expr, rates: Iterable[sp.Symbol] | None = None,
     found = _cache.get(key)
     if found is not None:
         return found
+    try:
+        result = _readable(expr, generators, ranges)
+    except Exception:  # noqa: BLE001 - display only (a RecursionError too): the derived form stands
+        result = expr
+    return _remember(key, result)
+
+
+def _readable(expr: sp.Expr, generators: frozenset, ranges: dict) -> sp.Expr:
     tidied = tidy(expr, ranges)
     numerator, denominator = tidied, sp.S.One
     if tidied.is_Mul and any(f.is_Pow and f.exp.is_negative and not f.base.is_Number
@@ -359,7 +370,7 @@ def readable(expr: sp.Expr, rates: Iterable[sp.Symbol] | None = None,
         result = _shortest([result, tidied])
     else:
         result = _grouped(tidied, generators, budget)
-    return _remember(key, result)
+    return result
 
 
 def _pull_common(terms: list[sp.Expr], keep: frozenset = frozenset()) -> sp.Expr:

@@ -409,8 +409,9 @@ def _animation(figure, draw, times: np.ndarray, fps: int):
             return _frame_images(figure, draw, len(times), dpi=dpi, progress=progress)
 
         def to_jshtml(self, fps=None, embed_frames=True, default_mode=None):
-            return player_html(self.frame_images(dpi=HTML_DPI), fps=fps or self.fps,
-                               times=times, title=self.title)
+            return player_html(self.frame_images(dpi=HTML_DPI),
+                               fps=playback_rate(times, fps or self.fps), times=times,
+                               title=self.title)
 
         def _repr_html_(self):
             # As matplotlib: shown inline only where rcParams["animation.html"] asks for it.
@@ -593,12 +594,20 @@ def save_animation(animation, path: str | Path, *, fps: int = 25,
     if not hasattr(animation, "frame_images"):  # any other matplotlib animation
         return _save_with_matplotlib(animation, path, fps=fps, protect=protect,
                                      progress=progress)
+    fps = playback_rate(animation.times, fps)
     if path.suffix.lower() == ".html":
         frames = animation.frame_images(dpi=HTML_DPI, progress=progress)
         page = player_html(frames, fps=fps, times=animation.times, title=animation.title)
         return atomic_write(path, page, protect=protect)
     return atomic_write(path, gif_bytes(animation.frame_images(progress=progress), fps),
                         protect=protect)
+
+
+def playback_rate(times: np.ndarray, fps: float) -> float:
+    """Frames a second that play the frames in real time: ``fps``, or fewer where the run was
+    longer than ``max_frames`` allow at ``fps`` (the frames are then further apart)."""
+    span = float(times[-1] - times[0]) if len(times) > 1 else 0.0
+    return min(float(fps), (len(times) - 1) / span) if span > 0 else float(fps)
 
 
 def _save_with_matplotlib(animation, path: Path, *, fps, protect, progress) -> Path:

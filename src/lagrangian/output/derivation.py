@@ -189,7 +189,8 @@ def _product_text(coefficient: sp.Expr, unknown: sp.Symbol) -> str:
         if sp.count_ops(negated) < sp.count_ops(coefficient) and not negated.is_Add:
             return "-" + format_expression(negated * unknown)
         return f"({format_expression(coefficient)})*{unknown}"
-    if coefficient.is_Mul and any(factor.is_Add for factor in coefficient.args):
+    if (coefficient.is_Mul and any(factor.is_Add for factor in coefficient.args)
+            and coefficient.as_coeff_Mul()[0].is_Integer):
         return f"{format_expression(coefficient)}*{unknown}"  # the unknown after the sum
     return format_expression(coefficient * unknown)
 

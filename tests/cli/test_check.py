@@ -67,6 +67,7 @@ def test_crosscheck_json_contract(cli):
     code, out, _ = cli("crosscheck", "ladder_pendulum", "--json")
     assert code == 0
     document = json.loads(out)
+    at_start = document["reactions"][0].pop("at_initial_state")
     assert document == {
         "agree": True,
         "coordinates": {"theta": {"agree": True, "difference": None}},
@@ -78,6 +79,18 @@ def test_crosscheck_json_contract(cli):
                 "x": "-m*(L*theta_dot**2 + g*cos(theta))*sin(theta)",
                 "y": "m*(L*theta_dot**2 + g*cos(theta))*cos(theta)"}}],
     }
+    # and its value where the model starts: the rod's pull m (L theta_dot^2 + g cos theta)
+    # along the rod toward the pivot
+    import math
+
+    import lagrangian
+
+    model = lagrangian.load("ladder_pendulum").model
+    p = {q.name: float(q.value) for q in model.parameters}
+    theta, rate = float(model.coordinates[0].initial or 0), float(model.coordinates[0].rate or 0)
+    pull = p["m"] * (p["L"] * rate**2 + p["g"] * math.cos(theta))
+    assert at_start["force"]["x"] == pytest.approx(-pull * math.sin(theta), abs=1e-12)
+    assert at_start["force"]["y"] == pytest.approx(pull * math.cos(theta), rel=1e-12)
 
 
 def test_crosscheck_text_and_refusal(cli):

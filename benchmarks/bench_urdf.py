@@ -9,7 +9,8 @@ Default: ``arm.dynamics()``, the recursive algorithms in generated C (numerics/r
 ``--symbolic`` times the derived equations instead (numpy or C backend).
 
 - Build: ``lagrangian.load(urdf, lock=...)`` then ``.dynamics()`` and a first call, in a fresh
-  process (interpreter start and ``import lagrangian, yourdfpy`` reported apart), first with an
+  process (interpreter start and ``from lagrangian import load; import yourdfpy`` reported
+  apart), first with an
   empty cache (cold: C generated and compiled), then again with the cache it filled (warm).
 - Per call: one state through the Python API and through Pinocchio's Python bindings (crba,
   rnea, aba), interleaved in one process, best of 7 runs of 2000 calls.
@@ -42,9 +43,10 @@ ROBOTS = {
 BUILD = """
 import json, sys, time
 t0 = time.perf_counter()
-import lagrangian, yourdfpy
+import yourdfpy
+from lagrangian import load  # the API layer (sympy, scipy): the library's fixed start-up
 t1 = time.perf_counter()
-arm = lagrangian.load(sys.argv[1], lock=json.loads(sys.argv[2]))
+arm = load(sys.argv[1], lock=json.loads(sys.argv[2]))
 f = arm.dynamics()
 n = f.n
 f.forward_dynamics([0.1] * n, [0.0] * n, [0.0] * n)
@@ -120,8 +122,8 @@ def bench(name: str, symbolic: str | None, states: int, timing: bool = True) -> 
         f = arm.dynamics()
         cold, warm = build_times(path, lock)
         print(f"\n{name}: {cold['kind']}; URDF -> compiled functions: cold {cold['build']:.2f} s, "
-              f"from the cache {warm['build']:.2f} s (fresh processes; import lagrangian + "
-              f"yourdfpy {warm['import']:.2f} s apart); load average {load_average()}")
+              f"from the cache {warm['build']:.2f} s (fresh processes; importing lagrangian.load "
+              f"and yourdfpy {warm['import']:.2f} s apart); load average {load_average()}")
     model = pin.buildModelFromUrdf(str(path))
     if lock:
         locked = [model.getJointId(j) for j in lock]

@@ -25,8 +25,22 @@ def numpy_function(args: Sequence[sp.Symbol], exprs: sp.Expr | Sequence[sp.Expr]
     expression); cse when the expressions are big enough to share work."""
     many = not isinstance(exprs, sp.Basic)
     items = [as_expression(e) for e in exprs] if many else [as_expression(exprs)]
-    cse = sum(sp.count_ops(e) for e in items) > CSE_MIN_OPERATIONS
+    cse = _operations_exceed(items, CSE_MIN_OPERATIONS)
     return sp.lambdify(list(args), items if many else items[0], modules="numpy", cse=cse)
+
+
+def _operations_exceed(items: Sequence[sp.Expr], limit: int) -> bool:
+    """sum(count_ops) > limit, without counting a large model's operations to the end (that
+    took longer than the lambdify of the Whipple bicycle's linearization): a tree of more
+    than 3 limit nodes has more than limit operations (each node with k arguments adds at
+    least k - 1 of them and its leaves are at most about half the nodes)."""
+    nodes = 0
+    for e in items:
+        for _ in sp.preorder_traversal(e):
+            nodes += 1
+            if nodes > 3 * limit:
+                return True
+    return sum(sp.count_ops(e) for e in items) > limit
 
 
 def mpmath_function(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr]) -> Callable:

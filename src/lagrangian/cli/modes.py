@@ -12,7 +12,28 @@ from .common import LOCK_HELP, SET_HELP, load_system, print_json, state_assignme
 
 ABOUT_HELP = "Equilibrium: COORDINATE=VALUE (pi, 180deg, 0.5m); the others are solved for."
 STEADY_HELP = ("Steady motion: a cyclic coordinate's constant rate, NAME_dot=VALUE (psi_dot=10, "
-               "rad/s); linearize about it instead of an equilibrium.")
+               "rad/s, or an expression in the parameters: thetaR_dot=-v/rR); linearize about "
+               "it instead of an equilibrium.")
+
+
+def steady_assignments(system, settings: list[str]) -> dict[str, float | str]:
+    """--steady NAME_dot=VALUE: a quantity (10, 600rpm), else the text, which the library reads
+    as an expression in the parameters (-v/rR) or refuses by name."""
+    from ..errors import ModelError
+    from .common import assignments, comma_separated
+
+    import re
+
+    parameters = {p.name for p in system.model.parameters}
+    rates: dict[str, float | str] = {}
+    for name, text in assignments(comma_separated(settings), "--steady"):
+        try:
+            rates |= state_assignments(system, [f"{name}={text}"], "--steady")
+        except ModelError:
+            if not parameters & set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", text)):
+                raise
+            rates[name] = text
+    return rates
 
 
 @app.command()
@@ -35,7 +56,7 @@ def modes(
     inputs = (Path(model),) if Path(model).exists() else ()
     if plot is not None:  # before the analysis: a path that cannot be written costs nothing
         check_output_path(check_plot_path(plot), "plot", inputs=inputs)
-    rates = state_assignments(system, steady, "--steady")
+    rates = steady_assignments(system, steady)
     analysis = system.modes(about=point or None, steady=rates or None)
     if plot is not None:
         write_mode_plot(analysis, plot, protect=inputs)

@@ -19,10 +19,10 @@ STEADY_HELP = ("Steady motion: a cyclic coordinate's constant rate, NAME_dot=VAL
 def steady_assignments(system, settings: list[str]) -> dict[str, float | str]:
     """--steady NAME_dot=VALUE: a quantity (10, 600rpm), else the text, which the library reads
     as an expression in the parameters (-v/rR) or refuses by name."""
+    import re
+
     from ..errors import ModelError
     from .common import assignments, comma_separated
-
-    import re
 
     parameters = {p.name for p in system.model.parameters}
     rates: dict[str, float | str] = {}

@@ -173,3 +173,20 @@ def test_below_the_weave_speed_the_bicycle_falls(bicycle):
     table = run.to_pandas()
     assert run.status == "stopped" and table["t"].iloc[-1] < 3.0  # the weave grows at 2.68 1/s at 2 m/s
     assert run.max_residual < 1e-8
+
+
+@pytest.mark.slow
+def test_readme_console_lines_are_real_output(form):
+    import re
+    from pathlib import Path
+
+    from lagrangian.output.speed_form import speed_form_text
+
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
+    section = readme[readme.index("<!-- BEGIN bicycle -->"):readme.index("<!-- END bicycle -->")]
+    shown = re.findall(r"```console\n\$ lagrangian speeds [^\n]*\n(.*?)```", section, re.S)[0]
+    text = speed_form_text(lagrangian.load("whipple_bicycle").model.name, form,
+                           speed_sweep(form, np.linspace(0, 10, 101)))
+    for line in shown.splitlines():
+        if line != "...":
+            assert line in text.splitlines(), line

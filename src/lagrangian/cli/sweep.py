@@ -13,7 +13,14 @@ import typer
 
 from ..errors import LagrangianError, ModelError
 from . import app
-from .common import assignments, in_flags, load_system, print_json, state_assignments
+from .common import (
+    LOCK_HELP,
+    assignments,
+    in_flags,
+    load_system,
+    print_json,
+    state_assignments,
+)
 
 # The library's field -> this command's flag (before the shared table of common.py).
 SWEEP_FLAGS = {
@@ -30,7 +37,7 @@ _COUNT = re.compile(r"^\s*\d+\s*$")
 
 @app.command()
 def sweep(
-    model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
+    model: Annotated[str, typer.Argument(help="Model file (TOML or URDF) or built-in example name.")],
     vary: Annotated[list[str], typer.Option("--vary", help=VARY_HELP)] = [],  # noqa: B006
     compute: Annotated[str, typer.Option("--compute", help="modes, equilibria or simulate.")] = "modes",
     out: Annotated[Path | None, typer.Option("--out", help="Write the Dataset: .nc (NetCDF) or .zarr.")] = None,  # noqa: E501
@@ -52,24 +59,26 @@ def sweep(
     resume: Annotated[bool, typer.Option("--resume", help="Continue an interrupted study writing to the same --out.")] = False,  # noqa: E501
     chunk_size: Annotated[int | None, typer.Option("--chunk-size", help="Points per task.")] = None,
     about: Annotated[list[str], typer.Option("--about", help="modes: the equilibrium, COORDINATE=VALUE (theta=0); default: the one nearest the initial values, as `lagrangian modes`.")] = [],  # noqa: B006,E501
+    lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
 ) -> None:
     """Evaluate modes, equilibria or simulations over a grid of parameters (and ensembles)."""
     try:
         _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_end,
              time_samples, method, rtol, atol, stop_when, trajectories, scheduler, workers,
-             resume, chunk_size, about)
+             resume, chunk_size, about, lock)
     except ModelError as exc:
         raise _flagged(exc) from None
 
 
 def _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_end,
          time_samples, method, rtol, atol, stop_when, trajectories, scheduler, workers, resume,
-         chunk_size, about):
+         chunk_size, about, lock=()):
     from ..model.units import parse_quantity
     from ..model.values import state_units
     from ..output.sweep import check_study_path, check_study_plot_path, study_summary, study_text
 
-    system = load_system(model, set_)
+    # the locked model's equations travel inside the Study to the Dask workers
+    system = load_system(model, set_, lock)
     units = {p.name: p.unit for p in system.model.parameters}
     units.update(state_units(system.model))
     grid = {name: grid_values(text, units.get(name), f"vary.{name}")

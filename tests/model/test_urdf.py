@@ -178,9 +178,13 @@ def _newton_euler_free_energy(q, v):
 
 @pytest.fixture(scope="module")
 def spatial(tmp_path_factory):
-    # numpy backend: the C build of these (unsimplified, float-laden) expressions takes ~1 min
+    # the derived equations, lambdified (numpy: the C build of these unsimplified, float-laden
+    # expressions takes ~1 min; System.dynamics(backend="numpy") would run the recursions)
+    from lagrangian.numerics.dynamics import Dynamics
+    from lagrangian.numerics.functions import numeric
+
     path = write(tmp_path_factory.mktemp("spatial"), SPATIAL)
-    return lagrangian.load(path).dynamics(backend="numpy")
+    return Dynamics(numeric(lagrangian.load(path).equations_of_motion(), backend="numpy"))
 
 
 @pytest.mark.slow

@@ -18,6 +18,7 @@ from lagrangian.numerics import compiled
 from lagrangian.numerics.dynamics import Dynamics, recursive_dynamics
 from lagrangian.numerics.functions import numeric
 from lagrangian.numerics.recursive import RecursiveDynamics, applicable_tree
+from lagrangian.numerics.recursive_numpy import RecursiveNumpyDynamics
 
 pytest.importorskip("yourdfpy")
 needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
@@ -207,7 +208,8 @@ def test_parameters_and_what_the_tree_does_not_describe(tree):
     edited = replace(tree.model, loads=tree.model.loads + (object(),))
     assert applicable_tree(edited) is None
     assert applicable_tree(replace(tree.model, generalized_forces=())) is None
-    assert recursive_dynamics(tree.model, backend="numpy") is None
+    # backend "numpy": the same recursions in numpy (recursive_numpy.py), not the C module
+    assert isinstance(recursive_dynamics(tree.model, backend="numpy"), RecursiveNumpyDynamics)
     with pytest.raises(ModelError, match="expected 4 values"):
         tree.dynamics().mass_matrix([0.1, 0.2])
     with pytest.raises(ModelError, match="expected 4 values"):

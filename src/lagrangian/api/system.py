@@ -177,14 +177,16 @@ class System:
 
     @cached_property
     def _recursive(self):
-        """Recursive dynamics of a URDF tree in generated C, or None (numerics/dynamics.py)."""
+        """Recursive dynamics of a URDF tree in generated C (numpy without a compiler), or
+        None (numerics/dynamics.py)."""
         return recursive_dynamics(self.model)
 
     def dynamics(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"):
         """M(q), bias C q_dot + g, g(q), inverse and forward dynamics and the energies, batched
         over leading axes (q of shape (n,) or (N, n)); a generalized force tau acts on top of
         the model's own loads (numerics/dynamics.py). A URDF robot runs recursive algorithms in
-        generated C (numerics/recursive.py), the other models their derived equations."""
+        generated C (numerics/recursive.py; in numpy without a compiler or with backend
+        "numpy"), the other models their derived equations."""
         if parameters is None and backend == "auto" and self._recursive is not None:
             return self._recursive
         return model_dynamics(self.model, lambda: self.numeric(parameters, backend),

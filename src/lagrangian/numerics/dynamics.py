@@ -11,12 +11,14 @@ For a URDF arm the actuator parameters tau_<joint> are 0, so f holds gravity and
 terms only. Units SI (rad or m per coordinate; N m or N for tau; J for energies).
 
 A robot read from URDF (a tree of rigid bodies on revolute, prismatic and fixed joints, nothing
-added) is evaluated by recursive algorithms in generated C instead (recursive.py), without
-deriving its equations: ``model_dynamics`` picks that path wherever it applies.
+added) is evaluated by recursive algorithms in generated C instead (recursive.py; in numpy,
+recursive_numpy.py, without a compiler), without deriving its equations: ``model_dynamics``
+picks that path wherever it applies.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping
 
 import numpy as np
@@ -99,23 +101,39 @@ class Dynamics:
 
 def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = None,
                        backend: str = "auto"):
-    """The compiled recursive dynamics of a URDF tree (recursive.RecursiveDynamics), or None
-    where they do not apply: not a bare tree, backend "numpy", no compiler (backend "auto"),
-    or a mass matrix that is not positive definite (the symbolic path names the joints)."""
-    from .compiled import BackendUnavailable
+    """The recursive dynamics of a URDF tree: generated C (recursive.RecursiveDynamics), or
+    numpy (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with backend
+    "auto", where no compiler works; None where they do not apply: not a bare tree, or a mass
+    matrix that is not positive definite (the symbolic path names the joints)."""
+    from .compiled import BackendUnavailable, CompilerMissing
+    from .functions import _tell_once, compiled_was_expected
     from .recursive import RecursiveDynamics, applicable_tree
+    from .recursive_numpy import RecursiveNumpyDynamics
 
-    if backend not in ("auto", "c"):
+    if backend not in ("auto", "c", "numpy"):
         return None
     tree = applicable_tree(model)
     if tree is None:
         return None
-    try:
-        dynamics = RecursiveDynamics(model, tree, parameters)
-    except BackendUnavailable:
-        if backend == "c":
-            raise
-        return None
+    dynamics = None
+    if backend != "numpy":
+        try:
+            dynamics = RecursiveDynamics(model, tree, parameters)
+        except BackendUnavailable as exc:
+            if backend == "c":
+                raise
+            # the same algorithms in numpy: the expanded equations of a 7-joint arm are too
+            # deep for lambdify, the recursions are not
+            if isinstance(exc, CompilerMissing):
+                _tell_once(f"note: {str(exc).split(' (')[0]}, so the robot's recursive dynamics "
+                           "run in numpy, about 100x slower than compiled C; for the fast path "
+                           + ("unset CC or point it at gcc or clang" if "CC=" in str(exc)
+                              else "install gcc or clang (or set CC)"))
+            elif compiled_was_expected():
+                warnings.warn(f"C backend unavailable, using numpy: {exc}", RuntimeWarning,
+                              stacklevel=2)
+    if dynamics is None:
+        dynamics = RecursiveNumpyDynamics(model, tree, parameters)
     return dynamics if dynamics.regular() else None
 
 

@@ -1,0 +1,374 @@
+"""Recursive rigid-body dynamics of a robot's kinematic tree (model/tree.py) in numpy: the
+fallback of recursive.py's generated C where no C compiler works, or backend "numpy".
+
+The same algorithms over the same tree, each body's quantities an array over a flat batch of
+states (N, 3) or (N, 3, 3), the bodies visited in Python:
+
+- inverse dynamics by recursive Newton-Euler: tau = M(q) a + C(q, q_dot) q_dot + g(q);
+- the mass matrix by the composite-rigid-body algorithm;
+- forward dynamics by M = L L^T (Cholesky, also with mimic joints): q_ddot = M^-1 (tau - b);
+- kinetic energy 1/2 sum (m v.v + 2 v.(w x h) + w.J_O w), potential energy m g height.
+
+Unlike the fully expanded equations (whose lambdified expression trees grow too deep for a
+7-joint arm), the cost grows with the number of bodies (CRBA: with bodies x depth). Units SI;
+gravity g and the actuator parameters tau_<joint> as in recursive.py (b = C q_dot + g - tau_p).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..errors import ModelError
+from ..model.model import Model
+from ..model.tree import KinematicTree
+from ..model.values import resolve_parameters
+
+
+def _cross(a, b):
+    """a x b over the last axis (either may be a constant 3-vector)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack(np.broadcast_arrays(a1 * b2 - a2 * b1, a2 * b0 - a0 * b2,
+                                        a0 * b1 - a1 * b0), axis=-1)
+
+
+def _apply(R, x):
+    """R x."""
+    return (R @ x[..., None])[..., 0]
+
+
+def _apply_transpose(R, x):
+    """R^T x."""
+    return (x[..., None, :] @ R)[..., 0, :]
+
+
+def _dot(a, b):
+    return (a * b).sum(axis=-1)
+
+
+def _skew(u) -> np.ndarray:
+    """[u]x, with [u]x x = u x x."""
+    return np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
+
+
+class _Joint:
+    """One joint's constants as arrays."""
+
+    def __init__(self, joint):
+        self.parent = joint.parent
+        self.revolute = joint.kind == "revolute"
+        self.coordinate = joint.coordinate
+        self.multiplier = joint.multiplier
+        self.offset = joint.offset
+        self.R0 = np.array(joint.rotation, dtype=float)
+        self.t0 = np.array(joint.translation, dtype=float)
+        self.u = np.array(joint.axis, dtype=float)
+        self.uu = np.outer(self.u, self.u)
+        self.K = _skew(self.u)
+        self.slide = self.R0 @ self.u  # a prismatic joint's axis in its parent
+        self.m = float(joint.mass)
+        self.h = np.array(joint.first_moment, dtype=float)
+        self.J = np.array(joint.inertia, dtype=float)
+
+
+class RecursiveNumpyDynamics:
+    """Recursive dynamics of a tree in numpy, batched over leading axes (SI units).
+
+    Every input is (..., n) (or (n,), broadcast against the others); outputs keep the batch
+    shape. Same interface as recursive.RecursiveDynamics.
+    """
+
+    backend = "recursive-numpy"
+
+    def __init__(self, model: Model, tree: KinematicTree,
+                 parameters: Mapping[str, float] | None = None):
+        names = tuple(p.name for p in model.parameters)
+        values = resolve_parameters(model, parameters)
+        self.model = model
+        self.tree = tree
+        self.coordinates = tree.coordinates
+        self.n = len(tree.coordinates)
+        self.parameters = {name: float(v) for name, v in zip(names, values.values, strict=True)}
+        missing = [name for name in (tree.gravity_parameter, *tree.actuators)
+                   if name not in self.parameters]
+        if missing:
+            raise ModelError(f"the tree's parameters {missing} are not the model's")
+        self._g = self.parameters[tree.gravity_parameter]
+        self._actuators = np.array([self.parameters[a] for a in tree.actuators], dtype=float)
+        # the ground accelerates up by g: every body feels gravity (Newton-Euler's trick)
+        self._up = -self._g * np.array(tree.gravity_direction, dtype=float)
+        self._joints = [_Joint(j) for j in tree.joints]
+
+    def __repr__(self) -> str:
+        return f"RecursiveNumpyDynamics(coordinates={list(self.coordinates)})"
+
+    # -- inputs ------------------------------------------------------------------------------
+
+    def _flat(self, arrays, fields):
+        """(N, n) float arrays broadcast against each other, and the batch shape."""
+        out = []
+        for value, field in zip(arrays, fields, strict=True):
+            array = np.asarray(value, dtype=float)
+            if array.ndim == 0 or array.shape[-1] != self.n:
+                shape = "()" if array.ndim == 0 else str(array.shape)
+                raise ModelError(f"expected {self.n} values ({', '.join(self.coordinates)}) "
+                                 f"along the last axis, got shape {shape}", field=field)
+            out.append(array)
+        batch = np.broadcast_shapes(*(x.shape[:-1] for x in out))
+        count = int(np.prod(batch, dtype=np.int64))
+        return [np.broadcast_to(x, batch + (self.n,)).reshape(count, self.n) for x in out], batch
+
+    # -- the recursions on flat batches --------------------------------------------------------
+
+    def _kinematics(self, Q):
+        """Each body's rotation R (body -> parent axes, (N, 3, 3) or constant) and origin p in
+        its parent ((N, 3) or constant)."""
+        placements = []
+        for j in self._joints:
+            theta = j.multiplier * Q[:, j.coordinate] + j.offset
+            if j.revolute:
+                c, s = np.cos(theta)[:, None, None], np.sin(theta)[:, None, None]
+                # Rot(u, theta) = c 1 + s [u]x + (1 - c) u u^T
+                turn = j.uu + c * (np.eye(3) - j.uu) + s * j.K
+                placements.append((j.R0 @ turn, j.t0))
+            else:
+                placements.append((j.R0, j.t0 + theta[:, None] * j.slide))
+        return placements
+
+    def _newton_euler(self, Q, V, A):
+        """tau (N, n) for q, q_dot, q_ddot, minus the actuator parameters (V, A None: zero)."""
+        count = len(Q)
+        placements = self._kinematics(Q)
+        zero = np.zeros((count, 3))
+        w, dw, acc, f, n = [], [], [], [], []
+        for i, j in enumerate(self._joints):
+            R, p = placements[i]
+            if j.parent < 0:
+                wl, dwl, al = zero, zero, np.broadcast_to(self._up, (count, 3))
+            else:
+                wl, dwl, al = w[j.parent], dw[j.parent], acc[j.parent]
+            w_in = _apply_transpose(R, wl)
+            dw_in = _apply_transpose(R, dwl)
+            a_i = _apply_transpose(R, al + _cross(dwl, p) + _cross(wl, _cross(wl, p)))
+            rate = zero if V is None else (j.multiplier * V[:, j.coordinate])[:, None] * j.u
+            accel = zero if A is None else (j.multiplier * A[:, j.coordinate])[:, None] * j.u
+            if j.revolute:
+                w_i = w_in + rate
+                dw_i = dw_in + _cross(w_in, rate) + accel
+            else:
+                w_i, dw_i = w_in, dw_in
+                a_i = a_i + 2.0 * _cross(w_i, rate) + accel
+            w.append(w_i)
+            dw.append(dw_i)
+            acc.append(a_i)
+            # about the body's origin: f = m a + dw x h + w x (w x h), n = J dw + w x J w + h x a
+            f.append(j.m * a_i + _cross(dw_i, j.h) + _cross(w_i, _cross(w_i, j.h)))
+            n.append(_apply(j.J, dw_i) + _cross(w_i, _apply(j.J, w_i)) + _cross(j.h, a_i))
+        tau = np.zeros((count, self.n))
+        for i in reversed(range(len(self._joints))):
+            j = self._joints[i]
+            tau[:, j.coordinate] += j.multiplier * _dot(j.u, n[i] if j.revolute else f[i])
+            if j.parent >= 0:
+                R, p = placements[i]
+                force = _apply(R, f[i])
+                f[j.parent] = f[j.parent] + force
+                n[j.parent] = n[j.parent] + _apply(R, n[i]) + _cross(p, force)
+        return tau - self._actuators
+
+    def _composite_rigid_body(self, Q):
+        """M (N, n, n) by the composite-rigid-body algorithm."""
+        count = len(Q)
+        placements = self._kinematics(Q)
+        joints = self._joints
+        mass = [j.m for j in joints]
+        h = [j.h for j in joints]
+        J = [j.J for j in joints]
+        M = np.zeros((count, self.n, self.n))
+        eye = np.eye(3)
+        for i in reversed(range(len(joints))):
+            j = joints[i]
+            if j.revolute:  # unit rate about u: f = u x h, n = J u
+                force, moment = _cross(j.u, h[i]), _apply(J[i], j.u)
+            else:  # unit rate along u: f = m u, n = h x u
+                force, moment = mass[i] * j.u, _cross(h[i], j.u)
+            force = np.broadcast_to(force, (count, 3))
+            moment = np.broadcast_to(moment, (count, 3))
+            ci, ki = j.coordinate, j.multiplier
+            M[:, ci, ci] += ki * ki * _dot(j.u, moment if j.revolute else force)
+            k = i
+            while joints[k].parent >= 0:
+                R, p = placements[k]
+                force = _apply(R, force)
+                moment = _apply(R, moment) + _cross(p, force)
+                k = joints[k].parent
+                ancestor = joints[k]
+                entry = ki * ancestor.multiplier * _dot(
+                    ancestor.u, moment if ancestor.revolute else force)
+                M[:, ci, ancestor.coordinate] += entry
+                M[:, ancestor.coordinate, ci] += entry
+            if j.parent >= 0:  # the composite inertia of body i, moved into its parent's axes
+                R, p = placements[i]
+                hr = _apply(R, h[i])
+                p = np.broadcast_to(p, (count, 3))
+                ph, pp = _dot(p, hr)[:, None, None], _dot(p, p)[:, None, None]
+                outer = p[:, :, None] * hr[..., None, :]
+                # J' = R J R^T + m (|p|^2 1 - p p^T) + 2 (p.h) 1 - p h^T - h p^T
+                shifted = (R @ J[i] @ np.swapaxes(R, -1, -2)
+                           + mass[i] * (pp * eye - p[:, :, None] * p[:, None, :])
+                           + 2.0 * ph * eye - outer - np.swapaxes(outer, -1, -2))
+                J[j.parent] = J[j.parent] + shifted
+                h[j.parent] = h[j.parent] + hr + mass[i] * p
+                mass[j.parent] = mass[j.parent] + mass[i]
+        return M
+
+    def _velocities(self, Q, V):
+        placements = self._kinematics(Q)
+        zero = np.zeros((len(Q), 3))
+        w, vel = [], []
+        for i, j in enumerate(self._joints):
+            R, p = placements[i]
+            wl, vl = (zero, zero) if j.parent < 0 else (w[j.parent], vel[j.parent])
+            rate = (j.multiplier * V[:, j.coordinate])[:, None] * j.u
+            w_i = _apply_transpose(R, wl)
+            v_i = _apply_transpose(R, vl + _cross(wl, p))
+            if j.revolute:
+                w_i = w_i + rate
+            else:
+                v_i = v_i + rate
+            w.append(w_i)
+            vel.append(v_i)
+        return w, vel
+
+    def _kinetic(self, Q, V):
+        w, vel = self._velocities(Q, V)
+        total = np.zeros(len(Q))
+        for j, w_i, v_i in zip(self._joints, w, vel, strict=True):
+            total += (j.m * _dot(v_i, v_i) + 2.0 * _dot(v_i, _cross(w_i, j.h))
+                      + _dot(w_i, _apply(j.J, w_i)))
+        return 0.5 * total
+
+    def _potential(self, Q):
+        placements = self._kinematics(Q)
+        count = len(Q)
+        up_world = np.broadcast_to(-np.array(self.tree.gravity_direction, dtype=float),
+                                   (count, 3))
+        up, height = [], []
+        total = np.zeros(count)
+        for i, j in enumerate(self._joints):
+            R, p = placements[i]
+            up_l, height_l = (up_world, 0.0) if j.parent < 0 else (up[j.parent],
+                                                                   height[j.parent])
+            up.append(_apply_transpose(R, up_l))
+            height.append(height_l + _dot(up_l, p))
+            total += j.m * height[i] + _dot(up[i], j.h)
+        return self._g * total
+
+    def _forward(self, Q, V, TAU):
+        """q_ddot = M^-1 (tau - b) by Cholesky; LinAlgError where M is not positive definite."""
+        mass = self._composite_rigid_body(Q)
+        rhs = TAU - self._newton_euler(Q, V, None)
+        try:
+            L = np.linalg.cholesky(mass)
+        except np.linalg.LinAlgError:
+            bad = next(k for k in range(len(mass)) if not _positive_definite(mass[k]))
+            raise np.linalg.LinAlgError(
+                f"the mass matrix is not positive definite (state {bad})") from None
+        y = np.linalg.solve(L, rhs[..., None])
+        return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
+
+    # -- the public functions --------------------------------------------------------------------
+
+    def regular(self) -> bool:
+        """Whether M is positive definite at a few random states (a massless branch is not)."""
+        rng = np.random.default_rng(0)
+        return all(_positive_definite(m)
+                   for m in self.mass_matrix(rng.uniform(-np.pi, np.pi, (3, self.n))))
+
+    def mass_matrix(self, q):
+        """M(q), shape (..., n, n)."""
+        (Q,), batch = self._flat((q,), ("q",))
+        return self._composite_rigid_body(Q).reshape(batch + (self.n, self.n))
+
+    def bias_forces(self, q, v):
+        """C(q, q_dot) q_dot + g(q), shape (..., n)."""
+        (Q, V), batch = self._flat((q, v), ("q", "v"))
+        return self._newton_euler(Q, V, None).reshape(batch + (self.n,))
+
+    def gravity(self, q):
+        """g(q), shape (..., n)."""
+        (Q,), batch = self._flat((q,), ("q",))
+        return self._newton_euler(Q, None, None).reshape(batch + (self.n,))
+
+    def inverse_dynamics(self, q, v, a):
+        """tau = M a + C q_dot + g, shape (..., n)."""
+        (Q, V, A), batch = self._flat((q, v, a), ("q", "v", "a"))
+        return self._newton_euler(Q, V, A).reshape(batch + (self.n,))
+
+    def forward_dynamics(self, q, v, tau):
+        """q_ddot = M^-1 (tau - C q_dot - g), shape (..., n)."""
+        (Q, V, TAU), batch = self._flat((q, v, tau), ("q", "v", "tau"))
+        return self._forward(Q, V, TAU).reshape(batch + (self.n,))
+
+    def kinetic_energy(self, q, v):
+        """T in J, shape (...)."""
+        (Q, V), batch = self._flat((q, v), ("q", "v"))
+        return self._kinetic(Q, V).reshape(batch)
+
+    def potential_energy(self, q):
+        """V in J, shape (...)."""
+        (Q,), batch = self._flat((q,), ("q",))
+        return self._potential(Q).reshape(batch)
+
+    def numeric_system(self):
+        """The NumericSystem over these functions (M, f = -b, energy, accelerations, rhs), as
+        the symbolic path gives it; simulation uses it."""
+        from .functions import NumericSystem
+
+        return NumericSystem(coordinates=self.coordinates, constraint_names=(),
+                             constraint_kinds=(), parameters=dict(self.parameters),
+                             _kernel=_TreeKernel(self))
+
+
+def _positive_definite(matrix) -> bool:
+    try:
+        np.linalg.cholesky(matrix)
+    except np.linalg.LinAlgError:
+        return False
+    return True
+
+
+class _TreeKernel:
+    """NumericSystem's kernel over the numpy recursions (no constraints: m = 0)."""
+
+    backend = "numpy"
+
+    def __init__(self, dynamics: RecursiveNumpyDynamics):
+        self.dynamics = dynamics
+        self.n = dynamics.n
+
+    def parts(self, Q, V, T):
+        d, count = self.dynamics, len(Q)
+        return (d._composite_rigid_body(Q), -d._newton_euler(Q, V, None),
+                np.zeros((count, 0, self.n)), np.zeros((count, 0)))
+
+    def residual(self, Q, V, T):
+        return np.zeros((len(Q), 0))
+
+    def energy(self, Q, V, T):
+        return self.dynamics._kinetic(Q, V) + self.dynamics._potential(Q)
+
+    def accelerations(self, Q, V, T):
+        return self.dynamics._forward(Q, V, np.zeros_like(Q)), np.zeros((len(Q), 0))
+
+    def rhs(self, t, y):
+        y = np.asarray(y, dtype=float)
+        n = self.n
+        if y.shape != (2 * n,):
+            raise ValueError(f"y must hold {2 * n} numbers [q, q_dot]")
+        q, v = y[None, :n], y[None, n:]
+        return np.concatenate([y[n:], self.dynamics._forward(q, v, np.zeros_like(q))[0]])
+
+
+__all__ = ["RecursiveNumpyDynamics"]

@@ -3,6 +3,8 @@ dynamics and energies of URDF arms at random states."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -40,12 +42,22 @@ ARM = """<?xml version="1.0"?>
 """
 
 
+def _dynamics(system, backend):
+    if backend == "symbolic":  # the derived equations, lambdified
+        from lagrangian.numerics.dynamics import Dynamics
+        from lagrangian.numerics.functions import numeric
+
+        return Dynamics(numeric(system.equations_of_motion(), backend="numpy"))
+    return system.dynamics(backend=backend)
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("backend", ["numpy", "auto"])  # derived equations; recursive C
+# derived equations; recursive numpy; recursive C (numpy without a compiler)
+@pytest.mark.parametrize("backend", ["symbolic", "numpy", "auto"])
 def test_spatial_arm_matches_pinocchio(tmp_path, backend):
     path = tmp_path / "spatial.urdf"
     path.write_text(ARM)
-    f = lagrangian.load(path).dynamics(backend=backend)
+    f = _dynamics(lagrangian.load(path), backend)
     model = pin.buildModelFromXML(ARM)
     data = model.createData()
     assert model.nq == f.n == 3
@@ -70,3 +82,53 @@ def test_spatial_arm_matches_pinocchio(tmp_path, backend):
                                            rel=1e-9)
         assert potential[k] == pytest.approx(pin.computePotentialEnergy(model, data, q[k]),
                                              rel=1e-9, abs=1e-12)
+
+
+def _robots() -> Path:
+    for parent in Path(pin.__file__).resolve().parents:
+        candidate = parent / "share/example-robot-data/robots"
+        if candidate.is_dir():
+            return candidate
+    pytest.skip("example-robot-data is not installed")
+
+
+@pytest.mark.slow
+def test_panda_numpy_fallback_matches_pinocchio(monkeypatch, tmp_path):
+    """The Panda (fingers locked, 7-DOF) where no compiler works: the recursions in numpy (the
+    expanded equations are too deep for lambdify), against Pinocchio's reduced model."""
+    from lagrangian.numerics import compiled
+    from lagrangian.numerics.recursive_numpy import RecursiveNumpyDynamics
+
+    monkeypatch.setenv("CC", "/nonexistent/cc")
+    monkeypatch.setenv("LAGRANGIAN_CACHE", str(tmp_path))
+    monkeypatch.setattr(compiled, "_LOADED", {})
+    path = _robots() / "panda_description/urdf/panda.urdf"
+    lock = {"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}
+    f = lagrangian.load(path, lock=lock).dynamics()
+    assert isinstance(f, RecursiveNumpyDynamics)
+    model = pin.buildModelFromUrdf(str(path))
+    model = pin.buildReducedModel(model, [model.getJointId(j) for j in lock], pin.neutral(model))
+    data = model.createData()
+    assert model.nq == f.n == 7
+    rng = np.random.default_rng(0)
+    q = rng.uniform(np.maximum(model.lowerPositionLimit, -3),
+                    np.minimum(model.upperPositionLimit, 3), (8, 7))
+    v, a, tau = (rng.uniform(-2, 2, (8, 7)) for _ in range(3))
+    mass, bias, gravity = f.mass_matrix(q), f.bias_forces(q, v), f.gravity(q)
+    inverse, forward = f.inverse_dynamics(q, v, a), f.forward_dynamics(q, v, tau)
+    kinetic, potential = f.kinetic_energy(q, v), f.potential_energy(q)
+
+    def close(ours, theirs):
+        np.testing.assert_allclose(ours, theirs, rtol=1e-9, atol=1e-9 * np.abs(theirs).max())
+
+    for k in range(len(q)):
+        m = pin.crba(model, data, q[k]).copy()
+        close(mass[k], np.triu(m) + np.triu(m, 1).T)
+        close(bias[k], pin.rnea(model, data, q[k], v[k], np.zeros(7)))
+        close(gravity[k], pin.computeGeneralizedGravity(model, data, q[k]))
+        close(inverse[k], pin.rnea(model, data, q[k], v[k], a[k]))
+        close(forward[k], pin.aba(model, data, q[k], v[k], tau[k]))
+        assert kinetic[k] == pytest.approx(pin.computeKineticEnergy(model, data, q[k], v[k]),
+                                           rel=1e-9)
+        assert potential[k] == pytest.approx(pin.computePotentialEnergy(model, data, q[k]),
+                                             rel=1e-9, abs=1e-9)

@@ -27,11 +27,15 @@ from ..model.values import resolve_parameters
 
 
 def _cross(a, b):
-    """a x b over the last axis (either may be a constant 3-vector)."""
+    """a x b over the last axis (either may be a constant 3-vector); where one factor is a
+    constant, [a]x b by a matrix made once is cheaper (numpy's cost is per call here)."""
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack(np.broadcast_arrays(a1 * b2 - a2 * b1, a2 * b0 - a0 * b2,
-                                        a0 * b1 - a1 * b0), axis=-1)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a1 * b2 - a2 * b1
+    out[..., 1] = a2 * b0 - a0 * b2
+    out[..., 2] = a0 * b1 - a1 * b0
+    return out
 
 
 def _apply(R, x):
@@ -46,6 +50,14 @@ def _apply_transpose(R, x):
 
 def _dot(a, b):
     return (a * b).sum(axis=-1)
+
+
+def _skew_batch(p) -> np.ndarray:
+    """[p]x for each row of p (N, 3)."""
+    out = np.zeros(p.shape[:-1] + (3, 3))
+    out[..., 0, 1], out[..., 0, 2], out[..., 1, 2] = -p[..., 2], p[..., 1], -p[..., 0]
+    out[..., 1, 0], out[..., 2, 0], out[..., 2, 1] = p[..., 2], -p[..., 1], p[..., 0]
+    return out
 
 
 def _skew(u) -> np.ndarray:
@@ -70,6 +82,8 @@ class _Joint:
         self.slide = self.R0 @ self.u  # a prismatic joint's axis in its parent
         self.m = float(joint.mass)
         self.h = np.array(joint.first_moment, dtype=float)
+        self.H = _skew(self.h)
+        self.P0 = _skew(self.t0)  # [p]x of a revolute joint's fixed origin
         self.J = np.array(joint.inertia, dtype=float)
 
 
@@ -123,8 +137,8 @@ class RecursiveNumpyDynamics:
     # -- the recursions on flat batches --------------------------------------------------------
 
     def _kinematics(self, Q):
-        """Each body's rotation R (body -> parent axes, (N, 3, 3) or constant) and origin p in
-        its parent ((N, 3) or constant)."""
+        """Each body's rotation R (body -> parent axes, (N, 3, 3) or constant), origin p in
+        its parent ((N, 3) or constant) and [p]x (p x y = [p]x y, y x p = [p]x^T y)."""
         placements = []
         for j in self._joints:
             theta = j.multiplier * Q[:, j.coordinate] + j.offset
@@ -132,9 +146,10 @@ class RecursiveNumpyDynamics:
                 c, s = np.cos(theta)[:, None, None], np.sin(theta)[:, None, None]
                 # Rot(u, theta) = c 1 + s [u]x + (1 - c) u u^T
                 turn = j.uu + c * (np.eye(3) - j.uu) + s * j.K
-                placements.append((j.R0 @ turn, j.t0))
+                placements.append((j.R0 @ turn, j.t0, j.P0))
             else:
-                placements.append((j.R0, j.t0 + theta[:, None] * j.slide))
+                p = j.t0 + theta[:, None] * j.slide
+                placements.append((j.R0, p, _skew_batch(p)))
         return placements
 
     def _newton_euler(self, Q, V, A):
@@ -144,37 +159,47 @@ class RecursiveNumpyDynamics:
         zero = np.zeros((count, 3))
         w, dw, acc, f, n = [], [], [], [], []
         for i, j in enumerate(self._joints):
-            R, p = placements[i]
-            if j.parent < 0:
-                wl, dwl, al = zero, zero, np.broadcast_to(self._up, (count, 3))
+            R, p, P = placements[i]
+            if j.parent < 0:  # the ground: at rest, accelerating up by g
+                w_in = dw_in = zero
+                a_i = _apply_transpose(R, np.broadcast_to(self._up, (count, 3)))
             else:
                 wl, dwl, al = w[j.parent], dw[j.parent], acc[j.parent]
-            w_in = _apply_transpose(R, wl)
-            dw_in = _apply_transpose(R, dwl)
-            a_i = _apply_transpose(R, al + _cross(dwl, p) + _cross(wl, _cross(wl, p)))
-            rate = zero if V is None else (j.multiplier * V[:, j.coordinate])[:, None] * j.u
-            accel = zero if A is None else (j.multiplier * A[:, j.coordinate])[:, None] * j.u
+                w_in = _apply_transpose(R, wl)
+                dw_in = _apply_transpose(R, dwl)
+                # a + dw x p + w x (w x p), with y x p = [p]x^T y
+                a_i = _apply_transpose(R, al + _apply_transpose(P, dwl)
+                                       + _cross(wl, _apply_transpose(P, wl)))
+            rate = None if V is None else j.multiplier * V[:, j.coordinate, None]
+            w_i, dw_i = w_in, dw_in
             if j.revolute:
-                w_i = w_in + rate
-                dw_i = dw_in + _cross(w_in, rate) + accel
-            else:
-                w_i, dw_i = w_in, dw_in
-                a_i = a_i + 2.0 * _cross(w_i, rate) + accel
+                if rate is not None:
+                    w_i = w_in + rate * j.u
+                    dw_i = dw_in - rate * _apply(j.K, w_in)  # + w_in x (rate u)
+            elif rate is not None:
+                a_i = a_i - 2.0 * rate * _apply(j.K, w_i)  # + 2 w x (rate u)
+            if A is not None:
+                accel = j.multiplier * A[:, j.coordinate, None] * j.u
+                if j.revolute:
+                    dw_i = dw_i + accel
+                else:
+                    a_i = a_i + accel
             w.append(w_i)
             dw.append(dw_i)
             acc.append(a_i)
             # about the body's origin: f = m a + dw x h + w x (w x h), n = J dw + w x J w + h x a
-            f.append(j.m * a_i + _cross(dw_i, j.h) + _cross(w_i, _cross(w_i, j.h)))
-            n.append(_apply(j.J, dw_i) + _cross(w_i, _apply(j.J, w_i)) + _cross(j.h, a_i))
+            Jw = _apply(j.J, w_i)
+            f.append(j.m * a_i - _apply(j.H, dw_i) - _cross(w_i, _apply(j.H, w_i)))
+            n.append(_apply(j.J, dw_i) + _cross(w_i, Jw) + _apply(j.H, a_i))
         tau = np.zeros((count, self.n))
         for i in reversed(range(len(self._joints))):
             j = self._joints[i]
-            tau[:, j.coordinate] += j.multiplier * _dot(j.u, n[i] if j.revolute else f[i])
+            tau[:, j.coordinate] += j.multiplier * (n[i] if j.revolute else f[i]) @ j.u
             if j.parent >= 0:
-                R, p = placements[i]
+                R, p, P = placements[i]
                 force = _apply(R, f[i])
                 f[j.parent] = f[j.parent] + force
-                n[j.parent] = n[j.parent] + _apply(R, n[i]) + _cross(p, force)
+                n[j.parent] = n[j.parent] + _apply(R, n[i]) + _apply(P, force)
         return tau - self._actuators
 
     def _composite_rigid_body(self, Q):
@@ -196,20 +221,20 @@ class RecursiveNumpyDynamics:
             force = np.broadcast_to(force, (count, 3))
             moment = np.broadcast_to(moment, (count, 3))
             ci, ki = j.coordinate, j.multiplier
-            M[:, ci, ci] += ki * ki * _dot(j.u, moment if j.revolute else force)
+            M[:, ci, ci] += ki * ki * ((moment if j.revolute else force) @ j.u)
             k = i
             while joints[k].parent >= 0:
-                R, p = placements[k]
+                R, p, P = placements[k]
                 force = _apply(R, force)
-                moment = _apply(R, moment) + _cross(p, force)
+                moment = _apply(R, moment) + _apply(P, force)
                 k = joints[k].parent
                 ancestor = joints[k]
-                entry = ki * ancestor.multiplier * _dot(
-                    ancestor.u, moment if ancestor.revolute else force)
+                entry = ki * ancestor.multiplier * (
+                    (moment if ancestor.revolute else force) @ ancestor.u)
                 M[:, ci, ancestor.coordinate] += entry
                 M[:, ancestor.coordinate, ci] += entry
             if j.parent >= 0:  # the composite inertia of body i, moved into its parent's axes
-                R, p = placements[i]
+                R, p, _ = placements[i]
                 hr = _apply(R, h[i])
                 p = np.broadcast_to(p, (count, 3))
                 ph, pp = _dot(p, hr)[:, None, None], _dot(p, p)[:, None, None]
@@ -228,11 +253,11 @@ class RecursiveNumpyDynamics:
         zero = np.zeros((len(Q), 3))
         w, vel = [], []
         for i, j in enumerate(self._joints):
-            R, p = placements[i]
+            R, p, P = placements[i]
             wl, vl = (zero, zero) if j.parent < 0 else (w[j.parent], vel[j.parent])
             rate = (j.multiplier * V[:, j.coordinate])[:, None] * j.u
             w_i = _apply_transpose(R, wl)
-            v_i = _apply_transpose(R, vl + _cross(wl, p))
+            v_i = _apply_transpose(R, vl + _apply_transpose(P, wl))
             if j.revolute:
                 w_i = w_i + rate
             else:
@@ -245,7 +270,7 @@ class RecursiveNumpyDynamics:
         w, vel = self._velocities(Q, V)
         total = np.zeros(len(Q))
         for j, w_i, v_i in zip(self._joints, w, vel, strict=True):
-            total += (j.m * _dot(v_i, v_i) + 2.0 * _dot(v_i, _cross(w_i, j.h))
+            total += (j.m * _dot(v_i, v_i) - 2.0 * _dot(v_i, _apply(j.H, w_i))
                       + _dot(w_i, _apply(j.J, w_i)))
         return 0.5 * total
 
@@ -257,7 +282,7 @@ class RecursiveNumpyDynamics:
         up, height = [], []
         total = np.zeros(count)
         for i, j in enumerate(self._joints):
-            R, p = placements[i]
+            R, p, _ = placements[i]
             up_l, height_l = (up_world, 0.0) if j.parent < 0 else (up[j.parent],
                                                                    height[j.parent])
             up.append(_apply_transpose(R, up_l))

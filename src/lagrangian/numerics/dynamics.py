@@ -126,7 +126,7 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
             # deep for lambdify, the recursions are not
             if isinstance(exc, CompilerMissing):
                 _tell_once(f"note: {str(exc).split(' (')[0]}, so the robot's recursive dynamics "
-                           "run in numpy, about 100x slower than compiled C; for the fast path "
+                           "run in numpy, about 1000x slower per call than compiled C; for the fast path "
                            + ("unset CC or point it at gcc or clang" if "CC=" in str(exc)
                               else "install gcc or clang (or set CC)"))
             elif compiled_was_expected():

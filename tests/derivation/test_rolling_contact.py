@@ -204,3 +204,9 @@ def _positions(text):
     for line in text.split("\n"):
         yield position, line
         position += len(line) + 1
+
+
+def test_newton_euler_crosscheck_agrees_on_the_coin_from_the_contacts_key(cli):
+    code, out, err = cli("crosscheck", "rolling_coin")
+    assert code == 0, err
+    assert out.rstrip().endswith("agree")

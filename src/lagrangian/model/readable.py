@@ -389,7 +389,7 @@ def _pull_common(terms: list[sp.Expr], keep: frozenset = frozenset()) -> sp.Expr
     for base, exponent in powers[0].items():
         if base.is_Number or base in keep or not (exponent.is_Integer and exponent > 0):
             continue
-        shared = [sp.sympify(p.get(base, 0)) for p in powers]
+        shared = [p.get(base, sp.S.Zero) for p in powers]
         if all(e.is_Integer and e > 0 for e in shared):
             common[base] = min(shared)
     scale = sp.S.One

@@ -42,6 +42,9 @@ MEANINGS = {
                    "b\"` (= 0)",
     "contacts": "a wheel rolling without slipping on the ground: `body`, `radius`, `axle` (body "
                 "axes); the ground `normal` (default against gravity)",
+    "steady": "the steady motion `speeds` linearizes about by default: `speed` a parameter "
+              "(m/s), `rates = { x_dot = \"v\" }` in the parameters, `keep` the coordinates "
+              "whose equations stay, `about` coordinate values",
 }
 
 
@@ -54,7 +57,7 @@ def table() -> str:
     lines = ["| table | required keys | optional keys | meaning |", "|---|---|---|---|"]
     for name, (required, optional) in model_file_schema().items():
         shown = "(top level)" if not name else f"`[{name}]`" if "<" in name else (
-            f"`[[{name}]]`" if name not in ("energy", "gravity") else f"`[{name}]`")
+            f"`[[{name}]]`" if name not in ("energy", "gravity", "steady") else f"`[{name}]`")
         lines.append(f"| {shown} | {_keys(required)} | {_keys(optional)} | "
                      f"{MEANINGS.get(name, '**undocumented**')} |")
     return "\n".join(lines) + "\n"

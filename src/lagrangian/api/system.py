@@ -245,20 +245,45 @@ class System:
         require_inertia(self.equations_of_motion(), "modes")
         return modal_analysis(self.linearize(about, steady=steady), self._model.name)
 
-    def speed_form(self, steady: Mapping[str, float | str], speed: str, keep: Sequence[str],
+    def speed_form(self, steady: Mapping[str, float | str] | None = None,
+                   speed: str | None = None, keep: Sequence[str] | None = None,
                    *, about: Mapping[str, float] | None = None) -> SpeedForm:
         """The reduced linear equations of the ``keep`` coordinates about steady motion at the
         speed parameter ``speed``, in the form M q'' + v C1 q' + (g K0 + v^2 K2) q = f
         (analysis/speed_form.py); ``steady`` gives each steady rate as an expression in the
-        parameters, e.g. {"x_dot": "v", "thetaR_dot": "-v/rR", "thetaF_dot": "-v/rF"}."""
+        parameters, e.g. {"x_dot": "v", "thetaR_dot": "-v/rR", "thetaF_dot": "-v/rF"}. What is
+        not given comes from the model's [steady] table."""
+        steady, speed, keep, about = self._steady_motion(steady, speed, keep, about)
         return speed_form(self.equations_of_motion(), about, steady, speed, keep)
 
-    def speed_sweep(self, steady: Mapping[str, float | str], speed: str, keep: Sequence[str],
-                    speeds: Sequence[float], *, about: Mapping[str, float] | None = None,
-                    ) -> SpeedSweep:
-        """Eigenvalues (1/s) of the reduced equations at each speed, and the speeds where their
-        real parts cross zero (a bicycle's weave and capsize speeds) with the stable range."""
+    def speed_sweep(self, steady: Mapping[str, float | str] | None = None,
+                    speed: str | None = None, keep: Sequence[str] | None = None,
+                    speeds: Sequence[float] | None = None, *,
+                    about: Mapping[str, float] | None = None) -> SpeedSweep:
+        """Eigenvalues (1/s) of the reduced equations at each speed (m/s; default 0 to 10 in
+        steps of 0.1), and the speeds where their real parts cross zero (a bicycle's weave and
+        capsize speeds) with the stable range."""
+        if speeds is None:
+            speeds = [i / 10 for i in range(101)]
         return speed_sweep(self.speed_form(steady, speed, keep, about=about), speeds)
+
+    def _steady_motion(self, steady, speed, keep, about):
+        """The steady motion asked for, each part not given taken from the model's [steady]."""
+        default = self._model.steady_motion
+        if default is None and (steady is None or speed is None or keep is None):
+            missing = [n for n, v in (("steady", steady), ("speed", speed), ("keep", keep))
+                       if v is None][0]
+            from ..errors import ModelError
+
+            raise ModelError("give the steady rates, the speed parameter and the kept "
+                             "coordinates, or a [steady] table in the model file",
+                             field=missing)
+        if default is not None:
+            steady = dict(default.rates) if steady is None else steady
+            speed = default.speed if speed is None else speed
+            keep = list(default.keep) if keep is None else keep
+            about = (dict(default.about) or None) if about is None else about
+        return steady, speed, keep, about
 
     # -- parameter studies and ensembles (Dask; see docs/sweeps.md) -------------------------------
 

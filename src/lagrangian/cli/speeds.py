@@ -12,8 +12,10 @@ from . import app
 from .common import LOCK_HELP, SET_HELP, assignments, comma_separated, load_system, print_json
 
 STEADY_HELP = ("A steady rate, NAME_dot=EXPRESSION in the parameters (x_dot=v, "
-               "thetaR_dot=-v/rR); repeat or join with commas.")
-KEEP_HELP = "The coordinates whose equations are kept (phi,delta); the rest are eliminated."
+               "thetaR_dot=-v/rR); repeat or join with commas. Default: the model's [steady] "
+               "table.")
+KEEP_HELP = ("The coordinates whose equations are kept (phi,delta); the rest are eliminated. "
+             "Default: the model's [steady] table.")
 
 
 def steady_settings(settings: list[str], option: str = "--steady") -> dict[str, str]:
@@ -25,10 +27,11 @@ def steady_settings(settings: list[str], option: str = "--steady") -> dict[str, 
 @app.command()
 def speeds(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
-    speed: Annotated[str, typer.Option("--speed", help="The parameter that is the forward "
-                                       "speed (m/s), e.g. v.")],
-    steady: Annotated[list[str], typer.Option("--steady", help=STEADY_HELP)],
-    keep: Annotated[list[str], typer.Option("--keep", help=KEEP_HELP)],
+    speed: Annotated[str | None, typer.Option("--speed", help="The parameter that is the "
+                                              "forward speed (m/s), e.g. v. Default: the "
+                                              "model's [steady] table.")] = None,
+    steady: Annotated[list[str], typer.Option("--steady", help=STEADY_HELP)] = [],  # noqa: B006
+    keep: Annotated[list[str], typer.Option("--keep", help=KEEP_HELP)] = [],  # noqa: B006
     about: Annotated[list[str], typer.Option("--about", help="Configuration of the steady "
                                              "motion, COORDINATE=VALUE (the rest solved for).")
                      ] = [],  # noqa: B006
@@ -58,7 +61,8 @@ def speeds(
                          field="--points")
     point = state_assignments(system, about, "--about")
     kept = [name.strip() for setting in keep for name in setting.split(",") if name.strip()]
-    form = system.speed_form(steady_settings(steady), speed, kept, about=point or None)
+    form = system.speed_form(steady_settings(steady) or None, speed, kept or None,
+                             about=point or None)
     import numpy as np
 
     from ..analysis.speed_form import speed_sweep

@@ -9,7 +9,7 @@ from __future__ import annotations
 import keyword
 import math
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 
 import sympy as sp
 
@@ -36,6 +36,7 @@ from .model import (
     Particle,
     PointForce,
     Spring,
+    SteadyMotion,
     Torque,
     Vector,
     acceleration_name,
@@ -75,6 +76,7 @@ class ModelBuilder:
         self._generalized: dict[str, list[sp.Expr]] = {}
         self._constraints: list[Constraint] = []
         self._contacts: list[RollingContact] = []
+        self._steady_motion: SteadyMotion | None = None
         self._component_names: set[str] = set()
         # Every vector given, in order: (field, components, what it places: "particle", "body"
         # or None). The first particle or body position fixes the model's dimension; every
@@ -652,6 +654,48 @@ class ModelBuilder:
                 )
         return value
 
+    def set_steady_motion(self, speed: str, rates: Mapping[str, object], keep: Sequence[str],
+                          about: Mapping[str, object] | None = None,
+                          field: str = "steady") -> ModelBuilder:
+        """The steady motion the model is studied about by default: ``speed`` a parameter (m/s),
+        ``rates`` NAME_dot -> a number or expression in the parameters, ``keep`` the coordinates
+        whose equations are kept, ``about`` coordinate values (the rest solved for)."""
+        parameters = [p.name for p in self._parameters]
+        if not isinstance(speed, str) or speed not in parameters:
+            raise self._error(f"{speed!r} is not a parameter{did_you_mean(str(speed), parameters)}",
+                              f"{field}.speed")
+        velocities = {c.velocity.name: c for c in self._coordinates}
+        names = [c.name for c in self._coordinates]
+        if not isinstance(rates, Mapping) or not rates:
+            raise self._error("expected a table of steady rates, NAME_dot = expression",
+                              f"{field}.rates")
+        texts = []
+        for name, value in rates.items():
+            where = f"{field}.rates.{name}"
+            if name not in velocities:
+                raise self._error(f"'{name}' is not a velocity of this model"
+                                  f"{did_you_mean(name, list(velocities))}", where)
+            expr = self.expression(value, where, velocities=False)
+            stray = expr.free_symbols - {p.symbol for p in self._parameters}
+            if stray:
+                raise self._error(f"a steady rate is written in the parameters only (found "
+                                  f"{sorted(map(str, stray))[0]})", where)
+            texts.append((name, str(value) if isinstance(value, str) else str(float(value))))
+        if isinstance(keep, str) or not isinstance(keep, Sequence) or not keep:
+            raise self._error("expected a list of coordinate names", f"{field}.keep")
+        for name in keep:
+            if name not in names:
+                raise self._error(f"{name!r} is not a coordinate{did_you_mean(str(name), names)}",
+                                  f"{field}.keep")
+        point = []
+        for name, value in (about or {}).items():
+            if name not in names:
+                raise self._error(f"'{name}' is not a coordinate{did_you_mean(name, names)}",
+                                  f"{field}.about.{name}")
+            point.append((name, float(self.expression(value, f"{field}.about.{name}"))))
+        self._steady_motion = SteadyMotion(speed, tuple(texts), tuple(keep), tuple(point))
+        return self
+
     # -- build ----------------------------------------------------------------------------
 
     def build_model(self) -> Model:
@@ -679,6 +723,7 @@ class ModelBuilder:
             constraints=tuple(self._constraints),
             source=self.source,
             contacts=tuple(self._contacts),
+            steady_motion=self._steady_motion,
         )
 
     # -- helpers --------------------------------------------------------------------------

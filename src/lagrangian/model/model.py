@@ -158,6 +158,18 @@ class Constraint:
 
 
 @dataclass(frozen=True)
+class SteadyMotion:
+    """The steady motion a model is usually studied about (a bicycle rolling straight ahead):
+    the parameter that is its speed (m/s), each steady rate as text in the parameters
+    (NAME_dot -> "v", "-v/rR"), the coordinates whose equations are kept, and where it is."""
+
+    speed: str
+    rates: tuple[tuple[str, str], ...]
+    keep: tuple[str, ...]
+    about: tuple[tuple[str, float], ...] = ()
+
+
+@dataclass(frozen=True)
 class Model:
     """A complete mechanical model: coordinates, parameters, energies and components."""
 
@@ -183,6 +195,8 @@ class Model:
     rigid_bodies: tuple[RigidBody, ...] = ()
     # Rolling contacts (model/contacts.py); their constraints are in ``constraints``.
     contacts: tuple[RollingContact, ...] = ()
+    # The steady motion `speeds` linearizes about when none is given ([steady] in the file).
+    steady_motion: SteadyMotion | None = None
     # A robot read from URDF keeps its tree in numbers (model/tree.py) for recursive dynamics;
     # not part of the model's identity (equal models with and without it are equal).
     kinematic_tree: KinematicTree | None = field(default=None, compare=False, repr=False)

@@ -15,7 +15,7 @@ from .units import check_unit, to_si
 TOP_LEVEL = {
     "name", "description", "coordinates", "parameters", "definitions", "energy", "gravity",
     "particles", "bodies", "springs", "dampers", "loads", "generalized_forces", "constraints",
-    "contacts",
+    "contacts", "steady",
 }
 COMPONENT_KEYS = {
     "particles": ({"name", "mass", "position"}, set()),
@@ -31,6 +31,7 @@ COORDINATE_KEYS = {"unit", "initial", "rate", "range"}  # a coordinate given as 
 PARAMETER_KEYS = {"value", "unit"}  # a parameter given as a table
 ENERGY_KEYS = {"T", "V", "D"}
 GRAVITY_KEYS = ({"g"}, {"direction"})
+STEADY_KEYS = ({"speed", "rates", "keep"}, {"about"})
 
 
 def model_file_schema() -> dict[str, tuple[frozenset[str], frozenset[str]]]:
@@ -41,7 +42,8 @@ def model_file_schema() -> dict[str, tuple[frozenset[str], frozenset[str]]]:
               "coordinates.<name>": (frozenset(), frozenset(COORDINATE_KEYS)),
               "parameters.<name>": (frozenset(), frozenset(PARAMETER_KEYS)),
               "energy": (frozenset(), frozenset(ENERGY_KEYS)),
-              "gravity": (frozenset(GRAVITY_KEYS[0]), frozenset(GRAVITY_KEYS[1]))}
+              "gravity": (frozenset(GRAVITY_KEYS[0]), frozenset(GRAVITY_KEYS[1])),
+              "steady": (frozenset(STEADY_KEYS[0]), frozenset(STEADY_KEYS[1]))}
     for table, (required, optional) in COMPONENT_KEYS.items():
         schema[table] = (frozenset(required), frozenset(optional))
     return schema
@@ -231,6 +233,26 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
             item["name"], holonomic=item.get("holonomic"), velocity=item.get("velocity"),
             field=f"constraints[{index}]",
         )
+    steady = _table(data, "steady", source)
+    if steady:
+        check_known_keys(steady, STEADY_KEYS[0] | STEADY_KEYS[1], "steady", source)
+        for key in sorted(STEADY_KEYS[0]):
+            if key not in steady:
+                raise ModelError(f"missing key '{key}'", field="steady", source=source)
+        rates = steady["rates"]
+        if not isinstance(rates, Mapping):
+            raise ModelError("expected a table, e.g. rates = { x_dot = \"v\" }",
+                             field="steady.rates", source=source)
+        about = steady.get("about", {})
+        if not isinstance(about, Mapping):
+            raise ModelError("expected a table of coordinate values", field="steady.about",
+                             source=source)
+        keep = steady["keep"]
+        if not isinstance(keep, list) or not all(isinstance(k, str) for k in keep):
+            raise ModelError("expected a list of coordinate names, e.g. [\"phi\", \"delta\"]",
+                             field="steady.keep", source=source)
+        builder.set_steady_motion(_string(steady["speed"], "steady.speed", source), rates, keep,
+                                  about)
     return builder.build_model()
 
 

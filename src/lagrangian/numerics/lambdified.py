@@ -25,11 +25,11 @@ def numpy_function(args: Sequence[sp.Symbol], exprs: sp.Expr | Sequence[sp.Expr]
     expression); cse when the expressions are big enough to share work."""
     many = not isinstance(exprs, sp.Basic)
     items = [as_expression(e) for e in exprs] if many else [as_expression(exprs)]
-    cse = _operations_exceed(items, CSE_MIN_OPERATIONS)
+    cse = operations_exceed(items, CSE_MIN_OPERATIONS)
     return sp.lambdify(list(args), items if many else items[0], modules="numpy", cse=cse)
 
 
-def _operations_exceed(items: Sequence[sp.Expr], limit: int) -> bool:
+def operations_exceed(items: Sequence[sp.Expr], limit: int) -> bool:
     """sum(count_ops) > limit, without counting a large model's operations to the end (that
     took longer than the lambdify of the Whipple bicycle's linearization): a tree of more
     than 3 limit nodes has more than limit operations (each node with k arguments adds at
@@ -45,8 +45,13 @@ def _operations_exceed(items: Sequence[sp.Expr], limit: int) -> bool:
 
 def mpmath_function(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr]) -> Callable:
     """One mpmath function of ``args`` returning the list ``exprs``, evaluated at mpmath's
-    working precision (the checks' random points); no cse."""
-    return sp.lambdify(list(args), [as_expression(e) for e in exprs], modules="mpmath")
+    working precision (the checks' random points); cse when the expressions are big."""
+    items = [as_expression(e) for e in exprs]
+    # Without cse a body in space's equations print and evaluate as a tree: the Whipple
+    # bicycle's Newton-Euler rows took ~1.4 million mpmath sin/cos at 12 points and a minute
+    # of printing; cse is exact (it only names repeated subexpressions).
+    cse = operations_exceed(items, CSE_MIN_OPERATIONS)
+    return sp.lambdify(list(args), items, modules="mpmath", cse=cse)
 
 
 class StateFunction:

@@ -152,6 +152,22 @@ def test_laws_of_the_recursive_functions(which, request):
 
 
 @needs_c
+def test_a_large_batch_split_over_threads_equals_one_call_per_state(tree):
+    """Past 1024 states per processor a batch runs on threads, each taking a range: every
+    state's result is its own single call's (an odd count, so a part ends mid-vector)."""
+    f = tree.dynamics()
+    q, v, a, _ = states(f.n, count=4097, seed=5)
+    tau = f.inverse_dynamics(q, v, a)
+    picks = [0, 1, 2047, 2048, 2049, 4095, 4096]
+    for name, args in [("mass_matrix", (q,)), ("inverse_dynamics", (q, v, a)),
+                       ("forward_dynamics", (q, v, tau)), ("potential_energy", (q,))]:
+        batch = getattr(f, name)(*args)
+        one_by_one = [getattr(f, name)(*(x[k] for x in args)) for k in picks]
+        np.testing.assert_allclose(batch[picks], one_by_one, rtol=1e-13, atol=1e-15)
+    np.testing.assert_allclose(f.forward_dynamics(q, v, tau), a, rtol=1e-8, atol=1e-9)
+
+
+@needs_c
 def test_free_motion_keeps_energy(tree):
     """Zero torque: T + V is constant along the motion q'' = M^-1 (-C q' - g)."""
     from scipy.integrate import solve_ivp

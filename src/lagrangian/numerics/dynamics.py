@@ -18,7 +18,6 @@ picks that path wherever it applies.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable, Mapping
 
 import numpy as np
@@ -105,8 +104,8 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
     numpy (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with backend
     "auto", where no compiler works; None where they do not apply: not a bare tree, or a mass
     matrix that is not positive definite (the symbolic path names the joints)."""
-    from .compiled import BackendUnavailable, CompilerMissing
-    from .functions import _tell_once, compiled_was_expected
+    from .compiled import BackendUnavailable
+    from .functions import tell_numpy_fallback
     from .recursive import RecursiveDynamics, applicable_tree
     from .recursive_numpy import RecursiveNumpyDynamics
 
@@ -124,14 +123,8 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
                 raise
             # the same algorithms in numpy: the expanded equations of a 7-joint arm are too
             # deep for lambdify, the recursions are not
-            if isinstance(exc, CompilerMissing):
-                _tell_once(f"note: {str(exc).split(' (')[0]}, so the robot's recursive dynamics "
-                           "run in numpy, about 1000x slower per call than compiled C; for the fast path "
-                           + ("unset CC or point it at gcc or clang" if "CC=" in str(exc)
-                              else "install gcc or clang (or set CC)"))
-            elif compiled_was_expected():
-                warnings.warn(f"C backend unavailable, using numpy: {exc}", RuntimeWarning,
-                              stacklevel=2)
+            tell_numpy_fallback(exc, "the robot's recursive dynamics run in numpy, about 1000x "
+                                "slower per call than compiled C")
     if dynamics is None:
         dynamics = RecursiveNumpyDynamics(model, tree, parameters)
     return dynamics if dynamics.regular() else None

@@ -313,21 +313,15 @@ def numeric(
     values = resolve_parameters(model, parameters).symbol_values(model)
     kernel = None
     if backend in ("auto", "c"):
-        from .compiled import BackendUnavailable, CompilerMissing
+        from .compiled import BackendUnavailable
 
         try:
             kernel = _c_kernel(eom, values)
         except BackendUnavailable as exc:
             if backend == "c":
                 raise
-            if isinstance(exc, CompilerMissing):
-                _tell_once(f"note: {str(exc).split(' (')[0]}, so the equations run as numpy "
-                           "functions, 50-100x slower than compiled C; for the fast path "
-                           + ("unset CC or point it at gcc or clang" if "CC=" in str(exc)
-                              else "install gcc or clang (or set CC)"))
-            elif compiled_was_expected():
-                warnings.warn(f"C backend unavailable, using numpy: {exc}", RuntimeWarning,
-                              stacklevel=2)
+            tell_numpy_fallback(exc, "the equations run as numpy functions, 50-100x slower "
+                                "than compiled C")
     if kernel is None:
         try:
             kernel = _numpy_kernel(eom, values)
@@ -341,6 +335,19 @@ def numeric(
         parameters={str(k): float(v) for k, v in values.items()},
         _kernel=kernel,
     )
+
+
+def tell_numpy_fallback(exc: Exception, what_happens: str) -> None:
+    """Say once, in one plain line, that C gave way to numpy for want of a compiler (and how to
+    get the fast path); a compiler that is there but failed is a warning."""
+    from .compiled import CompilerMissing
+
+    if isinstance(exc, CompilerMissing):
+        _tell_once(f"note: {str(exc).split(' (')[0]}, so {what_happens}; for the fast path "
+                   + ("unset CC or point it at gcc or clang" if "CC=" in str(exc)
+                      else "install gcc or clang (or set CC)"))
+    elif compiled_was_expected():
+        warnings.warn(f"C backend unavailable, using numpy: {exc}", RuntimeWarning, stacklevel=3)
 
 
 def compiled_was_expected() -> bool:

@@ -9,45 +9,16 @@ import random
 import numpy as np
 import pytest
 import sympy as sp
-from sympy.physics.mechanics import (
-    LagrangesMethod,
-    Lagrangian,
-    Point,
-    ReferenceFrame,
-    RigidBody,
-    dynamicsymbols,
-    inertia,
-)
+from sympy.physics.mechanics import dynamicsymbols
 
 import lagrangian
 from lagrangian.errors import ModelError
 from lagrangian.model.builder import ModelBuilder
 from lagrangian.model.examples import example_path
 from lagrangian.model.reader import parse_model
+from rolling_disc_models import VALUES, sympy_disc
 
-VALUES = {"m": 2.0, "r": 0.3, "g": 9.81}
 COIN = example_path("rolling_coin").read_text()
-
-
-def _sympy_disc():
-    """The disc in sympy.physics.mechanics with the contact constraints written by hand."""
-    yaw, lean, spin, x, y = q = dynamicsymbols("yaw lean spin x y")
-    m, r, g = (sp.Symbol(k) for k in VALUES)
-    N = ReferenceFrame("N")
-    A = N.orientnew("A", "Axis", [yaw, N.z])
-    B = A.orientnew("B", "Axis", [lean, A.x])
-    C = B.orientnew("C", "Axis", [spin, B.y])
-    O = Point("O")
-    O.set_vel(N, 0)
-    G = O.locatenew("G", x * N.x + y * N.y + r * B.z)
-    G.set_vel(N, G.pos_from(O).dt(N))
-    contact = G.vel(N) + C.ang_vel_in(N).cross(-r * B.z)
-    disc = RigidBody("disc", G, C, m, (inertia(C, m * r**2 / 4, m * r**2 / 2, m * r**2 / 4), G))
-    disc.potential_energy = m * g * G.pos_from(O).dot(N.z)
-    method = LagrangesMethod(Lagrangian(N, disc), q, frame=N,
-                             nonhol_coneqs=[contact.dot(N.x), contact.dot(N.y)])
-    method.form_lagranges_equations()
-    return q, method
 
 
 def test_the_coin_file_generates_the_two_no_slip_constraints_and_no_normal_one():
@@ -70,7 +41,7 @@ def test_coin_accelerations_and_friction_equal_lagranges_method_with_hand_writte
     system = lagrangian.System(parse_model(COIN))
     eom = system.equations_of_motion()
     numeric = system.numeric(backend="numpy")
-    q, method = _sympy_disc()
+    q, method = sympy_disc()
     t = dynamicsymbols._t
     constants = {sp.Symbol(k): v for k, v in VALUES.items()}
     model = system.model

@@ -126,35 +126,7 @@ def _compile(source: str, name: str, target: Path) -> None:
 
 def load(generated: GeneratedSource) -> ModuleType:
     """The compiled module for this source: in memory, else from the cache, else built now."""
-    name = module_name(generated)
-    if name in _LOADED:
-        return _LOADED[name]
-    suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
-    path = cache_dir() / f"{name}{suffix}"
-    if not path.exists():
-        if sys.platform == "win32":
-            raise BackendUnavailable("the C backend is not supported on Windows yet")
-        try:
-            _compile(generated.source, name, path)
-        except OSError as exc:
-            raise BackendUnavailable(f"cannot write the compiled-module cache {path.parent}: "
-                                     f"{exc.strerror or exc} (set LAGRANGIAN_CACHE)") from None
-    spec = importlib.util.spec_from_file_location(name, path)
-    if spec is None or spec.loader is None:
-        raise BackendUnavailable(f"cannot load {path}")
-    module = importlib.util.module_from_spec(spec)
-    try:
-        spec.loader.exec_module(module)
-    except ImportError as exc:  # a stale or foreign file: rebuild once
-        path.unlink(missing_ok=True)
-        _compile(generated.source, name, path)
-        module = importlib.util.module_from_spec(spec)
-        try:
-            spec.loader.exec_module(module)
-        except ImportError:
-            raise BackendUnavailable(f"cannot load the compiled module {path}: {exc}") from None
-    _LOADED[name] = module
-    return module
+    return _load_or_build(module_name(generated), lambda: generated)
 
 
 @lru_cache(maxsize=1)
@@ -174,25 +146,27 @@ def keyed_module_name(key: str) -> str:
 def load_keyed(key: str, make_source: Callable[[], GeneratedSource]) -> ModuleType:
     """The compiled module for the equations with this key: in memory, else from the on-disk
     cache (no C generated, no compiler needed), else ``make_source()`` generated and built now."""
-    name = keyed_module_name(key)
+    return _load_or_build(keyed_module_name(key), make_source)
+
+
+def _load_or_build(name: str, make_source: Callable[[], GeneratedSource]) -> ModuleType:
+    """The module ``name``: in memory, else the cached file, else built from ``make_source()``
+    (called only then, after the compiler is found: without one the C would be wasted)."""
     if name in _LOADED:
         return _LOADED[name]
     suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
     path = cache_dir() / f"{name}{suffix}"
     if path.exists():
-        spec = importlib.util.spec_from_file_location(name, path)
-        if spec is not None and spec.loader is not None:
-            module = importlib.util.module_from_spec(spec)
-            try:
-                spec.loader.exec_module(module)
-            except ImportError:  # a stale or foreign file: built again below
-                path.unlink(missing_ok=True)
-            else:
-                _LOADED[name] = module
-                return module
+        try:
+            module = _import(name, path)
+        except ImportError:  # a stale or foreign file: built again below
+            path.unlink(missing_ok=True)
+        else:
+            _LOADED[name] = module
+            return module
     if sys.platform == "win32":
         raise BackendUnavailable("the C backend is not supported on Windows yet")
-    check_compiler()  # before generating C: without a compiler it would be wasted
+    check_compiler()
     _include_dirs()
     generated = make_source()
     try:
@@ -200,15 +174,21 @@ def load_keyed(key: str, make_source: Callable[[], GeneratedSource]) -> ModuleTy
     except OSError as exc:
         raise BackendUnavailable(f"cannot write the compiled-module cache {path.parent}: "
                                  f"{exc.strerror or exc} (set LAGRANGIAN_CACHE)") from None
-    spec = importlib.util.spec_from_file_location(name, path)
-    if spec is None or spec.loader is None:
-        raise BackendUnavailable(f"cannot load {path}")
-    module = importlib.util.module_from_spec(spec)
     try:
-        spec.loader.exec_module(module)
+        module = _import(name, path)
     except ImportError as exc:
         raise BackendUnavailable(f"cannot load the compiled module {path}: {exc}") from None
     _LOADED[name] = module
+    return module
+
+
+def _import(name: str, path: Path) -> ModuleType:
+    """Import the extension module at ``path`` (ImportError if it is not one for this Python)."""
+    spec = importlib.util.spec_from_file_location(name, path)
+    if spec is None or spec.loader is None:
+        raise ImportError(f"cannot load {path}")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
     return module
 
 

@@ -11,24 +11,7 @@ import pytest
 import lagrangian
 from lagrangian.errors import ModelError
 from lagrangian.model.reader import parse_model
-
-INERTIAL = """
-name = "Bead on a spinning hoop, inertial frame"
-[coordinates]
-theta = { unit = "rad", initial = 0.5, range = [-3.141592653589793, 3.141592653589793] }
-[parameters]
-m = 0.1
-R = 0.5
-g = 9.81
-Omega = 6.0
-[gravity]
-g = "g"
-direction = [0, 0, -1]
-[[particles]]
-name = "bead"
-mass = "m"
-position = ["R*sin(theta)*cos(Omega*t)", "R*sin(theta)*sin(Omega*t)", "-R*cos(theta)"]
-"""
+from variable_models import BEAD_ON_SPINNING_HOOP
 
 # The same bead with t left in T by form only: 1 + sin(2 W t) - 2 sin(W t) cos(W t) = 1.
 BY_FORM = """
@@ -45,7 +28,7 @@ V = "-m*g*R*cos(theta)"
 """
 
 
-@pytest.mark.parametrize("text", [INERTIAL, BY_FORM], ids=["inertial-3d", "t-by-form"])
+@pytest.mark.parametrize("text", [BEAD_ON_SPINNING_HOOP, BY_FORM], ids=["inertial-3d", "t-by-form"])
 def test_same_equilibria_stability_and_frequencies_as_the_rotating_frame(text):
     system = lagrangian.System(parse_model(text))
     reference = lagrangian.load("bead_on_hoop")

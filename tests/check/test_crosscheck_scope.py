@@ -5,26 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-ROTOR = """
-name = "Rotor with a bead on a spoke"
-[coordinates]
-phi = "rad"
-r = "m"
-[parameters]
-I0 = 0.2
-m = 0.5
-M = 2.0
-[[bodies]]
-name = "rotor"
-mass = "M"
-inertia = "I0 + m*r^2"
-position = [0, 0]
-angle = "phi"
-[[particles]]
-name = "bead"
-mass = "m"
-position = ["r", 0]
-"""
+from variable_models import ROTOR_WITH_BEAD
 
 SKATER = """
 name = "Figure skater"
@@ -56,7 +37,7 @@ position = [0, "y"]
 
 
 @pytest.mark.parametrize("text, message", [
-    (ROTOR, "error: Newton-Euler (F = m a, M = I alpha) does not model inertia that changes "
+    (ROTOR_WITH_BEAD, "error: Newton-Euler (F = m a, M = I alpha) does not model inertia that changes "
             "with r: the inertia of body 'rotor' is I0 + m*r**2, so crosscheck cannot check this "
             "model (derive gives its Euler-Lagrange equations)\n"),
     (SKATER, "error: Newton-Euler (F = m a, M = I alpha) does not model inertia that changes "

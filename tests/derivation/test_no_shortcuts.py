@@ -16,6 +16,7 @@ from lagrangian.derivation.lagrange import derive
 from lagrangian.model.builder import ModelBuilder
 from lagrangian.model.model import Body, Particle, PointForce, Torque
 from lagrangian.model.reader import parse_model
+from variable_models import BEAD_ON_SPINNING_HOOP, ROTOR_WITH_BEAD
 
 t = sp.Symbol("t")
 
@@ -26,28 +27,6 @@ def symbols(model):
         names.update({c.name: c.symbol, c.velocity.name: c.velocity,
                       c.acceleration.name: c.acceleration})
     return names
-
-
-ROTOR_WITH_BEAD = """
-name = "Rotor with a bead on a spoke"
-[coordinates]
-phi = "rad"
-r = "m"
-[parameters]
-I0 = 0.2
-m = 0.5
-M = 2.0
-[[bodies]]
-name = "rotor"
-mass = "M"
-inertia = "I0 + m*r^2"
-position = [0, 0]
-angle = "phi"
-[[particles]]
-name = "bead"
-mass = "m"
-position = ["r", 0]
-"""
 
 
 def test_rotor_with_a_sliding_bead_keeps_the_coriolis_and_centrifugal_terms():
@@ -342,31 +321,12 @@ def test_particles_alone_need_no_shortcut_terms():
     assert isinstance(b.build_model().particles[0], Particle)
 
 
-BEAD_3D = """
-name = "Bead on a spinning hoop, in the inertial frame"
-[coordinates]
-theta = "rad"
-[parameters]
-m = 0.1
-R = 0.5
-g = 9.81
-Omega = 6.0
-[gravity]
-g = "g"
-direction = [0, 0, -1]
-[[particles]]
-name = "bead"
-mass = "m"
-position = ["R*sin(theta)*cos(Omega*t)", "R*sin(theta)*sin(Omega*t)", "-R*cos(theta)"]
-"""
-
-
 def test_bead_on_a_spinning_hoop_in_3d_reads_as_in_the_rotating_frame():
     """sin^2(Omega t) + cos^2(Omega t) is recognized inside longer products, so the inertial
     description prints the rotating-frame T, M and f, with no t left."""
     import lagrangian
 
-    inertial = derive(parse_model(BEAD_3D))
+    inertial = derive(parse_model(BEAD_ON_SPINNING_HOOP))
     rotating = derive(lagrangian.load("bead_on_hoop").model)
     s = symbols(inertial.model)
     assert inertial.mass_matrix == sp.Matrix([[s["R"] ** 2 * s["m"]]])

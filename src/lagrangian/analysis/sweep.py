@@ -25,7 +25,11 @@ import numpy as np
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
 from ..model.values import resolve_state
-from ..numerics.parametric import ParametricStaticFunctions, StaticFunctionsAt, integrate_member
+from ..numerics.parametric import (
+    ParametricStaticFunctions,
+    StaticFunctionsAt,
+    integrate_ensemble,
+)
 from .equilibria import (
     _difference,
     _Solver,
@@ -578,6 +582,8 @@ def _simulation_chunk(study, functions: _SimulationFunctions, values, count):
     options = study.simulation
     n = len(model.coordinates)
     out = _empty(study, count, {"state": 2 * n, "time": options.samples})
+    if functions.module is not None:
+        return _simulation_chunk_compiled(study, functions, values, count, out)
     parameter_names = set(functions.names)
     for i in range(count):
         point = {name: float(v[i]) for name, v in values.items()}
@@ -604,27 +610,41 @@ def _simulation_chunk(study, functions: _SimulationFunctions, values, count):
     return out
 
 
+def _simulation_chunk_compiled(study, functions: _SimulationFunctions, values, count, out):
+    """The whole chunk in one call of the module's ensemble loop (numerics/parametric.py): each
+    member the same DOP853 steps as the single-point simulate, the summaries computed in C."""
+    model = study.model
+    options = study.simulation
+    vectors = np.tile(functions.defaults, (count, 1))
+    for i, name in enumerate(functions.names):
+        if name in values:
+            vectors[:, i] = values[name]
+    start = resolve_state(model, field="initial")
+    states = np.tile(np.concatenate([start.q_array(), start.q_dot_array()]), (count, 1))
+    for i, c in enumerate(model.coordinates):
+        for offset, name in ((0, c.name), (len(model.coordinates), c.velocity.name)):
+            if name in values:
+                states[:, offset + i] = values[name]
+    grid = np.linspace(start.t, options.t_end, options.samples)
+    run = integrate_ensemble(functions.module, vectors, states, grid, options.rtol, options.atol,
+                             trajectories=options.trajectories)
+    out["final"][:] = run.final
+    out["minimum"][:] = run.minimum
+    out["maximum"][:] = run.maximum
+    out["t_final"][:] = run.t_final
+    out["invariant_drift"][:] = run.drift
+    if options.trajectories:
+        out["trajectory"][:] = run.trajectory
+    for i in np.flatnonzero(run.status != 0):
+        out["status"][i] = f"integration failed at t = {run.t_reached[i]:.9g} s"
+    return out
+
+
 def _simulate_member(study, functions, parameters, state):
-    """(t, y, invariant drift or None, status, message, stop time or None) of one member."""
+    """(t, y, invariant drift or None, status, message, stop time or None) of one member by the
+    single-point simulate (constraints, stop conditions, other methods, no compiled module)."""
     options = study.simulation
     model = study.model
-    if functions.module is not None:
-        vector = functions.defaults.copy()
-        for i, name in enumerate(functions.names):
-            if name in parameters:
-                vector[i] = parameters[name]
-        start = resolve_state(model, state, field="initial")
-        grid = np.linspace(start.t, options.t_end, options.samples)
-        y0 = np.concatenate([start.q_array(), start.q_dot_array()])
-        t, y, status, reached = integrate_member(functions.module, vector, y0, grid,
-                                                 options.rtol, options.atol)
-        if status != 0:
-            return t, y, None, "failed", f"integration failed at t = {reached:.9g} s", None
-        n = len(model.coordinates)
-        q, v = np.ascontiguousarray(y[:, :n]), np.ascontiguousarray(y[:, n:])
-        energy = functions.module.energy(q, v, t, vector)
-        kinetic = energy - functions.module.energy(q, np.zeros_like(v), t, vector)
-        return t, y, _drift(energy, kinetic), "finished", "", None
     from ..numerics.options import SaveAt, StepControl
     from ..numerics.simulate import parse_stop_condition, simulate
 

@@ -486,6 +486,156 @@ static PyObject *py_dop853(PyObject *self, PyObject *const *args, Py_ssize_t nar
     return Py_BuildValue("(NNLLid)", T, Y, nfev, accepted, status, t_reached);
 }
 
+/* ---- Ensembles: many members (parameters and initial state each) in one call ---- */
+
+/* What a study keeps of one member integrated onto the grid te[0..ne) (ys: ne x LG_S samples):
+ * final state, extremes, end time and the energy drift max|E - E0| / |E0| (relative to the
+ * largest kinetic energy when E0 = 0), as analysis/sweep.py's _drift. */
+static void lg_summary(const double *p, const double *te, npy_intp ne, const double *ys,
+                       double *final, double *lo, double *hi, double *t_final, double *drift)
+{
+    static const double zero[LG_N > 0 ? LG_N : 1] = {0.0};
+    memcpy(final, ys + (ne - 1) * LG_S, LG_S * sizeof(double));
+    memcpy(lo, ys, LG_S * sizeof(double));
+    memcpy(hi, ys, LG_S * sizeof(double));
+    double e0 = 0.0, change = 0.0, largest_t = 0.0;
+    for (npy_intp k = 0; k < ne; k++) {
+        const double *y = ys + k * LG_S;
+        for (int i = 0; i < LG_S; i++) {
+            if (y[i] < lo[i]) lo[i] = y[i];
+            if (y[i] > hi[i]) hi[i] = y[i];
+        }
+        double e = lg_energy(y, y + LG_N, te[k], p);
+        double kinetic = e - lg_energy(y, zero, te[k], p);
+        if (k == 0) e0 = e;
+        change = fmax(change, fabs(e - e0));
+        largest_t = fmax(largest_t, fabs(kinetic));
+    }
+    double scale = fabs(e0);
+    if (scale <= 1e-9 * largest_t) scale = largest_t;
+    *t_final = te[ne - 1];
+    *drift = scale > 0 ? change / scale : 0.0;
+}
+
+static void lg_missing(double *final, double *lo, double *hi, double *t_final, double *drift,
+                       double *traj, npy_intp ne)
+{
+    for (int i = 0; i < LG_S; i++) final[i] = lo[i] = hi[i] = NAN;
+    *t_final = *drift = NAN;
+    if (traj)
+        for (npy_intp k = 0; k < ne * LG_S; k++) traj[k] = NAN;
+}
+
+/* Outputs of an ensemble call, one row per member. */
+typedef struct {
+    double *final, *lo, *hi, *t_final, *drift, *t_reached, *traj;
+    int *status;
+} lg_ensemble_out;
+
+/* Members [0, N) one by one through lg_dop853 (the single-point loop itself). Returns
+ * LG_INTERRUPTED on Ctrl-C, LG_NOMEM, else LG_DONE (each member's own status in out). */
+static int lg_ensemble_scalar(const double *P, const double *Y0, npy_intp N, const double *te,
+                              npy_intp ne, double rtol, double atol, long long max_steps,
+                              lg_ensemble_out *o, PyThreadState **save)
+{
+    double *scratch_t = (double *)malloc((size_t)ne * sizeof(double));
+    double *scratch_y = o->traj ? NULL : (double *)malloc((size_t)ne * LG_S * sizeof(double));
+    if (!scratch_t || (!o->traj && !scratch_y)) { free(scratch_t); free(scratch_y); return LG_NOMEM; }
+    int result = LG_DONE;
+    for (npy_intp k = 0; k < N; k++) {
+        if ((k & 63) == 63) {
+            PyEval_RestoreThread(*save);
+            int interrupted = PyErr_CheckSignals();
+            *save = PyEval_SaveThread();
+            if (interrupted) { result = LG_INTERRUPTED; break; }
+        }
+        const double *p = P + k * LG_NP;
+        double *ys = o->traj ? o->traj + k * ne * LG_S : scratch_y;
+        lg_trace out = {scratch_t, ys, 0, ne};  /* room for every sample: never reallocated */
+        long long nfev, accepted;
+        int status = lg_dop853(p, te[0], te[ne - 1], Y0 + k * LG_S, rtol, atol, te, ne, max_steps,
+                               &out, &nfev, &accepted, o->t_reached + k, save);
+        if (status == LG_INTERRUPTED) { result = status; break; }
+        o->status[k] = status;
+        if (status == LG_DONE && out.len == ne)
+            lg_summary(p, te, ne, ys, o->final + k * LG_S, o->lo + k * LG_S, o->hi + k * LG_S,
+                       o->t_final + k, o->drift + k);
+        else
+            lg_missing(o->final + k * LG_S, o->lo + k * LG_S, o->hi + k * LG_S, o->t_final + k,
+                       o->drift + k, o->traj ? ys : NULL, ne);
+    }
+    free(scratch_t);
+    free(scratch_y);
+    return result;
+}
+
+#ifdef LG_VECTOR
+static int lg_ensemble_vector(const double *P, const double *Y0, npy_intp N, const double *te,
+                              npy_intp ne, double rtol, double atol, long long max_steps,
+                              lg_ensemble_out *o, PyThreadState **save);
+#endif
+
+/* ensemble(P, Y0, t_eval, rtol, atol, max_steps, trajectories, vector)
+ *   -> (final, minimum, maximum, t_final, drift, status, t_reached, trajectory or None)
+ * P: N x n_parameters, Y0: N x 2n, t_eval: the common grid (first = start, last = end). */
+static PyObject *py_ensemble(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 8) {
+        PyErr_SetString(PyExc_TypeError,
+                        "expected (P, Y0, t_eval, rtol, atol, max_steps, trajectories, vector)");
+        return NULL;
+    }
+    double rtol = PyFloat_AsDouble(args[3]), atol = PyFloat_AsDouble(args[4]);
+    long long max_steps = PyLong_AsLongLong(args[5]);
+    int trajectories = PyObject_IsTrue(args[6]), vector = PyObject_IsTrue(args[7]);
+    if (PyErr_Occurred()) return NULL;
+    PyArrayObject *Y0 = (PyArrayObject *)PyArray_FROMANY(args[1], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
+    if (!Y0) return NULL;
+    npy_intp N = PyArray_SIZE(Y0) / LG_S;
+    PyArrayObject *P = lg_doubles(args[0], N * LG_NP, "parameters");
+    if (!P) { Py_DECREF(Y0); return NULL; }
+    PyArrayObject *te = (PyArrayObject *)PyArray_FROMANY(args[2], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
+    if (!te) { Py_DECREF(Y0); Py_DECREF(P); return NULL; }
+    npy_intp ne = PyArray_SIZE(te);
+    if (ne < 1 || PyArray_SIZE(Y0) != N * LG_S) {
+        PyErr_SetString(PyExc_ValueError, "Y0 must be N x 2n and t_eval hold at least one time");
+        Py_DECREF(Y0); Py_DECREF(P); Py_DECREF(te);
+        return NULL;
+    }
+    PyObject *final = lg_new(2, N, LG_S, 0), *lo = lg_new(2, N, LG_S, 0), *hi = lg_new(2, N, LG_S, 0);
+    PyObject *t_final = lg_new(1, N, 0, 0), *drift = lg_new(1, N, 0, 0), *reached = lg_new(1, N, 0, 0);
+    npy_intp one = N;
+    PyObject *status = PyArray_SimpleNew(1, &one, NPY_INT);
+    PyObject *traj = trajectories ? lg_new(3, N, ne, LG_S) : (Py_INCREF(Py_None), Py_None);
+    PyObject *result = NULL;
+    if (final && lo && hi && t_final && drift && reached && status && traj) {
+        lg_ensemble_out o = {
+            (double *)PyArray_DATA((PyArrayObject *)final), (double *)PyArray_DATA((PyArrayObject *)lo),
+            (double *)PyArray_DATA((PyArrayObject *)hi), (double *)PyArray_DATA((PyArrayObject *)t_final),
+            (double *)PyArray_DATA((PyArrayObject *)drift), (double *)PyArray_DATA((PyArrayObject *)reached),
+            trajectories ? (double *)PyArray_DATA((PyArrayObject *)traj) : NULL,
+            (int *)PyArray_DATA((PyArrayObject *)status)};
+        const double *pP = (const double *)PyArray_DATA(P), *pY = (const double *)PyArray_DATA(Y0);
+        const double *pt = (const double *)PyArray_DATA(te);
+        PyThreadState *save = PyEval_SaveThread();
+        int done;
+#ifdef LG_VECTOR
+        if (vector)
+            done = lg_ensemble_vector(pP, pY, N, pt, ne, rtol, atol, max_steps, &o, &save);
+        else
+#endif
+            done = lg_ensemble_scalar(pP, pY, N, pt, ne, rtol, atol, max_steps, &o, &save);
+        PyEval_RestoreThread(save);
+        if (done == LG_NOMEM) PyErr_NoMemory();
+        else if (done == LG_INTERRUPTED) { if (!PyErr_Occurred()) PyErr_SetNone(PyExc_KeyboardInterrupt); }
+        else result = Py_BuildValue("(OOOOOOOO)", final, lo, hi, t_final, drift, status, reached, traj);
+    }
+    Py_XDECREF(final); Py_XDECREF(lo); Py_XDECREF(hi); Py_XDECREF(t_final); Py_XDECREF(drift);
+    Py_XDECREF(reached); Py_XDECREF(status); Py_XDECREF(traj);
+    Py_DECREF(Y0); Py_DECREF(P); Py_DECREF(te);
+    return result;
+}
+
 static PyMethodDef lg_methods[] = {
     {"parts", (PyCFunction)(void (*)(void))py_parts, METH_FASTCALL, "(Q, V, T, P) -> (M, f, Phi_q, gamma)"},
     {"energy", (PyCFunction)(void (*)(void))py_energy, METH_FASTCALL, "(Q, V, T, P) -> T + V"},
@@ -495,6 +645,9 @@ static PyMethodDef lg_methods[] = {
     {"rhs", (PyCFunction)(void (*)(void))py_rhs, METH_FASTCALL, "(P, t, y) -> [q_dot, q_ddot]"},
     {"dop853", (PyCFunction)(void (*)(void))py_dop853, METH_FASTCALL,
      "(P, t0, t1, y0, rtol, atol, t_eval, max_steps) -> (t, y, nfev, steps, status, t_reached)"},
+    {"ensemble", (PyCFunction)(void (*)(void))py_ensemble, METH_FASTCALL,
+     "(P, Y0, t_eval, rtol, atol, max_steps, trajectories, vector) -> (final, minimum, maximum, "
+     "t_final, drift, status, t_reached, trajectory)"},
 #ifdef LG_EXTRA_METHODS
     LG_EXTRA_METHODS /* more functions of a generated module (recursive.py) */
 #endif
@@ -516,6 +669,11 @@ PyMODINIT_FUNC LG_PASTE(PyInit_, LG_MODULE)(void)
         PyModule_AddIntConstant(m, "n", LG_N);
         PyModule_AddIntConstant(m, "m", LG_M);
         PyModule_AddIntConstant(m, "n_parameters", LG_NP);
+#ifdef LG_VECTOR
+        PyModule_AddIntConstant(m, "lanes", LG_LANES);
+#else
+        PyModule_AddIntConstant(m, "lanes", 1);
+#endif
     }
     return m;
 }

@@ -168,6 +168,22 @@ def test_a_large_batch_split_over_threads_equals_one_call_per_state(tree):
 
 
 @needs_c
+def test_a_compiler_that_refuses_the_native_flags_still_builds(tree, monkeypatch, tmp_path):
+    """The batches are built for this processor (its own vector width); a compiler that
+    refuses those flags gets the portable ones, with the same numbers."""
+    monkeypatch.setenv("LAGRANGIAN_CACHE", str(tmp_path))
+    monkeypatch.setattr(compiled, "NATIVE_CFLAGS", ("-mno-such-instruction-set",))
+    portable = RecursiveDynamics(tree.model, applicable_tree(tree.model))
+    native = tree.dynamics()
+    assert portable.module.__name__ != native.module.__name__
+    q, v, a, _ = states(native.n, count=9, seed=8)
+    np.testing.assert_allclose(portable.mass_matrix(q), native.mass_matrix(q),
+                               rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(portable.inverse_dynamics(q, v, a),
+                               native.inverse_dynamics(q, v, a), rtol=1e-12, atol=1e-12)
+
+
+@needs_c
 def test_free_motion_keeps_energy(tree):
     """Zero torque: T + V is constant along the motion q'' = M^-1 (-C q' - g)."""
     from scipy.integrate import solve_ivp

@@ -36,7 +36,7 @@ from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters
 
 Term = float | str  # a number, or the C name of a value computed before
-VECTOR_LIMIT = 16  # coordinates up to which batches run two states per vector operation
+VECTOR_LIMIT = 16  # coordinates up to which batches run several states per vector operation
 
 
 class _Emitter:
@@ -191,7 +191,7 @@ class _Emitter:
     def body(self, outputs: list[tuple[str, Term]], indent: str = "    ",
              vector: bool = False) -> str:
         """The C statements computing ``target = term`` for each output (dead temporaries
-        dropped). ``vector``: values that depend on q, v, a or tau are lg_v4 (four states),
+        dropped). ``vector``: values that depend on q, v, a or tau are lg_v4 (LG_LANES states),
         the others (parameters, numbers) stay double."""
         live = {t for _, t in outputs if isinstance(t, str)}
         keep = []
@@ -225,7 +225,7 @@ class _Emitter:
         return "\n".join(statements)
 
 
-_STATE = {"q", "v", "a", "tau"}  # the inputs that differ between the four states of a batch
+_STATE = {"q", "v", "a", "tau"}  # the inputs that differ between the states of one vector
 
 
 class _Layout:
@@ -592,7 +592,7 @@ def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix:
                        storage: str = "static ", vector: bool = False) -> str:
     """C99 functions <prefix>_mass_matrix, _bias_forces, _gravity, _inverse_dynamics,
     _forward_dynamics, _kinetic_energy, _potential_energy (the standalone API); with
-    ``vector``, also <prefix>4_<name> on two states at once (GCC/Clang vector extensions, for
+    ``vector``, also <prefix>4_<name> on LG_LANES states at once (GCC/Clang vector extensions, for
     the compiled module's batches)."""
     layout = _Layout(tree, parameters)
     n = layout.n
@@ -680,21 +680,30 @@ def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix:
 
 
 _VECTOR = r"""
-/* Two states at once: each operation on 2 lanes (one SSE2 instruction; wider vectors
-   without -mavx are split through memory by the compiler, slower than scalar code). */
+/* Several states at once, each operation on all lanes: four with AVX (a native build, see
+   compiled.NATIVE_CFLAGS), else two (one SSE2 instruction; wider vectors without AVX are split
+   through memory by the compiler, slower than scalar code). */
+#if defined(__AVX__)
+#define LG_LANES 4
+typedef double lg_v4 __attribute__((vector_size(32)));
+#else
 #define LG_LANES 2
 typedef double lg_v4 __attribute__((vector_size(16)));
-#define LG_V4(x) ((lg_v4){0.0, 0.0} + (x))
+#endif
+#define LG_V4(x) ((lg_v4){0.0} + (x))
 
 static inline lg_v4 lg_vsqrt(lg_v4 x)
 {
-    lg_v4 r = {sqrt(x[0]), sqrt(x[1])};
+    lg_v4 r;
+    for (int l = 0; l < LG_LANES; l++) r[l] = sqrt(x[l]);
     return r;
 }
 
 static inline void lg_vsincos(lg_v4 x, lg_v4 *sine, lg_v4 *cosine)
 {
-    if (!(fabs(x[0]) < 1.0e5 && fabs(x[1]) < 1.0e5)) {
+    int reducible = 1;
+    for (int l = 0; l < LG_LANES; l++) reducible &= fabs(x[l]) < 1.0e5;
+    if (!reducible) {
         for (int l = 0; l < LG_LANES; l++) {
             double s, c;
             lg_sincos(x[l], &s, &c);
@@ -1130,7 +1139,7 @@ class RecursiveDynamics:
         self.parameter_values = np.array(list(self.parameters.values()), dtype=float)
         self.parameter_values.flags.writeable = False
         self.module = compiled.load_keyed(tree_key(tree, names),
-                                          lambda: module_source(tree, names))
+                                          lambda: module_source(tree, names), native=True)
         P = self.parameter_values
         m = self.module
         # The fast path: one C call each, the parameters bound here.

@@ -547,6 +547,12 @@ def _equilibria_chunk(study, parametric, values, count):
 # -- ensembles of simulations -------------------------------------------------------------------
 
 
+# Ensembles use the model's module built for this processor (-O3 -march=native, keyed by the
+# CPU: another machine builds its own): with AVX the ensemble loop integrates four members per
+# vector operation instead of two. api/sweep.py builds it on the client, the workers load it.
+ENSEMBLE_NATIVE = True
+
+
 @dataclass
 class _SimulationFunctions:
     module: object
@@ -569,7 +575,8 @@ def _prepare_simulation(study: Study):
     if fast:
         try:
             # from the on-disk cache the caller filled; a worker on another machine builds it
-            module = compiled.load_keyed(study.compiled_key, lambda: generate(study.eom))
+            module = compiled.load_keyed(study.compiled_key, lambda: generate(study.eom),
+                                         native=ENSEMBLE_NATIVE)
         except (compiled.BackendUnavailable, CodegenError):
             module = None
     model = study.model

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.sweep import NOT_COMPUTED, Study, evaluate_chunk, layout
+from ..analysis.sweep import ENSEMBLE_NATIVE, NOT_COMPUTED, Study, evaluate_chunk, layout
 from ..errors import ModelError
 from ..output.sweep import check_study_path, study_dataset, write_study
 
@@ -56,7 +56,7 @@ def with_compiled_module(study: Study) -> Study:
         return study
     key = equations_key(study.eom)
     try:
-        compiled.load_keyed(key, lambda: generate(study.eom))
+        compiled.load_keyed(key, lambda: generate(study.eom), native=ENSEMBLE_NATIVE)
     except (CodegenError, compiled.BackendUnavailable):
         return study
     return replace(study, compiled_key=key)

@@ -8,6 +8,7 @@ The linear solve of M q_ddot = f (or the KKT system) and a DOP853 integrator are
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -142,22 +143,136 @@ def _basic_cse_pays(exprs: Sequence[sp.Expr]) -> bool:
     return tree <= BASIC_CSE_MAX_NODES and tree <= BASIC_CSE_MAX_NESTING * len(_nodes(exprs))
 
 
-def _block(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: _Printer) -> str:
-    """C statements computing ``targets[i] = exprs[i]`` with shared subexpressions hoisted."""
+def _statements(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: _Printer
+                ) -> list[tuple[str | None, str, str, bool]]:
+    """(name of a shared subexpression or None, target, C expression, constant?) computing
+    ``targets[i] = exprs[i]`` with shared subexpressions hoisted."""
     exprs = _fewer_trig_calls([sp.sympify(e) for e in exprs])  # safe: already sympy objects
     optimizations = "basic" if _basic_cse_pays(exprs) else None
     replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"),
                                    optimizations=optimizations)
-    statements = [(f"const double {symbol}", value) for symbol, value in replacements]
-    statements += list(zip(targets, reduced, strict=True))
-    lines = []
-    for target, value in statements:
+    statements = [(str(symbol), str(symbol), value) for symbol, value in replacements]
+    statements += [(None, target, value) for target, value in zip(targets, reduced, strict=True)]
+    out = []
+    for shared, target, value in statements:
         try:
             code = printer.doprint(optimize(value, [_EXPAND_POW]))
         except (NotImplementedError, TypeError, ValueError) as exc:
             raise CodegenError(str(exc).splitlines()[0]) from None
-        lines.append(f"    {target} = {code};")
+        out.append((shared, target, code, not value.free_symbols))
+    return out
+
+
+def _lines(statements, kind: str = "double") -> str:
+    return "\n".join(f"    {'const ' + kind + ' ' if shared else ''}{target} = {code};"
+                      for shared, target, code, _ in statements)
+
+
+def _block(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: _Printer) -> str:
+    """C statements computing ``targets[i] = exprs[i]`` with shared subexpressions hoisted."""
+    return _lines(_statements(exprs, targets, printer))
+
+
+# Functions with a vector version (vector_header): sin and cos by an inline polynomial kernel,
+# the others lane by lane through libm.
+_VECTOR_UNARY = {"sin", "cos", "tan", "asin", "acos", "atan", "exp", "log", "log10", "sinh",
+                 "cosh", "tanh", "floor", "ceil", "sqrt", "exp2", "expm1", "log2", "log1p",
+                 "cbrt", "fabs", "asinh", "acosh", "atanh", "erf", "erfc", "lgamma", "tgamma"}
+_VECTOR_BINARY = {"pow", "atan2", "hypot", "fmax", "fmin"}
+_CALL = re.compile(r"\b([A-Za-z_][A-Za-z0-9_]*)\s*\(")
+
+
+def vector_statements(statements) -> str | None:
+    """The same statements on LG_LANES members at once (every input a vector), or None when
+    one uses something without a vector version (a conditional, an unlisted function)."""
+    lines = []
+    for shared, target, code, constant in statements:
+        if any(c in code for c in "?<>=&|!"):
+            return None  # Piecewise, sign, Heaviside: lane-wise selects not printed here
+        if any(name not in _VECTOR_UNARY | _VECTOR_BINARY for name in _CALL.findall(code)):
+            return None
+        code = _CALL.sub(lambda m: f"lg_v_{m.group(1)}(", code)
+        if constant:
+            code = f"LG_VD({code})"
+        lines.append(f"    {'const lg_vd ' if shared else ''}{target} = {code};")
     return "\n".join(lines)
+
+
+VECTOR_HEADER = r"""
+/* Several ensemble members at once, each operation on all lanes: four with AVX (a native
+ * build), else two (one SSE2 instruction). */
+#define LG_VECTOR 1
+#if defined(__AVX__)
+#define LG_LANES 4
+typedef double lg_vd __attribute__((vector_size(32)));
+typedef long long lg_vi __attribute__((vector_size(32)));
+static const lg_vd LG_VNEG0 = {-0.0, -0.0, -0.0, -0.0};
+#else
+#define LG_LANES 2
+typedef double lg_vd __attribute__((vector_size(16)));
+typedef long long lg_vi __attribute__((vector_size(16)));
+static const lg_vd LG_VNEG0 = {-0.0, -0.0};
+#endif
+/* A number or a vector as a vector: x + (-0) is x for every x, -0 included. */
+#define LG_VD(x) ((x) + LG_VNEG0)
+
+static inline lg_vd lg_vsel(lg_vi mask, lg_vd a, lg_vd b)  /* mask ? a : b, lane by lane */
+{
+    return (lg_vd)(((lg_vi)a & mask) | ((lg_vi)b & ~mask));
+}
+
+#define LG_VUNARY(name) \
+    static inline lg_vd lg_v_##name(lg_vd x) \
+    { lg_vd r; for (int l = 0; l < LG_LANES; l++) r[l] = name(x[l]); return r; }
+#define LG_VBINARY(name) \
+    static inline lg_vd lg_v2_##name(lg_vd x, lg_vd y) \
+    { lg_vd r; for (int l = 0; l < LG_LANES; l++) r[l] = name(x[l], y[l]); return r; }
+LG_VUNARY(tan) LG_VUNARY(asin) LG_VUNARY(acos) LG_VUNARY(atan) LG_VUNARY(exp) LG_VUNARY(log)
+LG_VUNARY(log10) LG_VUNARY(sinh) LG_VUNARY(cosh) LG_VUNARY(tanh) LG_VUNARY(floor)
+LG_VUNARY(ceil) LG_VUNARY(sqrt) LG_VUNARY(exp2) LG_VUNARY(expm1) LG_VUNARY(log2)
+LG_VUNARY(log1p) LG_VUNARY(cbrt) LG_VUNARY(fabs) LG_VUNARY(asinh) LG_VUNARY(acosh)
+LG_VUNARY(atanh) LG_VUNARY(erf) LG_VUNARY(erfc) LG_VUNARY(lgamma) LG_VUNARY(tgamma)
+LG_VBINARY(pow) LG_VBINARY(atan2) LG_VBINARY(hypot) LG_VBINARY(fmax) LG_VBINARY(fmin)
+#define lg_v_pow(x, y) lg_v2_pow(LG_VD(x), LG_VD(y))
+#define lg_v_atan2(x, y) lg_v2_atan2(LG_VD(x), LG_VD(y))
+#define lg_v_hypot(x, y) lg_v2_hypot(LG_VD(x), LG_VD(y))
+#define lg_v_fmax(x, y) lg_v2_fmax(LG_VD(x), LG_VD(y))
+#define lg_v_fmin(x, y) lg_v2_fmin(LG_VD(x), LG_VD(y))
+
+#ifdef LG_LIBM_TRIG
+LG_VUNARY(sin) LG_VUNARY(cos)
+#else
+/* sin and cos on all lanes: Cody-Waite reduction by pi/2 and fdlibm's kernels on
+ * [-pi/4, pi/4] (within an ulp or so of libm); libm lane by lane beyond |x| = 1e5. */
+static inline lg_vd lg_vturn(lg_vd x, int quarter)
+{
+    lg_vd big = {0.0};
+    int reducible = 1;
+    for (int l = 0; l < LG_LANES; l++) reducible &= !(fabs(x[l]) >= 1.0e5);  /* NaN: on */
+    if (!reducible) {
+        for (int l = 0; l < LG_LANES; l++) big[l] = quarter ? cos(x[l]) : sin(x[l]);
+        return big;
+    }
+    const lg_vd n = (x * 6.36619772367581382433e-01 + 6755399441055744.0) - 6755399441055744.0;
+    const lg_vd r = ((x - n * 1.57079632673412561417e+00) - n * 6.07710050630396597660e-11)
+                    - n * 2.02226624871116645580e-21;
+    const lg_vd z = r * r;
+    const lg_vd s = r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03
+        + z * (-1.98412698298579493134e-04 + z * (2.75573137070700676789e-06
+        + z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
+    const lg_vd c = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02
+        + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05
+        + z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09
+        + z * -1.13596475577881948265e-11)))));
+    /* quadrant k = n (+1 for cosine): odd k takes the other kernel, k & 2 flips the sign */
+    const lg_vi k = __builtin_convertvector(n, lg_vi) + quarter;
+    const lg_vd v = lg_vsel((k & 1) != 0, c, s);
+    return (lg_vd)((lg_vi)v ^ ((k & 2) << 62));
+}
+static inline lg_vd lg_v_sin(lg_vd x) { return lg_vturn(x, 0); }
+static inline lg_vd lg_v_cos(lg_vd x) { return lg_vturn(x, 1); }
+#endif
+"""
 
 
 def generate(eom: EquationsOfMotion) -> GeneratedSource:
@@ -189,6 +304,10 @@ def generate(eom: EquationsOfMotion) -> GeneratedSource:
                      *eom.acceleration_rhs])
     targets = ([f"M[{i}]" for i in range(n * n)] + [f"f[{i}]" for i in range(n)]
                + [f"J[{i}]" for i in range(m * n)] + [f"g[{i}]" for i in range(m)])
+    parts_statements = _statements(parts, targets, printer)
+    # M and f on several ensemble members at once, where every function has a vector version
+    # (no constraints: the ensembles' compiled loop integrates unconstrained models only)
+    vector = vector_statements(parts_statements) if m == 0 else None
     energy = c_exprs([eom.kinetic_energy + eom.potential_energy])
     residual = c_exprs([c.expression for c in model.constraints])
     signature = "(const double *restrict q, const double *restrict v, double t, " \
@@ -208,7 +327,7 @@ def generate(eom: EquationsOfMotion) -> GeneratedSource:
         "double *restrict J, double *restrict g)",
         "{",
         "    (void)q; (void)v; (void)t; (void)p; (void)J; (void)g;",
-        _block(parts, targets, printer),
+        _lines(parts_statements),
         "}",
         "",
         f"static double lg_energy{signature})",
@@ -226,6 +345,15 @@ def generate(eom: EquationsOfMotion) -> GeneratedSource:
         "}",
         "",
     ]
+    if vector is not None:
+        body += [VECTOR_HEADER,
+                 "static void lg_vparts(const lg_vd *restrict q, const lg_vd *restrict v, "
+                 "lg_vd t, const lg_vd *restrict p, lg_vd *restrict M, lg_vd *restrict f)",
+                 "{",
+                 "    (void)q; (void)v; (void)t; (void)p;",
+                 vector,
+                 "}",
+                 ""]
     unsupported = printer._not_supported
     if unsupported:
         names = sorted({type(e).__name__ if not isinstance(e, sp.Basic) else str(e.func)

@@ -224,6 +224,19 @@ def test_two_link_mass_matrix_closed_form(tmp_path):
     np.testing.assert_allclose(mass[:, 0, 1], i2 + m2 * (c2**2 + l1 * c2 * np.cos(q2)),
                                rtol=1e-13)
     np.testing.assert_allclose(mass[:, 1, 1], i2 + m2 * c2**2, rtol=1e-13)
+    # Over many turns (the batch's vector sine and cosine in every quadrant): heights
+    # c1 sin q1 and l1 sin q1 + c2 sin(q1 + q2), so V = g (...) and g(q) = dV/dq.
+    q1, q2 = np.linspace(-40, 40, 4001), np.linspace(35, -45, 4001)
+    q = np.column_stack([q1, q2])
+    g = f.parameters["g"]
+    potential = g * (m1 * c1 * np.sin(q1) + m2 * (l1 * np.sin(q1) + c2 * np.sin(q1 + q2)))
+    gravity = g * np.column_stack([m1 * c1 * np.cos(q1) + m2 * (l1 * np.cos(q1)
+                                                                 + c2 * np.cos(q1 + q2)),
+                                   m2 * c2 * np.cos(q1 + q2)])
+    np.testing.assert_allclose(f.potential_energy(q), potential, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(f.gravity(q), gravity, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(f.mass_matrix(q)[:, 0, 1], i2 + m2 * (c2**2 + l1 * c2 * np.cos(q2)),
+                               rtol=1e-13, atol=1e-15)
 
 
 @needs_c

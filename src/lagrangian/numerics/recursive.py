@@ -691,6 +691,8 @@ typedef double lg_v4 __attribute__((vector_size(32)));
 typedef double lg_v4 __attribute__((vector_size(16)));
 #endif
 #define LG_V4(x) ((lg_v4){0.0} + (x))
+typedef long long lg_i4 __attribute__((vector_size(sizeof(lg_v4))));
+typedef unsigned long long lg_u4 __attribute__((vector_size(sizeof(lg_v4))));
 
 static inline lg_v4 lg_vsqrt(lg_v4 x)
 {
@@ -723,12 +725,12 @@ static inline void lg_vsincos(lg_v4 x, lg_v4 *sine, lg_v4 *cosine)
         + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05
         + z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09
         + z * -1.13596475577881948265e-11)))));
-    for (int l = 0; l < LG_LANES; l++) {
-        const double turn[4] = {s[l], c[l], -s[l], -c[l]};
-        const long k = (long)n[l];
-        (*sine)[l] = turn[k & 3];
-        (*cosine)[l] = turn[(k + 1) & 3];
-    }
+    /* the quadrant k = n mod 4 picks (s, c, -s, -c) by bit operations on all lanes at once:
+       odd k swaps sine and cosine, bit 2 of k (of k + 1 for the cosine) flips the sign */
+    const lg_u4 k = (lg_u4)__builtin_convertvector(n, lg_i4);
+    const lg_u4 odd = -(k & 1), si = (lg_u4)s, ci = (lg_u4)c;
+    *sine = (lg_v4)(((odd & ci) | (~odd & si)) ^ ((k & 2) << 62));
+    *cosine = (lg_v4)(((odd & si) | (~odd & ci)) ^ (((k + 1) & 2) << 62));
 }
 """
 

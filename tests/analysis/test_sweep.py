@@ -149,6 +149,26 @@ def test_ensemble_equals_serial_simulations(client, tmp_path):
     assert np.all(np.abs(ds["theta1"].values - 0.3) < 0.05)
 
 
+def test_failing_member_of_an_ensemble_is_recorded_and_the_rest_complete(client):
+    """A lower rod of zero length makes the mass matrix singular: that member is NaN with the
+    time its integration failed, the others equal the single-point simulation."""
+    pendulum = lagrangian.load("double_pendulum")
+    ds = pendulum.sweep({"l2": [1.0, 0.0, 0.5]}, compute="simulate", t_end=1.0, samples=11,
+                        sample={"theta1": "uniform(0.1, 0.5)"}, members=5, seed=1,
+                        trajectories=True, client=client, chunk_size=7)
+    failed = ds.sel(l2=0.0)
+    assert list(failed["status"].values) == ["integration failed at t = 0 s"] * 5
+    assert np.all(np.isnan(failed["final"])) and np.all(np.isnan(failed["trajectory"]))
+    for length, j in itertools.product([1.0, 0.5], range(5)):
+        point = ds.sel(l2=length).isel(member=j)
+        assert point["status"] == "ok"
+        one = pendulum.with_parameters(l2=length).simulate(
+            1.0, initial={"theta1": float(ds["theta1"][j])}, samples=11)
+        np.testing.assert_allclose(point["final"], [*one.q[-1], *one.q_dot[-1]], rtol=1e-12,
+                                   atol=1e-14)
+        assert float(point["invariant_drift"]) == pytest.approx(one.invariant_drift, rel=1e-6)
+
+
 def test_ensemble_loads_the_cached_module_without_generating_c(client, monkeypatch):
     """A second study of the same equations finds the compiled module by the equations' key:
     no C is generated again (that cost seconds per process for larger models)."""

@@ -222,6 +222,11 @@ def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence
         raise ModelError("at least 2 samples", field="samples")
     if chunk_size is None:
         chunk_size = {"modes": 2000, "equilibria": 50, "simulate": 100}[compute]
+        if compute == "simulate":
+            # A compiled ensemble member costs ~0.1 ms and a Dask task a few ms: chunks of up
+            # to 1000 members, at least 8 chunks so that every worker of a small cluster gets some
+            size = int(np.prod([len(v) for _, v in axes], dtype=np.int64)) * max(int(members), 1)
+            chunk_size = min(1000, max(100, -(-size // 8)))
     key = hashlib.sha256(pickle.dumps((model.name, str(eom.lagrangian), compute,
                                        [(n, v.tobytes()) for n, v in axes],
                                        [(n, v.tobytes()) for n, v in draws],

@@ -566,8 +566,11 @@ class _Checker:
         for name, value in answer.equations:
             items.append((f"equation[{name}]", value, None, ""))
         unknown = {s: None for _, symbols in answer.foreign for s in symbols}
-        # A number standing for a measured value (9.81) carries no unit to judge.
-        items = [item for item in items if not _measured(item[1])]
+        # A number standing for a measured value (9.81) carries no unit to judge; in a robot
+        # read from URDF every number is one (its masses and lengths are SI by the format).
+        robot = self.model.kinematic_tree is not None
+        items = [item for item in items
+                 if not (_measured(item[1]) or robot and _numbers(item[1]))]
         issues = answer_unit_issues(self.model, items, unknown)
         return [Finding(issue.item, "wrong", "units_mismatch", issue.message, None)
                 for issue in issues]
@@ -591,6 +594,11 @@ def _measured(expr: sp.Expr) -> bool:
         if p > 12 or q > 12:
             return True
     return bool(expr.atoms(sp.Float))
+
+
+def _numbers(expr: sp.Expr) -> bool:
+    """Contains a number other than 1 and -1."""
+    return bool(expr.atoms(sp.Rational, sp.Float) - {sp.S.One, sp.S.NegativeOne})
 
 
 def _planar(vector):

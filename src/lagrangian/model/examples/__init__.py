@@ -1,7 +1,8 @@
-"""Built-in example models, shipped as model files (TOML) beside this module."""
+"""Built-in example models, shipped as model files (TOML) and robots (URDF) beside this module."""
 
 from __future__ import annotations
 
+import re
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -14,7 +15,7 @@ def _files() -> dict[str, Path]:
     return {
         Path(entry.name).stem: Path(str(entry))
         for entry in folder.iterdir()
-        if entry.name.endswith(".toml")
+        if entry.name.endswith((".toml", ".urdf"))
     }
 
 
@@ -25,7 +26,7 @@ def example_names() -> list[str]:
 
 
 def example_path(name: str) -> Path:
-    """Path of a built-in example's model file."""
+    """Path of a built-in example's model file (or URDF)."""
     files = _files()
     if name not in files:
         raise ModelError(f"no such file or built-in example '{name}'{did_you_mean(name, files)} "
@@ -35,13 +36,23 @@ def example_path(name: str) -> Path:
 
 def example_summary(name: str) -> dict[str, str]:
     """{'name': ..., 'title': ..., 'description': ...} of a built-in example."""
-    data = tomllib.loads(example_path(name).read_text(encoding="utf-8"))
+    path = example_path(name)
+    if path.suffix == ".urdf":  # title and description from its first comment
+        comments = re.findall(r"<!--(.*?)-->", path.read_text(encoding="utf-8"), re.S)
+        text = next((" ".join(c.split()) for c in comments
+                     if not c.strip().startswith("order:")), name)
+        title, _, rest = text.partition(":")
+        return {"name": name, "title": f"{title[:1].upper()}{title[1:]} (URDF)",
+                "description": rest.strip()}
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
     return {"name": name, "title": data.get("name", name),
             "description": data.get("description", "")}
 
 
 def _order(path: Path) -> int:
-    head = path.read_text(encoding="utf-8").splitlines()[:1]
-    if head and head[0].startswith("# order:"):
-        return int(head[0].split(":")[1])
+    head = path.read_text(encoding="utf-8").splitlines()[:2]
+    for line in head:  # "# order: N" (TOML) or "<!-- order: N -->" (URDF)
+        found = re.fullmatch(r"(?:#|<!--)\s*order:\s*(\d+)\s*(?:-->)?\s*", line)
+        if found:
+            return int(found.group(1))
     return 1000

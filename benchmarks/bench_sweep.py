@@ -13,7 +13,11 @@ Run:  python benchmarks/bench_sweep.py [--quick]
      k x k_c sweep and 2,000 ensemble members);
   4. the time per point against a plain Python loop of the single-point API:
      system.with_parameters(k=..., k_c=...).modes() and
-     system.simulate(10, initial={...}) per member.
+     system.simulate(10, initial={...}) per member. For ensembles three figures per member:
+     end to end (the 10^4-member study of 2 with the default cluster's start and close), on
+     the running 2-worker cluster (10^4 members), and marginal there ((t(10^4) - t(2000)) /
+     8000: what one more member costs once the study's fixed costs are paid); and the CPU per
+     member of one 1000-member chunk in this process (evaluate_chunk: the C ensemble loop).
 Times are wall-clock seconds, best of ``--repeat`` runs (1 by default: the cluster start-up is
 part of what a user waits for), with the CPU seconds every process of the run used (this one,
 the workers it started, and for a running cluster its workers, from psutil): on a machine
@@ -129,6 +133,12 @@ def main() -> None:
             b = _timed(lambda c=client: pendulum.sweep(compute="simulate", client=c, **few),
                        args.repeat, client)
             cpu_b = CPU["last"]
+            if workers == 2:
+                big = _timed(lambda c=client: pendulum.sweep(compute="simulate", client=c,
+                                                             **ensemble), args.repeat, client)
+                rows.append((f"simulate, {members:,} x 10 s, running cluster of 2", big,
+                             members, CPU["last"]))
+                marginal = (big - b) / (members - few["members"])
         finally:
             client.close()
             cluster.close()
@@ -138,8 +148,20 @@ def main() -> None:
         rows.append((f"simulate, {few['members']:,} x 10 s, running cluster of {workers}", b,
                      few["members"], cpu_b))
 
+    # one chunk of the ensemble in this process: the C loop and the chunk's bookkeeping
+    from lagrangian.analysis.sweep import SimulationOptions, evaluate_chunk, make_study
+    from lagrangian.api.sweep import with_compiled_module
+
+    study = with_compiled_module(make_study(
+        pendulum._equations, "simulate", {}, sample=ensemble["sample"], members=1000,
+        simulation=SimulationOptions(10.0, samples=201), chunk_size=1000))
+    evaluate_chunk(study, 0, 8)
+    t_chunk = _timed(lambda: evaluate_chunk(study, 0, 1000), 3)
+    rows.append(("one 1000-member chunk in this process (evaluate_chunk)", t_chunk, 1000,
+                 CPU["last"]))
+
     # 4: a plain Python loop of the single-point API
-    loop_points = 20
+    loop_points = 50
     values = list(zip(np.linspace(10, 100, loop_points), np.linspace(1, 10, loop_points),
                       strict=True))
     t_modes = _timed(lambda: [two_mass.with_parameters(k=float(a), k_c=float(b)).modes()
@@ -177,11 +199,15 @@ def main() -> None:
     print(f"modes per point: loop {1e3 * t_modes / loop_points:.2f} ms, sweep "
           f"{1e3 * per_point_sweep:.4f} ms end to end: "
           f"{(t_modes / loop_points) / per_point_sweep:.0f}x")
-    per_member = rows[2][1] / rows[2][2]
-    print(f"simulate per member: loop {1e3 * t_sim / loop_points:.2f} ms, sweep "
-          f"{1e3 * per_member:.3f} ms end to end: {(t_sim / loop_points) / per_member:.1f}x; "
-          f"with a parameter changed per member: loop {1e3 * t_sim_p / loop_points:.2f} ms, "
-          f"{(t_sim_p / loop_points) / per_member:.1f}x")
+    loop, loop_p = t_sim / loop_points, t_sim_p / loop_points
+    print(f"simulate per member, loop of simulate(10): {1e3 * loop:.3f} ms; with a parameter "
+          f"changed per member: {1e3 * loop_p:.3f} ms")
+    running = next(r for r in rows if r[0].startswith(f"simulate, {members:,} x 10 s, running"))
+    for label, per_member in (("end to end (default cluster)", rows[2][1] / rows[2][2]),
+                              ("running cluster of 2", running[1] / running[2]),
+                              ("marginal on the running cluster", marginal)):
+        print(f"  ensemble {label}: {1e3 * per_member:.4f} ms per member: "
+              f"{loop / per_member:.1f}x the loop, {loop_p / per_member:.1f}x with a parameter")
 
 
 if __name__ == "__main__":

@@ -322,6 +322,10 @@ def generate(eom: EquationsOfMotion) -> GeneratedSource:
         "#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION",
         "#include <numpy/arrayobject.h>",
         "#include <math.h>",
+        # No fused multiply-add contraction, whatever -march allows: a native build (ensembles)
+        # then computes what the portable one does, and each vector lane what the scalar loop does.
+        "#pragma GCC optimize(\"fp-contract=off\")",
+        "#pragma STDC FP_CONTRACT OFF",
         "",
         f"static void lg_parts{signature}, double *restrict M, double *restrict f, "
         "double *restrict J, double *restrict g)",

@@ -221,6 +221,11 @@ static inline lg_vd lg_vsel(lg_vi mask, lg_vd a, lg_vd b)  /* mask ? a : b, lane
     return (lg_vd)(((lg_vi)a & mask) | ((lg_vi)b & ~mask));
 }
 
+static inline lg_vd lg_vabs(lg_vd x)  /* every bit but the sign */
+{
+    return (lg_vd)((lg_vi)x & ~(lg_vi)LG_VNEG0);
+}
+
 #define LG_VUNARY(name) \
     static inline lg_vd lg_v_##name(lg_vd x) \
     { lg_vd r; for (int l = 0; l < LG_LANES; l++) r[l] = name(x[l]); return r; }
@@ -246,14 +251,17 @@ LG_VUNARY(sin) LG_VUNARY(cos)
  * [-pi/4, pi/4] (within an ulp or so of libm); libm lane by lane beyond |x| = 1e5. */
 static inline lg_vd lg_vturn(lg_vd x, int quarter)
 {
-    lg_vd big = {0.0};
-    int reducible = 1;
-    for (int l = 0; l < LG_LANES; l++) reducible &= !(fabs(x[l]) >= 1.0e5);  /* NaN: on */
-    if (!reducible) {
+    const lg_vi far = (lg_vabs(x) >= 1.0e5);  /* NaN: not far */
+    long long any = 0;
+    for (int l = 0; l < LG_LANES; l++) any |= far[l];
+    if (any) {
+        lg_vd big;
         for (int l = 0; l < LG_LANES; l++) big[l] = quarter ? cos(x[l]) : sin(x[l]);
         return big;
     }
-    const lg_vd n = (x * 6.36619772367581382433e-01 + 6755399441055744.0) - 6755399441055744.0;
+    /* n = x 2/pi rounded to an integer by adding 1.5 2^52: the sum's low mantissa bits are n */
+    const lg_vd shifted = x * 6.36619772367581382433e-01 + 6755399441055744.0;
+    const lg_vd n = shifted - 6755399441055744.0;
     const lg_vd r = ((x - n * 1.57079632673412561417e+00) - n * 6.07710050630396597660e-11)
                     - n * 2.02226624871116645580e-21;
     const lg_vd z = r * r;
@@ -265,7 +273,7 @@ static inline lg_vd lg_vturn(lg_vd x, int quarter)
         + z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09
         + z * -1.13596475577881948265e-11)))));
     /* quadrant k = n (+1 for cosine): odd k takes the other kernel, k & 2 flips the sign */
-    const lg_vi k = __builtin_convertvector(n, lg_vi) + quarter;
+    const lg_vi k = (lg_vi)shifted + quarter;
     const lg_vd v = lg_vsel((k & 1) != 0, c, s);
     return (lg_vd)((lg_vi)v ^ ((k & 2) << 62));
 }

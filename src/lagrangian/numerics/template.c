@@ -574,11 +574,6 @@ static int lg_ensemble_scalar(const double *P, const double *Y0, npy_intp N, con
  * and dense output; a lane whose member ends takes the next member of the queue. Per lane the
  * arithmetic is lg_dop853's, in the same order. ---- */
 
-static inline lg_vd lg_vabs(lg_vd x)
-{
-    return (lg_vd)((lg_vi)x & ~(lg_vi)LG_VNEG0);  /* every bit but the sign */
-}
-
 static inline lg_vd lg_vmax(lg_vd a, lg_vd b)  /* fmax lane by lane (a NaN loses) */
 {
     return lg_vsel((b > a) | (a != a), b, a);

@@ -105,6 +105,32 @@ def main() -> None:
     rows = []
     print(f"cores: {os.cpu_count()}, load average before: {os.getloadavg()}")
 
+    # 4 first: a plain Python loop of the single-point API, as a user's fresh script runs it
+    # (before this process has started and gathered any cluster)
+    loop_rows = []
+    loop_points = 50
+    values = list(zip(np.linspace(10, 100, loop_points), np.linspace(1, 10, loop_points),
+                      strict=True))
+    t_modes = _timed(lambda: [two_mass.with_parameters(k=float(a), k_c=float(b)).modes()
+                              for a, b in values])
+    cpu_modes = CPU["last"]
+    rng = np.random.default_rng(0)
+    starts = rng.uniform(-1, 1, (loop_points, 2))
+    pendulum.simulate(10.0, samples=201)  # compile once, as the sweep does
+    t_sim = _timed(lambda: [pendulum.simulate(10.0, samples=201, initial={
+        "theta1": float(a), "theta2": float(b)}) for a, b in starts])
+    cpu_sim = CPU["last"]
+    lengths = rng.uniform(0.9, 1.1, loop_points)
+    t_sim_p = _timed(lambda: [pendulum.with_parameters(l1=float(a)).simulate(10.0, samples=201)
+                              for a in lengths])
+    cpu_sim_p = CPU["last"]
+    loop_rows.append((f"loop of System.with_parameters(...).modes(), {loop_points} points",
+                      t_modes, loop_points, cpu_modes))
+    loop_rows.append((f"loop of System.simulate(10 s), {loop_points} members", t_sim,
+                      loop_points, cpu_sim))
+    loop_rows.append((f"loop of System.with_parameters(l1=...).simulate(10 s), {loop_points} "
+                      "members", t_sim_p, loop_points, cpu_sim_p))
+
     # 1-2: end to end, the default cluster started and closed by System.sweep
     t = _timed(lambda: two_mass.sweep({"k": k, "k_c": second}, compute="modes"), args.repeat)
     rows.append((f"modes, two_mass, k x k_c = {points:,} points, default cluster", t, points,
@@ -160,30 +186,7 @@ def main() -> None:
     rows.append(("one 1000-member chunk in this process (evaluate_chunk)", t_chunk, 1000,
                  CPU["last"]))
 
-    # 4: a plain Python loop of the single-point API
-    loop_points = 50
-    values = list(zip(np.linspace(10, 100, loop_points), np.linspace(1, 10, loop_points),
-                      strict=True))
-    t_modes = _timed(lambda: [two_mass.with_parameters(k=float(a), k_c=float(b)).modes()
-                              for a, b in values])
-    cpu_modes = CPU["last"]
-    rng = np.random.default_rng(0)
-    starts = rng.uniform(-1, 1, (loop_points, 2))
-    pendulum.simulate(10.0, samples=201)  # compile once, as the sweep does
-    t_sim = _timed(lambda: [pendulum.simulate(10.0, samples=201, initial={
-        "theta1": float(a), "theta2": float(b)}) for a, b in starts])
-    cpu_sim = CPU["last"]
-    lengths = rng.uniform(0.9, 1.1, loop_points)
-    t_sim_p = _timed(lambda: [pendulum.with_parameters(l1=float(a)).simulate(10.0, samples=201)
-                              for a in lengths])
-    cpu_sim_p = CPU["last"]
-    rows.append((f"loop of System.with_parameters(...).modes(), {loop_points} points", t_modes,
-                 loop_points, cpu_modes))
-    rows.append((f"loop of System.simulate(10 s), {loop_points} members", t_sim, loop_points,
-                 cpu_sim))
-    rows.append((f"loop of System.with_parameters(l1=...).simulate(10 s), {loop_points} members",
-                 t_sim_p, loop_points, cpu_sim_p))
-
+    rows += loop_rows
     print()
     print("| what | wall (s) | wall per point (ms) | CPU (s) | CPU per point (ms) |")
     print("|---|---:|---:|---:|---:|")

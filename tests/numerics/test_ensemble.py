@@ -25,7 +25,8 @@ RTOL = ATOL = 1e-9
 def _module(system):
     """The model's module as ensembles load it (api/sweep.py)."""
     eom = system._equations
-    return compiled.load_keyed(equations_key(eom), lambda: generate(eom), native=ENSEMBLE_NATIVE)
+    return compiled.load_keyed(equations_key(eom), lambda: generate(eom, vector=True),
+                              native=ENSEMBLE_NATIVE)
 
 
 def _one_by_one(module, P, Y0, grid, max_steps=10_000_000):
@@ -82,7 +83,7 @@ def _assert_same(run, rows, rtol):
 def libm_module(pendulum2):
     """The double pendulum's module with libm's sin and cos on the lanes (LG_LIBM_TRIG): the
     vector loop then does each member's arithmetic exactly as the scalar loop."""
-    generated = generate(pendulum2._equations)
+    generated = generate(pendulum2._equations, vector=True)
     return compiled.load(dataclasses.replace(
         generated, source="#define LG_LIBM_TRIG 1\n" + generated.source))
 

@@ -552,9 +552,10 @@ def _equilibria_chunk(study, parametric, values, count):
 # -- ensembles of simulations -------------------------------------------------------------------
 
 
-# Ensembles use the model's module built for this processor (-O3 -march=native, keyed by the
-# CPU: another machine builds its own): with AVX the ensemble loop integrates four members per
-# vector operation instead of two. api/sweep.py builds it on the client, the workers load it.
+# Ensembles use the model's module with the vector kernel (codegen.generate(vector=True)) built
+# for this processor (-O3 -march=native, keyed by the CPU: another machine builds its own): with
+# AVX the ensemble loop integrates four members per vector operation instead of two. api/sweep.py
+# builds it on the client, the workers load it. (native=True names only this module.)
 ENSEMBLE_NATIVE = True
 
 
@@ -580,7 +581,8 @@ def _prepare_simulation(study: Study):
     if fast:
         try:
             # from the on-disk cache the caller filled; a worker on another machine builds it
-            module = compiled.load_keyed(study.compiled_key, lambda: generate(study.eom),
+            module = compiled.load_keyed(study.compiled_key,
+                                         lambda: generate(study.eom, vector=True),
                                          native=ENSEMBLE_NATIVE)
         except (compiled.BackendUnavailable, CodegenError):
             module = None

@@ -56,7 +56,9 @@ def with_compiled_module(study: Study) -> Study:
         return study
     key = equations_key(study.eom)
     try:
-        compiled.load_keyed(key, lambda: generate(study.eom), native=ENSEMBLE_NATIVE)
+        # the module with the vector kernel, built for this processor (its own cache name)
+        compiled.load_keyed(key, lambda: generate(study.eom, vector=True),
+                            native=ENSEMBLE_NATIVE)
     except (CodegenError, compiled.BackendUnavailable):
         return study
     return replace(study, compiled_key=key)

@@ -283,8 +283,10 @@ static inline lg_vd lg_v_cos(lg_vd x) { return lg_vturn(x, 1); }
 """
 
 
-def generate(eom: EquationsOfMotion) -> GeneratedSource:
-    """The C functions lg_parts, lg_energy and lg_residual for these equations."""
+def generate(eom: EquationsOfMotion, vector: bool = False) -> GeneratedSource:
+    """The C functions lg_parts, lg_energy and lg_residual for these equations; with
+    ``vector``, also lg_vparts on several members at once for the ensemble loop (where every
+    function has a vector version and there are no constraints)."""
     model = eom.model
     n, m = len(model.q), len(model.constraints)
     parameters = tuple(p.name for p in model.parameters)
@@ -315,7 +317,7 @@ def generate(eom: EquationsOfMotion) -> GeneratedSource:
     parts_statements = _statements(parts, targets, printer)
     # M and f on several ensemble members at once, where every function has a vector version
     # (no constraints: the ensembles' compiled loop integrates unconstrained models only)
-    vector = vector_statements(parts_statements) if m == 0 else None
+    vector = vector_statements(parts_statements) if vector and m == 0 else None
     energy = c_exprs([eom.kinetic_energy + eom.potential_energy])
     residual = c_exprs([c.expression for c in model.constraints])
     signature = "(const double *restrict q, const double *restrict v, double t, " \

@@ -691,7 +691,6 @@ typedef double lg_v4 __attribute__((vector_size(32)));
 typedef double lg_v4 __attribute__((vector_size(16)));
 #endif
 #define LG_V4(x) ((lg_v4){0.0} + (x))
-typedef long long lg_i4 __attribute__((vector_size(sizeof(lg_v4))));
 typedef unsigned long long lg_u4 __attribute__((vector_size(sizeof(lg_v4))));
 
 static inline lg_v4 lg_vsqrt(lg_v4 x)
@@ -714,7 +713,9 @@ static inline void lg_vsincos(lg_v4 x, lg_v4 *sine, lg_v4 *cosine)
         }
         return;
     }
-    const lg_v4 n = (x * 6.36619772367581382433e-01 + 6755399441055744.0) - 6755399441055744.0;
+    /* n = x 2/pi rounded to an integer by adding 1.5 2^52: the sum's low mantissa bits are n */
+    const lg_v4 shifted = x * 6.36619772367581382433e-01 + 6755399441055744.0;
+    const lg_v4 n = shifted - 6755399441055744.0;
     const lg_v4 r = ((x - n * 1.57079632673412561417e+00) - n * 6.07710050630396597660e-11)
                     - n * 2.02226624871116645580e-21;
     const lg_v4 z = r * r;
@@ -727,7 +728,7 @@ static inline void lg_vsincos(lg_v4 x, lg_v4 *sine, lg_v4 *cosine)
         + z * -1.13596475577881948265e-11)))));
     /* the quadrant k = n mod 4 picks (s, c, -s, -c) by bit operations on all lanes at once:
        odd k swaps sine and cosine, bit 2 of k (of k + 1 for the cosine) flips the sign */
-    const lg_u4 k = (lg_u4)__builtin_convertvector(n, lg_i4);
+    const lg_u4 k = (lg_u4)shifted;
     const lg_u4 odd = -(k & 1), si = (lg_u4)s, ci = (lg_u4)c;
     *sine = (lg_v4)(((odd & ci) | (~odd & si)) ^ ((k & 2) << 62));
     *cosine = (lg_v4)(((odd & si) | (~odd & ci)) ^ (((k + 1) & 2) << 62));

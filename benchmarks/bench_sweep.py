@@ -10,7 +10,7 @@ Run:  python benchmarks/bench_sweep.py [--quick]
   2. 10^4 ten-second double-pendulum simulations (DOP853, rtol = atol = 1e-9, 201 samples,
      theta1 ~ uniform(-1, 1), theta2 ~ uniform(-1, 1)): end to end with the default cluster;
   3. the speed-up from one worker process to two (clusters already running; the 10^5-point
-     k x k_c sweep and 2,000 ensemble members);
+     k x k_c sweep, 2,000 and 10^4 ensemble members, and the marginal cost per member);
   4. the time per point against a plain Python loop of the single-point API:
      system.with_parameters(k=..., k_c=...).modes() and
      system.simulate(10, initial={...}) per member. For ensembles three figures per member:
@@ -144,7 +144,7 @@ def main() -> None:
 
     # 3: clusters already running: one worker, then two
     few = {**ensemble, "members": 2000 // scale}
-    scaling = {}
+    scaling, marginal = {}, {}
     for workers in (1, 2):
         client, cluster = _cluster(workers)
         try:
@@ -159,20 +159,20 @@ def main() -> None:
             b = _timed(lambda c=client: pendulum.sweep(compute="simulate", client=c, **few),
                        args.repeat, client)
             cpu_b = CPU["last"]
-            if workers == 2:
-                big = _timed(lambda c=client: pendulum.sweep(compute="simulate", client=c,
-                                                             **ensemble), args.repeat, client)
-                rows.append((f"simulate, {members:,} x 10 s, running cluster of 2", big,
-                             members, CPU["last"]))
-                marginal = (big - b) / (members - few["members"])
+            big = _timed(lambda c=client: pendulum.sweep(compute="simulate", client=c,
+                                                         **ensemble), args.repeat, client)
+            cpu_big = CPU["last"]
+            marginal[workers] = (big - b) / (members - few["members"])
         finally:
             client.close()
             cluster.close()
-        scaling[workers] = (a, b)
+        scaling[workers] = (a, b, big, marginal[workers])
         rows.append((f"modes, k x k_c = {points:,} points, running cluster of {workers}", a,
                      points, cpu_a))
         rows.append((f"simulate, {few['members']:,} x 10 s, running cluster of {workers}", b,
                      few["members"], cpu_b))
+        rows.append((f"simulate, {members:,} x 10 s, running cluster of {workers}", big,
+                     members, cpu_big))
 
     # one chunk of the ensemble in this process: the C loop and the chunk's bookkeeping
     from lagrangian.analysis.sweep import SimulationOptions, evaluate_chunk, make_study
@@ -195,7 +195,8 @@ def main() -> None:
               f"{1e3 * cpu / count:.3f} |")
     print()
     print(f"load average after: {os.getloadavg()}")
-    for label, index in (("modes 10^5 (k x k_c)", 0), ("simulate", 1)):
+    for label, index in (("modes 10^5 (k x k_c)", 0), (f"simulate {few['members']:,}", 1),
+                         (f"simulate {members:,}", 2), ("simulate, marginal per member", 3)):
         one, two = scaling[1][index], scaling[2][index]
         print(f"speed-up 1 -> 2 workers, {label}: {one / two:.2f}x")
     per_point_sweep = rows[0][1] / rows[0][2]
@@ -205,10 +206,11 @@ def main() -> None:
     loop, loop_p = t_sim / loop_points, t_sim_p / loop_points
     print(f"simulate per member, loop of simulate(10): {1e3 * loop:.3f} ms; with a parameter "
           f"changed per member: {1e3 * loop_p:.3f} ms")
-    running = next(r for r in rows if r[0].startswith(f"simulate, {members:,} x 10 s, running"))
+    running = next(r for r in rows
+                   if r[0] == f"simulate, {members:,} x 10 s, running cluster of 2")
     for label, per_member in (("end to end (default cluster)", rows[2][1] / rows[2][2]),
                               ("running cluster of 2", running[1] / running[2]),
-                              ("marginal on the running cluster", marginal)):
+                              ("marginal on the running cluster", marginal[2])):
         print(f"  ensemble {label}: {1e3 * per_member:.4f} ms per member: "
               f"{loop / per_member:.1f}x the loop, {loop_p / per_member:.1f}x with a parameter")
 

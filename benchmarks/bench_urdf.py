@@ -15,7 +15,7 @@ Default: ``arm.dynamics()``, the recursive algorithms in generated C (numerics/r
 - Per call: one state through the Python API and through Pinocchio's Python bindings (crba,
   rnea, aba), interleaved in one process, best of 7 runs of 2000 calls.
 - Batch: one call on 10^4 states (ours) against a Python loop of 10^4 Pinocchio calls (best
-  of 3 each).
+  of 7 each, alternating).
 """
 
 from __future__ import annotations
@@ -179,7 +179,7 @@ def bench(name: str, symbolic: str | None, states: int, timing: bool = True) -> 
              lambda: [pin.rnea(model, data, x, y, z) for x, y, z in zip(Q, V, A, strict=True)]),
             ("forward dyn", lambda: f.forward_dynamics(Q, V, TAU),
              lambda: [pin.aba(model, data, x, y, z) for x, y, z in zip(Q, V, TAU, strict=True)])]:
-        t_ours, t_pin = side_by_side(mine, theirs, 3, 1)
+        t_ours, t_pin = side_by_side(mine, theirs, 7, 1)
         print(f"    {label:<20} {t_ours * 1e3:9.2f} {t_pin * 1e3:9.2f} {t_pin / t_ours:7.1f}")
 
 

@@ -198,6 +198,30 @@ def vector_statements(statements) -> str | None:
     return "\n".join(lines)
 
 
+_SINCOS_KERNEL = r"""    /* n = x 2/pi rounded to an integer by adding 1.5 2^52 (low mantissa bits: n) */
+    const TYPE shifted = x * 6.36619772367581382433e-01 + 6755399441055744.0;
+    const TYPE n = shifted - 6755399441055744.0;
+    const TYPE r = ((x - n * 1.57079632673412561417e+00) - n * 6.07710050630396597660e-11)
+                   - n * 2.02226624871116645580e-21;
+    const TYPE z = r * r;
+    const TYPE s = r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03
+        + z * (-1.98412698298579493134e-04 + z * (2.75573137070700676789e-06
+        + z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
+    const TYPE c = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02
+        + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05
+        + z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09
+        + z * -1.13596475577881948265e-11)))));
+"""
+
+
+def sincos_kernel(kind: str) -> str:
+    """C statements for x of type ``kind`` (double or a vector of doubles): the quarter turns
+    n = round(x 2/pi) (``shifted``, whose low mantissa bits are n) and fdlibm's kernels
+    s = sin r, c = cos r of the remainder r = x - n pi/2 in [-pi/4, pi/4] (Cody-Waite, three
+    parts): within an ulp or two of libm for |x| < 1e5. Shared by every generated module."""
+    return _SINCOS_KERNEL.replace("TYPE", kind)
+
+
 VECTOR_HEADER = r"""
 /* Several ensemble members at once, each operation on all lanes: four with AVX (a native
  * build), else two (one SSE2 instruction). */
@@ -259,19 +283,7 @@ static inline lg_vd lg_vturn(lg_vd x, int quarter)
         for (int l = 0; l < LG_LANES; l++) big[l] = quarter ? cos(x[l]) : sin(x[l]);
         return big;
     }
-    /* n = x 2/pi rounded to an integer by adding 1.5 2^52: the sum's low mantissa bits are n */
-    const lg_vd shifted = x * 6.36619772367581382433e-01 + 6755399441055744.0;
-    const lg_vd n = shifted - 6755399441055744.0;
-    const lg_vd r = ((x - n * 1.57079632673412561417e+00) - n * 6.07710050630396597660e-11)
-                    - n * 2.02226624871116645580e-21;
-    const lg_vd z = r * r;
-    const lg_vd s = r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03
-        + z * (-1.98412698298579493134e-04 + z * (2.75573137070700676789e-06
-        + z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
-    const lg_vd c = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02
-        + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05
-        + z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09
-        + z * -1.13596475577881948265e-11)))));
+""" + sincos_kernel("lg_vd") + r"""
     /* quadrant k = n (+1 for cosine): odd k takes the other kernel, k & 2 flips the sign */
     const lg_vi k = (lg_vi)shifted + quarter;
     const lg_vd v = lg_vsel((k & 1) != 0, c, s);

@@ -34,6 +34,7 @@ from ..errors import ModelError
 from ..model.model import Model
 from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters
+from .codegen import sincos_kernel
 
 Term = float | str  # a number, or the C name of a value computed before
 VECTOR_LIMIT = 16  # coordinates up to which batches run several states per vector operation
@@ -569,17 +570,7 @@ _SINCOS = r"""
 static inline void lg_sincos(double x, double *sine, double *cosine)
 {
     if (!(fabs(x) < 1.0e5)) { *sine = sin(x); *cosine = cos(x); return; }
-    const double n = (x * 6.36619772367581382433e-01 + 6755399441055744.0) - 6755399441055744.0;
-    const double r = ((x - n * 1.57079632673412561417e+00) - n * 6.07710050630396597660e-11)
-                     - n * 2.02226624871116645580e-21;
-    const double z = r * r;
-    const double s = r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03
-        + z * (-1.98412698298579493134e-04 + z * (2.75573137070700676789e-06
-        + z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
-    const double c = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02
-        + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05
-        + z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09
-        + z * -1.13596475577881948265e-11)))));
+""" + sincos_kernel("double") + r"""
     const double turn[4] = {s, c, -s, -c};
     const long k = (long)n;
     *sine = turn[k & 3];
@@ -713,19 +704,7 @@ static inline void lg_vsincos(lg_v4 x, lg_v4 *sine, lg_v4 *cosine)
         }
         return;
     }
-    /* n = x 2/pi rounded to an integer by adding 1.5 2^52: the sum's low mantissa bits are n */
-    const lg_v4 shifted = x * 6.36619772367581382433e-01 + 6755399441055744.0;
-    const lg_v4 n = shifted - 6755399441055744.0;
-    const lg_v4 r = ((x - n * 1.57079632673412561417e+00) - n * 6.07710050630396597660e-11)
-                    - n * 2.02226624871116645580e-21;
-    const lg_v4 z = r * r;
-    const lg_v4 s = r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03
-        + z * (-1.98412698298579493134e-04 + z * (2.75573137070700676789e-06
-        + z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
-    const lg_v4 c = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02
-        + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05
-        + z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09
-        + z * -1.13596475577881948265e-11)))));
+""" + sincos_kernel("lg_v4") + r"""
     /* the quadrant k = n mod 4 picks (s, c, -s, -c) by bit operations on all lanes at once:
        odd k swaps sine and cosine, bit 2 of k (of k + 1 for the cosine) flips the sign */
     const lg_u4 k = (lg_u4)shifted;

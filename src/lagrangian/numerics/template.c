@@ -154,6 +154,34 @@ static int lg_stages(int first, int last, double t, double h, const double *y, c
     return 0;
 }
 
+/* scipy's select_initial_step (Hairer, Norsett, Wanner II.4): the first step's size from y and
+ * f = y' at t0, heading for t1; -1 where the right-hand side is singular at the trial point. */
+static double lg_initial_step(const double *p, double t0, double t1, const double *y,
+                              const double *f, double rtol, double atol)
+{
+    const double dir = (t1 >= t0) ? 1.0 : -1.0;
+    double d0 = 0.0, d1 = 0.0, d2 = 0.0, len = fabs(t1 - t0), tmp[LG_S], k1[LG_S];
+    for (int i = 0; i < LG_S; i++) {
+        double sc = atol + fabs(y[i]) * rtol;
+        d0 += (y[i] / sc) * (y[i] / sc);
+        d1 += (f[i] / sc) * (f[i] / sc);
+    }
+    d0 = sqrt(d0 / LG_S);
+    d1 = sqrt(d1 / LG_S);
+    double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    if (h0 > len) h0 = len;
+    for (int i = 0; i < LG_S; i++) tmp[i] = y[i] + h0 * dir * f[i];
+    if (lg_rhs(t0 + h0 * dir, tmp, p, k1)) return -1.0;
+    for (int i = 0; i < LG_S; i++) {
+        double sc = atol + fabs(y[i]) * rtol, d = (k1[i] - f[i]) / sc;
+        d2 += d * d;
+    }
+    d2 = sqrt(d2 / LG_S) / h0;
+    double h1 = (d1 <= 1e-15 && d2 <= 1e-15) ? fmax(1e-6, h0 * 1e-3)
+                                             : pow(0.01 / fmax(d1, d2), 1.0 / 8.0);
+    return fmin(fmin(100.0 * h0, h1), len);
+}
+
 /* Integrate from t0 to t1; records every step (te == NULL) or the dense output at te[0..ne).
  * Called without the GIL; takes it back every 256 steps to notice Ctrl-C. */
 static int lg_dop853(const double *p, double t0, double t1, const double *y0, double rtol, double atol,
@@ -179,29 +207,9 @@ static int lg_dop853(const double *p, double t0, double t1, const double *y0, do
             if (lg_push(out, te[ie], y)) return LG_NOMEM;
         return LG_DONE;
     }
-    {   /* scipy's select_initial_step (Hairer, Norsett, Wanner II.4) */
-        double d0 = 0.0, d1 = 0.0, d2 = 0.0, len = fabs(t1 - t0);
-        for (int i = 0; i < LG_S; i++) {
-            double sc = atol + fabs(y[i]) * rtol;
-            d0 += (y[i] / sc) * (y[i] / sc);
-            d1 += (f[i] / sc) * (f[i] / sc);
-        }
-        d0 = sqrt(d0 / LG_S);
-        d1 = sqrt(d1 / LG_S);
-        double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
-        if (h0 > len) h0 = len;
-        for (int i = 0; i < LG_S; i++) tmp[i] = y[i] + h0 * dir * f[i];
-        (*nfev)++;
-        if (lg_rhs(t + h0 * dir, tmp, p, K[1])) return LG_SINGULAR;
-        for (int i = 0; i < LG_S; i++) {
-            double sc = atol + fabs(y[i]) * rtol, d = (K[1][i] - f[i]) / sc;
-            d2 += d * d;
-        }
-        d2 = sqrt(d2 / LG_S) / h0;
-        double h1 = (d1 <= 1e-15 && d2 <= 1e-15) ? fmax(1e-6, h0 * 1e-3)
-                                                 : pow(0.01 / fmax(d1, d2), 1.0 / 8.0);
-        h_abs = fmin(fmin(100.0 * h0, h1), len);
-    }
+    (*nfev)++;
+    h_abs = lg_initial_step(p, t0, t1, y, f, rtol, atol);
+    if (h_abs < 0.0) return LG_SINGULAR;
     for (long long steps = 0;; steps++) {
         if (steps >= max_steps) return LG_MAX_STEPS;
         if ((steps & 255) == 255) {
@@ -699,7 +707,7 @@ static int lg_ensemble_vector(const double *P, const double *Y0, npy_intp N, con
             while (lane->member < 0 && next < N) {
                 npy_intp k = next++;
                 const double *pk = P + k * LG_NP, *y0 = Y0 + k * LG_S;
-                double ys[LG_S], fs[LG_S], tmps[LG_S], k1[LG_S];
+                double ys[LG_S], fs[LG_S];
                 memcpy(ys, y0, sizeof ys);
                 lane->member = k;
                 lane->ie = 0;
@@ -707,26 +715,8 @@ static int lg_ensemble_vector(const double *P, const double *Y0, npy_intp N, con
                 lane->retry = 0;
                 lane->ys = o->traj ? o->traj + k * ne * LG_S : scratch + (npy_intp)l * ne * LG_S;
                 if (lg_rhs(t0, ys, pk, fs)) { lg_vfinish(o, P, te, ne, lane, LG_SINGULAR, t0); continue; }
-                double d0 = 0.0, d1 = 0.0, d2 = 0.0, len = fabs(t1 - t0);
-                for (int i = 0; i < LG_S; i++) {
-                    double sc = atol + fabs(ys[i]) * rtol;
-                    d0 += (ys[i] / sc) * (ys[i] / sc);
-                    d1 += (fs[i] / sc) * (fs[i] / sc);
-                }
-                d0 = sqrt(d0 / LG_S);
-                d1 = sqrt(d1 / LG_S);
-                double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
-                if (h0 > len) h0 = len;
-                for (int i = 0; i < LG_S; i++) tmps[i] = ys[i] + h0 * dir * fs[i];
-                if (lg_rhs(t0 + h0 * dir, tmps, pk, k1)) { lg_vfinish(o, P, te, ne, lane, LG_SINGULAR, t0); continue; }
-                for (int i = 0; i < LG_S; i++) {
-                    double sc = atol + fabs(ys[i]) * rtol, d = (k1[i] - fs[i]) / sc;
-                    d2 += d * d;
-                }
-                d2 = sqrt(d2 / LG_S) / h0;
-                double h1 = (d1 <= 1e-15 && d2 <= 1e-15) ? fmax(1e-6, h0 * 1e-3)
-                                                         : pow(0.01 / fmax(d1, d2), 1.0 / 8.0);
-                lane->h_abs = fmin(fmin(100.0 * h0, h1), len);
+                lane->h_abs = lg_initial_step(pk, t0, t1, ys, fs, rtol, atol);
+                if (lane->h_abs < 0.0) { lg_vfinish(o, P, te, ne, lane, LG_SINGULAR, t0); continue; }
                 t[l] = t0;
                 for (int i = 0; i < LG_S; i++) { y[i][l] = ys[i]; f[i][l] = fs[i]; }
                 for (int j = 0; j < LG_NP; j++) p[j][l] = pk[j];

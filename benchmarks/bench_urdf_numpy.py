@@ -10,7 +10,6 @@ alternation in one process (the same load for all); the load average is printed 
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -21,21 +20,10 @@ import lagrangian
 from lagrangian.numerics.recursive import RecursiveDynamics
 from lagrangian.numerics.recursive_numpy import RecursiveNumpyDynamics
 
+sys.path.insert(0, str(Path(__file__).parent))
+from bench_urdf import load_average, robots_folder  # noqa: E402 (the sibling benchmark's)
+
 LOCK = {"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}
-
-
-def robots_folder() -> Path:
-    import pinocchio
-
-    for parent in Path(pinocchio.__file__).resolve().parents:
-        candidate = parent / "share/example-robot-data/robots"
-        if candidate.is_dir():
-            return candidate
-    sys.exit("example-robot-data not found (pip install example-robot-data)")
-
-
-def load_average() -> str:
-    return " ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
 def per_call(functions, number) -> list[float]:

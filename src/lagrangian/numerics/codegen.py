@@ -25,6 +25,18 @@ TEMPLATE = Path(__file__).with_name("template.c")
 _EXPAND_POW = create_expand_pow_optimization(4)
 
 
+# Characters that may carry a user's name into a C comment: none of them can open or close a
+# comment, start a preprocessor line, continue a line (\\), form a trigraph (??) or leave ASCII.
+_COMMENT_SAFE = re.compile(r"[^A-Za-z0-9 _.,:;+=()\[\]-]")
+
+
+def c_comment_text(text: object, limit: int = 60) -> str:
+    """``text`` reduced to characters that are inert inside a C comment (others become '?'),
+    at most ``limit`` characters: a name from a file never reaches C as code."""
+    safe = _COMMENT_SAFE.sub("?", str(text))
+    return safe if len(safe) <= limit else safe[:limit - 3] + "..."
+
+
 class CodegenError(Exception):
     """The equations use a function the C printer cannot express (the numpy backend can)."""
 
@@ -335,7 +347,8 @@ def generate(eom: EquationsOfMotion, vector: bool = False) -> GeneratedSource:
     signature = "(const double *restrict q, const double *restrict v, double t, " \
                 "const double *restrict p"
     body = [
-        f"/* lagrangian: generated C for model {model.name!r} ({n} coordinates, {m} constraints) */",
+        f"/* lagrangian: generated C for model '{c_comment_text(model.name)}' ({n} coordinates, "
+        f"{m} constraints) */",
         f"#define LG_N {n}",
         f"#define LG_M {m}",
         f"#define LG_NP {len(parameters)}",

@@ -4,16 +4,26 @@ equations (load_keyed) or of its source (load).
 The cache lives in ``$LAGRANGIAN_CACHE``, else ``$XDG_CACHE_HOME/lagrangian``, else
 ``~/.cache/lagrangian``; a repeat run (any process) loads the module without generating C and
 without a compiler: the key is computed from the equations before any code is generated.
+
+The cache trusts nothing it finds: the directory must be the user's own and closed to others
+(created 0700), every file is written atomically (temp file + rename, which never follows a link
+at the destination), and a module is loaded only when its SHA-256 matches the digest written
+beside it when this project built it; anything else is rebuilt with one warning line. Builds of
+one module are serialized by a lock file, so two processes never race on it.
 Extension modules (not ctypes) because a ctypes call costs microseconds, METH_FASTCALL ~0.1 us.
 """
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import importlib.util
+import json
 import os
 import shlex
 import shutil
+import signal
+import stat
 import subprocess
 import sys
 import sysconfig
@@ -45,6 +55,11 @@ class CompilerMissing(BackendUnavailable):
     """No C compiler to build with: none on PATH, or $CC names a program that is not there."""
 
 
+class CacheRefused(LagrangianError):
+    """The compiled-module cache directory is not safe to load code from (owned by another user,
+    writable by others, or not a directory): refused, never used and never changed."""
+
+
 def cache_dir() -> Path:
     """Where compiled modules are kept (created on first use)."""
     if os.environ.get("LAGRANGIAN_CACHE"):
@@ -53,11 +68,40 @@ def cache_dir() -> Path:
     return Path(base) / "lagrangian"
 
 
+def trusted_cache_dir() -> Path:
+    """The cache directory, created 0700 where missing; CacheRefused where anyone but this user
+    could have put a module there (another owner, group- or world-writable, a link)."""
+    path = cache_dir()
+    try:
+        path.mkdir(mode=0o700, parents=True, exist_ok=True)
+        info = os.lstat(path)
+    except OSError as exc:
+        raise BackendUnavailable(f"cannot write the compiled-module cache {path}: "
+                                 f"{exc.strerror or exc} (set LAGRANGIAN_CACHE)") from None
+    fault = None
+    if stat.S_ISLNK(info.st_mode):
+        fault = "is a symbolic link"
+    elif not stat.S_ISDIR(info.st_mode):
+        fault = "is not a directory"
+    elif hasattr(os, "getuid") and info.st_uid != os.getuid():
+        fault = f"is owned by another user (uid {info.st_uid})"
+    elif info.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        fault = f"is writable by other users (mode {stat.S_IMODE(info.st_mode):o})"
+    if fault:
+        raise CacheRefused(f"the compiled-module cache {path} {fault}: refusing to load code "
+                           "from it (chmod 700 it, or set LAGRANGIAN_CACHE to a directory of "
+                           "your own)")
+    return path
+
+
 def find_compiler() -> list[str] | None:
     """The C compiler command ($CC, Python's own CC, or cc/gcc/clang on PATH), or None.
     A $CC that names no program is None too (never silently another compiler)."""
     if os.environ.get("CC", "").strip():
-        words = shlex.split(os.environ["CC"])
+        try:
+            words = shlex.split(os.environ["CC"])
+        except ValueError:  # an unbalanced quote: no command at all
+            return None
         found = shutil.which(words[0]) if words else None
         return [found, *words[1:]] if found else None
     candidates = [sysconfig.get_config_var("CC"), "cc", "gcc", "clang"]
@@ -110,8 +154,31 @@ def module_name(generated: GeneratedSource) -> str:
     return f"lg_{digest[:24]}"
 
 
+COMPILE_TIMEOUT_S = 600
+
+
 def _run_compiler(command: list[str]) -> subprocess.CompletedProcess:
-    return subprocess.run(command, capture_output=True, text=True, timeout=600)
+    """Run the compiler in its own process group: on a timeout the whole group (the driver and
+    its cc1, as, ld) is killed, not only the driver."""
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               stdin=subprocess.DEVNULL, text=True, start_new_session=True)
+    try:
+        out, err = process.communicate(timeout=COMPILE_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        _kill_group(process)
+        process.communicate()
+        raise subprocess.TimeoutExpired(command, COMPILE_TIMEOUT_S) from None
+    except BaseException:  # Ctrl-C included: no compiler left running
+        _kill_group(process)
+        raise
+    return subprocess.CompletedProcess(command, process.returncode, out, err)
+
+
+def _kill_group(process: subprocess.Popen) -> None:
+    try:
+        os.killpg(process.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        process.kill()
 
 
 def check_compiler() -> list[str]:
@@ -121,6 +188,11 @@ def check_compiler() -> list[str]:
         return compiler
     cc = os.environ.get("CC", "").strip()
     if cc:
+        try:
+            shlex.split(cc)
+        except ValueError:
+            raise CompilerMissing(f"CC={cc!r} is not a command (unbalanced quote; unset CC, or "
+                                  "point it at gcc or clang)") from None
         raise CompilerMissing(f"CC={cc!r} names no program on PATH (unset CC, or point it at gcc "
                               "or clang)")
     raise CompilerMissing("no C compiler found (set CC, or install gcc or clang)")
@@ -141,7 +213,6 @@ def _compile_with(source: str, name: str, target: Path, flags: tuple[str, ...]) 
     compiler = check_compiler()
     includes = [f"-I{d}" for d in _include_dirs()]
     extra = ["-undefined", "dynamic_lookup"] if sys.platform == "darwin" else []
-    target.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=target.parent, prefix=".build-") as tmp:
         c_file = Path(tmp) / f"{name}.c"
         c_file.write_text(f"#define LG_MODULE {name}\n{source}")
@@ -156,8 +227,61 @@ def _compile_with(source: str, name: str, target: Path, flags: tuple[str, ...]) 
             who = f"the C compiler CC={cc!r}" if cc else f"the C compiler {compiler[0]}"
             raise BackendUnavailable(f"compiling the generated C failed ({who}):\n"
                                      + (done.stderr or done.stdout or "no output")[-2000:])
-        shutil.copyfile(c_file, target.with_suffix(".c"))  # kept for inspection
-        os.replace(built, target)  # atomic: a concurrent process sees all or nothing
+        # the digest first, then the module, then the source kept for inspection; each by
+        # rename, which replaces a planted link rather than writing through it
+        _write_atomic(_digest_path(target), json.dumps(
+            {"module": target.name, "sha256": _file_digest(built)}).encode())
+        os.replace(built, target)
+        _write_atomic(target.with_suffix(".c"), c_file.read_bytes())
+
+
+def _write_atomic(path: Path, data: bytes) -> None:
+    """Write ``data`` to a new file beside ``path`` (0600, never through a link) and rename it
+    over ``path``: a reader sees the old file or the whole new one."""
+    descriptor, temporary = tempfile.mkstemp(dir=path.parent, prefix=".tmp-")
+    try:
+        with os.fdopen(descriptor, "wb") as handle:
+            handle.write(data)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def _digest_path(module: Path) -> Path:
+    return module.with_name(module.name.split(".", 1)[0] + ".sha256")
+
+
+def _file_digest(path: Path) -> str:
+    with open(path, "rb") as handle:
+        return hashlib.file_digest(handle, "sha256").hexdigest()
+
+
+def verify_module(path: Path) -> str | None:
+    """Why the cached module at ``path`` must not be loaded, or None when it is a regular file
+    of this user's whose SHA-256 is the digest recorded when this project built it."""
+    try:
+        info = os.lstat(path)
+    except FileNotFoundError:
+        return "missing"
+    if not stat.S_ISREG(info.st_mode):
+        return "not a regular file"
+    if hasattr(os, "getuid") and info.st_uid != os.getuid():
+        return "owned by another user"
+    try:
+        digest_info = os.lstat(_digest_path(path))
+        if not stat.S_ISREG(digest_info.st_mode) or digest_info.st_size > 4096:
+            return "its digest is not a small regular file"
+        recorded = json.loads(_digest_path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return "no digest recorded beside it"
+    except (OSError, ValueError):
+        return "its digest cannot be read"
+    if not isinstance(recorded, dict) or recorded.get("module") != path.name:
+        return "its digest names another module"
+    if recorded.get("sha256") != _file_digest(path):
+        return "its content does not match its digest (truncated or replaced)"
+    return None
 
 
 def load(generated: GeneratedSource) -> ModuleType:
@@ -193,36 +317,90 @@ def load_keyed(key: str, make_source: Callable[[], GeneratedSource],
 
 def _load_or_build(name: str, make_source: Callable[[], GeneratedSource],
                    native: bool = False) -> ModuleType:
-    """The module ``name``: in memory, else the cached file, else built from ``make_source()``
-    (called only then, after the compiler is found: without one the C would be wasted)."""
+    """The module ``name``: in memory, else the cached file once verified, else built from
+    ``make_source()`` (called only then, after the compiler is found: without one the C would
+    be wasted). One process builds a module at a time (a lock file beside it)."""
     if name in _LOADED:
         return _LOADED[name]
-    suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
-    path = cache_dir() / f"{name}{suffix}"
-    if path.exists():
-        try:
-            module = _import(name, path)
-        except ImportError:  # a stale or foreign file: built again below
-            path.unlink(missing_ok=True)
-        else:
-            _LOADED[name] = module
-            return module
     if sys.platform == "win32":
         raise BackendUnavailable("the C backend is not supported on Windows yet")
+    suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
+    path = trusted_cache_dir() / f"{name}{suffix}"
+    module = _load_verified(name, path, quiet=True)
+    if module is not None:
+        return module
     check_compiler()
     _include_dirs()
-    generated = make_source()
     try:
-        _compile(generated.source, name, path, native)
+        with _build_lock(path):
+            # another process may have built it while this one waited for the lock
+            module = _load_verified(name, path, quiet=False)
+            if module is not None:
+                return module
+            generated = make_source()
+            _compile(generated.source, name, path, native)
     except OSError as exc:
         raise BackendUnavailable(f"cannot write the compiled-module cache {path.parent}: "
                                  f"{exc.strerror or exc} (set LAGRANGIAN_CACHE)") from None
+    if verify_module(path) is not None:  # replaced between the build and the load
+        raise BackendUnavailable(f"the compiled module {path} changed after it was built")
     try:
         module = _import(name, path)
     except ImportError as exc:
         raise BackendUnavailable(f"cannot load the compiled module {path}: {exc}") from None
     _LOADED[name] = module
     return module
+
+
+_WARNED: set[str] = set()
+
+
+def _load_verified(name: str, path: Path, quiet: bool) -> ModuleType | None:
+    """The cached module if it passes verify_module and imports; else None, with one warning
+    line for a file that is there but failed (``quiet``: not yet, the caller checks again)."""
+    fault = verify_module(path)
+    if fault is None:
+        try:
+            module = _import(name, path)
+        except ImportError as exc:  # built for another Python, or damaged in a verified way
+            fault = f"it does not load ({str(exc).splitlines()[0] if str(exc) else 'ImportError'})"
+        else:
+            _LOADED[name] = module
+            return module
+    if fault != "missing" and not quiet and name not in _WARNED:
+        _WARNED.add(name)
+        print(f"warning: the cached compiled module {path.name} was not loaded ({fault}); "
+              "rebuilding it", file=sys.stderr)
+    return None
+
+
+class _build_lock:
+    """An exclusive lock on <module>.lock in the cache (fcntl.flock: released by the kernel if
+    the process dies), so concurrent builds of one module happen once."""
+
+    def __init__(self, module: Path):
+        self.path = module.with_name(module.name.split(".", 1)[0] + ".lock")
+        self.descriptor = -1
+
+    def __enter__(self):
+        import fcntl  # POSIX only, as the C backend is
+
+        flags = os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+        try:
+            self.descriptor = os.open(self.path, flags, 0o600)
+        except OSError as exc:
+            if exc.errno != errno.ELOOP:
+                raise
+            raise BackendUnavailable(f"the cache's lock file {self.path} is a symbolic link: "
+                                     "refusing to use it") from None
+        fcntl.flock(self.descriptor, fcntl.LOCK_EX)
+        return self
+
+    def __exit__(self, *exc_info):
+        import fcntl
+
+        fcntl.flock(self.descriptor, fcntl.LOCK_UN)
+        os.close(self.descriptor)
 
 
 def _import(name: str, path: Path) -> ModuleType:

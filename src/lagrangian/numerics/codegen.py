@@ -31,9 +31,10 @@ _COMMENT_SAFE = re.compile(r"[^A-Za-z0-9 _.,:;+=()\[\]-]")
 
 
 def c_comment_text(text: object, limit: int = 60) -> str:
-    """``text`` reduced to characters that are inert inside a C comment (others become '?'),
-    at most ``limit`` characters: a name from a file never reaches C as code."""
-    safe = _COMMENT_SAFE.sub("?", str(text))
+    """``text`` reduced to characters that are inert inside a C comment (others become '_',
+    never '?', which could form a trigraph), at most ``limit`` characters: a name from a file
+    never reaches C as code."""
+    safe = _COMMENT_SAFE.sub("_", str(text))
     return safe if len(safe) <= limit else safe[:limit - 3] + "..."
 
 

@@ -7,8 +7,11 @@ point is missing (its numbers are NaN). xarray is imported here, on the sweep pa
 from __future__ import annotations
 
 import io
+import json
 import os
 import shutil
+import tempfile
+import uuid
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -42,13 +45,56 @@ DESCRIPTIONS = {
 }
 
 
+# The attribute that marks a file or store as a study this project wrote: the only thing an
+# output path may already hold, since a command never replaces what it did not create.
+WRITTEN_BY = "lagrangian sweep"
+_LEGACY_ATTRS = {"model", "compute", "points", "finished", "failed", "about"}
+
+
 def check_study_path(path: str | Path) -> Path:
-    """The output file of a study: *.nc (NetCDF through h5netcdf) or *.zarr (a Zarr store)."""
+    """The output of a study: *.nc (NetCDF through h5netcdf) or *.zarr (a Zarr store), checked
+    before any work: where something is already there it must be a study this project wrote."""
     path = Path(path)
     if path.suffix.lower() not in STUDY_FORMATS:
         raise ModelError(f"a study is written as NetCDF (*.nc) or Zarr (*.zarr), not '{path}'",
                          field="out")
+    if path.is_symlink():
+        raise ModelError(f"{path} is a symbolic link: refusing to replace it", field="out")
+    if path.exists() and not is_study(path):
+        what = "a directory" if path.is_dir() else "a file"
+        raise ModelError(f"{path} exists and is {what} that is not a study written by lagrangian: "
+                         "refusing to replace it (move it away or choose another --out)",
+                         field="out")
     return path
+
+
+def is_study(path: Path) -> bool:
+    """Whether ``path`` holds a study written by write_study (its attributes say so); reads
+    only the attributes, and never raises on a foreign or damaged file."""
+    try:
+        if path.is_dir():
+            if path.suffix.lower() != ".zarr":
+                return False
+            attrs_file = path / ".zattrs"
+            if attrs_file.is_symlink() or not attrs_file.is_file() \
+                    or attrs_file.stat().st_size > 2**20:
+                return False
+            attrs = json.loads(attrs_file.read_text(encoding="utf-8"))
+        else:
+            if path.suffix.lower() != ".nc":
+                return False
+            import h5py
+
+            with h5py.File(path, "r") as handle:
+                attrs = {k: handle.attrs[k] for k in handle.attrs}
+        if not isinstance(attrs, dict):
+            return False
+        written_by = attrs.get("written_by")
+        if isinstance(written_by, bytes):
+            written_by = written_by.decode("utf-8", "replace")
+        return written_by == WRITTEN_BY or _LEGACY_ATTRS <= set(attrs)
+    except Exception:  # noqa: BLE001 - a file we cannot read is not ours
+        return False
 
 
 def check_study_plot_path(path: str | Path) -> Path:
@@ -99,7 +145,8 @@ def study_dataset(study: Study, arrays: Mapping[str, np.ndarray], finished: int 
     if "time" in extra_sizes:
         options = study.simulation
         coords["time"] = ("time", np.linspace(0.0, options.t_end, options.samples), {"units": "s"})
-    attrs = {"model": model.name, "compute": study.compute, "points": study.size,
+    attrs = {"written_by": WRITTEN_BY, "model": model.name, "compute": study.compute,
+             "points": study.size,
              "about": ", ".join(f"{k}={v:.6g}" for k, v in study.about),
              "finished": study.size if finished is None else int(finished),
              "failed": int(np.sum((status != OK) & (status != NOT_COMPUTED)))}
@@ -112,22 +159,39 @@ def study_dataset(study: Study, arrays: Mapping[str, np.ndarray], finished: int 
 
 
 def write_study(dataset, path: str | Path, *, protect: tuple[Path, ...] = ()) -> Path:
-    """NetCDF (h5netcdf) for *.nc, a Zarr store for *.zarr; written beside and moved into place,
-    so a half-written file never replaces a good one."""
-    path = check_study_path(path)
+    """NetCDF (h5netcdf) for *.nc, a Zarr store for *.zarr; written beside under a fresh name
+    and moved into place, so a half-written file never replaces a good one. What ``path``
+    already holds is replaced only when it is a study this project wrote (check_study_path)."""
+    path = Path(path)
     for guarded in protect:
         if path.exists() and guarded.exists() and path.resolve() == guarded.resolve():
             raise FileExistsError(f"{path}: refusing to overwrite an input file")
     path.parent.mkdir(parents=True, exist_ok=True)
-    temporary = path.with_name(f".{path.name}.tmp")
-    _remove(temporary)
+    path = check_study_path(path)
     if path.suffix.lower() == ".nc":
-        dataset.to_netcdf(temporary, engine="h5netcdf")
-    else:
+        handle, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        os.close(handle)
+        temporary = Path(name)
+        try:
+            dataset.to_netcdf(temporary, engine="h5netcdf")
+            os.replace(temporary, path)  # a file over a file: atomic
+        finally:
+            temporary.unlink(missing_ok=True)
+        return path
+    temporary = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp"))
+    try:
         # Zarr format 2: fixed-width text (status) and consolidated metadata are in its spec.
         dataset.to_zarr(temporary, mode="w", consolidated=True, zarr_format=2)
-    _remove(path)
-    os.replace(temporary, path)
+        old = None
+        if path.exists():  # our own earlier study (checked above): set aside, then removed
+            old = path.with_name(f".{path.name}.old-{uuid.uuid4().hex[:8]}")
+            os.replace(path, old)
+        os.replace(temporary, path)
+        if old is not None:
+            shutil.rmtree(old)
+    finally:
+        if temporary.exists():
+            shutil.rmtree(temporary)
     return path
 
 
@@ -140,13 +204,6 @@ def read_study(path: str | Path):
         return xr.open_zarr(path).load()
     with xr.open_dataset(path, engine="h5netcdf") as dataset:
         return dataset.load()
-
-
-def _remove(path: Path) -> None:
-    if path.is_dir():
-        shutil.rmtree(path)
-    elif path.exists():
-        path.unlink()
 
 
 def study_summary(dataset) -> dict:

@@ -214,6 +214,8 @@ def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence
                              field=f"parameters.{p.name}")
     if not axes and not draws:
         raise ModelError("nothing varies: give at least one name with its values", field="vary")
+    check_study_size([len(v) for _, v in axes] + ([int(members)] if draws else []),
+                     _floats_per_point(compute, len(model.coordinates), simulation))
     if compute == "simulate" and simulation is None:
         raise ModelError("a simulation study needs t_end", field="t_end")
     if compute == "simulate" and not (math.isfinite(simulation.t_end) and simulation.t_end > 0):
@@ -249,6 +251,38 @@ def _known(name: str, allowed: set, parameters: set, what: str, where: str) -> N
 
 
 # -- what each compute returns: variable -> (dims after the study's own, dtype) -----------------
+
+
+# A study's results are assembled in memory (one Dataset): its size is checked before any work,
+# the product of the axes included, so a mistyped count is one line, not an exhausted machine.
+MAX_STUDY_POINTS = 10_000_000
+MAX_STUDY_BYTES = 4 * 2**30
+
+
+def check_study_size(counts: Sequence[int], floats_per_point: int) -> None:
+    """Refuse a study over MAX_STUDY_POINTS points or MAX_STUDY_BYTES of results."""
+    points = math.prod(int(c) for c in counts)
+    grid = " x ".join(str(int(c)) for c in counts)
+    if points > MAX_STUDY_POINTS:
+        raise ModelError(f"{grid} = {points:,} points is more than a study holds (at most "
+                         f"{MAX_STUDY_POINTS:,}); use fewer values or split the study",
+                         field="vary")
+    size = points * floats_per_point * 8
+    if size > MAX_STUDY_BYTES:
+        raise ModelError(f"the results of {grid} points would take {size / 2**30:,.1f} GiB in "
+                         f"memory (at most {MAX_STUDY_BYTES // 2**30} GiB); use fewer points, "
+                         "fewer time samples or no trajectories", field="vary")
+
+
+def _floats_per_point(compute: str, n: int, simulation: SimulationOptions | None) -> int:
+    if compute == "modes":
+        return 3 * n + 1 + n + n * n
+    if compute == "equilibria":
+        return n + 2
+    per = 3 * 2 * n + 3
+    if simulation is not None and simulation.trajectories:
+        per += simulation.samples * 2 * n
+    return per
 
 
 def layout(study: Study) -> dict[str, tuple[tuple[str, ...], str]]:

@@ -276,6 +276,7 @@ def run_study(
     """
     if out is not None:
         check_study_path(out)
+    check_workers(workers)
     study = with_compiled_module(study)
     store = None
     done: set[int] = set()
@@ -338,6 +339,20 @@ def _run_chunks(client, study, todo, pieces, store, finished, progress) -> int:
     return finished
 
 
+# A local cluster's worker processes: more than a few per core only add start-up time and memory.
+WORKERS_PER_CORE = 4
+
+
+def check_workers(workers: int | None) -> None:
+    """Refuse a local cluster of fewer than 1 or more than WORKERS_PER_CORE workers per core."""
+    if workers is None:
+        return
+    most = WORKERS_PER_CORE * (os.cpu_count() or 1)
+    if not 1 <= int(workers) <= most:
+        raise ModelError(f"{workers} workers: give 1 to {most} ({WORKERS_PER_CORE} per core "
+                         "of this machine)", field="workers")
+
+
 class _cluster:
     """The dask Client to use: the caller's, one connected to ``scheduler``, or a LocalCluster
     started here (one single-threaded worker process per core) and closed afterwards."""
@@ -352,10 +367,15 @@ class _cluster:
         from dask.distributed import Client, LocalCluster
 
         if self.scheduler:
+            scheme = self.scheduler.split("://", 1)[0] if "://" in self.scheduler else "tcp"
+            if scheme not in ("tcp", "tls"):
+                raise ModelError(f"the scheduler address must be tcp://HOST:PORT or "
+                                 f"tls://HOST:PORT, not {scheme}://", field="scheduler")
             try:
                 client = Client(self.scheduler, timeout="10s")
-            except (OSError, TimeoutError, ValueError) as exc:  # unreachable, or no address
-                raise ModelError(f"cannot reach the Dask scheduler at {self.scheduler}: {exc}",
+            except Exception as exc:  # noqa: BLE001 - unreachable, no address, TLS without certificates
+                reason = " ".join(str(exc).split())[:200] or type(exc).__name__
+                raise ModelError(f"cannot reach the Dask scheduler at {self.scheduler}: {reason}",
                                  field="scheduler") from None
             self.owned = [client]
             return client

@@ -28,7 +28,7 @@ SWEEP_FLAGS = {
     "compute": "--compute", "t_end": "--t-end", "out": "--out", "plot": "--plot",
     "resume": "--resume", "scheduler": "--scheduler", "stop_when": "--stop-when",
     "method": "--method", "rtol": "--rtol", "atol": "--atol", "initial": "--vary",
-    "about": "--about",
+    "about": "--about", "workers": "--workers",
 }
 VARY_HELP = ("A varied name and its values: NAME=START:STOP:COUNT (COUNT evenly spaced values, "
              "both ends included), NAME=V1,V2,... or NAME=VALUE; units as in --set (0deg:90deg:19).")
@@ -143,8 +143,11 @@ def grid_values(text: str, unit: str | None, field: str) -> list[float]:
             raise ModelError(f"the COUNT of {text!r} must be a whole number of values, at least 1",
                              field=field)
         count = int(parts[2])
-        if count > 100_000_000:
-            raise ModelError(f"{count} values is more than a study holds", field=field)
+        from ..analysis.sweep import MAX_STUDY_POINTS
+
+        if count > MAX_STUDY_POINTS:
+            raise ModelError(f"{count:,} values is more than a study holds (at most "
+                             f"{MAX_STUDY_POINTS:,})", field=field)
         start = parse_quantity(parts[0].strip(), unit, field)
         stop = parse_quantity(parts[1].strip(), unit, field)
         return [float(v) for v in np.linspace(start, stop, count)]

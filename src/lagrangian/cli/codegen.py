@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from ..errors import ModelError
+from ..output.files import atomic_write, check_generated_target
 from . import app
 from .common import load_system
 
@@ -45,8 +46,11 @@ def codegen(
         code = standalone_for(system.model, system.equations_of_motion, system.parameters, name)
     except CodegenError as exc:
         raise ModelError(f"cannot write C: {exc}", field="--lang") from None
+    outputs = [(directory / f"{code.prefix}{suffix}", text)
+               for suffix, text in ((".h", code.header), (".c", code.source))]
+    for path, _ in outputs:  # both checked before either is written
+        check_generated_target(path)
     directory.mkdir(parents=True, exist_ok=True)
-    for suffix, text in ((".h", code.header), (".c", code.source)):
-        path = directory / f"{code.prefix}{suffix}"
-        path.write_text(text, encoding="utf-8")
+    for path, text in outputs:
+        atomic_write(path, text)
         typer.echo(f"wrote {path}")

@@ -36,7 +36,7 @@ def test_workers_are_bounded(cli, workers):
                    "--workers")
 
 
-@pytest.mark.parametrize("address", ["ucx://127.0.0.1:1", "inproc://x", "tls://127.0.0.1:1"])
+@pytest.mark.parametrize("address", ["ucx://127.0.0.1:1", "ws://127.0.0.1:1", "tls://127.0.0.1:1"])
 def test_a_scheduler_address_dask_cannot_use_is_one_line(cli, address):
     one_error_line(cli("sweep", "two_mass", "--vary", "k=1:2:2", "--scheduler", address),
                    "--scheduler")

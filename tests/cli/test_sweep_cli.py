@@ -54,7 +54,7 @@ def test_equilibria_with_units_and_zarr(cli, scheduler, tmp_path):
 def test_ensemble(cli, scheduler, tmp_path):
     out = tmp_path / "ensemble.nc"
     code, stdout, err = cli("sweep", "double_pendulum", "--compute", "simulate", "--t-end", "1",
-                            "--sample", "theta1=normal(0.3,0.01)", "--samples", "4",
+                            "--sample", "theta1=normal(0.3,0.01)", "--members", "4",
                             "--vary", "theta2=0deg,10deg", "--out", str(out), "--json",
                             "--scheduler", scheduler, "--trajectories", "--time-samples", "11")
     assert code == 0, err
@@ -77,9 +77,9 @@ def test_ensemble(cli, scheduler, tmp_path):
     (["--vary", "k=1,2", "--plot", "study.jpg"], "--plot"),
     (["--vary", "k=1,2", "--resume"], "--resume"),
     (["--vary", "k=1,2", "--compute", "spectrum"], "--compute"),
-    (["--compute", "simulate", "--sample", "x1=gauss(0,1)", "--samples", "3", "--t-end", "1"],
+    (["--compute", "simulate", "--sample", "x1=gauss(0,1)", "--members", "3", "--t-end", "1"],
      "--sample x1"),
-    (["--compute", "simulate", "--sample", "x1=normal(0,1)", "--t-end", "1"], "--samples"),
+    (["--compute", "simulate", "--sample", "x1=normal(0,1)", "--t-end", "1"], "--members"),
     (["--compute", "simulate", "--vary", "x1=0,1"], "--t-end"),
     (["--compute", "simulate", "--vary", "x1=0,1", "--t-end", "-1"], "--t-end"),
     (["--compute", "simulate", "--vary", "x1=0,1", "--t-end", "1", "--method", "Euler"],
@@ -96,3 +96,13 @@ def test_bad_input_one_line_naming_the_flag(cli, args, flag, tmp_path, monkeypat
     assert flag in lines[0], lines[0]
     assert "Traceback" not in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_old_samples_flag_still_sets_the_members_with_one_deprecation_line(cli):
+    """--samples meant ensemble members in sweep and time samples in simulate: now --members."""
+    code, stdout, err = cli("sweep", "two_mass", "--compute", "simulate", "--t-end", "0.1",
+                            "--sample", "x1=normal(0,0.01)", "--samples", "2", "--json",
+                            "--workers", "1")
+    assert code == 0, err
+    assert err.startswith("warning: --samples of a sweep is now --members")
+    assert json.loads(stdout)["dimensions"] == {"member": 2}

@@ -368,7 +368,7 @@ class _cluster:
 
         if self.scheduler:
             scheme = self.scheduler.split("://", 1)[0] if "://" in self.scheduler else "tcp"
-            if scheme not in ("tcp", "tls"):
+            if scheme not in ("tcp", "tls", "inproc"):  # inproc: a scheduler in this process
                 raise ModelError(f"the scheduler address must be tcp://HOST:PORT or "
                                  f"tls://HOST:PORT, not {scheme}://", field="scheduler")
             try:

@@ -24,7 +24,7 @@ from .common import (
 
 # The library's field -> this command's flag (before the shared table of common.py).
 SWEEP_FLAGS = {
-    "vary": "--vary", "sample": "--sample", "members": "--samples", "samples": "--time-samples",
+    "vary": "--vary", "sample": "--sample", "members": "--members", "samples": "--time-samples",
     "compute": "--compute", "t_end": "--t-end", "out": "--out", "plot": "--plot",
     "resume": "--resume", "scheduler": "--scheduler", "stop_when": "--stop-when",
     "method": "--method", "rtol": "--rtol", "atol": "--atol", "initial": "--vary",
@@ -45,7 +45,8 @@ def sweep(
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter for the whole study: NAME=VALUE.")] = [],  # noqa: B006,E501
     sample: Annotated[list[str], typer.Option("--sample", help="Ensemble: NAME=normal(MEAN,STD) or NAME=uniform(LOW,HIGH), SI.")] = [],  # noqa: B006,E501
-    samples: Annotated[int, typer.Option("--samples", help="Ensemble members drawn for --sample.")] = 0,
+    members: Annotated[int, typer.Option("--members", help="Ensemble members drawn for --sample.")] = 0,
+    samples: Annotated[int | None, typer.Option("--samples", hidden=True, help="Deprecated: --members.")] = None,  # noqa: E501
     seed: Annotated[int, typer.Option("--seed", help="Seed of the ensemble's draws.")] = 0,
     t_end: Annotated[str | None, typer.Option("--t-end", help="simulate: end time (s, or with a unit).")] = None,  # noqa: E501
     time_samples: Annotated[int, typer.Option("--time-samples", help="simulate: samples of the common time grid.")] = 201,  # noqa: E501
@@ -62,8 +63,14 @@ def sweep(
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
 ) -> None:
     """Evaluate modes, equilibria or simulations over a grid of parameters (and ensembles)."""
+    if samples is not None:  # the old name of --members: one flag, one meaning (--time-samples)
+        typer.echo("warning: --samples of a sweep is now --members (the ensemble's size); "
+                   "--samples will be removed", err=True)
+        if members and members != samples:
+            raise ModelError("give the ensemble's size once, as --members", field="--members")
+        members = samples
     try:
-        _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_end,
+        _run(model, vary, compute, out, plot, json_, set_, sample, members, seed, t_end,
              time_samples, method, rtol, atol, stop_when, trajectories, scheduler, workers,
              resume, chunk_size, about, lock)
     except ModelError as exc:

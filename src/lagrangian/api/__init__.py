@@ -8,6 +8,7 @@ from ..analysis.equilibria import Equilibria, Equilibrium
 from ..analysis.forces import ForceReport
 from ..analysis.linearization import LinearModel, SymbolicLinearModel
 from ..analysis.modes import ModalAnalysis, Mode
+from ..analysis.speed_form import SpeedForm, SpeedSweep
 from ..analysis.statics import StaticsReport
 from ..check.diagnose import CheckReport, Finding
 from ..check.newton_euler import CoordinateAgreement, CrosscheckReport, Reaction
@@ -19,8 +20,13 @@ from ..model.examples import example_names as examples
 from ..model.model import Model
 from ..model.reader import parse_model, read_model
 from ..model.values import ParameterValues, State
+from ..numerics.compiled import BackendUnavailable, CacheRefused, CompilerMissing
+from ..numerics.dynamics import Dynamics
+from ..numerics.events import StopCondition
 from ..numerics.functions import NumericSystem
+from ..numerics.options import SaveAt, StepControl
 from ..numerics.result import SimulationResult
+from ..numerics.standalone import StandaloneSource
 from .simulation import Simulation
 from .system import System, SystemBuilder, load
 
@@ -37,10 +43,14 @@ __all__ = [
     "Model",
     "ParameterValues",
     "State",
+    "SaveAt",
+    "StepControl",
+    "StopCondition",
     # what it returns
     "CheckReport",
     "CoordinateAgreement",
     "CrosscheckReport",
+    "Dynamics",
     "Equilibria",
     "Equilibrium",
     "EquationsOfMotion",
@@ -54,11 +64,17 @@ __all__ = [
     "Reaction",
     "Simulation",
     "SimulationResult",
+    "SpeedForm",
+    "SpeedSweep",
+    "StandaloneSource",
     "StaticsReport",
     "SymbolicLinearModel",
     "UnitIssue",
     "UnitsReport",
     # what it raises
+    "BackendUnavailable",
+    "CacheRefused",
+    "CompilerMissing",
     "DerivationError",
     "LagrangianError",
     "ModelError",

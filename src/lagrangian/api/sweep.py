@@ -91,7 +91,7 @@ class PartialStore:
         if resume:
             if not self.directory.exists():
                 raise ModelError(f"nothing to resume: {self.directory} does not exist (run "
-                                 "without --resume)", field="resume")
+                                 "without resume)", field="resume")
             stored = self._manifest()
             if stored is None:
                 raise ModelError(f"{self.directory} cannot be resumed: its {self.MANIFEST} is "

@@ -32,6 +32,7 @@ from ..check.units import UnitsReport, check_model_units
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
 from ..derivation.regularity import require_inertia
+from ..errors import ModelError, did_you_mean
 from ..model.answer import Answer, answer_from_mapping, read_answer
 from ..model.builder import ModelBuilder
 from ..model.examples import example_path
@@ -40,10 +41,12 @@ from ..model.notation import latex_symbol_names
 from ..model.reader import read_model
 from ..model.urdf import example_urdf, read_urdf
 from ..model.values import State, resolve_state
+from ..numerics.codegen import CodegenError
 from ..numerics.dynamics import model_dynamics, recursive_dynamics
 from ..numerics.events import StopCondition
 from ..numerics.functions import NumericSystem, numeric
 from ..numerics.simulate import SaveAt, StepControl, parse_stop_condition, simulate
+from ..numerics.standalone import StandaloneSource
 from ..numerics.static import StaticFunctions
 from .simulation import Simulation
 
@@ -129,29 +132,64 @@ class System:
         t_end: float,
         *,
         initial: Mapping[str, float] | State | None = None,
+        step_control: StepControl | None = None,
+        save_at: SaveAt | None = None,
+        stop_when: str | StopCondition | None = None,
+        progress=None,
         method: str = "DOP853",
         rtol: float = 1e-9,
         atol: float = 1e-9,
         samples: int = 1001,
-        stop_when: str | StopCondition | None = None,
-        progress=None,
     ) -> Simulation:
         """Integrate the equations of motion to ``t_end`` (s); returns a Simulation.
 
         ``initial`` overrides the model's initial/rate values (SI: rad, m, rad/s, m/s; 't' sets
-        the start time); ``stop_when`` is a condition such as "theta < 0" that ends the run.
-        Constrained models are kept on Phi = 0 by projection (see docs/simulation.md).
+        the start time); ``step_control`` (StepControl: method, rtol, atol, max_step) and
+        ``save_at`` (SaveAt: samples) say how to integrate and what to keep (``method``,
+        ``rtol``, ``atol`` and ``samples`` are the same as plain keywords); ``stop_when`` is a
+        condition such as "theta < 0" (or a StopCondition) that ends the run. Constrained models
+        are kept on Phi = 0 by projection (see docs/simulation.md).
         """
         require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
-        step_control = StepControl(method, rtol, atol)
-        save_at = SaveAt(samples)
+        step_control, save_at = _options(step_control, save_at, method, rtol, atol, samples,
+                                         1001)
         stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) \
             else stop_when
         result = simulate(self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
                           progress=progress, functions=self._numeric)
         return Simulation.of(result)
+
+    # -- standalone C for a controller -----------------------------------------------------------
+
+    def to_c(self, prefix: str | None = None, parameters: Mapping[str, float] | None = None
+             ) -> StandaloneSource:
+        """Standalone C99 (header and source, libm only, no allocation) of M(q), the bias
+        C q_dot + g, g(q), inverse and forward dynamics and the energies (SI units);
+        ``prefix`` names the functions (default: from the model's name), ``parameters`` override
+        the model's values compiled in as defaults. Write it with
+        ``lagrangian.output.write_c(code, directory)``."""
+        from ..numerics.standalone import c_prefix, standalone_for
+
+        if prefix is not None and c_prefix(prefix) != prefix:
+            raise ModelError(f"{prefix!r} is not a C identifier (lower-case ASCII letters, digits "
+                             "and _, a letter first, at most 40)", field="prefix")
+        values = dict(self.parameters)
+        for name, value in dict(parameters or {}).items():
+            if name not in values:
+                raise ModelError(f"'{name}' is not a parameter of this model"
+                                 f"{did_you_mean(name, values)}", field="parameters")
+            values[name] = float(value)
+        missing = [k for k, v in values.items() if v is None]
+        if missing:
+            raise ModelError(f"parameters without a value: {', '.join(missing)} (give them with "
+                             "parameters=...)", field="parameters")
+        system = self if not parameters else self.with_parameters(**dict(parameters))
+        try:
+            return standalone_for(system.model, system.equations_of_motion, values, prefix)
+        except CodegenError as exc:
+            raise ModelError(f"cannot write C: {exc}", field="lang") from None
 
     # -- compiled numeric functions -------------------------------------------------------------
 
@@ -294,7 +332,8 @@ class System:
               trajectories: bool = False, out: str | Path | None = None, resume: bool = False,
               scheduler: str | None = None, client=None, workers: int | None = None,
               chunk_size: int | None = None, progress=None,
-              about: Mapping[str, float] | None = None):
+              about: Mapping[str, float] | None = None,
+              step_control: StepControl | None = None, save_at: SaveAt | None = None):
         """A parameter study or ensemble as an xarray Dataset, one dimension per varied name.
 
         ``vary`` maps parameters (and, for ``compute="simulate"``, coordinates and velocities)
@@ -306,7 +345,9 @@ class System:
         'uniform(low, high)'. Runs on Dask: a LocalCluster of one process per core by default,
         ``scheduler`` an address of a running one, ``client`` a dask Client. A failing point is
         NaN with its reason in ``status``. With ``out`` (*.nc or *.zarr) the chunks are kept as
-        they finish and ``resume=True`` continues an interrupted study.
+        they finish and ``resume=True`` continues an interrupted study. ``step_control`` and
+        ``save_at`` (or the plain ``method``, ``rtol``, ``atol``, ``samples``) and ``stop_when`` (a
+        condition or a StopCondition) set each member's simulation, as in System.simulate.
         """
         from ..analysis.sweep import SimulationOptions, make_study
         from ..errors import ModelError
@@ -318,12 +359,13 @@ class System:
         if compute == "simulate":
             if t_end is None:
                 raise ModelError("a simulation study needs t_end (s)", field="t_end")
-            step = StepControl(method, rtol, atol)  # checks the method and tolerances
-            SaveAt(samples)
+            step, save = _options(step_control, save_at, method, rtol, atol, samples, 201)
+            if isinstance(stop_when, StopCondition):
+                stop_when = stop_when.text
             if stop_when is not None:
                 parse_stop_condition(stop_when, self._model)
             options = SimulationOptions(float(t_end), step.method, step.rtol, step.atol,
-                                        int(samples), stop_when, bool(trajectories))
+                                        int(save.samples), stop_when, bool(trajectories))
         study = make_study(eom, compute, vary or {}, sample, members, seed, options, chunk_size,
                            about)
         return run_study(study, out=out, resume=resume, scheduler=scheduler, client=client,
@@ -361,6 +403,33 @@ class System:
         eom = self.equations_of_motion()
         names = latex_symbol_names(self._model)
         return rf"$L = {sp.latex(eom.lagrangian, symbol_names=names)}$"
+
+
+def _options(step_control: StepControl | None, save_at: SaveAt | None, method: str,
+             rtol: float, atol: float, samples: int, samples_default: int
+             ) -> tuple[StepControl, SaveAt]:
+    """The option values from the option types or the plain keywords (a thin shim), never
+    both: a plain keyword that differs from its default beside its option type is refused."""
+    plain = {"method": (method, "DOP853"), "rtol": (rtol, 1e-9), "atol": (atol, 1e-9)}
+    if step_control is not None:
+        if not isinstance(step_control, StepControl):
+            raise ModelError("step_control must be a lagrangian.StepControl",
+                             field="step_control")
+        both = [k for k, (value, default) in plain.items() if value != default]
+        if both:
+            raise ModelError(f"give {', '.join(both)} in step_control or as a keyword, not both",
+                             field="step_control")
+    else:
+        step_control = StepControl(method, rtol, atol)
+    if save_at is not None:
+        if not isinstance(save_at, SaveAt):
+            raise ModelError("save_at must be a lagrangian.SaveAt", field="save_at")
+        if samples != samples_default:
+            raise ModelError("give samples in save_at or as a keyword, not both",
+                             field="save_at")
+    else:
+        save_at = SaveAt(samples)
+    return step_control, save_at
 
 
 class SystemBuilder(ModelBuilder):

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from ..errors import ModelError
-from ..output.files import atomic_write, check_generated_target
+from ..output.files import write_c
 from . import app
 from .common import load_system
 
@@ -26,14 +26,8 @@ def codegen(
 ) -> None:
     """Write M(q), bias C q_dot + g, gravity, inverse and forward dynamics and the energies as
     standalone C (no Python, no allocation, libm only) for embedding in a controller."""
-    from ..numerics.codegen import CodegenError
-    from ..numerics.standalone import c_prefix, standalone_for
-
     if lang.lower() not in LANGUAGES:
         raise ModelError(f"unknown language {lang!r}: use c", field="--lang")
-    if name is not None and c_prefix(name) != name:
-        raise ModelError(f"{name!r} is not a C identifier (letters, digits, _; a letter first)",
-                         field="--name")
     directory = Path(out)
     if directory.exists() and not directory.is_dir():
         raise ModelError("exists and is not a directory", field=f"--out {out}")
@@ -43,14 +37,9 @@ def codegen(
         raise ModelError(f"parameters without a value: {', '.join(missing)} (give them with --set)",
                          field="--set")
     try:
-        code = standalone_for(system.model, system.equations_of_motion, system.parameters, name)
-    except CodegenError as exc:
-        raise ModelError(f"cannot write C: {exc}", field="--lang") from None
-    outputs = [(directory / f"{code.prefix}{suffix}", text)
-               for suffix, text in ((".h", code.header), (".c", code.source))]
-    for path, _ in outputs:  # both checked before either is written
-        check_generated_target(path)
-    directory.mkdir(parents=True, exist_ok=True)
-    for path, text in outputs:
-        atomic_write(path, text)
+        code = system.to_c(name)
+    except ModelError as exc:
+        raise ModelError(exc.message, field={"prefix": "--name", "lang": "--lang"}.get(
+            exc.field or "", exc.field)) from None
+    for path in write_c(code, directory):
         typer.echo(f"wrote {path}")

@@ -63,7 +63,7 @@ def check_study_path(path: str | Path) -> Path:
     if path.exists() and not is_study(path):
         what = "a directory" if path.is_dir() else "a file"
         raise ModelError(f"{path} exists and is {what} that is not a study written by lagrangian: "
-                         "refusing to replace it (move it away or choose another --out)",
+                         "refusing to replace it (move it away or choose another output path)",
                          field="out")
     return path
 

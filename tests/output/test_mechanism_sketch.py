@@ -11,7 +11,7 @@ import pytest
 import sympy as sp
 
 import lagrangian
-from lagrangian.numerics.geometry import mechanism
+from lagrangian.output.geometry import mechanism
 from lagrangian.output.animation import mechanism_animation
 
 

@@ -9,7 +9,7 @@ from PIL import Image
 
 import lagrangian
 from lagrangian.errors import ModelError
-from lagrangian.numerics.geometry import mechanism, spring_end_points
+from lagrangian.output.geometry import mechanism, spring_end_points
 from lagrangian.output.animation import _dashpot, _zigzag, animation_frames
 
 RED = np.array([214, 39, 40])  # matplotlib tab:red, the particles

@@ -10,7 +10,7 @@ from PIL import Image
 import lagrangian
 from lagrangian.cli import main
 from lagrangian.errors import ModelError
-from lagrangian.numerics.geometry import mechanism, view_projection
+from lagrangian.output.geometry import mechanism, view_projection
 from lagrangian.output.animation import check_view
 
 

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.model import Model
-from ..numerics.geometry import ISOMETRIC_VIEW, mechanism, view_projection
+from .geometry import ISOMETRIC_VIEW, mechanism, view_projection
 from ..numerics.result import SimulationResult
 from .files import atomic_write
 

@@ -22,7 +22,7 @@ import sympy as sp
 from ..model.expressions import as_expression
 from ..model.model import Model
 from ..model.values import ParameterValues, resolve_parameters
-from .lambdified import StateFunction
+from ..numerics.lambdified import StateFunction
 
 
 class Frame(NamedTuple):

@@ -110,7 +110,8 @@ def solve_accelerations(
         budget = _Budget(seconds)
         for numerator in numerators[:n]:
             if len(numerator) * len(determinant) > SYMBOLIC_SOLVE_MAX_WORK or \
-                    max(*numerator.degrees(), *determinant.degrees(), 0) > SYMBOLIC_SOLVE_MAX_DEGREE:
+                    max((*numerator.degrees(), *determinant.degrees(), 0)) > \
+                    SYMBOLIC_SOLVE_MAX_DEGREE:  # a tuple: with no generators, max(0) would fail
                 pairs.append((numerator, determinant))
                 continue
             p, q = numerator.cancel(determinant)

@@ -178,6 +178,10 @@ def _symmetric_modes(linear: LinearModel) -> list[Mode]:
     except np.linalg.LinAlgError:
         raise DerivationError("the mass matrix is not positive definite at this equilibrium "
                               "(is the kinetic energy complete and positive?)") from None
+    for k, w2 in enumerate(squared):
+        _require_accurate(k, K @ vectors[:, k] - w2 * (M @ vectors[:, k]),
+                          (np.linalg.norm(K, 2) + abs(w2) * np.linalg.norm(M, 2))
+                          * np.linalg.norm(vectors[:, k]))
     zero = ZERO_SQUARED_TOLERANCE * max(np.abs(squared).max(), 1e-300)
     modes = []
     for w2, vector in zip(squared, vectors.T, strict=True):
@@ -200,7 +204,9 @@ def _state_space_modes(linear: LinearModel) -> list[Mode]:
     p = linear.mass_matrix.shape[0]
     if A.shape[0] == 0:
         return []
+    A = structural_zeros_cleaned(A)
     values, vectors = scipy.linalg.eig(A)
+    vectors = verified_eigenvectors(A, values, vectors)
     scale = max(np.abs(values).max(), 1e-300)
     # Defective zero eigenvalues (rigid-body modes) scatter by ~sqrt(eps); others by ~eps.
     values = np.where(np.abs(values) <= ZERO_TOLERANCE * scale, 0j, values)
@@ -225,6 +231,54 @@ def _state_space_modes(linear: LinearModel) -> list[Mode]:
         dominant = k if values[k].real >= values[j].real else j
         modes.append(_pair_mode(linear, vectors[:p, dominant], values[k], values[j]))
     return modes
+
+
+# A printed eigenpair satisfies its equation to this relative residual, or is refused.
+EIGEN_RESIDUAL_TOLERANCE = 1e-9
+
+
+def structural_zeros_cleaned(A: np.ndarray) -> np.ndarray:
+    """A with round-off entries (|a| <= 64 eps max|A|, the remains of cancelled symbolic terms
+    such as 1e-31 beside entries of 65) set to exact zeros: LAPACK balances and reduces A by
+    its entries, and such noise can steer it to eigenvectors that break A's own kinematic rows."""
+    A = np.array(A, dtype=float)
+    scale = np.abs(A).max(initial=0.0)
+    A[np.abs(A) <= 64 * np.finfo(float).eps * scale] = 0.0
+    return A
+
+
+def verified_eigenvectors(A: np.ndarray, values: np.ndarray, vectors: np.ndarray) -> np.ndarray:
+    """The eigenvectors with each pair's relative residual |A v - s v| / (|A| |v|) checked; a
+    vector that fails is replaced by the null vector of A - s I (the smallest singular
+    vector), and a pair that still fails is refused (DerivationError)."""
+    import scipy.linalg
+
+    vectors = np.array(vectors, dtype=complex)
+    norm = max(np.linalg.norm(A, 2), 1e-300)
+    identity = np.eye(A.shape[0])
+    for k, s in enumerate(values):
+        v = vectors[:, k]
+        if _residual(A, s, v, norm) <= EIGEN_RESIDUAL_TOLERANCE:
+            continue
+        _, _, vh = scipy.linalg.svd(A - s * identity)
+        refined = vh[-1].conj()
+        _require_accurate(k, A @ refined - s * refined, norm * np.linalg.norm(refined))
+        vectors[:, k] = refined
+    return vectors
+
+
+def _residual(A: np.ndarray, s: complex, v: np.ndarray, norm: float) -> float:
+    size = np.linalg.norm(v)
+    return float(np.linalg.norm(A @ v - s * v) / (norm * size)) if size else np.inf
+
+
+def _require_accurate(k: int, residual: np.ndarray, scale: float) -> None:
+    relative = np.linalg.norm(residual) / max(scale, 1e-300)
+    if not relative <= EIGEN_RESIDUAL_TOLERANCE:
+        raise DerivationError(f"eigenpair {k + 1} of the linear model cannot be computed "
+                              f"accurately (relative residual {relative:.1e}, more than "
+                              f"{EIGEN_RESIDUAL_TOLERANCE:g}): the model is ill-conditioned "
+                              "about this point; its mode shapes are not printed")
 
 
 def _pair_mode(linear: LinearModel, vector: np.ndarray, s1: complex, s2: complex | None) -> Mode:

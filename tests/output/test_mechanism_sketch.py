@@ -11,8 +11,8 @@ import pytest
 import sympy as sp
 
 import lagrangian
-from lagrangian.output.geometry import mechanism
 from lagrangian.output.animation import mechanism_animation
+from lagrangian.output.geometry import mechanism
 
 
 def drawn(animation, k: int, label: str) -> list[np.ndarray]:

@@ -9,8 +9,8 @@ from PIL import Image
 
 import lagrangian
 from lagrangian.errors import ModelError
-from lagrangian.output.geometry import mechanism, spring_end_points
 from lagrangian.output.animation import _dashpot, _zigzag, animation_frames
+from lagrangian.output.geometry import mechanism, spring_end_points
 
 RED = np.array([214, 39, 40])  # matplotlib tab:red, the particles
 

@@ -10,8 +10,8 @@ from PIL import Image
 import lagrangian
 from lagrangian.cli import main
 from lagrangian.errors import ModelError
-from lagrangian.output.geometry import mechanism, view_projection
 from lagrangian.output.animation import check_view
+from lagrangian.output.geometry import mechanism, view_projection
 
 
 @pytest.fixture(scope="module")

@@ -130,7 +130,15 @@ class _Solver:
 
 def _newton_step(jacobian: np.ndarray, residual: np.ndarray) -> np.ndarray:
     """-J^+ r for each point: an LU solve where J is square and regular, else the minimum-norm
-    least-squares step (neutral directions do not move, redundant equations are fine)."""
+    least-squares step (neutral directions do not move, redundant equations are fine). A point
+    whose J or r is not finite (outside the model's domain) gets a NaN step: it is dropped as
+    not converged instead of stopping LAPACK for every point."""
+    finite = np.all(np.isfinite(jacobian), axis=(-2, -1)) & np.all(np.isfinite(residual), axis=-1)
+    if not finite.all():
+        step = np.full(residual.shape[:-1] + (jacobian.shape[-1],), np.nan)
+        if finite.any():
+            step[finite] = _newton_step(jacobian[finite], residual[finite])
+        return step
     rows, columns = jacobian.shape[-2:]
     if rows == columns:
         try:

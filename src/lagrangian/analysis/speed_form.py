@@ -347,3 +347,44 @@ def speed_sweep(form: SpeedForm, speeds: Sequence[float], tolerance: float = 1e-
 
 __all__ = ["Crossing", "ReducedLinearModel", "SpeedForm", "SpeedSweep", "reduced_steady_model",
            "speed_form", "speed_sweep"]
+
+
+def speed_study_chunk(eom: EquationsOfMotion, values: Mapping[str, np.ndarray], count: int,
+                      cache: dict) -> dict[str, np.ndarray]:
+    """A parameter study of the model's steady motion ([steady] table): at each point the
+    eigenvalues (1/s) of the reduced equations at the point's speed, sorted by real part
+    (largest first), and whether none grows. ``values`` maps varied names to per-point values;
+    one SpeedForm is fitted per combination of the other parameters (kept in ``cache``)."""
+    steady = eom.model.steady_motion
+    if steady is None:
+        raise ModelError("a study of speeds needs the model's [steady] table (its speed "
+                         "parameter, steady rates and kept coordinates)", field="compute")
+    defaults = {p.name: p.value for p in eom.model.parameters}
+    size = 2 * len(steady.keep)
+    real = np.full((count, size), np.nan)
+    imag = np.full((count, size), np.nan)
+    stable = np.full(count, np.nan)
+    status = np.full(count, "ok", dtype=object)
+    others = sorted(name for name in values if name != steady.speed)
+    for i in range(count):
+        point = {name: float(values[name][i]) for name in values}
+        speed_value = point.get(steady.speed, defaults.get(steady.speed))
+        key = tuple(point[name] for name in others)
+        try:
+            form = cache.get(key)
+            if form is None:
+                base = {name: point[name] for name in others}
+                form = speed_form(eom, dict(steady.about) or None, dict(steady.rates),
+                                  steady.speed, list(steady.keep), base)
+                cache[key] = form
+            if speed_value is None:
+                raise ModelError(f"the speed '{steady.speed}' has no value", field="vary")
+            eigenvalues = form.eigenvalues(float(speed_value))
+        except (ModelError, np.linalg.LinAlgError, ValueError, ArithmeticError) as exc:
+            status[i] = str(exc).splitlines()[0] or type(exc).__name__
+            continue
+        real[i], imag[i] = eigenvalues.real, eigenvalues.imag
+        scale = max(float(np.abs(eigenvalues).max(initial=0.0)), 1e-300)
+        stable[i] = float(not np.any(eigenvalues.real > 1e-9 * scale))
+    return {"eigenvalue_real": real, "eigenvalue_imag": imag, "stable": stable,
+            "status": status}

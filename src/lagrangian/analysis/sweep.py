@@ -49,8 +49,9 @@ from .modes import (
     is_stable,
     modal_analysis,
 )
+from .speed_form import speed_study_chunk
 
-COMPUTES = ("modes", "equilibria", "simulate")
+COMPUTES = ("modes", "equilibria", "simulate", "speeds")
 OK = "ok"
 NOT_COMPUTED = "not computed"
 
@@ -124,6 +125,7 @@ class Study:
     key: str = field(default="", compare=False)
     functions_key: str = field(default="", compare=False)
     about: tuple[tuple[str, float], ...] = ()  # modes: the equilibrium, as System.modes(about)
+    warnings: tuple[str, ...] = field(default=(), compare=False)  # one line each, for the user
 
     @property
     def model(self):
@@ -199,6 +201,9 @@ def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence
         if not isinstance(distribution, Distribution):
             distribution = parse_distribution(distribution, field=f"sample.{name}")
         draws.append((name, distribution.draw(rng, int(members))))
+    if compute == "speeds" and model.steady_motion is None:
+        raise ModelError("compute='speeds' studies the steady motion of the model's [steady] "
+                         "table, and this model has none", field="compute")
     if about and compute != "modes":
         raise ModelError("about names the equilibrium of a modes study", field="about")
     about_values = ()
@@ -214,6 +219,9 @@ def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence
                              field=f"parameters.{p.name}")
     if not axes and not draws:
         raise ModelError("nothing varies: give at least one name with its values", field="vary")
+    speed = model.steady_motion.speed if compute == "speeds" else None
+    warnings = _unused_parameters(eom, [n for n, _ in (*axes, *draws) if n != speed],
+                                  parameters, allow_none=speed in varied)
     check_study_size([len(v) for _, v in axes] + ([int(members)] if draws else []),
                      _floats_per_point(compute, len(model.coordinates), simulation))
     if compute == "simulate" and simulation is None:
@@ -223,7 +231,7 @@ def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence
     if simulation is not None and simulation.samples < 2:
         raise ModelError("at least 2 samples", field="samples")
     if chunk_size is None:
-        chunk_size = {"modes": 2000, "equilibria": 50, "simulate": 100}[compute]
+        chunk_size = {"modes": 2000, "equilibria": 50, "simulate": 100, "speeds": 500}[compute]
         if compute == "simulate":
             # A compiled ensemble member costs ~0.1 ms and a Dask task a few ms: chunks of up
             # to 1000 members, at least 8 chunks so that every worker of a small cluster gets some
@@ -239,7 +247,27 @@ def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence
                                                  compute == "simulate", simulation_kind))
                                    ).hexdigest()[:20]
     return Study(eom, compute, tuple(axes), tuple(draws), simulation, None, int(chunk_size), key,
-                 functions_key, about_values)
+                 functions_key, about_values, warnings)
+
+
+def _unused_parameters(eom: EquationsOfMotion, varied: Sequence[str], parameters: set[str],
+                       allow_none: bool = False) -> tuple[str, ...]:
+    """A warning for each varied parameter the equations do not contain; a study that varies
+    only such parameters would compute the same point again and again, and is refused."""
+    unused = [n for n in varied if n in parameters and n not in eom.parameters_used]
+    if not unused:
+        return ()
+    steady = eom.model.steady_motion
+    hint = ""
+    if steady is not None and steady.speed in unused:
+        hint = (f"; '{steady.speed}' is the speed of the model's steady motion: study the "
+                "eigenvalues against it with compute='speeds'")
+    if len(unused) == len(varied) and not allow_none:
+        names = ", ".join(f"'{n}'" for n in unused)
+        raise ModelError(f"{names} does not appear in the equations of motion: varying it "
+                         f"alone computes the same point again and again{hint}", field="vary")
+    return tuple(f"'{n}' does not appear in the equations of motion: its values change "
+                 f"nothing{hint}" for n in unused)
 
 
 def _known(name: str, allowed: set, parameters: set, what: str, where: str) -> None:
@@ -279,6 +307,8 @@ def _floats_per_point(compute: str, n: int, simulation: SimulationOptions | None
         return 3 * n + 1 + n + n * n
     if compute == "equilibria":
         return n + 2
+    if compute == "speeds":
+        return 4 * n + 1
     per = 3 * 2 * n + 3
     if simulation is not None and simulation.trajectories:
         per += simulation.samples * 2 * n
@@ -294,6 +324,9 @@ def layout(study: Study) -> dict[str, tuple[tuple[str, ...], str]]:
     if study.compute == "equilibria":
         return {"configuration": (("equilibrium", "coordinate"), "f8"),
                 "stable": (("equilibrium",), "f8"), "count": ((), "f8")}
+    if study.compute == "speeds":
+        return {"eigenvalue_real": (("eigenvalue",), "f8"),
+                "eigenvalue_imag": (("eigenvalue",), "f8"), "stable": ((), "f8")}
     out = {"final": (("state",), "f8"), "minimum": (("state",), "f8"),
            "maximum": (("state",), "f8"), "t_final": ((), "f8"), "invariant_drift": ((), "f8"),
            "stop_time": ((), "f8")}
@@ -310,11 +343,13 @@ _PREPARED: dict[str, object] = {}
 def prepared(study: Study):
     """The compiled functions a chunk needs, built once per process and model (every study of
     the same equations shares them)."""
-    key = study.functions_key
+    key = study.functions_key + ("/speeds" if study.compute == "speeds" else "")
     hit = _PREPARED.get(key)
     if hit is None:
         if study.compute == "simulate":
             hit = _prepare_simulation(study)
+        elif study.compute == "speeds":
+            hit = {}  # speed forms fitted so far, by the values of the other parameters
         else:
             hit = ParametricStaticFunctions(study.eom)
         if len(_PREPARED) > 8:
@@ -330,6 +365,8 @@ def evaluate_chunk(study: Study, start: int, stop: int) -> dict[str, np.ndarray]
         return _modes_chunk(study, prepared(study), values, stop - start)
     if study.compute == "equilibria":
         return _equilibria_chunk(study, prepared(study), values, stop - start)
+    if study.compute == "speeds":
+        return speed_study_chunk(study.eom, values, stop - start, prepared(study))
     return _simulation_chunk(study, prepared(study), values, stop - start)
 
 

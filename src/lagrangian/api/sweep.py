@@ -252,7 +252,9 @@ def assemble(study: Study, pieces: dict[int, dict[str, np.ndarray]]):
 
 def _default_extra(study: Study, dims: tuple[str, ...]) -> tuple[int, ...]:
     n = len(study.model.coordinates)
+    steady = study.model.steady_motion
     sizes = {"mode": n, "coordinate": n, "equilibrium": 1, "state": 2 * n,
+             "eigenvalue": 2 * len(steady.keep) if steady is not None else 0,
              "time": study.simulation.samples if study.simulation else 1}
     return tuple(sizes[d] for d in dims)
 

@@ -279,8 +279,13 @@ class System:
     def modes(self, about: Mapping[str, float] | None = None, *,
               steady: Mapping[str, float] | None = None) -> ModalAnalysis:
         """Natural frequencies (rad/s), damping ratios and mode shapes about an equilibrium, or
-        about a steady motion (``steady``: velocity name -> constant rate)."""
+        about a steady motion (``steady``: velocity name -> constant rate). A model with a
+        [steady] table (a bicycle: it has no upright equilibrium at rest) is taken about that
+        steady motion when neither ``about`` nor ``steady`` is given."""
         require_inertia(self.equations_of_motion(), "modes")
+        default = self._model.steady_motion
+        if steady is None and about is None and default is not None:
+            steady, about = dict(default.rates), dict(default.about) or None
         return modal_analysis(self.linearize(about, steady=steady), self._model.name)
 
     def speed_form(self, steady: Mapping[str, float | str] | None = None,

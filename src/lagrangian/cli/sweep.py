@@ -39,7 +39,7 @@ _COUNT = re.compile(r"^\s*\d+\s*$")
 def sweep(
     model: Annotated[str, typer.Argument(help="Model file (TOML or URDF) or built-in example name.")],
     vary: Annotated[list[str], typer.Option("--vary", help=VARY_HELP)] = [],  # noqa: B006
-    compute: Annotated[str, typer.Option("--compute", help="modes, equilibria or simulate.")] = "modes",
+    compute: Annotated[str, typer.Option("--compute", help="modes, equilibria, simulate, or speeds (eigenvalues about the model's [steady] motion).")] = "modes",  # noqa: E501
     out: Annotated[Path | None, typer.Option("--out", help="Write the Dataset: .nc (NetCDF) or .zarr.")] = None,  # noqa: E501
     plot: Annotated[Path | None, typer.Option("--plot", help="Draw frequencies / stability / equilibria against the varied parameter(s): .png.")] = None,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
@@ -77,7 +77,7 @@ def sweep(
         raise _flagged(exc) from None
 
 
-def _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_end,
+def _run(model, vary, compute, out, plot, json_, set_, sample, members, seed, t_end,
          time_samples, method, rtol, atol, stop_when, trajectories, scheduler, workers, resume,
          chunk_size, about, lock=()):
     from ..model.units import parse_quantity
@@ -111,7 +111,7 @@ def _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_
     with _Progress() as progress:
         try:
             dataset = system.sweep(
-                grid, compute, sample=draws, members=samples, seed=seed, t_end=end,
+                grid, compute, sample=draws, members=members, seed=seed, t_end=end,
                 method=method, rtol=rtol, atol=atol, samples=time_samples,
                 stop_when=stop_when, trajectories=trajectories, out=out, resume=resume,
                 scheduler=scheduler, workers=workers, chunk_size=chunk_size,
@@ -122,12 +122,20 @@ def _run(model, vary, compute, out, plot, json_, set_, sample, samples, seed, t_
                      else "")
             typer.echo(f"interrupted{where}", err=True)
             raise SystemExit(130) from None
+    summary = study_summary(dataset)
+    for line in summary.get("warnings", []):
+        typer.echo(f"warning: {line}", err=True)
+    if summary["points"] and not summary["ok"]:  # nothing computed is a failure, not a result
+        from ..errors import DerivationError
+
+        reason, count = max(summary["missing"].items(), key=lambda item: item[1])
+        raise DerivationError(f"none of the {summary['points']} points could be computed "
+                              f"({reason}: {count} points)")
     if plot is not None:
         from ..output.sweep import write_study_plot
 
         write_study_plot(dataset, plot, protect=inputs)
     if json_:
-        summary = study_summary(dataset)
         summary["written"] = {k: str(v) for k, v in (("out", out), ("plot", plot)) if v}
         print_json(summary)
     else:

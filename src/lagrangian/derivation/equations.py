@@ -59,6 +59,18 @@ class EquationsOfMotion:
         return sp.Add(*terms)
 
     @cached_property
+    def parameters_used(self) -> frozenset[str]:
+        """The parameters M, f, the constraints (Phi and its Jacobian, gamma) and the energies
+        contain: a parameter outside this set changes no result (computed on first use)."""
+        parts = [self.mass_matrix, self.forcing, self.constraint_jacobian, self.acceleration_rhs,
+                 self.potential_energy, self.dissipation, *self.kinetic_terms,
+                 *(c.expression for c in self.model.constraints)]
+        if self.component_mass_matrix is not None:
+            parts.append(self.component_mass_matrix)
+        symbols = set().union(*(sp.sympify(part).free_symbols for part in parts))  # sympy objects
+        return frozenset(p.name for p in self.model.parameters if p.symbol in symbols)
+
+    @cached_property
     def _symbolic_accelerations(self):
         from .solve import solve_accelerations
 

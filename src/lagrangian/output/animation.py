@@ -26,9 +26,9 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.model import Model
-from .geometry import ISOMETRIC_VIEW, mechanism, view_projection
 from ..numerics.result import SimulationResult
 from .files import atomic_write
+from .geometry import ISOMETRIC_VIEW, mechanism, view_projection
 
 ANIMATION_FORMATS = (".gif", ".html")
 

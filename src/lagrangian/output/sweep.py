@@ -41,6 +41,10 @@ DESCRIPTIONS = {
                         "integral or the work balance) relative to its size"),
     "stop_time": ("s", "time the stop condition fired (NaN: it did not)"),
     "trajectory": ("SI", "state on the common time grid"),
+    "eigenvalue_real": ("1/s", "real part of each eigenvalue of the reduced equations about the "
+                        "steady motion, largest first (> 0: it grows)"),
+    "eigenvalue_imag": ("rad/s", "imaginary part of each eigenvalue, in the order of "
+                        "eigenvalue_real"),
     "status": ("", "'ok', or why the point has no numbers"),
 }
 
@@ -140,6 +144,8 @@ def study_dataset(study: Study, arrays: Mapping[str, np.ndarray], finished: int 
         coords["coordinate"] = ("coordinate", np.array(coordinates))
     if "equilibrium" in extra_sizes:
         coords["equilibrium"] = ("equilibrium", np.arange(extra_sizes["equilibrium"]))
+    if "eigenvalue" in extra_sizes:
+        coords["eigenvalue"] = ("eigenvalue", np.arange(1, extra_sizes["eigenvalue"] + 1))
     if "state" in extra_sizes:
         coords["state"] = ("state", np.array([*coordinates, *(f"{c}_dot" for c in coordinates)]))
     if "time" in extra_sizes:
@@ -150,6 +156,8 @@ def study_dataset(study: Study, arrays: Mapping[str, np.ndarray], finished: int 
              "about": ", ".join(f"{k}={v:.6g}" for k, v in study.about),
              "finished": study.size if finished is None else int(finished),
              "failed": int(np.sum((status != OK) & (status != NOT_COMPUTED)))}
+    if study.warnings:
+        attrs["warnings"] = "\n".join(study.warnings)
     if study.simulation is not None:
         options = study.simulation
         attrs.update({"invariant": study.eom.invariant_kind, "t_end": options.t_end,
@@ -218,14 +226,17 @@ def study_summary(dataset) -> dict:
     summary = {"model": dataset.attrs.get("model"), "compute": dataset.attrs.get("compute"),
                "dimensions": dims, "points": int(status.size),
                "ok": int(np.sum(status == OK)), "missing": reasons}
-    main = {"modes": "frequency", "equilibria": "count", "simulate": "invariant_drift"}
+    if dataset.attrs.get("warnings"):
+        summary["warnings"] = str(dataset.attrs["warnings"]).split("\n")
+    main = {"modes": "frequency", "equilibria": "count", "simulate": "invariant_drift",
+            "speeds": "eigenvalue_real"}
     name = main.get(str(dataset.attrs.get("compute")))
     if name in dataset:
         values = np.asarray(dataset[name].values, float)
         finite = values[np.isfinite(values)]
         summary[name] = ({"min": float(finite.min()), "max": float(finite.max())}
                          if finite.size else None)
-    if "stable" in dataset and dataset.attrs.get("compute") == "modes":
+    if "stable" in dataset and dataset.attrs.get("compute") in ("modes", "speeds"):
         stable = np.asarray(dataset["stable"].values, float)
         summary["stable_points"] = int(np.sum(stable == 1))
         summary["unstable_points"] = int(np.sum(stable == 0))
@@ -239,7 +250,7 @@ def study_text(dataset, path: Path | None = None) -> str:
              f"points computed"]
     for reason, count in s["missing"].items():
         lines.append(f"  {count} missing: {reason}")
-    for key in ("frequency", "count", "invariant_drift"):
+    for key in ("frequency", "count", "invariant_drift", "eigenvalue_real"):
         if s.get(key):
             lines.append(f"  {key}: {s[key]['min']:.6g} .. {s[key]['max']:.6g}")
     if "stable_points" in s:
@@ -248,6 +259,26 @@ def study_text(dataset, path: Path | None = None) -> str:
     if path is not None:
         lines.append(f"Written to {path}")
     return "\n".join(lines) + "\n"
+
+
+def _speeds_figure(figure, dataset, x):
+    """Real parts (growth) and imaginary parts (frequency) of the eigenvalues against the first
+    varied name, as the benchmark bicycle's eigenvalues against speed are drawn."""
+    axes = figure.subplots(2, 1, sharex=True)
+    figure.set_size_inches(8, 6.4)
+    rest = {d: 0 for d in dataset["status"].dims[1:]}
+    xs = dataset[x].values
+    for ax, name, label in ((axes[0], "eigenvalue_real", "real part (1/s)"),
+                            (axes[1], "eigenvalue_imag", "imaginary part (rad/s)")):
+        variable = dataset[name].isel(rest)
+        for k in variable["eigenvalue"].values:
+            ax.plot(xs, np.asarray(variable.sel(eigenvalue=k).values, float), ".", ms=3,
+                    color=f"C{(k - 1) % 10}")
+        ax.axhline(0.0, color="0.5", lw=0.8)
+        ax.set_ylabel(label)
+    axes[1].set_xlabel(_label(dataset, x))
+    axes[0].set_title(f"eigenvalues of {dataset.attrs.get('model', '')!s} against {x}")
+    return figure
 
 
 def study_figure(dataset):
@@ -263,6 +294,8 @@ def study_figure(dataset):
     if compute == "simulate":
         return _ensemble_figure(figure, dataset, dims)
     x = dims[0]
+    if compute == "speeds":
+        return _speeds_figure(figure, dataset, x)
     others = dims[1:]
     if compute == "equilibria":
         ax = figure.subplots()

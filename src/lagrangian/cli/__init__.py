@@ -52,14 +52,25 @@ from . import simulate as _simulate  # noqa: E402,F401
 from . import speeds as _speeds  # noqa: E402,F401
 from . import statics as _statics  # noqa: E402,F401
 from . import sweep as _sweep  # noqa: E402,F401
-from .common import in_flags  # noqa: E402
+from .common import TerminalText, in_flags  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> None:
     """Console entry point. Every bad input ends with one line `error: ...` and exit status 2:
     the library's errors (bad model, bad values, singular system), the command line's own
     (unknown option, bad or missing value: typer's 6-line box before) and files that cannot be
-    written."""
+    written. Everything printed passes through TerminalText: no control character from a
+    model file reaches the terminal."""
+    streams = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = TerminalText(sys.stdout), TerminalText(sys.stderr)
+    try:
+        _run(argv)
+    finally:
+        sys.stdout, sys.stderr = streams
+
+
+def _run(argv: list[str] | None) -> None:
+    """The command, its errors as one line `error: ...` and its exit status."""
     try:
         code = app(args=argv, prog_name="lagrangian", standalone_mode=False)
     except LagrangianError as exc:

@@ -127,6 +127,51 @@ def warn_if_unphysical(eom: EquationsOfMotion) -> None:
         typer.echo(f"warning: {warning}", err=True)
 
 
+# Characters that a terminal acts on rather than prints: C0 controls but newline and tab, DEL,
+# C1 controls, and the bidirectional overrides and isolates (and marks) that reorder a line.
+# A model's name or any other text from a file (a body, a coordinate, a load) could otherwise
+# clear the screen, move the cursor or print fake text (issue 21, item 13).
+_TERMINAL_CONTROLS = dict.fromkeys(
+    [*range(0x00, 0x09), *range(0x0B, 0x20), 0x7F, *range(0x80, 0xA0),
+     *range(0x202A, 0x202F), *range(0x2066, 0x206A), 0x200E, 0x200F, 0x061C])
+
+
+def terminal_text(text: str) -> str:
+    """``text`` with every character a terminal would act on removed (newline and tab kept)."""
+    return text.translate(_TERMINAL_CONTROLS)
+
+
+class TerminalText:
+    """A text stream that strips terminal controls from everything written to it: the one place
+    where the command line's output (stdout, stderr) meets the terminal. Everything else is the
+    wrapped stream's; rich's progress bars (our own text, their own escape codes) write to the
+    wrapped stream directly (``rich_proxied_file``)."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        if not isinstance(text, str):  # as a text stream: click probes with b""
+            raise TypeError(f"write() argument must be str, not {type(text).__name__}")
+        self._stream.write(terminal_text(text))
+        return len(text)
+
+    def writelines(self, lines: Iterable[str]) -> None:
+        for line in lines:
+            self.write(line)
+
+    @property
+    def rich_proxied_file(self):
+        return self._stream
+
+    @property
+    def buffer(self):  # no way around the filter (click writes bytes to a stream's buffer)
+        raise AttributeError("buffer")
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
 def print_json(document: Any) -> None:
     json.dump(document, sys.stdout, indent=2, allow_nan=False)
     sys.stdout.write("\n")

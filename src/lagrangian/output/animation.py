@@ -29,6 +29,7 @@ from ..model.model import Model
 from ..numerics.result import SimulationResult
 from .files import atomic_write
 from .geometry import ISOMETRIC_VIEW, mechanism, view_projection
+from .plots import plain_text
 
 ANIMATION_FORMATS = (".gif", ".html")
 
@@ -190,7 +191,7 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
     trail_length = max(1, int(fps))
     dots = ax.plot([], [], "o", color="tab:red", markersize=10, label="particles")[0]
     clock = _clock(ax)
-    ax.set_title(result.model_name)
+    ax.set_title(plain_text(result.model_name))
     angles = np.linspace(0, 2 * np.pi, 41)
     circle = np.column_stack([np.cos(angles), np.sin(angles)])
 
@@ -319,7 +320,8 @@ def _space_animation(result, geometry, times, q, v, view, fps):
     ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_yticks([])
-    ax.set_title(f"{result.model_name}\n(azimuth {view[0]:.4g}°, elevation {view[1]:.4g}°)")
+    ax.set_title(plain_text(result.model_name)
+                 + f"\n(azimuth {view[0]:.4g}°, elevation {view[1]:.4g}°)")
     # The world axes at the origin, short and grey, so the viewpoint reads.
     for unit in np.eye(3):
         end = project(unit * 0.3 * half)

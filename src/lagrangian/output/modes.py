@@ -13,6 +13,7 @@ from ..analysis.equilibria import Equilibria
 from ..analysis.modes import ModalAnalysis, Mode
 from ..errors import ModelError
 from .files import atomic_write
+from .plots import plain_text
 
 # The plot shows at most this many modes (the lowest), in a grid of at most PLOT_COLUMNS columns.
 PLOT_MAX_MODES = 12
@@ -206,7 +207,7 @@ def mode_shape_figure(analysis: ModalAnalysis):
         values = [mode.shape[n] for n in names]
         if len(names) <= 12:
             ax.bar(positions, values, color=["tab:blue" if v >= 0 else "tab:red" for v in values])
-            ax.set_xticks(positions, names, fontsize=8)
+            ax.set_xticks(positions, [plain_text(n) for n in names], fontsize=8)
         else:  # a chain of many coordinates reads better as a line
             from matplotlib.ticker import MaxNLocator
 
@@ -222,7 +223,7 @@ def mode_shape_figure(analysis: ModalAnalysis):
         ax.tick_params(labelsize=8)
     for ax in axes[len(modes):]:
         ax.set_visible(False)
-    title = f"Mode shapes of {analysis.model_name}"
+    title = f"Mode shapes of {plain_text(analysis.model_name)}"
     if len(analysis.modes) > len(modes):
         title += f" (lowest {len(modes)} of {len(analysis.modes)} modes)"
     figure.suptitle(title, fontsize=10)

@@ -15,6 +15,18 @@ from .simulation import INVARIANT_WORDS
 PLOT_FORMATS = (".png", ".svg", ".pdf")
 
 
+def plain_text(text: str) -> str:
+    """User text (a model's name, a coordinate's) for a matplotlib label, drawn as written:
+    control characters dropped (no font has a glyph for them), each '$' escaped, so that text
+    between two dollars is never parsed as mathtext (a name such as 'cost $\\frac$' raised a
+    ParseSyntaxException deep in the drawing)."""
+    return str(text).translate(_CONTROLS).replace("$", r"\$")
+
+
+_CONTROLS = dict.fromkeys([*range(0x00, 0x0A), *range(0x0B, 0x20), 0x7F, *range(0x80, 0xA0),
+                           *range(0x202A, 0x202F), *range(0x2066, 0x206A)])
+
+
 def time_history_figure(result: SimulationResult, units: dict[str, str] | None = None):
     """A matplotlib Figure: coordinates (one panel per unit), energy T + V, multipliers.
 
@@ -31,7 +43,7 @@ def time_history_figure(result: SimulationResult, units: dict[str, str] | None =
     axes = figure.subplots(panels, 1, sharex=True, squeeze=False)[:, 0]
     for ax, (unit, indices) in zip(axes, groups.items(), strict=False):
         for i in indices:
-            ax.plot(result.t, result.q[:, i], label=result.coordinates[i])
+            ax.plot(result.t, result.q[:, i], label=plain_text(result.coordinates[i]))
         ax.set_ylabel(f"coordinate ({unit})" if unit else "coordinate")
         _legend_outside(ax)
     ax = axes[len(groups)]
@@ -63,12 +75,12 @@ def time_history_figure(result: SimulationResult, units: dict[str, str] | None =
     if result.constraint_names:
         ax = axes[-1]
         for i, name in enumerate(result.constraint_names):
-            ax.plot(result.t, result.multipliers[:, i], label=f"lambda_{name}")
+            ax.plot(result.t, result.multipliers[:, i], label=plain_text(f"lambda_{name}"))
         ax.set_ylabel("multiplier")
         _legend_outside(ax)
     axes[-1].set_xlabel("t (s)")
     status = "" if result.completed else f" ({result.status})"
-    figure.suptitle(f"{result.model_name}{status}")
+    figure.suptitle(plain_text(f"{result.model_name}{status}"))
     return figure
 
 

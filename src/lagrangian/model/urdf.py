@@ -73,8 +73,11 @@ def _parse(text: str, source: str):
     import yourdfpy
 
     try:
-        urdf = yourdfpy.URDF.load(io.BytesIO(data), build_scene_graph=False, load_meshes=False,
-                                  load_collision_meshes=False, build_collision_scene_graph=False)
+        # a non-finite origin makes trimesh warn while parsing; the joint is named below
+        with np.errstate(all="ignore"):
+            urdf = yourdfpy.URDF.load(io.BytesIO(data), build_scene_graph=False,
+                                      load_meshes=False, load_collision_meshes=False,
+                                      build_collision_scene_graph=False)
     except Exception as exc:  # yourdfpy's own errors are plain exceptions of many kinds
         raise ModelError(f"not a URDF robot ({type(exc).__name__}: {exc})",
                          source=source) from None
@@ -117,13 +120,42 @@ def identifier(name: str) -> str:
 class _Tree:
     def __init__(self, robot, source: str):
         self.source = source
+        # two links or joints of one name would make one of them vanish (urdfdom refuses them)
+        for kind, items in (("link", robot.links), ("joint", robot.joints)):
+            seen: set[str] = set()
+            for item in items:
+                if item.name in seen:
+                    raise self.error(f"two {kind}s are named '{item.name}' (each {kind} needs a "
+                                     "name of its own)", f"{kind} '{item.name}'")
+                seen.add(item.name)
         self.links = {link.name: link for link in robot.links}
         self.joints = list(robot.joints)
         self.by_name = {j.name: j for j in self.joints}
         self.name = robot.name or "URDF robot"
+        for joint in self.joints:
+            self._check_numbers(joint)
 
     def error(self, message: str, field: str | None = None) -> ModelError:
         return ModelError(message, field=field, source=self.source)
+
+    def _check_numbers(self, joint) -> None:
+        """Every number of a joint finite (an origin of inf, a mimic multiplier of nan)."""
+        where = f"joint '{joint.name}'"
+        numbers = (("origin", joint.origin), ("axis", joint.axis))
+        if joint.mimic is not None:
+            numbers += (("mimic.multiplier", joint.mimic.multiplier),
+                        ("mimic.offset", joint.mimic.offset))
+        if joint.limit is not None:
+            numbers += (("limit.lower", joint.limit.lower), ("limit.upper", joint.limit.upper))
+        for name, value in numbers:
+            if value is None:
+                continue
+            try:
+                finite = bool(np.all(np.isfinite(np.asarray(value, dtype=float))))
+            except (TypeError, ValueError):
+                finite = False
+            if not finite:
+                raise self.error("a number that is not finite", f"{where}.{name}")
 
     def _check_tree(self) -> tuple[str, dict[str, list]]:
         parent_of: dict[str, object] = {}
@@ -292,10 +324,10 @@ class _Tree:
         for name, frame in frames.items():
             link = self.links[name]
             inertial = link.inertial
-            if inertial is None or not inertial.mass:
+            if _carries_nothing(inertial):
                 continue
             field = f"link '{name}'.inertial"
-            mass = float(inertial.mass)
+            mass = float(inertial.mass or 0.0)
             tensor = np.asarray(inertial.inertia if inertial.inertia is not None
                                 else np.zeros((3, 3)), dtype=float)
             if not math.isfinite(mass) or mass < 0:
@@ -355,9 +387,9 @@ class _Tree:
         inertias = [[0.0, np.zeros(3), np.zeros((3, 3))] for _ in joints]
         for name, (body, turn, shift) in anchor.items():
             inertial = self.links[name].inertial
-            if body < 0 or inertial is None or not inertial.mass:
+            if body < 0 or _carries_nothing(inertial):
                 continue
-            mass = float(inertial.mass)
+            mass = float(inertial.mass or 0.0)
             where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
                                dtype=float)
             tensor = np.asarray(inertial.inertia if inertial.inertia is not None
@@ -388,6 +420,15 @@ class _Tree:
             gravity_direction=(0.0, 0.0, -1.0),
             actuators=tuple(f"tau_{name}" for name in names.values()),
             rigid_bodies=tuple(bodies))
+
+
+def _carries_nothing(inertial) -> bool:
+    """No inertial, or mass and inertia tensor both zero: a link with mass 0 but a tensor (the
+    Bolt biped's feet) still turns with inertia, as Pinocchio keeps it."""
+    if inertial is None:
+        return True
+    tensor = inertial.inertia if inertial.inertia is not None else np.zeros((3, 3))
+    return not inertial.mass and not np.any(np.asarray(tensor, dtype=float))
 
 
 _KIND = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}

@@ -87,3 +87,36 @@ def test_an_eigenvalue_that_is_not_one_is_refused():
     A = np.array([[2.0, 1.0], [0.0, 3.0]])
     with pytest.raises(lagrangian.DerivationError, match="cannot be computed accurately"):
         verified_eigenvectors(A, np.array([2.5, 3.0]), np.eye(2))
+
+
+@pytest.mark.parametrize("name, steady", [
+    ("rolling_coin", {"spin_dot": 4.0, "x_dot": 1.2}),
+    ("whipple_bicycle", None),  # its [steady] table: straight ahead at v = 5 m/s
+])
+def test_every_mode_keeps_the_linearized_rolling_constraints(name, steady):
+    """About steady rolling the constraints linearize to H dq + G dq_dot = 0; a mode
+    dq = v e^(st) satisfies (H + s G) v = 0 (a heading offset alone does not: the contact point
+    then drifts sideways, so it is no mode), and (s^2 M + s C + K) v lies in the span of G^T."""
+    system = lagrangian.load(name)
+    about = {"lean": 0.0} if steady else None
+    analysis = system.modes(about, steady=steady)
+    linear = analysis.linear_model
+    rows = linear.state_constraints
+    n = len(linear.user_coordinates)
+    H, G = rows[:, :n], rows[:, n:]
+    M, C, K = linear.mass_matrix, linear.damping_matrix, linear.stiffness_matrix
+    constraint_rows = linear.velocity_constraints
+    for mode in analysis.modes:
+        v = np.array(mode.complex_shape)
+        for s in {*mode.eigenvalues, *np.conj(mode.eigenvalues)}:
+            scale = (abs(s) + 1) * (np.linalg.norm(H) + np.linalg.norm(G)) * np.linalg.norm(v)
+            if np.linalg.norm((H + s * G) @ v) <= 1e-9 * scale:
+                break
+        else:
+            pytest.fail(f"mode {mode} breaks the linearized constraints")
+        force = (s * s * M + s * C + K) @ v
+        outside = force - constraint_rows.T @ np.linalg.lstsq(constraint_rows.T, force,
+                                                              rcond=None)[0]
+        size = (abs(s) ** 2 * np.linalg.norm(M) + abs(s) * np.linalg.norm(C)
+                + np.linalg.norm(K)) * np.linalg.norm(v)
+        assert np.linalg.norm(outside) <= 1e-9 * size

@@ -89,26 +89,9 @@ for _name in MODELS:
 COMMANDS = ["derive", "forces", "equilibria", "modes", "modes-steady", "speeds", "statics",
             "simulate", "check", "crosscheck", "units", "dynamics", "codegen", "sweep"]
 
-# Cells that fail today because of defects owned by others (issue 21), kept visible here until
-# those fixes land: xfail(strict=False), so a fix turns them into XPASS, not a failure.
-_JORDAN = ("analysis (steady motion owner): the s = 0 heading mode (yaw = 1, all else 0) breaks "
-           "the linearized rolling constraint, (s A + B) v = B v = (0, -r spin_dot) != 0: at "
-           "s = 0 yaw and y form a Jordan chain (y drifts linearly), so yaw alone is no "
-           "eigenvector; the lean-yaw mode and the other s = 0 modes are right")
-_HEADING = ("analysis (steady motion owner): the s = 0 heading mode (psi = 1, all else 0) breaks "
-            "the linearized rolling constraints (B v != 0: heading and lateral position form a "
-            "Jordan chain at s = 0, y drifts linearly), relative residual 0.64")
-KNOWN = {
-    ("modes", "whipple_bicycle"): _HEADING + " (modes takes the model's [steady] table)",
-    ("modes-steady", "whipple_bicycle"): _HEADING,
-    ("equilibria", "whipple_bicycle"): (
-        "analysis/equilibria (steady motion owner): exit 0, but Newton's trial points outside "
-        "the model's domain leak numpy RuntimeWarnings (divide by zero, invalid value: 30 "
-        "lines with source) on stderr"),
-    ("modes-steady", "rolling_coin"): _JORDAN,
-    ("modes-steady", "coin_steady"): _JORDAN,
-    ("modes", "coin_steady"): _JORDAN + " (modes takes the model's [steady] table)",
-}
+# Cells that fail today because of a known defect: xfail(strict=False) with the defect named,
+# so a fix turns them into XPASS, not a failure. None are known now.
+KNOWN: dict[tuple[str, str], str] = {}
 
 SLOW_MODELS = {"whipple_bicycle"}
 SLOW_COMMANDS = {"simulate", "sweep", "crosscheck", "codegen"}

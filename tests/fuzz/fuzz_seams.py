@@ -210,7 +210,8 @@ def steady_models(draw) -> str:
     head = COIN_STEADY.split("[steady]")[0]
     lines = ["[steady]"]
     if draw(st.booleans()):
-        lines.append(f"speed = {draw(st.one_of(st.sampled_from(['V', 'm', 'spin', 'nope', 'V_dot']).map(json.dumps), _values()))}")
+        names = st.sampled_from(["V", "m", "spin", "nope", "V_dot"]).map(json.dumps)
+        lines.append(f"speed = {draw(st.one_of(names, _values()))}")
     if draw(st.booleans()):
         rates = draw(st.dictionaries(
             st.sampled_from(["spin_dot", "x_dot", "yaw_dot", "lean_dot", "spin", "nope_dot",

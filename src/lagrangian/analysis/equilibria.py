@@ -242,6 +242,13 @@ def find_equilibria(
 
     ``stability(q, lambda) -> bool`` decides stability (the modes module provides it).
     """
+    # Starting points and Newton's trials may leave the model's domain (a square root of a
+    # negative number): those points are dropped as not converged, without numpy's warnings.
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        return _find_equilibria(functions, t, stability)
+
+
+def _find_equilibria(functions: StaticFunctions, t: float, stability) -> Equilibria:
     model = functions.model
     neutral = neutral_coordinates(functions)
     free = ~neutral

@@ -72,6 +72,10 @@ class LinearModel:
     # About a steady motion (analysis/steady.py): velocity name -> its constant rate; empty
     # about an equilibrium.
     steady: dict[str, float] = field(default_factory=dict)
+    # About a steady motion with velocity constraints A(q) q_dot + b(q) = 0: their linearization
+    # H dq + G dq_dot = 0 as rows over the state (dq, dq_dot). A keeps H dq + G dq_dot constant,
+    # so the motions of the system are the invariant subspace where it is zero.
+    state_constraints: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
 
     @property
     def M(self) -> np.ndarray:

@@ -205,14 +205,24 @@ def _state_space_modes(linear: LinearModel) -> list[Mode]:
     if A.shape[0] == 0:
         return []
     A = structural_zeros_cleaned(A)
-    values, vectors = scipy.linalg.eig(A)
-    vectors = verified_eigenvectors(A, values, vectors)
-    scale = max(np.abs(values).max(), 1e-300)
+    rows = linear.state_constraints
+    Z = None
+    if rows.size:
+        # Only states that satisfy the linearized velocity constraints are motions: A restricted
+        # to that invariant subspace (orthonormal basis Z, A Z = Z (Z^T A Z)); outside it A has
+        # spurious s = 0 vectors (a heading offset alone, which the rolling constraint forbids).
+        Z = scipy.linalg.null_space(rows)
+        A = structural_zeros_cleaned(Z.T @ A @ Z)
+    raw, vectors = scipy.linalg.eig(A)
+    scale = max(np.abs(raw).max(), 1e-300)
     # Defective zero eigenvalues (rigid-body modes) scatter by ~sqrt(eps); others by ~eps.
-    values = np.where(np.abs(values) <= ZERO_TOLERANCE * scale, 0j, values)
+    values = np.where(np.abs(raw) <= ZERO_TOLERANCE * scale, 0j, raw)
     noise = ROUND_OFF_TOLERANCE * scale
     values = np.where(np.abs(values.real) <= noise, 1j * values.imag, values)
     values = np.where(np.abs(values.imag) <= noise, values.real + 0j, values)
+    values, vectors = verified_eigenpairs(A, values, raw, vectors)
+    if Z is not None:
+        vectors = Z @ vectors
     modes: list[Mode] = []
     real = []
     for k, s in enumerate(values):
@@ -249,22 +259,52 @@ def structural_zeros_cleaned(A: np.ndarray) -> np.ndarray:
 
 def verified_eigenvectors(A: np.ndarray, values: np.ndarray, vectors: np.ndarray) -> np.ndarray:
     """The eigenvectors with each pair's relative residual |A v - s v| / (|A| |v|) checked; a
-    vector that fails is replaced by the null vector of A - s I (the smallest singular
-    vector), and a pair that still fails is refused (DerivationError)."""
-    import scipy.linalg
+    vector that fails is replaced by its projection on the null space of A - s I (or, where
+    that is empty, the smallest singular vector), and a pair that still fails is refused
+    (DerivationError)."""
+    return verified_eigenpairs(A, values, values, vectors)[1]
 
+
+def verified_eigenpairs(A: np.ndarray, values: np.ndarray, raw: np.ndarray, vectors: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenpairs that satisfy A v = s v to EIGEN_RESIDUAL_TOLERANCE: each with its rounded
+    value ``values`` (0 for a rigid-body mode, pure imaginary without damping) where a vector
+    satisfies it, else with LAPACK's ``raw`` value; refined vectors where LAPACK's do not."""
+    values = np.array(values, dtype=complex)
     vectors = np.array(vectors, dtype=complex)
     norm = max(np.linalg.norm(A, 2), 1e-300)
-    identity = np.eye(A.shape[0])
-    for k, s in enumerate(values):
-        v = vectors[:, k]
-        if _residual(A, s, v, norm) <= EIGEN_RESIDUAL_TOLERANCE:
-            continue
-        _, _, vh = scipy.linalg.svd(A - s * identity)
-        refined = vh[-1].conj()
-        _require_accurate(k, A @ refined - s * refined, norm * np.linalg.norm(refined))
-        vectors[:, k] = refined
-    return vectors
+    for k in range(len(values)):
+        candidates = [values[k]] if values[k] == raw[k] else [values[k], raw[k]]
+        for s in candidates:
+            v = _refined(A, s, vectors[:, k], norm)
+            if v is not None:
+                values[k], vectors[:, k] = s, v
+                break
+        else:
+            v = vectors[:, k]
+            _require_accurate(k, A @ v - raw[k] * v, norm * np.linalg.norm(v))
+    return values, vectors
+
+
+def _refined(A: np.ndarray, s: complex, v: np.ndarray, norm: float) -> np.ndarray | None:
+    """v if A v = s v holds, else v projected on the null space of A - s I (a defective
+    eigenvalue's vectors carry ~sqrt(eps) of the generalized ones), else the smallest singular
+    vector; None where no vector satisfies it."""
+    import scipy.linalg
+
+    if _residual(A, s, v, norm) <= EIGEN_RESIDUAL_TOLERANCE:
+        return v
+    shifted = A - s * np.eye(A.shape[0])
+    null = scipy.linalg.null_space(shifted, rcond=1e-12)
+    if null.shape[1]:
+        projected = null @ (null.conj().T @ v)
+        if np.linalg.norm(projected) > 1e-3 * np.linalg.norm(v):
+            candidate = projected
+        else:
+            candidate = null[:, -1]
+    else:
+        candidate = scipy.linalg.svd(shifted)[2][-1].conj()
+    return candidate if _residual(A, s, candidate, norm) <= EIGEN_RESIDUAL_TOLERANCE else None
 
 
 def _residual(A: np.ndarray, s: complex, v: np.ndarray, norm: float) -> float:
@@ -306,7 +346,7 @@ def _mode(linear: LinearModel, vector: np.ndarray, frequency: float, zeta: float
         damping_ratio=None if zeta is None else float(zeta) + 0.0,
         growth_rate=float(growth) + 0.0,
         shape={n: _clean(v.real) for n, v in zip(names, shape, strict=True)},
-        complex_shape=tuple(complex(v) for v in shape),
+        complex_shape=tuple(complex(v) if abs(v) >= 1e-12 else 0j for v in shape),
         eigenvalues=tuple(complex(s) for s in eigenvalues),
     )
 

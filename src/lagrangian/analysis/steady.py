@@ -259,6 +259,18 @@ def steady_point(
                        H if k else np.zeros((0, n)), tuple(functions.holonomic), rates)
 
 
+def _state_constraints(point: SteadyPoint, n: int) -> np.ndarray:
+    """The linearized constraints over the state (dq, dq_dot): H dq + G dq_dot = 0 for each
+    constraint, and for a holonomic one also Phi_q dq = 0 (its rows of G)."""
+    if not point.G.shape[0]:
+        return np.zeros((0, 2 * n))
+    rows = [np.hstack([point.H, point.G])]
+    holonomic = list(point.holonomic)
+    if holonomic:
+        rows.append(np.hstack([point.G[holonomic], np.zeros((len(holonomic), n))]))
+    return np.vstack(rows)
+
+
 def steady_linear_model(
     eom: EquationsOfMotion, about: Mapping[str, float] | None, steady: Mapping[str, float | str],
     parameters: Mapping[str, float] | ParameterValues | None = None,
@@ -301,6 +313,7 @@ def steady_linear_model(
         full_damping_matrix=C,
         full_stiffness_matrix=K,
         steady={velocity_name(names[i]): float(r) for i, r in sorted(point.rates.items())},
+        state_constraints=_state_constraints(point, n),
     )
 
 

@@ -11,6 +11,7 @@ import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
 
+import numpy as np
 import sympy as sp
 
 from ..errors import ModelError, did_you_mean
@@ -22,7 +23,7 @@ from .contacts import (
     identically_zero,
     wheel_down_direction,
 )
-from .expressions import RESERVED, parse_expression
+from .expressions import MAX_TREE_NODES, RESERVED, parse_expression, tree_size
 from .model import (
     TIME,
     Attachment,
@@ -573,10 +574,20 @@ class ModelBuilder:
         vector = self.vector(normal, field)
         if any(c.free_symbols for c in vector):
             raise self._error("the ground normal must be numbers", field)
-        squared = sp.Add(*(c**2 for c in vector))
-        if squared == 0:
-            raise self._error("the ground normal is the zero vector", field)
-        return tuple(c / sp.sqrt(squared) for c in vector)
+        small = all(c.is_Rational and abs(c.p) < 10**6 and c.q < 10**6 for c in vector)
+        if small:  # (0, 0, 1), (3, 0, 4): exact, and the printed equations stay exact
+            squared = sp.Add(*(c**2 for c in vector))
+            if squared == 0:
+                raise self._error("the ground normal is the zero vector", field)
+            return tuple(c / sp.sqrt(squared) for c in vector)
+        # other numbers as floats: an exact 1e-290 made the unit normal cost half a minute
+        numbers = np.array([float(c) for c in vector])
+        length = float(np.linalg.norm(numbers))
+        if not math.isfinite(length) or length == 0:
+            raise self._error("the ground normal is the zero vector or not finite", field)
+        unit = numbers / length
+        return tuple(sp.Integer(round(c)) if abs(c - round(c)) < 1e-15 else sp.Float(c)
+                     for c in unit)
 
     def _nonpositive_at_values(self, expr: sp.Expr) -> bool:
         values = {p.symbol: p.value for p in self._parameters if p.value is not None}
@@ -597,6 +608,12 @@ class ModelBuilder:
             expr = parse_expression(value, self._names, field=field, source=self.source)
         if not isinstance(expr, sp.Expr):
             raise self._error("expected a scalar expression", field)
+        size = tree_size(expr, limit=MAX_TREE_NODES)
+        if size > MAX_TREE_NODES:
+            raise self._error(f"written out in full this expression has more than "
+                              f"{MAX_TREE_NODES:,} terms and functions (definitions that use "
+                              "one another several times grow exponentially); keep it smaller",
+                              field)
         if not velocities:
             used = expr.free_symbols & {c.velocity for c in self._coordinates}
             if used:

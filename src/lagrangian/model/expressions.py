@@ -41,6 +41,9 @@ CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}
 RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"t"}
 
 MAX_LENGTH = 50_000  # parsing and converting stay under about 1 s
+# An expression written out in full (definitions substituted, each use a copy): sympy walks many
+# expressions as trees, so 25 definitions that each use the one before twice cost 2^25 nodes.
+MAX_TREE_NODES = 20_000  # derive of such a term takes ~15 s (measured: 5,600 nodes 4 s)
 MAX_DEPTH = 100  # nesting (parentheses, calls, powers, signs); flat sums and products are free
 MAX_EXPONENT = 1000
 MAX_NUMBER_DIGITS = 300  # every number's size is below 10**300 (and a literal above 10**-300)
@@ -57,6 +60,26 @@ _FLOAT_FUNCTIONS = {
     "sign": lambda x: float((x > 0) - (x < 0)),
 }
 _INFINITIES = (sp.zoo, sp.oo, -sp.oo)
+
+
+def tree_size(expr: sp.Basic, limit: int | None = None) -> int:
+    """Nodes of ``expr`` counted as a tree (a shared subexpression once per use), found on its
+    graph in time linear in the distinct nodes; stops counting past ``limit``."""
+    sizes: dict[int, int] = {}
+    stack: list[tuple[sp.Basic, bool]] = [(expr, False)]
+    while stack:
+        node, ready = stack.pop()
+        key = id(node)
+        if key in sizes:
+            continue
+        if ready:
+            sizes[key] = 1 + sum(sizes[id(a)] for a in node.args)
+            if limit is not None and sizes[key] > limit:
+                return sizes[key]
+            continue
+        stack.append((node, True))
+        stack.extend((a, False) for a in node.args if id(a) not in sizes)
+    return sizes[id(expr)]
 
 
 def parse_expression(

@@ -34,10 +34,7 @@ def fuzz(examples: int) -> settings:
 
 # Defects found by this campaign in code owned by others (issue 21), tolerated here until their
 # fixes land and kept visible by the xfail reproducers at the end of this file.
-KNOWN = [
-    ("urdf", re.compile(r"LinAlgError|ValueError: (array must not contain infs or NaNs|"
-                        r"math domain)|ValueError: nan")),
-]
+KNOWN: list[tuple[str, re.Pattern]] = []  # none left
 TALLY: dict[str, dict[str, int]] = {}
 
 
@@ -200,9 +197,6 @@ def test_print_tally():
         print(f"{surface}: {counts}")
 
 
-@pytest.mark.xfail(strict=False, reason="model/urdf.py (model input owner): a NaN or inf in a "
-                   "link's inertial origin (xyz) ends in LinAlgError / ValueError: nan, not a "
-                   "one-line refusal")
 @pytest.mark.parametrize("xyz", ["nan", "inf 0 0"])
 def test_urdf_nan_inertial_origin_refused(xyz, folder):
     from fuzz_seams import URDF_TEXT

@@ -134,6 +134,12 @@ class _Tree:
         self.name = robot.name or "URDF robot"
         for joint in self.joints:
             self._check_numbers(joint)
+        for link in robot.links:
+            inertial = link.inertial
+            if inertial is not None:
+                self._check_finite(f"link '{link.name}'.inertial",
+                                   (("origin", inertial.origin), ("mass", inertial.mass),
+                                    ("inertia", inertial.inertia)))
 
     def error(self, message: str, field: str | None = None) -> ModelError:
         return ModelError(message, field=field, source=self.source)
@@ -147,6 +153,9 @@ class _Tree:
                         ("mimic.offset", joint.mimic.offset))
         if joint.limit is not None:
             numbers += (("limit.lower", joint.limit.lower), ("limit.upper", joint.limit.upper))
+        self._check_finite(where, numbers)
+
+    def _check_finite(self, where: str, numbers) -> None:
         for name, value in numbers:
             if value is None:
                 continue

@@ -20,6 +20,7 @@ import numpy as np
 from ..analysis.sweep import NOT_COMPUTED, OK, Study, layout
 from ..errors import ModelError
 from .files import atomic_write
+from .plots import plain_text
 
 STUDY_FORMATS = (".nc", ".zarr")
 PLOT_DPI = 120
@@ -277,7 +278,8 @@ def _speeds_figure(figure, dataset, x):
         ax.axhline(0.0, color="0.5", lw=0.8)
         ax.set_ylabel(label)
     axes[1].set_xlabel(_label(dataset, x))
-    axes[0].set_title(f"eigenvalues of {dataset.attrs.get('model', '')!s} against {x}")
+    axes[0].set_title(plain_text(f"eigenvalues of {dataset.attrs.get('model', '')!s} "
+                                 f"against {x}"))
     return figure
 
 
@@ -401,7 +403,7 @@ def _ensemble_figure(figure, dataset, dims):
 
 def _label(dataset, name: str) -> str:
     unit = dataset[name].attrs.get("units")
-    return f"{name} ({unit})" if unit else name
+    return plain_text(f"{name} ({unit})" if unit else name)
 
 
 def write_study_plot(dataset, path: str | Path, *, protect: tuple[Path, ...] = ()) -> Path:

@@ -38,6 +38,9 @@ def speeds(
     lowest: Annotated[float, typer.Option("--from", help="Lowest speed of the sweep.")] = 0.0,
     highest: Annotated[float, typer.Option("--to", help="Highest speed of the sweep.")] = 10.0,
     points: Annotated[int, typer.Option("--points", help="Speeds in the sweep.")] = 101,
+    at: Annotated[list[str], typer.Option("--at", help="Eigenvalues at chosen speeds, "
+                                          "SPEED=V1,V2,... (v=0.7,2.9,5.3; units allowed: "
+                                          "18km/h).")] = [],  # noqa: B006
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
@@ -49,7 +52,13 @@ def speeds(
     from ..errors import ModelError
     from ..output.files import check_output_path
     from ..output.plots import check_plot_path
-    from ..output.speed_form import speed_form_document, speed_form_text, write_speed_plot
+    from ..output.speed_form import (
+        chosen_speeds_document,
+        chosen_speeds_text,
+        speed_form_document,
+        speed_form_text,
+        write_speed_plot,
+    )
     from .common import state_assignments
 
     system = load_system(model, set_, lock)
@@ -68,11 +77,38 @@ def speeds(
     from ..analysis.speed_form import speed_sweep
 
     sweep = speed_sweep(form, np.linspace(lowest, highest, points))
+    chosen = _chosen_speeds(system, form, at)
     if plot is not None:
         write_speed_plot(form, sweep, plot, protect=inputs)
     if json_:
-        print_json(speed_form_document(system.model.name, form, sweep))
+        document = speed_form_document(system.model.name, form, sweep)
+        if chosen:
+            document["at"] = chosen_speeds_document(form, chosen)
+        print_json(document)
     else:
         typer.echo(speed_form_text(system.model.name, form, sweep), nl=False)
+        if chosen:
+            typer.echo(chosen_speeds_text(form, chosen), nl=False)
         if plot is not None:
             typer.echo(f"Eigenvalues against speed drawn to {plot}")
+
+
+def _chosen_speeds(system, form, settings: list[str]) -> list[float]:
+    """--at SPEED=V1,V2,...: the speeds (m/s) to evaluate, named by the speed parameter."""
+    from ..errors import ModelError
+    from ..model.units import parse_quantity
+
+    unit = next((p.unit for p in system.model.parameters if p.name == form.speed), None)
+    speeds: list[float] = []
+    for setting in settings:
+        name, sep, text = setting.partition("=")
+        if not sep or not text.strip():
+            raise ModelError(f"expected {form.speed}=V1,V2,..., got {setting!r}", field="--at")
+        if name.strip() != form.speed:
+            raise ModelError(f"'{name.strip()}' is not the speed parameter; write "
+                             f"{form.speed}=V1,V2,...", field="--at")
+        for item in text.split(","):
+            if not item.strip():
+                raise ModelError(f"an empty value in {text!r}", field="--at")
+            speeds.append(parse_quantity(item.strip(), unit, f"--at {form.speed}"))
+    return speeds

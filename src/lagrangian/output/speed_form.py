@@ -87,6 +87,34 @@ def speed_form_text(model: str, form: SpeedForm, sweep: SpeedSweep) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _stable_at(values: np.ndarray) -> bool:
+    scale = max(float(np.abs(values).max(initial=0.0)), 1e-300)
+    return not bool(np.any(values.real > 1e-9 * scale))
+
+
+def chosen_speeds_document(form: SpeedForm, speeds) -> list[dict[str, Any]]:
+    """The `at` entries of `speeds --json`: each chosen speed's eigenvalues ([re, im], 1/s,
+    largest real part first) and whether none grows."""
+    out = []
+    for v in speeds:
+        values = form.eigenvalues(float(v))
+        out.append({"speed": float(v),
+                    "eigenvalues": [[float(z.real), float(z.imag)] for z in values],
+                    "stable": _stable_at(values)})
+    return out
+
+
+def chosen_speeds_text(form: SpeedForm, speeds) -> str:
+    lines = ["", f"Eigenvalues (1/s) at the chosen speeds {form.speed}:"]
+    for v in speeds:
+        values = form.eigenvalues(float(v))
+        text = "  ".join(f"{z.real:+.9g}{z.imag:+.9g}j" if abs(z.imag) > 1e-9
+                         else f"{z.real:+.9g}" for z in values)
+        lines.append(f"  {float(v):8.4g}:  {text}   "
+                     f"({'stable' if _stable_at(values) else 'unstable'})")
+    return "\n".join(lines) + "\n"
+
+
 def speed_sweep_figure(form: SpeedForm, sweep: SpeedSweep):
     """Real parts (solid) and imaginary parts (dotted) of the eigenvalues against speed, with
     the crossings marked."""

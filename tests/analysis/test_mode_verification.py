@@ -120,3 +120,16 @@ def test_every_mode_keeps_the_linearized_rolling_constraints(name, steady):
         size = (abs(s) ** 2 * np.linalg.norm(M) + abs(s) * np.linalg.norm(C)
                 + np.linalg.norm(K)) * np.linalg.norm(v)
         assert np.linalg.norm(outside) <= 1e-9 * size
+
+
+@pytest.mark.parametrize("theta", [0.0, 1e-7, 1e-4])
+def test_a_steady_motion_at_gimbal_lock_is_refused_by_name(theta):
+    """z-x-z angles lose a rate where sin(theta) = 0: a steady top there has no linear model in
+    these coordinates (the sleeping top's x-y-z angles do), whatever Cholesky says of M."""
+    top = lagrangian.load("heavy_top")
+    with pytest.raises(lagrangian.DerivationError, match="gimbal lock: the z-x-z angles"):
+        top.modes({"theta": theta}, steady={"psi_dot": 60.0, "phi_dot": 0.0})
+    # the same top upright in x-y-z angles: stable above psi_dot = 51.1 rad/s (its description)
+    sleeping = lagrangian.load("sleeping_top")
+    assert sleeping.modes({"a": 0.0, "b": 0.0}, steady={"psi_dot": 60.0}).stable
+    assert not sleeping.modes({"a": 0.0, "b": 0.0}, steady={"psi_dot": 45.0}).stable

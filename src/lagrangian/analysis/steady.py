@@ -26,6 +26,7 @@ from ..derivation.kinematics import Differentiator
 from ..errors import DerivationError, ModelError, did_you_mean
 from ..model.expressions import as_expression
 from ..model.model import velocity_name
+from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, resolve_parameters, resolve_state
 from ..numerics.lambdified import StateFunction
 from .linearization import LinearModel
@@ -206,6 +207,12 @@ def steady_point(
         solution = scipy.optimize.least_squares(residual, q0[free], xtol=1e-14, ftol=1e-14,
                                                 gtol=1e-14)
         q0[free] = solution.x
+    if model.rigid_bodies:  # solved into (or given near) a rotation sequence's singularity
+        point = {**resolve_parameters(model, parameters, require=False).symbol_values(model),
+                 **dict(zip(model.q, q0, strict=True))}
+        lock = gimbal_lock(model.rigid_bodies, point)
+        if lock:
+            raise DerivationError(f"no linear model about this steady motion: {lock}")
     at = evaluate(q0, v0)
     M, C, G, H = at["M"], at["C"], at["A"], at["H"]
     if np.max(np.abs(at["Phi"]), initial=0.0) > 1e-9:

@@ -71,3 +71,40 @@ def test_a_tiny_normal_component_is_read_as_a_float_quickly(tmp_path):
     reference = lagrangian.load("rolling_coin").equations_of_motion()
     # the normal is (0, 0, 1) to double precision: the same equations
     assert system.equations_of_motion().mass_matrix == reference.mass_matrix
+
+
+def test_a_long_rotation_sequence_is_refused_before_any_work(tmp_path):
+    rotation = ", ".join(f'["{"xyz"[i % 3]}", "{"abc"[i % 3]}"]' for i in range(12))
+    text = ("[coordinates]\na = {}\nb = {}\nc = {}\n[[bodies]]\nname = \"b\"\nmass = \"1\"\n"
+            "inertia = [\"1\", \"2\", \"3\"]\nposition = [0, 0, 0]\n"
+            f"rotation = [{rotation}]\n")
+    started = time.perf_counter()
+    with pytest.raises(ModelError, match="12 rotations in one sequence.*at most 6"):
+        parse_model(text, source="spin.toml")
+    assert time.perf_counter() - started < 2
+
+
+def test_a_chain_too_long_to_derive_is_refused_where_it_passes_the_limit():
+    from lagrangian.model.builder import ModelBuilder
+    from lagrangian.model.rotations import MAX_CHAIN_ROTATIONS
+
+    b = ModelBuilder("chain")
+    parent = None
+    with pytest.raises(ModelError, match=f"at most {MAX_CHAIN_ROTATIONS}") as error:
+        for i in range(MAX_CHAIN_ROTATIONS + 5):
+            b.coordinate(f"q{i}", "rad")
+            joint = {"type": "revolute", "axis": "xy"[i % 2], "angle": f"q{i}"}
+            if parent:
+                joint["at"] = [0, 0, -1]
+            b.add_rigid_body(f"link{i}", 1.0, [0.1, 0.1, 0.02], parent=parent, joint=joint,
+                             center=[0, 0, -0.5])
+            parent = f"link{i}"
+    assert f"link{MAX_CHAIN_ROTATIONS}" in str(error.value)
+    # prismatic joints turn nothing: a long chain of sliders is fine
+    b = ModelBuilder("sliders")
+    parent = None
+    for i in range(MAX_CHAIN_ROTATIONS + 5):
+        b.coordinate(f"s{i}", "m")
+        joint = {"type": "prismatic", "axis": "x", "distance": f"s{i}"}
+        b.add_rigid_body(f"slider{i}", 1.0, [0.1, 0.1, 0.1], parent=parent, joint=joint)
+        parent = f"slider{i}"

@@ -44,12 +44,32 @@ from .model import (
     multiplier_name,
     velocity_name,
 )
-from .rotations import GROUND, Frame, Moment, RigidBody, RotationReader, apply
+from .rotations import (
+    GROUND,
+    MAX_CHAIN_ROTATIONS,
+    Frame,
+    Moment,
+    RigidBody,
+    RotationReader,
+    apply,
+)
 
 # A rolling contact's velocity coefficients are trigsimp'd only below this op count (cheap).
 TIDY_LIMIT = 40
 _IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _ZERO: Vector = (sp.S.Zero, sp.S.Zero, sp.S.Zero)
+
+
+def _elementary_rotations(joint: object) -> int:
+    """Elementary rotations a joint (or a body's own rotation sequence) adds: 1 for a revolute
+    joint, the length of a spherical or fixed joint's sequence, 0 for a prismatic one."""
+    if not isinstance(joint, Mapping):
+        return 0
+    if joint.get("type") == "revolute":
+        return 1
+    sequence = joint.get("rotation")
+    return len(sequence) if isinstance(sequence, Sequence) and not isinstance(sequence, str) \
+        else 0
 
 
 class ModelBuilder:
@@ -71,6 +91,7 @@ class ModelBuilder:
         self._bodies: list[Body] = []
         self._rigid_bodies: list[RigidBody] = []
         self._frames: dict = {}  # 3D body name -> its rotations.Frame, for joints on it
+        self._rotations: dict[str, int] = {}  # 3D body name -> elementary rotations from ground
         self._springs: list[Spring] = []
         self._dampers: list[Damper] = []
         self._loads: list[PointForce | Torque] = []
@@ -264,6 +285,15 @@ class ModelBuilder:
             if position is not None and center is not None:
                 raise self._error("'center' is measured from 'origin': give 'origin' with it, "
                                   "or 'position' alone", f"{field}.center")
+        rotations = self._rotations.get(parent, 0) if parent is not None else 0
+        rotations += _elementary_rotations(joint if joint is not None else {"rotation": rotation})
+        if rotations > MAX_CHAIN_ROTATIONS:
+            raise self._error(f"body '{name}' is {rotations} elementary rotations from the "
+                              f"ground (at most {MAX_CHAIN_ROTATIONS}: a longer chain of rotating "
+                              "bodies takes minutes to derive symbolically; a URDF robot uses the "
+                              "recursive algorithms instead)", f"{field}.joint" if joint is not None
+                              else f"{field}.rotation")
+        self._rotations[name] = rotations
         if joint is not None:
             frame = reader.joint(frame, joint, f"{field}.joint")
         else:

@@ -32,7 +32,7 @@ from ..check.units import UnitsReport, check_model_units
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
 from ..derivation.regularity import require_inertia
-from ..errors import ModelError, did_you_mean
+from ..errors import LagrangianError, ModelError, did_you_mean
 from ..model.answer import Answer, answer_from_mapping, read_answer
 from ..model.builder import ModelBuilder
 from ..model.examples import example_path
@@ -375,6 +375,25 @@ class System:
                            about)
         return run_study(study, out=out, resume=resume, scheduler=scheduler, client=client,
                          workers=workers, progress=progress)
+
+    def warnings(self, set_parameters: Mapping[str, object] | None = None) -> list[str]:
+        """Where the user is probably wrong, one line each: a declared g with no gravity, a
+        dimensionally inconsistent term (the units check), a parameter in ``set_parameters``
+        that no equation contains. Not errors: the results are right for what was written."""
+        from ..check.warnings import model_warnings, setting_warnings
+
+        eom = None
+        needs_equations = bool(set_parameters) or (
+            "g" in self.parameters and self._model.gravity is None)
+        if needs_equations and self._model.kinematic_tree is None:
+            try:
+                eom = self.equations_of_motion()
+            except LagrangianError:  # the command itself says what is wrong
+                return []
+        lines = model_warnings(self._model, eom)
+        if set_parameters and eom is not None:
+            lines += setting_warnings(eom, set_parameters)
+        return lines
 
     # -- checking a hand derivation: check, crosscheck, check_units --------------------------------
 

@@ -52,7 +52,7 @@ from . import simulate as _simulate  # noqa: E402,F401
 from . import speeds as _speeds  # noqa: E402,F401
 from . import statics as _statics  # noqa: E402,F401
 from . import sweep as _sweep  # noqa: E402,F401
-from .common import TerminalText, in_flags  # noqa: E402
+from .common import TerminalText, flush_warnings, in_flags, reset_warnings  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -62,6 +62,7 @@ def main(argv: list[str] | None = None) -> None:
     written. Everything printed passes through TerminalText: no control character from a
     model file reaches the terminal."""
     streams = sys.stdout, sys.stderr
+    reset_warnings()
     sys.stdout, sys.stderr = TerminalText(sys.stdout), TerminalText(sys.stderr)
     try:
         _run(argv)
@@ -72,7 +73,12 @@ def main(argv: list[str] | None = None) -> None:
 def _run(argv: list[str] | None) -> None:
     """The command, its errors as one line `error: ...` and its exit status."""
     try:
-        code = app(args=argv, prog_name="lagrangian", standalone_mode=False)
+        try:
+            code = app(args=argv, prog_name="lagrangian", standalone_mode=False)
+        except SystemExit as exc:  # a command's own status: warnings only with a success
+            if exc.code in (0, None):
+                flush_warnings()
+            raise
     except LagrangianError as exc:
         _fail(str(in_flags(exc)))
     except typer.Abort:  # end of input or Ctrl-C at a prompt
@@ -90,6 +96,7 @@ def _run(argv: list[str] | None) -> None:
     except OSError as exc:  # a file that passed the checks but could not be written after all
         where = f"{exc.filename}: " if exc.filename else ""
         _fail(f"{where}{exc.strerror or exc}")
+    flush_warnings()  # after a success only: a refusal or a failure is one `error:` line
     sys.exit(code if isinstance(code, int) else 0)  # as click's standalone mode did
 
 

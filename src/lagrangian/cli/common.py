@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import re
 import sys
 from collections.abc import Iterable, Mapping
@@ -69,7 +70,32 @@ def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = 
               for name, text in assignments(lock, "--lock")}
     system = load(model, lock=locked) if locked else load(model)
     values = parameter_values(system, settings)
-    return system.with_parameters(**values) if values else system
+    system = system.with_parameters(**values) if values else system
+    for line in system.warnings(set_parameters=values):
+        warn(line)
+    return system
+
+
+# Warnings of this command (one line each on stderr, and `warnings` in its JSON document).
+_WARNINGS: list[str] = []
+
+
+def reset_warnings() -> None:
+    _WARNINGS.clear()
+
+
+def warn(line: str) -> None:
+    """A line `warning: ...` for stderr (printed when the command ends, so that a refusal stays
+    one `error:` line), kept for the command's JSON document."""
+    if line not in _WARNINGS:
+        _WARNINGS.append(line)
+
+
+def flush_warnings() -> None:
+    """Print the command's warnings on stderr, one line each (main() calls it on success)."""
+    for line in _WARNINGS:
+        typer.echo(f"warning: {line}", err=True)
+    _WARNINGS.clear()
 
 
 def parameter_values(system: System, settings: Iterable[str]) -> dict[str, float | str]:
@@ -82,10 +108,22 @@ def state_assignments(system: System, settings: Iterable[str], option: str
                       ) -> dict[str, float | str]:
     """Read NAME=VALUE[unit] options for coordinates (e.g. 30deg), velocities and t, in SI
     units (names are judged by the library)."""
+    from ..model.units import is_angle_unit
     from ..model.values import state_units
 
-    return quantities(assignments(comma_separated(settings), option), state_units(system.model),
-                      option)
+    pairs = assignments(comma_separated(settings), option)
+    units = state_units(system.model)
+    values = quantities(pairs, units, option)
+    for name, text in pairs:  # a bare number is read in the unit of its name: rad for an angle
+        value = values.get(name)
+        if is_angle_unit(units.get(name)) and _BARE_NUMBER.fullmatch(text) and \
+                isinstance(value, float) and abs(value) > 2 * math.pi:
+            warn(f"{option} {name}={text} is read as {text} rad ({math.degrees(value):.6g} deg); "
+                 f"write {text}deg for degrees")
+    return values
+
+
+_BARE_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
 
 def quantities(pairs: Iterable[tuple[str, str]], units: Mapping[str, str | None], option: str
@@ -124,7 +162,7 @@ def warn_if_unphysical(eom: EquationsOfMotion) -> None:
     from ..derivation.regularity import physical_warnings
 
     for warning in physical_warnings(eom.model, eom.mass_matrix):
-        typer.echo(f"warning: {warning}", err=True)
+        warn(warning)
 
 
 # Characters that a terminal acts on rather than prints: C0 controls but newline and tab, DEL,
@@ -173,5 +211,9 @@ class TerminalText:
 
 
 def print_json(document: Any) -> None:
+    """The command's JSON document, with this command's warnings under `warnings`."""
+    if isinstance(document, dict) and _WARNINGS:
+        known = list(document.get("warnings") or [])
+        document = {**document, "warnings": known + [w for w in _WARNINGS if w not in known]}
     json.dump(document, sys.stdout, indent=2, allow_nan=False)
     sys.stdout.write("\n")

@@ -20,6 +20,7 @@ from .common import (
     load_system,
     print_json,
     state_assignments,
+    warn,
 )
 
 # The library's field -> this command's flag (before the shared table of common.py).
@@ -124,7 +125,7 @@ def _run(model, vary, compute, out, plot, json_, set_, sample, members, seed, t_
             raise SystemExit(130) from None
     summary = study_summary(dataset)
     for line in summary.get("warnings", []):
-        typer.echo(f"warning: {line}", err=True)
+        warn(line)
     if summary["points"] and not summary["ok"]:  # nothing computed is a failure, not a result
         from ..errors import DerivationError
 

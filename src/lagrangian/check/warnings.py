@@ -1,0 +1,58 @@
+"""Warnings where a user is probably wrong: one line each, for the CLI's stderr and the
+`warnings` of its JSON, and for the Python user (System.warnings).
+
+Not errors: the model is well formed and the results are right for what was written, but what
+was written is likely not what was meant (a declared g with no gravity, a parameter that no
+equation contains given a value, a dimensionally inconsistent term).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from ..derivation.equations import EquationsOfMotion
+from ..errors import LagrangianError
+from ..model.model import Model
+from .units import check_model_units
+
+# More unit issues than this are summed up in one line (the `units` command lists them all).
+MOST_UNIT_LINES = 3
+
+
+def model_warnings(model: Model, eom: EquationsOfMotion | None = None) -> list[str]:
+    """A declared g with no gravity; the units check's inconsistent terms (a g in m/s)."""
+    lines = []
+    names = {p.name for p in model.parameters}
+    if "g" in names and model.gravity is None and model.kinematic_tree is None and \
+            (eom is None or "g" not in eom.parameters_used):
+        lines.append("parameter 'g' is declared but the model has no [gravity]: the potential "
+                     "holds no weight (add a [gravity] table, or remove g)")
+    if model.kinematic_tree is None:  # a URDF robot's numbers are SI by the format
+        try:
+            report = check_model_units(model)
+        except (LagrangianError, ArithmeticError, ValueError, TypeError):
+            report = None
+        issues = list(report.issues) if report is not None else []
+        # A model whose parameters all carry units was written with units in mind: all its
+        # inconsistencies are news. Elsewhere (numbers, bare symbols) only gravity's is.
+        united = bool(model.parameters) and all(p.unit for p in model.parameters)
+        issues = [i for i in issues if united or i.item.startswith("gravity")]
+        for issue in issues[:MOST_UNIT_LINES]:
+            lines.append(f"units: {issue.item}: {issue.message} (see `units`)")
+        if len(issues) > MOST_UNIT_LINES:
+            lines.append(f"units: {len(issues) - MOST_UNIT_LINES} more inconsistent terms "
+                         "(see `units`)")
+    return lines
+
+
+def setting_warnings(eom: EquationsOfMotion, names: Iterable[str]) -> list[str]:
+    """A parameter given a value that no equation contains: its value changes nothing."""
+    steady = eom.model.steady_motion
+    speed = steady.speed if steady is not None else None
+    return [f"'{name}' is set but appears in no equation of motion: its value changes nothing"
+            + (f" here ('{name}' is the speed of the [steady] motion: `speeds`, `modes`)"
+               if name == speed else "")
+            for name in names if name not in eom.parameters_used]
+
+
+__all__ = ["model_warnings", "setting_warnings"]

@@ -11,7 +11,7 @@ import time
 
 from n_link import build_lagrangian
 
-from lagrangian.numerics.functions import numeric
+from lagrangian.compile.functions import numeric
 
 
 def main() -> None:

@@ -27,7 +27,7 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 import lagrangian  # noqa: F401
-from lagrangian.numerics.fast import integrate_fast
+from lagrangian.simulation.compiled_loop import integrate_fast
 
 sys.path.insert(0, str(Path(__file__).parent))
 from n_link import build_lagrangian  # noqa: E402  (the same model as bench_derive)

@@ -5,7 +5,7 @@ file to compiled functions (cold and from the cache).
     python benchmarks/bench_urdf.py [ur5|panda|xarm7 ...] [--states 100] [--symbolic numpy|c]
 
 Needs the bench extra (pin, example-robot-data). The Panda's finger joints are locked at 0.
-Default: ``arm.dynamics()``, the recursive algorithms in generated C (numerics/recursive.py);
+Default: ``arm.dynamics()``, the recursive algorithms in generated C (dynamics/recursive.py);
 ``--symbolic`` times the derived equations instead (numpy or C backend).
 
 - Build: ``lagrangian.load(urdf, lock=...)`` then ``.dynamics()`` and a first call, in a fresh
@@ -112,7 +112,7 @@ def bench(name: str, symbolic: str | None, states: int, timing: bool = True) -> 
     path = robots_folder() / relpath
     arm = lagrangian.load(path, lock=lock)
     if symbolic:
-        from lagrangian.numerics.dynamics import Dynamics
+        from lagrangian.dynamics.joint_space import Dynamics
 
         start = time.perf_counter()
         f = Dynamics(arm.numeric(backend=symbolic))

@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 import lagrangian
-from lagrangian.numerics.recursive import RecursiveDynamics
-from lagrangian.numerics.recursive_numpy import RecursiveNumpyDynamics
+from lagrangian.dynamics.recursive import RecursiveDynamics
+from lagrangian.dynamics.recursive_numpy import RecursiveNumpyDynamics
 
 sys.path.insert(0, str(Path(__file__).parent))
 from bench_urdf import load_average, robots_folder  # noqa: E402 (the sibling benchmark's)

@@ -26,8 +26,8 @@ def _package_of(path: Path) -> tuple[str, ...]:
 
 
 def test_import_contracts_hold():
-    """model -> derivation -> numerics -> analysis -> check -> output -> api -> cli: no stage
-    imports a later one, and only the CLI imports typer, click or rich."""
+    """model -> derivation -> compile -> dynamics | simulation -> analysis -> check -> output
+    -> api -> cli: no stage imports a later one, and only the CLI imports typer, click or rich."""
     executable = Path(sys.executable).with_name("lint-imports")
     command = str(executable) if executable.exists() else shutil.which("lint-imports")
     assert command, "lint-imports is missing: install the test extra, pip install -e '.[test]'"
@@ -86,7 +86,7 @@ def test_one_public_face():
 
 
 def test_expressions_become_numbers_in_one_place():
-    """Only numerics/lambdified.py calls sympy's lambdify; only errors.py suggests names."""
+    """Only compile/lambdified.py calls sympy's lambdify; only errors.py suggests names."""
     calls: dict[str, set[str]] = {"lambdify": set(), "get_close_matches": set()}
     for path, tree in _modules():
         for node in ast.walk(tree):
@@ -94,4 +94,4 @@ def test_expressions_become_numbers_in_one_place():
                 name = getattr(node.func, "attr", getattr(node.func, "id", ""))
                 if name in calls:
                     calls[name].add(path.relative_to(PACKAGE).as_posix())
-    assert calls == {"lambdify": {"numerics/lambdified.py"}, "get_close_matches": {"errors.py"}}
+    assert calls == {"lambdify": {"compile/lambdified.py"}, "get_close_matches": {"errors.py"}}

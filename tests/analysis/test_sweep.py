@@ -172,7 +172,7 @@ def test_failing_member_of_an_ensemble_is_recorded_and_the_rest_complete(client)
 def test_ensemble_loads_the_cached_module_without_generating_c(client, monkeypatch):
     """A second study of the same equations finds the compiled module by the equations' key:
     no C is generated again (that cost seconds per process for larger models)."""
-    from lagrangian.numerics import codegen, compiled
+    from lagrangian.compile import codegen, compiled
 
     if not compiled.available():
         pytest.skip("no C compiler")

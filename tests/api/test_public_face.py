@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import lagrangian
-from lagrangian.numerics import compiled
+from lagrangian.compile import compiled
 
 
 def test_every_returned_or_raised_type_is_exported():
@@ -36,7 +36,7 @@ def test_option_types_give_the_same_run_as_the_plain_keywords():
 def test_a_stop_condition_object_is_accepted():
     pendulum = lagrangian.load("pendulum")
     stop = lagrangian.load("pendulum").simulate(5.0, stop_when="theta < 0").t[-1]
-    from lagrangian.numerics.events import parse_stop_condition
+    from lagrangian.simulation.events import parse_stop_condition
 
     condition = parse_stop_condition("theta < 0", pendulum.model)
     assert isinstance(condition, lagrangian.StopCondition)

@@ -9,7 +9,7 @@ import math
 import pytest
 
 import lagrangian
-from lagrangian.numerics.options import StepControl
+from lagrangian.simulation.options import StepControl
 
 
 def test_derive_accepts_json_like_every_other_command(cli):

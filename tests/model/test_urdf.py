@@ -180,8 +180,8 @@ def _newton_euler_free_energy(q, v):
 def spatial(tmp_path_factory):
     # the derived equations, lambdified (numpy: the C build of these unsimplified, float-laden
     # expressions takes ~1 min; System.dynamics(backend="numpy") would run the recursions)
-    from lagrangian.numerics.dynamics import Dynamics
-    from lagrangian.numerics.functions import numeric
+    from lagrangian.compile.functions import numeric
+    from lagrangian.dynamics.joint_space import Dynamics
 
     path = write(tmp_path_factory.mktemp("spatial"), SPATIAL)
     return Dynamics(numeric(lagrangian.load(path).equations_of_motion(), backend="numpy"))

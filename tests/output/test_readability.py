@@ -12,9 +12,9 @@ import pytest
 import sympy as sp
 
 import lagrangian
+from lagrangian.derivation.readable import readable
 from lagrangian.model.examples import example_names
 from lagrangian.model.expressions import parse_expression
-from lagrangian.model.readable import readable
 from lagrangian.output.derivation import derivation_document, derivation_text
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))

@@ -13,11 +13,11 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from ..compile.at_rest import StaticFunctions
 from ..errors import ModelError
 from ..model.model import Model
 from ..model.rotations import gimbal_lock
 from ..model.values import State, resolve_state
-from ..numerics.static import StaticFunctions
 from .linearization import static_residual, total_stiffness
 
 MAX_ITERATIONS = 80

@@ -16,13 +16,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
+from ..compile.at_rest import StaticFunctions, linear_velocity_row
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import jacobian_row
 from ..errors import DerivationError, ModelError
 from ..model.expressions import as_expression
 from ..model.model import Model
 from ..model.values import ParameterValues, resolve_parameters, resolve_state
-from ..numerics.static import StaticFunctions, linear_velocity_row
 
 # Relative singular-value threshold for the rank of the constraint Jacobian.
 RANK_TOLERANCE = 1e-9

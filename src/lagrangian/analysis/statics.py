@@ -16,13 +16,13 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from ..compile.lambdified import numpy_function
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
 from ..model.expressions import as_expression
 from ..model.model import Model
 from ..model.units import generalized_force_unit
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state, unknown_name
-from ..numerics.lambdified import numpy_function
 
 _RANK_TOLERANCE = 1e-9
 _RESIDUAL_TOLERANCE = 1e-8

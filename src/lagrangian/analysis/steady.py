@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from ..compile.lambdified import StateFunction
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import Differentiator
 from ..errors import DerivationError, ModelError, did_you_mean
@@ -28,7 +29,6 @@ from ..model.expressions import as_expression
 from ..model.model import velocity_name
 from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, resolve_parameters, resolve_state
-from ..numerics.lambdified import StateFunction
 from .linearization import LinearModel
 
 FIELD = "steady"

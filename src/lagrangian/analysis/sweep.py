@@ -7,7 +7,7 @@ never raises for one point: a point that fails is NaN with its reason in ``statu
 the chunks (Dask, api/sweep.py) and writes the Dataset (output/sweep.py) live downstream.
 
 Per chunk the compiled functions are built once per process (``prepared``): the equations at
-rest with the parameters as inputs (numerics/parametric.py) for modes and equilibria, the
+rest with the parameters as inputs (compile/parametric_at_rest.py) for modes and equilibria, the
 model's C module (loaded from the on-disk cache the client filled) for simulations.
 """
 
@@ -22,14 +22,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..derivation.equations import EquationsOfMotion
-from ..errors import ModelError
-from ..model.values import resolve_state
-from ..numerics.parametric import (
+from ..compile.parametric_at_rest import (
     ParametricStaticFunctions,
     StaticFunctionsAt,
     integrate_ensemble,
 )
+from ..derivation.equations import EquationsOfMotion
+from ..errors import ModelError
+from ..model.values import resolve_state
 from .equilibria import (
     _difference,
     _Solver,
@@ -120,7 +120,7 @@ class Study:
     axes: tuple[tuple[str, np.ndarray], ...]
     draws: tuple[tuple[str, np.ndarray], ...] = ()
     simulation: SimulationOptions | None = None
-    compiled_key: str | None = None  # the compiled module's cache key (numerics/compiled.py)
+    compiled_key: str | None = None  # the compiled module's cache key (compile/compiled.py)
     chunk_size: int = 1000
     key: str = field(default="", compare=False)
     functions_key: str = field(default="", compare=False)
@@ -638,9 +638,9 @@ class _SimulationFunctions:
 
 
 def _prepare_simulation(study: Study):
-    from ..numerics import compiled
-    from ..numerics.codegen import CodegenError, generate
-    from ..numerics.invariants import energy_is_conserved
+    from ..compile import compiled
+    from ..compile.codegen import CodegenError, generate
+    from ..simulation.invariants import energy_is_conserved
 
     module = None
     # The compiled loop where it applies: no constraints (no projection), no stop condition
@@ -696,7 +696,7 @@ def _simulation_chunk(study, functions: _SimulationFunctions, values, count):
 
 
 def _simulation_chunk_compiled(study, functions: _SimulationFunctions, values, count, out):
-    """The whole chunk in one call of the module's ensemble loop (numerics/parametric.py): each
+    """The whole chunk in one call of the module's ensemble loop (compile/parametric_at_rest.py): each
     member the same DOP853 steps as the single-point simulate, the summaries computed in C."""
     model = study.model
     options = study.simulation
@@ -730,8 +730,8 @@ def _simulate_member(study, functions, parameters, state):
     single-point simulate (constraints, stop conditions, other methods, no compiled module)."""
     options = study.simulation
     model = study.model
-    from ..numerics.options import SaveAt, StepControl
-    from ..numerics.simulate import parse_stop_condition, simulate
+    from ..simulation.options import SaveAt, StepControl
+    from ..simulation.simulate import parse_stop_condition, simulate
 
     stop = parse_stop_condition(options.stop_when, model) if options.stop_when else None
     result = simulate(study.eom, options.t_end, initial=state, parameters=parameters,

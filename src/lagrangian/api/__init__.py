@@ -13,20 +13,20 @@ from ..analysis.statics import StaticsReport
 from ..check.diagnose import CheckReport, Finding
 from ..check.newton_euler import CoordinateAgreement, CrosscheckReport, Reaction
 from ..check.units import UnitIssue, UnitsReport
+from ..compile.compiled import BackendUnavailable, CacheRefused, CompilerMissing
+from ..compile.functions import NumericSystem
 from ..derivation.equations import EquationsOfMotion, LoadContribution
+from ..dynamics.joint_space import Dynamics
+from ..dynamics.standalone import StandaloneSource
 from ..errors import DerivationError, LagrangianError, ModelError
 from ..model.answer import Answer
 from ..model.examples import example_names as examples
 from ..model.model import Model
 from ..model.reader import parse_model, read_model
 from ..model.values import ParameterValues, State
-from ..numerics.compiled import BackendUnavailable, CacheRefused, CompilerMissing
-from ..numerics.dynamics import Dynamics
-from ..numerics.events import StopCondition
-from ..numerics.functions import NumericSystem
-from ..numerics.options import SaveAt, StepControl
-from ..numerics.result import SimulationResult
-from ..numerics.standalone import StandaloneSource
+from ..simulation.events import StopCondition
+from ..simulation.options import SaveAt, StepControl
+from ..simulation.result import SimulationResult
 from .simulation import Simulation
 from .system import System, SystemBuilder, load
 

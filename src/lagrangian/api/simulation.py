@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import fields
 from pathlib import Path
 
-from ..numerics.result import SimulationResult
+from ..simulation.result import SimulationResult
 
 
 class Simulation(SimulationResult):

@@ -51,9 +51,9 @@ def with_compiled_module(study: Study) -> Study:
     the equations (no C generated on a hit), so the workers load it instead of building it."""
     if study.compute != "simulate":
         return study
-    from ..numerics import compiled
-    from ..numerics.codegen import CodegenError, generate
-    from ..numerics.functions import equations_key
+    from ..compile import compiled
+    from ..compile.codegen import CodegenError, generate
+    from ..compile.functions import equations_key
 
     if not compiled.available():
         return study

@@ -29,9 +29,14 @@ from ..analysis.steady import steady_linear_model
 from ..check.diagnose import CheckReport, check_answer
 from ..check.newton_euler import CrosscheckReport, crosscheck
 from ..check.units import UnitsReport, check_model_units
+from ..compile.at_rest import StaticFunctions
+from ..compile.codegen import CodegenError
+from ..compile.functions import NumericSystem, numeric
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
 from ..derivation.regularity import require_inertia
+from ..dynamics.joint_space import model_dynamics, recursive_dynamics
+from ..dynamics.standalone import StandaloneSource
 from ..errors import LagrangianError, ModelError, did_you_mean
 from ..model.answer import Answer, answer_from_mapping, read_answer
 from ..model.builder import ModelBuilder
@@ -41,13 +46,8 @@ from ..model.notation import latex_symbol_names
 from ..model.reader import read_model
 from ..model.urdf import example_urdf, read_urdf
 from ..model.values import State, resolve_state
-from ..numerics.codegen import CodegenError
-from ..numerics.dynamics import model_dynamics, recursive_dynamics
-from ..numerics.events import StopCondition
-from ..numerics.functions import NumericSystem, numeric
-from ..numerics.simulate import SaveAt, StepControl, parse_stop_condition, simulate
-from ..numerics.standalone import StandaloneSource
-from ..numerics.static import StaticFunctions
+from ..simulation.events import StopCondition
+from ..simulation.simulate import SaveAt, StepControl, parse_stop_condition, simulate
 from .simulation import Simulation
 
 
@@ -170,7 +170,7 @@ class System:
         ``prefix`` names the functions (default: from the model's name), ``parameters`` override
         the model's values compiled in as defaults. Write it with
         ``lagrangian.output.write_c(code, directory)``."""
-        from ..numerics.standalone import c_prefix, standalone_for
+        from ..dynamics.standalone import c_prefix, standalone_for
 
         if prefix is not None and c_prefix(prefix) != prefix:
             raise ModelError(f"{prefix!r} is not a C identifier (lower-case ASCII letters, digits "
@@ -216,14 +216,14 @@ class System:
     @cached_property
     def _recursive(self):
         """Recursive dynamics of a URDF tree in generated C (numpy without a compiler), or
-        None (numerics/dynamics.py)."""
+        None (dynamics/joint_space.py)."""
         return recursive_dynamics(self.model)
 
     def dynamics(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"):
         """M(q), bias C q_dot + g, g(q), inverse and forward dynamics and the energies, batched
         over leading axes (q of shape (n,) or (N, n)); a generalized force tau acts on top of
-        the model's own loads (numerics/dynamics.py). A URDF robot runs recursive algorithms in
-        generated C (numerics/recursive.py; in numpy without a compiler or with backend
+        the model's own loads (dynamics/joint_space.py). A URDF robot runs recursive algorithms in
+        generated C (dynamics/recursive.py; in numpy without a compiler or with backend
         "numpy"), the other models their derived equations."""
         if parameters is None and backend == "auto" and self._recursive is not None:
             return self._recursive

@@ -16,9 +16,9 @@ from dataclasses import dataclass
 import mpmath
 import sympy as sp
 
+from ..compile.lambdified import mpmath_function, operations_exceed
+from ..derivation.readable import readable
 from ..model.model import Model
-from ..model.readable import readable
-from ..numerics.lambdified import mpmath_function, operations_exceed
 
 DIGITS = 30
 TOLERANCE = mpmath.mpf(10) ** -18  # relative: rounding at 30 digits leaves ~1e-28

@@ -9,7 +9,7 @@ from typing import Annotated
 
 import typer
 
-from ..numerics.options import METHODS  # light: the names only, no scipy
+from ..simulation.options import METHODS  # light: the names only, no scipy
 from . import app
 from .common import LOCK_HELP, SET_HELP, load_system, print_json, state_assignments, warn_if_unphysical
 
@@ -36,12 +36,12 @@ def simulate(
     from ..errors import ModelError
     from ..model.units import parse_quantity
     from ..model.values import resolve_state
-    from ..numerics.simulate import SaveAt, StepControl, parse_stop_condition
     from ..output.animation import check_animatable, check_animation_path, check_view
     from ..output.files import check_output_path, partial_path
     from ..output.plots import check_plot_path
     from ..output.simulation import projection_warning, simulation_document, simulation_text
     from ..output.tables import check_table_path
+    from ..simulation.simulate import SaveAt, StepControl, parse_stop_condition
 
     system = load_system(model, set_, lock)
     warn_if_unphysical(system.equations_of_motion())

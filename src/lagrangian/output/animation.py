@@ -6,7 +6,7 @@ elevation): each as its body axes (x red, y green, z blue), the wire box of the 
 inertia, lines from its joint to its centre of mass and from its parent's joint to its own, and a
 wheel on a rolling contact as its rim over a ground grid.
 
-It draws the positions numerics/geometry.py computes (its ``sketch`` finds the rods, pivots,
+It draws the positions output/geometry.py computes (its ``sketch`` finds the rods, pivots,
 blocks and wheels from the model's structure; a spring or damper with no ends found there is
 left out); nothing here evaluates an expression. Frames are rendered by blitting: the still
 parts once, the moving artists per frame.
@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.model import Model
-from ..numerics.result import SimulationResult
+from ..simulation.result import SimulationResult
 from .files import atomic_write
 from .geometry import ISOMETRIC_VIEW, mechanism, view_projection
 from .plots import plain_text

@@ -11,16 +11,16 @@ from typing import Any
 import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
+from ..derivation.readable import readable, readable_matrix
 from ..model.expressions import format_expression
 from ..model.notation import latex_printer
-from ..model.readable import readable, readable_matrix
 from ..model.units import generalized_force_unit
 
 CONVENTION = "M q_ddot + Phi_q^T lambda = forcing"
 
 
 class _Display:
-    """The readable form of the derivation's expressions (model/readable.py: equal to the
+    """The readable form of the derivation's expressions (derivation/readable.py: equal to the
     derived ones, grouped by products of the rates), as text in the model-file grammar."""
 
     def __init__(self, eom: EquationsOfMotion):

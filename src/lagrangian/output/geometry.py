@@ -19,10 +19,10 @@ from typing import NamedTuple
 import numpy as np
 import sympy as sp
 
+from ..compile.lambdified import StateFunction
 from ..model.expressions import as_expression
 from ..model.model import Model
 from ..model.values import ParameterValues, resolve_parameters
-from ..numerics.lambdified import StateFunction
 
 
 class Frame(NamedTuple):

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError
-from ..numerics.result import SimulationResult
+from ..simulation.result import SimulationResult
 from .files import atomic_write
 from .simulation import INVARIANT_WORDS
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from ..numerics.result import SimulationResult
+from ..simulation.result import SimulationResult
 
 # What each monitored quantity is, in the text summary and the plot's title.
 INVARIANT_WORDS = {

@@ -6,7 +6,7 @@ import io
 from pathlib import Path
 
 from ..errors import ModelError
-from ..numerics.result import SimulationResult
+from ..simulation.result import SimulationResult
 from .files import atomic_write
 
 TABLE_FORMATS = {".csv": "CSV", ".parquet": "Parquet"}

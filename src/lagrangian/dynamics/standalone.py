@@ -16,10 +16,10 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from ..compile.codegen import CodegenError, CPrinter, c_block, c_comment_text
 from ..derivation.equations import EquationsOfMotion
 from ..model.model import Model
 from ..model.tree import KinematicTree
-from .codegen import CodegenError, _block, _Printer, c_comment_text
 
 
 @dataclass(frozen=True)
@@ -62,10 +62,10 @@ def standalone_c(eom: EquationsOfMotion, values: dict[str, float], prefix: str |
             out.append(e.xreplace(rename))
         return out
 
-    printer = _Printer()
-    parts = _block(c_exprs([*eom.mass_matrix, *eom.forcing]),
+    printer = CPrinter()
+    parts = c_block(c_exprs([*eom.mass_matrix, *eom.forcing]),
                    [f"M[{i}]" for i in range(n * n)] + [f"f[{i}]" for i in range(n)], printer)
-    energy = _block(c_exprs([eom.kinetic_energy + eom.potential_energy]), ["e"], printer)
+    energy = c_block(c_exprs([eom.kinetic_energy + eom.potential_energy]), ["e"], printer)
     if printer._not_supported:
         raise CodegenError("no C translation for some functions of the equations")
     P = prefix

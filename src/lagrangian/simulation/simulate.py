@@ -2,9 +2,9 @@
 
 Unconstrained models integrate y = [q, q_dot], y' = [q_dot, M^-1 f]. Constrained models solve
 the index-1 form [[M, Phi_q^T], [Phi_q, 0]] [q_ddot; lambda] = [f; gamma] at every call and
-control drift by coordinate projection (numerics/drift.py). Units are SI throughout.
+control drift by coordinate projection (simulation/drift.py). Units are SI throughout.
 
-The driver: resolve the start, compile what the loop needs, run one loop (numerics/loops.py),
+The driver: resolve the start, compile what the loop needs, run one loop (simulation/integration_loops.py),
 then evaluate energy, power, multipliers and residuals on the saved samples.
 """
 
@@ -17,16 +17,16 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..compile.functions import NumericSystem, numeric
+from ..compile.lambdified import StateFunction
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
 from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state
 from .drift import DriftControl
 from .events import StopCondition, parse_stop_condition
-from .functions import NumericSystem, numeric
+from .integration_loops import LoopRun, integrate_compiled, integrate_steps
 from .invariants import cumulative_work, energy_is_conserved, invariant_kind
-from .lambdified import StateFunction
-from .loops import LoopRun, integrate_compiled, integrate_steps
 from .options import METHODS, SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
 

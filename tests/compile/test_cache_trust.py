@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lagrangian.numerics import compiled
+from lagrangian.compile import compiled
 
 needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
 

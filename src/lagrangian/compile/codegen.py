@@ -52,7 +52,7 @@ class GeneratedSource:
     m: int
 
 
-class _Printer(C99CodePrinter):
+class CPrinter(C99CodePrinter):
     """C99 with exact doubles (repr round-trips) and a record of unsupported functions."""
 
     def _print_Float(self, expr):
@@ -156,7 +156,7 @@ def _basic_cse_pays(exprs: Sequence[sp.Expr]) -> bool:
     return tree <= BASIC_CSE_MAX_NODES and tree <= BASIC_CSE_MAX_NESTING * len(_nodes(exprs))
 
 
-def _statements(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: _Printer
+def _statements(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: CPrinter
                 ) -> list[tuple[str | None, str, str, bool]]:
     """(name of a shared subexpression or None, target, C expression, constant?) computing
     ``targets[i] = exprs[i]`` with shared subexpressions hoisted."""
@@ -181,7 +181,7 @@ def _lines(statements, kind: str = "double") -> str:
                       for shared, target, code, _ in statements)
 
 
-def _block(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: _Printer) -> str:
+def c_block(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: CPrinter) -> str:
     """C statements computing ``targets[i] = exprs[i]`` with shared subexpressions hoisted."""
     return _lines(_statements(exprs, targets, printer))
 
@@ -334,7 +334,7 @@ def generate(eom: EquationsOfMotion, vector: bool = False) -> GeneratedSource:
             out.append(e)
         return _renamed(out, rename)
 
-    printer = _Printer()
+    printer = CPrinter()
     parts = c_exprs([*eom.mass_matrix, *eom.forcing, *eom.constraint_jacobian,
                      *eom.acceleration_rhs])
     targets = ([f"M[{i}]" for i in range(n * n)] + [f"f[{i}]" for i in range(n)]
@@ -379,14 +379,14 @@ def generate(eom: EquationsOfMotion, vector: bool = False) -> GeneratedSource:
         "{",
         "    (void)q; (void)v; (void)t; (void)p;",
         "    double e;",
-        _block(energy, ["e"], printer),
+        c_block(energy, ["e"], printer),
         "    return e;",
         "}",
         "",
         f"static void lg_residual{signature}, double *restrict r)",
         "{",
         "    (void)q; (void)v; (void)t; (void)p; (void)r;",
-        _block(residual, [f"r[{i}]" for i in range(m)], printer) if m else "",
+        c_block(residual, [f"r[{i}]" for i in range(m)], printer) if m else "",
         "}",
         "",
     ]

@@ -44,8 +44,8 @@ ARM = """<?xml version="1.0"?>
 
 def _dynamics(system, backend):
     if backend == "symbolic":  # the derived equations, lambdified
-        from lagrangian.numerics.dynamics import Dynamics
-        from lagrangian.numerics.functions import numeric
+        from lagrangian.compile.functions import numeric
+        from lagrangian.dynamics.joint_space import Dynamics
 
         return Dynamics(numeric(system.equations_of_motion(), backend="numpy"))
     return system.dynamics(backend=backend)
@@ -96,8 +96,8 @@ def _robots() -> Path:
 def test_panda_numpy_fallback_matches_pinocchio(monkeypatch, tmp_path):
     """The Panda (fingers locked, 7-DOF) where no compiler works: the recursions in numpy (the
     expanded equations are too deep for lambdify), against Pinocchio's reduced model."""
-    from lagrangian.numerics import compiled
-    from lagrangian.numerics.recursive_numpy import RecursiveNumpyDynamics
+    from lagrangian.compile import compiled
+    from lagrangian.dynamics.recursive_numpy import RecursiveNumpyDynamics
 
     monkeypatch.setenv("CC", "/nonexistent/cc")
     monkeypatch.setenv("LAGRANGIAN_CACHE", str(tmp_path))

@@ -17,8 +17,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import lagrangian
-from lagrangian.numerics import codegen, compiled
-from lagrangian.numerics.standalone import c_prefix, standalone_c
+from lagrangian.compile import codegen, compiled
+from lagrangian.dynamics.standalone import c_prefix, standalone_c
 
 needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
 

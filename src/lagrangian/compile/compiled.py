@@ -39,7 +39,7 @@ from ..errors import LagrangianError
 from .codegen import GeneratedSource
 
 CFLAGS = ("-O2", "-fPIC", "-shared", "-fno-math-errno", "-w")
-# Opt-in for kernels that vectorize over a batch (numerics/recursive.py): the processor's own
+# Opt-in for kernels that vectorize over a batch (dynamics/recursive.py): the processor's own
 # vector width (AVX2 + FMA: four states per operation instead of SSE2's two) halves their time.
 # Such a module only runs on this kind of processor, so its name carries a CPU fingerprint.
 NATIVE_CFLAGS = ("-O3", "-march=native")

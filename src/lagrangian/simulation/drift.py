@@ -10,9 +10,9 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from ..compile.functions import NumericSystem
+from ..compile.lambdified import StateFunction
 from ..errors import ModelError
-from .functions import NumericSystem
-from .lambdified import StateFunction
 
 # Explicit Runge-Kutta solvers keep only (y, f) between steps, so a projected state can be put
 # back in place; the others carry a history and are restarted from the projected state instead.

@@ -15,11 +15,11 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import lagrangian
+from lagrangian.compile import compiled
+from lagrangian.compile import functions as functions_module
+from lagrangian.compile.compiled import BackendUnavailable
+from lagrangian.compile.functions import numeric
 from lagrangian.model.examples import example_names
-from lagrangian.numerics import compiled
-from lagrangian.numerics import functions as functions_module
-from lagrangian.numerics.compiled import BackendUnavailable
-from lagrangian.numerics.functions import numeric
 
 needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
 
@@ -217,7 +217,7 @@ def test_second_build_loads_from_the_cache_without_compiling(tmp_path):
     """A fresh process with a warm cache must not run the compiler at all."""
     script = textwrap.dedent("""
         import lagrangian
-        from lagrangian.numerics import compiled
+        from lagrangian.compile import compiled
         def refuse(command):
             raise AssertionError("the compiler ran")
         compiled._run_compiler = refuse
@@ -265,7 +265,7 @@ def test_falls_back_to_numpy_when_the_build_fails(monkeypatch, tmp_path):
 
 @needs_c
 def test_generated_source_has_no_symbolic_inverse_and_shares_subexpressions():
-    from lagrangian.numerics.codegen import generate
+    from lagrangian.compile.codegen import generate
 
     source = generate(lagrangian.load("double_pendulum").equations_of_motion()).source
     assert "lg_solve(" in source  # the solve is numeric, in C
@@ -278,7 +278,7 @@ def test_generated_source_has_no_symbolic_inverse_and_shares_subexpressions():
 def test_angle_sums_are_split_only_when_that_saves_trig_calls():
     import sympy as sp
 
-    from lagrangian.numerics.codegen import _fewer_trig_calls
+    from lagrangian.compile.codegen import _fewer_trig_calls
 
     angles = sp.symbols("a b c d")
     w, t, phi = sp.symbols("w t phi")

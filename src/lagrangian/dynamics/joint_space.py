@@ -22,9 +22,9 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
+from ..compile.functions import NumericSystem
 from ..errors import ModelError
 from ..model.model import Model
-from .functions import NumericSystem
 
 
 class Dynamics:
@@ -104,8 +104,8 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
     numpy (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with backend
     "auto", where no compiler works; None where they do not apply: not a bare tree, or a mass
     matrix that is not positive definite (the symbolic path names the joints)."""
-    from .compiled import BackendUnavailable
-    from .functions import tell_numpy_fallback
+    from ..compile.compiled import BackendUnavailable
+    from ..compile.functions import tell_numpy_fallback
     from .recursive import RecursiveDynamics, applicable_tree
     from .recursive_numpy import RecursiveNumpyDynamics
 

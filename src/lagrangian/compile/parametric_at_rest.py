@@ -1,6 +1,6 @@
 """The equations at rest with the parameters as runtime inputs, for parameter studies.
 
-``StaticFunctions`` (numerics/static.py) puts the parameter values in before compiling, which is
+``StaticFunctions`` (compile/at_rest.py) puts the parameter values in before compiling, which is
 right for one system and wrong for a study of thousands of parameter points: here the same
 entries (M, f, -df/dq, -df/dq_dot, Phi_q, its q-derivatives, the static residuals) are compiled
 once with the parameters as arguments, and evaluated batched over configurations and parameter
@@ -23,8 +23,8 @@ from ..derivation.kinematics import jacobian_row
 from ..errors import ModelError
 from ..model.expressions import as_expression
 from ..model.model import Model
+from .at_rest import linear_velocity_row
 from .lambdified import numpy_function
-from .static import linear_velocity_row
 
 
 class ParametricStaticFunctions:
@@ -154,7 +154,7 @@ class StaticFunctionsAt:
 def integrate_member(module, parameters: np.ndarray, y0: np.ndarray, grid: np.ndarray,
                      rtol: float, atol: float, max_steps: int = 10_000_000):
     """One ensemble member by the compiled DOP853 loop onto ``grid`` (s): (t, y, status, t_reached);
-    status 0 when it reached the end (the codes of numerics/fast.py otherwise)."""
+    status 0 when it reached the end (the codes of simulation/compiled_loop.py otherwise)."""
     t, y, _, _, status, t_reached = module.dop853(
         np.ascontiguousarray(parameters, float), float(grid[0]), float(grid[-1]),
         np.ascontiguousarray(y0, float), float(rtol), float(atol), grid, int(max_steps))
@@ -165,7 +165,7 @@ def integrate_member(module, parameters: np.ndarray, y0: np.ndarray, grid: np.nd
 class EnsembleRun:
     """Per-member summaries of an ensemble integrated onto a common grid (SI; NaN where a member
     failed): final state, extremes over the samples, end time (s), energy drift, the loop's status
-    code (0: reached the end; numerics/fast.py's codes otherwise), the time reached (s), and the
+    code (0: reached the end; simulation/compiled_loop.py's codes otherwise), the time reached (s), and the
     samples (members x times x 2n) when asked."""
 
     final: np.ndarray

@@ -349,7 +349,7 @@ class RecursiveNumpyDynamics:
     def numeric_system(self):
         """The NumericSystem over these functions (M, f = -b, energy, accelerations, rhs), as
         the symbolic path gives it; simulation uses it."""
-        from .functions import NumericSystem
+        from ..compile.functions import NumericSystem
 
         return NumericSystem(coordinates=self.coordinates, constraint_names=(),
                              constraint_kinds=(), parameters=dict(self.parameters),

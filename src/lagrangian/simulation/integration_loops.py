@@ -2,7 +2,7 @@
 
 Both save onto a time grid (dense output), report progress and keep what was computed when
 a step fails or the user presses Ctrl-C; the scipy loop also stops at a stop condition and
-projects constrained states after each step (numerics/drift.py).
+projects constrained states after each step (simulation/drift.py).
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..compile.functions import NumericSystem
 from .drift import DriftControl
-from .functions import NumericSystem
 from .options import StepControl
 from .result import STATUS_MESSAGES
 
@@ -35,14 +35,14 @@ class LoopRun:
 def integrate_compiled(functions: NumericSystem, t_span: tuple[float, float], y0: np.ndarray,
                        step: StepControl, grid: np.ndarray,
                        progress: Callable[[float], None] | None = None) -> LoopRun | None:
-    """The compiled integration loop of numerics.fast when it is there; None to fall back.
+    """The compiled integration loop of simulation.compiled_loop when it is there; None to fall back.
 
     With a ``progress`` callback the run goes in pieces between output samples (a first short
     piece times the loop; the rest in one call when it will take under a second), so a long run
     can report progress; Ctrl-C inside the C loop keeps the states computed so far.
     """
     try:
-        from .fast import integrate_fast
+        from .compiled_loop import integrate_fast
     except ImportError:
         return None
     pieces = [(0, len(grid) - 1)]

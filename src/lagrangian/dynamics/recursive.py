@@ -30,11 +30,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..compile.codegen import sincos_kernel
 from ..errors import ModelError
 from ..model.model import Model
 from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters
-from .codegen import sincos_kernel
 
 Term = float | str  # a number, or the C name of a value computed before
 VECTOR_LIMIT = 16  # coordinates up to which batches run several states per vector operation
@@ -1002,7 +1002,7 @@ _METHODS = " ".join(
 def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
     """The compiled module's C: the recursive functions, lg_parts/lg_energy/lg_residual for
     template.c (simulation, accelerations), and batched bindings for each function."""
-    from .codegen import TEMPLATE, GeneratedSource
+    from ..compile.codegen import TEMPLATE, GeneratedSource
 
     n = len(tree.coordinates)
     # two-state vector variants for batches of arms; a long chain's code is big enough that
@@ -1109,7 +1109,7 @@ class RecursiveDynamics:
 
     def __init__(self, model: Model, tree: KinematicTree,
                  parameters: Mapping[str, float] | None = None):
-        from . import compiled
+        from ..compile import compiled
 
         names = tuple(p.name for p in model.parameters)
         values = resolve_parameters(model, parameters)
@@ -1142,11 +1142,11 @@ class RecursiveDynamics:
     def numeric_system(self):
         """The NumericSystem over this module (M, f = -b, energy, accelerations, rhs), as the
         symbolic path gives it; simulation uses it."""
-        from .functions import NumericSystem, _CKernel
+        from ..compile.functions import CKernel, NumericSystem
 
         return NumericSystem(coordinates=self.coordinates, constraint_names=(),
                              constraint_kinds=(), parameters=dict(self.parameters),
-                             _kernel=_CKernel(self.module, self.parameter_values))
+                             _kernel=CKernel(self.module, self.parameter_values))
 
     def __repr__(self) -> str:
         return f"RecursiveDynamics(coordinates={list(self.coordinates)})"

@@ -1,4 +1,4 @@
-"""The recursive algorithms in numpy (numerics/recursive_numpy.py), the fallback of the
+"""The recursive algorithms in numpy (dynamics/recursive_numpy.py), the fallback of the
 generated C for URDF trees: equal to the derived equations (Lagrange's method, lambdified) on
 the test URDFs, the two-link arm's textbook M, T = 1/2 v.M v, d(T + V)/dt = v.tau, forward
 undoes inverse; a 30-link chain without RecursionError; the dispatch without a compiler."""
@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 import lagrangian
+from lagrangian.compile import compiled
+from lagrangian.compile.compiled import BackendUnavailable
+from lagrangian.compile.functions import numeric
+from lagrangian.dynamics.joint_space import Dynamics
+from lagrangian.dynamics.recursive import RecursiveDynamics
+from lagrangian.dynamics.recursive_numpy import RecursiveNumpyDynamics
 from lagrangian.errors import DerivationError, ModelError
-from lagrangian.numerics import compiled
-from lagrangian.numerics.compiled import BackendUnavailable
-from lagrangian.numerics.dynamics import Dynamics
-from lagrangian.numerics.functions import numeric
-from lagrangian.numerics.recursive import RecursiveDynamics
-from lagrangian.numerics.recursive_numpy import RecursiveNumpyDynamics
 
 pytest.importorskip("yourdfpy")
 needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
@@ -239,7 +239,7 @@ def test_massless_branch_is_left_to_the_symbolic_path(tmp_path, no_compiler):
     text = URDF.robot(URDF.link("base"), URDF.link("a", 1.0, (0.3, 0, 0)), URDF.link("b"),
                       URDF.joint("j1", "base", "a", axis="0 -1 0"),
                       URDF.joint("j2", "a", "b", xyz="0.6 0 0", axis="0 -1 0"))
-    from lagrangian.numerics.dynamics import recursive_dynamics
+    from lagrangian.dynamics.joint_space import recursive_dynamics
 
     system = arm(tmp_path, text)
     assert recursive_dynamics(system.model, backend="numpy") is None

@@ -1,6 +1,6 @@
 """Expressions to numpy functions: the one lambdify of the package, with one cse policy.
 
-Every numeric function that is not generated C (numerics/codegen.py) is made here: the numpy
+Every numeric function that is not generated C (compile/codegen.py) is made here: the numpy
 kernel, the simulation's extra rows (power, velocity bias, stop condition), the static
 functions of equilibria and linearization, and the geometry of the mechanism.
 """

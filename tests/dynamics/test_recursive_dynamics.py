@@ -1,4 +1,4 @@
-"""Recursive dynamics of URDF trees in generated C (numerics/recursive.py): the same numbers as
+"""Recursive dynamics of URDF trees in generated C (dynamics/recursive.py): the same numbers as
 the derived equations (an independent path: Lagrange's equations, lambdified), and the laws
 they obey on their own: T = 1/2 v.M v, g = dV/dq, d(T + V)/dt = v.tau, T + V kept in a free
 motion; where the tree does not describe the model, the symbolic path."""
@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 
 import lagrangian
+from lagrangian.compile import compiled
+from lagrangian.compile.functions import numeric
+from lagrangian.dynamics.joint_space import Dynamics, recursive_dynamics
+from lagrangian.dynamics.recursive import RecursiveDynamics, applicable_tree
+from lagrangian.dynamics.recursive_numpy import RecursiveNumpyDynamics
 from lagrangian.errors import ModelError
-from lagrangian.numerics import compiled
-from lagrangian.numerics.dynamics import Dynamics, recursive_dynamics
-from lagrangian.numerics.functions import numeric
-from lagrangian.numerics.recursive import RecursiveDynamics, applicable_tree
-from lagrangian.numerics.recursive_numpy import RecursiveNumpyDynamics
 
 pytest.importorskip("yourdfpy")
 needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
@@ -276,7 +276,7 @@ def test_standalone_recursive_c_gives_the_python_numbers(tree, tmp_path):
     # (the Python numbers are the derived equations' in the first test)
     import ctypes
 
-    from lagrangian.numerics.standalone import standalone_tree_c
+    from lagrangian.dynamics.standalone import standalone_tree_c
 
     compiler = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
     code = standalone_tree_c(tree.model, applicable_tree(tree.model), tree.parameters, "tur")

@@ -10,8 +10,8 @@ from scipy.special import ellipk
 
 import lagrangian
 from lagrangian.errors import ModelError
-from lagrangian.numerics.simulate import SaveAt, StepControl, parse_stop_condition, simulate
 from lagrangian.output.simulation import simulation_summary
+from lagrangian.simulation.simulate import SaveAt, StepControl, parse_stop_condition, simulate
 
 G = 9.81
 
@@ -219,7 +219,7 @@ def test_columns_are_named_as_documented():
 
 def test_ctrl_c_in_the_compiled_loop_keeps_what_was_computed(monkeypatch):
     """A run that looks long (a clock that jumps 10 s a reading) goes in pieces with progress."""
-    import lagrangian.numerics.simulate as module
+    import lagrangian.simulation.simulate as module
 
     if run("double_pendulum", 0.1, samples=3).backend != "compiled":
         pytest.skip("no compiled integration loop here (no C compiler)")

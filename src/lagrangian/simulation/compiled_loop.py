@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .functions import NumericSystem
+from ..compile.functions import NumericSystem
 
 
 @dataclass(frozen=True)

@@ -8,8 +8,8 @@ from scipy.integrate import solve_ivp
 from scipy.special import ellipk
 
 import lagrangian
-from lagrangian.numerics import compiled
-from lagrangian.numerics.fast import FastResult, integrate_fast
+from lagrangian.compile import compiled
+from lagrangian.simulation.compiled_loop import FastResult, integrate_fast
 
 pytestmark = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
 

@@ -32,7 +32,7 @@ class NumericSystem:
     constraint_names: tuple[str, ...]
     constraint_kinds: tuple[str, ...]
     parameters: dict[str, float]
-    _kernel: _NumpyKernel | _CKernel
+    _kernel: _NumpyKernel | CKernel
 
     @property
     def n(self) -> int:
@@ -174,7 +174,7 @@ class _NumpyKernel:
         return np.concatenate([y[n:], np.linalg.solve(mass, forcing)[:n]])
 
 
-class _CKernel:
+class CKernel:
     """Generated C (see codegen.py / template.c): batch loops and the linear solve run in C."""
 
     backend = "c"
@@ -258,7 +258,7 @@ def _tree_text(expression, memo: dict) -> str:
     return text
 
 
-def _c_kernel(eom: EquationsOfMotion, values: dict) -> _CKernel:
+def _c_kernel(eom: EquationsOfMotion, values: dict) -> CKernel:
     from . import compiled
     from .codegen import CodegenError
 
@@ -270,7 +270,7 @@ def _c_kernel(eom: EquationsOfMotion, values: dict) -> _CKernel:
                                               ) from None
 
     module = compiled.load_keyed(equations_key(eom), source)
-    return _CKernel(module, np.array([float(values[p.symbol]) for p in eom.model.parameters]))
+    return CKernel(module, np.array([float(values[p.symbol]) for p in eom.model.parameters]))
 
 
 _TOLD: set[str] = set()

@@ -22,7 +22,7 @@ from .lambdified import numpy_function
 
 class StaticFunctions:
     """M, f, K0 = -df/dq, C = -df/dq_dot, Phi_q, its q-derivatives and the static constraint
-    residuals, all at q_dot = 0, compiled once (numerics.lambdified) and batched over q."""
+    residuals, all at q_dot = 0, compiled once (compile.lambdified) and batched over q."""
 
     def __init__(self, eom: EquationsOfMotion,
                  parameters: Mapping[str, float] | ParameterValues | None = None):

@@ -15,9 +15,9 @@ import pytest
 import sympy as sp
 
 import lagrangian
-from lagrangian.numerics import compiled
-from lagrangian.numerics import functions as functions_module
-from lagrangian.numerics.compiled import BackendUnavailable, CompilerMissing
+from lagrangian.compile import compiled
+from lagrangian.compile import functions as functions_module
+from lagrangian.compile.compiled import BackendUnavailable, CompilerMissing
 
 needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
 
@@ -36,7 +36,8 @@ def test_a_cached_module_loads_with_no_compiler_and_no_code_generation(tmp_path)
     """theta_ddot = -(g/L) sin(theta), from the module built by another process."""
     script = textwrap.dedent("""
         import lagrangian
-        from lagrangian.numerics import codegen, compiled
+        from lagrangian.compile import codegen
+        from lagrangian.compile import compiled
         if WARM:
             def refuse(*args):
                 raise AssertionError("C was generated or compiled on a cache hit")
@@ -102,7 +103,7 @@ def test_a_failing_compiler_named_by_cc_is_named(monkeypatch, tmp_path):
 
 def test_the_key_is_the_equations_exactly():
     """Same equations, same key (another load); a coefficient one bit apart, another key."""
-    from lagrangian.numerics.functions import equations_key
+    from lagrangian.compile.functions import equations_key
 
     def spring(k_scale: float) -> lagrangian.System:
         b = lagrangian.SystemBuilder("oscillator")

@@ -10,8 +10,8 @@ import pytest
 
 import lagrangian
 from lagrangian.errors import ModelError
-from lagrangian.numerics.result import SimulationResult
-from lagrangian.numerics.simulate import SaveAt, StepControl, parse_stop_condition, simulate
+from lagrangian.simulation.result import SimulationResult
+from lagrangian.simulation.simulate import SaveAt, StepControl, parse_stop_condition, simulate
 
 G = 9.81
 

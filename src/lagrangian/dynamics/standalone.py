@@ -215,7 +215,7 @@ def standalone_tree_c(model: Model, tree: KinematicTree, values: dict[str, float
     """The same API for a URDF tree by the recursive algorithms (recursive.py): composite rigid
     body M, Newton-Euler inverse dynamics, Cholesky forward dynamics; code linear in the
     number of bodies (M quadratic) instead of the expanded equations."""
-    from .recursive import dynamics_functions
+    from .tree_c import dynamics_functions
 
     parameters = [p.name for p in model.parameters]
     P = prefix or c_prefix(model.name)

@@ -1,0 +1,349 @@
+"""The recursions over a robot's kinematic tree, written against the emitter: joint
+kinematics, Newton-Euler inverse dynamics, the composite-rigid-body mass matrix, articulated-body
+(or Cholesky) forward dynamics and the energies (SI units)."""
+
+from __future__ import annotations
+
+from ..model.tree import KinematicTree
+from .tree_emitter import Term, _Emitter, _Layout
+
+
+def _rotation(E: _Emitter, joint, c: Term, s: Term):
+    """Rot(u, theta) = c 1 + s [u]x + (1 - c) u u^T as terms (c = cos, s = sin theta)."""
+    u = joint.axis
+    one_minus_c = E.sub(1.0, c)
+    R = [[E.mul(one_minus_c, u[i] * u[j]) for j in range(3)] for i in range(3)]
+    for i in range(3):
+        # along a coordinate axis the diagonal entry is exactly 1, not c + (1 - c)
+        R[i][i] = 1.0 if abs(u[i]) == 1.0 else E.add(c, R[i][i])
+    cross = ((0, 1, -u[2]), (0, 2, u[1]), (1, 0, u[2]), (1, 2, -u[0]), (2, 0, -u[1]),
+             (2, 1, u[0]))
+    for i, j, k in cross:
+        R[i][j] = E.add(R[i][j], E.mul(s, k))
+    return R
+
+
+def _kinematics(E: _Emitter, tree: KinematicTree, q):
+    """Each body's rotation R (body -> parent axes) and origin p (in its parent), as terms."""
+    placements = []
+    for joint in tree.joints:
+        theta = E.add(E.mul(q[joint.coordinate], joint.multiplier), joint.offset)
+        R0 = [list(row) for row in joint.rotation]
+        if joint.kind == "revolute":
+            sin, cos = E.sincos(theta)
+            R = E.matmul(R0, _rotation(E, joint, cos, sin))
+            p = list(joint.translation)
+        else:
+            R = R0
+            p = E.vadd(joint.translation, E.scale(theta, E.apply(R0, joint.axis)))
+        placements.append((R, p))
+    return placements
+
+
+def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a):
+    """Recursive Newton-Euler: the generalized forces tau_i (N m or N) for q, q_dot, q_ddot,
+    minus each actuator parameter (the model's own load)."""
+    placements = _kinematics(E, tree, q)
+    g = layout.gravity
+    up = [E.mul(g, -d) for d in tree.gravity_direction]  # the ground accelerates up by g
+    w, dw, acc, f, n = [], [], [], [], []
+    for i, joint in enumerate(tree.joints):
+        R, p = placements[i]
+        if joint.parent < 0:
+            wl, dwl, al = [0.0] * 3, [0.0] * 3, up
+        else:
+            wl, dwl, al = w[joint.parent], dw[joint.parent], acc[joint.parent]
+        u = list(joint.axis)
+        rate = E.mul(v[joint.coordinate], joint.multiplier)
+        accel = E.mul(a[joint.coordinate], joint.multiplier)
+        w_in = E.apply_transpose(R, wl)
+        dw_in = E.apply_transpose(R, dwl)
+        origin = E.vadd(al, E.vadd(E.cross(dwl, p), E.cross(wl, E.cross(wl, p))))
+        a_i = E.apply_transpose(R, origin)
+        if joint.kind == "revolute":
+            w_i = E.vadd(w_in, E.scale(rate, u))
+            dw_i = E.vadd(dw_in, E.vadd(E.cross(w_in, E.scale(rate, u)), E.scale(accel, u)))
+        else:
+            w_i, dw_i = w_in, dw_in
+            a_i = E.vadd(a_i, E.vadd(E.scale(2.0, E.cross(w_i, E.scale(rate, u))),
+                                     E.scale(accel, u)))
+        w.append(w_i)
+        dw.append(dw_i)
+        acc.append(a_i)
+        m, h, J = joint.mass, list(joint.first_moment), [list(r) for r in joint.inertia]
+        # about the body's origin: f = m a + dw x h + w x (w x h), n = J dw + w x J w + h x a
+        f.append(E.vadd(E.scale(m, a_i), E.vadd(E.cross(dw_i, h), E.cross(w_i, E.cross(w_i, h)))))
+        n.append(E.vadd(E.vadd(E.apply(J, dw_i), E.cross(w_i, E.apply(J, w_i))),
+                        E.cross(h, a_i)))
+    tau_full: list[Term] = [0.0] * len(tree.joints)
+    for i in reversed(range(len(tree.joints))):
+        joint = tree.joints[i]
+        tau_full[i] = E.dot(joint.axis, n[i] if joint.kind == "revolute" else f[i])
+        if joint.parent >= 0:
+            R, p = placements[i]
+            force = E.apply(R, f[i])
+            f[joint.parent] = E.vadd(f[joint.parent], force)
+            n[joint.parent] = E.vadd(n[joint.parent],
+                                     E.vadd(E.apply(R, n[i]), E.cross(p, force)))
+    tau: list[Term] = [0.0] * layout.n
+    for i, joint in enumerate(tree.joints):
+        tau[joint.coordinate] = E.add(tau[joint.coordinate], E.mul(tau_full[i], joint.multiplier))
+    return [E.sub(t, actuator) for t, actuator in zip(tau, layout.actuators, strict=True)]
+
+
+def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
+    """Composite-rigid-body algorithm: M (lower triangle, row-major entries i >= j)."""
+    placements = _kinematics(E, tree, q)
+    nb = len(tree.joints)
+    mass = [j.mass for j in tree.joints]
+    h = [list(j.first_moment) for j in tree.joints]
+    J = [[list(r) for r in j.inertia] for j in tree.joints]
+    full = {}
+    for i in reversed(range(nb)):
+        joint = tree.joints[i]
+        u = list(joint.axis)
+        if joint.kind == "revolute":  # unit rate about u: f = u x h, n = J u
+            force, moment = E.cross(u, h[i]), E.apply(J[i], u)
+        else:  # unit rate along u: f = m u, n = h x u
+            force, moment = E.scale(mass[i], u), E.cross(h[i], u)
+        full[i, i] = E.dot(u, moment if joint.kind == "revolute" else force)
+        k = i
+        while tree.joints[k].parent >= 0:
+            R, p = placements[k]
+            force = E.apply(R, force)
+            moment = E.vadd(E.apply(R, moment), E.cross(p, force))
+            k = tree.joints[k].parent
+            ancestor = tree.joints[k]
+            full[i, k] = E.dot(ancestor.axis, moment if ancestor.kind == "revolute" else force)
+        parent = joint.parent
+        if parent >= 0:  # the composite inertia of body i, moved into its parent's axes
+            R, p = placements[i]
+            hr = E.apply(R, h[i])
+            A = [E.apply(R, [J[i][0][c], J[i][1][c], J[i][2][c]]) for c in range(3)]  # columns
+            RJRt = [[None] * 3 for _ in range(3)]
+            for r in range(3):
+                for c in range(r, 3):
+                    RJRt[r][c] = RJRt[c][r] = E.dot([A[0][r], A[1][r], A[2][r]], R[c])
+            ph = E.dot(p, hr)
+            pp = E.dot(p, p)
+            for r in range(3):
+                for c in range(r, 3):
+                    # J' = R J R^T + m (|p|^2 1 - p p^T) + 2 (p.h) 1 - p h^T - h p^T
+                    shift = E.sub(E.neg(E.mul(mass[i], E.mul(p[r], p[c]))),
+                                  E.add(E.mul(p[r], hr[c]), E.mul(hr[r], p[c])))
+                    if r == c:
+                        shift = E.add(shift, E.add(E.mul(mass[i], pp), E.mul(2.0, ph)))
+                    entry = E.add(J[parent][r][c], E.add(RJRt[r][c], shift))
+                    J[parent][r][c] = J[parent][c][r] = entry
+            h[parent] = E.vadd(h[parent], E.vadd(hr, E.scale(mass[i], p)))
+            mass[parent] = mass[parent] + mass[i]
+    entries = {}
+    for (i, k), value in full.items():
+        a, b = tree.joints[i], tree.joints[k]
+        for (r, c, x) in ((a.coordinate, b.coordinate, value),) + (
+                ((b.coordinate, a.coordinate, value),) if i != k else ()):
+            if r >= c:
+                entries[r, c] = E.add(entries.get((r, c), 0.0),
+                                      E.mul(x, a.multiplier * b.multiplier))
+    return entries
+
+
+def _articulated(tree: KinematicTree) -> bool:
+    """Whether the articulated-body algorithm applies: each coordinate drives one joint, as
+    its angle or distance (no mimic joint)."""
+    used = [j.coordinate for j in tree.joints]
+    return len(set(used)) == len(used) and all(j.multiplier == 1.0 for j in tree.joints)
+
+
+def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, tau):
+    """Articulated-body algorithm (Featherstone): q_ddot for q, q_dot and tau (on top of the
+    actuator parameters), O(n). Spatial vectors in body axes about the body's origin: motion
+    (w, v), force (n, f); inertia blocks [[A, B], [B^T, C]] with n = A w + B v, f = B^T w + C v."""
+    placements = _kinematics(E, tree, q)
+    nb = len(tree.joints)
+    w, vel, c, A, B, C, pn, pf = [], [], [], [], [], [], [], []
+    for i, joint in enumerate(tree.joints):
+        R, p = placements[i]
+        u = list(joint.axis)
+        rate = v[joint.coordinate]
+        wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
+                                                                 vel[joint.parent])
+        w_i = E.apply_transpose(R, wl)
+        v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
+        su = E.scale(rate, u)
+        if joint.kind == "revolute":
+            w_i = E.vadd(w_i, su)
+            c.append((E.cross(w_i, su), E.cross(v_i, su)))  # (w, v) x S q_dot
+        else:
+            v_i = E.vadd(v_i, su)
+            c.append(([0.0] * 3, E.cross(w_i, su)))
+        w.append(w_i)
+        vel.append(v_i)
+        m, h, J = joint.mass, list(joint.first_moment), [list(r) for r in joint.inertia]
+        # the rigid body's inertia: A = J_O, B = [h]x, C = m 1
+        A.append([row[:] for row in J])
+        B.append([[0.0, E.neg(h[2]), h[1]], [h[2], 0.0, E.neg(h[0])],
+                  [E.neg(h[1]), h[0], 0.0]])
+        C.append([[m if r == k else 0.0 for k in range(3)] for r in range(3)])
+        # bias force (w, v) x* (I (w, v)): n0 = J w + h x v, f0 = m v + w x h
+        n0 = E.vadd(E.apply(J, w_i), E.cross(h, v_i))
+        f0 = E.vadd(E.scale(m, v_i), E.cross(w_i, h))
+        pn.append(E.vadd(E.cross(w_i, n0), E.cross(v_i, f0)))
+        pf.append(E.cross(w_i, f0))
+    U, D, uu = [None] * nb, [None] * nb, [None] * nb
+    for i in reversed(range(nb)):
+        joint = tree.joints[i]
+        u = list(joint.axis)
+        if joint.kind == "revolute":  # U = IA S: the first column block times u
+            Un = E.apply(A[i], u)
+            Uf = E.apply_transpose(B[i], u)
+            drive_n, drive_f = u, [0.0] * 3
+        else:
+            Un = E.apply(B[i], u)
+            Uf = E.apply(C[i], u)
+            drive_n, drive_f = [0.0] * 3, u
+        U[i] = (Un, Uf)
+        D[i] = E.add(E.dot(drive_n, Un), E.dot(drive_f, Uf))
+        effort = E.add(tau[joint.coordinate], layout.actuators[joint.coordinate])
+        uu[i] = E.sub(effort, E.add(E.dot(drive_n, pn[i]), E.dot(drive_f, pf[i])))
+        parent = joint.parent
+        if parent < 0:
+            continue
+        R, p = placements[i]
+        inv = E.div(1.0, D[i])
+        Uns, Ufs = E.scale(inv, Un), E.scale(inv, Uf)
+        # Ia = IA - U U^T / D, pa = pA + Ia c + U u / D
+        Aa = [[E.sub(A[i][r][k], E.mul(Un[r], Uns[k])) for k in range(3)] for r in range(3)]
+        Ba = [[E.sub(B[i][r][k], E.mul(Un[r], Ufs[k])) for k in range(3)] for r in range(3)]
+        Ca = [[E.sub(C[i][r][k], E.mul(Uf[r], Ufs[k])) for k in range(3)] for r in range(3)]
+        cw, cv = c[i]
+        Bt = [[Ba[k][r] for k in range(3)] for r in range(3)]
+        an = E.vadd(pn[i], E.vadd(E.vadd(E.apply(Aa, cw), E.apply(Ba, cv)), E.scale(uu[i], Uns)))
+        af = E.vadd(pf[i], E.vadd(E.vadd(E.apply(Bt, cw), E.apply(Ca, cv)), E.scale(uu[i], Ufs)))
+        # into the parent: rotate (R X R^T), then move the reference point by p
+        Ar, Br, Cr = _sandwich(E, R, Aa, True), _sandwich(E, R, Ba, False), _sandwich(E, R, Ca, True)
+        P = [[0.0, E.neg(p[2]), p[1]], [p[2], 0.0, E.neg(p[0])], [E.neg(p[1]), p[0], 0.0]]
+        K = E.matmul(P, Cr)  # [p]x C
+        PBt = E.matmul(P, [[Br[k][r] for k in range(3)] for r in range(3)])  # [p]x B^T
+        KP = E.matmul(K, P)
+        for r in range(3):
+            for k in range(r, 3):
+                # A_P = A + [p]x B^T + ([p]x B^T)^T - [p]x C [p]x
+                entry = E.add(Ar[r][k], E.sub(E.add(PBt[r][k], PBt[k][r]), KP[r][k]))
+                A[parent][r][k] = E.add(A[parent][r][k], entry)
+                if k != r:
+                    A[parent][k][r] = A[parent][r][k]
+                C[parent][r][k] = E.add(C[parent][r][k], Cr[r][k])
+                if k != r:
+                    C[parent][k][r] = C[parent][r][k]
+        for r in range(3):
+            for k in range(3):  # B_P = B + [p]x C
+                B[parent][r][k] = E.add(B[parent][r][k], E.add(Br[r][k], K[r][k]))
+        force = E.apply(R, af)
+        pf[parent] = E.vadd(pf[parent], force)
+        pn[parent] = E.vadd(pn[parent], E.vadd(E.apply(R, an), E.cross(p, force)))
+    up = [E.mul(layout.gravity, -d) for d in tree.gravity_direction]
+    acc_w, acc_v = [None] * nb, [None] * nb
+    qdd: list[Term] = [0.0] * layout.n
+    for i, joint in enumerate(tree.joints):
+        R, p = placements[i]
+        if joint.parent < 0:
+            aw_l, av_l = [0.0] * 3, up
+        else:
+            aw_l, av_l = acc_w[joint.parent], acc_v[joint.parent]
+        cw, cv = c[i]
+        aw = E.vadd(E.apply_transpose(R, aw_l), cw)
+        av = E.vadd(E.apply_transpose(R, E.vadd(av_l, E.cross(aw_l, p))), cv)
+        Un, Uf = U[i]
+        x = E.div(E.sub(uu[i], E.add(E.dot(Un, aw), E.dot(Uf, av))), D[i])
+        qdd[joint.coordinate] = x
+        if joint.kind == "revolute":
+            aw = E.vadd(aw, E.scale(x, joint.axis))
+        else:
+            av = E.vadd(av, E.scale(x, joint.axis))
+        acc_w[i], acc_v[i] = aw, av
+    return qdd
+
+
+def _sandwich(E: _Emitter, R, X, symmetric: bool):
+    """R X R^T (only the upper triangle computed when X is symmetric)."""
+    RX = E.matmul(R, X)
+    out = [[None] * 3 for _ in range(3)]
+    for r in range(3):
+        for k in range(3):
+            if symmetric and k < r:
+                continue
+            out[r][k] = E.dot(RX[r], R[k])
+            if symmetric:
+                out[k][r] = out[r][k]
+    return out
+
+
+def _velocities(E: _Emitter, tree: KinematicTree, q, v):
+    placements = _kinematics(E, tree, q)
+    w, vel = [], []
+    for i, joint in enumerate(tree.joints):
+        R, p = placements[i]
+        wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
+                                                                 vel[joint.parent])
+        rate = E.mul(v[joint.coordinate], joint.multiplier)
+        w_i = E.apply_transpose(R, wl)
+        v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
+        if joint.kind == "revolute":
+            w_i = E.vadd(w_i, E.scale(rate, joint.axis))
+        else:
+            v_i = E.vadd(v_i, E.scale(rate, joint.axis))
+        w.append(w_i)
+        vel.append(v_i)
+    return w, vel
+
+
+def _kinetic_energy(E: _Emitter, tree: KinematicTree, q, v) -> Term:
+    """T = sum 1/2 m v.v + v.(w x h) + 1/2 w.J_O w (J)."""
+    w, vel = _velocities(E, tree, q, v)
+    terms = []
+    for joint, w_i, v_i in zip(tree.joints, w, vel, strict=True):
+        twice = E.add(E.mul(joint.mass, E.dot(v_i, v_i)),
+                      E.add(E.mul(2.0, E.dot(v_i, E.cross(w_i, list(joint.first_moment)))),
+                            E.dot(w_i, E.apply([list(r) for r in joint.inertia], w_i))))
+        terms.append(twice)
+    return E.mul(E.sum(terms), 0.5)
+
+
+def _potential_energy(E: _Emitter, tree: KinematicTree, layout: _Layout, q) -> Term:
+    """V = g sum (m height of the origin + up.h), up in each body's axes (J)."""
+    placements = _kinematics(E, tree, q)
+    up_world = [-d + 0.0 for d in tree.gravity_direction]
+    up, height, terms = [], [], []
+    for i, joint in enumerate(tree.joints):
+        R, p = placements[i]
+        up_l, height_l = (up_world, 0.0) if joint.parent < 0 else (up[joint.parent],
+                                                                   height[joint.parent])
+        up.append(E.apply_transpose(R, up_l))
+        height.append(E.add(height_l, E.dot(up_l, p)))
+        terms.append(E.add(E.mul(joint.mass, height[i]), E.dot(up[i], list(joint.first_moment))))
+    return E.mul(E.sum(terms), layout.gravity)
+
+
+
+def _cholesky_solve(E: _Emitter, mass: dict, rhs: list) -> list:
+    """x with M x = rhs by M = L L^T, straight-line (zeros of M, e.g. between two branches of
+    the tree, fold away); M given by its lower triangle."""
+    n = len(rhs)
+    L: dict = {}
+    inverse = []
+    for j in range(n):
+        d = E.sub(mass.get((j, j), 0.0), E.sum(E.mul(L[j, k], L[j, k]) for k in range(j)))
+        inverse.append(E.div(1.0, E.call("sqrt", d)))
+        for i in range(j + 1, n):
+            e = E.sub(mass.get((i, j), 0.0), E.sum(E.mul(L[i, k], L[j, k]) for k in range(j)))
+            L[i, j] = E.mul(e, inverse[j])
+        L[j, j] = E.div(1.0, inverse[j])
+    y = []
+    for i in range(n):
+        y.append(E.mul(E.sub(rhs[i], E.sum(E.mul(L[i, k], y[k]) for k in range(i))), inverse[i]))
+    x = [0.0] * n
+    for i in reversed(range(n)):
+        x[i] = E.mul(E.sub(y[i], E.sum(E.mul(L[k, i], x[k]) for k in range(i + 1, n))),
+                     inverse[i])
+    return x

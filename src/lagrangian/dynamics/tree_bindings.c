@@ -1,0 +1,205 @@
+/* ---- batched bindings: each input (..., N) or (N,), outputs shaped like the largest ---- */
+enum { RT_MASS, RT_BIAS, RT_GRAVITY, RT_INVERSE, RT_FORWARD, RT_KINETIC, RT_POTENTIAL };
+static const char *rt_names[] = {"q", "v", "third"};
+#if defined(__unix__) || defined(__APPLE__)
+#define RT_PTHREADS 1
+#include <pthread.h>
+#include <unistd.h>
+#else
+#define RT_PTHREADS 0
+#endif
+#define RT_MAX_THREADS 8
+#define RT_THREAD_STATES 1024
+#ifndef LG_LANES
+#define LG_LANES 1
+#endif
+
+typedef struct {
+    int kind, nin, size;
+    npy_intp step[3];
+    const double *x0, *x1, *x2, *p;
+    double *y;
+    npy_intp k0, k1, failed;
+} rt_job;
+
+static void *rt_run(void *argument)
+{
+    rt_job *job = (rt_job *)argument;
+    const int kind = job->kind, nin = job->nin, size = job->size;
+    const npy_intp *step = job->step;
+    const double *x0 = job->x0, *x1 = job->x1, *x2 = job->x2, *p = job->p;
+    double *y = job->y;
+    npy_intp failed = -1, count = job->k1, k = job->k0;
+    (void)nin; (void)size;
+#if RT_VECTOR
+    /* LG_LANES states at a time through the vector variants, the rest one by one */
+    for (; k + LG_LANES <= count && (kind != RT_FORWARD || RT_VECTOR_FORWARD); k += LG_LANES) {
+        lg_v4 in[3][LG_N], out4[LG_N * LG_N];
+        for (int j = 0; j < nin; j++) {
+            const double *x = j == 0 ? x0 : j == 1 ? x1 : x2;
+            for (int l = 0; l < LG_LANES; l++)
+                for (int i = 0; i < LG_N; i++) in[j][i][l] = x[(k + l) * step[j] + i];
+        }
+        switch (kind) {
+        case RT_MASS: rt4_mass_matrix(in[0], p, out4); break;
+        case RT_BIAS: rt4_bias_forces(in[0], in[1], p, out4); break;
+        case RT_GRAVITY: rt4_gravity(in[0], p, out4); break;
+        case RT_INVERSE: rt4_inverse_dynamics(in[0], in[1], in[2], p, out4); break;
+#if RT_VECTOR_FORWARD
+        case RT_FORWARD: rt4_forward_dynamics(in[0], in[1], in[2], p, out4); break;
+#endif
+        case RT_KINETIC: rt4_kinetic_energy(in[0], in[1], p, out4); break;
+        case RT_POTENTIAL: rt4_potential_energy(in[0], p, out4); break;
+        }
+        for (int l = 0; l < LG_LANES; l++)
+            for (int i = 0; i < size; i++) {
+                const double x = out4[i][l];
+                y[(k + l) * size + i] = x;
+                if (kind == RT_FORWARD && !isfinite(x) && failed < 0) failed = k + l;
+            }
+    }
+#endif
+    for (; k < count; k++) {
+        const double *a0 = x0 + k * step[0], *a1 = x1 + k * step[1], *a2 = x2 + k * step[2];
+        switch (kind) {
+        case RT_MASS: rt_mass_matrix(a0, p, y + k * LG_N * LG_N); break;
+        case RT_BIAS: rt_bias_forces(a0, a1, p, y + k * LG_N); break;
+        case RT_GRAVITY: rt_gravity(a0, p, y + k * LG_N); break;
+        case RT_INVERSE: rt_inverse_dynamics(a0, a1, a2, p, y + k * LG_N); break;
+        case RT_FORWARD:
+            if (rt_forward_dynamics(a0, a1, a2, p, y + k * LG_N) && failed < 0) failed = k;
+            break;
+        case RT_KINETIC: y[k] = rt_kinetic_energy(a0, a1, p); break;
+        case RT_POTENTIAL: y[k] = rt_potential_energy(a0, p); break;
+        }
+    }
+    job->failed = failed;
+    return NULL;
+}
+
+/* How many threads a batch of ``count`` states runs on: one per processor (at most
+   RT_MAX_THREADS) once each has RT_THREAD_STATES states; LAGRANGIAN_THREADS caps it. */
+static int rt_threads(npy_intp count)
+{
+#if RT_PTHREADS
+    static int cap = 0;
+    if (cap == 0) {
+        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+        const char *env = getenv("LAGRANGIAN_THREADS");
+        long asked = env && *env ? strtol(env, NULL, 10) : cpus;
+        if (asked < 1) asked = 1;
+        if (cpus < 1) cpus = 1;
+        cap = (int)(asked < cpus ? asked : cpus);
+        if (cap > RT_MAX_THREADS) cap = RT_MAX_THREADS;
+    }
+    npy_intp parts = count / RT_THREAD_STATES;
+    if (parts > cap) parts = cap;
+    return parts < 1 ? 1 : (int)parts;
+#else
+    (void)count;
+    return 1;
+#endif
+}
+
+static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int kind)
+{
+    PyArrayObject *in[3] = {NULL, NULL, NULL}, *P = NULL;
+    PyObject *out = NULL;
+    npy_intp step[3] = {0, 0, 0};
+    if (nargs != nin + 1) {
+        PyErr_Format(PyExc_TypeError, "expected %d arguments", nin + 1);
+        return NULL;
+    }
+    int base = 0;
+    for (int i = 0; i < nin; i++) {
+        in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
+        if (!in[i]) goto done;
+        int nd = PyArray_NDIM(in[i]);
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != LG_N) {
+            PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
+                         i == 2 ? (kind == RT_FORWARD ? "tau" : "a") : rt_names[i], LG_N);
+            goto done;
+        }
+        if (PyArray_SIZE(in[i]) > PyArray_SIZE(in[base])) base = i;
+    }
+    npy_intp count = PyArray_SIZE(in[base]) / LG_N;
+    int nd = PyArray_NDIM(in[base]);
+    for (int i = 0; i < nin; i++) {
+        if (PyArray_SIZE(in[i]) == LG_N && PyArray_NDIM(in[i]) == 1) {
+            step[i] = count > 1 ? 0 : LG_N;
+            continue;
+        }
+        if (PyArray_NDIM(in[i]) != nd
+            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), nd * sizeof(npy_intp))) {
+            PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
+            goto done;
+        }
+        step[i] = LG_N;
+    }
+    P = lg_doubles(args[nin], LG_NP, "parameters");
+    if (!P) goto done;
+    npy_intp dims[NPY_MAXDIMS];
+    memcpy(dims, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
+    int od = nd - 1;
+    if (kind == RT_MASS) { dims[od++] = LG_N; dims[od++] = LG_N; }
+    else if (kind != RT_KINETIC && kind != RT_POTENTIAL) dims[od++] = LG_N;
+    out = PyArray_SimpleNew(od, dims, NPY_DOUBLE);
+    if (!out) goto done;
+    const double *x0 = (const double *)PyArray_DATA(in[0]);
+    const double *x1 = nin > 1 ? (const double *)PyArray_DATA(in[1]) : NULL;
+    const double *x2 = nin > 2 ? (const double *)PyArray_DATA(in[2]) : NULL;
+    const double *p = (const double *)PyArray_DATA(P);
+    double *y = (double *)PyArray_DATA((PyArrayObject *)out);
+    const int size = kind == RT_MASS ? LG_N * LG_N
+                     : (kind == RT_KINETIC || kind == RT_POTENTIAL) ? 1 : LG_N;
+    rt_job jobs[RT_MAX_THREADS];
+    int parts = rt_threads(count);
+    npy_intp share = (count / parts + LG_LANES - 1) / LG_LANES * LG_LANES;
+    for (int t = 0; t < parts; t++) {
+        rt_job job = {kind, nin, size, {step[0], step[1], step[2]}, x0, x1, x2, p, y,
+                      t * share < count ? t * share : count,
+                      t == parts - 1 || (t + 1) * share > count ? count : (t + 1) * share, -1};
+        jobs[t] = job;
+    }
+    npy_intp failed = -1;
+    NPY_BEGIN_THREADS_DEF;
+    if (count > 16) NPY_BEGIN_THREADS;
+    /* the batch in parts on threads of their own (the functions keep no state), this thread
+       taking the last part; a thread that cannot start leaves its part to this one */
+#if RT_PTHREADS
+    pthread_t threads[RT_MAX_THREADS];
+    int started[RT_MAX_THREADS] = {0};
+    for (int t = 0; t < parts - 1; t++)
+        started[t] = pthread_create(&threads[t], NULL, rt_run, &jobs[t]) == 0;
+    rt_run(&jobs[parts - 1]);
+    for (int t = 0; t < parts - 1; t++) {
+        if (started[t]) pthread_join(threads[t], NULL);
+        else rt_run(&jobs[t]);
+    }
+#else
+    for (int t = 0; t < parts; t++) rt_run(&jobs[t]);
+#endif
+    for (int t = 0; t < parts; t++)
+        if (jobs[t].failed >= 0 && (failed < 0 || jobs[t].failed < failed)) failed = jobs[t].failed;
+    if (count > 16) NPY_END_THREADS;
+    if (failed >= 0) {
+        PyErr_Format(lg_LinAlgError, "the mass matrix is not positive definite (state %zd)",
+                     (Py_ssize_t)failed);
+        Py_CLEAR(out);
+    }
+done:
+    for (int i = 0; i < 3; i++) Py_XDECREF(in[i]);
+    Py_XDECREF(P);
+    return out;
+}
+
+#define RT_WRAP(name, nin, kind) \
+    static PyObject *rt_py_##name(PyObject *self, PyObject *const *args, Py_ssize_t nargs) \
+    { (void)self; return rt_batch(args, nargs, nin, kind); }
+RT_WRAP(mass_matrix, 1, RT_MASS)
+RT_WRAP(bias_forces, 2, RT_BIAS)
+RT_WRAP(gravity, 1, RT_GRAVITY)
+RT_WRAP(inverse_dynamics, 3, RT_INVERSE)
+RT_WRAP(forward_dynamics, 3, RT_FORWARD)
+RT_WRAP(kinetic_energy, 2, RT_KINETIC)
+RT_WRAP(potential_energy, 1, RT_POTENTIAL)

@@ -1,0 +1,211 @@
+"""The C text of a tree's dynamics functions for a prefix: scalar, and on vector lanes
+for batches (the standalone C and the compiled module share it)."""
+
+from __future__ import annotations
+
+from ..compile.codegen import sincos_kernel
+from ..model.tree import KinematicTree
+from .tree_algorithms import (
+    _articulated,
+    _cholesky_solve,
+    _forward_dynamics,
+    _inverse_dynamics,
+    _kinetic_energy,
+    _mass_matrix,
+    _potential_energy,
+)
+from .tree_emitter import _Emitter, _Layout
+
+
+def _inputs(name: str, n: int) -> list[str]:
+    return [f"{name}[{i}]" for i in range(n)]
+
+
+_SINCOS = r"""
+/* sin and cos of x (fdlibm's kernels on [-pi/4, pi/4] after a three-part reduction by pi/2;
+   libm beyond |x| = 1e5 and for NaN): within an ulp or two, no library call. */
+static inline void lg_sincos(double x, double *sine, double *cosine)
+{
+    if (!(fabs(x) < 1.0e5)) { *sine = sin(x); *cosine = cos(x); return; }
+""" + sincos_kernel("double") + r"""
+    const double turn[4] = {s, c, -s, -c};
+    const long k = (long)n;
+    *sine = turn[k & 3];
+    *cosine = turn[(k + 1) & 3];
+}
+"""
+
+
+def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix: str,
+                       storage: str = "static ", vector: bool = False) -> str:
+    """C99 functions <prefix>_mass_matrix, _bias_forces, _gravity, _inverse_dynamics,
+    _forward_dynamics, _kinetic_energy, _potential_energy (the standalone API); with
+    ``vector``, also <prefix>4_<name> on LG_LANES states at once (GCC/Clang vector extensions, for
+    the compiled module's batches)."""
+    layout = _Layout(tree, parameters)
+    n = layout.n
+    q, v, a = _inputs("q", n), _inputs("v", n), _inputs("a", n)
+    zeros = [0.0] * n
+    P, S = prefix, storage
+    R = "const double *restrict"
+    sections = [_SINCOS]
+    straight = []  # (name, inputs, emitter, [(output index, term)]) for the vector variants
+
+    def function(signature: str, E: _Emitter, outputs, extra: str = "") -> None:
+        sections.append(f"{S}{signature}\n{{\n    (void)p;\n{E.body(outputs)}\n{extra}}}\n")
+
+    E = _Emitter()
+    entries = _mass_matrix(E, tree, layout, q)
+    outputs = []
+    for r in range(n):
+        for c in range(r + 1):
+            outputs.append((r * n + c, entries.get((r, c), 0.0)))
+    mirror = "".join(f"    M[{c * n + r}] = M[{r * n + c}];\n"
+                     for r in range(n) for c in range(r))
+    function(f"void {P}_mass_matrix({R} q, {R} p, double *restrict M)", E,
+             [(f"M[{k}]", t) for k, t in outputs], mirror)
+    straight.append(("mass_matrix", ("q",), E, outputs))
+    for name, args, rates, accels, inputs in (
+            ("inverse_dynamics", f"{R} q, {R} v, {R} a, {R} p, double *restrict tau", v, a,
+             ("q", "v", "a")),
+            ("bias_forces", f"{R} q, {R} v, {R} p, double *restrict tau", v, zeros, ("q", "v")),
+            ("gravity", f"{R} q, {R} p, double *restrict tau", zeros, zeros, ("q",))):
+        E = _Emitter()
+        tau = _inverse_dynamics(E, tree, layout, q, rates, accels)
+        function(f"void {P}_{name}({args})", E, [(f"tau[{i}]", t) for i, t in enumerate(tau)])
+        straight.append((name, inputs, E, list(enumerate(tau))))
+    E = _Emitter()
+    T = _kinetic_energy(E, tree, q, v)
+    function(f"double {P}_kinetic_energy({R} q, {R} v, {R} p)", E, [("double T", T)],
+             "    return T;\n")
+    straight.append(("kinetic_energy", ("q", "v"), E, [(0, T)]))
+    E = _Emitter()
+    V = _potential_energy(E, tree, layout, q)
+    function(f"double {P}_potential_energy({R} q, {R} p)", E, [("double V", V)],
+             "    return V;\n")
+    straight.append(("potential_energy", ("q",), E, [(0, V)]))
+    # forward dynamics: the articulated-body algorithm or M = L L^T straight-line (M and b
+    # sharing their kinematics), whichever takes fewer operations; loops for a big M
+    candidates = []
+    tau_in = _inputs("tau", n)
+    if _articulated(tree):
+        E = _Emitter()
+        try:
+            qdd = _forward_dynamics(E, tree, layout, q, v, tau_in)
+            candidates.append((E.count([(f"qdd[{i}]", x) for i, x in enumerate(qdd)]), E, qdd))
+        except ZeroDivisionError:  # a joint that moves no mass: singular at every state
+            pass
+    if n <= 24:
+        E = _Emitter()
+        try:
+            mass = _mass_matrix(E, tree, layout, q)
+            bias = _inverse_dynamics(E, tree, layout, q, v, zeros)
+            qdd = _cholesky_solve(E, mass, [E.sub(t, b) for t, b in zip(tau_in, bias, strict=True)])
+            candidates.append((E.count([(f"qdd[{i}]", x) for i, x in enumerate(qdd)]), E, qdd))
+        except ZeroDivisionError:
+            pass
+    qdd = None
+    if candidates:
+        _, E, qdd = min(candidates, key=lambda c: c[0])
+    if qdd is not None:
+        check = "".join(f"    if (!isfinite(qdd[{i}])) return -1;\n" for i in range(n))
+        function(f"int {P}_forward_dynamics({R} q, {R} v, {R} tau, {R} p, double *restrict qdd)",
+                 E, [(f"qdd[{i}]", x) for i, x in enumerate(qdd)], check + "    return 0;\n")
+        straight.append(("forward_dynamics", ("q", "v", "tau"), E, list(enumerate(qdd))))
+    else:
+        sections.append(_cholesky_forward(P, S, R, n))
+    if vector:
+        sections.append(_VECTOR)
+        for name, inputs, E, outs in straight:
+            body = E.body([(f"out[{k}]", t) for k, t in outs], vector=True)
+            if name == "mass_matrix":
+                body += "\n" + "".join(f"    out[{c * n + r}] = out[{r * n + c}];\n"
+                                        for r in range(n) for c in range(r))
+            args = ", ".join(f"const lg_v4 *restrict {x}" for x in inputs)
+            sections.append(f"static void {P}4_{name}({args}, {R} p, lg_v4 *restrict out)\n"
+                            f"{{\n    (void)p;\n{body}\n}}\n")
+    return "\n".join(sections)
+
+
+_VECTOR = r"""
+/* Several states at once, each operation on all lanes: four with AVX (a native build, see
+   compiled.NATIVE_CFLAGS), else two (one SSE2 instruction; wider vectors without AVX are split
+   through memory by the compiler, slower than scalar code). */
+#if defined(__AVX__)
+#define LG_LANES 4
+typedef double lg_v4 __attribute__((vector_size(32)));
+#else
+#define LG_LANES 2
+typedef double lg_v4 __attribute__((vector_size(16)));
+#endif
+#define LG_V4(x) ((lg_v4){0.0} + (x))
+typedef unsigned long long lg_u4 __attribute__((vector_size(sizeof(lg_v4))));
+
+static inline lg_v4 lg_vsqrt(lg_v4 x)
+{
+    lg_v4 r;
+    for (int l = 0; l < LG_LANES; l++) r[l] = sqrt(x[l]);
+    return r;
+}
+
+static inline void lg_vsincos(lg_v4 x, lg_v4 *sine, lg_v4 *cosine)
+{
+    int reducible = 1;
+    for (int l = 0; l < LG_LANES; l++) reducible &= fabs(x[l]) < 1.0e5;
+    if (!reducible) {
+        for (int l = 0; l < LG_LANES; l++) {
+            double s, c;
+            lg_sincos(x[l], &s, &c);
+            (*sine)[l] = s;
+            (*cosine)[l] = c;
+        }
+        return;
+    }
+""" + sincos_kernel("lg_v4") + r"""
+    /* the quadrant k = n mod 4 picks (s, c, -s, -c) by bit operations on all lanes at once:
+       odd k swaps sine and cosine, bit 2 of k (of k + 1 for the cosine) flips the sign */
+    const lg_u4 k = (lg_u4)shifted;
+    const lg_u4 odd = -(k & 1), si = (lg_u4)s, ci = (lg_u4)c;
+    *sine = (lg_v4)(((odd & ci) | (~odd & si)) ^ ((k & 2) << 62));
+    *cosine = (lg_v4)(((odd & si) | (~odd & ci)) ^ (((k + 1) & 2) << 62));
+}
+"""
+
+
+
+def _cholesky_forward(P: str, S: str, R: str, n: int) -> str:
+    """Forward dynamics by Cholesky of M (a tree with mimic joints)."""
+    return f"""/* q_ddot = M^-1 (tau - b): Cholesky M = L L^T on the stack; -1 where M is not
+   positive definite (a massless branch), else 0. */
+{S}int {P}_forward_dynamics({R} q, {R} v, {R} tau, {R} p, double *restrict qdd)
+{{
+    double L[{n * n}], b[{n}];
+    {P}_mass_matrix(q, p, L);
+    {P}_bias_forces(q, v, p, b);
+    for (int i = 0; i < {n}; i++) qdd[i] = tau[i] - b[i];
+    for (int j = 0; j < {n}; j++) {{
+        double d = L[j * {n} + j];
+        for (int k = 0; k < j; k++) d -= L[j * {n} + k] * L[j * {n} + k];
+        if (!(d > 0.0)) return -1;
+        d = sqrt(d);
+        L[j * {n} + j] = d;
+        const double inv = 1.0 / d;
+        for (int i = j + 1; i < {n}; i++) {{
+            double s = L[i * {n} + j];
+            for (int k = 0; k < j; k++) s -= L[i * {n} + k] * L[j * {n} + k];
+            L[i * {n} + j] = s * inv;
+        }}
+    }}
+    for (int i = 0; i < {n}; i++) {{
+        double s = qdd[i];
+        for (int k = 0; k < i; k++) s -= L[i * {n} + k] * qdd[k];
+        qdd[i] = s / L[i * {n} + i];
+    }}
+    for (int i = {n} - 1; i >= 0; i--) {{
+        double s = qdd[i];
+        for (int k = i + 1; k < {n}; k++) s -= L[k * {n} + i] * qdd[k];
+        qdd[i] = s / L[i * {n} + i];
+    }}
+    return 0;
+}}
+"""

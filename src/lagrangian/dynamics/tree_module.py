@@ -1,0 +1,99 @@
+"""The compiled Python extension module of a tree's dynamics: the functions of tree_c.py,
+batched bindings over states (tree_bindings.c) and template.c, cached by a key of the tree's
+numbers taken before any code is generated."""
+
+from __future__ import annotations
+
+import hashlib
+from functools import lru_cache
+from pathlib import Path
+
+from ..model.tree import KinematicTree
+from .tree_c import dynamics_functions
+from .tree_emitter import VECTOR_LIMIT
+
+# The Python bindings of the batched functions (threads over states, vector lanes): real C.
+_BINDINGS = "\n" + Path(__file__).with_name("tree_bindings.c").read_text(encoding="utf-8")
+
+_DECLARE = "\n".join(
+    f"static PyObject *rt_py_{name}(PyObject *, PyObject *const *, Py_ssize_t);"
+    for name in ("mass_matrix", "bias_forces", "gravity", "inverse_dynamics", "forward_dynamics",
+                 "kinetic_energy", "potential_energy"))
+
+_METHODS = " ".join(
+    f'{{"{name}", (PyCFunction)(void (*)(void))rt_py_{name}, METH_FASTCALL, "{doc}"}},'
+    for name, doc in (("mass_matrix", "(Q, P) -> M"), ("bias_forces", "(Q, V, P) -> b"),
+                      ("gravity", "(Q, P) -> g"), ("inverse_dynamics", "(Q, V, A, P) -> tau"),
+                      ("forward_dynamics", "(Q, V, TAU, P) -> q_ddot"),
+                      ("kinetic_energy", "(Q, V, P) -> T"), ("potential_energy", "(Q, P) -> V")))
+
+
+def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
+    """The compiled module's C: the recursive functions, lg_parts/lg_energy/lg_residual for
+    template.c (simulation, accelerations), and batched bindings for each function."""
+    from ..compile.codegen import TEMPLATE, GeneratedSource
+
+    n = len(tree.coordinates)
+    # two-state vector variants for batches of arms; a long chain's code is big enough that
+    # compiling it twice costs minutes, so there the batch runs the scalar functions
+    functions = dynamics_functions(tree, parameters, "rt", vector=n <= VECTOR_LIMIT)
+    source = "\n".join([
+        f"/* lagrangian: recursive dynamics of a tree of {len(tree.joints)} bodies, {n} "
+        "coordinates */",
+        f"#define LG_N {n}",
+        "#define LG_M 0",
+        f"#define LG_NP {len(parameters)}",
+        "#define PY_SSIZE_T_CLEAN",
+        "#include <Python.h>",
+        "#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION",
+        "#include <numpy/arrayobject.h>",
+        "#include <math.h>",
+        "",
+        functions,
+        """
+static void lg_parts(const double *restrict q, const double *restrict v, double t,
+                     const double *restrict p, double *restrict M, double *restrict f,
+                     double *restrict J, double *restrict g)
+{
+    (void)t; (void)J; (void)g;
+    rt_mass_matrix(q, p, M);
+    rt_bias_forces(q, v, p, f);
+    for (int i = 0; i < LG_N; i++) f[i] = -f[i];
+}
+
+static double lg_energy(const double *restrict q, const double *restrict v, double t,
+                        const double *restrict p)
+{
+    (void)t;
+    return rt_kinetic_energy(q, v, p) + rt_potential_energy(q, p);
+}
+
+static void lg_residual(const double *restrict q, const double *restrict v, double t,
+                        const double *restrict p, double *restrict r)
+{
+    (void)q; (void)v; (void)t; (void)p; (void)r;
+}
+""",
+        _DECLARE,
+        f"#define LG_EXTRA_METHODS {_METHODS}",
+        "#define RT_VECTOR_FORWARD " + ("1" if "rt4_forward_dynamics" in functions else "0"),
+        "#define RT_VECTOR " + ("1" if "rt4_mass_matrix" in functions else "0"),
+        TEMPLATE.read_text(),
+        _BINDINGS,
+    ])
+    return GeneratedSource(source=source, parameters=parameters, n=n, m=0)
+
+
+@lru_cache(maxsize=1)
+def _generator_key() -> str:
+    """The tree generator itself: a change to any of its files is a new module."""
+    here = Path(__file__).parent
+    files = ("tree_emitter.py", "tree_algorithms.py", "tree_c.py", "tree_module.py",
+             "tree_bindings.c")
+    return hashlib.sha256(b"".join((here / f).read_bytes() for f in files)).hexdigest()
+
+
+def tree_key(tree: KinematicTree, parameters: tuple[str, ...]) -> str:
+    """What the generated module is a function of: the tree's numbers (exact reprs) and the
+    parameters' order, and this generator."""
+    return "\n".join(["recursive", _generator_key(), repr(parameters), repr(tree)])

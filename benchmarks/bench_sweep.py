@@ -175,7 +175,8 @@ def main() -> None:
                      members, cpu_big))
 
     # one chunk of the ensemble in this process: the C loop and the chunk's bookkeeping
-    from lagrangian.analysis.sweep import SimulationOptions, evaluate_chunk, make_study
+    from lagrangian.analysis.study import SimulationOptions, make_study
+    from lagrangian.analysis.sweep import evaluate_chunk
     from lagrangian.api.sweep import with_compiled_module
 
     study = with_compiled_module(make_study(

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import lagrangian
-from lagrangian.analysis.sweep import parse_distribution
+from lagrangian.analysis.study import parse_distribution
 from lagrangian.errors import ModelError
 from lagrangian.output.sweep import read_study
 

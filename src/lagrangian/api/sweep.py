@@ -25,7 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.sweep import ENSEMBLE_NATIVE, NOT_COMPUTED, Study, evaluate_chunk, layout
+from ..analysis.study import NOT_COMPUTED, Study, layout
+from ..analysis.sweep import ENSEMBLE_NATIVE, evaluate_chunk
 from ..errors import ModelError
 from ..output.sweep import check_study_path, study_dataset, write_study
 

@@ -354,7 +354,7 @@ class System:
         ``save_at`` (or the plain ``method``, ``rtol``, ``atol``, ``samples``) and ``stop_when`` (a
         condition or a StopCondition) set each member's simulation, as in System.simulate.
         """
-        from ..analysis.sweep import SimulationOptions, make_study
+        from ..analysis.study import SimulationOptions, make_study
         from ..errors import ModelError
         from .sweep import run_study
 

@@ -159,7 +159,7 @@ def grid_values(text: str, unit: str | None, field: str) -> list[float]:
             raise ModelError(f"the COUNT of {text!r} must be a whole number of values, at least 1",
                              field=field)
         count = int(parts[2])
-        from ..analysis.sweep import MAX_STUDY_POINTS
+        from ..analysis.study import MAX_STUDY_POINTS
 
         if count > MAX_STUDY_POINTS:
             raise ModelError(f"{count:,} values is more than a study holds (at most "

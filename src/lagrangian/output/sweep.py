@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.sweep import NOT_COMPUTED, OK, Study, layout
+from ..analysis.study import NOT_COMPUTED, OK, Study, layout
 from ..errors import ModelError
 from .files import atomic_write
 from .plots import plain_text

@@ -8,22 +8,17 @@ from __future__ import annotations
 
 import keyword
 import math
-import re
 from collections.abc import Iterable, Mapping, Sequence
 
-import numpy as np
 import sympy as sp
 
 from ..errors import ModelError, did_you_mean
+from .builder_bodies import RigidBodiesMixin
+from .builder_constraints import ConstraintsMixin
 from .contacts import (
     RollingContact,
-    contact_velocity,
-    dot,
-    ground_tangents,
-    identically_zero,
-    wheel_down_direction,
 )
-from .expressions import MAX_TREE_NODES, RESERVED, parse_expression, tree_size
+from .expressions import IDENTIFIER, MAX_TREE_NODES, RESERVED, parse_expression, tree_size
 from .model import (
     TIME,
     Attachment,
@@ -44,35 +39,10 @@ from .model import (
     multiplier_name,
     velocity_name,
 )
-from .rotations import (
-    GROUND,
-    MAX_CHAIN_ROTATIONS,
-    Frame,
-    Moment,
-    RigidBody,
-    RotationReader,
-    apply,
-)
-
-# A rolling contact's velocity coefficients are trigsimp'd only below this op count (cheap).
-TIDY_LIMIT = 40
-_IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
-_ZERO: Vector = (sp.S.Zero, sp.S.Zero, sp.S.Zero)
+from .rotations import RigidBody
 
 
-def _elementary_rotations(joint: object) -> int:
-    """Elementary rotations a joint (or a body's own rotation sequence) adds: 1 for a revolute
-    joint, the length of a spherical or fixed joint's sequence, 0 for a prismatic one."""
-    if not isinstance(joint, Mapping):
-        return 0
-    if joint.get("type") == "revolute":
-        return 1
-    sequence = joint.get("rotation")
-    return len(sequence) if isinstance(sequence, Sequence) and not isinstance(sequence, str) \
-        else 0
-
-
-class ModelBuilder:
+class ModelBuilder(RigidBodiesMixin, ConstraintsMixin):
     """Mutable shell that validates each piece as it is added and builds an immutable Model."""
 
     def __init__(self, name: str = "", description: str = "", *, source: str | None = None):
@@ -238,120 +208,6 @@ class ModelBuilder:
         )
         return self
 
-    def add_rigid_body(
-        self, name: str, mass: object, inertia: object, *, position: Sequence[object] | None = None,
-        rotation: Sequence | None = None, origin: Sequence[object] | None = None,
-        center: Sequence[object] | None = None, parent: str | None = None,
-        joint: dict | None = None, field: str | None = None,
-    ) -> ModelBuilder:
-        """A rigid body in space: mass (kg), inertia about its centre of mass in body axes
-        (kg m^2; [Ixx, Iyy, Izz] or a symmetric 3x3), oriented by a body-fixed ``rotation``
-        sequence [[axis, angle], ...] or by a ``joint`` on its ``parent`` (or on the ground).
-
-        Where: ``position`` (its centre of mass, world, m), or ``origin`` (its body frame, world)
-        with ``center`` (the centre of mass from the origin, body axes); a body on a joint has
-        its origin at the joint and may give ``center``.
-        """
-        field = field or f"body '{name}'"
-        self._component(name, field)
-        self._vectors.append((field, 3, "rigid body"))
-        self._check_dimensions()
-        reader = self._rotation_reader()
-        given = {k for k, v in (("position", position), ("rotation", rotation),
-                                ("origin", origin), ("center", center), ("joint", joint))
-                 if v is not None}
-        if parent is not None:
-            if parent == name:
-                raise self._error(f"body '{name}' is its own parent (a cycle)", f"{field}.parent")
-            frame = self._frames.get(parent)
-            if frame is None:
-                names = list(self._frames)
-                raise self._error(f"no body '{parent}' to attach to (declare the parent first)"
-                                  f"{did_you_mean(parent, names)}", f"{field}.parent")
-            if joint is None:
-                raise self._error("a body with a parent needs a 'joint'", f"{field}.joint")
-            for key in sorted(given & {"position", "rotation", "origin"}):
-                raise self._error(f"'{key}' comes from the joint on '{parent}': give the joint "
-                                  "instead", f"{field}.{key}")
-        else:
-            frame = GROUND
-            if joint is not None:
-                for key in sorted(given & {"position", "rotation", "origin"}):
-                    raise self._error(f"'{key}' comes from the joint (on the ground): give one "
-                                      "or the other", f"{field}.{key}")
-            elif (position is None) == (origin is None):
-                raise self._error("give the centre of mass 'position' or the body's 'origin' "
-                                  "(with 'center')", field)
-            if position is not None and center is not None:
-                raise self._error("'center' is measured from 'origin': give 'origin' with it, "
-                                  "or 'position' alone", f"{field}.center")
-        rotations = self._rotations.get(parent, 0) if parent is not None else 0
-        rotations += _elementary_rotations(joint if joint is not None else {"rotation": rotation})
-        if rotations > MAX_CHAIN_ROTATIONS:
-            raise self._error(f"body '{name}' is {rotations} elementary rotations from the "
-                              f"ground (at most {MAX_CHAIN_ROTATIONS}: a longer chain of rotating "
-                              "bodies takes minutes to derive symbolically; a URDF robot uses the "
-                              "recursive algorithms instead)", f"{field}.joint" if joint is not None
-                              else f"{field}.rotation")
-        self._rotations[name] = rotations
-        if joint is not None:
-            frame = reader.joint(frame, joint, f"{field}.joint")
-        else:
-            start = position if position is not None else origin
-            key = "position" if position is not None else "origin"
-            frame = Frame(self.vector(start, f"{field}.{key}", velocities=False,
-                                      places="rigid body"), frame.rotation,
-                          frame.angular_velocity, (), frame.world_angular_velocity)
-            if rotation is not None:
-                frame = reader.sequence(frame, rotation, f"{field}.rotation")
-        offset = (self.vector(center, f"{field}.center", velocities=False)
-                  if center is not None else (sp.S.Zero,) * 3)
-        values = {p.symbol: p.value for p in self._parameters if p.value is not None}
-        body = RigidBody(
-            name,
-            self.expression(mass, f"{field}.mass", velocities=False),
-            reader.inertia(inertia, f"{field}.inertia", values),
-            # zero offsets skipped: 0 * (a deep rotation product) makes sympy ask is_finite
-            # of the whole tree (a tenth of a second per body down a chain)
-            tuple(o + sum((r * c for r, c in zip(row, offset, strict=True) if c != 0),
-                          sp.S.Zero)
-                  for o, row in zip(frame.origin, frame.rotation, strict=True)),
-            frame.rotation, frame.origin, frame.angular_velocity, parent, frame.singularities,
-        )
-        self._frames[name] = frame
-        self._rigid_bodies.append(body)
-        return self
-
-    def add_moment(
-        self, name: str, body: str, moment: Sequence[object], *, axes: str = "world",
-        field: str | None = None,
-    ) -> ModelBuilder:
-        """A moment (N m) on a rigid body, in world or body axes; Q_i = M . d omega/d q_dot_i."""
-        field = field or f"load '{name}'"
-        self._component(name, field)
-        target = next((b for b in self._rigid_bodies if b.name == body), None)
-        if target is None:
-            raise self._error(f"'{body}' is not a 3D body (declare it before use)"
-                              f"{did_you_mean(str(body), [b.name for b in self._rigid_bodies])}",
-                              f"{field}.body")
-        if axes not in ("world", "body"):
-            raise self._error(f"axes must be 'world' or 'body', not {axes!r}", f"{field}.axes")
-        omega = (target.world_angular_velocity() if axes == "world"
-                 else target.angular_velocity)
-        self._require_coordinate_dependence(
-            [e for row in target.rotation for e in row], name, f"{field}.body", "rotation")
-        self._loads.append(Moment(name, body, self.vector(moment, f"{field}.moment"), axes, omega))
-        return self
-
-    def _rotation_reader(self) -> RotationReader:
-        def angle(value, field):
-            return self.expression(value, field, velocities=False)
-
-        def vector(value, field):
-            return self.vector(value, field, velocities=False)
-
-        return RotationReader(angle, vector, self._time_derivative, self.source)
-
     def point(self, reference: object, *, field: str = "point") -> Vector:
         """Resolve a point: a particle or body name (its centre), a vector, or (body, offset)."""
         if isinstance(reference, str):
@@ -375,24 +231,6 @@ class ModelBuilder:
                 )
             return self.body_point(reference["body"], reference.get("offset"), field=field)
         return self.vector(reference, field, velocities=False)
-
-    def body_point(
-        self, body: str, offset: Sequence[object], *, field: str = "point"
-    ) -> Vector:
-        """The point fixed in a body at ``offset`` (m, in the body's axes; from a planar body's
-        centre of mass, from a 3D body's origin)."""
-        for candidate in self._rigid_bodies:
-            if candidate.name == body:
-                offset = (0, 0, 0) if offset is None else offset
-                return candidate.point(self.vector(offset, f"{field}.offset", velocities=False))
-        offset = (0, 0) if offset is None else offset
-        for candidate in self._bodies:
-            if candidate.name == body:
-                dx, dy, dz = self.vector(offset, f"{field}.offset", velocities=False)
-                c, s = sp.cos(candidate.angle), sp.sin(candidate.angle)
-                x, y, z = candidate.position
-                return (x + c * dx - s * dy, y + s * dx + c * dy, z + dz)
-        raise self._error(f"'{body}' is not a body (declare it before use)", f"{field}.body")
 
     def add_spring(
         self, name: str, stiffness: object, rest_length: object = 0, *, length: object = None,
@@ -475,149 +313,6 @@ class ModelBuilder:
         self._coordinate(name, field)
         self._generalized.setdefault(name, []).append(self.expression(Q, field))
         return self
-
-    def add_constraint(
-        self, name: str, *, holonomic: object = None, velocity: object = None,
-        field: str | None = None,
-    ) -> ModelBuilder:
-        """A constraint Phi(q, t) = 0 (holonomic) or A(q, t) q_dot + b(q, t) = 0 (velocity)."""
-        field = field or f"constraint '{name}'"
-        if not isinstance(name, str) or not _IDENTIFIER.match(name):
-            raise self._error(f"constraint name {name!r} must be an identifier", f"{field}.name")
-        self._component(name, field)
-        if (holonomic is None) == (velocity is None):
-            raise self._error("give exactly one of 'holonomic' or 'velocity'", field)
-        if holonomic is not None:
-            expression = self.expression(holonomic, f"{field}.holonomic", velocities=False)
-            kind = "holonomic"
-        else:
-            expression = self.expression(velocity, f"{field}.velocity")
-            velocities = [c.velocity for c in self._coordinates]
-            if not expression.free_symbols & set(velocities):
-                raise self._error(
-                    "a velocity constraint must contain at least one velocity (q_dot); "
-                    "write a constraint on positions as 'holonomic'", f"{field}.velocity",
-                )
-            for v in velocities:
-                if expression.diff(v).free_symbols & set(velocities):
-                    raise self._error(
-                        "a velocity constraint must be linear in the velocities",
-                        f"{field}.velocity",
-                    )
-            kind = "velocity"
-        if not expression.free_symbols & set(self._all_state_symbols()):
-            raise self._error("the constraint does not involve any coordinate", field)
-        self._constraints.append(Constraint(name, kind, expression))
-        return self
-
-    def add_rolling_contact(
-        self, name: str, body: str, radius: object, axle: object, *,
-        normal: Sequence[object] | None = None, field: str | None = None,
-    ) -> ModelBuilder:
-        """A knife-edge wheel rolling without slipping on the ground plane r . n = 0.
-
-        ``body``: a 3D body whose origin is the wheel's centre; ``radius`` (m, > 0); ``axle``
-        in body axes ("y" or a 3-vector); ``normal``: the ground's unit normal (numbers,
-        pointing out of the ground; default against gravity, else +z). Adds the velocity
-        constraints ``<name>_friction_<t>`` along the two ground tangents (the friction on the
-        wheel along t is -lambda) and, where the contact height r_C . n is not identically
-        zero in these coordinates, the holonomic ``<name>_normal`` (normal force -lambda).
-        """
-        field = field or f"contact '{name}'"
-        if not isinstance(name, str) or not _IDENTIFIER.match(name):
-            raise self._error(f"contact name {name!r} must be an identifier", f"{field}.name")
-        self._component(name, field)
-        target = next((b for b in self._rigid_bodies if b.name == body), None)
-        if target is None:
-            planar = any(b.name == body for b in self._bodies)
-            hint = (" (a rolling contact needs a body in space: give it 'rotation' or a "
-                    "'joint')" if planar else did_you_mean(str(body),
-                                                             [b.name for b in self._rigid_bodies]))
-            raise self._error(f"'{body}' is not a 3D body (declare it before the contact)"
-                              f"{hint}", f"{field}.body")
-        r = self._parameter_expression(radius, f"{field}.radius")
-        if r.is_number and not r.is_positive or self._nonpositive_at_values(r):
-            raise self._error(f"the radius must be positive (it is {r})", f"{field}.radius")
-        reader = self._rotation_reader()
-        a_body = reader.axis(axle, f"{field}.axle")
-        if any(c.free_symbols for c in a_body):
-            raise self._error("the axle must be numbers (a direction fixed in the body)",
-                              f"{field}.axle")
-        n = self._ground_normal(normal, f"{field}.normal")
-        frame = self._frames[body]
-        omega = frame.world_angular_velocity
-        if omega is None:
-            omega = target.world_angular_velocity()
-        reference = {c.symbol: (c.initial or 0.0) for c in self._coordinates}
-        reference |= {p.symbol: p.value for p in self._parameters if p.value is not None}
-        a = apply(target.rotation, a_body)
-        down = wheel_down_direction(a, n, reference)
-        arm = tuple(r * c for c in down)
-        centre = target.origin
-        contact = tuple(g + c for g, c in zip(centre, arm, strict=True))
-        v_centre = tuple(self._time_derivative(c) for c in centre)
-        slip = contact_velocity(v_centre, omega, arm)
-        tangents, labels = ground_tangents([float(c) for c in n])
-        names = []
-        for t, label in zip(tangents, labels, strict=True):
-            constraint = f"{name}_friction_{label}"
-            self._component(constraint, field)
-            self._constraints.append(Constraint(constraint, "velocity",
-                                                self._tidy_velocity_row(dot(slip, t))))
-            names.append(constraint)
-        height = dot(contact, n)
-        values = {p.symbol: p.value for p in self._parameters}
-        flat = identically_zero(height, [c.symbol for c in self._coordinates], values)
-        if not flat:
-            constraint = f"{name}_normal"
-            self._component(constraint, field)
-            self._constraints.append(Constraint(constraint, "holonomic", height))
-            names.append(constraint)
-        self._contacts.append(RollingContact(name, body, r, a_body, n, tangents, contact,
-                                             tuple(names), not flat))
-        return self
-
-    def _tidy_velocity_row(self, expr: sp.Expr) -> sp.Expr:
-        """sum_j A_j(q) q_dot_j with each short A_j trigsimp'd (the sin^2 + cos^2 that omega x
-        arm leaves); long ones are kept as they come (no simplify on long expressions)."""
-        velocities = [c.velocity for c in self._coordinates]
-        rest = expr.xreplace({v: 0 for v in velocities})
-        terms = [rest] if rest != 0 else []
-        for v in velocities:
-            coefficient = expr.diff(v)  # expr is linear in the velocities
-            if coefficient == 0:
-                continue
-            if sp.count_ops(coefficient) <= TIDY_LIMIT:
-                coefficient = sp.trigsimp(sp.expand(coefficient))
-            terms.append(coefficient * v)
-        return sp.Add(*terms)
-
-    def _ground_normal(self, normal, field: str) -> Vector:
-        if normal is None:
-            if self._gravity is not None:
-                direction = self._gravity.direction
-                if not all(c.is_number for c in direction):
-                    raise self._error("gravity's direction depends on parameters: give the "
-                                      "ground's 'normal' as numbers", field)
-                return tuple(sp.nsimplify(-c) if c.is_Rational else -c for c in direction)
-            return (sp.S.Zero, sp.S.Zero, sp.S.One)
-        vector = self.vector(normal, field)
-        if any(c.free_symbols for c in vector):
-            raise self._error("the ground normal must be numbers", field)
-        small = all(c.is_Rational and abs(c.p) < 10**6 and c.q < 10**6 for c in vector)
-        if small:  # (0, 0, 1), (3, 0, 4): exact, and the printed equations stay exact
-            squared = sp.Add(*(c**2 for c in vector))
-            if squared == 0:
-                raise self._error("the ground normal is the zero vector", field)
-            return tuple(c / sp.sqrt(squared) for c in vector)
-        # other numbers as floats: an exact 1e-290 made the unit normal cost half a minute
-        numbers = np.array([float(c) for c in vector])
-        length = float(np.linalg.norm(numbers))
-        if not math.isfinite(length) or length == 0:
-            raise self._error("the ground normal is the zero vector or not finite", field)
-        unit = numbers / length
-        return tuple(sp.Integer(round(c)) if abs(c - round(c)) < 1e-15 else sp.Float(c)
-                     for c in unit)
 
     def _nonpositive_at_values(self, expr: sp.Expr) -> bool:
         values = {p.symbol: p.value for p in self._parameters if p.value is not None}
@@ -823,7 +518,7 @@ class ModelBuilder:
         return ModelError(message, field=field, source=self.source)
 
     def _declare(self, name: str, field: str) -> None:
-        if not isinstance(name, str) or not _IDENTIFIER.match(name) or keyword.iskeyword(name):
+        if not isinstance(name, str) or not IDENTIFIER.match(name) or keyword.iskeyword(name):
             raise self._error(f"{name!r} is not a valid name (letters, digits, '_')", field)
         if name in RESERVED:
             raise self._error(f"'{name}' is reserved (a function, constant or time)", field)

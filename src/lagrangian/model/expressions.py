@@ -38,6 +38,8 @@ FUNCTIONS: dict[str, tuple[object, int]] = {
     "sign": (sp.sign, 1),
 }
 CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}
+# A name of the grammar: a coordinate, parameter, definition or component.
+IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"t"}
 
 MAX_LENGTH = 50_000  # parsing and converting stay under about 1 s

@@ -95,3 +95,19 @@ def test_expressions_become_numbers_in_one_place():
                 if name in calls:
                     calls[name].add(path.relative_to(PACKAGE).as_posix())
     assert calls == {"lambdify": {"compile/lambdified.py"}, "get_close_matches": {"errors.py"}}
+
+
+def test_rooms_stay_small():
+    """A room has one job (issue 26): no module over 700 lines, no top-level folder holding
+    more than 20% of the package's lines."""
+    sizes = {path.relative_to(PACKAGE).as_posix(): len(path.read_text().splitlines())
+             for path in PACKAGE.rglob("*.py")}
+    large = {name: n for name, n in sizes.items() if n > 700}
+    assert not large, large
+    total = sum(sizes.values())
+    folders: dict[str, int] = {}
+    for name, n in sizes.items():
+        if "/" in name:
+            folders[name.split("/")[0]] = folders.get(name.split("/")[0], 0) + n
+    crowded = {folder: f"{n / total:.1%}" for folder, n in folders.items() if n > 0.2 * total}
+    assert not crowded, crowded

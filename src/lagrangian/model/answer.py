@@ -17,9 +17,10 @@ from pathlib import Path
 import sympy as sp
 
 from ..errors import ModelError
-from .expressions import CONSTANTS, FUNCTIONS, parse_expression, plain_names
+from .expressions import CONSTANTS, FUNCTIONS, parse_expression
 from .model import Model, multiplier_name
 from .reader import check_known_keys, load_toml, read_text_file
+from .tokens import plain_names
 
 TABLES = ("energy", "generalized_forces", "equations", "multipliers")
 _FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")

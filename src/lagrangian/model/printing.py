@@ -14,6 +14,7 @@ from __future__ import annotations
 import sympy as sp
 from sympy.core.exprtools import decompose_power
 from sympy.core.sorting import default_sort_key
+from sympy.printing.str import StrPrinter
 
 _MEMO_LIMIT = 200_000  # printed sub-expressions kept per printer before the memo is cleared
 
@@ -99,3 +100,49 @@ class MemoizedPrinting:
         if (order or self.order) is None:
             return ordered_terms(expr)
         return super()._as_ordered_terms(expr, order=order)
+
+
+# -- the model grammar, printed back ----------------------------------------------------
+
+class _GrammarPrinter(MemoizedPrinting, StrPrinter):
+    """Prints sympy back into the model-file grammar (what :func:`parse_expression` reads)."""
+
+    def _print_Abs(self, expr):
+        return f"abs({self._print(expr.args[0])})"
+
+    def _print_Exp1(self, expr):
+        return "exp(1)"
+
+    def _print_Pi(self, expr):
+        return "pi"
+
+    def _print_Float(self, expr):
+        return repr(float(expr))
+
+    def _print_Pow(self, expr, rational=False):
+        base, exponent = expr.args
+        if exponent is sp.S.Half:
+            return f"sqrt({self._print(base)})"
+        if exponent == -sp.S.Half:
+            return f"1/sqrt({self._print(base)})"
+        return super()._print_Pow(expr, rational)
+
+
+_PRINTER = _GrammarPrinter({"order": None})
+
+
+def as_expression(value: object) -> sp.Basic:
+    """A sympy object or a Python number as a sympy object.
+
+    Strings are refused: user text goes through :func:`parse_expression` only.
+    """
+    if isinstance(value, sp.Basic):
+        return value
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise TypeError(f"expected a sympy object or a number, got {type(value).__name__}")
+    return sp.Integer(value) if isinstance(value, int) else sp.Float(value)
+
+
+def format_expression(expr: sp.Expr) -> str:
+    """Format a sympy expression as a string of the model-file grammar."""
+    return _PRINTER.doprint(as_expression(expr))

@@ -209,7 +209,8 @@ _UNIT_TAIL = re.compile(r"^(.*?\S)\s+([A-Za-z_µ°][\w*/^.µ°-]*)\s*$", re.DOTA
 
 def _constant_quantity(text: str, field: str) -> tuple[float, str]:
     """'pi/2' or '3*pi/4 rad': a constant expression and an optional unit after a space."""
-    from .expressions import parse_expression, plain_names
+    from .expressions import parse_expression
+    from .tokens import plain_names
 
     head, unit = text.strip(), ""
     split = _UNIT_TAIL.match(head)

@@ -91,3 +91,18 @@ def test_to_c_refuses_a_bad_prefix_and_an_unknown_parameter():
         arm.to_c("my arm")
     with pytest.raises(lagrangian.ModelError, match="not a parameter"):
         arm.to_c(parameters={"gg": 1.0})
+
+
+def test_every_dynamics_path_returns_the_one_dynamics_type():
+    """A URDF arm (recursive C, recursive numpy) and a model file (derived equations) give a
+    lagrangian.Dynamics with the same M at the same state: the two-link arm's closed form."""
+    arm = lagrangian.load("two_link_arm")
+    for backend in ("auto", "numpy"):
+        dynamics = arm.dynamics(backend=backend)
+        assert isinstance(dynamics, lagrangian.Dynamics)
+        M = dynamics.mass_matrix([0.3, 0.7])
+        np.testing.assert_allclose(M[1, 1], 0.34, rtol=1e-12)
+        np.testing.assert_allclose(M[0, 0], 2.54 + 1.2 * np.cos(0.7), rtol=1e-12)
+    pendulum = lagrangian.load("pendulum").dynamics()
+    assert isinstance(pendulum, lagrangian.Dynamics)
+    assert pendulum.coordinates == ("theta",) and pendulum.n == 1

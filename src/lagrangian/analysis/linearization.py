@@ -21,6 +21,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import jacobian_row
 from ..errors import DerivationError, ModelError
 from ..model.expressions import as_expression
+from ..model.kinds import ConstraintKind
 from ..model.model import Model
 from ..model.values import ParameterValues, resolve_parameters, resolve_state
 
@@ -172,8 +173,8 @@ def linear_model_at(
     mass, damping = values["mass"], values["damping"]
     stiffness = total_stiffness(values, multipliers)
     kinds = [c.kind for c in model.constraints]
-    holonomic = [i for i, k in enumerate(kinds) if k == "holonomic"]
-    velocity = [i for i, k in enumerate(kinds) if k != "holonomic"]
+    holonomic = [i for i, k in enumerate(kinds) if k == ConstraintKind.HOLONOMIC]
+    velocity = [i for i, k in enumerate(kinds) if k != ConstraintKind.HOLONOMIC]
     basis, independent = independent_basis(values["jacobian"][holonomic])
     names = tuple(c.name for c in model.coordinates)
     reduced = tuple(names[i] for i in independent)
@@ -221,8 +222,8 @@ def is_statically_stable(functions: StaticFunctions, q0: np.ndarray, multipliers
     values = functions.evaluate(np.asarray(q0, dtype=float), t)
     stiffness = total_stiffness(values, multipliers)
     kinds = [c.kind for c in functions.model.constraints]
-    holonomic = [i for i, k in enumerate(kinds) if k == "holonomic"]
-    velocity = [i for i, k in enumerate(kinds) if k != "holonomic"]
+    holonomic = [i for i, k in enumerate(kinds) if k == ConstraintKind.HOLONOMIC]
+    velocity = [i for i, k in enumerate(kinds) if k != ConstraintKind.HOLONOMIC]
     basis, _ = independent_basis(values["jacobian"][holonomic])
     admissible = basis @ null_space(values["jacobian"][velocity] @ basis)
     reduced = admissible.T @ stiffness @ admissible

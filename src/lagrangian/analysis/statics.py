@@ -20,6 +20,7 @@ from ..compile.lambdified import numpy_function
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
 from ..model.expressions import as_expression
+from ..model.kinds import ConstraintKind
 from ..model.model import Model
 from ..model.units import generalized_force_unit
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state, unknown_name
@@ -137,7 +138,7 @@ def solve_statics(
 def _configuration(model: Model, state: State, known: Mapping) -> tuple[np.ndarray, tuple]:
     """The coordinates, those not given found from the holonomic constraints (Newton)."""
     q = np.array(state.q, dtype=float)
-    holonomic = [c.expression for c in model.constraints if c.kind == "holonomic"]
+    holonomic = [c.expression for c in model.constraints if c.kind == ConstraintKind.HOLONOMIC]
     free = [i for i, c in enumerate(model.coordinates) if c.name not in state.given]
     if not holonomic or not free:
         return q, ()

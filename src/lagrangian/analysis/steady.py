@@ -26,6 +26,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import Differentiator
 from ..errors import DerivationError, ModelError, did_you_mean
 from ..model.expressions import as_expression
+from ..model.kinds import ConstraintKind
 from ..model.model import velocity_name
 from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, resolve_parameters, resolve_state
@@ -106,7 +107,7 @@ class SteadyFunctions:
         level_slope = [d(e, x) for e in level for x in q]
         jacobian_slope = [d(e, x) for e in jacobian for x in q]
         # Holonomic constraints hold at position level too: Phi(q0) = 0 on the steady motion.
-        self.holonomic = [i for i, c in enumerate(model.constraints) if c.kind == "holonomic"]
+        self.holonomic = [i for i, c in enumerate(model.constraints) if c.kind == ConstraintKind.HOLONOMIC]
         positions = [model.constraints[i].expression.xreplace(values) for i in self.holonomic]
         self.sizes = [n * n, n, n * n, n * n, k * n, k, k, k * n, k * n * n]
         self.function = StateFunction(model, [*mass, *forcing, *stiffness, *damping, *jacobian,

@@ -23,6 +23,7 @@ from ..compile.parametric_at_rest import (
     StaticFunctionsAt,
     integrate_ensemble,
 )
+from ..model.kinds import RunStatus
 from ..model.values import resolve_state
 from .equilibria import (
     _difference,
@@ -395,7 +396,7 @@ def _simulation_chunk(study, functions: _SimulationFunctions, values, count):
             out["status"][i] = _reason(exc)
             continue
         t, y, drift, status, message, stop_time = run
-        if status == "failed":
+        if status == RunStatus.FAILED:
             out["status"][i] = message
             continue
         out["final"][i] = y[-1]
@@ -406,7 +407,7 @@ def _simulation_chunk(study, functions: _SimulationFunctions, values, count):
         out["stop_time"][i] = np.nan if stop_time is None else stop_time
         if options.trajectories:
             out["trajectory"][i, : len(t)] = y
-        out["status"][i] = OK if status in ("finished", "stopped") else status
+        out["status"][i] = OK if status in (RunStatus.FINISHED, RunStatus.STOPPED) else status
     return out
 
 
@@ -453,7 +454,7 @@ def _simulate_member(study, functions, parameters, state):
                       step_control=StepControl(options.method, options.rtol, options.atol),
                       save_at=SaveAt(options.samples), stop=stop)
     y = np.concatenate([result.q, result.q_dot], axis=1)
-    stop_time = float(result.t[-1]) if result.status == "stopped" else None
+    stop_time = float(result.t[-1]) if result.status == RunStatus.STOPPED else None
     return result.t, y, result.invariant_drift, result.status, result.message, stop_time
 
 

@@ -21,6 +21,7 @@ from ..dynamics.standalone import StandaloneSource
 from ..errors import DerivationError, LagrangianError, ModelError
 from ..model.answer import Answer
 from ..model.examples import example_names as examples
+from ..model.kinds import Backend, ConstraintKind, InvariantKind, JointKind, RunStatus
 from ..model.model import Model
 from ..model.reader import parse_model, read_model
 from ..model.values import ParameterValues, State
@@ -44,6 +45,12 @@ __all__ = [
     "ParameterValues",
     "State",
     "SaveAt",
+    # the kinds and states it names (string enums)
+    "Backend",
+    "ConstraintKind",
+    "InvariantKind",
+    "JointKind",
+    "RunStatus",
     "StepControl",
     "StopCondition",
     # what it returns

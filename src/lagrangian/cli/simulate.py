@@ -79,7 +79,9 @@ def simulate(
         typer.echo(warning, err=True)
 
     # a partial result (failed or interrupted run) never replaces an existing file
-    partial = simulation.status in ("failed", "interrupted")
+    from ..api import RunStatus  # here, not at the top: `--help` starts without sympy
+
+    partial = simulation.status in (RunStatus.FAILED, RunStatus.INTERRUPTED)
     written = {}
     if out is not None:
         written["out"] = str(simulation.save(partial_path(out) if partial else out))
@@ -97,11 +99,11 @@ def simulate(
         print_json(simulation_document(simulation, written))
     else:
         typer.echo(simulation_text(simulation, written), nl=False)
-    if simulation.status == "failed":
+    if simulation.status == RunStatus.FAILED:
         saved = f"; partial result saved to {', '.join(written.values())}" if written else ""
         typer.echo(f"error: integration failed: {simulation.message}{saved}", err=True)
         raise SystemExit(1)  # not typer.Exit: click swallows its code outside standalone mode
-    if simulation.status == "interrupted":
+    if simulation.status == RunStatus.INTERRUPTED:
         saved = f"; partial result saved to {', '.join(written.values())}" if written else ""
         typer.echo(f"{simulation.message}{saved}", err=True)
         raise SystemExit(130)

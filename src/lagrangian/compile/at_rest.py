@@ -16,6 +16,7 @@ from ..derivation.kinematics import jacobian_row
 from ..derivation.regularity import independent_of_time
 from ..errors import ModelError
 from ..model.expressions import as_expression
+from ..model.kinds import ConstraintKind
 from ..model.values import ParameterValues, resolve_parameters
 from .lambdified import numpy_function
 
@@ -49,7 +50,7 @@ class StaticFunctions:
         static = []
         for c in model.constraints:
             residual = _floats(c.expression.xreplace(values))
-            residual = residual if c.kind == "holonomic" else residual.xreplace(at_rest)
+            residual = residual if c.kind == ConstraintKind.HOLONOMIC else residual.xreplace(at_rest)
             if residual != 0:
                 static.append((c.name, residual))
         self.static_names = tuple(name for name, _ in static)

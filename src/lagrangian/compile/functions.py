@@ -17,6 +17,7 @@ import numpy as np
 from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError
 from ..model.expressions import as_expression
+from ..model.kinds import Backend
 from ..model.values import ParameterValues, resolve_parameters
 from .lambdified import numpy_function
 
@@ -208,7 +209,7 @@ def _batch(q, q_dot, n: int):
     return np.broadcast_to(q, batch + (n,)), np.broadcast_to(q_dot, batch + (n,)), batch
 
 
-BACKENDS = ("auto", "c", "numpy")
+BACKENDS = tuple(Backend)  # "auto", "c", "numpy"
 
 # Generated C per equations object: cse + printing is the slow part of a C build.
 _SOURCES: dict[int, tuple[EquationsOfMotion, object]] = {}

@@ -22,6 +22,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import jacobian_row
 from ..errors import ModelError
 from ..model.expressions import as_expression
+from ..model.kinds import ConstraintKind
 from ..model.model import Model
 from .at_rest import linear_velocity_row
 from .lambdified import numpy_function
@@ -50,7 +51,7 @@ class ParametricStaticFunctions:
         static = []
         for c in model.constraints:
             residual = as_expression(c.expression)
-            residual = residual if c.kind == "holonomic" else residual.xreplace(at_rest)
+            residual = residual if c.kind == ConstraintKind.HOLONOMIC else residual.xreplace(at_rest)
             if residual != 0:
                 static.append((c.name, residual))
         self.static_names = tuple(name for name, _ in static)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..model.kinds import ConstraintKind
 from ..model.model import Model
 from .kinematics import jacobian_row, time_rate
 
@@ -21,7 +22,7 @@ def constraint_terms(
     rows, biases, gammas = [], [], []
     zero_velocity = {v: sp.S.Zero for v in q_dot}
     for constraint in model.constraints:
-        if constraint.kind == "holonomic":
+        if constraint.kind == ConstraintKind.HOLONOMIC:
             row = jacobian_row(constraint.expression, q)
             velocity_level = time_rate(constraint.expression, q, q_dot, t)
             bias = constraint.expression.diff(t) if t in constraint.expression.free_symbols \

@@ -7,6 +7,7 @@ from functools import cached_property
 
 import sympy as sp
 
+from ..model.kinds import InvariantKind
 from ..model.model import Model
 from ..model.notation import latex_symbol_names
 
@@ -145,23 +146,23 @@ class EquationsOfMotion:
         # The numeric test comes first: expanding h - (T + V) of a large model (the bicycle's
         # four bodies) took minutes, evaluating it milliseconds.
         if not vanishes(self.power, self.model) and sp.expand(self.power) != 0:
-            return "work_balance"
+            return InvariantKind.WORK_BALANCE
         # h = T + V exactly when T is a quadratic form in q_dot and V has none (Euler's
         # theorem); checked by value (T(2 q_dot) = 4 T) before h itself is formed, since
         # differentiating a large L for h takes seconds.
         T, V, q_dot = self.kinetic_energy, self.potential_energy, self.model.q_dot
         if not V.free_symbols & set(q_dot) and vanishes(
                 T.xreplace({v: 2 * v for v in q_dot}) - 4 * T, self.model):
-            return "energy"
+            return InvariantKind.ENERGY
         difference = self.jacobi_integral - self.kinetic_energy - self.potential_energy
         if vanishes(difference, self.model) or sp.expand(difference) == 0:
-            return "energy"
-        return "jacobi_integral"
+            return InvariantKind.ENERGY
+        return InvariantKind.JACOBI_INTEGRAL
 
     @property
     def invariant(self) -> sp.Expr:
         """The monitored quantity (J): T + V for 'energy', the Jacobi integral h otherwise."""
-        if self.invariant_kind == "energy":
+        if self.invariant_kind == InvariantKind.ENERGY:
             return self.kinetic_energy + self.potential_energy
         return self.jacobi_integral
 

@@ -28,21 +28,22 @@ from ..model.model import Model
 
 
 class Dynamics:
-    """Batched dynamics functions over one NumericSystem (compiled C where available)."""
+    """Joint-space dynamics, batched over leading axes (SI units): M(q), the bias
+    C(q, q_dot) q_dot + g(q), g(q), inverse and forward dynamics and the energies. The one type
+    every path returns: this class evaluates the derived equations (a NumericSystem), and the
+    recursive algorithms of a URDF tree (recursive.RecursiveDynamics in C,
+    recursive_numpy.RecursiveNumpyDynamics in numpy) are its subclasses."""
+
+    coordinates: tuple[str, ...]
+    n: int
 
     def __init__(self, functions: NumericSystem):
         if functions.m:
             raise ModelError("dynamics in joint space needs a model without constraints "
                              f"(this one has {functions.m}: {', '.join(functions.constraint_names)})")
         self.functions = functions
-
-    @property
-    def coordinates(self) -> tuple[str, ...]:
-        return self.functions.coordinates
-
-    @property
-    def n(self) -> int:
-        return self.functions.n
+        self.coordinates = functions.coordinates
+        self.n = functions.n
 
     def _vector(self, value, field: str) -> np.ndarray:
         array = np.asarray(value, dtype=float)

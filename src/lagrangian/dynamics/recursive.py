@@ -31,6 +31,7 @@ from ..errors import ModelError
 from ..model.model import Model
 from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters
+from .joint_space import Dynamics
 from .tree_module import module_source, tree_key
 
 
@@ -66,7 +67,7 @@ def applicable_tree(model: Model) -> KinematicTree | None:
     return tree
 
 
-class RecursiveDynamics:
+class RecursiveDynamics(Dynamics):
     """Compiled recursive dynamics of a tree, batched over leading axes (SI units).
 
     Every input is (..., n) (or (n,), broadcast against the others); outputs keep the batch

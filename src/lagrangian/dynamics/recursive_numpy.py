@@ -21,9 +21,11 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import ModelError
+from ..model.kinds import JointKind
 from ..model.model import Model
 from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters
+from .joint_space import Dynamics
 
 
 def _cross(a, b):
@@ -70,7 +72,7 @@ class _Joint:
 
     def __init__(self, joint):
         self.parent = joint.parent
-        self.revolute = joint.kind == "revolute"
+        self.revolute = joint.kind == JointKind.REVOLUTE
         self.coordinate = joint.coordinate
         self.multiplier = joint.multiplier
         self.offset = joint.offset
@@ -87,7 +89,7 @@ class _Joint:
         self.J = np.array(joint.inertia, dtype=float)
 
 
-class RecursiveNumpyDynamics:
+class RecursiveNumpyDynamics(Dynamics):
     """Recursive dynamics of a tree in numpy, batched over leading axes (SI units).
 
     Every input is (..., n) (or (n,), broadcast against the others); outputs keep the batch

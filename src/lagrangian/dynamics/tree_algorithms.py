@@ -4,6 +4,7 @@ kinematics, Newton-Euler inverse dynamics, the composite-rigid-body mass matrix,
 
 from __future__ import annotations
 
+from ..model.kinds import JointKind
 from ..model.tree import KinematicTree
 from .tree_emitter import Term, _Emitter, _Layout
 
@@ -29,7 +30,7 @@ def _kinematics(E: _Emitter, tree: KinematicTree, q):
     for joint in tree.joints:
         theta = E.add(E.mul(q[joint.coordinate], joint.multiplier), joint.offset)
         R0 = [list(row) for row in joint.rotation]
-        if joint.kind == "revolute":
+        if joint.kind == JointKind.REVOLUTE:
             sin, cos = E.sincos(theta)
             R = E.matmul(R0, _rotation(E, joint, cos, sin))
             p = list(joint.translation)
@@ -60,7 +61,7 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
         dw_in = E.apply_transpose(R, dwl)
         origin = E.vadd(al, E.vadd(E.cross(dwl, p), E.cross(wl, E.cross(wl, p))))
         a_i = E.apply_transpose(R, origin)
-        if joint.kind == "revolute":
+        if joint.kind == JointKind.REVOLUTE:
             w_i = E.vadd(w_in, E.scale(rate, u))
             dw_i = E.vadd(dw_in, E.vadd(E.cross(w_in, E.scale(rate, u)), E.scale(accel, u)))
         else:
@@ -78,7 +79,7 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
     tau_full: list[Term] = [0.0] * len(tree.joints)
     for i in reversed(range(len(tree.joints))):
         joint = tree.joints[i]
-        tau_full[i] = E.dot(joint.axis, n[i] if joint.kind == "revolute" else f[i])
+        tau_full[i] = E.dot(joint.axis, n[i] if joint.kind == JointKind.REVOLUTE else f[i])
         if joint.parent >= 0:
             R, p = placements[i]
             force = E.apply(R, f[i])
@@ -102,11 +103,11 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
     for i in reversed(range(nb)):
         joint = tree.joints[i]
         u = list(joint.axis)
-        if joint.kind == "revolute":  # unit rate about u: f = u x h, n = J u
+        if joint.kind == JointKind.REVOLUTE:  # unit rate about u: f = u x h, n = J u
             force, moment = E.cross(u, h[i]), E.apply(J[i], u)
         else:  # unit rate along u: f = m u, n = h x u
             force, moment = E.scale(mass[i], u), E.cross(h[i], u)
-        full[i, i] = E.dot(u, moment if joint.kind == "revolute" else force)
+        full[i, i] = E.dot(u, moment if joint.kind == JointKind.REVOLUTE else force)
         k = i
         while tree.joints[k].parent >= 0:
             R, p = placements[k]
@@ -114,7 +115,7 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
             moment = E.vadd(E.apply(R, moment), E.cross(p, force))
             k = tree.joints[k].parent
             ancestor = tree.joints[k]
-            full[i, k] = E.dot(ancestor.axis, moment if ancestor.kind == "revolute" else force)
+            full[i, k] = E.dot(ancestor.axis, moment if ancestor.kind == JointKind.REVOLUTE else force)
         parent = joint.parent
         if parent >= 0:  # the composite inertia of body i, moved into its parent's axes
             R, p = placements[i]
@@ -171,7 +172,7 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
         w_i = E.apply_transpose(R, wl)
         v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
         su = E.scale(rate, u)
-        if joint.kind == "revolute":
+        if joint.kind == JointKind.REVOLUTE:
             w_i = E.vadd(w_i, su)
             c.append((E.cross(w_i, su), E.cross(v_i, su)))  # (w, v) x S q_dot
         else:
@@ -194,7 +195,7 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
     for i in reversed(range(nb)):
         joint = tree.joints[i]
         u = list(joint.axis)
-        if joint.kind == "revolute":  # U = IA S: the first column block times u
+        if joint.kind == JointKind.REVOLUTE:  # U = IA S: the first column block times u
             Un = E.apply(A[i], u)
             Uf = E.apply_transpose(B[i], u)
             drive_n, drive_f = u, [0.0] * 3
@@ -257,7 +258,7 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
         Un, Uf = U[i]
         x = E.div(E.sub(uu[i], E.add(E.dot(Un, aw), E.dot(Uf, av))), D[i])
         qdd[joint.coordinate] = x
-        if joint.kind == "revolute":
+        if joint.kind == JointKind.REVOLUTE:
             aw = E.vadd(aw, E.scale(x, joint.axis))
         else:
             av = E.vadd(av, E.scale(x, joint.axis))
@@ -289,7 +290,7 @@ def _velocities(E: _Emitter, tree: KinematicTree, q, v):
         rate = E.mul(v[joint.coordinate], joint.multiplier)
         w_i = E.apply_transpose(R, wl)
         v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
-        if joint.kind == "revolute":
+        if joint.kind == JointKind.REVOLUTE:
             w_i = E.vadd(w_i, E.scale(rate, joint.axis))
         else:
             v_i = E.vadd(v_i, E.scale(rate, joint.axis))

@@ -20,6 +20,7 @@ from .contacts import (
     wheel_down_direction,
 )
 from .expressions import IDENTIFIER
+from .kinds import ConstraintKind
 from .model import (
     Constraint,
     Vector,
@@ -49,7 +50,7 @@ class ConstraintsMixin:
             raise self._error("give exactly one of 'holonomic' or 'velocity'", field)
         if holonomic is not None:
             expression = self.expression(holonomic, f"{field}.holonomic", velocities=False)
-            kind = "holonomic"
+            kind = ConstraintKind.HOLONOMIC
         else:
             expression = self.expression(velocity, f"{field}.velocity")
             velocities = [c.velocity for c in self._coordinates]
@@ -64,7 +65,7 @@ class ConstraintsMixin:
                         "a velocity constraint must be linear in the velocities",
                         f"{field}.velocity",
                     )
-            kind = "velocity"
+            kind = ConstraintKind.VELOCITY
         if not expression.free_symbols & set(self._all_state_symbols()):
             raise self._error("the constraint does not involve any coordinate", field)
         self._constraints.append(Constraint(name, kind, expression))
@@ -122,7 +123,7 @@ class ConstraintsMixin:
         for t, label in zip(tangents, labels, strict=True):
             constraint = f"{name}_friction_{label}"
             self._component(constraint, field)
-            self._constraints.append(Constraint(constraint, "velocity",
+            self._constraints.append(Constraint(constraint, ConstraintKind.VELOCITY,
                                                 self._tidy_velocity_row(dot(slip, t))))
             names.append(constraint)
         height = dot(contact, n)
@@ -131,7 +132,7 @@ class ConstraintsMixin:
         if not flat:
             constraint = f"{name}_normal"
             self._component(constraint, field)
-            self._constraints.append(Constraint(constraint, "holonomic", height))
+            self._constraints.append(Constraint(constraint, ConstraintKind.HOLONOMIC, height))
             names.append(constraint)
         self._contacts.append(RollingContact(name, body, r, a_body, n, tangents, contact,
                                              tuple(names), not flat))

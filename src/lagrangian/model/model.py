@@ -12,6 +12,8 @@ from typing import TYPE_CHECKING
 
 import sympy as sp
 
+from .kinds import ConstraintKind
+
 if TYPE_CHECKING:
     from .contacts import RollingContact
     from .rotations import RigidBody
@@ -153,8 +155,11 @@ class Constraint:
     """Phi(q, t) = 0 (``kind='holonomic'``) or A(q, t) q_dot + b(q, t) = 0 (``kind='velocity'``)."""
 
     name: str
-    kind: str
+    kind: ConstraintKind
     expression: sp.Expr
+
+    def __post_init__(self):
+        object.__setattr__(self, "kind", ConstraintKind(self.kind))
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from .kinds import JointKind
+
 Vector3 = tuple[float, float, float]
 Matrix3x3 = tuple[Vector3, Vector3, Vector3]
 
@@ -27,7 +29,7 @@ class TreeJoint:
 
     name: str
     parent: int  # index of the parent body in the tree, -1 for the ground
-    kind: str  # "revolute" or "prismatic"
+    kind: JointKind
     rotation: Matrix3x3  # R_0: joint axes -> parent body axes
     translation: Vector3  # t_0: the joint's origin in the parent body (m)
     axis: Vector3  # unit axis u in joint axes
@@ -37,6 +39,9 @@ class TreeJoint:
     mass: float  # kg
     first_moment: Vector3  # h = m c about the joint's origin, body axes (kg m)
     inertia: Matrix3x3  # J_O about the joint's origin, body axes (kg m^2)
+
+    def __post_init__(self):
+        object.__setattr__(self, "kind", JointKind(self.kind))
 
 
 @dataclass(frozen=True)

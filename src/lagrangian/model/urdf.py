@@ -29,6 +29,7 @@ import sympy as sp
 from ..errors import ModelError, did_you_mean
 from .builder import ModelBuilder
 from .expressions import RESERVED
+from .kinds import JointKind
 from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
@@ -440,7 +441,8 @@ def _carries_nothing(inertial) -> bool:
     return not inertial.mass and not np.any(np.asarray(tensor, dtype=float))
 
 
-_KIND = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
+_KIND = {"revolute": JointKind.REVOLUTE, "continuous": JointKind.REVOLUTE,
+         "prismatic": JointKind.PRISMATIC}
 
 
 def _snapped(a) -> np.ndarray:

@@ -21,6 +21,7 @@ import sympy as sp
 
 from ..compile.lambdified import StateFunction
 from ..model.expressions import as_expression
+from ..model.kinds import ConstraintKind
 from ..model.model import Model
 from ..model.values import ParameterValues, resolve_parameters
 
@@ -500,7 +501,7 @@ def sketch(model: Model, values: Mapping[sp.Symbol, sp.Expr]) -> Sketch:
     rods += [(points[i], points[j]) for _, i, j in best.values()]
     # A rod held by a constraint rather than by the coordinates: Phi = c (|P - A|^2 - L^2)
     # (the Cartesian pendulum's x^2 + y^2 - L^2), A the origin or another point.
-    holonomic = [c.expression for c in model.constraints if c.kind == "holonomic"]
+    holonomic = [c.expression for c in model.constraints if c.kind == ConstraintKind.HOLONOMIC]
     if holonomic:
         try:
             with np.errstate(all="ignore"):
@@ -575,7 +576,7 @@ def _rolling_bodies(model, values, points, owners, where, samples, tolerance) ->
         rows = [sp.diff(c, x) for c in body.position[:2] for x in model.q] + \
             [sp.diff(body.angle, x) for x in model.q]
         for constraint in model.constraints:
-            speeds = model.q_dot if constraint.kind == "velocity" else model.q
+            speeds = model.q_dot if constraint.kind == ConstraintKind.VELOCITY else model.q
             rows_c = [sp.diff(constraint.expression, x) for x in speeds]
             try:
                 with np.errstate(all="ignore"):

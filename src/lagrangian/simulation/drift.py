@@ -13,6 +13,7 @@ import numpy as np
 from ..compile.functions import NumericSystem
 from ..compile.lambdified import StateFunction
 from ..errors import ModelError
+from ..model.kinds import ConstraintKind
 
 # Explicit Runge-Kutta solvers keep only (y, f) between steps, so a projected state can be put
 # back in place; the others carry a history and are restarted from the projected state instead.
@@ -35,7 +36,7 @@ class DriftControl:
     def __init__(self, functions: NumericSystem, velocity_bias: StateFunction):
         self.functions = functions
         self.velocity_bias = velocity_bias
-        self.holonomic = np.array([k == "holonomic" for k in functions.constraint_kinds])
+        self.holonomic = np.array([k == ConstraintKind.HOLONOMIC for k in functions.constraint_kinds])
         self.nfev = 0
         self.steps_since_restart = 0
 

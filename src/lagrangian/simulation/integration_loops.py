@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..compile.functions import NumericSystem
+from ..model.kinds import RunStatus
 from .drift import DriftControl
 from .options import StepControl
 from .result import STATUS_MESSAGES
@@ -51,7 +52,7 @@ def integrate_compiled(functions: NumericSystem, t_span: tuple[float, float], y0
         pieces = [(0, first), (first, len(grid) - 1)]
     ts, ys, nfev, steps = [], [], 0, 0
     y_start = y0
-    status, message = "finished", STATUS_MESSAGES["finished"]
+    status, message = RunStatus.FINISHED, STATUS_MESSAGES["finished"]
     while pieces:
         a, b = pieces.pop(0)
         began = time.perf_counter()
@@ -69,7 +70,8 @@ def integrate_compiled(functions: NumericSystem, t_span: tuple[float, float], y0
         steps = None if piece_steps is None or steps is None else steps + int(piece_steps)
         if not result.success:
             text = str(result.message).rstrip(".")
-            status = "interrupted" if text.lower().startswith("interrupted") else "failed"
+            status = RunStatus.INTERRUPTED if text.lower().startswith("interrupted") \
+                else RunStatus.FAILED
             reached = float(t[-1]) if len(t) else float(grid[a])
             message = text if "t =" in text else f"{text} (stopped at t = {reached:.9g} s)"
             break
@@ -79,7 +81,7 @@ def integrate_compiled(functions: NumericSystem, t_span: tuple[float, float], y0
             except KeyboardInterrupt:
                 if not pieces:  # the run was complete already
                     break
-                status = "interrupted"
+                status = RunStatus.INTERRUPTED
                 message = f"interrupted by the user (Ctrl-C) at t = {float(t[-1]):.9g} s"
                 break
             spent = time.perf_counter() - began
@@ -114,7 +116,7 @@ def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y
 
     ts, ys = [t0], [y0.copy()]
     index = 1
-    status, message = "finished", STATUS_MESSAGES["finished"]
+    status, message = RunStatus.FINISHED, STATUS_MESSAGES["finished"]
     steps, nfev_done = 0, 0
     n = len(y0) // 2
     armed = event is not None and event(y0[:n], y0[n:], t0) < 0
@@ -125,12 +127,12 @@ def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y
             while solver.status == "running":
                 failure = solver.step()
                 if solver.status == "failed":
-                    status = "failed"
+                    status = RunStatus.FAILED
                     message = (f"{(failure or 'the step failed').rstrip('.')} "
                                f"(stopped at t = {solver.t:.9g} s)")
                     break
                 if not np.all(np.isfinite(solver.y)):
-                    status = "failed"
+                    status = RunStatus.FAILED
                     message = ("the state became infinite or NaN "
                                f"(stopped at t = {solver.t_old:.9g} s)")
                     break
@@ -151,20 +153,20 @@ def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y
                     if t_stop > ts[-1]:
                         ts.append(float(t_stop))
                         ys.append(dense(t_stop))
-                    status, message = "stopped", f"stop condition met at t = {t_stop:.12g} s"
+                    status, message = RunStatus.STOPPED, f"stop condition met at t = {t_stop:.12g} s"
                     break
                 if drift is not None and solver.status == "running":
                     solver = drift.correct(solver, start)
                 if progress is not None:
                     progress(solver.t)
     except KeyboardInterrupt:
-        status = "interrupted"
+        status = RunStatus.INTERRUPTED
         message = f"interrupted by the user (Ctrl-C) at t = {_reached(solver, t0):.9g} s"
     except np.linalg.LinAlgError:
-        status = "failed"
+        status = RunStatus.FAILED
         message = ("singular mass matrix (or constraint Jacobian without full rank) "
                    f"near t = {_reached(solver, t0):.9g} s")
-    if status in ("failed", "interrupted") and solver is not None and solver.t > ts[-1] \
+    if status in (RunStatus.FAILED, RunStatus.INTERRUPTED) and solver is not None and solver.t > ts[-1] \
             and np.all(np.isfinite(solver.y)):
         ts.append(float(solver.t))
         ys.append(np.array(solver.y, dtype=float))

@@ -12,8 +12,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..derivation.equations import EquationsOfMotion
+from ..model.kinds import InvariantKind
 
-INVARIANTS = ("energy", "jacobi_integral", "work_balance")
+INVARIANTS = tuple(InvariantKind)
 
 
 def invariant_kind(eom: EquationsOfMotion) -> str:
@@ -23,7 +24,7 @@ def invariant_kind(eom: EquationsOfMotion) -> str:
 
 def energy_is_conserved(eom: EquationsOfMotion) -> bool:
     """T + V itself is conserved (the published ``energy_conserved``)."""
-    return eom.invariant_kind == "energy"
+    return eom.invariant_kind == InvariantKind.ENERGY
 
 
 def cumulative_work(t: np.ndarray, power: np.ndarray) -> np.ndarray:

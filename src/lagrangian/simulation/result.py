@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model.kinds import InvariantKind, RunStatus
 from ..model.model import Model
 from ..model.values import State
 from .options import StepControl
@@ -76,7 +77,7 @@ class SimulationResult:
     @property
     def completed(self) -> bool:
         """True when the run reached its end time or its stop condition."""
-        return self.status in ("finished", "stopped")
+        return self.status in (RunStatus.FINISHED, RunStatus.STOPPED)
 
     def columns(self) -> dict[str, np.ndarray]:
         """Named columns: t, <q>, <q>_dot, energy, lambda_<c>, residual_<c>, power."""
@@ -91,9 +92,9 @@ class SimulationResult:
         for i, name in enumerate(self.constraint_names):
             out[f"residual_{name}"] = self.residuals[:, i]
         out["power"] = self.power
-        if self.invariant == "jacobi_integral" and self.invariant_values is not None:
+        if self.invariant == InvariantKind.JACOBI_INTEGRAL and self.invariant_values is not None:
             out["jacobi_integral"] = self.invariant_values
-        elif self.invariant == "work_balance" and self.balance is not None:
+        elif self.invariant == InvariantKind.WORK_BALANCE and self.balance is not None:
             out["work_balance"] = self.balance
         return out
 
@@ -105,7 +106,7 @@ class SimulationResult:
         if values is None or len(values) == 0 or not np.all(np.isfinite(values)):
             return None  # none (a run that failed on an overflow has an infinite energy)
         change = values - values[0]
-        if self.invariant == "work_balance":
+        if self.invariant == InvariantKind.WORK_BALANCE:
             if self.work is None:
                 return None
             change = change - self.work
@@ -124,7 +125,7 @@ class SimulationResult:
                   if x is not None and len(x)]
         if others and scale <= 1e-9 * max(others):
             scale = max(others)
-        if self.invariant == "work_balance" and others:
+        if self.invariant == InvariantKind.WORK_BALANCE and others:
             scale = max([scale, *others])
         return float(np.max(np.abs(balance))) / scale if scale > 0 else 0.0
 

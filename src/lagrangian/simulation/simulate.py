@@ -21,6 +21,7 @@ from ..compile.functions import NumericSystem, numeric
 from ..compile.lambdified import StateFunction
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
+from ..model.kinds import InvariantKind, RunStatus
 from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state
 from .drift import DriftControl
@@ -82,9 +83,9 @@ def simulate(
     run = _integrate(functions, y0, grid, step_control, event, drift, progress,
                      compiled_loop and not functions.m and event is None)
     wall = time.perf_counter() - began
-    if run.status == "failed":
+    if run.status == RunStatus.FAILED:
         run = replace(run, message=_explain_failure(functions, run))
-    if run.status == "failed" and model.rigid_bodies:  # an Euler-angle singularity, named
+    if run.status == RunStatus.FAILED and model.rigid_bodies:  # an Euler-angle singularity, named
         where = {**substitution, **dict(zip(model.q, run.y[-1][:functions.n], strict=True))}
         lock = gimbal_lock(model.rigid_bodies, where)
         if lock:
@@ -118,11 +119,11 @@ def _invariant(eom, substitution, t, q, q_dot, energy, power, multipliers):
     sample or None): T + V, the Jacobi integral h, or h with int P dt for a work balance, where
     P = Q . q_dot - dL/dt + lambda . b (b: the velocity bias of moving constraints)."""
     kind = invariant_kind(eom)
-    if kind == "energy":
+    if kind == InvariantKind.ENERGY:
         return kind, energy, None
     model = eom.model
     values = StateFunction(model, [eom.jacobi_integral], substitution)(q, q_dot, t)[:, 0]
-    if kind == "jacobi_integral":
+    if kind == InvariantKind.JACOBI_INTEGRAL:
         return kind, values, None
     supplied = np.array(power, dtype=float)
     if eom.explicit_time_power != 0:

@@ -1,0 +1,49 @@
+"""The kinds and states the package names, as string enums: each compares equal to its
+string (JSON, files and messages keep the same words), and a typo is an AttributeError, not a
+comparison that is silently never true."""
+
+from __future__ import annotations
+
+from enum import StrEnum
+
+
+class JointKind(StrEnum):
+    """How a joint of a kinematic tree moves its body: about its axis or along it."""
+
+    REVOLUTE = "revolute"
+    PRISMATIC = "prismatic"
+
+
+class ConstraintKind(StrEnum):
+    """Phi(q, t) = 0 (holonomic) or A(q, t) q_dot + b(q, t) = 0 (velocity)."""
+
+    HOLONOMIC = "holonomic"
+    VELOCITY = "velocity"
+
+
+class InvariantKind(StrEnum):
+    """What a run monitors: T + V, the Jacobi integral h, or the work balance h - h0 - int P dt."""
+
+    ENERGY = "energy"
+    JACOBI_INTEGRAL = "jacobi_integral"
+    WORK_BALANCE = "work_balance"
+
+
+class RunStatus(StrEnum):
+    """How a simulation ended."""
+
+    FINISHED = "finished"
+    STOPPED = "stopped"
+    INTERRUPTED = "interrupted"
+    FAILED = "failed"
+
+
+class Backend(StrEnum):
+    """Where the numeric functions run: generated C, numpy, or C when a compiler works."""
+
+    AUTO = "auto"
+    C = "c"
+    NUMPY = "numpy"
+
+
+__all__ = ["Backend", "ConstraintKind", "InvariantKind", "JointKind", "RunStatus"]

@@ -43,3 +43,12 @@ def _compiled_module_cache(tmp_path_factory):
         os.environ.pop("LAGRANGIAN_CACHE", None)
     else:
         os.environ["LAGRANGIAN_CACHE"] = previous
+
+
+@pytest.fixture(scope="module")
+def client():
+    """An in-process Dask cluster (one worker, two threads) for the studies of one module."""
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.Client(processes=False, n_workers=1, threads_per_worker=2,
+                            dashboard_address=":0") as c:
+        yield c

@@ -52,3 +52,15 @@ def test_speeds_at_chosen_speeds(cli):
 def test_a_bad_chosen_speed_is_one_line(cli, setting):
     result = cli("speeds", "whipple_bicycle", "--at", setting)
     assert result.code == 2 and result.err.count("\n") == 1 and "--at" in result.err
+
+
+def test_a_steady_about_value_naming_a_symbol_is_one_line(cli, tmp_path):
+    from lagrangian.model.examples import example_path
+
+    text = example_path("whipple_bicycle").read_text().replace(
+        'keep = ["phi", "delta"]', 'keep = ["phi", "delta"]\nabout = { phi = "v" }')
+    path = tmp_path / "bike.toml"
+    path.write_text(text)
+    result = cli("speeds", str(path))
+    assert result.code == 2 and result.err.count("\n") == 1
+    assert "steady.about.phi" in result.err and "must be a number" in result.err

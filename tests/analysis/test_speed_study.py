@@ -21,13 +21,6 @@ WEAVE, CAPSIZE = 4.29238253634111, 6.02426201538837
 
 
 @pytest.fixture(scope="module")
-def client():
-    with distributed.Client(processes=False, n_workers=1, threads_per_worker=1,
-                            dashboard_address=":0") as c:
-        yield c
-
-
-@pytest.fixture(scope="module")
 def bicycle():
     return lagrangian.load("whipple_bicycle")
 

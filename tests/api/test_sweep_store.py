@@ -19,13 +19,6 @@ VARY = {"k": np.linspace(1, 9, 9), "k_c": [0.5, 1.5]}
 
 
 @pytest.fixture(scope="module")
-def client():
-    with distributed.Client(processes=False, n_workers=1, threads_per_worker=2,
-                            dashboard_address=":0") as c:
-        yield c
-
-
-@pytest.fixture(scope="module")
 def two_mass():
     return lagrangian.load("two_mass")
 

@@ -20,8 +20,8 @@ from ..compile.at_rest import StaticFunctions, linear_velocity_row
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import jacobian_row
 from ..errors import DerivationError, ModelError
+from ..kinds import ConstraintKind
 from ..model.expressions import as_expression
-from ..model.kinds import ConstraintKind
 from ..model.model import Model
 from ..model.values import ParameterValues, resolve_parameters, resolve_state
 

@@ -19,8 +19,8 @@ import sympy as sp
 from ..compile.lambdified import numpy_function
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
+from ..kinds import ConstraintKind
 from ..model.expressions import as_expression
-from ..model.kinds import ConstraintKind
 from ..model.model import Model
 from ..model.units import generalized_force_unit
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state, unknown_name

@@ -25,8 +25,8 @@ from ..compile.lambdified import StateFunction
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import Differentiator
 from ..errors import DerivationError, ModelError, did_you_mean
+from ..kinds import ConstraintKind
 from ..model.expressions import as_expression
-from ..model.kinds import ConstraintKind
 from ..model.model import velocity_name
 from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, resolve_parameters, resolve_state

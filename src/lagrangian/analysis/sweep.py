@@ -23,7 +23,7 @@ from ..compile.parametric_at_rest import (
     StaticFunctionsAt,
     integrate_ensemble,
 )
-from ..model.kinds import RunStatus
+from ..kinds import RunStatus
 from ..model.values import resolve_state
 from .equilibria import (
     _difference,

@@ -19,9 +19,9 @@ from ..derivation.equations import EquationsOfMotion, LoadContribution
 from ..dynamics.joint_space import Dynamics
 from ..dynamics.standalone import StandaloneSource
 from ..errors import DerivationError, LagrangianError, ModelError
+from ..kinds import Backend, ConstraintKind, InvariantKind, JointKind, RunStatus
 from ..model.answer import Answer
 from ..model.examples import example_names as examples
-from ..model.kinds import Backend, ConstraintKind, InvariantKind, JointKind, RunStatus
 from ..model.model import Model
 from ..model.reader import parse_model, read_model
 from ..model.values import ParameterValues, State

@@ -15,8 +15,8 @@ from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import jacobian_row
 from ..derivation.regularity import independent_of_time
 from ..errors import ModelError
+from ..kinds import ConstraintKind
 from ..model.expressions import as_expression
-from ..model.kinds import ConstraintKind
 from ..model.values import ParameterValues, resolve_parameters
 from .lambdified import numpy_function
 

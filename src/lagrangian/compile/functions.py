@@ -16,8 +16,8 @@ import numpy as np
 
 from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError
+from ..kinds import Backend
 from ..model.expressions import as_expression
-from ..model.kinds import Backend
 from ..model.values import ParameterValues, resolve_parameters
 from .lambdified import numpy_function
 

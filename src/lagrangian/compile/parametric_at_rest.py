@@ -21,8 +21,8 @@ import sympy as sp
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import jacobian_row
 from ..errors import ModelError
+from ..kinds import ConstraintKind
 from ..model.expressions import as_expression
-from ..model.kinds import ConstraintKind
 from ..model.model import Model
 from .at_rest import linear_velocity_row
 from .lambdified import numpy_function

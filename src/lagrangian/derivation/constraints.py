@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..model.kinds import ConstraintKind
+from ..kinds import ConstraintKind
 from ..model.model import Model
 from .kinematics import jacobian_row, time_rate
 

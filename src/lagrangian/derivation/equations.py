@@ -7,7 +7,7 @@ from functools import cached_property
 
 import sympy as sp
 
-from ..model.kinds import InvariantKind
+from ..kinds import InvariantKind
 from ..model.model import Model
 from ..model.notation import latex_symbol_names
 

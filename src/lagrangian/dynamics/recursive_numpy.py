@@ -21,7 +21,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import ModelError
-from ..model.kinds import JointKind
+from ..kinds import JointKind
 from ..model.model import Model
 from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters

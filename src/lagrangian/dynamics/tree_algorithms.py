@@ -4,7 +4,7 @@ kinematics, Newton-Euler inverse dynamics, the composite-rigid-body mass matrix,
 
 from __future__ import annotations
 
-from ..model.kinds import JointKind
+from ..kinds import JointKind
 from ..model.tree import KinematicTree
 from .tree_emitter import Term, _Emitter, _Layout
 

@@ -434,7 +434,11 @@ class ModelBuilder(RigidBodiesMixin, ConstraintsMixin):
             if name not in names:
                 raise self._error(f"'{name}' is not a coordinate{did_you_mean(name, names)}",
                                   f"{field}.about.{name}")
-            point.append((name, float(self.expression(value, f"{field}.about.{name}"))))
+            value = self.expression(value, f"{field}.about.{name}")
+            if value.free_symbols or not value.is_real:
+                raise self._error(f"the value of '{name}' must be a number (SI), got "
+                                  f"'{value}'", f"{field}.about.{name}")
+            point.append((name, float(value)))
         self._steady_motion = SteadyMotion(speed, tuple(texts), tuple(keep), tuple(point))
         return self
 

@@ -11,6 +11,7 @@ import numpy as np
 import sympy as sp
 
 from ..errors import did_you_mean
+from ..kinds import ConstraintKind
 from .contacts import (
     RollingContact,
     contact_velocity,
@@ -20,7 +21,6 @@ from .contacts import (
     wheel_down_direction,
 )
 from .expressions import IDENTIFIER
-from .kinds import ConstraintKind
 from .model import (
     Constraint,
     Vector,

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import sympy as sp
 
-from .kinds import ConstraintKind
+from ..kinds import ConstraintKind
 
 if TYPE_CHECKING:
     from .contacts import RollingContact

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .kinds import JointKind
+from ..kinds import JointKind
 
 Vector3 = tuple[float, float, float]
 Matrix3x3 = tuple[Vector3, Vector3, Vector3]

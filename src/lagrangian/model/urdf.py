@@ -27,9 +27,9 @@ import numpy as np
 import sympy as sp
 
 from ..errors import ModelError, did_you_mean
+from ..kinds import JointKind
 from .builder import ModelBuilder
 from .expressions import RESERVED
-from .kinds import JointKind
 from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate

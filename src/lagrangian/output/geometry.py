@@ -20,8 +20,8 @@ import numpy as np
 import sympy as sp
 
 from ..compile.lambdified import StateFunction
+from ..kinds import ConstraintKind
 from ..model.expressions import as_expression
-from ..model.kinds import ConstraintKind
 from ..model.model import Model
 from ..model.values import ParameterValues, resolve_parameters
 

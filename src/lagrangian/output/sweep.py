@@ -161,7 +161,7 @@ def study_dataset(study: Study, arrays: Mapping[str, np.ndarray], finished: int 
         attrs["warnings"] = "\n".join(study.warnings)
     if study.simulation is not None:
         options = study.simulation
-        attrs.update({"invariant": study.eom.invariant_kind, "t_end": options.t_end,
+        attrs.update({"invariant": str(study.eom.invariant_kind), "t_end": options.t_end,
                       "method": options.method, "rtol": options.rtol, "atol": options.atol,
                       "stop_when": options.stop_when or ""})
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)

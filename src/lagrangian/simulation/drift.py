@@ -13,7 +13,7 @@ import numpy as np
 from ..compile.functions import NumericSystem
 from ..compile.lambdified import StateFunction
 from ..errors import ModelError
-from ..model.kinds import ConstraintKind
+from ..kinds import ConstraintKind
 
 # Explicit Runge-Kutta solvers keep only (y, f) between steps, so a projected state can be put
 # back in place; the others carry a history and are restarted from the projected state instead.

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..compile.functions import NumericSystem
-from ..model.kinds import RunStatus
+from ..kinds import RunStatus
 from .drift import DriftControl
 from .options import StepControl
 from .result import STATUS_MESSAGES

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..derivation.equations import EquationsOfMotion
-from ..model.kinds import InvariantKind
+from ..kinds import InvariantKind
 
 INVARIANTS = tuple(InvariantKind)
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model.kinds import InvariantKind, RunStatus
+from ..kinds import InvariantKind, RunStatus
 from ..model.model import Model
 from ..model.values import State
 from .options import StepControl

@@ -21,7 +21,7 @@ from ..compile.functions import NumericSystem, numeric
 from ..compile.lambdified import StateFunction
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
-from ..model.kinds import InvariantKind, RunStatus
+from ..kinds import InvariantKind, RunStatus
 from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state
 from .drift import DriftControl

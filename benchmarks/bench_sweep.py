@@ -39,11 +39,11 @@ import lagrangian
 
 
 def _cluster(workers: int):
-    """A running cluster set up as System.sweep sets up its own (api/sweep.py)."""
+    """A running cluster set up as System.sweep sets up its own (study/engine.py)."""
     import dask
     from dask.distributed import Client, LocalCluster
 
-    from lagrangian.api.sweep import WORKER_ENVIRONMENT
+    from lagrangian.study.engine import WORKER_ENVIRONMENT
 
     with dask.config.set(WORKER_ENVIRONMENT):
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
@@ -177,7 +177,7 @@ def main() -> None:
     # one chunk of the ensemble in this process: the C loop and the chunk's bookkeeping
     from lagrangian.analysis.study import SimulationOptions, make_study
     from lagrangian.analysis.sweep import evaluate_chunk
-    from lagrangian.api.sweep import with_compiled_module
+    from lagrangian.study.engine import with_compiled_module
 
     study = with_compiled_module(make_study(
         pendulum._equations, "simulate", {}, sample=ensemble["sample"], members=1000,

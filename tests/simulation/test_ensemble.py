@@ -23,7 +23,7 @@ RTOL = ATOL = 1e-9
 
 
 def _module(system):
-    """The model's module as ensembles load it (api/sweep.py)."""
+    """The model's module as ensembles load it (study/engine.py)."""
     eom = system._equations
     return compiled.load_keyed(equations_key(eom), lambda: generate(eom, vector=True),
                               native=ENSEMBLE_NATIVE)

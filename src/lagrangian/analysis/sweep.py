@@ -4,7 +4,7 @@ A study varies parameters (and, for simulations, initial values) over a grid, on
 varied name, and may add an ensemble axis ``member`` of values drawn from distributions. The
 grid is flattened and cut into chunks; ``evaluate_chunk`` computes every point of one chunk and
 never raises for one point: a point that fails is NaN with its reason in ``status``. What runs
-the chunks (Dask, api/sweep.py) and writes the Dataset (output/sweep.py) live downstream.
+the chunks (Dask, study/engine.py) and writes the Dataset (output/sweep.py) live downstream.
 
 Per chunk the compiled functions are built once per process (``prepared``): the equations at
 rest with the parameters as inputs (compile/parametric_at_rest.py) for modes and equilibria, the
@@ -341,7 +341,7 @@ def _equilibria_chunk(study, parametric, values, count):
 
 # Ensembles use the model's module with the vector kernel (codegen.generate(vector=True)) built
 # for this processor (-O3 -march=native, keyed by the CPU: another machine builds its own): with
-# AVX the ensemble loop integrates four members per vector operation instead of two. api/sweep.py
+# AVX the ensemble loop integrates four members per vector operation instead of two. study/engine.py
 # builds it on the client, the workers load it. (native=True names only this module.)
 ENSEMBLE_NATIVE = True
 

@@ -356,7 +356,7 @@ class System:
         """
         from ..analysis.study import SimulationOptions, make_study
         from ..errors import ModelError
-        from .sweep import run_study
+        from ..study.engine import run_study
 
         eom = self.equations_of_motion()
         require_inertia(eom, "simulate" if compute == "simulate" else "modes")

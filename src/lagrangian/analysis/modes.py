@@ -221,26 +221,87 @@ def _state_space_modes(linear: LinearModel) -> list[Mode]:
     values = np.where(np.abs(values.real) <= noise, 1j * values.imag, values)
     values = np.where(np.abs(values.imag) <= noise, values.real + 0j, values)
     values, vectors = verified_eigenpairs(A, values, raw, vectors)
+    rigid = _rigid_body_vectors(A, values, p, Z)
     if Z is not None:
         vectors = Z @ vectors
+    full = structural_zeros_cleaned(linear.A)
     modes: list[Mode] = []
+
+    def add(vector: np.ndarray, s: complex, s1: complex, s2: complex | None) -> None:
+        _require_printed(full, rows, vector, s, len(modes))
+        modes.append(_pair_mode(linear, vector, s1, s2))
+
     real = []
     for k, s in enumerate(values):
         if s.imag > 0:
-            modes.append(_pair_mode(linear, vectors[:p, k], s, np.conj(s)))
+            add(vectors[:p, k], s, s, np.conj(s))
         elif s.imag == 0:
             real.append(k)
+    if rigid is not None:
+        # The zero eigenvalues pair up as before (one mode per pair, a lone one with the real
+        # value of the most alike shape: a free coordinate with a damper), each mode showing
+        # another independent shift.
+        zeros = [k for k in real if values[k] == 0]
+        real = [k for k in real if values[k] != 0]
+        for j in range((len(zeros) + 1) // 2):
+            vector = rigid[:p, j % rigid.shape[1]]
+            if 2 * j + 1 < len(zeros):
+                add(vector, 0j, 0j, 0j)
+            elif real:
+                likeness = [_likeness(vector, vectors[:p, i]) for i in real]
+                add(vector, 0j, 0j, values[real.pop(int(np.argmax(likeness)))])
+            else:
+                add(vector, 0j, 0j, None)
     # Real eigenvalues pair up by the likeness of their displacement shapes.
     while real:
         k = real.pop(0)
         if not real:
-            modes.append(_pair_mode(linear, vectors[:p, k], values[k], None))
+            add(vectors[:p, k], values[k], values[k], None)
             break
         likeness = [_likeness(vectors[:p, k], vectors[:p, j]) for j in real]
         j = real.pop(int(np.argmax(likeness)))
         dominant = k if values[k].real >= values[j].real else j
-        modes.append(_pair_mode(linear, vectors[:p, dominant], values[k], values[j]))
+        add(vectors[:p, dominant], values[dominant], values[k], values[j])
     return modes
+
+
+def _rigid_body_vectors(A: np.ndarray, values: np.ndarray, p: int, Z: np.ndarray | None
+                        ) -> np.ndarray | None:
+    """For the zero eigenvalues, a real basis of the null space of A (over the full state) with
+    an identity on pivot coordinates (x, y, spin: each shift alone), in the coordinates'
+    order; None where there is none or it is larger than the zeros counted. LAPACK's vectors for a defective zero are nearly
+    parallel: they repeat one motion, miss others and carry ~sqrt(eps) of the generalized
+    vectors, which then show in the printed shape."""
+    import scipy.linalg
+
+    count = int(np.sum(values == 0))
+    if not count:
+        return None
+    null = scipy.linalg.null_space(A, rcond=EIGEN_RESIDUAL_TOLERANCE)
+    states = null if Z is None else Z @ null
+    shifts = states[:p]
+    if not 0 < null.shape[1] <= count or np.linalg.matrix_rank(shifts) < null.shape[1]:
+        return None
+    _, _, pivots = scipy.linalg.qr(shifts.T, pivoting=True)
+    pivots = np.sort(pivots[:null.shape[1]])
+    canonical = states @ np.linalg.inv(shifts[pivots])
+    scale = np.abs(canonical).max(axis=0, keepdims=True)
+    canonical[np.abs(canonical) <= 1e-13 * scale] = 0.0
+    return canonical
+
+
+def _require_printed(A: np.ndarray, rows: np.ndarray, shape: np.ndarray, s: complex,
+                     k: int) -> None:
+    """Refuse a mode whose printed shape u (largest component 1, entries under 1e-12 dropped,
+    as printed) does not satisfy A x = s x with x = [u; s u], nor the linearized constraints
+    ``rows`` x = 0, to EIGEN_RESIDUAL_TOLERANCE relative."""
+    u = normalized_shape(shape)
+    u = np.where(np.abs(u) >= 1e-12, u, 0)
+    x = np.concatenate([u, s * u])
+    size = np.linalg.norm(x)
+    _require_accurate(k, A @ x - s * x, np.linalg.norm(A, 2) * size)
+    if rows.size:
+        _require_accurate(k, rows @ x, np.linalg.norm(rows, 2) * size)
 
 
 # A printed eigenpair satisfies its equation to this relative residual, or is refused.

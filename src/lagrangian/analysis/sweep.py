@@ -38,6 +38,7 @@ from .equilibria import (
 )
 from .linearization import linear_model_at, total_stiffness
 from .modes import (
+    EIGEN_RESIDUAL_TOLERANCE,
     ROUND_OFF_TOLERANCE,
     ZERO_SQUARED_TOLERANCE,
     ZERO_TOLERANCE,
@@ -198,7 +199,14 @@ def _modes_batched(study, parametric, vectors, out) -> np.ndarray:
         growth[sym] = np.where(is_zero | (squared > 0), 0.0, np.sqrt(np.abs(squared)))
         zeta[sym] = 0.0
         shapes[sym] = np.swapaxes(vectors_, -1, -2).astype(complex)
-        done[sym] = True
+        # as in modes._symmetric_modes: each pair satisfies K v = w^2 M v to 1e-9 relative,
+        # else the point goes the verified point-by-point way
+        w2 = np.where(is_zero, 0.0, squared)[:, None, :]
+        residual = np.linalg.norm(Ks @ vectors_ - (Ms @ vectors_) * w2, axis=-2)
+        bound = (np.linalg.norm(Ks, 2, axis=(-2, -1))[:, None]
+                 + np.abs(w2[:, 0]) * np.linalg.norm(Ms, 2, axis=(-2, -1))[:, None]) \
+            * np.linalg.norm(vectors_, axis=-2)
+        done[sym] = np.all(residual <= EIGEN_RESIDUAL_TOLERANCE * bound, axis=-1)
 
     general = np.flatnonzero(found & ~symmetric)
     if general.size:
@@ -216,7 +224,12 @@ def _modes_batched(study, parametric, vectors, out) -> np.ndarray:
         # Every eigenvalue in a conjugate pair: each upper one is a mode. Real eigenvalues
         # (overdamped, divergent, rigid-body) pair by shape, which the single-point path does.
         upper = s.imag > 0
-        simple = upper.sum(axis=-1) == n
+        # each pair satisfies A v = s v to 1e-9 relative (modes.verified_eigenpairs), else the
+        # point goes the verified point-by-point way
+        residual = np.linalg.norm(A @ V - V * s[:, None, :], axis=-2)
+        bound = np.linalg.norm(A, 2, axis=(-2, -1))[:, None] * np.linalg.norm(V, axis=-2)
+        accurate = np.all(residual <= EIGEN_RESIDUAL_TOLERANCE * bound, axis=-1)
+        simple = (upper.sum(axis=-1) == n) & accurate
         rows = np.flatnonzero(simple)
         if rows.size:
             order = np.argsort(~upper[rows], axis=-1, kind="stable")[:, :n]

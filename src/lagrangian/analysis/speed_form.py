@@ -325,7 +325,8 @@ def _crossing(form: SpeedForm, a: float, b: float, k: int, xtol: float) -> float
 def speed_sweep(form: SpeedForm, speeds: Sequence[float], tolerance: float = 1e-9,
                 xtol: float = 1e-12) -> SpeedSweep:
     """Eigenvalues at each speed; each change in the number of eigenvalues with Re > 0 between
-    neighbouring speeds is located by bisection to ``xtol`` (m/s)."""
+    neighbouring speeds is located where a real part changes sign (Brent's method, to about
+    1e-15 relative; by bisection of the count to ``xtol`` only where no real part does)."""
     speeds = np.asarray(speeds, dtype=float)
     table = np.array([form.eigenvalues(v) for v in speeds])
     counts = [_unstable(form, v, tolerance) for v in speeds]

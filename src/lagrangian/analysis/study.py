@@ -228,7 +228,7 @@ def _unused_parameters(eom: EquationsOfMotion, varied: Sequence[str], parameters
     hint = ""
     if steady is not None and steady.speed in unused:
         hint = (f"; '{steady.speed}' is the speed of the model's steady motion: study the "
-                "eigenvalues against it with compute='speeds'")
+                "eigenvalues against it with compute='speeds' (sweep --compute speeds)")
     if len(unused) == len(varied) and not allow_none:
         names = ", ".join(f"'{n}'" for n in unused)
         raise ModelError(f"{names} does not appear in the equations of motion: varying it "

@@ -46,6 +46,7 @@ from .modes import (
     modal_analysis,
 )
 from .speed_form import speed_study_chunk
+from .steady import steady_linear_model
 from .study import (
     OK,
     Study,
@@ -121,6 +122,9 @@ def _modes_chunk(study, parametric: ParametricStaticFunctions, values, count):
     vectors = _parameter_vectors(parametric, values, count)
     todo = np.arange(count)
     about = dict(study.about) or None
+    steady = study.eom.model.steady_motion
+    if steady is not None and about is None:  # as `lagrangian modes` takes such a model
+        return _steady_modes_chunk(study, steady, values, count, out)
     if parametric.m == 0 and not parametric.static_names and about is None:
         try:
             with np.errstate(all="ignore"):
@@ -132,6 +136,22 @@ def _modes_chunk(study, parametric: ParametricStaticFunctions, values, count):
             view = parametric.at(vectors[i])
             q, lam = resolve_equilibrium(view, about)
             analysis = modal_analysis(linear_model_at(view, q, lam))
+        except Exception as exc:  # a failing point is recorded, the study goes on
+            out["status"][i] = _reason(exc)
+            continue
+        _store_modes(out, i, analysis, n)
+    return out
+
+
+def _steady_modes_chunk(study, steady, values, count, out):
+    """Modes about the model's [steady] motion at each point's parameter values."""
+    n = len(study.eom.model.coordinates)
+    for i in range(count):
+        point = {name: float(values[name][i]) for name in values}
+        try:
+            linear = steady_linear_model(study.eom, dict(steady.about) or None,
+                                         dict(steady.rates), point)
+            analysis = modal_analysis(linear)
         except Exception as exc:  # a failing point is recorded, the study goes on
             out["status"][i] = _reason(exc)
             continue

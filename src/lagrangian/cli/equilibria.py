@@ -20,8 +20,12 @@ def equilibria(
     """Find the equilibria (forces balance at rest, with the constraints) and their stability."""
     from ..output.modes import equilibria_document, equilibria_text
 
-    found = load_system(model, set_, lock).equilibria()
+    system = load_system(model, set_, lock)
+    found = system.equilibria()
     if json_:
         print_json(equilibria_document(found))
     else:
         typer.echo(equilibria_text(found), nl=False)
+        if system.model.steady_motion is not None:  # a bicycle: its motion of interest rolls
+            typer.echo("\nThese are configurations at rest. The model's [steady] table names a "
+                       "steady motion: `modes` (and `speeds`) without --about study it.")

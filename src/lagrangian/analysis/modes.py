@@ -269,9 +269,9 @@ def _rigid_body_vectors(A: np.ndarray, values: np.ndarray, p: int, Z: np.ndarray
                         ) -> np.ndarray | None:
     """For the zero eigenvalues, a real basis of the null space of A (over the full state) with
     an identity on pivot coordinates (x, y, spin: each shift alone), in the coordinates'
-    order; None where there is none or it is larger than the zeros counted. LAPACK's vectors for a defective zero are nearly
-    parallel: they repeat one motion, miss others and carry ~sqrt(eps) of the generalized
-    vectors, which then show in the printed shape."""
+    order; None where there is none or it is larger than the zeros counted. LAPACK's vectors
+    for a defective zero are nearly parallel: they repeat one motion, miss others and carry
+    ~sqrt(eps) of the generalized vectors, which then show in the printed shape."""
     import scipy.linalg
 
     count = int(np.sum(values == 0))

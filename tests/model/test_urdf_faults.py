@@ -95,3 +95,50 @@ def test_the_cli_says_it_in_one_line(cli, tmp_path):
     path.write_text(ARM.replace('<link name="fore">', '<link name="upper">'))
     result = cli("dynamics", str(path), "--q", "0,0")
     assert result.code == 2 and result.err.count("\n") == 1 and result.err.startswith("error: ")
+
+
+@pytest.mark.parametrize("edit, field, words", [
+    # yourdfpy reads a missing value as 0 and a missing moment as 1 (kg m^2): urdfdom refuses
+    (('<mass value="1.5"/>', '<mass/>'), "link 'fore'.inertial.mass", "no value"),
+    (('<mass value="1.5"/>', ''), "link 'fore'.inertial.mass", "no <mass>"),
+    (('iyy="0.1" ', ''), "link 'fore'.inertial.inertia", "iyy"),
+    (('<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/>', ''),
+     "link 'fore'.inertial.inertia", "no <inertia>"),
+])
+def test_an_inertial_missing_a_number_is_refused(tmp_path, edit, field, words):
+    text = ARM.replace(*edit)
+    assert text != ARM
+    with pytest.raises(ModelError, match=words) as error:
+        load(tmp_path, text)
+    assert field in str(error.value) and "\n" not in str(error.value)
+
+
+@pytest.mark.parametrize("edit, field", [
+    (('<mass value="1.5"/>', '<mass value="1e308"/>'), "link 'fore'.inertial.mass"),
+    (('<origin xyz="1 0 0" rpy="0 0 0"/>', '<origin xyz="1e200 0 0" rpy="0 0 0"/>'),
+     "joint 'elbow'.origin"),
+    (('iyy="0.1"', 'iyy="1e250"'), "link 'fore'.inertial.inertia"),
+])
+def test_numbers_too_large_to_multiply_are_refused(tmp_path, edit, field):
+    """M = m r^2 of a mass of 1e308 or a length of 1e200 is inf: printed as a result before."""
+    text = ARM.replace(*edit)
+    assert text != ARM
+    with pytest.raises(ModelError, match="too large") as error:
+        load(tmp_path, text)
+    assert field in str(error.value)
+
+
+def test_a_large_but_finite_robot_is_still_read(tmp_path):
+    """A 1000 kg forearm 20 m out: M22 = I + m c^2 = 0.1 + 1000 * 8^2 (c = 0.4 * 20)."""
+    text = ARM.replace('<mass value="1.5"/>', '<mass value="1000"/>').replace(
+        '<origin xyz="0.4 0 0" rpy="0 0 0"/>', '<origin xyz="8 0 0" rpy="0 0 0"/>')
+    M = load(tmp_path, text).dynamics().mass_matrix([0.0, 0.3])
+    assert M[1, 1] == pytest.approx(0.1 + 1000 * 64, rel=1e-12)
+
+
+def test_huge_joint_limits_are_only_a_range(tmp_path):
+    text = ARM.replace('lower="-3.1" upper="3.1" effort="30"',
+                       'lower="-1.79769e+308" upper="1.79769e+308" effort="30"')
+    assert text != ARM
+    M = load(tmp_path, text).dynamics().mass_matrix([0.3, 0.0])
+    assert M[1, 1] == pytest.approx(0.34, rel=1e-12)

@@ -68,9 +68,10 @@ def _parse(text: str, source: str):
 
     data = text.encode("utf-8")
     try:
-        etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True))
+        root = etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True))
     except etree.XMLSyntaxError as exc:
         raise ModelError(f"not well-formed XML ({exc})", source=source) from None
+    _check_inertials(root, source)
     import yourdfpy
 
     try:
@@ -83,6 +84,37 @@ def _parse(text: str, source: str):
         raise ModelError(f"not a URDF robot ({type(exc).__name__}: {exc})",
                          source=source) from None
     return urdf.robot
+
+
+def _check_inertials(root, source: str) -> None:
+    """Each link's inertial has its mass and all six moments, as urdfdom requires: yourdfpy
+    would read a missing mass as 0 and a missing ixx, iyy or izz as 1 kg m^2."""
+    for link in root.findall("link"):
+        inertial = link.find("inertial")
+        if inertial is None:
+            continue
+        where = f"link '{link.get('name')}'.inertial"
+        mass = inertial.find("mass")
+        if mass is None:
+            raise ModelError("no <mass> element (an inertial needs <mass value=\"...\"/>)",
+                             field=f"{where}.mass", source=source)
+        if mass.get("value") is None:
+            raise ModelError("no value (write <mass value=\"...\"/>)", field=f"{where}.mass",
+                             source=source)
+        inertia = inertial.find("inertia")
+        if inertia is None:
+            raise ModelError("no <inertia> element (an inertial needs ixx, ixy, ixz, iyy, iyz "
+                             "and izz)", field=f"{where}.inertia", source=source)
+        missing = [key for key in _MOMENTS if inertia.get(key) is None]
+        if missing:
+            raise ModelError(f"no {', '.join(missing)} (an inertia needs all six of "
+                             f"{', '.join(_MOMENTS)})", field=f"{where}.inertia", source=source)
+
+
+_MOMENTS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+# Every number of a URDF is below this in size: masses, lengths and moments multiply (m r^2, and
+# composite inertias down the chain), and a mass of 1e308 or a length of 1e200 gave inf.
+MAX_URDF_NUMBER = 1e30
 
 
 def _number(x: float) -> sp.Expr:
@@ -152,20 +184,26 @@ class _Tree:
         if joint.mimic is not None:
             numbers += (("mimic.multiplier", joint.mimic.multiplier),
                         ("mimic.offset", joint.mimic.offset))
-        if joint.limit is not None:
-            numbers += (("limit.lower", joint.limit.lower), ("limit.upper", joint.limit.upper))
         self._check_finite(where, numbers)
+        if joint.limit is not None:  # only a range: +-1.8e308 stands for none in some files
+            self._check_finite(where, (("limit.lower", joint.limit.lower),
+                                       ("limit.upper", joint.limit.upper)), bounded=False)
 
-    def _check_finite(self, where: str, numbers) -> None:
+    def _check_finite(self, where: str, numbers, bounded: bool = True) -> None:
         for name, value in numbers:
             if value is None:
                 continue
             try:
-                finite = bool(np.all(np.isfinite(np.asarray(value, dtype=float))))
+                numbers = np.asarray(value, dtype=float)
+                finite = bool(np.all(np.isfinite(numbers)))
             except (TypeError, ValueError):
                 finite = False
             if not finite:
                 raise self.error("a number that is not finite", f"{where}.{name}")
+            if bounded and np.any(np.abs(numbers) >= MAX_URDF_NUMBER):
+                raise self.error(f"the number {float(np.abs(numbers).max()):g} is too large (a "
+                                 f"URDF's numbers are SI and below {MAX_URDF_NUMBER:g} in size)",
+                                 f"{where}.{name}")
 
     def _check_tree(self) -> tuple[str, dict[str, list]]:
         parent_of: dict[str, object] = {}

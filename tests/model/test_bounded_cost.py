@@ -108,3 +108,33 @@ def test_a_chain_too_long_to_derive_is_refused_where_it_passes_the_limit():
         joint = {"type": "prismatic", "axis": "x", "distance": f"s{i}"}
         b.add_rigid_body(f"slider{i}", 1.0, [0.1, 0.1, 0.1], parent=parent, joint=joint)
         parent = f"slider{i}"
+
+
+@pytest.mark.parametrize("edit", [
+    ('direction = [0, 0, -1]', 'direction = [1e-290, 0, -1]'),
+    ('axle = "y"', 'axle = [1e-290, 1, 0]'),
+])
+def test_a_tiny_component_of_gravity_or_an_axle_is_read_as_a_float_quickly(edit):
+    """Each made the exact unit vector cost 5-7 s (a square root of a 580-digit rational);
+    (1e-290, 0, -1) is (0, 0, -1) to double precision: the same equations."""
+    from lagrangian.model.examples import example_path
+
+    source = example_path("rolling_coin").read_text()
+    assert edit[0] in source
+    started = time.perf_counter()
+    system = lagrangian.System(parse_model(source.replace(*edit)))
+    eom = system.equations_of_motion()
+    assert time.perf_counter() - started < 3
+    reference = lagrangian.load("rolling_coin").equations_of_motion()
+    assert eom.mass_matrix == reference.mass_matrix
+    assert eom.forcing == reference.forcing
+
+
+def test_a_direction_of_small_exact_numbers_stays_exact():
+    """(3, 0, -4) is (3/5, 0, -4/5) exactly: printed equations keep their fractions."""
+    import sympy as sp
+
+    model = parse_model("[coordinates]\nx = {}\n[parameters]\ng = 9.81\n[gravity]\ng = \"g\"\n"
+                        "direction = [3, 0, -4]\n[[particles]]\nname = \"p\"\nmass = \"1\"\n"
+                        "position = [\"x\", 0, 0]\n")
+    assert model.gravity.direction == (sp.Rational(3, 5), 0, sp.Rational(-4, 5))

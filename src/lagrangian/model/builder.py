@@ -39,7 +39,7 @@ from .model import (
     multiplier_name,
     velocity_name,
 )
-from .rotations import RigidBody
+from .rotations import RigidBody, floated, unit_vector
 
 
 class ModelBuilder(RigidBodiesMixin, ConstraintsMixin):
@@ -164,6 +164,13 @@ class ModelBuilder(RigidBodiesMixin, ConstraintsMixin):
         vector = self.vector(direction, f"{field}.direction")
         for i, component in enumerate(vector):
             self._parameter_expression(component, f"{field}.direction[{i}]")
+        if not any(c.free_symbols for c in vector):
+            unit = unit_vector(vector)
+            if unit is None:
+                raise self._error("the direction is the zero vector", f"{field}.direction")
+            self._gravity = Gravity(magnitude, unit)
+            return self
+        vector = tuple(floated(c) for c in vector)
         squared = sp.Add(*(c**2 for c in vector))
         if squared.free_symbols:
             # sin(a)^2 + cos(a)^2 and the like: small, parameters only, so trigsimp is cheap.

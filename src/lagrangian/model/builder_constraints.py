@@ -3,11 +3,9 @@ knife-edge wheels (a mixin of builder.ModelBuilder, sharing its declarations).""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Self
 
-import numpy as np
 import sympy as sp
 
 from ..errors import did_you_mean
@@ -25,9 +23,7 @@ from .model import (
     Constraint,
     Vector,
 )
-from .rotations import (
-    apply,
-)
+from .rotations import apply, unit_vector
 
 # A rolling contact's velocity coefficients are trigsimp'd only below this op count (cheap).
 TIDY_LIMIT = 40
@@ -165,17 +161,7 @@ class ConstraintsMixin:
         vector = self.vector(normal, field)
         if any(c.free_symbols for c in vector):
             raise self._error("the ground normal must be numbers", field)
-        small = all(c.is_Rational and abs(c.p) < 10**6 and c.q < 10**6 for c in vector)
-        if small:  # (0, 0, 1), (3, 0, 4): exact, and the printed equations stay exact
-            squared = sp.Add(*(c**2 for c in vector))
-            if squared == 0:
-                raise self._error("the ground normal is the zero vector", field)
-            return tuple(c / sp.sqrt(squared) for c in vector)
-        # other numbers as floats: an exact 1e-290 made the unit normal cost half a minute
-        numbers = np.array([float(c) for c in vector])
-        length = float(np.linalg.norm(numbers))
-        if not math.isfinite(length) or length == 0:
+        unit = unit_vector(vector)
+        if unit is None:
             raise self._error("the ground normal is the zero vector or not finite", field)
-        unit = numbers / length
-        return tuple(sp.Integer(round(c)) if abs(c - round(c)) < 1e-15 else sp.Float(c)
-                     for c in unit)
+        return unit

@@ -36,6 +36,9 @@ JOINT_KEYS = {
     "spherical": ({"type", "rotation"}, {"at"}),
     "fixed": ({"type"}, {"at", "rotation"}),
 }
+# Exact numbers up to this size (numerator and denominator) stay exact in a unit vector; others
+# are taken as floats: the exact length of (1e-290, 0, -1) cost 5-30 s of factoring.
+SMALL_EXACT = 10**6
 _IDENTITY: Matrix3 = (AXES["x"], AXES["y"], AXES["z"])
 _ZERO: Vector = (sp.S.Zero, sp.S.Zero, sp.S.Zero)
 
@@ -127,6 +130,30 @@ def axis_rotation(axis: Vector, angle: sp.Expr) -> Matrix3:
             (z * x * v - y * s, z * y * v + x * s, c + z * z * v))
 
 
+def floated(expr: sp.Expr) -> sp.Expr:
+    """``expr`` with each exact number that is not small (numerator or denominator of
+    SMALL_EXACT or more) taken as a float."""
+    big = {r: sp.Float(r) for r in expr.atoms(sp.Rational)
+           if abs(r.p) >= SMALL_EXACT or r.q >= SMALL_EXACT}
+    return expr.xreplace(big) if big else expr
+
+
+def unit_vector(vector: Vector) -> Vector | None:
+    """A vector of numbers over its length; None where it has none (zero, or not finite).
+    Small exact numbers stay exact ((3, 0, 4) -> (3/5, 0, 4/5)); others are taken as floats, a
+    component within round-off of an integer made that integer."""
+    if all(floated(c) == c for c in vector):
+        squared = sp.Add(*(c**2 for c in vector))
+        return None if squared == 0 else tuple(c / sp.sqrt(squared) for c in vector)
+    numbers = [float(c) for c in vector]
+    length = math.hypot(*numbers)
+    if not math.isfinite(length) or length == 0:
+        return None
+    unit = [c / length for c in numbers]
+    return tuple(sp.Integer(round(c)) if abs(c - round(c)) < 1e-15 else sp.Float(c)
+                 for c in unit)
+
+
 @dataclass(frozen=True)
 class Frame:
     """A body frame on the way down a tree: origin (world), R (body -> world), omega (body)."""
@@ -192,6 +219,12 @@ class RotationReader:
             raise self.error(f"an axis is x, y or z (or -x, ...) or a 3-component vector, not "
                              f"{value!r}", field)
         vector = self.vector(value, field)
+        if not any(c.free_symbols for c in vector):
+            unit = unit_vector(vector)
+            if unit is None:
+                raise self.error("the axis has zero length", field)
+            return unit
+        vector = tuple(floated(c) for c in vector)
         squared = sp.Add(*(c**2 for c in vector))
         if squared.free_symbols:
             # parameters only (a steering axis tilted by an angle lambda): fixed in the parent

@@ -15,6 +15,7 @@ from .model import (
 from .rotations import (
     GROUND,
     MAX_CHAIN_ROTATIONS,
+    MAX_SEQUENCE_ROTATIONS,
     Frame,
     Moment,
     RigidBody,
@@ -84,9 +85,10 @@ class RigidBodiesMixin:
             if position is not None and center is not None:
                 raise self._error("'center' is measured from 'origin': give 'origin' with it, "
                                   "or 'position' alone", f"{field}.center")
-        rotations = self._rotations.get(parent, 0) if parent is not None else 0
-        rotations += _elementary_rotations(joint if joint is not None else {"rotation": rotation})
-        if rotations > MAX_CHAIN_ROTATIONS:
+        own = _elementary_rotations(joint if joint is not None else {"rotation": rotation})
+        rotations = own + (self._rotations.get(parent, 0) if parent is not None else 0)
+        # one sequence too long is said as such, by the reader, before any work
+        if rotations > MAX_CHAIN_ROTATIONS and own <= MAX_SEQUENCE_ROTATIONS:
             raise self._error(f"body '{name}' is {rotations} elementary rotations from the "
                               f"ground (at most {MAX_CHAIN_ROTATIONS}: a longer chain of rotating "
                               "bodies takes minutes to derive symbolically; a URDF robot uses the "

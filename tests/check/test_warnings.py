@@ -95,3 +95,39 @@ def test_the_python_api_says_the_same():
     pendulum = lagrangian.load("pendulum")
     assert pendulum.warnings() == []
     assert pendulum.warnings(set_parameters={"m": 2.0}) == []
+
+
+@pytest.mark.parametrize("command", [("dynamics", "pendulum", "--q", "30"),
+                                     ("dynamics", "cart_pendulum", "--q", "0.1,30", "--json")])
+def test_a_bare_angle_in_a_list_of_coordinates(cli, command):
+    """--q lists the coordinates in order: the angle is named (cart_pendulum: x, theta)."""
+    result = cli(*command)
+    assert result.code == 0, result.err
+    assert warnings_of(result) == ["--q theta=30 is read as 30 rad (1718.87 deg); write 30deg "
+                                   "for degrees"]
+    assert cli("dynamics", "cart_pendulum", "--q", "30,30deg").err == ""  # x = 30 m is a length
+
+
+INCLINE = """
+[coordinates]
+s = { unit = "m" }
+[parameters]
+m = { value = 1.0, unit = "kg" }
+a = { value = 9.81, unit = "m/s^2" }
+alpha = { value = 0.3, unit = "rad" }
+c = { value = 0.1, unit = "N*s" }
+Omega = { value = 5.0, unit = "rad/s" }
+[energy]
+T = "m*s_dot^2/2"
+V = "m*a*sin(alpha)*s + c*Omega*s"
+"""
+
+
+def test_a_bare_angle_parameter_beyond_a_turn(cli, tmp_path):
+    path = tmp_path / "incline.toml"
+    path.write_text(INCLINE)
+    result = cli("derive", str(path), "--set", "alpha=30,Omega=30")  # a rate is no angle
+    assert result.code == 0, result.err
+    assert warnings_of(result) == ["--set alpha=30 is read as 30 rad (1718.87 deg); write 30deg "
+                                   "for degrees"]
+    assert cli("derive", str(path), "--set", "alpha=30deg").err == ""

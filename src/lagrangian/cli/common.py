@@ -101,26 +101,37 @@ def flush_warnings() -> None:
 def parameter_values(system: System, settings: Iterable[str]) -> dict[str, float | str]:
     """Read --set NAME=VALUE[unit] options in SI units (names are judged by the library)."""
     units = {p.name: p.unit for p in system.model.parameters}
-    return quantities(assignments(comma_separated(settings), "--set"), units, "--set")
+    pairs = assignments(comma_separated(settings), "--set")
+    values = quantities(pairs, units, "--set")
+    warn_bare_angles("--set", pairs, units, values)  # an incline angle of 30
+    return values
 
 
 def state_assignments(system: System, settings: Iterable[str], option: str
                       ) -> dict[str, float | str]:
     """Read NAME=VALUE[unit] options for coordinates (e.g. 30deg), velocities and t, in SI
     units (names are judged by the library)."""
-    from ..model.units import is_angle_unit
     from ..model.values import state_units
 
     pairs = assignments(comma_separated(settings), option)
     units = state_units(system.model)
     values = quantities(pairs, units, option)
-    for name, text in pairs:  # a bare number is read in the unit of its name: rad for an angle
+    warn_bare_angles(option, pairs, units, values)
+    return values
+
+
+def warn_bare_angles(option: str, pairs: Iterable[tuple[str, str]],
+                     units: Mapping[str, str | None], values: Mapping[str, object]) -> None:
+    """A warning for each angle written as a bare number beyond a turn: read as radians, and
+    30 was probably meant in degrees."""
+    from ..model.units import is_angle_unit
+
+    for name, text in pairs:
         value = values.get(name)
         if is_angle_unit(units.get(name)) and _BARE_NUMBER.fullmatch(text) and \
                 isinstance(value, float) and abs(value) > 2 * math.pi:
             warn(f"{option} {name}={text} is read as {text} rad ({math.degrees(value):.6g} deg); "
                  f"write {text}deg for degrees")
-    return values
 
 
 _BARE_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")

@@ -10,7 +10,7 @@ import typer
 from ..errors import ModelError
 from ..model.units import parse_quantity
 from . import app
-from .common import load_system, print_json
+from .common import load_system, print_json, warn_bare_angles
 
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
 
@@ -46,6 +46,13 @@ def dynamics(
     coordinates = system.model.coordinates
     n = len(coordinates)
     qs = _vector(q, n, "--q", [c.initial or 0.0 for c in coordinates])
+    if q is not None:  # --q 30,0 means 30 rad for an angle
+        from ..model.values import state_units
+
+        names = [c.name for c in coordinates]
+        texts = [part.strip() for part in q.split(",")]
+        warn_bare_angles("--q", zip(names, texts, strict=True), state_units(system.model),
+                         dict(zip(names, qs, strict=True)))
     vs = _vector(v, n, "--v", [c.rate or 0.0 for c in coordinates])
     f = system.dynamics()
     values = {"q": qs, "v": vs, "mass_matrix": f.mass_matrix(qs),

@@ -91,3 +91,16 @@ def test_bad_urdf_file_exits_2(cli, tmp_path):
     bad.write_text("<robot name='x'><link name='a'>")
     code, _, err = cli("derive", str(bad))
     assert code == 2 and "bad.urdf" in err and "not well-formed XML" in err
+
+
+@pytest.mark.parametrize("args, what", [
+    (("--set", "m=1e299,L=1e299"), "mass matrix"),   # m L^2 = 1e897
+    (("--v", "1e200"), "kinetic energy"),             # m L^2 v^2 / 2
+])
+@pytest.mark.parametrize("json_", [False, True])
+def test_a_value_beyond_floating_point_is_refused_not_printed(cli, args, what, json_):
+    """inf is no mass matrix: one line, never `inf` printed nor a JSON traceback."""
+    result = cli("dynamics", "pendulum", *args, *(("--json",) if json_ else ()))
+    assert result.code == 2 and result.out == ""
+    assert result.err.count("\n") == 1 and result.err.startswith("error: ")
+    assert what in result.err and "not finite" in result.err

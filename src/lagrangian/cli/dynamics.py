@@ -5,9 +5,10 @@ from __future__ import annotations
 
 from typing import Annotated
 
+import numpy as np
 import typer
 
-from ..errors import ModelError
+from ..errors import DerivationError, ModelError
 from ..model.units import parse_quantity
 from . import app
 from .common import load_system, print_json, warn_bare_angles
@@ -55,16 +56,22 @@ def dynamics(
                          dict(zip(names, qs, strict=True)))
     vs = _vector(v, n, "--v", [c.rate or 0.0 for c in coordinates])
     f = system.dynamics()
-    values = {"q": qs, "v": vs, "mass_matrix": f.mass_matrix(qs),
-              "bias_forces": f.bias_forces(qs, vs), "gravity": f.gravity(qs)}
-    if a is not None:
-        values["a"] = _vector(a, n, "--a", [])
-        values["inverse_dynamics"] = f.inverse_dynamics(qs, vs, values["a"])
-    if tau is not None:
-        values["tau"] = _vector(tau, n, "--tau", [])
-        values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"])
-    values["kinetic_energy"] = f.kinetic_energy(qs, vs)
-    values["potential_energy"] = f.potential_energy(qs)
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below
+        values = {"q": qs, "v": vs, "mass_matrix": f.mass_matrix(qs),
+                  "bias_forces": f.bias_forces(qs, vs), "gravity": f.gravity(qs)}
+        if a is not None:
+            values["a"] = _vector(a, n, "--a", [])
+            values["inverse_dynamics"] = f.inverse_dynamics(qs, vs, values["a"])
+        if tau is not None:
+            values["tau"] = _vector(tau, n, "--tau", [])
+            values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"])
+        values["kinetic_energy"] = f.kinetic_energy(qs, vs)
+        values["potential_energy"] = f.potential_energy(qs)
+    for key, value in values.items():  # an overflow is no result (m L^2 of 1e299 each)
+        if not np.all(np.isfinite(np.asarray(value, dtype=float))):
+            raise DerivationError(f"the {key.replace('_', ' ')} is not finite at this state "
+                                  "(a number beyond floating point, or a state outside the "
+                                  "model's domain)")
     names = [c.name for c in coordinates]
     if json_:
         print_json(dynamics_document(names, values))

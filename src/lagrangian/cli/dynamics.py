@@ -5,7 +5,6 @@ from __future__ import annotations
 
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from ..errors import DerivationError, ModelError
@@ -38,6 +37,8 @@ def dynamics(
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Mass matrix, bias forces C q_dot + g, gravity, inverse or forward dynamics, energies."""
+    import numpy as np  # here, not at the top: --help loads no numpy (tests/cli/test_startup.py)
+
     from ..output.dynamics import dynamics_document, dynamics_text
 
     if a is not None and tau is not None:

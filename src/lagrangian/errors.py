@@ -48,5 +48,16 @@ class ModelError(LagrangianError):
         text = f"{where}: {self.message}" if where else self.message
         return text.translate(_ONE_LINE)  # a TOML key or value may hold a newline
 
+
+class InputError(ModelError):
+    """A bad argument (an option, a keyword, an output path), as opposed to a bad model file.
+
+    Names the argument in ``field`` (``--t-end``, ``samples``). It is a ModelError too, so code
+    that caught ModelError for bad arguments before keeps working."""
+
+    def __init__(self, message: str, *, field: str | None = None):
+        super().__init__(message, field=field)
+
+
 class DerivationError(LagrangianError):
     """The model is well formed but its equations cannot be formed (singular mass matrix, ...)."""

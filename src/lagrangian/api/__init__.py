@@ -18,7 +18,7 @@ from ..compile.functions import NumericSystem
 from ..derivation.equations import EquationsOfMotion, LoadContribution
 from ..dynamics.joint_space import Dynamics
 from ..dynamics.standalone import StandaloneSource
-from ..errors import DerivationError, LagrangianError, ModelError
+from ..errors import DerivationError, InputError, LagrangianError, ModelError
 from ..kinds import Backend, ConstraintKind, InvariantKind, JointKind, RunStatus
 from ..model.answer import Answer
 from ..model.examples import example_names as examples
@@ -84,5 +84,6 @@ __all__ = [
     "CompilerMissing",
     "DerivationError",
     "LagrangianError",
+    "InputError",
     "ModelError",
 ]

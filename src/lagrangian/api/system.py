@@ -37,7 +37,7 @@ from ..derivation.lagrange import derive
 from ..derivation.regularity import require_inertia
 from ..dynamics.joint_space import model_dynamics, recursive_dynamics
 from ..dynamics.standalone import StandaloneSource
-from ..errors import LagrangianError, ModelError, did_you_mean
+from ..errors import InputError, LagrangianError, did_you_mean
 from ..model.answer import Answer, answer_from_mapping, read_answer
 from ..model.builder import ModelBuilder
 from ..model.examples import example_path
@@ -173,23 +173,23 @@ class System:
         from ..dynamics.standalone import c_prefix, standalone_for
 
         if prefix is not None and c_prefix(prefix) != prefix:
-            raise ModelError(f"{prefix!r} is not a C identifier (lower-case ASCII letters, digits "
+            raise InputError(f"{prefix!r} is not a C identifier (lower-case ASCII letters, digits "
                              "and _, a letter first, at most 40)", field="prefix")
         values = dict(self.parameters)
         for name, value in dict(parameters or {}).items():
             if name not in values:
-                raise ModelError(f"'{name}' is not a parameter of this model"
+                raise InputError(f"'{name}' is not a parameter of this model"
                                  f"{did_you_mean(name, values)}", field="parameters")
             values[name] = float(value)
         missing = [k for k, v in values.items() if v is None]
         if missing:
-            raise ModelError(f"parameters without a value: {', '.join(missing)} (give them with "
+            raise InputError(f"parameters without a value: {', '.join(missing)} (give them with "
                              "parameters=...)", field="parameters")
         system = self if not parameters else self.with_parameters(**dict(parameters))
         try:
             return standalone_for(system.model, system.equations_of_motion, values, prefix)
         except CodegenError as exc:
-            raise ModelError(f"cannot write C: {exc}", field="lang") from None
+            raise InputError(f"cannot write C: {exc}", field="lang") from None
 
     # -- compiled numeric functions -------------------------------------------------------------
 
@@ -355,7 +355,6 @@ class System:
         condition or a StopCondition) set each member's simulation, as in System.simulate.
         """
         from ..analysis.study import SimulationOptions, make_study
-        from ..errors import ModelError
         from ..study.engine import run_study
 
         eom = self.equations_of_motion()
@@ -363,7 +362,7 @@ class System:
         options = None
         if compute == "simulate":
             if t_end is None:
-                raise ModelError("a simulation study needs t_end (s)", field="t_end")
+                raise InputError("a simulation study needs t_end (s)", field="t_end")
             step, save = _options(step_control, save_at, method, rtol, atol, samples, 201)
             if isinstance(stop_when, StopCondition):
                 stop_when = stop_when.text
@@ -437,19 +436,19 @@ def _options(step_control: StepControl | None, save_at: SaveAt | None, method: s
     plain = {"method": (method, "DOP853"), "rtol": (rtol, 1e-9), "atol": (atol, 1e-9)}
     if step_control is not None:
         if not isinstance(step_control, StepControl):
-            raise ModelError("step_control must be a lagrangian.StepControl",
+            raise InputError("step_control must be a lagrangian.StepControl",
                              field="step_control")
         both = [k for k, (value, default) in plain.items() if value != default]
         if both:
-            raise ModelError(f"give {', '.join(both)} in step_control or as a keyword, not both",
+            raise InputError(f"give {', '.join(both)} in step_control or as a keyword, not both",
                              field="step_control")
     else:
         step_control = StepControl(method, rtol, atol)
     if save_at is not None:
         if not isinstance(save_at, SaveAt):
-            raise ModelError("save_at must be a lagrangian.SaveAt", field="save_at")
+            raise InputError("save_at must be a lagrangian.SaveAt", field="save_at")
         if samples != samples_default:
-            raise ModelError("give samples in save_at or as a keyword, not both",
+            raise InputError("give samples in save_at or as a keyword, not both",
                              field="save_at")
     else:
         save_at = SaveAt(samples)
@@ -483,9 +482,8 @@ def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None
     if urdf is not None:
         return System(replace(read_urdf(urdf, lock), source=f"example:{path_or_example}"))
     if lock:
-        from ..errors import ModelError
 
-        raise ModelError("only a URDF model has joints to lock", field="lock")
+        raise InputError("only a URDF model has joints to lock", field="lock")
     if path.exists() or path.suffix == ".toml" or len(path.parts) > 1:
         return System(read_model(path))
     model = read_model(example_path(str(path_or_example)))

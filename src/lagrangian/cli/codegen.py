@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from ..errors import ModelError
+from ..errors import InputError, ModelError
 from ..output.files import write_c
 from . import app
 from .common import load_system
@@ -27,19 +27,19 @@ def codegen(
     """Write M(q), bias C q_dot + g, gravity, inverse and forward dynamics and the energies as
     standalone C (no Python, no allocation, libm only) for embedding in a controller."""
     if lang.lower() not in LANGUAGES:
-        raise ModelError(f"unknown language {lang!r}: use c", field="--lang")
+        raise InputError(f"unknown language {lang!r}: use c", field="--lang")
     directory = Path(out)
     if directory.exists() and not directory.is_dir():
-        raise ModelError("exists and is not a directory", field=f"--out {out}")
+        raise InputError("exists and is not a directory", field=f"--out {out}")
     system = load_system(model, set_, lock)
     if any(v is None for v in system.parameters.values()):
         missing = [k for k, v in system.parameters.items() if v is None]
-        raise ModelError(f"parameters without a value: {', '.join(missing)} (give them with --set)",
+        raise InputError(f"parameters without a value: {', '.join(missing)} (give them with --set)",
                          field="--set")
     try:
         code = system.to_c(name)
     except ModelError as exc:
-        raise ModelError(exc.message, field={"prefix": "--name", "lang": "--lang"}.get(
+        raise InputError(exc.message, field={"prefix": "--name", "lang": "--lang"}.get(
             exc.field or "", exc.field)) from None
     for path in write_c(code, directory):
         typer.echo(f"wrote {path}")

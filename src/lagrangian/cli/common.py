@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from ..errors import LagrangianError, ModelError
+from ..errors import InputError, LagrangianError, ModelError
 
 if TYPE_CHECKING:
     from ..api.system import System
@@ -162,7 +162,7 @@ def assignments(settings: Iterable[str], option: str) -> list[tuple[str, str]]:
     for setting in settings:
         name, sep, value = setting.partition("=")
         if not sep or not name.strip() or not value.strip():
-            raise ModelError(f"expected NAME=VALUE, got {setting!r}", field=option)
+            raise InputError(f"expected NAME=VALUE, got {setting!r}", field=option)
         pairs.append((name.strip(), value.strip()))
     return pairs
 

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from ..errors import ModelError
+from ..errors import InputError
 from . import app
 from .common import LOCK_HELP, SET_HELP, load_system, print_json, warn_if_unphysical
 
@@ -32,7 +32,7 @@ def derive(
     eom = load_system(model, set_, lock).equations_of_motion()
     warn_if_unphysical(eom)
     if json_ and format is Format.latex:
-        raise ModelError("--json and --format latex ask for two formats; give one", field="--format")
+        raise InputError("--json and --format latex ask for two formats; give one", field="--format")
     if json_ or format is Format.json:
         print_json(derivation_document(eom))
     elif format is Format.latex:

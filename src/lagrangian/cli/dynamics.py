@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from ..errors import DerivationError, ModelError
+from ..errors import DerivationError, InputError
 from ..model.units import parse_quantity
 from . import app
 from .common import load_system, print_json, warn_bare_angles
@@ -21,7 +21,7 @@ def _vector(text: str | None, n: int, flag: str, default: list[float]) -> list[f
         return default
     parts = [p.strip() for p in text.split(",")]
     if len(parts) != n:
-        raise ModelError(f"expected {n} comma-separated values, got {len(parts)}", field=flag)
+        raise InputError(f"expected {n} comma-separated values, got {len(parts)}", field=flag)
     return [parse_quantity(p, None, flag) for p in parts]
 
 
@@ -42,7 +42,7 @@ def dynamics(
     from ..output.dynamics import dynamics_document, dynamics_text
 
     if a is not None and tau is not None:
-        raise ModelError("--a (inverse dynamics) and --tau (forward dynamics) ask for two "
+        raise InputError("--a (inverse dynamics) and --tau (forward dynamics) ask for two "
                          "things; give one")
     system = load_system(model, set_, lock)
     coordinates = system.model.coordinates

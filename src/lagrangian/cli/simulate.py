@@ -33,7 +33,7 @@ def simulate(
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
-    from ..errors import ModelError
+    from ..errors import InputError
     from ..model.units import parse_quantity
     from ..model.values import resolve_state
     from ..output.animation import check_animatable, check_animation_path, check_view
@@ -62,7 +62,7 @@ def simulate(
     if view is not None:
         check_view(view)
         if animate is None:
-            raise ModelError("a viewpoint is only used with --animate", field="view")
+            raise InputError("a viewpoint is only used with --animate", field="view")
     inputs = (Path(model),) if Path(model).exists() else ()
     for path, field in ((out, "table"), (plot, "plot"), (animate, "animation")):
         if path is not None:  # writable, not a directory, not the model: before the run

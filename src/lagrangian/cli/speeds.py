@@ -8,6 +8,7 @@ from typing import Annotated
 
 import typer
 
+from ..errors import InputError
 from . import app
 from .common import LOCK_HELP, SET_HELP, assignments, comma_separated, load_system, print_json
 
@@ -49,7 +50,7 @@ def speeds(
 ) -> None:
     """M q'' + v C1 q' + (g K0 + v^2 K2) q = f about steady motion, and a speed sweep with the
     speeds where the eigenvalues' real parts cross zero (weave, capsize)."""
-    from ..errors import ModelError
+    from ..errors import InputError
     from ..output.files import check_output_path
     from ..output.plots import check_plot_path
     from ..output.speed_form import (
@@ -66,7 +67,7 @@ def speeds(
     if plot is not None:
         check_output_path(check_plot_path(plot), "plot", inputs=inputs)
     if not (points >= 2 and highest > lowest):
-        raise ModelError("the sweep needs --to above --from and --points of at least 2",
+        raise InputError("the sweep needs --to above --from and --points of at least 2",
                          field="--points")
     point = state_assignments(system, about, "--about")
     kept = [name.strip() for setting in keep for name in setting.split(",") if name.strip()]
@@ -95,7 +96,6 @@ def speeds(
 
 def _chosen_speeds(system, form, settings: list[str]) -> list[float]:
     """--at SPEED=V1,V2,...: the speeds (m/s) to evaluate, named by the speed parameter."""
-    from ..errors import ModelError
     from ..model.units import parse_quantity
 
     unit = next((p.unit for p in system.model.parameters if p.name == form.speed), None)
@@ -103,12 +103,12 @@ def _chosen_speeds(system, form, settings: list[str]) -> list[float]:
     for setting in settings:
         name, sep, text = setting.partition("=")
         if not sep or not text.strip():
-            raise ModelError(f"expected {form.speed}=V1,V2,..., got {setting!r}", field="--at")
+            raise InputError(f"expected {form.speed}=V1,V2,..., got {setting!r}", field="--at")
         if name.strip() != form.speed:
-            raise ModelError(f"'{name.strip()}' is not the speed parameter; write "
+            raise InputError(f"'{name.strip()}' is not the speed parameter; write "
                              f"{form.speed}=V1,V2,...", field="--at")
         for item in text.split(","):
             if not item.strip():
-                raise ModelError(f"an empty value in {text!r}", field="--at")
+                raise InputError(f"an empty value in {text!r}", field="--at")
             speeds.append(parse_quantity(item.strip(), unit, f"--at {form.speed}"))
     return speeds

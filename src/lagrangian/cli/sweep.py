@@ -11,7 +11,7 @@ from typing import Annotated
 
 import typer
 
-from ..errors import LagrangianError, ModelError
+from ..errors import InputError, LagrangianError, ModelError
 from . import app
 from .common import (
     LOCK_HELP,
@@ -68,7 +68,7 @@ def sweep(
         typer.echo("warning: --samples of a sweep is now --members (the ensemble's size); "
                    "--samples will be removed", err=True)
         if members and members != samples:
-            raise ModelError("give the ensemble's size once, as --members", field="--members")
+            raise InputError("give the ensemble's size once, as --members", field="--members")
         members = samples
     try:
         _run(model, vary, compute, out, plot, json_, set_, sample, members, seed, t_end,
@@ -97,17 +97,17 @@ def _run(model, vary, compute, out, plot, json_, set_, sample, members, seed, t_
     if out is not None:
         check_study_path(out)
     elif resume:
-        raise ModelError("--resume continues the study written to --out; give --out", field="resume")
+        raise InputError("--resume continues the study written to --out; give --out", field="resume")
     if plot is not None:
         check_study_plot_path(plot)
     if workers is not None and workers < 1:
-        raise ModelError("at least one worker", field="workers")
+        raise InputError("at least one worker", field="workers")
     if chunk_size is not None and chunk_size < 1:
-        raise ModelError("at least one point per chunk", field="chunk_size")
+        raise InputError("at least one point per chunk", field="chunk_size")
     inputs = (Path(model),) if Path(model).exists() else ()
     for path in (out, plot):
         if path is not None and inputs and path.resolve() == inputs[0].resolve():
-            raise ModelError(f"{path}: refusing to overwrite the model file", field="out")
+            raise InputError(f"{path}: refusing to overwrite the model file", field="out")
 
     with _Progress() as progress:
         try:
@@ -154,22 +154,22 @@ def grid_values(text: str, unit: str | None, field: str) -> list[float]:
     if ":" in text:
         parts = text.split(":")
         if len(parts) != 3 or not all(p.strip() for p in parts):
-            raise ModelError(f"a range is START:STOP:COUNT, got {text!r}", field=field)
+            raise InputError(f"a range is START:STOP:COUNT, got {text!r}", field=field)
         if not _COUNT.match(parts[2]) or int(parts[2]) < 1:
-            raise ModelError(f"the COUNT of {text!r} must be a whole number of values, at least 1",
+            raise InputError(f"the COUNT of {text!r} must be a whole number of values, at least 1",
                              field=field)
         count = int(parts[2])
         from ..analysis.study import MAX_STUDY_POINTS
 
         if count > MAX_STUDY_POINTS:
-            raise ModelError(f"{count:,} values is more than a study holds (at most "
+            raise InputError(f"{count:,} values is more than a study holds (at most "
                              f"{MAX_STUDY_POINTS:,})", field=field)
         start = parse_quantity(parts[0].strip(), unit, field)
         stop = parse_quantity(parts[1].strip(), unit, field)
         return [float(v) for v in np.linspace(start, stop, count)]
     items = text.split(",")
     if not all(item.strip() for item in items):
-        raise ModelError(f"an empty value in {text!r}", field=field)
+        raise InputError(f"an empty value in {text!r}", field=field)
     return [parse_quantity(item.strip(), unit, field) for item in items]
 
 

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import InputError
 from ..model.model import Model
 from ..simulation.result import SimulationResult
 from .files import atomic_write
@@ -76,7 +76,7 @@ def animation_frames(result: SimulationResult, fps: int = 25, max_frames: int = 
 def check_animatable(model: Model) -> None:
     """Refuse a model with nothing to draw (given by its energies only)."""
     if not (model.particles or model.bodies or model.rigid_bodies):
-        raise ModelError("nothing to animate: the model has no particles or bodies "
+        raise InputError("nothing to animate: the model has no particles or bodies "
                          "(it is given by its energies only)", field="animation")
 
 
@@ -89,10 +89,10 @@ def check_view(view: object) -> tuple[float, float]:
     try:
         azimuth, elevation = (float(p) for p in parts)
     except (TypeError, ValueError):
-        raise ModelError(f"expected AZIMUTH,ELEVATION in degrees (e.g. 45,30), got {view!r}",
+        raise InputError(f"expected AZIMUTH,ELEVATION in degrees (e.g. 45,30), got {view!r}",
                          field="view") from None
     if not (np.isfinite(azimuth) and np.isfinite(elevation)) or abs(elevation) > 90:
-        raise ModelError(f"the azimuth must be finite and the elevation between -90 and 90 "
+        raise InputError(f"the azimuth must be finite and the elevation between -90 and 90 "
                          f"degrees, got {azimuth:g},{elevation:g}", field="view")
     return azimuth, elevation
 
@@ -631,5 +631,5 @@ def check_animation_path(path: str | Path) -> Path:
     """The path, if it names a .gif or .html file."""
     path = Path(path)
     if path.suffix.lower() not in ANIMATION_FORMATS:
-        raise ModelError(f"cannot write {path}: use a .gif or .html file name", field="animation")
+        raise InputError(f"cannot write {path}: use a .gif or .html file name", field="animation")
     return path

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import InputError
 from ..simulation.result import SimulationResult
 from .files import atomic_write
 from .simulation import INVARIANT_WORDS
@@ -102,5 +102,5 @@ def check_plot_path(path: str | Path) -> Path:
     """The path of a plot, refused unless it names a format we write (.png, .svg, .pdf)."""
     path = Path(path)
     if path.suffix.lower() not in PLOT_FORMATS:
-        raise ModelError(f"cannot write {path}: use a .png, .svg or .pdf file name", field="plot")
+        raise InputError(f"cannot write {path}: use a .png, .svg or .pdf file name", field="plot")
     return path

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.study import NOT_COMPUTED, OK, Study, layout
-from ..errors import ModelError
+from ..errors import InputError
 from .files import atomic_write
 from .plots import plain_text
 
@@ -61,13 +61,13 @@ def check_study_path(path: str | Path) -> Path:
     before any work: where something is already there it must be a study this project wrote."""
     path = Path(path)
     if path.suffix.lower() not in STUDY_FORMATS:
-        raise ModelError(f"a study is written as NetCDF (*.nc) or Zarr (*.zarr), not '{path}'",
+        raise InputError(f"a study is written as NetCDF (*.nc) or Zarr (*.zarr), not '{path}'",
                          field="out")
     if path.is_symlink():
-        raise ModelError(f"{path} is a symbolic link: refusing to replace it", field="out")
+        raise InputError(f"{path} is a symbolic link: refusing to replace it", field="out")
     if path.exists() and not is_study(path):
         what = "a directory" if path.is_dir() else "a file"
-        raise ModelError(f"{path} exists and is {what} that is not a study written by lagrangian: "
+        raise InputError(f"{path} exists and is {what} that is not a study written by lagrangian: "
                          "refusing to replace it (move it away or choose another output path)",
                          field="out")
     return path
@@ -105,7 +105,7 @@ def is_study(path: Path) -> bool:
 def check_study_plot_path(path: str | Path) -> Path:
     path = Path(path)
     if path.suffix.lower() != ".png":
-        raise ModelError(f"the plot is written as PNG; name the file *.png (got '{path}')",
+        raise InputError(f"the plot is written as PNG; name the file *.png (got '{path}')",
                          field="plot")
     return path
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import io
 from pathlib import Path
 
-from ..errors import ModelError
+from ..errors import InputError
 from ..simulation.result import SimulationResult
 from .files import atomic_write
 
@@ -34,7 +34,7 @@ def check_table_path(path: str | Path) -> Path:
     """The path of a table, refused unless it names a format we write (.csv, .parquet)."""
     path = Path(path)
     if path.suffix.lower() not in TABLE_FORMATS:
-        raise ModelError(f"cannot write {path}: use a .csv or .parquet file name", field="table")
+        raise InputError(f"cannot write {path}: use a .csv or .parquet file name", field="table")
     return path
 
 

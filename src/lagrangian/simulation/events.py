@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..errors import ModelError
+from ..errors import InputError
 from ..model.expressions import parse_expression
 from ..model.model import Model
 
@@ -35,23 +35,23 @@ class StopCondition:
 def parse_stop_condition(text: str, model: Model, *, field: str = "stop_when") -> StopCondition:
     """Parse 'EXPR < EXPR' (or >, <=, >=) with the model grammar; nothing is evaluated."""
     if not isinstance(text, str) or not text.strip():
-        raise ModelError("the stop condition is empty; write e.g. 'theta < 0'", field=field)
+        raise InputError("the stop condition is empty; write e.g. 'theta < 0'", field=field)
     operators = _COMPARISON.findall(text)
     if len(operators) != 1:
         what = "no comparison" if not operators else f"{len(operators)} comparisons"
-        raise ModelError(
+        raise InputError(
             f"a stop condition has exactly one comparison (<, >, <=, >=), found {what} "
             f"in {text!r}", field=field)
     operator = operators[0]
     if operator in ("==", "!="):
-        raise ModelError(f"'{operator}' is not allowed; use <, >, <= or >= (a crossing) "
+        raise InputError(f"'{operator}' is not allowed; use <, >, <= or >= (a crossing) "
                          f"in {text!r}", field=field)
     left, right = _COMPARISON.split(text)
     names = _condition_names(model)
     sides = []
     for side, part in (("left", left), ("right", right)):
         if not part.strip():
-            raise ModelError(f"the {side} side of {text!r} is empty", field=field)
+            raise InputError(f"the {side} side of {text!r} is empty", field=field)
         sides.append(parse_expression(part, names, field=field))
     return StopCondition(text.strip(), sides[0], operator, sides[1])
 

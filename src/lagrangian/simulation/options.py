@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..errors import ModelError
+from ..errors import InputError
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 MAX_SAMPLES = 10_000_000  # about 1 GB of results for a small model
@@ -30,13 +30,13 @@ class StepControl:
         if isinstance(self.method, str) and self.method.lower() in canonical:
             object.__setattr__(self, "method", canonical[self.method.lower()])
         if self.method not in METHODS:
-            raise ModelError(f"unknown method '{self.method}'; choose one of {', '.join(METHODS)}",
+            raise InputError(f"unknown method '{self.method}'; choose one of {', '.join(METHODS)}",
                              field="method")
         for name in ("rtol", "atol", "max_step"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int | float) or \
                     math.isnan(value) or value <= 0 or (name != "max_step" and math.isinf(value)):
-                raise ModelError(f"{name} must be a positive number, got {value}", field=name)
+                raise InputError(f"{name} must be a positive number, got {value}", field=name)
 
 
 @dataclass(frozen=True)
@@ -49,8 +49,8 @@ class SaveAt:
     def __post_init__(self):
         if isinstance(self.samples, bool) or not isinstance(self.samples, int) or \
                 self.samples < 2:
-            raise ModelError(f"samples must be at least 2, got {self.samples}", field="samples")
+            raise InputError(f"samples must be at least 2, got {self.samples}", field="samples")
         if self.samples > MAX_SAMPLES:
             # refused up front: each sample holds q, q_dot, energy, power, ... (1e12 was 7 TiB)
-            raise ModelError(f"samples must be at most {MAX_SAMPLES:,}, got {self.samples:,}",
+            raise InputError(f"samples must be at most {MAX_SAMPLES:,}, got {self.samples:,}",
                              field="samples")

@@ -20,7 +20,7 @@ import numpy as np
 from ..compile.functions import NumericSystem, numeric
 from ..compile.lambdified import StateFunction
 from ..derivation.equations import EquationsOfMotion
-from ..errors import ModelError
+from ..errors import InputError
 from ..kinds import InvariantKind, RunStatus
 from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state
@@ -62,7 +62,7 @@ def simulate(
     model = eom.model
     start = resolve_state(model, initial, field="initial", what="coordinate or velocity (or t)")
     if not (math.isfinite(t_end) and t_end > start.t):
-        raise ModelError(f"the end time ({t_end} s) must be after the start time ({start.t} s)",
+        raise InputError(f"the end time ({t_end} s) must be after the start time ({start.t} s)",
                          field="t_end")
     # Everything numeric is compiled here, once, before the loop.
     values = resolve_parameters(model, parameters)

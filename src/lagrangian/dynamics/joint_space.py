@@ -23,7 +23,7 @@ from collections.abc import Callable, Mapping
 import numpy as np
 
 from ..compile.functions import NumericSystem
-from ..errors import ModelError
+from ..errors import InputError, ModelError
 from ..model.model import Model
 
 
@@ -49,7 +49,7 @@ class Dynamics:
         array = np.asarray(value, dtype=float)
         if array.ndim == 0 or array.shape[-1] != self.n:
             shape = "()" if array.ndim == 0 else str(array.shape)
-            raise ModelError(f"expected {self.n} values ({', '.join(self.coordinates)}) along "
+            raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) along "
                              f"the last axis, got shape {shape}", field=field)
         return array
 

@@ -27,7 +27,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import InputError
 from ..model.model import Model
 from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters
@@ -130,7 +130,7 @@ class RecursiveDynamics(Dynamics):
                 arrays = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in arrays))
                 return function(*(np.ascontiguousarray(x) for x in arrays), self._P)
             field = str(exc).split(":")[0]
-            raise ModelError(f"expected {self.n} values ({', '.join(self.coordinates)}) "
+            raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) "
                              "along the last axis", field=field) from None
 
     def mass_matrix(self, q):

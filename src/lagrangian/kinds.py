@@ -8,10 +8,14 @@ from enum import StrEnum
 
 
 class JointKind(StrEnum):
-    """How a joint of a kinematic tree moves its body: about its axis or along it."""
+    """How a joint moves its body, in model files and URDF alike: about its axis (revolute),
+    along it (prismatic), by a rotation sequence (spherical) or not at all (fixed). A kinematic
+    tree moves its bodies by the one-degree-of-freedom kinds (dynamics/joint_models.py)."""
 
     REVOLUTE = "revolute"
     PRISMATIC = "prismatic"
+    SPHERICAL = "spherical"
+    FIXED = "fixed"
 
 
 class ConstraintKind(StrEnum):

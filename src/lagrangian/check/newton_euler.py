@@ -31,6 +31,7 @@ its length only still enters the virtual work, but then no reactions are reporte
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import singledispatchmethod
 
 import numpy as np
 import sympy as sp
@@ -347,33 +348,45 @@ class _AppliedForces:
             self.project(weight, fb.position)
 
     def add_loads(self) -> None:
-        """Point forces (N) and torques (N m) on the body they act on."""
+        """Point forces (N), moments and torques (N m) on the body they act on."""
         for load in self.model.loads:
-            if isinstance(load, PointForce):
-                self.project(load.force, load.point)
-                holder = _holder(load.point, self.bodies, self.model, self.points)
-                if holder is None:
-                    self.unattributed.append(load.name)
-                    continue
-                self.place(load.force, load.point, holder)
-            elif isinstance(load, Moment):
-                holder = next(fb for fb in self.bodies if fb.name == load.body)
-                world = list(holder.rotation * sp.Matrix(load.moment)) \
-                    if load.axes == "body" else list(load.moment)
-                omega = list(holder.rotation * sp.Matrix(holder.omega))  # world axes
-                for i, c in enumerate(self.model.coordinates):
-                    self.work[i].append(sp.Add(*(m * w.diff(c.velocity)
-                                                 for m, w in zip(world, omega, strict=True))))
-                holder.moment3 = [a + b for a, b in zip(holder.moment3, world, strict=True)]
-            elif isinstance(load, Torque):
-                for i, qi in enumerate(self.model.q):
-                    self.work[i].append(load.torque * load.angle.diff(qi))
-                holder = next((fb for fb in self.bodies if fb.angle is not None
-                               and eq.identical(fb.angle, load.angle, self.points)), None)
-                if holder is None:
-                    self.unattributed.append(load.name)
-                    continue
-                holder.moment += load.torque
+            self.add_load(load)
+
+    # one entry per load kind (tests/model/test_component_tables.py walks every kind)
+    @singledispatchmethod
+    def add_load(self, load) -> None:
+        raise TypeError(f"no free-body force for a load of kind {type(load).__name__}")
+
+    @add_load.register
+    def _(self, load: PointForce) -> None:
+        self.project(load.force, load.point)
+        holder = _holder(load.point, self.bodies, self.model, self.points)
+        if holder is None:
+            self.unattributed.append(load.name)
+            return
+        self.place(load.force, load.point, holder)
+
+    @add_load.register
+    def _(self, load: Moment) -> None:
+        holder = next(fb for fb in self.bodies if fb.name == load.body)
+        world = list(holder.rotation * sp.Matrix(load.moment)) \
+            if load.axes == "body" else list(load.moment)
+        omega = list(holder.rotation * sp.Matrix(holder.omega))  # world axes
+        for i, c in enumerate(self.model.coordinates):
+            self.work[i].append(sp.Add(*(m * w.diff(c.velocity)
+                                         for m, w in zip(world, omega, strict=True))))
+        holder.moment3 = [a + b for a, b in zip(holder.moment3, world, strict=True)]
+
+    @add_load.register
+    def _(self, load: Torque) -> None:
+        for i, qi in enumerate(self.model.q):
+            self.work[i].append(load.torque * load.angle.diff(qi))
+        holder = next((fb for fb in self.bodies if fb.angle is not None
+                       and eq.identical(fb.angle, load.angle, self.points)), None)
+        if holder is None:
+            self.unattributed.append(load.name)
+            return
+        holder.moment += load.torque
 
     def add_springs(self) -> None:
         """Tension k (l - l0) (N) along each spring, on the ends it joins."""

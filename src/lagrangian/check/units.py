@@ -10,11 +10,12 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import singledispatch
 
 import sympy as sp
 
 from ..model.expressions import format_expression
-from ..model.model import Model, PointForce, multiplier_name
+from ..model.model import Model, PointForce, Torque, multiplier_name
 from ..model.rotations import Moment
 from ..model.units import generalized_force_unit, is_angle_unit, registry
 
@@ -272,18 +273,8 @@ def check_model_units(model: Model) -> UnitsReport:
         c(f"{where}.dissipation", sp.Rational(1, 2) * damper.coefficient * damper.rate**2,
           POWER, "a power")
     for load in model.loads:
-        where = f"loads[{load.name}]"
-        if isinstance(load, PointForce):
-            for axis, component in zip("xyz", load.point, strict=True):
-                c(f"{where}.point.{axis}", component, "m", "a length")
-            for axis, component in zip("xyz", load.force, strict=True):
-                c(f"{where}.force.{axis}", component, "N", "a force")
-        elif isinstance(load, Moment):
-            for axis, component in zip("xyz", load.moment, strict=True):
-                c(f"{where}.moment.{axis}", component, "N*m", "a moment")
-        else:
-            c(f"{where}.torque", load.torque, "N*m", "a torque")
-            c(f"{where}.angle", load.angle, "", "an angle")
+        for item in load_unit_items(load, f"loads[{load.name}]"):
+            c(*item)
     for name, value in model.generalized_forces:
         coordinate = model.coordinate(name)
         c(f"Q[{name}]", value, generalized_force_unit(coordinate.unit),
@@ -292,6 +283,33 @@ def check_model_units(model: Model) -> UnitsReport:
         c(f"constraints[{constraint.name}]", constraint.expression, None)
     unchecked = tuple(p.name for p in model.parameters if p.unit is None)
     return UnitsReport(model.name, _unique(checker.issues), unchecked)
+
+
+@singledispatch
+def load_unit_items(load, where: str) -> list[tuple]:
+    """(field, expression, expected SI unit, what it is) for each part of one applied load:
+    one table entry per load kind (tests/model/test_component_tables.py walks every kind)."""
+    raise TypeError(f"no units for a load of kind {type(load).__name__}")
+
+
+@load_unit_items.register
+def _(load: PointForce, where: str) -> list[tuple]:
+    return [*((f"{where}.point.{axis}", r, "m", "a length")
+              for axis, r in zip("xyz", load.point, strict=True)),
+            *((f"{where}.force.{axis}", f, "N", "a force")
+              for axis, f in zip("xyz", load.force, strict=True))]
+
+
+@load_unit_items.register
+def _(load: Moment, where: str) -> list[tuple]:
+    return [(f"{where}.moment.{axis}", m, "N*m", "a moment")
+            for axis, m in zip("xyz", load.moment, strict=True)]
+
+
+@load_unit_items.register
+def _(load: Torque, where: str) -> list[tuple]:
+    return [(f"{where}.torque", load.torque, "N*m", "a torque"),
+            (f"{where}.angle", load.angle, "", "an angle")]
 
 
 def answer_unit_issues(model: Model, items: list[tuple[str, sp.Expr, str | None, str]],

@@ -19,6 +19,8 @@ import sympy as sp
 from ..model.model import Model, multiplier_name
 from .body_jacobians import jacobian_equations, takes_jacobian_form
 from .constraints import constraint_terms
+from .energies import dissipation_terms as component_dissipation
+from .energies import potential_terms as component_potential
 from .equations import EquationsOfMotion
 from .kinematics import Differentiator
 from .regularity import check_regularity
@@ -217,19 +219,10 @@ def derive(model: Model, *, check: bool = True,
             if entry != 0:
                 acc.add_force(i, entry)
 
-    if gravity is not None:
-        g, direction = gravity.magnitude, gravity.direction
-        for item in (*model.particles, *model.bodies, *model.rigid_bodies):
-            height = sp.Add(*(d * r for d, r in zip(direction, item.position, strict=True)
-                              if d != 0))
-            potential_terms.append(-item.mass * g * height)
-    spring_terms = [
-        sp.Rational(1, 2) * spring.stiffness * (spring.length - spring.rest_length) ** 2
-        for spring in model.springs
-    ]
-    potential_terms.extend(spring_terms)
-    for damper in model.dampers:
-        dissipation_terms.append(sp.Rational(1, 2) * damper.coefficient * damper.rate**2)
+    for item in (*model.particles, *model.bodies, *model.rigid_bodies, *model.springs,
+                 *model.dampers):
+        potential_terms.extend(component_potential(item, gravity))
+        dissipation_terms.extend(component_dissipation(item))
 
     # The user's T and V go through the general Euler-Lagrange formula.
     user_lagrangian = model.kinetic_energy - model.potential_energy

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from functools import singledispatch
+
 import sympy as sp
 
 from ..model.model import Damper, Model, PointForce, Torque
@@ -26,12 +28,7 @@ def load_contributions(model: Model) -> list[LoadContribution]:
                 contributions.append(LoadContribution(load, name, value))
 
     for load in model.loads:
-        if isinstance(load, PointForce):
-            add(load.name, point_force_projection(load, q))
-        elif isinstance(load, Torque):
-            add(load.name, [load.torque * d for d in jacobian_row(load.angle, q)])
-        elif isinstance(load, Moment):
-            add(load.name, moment_projection(load, q_dot))
+        add(load.name, load_projection(load, q, q_dot))
     for damper in model.dampers:
         add(damper.name, damper_forces(damper, q_dot))
     if model.dissipation != 0:
@@ -40,6 +37,29 @@ def load_contributions(model: Model) -> list[LoadContribution]:
     if given:
         add(GIVEN_LOAD, [given.get(name, sp.S.Zero) for name in names])
     return contributions
+
+
+@singledispatch
+def load_projection(load, q, q_dot) -> list[sp.Expr]:
+    """Q_i of one applied load, from its virtual work delta W = Q . delta q: one table entry
+    per load kind (tests/model/test_component_tables.py walks every kind)."""
+    raise TypeError(f"no virtual work for a load of kind {type(load).__name__}")
+
+
+@load_projection.register
+def _(load: PointForce, q, q_dot) -> list[sp.Expr]:
+    return point_force_projection(load, q)
+
+
+@load_projection.register
+def _(load: Torque, q, q_dot) -> list[sp.Expr]:
+    """Q_i = tau d(theta)/dq_i."""
+    return [load.torque * d for d in jacobian_row(load.angle, q)]
+
+
+@load_projection.register
+def _(load: Moment, q, q_dot) -> list[sp.Expr]:
+    return moment_projection(load, q_dot)
 
 
 def point_force_projection(load: PointForce, q) -> list[sp.Expr]:

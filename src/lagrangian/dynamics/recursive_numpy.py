@@ -20,11 +20,11 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import ModelError
-from ..kinds import JointKind
+from ..errors import InputError, ModelError
 from ..model.model import Model
 from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters
+from .joint_models import joint_model
 from .joint_space import Dynamics
 
 
@@ -67,21 +67,31 @@ def _skew(u) -> np.ndarray:
     return np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
 
 
+def _project(j, moment, force):
+    """S^T (n, f) = s_w . n + s_v . f for a batch of wrenches (N m or N)."""
+    total = 0.0
+    if j.s_w is not None:
+        total = total + moment @ j.s_w
+    if j.s_v is not None:
+        total = total + force @ j.s_v
+    return total
+
+
 class _Joint:
     """One joint's constants as arrays."""
 
     def __init__(self, joint):
         self.parent = joint.parent
-        self.revolute = joint.kind == JointKind.REVOLUTE
+        self.model = joint_model(joint.kind)
         self.coordinate = joint.coordinate
         self.multiplier = joint.multiplier
         self.offset = joint.offset
         self.R0 = np.array(joint.rotation, dtype=float)
         self.t0 = np.array(joint.translation, dtype=float)
         self.u = np.array(joint.axis, dtype=float)
-        self.uu = np.outer(self.u, self.u)
-        self.K = _skew(self.u)
-        self.slide = self.R0 @ self.u  # a prismatic joint's axis in its parent
+        s_w, s_v = self.model.subspace(self.u)  # the motion per unit rate (None: zero)
+        self.s_w = None if s_w is None else np.array(s_w)
+        self.s_v = None if s_v is None else np.array(s_v)
         self.m = float(joint.mass)
         self.h = np.array(joint.first_moment, dtype=float)
         self.H = _skew(self.h)
@@ -129,7 +139,7 @@ class RecursiveNumpyDynamics(Dynamics):
             array = np.asarray(value, dtype=float)
             if array.ndim == 0 or array.shape[-1] != self.n:
                 shape = "()" if array.ndim == 0 else str(array.shape)
-                raise ModelError(f"expected {self.n} values ({', '.join(self.coordinates)}) "
+                raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) "
                                  f"along the last axis, got shape {shape}", field=field)
             out.append(array)
         batch = np.broadcast_shapes(*(x.shape[:-1] for x in out))
@@ -144,14 +154,8 @@ class RecursiveNumpyDynamics(Dynamics):
         placements = []
         for j in self._joints:
             theta = j.multiplier * Q[:, j.coordinate] + j.offset
-            if j.revolute:
-                c, s = np.cos(theta)[:, None, None], np.sin(theta)[:, None, None]
-                # Rot(u, theta) = c 1 + s [u]x + (1 - c) u u^T
-                turn = j.uu + c * (np.eye(3) - j.uu) + s * j.K
-                placements.append((j.R0 @ turn, j.t0, j.P0))
-            else:
-                p = j.t0 + theta[:, None] * j.slide
-                placements.append((j.R0, p, _skew_batch(p)))
+            R, p = j.model.placement_arrays(j.R0, j.t0, j.u, theta)
+            placements.append((R, p, j.P0 if p is j.t0 else _skew_batch(p)))
         return placements
 
     def _newton_euler(self, Q, V, A):
@@ -174,18 +178,17 @@ class RecursiveNumpyDynamics(Dynamics):
                                        + _cross(wl, _apply_transpose(P, wl)))
             rate = None if V is None else j.multiplier * V[:, j.coordinate, None]
             w_i, dw_i = w_in, dw_in
-            if j.revolute:
-                if rate is not None:
-                    w_i = w_in + rate * j.u
-                    dw_i = dw_in - rate * _apply(j.K, w_in)  # + w_in x (rate u)
-            elif rate is not None:
-                a_i = a_i - 2.0 * rate * _apply(j.K, w_i)  # + 2 w x (rate u)
+            if rate is not None and j.s_w is not None:
+                w_i = w_in + rate * j.s_w
+                dw_i = dw_in + _cross(w_in, rate * j.s_w)
+            if rate is not None and j.s_v is not None:
+                a_i = a_i + 2.0 * _cross(w_i, rate * j.s_v)
             if A is not None:
-                accel = j.multiplier * A[:, j.coordinate, None] * j.u
-                if j.revolute:
-                    dw_i = dw_i + accel
-                else:
-                    a_i = a_i + accel
+                accel = j.multiplier * A[:, j.coordinate, None]
+                if j.s_w is not None:
+                    dw_i = dw_i + accel * j.s_w
+                if j.s_v is not None:
+                    a_i = a_i + accel * j.s_v
             w.append(w_i)
             dw.append(dw_i)
             acc.append(a_i)
@@ -196,7 +199,7 @@ class RecursiveNumpyDynamics(Dynamics):
         tau = np.zeros((count, self.n))
         for i in reversed(range(len(self._joints))):
             j = self._joints[i]
-            tau[:, j.coordinate] += j.multiplier * (n[i] if j.revolute else f[i]) @ j.u
+            tau[:, j.coordinate] += j.multiplier * _project(j, n[i], f[i])
             if j.parent >= 0:
                 R, p, P = placements[i]
                 force = _apply(R, f[i])
@@ -216,14 +219,16 @@ class RecursiveNumpyDynamics(Dynamics):
         eye = np.eye(3)
         for i in reversed(range(len(joints))):
             j = joints[i]
-            if j.revolute:  # unit rate about u: f = u x h, n = J u
-                force, moment = _cross(j.u, h[i]), _apply(J[i], j.u)
-            else:  # unit rate along u: f = m u, n = h x u
-                force, moment = mass[i] * j.u, _cross(h[i], j.u)
+            # unit rate along S: f = m s_v + s_w x h, n = J s_w + h x s_v
+            force, moment = np.zeros(3), np.zeros(3)
+            if j.s_w is not None:
+                force, moment = force + np.cross(j.s_w, h[i]), moment + J[i] @ j.s_w
+            if j.s_v is not None:
+                force, moment = force + mass[i] * j.s_v, moment + np.cross(h[i], j.s_v)
             force = np.broadcast_to(force, (count, 3))
             moment = np.broadcast_to(moment, (count, 3))
             ci, ki = j.coordinate, j.multiplier
-            M[:, ci, ci] += ki * ki * ((moment if j.revolute else force) @ j.u)
+            M[:, ci, ci] += ki * ki * _project(j, moment, force)
             k = i
             while joints[k].parent >= 0:
                 R, p, P = placements[k]
@@ -231,8 +236,7 @@ class RecursiveNumpyDynamics(Dynamics):
                 moment = _apply(R, moment) + _apply(P, force)
                 k = joints[k].parent
                 ancestor = joints[k]
-                entry = ki * ancestor.multiplier * (
-                    (moment if ancestor.revolute else force) @ ancestor.u)
+                entry = ki * ancestor.multiplier * _project(ancestor, moment, force)
                 M[:, ci, ancestor.coordinate] += entry
                 M[:, ancestor.coordinate, ci] += entry
             if j.parent >= 0:  # the composite inertia of body i, moved into its parent's axes
@@ -257,13 +261,13 @@ class RecursiveNumpyDynamics(Dynamics):
         for i, j in enumerate(self._joints):
             R, p, P = placements[i]
             wl, vl = (zero, zero) if j.parent < 0 else (w[j.parent], vel[j.parent])
-            rate = (j.multiplier * V[:, j.coordinate])[:, None] * j.u
+            rate = (j.multiplier * V[:, j.coordinate])[:, None]
             w_i = _apply_transpose(R, wl)
             v_i = _apply_transpose(R, vl + _apply_transpose(P, wl))
-            if j.revolute:
-                w_i = w_i + rate
-            else:
-                v_i = v_i + rate
+            if j.s_w is not None:
+                w_i = w_i + rate * j.s_w
+            if j.s_v is not None:
+                v_i = v_i + rate * j.s_v
             w.append(w_i)
             vel.append(v_i)
         return w, vel

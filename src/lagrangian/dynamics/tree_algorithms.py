@@ -4,8 +4,8 @@ kinematics, Newton-Euler inverse dynamics, the composite-rigid-body mass matrix,
 
 from __future__ import annotations
 
-from ..kinds import JointKind
 from ..model.tree import KinematicTree
+from .joint_models import joint_model
 from .tree_emitter import Term, _Emitter, _Layout
 
 
@@ -29,16 +29,27 @@ def _kinematics(E: _Emitter, tree: KinematicTree, q):
     placements = []
     for joint in tree.joints:
         theta = E.add(E.mul(q[joint.coordinate], joint.multiplier), joint.offset)
-        R0 = [list(row) for row in joint.rotation]
-        if joint.kind == JointKind.REVOLUTE:
-            sin, cos = E.sincos(theta)
-            R = E.matmul(R0, _rotation(E, joint, cos, sin))
-            p = list(joint.translation)
-        else:
-            R = R0
-            p = E.vadd(joint.translation, E.scale(theta, E.apply(R0, joint.axis)))
-        placements.append((R, p))
+        placements.append(joint_model(joint.kind).placement_terms(E, joint, theta, _rotation))
     return placements
+
+
+def _project(E: _Emitter, subspace, moment, force) -> Term:
+    """S^T (n, f) = s_w . n + s_v . f: a wrench's share along a joint's motion (N m or N)."""
+    s_w, s_v = subspace
+    return E.add(0.0 if s_w is None else E.dot(s_w, moment),
+                 0.0 if s_v is None else E.dot(s_v, force))
+
+
+def _unit_rate_wrench(E: _Emitter, subspace, m, h, J):
+    """The body's momentum (f, n) about its origin at one unit of joint rate along S:
+    f = m s_v + s_w x h, n = J s_w + h x s_v."""
+    s_w, s_v = subspace
+    zero = [0.0] * 3
+    force = E.vadd(zero if s_v is None else E.scale(m, s_v),
+                   zero if s_w is None else E.cross(s_w, h))
+    moment = E.vadd(zero if s_w is None else E.apply(J, s_w),
+                    zero if s_v is None else E.cross(h, s_v))
+    return force, moment
 
 
 def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a):
@@ -54,20 +65,20 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
             wl, dwl, al = [0.0] * 3, [0.0] * 3, up
         else:
             wl, dwl, al = w[joint.parent], dw[joint.parent], acc[joint.parent]
-        u = list(joint.axis)
+        s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
         rate = E.mul(v[joint.coordinate], joint.multiplier)
         accel = E.mul(a[joint.coordinate], joint.multiplier)
         w_in = E.apply_transpose(R, wl)
         dw_in = E.apply_transpose(R, dwl)
         origin = E.vadd(al, E.vadd(E.cross(dwl, p), E.cross(wl, E.cross(wl, p))))
         a_i = E.apply_transpose(R, origin)
-        if joint.kind == JointKind.REVOLUTE:
-            w_i = E.vadd(w_in, E.scale(rate, u))
-            dw_i = E.vadd(dw_in, E.vadd(E.cross(w_in, E.scale(rate, u)), E.scale(accel, u)))
-        else:
-            w_i, dw_i = w_in, dw_in
-            a_i = E.vadd(a_i, E.vadd(E.scale(2.0, E.cross(w_i, E.scale(rate, u))),
-                                     E.scale(accel, u)))
+        w_i, dw_i = w_in, dw_in
+        if s_w is not None:  # turning: w += rate s_w, dw += w_in x rate s_w + accel s_w
+            w_i = E.vadd(w_in, E.scale(rate, s_w))
+            dw_i = E.vadd(dw_in, E.vadd(E.cross(w_in, E.scale(rate, s_w)), E.scale(accel, s_w)))
+        if s_v is not None:  # sliding: the Coriolis term 2 w x rate s_v and accel s_v
+            a_i = E.vadd(a_i, E.vadd(E.scale(2.0, E.cross(w_i, E.scale(rate, s_v))),
+                                     E.scale(accel, s_v)))
         w.append(w_i)
         dw.append(dw_i)
         acc.append(a_i)
@@ -79,7 +90,7 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
     tau_full: list[Term] = [0.0] * len(tree.joints)
     for i in reversed(range(len(tree.joints))):
         joint = tree.joints[i]
-        tau_full[i] = E.dot(joint.axis, n[i] if joint.kind == JointKind.REVOLUTE else f[i])
+        tau_full[i] = _project(E, joint_model(joint.kind).subspace(joint.axis), n[i], f[i])
         if joint.parent >= 0:
             R, p = placements[i]
             force = E.apply(R, f[i])
@@ -102,12 +113,9 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
     full = {}
     for i in reversed(range(nb)):
         joint = tree.joints[i]
-        u = list(joint.axis)
-        if joint.kind == JointKind.REVOLUTE:  # unit rate about u: f = u x h, n = J u
-            force, moment = E.cross(u, h[i]), E.apply(J[i], u)
-        else:  # unit rate along u: f = m u, n = h x u
-            force, moment = E.scale(mass[i], u), E.cross(h[i], u)
-        full[i, i] = E.dot(u, moment if joint.kind == JointKind.REVOLUTE else force)
+        subspace = joint_model(joint.kind).subspace(joint.axis)
+        force, moment = _unit_rate_wrench(E, subspace, mass[i], h[i], J[i])
+        full[i, i] = _project(E, subspace, moment, force)
         k = i
         while tree.joints[k].parent >= 0:
             R, p = placements[k]
@@ -115,7 +123,8 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
             moment = E.vadd(E.apply(R, moment), E.cross(p, force))
             k = tree.joints[k].parent
             ancestor = tree.joints[k]
-            full[i, k] = E.dot(ancestor.axis, moment if ancestor.kind == JointKind.REVOLUTE else force)
+            full[i, k] = _project(E, joint_model(ancestor.kind).subspace(ancestor.axis), moment,
+                                  force)
         parent = joint.parent
         if parent >= 0:  # the composite inertia of body i, moved into its parent's axes
             R, p = placements[i]
@@ -165,19 +174,22 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
     w, vel, c, A, B, C, pn, pf = [], [], [], [], [], [], [], []
     for i, joint in enumerate(tree.joints):
         R, p = placements[i]
-        u = list(joint.axis)
+        s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
         rate = v[joint.coordinate]
         wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
                                                                  vel[joint.parent])
         w_i = E.apply_transpose(R, wl)
         v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
-        su = E.scale(rate, u)
-        if joint.kind == JointKind.REVOLUTE:
-            w_i = E.vadd(w_i, su)
-            c.append((E.cross(w_i, su), E.cross(v_i, su)))  # (w, v) x S q_dot
-        else:
-            v_i = E.vadd(v_i, su)
-            c.append(([0.0] * 3, E.cross(w_i, su)))
+        if s_w is not None:
+            w_i = E.vadd(w_i, E.scale(rate, s_w))
+        if s_v is not None:
+            v_i = E.vadd(v_i, E.scale(rate, s_v))
+        # (w, v) x S q_dot = (w x s_w q_dot, w x s_v q_dot + v x s_w q_dot)
+        zero = [0.0] * 3
+        cw = zero if s_w is None else E.cross(w_i, E.scale(rate, s_w))
+        cv = E.vadd(zero if s_v is None else E.cross(w_i, E.scale(rate, s_v)),
+                    zero if s_w is None else E.cross(v_i, E.scale(rate, s_w)))
+        c.append((cw, cv))
         w.append(w_i)
         vel.append(v_i)
         m, h, J = joint.mass, list(joint.first_moment), [list(r) for r in joint.inertia]
@@ -194,15 +206,14 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
     U, D, uu = [None] * nb, [None] * nb, [None] * nb
     for i in reversed(range(nb)):
         joint = tree.joints[i]
-        u = list(joint.axis)
-        if joint.kind == JointKind.REVOLUTE:  # U = IA S: the first column block times u
-            Un = E.apply(A[i], u)
-            Uf = E.apply_transpose(B[i], u)
-            drive_n, drive_f = u, [0.0] * 3
-        else:
-            Un = E.apply(B[i], u)
-            Uf = E.apply(C[i], u)
-            drive_n, drive_f = [0.0] * 3, u
+        s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
+        zero = [0.0] * 3
+        # U = IA S: Un = A s_w + B s_v, Uf = B^T s_w + C s_v
+        Un = E.vadd(zero if s_w is None else E.apply(A[i], s_w),
+                    zero if s_v is None else E.apply(B[i], s_v))
+        Uf = E.vadd(zero if s_w is None else E.apply_transpose(B[i], s_w),
+                    zero if s_v is None else E.apply(C[i], s_v))
+        drive_n, drive_f = s_w or zero, s_v or zero
         U[i] = (Un, Uf)
         D[i] = E.add(E.dot(drive_n, Un), E.dot(drive_f, Uf))
         effort = E.add(tau[joint.coordinate], layout.actuators[joint.coordinate])
@@ -258,10 +269,11 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
         Un, Uf = U[i]
         x = E.div(E.sub(uu[i], E.add(E.dot(Un, aw), E.dot(Uf, av))), D[i])
         qdd[joint.coordinate] = x
-        if joint.kind == JointKind.REVOLUTE:
-            aw = E.vadd(aw, E.scale(x, joint.axis))
-        else:
-            av = E.vadd(av, E.scale(x, joint.axis))
+        s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
+        if s_w is not None:
+            aw = E.vadd(aw, E.scale(x, s_w))
+        if s_v is not None:
+            av = E.vadd(av, E.scale(x, s_v))
         acc_w[i], acc_v[i] = aw, av
     return qdd
 
@@ -290,10 +302,11 @@ def _velocities(E: _Emitter, tree: KinematicTree, q, v):
         rate = E.mul(v[joint.coordinate], joint.multiplier)
         w_i = E.apply_transpose(R, wl)
         v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
-        if joint.kind == JointKind.REVOLUTE:
-            w_i = E.vadd(w_i, E.scale(rate, joint.axis))
-        else:
-            v_i = E.vadd(v_i, E.scale(rate, joint.axis))
+        s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
+        if s_w is not None:
+            w_i = E.vadd(w_i, E.scale(rate, s_w))
+        if s_v is not None:
+            v_i = E.vadd(v_i, E.scale(rate, s_v))
         w.append(w_i)
         vel.append(v_i)
     return w, vel

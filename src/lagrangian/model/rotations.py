@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..errors import ModelError, did_you_mean
+from ..kinds import JointKind
 from .model import Vector
 
 Matrix3 = tuple[Vector, Vector, Vector]
@@ -29,12 +30,12 @@ AXES: dict[str, Vector] = {
     "y": (sp.S.Zero, sp.S.One, sp.S.Zero),
     "z": (sp.S.Zero, sp.S.Zero, sp.S.One),
 }
-JOINT_TYPES = ("revolute", "prismatic", "spherical", "fixed")
-JOINT_KEYS = {
-    "revolute": ({"type", "axis", "angle"}, {"at"}),
-    "prismatic": ({"type", "axis", "distance"}, {"at"}),
-    "spherical": ({"type", "rotation"}, {"at"}),
-    "fixed": ({"type"}, {"at", "rotation"}),
+JOINT_TYPES = tuple(JointKind)  # each compares equal to its word in a model file
+JOINT_KEYS = {  # the required and optional keys of each kind's table
+    JointKind.REVOLUTE: ({"type", "axis", "angle"}, {"at"}),
+    JointKind.PRISMATIC: ({"type", "axis", "distance"}, {"at"}),
+    JointKind.SPHERICAL: ({"type", "rotation"}, {"at"}),
+    JointKind.FIXED: ({"type"}, {"at", "rotation"}),
 }
 # Exact numbers up to this size (numerator and denominator) stay exact in a unit vector; others
 # are taken as floats: the exact length of (1e-290, 0, -1) cost 5-30 s of factoring.
@@ -285,10 +286,11 @@ class RotationReader:
             raise self.error('a joint is a table {type = "revolute", axis = "z", angle = "q"}',
                              field)
         kind = value.get("type")
-        if kind not in JOINT_TYPES:
+        if not isinstance(kind, str) or kind not in JOINT_TYPES:
             raise self.error(f"unknown joint type {kind!r}: use one of "
                              f"{', '.join(JOINT_TYPES)}{did_you_mean(str(kind), JOINT_TYPES)}",
                              f"{field}.type")
+        kind = JointKind(kind)
         required, optional = JOINT_KEYS[kind]
         for key in value:
             if key not in required | optional:
@@ -300,17 +302,27 @@ class RotationReader:
         frame = parent
         if "at" in value:
             frame = translate(frame, self.vector(value["at"], f"{field}.at"))
-        if kind == "revolute":
-            axis = self.axis(value["axis"], f"{field}.axis")
-            angle = self.expression(value["angle"], f"{field}.angle")
-            frame = rotate(frame, axis, angle, self.rate(angle))
-        elif kind == "prismatic":
-            axis = self.axis(value["axis"], f"{field}.axis")
-            distance = self.expression(value["distance"], f"{field}.distance")
-            frame = translate(frame, tuple(distance * a for a in axis))
-        elif "rotation" in value:
-            frame = self.sequence(frame, value["rotation"], f"{field}.rotation")
-        return frame
+        return self._JOINT_FRAMES[kind](self, frame, value, field)
+
+    def _revolute(self, frame: Frame, value: Mapping, field: str) -> Frame:
+        axis = self.axis(value["axis"], f"{field}.axis")
+        angle = self.expression(value["angle"], f"{field}.angle")
+        return rotate(frame, axis, angle, self.rate(angle))
+
+    def _prismatic(self, frame: Frame, value: Mapping, field: str) -> Frame:
+        axis = self.axis(value["axis"], f"{field}.axis")
+        distance = self.expression(value["distance"], f"{field}.distance")
+        return translate(frame, tuple(distance * a for a in axis))
+
+    def _turned(self, frame: Frame, value: Mapping, field: str) -> Frame:
+        """A spherical joint's rotation sequence, or a fixed joint's optional one."""
+        if "rotation" not in value:
+            return frame
+        return self.sequence(frame, value["rotation"], f"{field}.rotation")
+
+    # one entry per JointKind (tests/model/test_component_tables.py checks none is missing)
+    _JOINT_FRAMES = {JointKind.REVOLUTE: _revolute, JointKind.PRISMATIC: _prismatic,
+                     JointKind.SPHERICAL: _turned, JointKind.FIXED: _turned}
 
     def inertia(self, value: object, field: str, values: Mapping[sp.Symbol, float]) -> Matrix3:
         """Principal [Ixx, Iyy, Izz] or a symmetric 3x3 tensor (kg m^2), about the centre of mass

@@ -1,0 +1,75 @@
+"""One seam per stage for component kinds (issue 26): every stage that treats components one kind
+at a time keeps a table keyed by the kind, and no kind is missing from any table. A new kind (a
+torsion spring, a helical joint) fails here until each stage knows it."""
+
+from __future__ import annotations
+
+import pytest
+import sympy as sp
+
+import lagrangian
+from lagrangian import JointKind
+from lagrangian.check.newton_euler import _AppliedForces
+from lagrangian.check.units import load_unit_items
+from lagrangian.derivation.energies import dissipation_terms, potential_terms
+from lagrangian.derivation.virtual_work import load_projection
+from lagrangian.dynamics.joint_models import JOINT_MODELS, joint_model
+from lagrangian.model.components import COMPONENT_KINDS, ELEMENT_KINDS, LOAD_KINDS, MASS_KINDS
+from lagrangian.model.rotations import JOINT_KEYS, RotationReader
+
+TABLES = {
+    "potential energy (derivation)": (potential_terms.registry, MASS_KINDS + ELEMENT_KINDS),
+    "dissipation (derivation)": (dissipation_terms.registry, MASS_KINDS + ELEMENT_KINDS),
+    "virtual work (derivation)": (load_projection.registry, LOAD_KINDS),
+    "units (check)": (load_unit_items.registry, LOAD_KINDS),
+    "free bodies (Newton-Euler check)": (_AppliedForces.__dict__["add_load"].dispatcher.registry, LOAD_KINDS),
+}
+
+
+@pytest.mark.parametrize("table", sorted(TABLES))
+def test_every_kind_has_its_entry(table):
+    registry, kinds = TABLES[table]
+    missing = [kind.__name__ for kind in kinds if kind not in registry]
+    assert not missing, f"{table} has no entry for {missing}"
+
+
+def test_the_kinds_are_each_named_once():
+    assert len(set(COMPONENT_KINDS)) == len(COMPONENT_KINDS)
+
+
+def test_every_joint_kind_is_read_from_a_model_file_and_moved_by_a_tree_or_refused():
+    assert set(JOINT_KEYS) == set(JointKind) == set(RotationReader._JOINT_FRAMES)
+    for kind in JointKind:
+        if kind in JOINT_MODELS:
+            assert joint_model(kind).kind is kind
+        else:
+            with pytest.raises(lagrangian.ModelError, match="one-degree-of-freedom"):
+                joint_model(kind)
+
+
+def test_the_tables_give_the_textbook_energies():
+    """A pendulum bob at (L sin q, -L cos q) under g along -y has V = -m g L cos q; a spring
+    stretched by x - l0 stores k (x - l0)^2 / 2; a damper dissipates c x_dot^2 / 2."""
+    m, g, L, k, l0, c, q, x, x_dot = sp.symbols("m g L k l0 c q x x_dot")
+    from lagrangian.model.model import Damper, Gravity, Particle, Spring
+
+    bob = Particle("bob", m, (L * sp.sin(q), -L * sp.cos(q), sp.S.Zero))
+    gravity = Gravity(g, (sp.S.Zero, -sp.S.One, sp.S.Zero))
+    assert sp.simplify(sum(potential_terms(bob, gravity)) + m * g * L * sp.cos(q)) == 0
+    assert potential_terms(bob, None) == []
+    spring = Spring("s", k, l0, x)
+    assert sp.expand(sum(potential_terms(spring, gravity)) - k * (x - l0) ** 2 / 2) == 0
+    assert sp.expand(sum(dissipation_terms(Damper("d", c, x_dot))) - c * x_dot**2 / 2) == 0
+
+
+def test_a_load_of_each_kind_does_its_virtual_work():
+    """delta W = Q delta q: a force F x-wards at (L sin q, -L cos q) gives F L cos q; a torque
+    tau through 2 q gives 2 tau."""
+    F, L, tau, q, q_dot = sp.symbols("F L tau q q_dot")
+    from lagrangian.model.model import PointForce, Torque
+
+    push = PointForce("push", (L * sp.sin(q), -L * sp.cos(q), sp.S.Zero), (F, sp.S.Zero, sp.S.Zero))
+    assert load_projection(push, (q,), (q_dot,)) == [F * L * sp.cos(q)]
+    assert load_projection(Torque("motor", tau, 2 * q), (q,), (q_dot,)) == [2 * tau]
+    with pytest.raises(TypeError, match="no virtual work"):
+        load_projection(object(), (q,), (q_dot,))

@@ -116,6 +116,18 @@ __all__ = [
     "load",
     "parse_model",
     "read_model",
+    "MAX_STUDY_POINTS",
+    "SIMULATION_METHODS",
+    "bare_angle_warnings",
+    "example_names",
+    "example_path",
+    "example_summary",
+    "parse_quantity",
+    "parse_stop_condition",
+    "physical_warnings",
+    "resolve_state",
+    "speed_sweep",
+    "state_units",
     "cos",
     "exp",
     "sin",
@@ -124,6 +136,23 @@ __all__ = [
 ]
 
 _SYMPY_NAMES = frozenset({"cos", "exp", "sin", "sqrt", "tan"})
+
+# Public functions and limits that live in one stage, loaded from their own module on first use
+# (not through the API, so that `lagrangian examples` starts without sympy or numpy).
+_HOMES = {
+    "parse_quantity": ("model.units", "parse_quantity"),
+    "state_units": ("model.values", "state_units"),
+    "resolve_state": ("model.values", "resolve_state"),
+    "example_names": ("model.examples", "example_names"),
+    "example_path": ("model.examples", "example_path"),
+    "example_summary": ("model.examples", "example_summary"),
+    "physical_warnings": ("derivation.regularity", "physical_warnings"),
+    "SIMULATION_METHODS": ("simulation.options", "METHODS"),
+    "parse_stop_condition": ("simulation.events", "parse_stop_condition"),
+    "speed_sweep": ("analysis.speed_form", "speed_sweep"),
+    "MAX_STUDY_POINTS": ("analysis.study", "MAX_STUDY_POINTS"),
+    "bare_angle_warnings": ("check.warnings", "bare_angle_warnings"),
+}
 
 
 def __getattr__(name: str):
@@ -135,6 +164,11 @@ def __getattr__(name: str):
         import sympy
 
         value = getattr(sympy, name)
+    elif name in _HOMES:
+        from importlib import import_module
+
+        home, attribute = _HOMES[name]
+        value = getattr(import_module(f"{__name__}.{home}"), attribute)
     else:
         from . import api
 

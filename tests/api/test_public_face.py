@@ -106,3 +106,17 @@ def test_every_dynamics_path_returns_the_one_dynamics_type():
     pendulum = lagrangian.load("pendulum").dynamics()
     assert isinstance(pendulum, lagrangian.Dynamics)
     assert pendulum.coordinates == ("theta",) and pendulum.n == 1
+
+
+def test_the_functions_the_command_line_uses_are_public():
+    """The CLI is a client of `lagrangian` (import contract in pyproject.toml): what it reads
+    with is public, e.g. 30deg is pi/6 rad and 0.5 min is 30 s."""
+    assert lagrangian.parse_quantity("30deg", "rad", "x") == pytest.approx(np.pi / 6)
+    assert lagrangian.parse_quantity("0.5 min", "s", "t") == pytest.approx(30.0)
+    assert "pendulum" in lagrangian.example_names()
+    assert "DOP853" in lagrangian.SIMULATION_METHODS
+    lines = lagrangian.bare_angle_warnings("--at", [("theta", "30")], {"theta": "rad"},
+                                           {"theta": 30.0})
+    assert len(lines) == 1 and "30deg" in lines[0]
+    assert lagrangian.bare_angle_warnings("--at", [("theta", "3")], {"theta": "rad"},
+                                          {"theta": 3.0}) == []

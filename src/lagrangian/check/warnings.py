@@ -8,11 +8,14 @@ equation contains given a value, a dimensionally inconsistent term).
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import math
+import re
+from collections.abc import Iterable, Mapping
 
 from ..derivation.equations import EquationsOfMotion
 from ..errors import LagrangianError
 from ..model.model import Model
+from ..model.units import is_angle_unit
 from .units import check_model_units
 
 # More unit issues than this are summed up in one line (the `units` command lists them all).
@@ -55,4 +58,21 @@ def setting_warnings(eom: EquationsOfMotion, names: Iterable[str]) -> list[str]:
             for name in names if name not in eom.parameters_used]
 
 
-__all__ = ["model_warnings", "setting_warnings"]
+def bare_angle_warnings(option: str, written: Iterable[tuple[str, str]],
+                        units: Mapping[str, str | None], values: Mapping[str, object]) -> list[str]:
+    """An angle written as a bare number beyond a turn (2 pi rad): read as radians, and 30 was
+    probably meant in degrees. ``written``: (name, text as typed); ``values``: SI values."""
+    lines = []
+    for name, text in written:
+        value = values.get(name)
+        if is_angle_unit(units.get(name)) and _BARE_NUMBER.fullmatch(text) and \
+                isinstance(value, float) and abs(value) > 2 * math.pi:
+            lines.append(f"{option} {name}={text} is read as {text} rad "
+                         f"({math.degrees(value):.6g} deg); write {text}deg for degrees")
+    return lines
+
+
+_BARE_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+
+
+__all__ = ["bare_angle_warnings", "model_warnings", "setting_warnings"]

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import math
 import re
 import sys
 from collections.abc import Iterable, Mapping
@@ -14,8 +13,7 @@ import typer
 from ..errors import InputError, LagrangianError, ModelError
 
 if TYPE_CHECKING:
-    from ..api.system import System
-    from ..derivation.equations import EquationsOfMotion
+    from .. import EquationsOfMotion, System
 
 # sympy, scipy and pint are imported inside the functions that need them, so that
 # `lagrangian --help` and `lagrangian examples` start in a fraction of a second.
@@ -63,8 +61,7 @@ def in_flags(error: LagrangianError) -> LagrangianError:
 def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = ()) -> System:
     """The system of a model file or built-in example, with --set overrides applied (and a
     URDF's joints frozen by --lock NAME=VALUE)."""
-    from ..api.system import load
-    from ..model.units import parse_quantity
+    from .. import load, parse_quantity
 
     locked = {name: parse_quantity(text, None, f"--lock {name}")
               for name, text in assignments(lock, "--lock")}
@@ -111,7 +108,7 @@ def state_assignments(system: System, settings: Iterable[str], option: str
                       ) -> dict[str, float | str]:
     """Read NAME=VALUE[unit] options for coordinates (e.g. 30deg), velocities and t, in SI
     units (names are judged by the library)."""
-    from ..model.values import state_units
+    from .. import state_units
 
     pairs = assignments(comma_separated(settings), option)
     units = state_units(system.model)
@@ -122,26 +119,18 @@ def state_assignments(system: System, settings: Iterable[str], option: str
 
 def warn_bare_angles(option: str, pairs: Iterable[tuple[str, str]],
                      units: Mapping[str, str | None], values: Mapping[str, object]) -> None:
-    """A warning for each angle written as a bare number beyond a turn: read as radians, and
-    30 was probably meant in degrees."""
-    from ..model.units import is_angle_unit
+    """A warning for each angle written as a bare number beyond a turn (the library judges)."""
+    from .. import bare_angle_warnings
 
-    for name, text in pairs:
-        value = values.get(name)
-        if is_angle_unit(units.get(name)) and _BARE_NUMBER.fullmatch(text) and \
-                isinstance(value, float) and abs(value) > 2 * math.pi:
-            warn(f"{option} {name}={text} is read as {text} rad ({math.degrees(value):.6g} deg); "
-                 f"write {text}deg for degrees")
-
-
-_BARE_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+    for line in bare_angle_warnings(option, pairs, units, values):
+        warn(line)
 
 
 def quantities(pairs: Iterable[tuple[str, str]], units: Mapping[str, str | None], option: str
                ) -> dict[str, float | str]:
     """Each value in SI units by the unit of its name. A name without a unit here is passed on
     as written: the library refuses it by name (with a suggestion), so the CLI need not judge."""
-    from ..model.units import parse_quantity
+    from .. import parse_quantity
 
     return {name: parse_quantity(text, units[name], f"{option} {name}") if name in units else text
             for name, text in pairs}
@@ -170,7 +159,7 @@ def assignments(settings: Iterable[str], option: str) -> list[tuple[str, str]]:
 def warn_if_unphysical(eom: EquationsOfMotion) -> None:
     """One line `warning: ...` on stderr for each thing that makes a well-formed model
     physically meaningless (a negative mass, a kinetic energy that is not positive)."""
-    from ..derivation.regularity import physical_warnings
+    from .. import physical_warnings
 
     for warning in physical_warnings(eom.model, eom.mass_matrix):
         warn(warning)

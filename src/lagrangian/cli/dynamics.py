@@ -8,7 +8,6 @@ from typing import Annotated
 import typer
 
 from ..errors import DerivationError, InputError
-from ..model.units import parse_quantity
 from . import app
 from .common import load_system, print_json, warn_bare_angles
 
@@ -17,6 +16,8 @@ LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeata
 
 def _vector(text: str | None, n: int, flag: str, default: list[float]) -> list[float]:
     """A comma-separated vector in the model's coordinate order (each entry may carry a unit)."""
+    from .. import parse_quantity
+
     if text is None:
         return default
     parts = [p.strip() for p in text.split(",")]
@@ -49,7 +50,7 @@ def dynamics(
     n = len(coordinates)
     qs = _vector(q, n, "--q", [c.initial or 0.0 for c in coordinates])
     if q is not None:  # --q 30,0 means 30 rad for an angle
-        from ..model.values import state_units
+        from .. import state_units
 
         names = [c.name for c in coordinates]
         texts = [part.strip() for part in q.split(",")]

@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from ..model.examples import example_names, example_path, example_summary
+from .. import example_names, example_path, example_summary
 from . import app
 from .common import print_json
 

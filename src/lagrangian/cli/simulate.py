@@ -9,7 +9,7 @@ from typing import Annotated
 
 import typer
 
-from ..simulation.options import METHODS  # light: the names only, no scipy
+from .. import SIMULATION_METHODS as METHODS  # light: the names only, no scipy
 from . import app
 from .common import LOCK_HELP, SET_HELP, load_system, print_json, state_assignments, warn_if_unphysical
 
@@ -33,15 +33,13 @@ def simulate(
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
+    from .. import SaveAt, StepControl, parse_quantity, parse_stop_condition, resolve_state
     from ..errors import InputError
-    from ..model.units import parse_quantity
-    from ..model.values import resolve_state
     from ..output.animation import check_animatable, check_animation_path, check_view
     from ..output.files import check_output_path, partial_path
     from ..output.plots import check_plot_path
     from ..output.simulation import projection_warning, simulation_document, simulation_text
     from ..output.tables import check_table_path
-    from ..simulation.simulate import SaveAt, StepControl, parse_stop_condition
 
     system = load_system(model, set_, lock)
     warn_if_unphysical(system.equations_of_motion())
@@ -79,7 +77,7 @@ def simulate(
         typer.echo(warning, err=True)
 
     # a partial result (failed or interrupted run) never replaces an existing file
-    from ..api import RunStatus  # here, not at the top: `--help` starts without sympy
+    from ..kinds import RunStatus
 
     partial = simulation.status in (RunStatus.FAILED, RunStatus.INTERRUPTED)
     written = {}

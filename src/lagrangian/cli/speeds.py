@@ -75,7 +75,7 @@ def speeds(
                              about=point or None)
     import numpy as np
 
-    from ..analysis.speed_form import speed_sweep
+    from .. import speed_sweep
 
     sweep = speed_sweep(form, np.linspace(lowest, highest, points))
     chosen = _chosen_speeds(system, form, at)
@@ -96,7 +96,7 @@ def speeds(
 
 def _chosen_speeds(system, form, settings: list[str]) -> list[float]:
     """--at SPEED=V1,V2,...: the speeds (m/s) to evaluate, named by the speed parameter."""
-    from ..model.units import parse_quantity
+    from .. import parse_quantity
 
     unit = next((p.unit for p in system.model.parameters if p.name == form.speed), None)
     speeds: list[float] = []

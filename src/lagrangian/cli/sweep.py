@@ -81,8 +81,7 @@ def sweep(
 def _run(model, vary, compute, out, plot, json_, set_, sample, members, seed, t_end,
          time_samples, method, rtol, atol, stop_when, trajectories, scheduler, workers, resume,
          chunk_size, about, lock=()):
-    from ..model.units import parse_quantity
-    from ..model.values import state_units
+    from .. import parse_quantity, state_units
     from ..output.sweep import check_study_path, check_study_plot_path, study_summary, study_text
 
     # the locked model's equations travel inside the Study to the Dask workers
@@ -149,7 +148,7 @@ def grid_values(text: str, unit: str | None, field: str) -> list[float]:
     """START:STOP:COUNT (evenly spaced, both ends), V1,V2,... or one VALUE, each with its unit."""
     import numpy as np
 
-    from ..model.units import parse_quantity
+    from .. import parse_quantity
 
     if ":" in text:
         parts = text.split(":")
@@ -159,7 +158,7 @@ def grid_values(text: str, unit: str | None, field: str) -> list[float]:
             raise InputError(f"the COUNT of {text!r} must be a whole number of values, at least 1",
                              field=field)
         count = int(parts[2])
-        from ..analysis.study import MAX_STUDY_POINTS
+        from .. import MAX_STUDY_POINTS
 
         if count > MAX_STUDY_POINTS:
             raise InputError(f"{count:,} values is more than a study holds (at most "

@@ -120,3 +120,10 @@ def test_the_functions_the_command_line_uses_are_public():
     assert len(lines) == 1 and "30deg" in lines[0]
     assert lagrangian.bare_angle_warnings("--at", [("theta", "3")], {"theta": "rad"},
                                           {"theta": 3.0}) == []
+
+
+def test_one_simulation_type():
+    """System.simulate returns a Simulation; the old name SimulationResult is that same type."""
+    assert lagrangian.SimulationResult is lagrangian.Simulation
+    run = lagrangian.load("pendulum").simulate(0.1)
+    assert type(run) is lagrangian.Simulation

@@ -1,4 +1,4 @@
-"""Ensembles in one C call (compile/parametric_at_rest.py integrate_ensemble): every member equals the
+"""Ensembles in one C call (simulation/ensemble.py integrate_ensemble): every member equals the
 single-point DOP853 loop run on it alone, on vector lanes or one by one, whatever the other
 members of the call do (fail, take 100x more steps); and the physics holds (closed forms,
 conservation of energy)."""
@@ -11,11 +11,12 @@ import numpy as np
 import pytest
 
 import lagrangian
-from lagrangian.analysis.sweep import ENSEMBLE_NATIVE, _drift
+from lagrangian.analysis.sweep import ENSEMBLE_NATIVE
 from lagrangian.compile import compiled
 from lagrangian.compile.codegen import generate
 from lagrangian.compile.functions import equations_key
-from lagrangian.compile.parametric_at_rest import integrate_ensemble
+from lagrangian.simulation.ensemble import integrate_ensemble
+from lagrangian.simulation.invariants import energy_drift as _drift
 
 pytestmark = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from ..compile.at_rest import StaticFunctions
+from ..compile.at_rest import AtRestFunctions
 from ..errors import ModelError
 from ..model.model import Model
 from ..model.rotations import gimbal_lock
@@ -78,7 +78,7 @@ class Equilibria:
 class _Solver:
     """Batched Newton on [f(q, 0) - Phi_q^T lambda; Phi(q)] = 0 over (q, lambda)."""
 
-    functions: StaticFunctions
+    functions: AtRestFunctions
     t: float
     force_scale: float
 
@@ -215,13 +215,13 @@ def starting_points(model: Model, free: np.ndarray) -> np.ndarray:
     return np.array(points, float).reshape(-1, n)
 
 
-def neutral_coordinates(functions: StaticFunctions) -> np.ndarray:
+def neutral_coordinates(functions: AtRestFunctions) -> np.ndarray:
     """Coordinates the equations of rest do not contain: any value is an equilibrium."""
     return np.array([c.symbol not in functions.depends_on for c in functions.model.coordinates],
                     dtype=bool)
 
 
-def force_scale(functions: StaticFunctions, points: np.ndarray, t: float) -> float:
+def force_scale(functions: AtRestFunctions, points: np.ndarray, t: float) -> float:
     """A typical size of the generalized forces over the starting points (for tolerances)."""
     low, high, _ = coordinate_spans(functions.model)
     values = functions.evaluate(points, t)
@@ -236,7 +236,7 @@ def force_scale(functions: StaticFunctions, points: np.ndarray, t: float) -> flo
 
 
 def find_equilibria(
-    functions: StaticFunctions, *, t: float = 0.0, stability=None,
+    functions: AtRestFunctions, *, t: float = 0.0, stability=None,
 ) -> Equilibria:
     """All equilibria found from the starting points, each once, sorted by coordinates.
 
@@ -248,7 +248,7 @@ def find_equilibria(
         return _find_equilibria(functions, t, stability)
 
 
-def _find_equilibria(functions: StaticFunctions, t: float, stability) -> Equilibria:
+def _find_equilibria(functions: AtRestFunctions, t: float, stability) -> Equilibria:
     model = functions.model
     neutral = neutral_coordinates(functions)
     free = ~neutral
@@ -294,7 +294,7 @@ def _find_equilibria(functions: StaticFunctions, t: float, stability) -> Equilib
 
 
 def resolve_equilibrium(
-    functions: StaticFunctions, about: Mapping[str, float] | State | None, *, t: float = 0.0,
+    functions: AtRestFunctions, about: Mapping[str, float] | State | None, *, t: float = 0.0,
     option: str = "about",
 ) -> tuple[np.ndarray, np.ndarray]:
     """The equilibrium (q, lambda) given by ``about`` (checked to be one; coordinates not given
@@ -361,7 +361,7 @@ def resolve_equilibrium(
                      f"{_why_not(functions, q, ~given, t)}{hint}", field=option)
 
 
-def _why_not(functions: StaticFunctions, q: np.ndarray, free: np.ndarray, t: float) -> str:
+def _why_not(functions: AtRestFunctions, q: np.ndarray, free: np.ndarray, t: float) -> str:
     """Which balance fails at q: first meet the constraints moving only the free coordinates,
     then report the largest unbalanced generalized force (or the violated constraint)."""
     names = [c.name for c in functions.model.coordinates]
@@ -399,7 +399,7 @@ def _wrap(q: np.ndarray, periodic: np.ndarray, low: np.ndarray) -> np.ndarray:
     return wrapped
 
 
-def periodic_coordinates(functions: StaticFunctions, t: float = 0.0) -> np.ndarray:
+def periodic_coordinates(functions: AtRestFunctions, t: float = 0.0) -> np.ndarray:
     """Angles in which the equations of rest repeat after 2 pi (checked at random points)."""
     low, high, periodic = coordinate_spans(functions.model)
     rng = np.random.default_rng(3)

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
-from ..compile.at_rest import StaticFunctions, linear_velocity_row
+from ..compile.at_rest import AtRestFunctions, linear_velocity_row
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import jacobian_row
 from ..errors import DerivationError, ModelError
@@ -44,6 +44,15 @@ def total_stiffness(values: dict[str, np.ndarray], multipliers: np.ndarray) -> n
 
 
 # -- the linear model ---------------------------------------------------------------------------
+
+
+def state_matrix(from_position: np.ndarray, from_velocity: np.ndarray) -> np.ndarray:
+    """A of x_dot = A x, x = [z; z_dot] (1/s units per row): [[0, 1], [from_position,
+    from_velocity]], the accelerations per unit displacement and per unit rate (-M^-1 K and
+    -M^-1 C where nothing constrains z). The one place this block form is written."""
+    p = from_position.shape[0]
+    return np.block([[np.zeros((p, p)), np.eye(p)], [from_position, from_velocity]])
+
 
 
 @dataclass(frozen=True)
@@ -108,6 +117,11 @@ class LinearModel:
     def state_names(self) -> tuple[str, ...]:
         return (*self.coordinates, *(f"{c}_dot" for c in self.coordinates))
 
+    def eigenvalues(self) -> np.ndarray:
+        """Eigenvalues of A (1/s), sorted by real part, largest first (the least stable first)."""
+        values = np.linalg.eigvals(self.A)
+        return values[np.lexsort((values.imag, -values.real))]
+
     def state_space(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(A, B, C, D) with the whole state as output: ``scipy.signal.StateSpace(*lm.state_space())``
         or ``control.ss(*lm.state_space())``."""
@@ -158,7 +172,7 @@ def null_space(matrix: np.ndarray) -> np.ndarray:
 
 
 def linear_model_at(
-    functions: StaticFunctions,
+    functions: AtRestFunctions,
     q0: np.ndarray,
     multipliers: np.ndarray,
     t: float = 0.0,
@@ -192,7 +206,7 @@ def linear_model_at(
                               "the linear model has no state-space form") from None
     columns = np.zeros((n, 0)) if input_columns is None else np.asarray(input_columns, float)
     Br = basis.T @ columns
-    A = np.block([[np.zeros((p, p)), np.eye(p)], [-projector @ Kr, -projector @ Cr]])
+    A = state_matrix(-projector @ Kr, -projector @ Cr)
     B = np.vstack([np.zeros((p, columns.shape[1])), projector @ Br])
     return LinearModel(
         equilibrium={name: float(v) for name, v in zip(names, q0, strict=True)},
@@ -215,7 +229,7 @@ def linear_model_at(
     )
 
 
-def is_statically_stable(functions: StaticFunctions, q0: np.ndarray, multipliers: np.ndarray,
+def is_statically_stable(functions: AtRestFunctions, q0: np.ndarray, multipliers: np.ndarray,
                          t: float = 0.0) -> bool:
     """For a mechanism without inertia: a strict minimum of the potential on the constraints
     (the stiffness K, reduced to the admissible displacements, positive definite)."""

@@ -30,6 +30,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, ModelError, did_you_mean
 from ..model.model import velocity_name
 from ..model.values import ParameterValues, resolve_parameters
+from .linearization import LinearModel, state_matrix
 from .steady import FIELD, steady_point
 
 # Couplings below this (relative to the largest entry of the kept rows) are zero.
@@ -38,28 +39,23 @@ COUPLING_TOLERANCE = 1e-8
 FIT_TOLERANCE = 1e-7
 
 
-@dataclass(frozen=True)
-class ReducedLinearModel:
-    """M q_ddot + C q_dot + K q = f in the kept coordinates about a steady motion (SI)."""
-
-    coordinates: tuple[str, ...]
-    independent_speeds: tuple[str, ...]
-    about: dict[str, float]
-    steady: dict[str, float]
-    M: np.ndarray
-    C: np.ndarray
-    K: np.ndarray
-
-    def state_matrix(self) -> np.ndarray:
-        """A of x_dot = A x, x = [q; q_dot]."""
-        p = len(self.coordinates)
-        inverse = np.linalg.inv(self.M)
-        return np.block([[np.zeros((p, p)), np.eye(p)], [-inverse @ self.K, -inverse @ self.C]])
-
-    def eigenvalues(self) -> np.ndarray:
-        """Eigenvalues (1/s) sorted by real part, largest first."""
-        values = np.linalg.eigvals(self.state_matrix())
-        return values[np.lexsort((values.imag, -values.real))]
+def kept_linear_model(coordinates: Sequence[str], about: dict[str, float],
+                      steady: dict[str, float], M: np.ndarray, C: np.ndarray,
+                      K: np.ndarray) -> LinearModel:
+    """The LinearModel M z_ddot + C z_dot + K z = 0 of the kept coordinates z about a steady
+    motion (SI); z are the model's own coordinates, the others dropped (they decouple)."""
+    p = len(coordinates)
+    try:
+        inverse = np.linalg.inv(M)
+    except np.linalg.LinAlgError:
+        raise DerivationError("the kept coordinates' mass matrix is singular on this steady "
+                              "motion; the linear model has no state-space form") from None
+    return LinearModel(
+        equilibrium=dict(about), multipliers={}, coordinates=tuple(coordinates),
+        user_coordinates=tuple(coordinates), basis=np.eye(p), mass_matrix=M, damping_matrix=C,
+        stiffness_matrix=K, A=state_matrix(-inverse @ K, -inverse @ C), B=np.zeros((2 * p, 0)),
+        input_matrix=np.zeros((p, 0)), full_mass_matrix=M, full_damping_matrix=C,
+        full_stiffness_matrix=K, steady=dict(steady))
 
 
 def _pivots(matrix: np.ndarray, count: int) -> list[int]:
@@ -75,7 +71,7 @@ def reduced_steady_model(
     eom: EquationsOfMotion, about: Mapping[str, float] | None,
     steady: Mapping[str, float | str], keep: Sequence[str],
     parameters: Mapping[str, float] | ParameterValues | None = None,
-) -> ReducedLinearModel:
+) -> LinearModel:
     """The linear equations of the ``keep`` coordinates about the steady motion, with the
     constraints eliminated by a null-space basis of independent speeds (module docstring)."""
     model = eom.model
@@ -147,14 +143,10 @@ def reduced_steady_model(
         if np.abs(stiffness[:p, j]).max(initial=0.0) > COUPLING_TOLERANCE * rows_scale:
             raise ModelError(f"the kept coordinates' equations depend on the position of "
                              f"'{names[i]}': keep it too", field="keep")
-    return ReducedLinearModel(
-        coordinates=tuple(keep),
-        independent_speeds=tuple(velocity_name(names[i]) for i in order),
-        about={name: float(v) for name, v in zip(names, point.q, strict=True)},
-        steady={velocity_name(names[i]): float(point.q_dot[i]) for i in range(n)
-                if point.q_dot[i] != 0},
-        M=mass[:p, :p], C=damping[:p, :p], K=stiffness[:p][:, kept_columns],
-    )
+    return kept_linear_model(
+        tuple(keep), {name: float(v) for name, v in zip(names, point.q, strict=True)},
+        {velocity_name(names[i]): float(point.q_dot[i]) for i in range(n) if point.q_dot[i] != 0},
+        mass[:p, :p], damping[:p, :p], stiffness[:p][:, kept_columns])
 
 
 @dataclass(frozen=True)
@@ -182,16 +174,17 @@ class SpeedForm:
         """(M, C, K) at speed v."""
         return (self.M, self.C0 + v * self.C1, self.g * self.K0 + v * self.K1 + v**2 * self.K2)
 
+    def at(self, v: float) -> LinearModel:
+        """The LinearModel of the kept coordinates at speed v (m/s)."""
+        return kept_linear_model(self.coordinates, self.about, {}, *self.matrices(v))
+
     def state_matrix(self, v: float) -> np.ndarray:
-        M, C, K = self.matrices(v)
-        p = len(self.coordinates)
-        inverse = np.linalg.inv(M)
-        return np.block([[np.zeros((p, p)), np.eye(p)], [-inverse @ K, -inverse @ C]])
+        """A of x_dot = A x at speed v, x = [q; q_dot]."""
+        return self.at(v).A
 
     def eigenvalues(self, v: float) -> np.ndarray:
         """Eigenvalues (1/s) at speed v, sorted by real part, largest first."""
-        values = np.linalg.eigvals(self.state_matrix(v))
-        return values[np.lexsort((values.imag, -values.real))]
+        return self.at(v).eigenvalues()
 
     def __repr__(self) -> str:
         return (f"SpeedForm({list(self.coordinates)} at speed {self.speed}; g = {self.g:g})\n"
@@ -257,7 +250,7 @@ def speed_form(
     C0 = np.where(np.abs(C0) < 1e-12 * size_C, 0.0, C0)
     K1 = np.where(np.abs(K1) < 1e-12 * size_K, 0.0, K1)
     return SpeedForm(coordinates=tuple(keep), speed=speed, g=g, M=Ms[0], C1=C1, K0=K0 / g,
-                     K2=K2, C0=C0, K1=K1, fit_error=error, about=fitted[0].about, rates=text)
+                     K2=K2, C0=C0, K1=K1, fit_error=error, about=fitted[0].equilibrium, rates=text)
 
 
 def _at_speed(model, text: str, speed: str, v: float, base: Mapping[str, float],
@@ -369,7 +362,7 @@ def speed_sweep(form: SpeedForm, speeds: Sequence[float], tolerance: float = 1e-
     return SpeedSweep(speeds, table, tuple(crossings), tuple(refined))
 
 
-__all__ = ["Crossing", "ReducedLinearModel", "SpeedForm", "SpeedSweep", "reduced_steady_model",
+__all__ = ["Crossing", "kept_linear_model", "SpeedForm", "SpeedSweep", "reduced_steady_model",
            "speed_form", "speed_sweep"]
 
 

@@ -30,7 +30,7 @@ from ..model.expressions import as_expression
 from ..model.model import velocity_name
 from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, resolve_parameters, resolve_state
-from .linearization import LinearModel
+from .linearization import LinearModel, state_matrix
 
 FIELD = "steady"
 # q_ddot smaller than this (relative to the rates squared) is a steady motion.
@@ -301,8 +301,7 @@ def steady_linear_model(
     # dq_ddot = M^-1 P (-C dq_dot - K dq) - M^-1 G^T S H dq_dot, P = 1 - G^T S G M^-1: the
     # multipliers' perturbation keeps d/dt (G dq_dot + H dq) = 0.
     P = np.eye(n) - G.T @ S @ G @ inverse
-    A = np.block([[np.zeros((n, n)), np.eye(n)],
-                  [-inverse @ P @ K, -inverse @ P @ C - inverse @ G.T @ S @ H]])
+    A = state_matrix(-inverse @ P @ K, -inverse @ P @ C - inverse @ G.T @ S @ H)
     return LinearModel(
         equilibrium={name: float(v) for name, v in zip(names, point.q, strict=True)},
         multipliers={c.name: float(v) for c, v in zip(model.constraints, point.multipliers,

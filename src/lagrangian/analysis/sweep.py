@@ -7,7 +7,7 @@ never raises for one point: a point that fails is NaN with its reason in ``statu
 the chunks (Dask, study/engine.py) and writes the Dataset (output/sweep.py) live downstream.
 
 Per chunk the compiled functions are built once per process (``prepared``): the equations at
-rest with the parameters as inputs (compile/parametric_at_rest.py) for modes and equilibria, the
+rest with the parameters as inputs (compile/at_rest.py, parametric) for modes and equilibria, the
 model's C module (loaded from the on-disk cache the client filled) for simulations.
 """
 
@@ -18,13 +18,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..compile.parametric_at_rest import (
-    ParametricStaticFunctions,
-    StaticFunctionsAt,
-    integrate_ensemble,
-)
+from ..compile.at_rest import AtRestFunctions
 from ..kinds import RunStatus
 from ..model.values import resolve_state
+from ..simulation.ensemble import (
+    integrate_ensemble,
+)
 from .equilibria import (
     _difference,
     _Solver,
@@ -69,7 +68,7 @@ def prepared(study: Study):
         elif study.compute == "speeds":
             hit = {}  # speed forms fitted so far, by the values of the other parameters
         else:
-            hit = ParametricStaticFunctions(study.eom)
+            hit = AtRestFunctions(study.eom, parametric=True)
         if len(_PREPARED) > 8:
             _PREPARED.pop(next(iter(_PREPARED)))
         _PREPARED[key] = hit
@@ -101,7 +100,7 @@ def _reason(exc: BaseException) -> str:
     return text or type(exc).__name__
 
 
-def _parameter_vectors(parametric: ParametricStaticFunctions, values: Mapping[str, np.ndarray],
+def _parameter_vectors(parametric: AtRestFunctions, values: Mapping[str, np.ndarray],
                        count: int) -> np.ndarray:
     # A parameter without a value is varied (make_study checked): its column is filled below.
     base = np.array([np.nan if p.value is None else float(p.value)
@@ -116,7 +115,7 @@ def _parameter_vectors(parametric: ParametricStaticFunctions, values: Mapping[st
 # -- modes ----------------------------------------------------------------------------------------
 
 
-def _modes_chunk(study, parametric: ParametricStaticFunctions, values, count):
+def _modes_chunk(study, parametric: AtRestFunctions, values, count):
     n = parametric.n
     out = _empty(study, count, {"mode": n, "coordinate": n})
     vectors = _parameter_vectors(parametric, values, count)
@@ -194,7 +193,7 @@ def _modes_batched(study, parametric, vectors, out) -> np.ndarray:
         found_q[members] = _nearest_equilibria(parametric, view, representatives[members])
     q_star = found_q[back]
     found = np.all(np.isfinite(q_star), axis=-1)
-    values = parametric.evaluate(np.where(found[:, None], q_star, 0.0), vectors)
+    values = parametric.evaluate(np.where(found[:, None], q_star, 0.0), parameters=vectors)
     M, K, C = values["mass"], values["stiffness"], values["damping"]
     scale = np.maximum(np.abs(K).max(axis=(-1, -2)), 1e-300)
     symmetric = (~np.any(C != 0, axis=(-1, -2))) & np.all(
@@ -292,7 +291,7 @@ def _normalized_shapes(shapes: np.ndarray) -> np.ndarray:
     return np.where(np.abs(real) < 1e-12, 0.0, real)
 
 
-def _nearest_equilibria(parametric, view: StaticFunctionsAt, vectors: np.ndarray) -> np.ndarray:
+def _nearest_equilibria(parametric, view: AtRestFunctions, vectors: np.ndarray) -> np.ndarray:
     """For each parameter point (rows of ``vectors``, sharing the search spans of ``view``):
     the equilibrium found nearest the model's initial values (resolve_equilibrium without
     ``about``), or NaN where none was found."""
@@ -302,7 +301,7 @@ def _nearest_equilibria(parametric, view: StaticFunctionsAt, vectors: np.ndarray
     points = starting_points(model, free)
     low, high, _ = coordinate_spans(model)
     periodic = periodic_coordinates(view)
-    batch_view = StaticFunctionsAt(parametric, vectors[:, None, :], model)
+    batch_view = parametric.at(vectors[:, None, :], model)
     values = batch_view.evaluate(np.broadcast_to(points, (count, *points.shape)))
     lam = initial_multipliers(values)
     span = np.abs(high - low)
@@ -336,7 +335,7 @@ def _nearest_equilibria(parametric, view: StaticFunctionsAt, vectors: np.ndarray
 # -- equilibria ---------------------------------------------------------------------------------
 
 
-def equilibria_at(view: StaticFunctionsAt):
+def equilibria_at(view: AtRestFunctions):
     """find_equilibria with linear stability, as System.equilibria does, at one point."""
 
     def stable(q, multipliers) -> bool:
@@ -445,7 +444,7 @@ def _simulation_chunk(study, functions: _SimulationFunctions, values, count):
 
 
 def _simulation_chunk_compiled(study, functions: _SimulationFunctions, values, count, out):
-    """The whole chunk in one call of the module's ensemble loop (compile/parametric_at_rest.py): each
+    """The whole chunk in one call of the module's ensemble loop (compile/at_rest.py, parametric): each
     member the same DOP853 steps as the single-point simulate, the summaries computed in C."""
     model = study.model
     options = study.simulation
@@ -491,12 +490,3 @@ def _simulate_member(study, functions, parameters, state):
     return result.t, y, result.invariant_drift, result.status, result.message, stop_time
 
 
-def _drift(energy: np.ndarray, kinetic: np.ndarray) -> float:
-    """max |E - E0| / |E0| (relative to the largest T when E0 = 0), as SimulationResult's
-    invariant_drift for the energy."""
-    change = float(np.max(np.abs(energy - energy[0])))
-    scale = abs(float(energy[0]))
-    largest_t = float(np.max(np.abs(kinetic)))
-    if scale <= 1e-9 * largest_t:
-        scale = largest_t
-    return change / scale if scale > 0 else 0.0

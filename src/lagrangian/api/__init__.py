@@ -27,9 +27,11 @@ from ..model.reader import parse_model, read_model
 from ..model.values import ParameterValues, State
 from ..simulation.events import StopCondition
 from ..simulation.options import SaveAt, StepControl
-from ..simulation.result import SimulationResult
 from .simulation import Simulation
 from .system import System, SystemBuilder, load
+
+# One Simulation (issue 26): the old public name of a run's result names the same type.
+SimulationResult = Simulation
 
 __all__ = [
     # entry points

@@ -29,7 +29,7 @@ from ..analysis.steady import steady_linear_model
 from ..check.diagnose import CheckReport, check_answer
 from ..check.newton_euler import CrosscheckReport, crosscheck
 from ..check.units import UnitsReport, check_model_units
-from ..compile.at_rest import StaticFunctions
+from ..compile.at_rest import AtRestFunctions
 from ..compile.codegen import CodegenError
 from ..compile.functions import NumericSystem, numeric
 from ..derivation.equations import EquationsOfMotion
@@ -233,9 +233,9 @@ class System:
     # -- equilibria, linearization and modes -----------------------------------------------------
 
     @cached_property
-    def _static_functions(self) -> StaticFunctions:
+    def _static_functions(self) -> AtRestFunctions:
         """Compiled functions at rest, built once per System (parameters are fixed per System)."""
-        return StaticFunctions(self.equations_of_motion())
+        return AtRestFunctions(self.equations_of_motion())
 
     def equilibria(self) -> Equilibria:
         """Configurations of rest, f(q, 0) = Phi_q^T lambda with Phi(q) = 0, each with its stability."""

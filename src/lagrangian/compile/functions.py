@@ -108,7 +108,8 @@ class NumericSystem:
         return q_ddot.reshape(batch + (self.n,)), multipliers.reshape(batch + (self.m,))
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
-        """First-order right-hand side for y = [q, q_dot]; always returns a fresh array."""
+        """First-order right-hand side for y = [q, q_dot] (the one simulate integrates); always
+        returns a fresh array."""
         return self._kernel.rhs(t, y)
 
 

@@ -498,7 +498,7 @@ static PyObject *py_dop853(PyObject *self, PyObject *const *args, Py_ssize_t nar
 
 /* What a study keeps of one member integrated onto the grid te[0..ne) (ys: ne x LG_S samples):
  * final state, extremes, end time and the energy drift max|E - E0| / |E0| (relative to the
- * largest kinetic energy when E0 = 0), as analysis/sweep.py's _drift. */
+ * largest kinetic energy when E0 = 0), as simulation/invariants.py's energy_drift. */
 static void lg_summary(const double *p, const double *te, npy_intp ne, const double *ys,
                        double *final, double *lo, double *hi, double *t_final, double *drift)
 {

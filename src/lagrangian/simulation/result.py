@@ -11,6 +11,7 @@ import numpy as np
 from ..kinds import InvariantKind, RunStatus
 from ..model.model import Model
 from ..model.values import State
+from .invariants import energy_drift, relative_drift
 from .options import StepControl
 
 STATUS_MESSAGES = {
@@ -120,14 +121,8 @@ class SimulationResult:
         if balance is None:
             return None
         values = self.invariant_values if self.invariant_values is not None else self.energy
-        scale = abs(float(values[0]))
-        others = [float(np.max(np.abs(x))) for x in (self.kinetic_energy, self.work)
-                  if x is not None and len(x)]
-        if others and scale <= 1e-9 * max(others):
-            scale = max(others)
-        if self.invariant == InvariantKind.WORK_BALANCE and others:
-            scale = max([scale, *others])
-        return float(np.max(np.abs(balance))) / scale if scale > 0 else 0.0
+        return relative_drift(balance, values[0], (self.kinetic_energy, self.work),
+                              against_others=self.invariant == InvariantKind.WORK_BALANCE)
 
     @property
     def last_state(self) -> State:
@@ -151,14 +146,7 @@ class SimulationResult:
         if not self.energy_conserved or len(self.energy) == 0 or \
                 not np.all(np.isfinite(self.energy)):  # a run failed on an overflow
             return None
-        change = float(np.max(np.abs(self.energy - self.energy[0])))
-        scale = abs(float(self.energy[0]))
-        if self.kinetic_energy is not None and len(self.kinetic_energy):
-            # E0 = 0 (a body starting at rest at the potential's zero): relative to the largest T
-            largest_t = float(np.max(np.abs(self.kinetic_energy)))
-            if scale <= 1e-9 * largest_t:
-                scale = largest_t
-        return change / scale if scale > 0 else 0.0
+        return energy_drift(self.energy, self.kinetic_energy)
 
     @property
     def max_residual(self) -> float | None:

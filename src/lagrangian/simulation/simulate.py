@@ -142,7 +142,7 @@ def _integrate(functions, y0, grid, step_control, event, drift, progress, compil
                                  grid, progress)
         if run is not None:
             return run
-    return integrate_steps(_rhs(functions), float(grid[0]), y0, float(grid[-1]), grid,
+    return integrate_steps(functions.rhs, float(grid[0]), y0, float(grid[-1]), grid,
                            step_control, event, drift, progress)
 
 
@@ -209,14 +209,3 @@ def _event(g: StateFunction) -> Callable[[np.ndarray, np.ndarray, float], float]
         return float(g.at(q, v, t)[0])
 
     return event
-
-
-def _rhs(functions: NumericSystem) -> Callable[[float, np.ndarray], np.ndarray]:
-    n = functions.n
-
-    def rhs(t: float, y: np.ndarray) -> np.ndarray:
-        # Always a fresh array: solve_ivp-style solvers keep references to what we return.
-        q_ddot, _ = functions.accelerations_and_multipliers(y[:n], y[n:], t)
-        return np.concatenate([y[n:], q_ddot])
-
-    return rhs

@@ -2,7 +2,9 @@
 
 Tables: ``[energy]`` T, V, D; ``[generalized_forces]`` one entry per coordinate;
 ``[equations]`` one entry per coordinate, ``"lhs = rhs"`` or an expression equal to zero;
-``[multipliers]`` ``count`` or ``names``. Names that the model does not know (a reaction force
+``[multipliers]`` ``count`` or ``names``; the final answers (``[matrices]``, ``[frequencies]``,
+``[mode_shapes]``, ``[linearized]``, ``[generalized_forces]`` with ``at``, ``[equilibria]``) are
+read by :mod:`.final_answer`. Names that the model does not know (a reaction force
 ``N``, a tension ``T_rod``) are kept as *foreign symbols*, so the checker can say why they do
 not belong, instead of failing to parse.
 """
@@ -18,11 +20,13 @@ import sympy as sp
 
 from ..errors import ModelError
 from .expressions import CONSTANTS, FUNCTIONS, parse_expression
+from .final_answer import FINAL_TABLES, FinalAnswers, read_final_answers
 from .model import Model, multiplier_name
 from .reader import check_known_keys, load_toml, read_text_file
 from .tokens import plain_names
 
-TABLES = ("energy", "generalized_forces", "equations", "multipliers")
+TABLES = ("energy", "generalized_forces", "equations", "multipliers", *FINAL_TABLES,
+          "coordinates")
 _FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 
@@ -40,6 +44,8 @@ class Answer:
     multiplier_names: tuple[str, ...] | None = None
     # item ("T", "Q[theta]", "equation[x]") -> names the model does not declare
     foreign: tuple[tuple[str, frozenset[sp.Symbol]], ...] = field(default=())
+    # matrices, frequencies, mode shapes, linearized equations, Q at a point, equilibria
+    final: FinalAnswers | None = None
 
     def foreign_symbols(self, item: str) -> frozenset[sp.Symbol]:
         return dict(self.foreign).get(item, frozenset())
@@ -49,7 +55,8 @@ class Answer:
         return (self.kinetic_energy is None and self.potential_energy is None
                 and self.dissipation is None and not self.generalized_forces
                 and not self.equations and self.multiplier_count is None
-                and self.multiplier_names is None)
+                and self.multiplier_names is None
+                and (self.final is None or self.final.is_empty))
 
 
 def answer_names(model: Model) -> dict[str, sp.Expr]:
@@ -100,11 +107,15 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
     values = {key: expression(energy[key], f"energy.{key}", key) for key in energy}
 
     forces = _table(data, "generalized_forces", source)
-    check_known_keys(forces, coordinates, "generalized_forces", source, what="coordinate")
-    generalized = tuple(
-        (name, expression(forces[name], f"generalized_forces.{name}", f"Q[{name}]"))
-        for name in coordinates if name in forces
-    )
+    generalized: tuple[tuple[str, sp.Expr], ...] = ()
+    if "at" not in forces:  # with `at`, values at a configuration: a final answer
+        check_known_keys(forces, coordinates, "generalized_forces", source, what="coordinate")
+        generalized = tuple(
+            (name, expression(forces[name], f"generalized_forces.{name}", f"Q[{name}]"))
+            for name in coordinates if name in forces
+        )
+    final = read_final_answers(data, model, lambda value, where: parse_expression(
+        value, names, field=where, source=source), source)
 
     table = _table(data, "equations", source)
     check_known_keys(table, coordinates, "equations", source, what="coordinate")
@@ -151,10 +162,13 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
         multiplier_count=count,
         multiplier_names=multiplier_names,
         foreign=tuple(sorted(foreign.items(), key=lambda kv: kv[0])),
+        final=None if final.is_empty else final,
     )
     if answer.is_empty:
         raise ModelError("the answer has nothing to check: give [energy] T/V/D, "
-                         "[generalized_forces], [equations] or [multipliers]", source=source)
+                         "[generalized_forces], [equations], [multipliers], [matrices], "
+                         "[frequencies], [mode_shapes], [linearized] or [equilibria]",
+                         source=source)
     return answer
 
 

@@ -125,10 +125,11 @@ class _FinalChecker:
 
     def symbolic(self):
         """Exact M, C, K about the equilibrium (None where only numbers can be had)."""
+        equilibrium = self.equilibrium()  # not an equilibrium: refused (ModelError)
         if self.model.constraints:
             return None
         try:
-            return self.system.linearize(self.equilibrium(), symbolic=True)
+            return self.system.linearize(equilibrium, symbolic=True)
         except ModelError:  # more coordinates than the symbolic linearization takes
             return None
 
@@ -238,11 +239,12 @@ class _FinalChecker:
                  <= 1e-6 * max(mode.frequency, 1e-12)]
         basis = np.array([[m.complex_shape[k] for k in index] for m in group]).T
         v = np.array([w.value for w in shape], dtype=complex)
-        alpha = np.linalg.lstsq(basis, v, rcond=None)[0]
-        fitted = basis @ alpha
         largest = max(abs(v))
-        ok = all(abs(f - w.value) <= (w.step or 0) / 2 + SHAPE_SLACK * largest
-                 for f, w in zip(fitted, shape, strict=True))
+        tolerance = np.array([(w.step or 0) / 2 + SHAPE_SLACK * largest for w in shape])
+        # weighted by each entry's tolerance, so exact entries (1) pin the scale
+        alpha = np.linalg.lstsq(basis / tolerance[:, None], v / tolerance, rcond=None)[0]
+        fitted = basis @ alpha
+        ok = bool(np.all(np.abs(fitted - v) <= tolerance))
         ours = [mode.shape[n] for n in self.order]
         text = "(" + ", ".join(w.text for w in shape) + ")"
         expected = "(" + ", ".join(f"{x:.4g}" for x in ours) + ")"

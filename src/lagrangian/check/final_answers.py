@@ -168,9 +168,12 @@ class _FinalChecker:
                 f"{rows[i][j].text} in yours, ours is {fmt(eq.display(mine[i, j]))}"
                 + ("" if rows[i][j].written is None else f" = {self.value(mine[i, j]):.6g}")
                 for i, j in wrong[:4])
-            findings.append(Finding(name, "wrong", "matrix_entry",
-                                    f"{named} ({order}; numbers compared at the model's "
-                                    "parameter values, to the precision you wrote).", expected))
+            numbers = any(rows[i][j].written is not None or rows[i][j].relative is not None
+                          for i, j in wrong)
+            note = ("; numbers compared at the model's parameter values, to the precision you "
+                    "wrote" if numbers else "")
+            findings.append(Finding(name, "wrong", "matrix_entry", f"{named} ({order}{note}).",
+                                    expected))
         return findings
 
     # -- frequencies, damping ratios, mode shapes -------------------------------------------

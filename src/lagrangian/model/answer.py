@@ -20,7 +20,13 @@ import sympy as sp
 
 from ..errors import ModelError
 from .expressions import CONSTANTS, FUNCTIONS, parse_expression
-from .final_answer import FINAL_TABLES, FinalAnswers, read_final_answers
+from .final_answer import (
+    FINAL_TABLES,
+    FREQUENCY_KINDS,
+    MATRICES,
+    FinalAnswers,
+    read_final_answers,
+)
 from .model import Model, multiplier_name
 from .reader import check_known_keys, load_toml, read_text_file
 from .tokens import plain_names
@@ -28,6 +34,24 @@ from .tokens import plain_names
 TABLES = ("energy", "generalized_forces", "equations", "multipliers", *FINAL_TABLES,
           "coordinates")
 _FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+ENERGY_KEYS = ("T", "V", "D")
+MULTIPLIER_KEYS = ("count", "names")
+
+
+def answer_file_schema() -> dict[str, tuple[frozenset[str], frozenset[str]]]:
+    """Every key the answer reader accepts: table -> (required keys, optional keys); "" is the
+    top level, "<coordinate>" any coordinate's name. The README's table is checked against it."""
+    none, coordinate = frozenset(), frozenset({"<coordinate>"})
+    return {"": (none, frozenset(TABLES)),
+            "energy": (none, frozenset(ENERGY_KEYS)),
+            "generalized_forces": (none, coordinate | {"at"}),
+            "equations": (none, coordinate),
+            "multipliers": (none, frozenset(MULTIPLIER_KEYS)),
+            "matrices": (none, frozenset(MATRICES)),
+            "frequencies": (none, frozenset({*FREQUENCY_KINDS, "zeta"})),
+            "mode_shapes": (frozenset({"shapes"}), none),
+            "linearized": (frozenset({"about"}), coordinate),
+            "equilibria": (none, coordinate)}
 
 
 @dataclass(frozen=True)
@@ -103,7 +127,7 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
         return parse_expression(value, scope, field=field, source=source)
 
     energy = _table(data, "energy", source)
-    check_known_keys(energy, ("T", "V", "D"), "energy", source)
+    check_known_keys(energy, ENERGY_KEYS, "energy", source)
     values = {key: expression(energy[key], f"energy.{key}", key) for key in energy}
 
     forces = _table(data, "generalized_forces", source)
@@ -137,7 +161,7 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
 
     count, multiplier_names = None, None
     multipliers = _table(data, "multipliers", source)
-    check_known_keys(multipliers, ("count", "names"), "multipliers", source)
+    check_known_keys(multipliers, MULTIPLIER_KEYS, "multipliers", source)
     if "count" in multipliers:
         count = multipliers["count"]
         if isinstance(count, bool) or not isinstance(count, int) or count < 0:

@@ -84,14 +84,19 @@ def test_worked_example_2_generalized_force_accepted():
     assert "3 significant figures" in finding(report, "Q_theta").message
 
 
-@pytest.mark.parametrize("value", ["86.6 N*m", "25 N*m", "50.0 N*m"])
-def test_worked_example_2_wrong_values_rejected(value):
-    # 86.6: F L cos x 2 (the link's length twice); 25: F L sin 30 (sin for cos); 50: no cos.
+@pytest.mark.parametrize(("value", "hint"), [
+    ("86.6 N*m", "twice ours"),          # F L cos 30 x 2
+    ("25 N*m", "sin and cos exchanged"),  # F L sin 30 = 25 exactly
+    ("-43.3 N*m", "opposite sign"),
+    ("50.0 N*m", "Did I do virtual work"),  # F L, no projection
+])
+def test_worked_example_2_wrong_values_rejected(value, hint):
     report = check_text("virtual_work_link",
                         f'[generalized_forces]\nat = {{ theta = "30deg" }}\ntheta = "{value}"\n')
     q = finding(report, "Q_theta")
     assert q.code == "generalized_force_value"
     assert "'F': 43.3013" in q.message and q.expected == "43.3013 N*m"
+    assert hint in q.message
 
 
 def test_generalized_force_in_other_units_and_at_90_degrees():

@@ -350,9 +350,35 @@ class _FinalChecker:
                 item, "wrong", "generalized_force_value",
                 f"{item} = {written.text} at {where}: ours is {true:.6g} {unit}"
                 + (f" (each load's part: {loads})" if loads else "")
-                + f", compared {written.precision}. Did I do virtual work for every "
-                "non-potential load, dW = F . dr with dr = dr/dq dq?", f"{true:.6g} {unit}"))
+                + f", compared {written.precision}.{self.force_hint(name, written, true, report)}"
+                " Did I do virtual work for every non-potential load, dW = F . dr with dr = "
+                "dr/dq dq?", f"{true:.6g} {unit}"))
         return findings
+
+    def force_hint(self, name: str, written: Written, true: float, report) -> str:
+        """A slip the value shows: the sign, a factor 2, or sin for cos in the projection."""
+        if true != 0 and agrees(written, -true):
+            return " Yours has the opposite sign."
+        for factor, words in ((2.0, "twice ours"), (0.5, "half of ours")):
+            if true != 0 and agrees(written, factor * true):
+                return f" Yours is {words}: the lever arm?"
+        values = {p.symbol: p.value for p in self.model.parameters if p.value is not None}
+        values.update({c.symbol: report.configuration[c.name] for c in self.model.coordinates})
+        values.update(dict.fromkeys(self.model.q_dot, 0.0))
+        x = sp.Dummy("x")
+        swapped = sum((c.expression.replace(sp.sin, sp.Lambda(x, sp.Function("_c")(x)))
+                       .replace(sp.cos, sp.Lambda(x, sp.sin(x))).replace(
+                           sp.Function("_c"), sp.Lambda(x, sp.cos(x)))
+                       for c in self.system.equations_of_motion().load_contributions
+                       if c.coordinate == name), sp.S.Zero)
+        try:
+            other = float(sp.sympify(swapped).xreplace(values))  # safe: a sympy expression
+        except (TypeError, ValueError):
+            return ""
+        if agrees(written, other) or agrees(written, -other):
+            return " It is ours with sin and cos exchanged: which component of dr does the " \
+                   "force do work through?"
+        return ""
 
     # -- equilibria ------------------------------------------------------------------------
 

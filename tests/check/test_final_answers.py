@@ -12,10 +12,10 @@ from check_helpers import ANSWERS, check_file, check_text, finding, system
 
 import lagrangian
 from lagrangian import ModelError
-from lagrangian.check.final_answers import FINAL_CODES, agrees
+from lagrangian.check.final_answers import FINAL_CODES
+from lagrangian.check.final_reading import agrees, read_written
 from lagrangian.cli import main
 from lagrangian.model.answer import parse_answer
-from lagrangian.model.final_answer import read_written
 
 OMEGA_PENDULUM = math.sqrt(9.81 / 0.5)  # worked example 1: 4.429... rad/s
 
@@ -280,8 +280,9 @@ def test_cli_json_and_exit_status(capsys):
     ('coordinates = ["x1"]\n[equilibria]\nx1 = [0]\n', "a.toml: coordinates: list every"),
 ])
 def test_malformed_tables_refused_by_field(text, message):
+    two_mass = system("two_mass")
     with pytest.raises(ModelError) as error:
-        parse_answer(text, system("two_mass").model, source="a.toml")
+        two_mass.check(parse_answer(text, two_mass.model, source="a.toml"))
     assert str(error.value).startswith(message), str(error.value)
     assert "\n" not in str(error.value)
 

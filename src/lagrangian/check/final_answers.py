@@ -17,19 +17,27 @@ import numpy as np
 import sympy as sp
 
 from ..errors import DerivationError, ModelError
-from ..model.answer import Answer
+from ..model.answer import Answer, answer_names
 from ..model.expressions import format_expression as fmt
-from ..model.final_answer import FREQUENCY_KINDS, Entry, FinalAnswers, Written
-from ..model.units import generalized_force_unit, is_angle_unit
+from ..model.expressions import parse_expression
 from . import equivalence as eq
 from .diagnose import Finding
+from .final_at_rest import AtRest
+from .final_reading import (
+    FREQUENCY_KINDS,
+    SLACK,
+    Entry,
+    FinalAnswers,
+    Written,
+    agrees,
+    read_final_answers,
+)
 
 FINAL_CODES = (
     "matrix_entry", "frequency_wrong", "frequency_count", "damping_ratio_wrong",
     "mode_shape_wrong", "linear_coefficient", "linear_offset", "not_linearized",
     "generalized_force_value", "equilibrium_wrong", "equilibrium_missing",
 )
-SLACK = 1e-9      # relative: a value that rounds to the written one up to float rounding
 SHAPE_SLACK = 1e-6  # relative to the largest component: eigenvectors are computed numerically
 
 
@@ -43,20 +51,16 @@ class Analysis(Protocol):
     def generalized_forces_at(self, configuration, parameters=None): ...
 
 
-def agrees(written: Written, true: float, scale: float = 1.0) -> bool:
-    """``true`` rounds to ``written`` at the precision it was written to (exact: to 1e-9)."""
-    if not math.isfinite(true):
-        return False
-    if written.step is None:
-        return abs(true - written.value) <= SLACK * max(abs(true), abs(written.value), scale)
-    return abs(true - written.value) <= written.step / 2 + SLACK * max(abs(true), written.step)
-
-
 def check_final_answers(system: Analysis, answer: Answer) -> list[Finding]:
-    """Findings on every final answer of ``answer`` (none when it has none)."""
-    final = answer.final
-    if final is None:
+    """Findings on every final answer of ``answer`` (none when it has none); a malformed
+    table is a ModelError naming the file, the table and the field."""
+    if not answer.final_tables:
         return []
+    model = system.equations_of_motion().model
+    names = answer_names(model)
+    final = read_final_answers(dict(answer.final_tables), model, lambda value, field:
+                               parse_expression(value, names, field=field, source=answer.source),
+                               answer.source)
     return _FinalChecker(system, final, answer.source).run()
 
 
@@ -81,10 +85,9 @@ class _FinalChecker:
             findings += self.guarded("frequencies", self.modes)
         if final.linearized:
             findings += self.guarded("linearized", self.linearized)
-        if final.forces:
-            findings += self.forces()
-        if final.equilibria:
-            findings += self.equilibria()
+        if final.forces or final.equilibria:
+            statics = AtRest(self.system, final)
+            findings += statics.forces() + statics.equilibria()
         return findings
 
     def guarded(self, table: str, method) -> list[Finding]:
@@ -324,117 +327,6 @@ class _FinalChecker:
                        f"term is {fmt(eq.display(offset))}. Write it in the coordinates or in "
                        "their deviations from the equilibrium.", expected)
 
-    # -- generalized forces at a configuration ---------------------------------------------
-
-    def forces(self) -> list[Finding]:
-        at = dict(self.final.forces_at or ())
-        rest = {c.velocity.name: 0.0 for c in self.model.coordinates}
-        report = self.system.generalized_forces_at({**at, **rest})
-        where = ", ".join(f"{k} = {_angle(self.model, k, v)}" for k, v in
-                          report.configuration.items() if k in self.names)
-        findings = []
-        for name, written in self.final.forces:
-            item, unit = f"Q_{name}", generalized_force_unit(self.model.coordinate(name).unit)
-            true = report.generalized_forces[name]
-            parts = [(load, value) for load, coordinate, value in report.contributions
-                     if coordinate == name]
-            scale = max([abs(v) for _, v in parts] + [1.0])
-            if agrees(written, true, scale):
-                findings.append(Finding(item, "correct", None,
-                                        f"{item} = {written.text} matches ours, {true:.6g} "
-                                        f"{unit} at {where}, compared {written.precision}.",
-                                        None))
-                continue
-            loads = ", ".join(f"{load!r}: {value:.6g} {unit}" for load, value in parts)
-            findings.append(Finding(
-                item, "wrong", "generalized_force_value",
-                f"{item} = {written.text} at {where}: ours is {true:.6g} {unit}"
-                + (f" (each load's part: {loads})" if loads else "")
-                + f", compared {written.precision}.{self.force_hint(name, written, true, report)}"
-                " Did I do virtual work for every non-potential load, dW = F . dr with dr = "
-                "dr/dq dq?", f"{true:.6g} {unit}"))
-        return findings
-
-    def force_hint(self, name: str, written: Written, true: float, report) -> str:
-        """A slip the value shows: the sign, a factor 2, or sin for cos in the projection."""
-        if true != 0 and agrees(written, -true):
-            return " Yours has the opposite sign."
-        for factor, words in ((2.0, "twice ours"), (0.5, "half of ours")):
-            if true != 0 and agrees(written, factor * true):
-                return f" Yours is {words}: the lever arm?"
-        values = {p.symbol: p.value for p in self.model.parameters if p.value is not None}
-        values.update({c.symbol: report.configuration[c.name] for c in self.model.coordinates})
-        values.update(dict.fromkeys(self.model.q_dot, 0.0))
-        x = sp.Dummy("x")
-        swapped = sum((c.expression.replace(sp.sin, sp.Lambda(x, sp.Function("_c")(x)))
-                       .replace(sp.cos, sp.Lambda(x, sp.sin(x))).replace(
-                           sp.Function("_c"), sp.Lambda(x, sp.cos(x)))
-                       for c in self.system.equations_of_motion().load_contributions
-                       if c.coordinate == name), sp.S.Zero)
-        try:
-            other = float(sp.sympify(swapped).xreplace(values))  # safe: a sympy expression
-        except (TypeError, ValueError):
-            return ""
-        if agrees(written, other) or agrees(written, -other):
-            return " It is ours with sin and cos exchanged: which component of dr does the " \
-                   "force do work through?"
-        return ""
-
-    # -- equilibria ------------------------------------------------------------------------
-
-    def equilibria(self) -> list[Finding]:
-        found = list(self.system.equilibria())
-        listed = dict(self.final.equilibria)
-        names = list(listed)
-        count = len(next(iter(listed.values())))
-        matched: set[int] = set()
-        findings = []
-        for k in range(count):
-            point = {n: listed[n][k] for n in names}
-            item = f"equilibrium.{names[0]}[{k + 1}]" if len(names) == 1 else f"equilibrium[{k + 1}]"
-            text = ", ".join(f"{n} = {w.text}" for n, w in point.items())
-            hits = [e for e, ours in enumerate(found) if all(
-                n in ours.neutral or self.at_position(n, w, ours.coordinates[n])
-                for n, w in point.items())]
-            matched.update(hits)
-            precision = "; ".join(sorted({w.precision for w in point.values()}))
-            if hits:
-                findings.append(Finding(item, "correct", None, f"{text} is an equilibrium, "
-                                        f"compared {precision}.", None))
-            else:
-                findings.append(Finding(item, "wrong", "equilibrium_wrong",
-                                        f"{text} is not an equilibrium, compared {precision}; "
-                                        f"ours: {self.listing(found, names)}. Is dV/dq = Q there "
-                                        "(no generalized force left at rest)?",
-                                        self.listing(found, names)))
-        missing = [e for e in range(len(found)) if e not in matched]
-        if missing:
-            findings.append(Finding(
-                "equilibria", "wrong", "equilibrium_missing",
-                f"you list {count} equilibrium position(s); the model has {len(found)}: "
-                f"missing {self.listing([found[e] for e in missing], names)}.",
-                self.listing(found, names)))
-        return findings
-
-    def at_position(self, name: str, written: Written, true: float) -> bool:
-        """Angles agree modulo a full turn."""
-        if is_angle_unit(self.model.coordinate(name).unit):
-            turns = round((written.value - true) / (2 * math.pi))
-            true += 2 * math.pi * turns
-        return agrees(written, true, 1.0)
-
-    def listing(self, found, names) -> str:
-        return "; ".join(", ".join(f"{n} = {_angle(self.model, n, e.coordinates[n])}"
-                                   for n in names) for e in found) or "none found"
-
-
-def _angle(model, name: str, value: float) -> str:
-    """A coordinate value, with its angle in degrees where it is one."""
-    if is_angle_unit(model.coordinate(name).unit):
-        return f"{value:.6g} rad ({math.degrees(value):.4g} deg)"
-    unit = model.coordinate(name).unit or "m"
-    return f"{value:.6g} {unit}"
-
 
 def _frequency_hint(yours: float, ours: float) -> str:
     """A ratio a known slip explains: Hz for rad/s (2 pi), omega^2 for omega."""
@@ -448,4 +340,4 @@ def _frequency_hint(yours: float, ours: float) -> str:
     return ""
 
 
-__all__ = ["FINAL_CODES", "agrees", "check_final_answers"]
+__all__ = ["FINAL_CODES", "check_final_answers"]

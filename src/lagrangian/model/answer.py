@@ -4,9 +4,9 @@ Tables: ``[energy]`` T, V, D; ``[generalized_forces]`` one entry per coordinate;
 ``[equations]`` one entry per coordinate, ``"lhs = rhs"`` or an expression equal to zero;
 ``[multipliers]`` ``count`` or ``names``; the final answers (``[matrices]``, ``[frequencies]``,
 ``[mode_shapes]``, ``[linearized]``, ``[generalized_forces]`` with ``at``, ``[equilibria]``) are
-read by :mod:`.final_answer`. Names that the model does not know (a reaction force
-``N``, a tension ``T_rod``) are kept as *foreign symbols*, so the checker can say why they do
-not belong, instead of failing to parse.
+kept as written here and read where they are checked (check/final_reading.py). Names that the
+model does not know (a reaction force ``N``, a tension ``T_rod``) are kept as *foreign symbols*,
+so the checker can say why they do not belong, instead of failing to parse.
 """
 
 from __future__ import annotations
@@ -20,17 +20,14 @@ import sympy as sp
 
 from ..errors import ModelError
 from .expressions import CONSTANTS, FUNCTIONS, parse_expression
-from .final_answer import (
-    FINAL_TABLES,
-    FREQUENCY_KINDS,
-    MATRICES,
-    FinalAnswers,
-    read_final_answers,
-)
 from .model import Model, multiplier_name
 from .reader import check_known_keys, load_toml, read_text_file
 from .tokens import plain_names
 
+# Final answers: results to compare with the analysis (check/final_answers.py).
+FINAL_TABLES = ("matrices", "frequencies", "mode_shapes", "linearized", "equilibria")
+MATRICES = ("M", "K", "C")
+FREQUENCY_KEYS = ("omega", "f", "period", "zeta")
 TABLES = ("energy", "generalized_forces", "equations", "multipliers", *FINAL_TABLES,
           "coordinates")
 _FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
@@ -48,7 +45,7 @@ def answer_file_schema() -> dict[str, tuple[frozenset[str], frozenset[str]]]:
             "equations": (none, coordinate),
             "multipliers": (none, frozenset(MULTIPLIER_KEYS)),
             "matrices": (none, frozenset(MATRICES)),
-            "frequencies": (none, frozenset({*FREQUENCY_KINDS, "zeta"})),
+            "frequencies": (none, frozenset(FREQUENCY_KEYS)),
             "mode_shapes": (frozenset({"shapes"}), none),
             "linearized": (frozenset({"about"}), coordinate),
             "equilibria": (none, coordinate)}
@@ -68,8 +65,9 @@ class Answer:
     multiplier_names: tuple[str, ...] | None = None
     # item ("T", "Q[theta]", "equation[x]") -> names the model does not declare
     foreign: tuple[tuple[str, frozenset[sp.Symbol]], ...] = field(default=())
-    # matrices, frequencies, mode shapes, linearized equations, Q at a point, equilibria
-    final: FinalAnswers | None = None
+    # The final-answer tables as written (matrices, frequencies, mode_shapes, linearized,
+    # generalized_forces with `at`, equilibria, coordinates): read where they are checked.
+    final_tables: tuple[tuple[str, object], ...] = ()
 
     def foreign_symbols(self, item: str) -> frozenset[sp.Symbol]:
         return dict(self.foreign).get(item, frozenset())
@@ -80,7 +78,7 @@ class Answer:
                 and self.dissipation is None and not self.generalized_forces
                 and not self.equations and self.multiplier_count is None
                 and self.multiplier_names is None
-                and (self.final is None or self.final.is_empty))
+                and not self.final_tables)
 
 
 def answer_names(model: Model) -> dict[str, sp.Expr]:
@@ -138,8 +136,9 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
             (name, expression(forces[name], f"generalized_forces.{name}", f"Q[{name}]"))
             for name in coordinates if name in forces
         )
-    final = read_final_answers(data, model, lambda value, where: parse_expression(
-        value, names, field=where, source=source), source)
+    final = tuple((key, data[key]) for key in (*FINAL_TABLES, "coordinates") if key in data)
+    if "at" in forces:
+        final += (("generalized_forces", forces),)
 
     table = _table(data, "equations", source)
     check_known_keys(table, coordinates, "equations", source, what="coordinate")
@@ -186,7 +185,7 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
         multiplier_count=count,
         multiplier_names=multiplier_names,
         foreign=tuple(sorted(foreign.items(), key=lambda kv: kv[0])),
-        final=None if final.is_empty else final,
+        final_tables=final,
     )
     if answer.is_empty:
         raise ModelError("the answer has nothing to check: give [energy] T/V/D, "

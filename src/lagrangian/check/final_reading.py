@@ -1,5 +1,6 @@
-"""The final answers of an answer file: matrices, frequencies, mode shapes, linearized equations,
-generalized forces at a configuration, equilibria (tables of ANSWER.toml, read here).
+"""The final answers of an answer file read: matrices, frequencies, mode shapes, linearized
+equations, generalized forces at a configuration, equilibria (tables of ANSWER.toml that
+model/answer.py keeps as written); errors name the file, the table and the field.
 
 A decimal number keeps the precision it was written with: "4.43 rad/s" is 3 significant figures,
 so it stands for any value that rounds to it (half a unit in the last written digit, in SI here);
@@ -8,6 +9,7 @@ a whole number (2, -1, 0) and a constant (pi, pi/2) are exact.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -15,12 +17,11 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..errors import ModelError
-from .model import Model
-from .reader import check_known_keys
-from .units import generalized_force_unit, parse_quantity
+from ..model.answer import FREQUENCY_KEYS, MATRICES
+from ..model.model import Model
+from ..model.reader import check_known_keys
+from ..model.units import generalized_force_unit, parse_quantity
 
-FINAL_TABLES = ("matrices", "frequencies", "mode_shapes", "linearized", "equilibria")
-MATRICES = ("M", "K", "C")
 FREQUENCY_KINDS = {"omega": ("rad/s", "natural frequency"), "f": ("Hz", "frequency"),
                    "period": ("s", "period")}
 # A written number: sign, digits with an optional point, optional exponent, optional unit.
@@ -80,6 +81,18 @@ class FinalAnswers:
     def is_empty(self) -> bool:
         return not (self.matrices or self.frequencies or self.damping_ratios or self.mode_shapes
                     or self.linearized or self.forces or self.equilibria)
+
+
+SLACK = 1e-9  # relative: a value that rounds to the written one, up to float rounding
+
+
+def agrees(written: Written, true: float, scale: float = 1.0) -> bool:
+    """``true`` rounds to ``written`` at the precision it was written to (exact: to 1e-9)."""
+    if not math.isfinite(true):
+        return False
+    if written.step is None:
+        return abs(true - written.value) <= SLACK * max(abs(true), abs(written.value), scale)
+    return abs(true - written.value) <= written.step / 2 + SLACK * max(abs(true), written.step)
 
 
 def read_written(value: object, unit: str | None, field: str, source: str) -> Written:
@@ -198,7 +211,7 @@ class _Reader:
         return Entry(value, self.expression(value, field), relative=relative_precision(value))
 
     def frequencies(self, table: Mapping) -> dict:
-        _known(table, (*FREQUENCY_KINDS, "zeta"), "frequencies", self.source)
+        _known(table, FREQUENCY_KEYS, "frequencies", self.source)
         kinds = [k for k in FREQUENCY_KINDS if k in table]
         if len(kinds) > 1:
             raise self.fail(f"give one of omega, f or period, not {' and '.join(kinds)}",

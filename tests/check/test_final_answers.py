@@ -176,6 +176,9 @@ def test_damping_ratio_and_frequency_of_a_damped_oscillator():
     assert right.verdict == "correct", right
     wrong = check_text("damped_oscillator", "[frequencies]\nzeta = [0.2]\n")
     assert finding(wrong, "zeta[1]").code == "damping_ratio_wrong"
+    # omega_d = omega_n sqrt(1 - zeta^2) = 2 sqrt(0.99) = 1.990 is not the natural frequency
+    damped = check_text("damped_oscillator", '[frequencies]\nomega = ["1.990 rad/s"]\n')
+    assert "damped one" in finding(damped, "omega[1]").message
 
 
 def test_frequency_in_hertz_and_period():

@@ -168,7 +168,7 @@ class _FinalChecker:
                 continue
             named = "; ".join(
                 f"{name}[{i + 1},{j + 1}] (row {self.order[i]}, column {self.order[j]}) is "
-                f"{rows[i][j].text} in yours, ours is {fmt(eq.display(mine[i, j]))}"
+                f"{_shown(rows[i][j])} in yours, ours is {fmt(eq.display(mine[i, j]))}"
                 + ("" if rows[i][j].written is None else f" = {self.value(mine[i, j]):.6g}")
                 for i, j in wrong[:4])
             numbers = any(rows[i][j].written is not None or rows[i][j].relative is not None
@@ -208,7 +208,8 @@ class _FinalChecker:
         unit, what = FREQUENCY_KINDS[kind]
         convert = {"omega": lambda w: w, "f": lambda w: w / (2 * math.pi),
                    "period": lambda w: 2 * math.pi / w if w > 0 else math.inf}[kind]
-        ours = sorted(convert(m.frequency) for m in chosen)
+        by_value = sorted((convert(m.frequency), m) for m in chosen)
+        ours = [v for v, _ in by_value]
         listed = self.final.frequencies
         findings = []
         if len(listed) != len(ours):
@@ -222,9 +223,10 @@ class _FinalChecker:
             written = listed[k]
             item = f"{kind}[{k + 1}]"
             if len(listed) == len(ours):
-                true = ours[rank]
+                true, mode = by_value[rank]
             else:  # the nearest of ours
-                true = min(ours, key=lambda v: abs(v - written.value), default=math.nan)
+                true, mode = min(by_value, key=lambda vm: abs(vm[0] - written.value),
+                                 default=(math.nan, None))
             if agrees(written, true):
                 findings.append(Finding(item, "correct", None,
                                         f"{item} = {written.text} matches ours, {true:.6g} "
@@ -233,9 +235,22 @@ class _FinalChecker:
             findings.append(Finding(
                 item, "wrong", "frequency_wrong",
                 f"{item} = {written.text}: ours is {true:.6g} {unit}, which does not round to "
-                f"yours (compared {written.precision}).{_frequency_hint(written.value, true)}",
+                f"yours (compared {written.precision}).{self.damped_hint(written, mode, convert)}"
+                f"{_frequency_hint(written.value, true, kind)}",
                 f"{true:.6g} {unit}"))
         return findings
+
+    @staticmethod
+    def damped_hint(written: Written, mode, convert) -> str:
+        """Yours is the damped frequency omega_d = omega_n sqrt(1 - zeta^2) (or its f, period)."""
+        zeta = (mode.damping_ratio or 0.0) if mode is not None else 0.0
+        if not 0 < zeta < 1:
+            return ""
+        damped = convert(mode.frequency * math.sqrt(1 - zeta**2))
+        if not agrees(written, damped):
+            return ""
+        return (f" Yours is the damped one, omega_d = omega_n sqrt(1 - zeta^2) ({damped:.6g}); "
+                "the table asks for the natural frequency omega_n (undamped).")
 
     def shape(self, i: int, shape: tuple[Written, ...], mode, modes) -> Finding:
         """Equal up to a (complex) factor: the best fit of ours, entry by entry within the
@@ -328,14 +343,19 @@ class _FinalChecker:
                        "their deviations from the equilibrium.", expected)
 
 
-def _frequency_hint(yours: float, ours: float) -> str:
+def _shown(entry: Entry) -> str:
+    """An entry as written when a number, else as we read it (never raw text: one line)."""
+    return entry.written.text if entry.written is not None else fmt(entry.value)
+
+
+def _frequency_hint(yours: float, ours: float, kind: str) -> str:
     """A ratio a known slip explains: Hz for rad/s (2 pi), omega^2 for omega."""
     if ours <= 0 or yours <= 0:
         return ""
     ratio = yours / ours
     if abs(ratio - 2 * math.pi) < 0.02 * 2 * math.pi or abs(ratio * 2 * math.pi - 1) < 0.02:
         return " It is off by a factor 2 pi: rad/s and Hz mixed up (omega = 2 pi f)?"
-    if abs(yours - ours**2) <= 0.02 * ours**2 and abs(ours - 1) > 0.05:
+    if kind == "omega" and abs(yours - ours**2) <= 0.02 * ours**2 and abs(ours - 1) > 0.05:
         return " It is ours squared: omega^2 = k/m, so omega = sqrt(k/m)?"
     return ""
 

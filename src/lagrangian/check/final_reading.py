@@ -101,7 +101,7 @@ def read_written(value: object, unit: str | None, field: str, source: str) -> Wr
     if isinstance(value, bool) or not isinstance(value, int | float | str):
         raise ModelError(f"expected a number with its unit as a string (like '4.43 rad/s'), "
                          f"got {value!r}", field=field, source=source)
-    text = repr(value) if isinstance(value, float) else str(value)
+    text = repr(value) if isinstance(value, float) else " ".join(str(value).split())
     try:
         si = parse_quantity(text, unit, field)
     except ModelError as error:

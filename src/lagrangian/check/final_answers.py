@@ -75,6 +75,7 @@ class _FinalChecker:
         self.random = eq.random_points(self.model)
         self.valued = eq.random_points(self.model, model_values=True)
         self.about = dict(final.about) if final.about is not None else None
+        self._equilibrium: dict[str, float] | None = None
 
     def run(self) -> list[Finding]:
         findings: list[Finding] = []
@@ -96,22 +97,25 @@ class _FinalChecker:
         try:
             return method()
         except ModelError as error:
-            raise ModelError(error.message, field="linearized.about" if self.about is not None
-                             else table, source=self.source) from None
+            field = error.field if error.field not in (None, "about") else (
+                "linearized.about" if self.about is not None else table)
+            raise ModelError(error.message, field=field, source=self.source) from None
         except DerivationError as error:
             return [Finding(table, "note", None, f"not checked: {error}", None)]
 
     # -- numbers and expressions -----------------------------------------------------------
 
-    def same(self, entry: Entry, ours: sp.Expr, scale: float = 1.0) -> bool:
+    def same(self, entry: Entry, ours: sp.Expr, scale: float = 1.0, numeric: bool = False
+             ) -> bool:
         """An entry equals ours: a number at the model's values to its written precision, an
-        expression identically (measured numbers in it: at the model's values, to theirs)."""
+        expression identically (measured numbers in it, or ``numeric`` ours: at the model's
+        values, to the precision of its numbers)."""
         if entry.written is not None:
             return agrees(entry.written, self.value(ours), scale)
-        if entry.relative is None:
+        if entry.relative is None and not numeric:
             return eq.identical(entry.value, ours, self.random)
         rows = self.valued.evaluate([entry.value, ours])
-        tolerance = entry.relative + SLACK
+        tolerance = (entry.relative or 0.0) + SLACK
         return all(not mpmath.isnan(a.real) and abs(a - b) <= tolerance * max(abs(a), abs(b))
                    + SLACK * scale for a, b in rows)
 
@@ -122,9 +126,12 @@ class _FinalChecker:
 
     def equilibrium(self) -> dict[str, float]:
         """The equilibrium of [linearized] about, else the one `modes` takes by default."""
-        if self.about is not None:
-            return dict(self.system.linearize(self.about).equilibrium)
-        return dict(self.system.modes().equilibrium)
+        if self._equilibrium is None:
+            if self.about is not None:
+                self._equilibrium = dict(self.system.linearize(self.about).equilibrium)
+            else:
+                self._equilibrium = dict(self.system.modes().equilibrium)
+        return self._equilibrium
 
     def symbolic(self):
         """Exact M, C, K about the equilibrium (None where only numbers can be had)."""
@@ -158,7 +165,7 @@ class _FinalChecker:
             mine = sp.Matrix([[matrix[i, j] for j in index] for i in index])
             scale = max([abs(self.value(e)) for e in mine] + [1e-300])
             wrong = [(i, j) for i, row in enumerate(rows) for j, entry in enumerate(row)
-                     if not self.same(entry, mine[i, j], scale)]
+                     if not self.same(entry, mine[i, j], scale, numeric=linear is None)]
             expected = "[" + ", ".join("[" + ", ".join(fmt(eq.display(e)) for e in mine.row(i))
                                        + "]" for i in range(mine.rows)) + "]"
             order = f"rows and columns {', '.join(self.order)}, about {where}"

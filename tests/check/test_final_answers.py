@@ -143,6 +143,13 @@ def test_worked_example_3_a_wrong_stiffness_entry_is_named():
     assert "K[2,1]" not in k.message
 
 
+def test_shapes_as_constants_and_decimals():
+    # (1, -1) written as (sqrt(2), -sqrt(2)) or (0.707, -0.707): any scale
+    for shapes in ('[[1, 1], ["sqrt(2)", "-sqrt(2)"]]', '[[1, 1], [0.707, -0.707]]'):
+        report = check_text("two_mass", f"[mode_shapes]\nshapes = {shapes}\n")
+        assert report.verdict == "correct", report
+
+
 def test_wrong_shape_and_missing_frequency():
     report = check_text("two_mass", '[frequencies]\nomega = ["1 rad/s"]\n'
                                     '[mode_shapes]\nshapes = [[1, 1], [1, 1]]\n')
@@ -270,6 +277,10 @@ def test_cli_json_and_exit_status(capsys):
     ('[frequencies]\nomega = [1]\nf = [1]\n', "a.toml: frequencies: give one of omega"),
     ('[frequencies]\nomega = [true]\n', "a.toml: frequencies.omega[1]: expected a number"),
     ('[mode_shapes]\nshapes = [[1, 1, 1]]\n', "a.toml: mode_shapes.shapes[1]: expected 2 entries"),
+    ('[mode_shapes]\nshapes = [["1 m", 1]]\n', "a.toml: mode_shapes.shapes[1][1]: expected a plain"),
+    ('[frequencies]\nzeta = ["0.1 m"]\n', "a.toml: frequencies.zeta[1]: expected a plain number"),
+    ('[frequencies]\nomega = ["-1 rad/s"]\n', "a.toml: frequencies.omega[1]: expected a positive"),
+    ('[matrices]\nK = [["1/0", 0], [0, 1]]\n', "a.toml: matrices.K[1][1]: division by zero"),
     ('[mode_shapes]\nshapes = [[0, 0]]\n', "a.toml: mode_shapes.shapes[1]: a mode shape cannot"),
     ('[mode_shapes]\nvectors = [[1, 0]]\n', "a.toml: mode_shapes.vectors: unknown key"),
     ('[linearized]\nx1 = "x1_ddot = 0"\n', "a.toml: linearized.about: give the equilibrium"),

@@ -277,7 +277,7 @@ class _FinalChecker:
         text = "(" + ", ".join(w.text for w in shape) + ")"
         expected = "(" + ", ".join(f"{x:.4g}" for x in ours) + ")"
         precision = ("to the precision you wrote" if any(w.step for w in shape)
-                     else "exactly (whole numbers)")
+                     else "exactly (whole numbers and constants)")
         if ok:
             return Finding(f"shape[{i}]", "correct", None,
                            f"shape[{i}] = {text} is ours, {expected}, up to scale and sign, "

@@ -26,6 +26,8 @@ FREQUENCY_KINDS = {"omega": ("rad/s", "natural frequency"), "f": ("Hz", "frequen
                    "period": ("s", "period")}
 # A written number: sign, digits with an optional point, optional exponent, optional unit.
 _NUMBER = re.compile(r"^\s*([-+]?)(\d+\.?\d*|\.\d+)(?:[eE]([-+]?\d+))?\s*(.*?)\s*$")
+_CONSTANT_WORDS = re.compile(r"\bpi\b|\b[A-Za-z_]\w*\s*\(")  # pi and function calls
+_LETTER = re.compile(r"[^\W\d]")
 _DECIMAL = re.compile(r"(?<![A-Za-z_0-9.])(\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 
 
@@ -107,6 +109,10 @@ def read_written(value: object, unit: str | None, field: str, source: str) -> Wr
     except ModelError as error:
         raise ModelError(error.message, field=field, source=source) from None
     match = _NUMBER.match(text)
+    # a ratio (zeta, a shape component) has no unit: the unit library would take '1 m' as 1
+    if unit == "1" and (match[4] if match else _LETTER.search(_CONSTANT_WORDS.sub("", text))):
+        raise ModelError(f"expected a plain number without a unit, got {text!r}", field=field,
+                         source=source)
     if match is None:  # a constant expression: pi, 3*pi/4 rad
         return Written(text, si, None)
     sign, digits, exponent, unit_text = match.groups()

@@ -45,7 +45,7 @@ class Written:
     def precision(self) -> str:
         """How it is compared, in words ("to the 3 significant figures you wrote")."""
         if self.step is None:
-            return "exactly (a whole number or a constant is exact)"
+            return "exactly: a whole number or a constant is exact"
         if self.figures is not None:
             plural = "" if self.figures == 1 else "s"
             return f"to the {self.figures} significant figure{plural} you wrote"

@@ -27,6 +27,7 @@ def unequal():
 # -- worked example 1: the pendulum's small-angle equation and omega_n ----------------------
 
 def test_worked_example_1_small_angle_equation_and_frequency_accepted():
+    assert round(OMEGA_PENDULUM, 2) == 4.43  # the seed's closed form
     report = check_file("pendulum", "final_pendulum.toml")
     assert report.verdict == "correct", report
     assert finding(report, "linearized.theta").status == "correct"
@@ -324,3 +325,21 @@ def test_every_final_code_is_exercised_by_this_file():
     source = inspect.getsource(sys.modules[__name__])
     missing = [code for code in FINAL_CODES if f'"{code}"' not in source]
     assert not missing, missing
+
+
+# -- the practice ladder -----------------------------------------------------------------------
+
+def test_ladder_levels_1_and_2():
+    # level 1: omega_n = sqrt(9.81/2) = 2.21 rad/s; level 2: Q_theta = -F L sin 0 = 0
+    assert math.sqrt(9.81 / 2) == pytest.approx(2.2147, abs=1e-4)
+    level_1 = check_text("ladder_pendulum", '[frequencies]\nomega = ["2.21 rad/s"]\n')
+    assert level_1.verdict == "correct", level_1
+    assert check_text("ladder_pendulum", '[frequencies]\nomega = ["2.22 rad/s"]\n').verdict \
+        == "incorrect"
+    level_2 = check_text("ladder_vertical_force",
+                         '[generalized_forces]\nat = { theta = 0 }\ntheta = "0 N*m"\n')
+    assert level_2.verdict == "correct", level_2
+    # at 30 deg, -F L sin 30 = -60 * 0.4 * 0.5 = -12 N m
+    at_30 = check_text("ladder_vertical_force",
+                       '[generalized_forces]\nat = { theta = "30deg" }\ntheta = "-12.0 N*m"\n')
+    assert at_30.verdict == "correct", at_30

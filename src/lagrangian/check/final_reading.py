@@ -182,11 +182,14 @@ class _Reader:
     def fail(self, message: str, field: str) -> ModelError:
         return ModelError(message, field=field, source=self.source)
 
-    def _list(self, value: object, field: str, length: int | None = None, what: str = "") -> list:
+    def _list(self, value: object, field: str, length: int | None = None,
+              noun: str = "entries", per: str = "") -> list:
+        """A non-empty list (of ``length`` items where given)."""
         if not isinstance(value, list) or not value:
-            raise self.fail(f"expected a list{what}, got {value!r}", field)
+            shown = repr(value) if len(repr(value)) <= 60 else repr(value)[:57] + "..."
+            raise self.fail(f"expected a list of {noun}{per}, got {shown}", field)
         if length is not None and len(value) != length:
-            raise self.fail(f"expected {length} entries{what}, got {len(value)}", field)
+            raise self.fail(f"expected {length} {noun}{per}, got {len(value)}", field)
         return value
 
     def matrices(self, table: Mapping) -> tuple:
@@ -198,10 +201,10 @@ class _Reader:
             if name not in table:
                 continue
             field = f"matrices.{name}"
-            rows = self._list(table[name], field, n, " of rows" + per)
+            rows = self._list(table[name], field, n, "rows", per)
             matrix = []
             for i, row in enumerate(rows, start=1):
-                row = self._list(row, f"{field}[{i}]", n, per)
+                row = self._list(row, f"{field}[{i}]", n, "entries", per)
                 matrix.append(tuple(self._entry(v, f"{field}[{i}][{j}]")
                                     for j, v in enumerate(row, start=1)))
             result.append((name, tuple(matrix)))
@@ -227,12 +230,12 @@ class _Reader:
             kind = kinds[0]
             unit = FREQUENCY_KINDS[kind][0]
             field = f"frequencies.{kind}"
-            values = self._list(table[kind], field, what=f" of values in {unit}")
+            values = self._list(table[kind], field, noun=f"values in {unit}")
             fields["frequency_kind"] = kind
             fields["frequencies"] = tuple(
                 self._frequency(v, kind, f"{field}[{i}]") for i, v in enumerate(values, start=1))
         if "zeta" in table:
-            values = self._list(table["zeta"], "frequencies.zeta", what=" of damping ratios")
+            values = self._list(table["zeta"], "frequencies.zeta", noun="damping ratios")
             fields["damping_ratios"] = tuple(read_written(v, "1", f"frequencies.zeta[{i}]",
                                                           self.source)
                                              for i, v in enumerate(values, start=1))
@@ -260,13 +263,13 @@ class _Reader:
         _known(table, ("shapes",), "mode_shapes", self.source)
         if "shapes" not in table:
             raise self.fail("give shapes = [[...], ...], one list per mode", "mode_shapes.shapes")
-        shapes = self._list(table["shapes"], "mode_shapes.shapes", what=" of shapes")
+        shapes = self._list(table["shapes"], "mode_shapes.shapes", noun="shapes")
         n = len(self.order)
         per = f" (one per coordinate: {', '.join(self.order)})"
         result = []
         for i, shape in enumerate(shapes, start=1):
             field = f"mode_shapes.shapes[{i}]"
-            shape = self._list(shape, field, n, per)
+            shape = self._list(shape, field, n, "components", per)
             written = tuple(read_written(v, "1", f"{field}[{j}]", self.source)
                             for j, v in enumerate(shape, start=1))
             if all(w.value == 0 for w in written):
@@ -330,7 +333,7 @@ class _Reader:
             if name not in table:
                 continue
             field = f"equilibria.{name}"
-            values = self._list(table[name], field, what=" of positions")
+            values = self._list(table[name], field, noun="positions")
             if length is not None and len(values) != length:
                 raise self.fail(f"expected {length} positions, one per equilibrium (as the "
                                 f"coordinates before it), got {len(values)}", field)

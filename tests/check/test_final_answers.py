@@ -293,6 +293,7 @@ def test_cli_json_and_exit_status(capsys):
      "a.toml: generalized_forces.x1: '1 N*m' is not in units compatible with 'N'"),
     ('[equilibria]\nx1 = [0, 1]\nx2 = [0]\n', "a.toml: equilibria.x2: expected 2 positions"),
     ('coordinates = ["x1"]\n[equilibria]\nx1 = [0]\n', "a.toml: coordinates: list every"),
+    ('coordinates = ["x2", "x1"]\n', "a.toml: the answer has nothing to check"),
 ])
 def test_malformed_tables_refused_by_field(text, message):
     two_mass = system("two_mass")

@@ -78,7 +78,7 @@ class Answer:
                 and self.dissipation is None and not self.generalized_forces
                 and not self.equations and self.multiplier_count is None
                 and self.multiplier_names is None
-                and not self.final_tables)
+                and all(key == "coordinates" for key, _ in self.final_tables))
 
 
 def answer_names(model: Model) -> dict[str, sp.Expr]:

@@ -1,6 +1,7 @@
 """The README's table of model-file keys is generated from the reader's own schema
 (model/reader.py, ``model_file_schema``): a key the reader accepts and the README does not list,
-or one the README lists and the reader refuses, fails here.
+or one the README lists and the reader refuses, fails here. The table of answer-file keys below it
+(``lagrangian check``) comes from model/answer.py's ``answer_file_schema`` the same way.
 
 Regenerate the table after changing the reader:  python tests/test_readme_model_keys.py
 (prints the table to paste between the README's model-keys markers; the meanings are below).
@@ -10,11 +11,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from lagrangian.model.answer import answer_file_schema
 from lagrangian.model.reader import model_file_schema
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 BEGIN, END = "<!-- BEGIN model-keys (generated: python tests/test_readme_model_keys.py) -->", \
     "<!-- END model-keys -->"
+ANSWER_BEGIN, ANSWER_END = ("<!-- BEGIN answer-keys (generated: python "
+                            "tests/test_readme_model_keys.py) -->", "<!-- END answer-keys -->")
 
 # What each table is for; the keys themselves come from the reader.
 MEANINGS = {
@@ -48,6 +52,29 @@ MEANINGS = {
 }
 
 
+# The tables of an answer file (lagrangian check MODEL ANSWER.toml); keys from the answer reader.
+ANSWER_MEANINGS = {
+    "": "`coordinates = [\"x2\", \"x1\"]` (or a `[coordinates]` table): your order of rows, "
+        "columns and shape components (default the model's); the other keys are the tables below",
+    "energy": "your T, V, D as expressions",
+    "generalized_forces": "`coordinate = \"Q\"` expressions; with `at = { theta = \"30deg\" }`, "
+                          "values at that configuration (at rest): `theta = \"43.3 N*m\"`, item "
+                          "`Q_theta`",
+    "equations": "one per coordinate, `\"lhs = rhs\"` or an expression equal to zero",
+    "multipliers": "`count = N` or `names = [...]`",
+    "matrices": "`M`, `K`, `C` as lists of rows (expressions, or numbers read at the model's "
+                "values), about the equilibrium of `[linearized]` or the one `modes` takes",
+    "frequencies": "one of `omega = [\"4.43 rad/s\"]`, `f = [...]` (Hz), `period = [...]` (s), any "
+                   "order; `zeta = [...]` damping ratios in ascending frequency",
+    "mode_shapes": "`shapes = [[1, 1], [1, -1]]`, one per mode in ascending frequency, any scale "
+                   "and sign",
+    "linearized": "`about = { theta = 0 }`, one equation per coordinate (any factor; in q or in "
+                  "its deviation from `about`)",
+    "equilibria": "`theta = [\"0\", \"pi\"]` positions, any order (several coordinates: the i-th "
+                  "entries make the i-th equilibrium)",
+}
+
+
 def _keys(keys) -> str:
     return ", ".join(f"`{k}`" for k in sorted(keys)) or "-"
 
@@ -63,10 +90,20 @@ def table() -> str:
     return "\n".join(lines) + "\n"
 
 
-def _readme_table() -> str:
+def answer_table() -> str:
+    """The README table of an answer file's tables, keys from the answer reader's schema."""
+    lines = ["| table | required keys | optional keys | meaning |", "|---|---|---|---|"]
+    for name, (required, optional) in answer_file_schema().items():
+        shown = "(top level)" if not name else f"`[{name}]`"
+        lines.append(f"| {shown} | {_keys(required)} | {_keys(optional)} | "
+                     f"{ANSWER_MEANINGS.get(name, '**undocumented**')} |")
+    return "\n".join(lines) + "\n"
+
+
+def _readme_table(begin: str = BEGIN, end: str = END) -> str:
     text = README.read_text(encoding="utf-8")
-    assert BEGIN in text and END in text, "README lost its model-keys markers"
-    return text.split(BEGIN, 1)[1].split(END, 1)[0].strip("\n") + "\n"
+    assert begin in text and end in text, f"README lost its markers {begin}"
+    return text.split(begin, 1)[1].split(end, 1)[0].strip("\n") + "\n"
 
 
 def test_every_table_of_the_reader_has_a_meaning():
@@ -79,7 +116,21 @@ def test_readme_lists_exactly_the_keys_the_reader_accepts():
         "python tests/test_readme_model_keys.py and paste the table between the markers")
 
 
+def test_every_table_of_the_answer_reader_has_a_meaning():
+    assert set(answer_file_schema()) == set(ANSWER_MEANINGS)
+
+
+def test_readme_lists_exactly_the_answer_keys_the_reader_accepts():
+    assert _readme_table(ANSWER_BEGIN, ANSWER_END) == answer_table(), (
+        "README's answer-file keys differ from model/answer.py: run "
+        "python tests/test_readme_model_keys.py and paste the table between the markers")
+
+
 if __name__ == "__main__":
     print(BEGIN)
     print(table(), end="")
     print(END)
+    print()
+    print(ANSWER_BEGIN)
+    print(answer_table(), end="")
+    print(ANSWER_END)

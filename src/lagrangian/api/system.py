@@ -27,6 +27,7 @@ from ..analysis.speed_form import SpeedForm, SpeedSweep, speed_form, speed_sweep
 from ..analysis.statics import StaticsReport, solve_statics
 from ..analysis.steady import steady_linear_model
 from ..check.diagnose import CheckReport, check_answer
+from ..check.final_answers import check_final_answers
 from ..check.newton_euler import CrosscheckReport, crosscheck
 from ..check.units import UnitsReport, check_model_units
 from ..compile.at_rest import AtRestFunctions
@@ -401,13 +402,20 @@ class System:
         dict ({"energy": {"V": "..."}}), or an Answer.
 
         Returns a CheckReport (``verdict``, ``findings`` with item, status, code, message,
-        expected); items written differently but equivalently are accepted.
+        expected); items written differently but equivalently are accepted. Final answers
+        (``[matrices]``, ``[frequencies]``, ``[mode_shapes]``, ``[linearized]``,
+        ``[generalized_forces]`` with ``at``, ``[equilibria]``) are compared with this system's
+        linearize, modes, generalized_forces_at and equilibria, numbers to their written precision.
         """
         if isinstance(answer, Mapping):
             answer = answer_from_mapping(answer, self._model, source="<answer>")
         elif not isinstance(answer, Answer):
             answer = read_answer(answer, self._model)
-        return check_answer(self.equations_of_motion(), answer)
+        report = check_answer(self.equations_of_motion(), answer)
+        if not answer.final_tables:
+            return report
+        # final answers (M, K, omega, shapes, ...) come from this system's own analysis
+        return replace(report, findings=report.findings + tuple(check_final_answers(self, answer)))
 
     def crosscheck(self) -> CrosscheckReport:
         """Newton-Euler (free bodies, reactions eliminated) vs Lagrange, coordinate by

@@ -2,9 +2,11 @@
 
 Tables: ``[energy]`` T, V, D; ``[generalized_forces]`` one entry per coordinate;
 ``[equations]`` one entry per coordinate, ``"lhs = rhs"`` or an expression equal to zero;
-``[multipliers]`` ``count`` or ``names``. Names that the model does not know (a reaction force
-``N``, a tension ``T_rod``) are kept as *foreign symbols*, so the checker can say why they do
-not belong, instead of failing to parse.
+``[multipliers]`` ``count`` or ``names``; the final answers (``[matrices]``, ``[frequencies]``,
+``[mode_shapes]``, ``[linearized]``, ``[generalized_forces]`` with ``at``, ``[equilibria]``) are
+kept as written here and read where they are checked (check/final_reading.py). Names that the
+model does not know (a reaction force ``N``, a tension ``T_rod``) are kept as *foreign symbols*,
+so the checker can say why they do not belong, instead of failing to parse.
 """
 
 from __future__ import annotations
@@ -22,8 +24,31 @@ from .model import Model, multiplier_name
 from .reader import check_known_keys, load_toml, read_text_file
 from .tokens import plain_names
 
-TABLES = ("energy", "generalized_forces", "equations", "multipliers")
+# Final answers: results to compare with the analysis (check/final_answers.py).
+FINAL_TABLES = ("matrices", "frequencies", "mode_shapes", "linearized", "equilibria")
+MATRICES = ("M", "K", "C")
+FREQUENCY_KEYS = ("omega", "f", "period", "zeta")
+TABLES = ("energy", "generalized_forces", "equations", "multipliers", *FINAL_TABLES,
+          "coordinates")
 _FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+ENERGY_KEYS = ("T", "V", "D")
+MULTIPLIER_KEYS = ("count", "names")
+
+
+def answer_file_schema() -> dict[str, tuple[frozenset[str], frozenset[str]]]:
+    """Every key the answer reader accepts: table -> (required keys, optional keys); "" is the
+    top level, "<coordinate>" any coordinate's name. The README's table is checked against it."""
+    none, coordinate = frozenset(), frozenset({"<coordinate>"})
+    return {"": (none, frozenset(TABLES)),
+            "energy": (none, frozenset(ENERGY_KEYS)),
+            "generalized_forces": (none, coordinate | {"at"}),
+            "equations": (none, coordinate),
+            "multipliers": (none, frozenset(MULTIPLIER_KEYS)),
+            "matrices": (none, frozenset(MATRICES)),
+            "frequencies": (none, frozenset(FREQUENCY_KEYS)),
+            "mode_shapes": (frozenset({"shapes"}), none),
+            "linearized": (frozenset({"about"}), coordinate),
+            "equilibria": (none, coordinate)}
 
 
 @dataclass(frozen=True)
@@ -40,6 +65,9 @@ class Answer:
     multiplier_names: tuple[str, ...] | None = None
     # item ("T", "Q[theta]", "equation[x]") -> names the model does not declare
     foreign: tuple[tuple[str, frozenset[sp.Symbol]], ...] = field(default=())
+    # The final-answer tables as written (matrices, frequencies, mode_shapes, linearized,
+    # generalized_forces with `at`, equilibria, coordinates): read where they are checked.
+    final_tables: tuple[tuple[str, object], ...] = ()
 
     def foreign_symbols(self, item: str) -> frozenset[sp.Symbol]:
         return dict(self.foreign).get(item, frozenset())
@@ -49,7 +77,8 @@ class Answer:
         return (self.kinetic_energy is None and self.potential_energy is None
                 and self.dissipation is None and not self.generalized_forces
                 and not self.equations and self.multiplier_count is None
-                and self.multiplier_names is None)
+                and self.multiplier_names is None
+                and all(key == "coordinates" for key, _ in self.final_tables))
 
 
 def answer_names(model: Model) -> dict[str, sp.Expr]:
@@ -96,15 +125,20 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
         return parse_expression(value, scope, field=field, source=source)
 
     energy = _table(data, "energy", source)
-    check_known_keys(energy, ("T", "V", "D"), "energy", source)
+    check_known_keys(energy, ENERGY_KEYS, "energy", source)
     values = {key: expression(energy[key], f"energy.{key}", key) for key in energy}
 
     forces = _table(data, "generalized_forces", source)
-    check_known_keys(forces, coordinates, "generalized_forces", source, what="coordinate")
-    generalized = tuple(
-        (name, expression(forces[name], f"generalized_forces.{name}", f"Q[{name}]"))
-        for name in coordinates if name in forces
-    )
+    generalized: tuple[tuple[str, sp.Expr], ...] = ()
+    if "at" not in forces:  # with `at`, values at a configuration: a final answer
+        check_known_keys(forces, coordinates, "generalized_forces", source, what="coordinate")
+        generalized = tuple(
+            (name, expression(forces[name], f"generalized_forces.{name}", f"Q[{name}]"))
+            for name in coordinates if name in forces
+        )
+    final = tuple((key, data[key]) for key in (*FINAL_TABLES, "coordinates") if key in data)
+    if "at" in forces:
+        final += (("generalized_forces", forces),)
 
     table = _table(data, "equations", source)
     check_known_keys(table, coordinates, "equations", source, what="coordinate")
@@ -126,7 +160,7 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
 
     count, multiplier_names = None, None
     multipliers = _table(data, "multipliers", source)
-    check_known_keys(multipliers, ("count", "names"), "multipliers", source)
+    check_known_keys(multipliers, MULTIPLIER_KEYS, "multipliers", source)
     if "count" in multipliers:
         count = multipliers["count"]
         if isinstance(count, bool) or not isinstance(count, int) or count < 0:
@@ -151,10 +185,13 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
         multiplier_count=count,
         multiplier_names=multiplier_names,
         foreign=tuple(sorted(foreign.items(), key=lambda kv: kv[0])),
+        final_tables=final,
     )
     if answer.is_empty:
         raise ModelError("the answer has nothing to check: give [energy] T/V/D, "
-                         "[generalized_forces], [equations] or [multipliers]", source=source)
+                         "[generalized_forces], [equations], [multipliers], [matrices], "
+                         "[frequencies], [mode_shapes], [linearized] or [equilibria]",
+                         source=source)
     return answer
 
 

@@ -106,7 +106,7 @@ _SUPERSCRIPTS = {"\u2070": "0", "\u00b9": "1", "\u00b2": "2", "\u00b3": "3",
 _FRACTIONS = {c: str(Fraction(unicodedata.numeric(c)).limit_denominator(10))
               for c in "\u00bd\u2153\u2154\u00bc\u00be\u2155\u2156\u2157\u2158\u2159"
                        "\u215a\u2150\u215b\u215c\u215d\u215e\u2151\u2152"}
-_OPERATORS = {"\u00b7": "*", "\u22c5": "*", "\u2219": "*", "\u00d7": "*", "\u2715": "*",
+_OPERATORS = {"\u00b7": "*", "\u22c5": "*", "\u2217": "*", "\u2219": "*", "\u00d7": "*", "\u2715": "*",
               "\u2212": "-", "\u2013": "-", "\u2010": "-", "\u2012": "-", "\u00f7": "/",
               "\u2215": "/", "\u2044": "/"}
 _MARKS = {"\u0307": 1, "\u0308": 2}  # a dot above: the rate (theta_dot); two: theta_ddot
@@ -135,7 +135,7 @@ def _unicode_tokens(text: str, position: int, match, fail):
             while end < len(text) and text[end] in _SUPERSCRIPTS:
                 end += 1
             return _power(text, position, end, fail), end
-        if char in _REFUSED or unicodedata.combining(char):
+        if not char.isascii() and not char.isspace():
             raise fail(f"cannot parse {_at(text, position)} at column {position + 1}: "
                        f"{_refusal(char)}")
         return None
@@ -196,6 +196,10 @@ def _spelled_name(text: str, start: int, end: int, fail) -> list[tuple[str, str,
     index = 0
     while index < len(spelling):
         char = spelling[index]
+        folded = unicodedata.normalize("NFKC", char)  # a mathematical italic 𝜃, a fullwidth ｍ
+        if folded != char and len(folded) == 1 and char not in _SUBSCRIPTS and (
+                folded in _GREEK or folded.isascii() and folded.isalpha()):
+            char = folded
         if char in _SUPERSCRIPTS:
             stop = index
             while stop < len(spelling) and spelling[stop] in _SUPERSCRIPTS:

@@ -60,6 +60,9 @@ def class_text(report: ClassReport) -> str:
     for row, result in zip(rows, report.results, strict=True):
         findings = row["findings"] if result.report is not None else f"error: {summary(result)}"
         lines.append(f"  {row['file']:<{width}}  {row['verdict']:<10}  {findings}")
+        if report.hints_only and result.report is not None:  # the question, once per finding
+            lines += [f"      {f.item}: {f.message}" for f in result.report.findings
+                      if f.status != "correct"]
     lines.append(", ".join(f"{n} {v}" for v, n in report.counts.items()))
     return "\n".join(lines) + "\n"
 

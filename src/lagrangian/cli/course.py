@@ -6,8 +6,8 @@ from pathlib import Path
 
 import typer
 
+from ..check.course import course_document, course_folder, course_lessons
 from ..errors import ModelError
-from ..model.course import course_document, course_folder, course_lessons
 from ..model.examples import example_path
 from .common import print_json
 

@@ -6,9 +6,15 @@ from __future__ import annotations
 import keyword
 import re
 import unicodedata
-from fractions import Fraction
 
 from ..errors import ModelError
+from ..spelling import FRACTIONS as _FRACTIONS
+from ..spelling import GREEK as _GREEK
+from ..spelling import MARKS as _MARKS
+from ..spelling import OPERATORS as _OPERATORS
+from ..spelling import REFUSED as _REFUSED
+from ..spelling import SUBSCRIPTS as _SUBSCRIPTS
+from ..spelling import SUPERSCRIPTS as _SUPERSCRIPTS
 
 # -- quoting ------------------------------------------------------------------------------
 
@@ -89,36 +95,6 @@ def _tokens(text: str, fail):
 
 # -- what students type: Unicode spellings read as the grammar's ASCII names --------------------
 
-# Greek letters by their ASCII names (theta, Omega); variants and the micro sign as their letter.
-_GREEK = {chr(0x3B1 + i): name for i, name in enumerate(
-    "alpha beta gamma delta epsilon zeta eta theta iota kappa lambda mu nu xi omicron pi rho "
-    "sigma sigma tau upsilon phi chi psi omega".split())}
-_GREEK.update({letter.upper(): name.capitalize() for letter, name in _GREEK.items()
-               if letter != "\u03c2"})
-_GREEK.update({"\u03d1": "theta", "\u03d5": "phi", "\u03f5": "epsilon", "\u03f1": "rho",
-               "\u03d6": "pi", "\u00b5": "mu"})
-_SUBSCRIPTS = {chr(0x2080 + d): str(d) for d in range(10)}
-_SUBSCRIPTS.update({c: f"_{letter}" for c, letter in zip(
-    "\u2090\u2091\u2092\u2093\u2095\u2096\u2097\u2098\u2099\u209a\u209b\u209c"
-    "\u1d62\u2c7c\u1d63\u1d64\u1d65", "aeoxhklmnpstijruv", strict=True)})
-_SUPERSCRIPTS = {"\u2070": "0", "\u00b9": "1", "\u00b2": "2", "\u00b3": "3",
-                 **{chr(0x2070 + d): str(d) for d in range(4, 10)}, "\u207b": "-", "\u207a": "+"}
-_FRACTIONS = {c: str(Fraction(unicodedata.numeric(c)).limit_denominator(10))
-              for c in "\u00bd\u2153\u2154\u00bc\u00be\u2155\u2156\u2157\u2158\u2159"
-                       "\u215a\u2150\u215b\u215c\u215d\u215e\u2151\u2152"}
-_OPERATORS = {"\u00b7": "*", "\u22c5": "*", "\u2217": "*", "\u2219": "*", "\u00d7": "*", "\u2715": "*",
-              "\u2212": "-", "\u2013": "-", "\u2010": "-", "\u2012": "-", "\u00f7": "/",
-              "\u2215": "/", "\u2044": "/"}
-_MARKS = {"\u0307": 1, "\u0308": 2}  # a dot above: the rate (theta_dot); two: theta_ddot
-# Characters refused with the ASCII spelling to use instead.
-_REFUSED = {
-    "\u2032": "a prime is not read: write theta_dot for a rate",
-    "\u2033": "a double prime is not read: write theta_ddot for an acceleration",
-    "\u221a": "write sqrt(...) for a square root",
-    "\u2202": "write the derivative out (the answer holds expressions, not operators)",
-    "\u00b0": "write an angle in radians (30 degrees is 30*pi/180)",
-    "\u221e": "infinity is not a value",
-}
 _WORD = re.compile(r"\w")
 
 
@@ -131,9 +107,7 @@ def _unicode_tokens(text: str, position: int, match, fail):
         if char in _OPERATORS:
             return [("op", _OPERATORS[char], position, position + 1)], position + 1
         if char in _SUPERSCRIPTS:
-            end = position
-            while end < len(text) and text[end] in _SUPERSCRIPTS:
-                end += 1
+            end = _superscripts_end(text, position)
             return _power(text, position, end, fail), end
         if not char.isascii() and not char.isspace():
             raise fail(f"cannot parse {_at(text, position)} at column {position + 1}: "
@@ -157,17 +131,22 @@ def _refusal(char: str) -> str:
     return f"unexpected character {char!r}{f' ({name})' if name else ''}: {hint}"
 
 
+def _superscripts_end(text: str, position: int) -> int:
+    while position < len(text) and text[position] in _SUPERSCRIPTS:
+        position += 1
+    return position
+
+
 def _power(text: str, start: int, end: int, fail) -> list[tuple[str, str, int, int]]:
     """A run of superscripts (², ⁻¹) as ** and its exponent."""
     run = "".join(_SUPERSCRIPTS[c] for c in text[start:end])
-    sign, digits = (run[0], run[1:]) if run[0] in "+-" else ("", run)
+    digits = run[1:] if run[0] in "+-" else run
     if not digits.isdigit():
         raise fail(f"cannot parse {_at(text, start)} at column {start + 1}: the superscript "
                    f"{text[start:end]!r} is not a power (write **2 or **(-1))")
-    if not sign:
-        return [("op", "**", start, end), ("number", digits, start, end)]
-    return [("op", "**", start, end), ("op", "(", start, end), ("op", sign, start, end),
-            ("number", digits, start, end), ("op", ")", start, end)]
+    signed = [("(", "op"), (run[0], "op"), (digits, "number"), (")", "op")]
+    return [("op", "**", start, end), *((kind, value, start, end) for value, kind in (
+        signed if digits != run else [(digits, "number")]))]
 
 
 def _spelled_name(text: str, start: int, end: int, fail) -> list[tuple[str, str, int, int]]:
@@ -176,21 +155,17 @@ def _spelled_name(text: str, start: int, end: int, fail) -> list[tuple[str, str,
     tokens: list[tuple[str, str, int, int]] = []
     name, dots = "", 0
 
+    def refuse(reason: str) -> ModelError:
+        return fail(f"cannot parse {_at(text, start)} at column {start + 1}: {reason}")
+
     def flush() -> None:
         nonlocal name, dots
-        if not name:
-            return
-        spelled = name + ("_dot" if dots == 1 else "_ddot" if dots == 2 else "")
+        spelled = name + ("", "_dot", "_ddot")[dots]
         if keyword.iskeyword(spelled):
-            raise fail(f"cannot parse {_at(text, start)} at column {start + 1}: "
-                       f"{text[start:end]!r} is read as {spelled!r}, a reserved word (a "
-                       f"multiplier is lambda_<constraint>, e.g. lambda_rod)")
-        tokens.append(("name", spelled, start, end))
+            raise refuse(f"{text[start:end]!r} is read as {spelled!r}, a reserved word (a "
+                         "multiplier is lambda_<constraint>, e.g. lambda_rod)")
+        tokens.extend([("name", spelled, start, end)] if name else [])
         name, dots = "", 0
-
-    def directly_after(what: str, char: str) -> ModelError:
-        return fail(f"cannot parse {_at(text, start)} at column {start + 1}: {what} is directly "
-                    f"followed by {char!r} (write * to multiply)")
 
     spelling = unicodedata.normalize("NFD", text[start:end])
     index = 0
@@ -201,44 +176,37 @@ def _spelled_name(text: str, start: int, end: int, fail) -> list[tuple[str, str,
                 folded in _GREEK or folded.isascii() and folded.isalpha()):
             char = folded
         if char in _SUPERSCRIPTS:
-            stop = index
-            while stop < len(spelling) and spelling[stop] in _SUPERSCRIPTS:
-                stop += 1
+            stop = _superscripts_end(spelling, index)
             flush()  # a power with nothing before it in the spelling raises what precedes it
             tokens += _power(spelling, index, stop, fail)
             if stop < len(spelling):
-                raise directly_after(f"the power {spelling[index:stop]!r}", spelling[stop])
+                raise refuse(f"the power {spelling[index:stop]!r} is directly followed by "
+                             f"{spelling[stop]!r} (write * to multiply)")
             index = stop
             continue
         if char in _FRACTIONS:
             if name or index + 1 < len(spelling):
-                raise fail(f"cannot parse {_at(text, start)} at column {start + 1}: {char!r} "
-                           f"touches a name (write {_FRACTIONS[char]}*... to multiply)")
+                raise refuse(f"{char!r} touches a name (write {_FRACTIONS[char]}*... to multiply)")
             numerator, _, denominator = _FRACTIONS[char].partition("/")
             tokens += [("op", "(", start, end), ("number", numerator, start, end),
                        ("op", "/", start, end), ("number", denominator, start, end),
                        ("op", ")", start, end)]
-        elif char.isascii() and (char.isalnum() or char == "_"):
+        elif char in _GREEK or char.isascii() and (char.isalnum() or char == "_"):
             if tokens and not name:
-                raise directly_after(repr(text[start:end]), char)
-            name += char
-        elif char in _GREEK:
-            if tokens and not name:
-                raise directly_after(repr(text[start:end]), char)
-            name += _GREEK[char]
+                raise refuse(f"{text[start:end]!r} is directly followed by {char!r} (write * "
+                             "to multiply)")
+            name += _GREEK.get(char, char)
         elif char in _SUBSCRIPTS and name:
             name += _SUBSCRIPTS[char]
         elif char in _MARKS and name:
             dots += _MARKS[char]
             if dots > 2:
-                raise fail(f"cannot parse {_at(text, start)} at column {start + 1}: only a "
-                           "rate (one dot, theta_dot) and an acceleration (two, theta_ddot) "
-                           "are read")
+                raise refuse("only a rate (one dot, theta_dot) and an acceleration (two, "
+                             "theta_ddot) are read")
         else:
             shown = unicodedata.normalize("NFC", spelling[index - 1:index + 1]) \
                 if index and unicodedata.combining(char) else char
-            raise fail(f"cannot parse {_at(text, start)} at column {start + 1}: "
-                       f"{_refusal(shown)}")
+            raise refuse(_refusal(shown))
         index += 1
     flush()
     return tokens

@@ -70,19 +70,19 @@ def class_text(report: ClassReport) -> str:
 def check_class_csv_path(path: str | Path, *, inputs: tuple[Path, ...] = ()) -> Path:
     """The --csv path, checked before any work: writable, not a directory, not an input, and
     either new or a class CSV that check wrote before (its header is RECORD_KEYS)."""
-    path = check_output_path(path, "--csv", inputs=inputs)
+    path = check_output_path(path, "csv", inputs=inputs)
     if path.is_symlink():
         raise ModelError(f"{path} is a symbolic link: refusing to write through it",
-                         field="--csv")
+                         field="csv")
     if path.exists():
         try:
             with open(path, encoding="utf-8", errors="replace") as handle:
                 first = handle.readline(400).strip()
         except OSError as exc:
-            raise ModelError(f"cannot read {path}: {exc.strerror or exc}", field="--csv") from None
+            raise ModelError(f"cannot read {path}: {exc.strerror or exc}", field="csv") from None
         if first != ",".join(RECORD_KEYS):
             raise ModelError(f"{path} exists and is not a class table written by check: "
-                             "refusing to overwrite it", field="--csv")
+                             "refusing to overwrite it", field="csv")
     return path
 
 

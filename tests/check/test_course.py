@@ -12,8 +12,8 @@ from pathlib import Path
 import pytest
 
 import lagrangian
+from lagrangian.check.course import course_folder, course_lessons
 from lagrangian.check.hints import HINTS
-from lagrangian.model.course import course_folder, course_lessons
 
 ROOT = Path(__file__).resolve().parents[2]
 LESSONS = course_lessons()

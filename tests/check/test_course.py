@@ -64,7 +64,7 @@ def test_examples_course_lists_json_and_copies(cli, tmp_path):
     target = tmp_path / "course"
     assert cli("examples", "--course", "--copy", str(target)).code == 0
     code, out, _ = cli("check", str(target / "multipliers" / "model.toml"),
-                       str(target / "multipliers"))
+                       str(target / "multipliers" / "answers"))
     assert code == 1 and "multiplier_count" in out and "1 correct, 1 incorrect" in out
     # never over an existing folder's files
     code, _, err = cli("examples", "--course", "--copy", str(target))

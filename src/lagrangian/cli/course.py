@@ -18,7 +18,7 @@ def course_command(json_: bool, copy: str | None) -> None:
         typer.echo(f"wrote {len(written)} files of the teaching set to {copy}")
         typer.echo(f"check a lesson's answers with, e.g.: lagrangian check "
                    f"{Path(copy) / 'worked_example_1' / 'model.toml'} "
-                   f"{Path(copy) / 'worked_example_1'}")
+                   f"{Path(copy) / 'worked_example_1' / 'answers'}")
         return
     if json_:
         print_json(course_document())
@@ -40,8 +40,8 @@ def course_command(json_: bool, copy: str | None) -> None:
 
 
 def copy_course(target: Path) -> list[Path]:
-    """Write each lesson's folder (model.toml, the built-in model, and its answer files) into
-    ``target``, a new or empty folder; nothing is overwritten."""
+    """Write each lesson's folder (model.toml, the built-in model, and answers/ with its answer
+    files) into ``target``, a new or empty folder; nothing is overwritten."""
     from ..output.files import atomic_write, check_output_path
 
     if target.exists() and (not target.is_dir() or any(target.iterdir())):
@@ -54,6 +54,6 @@ def copy_course(target: Path) -> list[Path]:
         written.append(atomic_write(folder / "model.toml",
                                     example_path(lesson.model).read_text(encoding="utf-8")))
         for answer in lesson.answers:
-            written.append(atomic_write(folder / answer.file,
+            written.append(atomic_write(folder / "answers" / answer.file,
                                         lesson.answer_path(answer).read_text(encoding="utf-8")))
     return written

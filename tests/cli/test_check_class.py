@@ -113,3 +113,15 @@ def test_hints_only_show_no_expected_expression(cli):
             assert "expected:" not in shown
             assert not any(e in shown for e in expected), (answer, expected)
         assert all(f["expected"] is None for f in json.loads(document)["findings"])
+
+
+def test_one_unreadable_file_under_json_is_a_document_and_an_error_line(cli, tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[energy]\nW = "m"\n')
+    code, out, err = cli("check", "pendulum", str(bad), "--json")
+    assert code == 2 and err.startswith("error: ") and err.count("\n") == 1
+    document = json.loads(out)
+    assert document["verdict"] == "unreadable" and document["findings"] == []
+    assert "unknown key 'W'" in document["error"] and "bad.toml" in document["error"]
+    code, out, _ = cli("check", "pendulum", str(bad))  # text: today's error line only
+    assert code == 2 and out == ""

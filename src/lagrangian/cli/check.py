@@ -15,6 +15,7 @@ from typing import Annotated
 
 import typer
 
+from ..errors import LagrangianError
 from . import app
 from .common import LOCK_HELP, SET_HELP, load_system, print_json
 
@@ -61,7 +62,13 @@ def check(
         check_class_csv_path(csv, inputs=inputs)
     system = load_system(model, set_, lock)
     if single:
-        report = system.check(answers[0], hints_only=hints_only)
+        system.equations_of_motion()  # the model's own faults stay errors without a document
+        try:
+            report = system.check(answers[0], hints_only=hints_only)
+        except LagrangianError as exc:
+            if json_:  # a script reading the JSON gets a document, not an empty stdout
+                print_json({"verdict": "unreadable", "findings": [], "error": str(exc)})
+            raise
         if csv is not None:
             write_class_csv(ClassReport(system.name, (AnswerResult(answers[0], report),),
                                         hints_only), csv, inputs=inputs)

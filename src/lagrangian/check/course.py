@@ -22,6 +22,8 @@ class CourseAnswer:
 
 @dataclass(frozen=True)
 class Lesson:
+    """One lesson of the teaching set: its model (a built-in example), task and answer files."""
+
     name: str
     title: str
     model: str  # a built-in example's name

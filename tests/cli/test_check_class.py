@@ -125,3 +125,18 @@ def test_one_unreadable_file_under_json_is_a_document_and_an_error_line(cli, tmp
     assert "unknown key 'W'" in document["error"] and "bad.toml" in document["error"]
     code, out, _ = cli("check", "pendulum", str(bad))  # text: today's error line only
     assert code == 2 and out == ""
+
+
+def test_a_class_with_hints_only_prints_each_question_under_its_row(cli, klass):
+    code, out, _ = cli("check", "pendulum", str(klass), "--hints-only")
+    assert code == 1 and "(hints only)" in out.splitlines()[0]
+    assert "      V: Does V increase as the body rises?" in out
+    assert "cos(theta)" not in out  # neither the expected V nor any term of it
+
+
+def test_one_file_with_csv_writes_its_records(cli, klass, tmp_path):
+    table = tmp_path / "one.csv"
+    code, out, _ = cli("check", "pendulum", str(klass / "b.toml"), "--csv", str(table))
+    assert code == 1 and out.startswith("Checking ")  # today's text, and the table beside it
+    rows = list(csv.DictReader(table.open()))
+    assert [r["code"] for r in rows] == ["", "potential_sign"]

@@ -6,13 +6,36 @@ import difflib
 from collections.abc import Iterable
 
 
-def did_you_mean(name: str, known: Iterable[str]) -> str:
-    """"; did you mean 'x'?" naming the known name closest to ``name``, or "" when none is close.
+def closest_name(name: str, known: Iterable[str]) -> str | None:
+    """The known name closest to ``name`` (difflib, ignoring case), or None when none is close.
     A name that differs only in case ('l' for 'L') is the closest of all."""
     known = list(known)
     same_but_case = [k for k in known if k.lower() == name.lower()]
-    close = same_but_case or difflib.get_close_matches(name, known, n=1)
-    return f"; did you mean '{close[0]}'?" if close else ""
+    if same_but_case:
+        return same_but_case[0]
+    lowered: dict[str, str] = {}
+    for k in known:
+        lowered.setdefault(k.lower(), k)
+    close = difflib.get_close_matches(name.lower(), lowered, n=1)
+    return lowered[close[0]] if close else None
+
+
+def misspelled(label: str | None, names: Iterable[str], known: Iterable[str]) -> str:
+    """"V uses L1, which the model does not declare; did you mean l1?" when some of ``names``
+    are close to ``known`` ones (closest_name), else ""."""
+    known = list(known)
+    close = {name: closest_name(name, known) for name in sorted(names)}
+    if not any(close.values()):
+        return ""
+    means = ", ".join(c for c in close.values() if c)
+    return f"{label} uses {', '.join(close)}, which the model does not declare; did you mean {means}?"
+
+
+def did_you_mean(name: str, known: Iterable[str]) -> str:
+    """"; did you mean 'x'?" naming the known name closest to ``name`` (closest_name), or ""
+    when none is close."""
+    close = closest_name(name, known)
+    return f"; did you mean '{close}'?" if close else ""
 
 
 def did_you_mean_or_list(name: str, known: Iterable[str], most: int = 24) -> str:

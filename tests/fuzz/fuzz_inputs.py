@@ -50,6 +50,13 @@ HOSTILE_EXPRESSIONS = [
     "1/(x - x)", "sinh(exp(7))", "(2*theta)^0.123456789",
 ]
 
+# What students type (issue 20): Unicode spellings read as ASCII names, or refused with a hint;
+# combining marks, superscripts and fractions in every position, and look-alikes.
+UNICODE_PIECES = ["θ", "θ̇", "θ̈", "θ̇̇̇", "ẋ", "ẍ₁", "½", "¾", "²", "⁻¹", "⁻", "⁺²", "·", "×", "−", "÷",
+                  "′", "″", "°", "√", "∂", "λ", "λ_rod", "ω", "ωₙ", "φ", "Ω", "π", "µ", "x̂", "é",
+                  "\u0307", "\u0308", "\u20db", "₁", "ₙ", "\u00a0", "\u200b", "\u202e", "ｍ",
+                  "а", "ⁿ", "⅟", "𝜃", "ǅ"]
+
 UNIT_NAMES = ["m", "kg", "s", "rad", "deg", "N", "J", "W", "pi", "degC", "g", "km", "foo",
               "meter", "radian", "revolution", "percent", "dimensionless", "µm", "°"]
 UNIT_OPS = ["*", "/", "^", "**", " ", "·", "(", ")", "-", "."]
@@ -98,6 +105,16 @@ def _expressions(names: tuple[str, ...]) -> st.SearchStrategy[str]:
     spliced = st.tuples(grammar, st.sampled_from(JUNK), st.integers(0, 10**6)).map(
         lambda t: t[0][: t[2] % (len(t[0]) + 1)] + t[1] + t[0][t[2] % (len(t[0]) + 1):])
     return st.one_of(grammar, grammar, spliced, st.text(max_size=40))
+
+
+def unicode_expressions() -> st.SearchStrategy[str]:
+    """Grammar text with Unicode spellings spliced in, and runs of the pieces alone."""
+    spliced = st.tuples(expressions(), st.lists(st.sampled_from(UNICODE_PIECES), min_size=1,
+                                                max_size=4), st.integers(0, 10**6)).map(
+        lambda t: t[0][: t[2] % (len(t[0]) + 1)] + "".join(t[1]) + t[0][t[2] % (len(t[0]) + 1):])
+    alone = st.lists(st.one_of(st.sampled_from(UNICODE_PIECES), st.sampled_from(NAMES),
+                               st.sampled_from(BINARY)), min_size=1, max_size=12).map("".join)
+    return st.one_of(spliced, alone)
 
 
 def unit_strings() -> st.SearchStrategy[str]:

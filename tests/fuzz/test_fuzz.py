@@ -19,6 +19,7 @@ from fuzz_inputs import (
     read_expression,
     read_model_text,
     run_input,
+    unicode_expressions,
     unit_strings,
 )
 from hypothesis import HealthCheck, given, settings
@@ -48,6 +49,13 @@ def check(outcome, text):
 @fuzz(1000)
 @given(expressions())
 def test_expressions(text):
+    check(run_input(lambda: read_expression(text), 5.0), text)
+
+
+@fuzz(400)
+@given(unicode_expressions())
+def test_unicode_spellings(text):
+    """θ̇, ½, ², ⁻¹, · and their misuses: accepted and printed back, or refused in one line."""
     check(run_input(lambda: read_expression(text), 5.0), text)
 
 

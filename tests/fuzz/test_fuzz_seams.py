@@ -18,6 +18,7 @@ from fuzz_seams import (
     contact_models,
     contract,
     named_model,
+    run_cli,
     special_names,
     steady_models,
     urdf_files,
@@ -167,6 +168,25 @@ def test_answer_files_check(text, folder):
     path.write_text(text, encoding="utf-8")
     outcome = contract(["check", "pendulum", str(path), "--json"], 30.0, verdicts=(0, 1))
     check(outcome, text, "check")
+
+
+@fuzz(25)
+@given(texts=st.lists(answer_files(), min_size=1, max_size=4))
+def test_a_class_of_answer_files_is_always_a_document(texts, folder):
+    """`check MODEL FOLDER --json` (issue 20): whatever the files hold, a JSON document with a
+    record for every file (an unreadable one: its error), never a traceback or empty stdout."""
+    import json
+    import uuid
+
+    klass = folder / f"class-{uuid.uuid4().hex}"
+    klass.mkdir()
+    for i, text in enumerate(texts):
+        (klass / f"student_{i}.toml").write_text(text, encoding="utf-8")
+    out = run_cli(["check", "pendulum", str(klass), "--json"], verdicts=(0, 1, 2))
+    document = json.loads(out)
+    files = {record["file"] for record in document["records"]}
+    assert files == {str(klass / f"student_{i}.toml") for i in range(len(texts))}
+    assert all(r["error"] for r in document["records"] if r["verdict"] == "unreadable")
 
 
 # -- the bigger run (still in CI, marked slow) ------------------------------------------------

@@ -10,6 +10,8 @@ from ..analysis.linearization import LinearModel, SymbolicLinearModel
 from ..analysis.modes import ModalAnalysis, Mode
 from ..analysis.speed_form import SpeedForm, SpeedSweep
 from ..analysis.statics import StaticsReport
+from ..check.classroom import AnswerResult, ClassReport
+from ..check.course import Lesson, course_lessons
 from ..check.diagnose import CheckReport, Finding
 from ..check.newton_euler import CoordinateAgreement, CrosscheckReport, Reaction
 from ..check.units import UnitIssue, UnitsReport
@@ -37,6 +39,7 @@ __all__ = [
     # entry points
     "System",
     "SystemBuilder",
+    "course_lessons",
     "examples",
     "load",
     "parse_model",
@@ -56,7 +59,9 @@ __all__ = [
     "StepControl",
     "StopCondition",
     # what it returns
+    "AnswerResult",
     "CheckReport",
+    "ClassReport",
     "CoordinateAgreement",
     "CrosscheckReport",
     "Dynamics",
@@ -66,6 +71,7 @@ __all__ = [
     "Finding",
     "ForceReport",
     "LinearModel",
+    "Lesson",
     "LoadContribution",
     "ModalAnalysis",
     "Mode",

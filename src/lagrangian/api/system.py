@@ -26,8 +26,10 @@ from ..analysis.modes import ModalAnalysis, is_stable, modal_analysis
 from ..analysis.speed_form import SpeedForm, SpeedSweep, speed_form, speed_sweep
 from ..analysis.statics import StaticsReport, solve_statics
 from ..analysis.steady import steady_linear_model
+from ..check.classroom import ClassReport, check_class
 from ..check.diagnose import CheckReport, check_answer
 from ..check.final_answers import check_final_answers
+from ..check.hints import hinted
 from ..check.newton_euler import CrosscheckReport, crosscheck
 from ..check.units import UnitsReport, check_model_units
 from ..compile.at_rest import AtRestFunctions
@@ -397,7 +399,7 @@ class System:
 
     # -- checking a hand derivation: check, crosscheck, check_units --------------------------------
 
-    def check(self, answer) -> CheckReport:
+    def check(self, answer, *, hints_only: bool = False) -> CheckReport:
         """Verdicts and diagnoses on a hand derivation: a path to ANSWER.toml, its tables as a
         dict ({"energy": {"V": "..."}}), or an Answer.
 
@@ -406,16 +408,28 @@ class System:
         (``[matrices]``, ``[frequencies]``, ``[mode_shapes]``, ``[linearized]``,
         ``[generalized_forces]`` with ``at``, ``[equilibria]``) are compared with this system's
         linearize, modes, generalized_forces_at and equilibria, numbers to their written precision.
+        ``hints_only``: no expected expression or value, the module's diagnostic question instead.
         """
         if isinstance(answer, Mapping):
             answer = answer_from_mapping(answer, self._model, source="<answer>")
         elif not isinstance(answer, Answer):
             answer = read_answer(answer, self._model)
         report = check_answer(self.equations_of_motion(), answer)
-        if not answer.final_tables:
-            return report
-        # final answers (M, K, omega, shapes, ...) come from this system's own analysis
-        return replace(report, findings=report.findings + tuple(check_final_answers(self, answer)))
+        if answer.final_tables:
+            # final answers (M, K, omega, shapes, ...) come from this system's own analysis
+            report = replace(report, findings=report.findings
+                             + tuple(check_final_answers(self, answer)))
+        return hinted(report) if hints_only else report
+
+    def check_many(self, answers, *, hints_only: bool = False) -> ClassReport:
+        """Grade a class: every answer file named in ``answers`` (paths, globs, folders of
+        *.toml, or one such name) checked against this model, derived once. A file that cannot
+        be read is a result with its error. Returns a ClassReport (``results``, ``counts``,
+        ``records()`` one per file per item, ``csv_text()``; a table in a notebook)."""
+        named = [answers] if isinstance(answers, str | Path) else list(answers)
+        return check_class(self.equations_of_motion(), named, hints_only=hints_only,
+                           exclude=[self._model.source] if self._model.source else [],
+                           final=lambda answer: check_final_answers(self, answer))
 
     def crosscheck(self) -> CrosscheckReport:
         """Newton-Euler (free bodies, reactions eliminated) vs Lagrange, coordinate by

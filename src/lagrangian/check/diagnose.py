@@ -15,7 +15,8 @@ import sympy as sp
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import time_rate
 from ..derivation.virtual_work import DISSIPATION_LOAD, GIVEN_LOAD
-from ..model.answer import Answer
+from ..errors import misspelled
+from ..model.answer import Answer, answer_names
 from ..model.expressions import as_expression
 from ..model.expressions import format_expression as fmt
 from ..model.model import Damper, Model, PointForce, Torque
@@ -289,6 +290,9 @@ class _Checker:
         Q = self.eom.generalized_forces[i]
         expected = fmt(eq.display(Q))
         foreign = self.answer.foreign_symbols(item)
+        if self._misspelled(foreign):
+            return [Finding(item, "wrong", "equation_wrong", self._misspelled(foreign, item),
+                            expected)]
         if foreign:
             listed = ", ".join(sorted(map(str, foreign)))
             stripped = Q_user.xreplace({s: 0 for s in foreign})
@@ -392,6 +396,11 @@ class _Checker:
                 if not extra:
                     continue
                 i = self.names.index(name)
+                if self._misspelled(extra):  # a typo of a declared name, not a reaction
+                    findings.append(Finding(item, "wrong", "equation_wrong",
+                                            self._misspelled(extra, "the equation"),
+                                            self._expected(i)))
+                    continue
                 stripped = value.xreplace({s: 0 for s in extra})
                 rest = (" Without them the equation matches ours."
                         if self._multiple(stripped, ours[i]) is not None else "")
@@ -581,9 +590,14 @@ class _Checker:
             return []
         listed = ", ".join(sorted(map(str, foreign)))
         return [Finding(item, "wrong", "equation_wrong",
-                        f"{label} uses {listed}, which the model does not declare.",
+                        self._misspelled(foreign, label)
+                        or f"{label} uses {listed}, which the model does not declare.",
                         fmt(self.eom.kinetic_energy if item == "T" else
                             self.eom.potential_energy if item == "V" else self.eom.dissipation))]
+
+    def _misspelled(self, foreign, label: str | None = None) -> str:
+        """'V uses L1, ...; did you mean l1?' when an undeclared name is close to a declared one."""
+        return misspelled(label, map(str, foreign), answer_names(self.model))
 
 
 def _measured(expr: sp.Expr) -> bool:

@@ -1,6 +1,8 @@
-"""`lagrangian check MODEL ANSWER.toml`, `lagrangian crosscheck MODEL`, `lagrangian units MODEL`.
+"""`lagrangian check MODEL ANSWER.toml` (or ANSWERS... of a class), `lagrangian crosscheck MODEL`,
+`lagrangian units MODEL`.
 
 check exits 0 when the answer is correct, 1 when it is not, 2 when a file cannot be read
+(a class: the worst file's status; an unreadable file is a row with its error)
 (crosscheck: 1 when the derivations disagree; units: 1 when a term is inconsistent).
 SystemExit(1) rather than typer.Exit(1): the app runs with standalone_mode=False, where click
 returns an Exit's code instead of raising it, and the status would be lost.
@@ -8,10 +10,12 @@ returns an Exit's code instead of raising it, and the status would be lost.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Annotated
 
 import typer
 
+from ..errors import LagrangianError
 from . import app
 from .common import LOCK_HELP, SET_HELP, load_system, print_json
 
@@ -24,23 +28,77 @@ _JSON = Annotated[bool, typer.Option("--json", help="Print JSON.")]
 @app.command()
 def check(
     model: _MODEL,
-    answer: Annotated[str, typer.Argument(help="Your derivation, ANSWER.toml: tables energy (T, V, "
-                                                "D), generalized_forces, equations, multipliers.")],
+    answers: Annotated[list[str], typer.Argument(
+        help="Your derivation, ANSWER.toml: tables energy (T, V, D), generalized_forces, "
+             "equations, multipliers. A class: several files, globs or folders (their *.toml); "
+             "one row per file.", show_default=False)],
     set_: _SET = [],  # noqa: B006
     lock: _LOCK = [],  # noqa: B006
     json_: _JSON = False,
+    csv: Annotated[str | None, typer.Option(
+        "--csv", help="Also write one row per file per item to this CSV (new, or one that "
+                      "check wrote).")] = None,
+    hints_only: Annotated[bool, typer.Option(
+        "--hints-only", help="Hide the expected expressions and values: give the module's "
+                             "diagnostic question for each finding instead.")] = False,
 ) -> None:
-    """Check a hand derivation (T, V, Q, equations, multipliers) and diagnose each mistake."""
-    from ..output.check import check_document, check_text
+    """Check a hand derivation (T, V, Q, equations, multipliers) and diagnose each mistake;
+    with several answer files, grade a class (derived once, one row per file)."""
+    from .. import AnswerResult, ClassReport, answer_files
+    from ..output.check import (
+        check_class_csv_path,
+        check_document,
+        check_text,
+        class_document,
+        class_text,
+        write_class_csv,
+    )
 
+    single = len(answers) == 1 and _one_file(answers[0])
+    inputs: tuple[Path, ...] = ()
+    if csv is not None:
+        named = answers if single else [p for p, error in answer_files(answers) if not error]
+        inputs = tuple(Path(p) for p in [model, *named] if Path(p).exists())
+        check_class_csv_path(csv, inputs=inputs)
     system = load_system(model, set_, lock)
-    report = system.check(answer)
+    if single:
+        system.equations_of_motion()  # the model's own faults stay errors without a document
+        try:
+            report = system.check(answers[0], hints_only=hints_only)
+        except LagrangianError as exc:
+            if json_:  # a script reading the JSON gets a document, not an empty stdout
+                print_json({"verdict": "unreadable", "findings": [], "error": str(exc)})
+            raise
+        if csv is not None:
+            write_class_csv(ClassReport(system.name, (AnswerResult(answers[0], report),),
+                                        hints_only), csv, inputs=inputs)
+        if json_:
+            print_json(check_document(report))
+        else:
+            typer.echo(check_text(report), nl=False)
+        if not report.passed:
+            raise SystemExit(1)
+        return
+    grades = system.check_many(answers, hints_only=hints_only)
+    if csv is not None:
+        write_class_csv(grades, csv, inputs=inputs)
     if json_:
-        print_json(check_document(report))
+        print_json(class_document(grades))
     else:
-        typer.echo(check_text(report), nl=False)
-    if not report.passed:
-        raise SystemExit(1)
+        typer.echo(class_text(grades), nl=False)
+    if grades.exit_status:
+        raise SystemExit(grades.exit_status)
+
+
+def _one_file(name: str) -> bool:
+    """ANSWER is one file as before (today's output and JSON): not a folder or a glob that
+    names files; a missing file stays one, refused as before."""
+    import glob
+
+    path = Path(name)
+    if path.is_dir():
+        return False
+    return path.exists() or not glob.has_magic(name)
 
 
 @app.command()

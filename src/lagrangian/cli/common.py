@@ -41,6 +41,7 @@ FLAG_OF_FIELD = {
     "keep": "--keep",
     "speed": "--speed",
     "out": "--out",
+    "csv": "--csv",
 }
 
 SET_HELP = "Override a parameter: NAME=VALUE; repeat, or join with commas (m=2,L=0.5)."

@@ -15,8 +15,19 @@ from .common import print_json
 def examples(
     show: Annotated[str | None, typer.Option("--show", help="Print one example's model file.")] = None,
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+    course: Annotated[bool, typer.Option(
+        "--course", help="List the course module's teaching set: its lessons' models, right "
+                         "answers and one wrong answer per misconception.")] = False,
+    copy: Annotated[str | None, typer.Option(
+        "--copy", help="With --course: write the teaching set into this new folder (each "
+                       "lesson's model.toml and answer files).")] = None,
 ) -> None:
     """List the built-in examples (use a name wherever a MODEL file is expected)."""
+    if course or copy is not None:
+        from .course import course_command
+
+        course_command(json_, copy)
+        return
     if show is not None:
         typer.echo(example_path(show).read_text(encoding="utf-8"), nl=False)
         return

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
+from ..check.classroom import RECORD_KEYS, ClassReport, summary
 from ..check.diagnose import CheckReport
 from ..check.newton_euler import CrosscheckReport
 from ..check.units import UnitsReport
+from ..errors import ModelError
 from ..model.expressions import format_expression as fmt
+from .files import atomic_write, check_output_path
 
 _MARK = {"correct": "ok", "equivalent": "equivalent", "wrong": "WRONG", "note": "note"}
 
@@ -36,6 +40,57 @@ def check_text(report: CheckReport) -> str:
             lines.append(f"      expected: {f.expected}")
     lines.append(f"verdict: {report.verdict}")
     return "\n".join(lines) + "\n"
+
+
+# -- a class: many answer files against one model ----------------------------------------------
+
+
+def class_document(report: ClassReport) -> dict[str, Any]:
+    """The `check MODEL ANSWERS...` JSON document: counts and one record per file per item."""
+    return {"model": report.model, "answers": len(report), "counts": report.counts,
+            "hints_only": report.hints_only, "records": report.records()}
+
+
+def class_text(report: ClassReport) -> str:
+    """One row per answer file: file, verdict, the findings by item name (or the error)."""
+    rows = report.rows()
+    lines = [f"Checking {len(rows)} answer file(s) against {report.model}"
+             + (" (hints only)" if report.hints_only else "")]
+    width = max([len(row["file"]) for row in rows] + [4])
+    for row, result in zip(rows, report.results, strict=True):
+        findings = row["findings"] if result.report is not None else f"error: {summary(result)}"
+        lines.append(f"  {row['file']:<{width}}  {row['verdict']:<10}  {findings}")
+        if report.hints_only and result.report is not None:  # the question, once per finding
+            lines += [f"      {f.item}: {f.message}" for f in result.report.findings
+                      if f.status != "correct"]
+    lines.append(", ".join(f"{n} {v}" for v, n in report.counts.items()))
+    return "\n".join(lines) + "\n"
+
+
+def check_class_csv_path(path: str | Path, *, inputs: tuple[Path, ...] = ()) -> Path:
+    """The --csv path, checked before any work: writable, not a directory, not an input, and
+    either new or a class CSV that check wrote before (its header is RECORD_KEYS)."""
+    path = check_output_path(path, "csv", inputs=inputs)
+    if path.is_symlink():
+        raise ModelError(f"{path} is a symbolic link: refusing to write through it",
+                         field="csv")
+    if path.exists():
+        try:
+            with open(path, encoding="utf-8", errors="replace") as handle:
+                first = handle.readline(400).strip()
+        except OSError as exc:
+            raise ModelError(f"cannot read {path}: {exc.strerror or exc}", field="csv") from None
+        if first != ",".join(RECORD_KEYS):
+            raise ModelError(f"{path} exists and is not a class table written by check: "
+                             "refusing to overwrite it", field="csv")
+    return path
+
+
+def write_class_csv(report: ClassReport, path: str | Path, *, inputs: tuple[Path, ...] = ()
+                    ) -> Path:
+    """Write the class's records as CSV, atomically (a partial file never replaces a good one)."""
+    path = check_class_csv_path(path, inputs=inputs)
+    return atomic_write(path, report.csv_text(), protect=inputs)
 
 
 def crosscheck_document(report: CrosscheckReport) -> dict[str, Any]:

@@ -35,6 +35,7 @@ from ..compile.functions import NumericSystem, numeric
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
 from ..derivation.regularity import require_inertia
+from ..derivation.steps import DerivationSteps
 from ..dynamics.joint_space import model_dynamics, recursive_dynamics
 from ..dynamics.standalone import StandaloneSource
 from ..errors import LagrangianError, ModelError, did_you_mean
@@ -104,6 +105,11 @@ class System:
     def equations_of_motion(self) -> EquationsOfMotion:
         """M q_ddot + Phi_q^T lambda = f by Lagrange's method (derived once, then cached)."""
         return self._equations
+
+    def steps(self) -> DerivationSteps:
+        """The working of Lagrange's method (derive --steps): per coordinate dL/dq_dot, its
+        d/dt, dL/dq, Q and the equation; per load its virtual displacement and work."""
+        return self.equations_of_motion().steps()
 
     @cached_property
     def _equations(self) -> EquationsOfMotion:

@@ -27,6 +27,7 @@ from ..analysis.speed_form import SpeedForm, SpeedSweep, speed_form, speed_sweep
 from ..analysis.statics import StaticsReport, solve_statics
 from ..analysis.steady import steady_linear_model
 from ..check.diagnose import CheckReport, check_answer
+from ..check.free_body_steps import CrosscheckSteps, crosscheck_steps
 from ..check.newton_euler import CrosscheckReport, crosscheck
 from ..check.units import UnitsReport, check_model_units
 from ..compile.at_rest import StaticFunctions
@@ -420,6 +421,11 @@ class System:
         """Newton-Euler (free bodies, reactions eliminated) vs Lagrange, coordinate by
         coordinate, with the reaction force on each body (N; moment about the centre, N m)."""
         return crosscheck(self.equations_of_motion())
+
+    def crosscheck_steps(self) -> CrosscheckSteps:
+        """The working of crosscheck: each body's free-body equations (m a_G = sum F + R,
+        I alpha = sum M_G + M_R) and their projection onto dr/dq_i, coordinate by coordinate."""
+        return crosscheck_steps(self.equations_of_motion())
 
     def check_units(self) -> UnitsReport:
         """Every dimensionally inconsistent term of the model (T, V: J; D: W; Q: J per unit of q)."""

@@ -110,7 +110,9 @@ class DerivationSteps:
 
 
 def _latex_text(name: str) -> str:
-    return "".join("\\" + ch if ch in "_&%$#{}" else ch for ch in name)
+    """A name as LaTeX text: its special characters escaped, never read as commands."""
+    special = {"\\": r"\textbackslash{}", "^": r"\^{}", "~": r"\~{}"}
+    return "".join(special.get(ch, "\\" + ch if ch in "_&%$#{}" else ch) for ch in name)
 
 
 def variation_symbols(model: Model) -> tuple[sp.Symbol, ...]:

@@ -220,5 +220,10 @@ def steps_latex(steps: DerivationSteps) -> str:
     return "\n".join(lines) + "\n"
 
 
+_LATEX_SPECIAL = {"\\": r"\textbackslash{}", "^": r"\^{}", "~": r"\~{}",
+                  **{ch: "\\" + ch for ch in "_&%$#{}"}}
+
+
 def _escape(name: str) -> str:
-    return "".join("\\" + ch if ch in "_&%$#{}" else ch for ch in name)
+    """A name as LaTeX text: its special characters escaped, never read as commands."""
+    return "".join(_LATEX_SPECIAL.get(ch, ch) for ch in name)

@@ -459,13 +459,15 @@ class _Checker:
         factor = self._multiple(user, linear) if linear is not None else None
         if factor is not None:
             about = about_zero(self.model, ours)
-            q = about.split(" = ")[0]
+            angle = next((c.name for c in self.model.coordinates
+                          if c.is_angle and ours.has(c.symbol)), None)
+            example = (f" (sin({angle}) where the small-angle form has {angle})" if angle
+                       else "")
             return Finding(item, "wrong", "equation_linearized",
                            f"your equation is the small-angle (linearized) form of ours about "
                            f"{about}: correct near {about}, but the equation of motion keeps "
-                           f"its full nonlinear terms (sin({q}) where the small-angle form has "
-                           f"{q}). Give it under [linearized] to have it checked as a "
-                           "linearization.", expected)
+                           f"its full nonlinear terms{example}. Give it under [linearized] to "
+                           "have it checked as a linearization.", expected)
         contributions = [(c.load, c.expression) for c in self.eom.load_contributions
                          if c.coordinate == name]
         traced = traced_load(user, ours, contributions, self.model, self.points)

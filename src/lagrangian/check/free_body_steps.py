@@ -169,13 +169,11 @@ def crosscheck_steps(eom: EquationsOfMotion) -> CrosscheckSteps:
             reaction_moment=fb.inertia * fb.angular_acceleration - fb.moment if planar else None))
     newton_euler = _projected_equations(model, bodies, recorder.work)
     lagrange = list(eom.mass_matrix * eom.acceleration_symbols - eom.forcing)
+    # each body's inertial share m a_G . dr_G/dq_i + I alpha dangle/dq_i, all coordinates at once
+    shares = {fb.name: _projected_equations(model, [fb], [[] for _ in model.q]) for fb in bodies}
     projections = []
     for i, c in enumerate(model.coordinates):
-        inertial = []
-        for fb in bodies:
-            share = _projected_equations(model, [fb], [[] for _ in model.q])[i]
-            if share != 0:
-                inertial.append((fb.name, share))
+        inertial = [(fb.name, shares[fb.name][i]) for fb in bodies if shares[fb.name][i] != 0]
         work = tuple((source, values[i]) for source, values in recorder.shares if values[i] != 0)
         projections.append(ProjectionStep(c.name, tuple(inertial), work, newton_euler[i],
                                           lagrange[i],

@@ -210,3 +210,22 @@ def test_a_missing_term_of_V_is_not_a_sign_error():
     v = finding(check_text("double_pendulum", '[energy]\nV = "-(m1 + m2)*g*l1*cos(theta1)"\n'),
                 "V")
     assert v.code == "equation_wrong" and "missing" in v.message
+
+
+def test_a_potential_force_left_out_of_an_equation_names_its_body():
+    text = ('[equations]\ntheta2 = "m2*l1*l2*theta1_ddot*cos(theta1 - theta2) + m2*l2^2*theta2_ddot'
+            ' - m2*l1*l2*theta1_dot^2*sin(theta1 - theta2) = 0"\n')
+    f = finding(check_text("double_pendulum", text), "equation[theta2]")
+    assert f.code == "equation_wrong"
+    assert "lacks the term -g*l2*m2*sin(theta2)" in f.message
+    assert "-dV/dtheta2 = -g*l2*m2*sin(theta2) of the gravity potential of 'bob2', left out" \
+        in f.message
+    right = check_text("double_pendulum", text.replace("= 0", "= -m2*g*l2*sin(theta2)"))
+    assert right.verdict == "correct", right
+
+
+def test_a_potential_force_with_the_wrong_sign_is_said_so():
+    f = finding(check_text("pendulum", '[equations]\ntheta = "m*L^2*theta_ddot = m*g*L*sin(theta)"\n'),
+                "equation[theta]")
+    assert "yours has L*g*m*sin(theta) where ours has -L*g*m*sin(theta)" in f.message
+    assert "with the wrong sign" in f.message

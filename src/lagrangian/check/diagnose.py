@@ -27,6 +27,7 @@ from .diagnose_terms import (
     kinetic_parts,
     linearized,
     potential_parts,
+    potential_source,
     scaled_phrase,
     traced_load,
 )
@@ -490,9 +491,12 @@ class _Checker:
             return Finding(item, "wrong", "generalized_force_projection",
                            f"in the equation{scaled}, " + self._projection_message(
                                load, part, name, yours), expected)
+        message = difference_message(user, ours, self.model.q_ddot, list(self.eom.multipliers),
+                                     self.points)
+        source = potential_source(user, ours, self.model.coordinates[i].symbol, self.model,
+                                  self.points)
         return Finding(item, "wrong", "equation_wrong",
-                       difference_message(user, ours, self.model.q_ddot, list(self.eom.multipliers),
-                                          self.points), expected)
+                       message + (f" {source}" if source else ""), expected)
 
     def _same_motion(self, user: list[sp.Expr], user_multipliers: list[sp.Symbol]) -> bool:
         """Both sets give the same accelerations at random states (solved numerically)."""

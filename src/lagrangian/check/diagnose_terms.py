@@ -192,6 +192,25 @@ def traced_load(user: sp.Expr, ours: sp.Expr, contributions: list[tuple[str, sp.
     return None
 
 
+def potential_source(user: sp.Expr, ours: sp.Expr, coordinate: sp.Symbol, model: Model,
+                     points: eq.Points) -> str | None:
+    """A sentence naming the component of V whose force -dV/dq_i is left out of the equation
+    or has the wrong sign (a spring forgotten), else None."""
+    scale = scale_of(user, ours, model.q_ddot, points)
+    difference = user / scale - ours  # ours has +dV/dq_i: left out, yours - ours = -dV/dq_i
+    for label, part in potential_parts(model):
+        force = -part.diff(coordinate)
+        if force == 0:
+            continue
+        shown = fmt(eq.display(force)) if eq.is_small(force) else "its -dV/dq"
+        if eq.identical(difference, force, points):
+            return f"It is the force -dV/d{coordinate} = {shown} of the {label}, left out."
+        if eq.identical(difference, 2 * force, points):
+            return (f"Yours has the force -dV/d{coordinate} = {shown} of the {label} with "
+                    "the wrong sign.")
+    return None
+
+
 def linearized(ours: sp.Expr, model: Model) -> sp.Expr | None:
     """Ours to first order about q = 0, q_dot = 0, q_ddot = 0 (None when it is ours already,
     or for a model with multipliers)."""
@@ -217,4 +236,5 @@ def about_zero(model: Model, equation: sp.Expr) -> str:
 
 
 __all__ = ["about_zero", "difference_message", "flipped_potential_term", "kinetic_parts",
-           "linearized", "potential_parts", "scale_of", "scaled_phrase", "traced_load"]
+           "linearized", "potential_parts", "potential_source", "scale_of", "scaled_phrase",
+           "traced_load"]

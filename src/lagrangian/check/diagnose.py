@@ -13,11 +13,10 @@ from dataclasses import dataclass, replace
 import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
-from ..derivation.virtual_work import DISSIPATION_LOAD, GIVEN_LOAD
 from ..model.answer import Answer
 from ..model.expressions import as_expression
 from ..model.expressions import format_expression as fmt
-from ..model.model import Damper, Model, PointForce, Torque
+from ..model.model import Model
 from ..model.units import generalized_force_unit
 from . import equivalence as eq
 from .diagnose_terms import (
@@ -28,6 +27,7 @@ from .diagnose_terms import (
     linearized,
     potential_parts,
     potential_source,
+    projection_message,
     scaled_phrase,
     traced_load,
 )
@@ -309,7 +309,7 @@ class _Checker:
         if suspect is not None:
             load, part = suspect
             return [Finding(item, "wrong", "generalized_force_projection",
-                            self._projection_message(load, part, name, Q_user - (Q - part)),
+                            projection_message(self.model, load, part, name, Q_user - (Q - part)),
                             expected)]
         difference = eq.display(Q_user - Q)
         if not contributions:
@@ -331,28 +331,6 @@ class _Checker:
             if (yours.free_symbols & parameters) == (part.free_symbols & parameters):
                 return load, part
         return None
-
-    def _projection_message(self, load_name: str, part: sp.Expr, name: str,
-                            yours: sp.Expr) -> str:
-        q = self.model.coordinate(name).symbol
-        load = next((item for item in self.model.loads if item.name == load_name), None)
-        damper = next((d for d in self.model.dampers if d.name == load_name), None)
-        tail = (f"so its generalized force is {fmt(eq.display(part))}; yours is "
-                f"{fmt(eq.display(yours))} (sin for cos, lever arm or sign?).")
-        if isinstance(load, PointForce):
-            dr = ", ".join(fmt(eq.display(r.diff(q))) for r in _planar(load.point))
-            force = ", ".join(fmt(f) for f in _planar(load.force))
-            return (f"the load '{load_name}' is projected wrongly: its point moves by "
-                    f"dr = dr/d{name} d{name} = ({dr}) d{name}, and dW = F . dr with "
-                    f"F = ({force}), {tail}")
-        if isinstance(load, Torque):
-            return (f"the torque '{load_name}' is projected wrongly: it turns through "
-                    f"d(angle) = ({fmt(eq.display(load.angle.diff(q)))}) d{name}, {tail}")
-        if isinstance(damper, Damper):
-            return (f"the damper '{load_name}' is projected wrongly: Q = -c (rate) d(rate)/"
-                    f"d{name}_dot with rate = {fmt(damper.rate)}, {tail}")
-        what = {DISSIPATION_LOAD: "the dissipation D", GIVEN_LOAD: "the given generalized force"}
-        return f"{what.get(load_name, repr(load_name))} is projected wrongly, {tail}"
 
     # equations -------------------------------------------------------------------------
 
@@ -489,8 +467,8 @@ class _Checker:
                                f"give Q[{name}] shares {listed} ({unit}).", expected)
             _, load, part, yours, _ = traced
             return Finding(item, "wrong", "generalized_force_projection",
-                           f"in the equation{scaled}, " + self._projection_message(
-                               load, part, name, yours), expected)
+                           f"in the equation{scaled}, " + projection_message(
+                               self.model, load, part, name, yours), expected)
         message = difference_message(user, ours, self.model.q_ddot, list(self.eom.multipliers),
                                      self.points)
         source = potential_source(user, ours, self.model.coordinates[i].symbol, self.model,
@@ -591,9 +569,6 @@ def _numbers(expr: sp.Expr) -> bool:
     """Contains a number other than 1 and -1."""
     return bool(expr.atoms(sp.Rational, sp.Float) - {sp.S.One, sp.S.NegativeOne})
 
-
-def _planar(vector):
-    return vector[:2] if vector[2] == 0 else vector
 
 
 __all__ = ["CODES", "CheckReport", "Finding", "check_answer", "kinetic_parts", "potential_parts"]

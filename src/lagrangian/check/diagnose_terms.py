@@ -17,8 +17,9 @@ from collections.abc import Sequence
 import sympy as sp
 
 from ..derivation.kinematics import time_rate
+from ..derivation.virtual_work import DISSIPATION_LOAD, GIVEN_LOAD
 from ..model.expressions import format_expression as fmt
-from ..model.model import Model
+from ..model.model import Damper, Model, PointForce, Torque
 from . import equivalence as eq
 
 # -- energy parts, to name a missing term ------------------------------------------------
@@ -211,6 +212,35 @@ def potential_source(user: sp.Expr, ours: sp.Expr, coordinate: sp.Symbol, model:
     return None
 
 
+def projection_message(model: Model, load_name: str, part: sp.Expr, name: str,
+                       yours: sp.Expr) -> str:
+    """Why a load's share is wrong: its dr/dq (or d(angle)/dq, d(rate)/dq_dot), its Q and yours."""
+    q = model.coordinate(name).symbol
+    load = next((item for item in model.loads if item.name == load_name), None)
+    damper = next((d for d in model.dampers if d.name == load_name), None)
+    tail = (f"so its generalized force is {fmt(eq.display(part))}; yours is "
+            f"{fmt(eq.display(yours))} (sin for cos, lever arm or sign?).")
+    if isinstance(load, PointForce):
+        dr = ", ".join(fmt(eq.display(r.diff(q))) for r in _planar(load.point))
+        force = ", ".join(fmt(f) for f in _planar(load.force))
+        return (f"the load '{load_name}' is projected wrongly: its point moves by "
+                f"dr = dr/d{name} d{name} = ({dr}) d{name}, and dW = F . dr with "
+                f"F = ({force}), {tail}")
+    if isinstance(load, Torque):
+        return (f"the torque '{load_name}' is projected wrongly: it turns through "
+                f"d(angle) = ({fmt(eq.display(load.angle.diff(q)))}) d{name}, {tail}")
+    if isinstance(damper, Damper):
+        return (f"the damper '{load_name}' is projected wrongly: Q = -c (rate) d(rate)/"
+                f"d{name}_dot with rate = {fmt(damper.rate)}, {tail}")
+    what = {DISSIPATION_LOAD: "the dissipation D", GIVEN_LOAD: "the given generalized force"}
+    return f"{what.get(load_name, repr(load_name))} is projected wrongly, {tail}"
+
+
+
+def _planar(vector):
+    return vector[:2] if vector[2] == 0 else vector
+
+
 def linearized(ours: sp.Expr, model: Model) -> sp.Expr | None:
     """Ours to first order about q = 0, q_dot = 0, q_ddot = 0 (None when it is ours already,
     or for a model with multipliers)."""
@@ -236,5 +266,5 @@ def about_zero(model: Model, equation: sp.Expr) -> str:
 
 
 __all__ = ["about_zero", "difference_message", "flipped_potential_term", "kinetic_parts",
-           "linearized", "potential_parts", "potential_source", "scale_of", "scaled_phrase",
-           "traced_load"]
+           "linearized", "potential_parts", "potential_source", "projection_message",
+           "scale_of", "scaled_phrase", "traced_load"]

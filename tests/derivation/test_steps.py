@@ -175,3 +175,26 @@ def test_derive_steps_bad_input(cli):
     assert result.code == 2 and result.err.startswith("error:")
     both = cli("derive", "pendulum", "--steps", "--json", "--format", "latex")
     assert both.code == 2 and "--format" in both.err
+
+
+def test_the_printed_text_reads_back_to_sympys_derivatives(cli):
+    # the terminal text itself, line by line: L, then dL/dq_dot, d/dt(dL/dq_dot) and dL/dq
+    system = lagrangian.load("cart_pendulum")
+    model = system.model
+    out = cli("derive", "cart_pendulum", "--steps").out
+    steps = out[out.index("Steps (Lagrange"):]
+    names = _names(model, {"variations": {c.name: f"delta_{c.name}" for c in model.coordinates}})
+    symbols = list(names.values())
+
+    def value(prefix: str) -> sp.Expr:
+        line = next(line for line in steps.splitlines() if line.strip().startswith(prefix))
+        return parse_expression(line.split(" = ", 1)[1], names)
+
+    L = parse_expression(next(line for line in steps.splitlines()
+                              if line.strip().startswith("L = T - V = ")).split(" = ")[-1], names)
+    for c in model.coordinates:
+        momentum = L.diff(c.velocity)
+        assert _same(value(f"dL/d{c.velocity} = "), momentum, symbols)
+        assert _same(value(f"d/dt(dL/d{c.velocity}) = "), _time_derivative(momentum, model),
+                     symbols)
+        assert _same(value(f"dL/d{c.name} = "), L.diff(c.symbol), symbols)

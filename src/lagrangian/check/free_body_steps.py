@@ -13,12 +13,13 @@ which is Lagrange's (M q_ddot - f)_i; each share is listed so the mapping can be
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
 from ..model.model import Model
+from ..model.notation import latex_symbol_names
 from . import equivalence as eq
 from .newton_euler import (
     _AppliedForces,
@@ -74,16 +75,39 @@ class CrosscheckSteps:
     model: str
     bodies: tuple[FreeBodyStep, ...]
     projections: tuple[ProjectionStep, ...]
+    # symbol -> LaTeX (q_dot as a dot over q) for _repr_latex_
+    latex_names: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def agree(self) -> bool:
         return all(p.agree for p in self.projections)
+
+    def _repr_latex_(self) -> str:
+        def tex(expr) -> str:
+            return sp.latex(expr, symbol_names=self.latex_names)
+
+        rows = []
+        for b in self.bodies:
+            axes = "xyz" if any(a != 0 for a in b.acceleration[2:]) else "xy"
+            for k, axis in enumerate(axes):
+                total = sp.Add(*(f.force[k] for f in b.forces))
+                rows.append(rf"{tex(b.mass * b.acceleration[k])} &= {tex(total)} + "
+                            rf"R_{{{axis}}} && \text{{({_latex_text(b.body)}, {axis})}}")
+        for p in self.projections:
+            rows.append(rf"0 &= {tex(p.newton_euler)} && \text{{({_latex_text(p.coordinate)})}}")
+        return r"$\begin{aligned}" + r"\\ ".join(rows) + r"\end{aligned}$"
 
     def __repr__(self) -> str:
         lines = [f"CrosscheckSteps({self.model!r}, agree={self.agree})"]
         lines += [f"  {b.body}: m a_G = " + " + ".join(f.source for f in b.forces) + " + R"
                   for b in self.bodies]
         return "\n".join(lines)
+
+
+def _latex_text(name: str) -> str:
+    """A name as LaTeX text: its special characters escaped, never read as commands."""
+    special = {"\\": r"\textbackslash{}", "^": r"\^{}", "~": r"\~{}"}
+    return "".join(special.get(ch, "\\" + ch if ch in "_&%$#{}" else ch) for ch in name)
 
 
 class _View:
@@ -178,7 +202,8 @@ def crosscheck_steps(eom: EquationsOfMotion) -> CrosscheckSteps:
         projections.append(ProjectionStep(c.name, tuple(inertial), work, newton_euler[i],
                                           lagrange[i],
                                           eq.identical(newton_euler[i], lagrange[i], points)))
-    return CrosscheckSteps(model.name, tuple(steps), tuple(projections))
+    return CrosscheckSteps(model.name, tuple(steps), tuple(projections),
+                           latex_symbol_names(model))
 
 
 __all__ = ["AppliedForce", "CrosscheckSteps", "FreeBodyStep", "ProjectionStep",

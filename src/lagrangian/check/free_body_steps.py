@@ -75,6 +75,7 @@ class CrosscheckSteps:
     model: str
     bodies: tuple[FreeBodyStep, ...]
     projections: tuple[ProjectionStep, ...]
+    constrained: bool = False  # then Phi_q^T lambda stands on both sides, left out of E_i
     # symbol -> LaTeX (q_dot as a dot over q) for _repr_latex_
     latex_names: dict = field(default_factory=dict, compare=False, repr=False)
 
@@ -203,7 +204,7 @@ def crosscheck_steps(eom: EquationsOfMotion) -> CrosscheckSteps:
                                           lagrange[i],
                                           eq.identical(newton_euler[i], lagrange[i], points)))
     return CrosscheckSteps(model.name, tuple(steps), tuple(projections),
-                           latex_symbol_names(model))
+                           bool(model.constraints), latex_symbol_names(model))
 
 
 __all__ = ["AppliedForce", "CrosscheckSteps", "FreeBodyStep", "ProjectionStep",

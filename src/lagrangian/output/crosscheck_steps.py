@@ -66,7 +66,9 @@ def crosscheck_steps_text(steps: CrosscheckSteps) -> str:
         lines.append("  on no free body (the model gives no force vector or point): "
                      + ", ".join(elsewhere) + "; they enter by their virtual work only")
     lines += ["", "  Projection: E_i = sum_bodies (m a_G . dr_G/dq_i + I alpha dangle/dq_i) - "
-              "sum_forces F . dr/dq_i;", "  the reactions do no virtual work and drop out:"]
+              "sum_forces F . dr/dq_i;", "  the reactions do no virtual work and drop out"
+              + (" (the constraints' Phi_q^T lambda stands on both sides and is left out):"
+                 if steps.constrained else ":")]
     kinds = {b.body: b.kind for b in steps.bodies}
     for p in steps.projections:
         q = p.coordinate

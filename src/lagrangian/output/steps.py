@@ -12,8 +12,10 @@ import sympy as sp
 
 from ..derivation.readable import readable
 from ..derivation.steps import DerivationSteps
-from ..model.expressions import format_expression
+from ..model.expressions import format_expression, tree_size
 from ..model.notation import latex_symbol_names
+
+SMALL = 400  # nodes: a step this small has its common factors taken out before it is grouped
 
 
 class _Form:
@@ -27,6 +29,10 @@ class _Form:
         self.ranges = {c.symbol: tuple(c.range) for c in model.coordinates if c.range}
 
     def __call__(self, expr) -> sp.Expr:
+        expr = sp.sympify(expr)  # safe: a sympy object or a number
+        if not expr.is_Atom and tree_size(expr, SMALL) <= SMALL:
+            # -k*(2*x - 2*x0)/2, as d/dx of k*(x - x0)**2/2 comes out, reads -k*(x - x0)
+            expr = sp.factor_terms(expr)
         return readable(expr, self.rates, self.ranges)
 
     def text(self, expr) -> str:

@@ -202,6 +202,7 @@ def test_a_spring_of_the_wrong_sign_is_named():
     s = b.build()
     v = finding(_check(s, '[energy]\nV = "m*g*x + 1/2*k1*x^2 - 1/2*k2*x^2"\n'), "V")
     assert v.code == "potential_sign" and "'lower'" in v.message and "'upper'" not in v.message
+    assert "Does the spring store 1/2 k s^2 >= 0" in v.message
     assert finding(_check(s, '[energy]\nV = "m*g*x + 1/2*k1*x^2 + 1/2*k2*x^2"\n'),
                    "V").status == "correct"
 

@@ -29,6 +29,7 @@ from .diagnose_terms import (
     potential_source,
     projection_message,
     scaled_phrase,
+    sign_question,
     traced_load,
 )
 from .units import answer_unit_issues
@@ -223,14 +224,16 @@ class _Checker:
                 if eq.constant_in_state(V_user - (V - 2 * part), self.points):
                     return [Finding("V", "wrong", "potential_sign",
                                     f"the {label} has the wrong sign (it should be "
-                                    f"{fmt(eq.display(part))}). {rises}", expected)]
+                                    f"{fmt(eq.display(part))}). {sign_question([label], rises)}",
+                                    expected)]
         flipped = flipped_potential_term(V_user, V, self.model, self.points)
         if flipped is not None:
             labels, term = flipped
             return [Finding("V", "wrong", "potential_sign",
                             f"the term {fmt(eq.display(term))} of the "
                             f"{' and the '.join(labels)} has the wrong sign (yours has "
-                            f"{fmt(eq.display(-term))}). {rises}", expected)]
+                            f"{fmt(eq.display(-term))}). {sign_question(labels, rises)}",
+                            expected)]
         for label, part in parts:
             if eq.constant_in_state(V_user - (V - part), self.points):
                 return [Finding("V", "wrong", "equation_wrong",

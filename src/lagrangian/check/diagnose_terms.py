@@ -94,6 +94,15 @@ def flipped_potential_term(V_user: sp.Expr, V: sp.Expr, model: Model, points: eq
     return None
 
 
+def sign_question(labels: list[str], rises: str) -> str:
+    """The module's question for a sign error in V: 'Does V increase as the body rises?' for
+    gravity, the spring's own for springs only."""
+    if labels and all(label.startswith("potential of spring") for label in labels):
+        return ("Does the spring store 1/2 k s^2 >= 0 (s its stretch), whichever way it is "
+                "stretched?")
+    return rises
+
+
 # -- equations ---------------------------------------------------------------------------
 
 
@@ -267,4 +276,4 @@ def about_zero(model: Model, equation: sp.Expr) -> str:
 
 __all__ = ["about_zero", "difference_message", "flipped_potential_term", "kinetic_parts",
            "linearized", "potential_parts", "potential_source", "projection_message",
-           "scale_of", "scaled_phrase", "traced_load"]
+           "scale_of", "scaled_phrase", "sign_question", "traced_load"]

@@ -37,3 +37,30 @@ def test_console_lines_are_real_output(cli):
         assert result.code == 0, command
         out = result.out.splitlines()
         assert all(line in out for line in shown), (command, [s for s in shown if s not in out])
+
+
+def _keys(value, skip=()) -> set[str]:
+    """Every key of a JSON document, but not the names of coordinates, bodies or loads."""
+    found: set[str] = set()
+    if isinstance(value, dict):
+        for key, inner in value.items():
+            if key not in skip:
+                found.add(key)
+            found |= _keys(inner, skip)
+    elif isinstance(value, list):
+        for inner in value:
+            found |= _keys(inner, skip)
+    return found
+
+
+def test_every_steps_key_is_documented(cli):
+    import json
+
+    text = section()
+    names = {"x", "y", "theta", "link", "F", "rod"}  # coordinates, bodies, loads of the models
+    derive = json.loads(cli("derive", "cartesian_pendulum", "--steps", "--json").out)["steps"]
+    link = json.loads(cli("derive", "virtual_work_link", "--steps", "--json").out)["steps"]
+    cross = json.loads(cli("crosscheck", "virtual_work_link", "--steps", "--json").out)["steps"]
+    for document in (derive, link, cross):
+        for key in _keys(document, names):
+            assert f"`{key}`" in text or f"`{key}." in text, key

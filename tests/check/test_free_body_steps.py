@@ -107,6 +107,7 @@ def test_cart_free_bodies_carry_weight_and_push():
                                                              "push": (F, 0)}
     assert cart.reaction[1] == M * g  # the rail holds the cart's weight (its a_y is 0)
     assert "CrosscheckSteps" in repr(steps) and steps.agree
+    assert isinstance(steps, lagrangian.CrosscheckSteps)
     latex = steps._repr_latex_()
     assert latex.startswith("$") and r"\ddot{x}" in latex and r"\text{(cart, x)}" in latex
 

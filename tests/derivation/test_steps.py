@@ -147,6 +147,7 @@ def test_pendulum_momentum_is_m_L2_theta_dot():
 
 def test_steps_display_themselves():
     steps = lagrangian.load("cartesian_pendulum").steps()
+    assert isinstance(steps, lagrangian.DerivationSteps)
     latex = steps._repr_latex_()
     assert latex.startswith("$") and r"\frac{\partial \mathcal{L}}" in latex
     assert "x" in repr(steps) and "DerivationSteps" in repr(steps)

@@ -11,11 +11,13 @@ from ..analysis.modes import ModalAnalysis, Mode
 from ..analysis.speed_form import SpeedForm, SpeedSweep
 from ..analysis.statics import StaticsReport
 from ..check.diagnose import CheckReport, Finding
+from ..check.free_body_steps import CrosscheckSteps
 from ..check.newton_euler import CoordinateAgreement, CrosscheckReport, Reaction
 from ..check.units import UnitIssue, UnitsReport
 from ..compile.compiled import BackendUnavailable, CacheRefused, CompilerMissing
 from ..compile.functions import NumericSystem
 from ..derivation.equations import EquationsOfMotion, LoadContribution
+from ..derivation.steps import DerivationSteps
 from ..dynamics.joint_space import Dynamics
 from ..dynamics.standalone import StandaloneSource
 from ..errors import DerivationError, LagrangianError, ModelError
@@ -57,6 +59,8 @@ __all__ = [
     "CheckReport",
     "CoordinateAgreement",
     "CrosscheckReport",
+    "CrosscheckSteps",
+    "DerivationSteps",
     "Dynamics",
     "Equilibria",
     "Equilibrium",

@@ -21,7 +21,9 @@ def test_pendulum_potential_with_the_wrong_sign():
     # The equation built from that V has the gravity term with the wrong sign.
     eq = finding(report, "equation[theta]")
     assert eq.code == "equation_wrong"
-    assert "-2*L*g*m*sin(theta)" in eq.message
+    # the gravity term on the right-hand side with the sign of V flipped, each term stated with
+    # the sign it has there
+    assert "yours has L*g*m*sin(theta) where ours has -L*g*m*sin(theta)" in eq.message
 
 
 def test_other_datum_is_fine_and_said_so():
@@ -193,7 +195,8 @@ def test_equation_times_minus_m_L_squared_is_accepted():
 def test_missing_coupling_term_is_named():
     eq = finding(check_file("two_mass", "two_mass_missing_coupling.toml"), "equation[x1]")
     assert eq.code == "equation_wrong"
-    assert "k_c*(-x1 + x2)" in eq.message
+    # the coupling spring's force k_c (x1 - x2), stated once, with the sign it has in ours
+    assert "right-hand side (the forcing f) lacks the term k_c*(-x1 + x2)" in eq.message
     assert eq.expected == "m*x1_ddot = -(k*x1 + k_c*(x1 - x2))"
 
 
@@ -343,3 +346,12 @@ def test_python_api_takes_the_tables_as_a_dict():
     assert report.codes() == ["potential_sign"] and not report.correct
     with pytest.raises(lagrangian.ModelError, match="unknown key 'U'"):
         lagrangian.load("pendulum").check({"energy": {"U": "0"}})
+
+
+def test_small_angle_equation_is_named_a_linearization():
+    # worked example 1's own step: correct about theta = 0, not the equation of motion
+    report = check_text("pendulum", '[equations]\ntheta = "theta_ddot + g/L*theta = 0"\n')
+    eq = finding(report, "equation[theta]")
+    assert (eq.status, eq.code) == ("wrong", "equation_linearized")
+    assert "small-angle" in eq.message and "theta = 0" in eq.message
+    assert "dividing" not in eq.message

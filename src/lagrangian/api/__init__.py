@@ -13,11 +13,13 @@ from ..analysis.statics import StaticsReport
 from ..check.classroom import AnswerResult, ClassReport
 from ..check.course import Lesson, course_lessons
 from ..check.diagnose import CheckReport, Finding
+from ..check.free_body_steps import CrosscheckSteps
 from ..check.newton_euler import CoordinateAgreement, CrosscheckReport, Reaction
 from ..check.units import UnitIssue, UnitsReport
 from ..compile.compiled import BackendUnavailable, CacheRefused, CompilerMissing
 from ..compile.functions import NumericSystem
 from ..derivation.equations import EquationsOfMotion, LoadContribution
+from ..derivation.steps import DerivationSteps
 from ..dynamics.joint_space import Dynamics
 from ..dynamics.standalone import StandaloneSource
 from ..errors import DerivationError, InputError, LagrangianError, ModelError
@@ -64,6 +66,8 @@ __all__ = [
     "ClassReport",
     "CoordinateAgreement",
     "CrosscheckReport",
+    "CrosscheckSteps",
+    "DerivationSteps",
     "Dynamics",
     "Equilibria",
     "Equilibrium",

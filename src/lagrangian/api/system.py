@@ -29,6 +29,7 @@ from ..analysis.steady import steady_linear_model
 from ..check.classroom import ClassReport, check_class
 from ..check.diagnose import CheckReport, check_answer
 from ..check.final_answers import check_final_answers
+from ..check.free_body_steps import CrosscheckSteps, crosscheck_steps
 from ..check.hints import hinted
 from ..check.newton_euler import CrosscheckReport, crosscheck
 from ..check.units import UnitsReport, check_model_units
@@ -38,6 +39,7 @@ from ..compile.functions import NumericSystem, numeric
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
 from ..derivation.regularity import require_inertia
+from ..derivation.steps import DerivationSteps
 from ..dynamics.joint_space import model_dynamics, recursive_dynamics
 from ..dynamics.standalone import StandaloneSource
 from ..errors import InputError, LagrangianError, did_you_mean
@@ -107,6 +109,11 @@ class System:
     def equations_of_motion(self) -> EquationsOfMotion:
         """M q_ddot + Phi_q^T lambda = f by Lagrange's method (derived once, then cached)."""
         return self._equations
+
+    def steps(self) -> DerivationSteps:
+        """The working of Lagrange's method (derive --steps): per coordinate dL/dq_dot, its
+        d/dt, dL/dq, Q and the equation; per load its virtual displacement and work."""
+        return self.equations_of_motion().steps()
 
     @cached_property
     def _equations(self) -> EquationsOfMotion:
@@ -435,6 +442,11 @@ class System:
         """Newton-Euler (free bodies, reactions eliminated) vs Lagrange, coordinate by
         coordinate, with the reaction force on each body (N; moment about the centre, N m)."""
         return crosscheck(self.equations_of_motion())
+
+    def crosscheck_steps(self) -> CrosscheckSteps:
+        """The working of crosscheck: each body's free-body equations (m a_G = sum F + R,
+        I alpha = sum M_G + M_R) and their projection onto dr/dq_i, coordinate by coordinate."""
+        return crosscheck_steps(self.equations_of_motion())
 
     def check_units(self) -> UnitsReport:
         """Every dimensionally inconsistent term of the model (T, V: J; D: W; Q: J per unit of q)."""

@@ -13,22 +13,33 @@ from dataclasses import dataclass, replace
 import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
-from ..derivation.kinematics import time_rate
-from ..derivation.virtual_work import DISSIPATION_LOAD, GIVEN_LOAD
 from ..errors import misspelled
 from ..model.answer import Answer, answer_names
 from ..model.expressions import as_expression
 from ..model.expressions import format_expression as fmt
-from ..model.model import Damper, Model, PointForce, Torque
+from ..model.model import Model
 from ..model.units import generalized_force_unit
 from . import equivalence as eq
+from .diagnose_terms import (
+    about_zero,
+    difference_message,
+    flipped_potential_term,
+    kinetic_parts,
+    linearized,
+    potential_parts,
+    potential_source,
+    projection_message,
+    scaled_phrase,
+    sign_question,
+    traced_load,
+)
 from .units import answer_unit_issues
 
 CODES = (
     "potential_sign", "potential_datum", "kinetic_factor", "kinetic_term",
     "generalized_force_missing", "generalized_force_projection",
     "reaction_in_minimal_coordinates", "multiplier_count", "equation_wrong",
-    "equation_equivalent", "units_mismatch",
+    "equation_equivalent", "units_mismatch", "equation_linearized",
 )
 
 
@@ -72,50 +83,6 @@ class CheckReport:
         lines += [f"  {f.item}: {f.status}" + (f" [{f.code}]" if f.code else "") + f" {f.message}"
                   for f in self.findings]
         return "\n".join(lines)
-
-
-# -- energy parts, to name a missing term ------------------------------------------------
-
-
-def kinetic_parts(model: Model) -> list[tuple[str, sp.Expr]]:
-    """Each component's share of T: 1/2 m v^2 of a particle, 1/2 m v_G^2 and 1/2 I w^2 of a body."""
-    q, q_dot, t = model.q, model.q_dot, model.time
-    half = sp.Rational(1, 2)
-    parts = []
-
-    def speed2(position):
-        return sp.Add(*(time_rate(r, q, q_dot, t) ** 2 for r in position))
-
-    for particle in model.particles:
-        parts.append((f"translational energy 1/2 m v^2 of particle '{particle.name}'",
-                      half * particle.mass * speed2(particle.position)))
-    for body in model.bodies:
-        parts.append((f"translational energy 1/2 m v_G^2 of body '{body.name}'",
-                      half * body.mass * speed2(body.position)))
-        omega = time_rate(body.angle, q, q_dot, t)
-        if omega != 0:
-            parts.append((f"rotational energy 1/2 I w^2 of body '{body.name}'",
-                          half * body.inertia * omega**2))
-    if model.kinetic_energy != 0:
-        parts.append(("kinetic energy given in the model ([energy] T)", model.kinetic_energy))
-    return [(label, value) for label, value in parts if value != 0]
-
-
-def potential_parts(model: Model) -> list[tuple[str, sp.Expr]]:
-    """Each source of V: gravity of each particle and body, each spring, the model's V."""
-    parts = []
-    if model.gravity is not None:
-        g, direction = model.gravity.magnitude, model.gravity.direction
-        for item in (*model.particles, *model.bodies):
-            height = sp.Add(*(d * r for d, r in zip(direction, item.position, strict=True)))
-            if height.free_symbols & set(model.q):
-                parts.append((f"gravity potential of '{item.name}'", -item.mass * g * height))
-    for spring in model.springs:
-        parts.append((f"potential of spring '{spring.name}'",
-                      sp.Rational(1, 2) * spring.stiffness * (spring.length - spring.rest_length) ** 2))
-    if model.potential_energy != 0:
-        parts.append(("potential given in the model ([energy] V)", model.potential_energy))
-    return parts
 
 
 # -- the checker -------------------------------------------------------------------------
@@ -258,11 +225,26 @@ class _Checker:
                 if eq.constant_in_state(V_user - (V - 2 * part), self.points):
                     return [Finding("V", "wrong", "potential_sign",
                                     f"the {label} has the wrong sign (it should be "
-                                    f"{fmt(eq.display(part))}). {rises}", expected)]
+                                    f"{fmt(eq.display(part))}). {sign_question([label], rises)}",
+                                    expected)]
+        flipped = flipped_potential_term(V_user, V, self.model, self.points)
+        if flipped is not None:
+            labels, term = flipped
+            return [Finding("V", "wrong", "potential_sign",
+                            f"the term {fmt(eq.display(term))} of the "
+                            f"{' and the '.join(labels)} has the wrong sign (yours has "
+                            f"{fmt(eq.display(-term))}). {sign_question(labels, rises)}",
+                            expected)]
         for label, part in parts:
             if eq.constant_in_state(V_user - (V - part), self.points):
                 return [Finding("V", "wrong", "equation_wrong",
                                 f"V is missing the {label}: {fmt(eq.display(part))}.", expected)]
+        missing = flipped_potential_term(V_user, V, self.model, self.points, factor=1)
+        if missing is not None:
+            labels, term = missing
+            return [Finding("V", "wrong", "equation_wrong",
+                            f"V is missing the term {fmt(eq.display(term))} of the "
+                            f"{' and the '.join(labels)}.", expected)]
         difference = eq.display(V_user - V)
         return [Finding("V", "wrong", "equation_wrong",
                         f"V differs from ours by {fmt(difference)} (not a constant).", expected)]
@@ -334,7 +316,7 @@ class _Checker:
         if suspect is not None:
             load, part = suspect
             return [Finding(item, "wrong", "generalized_force_projection",
-                            self._projection_message(load, part, name, Q_user - (Q - part)),
+                            projection_message(self.model, load, part, name, Q_user - (Q - part)),
                             expected)]
         difference = eq.display(Q_user - Q)
         if not contributions:
@@ -356,28 +338,6 @@ class _Checker:
             if (yours.free_symbols & parameters) == (part.free_symbols & parameters):
                 return load, part
         return None
-
-    def _projection_message(self, load_name: str, part: sp.Expr, name: str,
-                            yours: sp.Expr) -> str:
-        q = self.model.coordinate(name).symbol
-        load = next((item for item in self.model.loads if item.name == load_name), None)
-        damper = next((d for d in self.model.dampers if d.name == load_name), None)
-        tail = (f"so its generalized force is {fmt(eq.display(part))}; yours is "
-                f"{fmt(eq.display(yours))} (sin for cos, lever arm or sign?).")
-        if isinstance(load, PointForce):
-            dr = ", ".join(fmt(eq.display(r.diff(q))) for r in _planar(load.point))
-            force = ", ".join(fmt(f) for f in _planar(load.force))
-            return (f"the load '{load_name}' is projected wrongly: its point moves by "
-                    f"dr = dr/d{name} d{name} = ({dr}) d{name}, and dW = F . dr with "
-                    f"F = ({force}), {tail}")
-        if isinstance(load, Torque):
-            return (f"the torque '{load_name}' is projected wrongly: it turns through "
-                    f"d(angle) = ({fmt(eq.display(load.angle.diff(q)))}) d{name}, {tail}")
-        if isinstance(damper, Damper):
-            return (f"the damper '{load_name}' is projected wrongly: Q = -c (rate) d(rate)/"
-                    f"d{name}_dot with rate = {fmt(damper.rate)}, {tail}")
-        what = {DISSIPATION_LOAD: "the dissipation D", GIVEN_LOAD: "the given generalized force"}
-        return f"{what.get(load_name, repr(load_name))} is projected wrongly, {tail}"
 
     # equations -------------------------------------------------------------------------
 
@@ -453,9 +413,7 @@ class _Checker:
                     "your equations are an invertible combination of ours: they give the same "
                     "accelerations.", self._expected(i)))
             else:
-                findings.append(Finding(item, "wrong", "equation_wrong",
-                                        self._difference_message(mapped, ours[i]),
-                                        self._expected(i)))
+                findings.append(self._wrong_equation(item, i, mapped, ours[i]))
         return findings
 
     def _expected(self, i: int) -> str:
@@ -485,36 +443,50 @@ class _Checker:
             return None
         return None
 
-    def _difference_message(self, user: sp.Expr, ours: sp.Expr) -> str:
-        """Name the term that differs, after scaling the user's equation like ours."""
-        scale = sp.S.One
-        for a in self.model.q_ddot:
-            c_ours = ours.diff(a)
-            if ours.has(a) and not eq.zero(c_ours, self.points):
-                c_user = user.diff(a)
-                if not eq.zero(c_user, self.points):
-                    scale = c_user / c_ours
-                    if eq.is_small(scale):
-                        scale = sp.cancel(scale)
-                break
-        difference = eq.display(sp.expand(user / scale - ours)) if eq.is_small(user) \
-            else user / scale - ours
-        extra_terms, missing_terms = [], []
-        if eq.is_small(user) and eq.is_small(ours):
-            mine = set(sp.Add.make_args(sp.expand(user / scale)))
-            theirs = set(sp.Add.make_args(sp.expand(ours)))
-            extra_terms = sorted(fmt(t) for t in mine - theirs)
-            missing_terms = sorted(fmt(t) for t in theirs - mine)
-        scaled = "" if scale == 1 else f" (after dividing yours by {fmt(scale)})"
-        detail = ""
-        if missing_terms and len(missing_terms) <= 3:
-            detail += f" Ours has {', '.join(missing_terms)}"
-            detail += f" where yours has {', '.join(extra_terms)}." if extra_terms else \
-                " which yours lacks."
-        elif extra_terms and len(extra_terms) <= 3:
-            detail += f" Yours has the extra term(s) {', '.join(extra_terms)}."
-        return (f"the equation differs from ours{scaled} by the term {fmt(difference)}."
-                + detail)
+    def _wrong_equation(self, item: str, i: int, user: sp.Expr, ours: sp.Expr) -> Finding:
+        """The small-angle form, a load left out or projected wrongly, or the differing term."""
+        name, expected = self.names[i], self._expected(i)
+        linear = linearized(ours, self.model)
+        factor = self._multiple(user, linear) if linear is not None else None
+        if factor is not None:
+            about = about_zero(self.model, ours)
+            angle = next((c.name for c in self.model.coordinates
+                          if c.is_angle and ours.has(c.symbol)), None)
+            example = (f" (sin({angle}) where the small-angle form has {angle})" if angle
+                       else "")
+            return Finding(item, "wrong", "equation_linearized",
+                           f"your equation is the small-angle (linearized) form of ours about "
+                           f"{about}: correct near {about}, but the equation of motion keeps "
+                           f"its full nonlinear terms{example}. Give it under [linearized] to "
+                           "have it checked as a linearization.", expected)
+        contributions = [(c.load, c.expression) for c in self.eom.load_contributions
+                         if c.coordinate == name]
+        traced = traced_load(user, ours, contributions, self.model, self.points)
+        if traced is not None:
+            unit = generalized_force_unit(self.model.coordinates[i].unit)
+            scaled = scaled_phrase(traced[-1])
+            if traced[0] == "missing":
+                _, load, part, _ = traced
+                return Finding(item, "wrong", "generalized_force_missing",
+                               f"the equation{scaled} lacks the load '{load}': it does virtual "
+                               f"work dW = ({fmt(eq.display(part))}) d{name}, so Q[{name}] = "
+                               f"{fmt(eq.display(part))} ({unit}) belongs on the right-hand side. "
+                               "Did you do virtual work for every non-potential load?", expected)
+            if traced[0] == "all":
+                listed = "; ".join(f"'{load}': {fmt(eq.display(p))}" for load, p in traced[1])
+                return Finding(item, "wrong", "generalized_force_missing",
+                               f"the equation{scaled} lacks every load; by virtual work they "
+                               f"give Q[{name}] shares {listed} ({unit}).", expected)
+            _, load, part, yours, _ = traced
+            return Finding(item, "wrong", "generalized_force_projection",
+                           f"in the equation{scaled}, " + projection_message(
+                               self.model, load, part, name, yours), expected)
+        message = difference_message(user, ours, self.model.q_ddot, list(self.eom.multipliers),
+                                     self.points)
+        source = potential_source(user, ours, self.model.coordinates[i].symbol, self.model,
+                                  self.points)
+        return Finding(item, "wrong", "equation_wrong",
+                       message + (f" {source}" if source else ""), expected)
 
     def _same_motion(self, user: list[sp.Expr], user_multipliers: list[sp.Symbol]) -> bool:
         """Both sets give the same accelerations at random states (solved numerically)."""
@@ -614,9 +586,6 @@ def _numbers(expr: sp.Expr) -> bool:
     """Contains a number other than 1 and -1."""
     return bool(expr.atoms(sp.Rational, sp.Float) - {sp.S.One, sp.S.NegativeOne})
 
-
-def _planar(vector):
-    return vector[:2] if vector[2] == 0 else vector
 
 
 __all__ = ["CODES", "CheckReport", "Finding", "check_answer", "kinetic_parts", "potential_parts"]

@@ -103,16 +103,25 @@ def _one_file(name: str) -> bool:
 
 @app.command()
 def crosscheck(model: _MODEL, set_: _SET = [], lock: _LOCK = [],  # noqa: B006
-               json_: _JSON = False) -> None:
+               json_: _JSON = False,
+               steps: Annotated[bool, typer.Option("--steps", help="Show each body's free-body equations and how they map to Lagrange's (a 'steps' key in JSON).")] = False,  # noqa: E501
+               ) -> None:
     """Derive again by Newton-Euler (free bodies, reactions eliminated) and compare with Lagrange."""
     from ..output.check import crosscheck_document, crosscheck_text
+    from ..output.crosscheck_steps import crosscheck_steps_document, crosscheck_steps_text
 
     system = load_system(model, set_, lock)
     report = system.crosscheck()
+    working = system.crosscheck_steps() if steps else None
     if json_:
-        print_json(crosscheck_document(report))
+        document = crosscheck_document(report)
+        if working is not None:
+            document["steps"] = crosscheck_steps_document(working)
+        print_json(document)
     else:
         typer.echo(crosscheck_text(report), nl=False)
+        if working is not None:
+            typer.echo("\n" + crosscheck_steps_text(working), nl=False)
     if not report.passed:
         raise SystemExit(1)
 

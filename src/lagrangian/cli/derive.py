@@ -25,6 +25,7 @@ def derive(
     json_: Annotated[bool, typer.Option("--json", help="Print JSON (as --format json, the flag of every other command).")] = False,  # noqa: E501
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
+    steps: Annotated[bool, typer.Option("--steps", help="Show the working: dL/dq_dot, its d/dt, dL/dq, Q and each load's virtual work (a 'steps' key in JSON).")] = False,  # noqa: E501
 ) -> None:
     """Derive the equations of motion by Lagrange's method."""
     from ..output.derivation import derivation_document, derivation_latex, derivation_text
@@ -33,9 +34,23 @@ def derive(
     warn_if_unphysical(eom)
     if json_ and format is Format.latex:
         raise InputError("--json and --format latex ask for two formats; give one", field="--format")
+    working = eom.steps() if steps else None
     if json_ or format is Format.json:
-        print_json(derivation_document(eom))
+        document = derivation_document(eom)
+        if working is not None:
+            from ..output.steps import steps_document
+
+            document["steps"] = steps_document(working)
+        print_json(document)
     elif format is Format.latex:
         typer.echo(derivation_latex(eom), nl=False)
+        if working is not None:
+            from ..output.steps import steps_latex
+
+            typer.echo(steps_latex(working), nl=False)
     else:
         typer.echo(derivation_text(eom), nl=False)
+        if working is not None:
+            from ..output.steps import steps_text
+
+            typer.echo("\n" + steps_text(working), nl=False)

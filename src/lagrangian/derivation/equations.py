@@ -213,6 +213,13 @@ class EquationsOfMotion:
             rows.append(sp.Add(*terms))
         return sp.ImmutableMatrix(M.rows, 1, rows)
 
+    def steps(self):
+        """The working of Lagrange's method from L = T - V, coordinate by coordinate and load
+        by load (a DerivationSteps; derivation/steps.py)."""
+        from .steps import derivation_steps
+
+        return derivation_steps(self)
+
     def _repr_latex_(self) -> str:
         names = latex_symbol_names(self.model)
         rows = []

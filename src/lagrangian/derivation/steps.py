@@ -1,0 +1,204 @@
+"""The working of Lagrange's method, step by step, for a reader to follow (``derive --steps``).
+
+Each step is derived here from L = T - V by differentiation, not restated from M and f:
+per coordinate q_i, the momentum p_i = dL/dq_dot_i (kg m^2/s for an angle, kg m/s for a length),
+its rate d/dt(p_i) = sum_j (dp_i/dq_j q_dot_j + dp_i/dq_dot_j q_ddot_j) + dp_i/dt, the force
+term dL/dq_i, the generalized force Q_i of the non-potential loads and, with constraints, the
+multiplier terms (Phi_q^T lambda)_i; the equation is d/dt(p_i) - dL/dq_i - Q_i + (Phi_q^T
+lambda)_i = 0. Per load, the virtual displacement of what it acts on (delta r = sum_i dr/dq_i
+delta q_i for a point, delta(angle) for a torque, delta(length) for a damper) and its virtual
+work delta W = sum_i Q_i delta q_i.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..model.model import Damper, Model, PointForce, Torque
+from ..model.notation import latex_printer
+from ..model.rotations import Moment
+from .equations import EquationsOfMotion
+from .kinematics import Differentiator
+from .virtual_work import DISSIPATION_LOAD
+
+
+@dataclass(frozen=True)
+class CoordinateStep:
+    """Lagrange's equation for one coordinate, term by term (units of a generalized force)."""
+
+    coordinate: str
+    momentum: sp.Expr            # dL/dq_dot_i
+    momentum_rate: sp.Expr       # d/dt(dL/dq_dot_i)
+    force_gradient: sp.Expr      # dL/dq_i
+    generalized_force: sp.Expr   # Q_i (N or N m)
+    multiplier_terms: sp.Expr    # (Phi_q^T lambda)_i
+    equation: sp.Expr            # momentum_rate - force_gradient - Q_i + multiplier terms (= 0)
+
+
+@dataclass(frozen=True)
+class LoadStep:
+    """One load's virtual work: what it acts on moves by ``displacement`` (in the delta q),
+    and delta W = ``virtual_work`` (J) = sum_i ``shares`` Q_i delta q_i."""
+
+    load: str
+    kind: str                            # force, torque, moment, damper, dissipation, given
+    acts_at: tuple[sp.Expr, ...]         # the point r, the angle, the damper's rate; () if none
+    displacement: tuple[sp.Expr, ...]    # delta r, delta(angle) or delta(length); () if none
+    work_form: sp.Expr | None            # delta W as the load writes it (F . delta r, tau d angle)
+    virtual_work: sp.Expr                # sum_i Q_i delta q_i
+    shares: tuple[tuple[str, sp.Expr], ...]
+
+
+@dataclass(frozen=True)
+class ConstraintStep:
+    """One constraint: Phi (or A q_dot + b), its row of Phi_q and its multiplier."""
+
+    constraint: str
+    kind: str
+    expression: sp.Expr
+    jacobian: tuple[sp.Expr, ...]
+    multiplier: sp.Symbol
+
+
+@dataclass(frozen=True)
+class DerivationSteps:
+    """The steps of ``derive --steps``: L, then each coordinate, load and constraint."""
+
+    model: Model
+    kinetic_energy: sp.Expr
+    potential_energy: sp.Expr
+    lagrangian: sp.Expr
+    variations: tuple[sp.Symbol, ...]    # delta q_i, one per coordinate
+    coordinates: tuple[CoordinateStep, ...]
+    loads: tuple[LoadStep, ...]
+    constraints: tuple[ConstraintStep, ...]
+
+    def coordinate(self, name: str) -> CoordinateStep:
+        for step in self.coordinates:
+            if step.coordinate == name:
+                return step
+        raise KeyError(name)
+
+    def __repr__(self) -> str:
+        lines = [f"DerivationSteps({self.model.name!r})", f"  L = {self.lagrangian}"]
+        for s in self.coordinates:
+            lines += [f"  [{s.coordinate}] dL/dq_dot = {s.momentum}",
+                      f"  [{s.coordinate}] d/dt(dL/dq_dot) = {s.momentum_rate}",
+                      f"  [{s.coordinate}] dL/dq = {s.force_gradient}",
+                      f"  [{s.coordinate}] Q = {s.generalized_force}",
+                      f"  [{s.coordinate}] {s.equation} = 0"]
+        lines += [f"  {load.load}: delta W = {load.virtual_work}" for load in self.loads]
+        return "\n".join(lines)
+
+    def _repr_latex_(self) -> str:
+        tex = latex_printer(self.model)
+        rows = [rf"\mathcal{{L}} &= {tex(self.lagrangian)}"]
+        for c, s in zip(self.model.coordinates, self.coordinates, strict=True):
+            q, v = tex(c.symbol), tex(c.velocity)
+            rows += [rf"\frac{{\partial \mathcal{{L}}}}{{\partial {v}}} &= {tex(s.momentum)}",
+                     rf"\frac{{d}}{{dt}}\frac{{\partial \mathcal{{L}}}}{{\partial {v}}} &= "
+                     rf"{tex(s.momentum_rate)}",
+                     rf"\frac{{\partial \mathcal{{L}}}}{{\partial {q}}} &= "
+                     rf"{tex(s.force_gradient)}",
+                     rf"\mathcal{{Q}}_{{{q}}} &= {tex(s.generalized_force)}",
+                     rf"0 &= {tex(s.equation)}"]
+        rows += [rf"\delta W_{{\mathrm{{{_latex_text(load.load)}}}}} &= {tex(load.virtual_work)}"
+                 for load in self.loads]
+        return r"$\begin{aligned}" + r"\\ ".join(rows) + r"\end{aligned}$"
+
+
+def _latex_text(name: str) -> str:
+    """A name as LaTeX text: its special characters escaped, never read as commands."""
+    special = {"\\": r"\textbackslash{}", "^": r"\^{}", "~": r"\~{}"}
+    return "".join(special.get(ch, "\\" + ch if ch in "_&%$#{}" else ch) for ch in name)
+
+
+def variation_symbols(model: Model) -> tuple[sp.Symbol, ...]:
+    """delta_q for each coordinate q (delta_q_ when a model name is already delta_q)."""
+    taken = {p.name for p in model.parameters} | {c.name for c in model.coordinates}
+    out = []
+    for c in model.coordinates:
+        name = f"delta_{c.name}"
+        while name in taken:
+            name += "_"
+        out.append(sp.Symbol(name))
+    return tuple(out)
+
+
+def derivation_steps(eom: EquationsOfMotion) -> DerivationSteps:
+    """Differentiate L = T - V of ``eom`` step by step and project each load (see module doc)."""
+    model = eom.model
+    q, q_dot, q_ddot, t = model.q, model.q_dot, model.q_ddot, model.time
+    d = Differentiator()
+    T, V = eom.kinetic_energy, eom.potential_energy
+    L = T - V
+    A, multipliers = eom.constraint_jacobian, eom.multipliers
+    coordinates = []
+    for i, c in enumerate(model.coordinates):
+        momentum = d(L, q_dot[i])
+        rate = sp.Add(*(d(momentum, qj) * vj for qj, vj in zip(q, q_dot, strict=True)),
+                      *(d(momentum, vj) * aj for vj, aj in zip(q_dot, q_ddot, strict=True)),
+                      d(momentum, t))
+        gradient = d(L, q[i])
+        Q = eom.generalized_forces[i]
+        lam = sp.Add(*(A[k, i] * multipliers[k] for k in range(A.rows) if A[k, i] != 0))
+        coordinates.append(CoordinateStep(c.name, momentum, rate, gradient, Q, lam,
+                                          rate - gradient - Q + lam))
+    variations = variation_symbols(model)
+    constraints = tuple(
+        ConstraintStep(constraint.name, str(constraint.kind), constraint.expression,
+                       tuple(A.row(k)), multipliers[k])
+        for k, constraint in enumerate(model.constraints))
+    return DerivationSteps(model, T, V, L, variations, tuple(coordinates),
+                           tuple(_load_steps(eom, variations, d)), constraints)
+
+
+def _load_steps(eom: EquationsOfMotion, variations, d: Differentiator) -> list[LoadStep]:
+    """Each load's virtual displacement and virtual work, in the order of derive's breakdown."""
+    model = eom.model
+    q, q_dot = model.q, model.q_dot
+    names = [c.name for c in model.coordinates]
+    by_load: dict[str, list[tuple[str, sp.Expr]]] = {}
+    for part in eom.load_contributions:
+        by_load.setdefault(part.load, []).append((part.coordinate, part.expression))
+    loads = {load.name: load for load in model.loads}
+    dampers = {damper.name: damper for damper in model.dampers}
+
+    def moved(expr, variables) -> sp.Expr:
+        return sp.Add(*(d(expr, x) * dq for x, dq in zip(variables, variations, strict=True)))
+
+    steps = []
+    for name, shares in by_load.items():
+        work = sp.Add(*(value * variations[names.index(c)] for c, value in shares))
+        load, damper = loads.get(name), dampers.get(name)
+        acts_at: tuple = ()
+        displacement: tuple = ()
+        form = None
+        if isinstance(load, PointForce):
+            kind, acts_at = "force", tuple(load.point)
+            displacement = tuple(moved(r, q) for r in load.point)
+            form = sp.Add(*(f * dr for f, dr in zip(load.force, displacement, strict=True)))
+        elif isinstance(load, Torque):
+            kind, acts_at = "torque", (load.angle,)
+            displacement = (moved(load.angle, q),)
+            form = load.torque * displacement[0]
+        elif isinstance(load, Moment):
+            # delta phi_k = sum_i d omega_k/d q_dot_i delta q_i, in the axes the moment is given in
+            kind = "moment"
+            displacement = tuple(moved(w, q_dot) for w in load.angular_velocity)
+            form = sp.Add(*(m * dp for m, dp in zip(load.moment, displacement, strict=True)))
+        elif isinstance(damper, Damper):
+            # the rate l_dot is linear in q_dot: delta l = sum_i d l_dot/d q_dot_i delta q_i
+            kind, acts_at = "damper", (damper.rate,)
+            displacement = (moved(damper.rate, q_dot),)
+            form = -damper.coefficient * damper.rate * displacement[0]
+        else:
+            kind = "dissipation" if name == DISSIPATION_LOAD else "given"
+        steps.append(LoadStep(name, kind, acts_at, displacement, form, work, tuple(shares)))
+    return steps
+
+
+__all__ = ["ConstraintStep", "CoordinateStep", "DerivationSteps", "LoadStep", "derivation_steps",
+           "variation_symbols"]

@@ -1,0 +1,235 @@
+"""The working of `derive --steps`: text, LaTeX and the `steps` key of the JSON document.
+
+Expressions are written in the model-file grammar (text, JSON; read back by
+``parse_expression`` with the delta q symbols declared) or with the model's LaTeX names.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import sympy as sp
+
+from ..derivation.readable import readable
+from ..derivation.steps import DerivationSteps
+from ..model.expressions import format_expression, tree_size
+from ..model.notation import latex_symbol_names
+
+SMALL = 400  # nodes: a step this small has its common factors taken out before it is grouped
+
+
+class _Form:
+    """The readable form of a step (derivation/readable.py: equal, grouped by products of the
+    rates and of the delta q)."""
+
+    def __init__(self, steps: DerivationSteps):
+        model = steps.model
+        self.rates = frozenset([*model.q_dot, *model.q_ddot, *steps.variations,
+                                *(c.multiplier for c in steps.constraints)])
+        self.ranges = {c.symbol: tuple(c.range) for c in model.coordinates if c.range}
+
+    def __call__(self, expr) -> sp.Expr:
+        expr = sp.sympify(expr)  # safe: a sympy object or a number
+        if not expr.is_Atom and tree_size(expr, SMALL) <= SMALL:
+            # -k*(2*x - 2*x0)/2, as d/dx of k*(x - x0)**2/2 comes out, reads -k*(x - x0)
+            expr = sp.factor_terms(expr)
+        return readable(expr, self.rates, self.ranges)
+
+    def text(self, expr) -> str:
+        return format_expression(self(expr))
+
+
+def _lagrangian_name(model) -> str:
+    """"L", or words where the model has a symbol L (a pendulum's length), as derive does."""
+    names = {p.name for p in model.parameters} | {c.name for c in model.coordinates}
+    return "L" if "L" not in names else "(T - V)" if not names & {"T", "V"} else "(Lagrangian)"
+
+
+def _force_name(model) -> str:
+    names = {p.name for p in model.parameters} | {c.name for c in model.coordinates}
+    return "Q" if "Q" not in names else "(generalized force)"
+
+
+# -- text ---------------------------------------------------------------------------------------
+
+
+def steps_text(steps: DerivationSteps) -> str:
+    """The working as text: L, each coordinate's derivatives, each load's virtual work."""
+    model, form = steps.model, _Form(steps)
+    lag, force = _lagrangian_name(model), _force_name(model)
+    label = {"L": "L = T - V", "(T - V)": "T - V"}.get(lag, "Lagrangian T - V")
+    lines = ["Steps (Lagrange's method, each derived from L = T - V):",
+             f"  {label} = {form.text(steps.lagrangian)}", ""]
+    for c, s in zip(model.coordinates, steps.coordinates, strict=True):
+        lines.append(f"  [{c.name}]")
+        lines.append(f"    d{lag}/d{c.velocity} = {form.text(s.momentum)}")
+        lines.append(f"    d/dt(d{lag}/d{c.velocity}) = {form.text(s.momentum_rate)}")
+        lines.append(f"    d{lag}/d{c.name} = {form.text(s.force_gradient)}")
+        lines.append(f"    {force}[{c.name}] = {form.text(s.generalized_force)}")
+        multipliers = ""
+        if steps.constraints:
+            lines.append(f"    (Phi_q^T lambda)[{c.name}] = {form.text(s.multiplier_terms)}")
+            multipliers = " + (Phi_q^T lambda)"
+        lines.append(f"    d/dt(d{lag}/d{c.velocity}) - d{lag}/d{c.name} - {force}[{c.name}]"
+                     f"{multipliers} = 0:")
+        lines.append(f"      {form.text(s.equation)} = 0")
+    if steps.loads:
+        variations = ", ".join(str(v) for v in steps.variations)
+        lines += ["", f"  Virtual work of the loads (virtual displacements {variations}):"]
+        for load in steps.loads:
+            lines += _load_lines(load, form, model, force)
+    if steps.constraints:
+        lines += ["", "  Constraints (one multiplier each, Phi_q^T lambda in each equation):"]
+        for k in steps.constraints:
+            written = "Phi" if k.kind == "holonomic" else "A q_dot + b"
+            row = ", ".join(form.text(v) for v in k.jacobian)
+            lines.append(f"    {k.constraint} ({k.kind}): {written} = "
+                         f"{form.text(k.expression)} = 0")
+            lines.append(f"      Phi_q row = [{row}]   multiplier {k.multiplier}")
+    return "\n".join(lines) + "\n"
+
+
+_WHAT = {"force": "force at r", "torque": "torque through the angle",
+         "moment": "moment on a body in space", "damper": "damper of rate",
+         "dissipation": "dissipation function D", "given": "generalized forces given"}
+
+
+def _load_lines(load, form: _Form, model, force: str) -> list[str]:
+    lines = []
+    if load.kind == "force":
+        point = ", ".join(form.text(r) for r in _planar(load.acts_at))
+        moved = ", ".join(form.text(r) for r in _planar(load.displacement))
+        lines += [f"    {load.load} (force at r = ({point})):",
+                  f"      delta r = sum_i dr/dq_i delta q_i = ({moved})",
+                  f"      delta W = F . delta r = {form.text(load.work_form)}"
+                  + _same(load, form)]
+    elif load.kind == "torque":
+        lines += [f"    {load.load} (torque through the angle {form.text(load.acts_at[0])}):",
+                  f"      delta(angle) = {form.text(load.displacement[0])}",
+                  f"      delta W = tau delta(angle) = {form.text(load.work_form)}"
+                  + _same(load, form)]
+    elif load.kind == "moment":
+        turned = ", ".join(form.text(v) for v in load.displacement)
+        lines += [f"    {load.load} (moment on a body in space):",
+                  f"      delta phi = sum_i d omega/d q_dot_i delta q_i = ({turned})",
+                  f"      delta W = M . delta phi = {form.text(load.work_form)}"
+                  + _same(load, form)]
+    elif load.kind == "damper":
+        lines += [f"    {load.load} (damper, rate of its length {form.text(load.acts_at[0])}):",
+                  f"      delta(length) = {form.text(load.displacement[0])}",
+                  f"      delta W = -c (rate) delta(length) = {form.text(load.work_form)}"
+                  + _same(load, form)]
+    else:
+        what = ("the dissipation function: Q_i = -dD/dq_dot_i" if load.kind == "dissipation"
+                else "given as generalized forces")
+        lines.append(f"    {load.load} ({what}):")
+        lines.append(f"      delta W = {form.text(load.virtual_work)}")
+    lines += [f"      {force}[{name}] from {load.load} = {form.text(value)}"
+              for name, value in load.shares]
+    return lines
+
+
+def _same(load, form: _Form) -> str:
+    """' = sum_i Q_i delta q_i' where that reads differently from the load's own form."""
+    written, summed = form.text(load.work_form), form.text(load.virtual_work)
+    return "" if written == summed else f" = {summed}"
+
+
+def _planar(vector) -> tuple:
+    """(x, y) when every z is 0, else (x, y, z)."""
+    return tuple(vector[:2]) if len(vector) == 3 and vector[2] == 0 else tuple(vector)
+
+
+# -- JSON ---------------------------------------------------------------------------------------
+
+
+def steps_document(steps: DerivationSteps) -> dict[str, Any]:
+    """The `steps` key of `derive --steps --json`: every expression in the model grammar."""
+    form = _Form(steps)
+    text = form.text
+    return {
+        "lagrangian": text(steps.lagrangian),
+        "variations": {c.name: str(v) for c, v in zip(steps.model.coordinates, steps.variations,
+                                                       strict=True)},
+        "coordinates": {
+            s.coordinate: {"dL_dq_dot": text(s.momentum), "d_dt_dL_dq_dot": text(s.momentum_rate),
+                           "dL_dq": text(s.force_gradient), "Q": text(s.generalized_force),
+                           "multiplier_terms": text(s.multiplier_terms),
+                           "equation": text(s.equation)}
+            for s in steps.coordinates},
+        "loads": [
+            {"load": load.load, "kind": load.kind,
+             "acts_at": [text(v) for v in load.acts_at],
+             "virtual_displacement": [text(v) for v in load.displacement],
+             "work_form": None if load.work_form is None else text(load.work_form),
+             "virtual_work": text(load.virtual_work),
+             "Q": {name: text(value) for name, value in load.shares}}
+            for load in steps.loads],
+        "constraints": [
+            {"constraint": k.constraint, "kind": k.kind, "expression": text(k.expression),
+             "jacobian": [text(v) for v in k.jacobian], "multiplier": str(k.multiplier)}
+            for k in steps.constraints],
+    }
+
+
+# -- LaTeX --------------------------------------------------------------------------------------
+
+
+def steps_latex(steps: DerivationSteps) -> str:
+    """The working as an amsmath align block, to follow `derive --format latex`."""
+    model, form = steps.model, _Form(steps)
+    symbol_names = latex_symbol_names(model)
+    symbol_names.update({v: rf"\delta {sp.latex(c.symbol)}"
+                         for c, v in zip(model.coordinates, steps.variations, strict=True)})
+
+    def printer(expr) -> str:
+        return sp.latex(expr, symbol_names=symbol_names)
+
+    names = {p.name for p in model.parameters} | {c.name for c in model.coordinates}
+    L = r"\mathcal{L}" if "L" in names else "L"
+    Q = r"\mathcal{Q}" if "Q" in names else "Q"
+    def tex(expr) -> str:
+        if isinstance(expr, sp.MatrixBase):
+            return printer(sp.ImmutableMatrix(expr.rows, expr.cols, [form(e) for e in expr]))
+        return printer(form(expr))
+
+    lines = [f"% {model.name}: the steps of Lagrange's method", r"\begin{align}",
+             rf"{L} &= T - V = {tex(steps.lagrangian)} \\"]
+    for c, s in zip(model.coordinates, steps.coordinates, strict=True):
+        q, v = printer(c.symbol), printer(c.velocity)
+        lines += [rf"\frac{{\partial {L}}}{{\partial {v}}} &= {tex(s.momentum)} \\",
+                  rf"\frac{{d}}{{dt}}\frac{{\partial {L}}}{{\partial {v}}} &= "
+                  rf"{tex(s.momentum_rate)} \\",
+                  rf"\frac{{\partial {L}}}{{\partial {q}}} &= {tex(s.force_gradient)} \\",
+                  rf"{Q}_{{{q}}} &= {tex(s.generalized_force)} \\"]
+        if steps.constraints:
+            lines.append(rf"(\Phi_q^T \lambda)_{{{q}}} &= {tex(s.multiplier_terms)} \\")
+        lines.append(rf"0 &= {tex(s.equation)} && \text{{({_escape(c.name)})}} \\")
+    for load in steps.loads:
+        label = _escape(load.load)
+        if load.kind == "force":
+            moved = tex(sp.Matrix(_planar(load.displacement)))
+            lines.append(rf"\delta \mathbf{{r}}_{{\mathrm{{{label}}}}} &= {moved} \\")
+        elif load.kind == "moment":
+            lines.append(rf"\delta \boldsymbol{{\phi}}_{{\mathrm{{{label}}}}} &= "
+                         rf"{tex(sp.Matrix(load.displacement))} \\")
+        elif load.displacement:
+            symbol = r"\ell" if load.kind == "damper" else r"\theta"
+            lines.append(rf"\delta {symbol}_{{\mathrm{{{label}}}}} &= "
+                         rf"{tex(load.displacement[0])} \\")
+        lines.append(rf"\delta W_{{\mathrm{{{label}}}}} &= {tex(load.virtual_work)} \\")
+    for k in steps.constraints:
+        lines.append(rf"\Phi_{{q,\mathrm{{{_escape(k.constraint)}}}}} &= "
+                     rf"{tex(sp.Matrix([list(k.jacobian)]))} \\")
+    lines[-1] = lines[-1].removesuffix(r" \\")
+    lines.append(r"\end{align}")
+    return "\n".join(lines) + "\n"
+
+
+_LATEX_SPECIAL = {"\\": r"\textbackslash{}", "^": r"\^{}", "~": r"\~{}",
+                  **{ch: "\\" + ch for ch in "_&%$#{}"}}
+
+
+def _escape(name: str) -> str:
+    """A name as LaTeX text: its special characters escaped, never read as commands."""
+    return "".join(_LATEX_SPECIAL.get(ch, ch) for ch in name)

@@ -22,7 +22,7 @@ from ..analysis.linearization import (
     linear_model_at,
     symbolic_linear_model,
 )
-from ..analysis.modes import ModalAnalysis, is_stable, modal_analysis
+from ..analysis.modes import is_stable, modal_analysis
 from ..analysis.speed_form import SpeedForm, SpeedSweep, speed_form, speed_sweep
 from ..analysis.statics import StaticsReport, solve_statics
 from ..analysis.steady import steady_linear_model
@@ -48,6 +48,7 @@ from ..model.urdf import example_urdf, read_urdf
 from ..model.values import State, resolve_state
 from ..simulation.events import StopCondition
 from ..simulation.simulate import SaveAt, StepControl, parse_stop_condition, simulate
+from .modes import ModalAnalysis
 from .simulation import Simulation
 
 
@@ -286,7 +287,8 @@ class System:
         default = self._model.steady_motion
         if steady is None and about is None and default is not None:
             steady, about = dict(default.rates), dict(default.about) or None
-        return modal_analysis(self.linearize(about, steady=steady), self._model.name)
+        return ModalAnalysis.of(modal_analysis(self.linearize(about, steady=steady),
+                                               self._model.name), self._model)
 
     def speed_form(self, steady: Mapping[str, float | str] | None = None,
                    speed: str | None = None, keep: Sequence[str] | None = None,

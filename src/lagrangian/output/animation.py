@@ -122,7 +122,7 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
     figure = animation_figure(size)
     ax = figure.add_subplot()
     panel = mechanism_panel(ax, geometry, q, v, times, view=view, trail=max(1, int(fps)),
-                            title=plain_text(result.model_name), fit=size is not None)
+                            title=plain_text(result.model_name))
     clock = _clock(ax)
 
     def draw(k):
@@ -156,11 +156,11 @@ class Panel(NamedTuple):
 
 def mechanism_panel(ax, geometry: Mechanism, q: np.ndarray, v: np.ndarray, times: np.ndarray, *,
                     view: tuple[float, float] = ISOMETRIC_VIEW, trail: int = 25, title: str = "",
-                    fit: bool = False, show_axes: bool = True) -> Panel:
-    """Draw the mechanism at states q, v (k, n) on ``ax``; each particle leaves a trail of
-    ``trail`` frames. ``fit``: the view widens to fill a non-square panel (equal scales)."""
+                    show_axes: bool = True) -> Panel:
+    """Draw the mechanism at states q, v (k, n) on ``ax`` (equal scales; a non-square panel
+    gets a square drawing in its middle); each particle leaves a trail of ``trail`` frames."""
     if geometry.rigid_body_names:
-        return _space_panel(ax, geometry, times, q, v, view, title, fit)
+        return _space_panel(ax, geometry, times, q, v, view, title)
     frame = geometry.frame(q, v, times)
     particles, bars, springs, dampers = frame.particles, frame.bars, frame.springs, frame.dampers
     rolling = {j: (radius, np.array(normal)) for j, radius, normal in geometry.rolling}
@@ -186,7 +186,7 @@ def mechanism_panel(ax, geometry: Mechanism, q: np.ndarray, v: np.ndarray, times
 
     ax.set_xlim(low[0], high[0])
     ax.set_ylim(low[1], high[1])
-    ax.set_aspect("equal", adjustable="datalim" if fit else "box")
+    ax.set_aspect("equal")
     if show_axes:
         ax.set_xlabel("x (m)")
         ax.set_ylabel("y (m)")
@@ -324,7 +324,7 @@ _EDGES = [(a, b) for a in range(8) for b in range(a + 1, 8)
           if np.sum(_CORNERS[a] != _CORNERS[b]) == 1]
 
 
-def _space_panel(ax, geometry, times, q, v, view, title, fit) -> Panel:
+def _space_panel(ax, geometry, times, q, v, view, title) -> Panel:
     """The 3D mechanism projected on the screen seen from ``view`` (azimuth, elevation)."""
     space = geometry.space_frame(q, v, times)
     screen = view_projection(*view)
@@ -357,7 +357,7 @@ def _space_panel(ax, geometry, times, q, v, view, title, fit) -> Panel:
 
     ax.set_xlim(centre[0] - half, centre[0] + half)
     ax.set_ylim(centre[1] - half, centre[1] + half)
-    ax.set_aspect("equal", adjustable="datalim" if fit else "box")
+    ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_yticks([])
     ax.set_title(title + f"\n(azimuth {view[0]:.4g}°, elevation {view[1]:.4g}°)")

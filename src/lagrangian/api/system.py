@@ -375,8 +375,10 @@ class System:
                                         int(save.samples), stop_when, bool(trajectories))
         study = make_study(eom, compute, vary or {}, sample, members, seed, options, chunk_size,
                            about)
-        return run_study(study, out=out, resume=resume, scheduler=scheduler, client=client,
-                         workers=workers, progress=progress)
+        from .sweep import Sweep
+
+        return Sweep.of(run_study(study, out=out, resume=resume, scheduler=scheduler,
+                                  client=client, workers=workers, progress=progress))
 
     def warnings(self, set_parameters: Mapping[str, object] | None = None) -> list[str]:
         """Where the user is probably wrong, one line each: a declared g with no gravity, a

@@ -466,6 +466,9 @@ def _animation(figure, draw, times: np.ndarray, fps: int, *, html_dpi: float | N
 
     animation = MechanismAnimation(figure, draw, frames=len(times), interval=1000 / fps,
                                    blit=False)
+    # Frames are drawn on demand (a file, a player), not by a GUI event loop: an animation
+    # kept for its geometry alone is not a forgotten one, so matplotlib need not warn about it.
+    animation._draw_was_started = True
     animation.fps = fps
     animation.times = times
     animation.title = figure.axes[0].get_title()

@@ -167,6 +167,13 @@ def test_simulate_takes_size_and_fps(tmp_path, capsys):
     with Image.open(out) as gif:
         assert gif.size == (300, 200)
         assert gif.n_frames == 11  # 1 s at 10 frames a second, both ends
+    page = tmp_path / "run.html"
+    with pytest.raises(SystemExit) as exit_info:
+        main(["simulate", "double_pendulum", "--t-end", "0.5", "--animate", str(page),
+              "--size", "300x200"])
+    assert exit_info.value.code in (0, None)
+    assert 'width="300" height="200"' in page.read_text(encoding="utf-8")
+    capsys.readouterr()
     with pytest.raises(SystemExit) as exit_info:
         main(["simulate", "double_pendulum", "--t-end", "1", "--size", "300x200"])
     assert exit_info.value.code == 2

@@ -286,7 +286,7 @@ def check_animation_path(path: str | Path) -> Path:
     return path
 
 
-# What each kind of file we write begins with (an HTML player: its marker, in its first bytes).
+# What each kind of file we write begins with (an HTML player: its marker, near its start).
 _SIGNATURES = {".gif": lambda head: head.startswith((b"GIF87a", b"GIF89a")),
                ".mp4": lambda head: head[4:8] == b"ftyp",
                ".html": lambda head: b"lagrangian-animation" in head}
@@ -305,7 +305,7 @@ def check_animation_target(path: str | Path, field: str = "animation") -> Path:
         raise ModelError(f"cannot write {path}: it exists and is not a file", field=field)
     try:
         with open(path, "rb") as handle:
-            head = handle.read(4096)
+            head = handle.read(65536)
     except OSError as exc:
         raise ModelError(f"cannot read {path}: {exc.strerror or exc}", field=field) from None
     if head and not _SIGNATURES[path.suffix.lower()](head):

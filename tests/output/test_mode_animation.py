@@ -132,8 +132,8 @@ def test_our_own_animation_is_replaced(tmp_path, capsys):
                                               "(e.g. 800x600), got 'big'"),
     (["--animate", "m.gif", "--size", "10x10"], "error: --size: the size must be between 64 and "
                                                 "4096 pixels a side, got 10x10"),
-    (["--animate", "m.gif", "--fps", "0"], "error: --fps: frames a second must be a whole number "
-                                           "from 1 to 120, got 0"),
+    (["--animate", "m.gif", "--fps", "0"], "error: --fps: frames a second must be a number from 1 "
+                                           "to 120, got 0"),
     (["--animate", "m.avi"], "error: --animate: cannot write m.avi: use a .gif, .html or .mp4 "
                              "file name"),
     (["--fps", "10"], "error: --fps: frames a second are only used with --animate"),

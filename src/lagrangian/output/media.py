@@ -339,11 +339,11 @@ def check_size(size: object, field: str = "size") -> tuple[int, int] | None:
     return width, height
 
 
-def check_fps(fps: object, field: str = "fps") -> int:
-    """Frames a second, a whole number from 1 to 120."""
+def check_fps(fps: object, field: str = "fps") -> float:
+    """Frames a second, from 1 to 120 (a whole number comes back as an int)."""
     low, high = FPS_LIMITS
     if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) or \
-            not np.isfinite(fps) or fps != int(fps) or not low <= fps <= high:
-        raise ModelError(f"frames a second must be a whole number from {low} to {high}, got "
-                         f"{fps!r}", field=field)
-    return int(fps)
+            not np.isfinite(fps) or not low <= fps <= high:
+        raise ModelError(f"frames a second must be a number from {low} to {high}, got {fps!r}",
+                         field=field)
+    return int(fps) if fps == int(fps) else float(fps)

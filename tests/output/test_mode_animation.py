@@ -179,3 +179,17 @@ def test_simulate_takes_size_and_fps(tmp_path, capsys):
     assert exit_info.value.code == 2
     assert capsys.readouterr().err.endswith("error: --size: a frame size is only used with "
                                             "--animate\n")
+
+
+def test_mp4_without_its_extra_is_refused_naming_it(tmp_path, monkeypatch, capsys):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "imageio_ffmpeg", None)  # as where it is not installed
+    target = tmp_path / "modes.mp4"
+    with pytest.raises(SystemExit) as exit_info:
+        main(["modes", "two_mass", "--animate", str(target)])
+    assert exit_info.value.code == 2
+    assert capsys.readouterr().err == (
+        'error: --animate: writing MP4 needs the optional extra: pip install "lagrangian[mp4]" '
+        "(imageio-ffmpeg, which ships the encoder); or write .gif or .html\n")
+    assert not target.exists()

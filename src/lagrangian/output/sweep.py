@@ -277,6 +277,7 @@ def _speeds_figure(figure, dataset, x):
                     color=f"C{(k - 1) % 10}")
         ax.axhline(0.0, color="0.5", lw=0.8)
         ax.set_ylabel(label)
+        flat_axis(ax, np.asarray(variable.values, float))
     axes[1].set_xlabel(_label(dataset, x))
     axes[0].set_title(plain_text(f"eigenvalues of {dataset.attrs.get('model', '')!s} "
                                  f"against {x}"))
@@ -313,6 +314,7 @@ def study_figure(dataset):
                 ax.plot(xs[s == 1], y[s == 1], "o", color="C0", ms=4)
                 ax.plot(xs[s == 0], y[s == 0], "o", mfc="none", color="C3", ms=4)
             ax.set_ylabel(f"equilibrium {c}")
+        flat_axis(ax, np.asarray(eq.values, float))
         ax.set_xlabel(_label(dataset, x))
         ax.set_title("stable filled, unstable hollow", fontsize="small")
         figure.suptitle(plain_text(f"Equilibria of {dataset.attrs.get('model', '')} against "

@@ -193,3 +193,20 @@ def test_mp4_without_its_extra_is_refused_naming_it(tmp_path, monkeypatch, capsy
         'error: --animate: writing MP4 needs the optional extra: pip install "lagrangian[mp4]" '
         "(imageio-ffmpeg, which ships the encoder); or write .gif or .html\n")
     assert not target.exists()
+
+
+def test_a_still_picture_puts_the_bobs_where_the_angles_say():
+    """mechanism_picture (the drawing a report or a notebook shows of the model): the double
+    pendulum's bobs at l1 (sin t1, -cos t1) and that plus l2 (sin t2, -cos t2), l = 1 m."""
+    from lagrangian.output.animation import mechanism_picture
+
+    model = lagrangian.load("double_pendulum").model
+    figure = mechanism_picture(model, {"theta1": 0.3, "theta2": -0.4}, size=(300, 200))
+    assert tuple(figure.get_size_inches() * figure.dpi) == (300, 200)
+    x = [math.sin(0.3), math.sin(0.3) + math.sin(-0.4)]
+    y = [-math.cos(0.3), -math.cos(0.3) - math.cos(-0.4)]
+    assert any(np.allclose(line.get_xdata(), x) and np.allclose(line.get_ydata(), y)
+               for line in figure.axes[0].lines)
+    assert figure._repr_png_().startswith(b"\x89PNG")
+    with pytest.raises(ModelError, match="nothing to animate"):
+        mechanism_picture(lagrangian.load("pendulum").model)  # given by its energies only

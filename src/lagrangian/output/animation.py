@@ -134,6 +134,28 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
     return animation
 
 
+def mechanism_picture(model: Model, q=None, parameters=None, *, size: object = None,
+                      view: object = None, title: str | None = None):
+    """A still drawing of the mechanism at configuration ``q`` (coordinate name -> value, SI;
+    the model's initial values where not given): a matplotlib Figure that shows itself in a
+    notebook, drawn as the animations draw it."""
+    from .plots import notebook_figure
+
+    check_animatable(model)
+    view, size = check_view(view), check_size(size) or DEFAULT_SIZE
+    given = dict(q or {})
+    state = np.array([[float(given.get(c.name, c.initial if c.initial is not None else 0.0))
+                       for c in model.coordinates]])
+    figure = notebook_figure(figsize=(size[0] / ANIMATION_DPI, size[1] / ANIMATION_DPI),
+                             dpi=ANIMATION_DPI, layout="constrained")
+    ax = figure.add_subplot()
+    panel = mechanism_panel(ax, mechanism(model, parameters), state, np.zeros_like(state),
+                            np.zeros(1), view=view, trail=1,
+                            title=plain_text(model.name if title is None else title))
+    panel.draw(0)
+    return figure
+
+
 def animation_figure(size: tuple[int, int] | None = None, dpi: float = ANIMATION_DPI):
     """A Figure drawn by Agg (never pyplot: nothing is left open) of ``size`` pixels."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg

@@ -88,8 +88,8 @@ def test_parameters_and_units_on_the_command_line(capsys, tmp_path):
     (["--method", "Euler"], "error: --method: unknown method 'Euler'; choose one of DOP853, RK45, "
                             "RK23, Radau, BDF, LSODA"),
     (["--out", "run.xlsx"], "error: --out: cannot write run.xlsx: use a .csv or .parquet file name"),
-    (["--animate", "run.mp4"], "error: --animate: cannot write run.mp4: use a .gif or .html file "
-                               "name"),
+    (["--animate", "run.avi"], "error: --animate: cannot write run.avi: use a .gif, .html or .mp4 "
+                               "file name"),
     (["--set", "q=1"], "error: --set: 'q' is not a parameter of this model; expected one of: m, L, g"),
 ])
 def test_bad_input_exits_with_status_2(capsys, args, message):

@@ -141,8 +141,8 @@ def test_a_model_without_particles_or_bodies_cannot_be_animated(tmp_path):
     run = lagrangian.load("pendulum").simulate(0.2, samples=5)  # given by T and V only
     with pytest.raises(ModelError, match="nothing to animate"):
         run.animate(tmp_path / "run.gif")
-    with pytest.raises(ModelError, match="use a .gif or .html file name"):
-        lagrangian.load("double_pendulum").simulate(0.1, samples=3).animate(tmp_path / "x.mp4")
+    with pytest.raises(ModelError, match="use a .gif, .html or .mp4 file name"):
+        lagrangian.load("double_pendulum").simulate(0.1, samples=3).animate(tmp_path / "x.avi")
     assert not (tmp_path / "run.gif").exists()
 
 

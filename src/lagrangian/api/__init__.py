@@ -7,7 +7,7 @@ points, the values a System takes, the results it returns and the errors it rais
 from ..analysis.equilibria import Equilibria, Equilibrium
 from ..analysis.forces import ForceReport
 from ..analysis.linearization import LinearModel, SymbolicLinearModel
-from ..analysis.modes import ModalAnalysis, Mode
+from ..analysis.modes import Mode
 from ..analysis.speed_form import SpeedForm, SpeedSweep
 from ..analysis.statics import StaticsReport
 from ..check.classroom import AnswerResult, ClassReport
@@ -31,6 +31,7 @@ from ..model.reader import parse_model, read_model
 from ..model.values import ParameterValues, State
 from ..simulation.events import StopCondition
 from ..simulation.options import SaveAt, StepControl
+from .modes import ModalAnalysis
 from .simulation import Simulation
 from .system import System, SystemBuilder, load
 

@@ -51,19 +51,28 @@ class Simulation(SimulationResult):
         return figure
 
     def animate(self, path: str | Path | None = None, *, fps: int = 20, max_frames: int = 250,
-                view: tuple[float, float] | str | None = None, progress=None):
-        """The mechanism moving: a matplotlib animation, also written to ``path`` (.gif or
-        .html with a player) when given. Bodies in space are seen from ``view`` = (azimuth,
-        elevation) in degrees (default isometric). In Jupyter,
-        ``HTML(sim.animate().to_jshtml())``. ``progress(frame, frames)`` follows a GIF's writing."""
-        from ..output.animation import check_animation_path, mechanism_animation, save_animation
+                view: tuple[float, float] | str | None = None, progress=None,
+                size: tuple[int, int] | str | None = None):
+        """The mechanism moving: a matplotlib animation, also written to ``path`` (.gif, .html
+        with a player, or .mp4 with the extra lagrangian[mp4]) when given; ``size`` = (width,
+        height) of its frames in pixels (default 400 x 400). Bodies in space are seen from
+        ``view`` = (azimuth, elevation) in degrees (default isometric). In a notebook it shows
+        itself as a player. ``progress(frame, frames)`` follows the frames' writing."""
+        from ..output.animation import check_animation_target, mechanism_animation, save_animation
 
         if path is not None:
-            check_animation_path(path)
-        animation = mechanism_animation(self, fps=fps, max_frames=max_frames, view=view)
+            check_animation_target(path)
+        animation = mechanism_animation(self, fps=fps, max_frames=max_frames, view=view,
+                                        size=size)
         if path is not None:
             save_animation(animation, path, fps=fps, protect=self._inputs(), progress=progress)
         return animation
+
+    def _repr_png_(self) -> bytes:
+        """Jupyter: the time histories (``plot()``) as a PNG image, with no %matplotlib magic."""
+        from ..output.plots import figure_png
+
+        return figure_png(self.plot())
 
     def summary(self) -> dict:
         """JSON-ready summary: final state, steps, wall time, energy drift, largest residual."""

@@ -22,7 +22,7 @@ from ..analysis.linearization import (
     linear_model_at,
     symbolic_linear_model,
 )
-from ..analysis.modes import ModalAnalysis, is_stable, modal_analysis
+from ..analysis.modes import is_stable, modal_analysis
 from ..analysis.speed_form import SpeedForm, SpeedSweep, speed_form, speed_sweep
 from ..analysis.statics import StaticsReport, solve_statics
 from ..analysis.steady import steady_linear_model
@@ -53,6 +53,7 @@ from ..model.urdf import example_urdf, read_urdf
 from ..model.values import State, resolve_state
 from ..simulation.events import StopCondition
 from ..simulation.simulate import SaveAt, StepControl, parse_stop_condition, simulate
+from .modes import ModalAnalysis
 from .simulation import Simulation
 
 
@@ -296,7 +297,8 @@ class System:
         default = self._model.steady_motion
         if steady is None and about is None and default is not None:
             steady, about = dict(default.rates), dict(default.about) or None
-        return modal_analysis(self.linearize(about, steady=steady), self._model.name)
+        return ModalAnalysis.of(modal_analysis(self.linearize(about, steady=steady),
+                                               self._model.name), self._model)
 
     def speed_form(self, steady: Mapping[str, float | str] | None = None,
                    speed: str | None = None, keep: Sequence[str] | None = None,
@@ -382,8 +384,10 @@ class System:
                                         int(save.samples), stop_when, bool(trajectories))
         study = make_study(eom, compute, vary or {}, sample, members, seed, options, chunk_size,
                            about)
-        return run_study(study, out=out, resume=resume, scheduler=scheduler, client=client,
-                         workers=workers, progress=progress)
+        from .sweep import Sweep
+
+        return Sweep.of(run_study(study, out=out, resume=resume, scheduler=scheduler,
+                                  client=client, workers=workers, progress=progress))
 
     def warnings(self, set_parameters: Mapping[str, object] | None = None) -> list[str]:
         """Where the user is probably wrong, one line each: a declared g with no gravity, a

@@ -37,6 +37,9 @@ FLAG_OF_FIELD = {
     "plot": "--plot",
     "animation": "--animate",
     "view": "--view",
+    "size": "--size",
+    "fps": "--fps",
+    "mode": "--mode",
     "lock": "--lock",
     "keep": "--keep",
     "speed": "--speed",
@@ -45,6 +48,11 @@ FLAG_OF_FIELD = {
 }
 
 SET_HELP = "Override a parameter: NAME=VALUE; repeat, or join with commas (m=2,L=0.5)."
+# What an animation's option is called where it is given without --animate.
+ONLY_WITH_ANIMATE = {"size": "a frame size is", "fps": "frames a second are",
+                     "mode": "a mode number is", "view": "a viewpoint is"}
+SIZE_HELP = "Frame size of the animation in pixels, WIDTHxHEIGHT (default 400x400 a drawing)."
+FPS_HELP = "Frames a second of the animation (1 to 120)."
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
 
 

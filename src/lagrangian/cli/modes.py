@@ -1,4 +1,5 @@
-"""`lagrangian modes MODEL [--about theta=0] [--json] [--plot modes.png]`: natural frequencies."""
+"""`lagrangian modes MODEL [--about theta=0] [--json] [--plot modes.png] [--animate modes.gif]`:
+natural frequencies, mode shapes, and the mechanism animated in each mode."""
 
 from __future__ import annotations
 
@@ -8,9 +9,22 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import LOCK_HELP, SET_HELP, load_system, print_json, state_assignments
+from .common import (
+    FPS_HELP,
+    LOCK_HELP,
+    ONLY_WITH_ANIMATE,
+    SET_HELP,
+    SIZE_HELP,
+    load_system,
+    print_json,
+    state_assignments,
+)
 
 ABOUT_HELP = "Equilibrium: COORDINATE=VALUE (pi, 180deg, 0.5m); the others are solved for."
+ANIMATE_HELP = ("Animate the mechanism oscillating in each mode (the lowest six side by side): "
+                ".gif, .html (a player) or .mp4 (needs lagrangian[mp4]).")
+MODE_HELP = "With --animate: only this mode, numbered from 1 as printed."
+VIEW_HELP = "With --animate, bodies in space: AZIMUTH,ELEVATION in degrees (default isometric)."
 STEADY_HELP = ("Steady motion: a cyclic coordinate's constant rate, NAME_dot=VALUE (psi_dot=10, "
                "rad/s, or an expression in the parameters: thetaR_dot=-v/rR); linearize about "
                "it instead of an equilibrium.")
@@ -45,8 +59,15 @@ def modes(
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option("--plot", help="Draw the mode shapes to a PNG file.")] = None,
+    animate: Annotated[Path | None, typer.Option("--animate", help=ANIMATE_HELP)] = None,
+    mode: Annotated[int | None, typer.Option("--mode", help=MODE_HELP)] = None,
+    size: Annotated[str | None, typer.Option("--size", help=SIZE_HELP)] = None,
+    fps: Annotated[int | None, typer.Option("--fps", help=FPS_HELP + " Default 20.")] = None,
+    view: Annotated[str | None, typer.Option("--view", help=VIEW_HELP)] = None,
 ) -> None:
     """Linearize about an equilibrium: M, C, K, natural frequencies, damping and mode shapes."""
+    from ..errors import InputError
+    from ..output.animation import check_animation_target, check_fps, check_size, check_view
     from ..output.files import check_output_path
     from ..output.modes import modes_document, modes_text, write_mode_plot
     from ..output.plots import check_plot_path
@@ -56,14 +77,29 @@ def modes(
     inputs = (Path(model),) if Path(model).exists() else ()
     if plot is not None:  # before the analysis: a path that cannot be written costs nothing
         check_output_path(check_plot_path(plot), "plot", inputs=inputs)
+    for given, field in ((mode, "mode"), (size, "size"), (fps, "fps"), (view, "view")):
+        if given is not None and animate is None:
+            raise InputError(f"{ONLY_WITH_ANIMATE[field]} only used with --animate", field=field)
+    if animate is not None:  # the same: everything checked before the analysis
+        check_output_path(animate, "animation", inputs=inputs)
+        check_animation_target(animate)
+        size, fps, view = check_size(size), check_fps(20 if fps is None else fps), check_view(view)
     rates = steady_assignments(system, steady)
     analysis = system.modes(about=point or None, steady=rates or None)
     if plot is not None:
         write_mode_plot(analysis, plot, protect=inputs)
+    if animate is not None:
+        analysis.animate(animate, mode=mode, fps=fps, size=size, view=view)
     if json_:
-        print_json(modes_document(analysis))
+        document = modes_document(analysis)
+        if animate is not None:
+            document["animation"] = str(animate)
+        print_json(document)
     else:
         typer.echo(modes_text(analysis), nl=False)
         if plot is not None:
             typer.echo(f"Mode shapes drawn to {plot}")
+        if animate is not None:
+            which = f"mode {mode}" if mode is not None else "each mode"
+            typer.echo(f"The mechanism in {which} animated to {animate}")
 

@@ -11,7 +11,17 @@ import typer
 
 from .. import SIMULATION_METHODS as METHODS  # light: the names only, no scipy
 from . import app
-from .common import LOCK_HELP, SET_HELP, load_system, print_json, state_assignments, warn_if_unphysical
+from .common import (
+    FPS_HELP,
+    LOCK_HELP,
+    ONLY_WITH_ANIMATE,
+    SET_HELP,
+    SIZE_HELP,
+    load_system,
+    print_json,
+    state_assignments,
+    warn_if_unphysical,
+)
 
 
 @app.command()
@@ -27,15 +37,24 @@ def simulate(
     samples: Annotated[int, typer.Option("--samples", help="Output samples, evenly spaced in time.")] = 1001,
     out: Annotated[Path | None, typer.Option("--out", help="Write the table: .csv or .parquet.")] = None,
     plot: Annotated[Path | None, typer.Option("--plot", help="Plot coordinates and energy: .png (.svg, .pdf).")] = None,  # noqa: E501
-    animate: Annotated[Path | None, typer.Option("--animate", help="Animate the mechanism: .gif or .html.")] = None,  # noqa: E501
+    animate: Annotated[Path | None, typer.Option("--animate", help="Animate the mechanism: .gif, .html or .mp4 (MP4 needs lagrangian[mp4]).")] = None,  # noqa: E501
     view: Annotated[str | None, typer.Option("--view", help="Viewpoint of the animation of bodies in space: AZIMUTH,ELEVATION in degrees (default 45,35.26: isometric).")] = None,  # noqa: E501
+    size: Annotated[str | None, typer.Option("--size", help=SIZE_HELP)] = None,
+    fps: Annotated[int | None, typer.Option("--fps", help=FPS_HELP + " Default 20.")] = None,
     stop_when: Annotated[str | None, typer.Option("--stop-when", help="Stop when a condition turns true, e.g. \"theta < 0\".")] = None,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
     from .. import SaveAt, StepControl, parse_quantity, parse_stop_condition, resolve_state
     from ..errors import InputError
-    from ..output.animation import check_animatable, check_animation_path, check_view
+    from ..output.animation import (
+        check_animatable,
+        check_animation_path,
+        check_animation_target,
+        check_fps,
+        check_size,
+        check_view,
+    )
     from ..output.files import check_output_path, partial_path
     from ..output.plots import check_plot_path
     from ..output.simulation import projection_warning, simulation_document, simulation_text
@@ -61,10 +80,19 @@ def simulate(
         check_view(view)
         if animate is None:
             raise InputError("a viewpoint is only used with --animate", field="view")
+    if size is not None:
+        check_size(size)
+    if fps is not None:
+        check_fps(fps)
+    for given, field in ((size, "size"), (fps, "fps")):
+        if given is not None and animate is None:
+            raise InputError(f"{ONLY_WITH_ANIMATE[field]} only used with --animate", field=field)
     inputs = (Path(model),) if Path(model).exists() else ()
     for path, field in ((out, "table"), (plot, "plot"), (animate, "animation")):
         if path is not None:  # writable, not a directory, not the model: before the run
             check_output_path(path, field, inputs=inputs)
+    if animate is not None:  # free, or an animation this project wrote: never another file
+        check_animation_target(animate)
 
     with _Progress(end) as progress:
         simulation = system.simulate(
@@ -90,7 +118,8 @@ def simulate(
     if animate is not None:
         target = partial_path(animate) if partial else animate
         with _FrameProgress() as frames:
-            simulation.animate(target, view=view, progress=frames.update)
+            simulation.animate(target, view=view, progress=frames.update, size=size,
+                               fps=20 if fps is None else fps)
         written["animate"] = str(target)
 
     if json_:

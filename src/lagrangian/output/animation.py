@@ -14,24 +14,31 @@ parts once, the moving artists per frame.
 
 from __future__ import annotations
 
-import base64
-import html
-import io
-import os
-import tempfile
-import uuid
-from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from ..errors import InputError
 from ..model.model import Model
 from ..simulation.result import SimulationResult
-from .files import atomic_write
-from .geometry import ISOMETRIC_VIEW, mechanism, view_projection
+from .geometry import ISOMETRIC_VIEW, Frame, Mechanism, SpaceFrame, mechanism, view_projection
+from .media import (  # noqa: F401 - re-exported: the names callers know from here
+    ANIMATION_DPI,
+    ANIMATION_FORMATS,
+    DEFAULT_SIZE,
+    HTML_DPI,
+    _frame_images,
+    check_animation_path,
+    check_animation_target,
+    check_fps,
+    check_size,
+    gif_bytes,
+    playback_rate,
+    player_html,
+    save_animation,
+    write_mp4,
+)
 from .plots import plain_text
-
-ANIMATION_FORMATS = (".gif", ".html")
 
 
 def _zigzag(a: np.ndarray, b: np.ndarray, turns: int = 8, width: float = 0.06):
@@ -98,22 +105,84 @@ def check_view(view: object) -> tuple[float, float]:
 
 
 def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: int = 250,
-                        view: object = None):
+                        view: object = None, size: object = None):
     """A matplotlib FuncAnimation of the mechanism over the run (planar x-y view; a model with
-    bodies in space is seen from ``view`` = (azimuth, elevation) in degrees)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
+    bodies in space is seen from ``view`` = (azimuth, elevation) in degrees); ``size`` =
+    (width, height) of its frames in pixels (default 400 x 400)."""
     check_animatable(result.model)
     view = check_view(view)
+    size = check_size(size)
+    fps = check_fps(fps)
     geometry = mechanism(result.model, result.parameters)
     times = animation_frames(result, fps, max_frames)
     q = np.column_stack([np.interp(times, result.t, result.q[:, i])
                          for i in range(result.q.shape[1])])
     v = np.column_stack([np.interp(times, result.t, result.q_dot[:, i])
                          for i in range(result.q.shape[1])])
+    figure = animation_figure(size)
+    ax = figure.add_subplot()
+    panel = mechanism_panel(ax, geometry, q, v, times, view=view, trail=max(1, int(fps)),
+                            title=plain_text(result.model_name))
+    clock = _clock(ax)
+
+    def draw(k):
+        clock.set_text(f"{times[k]:.2f}")
+        return [*panel.draw(k), clock]
+
+    animation = _animation(figure, draw, times, fps, html_dpi=None if size else HTML_DPI)
+    animation.panels = (panel,)
+    return animation
+
+
+def mechanism_picture(model: Model, q=None, parameters=None, *, size: object = None,
+                      view: object = None, title: str | None = None):
+    """A still drawing of the mechanism at configuration ``q`` (coordinate name -> value, SI;
+    the model's initial values where not given): a matplotlib Figure that shows itself in a
+    notebook, drawn as the animations draw it."""
+    from .plots import notebook_figure
+
+    check_animatable(model)
+    view, size = check_view(view), check_size(size) or DEFAULT_SIZE
+    given = dict(q or {})
+    state = np.array([[float(given.get(c.name, c.initial if c.initial is not None else 0.0))
+                       for c in model.coordinates]])
+    figure = notebook_figure(figsize=(size[0] / ANIMATION_DPI, size[1] / ANIMATION_DPI),
+                             dpi=ANIMATION_DPI, layout="constrained")
+    ax = figure.add_subplot()
+    panel = mechanism_panel(ax, mechanism(model, parameters), state, np.zeros_like(state),
+                            np.zeros(1), view=view, trail=1,
+                            title=plain_text(model.name if title is None else title))
+    panel.draw(0)
+    return figure
+
+
+def animation_figure(size: tuple[int, int] | None = None, dpi: float = ANIMATION_DPI):
+    """A Figure drawn by Agg (never pyplot: nothing is left open) of ``size`` pixels."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    width, height = size or DEFAULT_SIZE
+    figure = Figure(figsize=(width / dpi, height / dpi), dpi=dpi, layout="constrained")
+    FigureCanvasAgg(figure)
+    return figure
+
+
+class Panel(NamedTuple):
+    """One drawing of the mechanism on its axes: ``draw(k)`` puts frame k on it and returns the
+    artists it moved; ``frame`` holds the positions drawn (geometry.Frame in the plane,
+    geometry.SpaceFrame for bodies in space), frame by frame."""
+
+    draw: object
+    frame: Frame | SpaceFrame
+
+
+def mechanism_panel(ax, geometry: Mechanism, q: np.ndarray, v: np.ndarray, times: np.ndarray, *,
+                    view: tuple[float, float] = ISOMETRIC_VIEW, trail: int = 25, title: str = "",
+                    show_axes: bool = True) -> Panel:
+    """Draw the mechanism at states q, v (k, n) on ``ax`` (equal scales; a non-square panel
+    gets a square drawing in its middle); each particle leaves a trail of ``trail`` frames."""
     if geometry.rigid_body_names:
-        return _space_animation(result, geometry, times, q, v, view, fps)
+        return _space_panel(ax, geometry, times, q, v, view, title)
     frame = geometry.frame(q, v, times)
     particles, bars, springs, dampers = frame.particles, frame.bars, frame.springs, frame.dampers
     rolling = {j: (radius, np.array(normal)) for j, radius, normal in geometry.rolling}
@@ -137,14 +206,15 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
     low, high = centre - half, centre + half
     span = 2 * half
 
-    figure = Figure(figsize=(5, 5), dpi=80, layout="constrained")
-    FigureCanvasAgg(figure)
-    ax = figure.add_subplot()
     ax.set_xlim(low[0], high[0])
     ax.set_ylim(low[1], high[1])
     ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
+    if show_axes:
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+    else:
+        ax.set_xticks([])
+        ax.set_yticks([])
     ax.plot([0], [0], marker="+", color="grey")
     if geometry.gravity is not None:
         _gravity_arrow(ax, geometry.gravity)
@@ -188,10 +258,9 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
     free = [i for i in range(len(geometry.particle_names)) if i not in block_of]
     # Each particle leaves a short trail (its last second) so the motion reads in one frame.
     trails = [ax.plot([], [], color="tab:red", alpha=0.35, linewidth=1)[0] for _ in free]
-    trail_length = max(1, int(fps))
+    trail_length = max(1, int(trail))
     dots = ax.plot([], [], "o", color="tab:red", markersize=10, label="particles")[0]
-    clock = _clock(ax)
-    ax.set_title(plain_text(result.model_name))
+    ax.set_title(title)
     angles = np.linspace(0, 2 * np.pi, 41)
     circle = np.column_stack([np.cos(angles), np.sin(angles)])
 
@@ -222,11 +291,10 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
             path = particles[max(0, k - trail_length): k + 1, i]
             line.set_data(path[:, 0], path[:, 1])
         dots.set_data(particles[k, free, 0], particles[k, free, 1])
-        clock.set_text(f"{times[k]:.2f}")
         return [*spring_lines, *damper_lines, *rod_lines, *bar_lines.values(),
-                *wheel_lines.values(), *blocks, *trails, dots, pivot_marks, hinges, clock]
+                *wheel_lines.values(), *blocks, *trails, dots, pivot_marks, hinges]
 
-    return _animation(figure, draw, times, fps)
+    return Panel(draw, frame)
 
 
 def _clock(ax):
@@ -278,11 +346,8 @@ _EDGES = [(a, b) for a in range(8) for b in range(a + 1, 8)
           if np.sum(_CORNERS[a] != _CORNERS[b]) == 1]
 
 
-def _space_animation(result, geometry, times, q, v, view, fps):
+def _space_panel(ax, geometry, times, q, v, view, title) -> Panel:
     """The 3D mechanism projected on the screen seen from ``view`` (azimuth, elevation)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
     space = geometry.space_frame(q, v, times)
     screen = view_projection(*view)
 
@@ -312,16 +377,12 @@ def _space_animation(result, geometry, times, q, v, view, fps):
     half = 0.55 * max(float(np.max(high - low)), 1e-3)
     centre = (low + high) / 2
 
-    figure = Figure(figsize=(5, 5), dpi=80, layout="constrained")
-    FigureCanvasAgg(figure)
-    ax = figure.add_subplot()
     ax.set_xlim(centre[0] - half, centre[0] + half)
     ax.set_ylim(centre[1] - half, centre[1] + half)
     ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_yticks([])
-    ax.set_title(plain_text(result.model_name)
-                 + f"\n(azimuth {view[0]:.4g}°, elevation {view[1]:.4g}°)")
+    ax.set_title(title + f"\n(azimuth {view[0]:.4g}°, elevation {view[1]:.4g}°)")
     # The world axes at the origin, short and grey, so the viewpoint reads.
     for unit in np.eye(3):
         end = project(unit * 0.3 * half)
@@ -350,7 +411,6 @@ def _space_animation(result, geometry, times, q, v, view, fps):
     axes = [[ax.plot([], [], color=c, linewidth=2)[0] for c in colours]
             for _ in geometry.rigid_body_names]
     dots = ax.plot([], [], "o", color="tab:red", markersize=8)[0]
-    clock = _clock(ax)
     gap = np.full((1, 2), np.nan)
 
     def draw(k):
@@ -385,21 +445,25 @@ def _space_animation(result, geometry, times, q, v, view, fps):
                 line.set_data([start[0], end[0]], [start[1], end[1]])
         flat_particles = project(space.particles[k])
         dots.set_data(flat_particles[:, 0], flat_particles[:, 1])
-        clock.set_text(f"{times[k]:.2f}")
         return [*tracks, *wheel_lines, *boxes, *links, *bars, *rods, *spring_lines, *damper_lines,
-                *(line for triad in axes for line in triad), dots, clock]
+                *(line for triad in axes for line in triad), dots]
 
-    return _animation(figure, draw, times, fps)
+    return Panel(draw, space)
 
 
-def _animation(figure, draw, times: np.ndarray, fps: int):
-    """Wrap a figure and its per-frame ``draw(k)`` (returning the artists it changed)."""
+def _animation(figure, draw, times: np.ndarray, fps: int, *, html_dpi: float | None = HTML_DPI,
+               real_time: bool = True, clock: str = "t = {:.2f} s"):
+    """Wrap a figure and its per-frame ``draw(k)`` (returning the artists it changed).
+    ``html_dpi``: the HTML player's resolution (None: the figure's own); ``real_time``: the
+    frames play at the run's pace (False: at ``fps``, a mode over one period); ``clock``
+    formats a frame's time under the HTML player."""
     from matplotlib.animation import FuncAnimation
 
     class MechanismAnimation(FuncAnimation):
         """A matplotlib FuncAnimation that also renders its frames fast (``frame_images``: one
-        full draw of the still parts, then only the moving artists per frame) and whose
-        ``to_jshtml`` is a self-contained player (no remote font or script)."""
+        full draw of the still parts, then only the moving artists per frame), whose
+        ``to_jshtml`` is a self-contained player (no remote font or script) and which shows
+        itself as that player in a notebook (``_repr_html_``)."""
 
         def draw(self, k: int) -> list:
             """Put frame k on the figure; the artists it moved."""
@@ -410,154 +474,30 @@ def _animation(figure, draw, times: np.ndarray, fps: int):
             self._draw_was_started = True
             return _frame_images(figure, draw, len(times), dpi=dpi, progress=progress)
 
-        def to_jshtml(self, fps=None, embed_frames=True, default_mode=None):
-            return player_html(self.frame_images(dpi=HTML_DPI),
-                               fps=playback_rate(times, fps or self.fps), times=times,
-                               title=self.title)
+        def to_jshtml(self, fps=None, embed_frames=True, default_mode=None, *,
+                      fragment: bool = False):
+            rate = fps or self.fps
+            return player_html(self.frame_images(dpi=self.html_dpi),
+                               fps=playback_rate(times, rate) if self.real_time else rate,
+                               times=times, title=self.title, fragment=fragment,
+                               clock=self.clock_format)
 
         def _repr_html_(self):
-            # As matplotlib: shown inline only where rcParams["animation.html"] asks for it.
-            from matplotlib import rcParams
-
-            if rcParams["animation.html"] == "jshtml":
-                return self.to_jshtml()
-            return super()._repr_html_()
+            # The player, with no %matplotlib magic and nothing from the network.
+            return self.to_jshtml(fragment=True)
 
     animation = MechanismAnimation(figure, draw, frames=len(times), interval=1000 / fps,
                                    blit=False)
+    # Frames are drawn on demand (a file, a player), not by a GUI event loop: an animation
+    # kept for its geometry alone is not a forgotten one, so matplotlib need not warn about it.
+    animation._draw_was_started = True
     animation.fps = fps
     animation.times = times
     animation.title = figure.axes[0].get_title()
+    animation.html_dpi = html_dpi
+    animation.real_time = real_time
+    animation.clock_format = clock
     return animation
-
-
-# The HTML player's frames are drawn smaller than the GIF's (80 dpi, 400 px): a page of
-# many embedded images stays small.
-HTML_DPI = 64
-# Colours in the GIF's shared palette (the drawing has a dozen colours and their antialiasing).
-GIF_COLOURS = 64
-
-
-def _frame_images(figure, draw, count: int, *, dpi: float | None = None, progress=None):
-    """RGB frames (H, W, 3) uint8: the still parts (axes, ticks, labels) are drawn once and
-    restored as a background; each frame draws only the artists ``draw(k)`` moves (blitting).
-    ``progress(frame, frames)`` is called after each frame."""
-    canvas = figure.canvas
-    if dpi is not None:
-        figure.set_dpi(dpi)
-    moving = draw(0)
-    for artist in moving:
-        artist.set_animated(True)  # left out of the full draw: the background
-    try:
-        canvas.draw()
-        background = canvas.copy_from_bbox(figure.bbox)
-        for k in range(count):
-            canvas.restore_region(background)
-            for artist in draw(k):
-                artist.axes.draw_artist(artist)
-            yield np.asarray(canvas.buffer_rgba())[..., :3].copy()
-            if progress is not None:
-                progress(k, count)
-    finally:
-        for artist in moving:
-            artist.set_animated(False)
-
-
-def _palette_frames(frames) -> list:
-    """The frames as palette images sharing one palette (taken from a few spread frames), so
-    the GIF needs no per-frame quantization search and its colours do not flicker."""
-    from PIL import Image
-
-    frames = list(frames)
-    picks = sorted({0, len(frames) // 3, 2 * len(frames) // 3, len(frames) - 1})
-    mosaic = Image.fromarray(np.concatenate([frames[i] for i in picks], axis=0))
-    palette = mosaic.quantize(colors=GIF_COLOURS, method=Image.Quantize.MEDIANCUT)
-    # Pillow maps a colour to a palette entry through a coarse lookup, so pure white landed on
-    # a near-white neighbour (an off-white background): an entry within 12 levels of a more
-    # used one becomes that one.
-    entries = np.array(palette.getpalette()[:3 * GIF_COLOURS]).reshape(-1, 3)
-    used = np.array(palette.histogram()[:len(entries)])
-    for a in np.argsort(-used, kind="stable"):
-        near = (used < used[a]) & (np.abs(entries - entries[a]).max(axis=1) <= 12)
-        entries[near] = entries[a]
-    palette.putpalette([int(c) for c in entries.ravel()])
-    return [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE)
-            for f in frames]
-
-
-def gif_bytes(frames, fps: float) -> bytes:
-    """An endlessly looping GIF of the RGB frames at ``fps``."""
-    images = _palette_frames(frames)
-    buffer = io.BytesIO()
-    images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:],
-                   duration=round(1000 / fps), loop=0)
-    return buffer.getvalue()
-
-
-def player_html(frames, *, fps: float, times: np.ndarray, title: str = "") -> str:
-    """A self-contained HTML page that plays the RGB frames: play/pause, step, a slider and
-    the time; every image is embedded (palette PNG, base64) and nothing is loaded from
-    elsewhere, so it works offline."""
-    images = _palette_frames(frames)
-    encoded = []
-    for image in images:
-        buffer = io.BytesIO()
-        image.save(buffer, format="PNG", optimize=True)
-        encoded.append(base64.b64encode(buffer.getvalue()).decode("ascii"))
-    lines = "\n".join(f'frames[{k}] = "data:image/png;base64,{data}";'
-                      for k, data in enumerate(encoded))
-    stamps = ", ".join(f"{t:.3f}" for t in times[:len(encoded)])
-    return _PLAYER.format(id=f"lagrangian-{uuid.uuid4().hex[:12]}",
-                          title=html.escape(title or "animation"), frames=lines,
-                          times=stamps, count=len(encoded), last=len(encoded) - 1,
-                          interval=round(1000 / fps))
-
-
-_PLAYER = """<!DOCTYPE html>
-<html><head><meta charset="utf-8"><title>{title}</title></head>
-<body style="font-family: sans-serif">
-<div class="lagrangian-animation" id="{id}">
-<img id="{id}-frame" alt="{title}" style="display: block">
-<div>
-<button id="{id}-back" title="previous frame">&#9664;&#9664;</button>
-<button id="{id}-play" title="play / pause">&#9654;</button>
-<button id="{id}-next" title="next frame">&#9654;&#9654;</button>
-<input id="{id}-slider" type="range" min="0" max="{last}" value="0" style="width: 60%">
-<span id="{id}-clock"></span>
-<label><input id="{id}-loop" type="checkbox" checked> loop</label>
-</div>
-</div>
-<script>
-(function () {{
-// The animation's frames, embedded: this page needs nothing from the network. Ids carry a
-// prefix of their own, so several players on one page (a notebook) stay apart.
-var frames = new Array({count});
-{frames}
-var times = [{times}];
-var k = 0, timer = null;
-function part(name) {{ return document.getElementById("{id}-" + name); }}
-var img = part("frame"), slider = part("slider"), play = part("play"), clock = part("clock");
-function show(i) {{
-  k = (i + frames.length) % frames.length;
-  img.src = frames[k]; slider.value = k; clock.textContent = "t = " + times[k].toFixed(2) + " s";
-}}
-function stop() {{ clearInterval(timer); timer = null; play.innerHTML = "&#9654;"; }}
-function tick() {{
-  if (k == frames.length - 1 && !part("loop").checked) {{ stop(); return; }}
-  show(k + 1);
-}}
-play.onclick = function () {{
-  if (timer) {{ stop(); return; }}
-  timer = setInterval(tick, {interval}); play.innerHTML = "&#10074;&#10074;";
-}};
-part("back").onclick = function () {{ stop(); show(k - 1); }};
-part("next").onclick = function () {{ stop(); show(k + 1); }};
-slider.oninput = function () {{ stop(); show(parseInt(slider.value)); }};
-show(0);
-}})();
-</script>
-</body></html>
-"""
 
 
 def _ground_grid(geometry, contacts: np.ndarray, lines: int = 7) -> np.ndarray:
@@ -587,49 +527,3 @@ def _ground_grid(geometry, contacts: np.ndarray, lines: int = 7) -> np.ndarray:
                          (middle[0] + half) * t1 + (middle[1] + x) * t2])
     return np.array(segments)
 
-
-def save_animation(animation, path: str | Path, *, fps: int = 25,
-                   protect: tuple[Path, ...] = (), progress=None) -> Path:
-    """Save a built animation as .gif or .html (a self-contained player), through a temporary
-    file and a rename. ``progress(frame, frames)`` is called as each frame is drawn."""
-    path = check_animation_path(path)
-    if not hasattr(animation, "frame_images"):  # any other matplotlib animation
-        return _save_with_matplotlib(animation, path, fps=fps, protect=protect,
-                                     progress=progress)
-    fps = playback_rate(animation.times, fps)
-    if path.suffix.lower() == ".html":
-        frames = animation.frame_images(dpi=HTML_DPI, progress=progress)
-        page = player_html(frames, fps=fps, times=animation.times, title=animation.title)
-        return atomic_write(path, page, protect=protect)
-    return atomic_write(path, gif_bytes(animation.frame_images(progress=progress), fps),
-                        protect=protect)
-
-
-def playback_rate(times: np.ndarray, fps: float) -> float:
-    """Frames a second that play the frames in real time: ``fps``, or fewer where the run was
-    longer than ``max_frames`` allow at ``fps`` (the frames are then further apart)."""
-    span = float(times[-1] - times[0]) if len(times) > 1 else 0.0
-    return min(float(fps), (len(times) - 1) / span) if span > 0 else float(fps)
-
-
-def _save_with_matplotlib(animation, path: Path, *, fps, protect, progress) -> Path:
-    if path.suffix.lower() == ".html":
-        return atomic_write(path, animation.to_jshtml(fps=fps), protect=protect)
-    from matplotlib.animation import PillowWriter
-
-    handle, temporary = tempfile.mkstemp(suffix=".gif")
-    os.close(handle)
-    try:
-        animation.save(temporary, writer=PillowWriter(fps=fps), progress_callback=progress)
-        data = Path(temporary).read_bytes()
-    finally:
-        os.unlink(temporary)
-    return atomic_write(path, data, protect=protect)
-
-
-def check_animation_path(path: str | Path) -> Path:
-    """The path, if it names a .gif or .html file."""
-    path = Path(path)
-    if path.suffix.lower() not in ANIMATION_FORMATS:
-        raise InputError(f"cannot write {path}: use a .gif or .html file name", field="animation")
-    return path

@@ -13,7 +13,7 @@ from ..analysis.equilibria import Equilibria
 from ..analysis.modes import ModalAnalysis, Mode
 from ..errors import ModelError
 from .files import atomic_write
-from .plots import plain_text
+from .plots import notebook_figure, plain_text
 
 # The plot shows at most this many modes (the lowest), in a grid of at most PLOT_COLUMNS columns.
 PLOT_MAX_MODES = 12
@@ -190,14 +190,12 @@ def mode_plot_size(mode_count: int) -> tuple[int, int]:
 
 def mode_shape_figure(analysis: ModalAnalysis):
     """A matplotlib Figure with one panel per mode (the lowest twelve): the shape per coordinate."""
-    from matplotlib.figure import Figure
-
     modes = analysis.modes[:PLOT_MAX_MODES]
     if not modes:
         raise ModelError("there are no modes to plot (no degree of freedom)", field="plot")
     width, height = mode_plot_size(len(modes))
-    figure = Figure(figsize=(width / PLOT_DPI, height / PLOT_DPI), dpi=PLOT_DPI,
-                    layout="constrained")
+    figure = notebook_figure(figsize=(width / PLOT_DPI, height / PLOT_DPI), dpi=PLOT_DPI,
+                             layout="constrained")
     columns = min(PLOT_COLUMNS, len(modes))
     rows = math.ceil(len(modes) / columns)
     axes = figure.subplots(rows, columns, squeeze=False).ravel()

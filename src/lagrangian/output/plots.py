@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import io
 from pathlib import Path
 
@@ -27,19 +28,49 @@ _CONTROLS = dict.fromkeys([*range(0x00, 0x0A), *range(0x0B, 0x20), 0x7F, *range(
                            *range(0x202A, 0x202F), *range(0x2066, 0x206A)])
 
 
+def notebook_figure(**options):
+    """A matplotlib Figure (drawn by Agg, never through pyplot, so nothing is left open) that
+    shows itself in a notebook: the last line of a cell displays it as PNG with no
+    %matplotlib magic. ``options`` go to Figure (figsize, dpi, layout)."""
+    return _notebook_figure_class()(**options)
+
+
+@functools.cache
+def _notebook_figure_class():
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    class NotebookFigure(Figure):
+        """A Figure with ``_repr_png_`` (Jupyter's image/png)."""
+
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            FigureCanvasAgg(self)
+
+        def _repr_png_(self) -> bytes:
+            return figure_png(self)
+
+    return NotebookFigure
+
+
+def figure_png(figure, dpi: float = 100) -> bytes:
+    """The figure as PNG bytes, rendered by Agg."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=dpi)
+    return buffer.getvalue()
+
+
 def time_history_figure(result: SimulationResult, units: dict[str, str] | None = None):
     """A matplotlib Figure: coordinates (one panel per unit), energy T + V, multipliers.
 
     Built without pyplot, so it works headless; in Jupyter the Figure shows itself.
     """
-    from matplotlib.figure import Figure
-
     units = units or {}
     groups: dict[str, list[int]] = {}
     for i, name in enumerate(result.coordinates):
         groups.setdefault(units.get(name, ""), []).append(i)
     panels = len(groups) + 1 + (1 if result.constraint_names else 0)
-    figure = Figure(figsize=(8, 2.4 * panels + 0.6), layout="constrained")
+    figure = notebook_figure(figsize=(8, 2.4 * panels + 0.6), layout="constrained")
     axes = figure.subplots(panels, 1, sharex=True, squeeze=False)[:, 0]
     for ax, (unit, indices) in zip(axes, groups.items(), strict=False):
         for i in indices:

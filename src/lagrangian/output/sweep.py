@@ -20,7 +20,7 @@ import numpy as np
 from ..analysis.study import NOT_COMPUTED, OK, Study, layout
 from ..errors import InputError
 from .files import atomic_write
-from .plots import plain_text
+from .plots import notebook_figure, plain_text
 
 STUDY_FORMATS = (".nc", ".zarr")
 PLOT_DPI = 120
@@ -277,6 +277,7 @@ def _speeds_figure(figure, dataset, x):
                     color=f"C{(k - 1) % 10}")
         ax.axhline(0.0, color="0.5", lw=0.8)
         ax.set_ylabel(label)
+        flat_axis(ax, np.asarray(variable.values, float))
     axes[1].set_xlabel(_label(dataset, x))
     axes[0].set_title(plain_text(f"eigenvalues of {dataset.attrs.get('model', '')!s} "
                                  f"against {x}"))
@@ -284,15 +285,15 @@ def _speeds_figure(figure, dataset, x):
 
 
 def study_figure(dataset):
-    """Frequencies against the (first) varied parameter, a line per mode and per value of a
-    second; for two or more varied parameters also a stability map over the first two. For
+    """The quantities that vary (drawn_quantities: the frequency, and the damping ratio and
+    growth rate where they change) against the (first) varied parameter, a line per mode and
+    per value of a second, the model and the varied names in the title; a flat quantity drawn
+    flat (flat_axis); for two or more varied parameters also a stability map. For
     equilibria: each equilibrium's coordinates, stable solid, unstable hollow; for an ensemble
     the spread of the final states."""
-    from matplotlib.figure import Figure
-
     compute = dataset.attrs.get("compute")
     dims = [d for d in dataset["status"].dims]
-    figure = Figure(figsize=(8, 5), layout="constrained")
+    figure = notebook_figure(figsize=(8, 5), layout="constrained")
     if compute == "simulate":
         return _ensemble_figure(figure, dataset, dims)
     x = dims[0]
@@ -313,18 +314,19 @@ def study_figure(dataset):
                 ax.plot(xs[s == 1], y[s == 1], "o", color="C0", ms=4)
                 ax.plot(xs[s == 0], y[s == 0], "o", mfc="none", color="C3", ms=4)
             ax.set_ylabel(f"equilibrium {c}")
+        flat_axis(ax, np.asarray(eq.values, float))
         ax.set_xlabel(_label(dataset, x))
-        ax.set_title("equilibria: stable filled, unstable hollow")
+        ax.set_title("stable filled, unstable hollow", fontsize="small")
+        figure.suptitle(plain_text(f"Equilibria of {dataset.attrs.get('model', '')} against "
+                                   f"{' and '.join(dims)}"))
         return figure
-    growth = np.asarray(dataset["growth_rate"].values, float)
-    grows = bool(np.any(growth[np.isfinite(growth)] > 0))
-    panels = 1 + int(grows) + int(bool(others))
-    figure.set_size_inches(8, 3.2 * panels + 0.4)
-    axes = figure.subplots(panels, 1, squeeze=False)[:, 0]
+    quantities = drawn_quantities(dataset)
+    panels = len(quantities) + int(bool(others))
+    figure.set_size_inches(8, 2.6 * panels + 0.7)
+    axes = figure.subplots(panels, 1, squeeze=False, sharex=not others)[:, 0]
     series = [{}] if not others else [{others[0]: i} for i in range(dataset.sizes[others[0]])]
     rest = {d: 0 for d in others[1:]}
-    for ax, name, label in ((axes[0], "frequency", "natural frequency (rad/s)"),
-                            *(((axes[1], "growth_rate", "growth rate (1/s)"),) if grows else ())):
+    for ax, name in zip(axes, quantities, strict=False):
         variable = dataset[name]
         for j, selection in enumerate(series):
             sub = variable.isel({**selection, **rest})
@@ -333,18 +335,21 @@ def study_figure(dataset):
                                       if selection else "")
                 ax.plot(dataset[x].values, np.asarray(sub.sel(mode=k).values, float),
                         color=f"C{j % 10}", ls=["-", "--", ":", "-."][(k - 1) % 4],
+                        marker="." if dataset.sizes[x] <= 30 else None,
                         label=text if len(series) * len(sub["mode"]) <= 12 else None)
-        ax.set_xlabel(_label(dataset, x))
-        ax.set_ylabel(label)
-        if name == "frequency" and ax.get_legend_handles_labels()[0]:
-            ax.legend(fontsize="small")
+        if others or name == quantities[-1]:  # shared x: labelled once, under the last
+            ax.set_xlabel(_label(dataset, x))
+        ax.set_ylabel(QUANTITY_LABELS[name])
+        if name == "growth_rate":
+            ax.axhline(0.0, color="0.5", lw=0.8)
+        flat_axis(ax, np.asarray(variable.isel(rest).values, float))
         if not others:
             unstable = np.asarray(dataset["stable"].values, float) == 0
             if unstable.any():
                 ax.fill_between(dataset[x].values, 0, 1, where=unstable, alpha=0.12,
                                 color="C3", transform=ax.get_xaxis_transform(),
-                                label="unstable" if name == "frequency" else None)
-    if not others and axes[0].get_legend_handles_labels()[0]:
+                                label="unstable" if ax is axes[0] else None)
+    if axes[0].get_legend_handles_labels()[0]:
         axes[0].legend(fontsize="small")
     if others:
         ax2 = axes[-1]
@@ -355,11 +360,56 @@ def study_figure(dataset):
                        shading="nearest")
         ax2.set_xlabel(_label(dataset, x))
         ax2.set_ylabel(_label(dataset, y))
-        ax2.set_title("stable (green) / unstable (red)")
+        ax2.set_title("stable (green) / unstable (red)", fontsize="small")
     about = dataset.attrs.get("about")
-    axes[0].set_title(f"modes about {about}" if about else
-                      "modes about the equilibrium nearest the initial values")
+    axes[0].set_title(f"about {about}" if about else
+                      "about the equilibrium nearest the initial values", fontsize="small")
+    varied = " and ".join(dims)
+    figure.suptitle(plain_text(f"Modes of {dataset.attrs.get('model', '')} against {varied}"))
     return figure
+
+
+# The quantities a modes study draws, each in a panel of its own, with their axis labels.
+QUANTITY_LABELS = {"frequency": "natural frequency (rad/s)", "damping_ratio": "damping ratio ζ",
+                   "growth_rate": "growth rate (1/s)"}
+# A quantity whose values differ by less than this (relative to their size) does not vary.
+FLAT_TOLERANCE = 1e-9
+
+
+def varies(values: np.ndarray) -> bool:
+    """Whether the finite values differ by more than round-off (FLAT_TOLERANCE relative)."""
+    finite = np.asarray(values, float)
+    finite = finite[np.isfinite(finite)]
+    if finite.size < 2:
+        return False
+    return float(np.ptp(finite)) > FLAT_TOLERANCE * max(float(np.max(np.abs(finite))), 1e-300)
+
+
+def drawn_quantities(dataset) -> list[str]:
+    """The quantities of a modes study drawn: the frequency always; the damping ratio and the
+    growth rate where they vary over the study (or a mode grows), so a damping sweep shows
+    zeta and the decay rate beside a frequency that does not change."""
+    names = ["frequency"]
+    zeta = np.asarray(dataset["damping_ratio"].values, float)
+    if varies(zeta) or bool(np.any(np.abs(zeta[np.isfinite(zeta)]) > 0)):
+        names.append("damping_ratio")
+    growth = np.asarray(dataset["growth_rate"].values, float)
+    if varies(growth) or bool(np.any(growth[np.isfinite(growth)] > 0)):
+        names.append("growth_rate")
+    return names
+
+
+def flat_axis(ax, values: np.ndarray) -> None:
+    """Values on the y axis as written, never as an offset plus round-off ('1e-12 + 4.4294'):
+    a quantity that does not vary is drawn flat, in a range of +-5 % about its value (+-1 about
+    zero)."""
+    ax.ticklabel_format(axis="y", useOffset=False, style="plain")
+    finite = np.asarray(values, float)
+    finite = finite[np.isfinite(finite)]
+    if finite.size and not varies(finite):
+        middle = float(np.median(finite))
+        half = 0.05 * abs(middle) if middle != 0 else 1.0
+        ax.set_ylim(middle - half, middle + half)
 
 
 def _ensemble_figure(figure, dataset, dims):
@@ -397,7 +447,9 @@ def _ensemble_figure(figure, dataset, dims):
             ax.legend(fontsize="small")
     members = dataset.sizes.get("member", 1)
     axes[0].set_title(f"{members} members: median and 5-95 % band" if "trajectory" in dataset
-                      else f"final state of {members} members")
+                      else f"final state of {members} members", fontsize="small")
+    figure.suptitle(plain_text(f"Simulations of {dataset.attrs.get('model', '')} over "
+                               f"{' and '.join(dims)}"))
     return figure
 
 

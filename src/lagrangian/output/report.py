@@ -120,6 +120,9 @@ def build_report(system, *, answer=None, t_end: float | None = None,
     An unreadable answer is refused before any work."""
     from . import report_sections as numeric
 
+    if t_end is not None and not (np.isfinite(float(t_end)) and float(t_end) > 0):
+        raise ModelError(f"the simulation's length must be a positive number of seconds, got "
+                         f"{t_end!r}", field="t_end")
     checked = system.check(answer) if answer is not None else None
     context = _Page(system)
     builders = [
@@ -279,7 +282,8 @@ def _equations_section(c: _Page) -> tuple[Markup, str]:
     eom = c.eom
     model = c.model
     M, A, f = eom.mass_matrix, eom.constraint_jacobian, eom.forcing
-    parts = [paragraph("In the form ", math(_convention()), ": one equation per coordinate, the "
+    parts = [paragraph("In the form ", math(_convention()), " (M the mass matrix, f the forcing, "
+                       "λ the multipliers): one equation per coordinate, the "
                        "accelerations on the left in coordinate order"
                        + (", then the constraint reactions" if A.rows else "") + ".")]
     for i, coordinate in enumerate(model.coordinates):
@@ -288,9 +292,9 @@ def _equations_section(c: _Page) -> tuple[Markup, str]:
         parts.append(c.formula(f"{coordinate.name}:", _signed_sum(c, left), mo("="),
                                c.write(c.readable(f[i]))))
     parts.append(element("h3", "Mass matrix and forcing"))
-    parts.append(c.formula(None, mi("M"), mo("="), c.write(sp.Matrix(
+    parts.append(c.formula("Mass matrix (kg, kg m, kg m²)", c.letter("M"), c.write(sp.Matrix(
         M.rows, M.cols, [c.readable(x) for x in M]))))
-    parts.append(c.formula(None, mi("f"), mo("="), c.write(sp.Matrix(
+    parts.append(c.formula("Forcing (N, N m)", c.letter("f"), c.write(sp.Matrix(
         [c.readable(x) for x in f]))))
     if model.constraints:
         parts.append(element("h3", "Constraints"))

@@ -60,7 +60,9 @@ class Browser:
             [executable, *FLAGS, f"--user-data-dir={self._profile}",
              f"--window-size={width},{height}", "about:blank"],
             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-            preexec_fn=descriptors, pass_fds=(3, 4))
+            # Python's own descriptors are not inherited (PEP 446); the two dup2'd in the child
+            # are, and close_fds would close them after preexec_fn.
+            preexec_fn=descriptors, close_fds=False)
         os.close(to_browser_r)
         os.close(from_browser_w)
         self._out = os.fdopen(to_browser_w, "wb", buffering=0)
@@ -168,10 +170,11 @@ class Browser:
             params["captureBeyondViewport"] = True
         return base64.b64decode(self.call("Page.captureScreenshot", session=True, **params)["data"])
 
-    def console_errors(self) -> list[str]:
-        """Console errors, uncaught exceptions and browser log errors (a blocked load, say)."""
+    def console_errors(self, since: int = 0) -> list[str]:
+        """Console errors, uncaught exceptions and browser log errors (a blocked load, say),
+        from event number ``since`` on."""
         errors = []
-        for event in self.events:
+        for event in self.events[since:]:
             method, params = event.get("method"), event.get("params", {})
             if method == "Runtime.consoleAPICalled" and params.get("type") in ("error", "assert"):
                 errors.append(" ".join(str(a.get("value", a.get("description", "")))

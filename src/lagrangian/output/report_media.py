@@ -25,7 +25,7 @@ from .geometry import mechanism
 # by MODE_REACH of the drawing's size (at most MODE_MAX_ANGLE rad in any angle).
 MODE_FRAMES = 24
 MODE_CYCLE = 1.6
-MODE_REACH = 0.12
+MODE_REACH = 0.2
 MODE_MAX_ANGLE = 0.5
 MODES_ANIMATED = 6  # the lowest modes get an animation; the others their numbers only
 # The simulation's animation: frames a second and at most this many (a page stays ~1 MB).

@@ -66,3 +66,13 @@ def test_only_mathml_core_elements_and_a_real_minus():
     tags = set(re.findall(r"<([a-z]+)", markup))
     assert tags <= CORE, tags - CORE
     assert "<mo>-</mo>" not in markup and "<mo>\u2212</mo>" in markup
+
+
+def test_parentheses_stretch_only_around_something_taller_than_a_line():
+    x, y = sp.symbols("x y")
+    flat = MathWriter()(sp.cos(x + y))
+    assert flat.count('<mo stretchy="false">') == 2
+    tall = MathWriter()(sp.cos(x / (y + 1) + 1))  # the fraction inside: fences grow
+    assert "stretchy" not in tall
+    matrix = MathWriter()(sp.Matrix([[x], [y]]))
+    assert "stretchy" not in matrix.split("<mtable>")[0]  # a matrix's brackets grow

@@ -13,10 +13,10 @@ import time
 from pathlib import Path
 
 import pytest
-from headless_chromium import Browser, find_chromium
-from test_report import HOSTILE_MODEL
 
 import lagrangian
+from headless_chromium import Browser, find_chromium
+from report_models import HOSTILE_MODEL
 
 CHROMIUM = find_chromium()
 pytestmark = pytest.mark.skipif(

@@ -24,6 +24,8 @@ DOT, DOUBLE_DOT = "\u02d9", "\u00a8"  # the accents over a velocity and an accel
 _ENTITY = re.compile(r"&(#x[0-9A-Fa-f]+|#[0-9]+|[A-Za-z]+);?")
 # Tags sympy's printer may use that MathML Core leaves out, mapped to what Core renders.
 _CORE_TAGS = {"mfenced": "mrow"}
+_FENCES = {"(", ")", "[", "]", "{", "}", "|"}
+_TALL = ("mfrac", "mtable", "msqrt", "mroot", "munderover", "munder")
 
 
 def escape(text: str) -> str:
@@ -83,7 +85,28 @@ def serialize(node) -> str:
         return f"<{tag}>{children}</{tag}>"
     attributes = "".join(f' {escape(name)}="{escape(value)}"'
                          for name, value in node.attributes.items())
+    if tag == "mrow" and _fenced(node) and not _tall(node):
+        # Parentheses around one line of math keep their text size: a stretched variant (Latin
+        # Modern Math's) stands apart from what it encloses, as "( m1 + m2 )".
+        first, last = serialize(node.firstChild), serialize(node.lastChild)
+        middle = "".join(serialize(child) for child in node.childNodes[1:-1])
+        children = (first.replace("<mo>", '<mo stretchy="false">', 1) + middle
+                    + last.replace("<mo>", '<mo stretchy="false">', 1))
     return f"<{tag}{attributes}>{children}</{tag}>"
+
+
+def _fenced(node) -> bool:
+    """A row between two fences: (, [, { ... ), ], }."""
+    items = [c for c in node.childNodes if c.nodeType == c.ELEMENT_NODE]
+    return (len(items) >= 2 and len(items) == len(node.childNodes)
+            and all(i.tagName == "mo" and i.firstChild is not None
+                    and i.firstChild.nodeType == i.TEXT_NODE and i.firstChild.data in _FENCES
+                    for i in (items[0], items[-1])))
+
+
+def _tall(node) -> bool:
+    """Whether a row holds something taller than a line (a fraction, a matrix, a root)."""
+    return any(node.getElementsByTagName(tag) for tag in _TALL)
 
 
 class _Printer(MathMLPresentationPrinter):

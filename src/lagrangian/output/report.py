@@ -29,6 +29,7 @@ from .report_html import Markup, element, h, image, join, math, note, page, para
 
 DEFAULT_T_END = 10.0  # s: the simulation's length when none is given
 _LONG_SOURCE = 20_000  # characters of model file shown before it is folded away
+TYPESET_LIMIT = 2500  # nodes of the expressions in one formula (the largest example but one: 133)
 
 
 @dataclass(frozen=True)
@@ -105,6 +106,18 @@ class _Page:
         """A labelled displayed formula, scrolling sideways when long."""
         block = element("div", math(math_block(*parts)), class_="formula")
         return join([paragraph(label, class_="formula-label"), block]) if label else block
+
+    def typeset(self, what: str, exprs, make: Callable[[], Markup]) -> Markup:
+        """``make()``, or one line saying ``what`` is too long to typeset: past TYPESET_LIMIT
+        nodes (the benchmark bicycle's M: 32000) a formula is pages wide and costs minutes."""
+        size = 0
+        for expr in exprs:
+            for _ in sp.preorder_traversal(sp.sympify(expr)):
+                size += 1
+                if size > TYPESET_LIMIT:
+                    return note(f"{what}: more than {TYPESET_LIMIT} terms and factors, too long "
+                                "to typeset here (`lagrangian derive MODEL` prints it).")
+        return make()
 
     def letter(self, letter: str) -> str:
         """``letter =`` as MathML, or nothing when the model has a symbol of that name (a
@@ -230,13 +243,16 @@ def _energy_section(c: _Page) -> tuple[Markup, str]:
     if c.urdf:
         return _urdf_note(c, "energies")
     eom = c.eom
-    kinetic, potential = c.readable(eom.kinetic_energy), c.readable(eom.potential_energy)
-    parts = [c.formula("Kinetic energy (J)", c.letter("T"), c.write(kinetic)),
-             c.formula("Potential energy (J)", c.letter("V"), c.write(potential))]
-    if eom.dissipation != 0:
-        parts.append(c.formula("Dissipation function (W)", c.letter("D"),
-                               c.write(c.readable(eom.dissipation))))
-    parts.append(c.formula("Lagrangian (J)", c.letter("L"), c.write(kinetic - potential)))
+    T, V, D = eom.kinetic_energy, eom.potential_energy, eom.dissipation
+    parts = [c.typeset("Kinetic energy T", [T], lambda: c.formula(
+                 "Kinetic energy (J)", c.letter("T"), c.write(c.readable(T)))),
+             c.typeset("Potential energy V", [V], lambda: c.formula(
+                 "Potential energy (J)", c.letter("V"), c.write(c.readable(V))))]
+    if D != 0:
+        parts.append(c.typeset("Dissipation function D", [D], lambda: c.formula(
+            "Dissipation function (W)", c.letter("D"), c.write(c.readable(D)))))
+    parts.append(c.typeset("Lagrangian L = T - V", [T, V], lambda: c.formula(
+        "Lagrangian (J)", c.letter("L"), c.write(c.readable(T) - c.readable(V)))))
     return join(parts), "shown"
 
 
@@ -252,16 +268,22 @@ def _forces_section(c: _Page) -> tuple[Markup, str]:
     for load in dict.fromkeys(x.load for x in contributions):
         parts.append(element("h3", f"Load {load}"))
         for x in (x for x in contributions if x.load == load):
-            symbol = c.model.coordinate(x.coordinate).symbol
-            name = mrow("<msub>" + mi("Q") + c.write(symbol) + "</msub>", mo("="))
-            parts.append(c.formula(None, name, c.write(c.readable(x.expression))))
+            name = _force_name(c, c.model.coordinate(x.coordinate).symbol)
+            parts.append(c.typeset(f"Q of {x.coordinate}", [x.expression], lambda x=x, name=name:
+                                   c.formula(None, name, c.write(c.readable(x.expression)))))
     totals = [(co, q) for co, q in zip(c.model.coordinates, eom.generalized_forces, strict=True)
               if q != 0]
     parts.append(element("h3", "Total generalized force"))
     for co, q in totals:
-        name = mrow("<msub>" + mi("Q") + c.write(co.symbol) + "</msub>", mo("="))
-        parts.append(c.formula(None, name, c.write(c.readable(q))))
+        name = _force_name(c, co.symbol)
+        parts.append(c.typeset(f"Q of {co.name}", [q], lambda q=q, name=name:
+                               c.formula(None, name, c.write(c.readable(q)))))
     return join(parts), "shown"
+
+
+def _force_name(c: _Page, coordinate: sp.Symbol) -> str:
+    """Q with the coordinate as its index, then =."""
+    return mrow("<msub>" + mi("Q") + c.write(coordinate) + "</msub>", mo("="))
 
 
 def _signed_sum(c: _Page, terms: list[sp.Expr]) -> str:
@@ -287,24 +309,32 @@ def _equations_section(c: _Page) -> tuple[Markup, str]:
                        "accelerations on the left in coordinate order"
                        + (", then the constraint reactions" if A.rows else "") + ".")]
     for i, coordinate in enumerate(model.coordinates):
-        left = [c.readable(M[i, j]) * a for j, a in enumerate(model.q_ddot) if M[i, j] != 0]
-        left += [c.readable(A[k, i]) * eom.multipliers[k] for k in range(A.rows) if A[k, i] != 0]
-        parts.append(c.formula(f"{coordinate.name}:", _signed_sum(c, left), mo("="),
-                               c.write(c.readable(f[i]))))
+        def row(i=i, coordinate=coordinate) -> Markup:
+            left = [c.readable(M[i, j]) * a for j, a in enumerate(model.q_ddot) if M[i, j] != 0]
+            left += [c.readable(A[k, i]) * eom.multipliers[k] for k in range(A.rows)
+                     if A[k, i] != 0]
+            return c.formula(f"{coordinate.name}:", _signed_sum(c, left), mo("="),
+                             c.write(c.readable(f[i])))
+
+        parts.append(c.typeset(f"The equation of {coordinate.name}",
+                               [*M.row(i), *A.col(i), f[i]], row))
     parts.append(element("h3", "Mass matrix and forcing"))
-    parts.append(c.formula("Mass matrix (kg, kg m, kg m²)", c.letter("M"), c.write(sp.Matrix(
-        M.rows, M.cols, [c.readable(x) for x in M]))))
-    parts.append(c.formula("Forcing (N, N m)", c.letter("f"), c.write(sp.Matrix(
-        [c.readable(x) for x in f]))))
+    parts.append(c.typeset("The mass matrix", [M], lambda: c.formula(
+        "Mass matrix (kg, kg m, kg m²)", c.letter("M"),
+        c.write(sp.Matrix(M.rows, M.cols, [c.readable(x) for x in M])))))
+    parts.append(c.typeset("The forcing", [f], lambda: c.formula(
+        "Forcing (N, N m)", c.letter("f"), c.write(sp.Matrix([c.readable(x) for x in f])))))
     if model.constraints:
         parts.append(element("h3", "Constraints"))
         for constraint in model.constraints:
             kind = str(getattr(constraint.kind, "value", constraint.kind))
-            parts.append(c.formula(f"{constraint.name} ({kind}):", c.write(constraint.expression),
-                                   mo("="), c.write(0)))
-        parts.append(c.formula(None, "<msub>" + mi("\u03a6") + mi("q") + "</msub>", mo("="),
-                               c.write(sp.Matrix(A.rows, A.cols,
-                                                 [c.readable(x) for x in A]))))
+            parts.append(c.typeset(f"The constraint {constraint.name}", [constraint.expression],
+                                   lambda constraint=constraint, kind=kind: c.formula(
+                                       f"{constraint.name} ({kind}):",
+                                       c.write(constraint.expression), mo("="), c.write(0))))
+        parts.append(c.typeset("The constraint Jacobian", [A], lambda: c.formula(
+            None, "<msub>" + mi("\u03a6") + mi("q") + "</msub>", mo("="),
+            c.write(sp.Matrix(A.rows, A.cols, [c.readable(x) for x in A])))))
     return join(parts), "shown"
 
 

@@ -147,3 +147,37 @@ def mode_gif(model: Model, analysis: ModalAnalysis, mode: Mode, index: int) -> b
     animation = mechanism_animation(motion, fps=10**6, max_frames=MODE_FRAMES)
     frames = list(animation.frame_images(dpi=HTML_DPI))
     return gif_bytes(frames, MODE_FRAMES / MODE_CYCLE)
+
+
+def coordinate_mode_gif(analysis: ModalAnalysis, mode: Mode, index: int, units: dict) -> bytes:
+    """A model given by its energies has nothing to draw: mode ``index`` (1-based) shown as each
+    coordinate's dot moving along its own track, q_i = Re(phi_i e^(i theta)) over one period
+    (largest +-1), so in phase and out of phase read at a glance."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from .plots import plain_text
+
+    names = list(analysis.linear_model.user_coordinates)
+    shape = np.array([complex(_shape_entry(mode, analysis, n)) for n in names])
+    shape = shape / (np.max(np.abs(shape)) or 1.0)
+    rows = len(names)
+    figure = Figure(figsize=(5, 1.2 + 0.55 * rows), dpi=HTML_DPI, layout="constrained")
+    FigureCanvasAgg(figure)
+    ax = figure.add_subplot()
+    ax.set_xlim(-1.3, 1.3)
+    ax.set_ylim(rows - 0.4, -0.6)
+    ax.set_yticks(range(rows), [f"{plain_text(n)} ({units.get(n) or '1'})" for n in names])
+    ax.set_xticks([-1, 0, 1], ["-a", "0", "+a"])
+    for row in range(rows):
+        ax.plot([-1.1, 1.1], [row, row], color="0.6", linewidth=1)
+        ax.plot([0, 0], [row - 0.15, row + 0.15], color="0.6", linewidth=1)
+    dots = ax.plot(np.zeros(rows), np.arange(rows), "o", color="tab:red", markersize=12)[0]
+    ax.set_title(f"mode {index}: each coordinate's motion (a: the largest amplitude)",
+                 fontsize=9)
+    frames = []
+    for theta in 2 * np.pi * np.arange(MODE_FRAMES) / MODE_FRAMES:
+        dots.set_xdata(np.real(shape * np.exp(1j * theta)))
+        figure.canvas.draw()
+        frames.append(np.asarray(figure.canvas.buffer_rgba())[..., :3].copy())
+    return gif_bytes(frames, MODE_FRAMES / MODE_CYCLE)

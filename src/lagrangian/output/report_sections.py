@@ -11,6 +11,7 @@ from .report_html import Markup, element, image, join, note, number, paragraph, 
 from .report_media import (
     MODE_CYCLE,
     MODES_ANIMATED,
+    coordinate_mode_gif,
     data_uri,
     figure_png,
     mode_gif,
@@ -85,9 +86,7 @@ def modes_section(c) -> tuple[Markup, str]:
 
 def _mode_animations(c, analysis) -> Markup:
     """A looping GIF of the mechanism in each of the lowest oscillating modes."""
-    if not (c.model.particles or c.model.bodies or c.model.rigid_bodies):
-        return note("Nothing to draw: the model is given by its energies only (no particles or "
-                    "bodies); the mode shapes above show each coordinate's part.")
+    drawable = bool(c.model.particles or c.model.bodies or c.model.rigid_bodies)
     figures = []
     for i, mode in enumerate(analysis.modes[:MODES_ANIMATED], 1):
         if mode.frequency <= 0:
@@ -95,20 +94,26 @@ def _mode_animations(c, analysis) -> Markup:
                                                   "oscillate, so there is no motion to show.")))
             continue
         try:
-            gif = mode_gif(c.model, analysis, mode, i)
+            gif = mode_gif(c.model, analysis, mode, i) if drawable else \
+                coordinate_mode_gif(analysis, mode, i, _units(c))
         except LagrangianError as exc:
             figures.append(note(f"Mode {i}: no animation ({exc})."))
             continue
         caption = (f"Mode {i}: {number(mode.frequency, 4)} rad/s, period "
-                   f"{number(mode.period, 4)} s, played in {MODE_CYCLE:g} s; amplitude "
-                   "exaggerated, growth or decay left out.")
+                   f"{number(mode.period, 4)} s, played in {MODE_CYCLE:g} s; "
+                   + ("amplitude exaggerated, " if drawable else "")
+                   + "growth or decay left out.")
         figures.append(element("figure", image(data_uri(gif, "image/gif"),
                                                f"the mechanism moving in mode {i}",
                                                class_="animation"),
                                element("figcaption", caption)))
     if len(analysis) > MODES_ANIMATED:
         figures.append(note(f"The {len(analysis) - MODES_ANIMATED} higher modes are not drawn."))
-    return element("div", *figures, class_="gallery")
+    gallery = element("div", *figures, class_="gallery")
+    if drawable:
+        return gallery
+    return join([note("The model is given by its energies only (no particles or bodies): each "
+                      "mode is shown as its coordinates moving, each on its own track."), gallery])
 
 
 def simulation_section(c, t_end: float) -> tuple[Markup, str]:

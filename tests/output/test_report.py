@@ -207,3 +207,28 @@ def test_a_formula_too_long_to_typeset_is_one_line(monkeypatch):
     assert "Kinetic energy T: more than 12 terms and factors, too long to typeset" in energy
     assert "Potential energy (J)" in energy  # V = -m g l cos(theta): 9 nodes, still set
     assert "The mass matrix: more than 12" in page.section("equations")
+
+
+def test_parameters_without_a_value_leave_the_numbers_out(tmp_path):
+    model = tmp_path / "symbolic.toml"
+    model.write_text("""name = "Symbolic pendulum"
+[coordinates]
+theta = { unit = "rad", initial = 0.3 }
+[parameters]
+m = { unit = "kg" }
+L = { unit = "m" }
+g = { value = 9.81, unit = "m/s^2" }
+[gravity]
+g = "g"
+direction = [0, -1]
+[[particles]]
+name = "bob"
+mass = "m"
+position = ["L*sin(theta)", "-L*cos(theta)"]
+""", encoding="utf-8")
+    report = lagrangian.load(model).report(t_end=0.2)
+    statuses = {s.key: s.status for s in report.sections}
+    assert statuses["energy"] == statuses["equations"] == "shown"  # symbols need no values
+    for key in ("equilibria", "modes", "simulation"):
+        assert statuses[key].startswith("not available:") and "'m'" in statuses[key]
+    assert "No drawing: parameters: no value for m, L" in Page(report.html).section("model")

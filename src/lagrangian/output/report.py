@@ -199,27 +199,28 @@ def _model_section(c: _Page) -> tuple[Markup, str]:
     if model.description:
         parts.append(paragraph(model.description))
     rows = [(co.name, co.unit or "1", _value(co.initial), _value(co.rate)) for co in model.coordinates]
-    parts.append(element("h3", "Coordinates"))
-    parts.append(table(["name", "unit", "initial", "rate (per s)"], rows))
+    tables = [element("h3", "Coordinates"), table(["name", "unit", "initial", "rate (per s)"], rows)]
     if model.parameters:
-        parts.append(element("h3", "Parameters"))
-        parts.append(table(["name", "value (SI)", "unit"],
-                           [(p.name, _value(p.value), p.unit or "") for p in model.parameters]))
-    parts.append(element("h3", "Drawing"))
+        tables += [element("h3", "Parameters"), table(
+            ["name", "value (SI)", "unit"],
+            [(p.name, _value(p.value), p.unit or "") for p in model.parameters])]
+    drawing = [element("h3", "Drawing")]
     try:
         q = np.array([co.initial or 0.0 for co in model.coordinates], dtype=float)
-        parts.append(element("figure", image(data_uri(drawing_png(model, q), "image/png"),
-                                             f"the mechanism {model.name} at its initial state"),
-                             element("figcaption", "At the initial values of the coordinates.")))
+        drawing.append(element("figure", image(data_uri(drawing_png(model, q), "image/png"),
+                                               f"the mechanism {model.name} at its initial state"),
+                               element("figcaption", "At the initial values of the coordinates.")))
     except LagrangianError as exc:
-        parts.append(note(f"No drawing: {exc}"))
+        drawing.append(note(f"No drawing: {exc}"))
+    parts.append(element("div", element("div", *tables), element("div", *drawing),
+                         class_="columns"))
     found = model_file_text(model)
     parts.append(element("h3", "Model file"))
     if found is None:
         parts.append(note("Built in Python (no model file)."))
     else:
         where, text = found
-        folded = len(text) > _LONG_SOURCE or where.endswith(".urdf") or "URDF" in where
+        folded = len(text) > _LONG_SOURCE or c.urdf  # a robot's XML is long and not the point
         summary = element("summary", f"{where} ({len(text.splitlines())} lines)")
         parts.append(element("details", summary, element("pre", element("code", text)),
                              open=None if folded else "open"))

@@ -94,6 +94,7 @@ td.number, th.number { text-align: right; }
 .good { color: #1a6b1a; font-weight: bold; }
 .bad { color: #a01818; font-weight: bold; }
 .gallery { display: flex; flex-wrap: wrap; gap: 1rem; }
+.columns { display: flex; flex-wrap: wrap; gap: 0 3rem; align-items: flex-start; }
 figure { margin: 0.4rem 0; }
 figcaption { font-size: 0.85rem; color: #444; max-width: 22rem; }
 img { max-width: 100%; }

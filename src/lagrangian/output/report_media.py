@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis.modes import ModalAnalysis, Mode
+from ..errors import ModelError
 from ..model.model import Model
 from .animation import HTML_DPI, gif_bytes, mechanism_animation, playback_rate
 from .geometry import mechanism
@@ -74,6 +75,10 @@ def _png(frame: np.ndarray) -> bytes:
 
 def drawing_png(model: Model, q: np.ndarray) -> bytes:
     """The mechanism drawn at the configuration q (SI, model order), at rest."""
+    missing = [p.name for p in model.parameters if p.value is None]
+    if missing:  # the drawing is made of numbers
+        raise ModelError(f"no value for {', '.join(missing)} (give one: --set NAME=VALUE, or "
+                         "System.with_parameters)", field="parameters")
     still = Motion(model, _parameters(model), np.array([0.0, 1.0]), np.array([q, q], float),
                    np.zeros((2, len(q))), model.name)
     animation = mechanism_animation(still, fps=1, max_frames=2)

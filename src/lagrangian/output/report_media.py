@@ -77,8 +77,8 @@ def drawing_png(model: Model, q: np.ndarray) -> bytes:
     """The mechanism drawn at the configuration q (SI, model order), at rest."""
     missing = [p.name for p in model.parameters if p.value is None]
     if missing:  # the drawing is made of numbers
-        raise ModelError(f"no value for {', '.join(missing)} (give one: --set NAME=VALUE, or "
-                         "System.with_parameters)", field="parameters")
+        raise ModelError(f"no value for {', '.join(missing)} (the drawing needs numbers: give "
+                         "each a value)", field="parameters")
     still = Motion(model, _parameters(model), np.array([0.0, 1.0]), np.array([q, q], float),
                    np.zeros((2, len(q))), model.name)
     animation = mechanism_animation(still, fps=1, max_frames=2)

@@ -67,3 +67,17 @@ def test_never_over_a_file_it_did_not_write(cli, tmp_path):
                      "examples" / "pendulum.toml").read_text())
     _refused(cli("report", str(toml), "--out", str(toml)), "*.html")
     assert not model.exists()
+
+
+def test_a_urdf_robot_with_a_locked_joint(cli, tmp_path):
+    import pytest
+
+    pytest.importorskip("yourdfpy")
+    out = tmp_path / "arm.html"
+    code, stdout, stderr = cli("report", "two_link_arm", "--lock", "elbow=0.2", "--t-end", "0.2",
+                               "--out", str(out), "--json")
+    assert code == 0, stderr
+    statuses = {s["section"]: s["status"] for s in json.loads(stdout)["sections"]}
+    assert statuses["equations"] == "not applicable: URDF" and statuses["modes"] == "shown"
+    page = out.read_text(encoding="utf-8")
+    assert "shoulder" in page and "<td>elbow</td>" not in page  # one coordinate left

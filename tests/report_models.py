@@ -1,6 +1,6 @@
 """Models for the report tests: one whose every piece of text is hostile markup."""
 
-HOSTILE_NAME = '<script>alert("name")</script></math><img src=x onerror=alert(1)>'
+HOSTILE_NAME = '<script>alert("name")</script></math><img src=x onerror=alert(1)> cost $\\frac$'
 HOSTILE_MODEL = f"""# </code></pre><script>alert("file")</script>
 name = '{HOSTILE_NAME}'
 description = "</p><script>alert('description')</script>"

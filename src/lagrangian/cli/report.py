@@ -3,6 +3,7 @@ of the model, its equations, equilibria, modes (each drawn moving), a simulation
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Annotated
 
@@ -34,7 +35,12 @@ def report(
     inputs = tuple(p for p in (Path(model), answer) if p is not None and p.exists())
     check_report_path(out, inputs)  # before any work: a path that cannot be written costs nothing
     end = parse_quantity(t_end, "s", "--t-end") if t_end is not None else None
-    page = system.report(answer=str(answer) if answer is not None else None, t_end=end)
+    progress = None
+    if sys.stderr.isatty():  # a big model takes a while: say which section is being made
+        def progress(title: str) -> None:
+            typer.echo(f"report: {title} ...", err=True)
+    page = system.report(answer=str(answer) if answer is not None else None, t_end=end,
+                         progress=progress)
     page.save(out, protect=inputs)
     if json_:
         print_json({"report": str(out), "model": page.model_name,

@@ -98,6 +98,7 @@ td.number, th.number { text-align: right; }
 figure { margin: 0.4rem 0; }
 figcaption { font-size: 0.85rem; color: #444; max-width: 22rem; }
 img { max-width: 100%; }
+@media print { figure, .formula, table { break-inside: avoid; } nav { display: none; } }
 """
 
 

@@ -21,7 +21,8 @@ from pathlib import Path
 CHROMIUM = "/usr/bin/chromium"
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
          "--disable-component-update", "--disable-sync", "--no-first-run", "--hide-scrollbars",
-         "--remote-debugging-pipe"]
+         # a container's /dev/shm is often 64 MB, too small for the renderer's shared memory
+         "--disable-dev-shm-usage", "--remote-debugging-pipe"]
 INSTALLER = Path(__file__).resolve().parents[1] / ".ci" / "install-chromium"
 
 

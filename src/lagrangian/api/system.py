@@ -456,6 +456,18 @@ class System:
         """Every dimensionally inconsistent term of the model (T, V: J; D: W; Q: J per unit of q)."""
         return check_model_units(self._model)
 
+    # -- the report page ---------------------------------------------------------------------
+
+    def report(self, answer=None, *, t_end: float | None = None, progress=None):
+        """One self-contained HTML page (output/report.py): the model and its drawing, T, V, L,
+        the generalized forces per load, the equations, equilibria, modes (each drawn moving), a
+        simulation of ``t_end`` s (default 10), the units check and, given ``answer`` (as in
+        ``check``), the check's findings. Returns a Report: ``.html``, ``.save(path)``; it shows
+        itself in Jupyter."""
+        from ..output.report import build_report
+
+        return build_report(self, answer=answer, t_end=t_end, progress=progress)
+
     def __repr__(self) -> str:
         names = ", ".join(c.name for c in self._model.coordinates)
         return f"System({self._model.name!r}, coordinates=[{names}])"

@@ -88,8 +88,8 @@ static void lg_residual(const double *restrict q, const double *restrict v, doub
 def _generator_key() -> str:
     """The tree generator itself: a change to any of its files is a new module."""
     here = Path(__file__).parent
-    files = ("tree_emitter.py", "tree_algorithms.py", "tree_c.py", "tree_module.py",
-             "tree_bindings.c")
+    files = ("tree_emitter.py", "tree_algorithms.py", "joint_models.py", "tree_c.py",
+             "tree_module.py", "tree_bindings.c")
     return hashlib.sha256(b"".join((here / f).read_bytes() for f in files)).hexdigest()
 
 

@@ -145,13 +145,13 @@ def _amplitude(model: Model, q0: np.ndarray, shape: np.ndarray) -> float:
 
 
 def mode_gif(model: Model, analysis: ModalAnalysis, mode: Mode, index: int) -> bytes:
-    """Mode ``index`` (1-based) drawn moving over one period, as a looping GIF."""
-    motion = mode_motion(model, analysis, mode, index)
-    # A frame rate far above the mode's keeps all MODE_FRAMES samples (animation_frames takes
-    # real time at fps, at most max_frames); the GIF's own rate is set below.
-    animation = mechanism_animation(motion, fps=10**6, max_frames=MODE_FRAMES)
-    frames = list(animation.frame_images(dpi=HTML_DPI))
-    return gif_bytes(frames, MODE_FRAMES / MODE_CYCLE)
+    """Mode ``index`` (1-based) drawn moving over one period, as a looping GIF: the modes
+    command's own animation (output/mode_animation.py), one period in MODE_CYCLE seconds."""
+    from .mode_animation import mode_animation
+
+    fps = round(MODE_FRAMES / MODE_CYCLE)
+    animation = mode_animation(analysis, model, mode=index, fps=fps, size=(320, 320))
+    return gif_bytes(list(animation.frame_images()), fps)
 
 
 def coordinate_mode_gif(analysis: ModalAnalysis, mode: Mode, index: int, units: dict) -> bytes:

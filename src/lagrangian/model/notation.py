@@ -1,8 +1,14 @@
-"""How the model's symbols are written in LaTeX: q_dot as a dot over q, multipliers as lambda."""
+"""How the model's symbols are written in LaTeX: q_dot as a dot over q, multipliers as lambda.
+
+Dots go on the symbol's body, before its subscript, as sympy.physics.mechanics' ``vlatex``
+writes them: ``\\dot{\\theta}_{1}^{2}``, not ``\\dot{\\theta_{1}}^{2}`` (whose exponent floats
+beside the accent).
+"""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import re
+from collections.abc import Callable, Sequence
 
 import sympy as sp
 from sympy.printing.latex import LatexPrinter
@@ -11,24 +17,135 @@ from .model import Model, multiplier_name
 from .printing import MemoizedPrinting
 
 
+def dotted(base: str, dots: int) -> str:
+    """``base`` (a symbol's LaTeX) with ``dots`` dots over its body, the subscript after:
+    ``\\theta_{1}`` -> ``\\dot{\\theta}_{1}``."""
+    depth = 0
+    for i, char in enumerate(base):
+        if char == "{":
+            depth += 1
+        elif char == "}":
+            depth -= 1
+        elif char in "_^" and depth == 0 and i > 0:
+            body, tail = base[:i], base[i:]
+            break
+    else:
+        body, tail = base, ""
+    accent = {1: r"\dot", 2: r"\ddot", 3: r"\dddot"}[dots]
+    return rf"{accent}{{{body}}}{tail}"
+
+
 def latex_symbol_names(model: Model) -> dict[sp.Symbol, str]:
     """Symbol -> LaTeX for velocities, accelerations and multipliers of ``model``."""
     names: dict[sp.Symbol, str] = {}
     for c in model.coordinates:
         base = sp.latex(c.symbol)
-        names[c.velocity] = rf"\dot{{{base}}}"
-        names[c.acceleration] = rf"\ddot{{{base}}}"
+        names[c.velocity] = dotted(base, 1)
+        names[c.acceleration] = dotted(base, 2)
     for constraint in model.constraints:
         label = constraint.name.replace("_", r"\_")
         names[sp.Symbol(multiplier_name(constraint.name))] = rf"\lambda_{{\mathrm{{{label}}}}}"
     return names
 
 
-class _LatexPrinter(MemoizedPrinting, LatexPrinter):
-    """sympy's LaTeX printer, each sub-expression printed once."""
+_ACCENTED_WORD = re.compile(r"^\\d*dot\{(?!\\[A-Za-z]+\}$)[^{}]{2,}\}$")
+
+
+class ModelLatexPrinter(MemoizedPrinting, LatexPrinter):
+    """sympy's LaTeX printer with a model's symbol names, each sub-expression printed once."""
+
+    def _print_Pow(self, expr):
+        # A power of a dotted word (\dot{lean}^{2}) would be raised above the dot: set at
+        # the height of a plain letter's exponent instead.
+        name = self._settings["symbol_names"].get(expr.base)
+        if name and _ACCENTED_WORD.match(name) and expr.exp.is_Integer and expr.exp > 1:
+            return f"{name}{{}}^{{{expr.exp}}}"
+        return super()._print_Pow(expr)
+
+    def signed_terms(self, expr: sp.Expr) -> list[tuple[bool, str]]:
+        """The terms of a sum in print order as (negative, LaTeX of the magnitude)."""
+        terms = self._as_ordered_terms(expr) if expr.is_Add else [expr]
+        return [_signed(self._print(term)) for term in terms]
+
+    def product_terms(self, pairs: Sequence[tuple[sp.Expr, sp.Symbol]]) -> list[tuple[bool, str]]:
+        """sum coefficient * unknown as (negative, LaTeX) terms, the unknown after its
+        coefficient (``l^{2} m \\ddot{\\theta}``), a sum coefficient in parentheses."""
+        terms = []
+        for coefficient, unknown in pairs:
+            if coefficient == 0:
+                continue
+            negative = coefficient.could_extract_minus_sign()
+            magnitude = -coefficient if negative else coefficient
+            if magnitude == 1:
+                text = self._print(unknown)
+            elif magnitude.is_Add:
+                text = rf"\left({self._print(magnitude)}\right) {self._print(unknown)}"
+            else:
+                text = f"{self._print(magnitude)} {self._print(unknown)}"
+            terms.append((negative, text))
+        return terms
+
+
+def _signed(text: str) -> tuple[bool, str]:
+    return (True, text[1:].lstrip()) if text.startswith("-") else (False, text)
+
+
+def join_terms(terms: Sequence[tuple[bool, str]]) -> str:
+    """(negative, LaTeX) terms as one sum: ``a - b + c``; ``0`` for none."""
+    out = ""
+    for negative, text in terms:
+        if not out:
+            out = f"- {text}" if negative else text
+        else:
+            out += f" - {text}" if negative else f" + {text}"
+    return out or "0"
+
+
+def model_latex_printer(model: Model) -> ModelLatexPrinter:
+    """One printer for a whole document, so repeated sub-expressions are printed once."""
+    return ModelLatexPrinter({"symbol_names": latex_symbol_names(model)})
 
 
 def latex_printer(model: Model) -> Callable[[sp.Basic], str]:
     """``expr -> LaTeX`` with the model's symbol names (as ``sp.latex(expr, symbol_names=...)``);
     one printer for a whole document, so repeated sub-expressions are printed once."""
-    return _LatexPrinter({"symbol_names": latex_symbol_names(model)}).doprint
+    return model_latex_printer(model).doprint
+
+
+def names_by_suffix(symbols) -> dict[sp.Symbol, str]:
+    """LaTeX for the rate and multiplier symbols among ``symbols``, read from their names
+    (NAME_dot, NAME_ddot, lambda_NAME: the names the model reserves for them)."""
+    names = {}
+    for symbol in symbols:
+        if not isinstance(symbol, sp.Symbol):
+            continue
+        for suffix, dots in (("_ddot", 2), ("_dot", 1)):
+            base = symbol.name.removesuffix(suffix)
+            if base != symbol.name and base:
+                names[symbol] = dotted(sp.latex(sp.Symbol(base)), dots)
+                break
+        else:
+            if symbol.name.startswith("lambda_") and len(symbol.name) > 7:
+                label = symbol.name[7:].replace("_", r"\_")
+                names[symbol] = rf"\lambda_{{\mathrm{{{label}}}}}"
+    return names
+
+
+class ModelMatrix(sp.ImmutableDenseMatrix):
+    """An immutable matrix of a model's expressions that Jupyter (and ``sp.latex``) shows in the
+    model's notation: theta_dot as a dot over theta, not ``\\theta_{dot}``. Equal to, and
+    hashed as, the same entries in a plain ``sp.ImmutableMatrix``; results of arithmetic on it
+    (and copies through pickle) are ModelMatrix too."""
+
+    @classmethod
+    def of(cls, matrix: sp.MatrixBase) -> ModelMatrix:
+        return cls._fromrep(sp.ImmutableMatrix(matrix)._rep)
+
+    def __hash__(self) -> int:
+        return hash(sp.ImmutableDenseMatrix._fromrep(self._rep))
+
+    def _latex(self, printer: LatexPrinter) -> str:
+        names = {**names_by_suffix(self.free_symbols), **printer._settings["symbol_names"]}
+        settings = {key: value for key, value in printer._settings.items()
+                    if key in LatexPrinter._default_settings}
+        return ModelLatexPrinter({**settings, "symbol_names": names})._print_MatrixBase(self)

@@ -419,6 +419,14 @@ class System:
         """Every dimensionally inconsistent term of the model (T, V: J; D: W; Q: J per unit of q)."""
         return check_model_units(self._model)
 
+    def to_latex(self, standalone: bool = False) -> str:
+        """The derivation as LaTeX (amsmath), as ``derive --format latex``: M q_ddot
+        (+ Phi_q^T lambda) = f per coordinate, long rows broken; with ``standalone`` a complete
+        document for pdflatex titled with the model's name."""
+        from ..output.derivation import derivation_latex
+
+        return derivation_latex(self.equations_of_motion(), standalone=standalone)
+
     def __repr__(self) -> str:
         names = ", ".join(c.name for c in self._model.coordinates)
         return f"System({self._model.name!r}, coordinates=[{names}])"

@@ -9,7 +9,8 @@ import sympy as sp
 
 from ..kinds import InvariantKind
 from ..model.model import Model
-from ..model.notation import ModelMatrix, join_terms, model_latex_printer
+from ..model.notation import join_terms, model_latex_printer
+from .display import ModelMatrix
 
 
 @dataclass(frozen=True)

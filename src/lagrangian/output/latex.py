@@ -22,6 +22,7 @@ from .derivation import _Display, _latex_letters
 # standalone page is 453 pt wide (A4, 25 mm margins) and article's default column 345 pt:
 # 320 pt leaves room for a tag and the estimate's error (within 15 % of pdflatex's widths).
 LINE_WIDTH_PT = 320.0
+STANDALONE_WIDTH_PT = 370.0  # the standalone page's own 453 pt, less a tag and the error
 
 Terms = list[tuple[bool, str]]  # (negative, LaTeX of the magnitude), joined with + and -
 
@@ -359,10 +360,11 @@ _PREAMBLE = r"""\documentclass[10pt,a4paper]{article}
 def handout_latex(eom: EquationsOfMotion, standalone: bool = False) -> str:
     """The derivation as LaTeX (amsmath): a fragment to paste into a paper, or with
     ``standalone`` a complete document for pdflatex, titled with the model's name."""
-    handout = _Handout(eom)
+    handout = _Handout(eom, STANDALONE_WIDTH_PT if standalone else LINE_WIDTH_PT)
     name = escape_text(eom.model.name)
     k = handout.letters
-    convention = rf"{k['M']} \ddot{{\mathbf{{q}}}} + \Phi_q^T \lambda = {k['f']}"
+    constraint = r" + \Phi_q^T \lambda" if eom.model.constraints else ""
+    convention = rf"{k['M']} \ddot{{\mathbf{{q}}}}{constraint} = {k['f']}"
     blocks = [
         ("Energies, Lagrangian and generalized forces", handout.definitions()),
         (rf"Equations of motion, ${convention}$, one per coordinate", handout.equations()),

@@ -8,6 +8,7 @@ from __future__ import annotations
 import re
 import shutil
 import subprocess
+from pathlib import Path
 
 import pytest
 import sympy as sp
@@ -318,3 +319,34 @@ def test_pdflatex_compiles_the_handout_without_overfull_lines(name, tmp_path):
     assert "Overfull \\hbox" not in log, re.findall(r"Overfull \\hbox.*", log)
     assert "/etc/passwd" not in log  # the hostile name's \input was never run
     assert (tmp_path / "handout.pdf").stat().st_size > 1000
+
+
+# -- docs/handouts.md ---------------------------------------------------------------------------
+
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "handouts.md"
+
+
+def _docs_section() -> str:
+    text = DOCS.read_text(encoding="utf-8")
+    return text[text.index("<!-- BEGIN handout -->"):text.index("<!-- END handout -->")]
+
+
+def test_docs_python_example_prints_what_it_says(capsys):
+    code = re.findall(r"```python\n(.*?)```", _docs_section(), re.S)[0]
+    exec(compile(code, "docs/handouts.md", "exec"), {})
+    shown = re.findall(r"```text\n(.*?)```", _docs_section(), re.S)[0]
+    assert capsys.readouterr().out == shown
+
+
+def test_docs_commands_run(cli, tmp_path):
+    commands = re.findall(r"^\$ (.*)$", _docs_section(), re.M)
+    derive = commands[0].split(" > ")[0].split()[1:]
+    result = cli(*derive)
+    assert commands[0].startswith("lagrangian derive") and result.code == 0
+    assert result.out == lagrangian.load("double_pendulum").to_latex(standalone=True)
+    if shutil.which("pdflatex"):
+        (tmp_path / "handout.tex").write_text(result.out, encoding="utf-8")
+        program, *arguments = commands[1].split()
+        run = subprocess.run([program, "-interaction=nonstopmode", *arguments], cwd=tmp_path,
+                             capture_output=True, text=True, timeout=120)
+        assert run.returncode == 0 and (tmp_path / "handout.pdf").exists()

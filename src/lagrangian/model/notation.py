@@ -64,8 +64,11 @@ class ModelLatexPrinter(MemoizedPrinting, LatexPrinter):
 
     def signed_terms(self, expr: sp.Expr) -> list[tuple[bool, str]]:
         """The terms of a sum in print order as (negative, LaTeX of the magnitude)."""
-        terms = self._as_ordered_terms(expr) if expr.is_Add else [expr]
-        return [_signed(self._print(term)) for term in terms]
+        return [_signed(self._print(term)) for term in self.terms_in_order(expr)]
+
+    def terms_in_order(self, expr: sp.Expr) -> list[sp.Expr]:
+        """The terms of a sum in the order this printer writes them ([expr] for a non-sum)."""
+        return list(self._as_ordered_terms(expr)) if expr.is_Add else [expr]
 
     def product_terms(self, pairs: Sequence[tuple[sp.Expr, sp.Symbol]]) -> list[tuple[bool, str]]:
         """sum coefficient * unknown as (negative, LaTeX) terms, the unknown after its

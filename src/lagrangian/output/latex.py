@@ -9,8 +9,10 @@ model's name) reaches LaTeX only through :func:`escape_text`.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Sequence
+from functools import lru_cache
 
 import sympy as sp
 
@@ -54,7 +56,7 @@ def escape_text(text: str) -> str:
 
 # -- printed width, estimated -------------------------------------------------------------------
 
-_TOKEN = re.compile(r"\\[A-Za-z]+|\\.|[{}]|\s+|.", re.S)
+_TOKEN = re.compile(r"\\[A-Za-z]+|\\.|\S")  # commands, escaped characters, glyphs
 _SPACES = {r"\,": 1.67, r"\;": 2.78, r"\:": 2.22, r"\!": -1.67, r"\quad": 10.0,
            r"\qquad": 20.0, "~": 3.33, r"\ ": 3.33}
 _FUNCTIONS = {"sin", "cos", "tan", "cot", "sec", "csc", "sinh", "cosh", "tanh", "log", "ln",
@@ -81,11 +83,20 @@ def _glyph(char: str) -> float:
             "|": 2.8}.get(char, 7.8)
 
 
+_GLYPHS = {char: _glyph(char) for char in
+           "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789()[],;.|"}
+
+
+class _TooWide(Exception):
+    """Raised by a reader as soon as the width passes its room (long rows are read no further)."""
+
+
 class _WidthReader:
-    """Reads LaTeX math token by token, summing glyph widths (sizes by style)."""
+    """Reads LaTeX math token by token, summing glyph widths (sizes by style); a group whose
+    width passes its ``room`` raises _TooWide."""
 
     def __init__(self, text: str):
-        self.tokens = [t for t in _TOKEN.findall(text) if not t.isspace()]
+        self.tokens = _TOKEN.findall(text)
         self.position = 0
 
     def _next(self) -> str | None:
@@ -94,29 +105,34 @@ class _WidthReader:
         self.position += 1
         return self.tokens[self.position - 1]
 
-    def group(self, scale: float, fraction: float) -> float:
+    def group(self, scale: float, fraction: float, room: float = math.inf) -> float:
         width, after_operand = 0.0, False
         while (token := self._next()) is not None and token != "}":
-            w, after_operand = self._atom(token, scale, fraction, after_operand)
+            w, after_operand = self._atom(token, scale, fraction, after_operand, room - width)
             width += w
+            if width > room:
+                raise _TooWide
         return width
 
-    def _argument(self, scale: float, fraction: float) -> float:
+    def _argument(self, scale: float, fraction: float, room: float) -> float:
         token = self._next()
         if token is None:
             return 0.0
         if token == "{":
-            return self.group(scale, fraction)
-        return self._atom(token, scale, fraction, False)[0]
+            return self.group(scale, fraction, room)
+        return self._atom(token, scale, fraction, False, room)[0]
 
-    def _atom(self, token: str, scale: float, fraction: float,
-              after_operand: bool) -> tuple[float, bool]:
+    def _atom(self, token: str, scale: float, fraction: float, after_operand: bool,
+              room: float) -> tuple[float, bool]:
         """(width, whether it ends an operand, so that a following +/- is binary)."""
+        glyph = _GLYPHS.get(token)
+        if glyph is not None:  # most tokens: a letter, a digit, a parenthesis
+            return glyph * scale, token not in "(["
         if token == "{":
-            return self.group(scale, fraction), True
+            return self.group(scale, fraction, room), True
         if token in "^_":
             small = _SMALLER[scale]
-            return self._argument(small, _SMALLER[small]) + 0.5, True
+            return self._argument(small, _SMALLER[small], room) + 0.5, True
         if token in _RELATIONS:
             return 7.8 * scale + (5.56 if scale == 1.0 else 0.0), False
         if token in _BINARY:
@@ -124,18 +140,18 @@ class _WidthReader:
         if token in _SPACES:
             return _SPACES[token] * scale, after_operand
         if token == r"\frac":
-            numerator = self._argument(fraction, _SMALLER[fraction])
-            denominator = self._argument(fraction, _SMALLER[fraction])
+            numerator = self._argument(fraction, _SMALLER[fraction], room)
+            denominator = self._argument(fraction, _SMALLER[fraction], room)
             return max(numerator, denominator) + 2.4, True
         if token == r"\sqrt":
-            return self._argument(scale, fraction) + 8.3 * scale, True
+            return self._argument(scale, fraction, room) + 8.3 * scale, True
         if token in _DELIMITERS:
             self._next()  # the delimiter itself
             return _DELIMITERS[token] * scale, token.endswith(("right", "r"))
         if token in _ONE_ARGUMENT:
-            return self._argument(scale, fraction), True
+            return self._argument(scale, fraction, room), True
         if token in (r"\mathcal", r"\mathbf"):
-            return 1.3 * self._argument(scale, fraction), True
+            return 1.3 * self._argument(scale, fraction, room), True
         if token.startswith("\\") and token[1:] in _FUNCTIONS:
             return (4.6 * (len(token) - 1) + 1.67) * scale, False
         if token.startswith("\\") and token[1:].isalpha():  # a Greek letter or symbol
@@ -150,6 +166,24 @@ def estimated_width(latex: str) -> float:
     return _WidthReader(latex).group(1.0, 1.0)
 
 
+@lru_cache(maxsize=1 << 16)  # a line's text is measured again as it grows (lines, terms)
+def _width_within(latex: str, cap: float) -> float:
+    """estimated_width, or inf past ``cap`` pt. A long text is first read in part: printed
+    math takes more than 1/6 pt a character, and a part wider than the cap settles it."""
+    try:
+        prefix = int(6 * cap) + 100
+        if len(latex) > prefix:
+            _WidthReader(latex[:prefix]).group(1.0, 1.0, cap)
+        return _WidthReader(latex).group(1.0, 1.0, cap)
+    except _TooWide:
+        return math.inf
+
+
+def fits(latex: str, width: float) -> bool:
+    """Whether ``latex`` is estimated to print within ``width`` pt (read only that far)."""
+    return _width_within(latex, width) <= width
+
+
 # -- breaking sums over lines -------------------------------------------------------------------
 
 
@@ -162,13 +196,16 @@ class _Breaker:
     def terms(self, expr: sp.Expr, width: float | None = None) -> Terms:
         """expr as terms; a term wider than ``width`` (pt) is opened at its widest sum."""
         width = self.width if width is None else width
+        whole = self.printer.doprint(expr)
+        if fits(whole, width):
+            return [_signed(whole)]
         out: Terms = []
-        for (negative, text), term in zip(self.printer.signed_terms(expr),
-                                          self._ordered(expr), strict=True):
-            if estimated_width(text) <= width:
+        for term in self._ordered(expr):
+            negative, text = _signed(self.printer.doprint(term))
+            if fits(text, width):
                 out.append((negative, text))
             else:
-                out += self._opened(negative, term if not negative else -term, text, width)
+                out += self._opened(negative, -term if negative else term, text, width)
         return out
 
     def product_terms(self, pairs: Sequence[tuple[sp.Expr, sp.Symbol]], width: float) -> Terms:
@@ -177,7 +214,7 @@ class _Breaker:
         out: Terms = []
         for pair, (negative, text) in zip([p for p in pairs if p[0] != 0],
                                           self.printer.product_terms(pairs), strict=True):
-            if estimated_width(text) <= width:
+            if fits(text, width):
                 out.append((negative, text))
                 continue
             coefficient, unknown = pair
@@ -187,7 +224,7 @@ class _Breaker:
         return out
 
     def _ordered(self, expr: sp.Expr) -> list[sp.Expr]:
-        return list(self.printer._as_ordered_terms(expr)) if expr.is_Add else [expr]
+        return self.printer.terms_in_order(expr)
 
     def _opened(self, negative: bool, term: sp.Expr, text: str, width: float,
                 suffix: str = "") -> Terms:
@@ -196,7 +233,7 @@ class _Breaker:
         sums = [f for f in sp.Mul.make_args(term) if f.is_Add]
         if not sums:
             return [(negative, text)]  # nothing to open: a function's argument, a power
-        widest = max(sums, key=lambda f: estimated_width(self.printer.doprint(f)))
+        widest = max(sums, key=lambda f: len(self.printer.doprint(f)))  # the longest
         rest = sp.Mul(*[f for f in sp.Mul.make_args(term) if f is not widest])
         inner = self.terms(widest, width)
         big = r"\biggl(" if any(r"\frac" in t for _, t in inner) else r"\Bigl("
@@ -210,19 +247,27 @@ class _Breaker:
         return opened
 
 
+def _signed(text: str) -> tuple[bool, str]:
+    return (True, text[1:].lstrip()) if text.startswith("-") else (False, text)
+
+
 def lines(terms: Terms, first_width: float, width: float) -> list[str]:
     """The terms filled greedily into lines: the first line ``first_width`` wide, the rest
     ``width``; a line after the first starts ``{} + `` or ``{} - `` (a binary sign)."""
     out: list[str] = []
     current: Terms = []
-    room = first_width
+    room, used = first_width, 0.0
     for negative, text in terms:
-        trial = _joined(current + [(negative, text)], bool(out))
-        if current and estimated_width(trial) > room:
+        # a term's width once (each read no further than a line), plus its sign's
+        sign = 0.0 if text.startswith("= ") else 12.2 if current or out else (
+            7.8 if negative else 0.0)
+        taken = _width_within(text, width + 1.0) + sign
+        if current and used + taken > room:
             out.append(_joined(current, bool(out)))
-            current, room = [(negative, text)], width
+            current, room, used = [(negative, text)], width, taken + (0.0 if sign else 12.2)
         else:
             current.append((negative, text))
+            used += taken
     out.append(_joined(current, bool(out)))
     return out
 
@@ -297,11 +342,11 @@ class _Handout:
             left = join_terms(self.printer.product_terms(pairs))
             tag = rf"\tag{{${self.tex(c.symbol)}$}}"
             single = f"{left} = {self.tex(right)}"
-            if estimated_width(single) <= self.width:
+            if fits(single, self.width):
                 out += [r"\begin{equation}", f"{single} {tag}", r"\end{equation}"]
                 continue
-            left_width = estimated_width(left)
-            if left_width <= 0.45 * self.width:
+            if fits(left, 0.45 * self.width):
+                left_width = estimated_width(left)
                 room = self.width - left_width - 14.0
                 parts = lines(self.breaker.terms(right, room - 10.0), room, room - 10.0)
                 rows = [f"{left} &= {parts[0]}", *(rf"&\quad {p}" for p in parts[1:])]
@@ -320,8 +365,9 @@ class _Handout:
         """``label &= [matrix]``, or its nonzero entries one per row when too wide."""
         form = self.display.matrix(matrix)
         entries = [[self.tex(v) for v in form.row(i)] for i in range(form.rows)]
-        columns = [max(estimated_width(row[j]) for row in entries) for j in range(form.cols)]
-        if sum(columns) + 10.0 * (form.cols - 1) + 12.0 + estimated_width(label) <= self.width:
+        room = self.width - 10.0 * (form.cols - 1) - 12.0 - estimated_width(label)
+        if all(fits(entry, room) for row in entries for entry in row) and sum(
+                max(estimated_width(row[j]) for row in entries) for j in range(form.cols)) <= room:
             body = r" \\ ".join(" & ".join(row) for row in entries)
             return [rf"{label} &= \begin{{bmatrix}} {body} \end{{bmatrix}}"]
         rows = []
@@ -360,6 +406,13 @@ _PREAMBLE = r"""\documentclass[10pt,a4paper]{article}
 def handout_latex(eom: EquationsOfMotion, standalone: bool = False) -> str:
     """The derivation as LaTeX (amsmath): a fragment to paste into a paper, or with
     ``standalone`` a complete document for pdflatex, titled with the model's name."""
+    try:
+        return _handout_latex(eom, standalone)
+    finally:
+        _width_within.cache_clear()  # the texts measured belong to this document only
+
+
+def _handout_latex(eom: EquationsOfMotion, standalone: bool) -> str:
     handout = _Handout(eom, STANDALONE_WIDTH_PT if standalone else LINE_WIDTH_PT)
     name = escape_text(eom.model.name)
     k = handout.letters

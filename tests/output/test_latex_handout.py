@@ -187,6 +187,12 @@ def test_jupyter_shows_dots_in_matrices_and_equations():
     assert shown.index(r"\ddot{\theta}_{1}") < shown.index(r"\ddot{\theta}_{2}")
 
 
+def test_jupyter_shows_dots_in_the_reactions():
+    reaction = lagrangian.load("double_pendulum").crosscheck().reactions[0]._repr_latex_()
+    assert r"\ddot{\theta}_{1}" in reaction and r"\dot{\theta}_{1}^{2}" in reaction
+    assert "dot}" not in reaction and r"\dot{d}" not in reaction
+
+
 # -- M q_ddot + Phi_q^T lambda = f --------------------------------------------------------------
 
 

@@ -45,3 +45,9 @@ class ModelMatrix(sp.ImmutableDenseMatrix):
         settings = {key: value for key, value in printer._settings.items()
                     if key in LatexPrinter._default_settings}
         return ModelLatexPrinter({**settings, "symbol_names": names})._print_MatrixBase(self)
+
+
+def latex_with_rates(expr: sp.Basic) -> str:
+    """``sp.latex(expr)`` with its rates dotted and multipliers as lambda, read from the names
+    (for results that no longer carry their model: reactions, residuals)."""
+    return ModelLatexPrinter({"symbol_names": names_by_suffix(expr.free_symbols)}).doprint(expr)

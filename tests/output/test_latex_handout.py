@@ -312,7 +312,8 @@ def _pdflatex():
     return found
 
 
-@pytest.mark.parametrize("name", ["pendulum", "double_pendulum", "rolling_coin", "<hostile>"])
+@pytest.mark.parametrize("name", ["pendulum", "double_pendulum", "rolling_coin", "torque_free_body",
+                                  "<hostile>"])
 def test_pdflatex_compiles_the_handout_without_overfull_lines(name, tmp_path):
     pdflatex = _pdflatex()
     system = _hostile_system() if name == "<hostile>" else lagrangian.load(name)

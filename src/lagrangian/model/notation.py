@@ -70,6 +70,16 @@ class ModelLatexPrinter(MemoizedPrinting, LatexPrinter):
         """The terms of a sum in the order this printer writes them ([expr] for a non-sum)."""
         return list(self._as_ordered_terms(expr)) if expr.is_Add else [expr]
 
+    def _as_ordered_terms(self, expr, order=None):
+        # Ordered once per sum: printing it and breaking it over lines both ask.
+        if (order or self.order) is not None:
+            return super()._as_ordered_terms(expr, order=order)
+        memo = self.__dict__.setdefault("_ordered_memo", {})
+        found = memo.get(expr)
+        if found is None:
+            found = memo[expr] = super()._as_ordered_terms(expr, order=order)
+        return found
+
     def product_terms(self, pairs: Sequence[tuple[sp.Expr, sp.Symbol]]) -> list[tuple[bool, str]]:
         """sum coefficient * unknown as (negative, LaTeX) terms, the unknown after its
         coefficient (``l^{2} m \\ddot{\\theta}``), a sum coefficient in parentheses."""

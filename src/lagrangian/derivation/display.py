@@ -38,7 +38,9 @@ class ModelMatrix(sp.ImmutableDenseMatrix):
         return cls._fromrep(sp.ImmutableMatrix(matrix)._rep)
 
     def __hash__(self) -> int:
-        return hash(sp.ImmutableDenseMatrix._fromrep(self._rep))
+        if self._mhash is None:  # Basic's cache of the hash
+            self._mhash = hash(sp.ImmutableDenseMatrix._fromrep(self._rep))
+        return self._mhash
 
     def _latex(self, printer: LatexPrinter) -> str:
         names = {**names_by_suffix(self.free_symbols), **printer._settings["symbol_names"]}

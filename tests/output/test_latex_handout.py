@@ -248,13 +248,15 @@ def test_the_width_estimate_tracks_the_glyphs():
 
 # -- user text never reaches LaTeX unescaped --------------------------------------------------
 
-HOSTILE = r"Evil } \input{/etc/passwd} $x$ 100% #1 a_b ^^5c ~ & \end{document}"
+HOSTILE = (r"Evil } \input{/etc/passwd} $x$ 100% #1 a_b ^^5c ~ & \end{document}"
+           " Pendule à ressort – “q” ☺")
 
 
 def test_escape_text_neutralises_every_special_character():
     escaped = escape_text(HOSTILE + "\nnext \x00 \u263a")
     assert r"\input" not in escaped.replace(r"\textbackslash{}input", "")
     assert "\n" not in escaped and "\x00" not in escaped and "\u263a" not in escaped
+    assert "Pendule à ressort -- ``q'' ?" in escaped
     unescaped = re.sub(r"\\(textbackslash|textasciicircum|textasciitilde|textless|textgreater|"
                        r"textbar)\{\}|\\[{}$&%#_]", "", escaped)
     assert not set(unescaped) & set("\\{}$&%#_^~")

@@ -196,12 +196,14 @@ class _Breaker:
     def __init__(self, printer: ModelLatexPrinter, width: float = LINE_WIDTH_PT):
         self.printer, self.width = printer, width
 
-    def terms(self, expr: sp.Expr, width: float | None = None) -> Terms:
-        """expr as terms; a term wider than ``width`` (pt) is opened at its widest sum."""
+    def terms(self, expr: sp.Expr, width: float | None = None, whole: bool = True) -> Terms:
+        """expr as terms (one, with ``whole``, when it all fits); a term wider than ``width``
+        (pt) is opened at its widest sum."""
         width = self.width if width is None else width
-        whole = self.printer.doprint(expr)
-        if fits(whole, width):
-            return [_signed(whole)]
+        if whole:
+            text = self.printer.doprint(expr)
+            if fits(text, width):
+                return [_signed(text)]
         out: Terms = []
         for term in self._ordered(expr):
             negative, text = _signed(self.printer.doprint(term))
@@ -238,7 +240,7 @@ class _Breaker:
             return [(negative, text)]  # nothing to open: a function's argument, a power
         widest = max(sums, key=lambda f: len(self.printer.doprint(f)))  # the longest
         rest = sp.Mul(*[f for f in sp.Mul.make_args(term) if f is not widest])
-        inner = self.terms(widest, width)
+        inner = self.terms(widest, width, whole=False)  # the sum, to break inside
         big = r"\biggl(" if any(r"\frac" in t for _, t in inner) else r"\Bigl("
         close = r"\biggr)" if big == r"\biggl(" else r"\Bigr)"
         first_negative, first = inner[0]
@@ -315,8 +317,7 @@ class _Handout:
 
     def definitions(self) -> list[str]:
         eom, k, form = self.eom, self.letters, self.display.form
-        q = ", ".join(self.tex(c.symbol) for c in self.model.coordinates)
-        rows = [rf"\mathbf{{q}} &= \left({q}\right)"]
+        rows = self.coordinate_rows()
         rows += self.row(k["T"], form(eom.kinetic_energy))
         rows += self.row(k["V"], form(eom.potential_energy))
         if eom.dissipation != 0:
@@ -325,6 +326,21 @@ class _Handout:
         for c, total in zip(self.model.coordinates, eom.generalized_forces, strict=True):
             rows += self.row(f"{k['Q']}_{{{self.tex(c.symbol)}}}", form(total))
         return _environment("align", rows, notag=True)
+
+    def coordinate_rows(self) -> list[str]:
+        """``q = (q_1, q_2, ...)``, continued on further rows when too long for one."""
+        names = [self.tex(c.symbol) for c in self.model.coordinates]
+        parts, current = [], []
+        for name in names:
+            if current and not fits(", ".join([*current, name]), self.width - 60.0):
+                parts.append(", ".join(current) + ",")
+                current = []
+            current.append(name)
+        parts.append(", ".join(current))
+        if len(parts) == 1:
+            return [rf"\mathbf{{q}} &= \left({parts[0]}\right)"]
+        return [rf"\mathbf{{q}} &= \bigl({parts[0]}", *(rf"&\quad {p}" for p in parts[1:-1]),
+                rf"&\quad {parts[-1]}\bigr)"]
 
     def equation_sides(self, i: int) -> tuple[list[tuple[sp.Expr, sp.Symbol]], sp.Expr]:
         """Row i as (coefficient, unknown) pairs, M_ij q_ddot_j then (Phi_q)_ki lambda_k, and
@@ -336,9 +352,9 @@ class _Handout:
         return pairs, form(eom.forcing[i])
 
     def equations(self) -> list[str]:
-        """One equation per coordinate, tagged with it: on one line where it fits, else a
-        split with the right side's lines under the '=' (or, after a wide left side, the '='
-        starting a line of its own)."""
+        """One equation per coordinate, tagged with it: on one line where it fits, else rows
+        with the right side's lines under the '=' (or, after a wide left side, the '='
+        starting a row of its own)."""
         out = []
         for i, c in enumerate(self.model.coordinates):
             pairs, right = self.equation_sides(i)
@@ -359,9 +375,9 @@ class _Handout:
                 parts = lines(self.breaker.terms(right, room), room, room)
                 rows = [f"&{left_lines[0]}", *(rf"&\quad {p}" for p in left_lines[1:]),
                         f"&= {parts[0]}", *(rf"&\quad {p}" for p in parts[1:])]
-            out += [r"\begin{equation}", r"\begin{split}",
-                    *(row + r" \\" for row in rows[:-1]), rows[-1], r"\end{split}", tag,
-                    r"\end{equation}"]
+            # rows of an align, not a split: \allowdisplaybreaks may break a long one
+            out += [r"\begin{align}", *(row + r" \notag \\" for row in rows[:-1]),
+                    f"{rows[-1]} {tag}", r"\end{align}"]
         return out
 
     def matrix(self, label: str, matrix: sp.MatrixBase, symmetric: bool = False) -> list[str]:

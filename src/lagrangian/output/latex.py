@@ -24,7 +24,7 @@ from .derivation import _Display, _latex_letters
 # standalone page is 453 pt wide (A4, 25 mm margins) and article's default column 345 pt:
 # 320 pt leaves room for a tag and the estimate's error (within 15 % of pdflatex's widths).
 LINE_WIDTH_PT = 320.0
-STANDALONE_WIDTH_PT = 370.0  # the standalone page's own 453 pt, less a tag and the error
+STANDALONE_WIDTH_PT = 395.0  # the standalone page's own 453 pt, less a tag and the error
 
 Terms = list[tuple[bool, str]]  # (negative, LaTeX of the magnitude), joined with + and -
 
@@ -393,7 +393,8 @@ class _Handout:
         for i in range(form.rows):
             for j in range(form.cols):
                 if form[i, j] != 0 and not (symmetric and j < i):
-                    index = f"{i + 1}{j + 1}" if form.cols > 1 else f"{i + 1}"
+                    index = (f"{i + 1}" if form.cols == 1 else f"{i + 1}{j + 1}"
+                             if max(form.shape) < 10 else f"{i + 1},{j + 1}")  # M_{9,21}
                     rows += self.row(f"{label}_{{{index}}}", form[i, j])
         return rows or [rf"{label} &= 0"]
 

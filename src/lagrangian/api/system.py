@@ -468,6 +468,14 @@ class System:
 
         return build_report(self, answer=answer, t_end=t_end, progress=progress)
 
+    def to_latex(self, standalone: bool = False) -> str:
+        """The derivation as LaTeX (amsmath), as ``derive --format latex``: M q_ddot
+        (+ Phi_q^T lambda) = f per coordinate, long rows broken; with ``standalone`` a complete
+        document for pdflatex titled with the model's name."""
+        from ..output.derivation import derivation_latex
+
+        return derivation_latex(self.equations_of_motion(), standalone=standalone)
+
     def __repr__(self) -> str:
         names = ", ".join(c.name for c in self._model.coordinates)
         return f"System({self._model.name!r}, coordinates=[{names}])"

@@ -36,6 +36,7 @@ from functools import singledispatchmethod
 import numpy as np
 import sympy as sp
 
+from ..derivation.display import latex_with_rates
 from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, LagrangianError
 from ..model.expressions import format_expression as fmt
@@ -73,7 +74,7 @@ class Reaction:
     at_initial_state: tuple[float, ...] | None = None
 
     def _repr_latex_(self) -> str:
-        rows = [rf"{label} &= {sp.latex(value)}" for label, value in zip(self.labels,
+        rows = [rf"{label} &= {latex_with_rates(value)}" for label, value in zip(self.labels,
                                                                        self.components,
                                                                        strict=True)]
         return r"$\begin{aligned}" + r"\\ ".join(rows) + r"\end{aligned}$"

@@ -26,6 +26,7 @@ def derive(
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     steps: Annotated[bool, typer.Option("--steps", help="Show the working: dL/dq_dot, its d/dt, dL/dq, Q and each load's virtual work (a 'steps' key in JSON).")] = False,  # noqa: E501
+    standalone: Annotated[bool, typer.Option("--standalone", help="With --format latex: a complete document for pdflatex (title, amsmath), not a fragment.")] = False,  # noqa: E501
 ) -> None:
     """Derive the equations of motion by Lagrange's method."""
     from ..output.derivation import derivation_document, derivation_latex, derivation_text
@@ -34,6 +35,9 @@ def derive(
     warn_if_unphysical(eom)
     if json_ and format is Format.latex:
         raise InputError("--json and --format latex ask for two formats; give one", field="--format")
+    if standalone and (json_ or format is not Format.latex):
+        raise InputError("--standalone writes a LaTeX document; give it with --format latex",
+                         field="--standalone")
     working = eom.steps() if steps else None
     if json_ or format is Format.json:
         document = derivation_document(eom)
@@ -43,11 +47,15 @@ def derive(
             document["steps"] = steps_document(working)
         print_json(document)
     elif format is Format.latex:
-        typer.echo(derivation_latex(eom), nl=False)
+        latex = derivation_latex(eom, standalone=standalone)
         if working is not None:
             from ..output.steps import steps_latex
 
-            typer.echo(steps_latex(working), nl=False)
+            end = "\\end{document}"
+            working_latex = steps_latex(working)
+            latex = (latex.replace(end, working_latex + end) if standalone and end in latex
+                     else latex + working_latex)
+        typer.echo(latex, nl=False)
     else:
         typer.echo(derivation_text(eom), nl=False)
         if working is not None:

@@ -9,7 +9,8 @@ import sympy as sp
 
 from ..kinds import InvariantKind
 from ..model.model import Model
-from ..model.notation import latex_symbol_names
+from ..model.notation import join_terms, model_latex_printer
+from .display import ModelMatrix
 
 
 @dataclass(frozen=True)
@@ -44,6 +45,12 @@ class EquationsOfMotion:
     velocity_bias: sp.ImmutableMatrix
     acceleration_rhs: sp.ImmutableMatrix
     multipliers: sp.ImmutableMatrix
+
+    def __post_init__(self):
+        # Matrices that Jupyter shows with dots over the rates (not \theta_{dot}).
+        for name in ("mass_matrix", "forcing", "generalized_forces", "constraint_jacobian",
+                     "velocity_bias", "acceleration_rhs", "multipliers"):
+            object.__setattr__(self, name, ModelMatrix.of(getattr(self, name)))
 
     @cached_property
     def kinetic_energy(self) -> sp.Expr:
@@ -82,7 +89,8 @@ class EquationsOfMotion:
     def accelerations(self) -> sp.ImmutableMatrix | None:
         """q_ddot solved symbolically (with the multipliers eliminated), or None where the solve
         would exceed its budget (see ``accelerations_note``); computed on first use."""
-        return self._symbolic_accelerations.accelerations
+        accelerations = self._symbolic_accelerations.accelerations
+        return None if accelerations is None else ModelMatrix.of(accelerations)
 
     @property
     def accelerations_note(self) -> str | None:
@@ -211,7 +219,7 @@ class EquationsOfMotion:
             terms += [A[k, i] * multipliers[k] for k in range(A.rows) if A[k, i] != 0]
             terms += [-term for term in sp.Add.make_args(f[i])]
             rows.append(sp.Add(*terms))
-        return sp.ImmutableMatrix(M.rows, 1, rows)
+        return ModelMatrix(M.rows, 1, rows)
 
     def steps(self):
         """The working of Lagrange's method from L = T - V, coordinate by coordinate and load
@@ -221,11 +229,14 @@ class EquationsOfMotion:
         return derivation_steps(self)
 
     def _repr_latex_(self) -> str:
-        names = latex_symbol_names(self.model)
+        """Jupyter: M q_ddot + Phi_q^T lambda = f, one row per coordinate (named at the right),
+        the accelerations on the left in coordinate order."""
+        printer = model_latex_printer(self.model)
+        M, A, f = self.mass_matrix, self.constraint_jacobian, self.forcing
         rows = []
-        for coordinate, equation in zip(self.model.coordinates, self.equations, strict=True):
-            rows.append(
-                rf"{sp.latex(coordinate.symbol)}:\quad & "
-                rf"{sp.latex(equation, symbol_names=names)} = 0"
-            )
-        return r"$\begin{aligned}" + r"\\ ".join(rows) + r"\end{aligned}$"
+        for i, coordinate in enumerate(self.model.coordinates):
+            pairs = [(M[i, j], a) for j, a in enumerate(self.model.q_ddot)]
+            pairs += [(A[k, i], self.multipliers[k]) for k in range(A.rows)]
+            rows.append(rf"{join_terms(printer.product_terms(pairs))} &= {printer.doprint(f[i])}"
+                        rf" &&({printer.doprint(coordinate.symbol)})")
+        return r"$\begin{aligned}" + r" \\ ".join(rows) + r"\end{aligned}$"

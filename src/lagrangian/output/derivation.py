@@ -13,7 +13,6 @@ import sympy as sp
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.readable import readable, readable_matrix
 from ..model.expressions import format_expression
-from ..model.notation import latex_printer
 from ..model.units import generalized_force_unit
 
 CONVENTION = "M q_ddot + Phi_q^T lambda = forcing"
@@ -245,34 +244,9 @@ def derivation_document(eom: EquationsOfMotion) -> dict[str, Any]:
 # -- LaTeX --------------------------------------------------------------------------------------
 
 
-def derivation_latex(eom: EquationsOfMotion) -> str:
-    """A self-contained LaTeX fragment (amsmath) ready to paste into a paper."""
-    model = eom.model
-    printer = latex_printer(model)
-    display = _Display(eom)
+def derivation_latex(eom: EquationsOfMotion, standalone: bool = False) -> str:
+    """LaTeX (amsmath) ready to paste into a paper, or with ``standalone`` a complete document
+    for pdflatex (output/latex.py: M q_ddot = f per coordinate, long rows broken)."""
+    from .latex import handout_latex  # it builds on _Display above
 
-    def tex(expr) -> str:
-        form = display.matrix(expr) if isinstance(expr, sp.MatrixBase) else display.form(expr)
-        return printer(form)
-
-    k = _latex_letters(model)
-    lines = [f"% {model.name}: equations of motion by Lagrange's method",
-             rf"% Convention: {k['M']} \ddot{{q}} + \Phi_q^T \lambda = {k['f']}",
-             r"\begin{align}"]
-    lines.append(rf"{k['T']} &= {tex(eom.kinetic_energy)} \\")
-    lines.append(rf"{k['V']} &= {tex(eom.potential_energy)} \\")
-    if eom.dissipation != 0:
-        lines.append(rf"{k['D']} &= {tex(eom.dissipation)} \\")
-    lines.append(rf"{k['L']} &= {k['T']} - {k['V']} = {printer(display.lagrangian(eom))} \\")
-    for c, total in zip(model.coordinates, eom.generalized_forces, strict=True):
-        lines.append(rf"{k['Q']}_{{{tex(c.symbol)}}} &= {tex(total)} \\")
-    for c, equation in zip(model.coordinates, display.equations(eom), strict=True):
-        lines.append(rf"0 &= {printer(equation)} && \text{{({c.name})}} \\")
-    lines.append(rf"{k['M']} &= {tex(eom.mass_matrix)} \\")
-    lines.append(rf"{k['f']} &= {tex(eom.forcing)}")
-    if model.constraints:
-        lines[-1] += r" \\"
-        lines.append(rf"\Phi_q &= {tex(eom.constraint_jacobian)} \\")
-        lines.append(rf"\gamma &= {tex(eom.acceleration_rhs)}")
-    lines.append(r"\end{align}")
-    return "\n".join(lines) + "\n"
+    return handout_latex(eom, standalone=standalone)

@@ -20,6 +20,7 @@ from ..compile.compiled import BackendUnavailable, CacheRefused, CompilerMissing
 from ..compile.functions import NumericSystem
 from ..derivation.equations import EquationsOfMotion, LoadContribution
 from ..derivation.steps import DerivationSteps
+from ..dynamics.frames import TreeKinematics
 from ..dynamics.joint_space import Dynamics
 from ..dynamics.standalone import StandaloneSource
 from ..errors import DerivationError, InputError, LagrangianError, ModelError
@@ -41,6 +42,7 @@ SimulationResult = Simulation
 __all__ = [
     # entry points
     "System",
+    "TreeKinematics",
     "SystemBuilder",
     "course_lessons",
     "examples",

@@ -45,6 +45,8 @@ FLAG_OF_FIELD = {
     "speed": "--speed",
     "out": "--out",
     "csv": "--csv",
+    "frame": "--frame",
+    "reference": "--reference",
 }
 
 SET_HELP = "Override a parameter: NAME=VALUE; repeat, or join with commas (m=2,L=0.5)."

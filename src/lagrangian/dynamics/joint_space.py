@@ -25,6 +25,7 @@ import numpy as np
 from ..compile.functions import NumericSystem
 from ..errors import InputError, ModelError
 from ..model.model import Model
+from .frames import TreeKinematics, tree_kinematics
 
 
 class Dynamics:
@@ -58,6 +59,39 @@ class Dynamics:
         v = np.zeros_like(q) if v is None else self._vector(v, "v")
         batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
         return np.broadcast_to(q, batch + (self.n,)), np.broadcast_to(v, batch + (self.n,))
+
+    # -- frames, Jacobians and the centre of mass (a URDF robot's tree: frames.py) --------------
+
+    @property
+    def kinematics(self) -> TreeKinematics:
+        """Placements, frame Jacobians and the centre of mass of the robot's kinematic tree
+        (refused in one line for a model without one)."""
+        found = self.__dict__.get("_tree_kinematics")
+        if found is None:
+            found = self.__dict__["_tree_kinematics"] = tree_kinematics(getattr(self, "tree", None))
+        return found
+
+    @property
+    def frames(self) -> tuple[str, ...]:
+        """The names of the robot's link and joint frames."""
+        return self.kinematics.frames
+
+    def placement(self, q, frame: str) -> np.ndarray:
+        """The frame's 4 x 4 placement in the world (rotation and origin in m), (..., 4, 4)."""
+        return self.kinematics.placement(q, frame)
+
+    def jacobian(self, q, frame: str, reference: str = "local_world_aligned") -> np.ndarray:
+        """The frame's 6 x n Jacobian, linear rows first, (..., 6, n); ``reference`` "world",
+        "local" or "local_world_aligned" as Pinocchio's ReferenceFrame."""
+        return self.kinematics.jacobian(q, frame, reference)
+
+    def center_of_mass(self, q) -> np.ndarray:
+        """The moving bodies' centre of mass in the world (m), (..., 3)."""
+        return self.kinematics.center_of_mass(q)
+
+    def center_of_mass_jacobian(self, q) -> np.ndarray:
+        """J_c with c_dot = J_c q_dot, (..., 3, n)."""
+        return self.kinematics.center_of_mass_jacobian(q)
 
     def mass_matrix(self, q) -> np.ndarray:
         """M(q), shape (..., n, n) (kg, kg m or kg m^2 per entry)."""

@@ -45,6 +45,18 @@ class TreeJoint:
 
 
 @dataclass(frozen=True)
+class TreeFrame:
+    """A named frame (a URDF link, or the joint whose child it is) fixed to a body of the tree:
+    its axes are ``rotation`` (frame -> body axes) and its origin ``translation`` (m, in the
+    body's axes) relative to the body's own frame; ``body`` -1 is the ground."""
+
+    name: str
+    body: int
+    rotation: Matrix3x3
+    translation: Vector3
+
+
+@dataclass(frozen=True)
 class KinematicTree:
     """The moving bodies of a robot, gravity g along ``gravity_direction`` (world axes, unit),
     and for each coordinate the parameter whose value is its actuator force (tau_<joint>)."""
@@ -57,6 +69,9 @@ class KinematicTree:
     # The model's rigid bodies built from the same joints: a model whose bodies are not these
     # (edited after reading) is not described by this tree.
     rigid_bodies: tuple = field(default=(), compare=False, repr=False)
+    # Every link and joint frame, for placements and Jacobians (dynamics/frames.py); not part of
+    # the tree's identity (the dynamics, and the compiled module's key, do not depend on them).
+    frames: tuple[TreeFrame, ...] = field(default=(), compare=False, repr=False)
 
 
-__all__ = ["KinematicTree", "TreeJoint"]
+__all__ = ["KinematicTree", "TreeFrame", "TreeJoint"]

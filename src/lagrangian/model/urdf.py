@@ -15,6 +15,7 @@ the rigid-body terms a controller needs.
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import keyword
 import math
@@ -33,7 +34,7 @@ from .expressions import RESERVED
 from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
-from .tree import KinematicTree, TreeJoint
+from .tree import KinematicTree, TreeFrame, TreeJoint
 
 MOVABLE = ("revolute", "continuous", "prismatic")
 SUPPORTED = (*MOVABLE, "fixed")
@@ -457,7 +458,14 @@ class _Tree:
         def matrix(a):
             return tuple(vector(row) for row in a)
 
+        # every link's frame on its moving body, and each joint's frame (its child link's)
+        frames = [TreeFrame(name, body, matrix(turn), vector(shift))
+                  for name, (body, turn, shift) in anchor.items()]
+        by_link = {f.name: f for f in frames}
+        frames += [dataclasses.replace(by_link[joint.child], name=joint.name)
+                   for joint in order if joint.name not in by_link and joint.child in by_link]
         return KinematicTree(
+            frames=tuple(frames),
             joints=tuple(TreeJoint(
                 name=j["name"], parent=j["parent"], kind=j["kind"], rotation=matrix(j["rotation"]),
                 translation=vector(j["translation"]), axis=vector(j["axis"]),

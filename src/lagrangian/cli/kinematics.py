@@ -1,0 +1,41 @@
+"""`lagrangian kinematics ROBOT.urdf --q ... --frame NAME [--reference ...] [--json]`: a frame's
+placement and Jacobian and the centre of mass of a URDF robot at one configuration."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from . import app
+from .common import load_system, print_json
+from .dynamics import LOCK_HELP, _vector
+
+
+@app.command()
+def kinematics(
+    model: Annotated[str, typer.Argument(help="URDF robot (file or built-in example name).")],
+    frame: Annotated[str | None, typer.Option("--frame", help="A link or joint frame (default: the last link).")] = None,  # noqa: E501
+    q: Annotated[str | None, typer.Option("--q", help="Coordinates, comma-separated in the model's order (default: the initial values).")] = None,  # noqa: E501
+    reference: Annotated[str, typer.Option("--reference", help="The Jacobian's frame: local_world_aligned (the origin's velocity in world axes), local or world, as Pinocchio's.")] = "local_world_aligned",  # noqa: E501
+    lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
+    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+) -> None:
+    """A frame's placement (4 x 4) and Jacobian (6 x n), the centre of mass and its Jacobian."""
+    from ..output.kinematics import kinematics_document, kinematics_text
+
+    system = load_system(model, set_, lock)
+    coordinates = system.model.coordinates
+    qs = _vector(q, len(coordinates), "--q", [c.initial or 0.0 for c in coordinates])
+    robot = system.dynamics().kinematics
+    name = frame if frame is not None else robot.frames[-1]
+    values = {"q": qs, "placement": robot.placement(qs, name),
+              "jacobian": robot.jacobian(qs, name, reference),
+              "center_of_mass": robot.center_of_mass(qs),
+              "center_of_mass_jacobian": robot.center_of_mass_jacobian(qs)}
+    names = [c.name for c in coordinates]
+    if json_:
+        print_json(kinematics_document(names, name, reference, values))
+    else:
+        typer.echo(kinematics_text(names, name, reference, values), nl=False)

@@ -1,0 +1,188 @@
+"""Frames, Jacobians and the centre of mass of a robot's kinematic tree, batched over states
+(Pinocchio's conventions: 4 x 4 placements in the world, 6 x n Jacobians with the linear rows
+first, and the three reference frames WORLD, LOCAL and LOCAL_WORLD_ALIGNED).
+
+Built on the joint models (joint_models.py): a joint moves its body by the motion subspace
+S = (s_w, s_v) per unit of joint variable, so the Jacobian's column of a coordinate is, summed
+over the joints it drives (theta = k q + offset), k times S carried to the frame:
+angular s_w and linear s_v + s_w x (p - o), in world axes (p the frame's origin, o the joint's).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError, did_you_mean_or_list
+from ..model.tree import KinematicTree
+from .joint_models import joint_model
+
+REFERENCES = ("world", "local", "local_world_aligned")
+
+
+class TreeKinematics:
+    """Placements, frame Jacobians and the centre of mass of a kinematic tree (SI units).
+
+    Every function takes q of shape (n,) or (..., n) and keeps the batch shape in front."""
+
+    def __init__(self, tree: KinematicTree):
+        self.tree = tree
+        self.n = len(tree.coordinates)
+        self.coordinates = tree.coordinates
+        self._frames = {f.name: f for f in tree.frames}
+        self._models = [joint_model(j.kind) for j in tree.joints]
+
+    @property
+    def frames(self) -> tuple[str, ...]:
+        """The names of every link and joint frame, in the URDF's order."""
+        return tuple(self._frames)
+
+    # -- placements -----------------------------------------------------------------------------
+
+    def _q(self, q) -> tuple[np.ndarray, tuple[int, ...]]:
+        q = np.asarray(q, dtype=float)
+        if q.ndim == 0 or q.shape[-1] != self.n:
+            shape = "()" if q.ndim == 0 else str(q.shape)
+            raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) along the "
+                             f"last axis, got shape {shape}", field="q")
+        batch = q.shape[:-1]
+        return q.reshape(-1, self.n), batch
+
+    def _bodies(self, Q: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Each body's rotation (N, 3, 3: body -> world) and origin (N, 3: m, world)."""
+        count = len(Q)
+        world = []
+        for joint, model in zip(self.tree.joints, self._models, strict=True):
+            theta = joint.multiplier * Q[:, joint.coordinate] + joint.offset
+            R, p = model.placement_arrays(np.array(joint.rotation), np.array(joint.translation),
+                                          np.array(joint.axis), theta)
+            R = np.broadcast_to(R, (count, 3, 3))
+            p = np.broadcast_to(p, (count, 3))
+            if joint.parent < 0:
+                world.append((R, p))
+            else:
+                R_parent, p_parent = world[joint.parent]
+                world.append((R_parent @ R, p_parent + np.einsum("nij,nj->ni", R_parent, p)))
+        return world
+
+    def _frame(self, name: str):
+        if name not in self._frames:
+            raise InputError(f"no frame named '{name}'{did_you_mean_or_list(name, self._frames)}",
+                             field="frame")
+        return self._frames[name]
+
+    def _frame_pose(self, Q, bodies, name: str) -> tuple[np.ndarray, np.ndarray]:
+        frame = self._frame(name)
+        rotation = np.array(frame.rotation)
+        translation = np.array(frame.translation)
+        if frame.body < 0:
+            count = len(Q)
+            return (np.broadcast_to(rotation, (count, 3, 3)),
+                    np.broadcast_to(translation, (count, 3)))
+        R, p = bodies[frame.body]
+        return R @ rotation, p + R @ translation
+
+    def placement(self, q, frame: str) -> np.ndarray:
+        """The frame's placement in the world: [[R, p], [0, 1]] (R frame -> world axes, p its
+        origin in m), shape (..., 4, 4)."""
+        Q, batch = self._q(q)
+        R, p = self._frame_pose(Q, self._bodies(Q), frame)
+        out = np.zeros((len(Q), 4, 4))
+        out[:, :3, :3], out[:, :3, 3], out[:, 3, 3] = R, p, 1.0
+        return out.reshape(batch + (4, 4))
+
+    # -- Jacobians ------------------------------------------------------------------------------
+
+    def _ancestors(self, body: int) -> list[int]:
+        chain = []
+        while body >= 0:
+            chain.append(body)
+            body = self.tree.joints[body].parent
+        return chain
+
+    def _point_jacobian(self, Q, bodies, body: int, point: np.ndarray) -> np.ndarray:
+        """(N, 6, n): the linear velocity of the world point ``point`` (N, 3) fixed to ``body``
+        and the body's angular velocity, both in world axes, per unit rate of each coordinate."""
+        J = np.zeros((len(Q), 6, self.n))
+        for k in self._ancestors(body):
+            joint = self.tree.joints[k]
+            R, o = bodies[k]
+            s_w, s_v = self._models[k].subspace(joint.axis)
+            column = np.zeros((len(Q), 6))
+            if s_w is not None:
+                w = R @ np.array(s_w)
+                column[:, 3:] += w
+                column[:, :3] += np.cross(w, point - o)
+            if s_v is not None:
+                column[:, :3] += R @ np.array(s_v)
+            J[:, :, joint.coordinate] += joint.multiplier * column
+        return J
+
+    def jacobian(self, q, frame: str, reference: str = "local_world_aligned") -> np.ndarray:
+        """J with [v; w] = J q_dot for the frame, shape (..., 6, n): linear rows first (m/s per
+        unit rate), then angular (rad/s). ``reference``: "local_world_aligned" (the frame
+        origin's velocity and w, in world axes), "local" (the same in the frame's axes) or
+        "world" (the velocity of the point at the world's origin moving with the frame)."""
+        if reference not in REFERENCES:
+            raise InputError(f"unknown reference '{reference}'; use one of "
+                             f"{', '.join(REFERENCES)}", field="reference")
+        Q, batch = self._q(q)
+        bodies = self._bodies(Q)
+        R, p = self._frame_pose(Q, bodies, frame)
+        body = self._frame(frame).body
+        if body < 0:
+            return np.zeros(batch + (6, self.n))
+        J = self._point_jacobian(Q, bodies, body, p)
+        if reference == "local":
+            Rt = np.swapaxes(R, -1, -2)
+            J = np.concatenate([Rt @ J[:, :3], Rt @ J[:, 3:]], axis=1)
+        elif reference == "world":  # v(0) = v(p) + w x (0 - p)
+            J = J.copy()
+            J[:, :3] += np.cross(J[:, 3:], -p[:, :, None], axisa=1, axisb=1, axisc=1)
+        return J.reshape(batch + (6, self.n))
+
+    # -- centre of mass -------------------------------------------------------------------------
+
+    def mass(self) -> float:
+        """The moving bodies' total mass (kg); links welded to the ground are not counted."""
+        return float(sum(j.mass for j in self.tree.joints))
+
+    def center_of_mass(self, q) -> np.ndarray:
+        """The centre of mass of the moving bodies in the world (m), shape (..., 3)."""
+        Q, batch = self._q(q)
+        bodies = self._bodies(Q)
+        total = self.mass()
+        if total <= 0:
+            raise InputError("the robot's moving bodies have no mass: no centre of mass",
+                             field="q")
+        moment = np.zeros((len(Q), 3))
+        for joint, (R, p) in zip(self.tree.joints, bodies, strict=True):
+            moment += joint.mass * p + R @ np.array(joint.first_moment)
+        return (moment / total).reshape(batch + (3,))
+
+    def center_of_mass_jacobian(self, q) -> np.ndarray:
+        """J_c with c_dot = J_c q_dot (m per unit rate), shape (..., 3, n)."""
+        Q, batch = self._q(q)
+        bodies = self._bodies(Q)
+        total = self.mass()
+        if total <= 0:
+            raise InputError("the robot's moving bodies have no mass: no centre of mass",
+                             field="q")
+        J = np.zeros((len(Q), 3, self.n))
+        for k, (joint, (R, p)) in enumerate(zip(self.tree.joints, bodies, strict=True)):
+            if joint.mass <= 0:
+                continue
+            centre = p + R @ (np.array(joint.first_moment) / joint.mass)
+            J += joint.mass * self._point_jacobian(Q, bodies, k, centre)[:, :3]
+        return (J / total).reshape(batch + (3, self.n))
+
+
+def tree_kinematics(tree: KinematicTree | None) -> TreeKinematics:
+    """The kinematics of a URDF robot's tree; refused in one line for a model without one."""
+    if tree is None or not tree.frames:
+        raise InputError("frames, Jacobians and the centre of mass are computed for a URDF "
+                         "robot's kinematic tree; this model has none (a model file's bodies: "
+                         "not yet)", field="frame")
+    return TreeKinematics(tree)
+
+
+__all__ = ["REFERENCES", "TreeKinematics", "tree_kinematics"]

@@ -1,0 +1,44 @@
+"""A robot frame's kinematics at one state (`kinematics`): text for a terminal, the JSON document."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+
+def kinematics_document(coordinates, frame: str, reference: str,
+                        values: Mapping[str, Any]) -> dict[str, Any]:
+    """The `kinematics --json` document: the frame, the reference of its Jacobian and every array
+    as nested lists (SI: m, rad)."""
+    document: dict[str, Any] = {"coordinates": list(coordinates), "frame": frame,
+                                "reference": reference}
+    for key, value in values.items():
+        document[key] = np.asarray(value, dtype=float).tolist()
+    return document
+
+
+_TITLES = {
+    "q": "q", "placement": "placement (rotation | origin in m) in the world",
+    "jacobian": "Jacobian [v; w] = J q_dot (linear rows first)",
+    "center_of_mass": "centre of mass (m, world)",
+    "center_of_mass_jacobian": "centre-of-mass Jacobian",
+}
+
+
+def kinematics_text(coordinates, frame: str, reference: str, values: Mapping[str, Any]) -> str:
+    names = list(coordinates)
+    lines = [f"Frame {frame}; coordinates {', '.join(names)} (SI: rad or m)"]
+    for key, value in values.items():
+        array = np.asarray(value, dtype=float)
+        title = _TITLES.get(key, key)
+        if key == "jacobian":
+            title += f", reference {reference}"
+        lines.append(f"{title}:")
+        rows = array[None] if array.ndim == 1 else array
+        lines += ["  " + "  ".join(f"{x: .9g}" for x in row) for row in rows]
+    return "\n".join(lines) + "\n"
+
+
+__all__ = ["kinematics_document", "kinematics_text"]

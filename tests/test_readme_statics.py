@@ -1,23 +1,20 @@
-"""The README's statics section: its Python example runs and gives the closed form, and its
-console lines are real output."""
+"""The statics section (docs/getting-started/engineers.md): its Python example runs and gives the
+closed form, and its console lines are real output."""
 
 import math
 import re
-from pathlib import Path
 
+import docs_blocks
 from statics_models import SLIDER_CRANK as CRANK
-
-README = Path(__file__).resolve().parents[1] / "README.md"
 
 
 def section() -> str:
-    text = README.read_text(encoding="utf-8")
-    return text[text.index("<!-- BEGIN statics -->"):text.index("<!-- END statics -->")]
+    return docs_blocks.block("statics")
 
 
 def test_python_example_runs_and_gives_the_closed_form(capsys):
     code = re.findall(r"```python\n(.*?)```", section(), re.S)[0]
-    exec(compile(code, "README.md", "exec"), {})
+    exec(compile(code, "statics", "exec"), {})
     out = capsys.readouterr().out
     theta = math.radians(40)
     closed = 12.0 / (0.1 * math.sin(theta) * (1 + 0.1 * math.cos(theta)

@@ -1,0 +1,31 @@
+"""Find a documented example wherever it lives: the README and the pages under docs/ mark each
+runnable section with <!-- BEGIN name --> ... <!-- END name -->, and the tests that run those
+sections read them through here, so a section can move between pages without its test losing it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+README = ROOT / "README.md"
+DOCS = ROOT / "docs"
+
+
+def pages() -> list[Path]:
+    """The README and every Markdown page of the docs, in a fixed order."""
+    return [README, *sorted(DOCS.rglob("*.md"))]
+
+
+def block_file(name: str) -> Path:
+    """The one page holding the block ``name`` (a block name is unique across the docs)."""
+    begin = f"<!-- BEGIN {name} "
+    found = [page for page in pages() if begin in page.read_text(encoding="utf-8")]
+    assert len(found) == 1, f"block {name!r} is in {len(found)} pages, not one: {found}"
+    return found[0]
+
+
+def block(name: str) -> str:
+    """The text of block ``name``, from its BEGIN marker to just before its END marker."""
+    text = block_file(name).read_text(encoding="utf-8")
+    start = text.index(f"<!-- BEGIN {name}")
+    return text[start:text.index(f"<!-- END {name} -->", start)]

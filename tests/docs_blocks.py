@@ -16,16 +16,18 @@ def pages() -> list[Path]:
     return [README, *sorted(DOCS.rglob("*.md"))]
 
 
-def block_file(name: str) -> Path:
-    """The one page holding the block ``name`` (a block name is unique across the docs)."""
+def block_file(name: str, page: str | None = None) -> Path:
+    """The one page holding the block ``name``; ``page`` (relative to docs/) picks one where two
+    pages use the same name."""
     begin = f"<!-- BEGIN {name} "
-    found = [page for page in pages() if begin in page.read_text(encoding="utf-8")]
+    found = [path for path in ([DOCS / page] if page else pages())
+             if begin in path.read_text(encoding="utf-8")]
     assert len(found) == 1, f"block {name!r} is in {len(found)} pages, not one: {found}"
     return found[0]
 
 
-def block(name: str) -> str:
+def block(name: str, page: str | None = None) -> str:
     """The text of block ``name``, from its BEGIN marker to just before its END marker."""
-    text = block_file(name).read_text(encoding="utf-8")
+    text = block_file(name, page).read_text(encoding="utf-8")
     start = text.index(f"<!-- BEGIN {name}")
     return text[start:text.index(f"<!-- END {name} -->", start)]

@@ -20,7 +20,7 @@ WALL = re.compile(r"wall time [0-9.e+-]+ s")
 def _commands() -> list[tuple[list[str], str]]:
     """(arguments, the lines shown after the command) for each command of the section's first
     console block, continuation lines joined."""
-    section = docs_blocks.block("simulate")
+    section = docs_blocks.block("simulate", "getting-started/engineers.md")
     block = re.findall(r"```console\n(.*?)```", section, re.S)[0].replace("\\\n", "")
     runs = []
     for run in re.split(r"^\$ ", block, flags=re.M)[1:]:

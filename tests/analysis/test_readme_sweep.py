@@ -14,7 +14,7 @@ distributed = pytest.importorskip("dask.distributed")
 
 
 def section() -> str:
-    return docs_blocks.block("sweep")
+    return docs_blocks.block("sweep", "getting-started/studies.md")
 
 
 def commands() -> list[tuple[list[str], str]]:

@@ -153,6 +153,19 @@ def test_the_example_error_is_what_the_cli_prints(cli, tmp_path, monkeypatch):
     assert (code, err) == (2, shown)
 
 
+def test_a_planar_body_point_is_offset_in_the_body_axes_as_the_page_says(tmp_path):
+    assert "turned counterclockwise\nby `angle`" in PAGE.read_text(encoding="utf-8")
+    # A link turned by theta, a vertical force F at offset [l, 0]: the point is at
+    # (l cos(theta), l sin(theta)), so delta W = F l cos(theta) delta theta.
+    (tmp_path / "link.toml").write_text(
+        '[coordinates]\ntheta = "rad"\n[parameters]\nm = 1.0\nI = 0.1\nl = 0.5\nF = 2.0\n'
+        '[[bodies]]\nname = "link"\nmass = "m"\ninertia = "I"\nposition = [0, 0]\n'
+        'angle = "theta"\n[[loads]]\nname = "lift"\npoint = { body = "link", offset = ["l", 0] }\n'
+        'force = [0, "F"]\n', encoding="utf-8")
+    (q,) = lagrangian.load(tmp_path / "link.toml").equations_of_motion().generalized_forces
+    assert str(q) == "F*l*cos(theta)"
+
+
 def _rewritten(text: str) -> str:
     for begin, end, rows in ((BEGIN, END, table()), (ANSWER_BEGIN, ANSWER_END, answer_table())):
         head, rest = text.split(begin, 1)

@@ -3,6 +3,7 @@ closed form, and its console lines are real output."""
 
 import math
 import re
+import tomllib
 
 import docs_blocks
 from statics_models import SLIDER_CRANK as CRANK
@@ -23,9 +24,14 @@ def test_python_example_runs_and_gives_the_closed_form(capsys):
     assert abs(value - closed) < 1e-9 * closed
 
 
+def test_the_model_file_shown_is_the_tested_slider_crank():
+    (model,) = re.findall(r"```toml\n# crank.toml\n(.*?)```", section(), re.S)
+    assert tomllib.loads(model) == tomllib.loads(CRANK)
+
+
 def test_console_lines_are_real_output(cli, tmp_path):
     path = tmp_path / "crank.toml"
-    path.write_text(CRANK)
+    path.write_text(re.findall(r"```toml\n(# crank.toml\n.*?)```", section(), re.S)[0])
     out = cli("statics", str(path), "--at", "theta=40deg", "--solve-for", "P").out
     shown = re.findall(r"```console\n(.*?)```", section(), re.S)[0]
     lines = [line for line in shown.splitlines()[1:] if line and not line.startswith(("$", "..."))]

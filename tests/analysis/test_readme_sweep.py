@@ -61,6 +61,6 @@ def test_python_example_runs(client, capsys, tmp_path, monkeypatch):
     code = re.findall(r"```python\n(.*?)```", section(), re.S)[0]
     # The docs' script starts a local cluster; here it runs on the test's in-process one.
     code = code.replace('compute="modes")', 'compute="modes", client=client)')
-    exec(compile(code, "sweep", "exec"), {"client": client})  # noqa: S102 (our own docs)
+    exec(compile(code, "sweep", "exec"), {"client": client, "__name__": "__main__"})  # noqa: S102
     assert "[2.23606798 2.44948974 2.64575131]" in capsys.readouterr().out
     assert (tmp_path / "study.nc").exists()

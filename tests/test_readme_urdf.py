@@ -11,7 +11,6 @@ import docs_blocks
 pytest.importorskip("yourdfpy")
 
 
-
 def section() -> str:
     return docs_blocks.block("urdf")
 

@@ -1,4 +1,4 @@
-"""Model files shared by the statics tests (analysis, CLI, check, README)."""
+"""Model files shared by the statics tests (analysis, CLI, check, docs)."""
 
 # A massless slider-crank: crank r, rod l, a crank torque tau and a piston force P (the unknown),
 # closed by two loop constraints. Closed form: P = tau / (r sin(theta) (1 + r cos(theta) /

@@ -1,21 +1,20 @@
-"""The README's core section: its Python example runs and its console lines are real output."""
+"""The core section (docs/getting-started/engineers.md): its Python example runs and its console
+lines are real output."""
 
 import re
-from pathlib import Path
 
 import pytest
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+import docs_blocks
 
 
 def core_section() -> str:
-    text = README.read_text(encoding="utf-8")
-    return text[text.index("<!-- BEGIN core -->"):text.index("<!-- END core -->")]
+    return docs_blocks.block("core")
 
 
 def test_python_example_runs(capsys):
     code = re.findall(r"```python\n(.*?)```", core_section(), re.S)[0]
-    exec(compile(code, "README.md", "exec"), {})
+    exec(compile(code, "core", "exec"), {})
     out = capsys.readouterr().out
     assert "Matrix([[F*L*cos(theta)]])" in out
     assert "{'theta': 0.877" in out

@@ -1,20 +1,25 @@
-"""The README's table of model-file keys is generated from the reader's own schema
-(model/reader.py, ``model_file_schema``): a key the reader accepts and the README does not list,
-or one the README lists and the reader refuses, fails here. The table of answer-file keys below it
-(``lagrangian check``) comes from model/answer.py's ``answer_file_schema`` the same way.
+"""The model-file reference (docs/model-file.md) is generated from the reader's own schema
+(model/reader.py, ``model_file_schema``): a key the reader accepts and the page does not list,
+or one the page lists and the reader refuses, fails here. The table of answer-file keys below it
+(``lagrangian check``) comes from model/answer.py's ``answer_file_schema`` the same way. The
+page's example model reads and its example error is what the CLI prints.
 
-Regenerate the table after changing the reader:  python tests/test_readme_model_keys.py
-(prints the table to paste between the README's model-keys markers; the meanings are below).
+Regenerate the tables after changing a reader:  python tests/test_readme_model_keys.py --write
+(rewrites the tables between the page's markers; without --write it prints them; the meanings
+are below).
 """
 
 from __future__ import annotations
 
+import re
+import sys
 from pathlib import Path
 
+import lagrangian
 from lagrangian.model.answer import answer_file_schema
 from lagrangian.model.reader import model_file_schema
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+PAGE = Path(__file__).resolve().parents[1] / "docs" / "model-file.md"
 BEGIN, END = "<!-- BEGIN model-keys (generated: python tests/test_readme_model_keys.py) -->", \
     "<!-- END model-keys -->"
 ANSWER_BEGIN, ANSWER_END = ("<!-- BEGIN answer-keys (generated: python "
@@ -101,8 +106,8 @@ def answer_table() -> str:
 
 
 def _readme_table(begin: str = BEGIN, end: str = END) -> str:
-    text = README.read_text(encoding="utf-8")
-    assert begin in text and end in text, f"README lost its markers {begin}"
+    text = PAGE.read_text(encoding="utf-8")
+    assert begin in text and end in text, f"docs/model-file.md lost its markers {begin}"
     return text.split(begin, 1)[1].split(end, 1)[0].strip("\n") + "\n"
 
 
@@ -112,8 +117,8 @@ def test_every_table_of_the_reader_has_a_meaning():
 
 def test_readme_lists_exactly_the_keys_the_reader_accepts():
     assert _readme_table() == table(), (
-        "README's model-file keys differ from model/reader.py: run "
-        "python tests/test_readme_model_keys.py and paste the table between the markers")
+        "docs/model-file.md's model-file keys differ from model/reader.py: run "
+        "python tests/test_readme_model_keys.py --write")
 
 
 def test_every_table_of_the_answer_reader_has_a_meaning():
@@ -122,11 +127,56 @@ def test_every_table_of_the_answer_reader_has_a_meaning():
 
 def test_readme_lists_exactly_the_answer_keys_the_reader_accepts():
     assert _readme_table(ANSWER_BEGIN, ANSWER_END) == answer_table(), (
-        "README's answer-file keys differ from model/answer.py: run "
-        "python tests/test_readme_model_keys.py and paste the table between the markers")
+        "docs/model-file.md's answer-file keys differ from model/answer.py: run "
+        "python tests/test_readme_model_keys.py --write")
+
+
+def test_the_example_model_reads_and_derives(tmp_path):
+    text = PAGE.read_text(encoding="utf-8")
+    example = re.findall(r"```toml\n(.*?)```", text, re.S)[0]
+    (tmp_path / "cart.toml").write_text(example, encoding="utf-8")
+    system = lagrangian.load(tmp_path / "cart.toml")
+    assert system.model.name == "Cart with a pendulum"
+    assert [q.name for q in system.model.coordinates] == ["x", "theta"]
+    # The push acts on the cart's coordinate only: Q = (F, 0).
+    assert [str(q) for q in system.equations_of_motion().generalized_forces] == ["F", "0"]
+
+
+def test_the_example_error_is_what_the_cli_prints(cli, tmp_path, monkeypatch):
+    text = PAGE.read_text(encoding="utf-8")
+    command, shown = re.search(r"```console\n\$ lagrangian (derive bad.toml)\n(.*?)```", text, re.S).groups()
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "bad.toml").write_text(
+        '[coordinates]\ntheta = "rad"\n[parameters]\nL = 1.0\n[energy]\nT = "theta_dot^2"\n'
+        'V = "Ln*cos(theta)"\n', encoding="utf-8")
+    code, _, err = cli(*command.split())
+    assert (code, err) == (2, shown)
+
+
+def test_a_planar_body_point_is_offset_in_the_body_axes_as_the_page_says(tmp_path):
+    assert "turned counterclockwise\nby `angle`" in PAGE.read_text(encoding="utf-8")
+    # A link turned by theta, a vertical force F at offset [l, 0]: the point is at
+    # (l cos(theta), l sin(theta)), so delta W = F l cos(theta) delta theta.
+    (tmp_path / "link.toml").write_text(
+        '[coordinates]\ntheta = "rad"\n[parameters]\nm = 1.0\nI = 0.1\nl = 0.5\nF = 2.0\n'
+        '[[bodies]]\nname = "link"\nmass = "m"\ninertia = "I"\nposition = [0, 0]\n'
+        'angle = "theta"\n[[loads]]\nname = "lift"\npoint = { body = "link", offset = ["l", 0] }\n'
+        'force = [0, "F"]\n', encoding="utf-8")
+    (q,) = lagrangian.load(tmp_path / "link.toml").equations_of_motion().generalized_forces
+    assert str(q) == "F*l*cos(theta)"
+
+
+def _rewritten(text: str) -> str:
+    for begin, end, rows in ((BEGIN, END, table()), (ANSWER_BEGIN, ANSWER_END, answer_table())):
+        head, rest = text.split(begin, 1)
+        text = head + begin + "\n" + rows + end + rest.split(end, 1)[1]
+    return text
 
 
 if __name__ == "__main__":
+    if sys.argv[1:] == ["--write"]:
+        PAGE.write_text(_rewritten(PAGE.read_text(encoding="utf-8")), encoding="utf-8")
+        sys.exit(0)
     print(BEGIN)
     print(table(), end="")
     print(END)

@@ -1,16 +1,14 @@
-"""The README's report section: its console lines are real output, its Python example runs and
-writes the page, and its picture is there."""
+"""The report section (docs/getting-started/students-and-teachers.md): its console lines are real
+output, its Python example runs and writes the page, and its picture is there."""
 
 import os
 import re
-from pathlib import Path
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+import docs_blocks
 
 
 def section() -> str:
-    text = README.read_text(encoding="utf-8")
-    return text[text.index("<!-- BEGIN report -->"):text.index("<!-- END report -->")]
+    return docs_blocks.block("report")
 
 
 def test_console_lines_are_real_output(cli, tmp_path, monkeypatch):
@@ -27,7 +25,7 @@ def test_console_lines_are_real_output(cli, tmp_path, monkeypatch):
 def test_python_example_runs(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     code = re.findall(r"```python\n(.*?)```", section(), re.S)[0]
-    exec(compile(code.replace("t_end=5", "t_end=1"), "README.md", "exec"), {})
+    exec(compile(code.replace("t_end=5", "t_end=1"), "report", "exec"), {})
     assert capsys.readouterr().out.strip() == \
         "Report('Two masses on three springs', 7 of 9 sections shown)"
     assert os.path.getsize(tmp_path / "two_mass.html") > 10_000
@@ -35,4 +33,4 @@ def test_python_example_runs(tmp_path, monkeypatch, capsys):
 
 def test_the_picture_is_there():
     picture = re.search(r"!\[[^\]]+\]\(([^)]+)\)", section()).group(1)
-    assert (README.parent / picture).stat().st_size > 10_000
+    assert (docs_blocks.block_file("report").parent / picture).stat().st_size > 10_000

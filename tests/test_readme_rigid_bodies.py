@@ -1,17 +1,14 @@
-"""The README's section on bodies in space: its model file reads, its Python runs, and its
-console line is real output."""
+"""The section on bodies in space (docs/getting-started/engineers.md): its model file reads, its
+Python runs, and its console line is real output."""
 
 import re
-from pathlib import Path
 
+import docs_blocks
 import lagrangian
-
-README = Path(__file__).resolve().parents[1] / "README.md"
 
 
 def section() -> str:
-    text = README.read_text(encoding="utf-8")
-    return text[text.index("<!-- BEGIN bodies3d -->"):text.index("<!-- END bodies3d -->")]
+    return docs_blocks.block("bodies3d")
 
 
 def test_model_file_is_the_heavy_top_example():
@@ -30,5 +27,5 @@ def test_console_line_is_real_output(cli):
 
 def test_python_example_runs(capsys):
     code = re.findall(r"```python\n(.*?)```", section(), re.S)[0]
-    exec(compile(code, "README.md", "exec"), {})
+    exec(compile(code, "bodies3d", "exec"), {})
     assert "{'q1': 0.0, 'q2': 0.3}" in capsys.readouterr().out

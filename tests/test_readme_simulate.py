@@ -1,5 +1,6 @@
-"""The README's simulate section shows what the program prints: its commands are re-run here
-(only the wall time may differ), so the README cannot drift from the program again (issue 12)."""
+"""The simulate section (docs/getting-started/engineers.md) shows what the program prints: its
+commands are re-run here (only the wall time may differ), so the docs cannot drift from the
+program again (issue 12)."""
 
 from __future__ import annotations
 
@@ -9,18 +10,17 @@ from pathlib import Path
 
 import pytest
 
+import docs_blocks
 from lagrangian.api.simulation import Simulation
 from lagrangian.cli import main
 
-README = Path(__file__).resolve().parents[1] / "README.md"
 WALL = re.compile(r"wall time [0-9.e+-]+ s")
 
 
 def _commands() -> list[tuple[list[str], str]]:
     """(arguments, the lines shown after the command) for each command of the section's first
     console block, continuation lines joined."""
-    text = README.read_text(encoding="utf-8")
-    section = text[text.index("<!-- BEGIN simulate -->"):text.index("<!-- END simulate -->")]
+    section = docs_blocks.block("simulate", "getting-started/engineers.md")
     block = re.findall(r"```console\n(.*?)```", section, re.S)[0].replace("\\\n", "")
     runs = []
     for run in re.split(r"^\$ ", block, flags=re.M)[1:]:

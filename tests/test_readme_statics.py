@@ -1,23 +1,21 @@
-"""The README's statics section: its Python example runs and gives the closed form, and its
-console lines are real output."""
+"""The statics section (docs/getting-started/engineers.md): its Python example runs and gives the
+closed form, and its console lines are real output."""
 
 import math
 import re
-from pathlib import Path
+import tomllib
 
+import docs_blocks
 from statics_models import SLIDER_CRANK as CRANK
-
-README = Path(__file__).resolve().parents[1] / "README.md"
 
 
 def section() -> str:
-    text = README.read_text(encoding="utf-8")
-    return text[text.index("<!-- BEGIN statics -->"):text.index("<!-- END statics -->")]
+    return docs_blocks.block("statics")
 
 
 def test_python_example_runs_and_gives_the_closed_form(capsys):
     code = re.findall(r"```python\n(.*?)```", section(), re.S)[0]
-    exec(compile(code, "README.md", "exec"), {})
+    exec(compile(code, "statics", "exec"), {})
     out = capsys.readouterr().out
     theta = math.radians(40)
     closed = 12.0 / (0.1 * math.sin(theta) * (1 + 0.1 * math.cos(theta)
@@ -26,9 +24,14 @@ def test_python_example_runs_and_gives_the_closed_form(capsys):
     assert abs(value - closed) < 1e-9 * closed
 
 
+def test_the_model_file_shown_is_the_tested_slider_crank():
+    (model,) = re.findall(r"```toml\n# crank.toml\n(.*?)```", section(), re.S)
+    assert tomllib.loads(model) == tomllib.loads(CRANK)
+
+
 def test_console_lines_are_real_output(cli, tmp_path):
     path = tmp_path / "crank.toml"
-    path.write_text(CRANK)
+    path.write_text(re.findall(r"```toml\n(# crank.toml\n.*?)```", section(), re.S)[0])
     out = cli("statics", str(path), "--at", "theta=40deg", "--solve-for", "P").out
     shown = re.findall(r"```console\n(.*?)```", section(), re.S)[0]
     lines = [line for line in shown.splitlines()[1:] if line and not line.startswith(("$", "..."))]

@@ -1,19 +1,17 @@
-"""The README's "For students and teachers" section: its commands run, in order, in a fresh folder,
-and the output it shows is what they print."""
+"""The "For students and teachers" section (docs/getting-started/students-and-teachers.md): its
+commands run, in order, in a fresh folder, and the output it shows is what they print."""
 
 from __future__ import annotations
 
 import shlex
-from pathlib import Path
 
 import pytest
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+import docs_blocks
 
 
 def section() -> str:
-    text = README.read_text(encoding="utf-8")
-    return text[text.index("<!-- BEGIN teaching -->"):text.index("<!-- END teaching -->")]
+    return docs_blocks.block("teaching")
 
 
 def blocks(language: str) -> list[str]:

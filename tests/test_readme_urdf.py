@@ -1,25 +1,24 @@
-"""The README's section on URDF arms: its Python runs and its numbers are the library's."""
+"""The section on URDF arms (docs/getting-started/robotics.md): its Python runs and its numbers are
+the library's."""
 
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-pytest.importorskip("yourdfpy")
+import docs_blocks
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+pytest.importorskip("yourdfpy")
 
 
 def section() -> str:
-    text = README.read_text(encoding="utf-8")
-    return text[text.index("<!-- BEGIN urdf -->"):text.index("<!-- END urdf -->")]
+    return docs_blocks.block("urdf")
 
 
 def test_python_example_runs_and_its_numbers_are_textbook():
     code = re.findall(r"```python\n(.*?)```", section(), re.S)[0]
     scope: dict = {}
-    exec(compile(code, "README.md", "exec"), scope)
+    exec(compile(code, "urdf", "exec"), scope)
     f = scope["f"]
     q2 = 0.5
     # M of the shipped arm in closed form (its file's comment): 2.54 + 1.2 cos, 0.34 + 0.6 cos

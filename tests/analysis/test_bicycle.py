@@ -178,12 +178,11 @@ def test_below_the_weave_speed_the_bicycle_falls(bicycle):
 @pytest.mark.slow
 def test_readme_console_lines_are_real_output(form):
     import re
-    from pathlib import Path
 
+    import docs_blocks
     from lagrangian.output.speed_form import speed_form_text
 
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
-    section = readme[readme.index("<!-- BEGIN bicycle -->"):readme.index("<!-- END bicycle -->")]
+    section = docs_blocks.block("bicycle")   # docs/getting-started/engineers.md
     shown = re.findall(r"```console\n\$ lagrangian speeds [^\n]*\n(.*?)```", section, re.S)[0]
     text = speed_form_text(lagrangian.load("whipple_bicycle").model.name, form,
                            speed_sweep(form, np.linspace(0, 10, 101)))

@@ -1,22 +1,17 @@
-"""The README's analysis section shows real output: re-run it and compare."""
+"""The analysis section (docs/getting-started/engineers.md) shows real output: re-run it and compare."""
 
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import pytest
 
+import docs_blocks
 from lagrangian.cli import main
-
-README = Path(__file__).resolve().parents[2] / "README.md"
 
 
 def section() -> str:
-    text = README.read_text(encoding="utf-8")
-    match = re.search(r"<!-- BEGIN analysis -->(.*?)<!-- END analysis -->", text, re.S)
-    assert match, "README.md lacks the analysis section"
-    return match.group(1)
+    return docs_blocks.block("analysis")
 
 
 def test_readme_modes_two_mass_output_is_current(capsys):
@@ -30,7 +25,7 @@ def test_readme_modes_two_mass_output_is_current(capsys):
 
 def test_readme_python_examples_run(capsys):
     for code in re.findall(r"```python\n(.*?)```", section(), re.S):
-        exec(compile(code, "README.md", "exec"), {})  # noqa: S102 (our own documentation)
+        exec(compile(code, "analysis", "exec"), {})  # noqa: S102 (our own documentation)
     printed = capsys.readouterr().out
     assert "[1.         1.73205081]" in printed
     assert "20.4375 0.8333333333333334" in printed

@@ -1,23 +1,20 @@
-"""The README's sweep section shows real output: its commands re-run on an in-process Dask
-scheduler print what the README shows, and its Python example runs."""
+"""The sweep section (docs/getting-started/studies.md) shows real output: its commands re-run on
+an in-process Dask scheduler print what the page shows, and its Python example runs."""
 
 from __future__ import annotations
 
 import re
 import shlex
-from pathlib import Path
 
 import pytest
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+import docs_blocks
+
 distributed = pytest.importorskip("dask.distributed")
 
 
 def section() -> str:
-    text = README.read_text(encoding="utf-8")
-    match = re.search(r"<!-- BEGIN sweep -->(.*?)<!-- END sweep -->", text, re.S)
-    assert match, "README.md lacks the sweep section"
-    return match.group(1)
+    return docs_blocks.block("sweep", "getting-started/studies.md")
 
 
 def commands() -> list[tuple[list[str], str]]:
@@ -62,8 +59,8 @@ def assert_same_output(out: str, shown: str) -> None:
 def test_python_example_runs(client, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     code = re.findall(r"```python\n(.*?)```", section(), re.S)[0]
-    # The README's script starts a local cluster; here it runs on the test's in-process one.
+    # The docs' script starts a local cluster; here it runs on the test's in-process one.
     code = code.replace('compute="modes")', 'compute="modes", client=client)')
-    exec(compile(code, "README.md", "exec"), {"client": client})  # noqa: S102 (our own docs)
+    exec(compile(code, "sweep", "exec"), {"client": client, "__name__": "__main__"})  # noqa: S102
     assert "[2.23606798 2.44948974 2.64575131]" in capsys.readouterr().out
     assert (tmp_path / "study.nc").exists()

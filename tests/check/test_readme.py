@@ -1,22 +1,19 @@
-"""The README's check section shows real output: every command in it is re-run here."""
+"""The check section (docs/getting-started/students-and-teachers.md) shows real output: every
+command in it is re-run here."""
 
 from __future__ import annotations
 
 import re
 import shlex
-from pathlib import Path
 
 import pytest
 
+import docs_blocks
 from lagrangian.cli import main
-
-README = Path(__file__).parents[2] / "README.md"
 
 
 def section() -> str:
-    text = README.read_text(encoding="utf-8")
-    start, end = text.index("<!-- BEGIN check -->"), text.index("<!-- END check -->")
-    return text[start:end]
+    return docs_blocks.block("check")
 
 
 def test_readme_commands_print_what_the_readme_shows(tmp_path, monkeypatch, capsys):

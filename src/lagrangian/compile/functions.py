@@ -102,7 +102,7 @@ class NumericSystem:
         return self._kernel.energy(Q, V, T).reshape(batch)
 
     def accelerations_and_multipliers(self, q, q_dot, t=0.0) -> tuple[np.ndarray, np.ndarray]:
-        """Solve [[M, Phi_q^T], [Phi_q, 0]] [q_ddot; lambda] = [f; gamma]: (q_ddot, lambda)."""
+        """Solve `[[M, Phi_q^T], [Phi_q, 0]] [q_ddot; lambda] = [f; gamma]`: (q_ddot, lambda)."""
         Q, V, T, batch = self._flat(q, q_dot, t)
         q_ddot, multipliers = self._kernel.accelerations(Q, V, T)
         return q_ddot.reshape(batch + (self.n,)), multipliers.reshape(batch + (self.m,))

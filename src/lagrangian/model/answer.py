@@ -37,7 +37,7 @@ MULTIPLIER_KEYS = ("count", "names")
 
 def answer_file_schema() -> dict[str, tuple[frozenset[str], frozenset[str]]]:
     """Every key the answer reader accepts: table -> (required keys, optional keys); "" is the
-    top level, "<coordinate>" any coordinate's name. The README's table is checked against it."""
+    top level, "<coordinate>" any coordinate's name. docs/model-file.md's table is checked against it."""
     none, coordinate = frozenset(), frozenset({"<coordinate>"})
     return {"": (none, frozenset(TABLES)),
             "energy": (none, frozenset(ENERGY_KEYS)),

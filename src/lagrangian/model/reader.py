@@ -36,7 +36,7 @@ STEADY_KEYS = ({"speed", "rates", "keep"}, {"about"})
 
 def model_file_schema() -> dict[str, tuple[frozenset[str], frozenset[str]]]:
     """Every key the reader accepts: table -> (required keys, optional keys); "" is the file's
-    top level. The README's table of model-file keys is checked against it."""
+    top level. The table of docs/model-file.md is checked against it."""
     optional_top = TOP_LEVEL - {"coordinates"}
     schema = {"": (frozenset({"coordinates"}), frozenset(optional_top)),
               "coordinates.<name>": (frozenset(), frozenset(COORDINATE_KEYS)),

@@ -134,6 +134,7 @@ __all__ = [
     "SIMULATION_METHODS",
     "answer_files",
     "bare_angle_warnings",
+    "check_report_path",
     "course_document",
     "course_folder",
     "example_names",
@@ -173,6 +174,7 @@ _HOMES = {
     "course_document": ("check.course", "course_document"),
     "course_folder": ("check.course", "course_folder"),
     "course_lessons": ("check.course", "course_lessons"),
+    "check_report_path": ("report.page", "check_report_path"),
 }
 
 

@@ -459,12 +459,12 @@ class System:
     # -- the report page ---------------------------------------------------------------------
 
     def report(self, answer=None, *, t_end: float | None = None, progress=None):
-        """One self-contained HTML page (output/report.py): the model and its drawing, T, V, L,
+        """One self-contained HTML page (report/page.py): the model and its drawing, T, V, L,
         the generalized forces per load, the equations, equilibria, modes (each drawn moving), a
         simulation of ``t_end`` s (default 10), the units check and, given ``answer`` (as in
         ``check``), the check's findings. Returns a Report: ``.html``, ``.save(path)``; it shows
         itself in Jupyter."""
-        from ..output.report import build_report
+        from ..report.page import build_report
 
         return build_report(self, answer=answer, t_end=t_end, progress=progress)
 

@@ -28,8 +28,7 @@ def report(
 ) -> None:
     """Write one self-contained HTML page (offline, math as MathML): the model and its drawing,
     T, V, L, generalized forces, equations, equilibria, modes, a simulation, the units check."""
-    from .. import parse_quantity
-    from ..output.report import check_report_path
+    from .. import check_report_path, parse_quantity
 
     system = load_system(model, set_, lock)
     inputs = tuple(p for p in (Path(model), answer) if p is not None and p.exists())

@@ -9,7 +9,7 @@ from xml.dom import minidom
 import sympy as sp
 
 import lagrangian
-from lagrangian.output.mathml import DOT, DOUBLE_DOT, MathWriter, math_block, mi, mtext
+from lagrangian.report.mathml import DOT, DOUBLE_DOT, MathWriter, math_block, mi, mtext
 
 # The presentation elements of MathML Core (https://w3c.github.io/mathml-core/).
 CORE = {"math", "mrow", "mi", "mn", "mo", "mtext", "mspace", "ms", "mfrac", "msqrt", "mroot",

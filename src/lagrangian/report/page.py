@@ -4,9 +4,9 @@ the units check and, given an answer, the check of a hand derivation.
 
 Offline by construction: no script, no style sheet or font from elsewhere, every picture a data:
 URI (a Content-Security-Policy in the page forbids anything else). Math is MathML, which browsers
-render without JavaScript (output/mathml.py). Each section that does not apply to the model (no
+render without JavaScript (report/mathml.py). Each section that does not apply to the model (no
 loads, no equilibrium found, a URDF robot's equations) says so in one line. The numeric
-sections are in output/report_sections.py, the pictures in output/report_media.py.
+sections are in report/sections.py, the pictures in report/media.py.
 """
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ from ..derivation.readable import readable
 from ..errors import LagrangianError, ModelError
 from ..model.examples import example_path
 from ..model.urdf import example_urdf
-from .files import atomic_write, check_generated_target, check_output_path
+from ..output.files import atomic_write, check_generated_target, check_output_path
+from .html import Markup, element, h, image, join, math, note, page, paragraph, table
 from .mathml import MathWriter, math_block, mi, mo, mrow, mtext
-from .report_html import Markup, element, h, image, join, math, note, page, paragraph, table
 
 DEFAULT_T_END = 10.0  # s: the simulation's length when none is given
 _LONG_SOURCE = 20_000  # characters of model file shown before it is folded away
@@ -131,7 +131,7 @@ def build_report(system, *, answer=None, t_end: float | None = None,
     """The report of ``system`` (an api.System): ``answer`` (a path, dict or Answer) adds the
     check of a hand derivation; ``t_end`` (s) sets the simulation's length (default 10 s).
     An unreadable answer is refused before any work."""
-    from . import report_sections as numeric
+    from . import sections as numeric
 
     if t_end is not None and not (np.isfinite(float(t_end)) and float(t_end) > 0):
         raise ModelError(f"the simulation's length must be a positive number of seconds, got "
@@ -192,7 +192,7 @@ def model_file_text(model) -> tuple[str, str] | None:
 
 
 def _model_section(c: _Page) -> tuple[Markup, str]:
-    from .report_media import data_uri, drawing_png
+    from .media import data_uri, drawing_png
 
     model = c.model
     parts = []

@@ -14,7 +14,7 @@ import pytest
 
 import lagrangian
 from lagrangian.errors import ModelError
-from lagrangian.output.report_html import CONTENT_POLICY, FIRST_LINE
+from lagrangian.report.html import CONTENT_POLICY, FIRST_LINE
 from report_models import HOSTILE_MODEL, HOSTILE_NAME
 
 
@@ -203,7 +203,7 @@ def test_save_writes_atomically_and_only_where_we_may(double_pendulum, tmp_path)
 
 def test_a_formula_too_long_to_typeset_is_one_line(monkeypatch):
     """The benchmark bicycle's M has 32000 nodes: past the limit a formula is named, not set."""
-    from lagrangian.output import report as module
+    from lagrangian.report import page as module
 
     monkeypatch.setattr(module, "TYPESET_LIMIT", 12)
     report = lagrangian.load("cart_pendulum").report(t_end=0.2)

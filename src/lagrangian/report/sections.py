@@ -1,4 +1,4 @@
-"""The numeric sections of the report page (output/report.py): equilibria and their stability,
+"""The numeric sections of the report page (report/page.py): equilibria and their stability,
 modes (numbers, shapes and each mode drawn moving), a simulation (plot and animation), the
 units check and the check of a hand derivation. Each returns (body, status); a section that does
 not apply returns one line saying why.
@@ -7,8 +7,8 @@ not apply returns one line saying why.
 from __future__ import annotations
 
 from ..errors import LagrangianError
-from .report_html import Markup, element, image, join, note, number, paragraph, table
-from .report_media import (
+from .html import Markup, element, image, join, note, number, paragraph, table
+from .media import (
     MODE_CYCLE,
     MODES_ANIMATED,
     coordinate_mode_gif,
@@ -58,7 +58,7 @@ def equilibria_section(c) -> tuple[Markup, str]:
 
 
 def modes_section(c) -> tuple[Markup, str]:
-    from .modes import mode_shape_figure
+    from ..output.modes import mode_shape_figure
 
     analysis = c.system.modes()
     if not len(analysis):
@@ -117,7 +117,7 @@ def _mode_animations(c, analysis) -> Markup:
 
 
 def simulation_section(c, t_end: float) -> tuple[Markup, str]:
-    from .plots import time_history_figure
+    from ..output.plots import time_history_figure
 
     simulation = c.system.simulate(t_end)
     parts = [paragraph(f"From the model's initial values to t = {number(simulation.t[-1])} s "

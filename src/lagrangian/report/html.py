@@ -1,5 +1,5 @@
 """HTML built so that user text is escaped by construction: a plain ``str`` is always escaped;
-only ``Markup`` (made here, or by output/mathml.py, which escapes its own text) passes as markup.
+only ``Markup`` (made here, or by report/mathml.py, which escapes its own text) passes as markup.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ def note(text) -> Markup:
 
 
 def math(markup: str) -> Markup:
-    """MathML made by output/mathml.py (which escapes every text it holds)."""
+    """MathML made by report/mathml.py (which escapes every text it holds)."""
     return Markup(markup)
 
 

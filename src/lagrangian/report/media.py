@@ -1,4 +1,4 @@
-"""Pictures for the report page (output/report.py), each inline as a data: URI so the page needs
+"""Pictures for the report page (report/page.py), each inline as a data: URI so the page needs
 nothing from anywhere else: a drawing of the mechanism, the time-history plot, and animated GIFs
 of the simulation and of each mode (a GIF plays in any browser without JavaScript).
 
@@ -18,8 +18,8 @@ import numpy as np
 from ..analysis.modes import ModalAnalysis, Mode
 from ..errors import ModelError
 from ..model.model import Model
-from .animation import HTML_DPI, gif_bytes, mechanism_animation, playback_rate
-from .geometry import mechanism
+from ..output.animation import HTML_DPI, gif_bytes, mechanism_animation, playback_rate
+from ..output.geometry import mechanism
 
 # A mode's motion: this many frames over one period, played in MODE_CYCLE seconds whatever the
 # period (a 0.01 s mode and a 10 s mode both read), and the largest point of the mechanism moved
@@ -147,7 +147,7 @@ def _amplitude(model: Model, q0: np.ndarray, shape: np.ndarray) -> float:
 def mode_gif(model: Model, analysis: ModalAnalysis, mode: Mode, index: int) -> bytes:
     """Mode ``index`` (1-based) drawn moving over one period, as a looping GIF: the modes
     command's own animation (output/mode_animation.py), one period in MODE_CYCLE seconds."""
-    from .mode_animation import mode_animation
+    from ..output.mode_animation import mode_animation
 
     fps = round(MODE_FRAMES / MODE_CYCLE)
     animation = mode_animation(analysis, model, mode=index, fps=fps, size=(320, 320))
@@ -161,7 +161,7 @@ def coordinate_mode_gif(analysis: ModalAnalysis, mode: Mode, index: int, units: 
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from .plots import plain_text
+    from ..output.plots import plain_text
 
     names = list(analysis.linear_model.user_coordinates)
     shape = np.array([complex(_shape_entry(mode, analysis, n)) for n in names])

@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from .. import example_names, example_path, example_summary
+from .. import example_names, example_summary, example_text
 from . import app
 from .common import print_json
 
@@ -29,7 +29,7 @@ def examples(
         course_command(json_, copy)
         return
     if show is not None:
-        typer.echo(example_path(show).read_text(encoding="utf-8"), nl=False)
+        typer.echo(example_text(show), nl=False)
         return
     summaries = [example_summary(name) for name in example_names()]
     if json_:

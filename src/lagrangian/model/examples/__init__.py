@@ -49,10 +49,20 @@ def example_summary(name: str) -> dict[str, str]:
             "description": data.get("description", "")}
 
 
+def example_text(name: str) -> str:
+    """A built-in example's file as a user would write it: without the "order: N" line that
+    places it in `lagrangian examples`' list."""
+    lines = example_path(name).read_text(encoding="utf-8").splitlines(keepends=True)
+    return "".join(line for line in lines if not _ORDER.fullmatch(line.rstrip("\n")))
+
+
+_ORDER = re.compile(r"(?:#|<!--)\s*order:\s*(\d+)\s*(?:-->)?\s*")
+
+
 def _order(path: Path) -> int:
     head = path.read_text(encoding="utf-8").splitlines()[:2]
     for line in head:  # "# order: N" (TOML) or "<!-- order: N -->" (URDF)
-        found = re.fullmatch(r"(?:#|<!--)\s*order:\s*(\d+)\s*(?:-->)?\s*", line)
+        found = _ORDER.fullmatch(line)
         if found:
             return int(found.group(1))
     return 1000

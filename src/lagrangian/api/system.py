@@ -239,7 +239,7 @@ class System:
         if parameters is None and backend == "auto" and self._recursive is not None:
             return self._recursive
         return model_dynamics(self.model, lambda: self.numeric(parameters, backend),
-                              parameters, backend)
+                              parameters, backend, equations=self.equations_of_motion)
 
     # -- equilibria, linearization and modes -----------------------------------------------------
 

@@ -35,6 +35,7 @@ def dynamics(
     tau: Annotated[str | None, typer.Option("--tau", help="Generalized forces on top of the model's loads: print the forward dynamics q_ddot.")] = None,  # noqa: E501
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    coriolis: Annotated[bool, typer.Option("--coriolis", help="Also print C(q, q_dot), the matrix of the Coriolis and centrifugal terms (M_dot - 2C skew).")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Mass matrix, bias forces C q_dot + g, gravity, inverse or forward dynamics, energies."""
@@ -67,6 +68,8 @@ def dynamics(
         if tau is not None:
             values["tau"] = _vector(tau, n, "--tau", [])
             values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"])
+        if coriolis:
+            values["coriolis_matrix"] = f.coriolis_matrix(qs, vs)
         values["kinetic_energy"] = f.kinetic_energy(qs, vs)
         values["potential_energy"] = f.potential_energy(qs)
     for key, value in values.items():  # an overflow is no result (m L^2 of 1e299 each)

@@ -23,7 +23,8 @@ from collections.abc import Callable, Mapping
 import numpy as np
 
 from ..compile.functions import NumericSystem
-from ..errors import InputError, ModelError
+from ..derivation.equations import EquationsOfMotion
+from ..errors import DerivationError, InputError, ModelError
 from ..model.model import Model
 from .frames import TreeKinematics, tree_kinematics
 
@@ -38,13 +39,19 @@ class Dynamics:
     coordinates: tuple[str, ...]
     n: int
 
-    def __init__(self, functions: NumericSystem):
+    # whether f's velocity terms are -C(q, q_dot) q_dot of M's Christoffel symbols (a tree's
+    # recursions: always; the derived equations: checked once, on first use)
+    _christoffel: bool | None = None
+
+    def __init__(self, functions: NumericSystem,
+                 equations: Callable[[], EquationsOfMotion] | None = None):
         if functions.m:
             raise ModelError("dynamics in joint space needs a model without constraints "
                              f"(this one has {functions.m}: {', '.join(functions.constraint_names)})")
         self.functions = functions
         self.coordinates = functions.coordinates
         self.n = functions.n
+        self._equations = equations
 
     def _vector(self, value, field: str) -> np.ndarray:
         array = np.asarray(value, dtype=float)
@@ -92,6 +99,33 @@ class Dynamics:
     def center_of_mass_jacobian(self, q) -> np.ndarray:
         """J_c with c_dot = J_c q_dot, (..., 3, n)."""
         return self.kinematics.center_of_mass_jacobian(q)
+
+    def coriolis_matrix(self, q, v) -> np.ndarray:
+        """C(q, q_dot) of the Coriolis and centrifugal terms, C q_dot = bias - g, with
+        C_ij = sum_k Gamma_ijk q_dot_k (M's Christoffel symbols), so that M_dot - 2 C is
+        skew-symmetric; as Pinocchio's computeCoriolisMatrix. Shape (..., n, n).
+
+        Exact: the velocity terms are quadratic in q_dot, so column j is
+        (bias(q, q_dot + e_j) - bias(q, q_dot - e_j)) / 4. Refused where the model's velocity
+        terms are not M's (a damper, a gyroscopic load, a moving support, M changing with t)."""
+        if not self._velocity_terms_are_christoffel():
+            raise DerivationError(
+                "C(q, q_dot) is the matrix of the Coriolis and centrifugal terms of M; this "
+                "model's velocity terms are not only those (a damper, a velocity-dependent load, "
+                "a moving support, or M changing with t): use bias_forces(q, q_dot)")
+        q, v = self._state(q, v)
+        eye = np.eye(self.n)
+        ahead = self.bias_forces(q[..., None, :], v[..., None, :] + eye)
+        behind = self.bias_forces(q[..., None, :], v[..., None, :] - eye)
+        return np.swapaxes((ahead - behind) / 4.0, -1, -2)
+
+    def _velocity_terms_are_christoffel(self) -> bool:
+        if self._christoffel is None:
+            from ..derivation.coriolis import velocity_terms_are_christoffel
+
+            self._christoffel = (self._equations is not None
+                                 and velocity_terms_are_christoffel(self._equations()))
+        return self._christoffel
 
     def mass_matrix(self, q) -> np.ndarray:
         """M(q), shape (..., n, n) (kg, kg m or kg m^2 per entry)."""
@@ -166,11 +200,12 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
 
 
 def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
-                   parameters: Mapping[str, float] | None = None, backend: str = "auto"):
+                   parameters: Mapping[str, float] | None = None, backend: str = "auto",
+                   equations: Callable[[], EquationsOfMotion] | None = None):
     """Recursive dynamics where they apply, else Dynamics over ``symbolic()`` (the numeric
-    functions of the derived equations)."""
+    functions of the derived equations; ``equations()`` gives them for coriolis_matrix)."""
     fast = recursive_dynamics(model, parameters, backend)
-    return fast if fast is not None else Dynamics(symbolic())
+    return fast if fast is not None else Dynamics(symbolic(), equations)
 
 
 __all__ = ["Dynamics", "model_dynamics", "recursive_dynamics"]

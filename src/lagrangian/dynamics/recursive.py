@@ -74,6 +74,8 @@ class RecursiveDynamics(Dynamics):
     shape. ``functions`` (lazy) is the NumericSystem over the same module (simulation).
     """
 
+    _christoffel = True  # a tree's only velocity terms are M's (no dampers in the tree)
+
     backend = "recursive"
 
     def __init__(self, model: Model, tree: KinematicTree,

@@ -106,6 +106,8 @@ class RecursiveNumpyDynamics(Dynamics):
     shape. Same interface as recursive.RecursiveDynamics.
     """
 
+    _christoffel = True  # a tree's only velocity terms are M's (no dampers in the tree)
+
     backend = "recursive-numpy"
 
     def __init__(self, model: Model, tree: KinematicTree,

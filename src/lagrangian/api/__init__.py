@@ -22,7 +22,7 @@ from ..derivation.equations import EquationsOfMotion, LoadContribution
 from ..derivation.steps import DerivationSteps
 from ..dynamics.joint_space import Dynamics
 from ..dynamics.standalone import StandaloneSource
-from ..errors import DerivationError, InputError, LagrangianError, ModelError
+from ..errors import DerivationError, InputError, LagrangianError, MissingExtraError, ModelError
 from ..kinds import Backend, ConstraintKind, InvariantKind, JointKind, RunStatus
 from ..model.answer import Answer
 from ..model.examples import example_names as examples
@@ -98,5 +98,6 @@ __all__ = [
     "DerivationError",
     "LagrangianError",
     "InputError",
+    "MissingExtraError",
     "ModelError",
 ]

@@ -1,6 +1,6 @@
 """Robot arms from URDF: joints become the kinematic tree of 3D bodies, links their inertia.
 
-URDF is read by yourdfpy (meshes, visual and collision elements are never loaded). Each
+URDF is read by model/urdf_xml.py (expat, entities refused; meshes are never loaded). Each
 revolute, continuous or prismatic joint that is neither locked nor a mimic is a coordinate named
 after it (rad or m); its actuator is the generalized force ``tau_<joint>`` (N m, or N for a
 prismatic joint), a parameter of value 0. Gravity is g = 9.81 m/s^2 along -z. A link's frame is
@@ -15,7 +15,6 @@ the rigid-body terms a controller needs.
 
 from __future__ import annotations
 
-import io
 import keyword
 import math
 import re
@@ -34,6 +33,7 @@ from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
 from .tree import KinematicTree, TreeJoint
+from .urdf_xml import parse_robot
 
 MOVABLE = ("revolute", "continuous", "prismatic")
 SUPPORTED = (*MOVABLE, "fixed")
@@ -59,59 +59,10 @@ def example_urdf(name: str):
 def parse_urdf(text: str, *, source: str = "<urdf>",
                lock: Mapping[str, float] | None = None) -> Model:
     """The model of a URDF document (see the module docstring for what each element becomes)."""
-    robot = _parse(text, source)
+    robot = parse_robot(text, source)
     return _Tree(robot, source).model(dict(lock or {}))
 
 
-def _parse(text: str, source: str):
-    from lxml import etree
-
-    data = text.encode("utf-8")
-    try:
-        root = etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True))
-    except etree.XMLSyntaxError as exc:
-        raise ModelError(f"not well-formed XML ({exc})", source=source) from None
-    _check_inertials(root, source)
-    import yourdfpy
-
-    try:
-        # a non-finite origin makes trimesh warn while parsing; the joint is named below
-        with np.errstate(all="ignore"):
-            urdf = yourdfpy.URDF.load(io.BytesIO(data), build_scene_graph=False,
-                                      load_meshes=False, load_collision_meshes=False,
-                                      build_collision_scene_graph=False)
-    except Exception as exc:  # yourdfpy's own errors are plain exceptions of many kinds
-        raise ModelError(f"not a URDF robot ({type(exc).__name__}: {exc})",
-                         source=source) from None
-    return urdf.robot
-
-
-def _check_inertials(root, source: str) -> None:
-    """Each link's inertial has its mass and all six moments, as urdfdom requires: yourdfpy
-    would read a missing mass as 0 and a missing ixx, iyy or izz as 1 kg m^2."""
-    for link in root.findall("link"):
-        inertial = link.find("inertial")
-        if inertial is None:
-            continue
-        where = f"link '{link.get('name')}'.inertial"
-        mass = inertial.find("mass")
-        if mass is None:
-            raise ModelError("no <mass> element (an inertial needs <mass value=\"...\"/>)",
-                             field=f"{where}.mass", source=source)
-        if mass.get("value") is None:
-            raise ModelError("no value (write <mass value=\"...\"/>)", field=f"{where}.mass",
-                             source=source)
-        inertia = inertial.find("inertia")
-        if inertia is None:
-            raise ModelError("no <inertia> element (an inertial needs ixx, ixy, ixz, iyy, iyz "
-                             "and izz)", field=f"{where}.inertia", source=source)
-        missing = [key for key in _MOMENTS if inertia.get(key) is None]
-        if missing:
-            raise ModelError(f"no {', '.join(missing)} (an inertia needs all six of "
-                             f"{', '.join(_MOMENTS)})", field=f"{where}.inertia", source=source)
-
-
-_MOMENTS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 # Every number of a URDF is below this in size: masses, lengths and moments multiply (m r^2, and
 # composite inertias down the chain), and a mass of 1e308 or a length of 1e200 gave inf.
 MAX_URDF_NUMBER = 1e30

@@ -9,7 +9,7 @@ Default: ``arm.dynamics()``, the recursive algorithms in generated C (dynamics/r
 ``--symbolic`` times the derived equations instead (numpy or C backend).
 
 - Build: ``lagrangian.load(urdf, lock=...)`` then ``.dynamics()`` and a first call, in a fresh
-  process (interpreter start and ``from lagrangian import load; import yourdfpy`` reported
+  process (interpreter start and ``from lagrangian import load; import lagrangian.model.urdf`` reported
   apart), first with an
   empty cache (cold: C generated and compiled), then again with the cache it filled (warm).
 - Per call: one state through the Python API and through Pinocchio's Python bindings (crba,
@@ -43,7 +43,7 @@ ROBOTS = {
 BUILD = """
 import json, sys, time
 t0 = time.perf_counter()
-import yourdfpy
+import lagrangian.model.urdf  # the URDF reader (model/urdf_xml.py, the standard library's expat)
 from lagrangian import load  # the API layer (sympy, scipy): the library's fixed start-up
 t1 = time.perf_counter()
 arm = load(sys.argv[1], lock=json.loads(sys.argv[2]))
@@ -123,7 +123,7 @@ def bench(name: str, symbolic: str | None, states: int, timing: bool = True) -> 
         cold, warm = build_times(path, lock)
         print(f"\n{name}: {cold['kind']}; URDF -> compiled functions: cold {cold['build']:.2f} s, "
               f"from the cache {warm['build']:.2f} s (fresh processes; importing lagrangian.load "
-              f"and yourdfpy {warm['import']:.2f} s apart); load average {load_average()}")
+              f"and the URDF reader {warm['import']:.2f} s apart); load average {load_average()}")
     model = pin.buildModelFromUrdf(str(path))
     if lock:
         locked = [model.getJointId(j) for j in lock]

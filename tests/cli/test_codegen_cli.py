@@ -12,8 +12,6 @@ import pytest
 
 import lagrangian
 
-pytest.importorskip("yourdfpy")
-
 ARM = """<?xml version="1.0"?>
 <robot name="two link arm">
   <link name="base"/>

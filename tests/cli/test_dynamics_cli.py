@@ -7,8 +7,6 @@ import math
 
 import pytest
 
-pytest.importorskip("yourdfpy")
-
 ARM = """<?xml version="1.0"?>
 <robot name="pendulum_arm">
   <link name="base"/>

@@ -8,8 +8,6 @@ import json
 
 import pytest
 
-pytest.importorskip("yourdfpy")
-
 
 def test_simulate_with_a_locked_elbow(cli):
     code, out, err = cli("simulate", "two_link_arm", "--t-end", "0.1", "--lock", "elbow=0.1")

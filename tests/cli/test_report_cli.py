@@ -70,9 +70,6 @@ def test_never_over_a_file_it_did_not_write(cli, tmp_path):
 
 
 def test_a_urdf_robot_with_a_locked_joint(cli, tmp_path):
-    import pytest
-
-    pytest.importorskip("yourdfpy")
     out = tmp_path / "arm.html"
     code, stdout, stderr = cli("report", "two_link_arm", "--lock", "elbow=0.2", "--t-end", "0.2",
                                "--out", str(out), "--json")

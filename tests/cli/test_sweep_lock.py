@@ -13,7 +13,6 @@ import lagrangian
 from lagrangian.output.sweep import read_study
 
 distributed = pytest.importorskip("dask.distributed")
-pytest.importorskip("yourdfpy")
 
 ELBOW = 0.3
 GRAVITY = [1.62, 3.71, 9.81]

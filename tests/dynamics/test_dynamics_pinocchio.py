@@ -11,7 +11,6 @@ import pytest
 import lagrangian
 
 pin = pytest.importorskip("pinocchio")
-pytest.importorskip("yourdfpy")
 
 # Revolute and prismatic joints (continuous joints are (cos, sin) pairs in Pinocchio), offsets
 # in every axis, rpy origins, a tilted axis, full inertia tensors, an inertial rpy, a fixed

@@ -20,7 +20,6 @@ from lagrangian.dynamics.recursive import RecursiveDynamics, applicable_tree
 from lagrangian.dynamics.recursive_numpy import RecursiveNumpyDynamics
 from lagrangian.errors import ModelError
 
-pytest.importorskip("yourdfpy")
 needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
 
 INERTIA = '<inertia ixx="{0}" ixy="{1}" ixz="{2}" iyy="{3}" iyz="{4}" izz="{5}"/>'

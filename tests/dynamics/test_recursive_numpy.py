@@ -20,7 +20,6 @@ from lagrangian.dynamics.recursive import RecursiveDynamics
 from lagrangian.dynamics.recursive_numpy import RecursiveNumpyDynamics
 from lagrangian.errors import DerivationError, ModelError
 
-pytest.importorskip("yourdfpy")
 needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
 HERE = Path(__file__).resolve().parent
 

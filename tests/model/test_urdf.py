@@ -8,8 +8,6 @@ import pytest
 import lagrangian
 from lagrangian.errors import LagrangianError, ModelError
 
-pytest.importorskip("yourdfpy")
-
 INERTIAL = ('<inertial><origin xyz="{x} {y} {z}" rpy="{rpy}"/><mass value="{m}"/>'
             '<inertia ixx="{ixx}" ixy="{ixy}" ixz="{ixz}" iyy="{iyy}" iyz="{iyz}" izz="{izz}"/>'
             '</inertial>')

@@ -98,7 +98,7 @@ def test_the_cli_says_it_in_one_line(cli, tmp_path):
 
 
 @pytest.mark.parametrize("edit, field, words", [
-    # yourdfpy reads a missing value as 0 and a missing moment as 1 (kg m^2): urdfdom refuses
+    # a missing value read as 0, or a missing moment as 1 (kg m^2), as yourdfpy did: urdfdom refuses
     (('<mass value="1.5"/>', '<mass/>'), "link 'fore'.inertial.mass", "no value"),
     (('<mass value="1.5"/>', ''), "link 'fore'.inertial.mass", "no <mass>"),
     (('iyy="0.1" ', ''), "link 'fore'.inertial.inertia", "iyy"),

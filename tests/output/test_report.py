@@ -4,7 +4,6 @@ and the file written only where we may."""
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import re
 from html.parser import HTMLParser
@@ -136,9 +135,7 @@ def test_hostile_user_text_is_escaped_everywhere(hostile):
 
 def test_sections_that_do_not_apply_say_so_in_one_line():
     statuses = {}
-    models = [("pendulum", 1), ("atwood", 0.5), ("two_mass", 1)]
-    if importlib.util.find_spec("yourdfpy") is not None:  # URDF support may be an extra
-        models.append(("two_link_arm", 0.5))
+    models = [("pendulum", 1), ("atwood", 0.5), ("two_mass", 1), ("two_link_arm", 0.5)]
     for name, t_end in models:
         report = lagrangian.load(name).report(t_end=t_end)
         statuses[name] = {s.key: s.status for s in report.sections}

@@ -3,8 +3,8 @@ parent, child, origin, axis, limit, mimic), with the defaults of the URDF specif
 absent origin is the identity, an absent axis is x, a mimic's multiplier 1 and offset 0).
 
 Read with the standard library's expat parser, entities refused: an entity declaration, an
-external entity or a reference to an undeclared one is an error, never expanded or fetched
-(what defusedxml does), so a file cannot grow a billion laughs or read another file. Visual,
+external entity or DTD, or a reference to an undeclared entity is an error, never expanded or
+fetched (as defusedxml does), so a file cannot grow a billion laughs or read another. Visual,
 collision, material, transmission and gazebo elements are skipped unread: meshes are never
 loaded. An origin's rpy is roll about x, pitch about y, yaw about z, fixed axes:
 R = Rz(yaw) Ry(pitch) Rx(roll), as urdfdom, Pinocchio and yourdfpy read it.
@@ -100,6 +100,12 @@ def _elements(text: str, source: str) -> Element:
     parser.UnparsedEntityDeclHandler = refuse("an entity declaration (<!ENTITY ...>)")
     parser.ExternalEntityRefHandler = refuse("an external entity")
     parser.SkippedEntityHandler = refuse("an entity reference that is not declared")
+
+    def doctype(name, system_id, public_id, internal_subset):
+        if system_id or public_id:  # unread, its entities would silently vanish from attributes
+            refuse("an external DTD (<!DOCTYPE ... SYSTEM ...>)")()
+
+    parser.StartDoctypeDeclHandler = doctype
     parser.StartElementHandler = builder.start
     parser.EndElementHandler = builder.end
     parser.CharacterDataHandler = builder.data

@@ -90,6 +90,7 @@ def test_a_doctype_without_entities_is_read(tmp_path):
     (('<robot name="two_link_arm">', '<model name="two_link_arm">'), None),
     (('<robot name="two_link_arm">', "<robot>"), "robot: a <robot> without a name"),
     (('<joint name="elbow"', "<joint"), "joint: a <joint> without a name"),
+    (('<link name="fore">', "<link>"), "link: a <link> without a name"),
     (('<parent link="upper"/>', ""), "joint 'elbow': no <parent link"),
     (('<origin xyz="1 0 0" rpy="0 0 0"/>', '<origin xyz="1 0" rpy="0 0 0"/>'),
      "joint 'elbow'.origin: xyz=\"1 0\" is not 3 numbers"),

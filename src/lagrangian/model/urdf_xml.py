@@ -76,8 +76,11 @@ def parse_robot(text: str, source: str) -> Robot:
     if root.tag != "robot":
         raise ModelError(f"the root element is <{root.tag}>, not <robot> (not a URDF robot)",
                          source=source)
-    _check_inertials(root, source)
     reader = _Reader(source)
+    for kind in ("link", "joint"):  # named before any fault is named with them
+        for element in root.findall(kind):
+            reader.name(element, kind)
+    _check_inertials(root, source)
     robot = Robot(reader.name(root, "robot"))
     robot.links = [reader.link(element) for element in root.findall("link")]
     robot.joints = [reader.joint(element) for element in root.findall("joint")]

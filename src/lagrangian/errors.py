@@ -82,5 +82,37 @@ class InputError(ModelError):
         super().__init__(message, field=field)
 
 
+class MissingExtraError(InputError):
+    """An optional part of the library whose packages are not installed (the study stack of
+    [sweep], pyarrow of [parquet], ...): names the extra that installs them, in one line.
+
+    ``extra`` is its name and ``module`` the module that could not be imported."""
+
+    def __init__(self, what: str, extra: str, module: str, reason: str = ""):
+        self.extra = extra
+        self.module = module
+        why = f"{module} cannot be imported: {reason}" if reason else f"{module} is not installed"
+        super().__init__(f'{what} needs the optional extra [{extra}]: pip install '
+                         f'"lagrangian[{extra}]" ({why})')
+
+
+def require_extra(extra: str, modules: Iterable[str], what: str) -> None:
+    """Import each of ``modules`` (the packages of the optional extra ``extra``), or raise a
+    MissingExtraError naming the extra for ``what`` the user asked for ("a parameter study")."""
+    import importlib
+
+    for module in modules:
+        try:
+            importlib.import_module(module)
+        except ImportError as exc:
+            # a module absent (the usual case: named, even when it is a dependency of one of
+            # ``modules``) or present but broken (a shared library of its own missing): either
+            # way installing the extra is the fix, and the reason is kept
+            if isinstance(exc, ModuleNotFoundError):
+                raise MissingExtraError(what, extra, exc.name or module) from None
+            reason = " ".join(str(exc).split())[:160]
+            raise MissingExtraError(what, extra, module, reason) from None
+
+
 class DerivationError(LagrangianError):
     """The model is well formed but its equations cannot be formed (singular mass matrix, ...)."""

@@ -23,7 +23,7 @@ from ..derivation.steps import DerivationSteps
 from ..dynamics.frames import TreeKinematics
 from ..dynamics.joint_space import Dynamics
 from ..dynamics.standalone import StandaloneSource
-from ..errors import DerivationError, InputError, LagrangianError, ModelError
+from ..errors import DerivationError, InputError, LagrangianError, MissingExtraError, ModelError
 from ..kinds import Backend, ConstraintKind, InvariantKind, JointKind, RunStatus
 from ..model.answer import Answer
 from ..model.examples import example_names as examples
@@ -100,5 +100,6 @@ __all__ = [
     "DerivationError",
     "LagrangianError",
     "InputError",
+    "MissingExtraError",
     "ModelError",
 ]

@@ -367,8 +367,10 @@ class System:
         condition or a StopCondition) set each member's simulation, as in System.simulate.
         """
         from ..analysis.study import SimulationOptions, make_study
+        from ..output.sweep import require_study_packages
         from ..study.engine import run_study
 
+        require_study_packages(out)  # the extra [sweep], asked before the derivation
         eom = self.equations_of_motion()
         require_inertia(eom, "simulate" if compute == "simulate" else "modes")
         options = None

@@ -82,8 +82,15 @@ def _run(model, vary, compute, out, plot, json_, set_, sample, members, seed, t_
          time_samples, method, rtol, atol, stop_when, trajectories, scheduler, workers, resume,
          chunk_size, about, lock=()):
     from .. import parse_quantity, state_units
-    from ..output.sweep import check_study_path, check_study_plot_path, study_summary, study_text
+    from ..output.sweep import (
+        check_study_path,
+        check_study_plot_path,
+        require_study_packages,
+        study_summary,
+        study_text,
+    )
 
+    require_study_packages(out)  # the extra [sweep], asked before the model is derived
     # the locked model's equations travel inside the Study to the Dask workers
     system = load_system(model, set_, lock)
     units = {p.name: p.unit for p in system.model.parameters}

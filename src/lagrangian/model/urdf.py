@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
-from ..errors import ModelError, did_you_mean
+from ..errors import ModelError, did_you_mean, require_extra
 from ..kinds import JointKind
 from .builder import ModelBuilder
 from .expressions import RESERVED
@@ -65,6 +65,7 @@ def parse_urdf(text: str, *, source: str = "<urdf>",
 
 
 def _parse(text: str, source: str):
+    require_extra("urdf", ("lxml", "yourdfpy"), "reading a URDF robot")
     from lxml import etree
 
     data = text.encode("utf-8")

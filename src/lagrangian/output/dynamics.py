@@ -20,7 +20,8 @@ def dynamics_document(coordinates, values: Mapping[str, Any]) -> dict[str, Any]:
 _TITLES = {
     "q": "q", "v": "q_dot", "a": "q_ddot (given)", "tau": "tau (given)",
     "mass_matrix": "mass matrix M(q)", "bias_forces": "bias forces C(q, q_dot) q_dot + g(q)",
-    "gravity": "gravity g(q)", "coriolis_matrix": "Coriolis matrix C(q, q_dot)", "inverse_dynamics": "inverse dynamics tau = M q_ddot + C q_dot + g",
+    "gravity": "gravity g(q)", "coriolis_matrix": "Coriolis matrix C(q, q_dot)",
+    "inverse_dynamics": "inverse dynamics tau = M q_ddot + C q_dot + g",
     "forward_dynamics": "forward dynamics q_ddot = M^-1 (tau - C q_dot - g)",
     "kinetic_energy": "kinetic energy T (J)", "potential_energy": "potential energy V (J)",
 }

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.study import NOT_COMPUTED, OK, Study, layout
-from ..errors import InputError
+from ..errors import InputError, require_extra
 from .files import atomic_write
 from .plots import notebook_figure, plain_text
 
@@ -56,6 +56,21 @@ WRITTEN_BY = "lagrangian sweep"
 _LEGACY_ATTRS = {"model", "compute", "points", "finished", "failed", "about"}
 
 
+# The packages of a study, the optional extra [sweep] (docs/dependencies.md): the engine, the
+# Dataset, and the writer of each file format.
+STUDY_MODULES = ("dask", "dask.distributed", "xarray")
+STUDY_WRITERS = {".nc": ("h5netcdf", "h5py"), ".zarr": ("zarr",)}
+
+
+def require_study_packages(out: str | Path | None = None) -> None:
+    """The study stack (and the writer of ``out``'s format) importable, or a MissingExtraError
+    naming the extra [sweep]: asked before any work, not when the results are written."""
+    require_extra("sweep", STUDY_MODULES, "a parameter study (sweep)")
+    suffix = Path(out).suffix.lower() if out is not None else ""
+    if suffix in STUDY_WRITERS:
+        require_extra("sweep", STUDY_WRITERS[suffix], f"writing a study as {suffix}")
+
+
 def check_study_path(path: str | Path) -> Path:
     """The output of a study: *.nc (NetCDF through h5netcdf) or *.zarr (a Zarr store), checked
     before any work: where something is already there it must be a study this project wrote."""
@@ -63,6 +78,7 @@ def check_study_path(path: str | Path) -> Path:
     if path.suffix.lower() not in STUDY_FORMATS:
         raise InputError(f"a study is written as NetCDF (*.nc) or Zarr (*.zarr), not '{path}'",
                          field="out")
+    require_study_packages(path)  # is_study below reads the file with its format's reader
     if path.is_symlink():
         raise InputError(f"{path} is a symbolic link: refusing to replace it", field="out")
     if path.exists() and not is_study(path):
@@ -206,6 +222,7 @@ def write_study(dataset, path: str | Path, *, protect: tuple[Path, ...] = ()) ->
 
 def read_study(path: str | Path):
     """A study written by ``write_study``, loaded into memory."""
+    require_study_packages(path)
     import xarray as xr
 
     path = Path(path)

@@ -5,11 +5,13 @@ from __future__ import annotations
 import io
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, require_extra
 from ..simulation.result import SimulationResult
 from .files import atomic_write
 
 TABLE_FORMATS = {".csv": "CSV", ".parquet": "Parquet"}
+# the Parquet engine pandas uses: the optional extra [parquet] (docs/dependencies.md)
+PARQUET_MODULES = ("pyarrow",)
 
 
 def result_frame(result: SimulationResult):
@@ -35,6 +37,8 @@ def check_table_path(path: str | Path) -> Path:
     path = Path(path)
     if path.suffix.lower() not in TABLE_FORMATS:
         raise InputError(f"cannot write {path}: use a .csv or .parquet file name", field="table")
+    if path.suffix.lower() == ".parquet":  # asked before the run, not after it
+        require_extra("parquet", PARQUET_MODULES, "writing Parquet (.parquet)")
     return path
 
 

@@ -23,7 +23,7 @@ import numpy as np
 from ..analysis.study import NOT_COMPUTED, Study, layout
 from ..analysis.sweep import ENSEMBLE_NATIVE, evaluate_chunk
 from ..errors import ModelError
-from ..output.sweep import check_study_path, study_dataset, write_study
+from ..output.sweep import check_study_path, require_study_packages, study_dataset, write_study
 from .store import PartialStore
 
 # Tasks of a chunk whose worker died are run again this many times before the study gives up.
@@ -115,6 +115,7 @@ def run_study(
     what finished is written to ``out`` (status 'not computed' elsewhere) and kept in
     ``<out>.partial``; ``resume=True`` continues from there.
     """
+    require_study_packages(out)
     if out is not None:
         check_study_path(out)
     check_workers(workers)

@@ -376,8 +376,8 @@ def test_docs_python_example_prints_what_it_says(capsys):
 
 def test_docs_commands_run(cli, tmp_path):
     commands = re.findall(r"^\$ (.*)$", _docs_section(), re.M)
-    readme = (DOCS.parents[1] / "README.md").read_text(encoding="utf-8")
-    assert f"$ {commands[0]}   #" in readme  # the README's line is this command
+    engineers = (DOCS.parent / "getting-started" / "engineers.md").read_text(encoding="utf-8")
+    assert f"$ {commands[0]}   #" in engineers  # the engineers' page shows this command
     derive = commands[0].split(" > ")[0].split()[1:]
     result = cli(*derive)
     assert commands[0].startswith("lagrangian derive") and result.code == 0

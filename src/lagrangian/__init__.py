@@ -68,6 +68,7 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
         parse_model,
         read_model,
     )
+    from .errors import DynamicsWarning
 
 __version__ = "0.1.0"
 
@@ -88,6 +89,7 @@ __all__ = [
     "DerivationError",
     "DerivationSteps",
     "Dynamics",
+    "DynamicsWarning",
     "EquationsOfMotion",
     "Equilibria",
     "Equilibrium",
@@ -155,6 +157,7 @@ _SYMPY_NAMES = frozenset({"cos", "exp", "sin", "sqrt", "tan"})
 # Public functions and limits that live in one stage, loaded from their own module on first use
 # (not through the API, so that `lagrangian examples` starts without sympy or numpy).
 _HOMES = {
+    "DynamicsWarning": ("errors", "DynamicsWarning"),
     "parse_quantity": ("model.units", "parse_quantity"),
     "state_units": ("model.values", "state_units"),
     "resolve_state": ("model.values", "resolve_state"),

@@ -3,13 +3,14 @@ inverse or forward dynamics and the energies at one state."""
 
 from __future__ import annotations
 
+import warnings
 from typing import Annotated
 
 import typer
 
-from ..errors import DerivationError, InputError
+from ..errors import DerivationError, DynamicsWarning, InputError
 from . import app
-from .common import load_system, print_json, warn_bare_angles
+from .common import load_system, print_json, warn, warn_bare_angles
 
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
 
@@ -58,7 +59,10 @@ def dynamics(
                          dict(zip(names, qs, strict=True)))
     vs = _vector(v, n, "--v", [c.rate or 0.0 for c in coordinates])
     f = system.dynamics()
-    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below
+    with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings(record=True) as seen:
+        # an overflow is refused below; a state without dynamics (M not positive definite)
+        # is a DynamicsWarning and NaN, reported in one line
+        warnings.simplefilter("always", DynamicsWarning)
         values = {"q": qs, "v": vs, "mass_matrix": f.mass_matrix(qs),
                   "bias_forces": f.bias_forces(qs, vs), "gravity": f.gravity(qs)}
         if a is not None:
@@ -69,8 +73,17 @@ def dynamics(
             values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"])
         values["kinetic_energy"] = f.kinetic_energy(qs, vs)
         values["potential_energy"] = f.potential_energy(qs)
+    undefined = [w for w in seen if issubclass(w.category, DynamicsWarning)]
+    if undefined:
+        nan = [key.replace("_", " ") for key, value in values.items()
+               if np.isnan(np.asarray(value, dtype=float)).all()]
+        warn(f"no {', '.join(nan) or 'dynamics'} at this state: the mass matrix is not "
+             "positive definite there (or an input is not finite); shown as NaN (null in JSON)")
     for key, value in values.items():  # an overflow is no result (m L^2 of 1e299 each)
-        if not np.all(np.isfinite(np.asarray(value, dtype=float))):
+        array = np.asarray(value, dtype=float)
+        if undefined and np.isnan(array).all():
+            continue
+        if not np.all(np.isfinite(array)):
             raise DerivationError(f"the {key.replace('_', ' ')} is not finite at this state "
                                   "(a number beyond floating point, or a state outside the "
                                   "model's domain)")

@@ -107,6 +107,15 @@ class System:
         """A copy of the system with some parameter values replaced (SI units)."""
         return System(self._model.with_parameter_values(values))
 
+    def with_gravity(self, gravity: Sequence[float]) -> System:
+        """A copy under uniform gravity ``(g_x, g_y, g_z)`` in world axes (m/s^2): the gravity
+        parameter (a URDF's ``g``) becomes |g| and the direction g/|g|, as Pinocchio's
+        ``model.gravity``; a robot's compiled dynamics are rebuilt for (and cached by) the
+        direction."""
+        from ..model.gravity import with_gravity
+
+        return System(with_gravity(self._model, gravity))
+
     def equations_of_motion(self) -> EquationsOfMotion:
         """M q_ddot + Phi_q^T lambda = f by Lagrange's method (derived once, then cached)."""
         return self._equations
@@ -522,9 +531,16 @@ class SystemBuilder(ModelBuilder):
         return System(self.build_model())
 
 
-def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None) -> System:
+def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None,
+         gravity: Sequence[float] | None = None) -> System:
     """Load a model file (TOML), a robot (URDF: ``lock`` freezes joints by name, rad or m), or
-    a built-in example by name (see ``examples()``)."""
+    a built-in example by name (see ``examples()``); ``gravity`` (g_x, g_y, g_z) in m/s^2 turns
+    the model's gravity (System.with_gravity)."""
+    system = _load(path_or_example, lock)
+    return system if gravity is None else system.with_gravity(gravity)
+
+
+def _load(path_or_example: str | Path, lock: Mapping[str, float] | None) -> System:
     path = Path(path_or_example)
     if path.suffix.lower() == ".urdf":
         return System(read_urdf(path, lock))

@@ -28,7 +28,7 @@ def report(
 ) -> None:
     """Write one self-contained HTML page (offline, math as MathML): the model and its drawing,
     T, V, L, generalized forces, equations, equilibria, modes, a simulation, the units check."""
-    from ..model.units import parse_quantity
+    from .. import parse_quantity
     from ..output.report import check_report_path
 
     system = load_system(model, set_, lock)

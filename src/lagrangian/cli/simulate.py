@@ -13,6 +13,7 @@ from .. import SIMULATION_METHODS as METHODS  # light: the names only, no scipy
 from . import app
 from .common import (
     FPS_HELP,
+    GRAVITY_HELP,
     LOCK_HELP,
     ONLY_WITH_ANIMATE,
     SET_HELP,
@@ -31,6 +32,7 @@ def simulate(
     initial: Annotated[list[str], typer.Option("--initial", help="Initial value: NAME=VALUE (theta=30deg, theta_dot=0, t=0); default: the model's initial/rate; repeat, or separate by commas.")] = [],  # noqa: B006,E501
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
+    gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
     method: Annotated[str, typer.Option("--method", help=f"Integrator: {', '.join(METHODS)}.")] = "DOP853",
     rtol: Annotated[float, typer.Option("--rtol", help="Relative tolerance.")] = 1e-9,
     atol: Annotated[float, typer.Option("--atol", help="Absolute tolerance.")] = 1e-9,
@@ -60,7 +62,7 @@ def simulate(
     from ..output.simulation import projection_warning, simulation_document, simulation_text
     from ..output.tables import check_table_path
 
-    system = load_system(model, set_, lock)
+    system = load_system(model, set_, lock, gravity)
     warn_if_unphysical(system.equations_of_motion())
     end = parse_quantity(t_end, "s", "--t-end")
     # Everything the user typed is checked (by the library) before the integration starts.

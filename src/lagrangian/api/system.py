@@ -92,6 +92,18 @@ class System:
         """Parameter name -> SI value (None for symbolic-only parameters)."""
         return {p.name: p.value for p in self._model.parameters}
 
+    @property
+    def joint_names(self) -> dict[str, str]:
+        """A robot read from URDF: coordinate name -> the file's joint name (the coordinate is
+        the joint's name made an identifier, "joint_8.0" -> "joint_8_0"); {} for other models."""
+        return dict(self._model.source_names)
+
+    @property
+    def coordinate_names(self) -> dict[str, str]:
+        """The reverse of ``joint_names``: the URDF's joint name -> coordinate name (joints that
+        move; locked, fixed and mimic joints have no coordinate)."""
+        return {joint: coordinate for coordinate, joint in self._model.source_names}
+
     def symbol(self, name: str) -> sp.Symbol:
         """The sympy symbol of a coordinate, velocity or parameter, by name."""
         for c in self._model.coordinates:

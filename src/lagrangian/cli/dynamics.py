@@ -90,6 +90,6 @@ def dynamics(
                                   "model's domain)")
     names = [c.name for c in coordinates]
     if json_:
-        print_json(dynamics_document(names, values))
+        print_json(dynamics_document(names, values, system.joint_names))
     else:
         typer.echo(dynamics_text(names, values), nl=False)

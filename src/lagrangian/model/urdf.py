@@ -306,7 +306,8 @@ class _Tree:
         bodies = tuple(self._bodies(root, order, position))
         model = builder.build_model()
         tree = self._tree(root, order, position, names, bodies)
-        return replace(model, rigid_bodies=bodies, kinematic_tree=tree)
+        return replace(model, rigid_bodies=bodies, kinematic_tree=tree,
+                       source_names=tuple((name, joint) for joint, name in names.items()))
 
     def _positions(self, lock: dict[str, float], names: dict[str, str]):
         """Each movable joint's position (angle or distance) and rate as expressions in q."""

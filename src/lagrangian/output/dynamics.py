@@ -8,10 +8,14 @@ from typing import Any
 import numpy as np
 
 
-def dynamics_document(coordinates, values: Mapping[str, Any]) -> dict[str, Any]:
+def dynamics_document(coordinates, values: Mapping[str, Any],
+                      joint_names: Mapping[str, str] | None = None) -> dict[str, Any]:
     """The `dynamics --json` document: every array as nested lists, SI units; NaN (a state
-    without dynamics, DynamicsWarning) as null."""
+    without dynamics, DynamicsWarning) as null; ``joint_names`` (coordinate -> the URDF's
+    joint name, {} for a model file) under that key."""
     document: dict[str, Any] = {"coordinates": list(coordinates)}
+    if joint_names is not None:
+        document["joint_names"] = dict(joint_names)
     for key, value in values.items():
         array = np.asarray(value, dtype=float)
         listed = array.tolist() if array.ndim else float(array)

@@ -104,6 +104,14 @@ class System:
         move; locked, fixed and mimic joints have no coordinate)."""
         return {joint: coordinate for coordinate, joint in self._model.source_names}
 
+    @property
+    def joint_limits(self) -> dict[str, tuple[float, float]]:
+        """A robot read from URDF: coordinate name -> its joint's position limit (lower, upper)
+        in rad or m, where the file gives one; {} for other models."""
+        from ..check.warnings import joint_limits
+
+        return joint_limits(self._model)
+
     def symbol(self, name: str) -> sp.Symbol:
         """The sympy symbol of a coordinate, velocity or parameter, by name."""
         for c in self._model.coordinates:

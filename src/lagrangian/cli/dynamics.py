@@ -58,6 +58,10 @@ def dynamics(
         texts = [part.strip() for part in q.split(",")]
         warn_bare_angles("--q", zip(names, texts, strict=True), state_units(system.model),
                          dict(zip(names, qs, strict=True)))
+        from .. import limit_warnings
+
+        for line in limit_warnings(system.model, dict(zip(names, qs, strict=True)), "--q"):
+            warn(line)
     vs = _vector(v, n, "--v", [c.rate or 0.0 for c in coordinates])
     f = system.dynamics()
     with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings(record=True) as seen:

@@ -4,8 +4,11 @@
 
 from __future__ import annotations
 
+import ctypes
 import json
 import math
+import shutil
+import subprocess
 
 import numpy as np
 import pytest
@@ -106,3 +109,22 @@ def test_cli_bad_gravity_exits_2(cli, text, words):
 def test_cli_gravity_on_a_model_without_gravity_exits_2(cli):
     result = cli("dynamics", "pendulum", "--gravity", "0,0,-9.81")
     assert result.code == 2 and "declares no gravity" in result.err
+
+
+@pytest.mark.skipif(not (shutil.which("gcc") or shutil.which("cc")), reason="no C compiler")
+def test_codegen_with_gravity_gives_the_tilted_torques(cli, tmp_path):
+
+    result = cli("codegen", "two_link_arm", "--out", str(tmp_path), "--name", "arm",
+                 "--gravity", "9.81,0,0")
+    assert result.code == 0, result.err
+    library = tmp_path / "arm.so"
+    subprocess.run([shutil.which("gcc") or shutil.which("cc"), "-std=c99", "-O2", "-shared",
+                    "-fPIC", str(tmp_path / "arm.c"), "-o", str(library), "-lm"], check=True)
+    c = ctypes.CDLL(str(library))
+    vec = ctypes.c_double * 2
+    params = (ctypes.c_double * 3).in_dll(c, "arm_parameters")
+    assert params[0] == pytest.approx(9.81)  # the magnitude g, a runtime parameter
+    out = vec()
+    c.arm_gravity(vec(0.4, -1.2), params, out)
+    np.testing.assert_allclose(list(out), closed_form_gravity((0.4, -1.2), (9.81, 0, 0)),
+                               rtol=1e-12)

@@ -39,7 +39,7 @@ def wall_gravity(q1, q2, g=9.81):
 
 
 def test_the_command_lines(cli):
-    gravity, equilibria, as_json, show, beyond = commands("robotics-cli")
+    gravity, equilibria, as_json, show, beyond, stops, through = commands("robotics-cli")
     result = cli(*gravity)
     assert result.code == 0, result.err
     for value in wall_gravity(0.3, 0.5):
@@ -54,6 +54,11 @@ def test_the_command_lines(cli):
     assert result.code == 0
     (line,) = [x for x in result.err.splitlines() if x.startswith("warning: ")]
     assert "'shoulder'" in line and "[-3.1, 3.1] rad" in line
+    document = json.loads(cli(*stops, "--json").out)
+    assert document["status"] == "limit" and "joint 'shoulder'" in document["message"]
+    assert document["final_state"]["shoulder"] == pytest.approx(-3.1, abs=1e-9)
+    free = json.loads(cli(*through, "--json").out)
+    assert free["status"] == "finished" and free["t_final"] == pytest.approx(3.0)
 
 
 def test_the_python():

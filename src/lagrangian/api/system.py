@@ -52,7 +52,13 @@ from ..model.reader import read_model
 from ..model.urdf import example_urdf, read_urdf
 from ..model.values import State, resolve_state
 from ..simulation.events import StopCondition
-from ..simulation.simulate import SaveAt, StepControl, parse_stop_condition, simulate
+from ..simulation.simulate import (
+    PositionLimit,
+    SaveAt,
+    StepControl,
+    parse_stop_condition,
+    simulate,
+)
 from .modes import ModalAnalysis
 from .simulation import Simulation
 
@@ -180,6 +186,7 @@ class System:
         rtol: float = 1e-9,
         atol: float = 1e-9,
         samples: int = 1001,
+        limits: bool = True,
     ) -> Simulation:
         """Integrate the equations of motion to ``t_end`` (s); returns a Simulation.
 
@@ -188,7 +195,9 @@ class System:
         ``save_at`` (SaveAt: samples) say how to integrate and what to keep (``method``,
         ``rtol``, ``atol`` and ``samples`` are the same as plain keywords); ``stop_when`` is a
         condition such as "theta < 0" (or a StopCondition) that ends the run. Constrained models
-        are kept on Phi = 0 by projection (see docs/simulation.md).
+        are kept on Phi = 0 by projection (see docs/simulation.md). A robot read from URDF
+        stops with status 'limit' when a joint reaches its position limit, naming it
+        (``limits=False`` ignores them).
         """
         require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
@@ -198,8 +207,17 @@ class System:
             else stop_when
         result = simulate(self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
-                          progress=progress, functions=self._numeric)
+                          progress=progress, functions=self._numeric,
+                          limits=self._position_limits() if limits else ())
         return Simulation.of(result)
+
+    def _position_limits(self) -> tuple[PositionLimit, ...]:
+        names = [c.name for c in self._model.coordinates]
+        joints = self.joint_names
+        units = {c.name: c.unit for c in self._model.coordinates}
+        return tuple(PositionLimit(names.index(name), name, joints[name], lower, upper,
+                                   units[name])
+                     for name, (lower, upper) in self.joint_limits.items())
 
     # -- standalone C for a controller -----------------------------------------------------------
 

@@ -44,6 +44,7 @@ def simulate(
     size: Annotated[str | None, typer.Option("--size", help=SIZE_HELP)] = None,
     fps: Annotated[int | None, typer.Option("--fps", help=FPS_HELP + " Default 20.")] = None,
     stop_when: Annotated[str | None, typer.Option("--stop-when", help="Stop when a condition turns true, e.g. \"theta < 0\".")] = None,  # noqa: E501
+    ignore_limits: Annotated[bool, typer.Option("--ignore-limits", help="URDF: run through the joints' position limits (by default a joint reaching one ends the run, status 'limit').")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
@@ -100,7 +101,7 @@ def simulate(
         simulation = system.simulate(
             end, initial=start, method=step_control.method,
             rtol=step_control.rtol, atol=step_control.atol, samples=save_at.samples,
-            stop_when=stop, progress=progress.update,
+            stop_when=stop, progress=progress.update, limits=not ignore_limits,
         )
     warning = projection_warning(simulation)
     if warning:

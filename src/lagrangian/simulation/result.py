@@ -17,6 +17,7 @@ from .options import StepControl
 STATUS_MESSAGES = {
     "finished": "reached the end time",
     "stopped": "stopped by the stop condition",
+    "limit": "stopped at a joint's position limit",
     "interrupted": "interrupted",
     "failed": "integration failed",
 }
@@ -77,8 +78,8 @@ class SimulationResult:
 
     @property
     def completed(self) -> bool:
-        """True when the run reached its end time or its stop condition."""
-        return self.status in (RunStatus.FINISHED, RunStatus.STOPPED)
+        """True when the run reached its end time, its stop condition or a joint's limit."""
+        return self.status in (RunStatus.FINISHED, RunStatus.STOPPED, RunStatus.LIMIT)
 
     def columns(self) -> dict[str, np.ndarray]:
         """Named columns: t, <q>, <q>_dot, energy, lambda_<c>, residual_<c>, power."""

@@ -59,6 +59,8 @@ def test_the_command_lines(cli):
     assert document["final_state"]["shoulder"] == pytest.approx(-3.1, abs=1e-9)
     free = json.loads(cli(*through, "--json").out)
     assert free["status"] == "finished" and free["t_final"] == pytest.approx(3.0)
+    for record in free["limits_exceeded"]:  # the arm's velocity limits are 5 rad/s
+        assert record["quantity"] == "velocity" and record["value"] > record["limit"] == 5.0
 
 
 def test_the_python():

@@ -75,3 +75,21 @@ def test_a_stop_condition_before_the_limit_still_stops(pendulum):
     run = lagrangian.load(pendulum).simulate(3.0, initial={"hinge_1": 0.4},
                                              stop_when="hinge_1 < 0")
     assert run.status == "stopped" and run.q[-1, 0] == pytest.approx(0, abs=1e-9)
+
+
+def test_velocity_and_effort_limits_exceeded_are_reported(pendulum, cli):
+    # the URDF's velocity limit 1 rad/s; from 0.4 rad at rest the bob passes the bottom at
+    # sqrt(2 g (1 - cos 0.4)) = 1.24 rad/s, a quarter of a small-angle period in
+    run = lagrangian.load(pendulum).simulate(3.0, initial={"hinge_1": 0.4}, limits=False)
+    (record,) = run.summary()["limits_exceeded"]
+    assert record["joint"] == "hinge.1" and record["quantity"] == "velocity"
+    assert record["limit"] == 1.0 and record["unit"] == "rad/s"
+    assert record["value"] == pytest.approx(math.sqrt(2 * G * (1 - math.cos(0.4))), rel=1e-4)
+    assert record["t"] == pytest.approx(0.5 * math.pi * math.sqrt(1 / G), rel=0.02)
+    # an actuator torque above the effort limit (1 N m), and the text summary
+    result = cli("simulate", str(pendulum), "--t-end", "0.2", "--set", "tau_hinge_1=2")
+    assert result.code == 0, result.err
+    assert "effort limit exceeded: joint 'hinge.1' (hinge_1) 2 N m > 1 N m" in result.out
+    # a slow swing exceeds nothing
+    calm = lagrangian.load(pendulum).simulate(3.0, initial={"hinge_1": 0.1})
+    assert calm.summary()["limits_exceeded"] == []

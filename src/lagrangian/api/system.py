@@ -53,11 +53,11 @@ from ..model.urdf import example_urdf, read_urdf
 from ..model.values import State, resolve_state
 from ..simulation.events import StopCondition
 from ..simulation.simulate import (
-    PositionLimit,
     SaveAt,
     StepControl,
     parse_stop_condition,
     simulate,
+    urdf_limits,
 )
 from .modes import ModalAnalysis
 from .simulation import Simulation
@@ -197,7 +197,8 @@ class System:
         condition such as "theta < 0" (or a StopCondition) that ends the run. Constrained models
         are kept on Phi = 0 by projection (see docs/simulation.md). A robot read from URDF
         stops with status 'limit' when a joint reaches its position limit, naming it
-        (``limits=False`` ignores them).
+        (``limits=False`` ignores them); velocity and effort limits exceeded are reported
+        either way (``summary()["limits_exceeded"]``).
         """
         require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
@@ -208,16 +209,8 @@ class System:
         result = simulate(self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
                           progress=progress, functions=self._numeric,
-                          limits=self._position_limits() if limits else ())
+                          limits=urdf_limits(self._model, positions=limits))
         return Simulation.of(result)
-
-    def _position_limits(self) -> tuple[PositionLimit, ...]:
-        names = [c.name for c in self._model.coordinates]
-        joints = self.joint_names
-        units = {c.name: c.unit for c in self._model.coordinates}
-        return tuple(PositionLimit(names.index(name), name, joints[name], lower, upper,
-                                   units[name])
-                     for name, (lower, upper) in self.joint_limits.items())
 
     # -- standalone C for a controller -----------------------------------------------------------
 

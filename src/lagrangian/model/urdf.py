@@ -307,7 +307,23 @@ class _Tree:
         model = builder.build_model()
         tree = self._tree(root, order, position, names, bodies)
         return replace(model, rigid_bodies=bodies, kinematic_tree=tree,
-                       source_names=tuple((name, joint) for joint, name in names.items()))
+                       source_names=tuple((name, joint) for joint, name in names.items()),
+                       source_ratings=tuple((name, *self._ratings(joint))
+                                            for joint, name in names.items()))
+
+    def _ratings(self, name: str) -> tuple[float | None, float | None]:
+        """A joint's velocity and effort limits (positive numbers, else None)."""
+        limit = self.by_name[name].limit
+
+        def positive(value):
+            try:
+                value = float(value)
+            except (TypeError, ValueError):
+                return None
+            return value if math.isfinite(value) and value > 0 else None
+
+        return (None, None) if limit is None else (positive(limit.velocity),
+                                                   positive(limit.effort))
 
     def _positions(self, lock: dict[str, float], names: dict[str, str]):
         """Each movable joint's position (angle or distance) and rate as expressions in q."""

@@ -59,6 +59,9 @@ class SimulationResult:
     invariant: str = "energy"
     invariant_values: np.ndarray | None = None
     work: np.ndarray | None = None
+    # URDF velocity and effort limits exceeded (simulate.JointLimit): one dict each, with
+    # joint, coordinate, quantity, limit, value, t (None for effort) and unit
+    limits_exceeded: tuple[dict, ...] = ()
 
     @property
     def model_name(self) -> str:

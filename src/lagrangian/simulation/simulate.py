@@ -31,8 +31,8 @@ from .invariants import cumulative_work, energy_is_conserved, invariant_kind
 from .options import METHODS, SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
 
-__all__ = ["METHODS", "STATUS_MESSAGES", "PositionLimit", "SaveAt", "SimulationResult", "StepControl",
-           "StopCondition", "parse_stop_condition", "simulate"]
+__all__ = ["METHODS", "STATUS_MESSAGES", "JointLimit", "SaveAt", "SimulationResult", "StepControl",
+           "StopCondition", "parse_stop_condition", "simulate", "urdf_limits"]
 
 DEFAULT_STEP_CONTROL = StepControl()  # DOP853, rtol = atol = 1e-9
 DEFAULT_SAVE_AT = SaveAt()  # 1001 evenly spaced samples
@@ -50,7 +50,7 @@ def simulate(
     progress: Callable[[float], None] | None = None,
     functions: NumericSystem | None = None,
     compiled_loop: bool = True,
-    limits: Sequence[PositionLimit] = (),
+    limits: Sequence[JointLimit] = (),
 ) -> SimulationResult:
     """Integrate from the initial state to ``t_end`` (s), saving where ``save_at`` says.
 
@@ -59,7 +59,8 @@ def simulate(
     the time reached after each step. ``compiled_loop`` allows the DOP853 loop in C where it
     applies. Failures and Ctrl-C return the partial result with ``status`` 'failed' or
     'interrupted' and the time reached in ``message``. ``limits`` (a robot's URDF position
-    limits) end the run with status 'limit' when a joint reaches one, naming it.
+    limits, JointLimit) end the run with status 'limit' when a joint reaches one, naming it;
+    velocity and effort limits exceeded are reported in ``limits_exceeded``.
     """
     model = eom.model
     start = resolve_state(model, initial, field="initial", what="coordinate or velocity (or t)")
@@ -74,6 +75,7 @@ def simulate(
         if functions.m else None
     event = _event(StateFunction(model, [stop.function], substitution)) if stop else None
     beyond = _beyond(limits) if limits else None
+    positioned = [m for m in limits if m.lower is not None and m.upper is not None]
     power_terms = StateFunction(model, eom.generalized_forces, substitution)
 
     q0, v0, projected = start.q_array(), start.q_dot_array(), {}
@@ -86,7 +88,7 @@ def simulate(
     run = _integrate(functions, y0, grid, step_control, event, drift, progress,
                      compiled_loop and not functions.m and event is None, beyond)
     if beyond is not None and run.status == RunStatus.STOPPED:
-        run = _at_limit(run, limits, beyond, event, functions.n)
+        run = _at_limit(run, positioned, beyond, event, functions.n)
     wall = time.perf_counter() - began
     if run.status == RunStatus.FAILED:
         run = replace(run, message=_explain_failure(functions, run))
@@ -116,6 +118,7 @@ def simulate(
         energy_conserved=energy_is_conserved(eom), t_end=float(t_end),
         stop_when=stop.text if stop else None, projected_initial_state=projected,
         kinetic_energy=kinetic, invariant=kind, invariant_values=invariant, work=work,
+        limits_exceeded=_exceeded(limits, functions.parameters, t, q_dot),
     )
 
 
@@ -162,20 +165,67 @@ def _integrate(functions, y0, grid, step_control, event, drift, progress, compil
 
 
 @dataclass(frozen=True)
-class PositionLimit:
-    """A joint's position limit on one coordinate (rad or m), as the URDF gives it."""
+class JointLimit:
+    """A URDF joint's limits on one coordinate: position (rad or m; None: none), velocity
+    (rad/s or m/s) and effort (N m or N, on its actuator parameter), as the file gives them."""
 
     coordinate: int  # index in the model's coordinates
     name: str  # the coordinate's name
     joint: str  # the URDF's joint name
-    lower: float
-    upper: float
+    lower: float | None = None
+    upper: float | None = None
     unit: str = "rad"
+    velocity: float | None = None
+    effort: float | None = None
+    actuator: str | None = None  # the parameter of its generalized force (tau_<joint>)
 
 
-def _beyond(limits: Sequence[PositionLimit]):
-    """h(q) = the largest distance beyond a limit (< 0 while every joint is inside): the event
-    turns true when a joint reaches its limit."""
+def urdf_limits(model, positions: bool = True) -> tuple[JointLimit, ...]:
+    """A robot read from URDF: its joints' limits per coordinate (the position limits left out
+    where ``positions`` is False); () for other models."""
+    coordinates = {c.name: (i, c) for i, c in enumerate(model.coordinates)}
+    ratings = {name: (velocity, effort) for name, velocity, effort in model.source_ratings}
+    parameters = {p.name for p in model.parameters}
+    out = []
+    for name, joint in model.source_names:
+        if name not in coordinates:
+            continue
+        i, c = coordinates[name]
+        lower, upper = c.range if positions and c.range is not None else (None, None)
+        actuator = f"tau_{name}" if f"tau_{name}" in parameters else None
+        out.append(JointLimit(i, name, joint, lower, upper, c.unit,
+                              *ratings.get(name, (None, None)), actuator))
+    return tuple(out)
+
+
+def _exceeded(limits: Sequence[JointLimit], parameters: Mapping[str, float], t, q_dot
+              ) -> tuple[dict, ...]:
+    """Velocity limits exceeded on the samples (the largest |q_dot|, and when) and effort
+    limits exceeded by the actuator parameters, one record each."""
+    out = []
+    for limit in limits:
+        if limit.velocity is not None and len(t):
+            speeds = np.abs(q_dot[:, limit.coordinate])
+            k = int(np.argmax(speeds))
+            if speeds[k] > limit.velocity:
+                out.append({"joint": limit.joint, "coordinate": limit.name,
+                            "quantity": "velocity", "limit": limit.velocity,
+                            "value": float(speeds[k]), "t": float(t[k]),
+                            "unit": f"{limit.unit}/s"})
+        value = parameters.get(limit.actuator) if limit.actuator else None
+        if limit.effort is not None and value is not None and abs(value) > limit.effort:
+            out.append({"joint": limit.joint, "coordinate": limit.name, "quantity": "effort",
+                        "limit": limit.effort, "value": float(abs(value)), "t": None,
+                        "unit": "N" if limit.unit == "m" else "N m"})
+    return tuple(out)
+
+
+def _beyond(limits: Sequence[JointLimit]):
+    """h(q) = the largest distance beyond a position limit (< 0 while every joint is inside):
+    the event turns true when a joint reaches its limit; None without position limits."""
+    limits = [limit for limit in limits if limit.lower is not None and limit.upper is not None]
+    if not limits:
+        return None
     index = np.array([limit.coordinate for limit in limits])
     lower = np.array([limit.lower for limit in limits])
     upper = np.array([limit.upper for limit in limits])

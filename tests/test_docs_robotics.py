@@ -39,7 +39,7 @@ def wall_gravity(q1, q2, g=9.81):
 
 
 def test_the_command_lines(cli):
-    gravity, equilibria, as_json, show, beyond, stops, through = commands("robotics-cli")
+    gravity, equilibria, as_json, show, beyond, stops, through, payload = commands("robotics-cli")
     result = cli(*gravity)
     assert result.code == 0, result.err
     for value in wall_gravity(0.3, 0.5):
@@ -61,6 +61,8 @@ def test_the_command_lines(cli):
     assert free["status"] == "finished" and free["t_final"] == pytest.approx(3.0)
     for record in free["limits_exceeded"]:  # the arm's velocity limits are 5 rad/s
         assert record["quantity"] == "velocity" and record["value"] > record["limit"] == 5.0
+    M = np.array(json.loads(cli(*payload, "--json").out)["mass_matrix"])
+    assert M[1, 1] == pytest.approx(0.34 + 2.0 * 0.5**2, rel=1e-12)  # M22 + m r^2
 
 
 def test_the_python():

@@ -563,21 +563,27 @@ class SystemBuilder(ModelBuilder):
 
 
 def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None,
-         gravity: Sequence[float] | None = None) -> System:
-    """Load a model file (TOML), a robot (URDF: ``lock`` freezes joints by name, rad or m), or
-    a built-in example by name (see ``examples()``); ``gravity`` (g_x, g_y, g_z) in m/s^2 turns
-    the model's gravity (System.with_gravity)."""
-    system = _load(path_or_example, lock)
+         gravity: Sequence[float] | None = None, payload: Mapping[str, object] | None = None
+         ) -> System:
+    """Load a model file (TOML), a robot (URDF: ``lock`` freezes joints by name, rad or m;
+    ``payload`` {link: mass, or (mass, (x, y, z))} fixes point masses (kg, m in the link's
+    frame) to links, as an edited URDF would), or a built-in example by name (see
+    ``examples()``); ``gravity`` (g_x, g_y, g_z) in m/s^2 turns the model's gravity
+    (System.with_gravity)."""
+    system = _load(path_or_example, lock, payload)
     return system if gravity is None else system.with_gravity(gravity)
 
 
-def _load(path_or_example: str | Path, lock: Mapping[str, float] | None) -> System:
+def _load(path_or_example: str | Path, lock, payload) -> System:
     path = Path(path_or_example)
     if path.suffix.lower() == ".urdf":
-        return System(read_urdf(path, lock))
+        return System(read_urdf(path, lock, payload))
     urdf = None if path.exists() else example_urdf(str(path_or_example))
     if urdf is not None:
-        return System(replace(read_urdf(urdf, lock), source=f"example:{path_or_example}"))
+        return System(replace(read_urdf(urdf, lock, payload),
+                              source=f"example:{path_or_example}"))
+    if payload:
+        raise InputError("only a URDF model has links to carry a payload", field="payload")
     if lock:
 
         raise InputError("only a URDF model has joints to lock", field="lock")

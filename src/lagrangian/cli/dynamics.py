@@ -10,7 +10,7 @@ import typer
 
 from ..errors import DerivationError, DynamicsWarning, InputError
 from . import app
-from .common import GRAVITY_HELP, load_system, print_json, warn, warn_bare_angles
+from .common import GRAVITY_HELP, PAYLOAD_HELP, load_system, print_json, warn, warn_bare_angles
 
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
 
@@ -36,6 +36,7 @@ def dynamics(
     tau: Annotated[str | None, typer.Option("--tau", help="Generalized forces on top of the model's loads: print the forward dynamics q_ddot.")] = None,  # noqa: E501
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
+    payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
@@ -47,7 +48,7 @@ def dynamics(
     if a is not None and tau is not None:
         raise InputError("--a (inverse dynamics) and --tau (forward dynamics) ask for two "
                          "things; give one")
-    system = load_system(model, set_, lock, gravity)
+    system = load_system(model, set_, lock, gravity, payload)
     coordinates = system.model.coordinates
     n = len(coordinates)
     qs = _vector(q, n, "--q", [c.initial or 0.0 for c in coordinates])

@@ -16,6 +16,7 @@ from .common import (
     GRAVITY_HELP,
     LOCK_HELP,
     ONLY_WITH_ANIMATE,
+    PAYLOAD_HELP,
     SET_HELP,
     SIZE_HELP,
     load_system,
@@ -33,6 +34,7 @@ def simulate(
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
+    payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
     method: Annotated[str, typer.Option("--method", help=f"Integrator: {', '.join(METHODS)}.")] = "DOP853",
     rtol: Annotated[float, typer.Option("--rtol", help="Relative tolerance.")] = 1e-9,
     atol: Annotated[float, typer.Option("--atol", help="Absolute tolerance.")] = 1e-9,
@@ -63,7 +65,7 @@ def simulate(
     from ..output.simulation import projection_warning, simulation_document, simulation_text
     from ..output.tables import check_table_path
 
-    system = load_system(model, set_, lock, gravity)
+    system = load_system(model, set_, lock, gravity, payload)
     warn_if_unphysical(system.equations_of_motion())
     end = parse_quantity(t_end, "s", "--t-end")
     # Everything the user typed is checked (by the library) before the integration starts.

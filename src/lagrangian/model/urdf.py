@@ -43,9 +43,11 @@ GRAVITY = 9.81  # m/s^2, along -z
 _SNAP = 1e-14
 
 
-def read_urdf(path, lock: Mapping[str, float] | None = None) -> Model:
-    """Load a URDF file as a model; ``lock`` freezes joints at values (rad or m) by name."""
-    return parse_urdf(read_text_file(path), source=str(path), lock=lock)
+def read_urdf(path, lock: Mapping[str, float] | None = None,
+              payload: Mapping[str, object] | None = None) -> Model:
+    """Load a URDF file as a model; ``lock`` freezes joints at values (rad or m) by name,
+    ``payload`` adds point masses to links (urdf_payload.py)."""
+    return parse_urdf(read_text_file(path), source=str(path), lock=lock, payload=payload)
 
 
 def example_urdf(name: str):
@@ -57,13 +59,17 @@ def example_urdf(name: str):
 
 
 def parse_urdf(text: str, *, source: str = "<urdf>",
-               lock: Mapping[str, float] | None = None) -> Model:
-    """The model of a URDF document (see the module docstring for what each element becomes)."""
-    robot = _parse(text, source)
+               lock: Mapping[str, float] | None = None,
+               payload: Mapping[str, object] | None = None) -> Model:
+    """The model of a URDF document (see the module docstring for what each element becomes);
+    ``payload`` {link: mass or (mass, (x, y, z))} adds point masses (urdf_payload.py)."""
+    from .urdf_payload import payload_values
+
+    robot = _parse(text, source, payload_values(payload) if payload else None)
     return _Tree(robot, source).model(dict(lock or {}))
 
 
-def _parse(text: str, source: str):
+def _parse(text: str, source: str, payloads=None):
     from lxml import etree
 
     data = text.encode("utf-8")
@@ -72,6 +78,11 @@ def _parse(text: str, source: str):
     except etree.XMLSyntaxError as exc:
         raise ModelError(f"not well-formed XML ({exc})", source=source) from None
     _check_inertials(root, source)
+    if payloads:
+        from .urdf_payload import add_payloads
+
+        add_payloads(root, payloads, source)
+        data = etree.tostring(root)
     import yourdfpy
 
     try:

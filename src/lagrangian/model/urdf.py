@@ -3,7 +3,9 @@
 URDF is read by yourdfpy (meshes, visual and collision elements are never loaded). Each
 revolute, continuous or prismatic joint that is neither locked nor a mimic is a coordinate named
 after it (rad or m); its actuator is the generalized force ``tau_<joint>`` (N m, or N for a
-prismatic joint), a parameter of value 0. Gravity is g = 9.81 m/s^2 along -z. A link's frame is
+prismatic joint), a parameter of value 0. Gravity is g = 9.81 m/s^2 along -z (gravity.py turns
+it). The file's joint names and limits are kept (Model.source_names, source_ratings; the
+position limits as the coordinates' ranges). A link's frame is
 
     R_child = R_parent R_origin(rpy) R_axis(angle),  x_child = x_parent + R_parent xyz (+ d axis)
 

@@ -70,6 +70,7 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
         parse_model,
         read_model,
     )
+    from .errors import DynamicsWarning
 
 __version__ = "0.1.0"
 
@@ -90,6 +91,7 @@ __all__ = [
     "DerivationError",
     "DerivationSteps",
     "Dynamics",
+    "DynamicsWarning",
     "EquationsOfMotion",
     "Equilibria",
     "Equilibrium",
@@ -137,6 +139,7 @@ __all__ = [
     "answer_files",
     "bare_angle_warnings",
     "check_report_path",
+    "limit_warnings",
     "course_document",
     "course_folder",
     "example_names",
@@ -161,6 +164,7 @@ _SYMPY_NAMES = frozenset({"cos", "exp", "sin", "sqrt", "tan"})
 # Public functions and limits that live in one stage, loaded from their own module on first use
 # (not through the API, so that `lagrangian examples` starts without sympy or numpy).
 _HOMES = {
+    "DynamicsWarning": ("errors", "DynamicsWarning"),
     "parse_quantity": ("model.units", "parse_quantity"),
     "state_units": ("model.values", "state_units"),
     "resolve_state": ("model.values", "resolve_state"),
@@ -174,6 +178,7 @@ _HOMES = {
     "speed_sweep": ("analysis.speed_form", "speed_sweep"),
     "MAX_STUDY_POINTS": ("analysis.study", "MAX_STUDY_POINTS"),
     "bare_angle_warnings": ("check.warnings", "bare_angle_warnings"),
+    "limit_warnings": ("check.warnings", "limit_warnings"),
     "answer_files": ("check.classroom", "answer_files"),
     "course_document": ("check.course", "course_document"),
     "course_folder": ("check.course", "course_folder"),

@@ -116,3 +116,13 @@ def require_extra(extra: str, modules: Iterable[str], what: str) -> None:
 
 class DerivationError(LagrangianError):
     """The model is well formed but its equations cannot be formed (singular mass matrix, ...)."""
+
+
+class DynamicsWarning(UserWarning):
+    """Some states of a batch have no dynamics (an input not finite, or for forward dynamics a
+    mass matrix that is not positive definite): their output rows are NaN, the others exact.
+    Issued once per call; ``count`` and ``total`` say how many states of how many."""
+
+    def __init__(self, message: str, count: int = 0, total: int = 0):
+        super().__init__(message)
+        self.count, self.total = count, total

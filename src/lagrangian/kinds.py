@@ -38,6 +38,7 @@ class RunStatus(StrEnum):
 
     FINISHED = "finished"
     STOPPED = "stopped"
+    LIMIT = "limit"  # a joint reached its URDF position limit (simulate's limits)
     INTERRUPTED = "interrupted"
     FAILED = "failed"
 

@@ -52,7 +52,13 @@ from ..model.reader import read_model
 from ..model.urdf import example_urdf, read_urdf
 from ..model.values import State, resolve_state
 from ..simulation.events import StopCondition
-from ..simulation.simulate import SaveAt, StepControl, parse_stop_condition, simulate
+from ..simulation.simulate import (
+    SaveAt,
+    StepControl,
+    parse_stop_condition,
+    simulate,
+    urdf_limits,
+)
 from .modes import ModalAnalysis
 from .simulation import Simulation
 
@@ -92,6 +98,26 @@ class System:
         """Parameter name -> SI value (None for symbolic-only parameters)."""
         return {p.name: p.value for p in self._model.parameters}
 
+    @property
+    def joint_names(self) -> dict[str, str]:
+        """A robot read from URDF: coordinate name -> the file's joint name (the coordinate is
+        the joint's name made an identifier, "joint_8.0" -> "joint_8_0"); {} for other models."""
+        return dict(self._model.source_names)
+
+    @property
+    def coordinate_names(self) -> dict[str, str]:
+        """The reverse of ``joint_names``: the URDF's joint name -> coordinate name (joints that
+        move; locked, fixed and mimic joints have no coordinate)."""
+        return {joint: coordinate for coordinate, joint in self._model.source_names}
+
+    @property
+    def joint_limits(self) -> dict[str, tuple[float, float]]:
+        """A robot read from URDF: coordinate name -> its joint's position limit (lower, upper)
+        in rad or m, where the file gives one; {} for other models."""
+        from ..check.warnings import joint_limits
+
+        return joint_limits(self._model)
+
     def symbol(self, name: str) -> sp.Symbol:
         """The sympy symbol of a coordinate, velocity or parameter, by name."""
         for c in self._model.coordinates:
@@ -106,6 +132,15 @@ class System:
     def with_parameters(self, **values: float) -> System:
         """A copy of the system with some parameter values replaced (SI units)."""
         return System(self._model.with_parameter_values(values))
+
+    def with_gravity(self, gravity: Sequence[float]) -> System:
+        """A copy under uniform gravity ``(g_x, g_y, g_z)`` in world axes (m/s^2): the gravity
+        parameter (a URDF's ``g``) becomes |g| and the direction g/|g|, as Pinocchio's
+        ``model.gravity``; a robot's compiled dynamics are rebuilt for (and cached by) the
+        direction."""
+        from ..model.gravity import with_gravity
+
+        return System(with_gravity(self._model, gravity))
 
     def equations_of_motion(self) -> EquationsOfMotion:
         """M q_ddot + Phi_q^T lambda = f by Lagrange's method (derived once, then cached)."""
@@ -151,6 +186,7 @@ class System:
         rtol: float = 1e-9,
         atol: float = 1e-9,
         samples: int = 1001,
+        limits: bool = True,
     ) -> Simulation:
         """Integrate the equations of motion to ``t_end`` (s); returns a Simulation.
 
@@ -159,7 +195,10 @@ class System:
         ``save_at`` (SaveAt: samples) say how to integrate and what to keep (``method``,
         ``rtol``, ``atol`` and ``samples`` are the same as plain keywords); ``stop_when`` is a
         condition such as "theta < 0" (or a StopCondition) that ends the run. Constrained models
-        are kept on Phi = 0 by projection (see docs/simulation.md).
+        are kept on Phi = 0 by projection (see docs/simulation.md). A robot read from URDF
+        stops with status 'limit' when a joint reaches its position limit, naming it
+        (``limits=False`` ignores them); velocity and effort limits exceeded are reported
+        either way (``summary()["limits_exceeded"]``).
         """
         require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
@@ -169,7 +208,8 @@ class System:
             else stop_when
         result = simulate(self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
-                          progress=progress, functions=self._numeric)
+                          progress=progress, functions=self._numeric,
+                          limits=urdf_limits(self._model, positions=limits))
         return Simulation.of(result)
 
     # -- standalone C for a controller -----------------------------------------------------------
@@ -532,15 +572,28 @@ class SystemBuilder(ModelBuilder):
         return System(self.build_model())
 
 
-def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None) -> System:
-    """Load a model file (TOML), a robot (URDF: ``lock`` freezes joints by name, rad or m), or
-    a built-in example by name (see ``examples()``)."""
+def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None,
+         gravity: Sequence[float] | None = None, payload: Mapping[str, object] | None = None
+         ) -> System:
+    """Load a model file (TOML), a robot (URDF: ``lock`` freezes joints by name, rad or m;
+    ``payload`` {link: mass, or (mass, (x, y, z))} fixes point masses (kg, m in the link's
+    frame) to links, as an edited URDF would), or a built-in example by name (see
+    ``examples()``); ``gravity`` (g_x, g_y, g_z) in m/s^2 turns the model's gravity
+    (System.with_gravity)."""
+    system = _load(path_or_example, lock, payload)
+    return system if gravity is None else system.with_gravity(gravity)
+
+
+def _load(path_or_example: str | Path, lock, payload) -> System:
     path = Path(path_or_example)
     if path.suffix.lower() == ".urdf":
-        return System(read_urdf(path, lock))
+        return System(read_urdf(path, lock, payload))
     urdf = None if path.exists() else example_urdf(str(path_or_example))
     if urdf is not None:
-        return System(replace(read_urdf(urdf, lock), source=f"example:{path_or_example}"))
+        return System(replace(read_urdf(urdf, lock, payload),
+                              source=f"example:{path_or_example}"))
+    if payload:
+        raise InputError("only a URDF model has links to carry a payload", field="payload")
     if lock:
 
         raise InputError("only a URDF model has joints to lock", field="lock")

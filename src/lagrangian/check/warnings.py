@@ -72,7 +72,33 @@ def bare_angle_warnings(option: str, written: Iterable[tuple[str, str]],
     return lines
 
 
+def joint_limits(model: Model) -> dict[str, tuple[float, float]]:
+    """A robot read from URDF: coordinate name -> its joint's position limit (lower, upper) in
+    rad or m, for the joints that have one (a continuous joint has none)."""
+    coordinates = {c.name: c for c in model.coordinates}
+    return {name: coordinates[name].range for name, _ in model.source_names
+            if name in coordinates and coordinates[name].range is not None}
+
+
+def limit_warnings(model: Model, values: Mapping[str, float], option: str = "--q") -> list[str]:
+    """One line for each coordinate of ``values`` (SI) beyond its URDF joint's position limit,
+    naming the file's joint and the limit."""
+    limits, joints = joint_limits(model), dict(model.source_names)
+    units = {c.name: c.unit for c in model.coordinates}
+    lines = []
+    for name, value in values.items():
+        if name not in limits or not math.isfinite(value):
+            continue
+        lower, upper = limits[name]
+        if lower <= value <= upper:
+            continue
+        lines.append(f"{option} {name}={value:.6g} {units[name]} is beyond the position limit "
+                     f"[{lower:.6g}, {upper:.6g}] {units[name]} of URDF joint '{joints[name]}'")
+    return lines
+
+
 _BARE_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
 
-__all__ = ["bare_angle_warnings", "model_warnings", "setting_warnings"]
+__all__ = ["bare_angle_warnings", "joint_limits", "limit_warnings", "model_warnings",
+           "setting_warnings"]

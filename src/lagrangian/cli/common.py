@@ -56,6 +56,10 @@ ONLY_WITH_ANIMATE = {"size": "a frame size is", "fps": "frames a second are",
 SIZE_HELP = "Frame size of the animation in pixels, WIDTHxHEIGHT (default 400x400 a drawing)."
 FPS_HELP = "Frames a second of the animation (1 to 120)."
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
+PAYLOAD_HELP = ("URDF: a point mass fixed to a link, LINK=MASS[@X,Y,Z] (kg; m in the link's "
+                "frame, default its origin); repeatable.")
+GRAVITY_HELP = ("Gravity as a vector in world axes, GX,GY,GZ in m/s^2 (default: the model's; "
+                "a URDF's is 0,0,-9.81).")
 
 
 def in_flags(error: LagrangianError) -> LagrangianError:
@@ -69,14 +73,23 @@ def in_flags(error: LagrangianError) -> LagrangianError:
     return ModelError(error.message, field=f"{FLAG_OF_FIELD[head]} {rest}".strip())
 
 
-def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = ()) -> System:
+def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = (),
+                gravity: str | None = None, payload: Iterable[str] = ()) -> System:
     """The system of a model file or built-in example, with --set overrides applied (and a
-    URDF's joints frozen by --lock NAME=VALUE)."""
+    URDF's joints frozen by --lock NAME=VALUE, its gravity turned by --gravity GX,GY,GZ; a
+    later --set g=... rescales that vector's magnitude)."""
     from .. import load, parse_quantity
 
     locked = {name: parse_quantity(text, None, f"--lock {name}")
               for name, text in assignments(lock, "--lock")}
-    system = load(model, lock=locked) if locked else load(model)
+    carried = payloads(payload)
+    system = load(model, lock=locked, payload=carried) if locked or carried else load(model)
+    if gravity is not None:
+        parts = [part.strip() for part in gravity.split(",")]
+        if len(parts) != 3:
+            raise InputError(f"expected 3 comma-separated components g_x,g_y,g_z (m/s^2), got "
+                             f"{len(parts)}", field="--gravity")
+        system = system.with_gravity([parse_quantity(p, "m/s^2", "--gravity") for p in parts])
     values = parameter_values(system, settings)
     system = system.with_parameters(**values) if values else system
     for line in system.warnings(set_parameters=values):
@@ -154,6 +167,22 @@ def comma_separated(settings: Iterable[str]) -> list[str]:
 
 
 _NEXT_ASSIGNMENT = re.compile(r",(?=\s*[A-Za-z_][A-Za-z0-9_]*\s*=)")
+
+
+def payloads(settings: Iterable[str]) -> dict[str, tuple[float, tuple[float, ...]]]:
+    """--payload LINK=MASS[@X,Y,Z] options as {link: (kg, (x, y, z) in m)}."""
+    from .. import parse_quantity
+
+    out = {}
+    for link, text in assignments(settings, "--payload"):
+        mass, _, point = text.partition("@")
+        field = f"--payload {link}"
+        parts = [p.strip() for p in point.split(",")] if point.strip() else ["0", "0", "0"]
+        if len(parts) != 3:
+            raise InputError(f"expected MASS@X,Y,Z, got {len(parts)} coordinates", field=field)
+        out[link] = (parse_quantity(mass.strip(), "kg", field),
+                     tuple(parse_quantity(p, "m", field) for p in parts))
+    return out
 
 
 def assignments(settings: Iterable[str], option: str) -> list[tuple[str, str]]:

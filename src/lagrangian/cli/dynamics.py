@@ -3,13 +3,14 @@ inverse or forward dynamics and the energies at one state."""
 
 from __future__ import annotations
 
+import warnings
 from typing import Annotated
 
 import typer
 
-from ..errors import DerivationError, InputError
+from ..errors import DerivationError, DynamicsWarning, InputError
 from . import app
-from .common import load_system, print_json, warn_bare_angles
+from .common import GRAVITY_HELP, PAYLOAD_HELP, load_system, print_json, warn, warn_bare_angles
 
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
 
@@ -34,6 +35,8 @@ def dynamics(
     a: Annotated[str | None, typer.Option("--a", help="Accelerations: print the inverse dynamics tau.")] = None,  # noqa: E501
     tau: Annotated[str | None, typer.Option("--tau", help="Generalized forces on top of the model's loads: print the forward dynamics q_ddot.")] = None,  # noqa: E501
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
+    gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
+    payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
     coriolis: Annotated[bool, typer.Option("--coriolis", help="Also print C(q, q_dot), the matrix of the Coriolis and centrifugal terms (M_dot - 2C skew).")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
@@ -46,7 +49,7 @@ def dynamics(
     if a is not None and tau is not None:
         raise InputError("--a (inverse dynamics) and --tau (forward dynamics) ask for two "
                          "things; give one")
-    system = load_system(model, set_, lock)
+    system = load_system(model, set_, lock, gravity, payload)
     coordinates = system.model.coordinates
     n = len(coordinates)
     qs = _vector(q, n, "--q", [c.initial or 0.0 for c in coordinates])
@@ -57,9 +60,16 @@ def dynamics(
         texts = [part.strip() for part in q.split(",")]
         warn_bare_angles("--q", zip(names, texts, strict=True), state_units(system.model),
                          dict(zip(names, qs, strict=True)))
+        from .. import limit_warnings
+
+        for line in limit_warnings(system.model, dict(zip(names, qs, strict=True)), "--q"):
+            warn(line)
     vs = _vector(v, n, "--v", [c.rate or 0.0 for c in coordinates])
     f = system.dynamics()
-    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below
+    with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings(record=True) as seen:
+        # an overflow is refused below; a state without dynamics (M not positive definite)
+        # is a DynamicsWarning and NaN, reported in one line
+        warnings.simplefilter("always", DynamicsWarning)
         values = {"q": qs, "v": vs, "mass_matrix": f.mass_matrix(qs),
                   "bias_forces": f.bias_forces(qs, vs), "gravity": f.gravity(qs)}
         if a is not None:
@@ -72,13 +82,22 @@ def dynamics(
             values["coriolis_matrix"] = f.coriolis_matrix(qs, vs)
         values["kinetic_energy"] = f.kinetic_energy(qs, vs)
         values["potential_energy"] = f.potential_energy(qs)
+    undefined = [w for w in seen if issubclass(w.category, DynamicsWarning)]
+    if undefined:
+        nan = [key.replace("_", " ") for key, value in values.items()
+               if np.isnan(np.asarray(value, dtype=float)).all()]
+        warn(f"no {', '.join(nan) or 'dynamics'} at this state: the mass matrix is not "
+             "positive definite there (or an input is not finite); shown as NaN (null in JSON)")
     for key, value in values.items():  # an overflow is no result (m L^2 of 1e299 each)
-        if not np.all(np.isfinite(np.asarray(value, dtype=float))):
+        array = np.asarray(value, dtype=float)
+        if undefined and np.isnan(array).all():
+            continue
+        if not np.all(np.isfinite(array)):
             raise DerivationError(f"the {key.replace('_', ' ')} is not finite at this state "
                                   "(a number beyond floating point, or a state outside the "
                                   "model's domain)")
     names = [c.name for c in coordinates]
     if json_:
-        print_json(dynamics_document(names, values))
+        print_json(dynamics_document(names, values, system.joint_names))
     else:
         typer.echo(dynamics_text(names, values), nl=False)

@@ -7,7 +7,7 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import LOCK_HELP, SET_HELP, load_system, print_json
+from .common import GRAVITY_HELP, LOCK_HELP, PAYLOAD_HELP, SET_HELP, load_system, print_json
 
 
 @app.command()
@@ -15,12 +15,14 @@ def equilibria(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
+    gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
+    payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Find the equilibria (forces balance at rest, with the constraints) and their stability."""
     from ..output.modes import equilibria_document, equilibria_text
 
-    system = load_system(model, set_, lock)
+    system = load_system(model, set_, lock, gravity, payload)
     found = system.equilibria()
     if json_:
         print_json(equilibria_document(found))

@@ -6,9 +6,30 @@ from typing import Annotated
 
 import typer
 
-from .. import example_names, example_summary, example_text
+from .. import example_names, example_path, example_summary, example_text
 from . import app
 from .common import print_json
+
+
+def _show(name: str, json_: bool) -> None:
+    """The example's file; for a robot (URDF) its coordinates' joint names after it, as an XML
+    comment (the text stays a valid URDF), or with --json a document of both."""
+    path = example_path(name)
+    text = example_text(name)
+    joint_names: dict[str, str] = {}
+    if path.suffix == ".urdf":
+        from .. import load
+
+        joint_names = load(name).joint_names
+    if json_:
+        print_json({"name": name, "file": path.name, "text": text, "joint_names": joint_names})
+        return
+    typer.echo(text, nl=False)
+    if joint_names:
+        pairs = ", ".join(f"{c} = '{j}'" for c, j in joint_names.items())
+        # "--" may not appear inside an XML comment; URDF names rarely hold it
+        typer.echo(f"<!-- lagrangian coordinates (coordinate = URDF joint): "
+                   f"{pairs.replace('--', '- -')} -->")
 
 
 @app.command()
@@ -29,7 +50,7 @@ def examples(
         course_command(json_, copy)
         return
     if show is not None:
-        typer.echo(example_text(show), nl=False)
+        _show(show, json_)
         return
     summaries = [example_summary(name) for name in example_names()]
     if json_:

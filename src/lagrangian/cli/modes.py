@@ -11,8 +11,10 @@ import typer
 from . import app
 from .common import (
     FPS_HELP,
+    GRAVITY_HELP,
     LOCK_HELP,
     ONLY_WITH_ANIMATE,
+    PAYLOAD_HELP,
     SET_HELP,
     SIZE_HELP,
     load_system,
@@ -57,6 +59,8 @@ def modes(
     steady: Annotated[list[str], typer.Option("--steady", help=STEADY_HELP)] = [],  # noqa: B006
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
+    gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
+    payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option("--plot", help="Draw the mode shapes to a PNG file.")] = None,
     animate: Annotated[Path | None, typer.Option("--animate", help=ANIMATE_HELP)] = None,
@@ -72,7 +76,7 @@ def modes(
     from ..output.modes import modes_document, modes_text, write_mode_plot
     from ..output.plots import check_plot_path
 
-    system = load_system(model, set_, lock)
+    system = load_system(model, set_, lock, gravity, payload)
     point = state_assignments(system, about, "--about")
     inputs = (Path(model),) if Path(model).exists() else ()
     if plot is not None:  # before the analysis: a path that cannot be written costs nothing

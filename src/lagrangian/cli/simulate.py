@@ -13,8 +13,10 @@ from .. import SIMULATION_METHODS as METHODS  # light: the names only, no scipy
 from . import app
 from .common import (
     FPS_HELP,
+    GRAVITY_HELP,
     LOCK_HELP,
     ONLY_WITH_ANIMATE,
+    PAYLOAD_HELP,
     SET_HELP,
     SIZE_HELP,
     load_system,
@@ -31,6 +33,8 @@ def simulate(
     initial: Annotated[list[str], typer.Option("--initial", help="Initial value: NAME=VALUE (theta=30deg, theta_dot=0, t=0); default: the model's initial/rate; repeat, or separate by commas.")] = [],  # noqa: B006,E501
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
+    gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
+    payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
     method: Annotated[str, typer.Option("--method", help=f"Integrator: {', '.join(METHODS)}.")] = "DOP853",
     rtol: Annotated[float, typer.Option("--rtol", help="Relative tolerance.")] = 1e-9,
     atol: Annotated[float, typer.Option("--atol", help="Absolute tolerance.")] = 1e-9,
@@ -42,6 +46,7 @@ def simulate(
     size: Annotated[str | None, typer.Option("--size", help=SIZE_HELP)] = None,
     fps: Annotated[int | None, typer.Option("--fps", help=FPS_HELP + " Default 20.")] = None,
     stop_when: Annotated[str | None, typer.Option("--stop-when", help="Stop when a condition turns true, e.g. \"theta < 0\".")] = None,  # noqa: E501
+    ignore_limits: Annotated[bool, typer.Option("--ignore-limits", help="URDF: run through the joints' position limits (by default a joint reaching one ends the run, status 'limit').")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
@@ -60,7 +65,7 @@ def simulate(
     from ..output.simulation import projection_warning, simulation_document, simulation_text
     from ..output.tables import check_table_path
 
-    system = load_system(model, set_, lock)
+    system = load_system(model, set_, lock, gravity, payload)
     warn_if_unphysical(system.equations_of_motion())
     end = parse_quantity(t_end, "s", "--t-end")
     # Everything the user typed is checked (by the library) before the integration starts.
@@ -98,7 +103,7 @@ def simulate(
         simulation = system.simulate(
             end, initial=start, method=step_control.method,
             rtol=step_control.rtol, atol=step_control.atol, samples=save_at.samples,
-            stop_when=stop, progress=progress.update,
+            stop_when=stop, progress=progress.update, limits=not ignore_limits,
         )
     warning = projection_warning(simulation)
     if warning:

@@ -14,19 +14,51 @@ A robot read from URDF (a tree of rigid bodies on revolute, prismatic and fixed 
 added) is evaluated by recursive algorithms in generated C instead (recursive.py; in numpy,
 recursive_numpy.py, without a compiler), without deriving its equations: ``model_dynamics``
 picks that path wherever it applies.
+
+Batches report, not fail: a state whose inputs are not all finite, or (forward dynamics) whose
+M is not positive definite, gives NaN in its own output row; every other row equals the call
+for that state alone, and one DynamicsWarning per call counts the states (errors.py).
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping
 
 import numpy as np
 
 from ..compile.functions import NumericSystem
 from ..derivation.equations import EquationsOfMotion
-from ..errors import DerivationError, InputError, ModelError
+from ..errors import DerivationError, DynamicsWarning, InputError, ModelError
 from ..model.model import Model
 from .frames import TreeKinematics, tree_kinematics
+
+
+def warn_undefined(count: int, total: int, stacklevel: int = 4) -> None:
+    """One DynamicsWarning for ``count`` of ``total`` states with NaN rows (at the user's call)."""
+    warnings.warn(DynamicsWarning(
+        f"{count} of {total} states have no dynamics (an input not finite, or a mass matrix "
+        "that is not positive definite): their rows are NaN", count, total),
+        stacklevel=stacklevel)
+
+
+def solve_positive(mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """M^-1 rhs for a flat batch (N, n, n), (N, n) by Cholesky, NaN in the rows whose M is not
+    positive definite (each row as if alone)."""
+    try:
+        L = np.linalg.cholesky(mass)
+    except np.linalg.LinAlgError:
+        out = np.full(rhs.shape, np.nan)
+        for k in range(len(mass)):  # only on this path: find the rows without a factor
+            try:
+                L = np.linalg.cholesky(mass[k:k + 1])
+            except np.linalg.LinAlgError:
+                continue
+            y = np.linalg.solve(L, rhs[k:k + 1, :, None])
+            out[k] = np.linalg.solve(np.swapaxes(L, -1, -2), y)[0, :, 0]
+        return out
+    y = np.linalg.solve(L, rhs[..., None])
+    return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
 
 
 class Dynamics:
@@ -61,11 +93,31 @@ class Dynamics:
                              f"the last axis, got shape {shape}", field=field)
         return array
 
-    def _state(self, q, v=None):
-        q = self._vector(q, "q")
-        v = np.zeros_like(q) if v is None else self._vector(v, "v")
-        batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
-        return np.broadcast_to(q, batch + (self.n,)), np.broadcast_to(v, batch + (self.n,))
+    def _guarded(self, compute, arrays, fields, tail: tuple[int, ...], forward: bool = False):
+        """compute(*flat inputs (N, n)) -> (N, *tail) over the states whose inputs are finite,
+        NaN rows for the others (and for forward dynamics, for rows without a finite result),
+        reshaped to the batch; one DynamicsWarning when any row is NaN."""
+        arrays = [self._vector(x, f) for x, f in zip(arrays, fields, strict=True)]
+        batch = np.broadcast_shapes(*(x.shape[:-1] for x in arrays))
+        total = int(np.prod(batch, dtype=np.int64))
+        flat = [np.broadcast_to(x, batch + (self.n,)).reshape(total, self.n) for x in arrays]
+        good = np.ones(total, dtype=bool)
+        for x in flat:
+            good &= np.isfinite(x).all(axis=-1)
+        if good.all():
+            out = np.asarray(compute(*flat), dtype=float).reshape((total,) + tail)
+        else:
+            out = np.full((total,) + tail, np.nan)
+            if good.any():
+                out[good] = np.asarray(compute(*(x[good] for x in flat)),
+                                       dtype=float).reshape((-1,) + tail)
+        if forward:
+            good &= np.isfinite(out.reshape(total, -1)).all(axis=-1)
+            out[~good] = np.nan
+        bad = total - int(good.sum())
+        if bad:
+            warn_undefined(bad, total)
+        return out.reshape(batch + tail)
 
     # -- frames, Jacobians and the centre of mass (a URDF robot's tree: frames.py) --------------
 
@@ -129,42 +181,45 @@ class Dynamics:
 
     def mass_matrix(self, q) -> np.ndarray:
         """M(q), shape (..., n, n) (kg, kg m or kg m^2 per entry)."""
-        q, v = self._state(q)
-        return self.functions.mass_matrix(q, v)
+        return self._guarded(lambda Q: self.functions.mass_matrix(Q, np.zeros_like(Q)), (q,),
+                             ("q",), (self.n, self.n))
 
     def bias_forces(self, q, v) -> np.ndarray:
         """C(q, q_dot) q_dot + g(q) = -f(q, q_dot), shape (..., n)."""
-        return -self.functions.forcing(*self._state(q, v))
+        return self._guarded(lambda Q, V: -self.functions.forcing(Q, V), (q, v), ("q", "v"),
+                             (self.n,))
 
     def gravity(self, q) -> np.ndarray:
         """g(q) = -f(q, 0): the generalized forces that hold the arm at rest, shape (..., n)."""
-        return -self.functions.forcing(*self._state(q))
+        return self._guarded(lambda Q: -self.functions.forcing(Q, np.zeros_like(Q)), (q,),
+                             ("q",), (self.n,))
 
     def inverse_dynamics(self, q, v, a) -> np.ndarray:
         """tau = M(q) a + C(q, q_dot) q_dot + g(q), shape (..., n)."""
-        q, v = self._state(q, v)
-        a = self._vector(a, "a")
-        mass, forcing = self.functions._parts(q, v, 0.0)[:2]
-        return np.einsum("...ij,...j->...i", mass, a) - forcing
+        def compute(Q, V, A):
+            mass, forcing = self.functions._parts(Q, V, 0.0)[:2]
+            return np.einsum("...ij,...j->...i", mass, A) - forcing
+
+        return self._guarded(compute, (q, v, a), ("q", "v", "a"), (self.n,))
 
     def forward_dynamics(self, q, v, tau) -> np.ndarray:
-        """q_ddot = M(q)^-1 (tau - C(q, q_dot) q_dot - g(q)), shape (..., n)."""
-        q, v = self._state(q, v)
-        tau = self._vector(tau, "tau")
-        mass, forcing = self.functions._parts(q, v, 0.0)[:2]
-        rhs = np.broadcast_to(forcing + tau, np.broadcast_shapes(forcing.shape, tau.shape))
-        batch = np.broadcast_shapes(mass.shape[:-2], rhs.shape[:-1])
-        mass = np.broadcast_to(mass, batch + (self.n, self.n))
-        return np.linalg.solve(mass, np.broadcast_to(rhs, batch + (self.n,))[..., None])[..., 0]
+        """q_ddot = M(q)^-1 (tau - C(q, q_dot) q_dot - g(q)), shape (..., n); NaN where M is
+        not positive definite."""
+        def compute(Q, V, TAU):
+            mass, forcing = self.functions._parts(Q, V, 0.0)[:2]
+            return solve_positive(mass, forcing + TAU)
+
+        return self._guarded(compute, (q, v, tau), ("q", "v", "tau"), (self.n,), forward=True)
 
     def potential_energy(self, q) -> np.ndarray:
         """V(q) in J, shape (...)."""
-        return self.functions.energy(*self._state(q))
+        return self._guarded(lambda Q: self.functions.energy(Q, np.zeros_like(Q)), (q,), ("q",),
+                             ())
 
     def kinetic_energy(self, q, v) -> np.ndarray:
         """T(q, q_dot) = (T + V)(q, q_dot) - V(q) in J, shape (...)."""
-        q, v = self._state(q, v)
-        return self.functions.energy(q, v) - self.functions.energy(q, np.zeros_like(v))
+        return self._guarded(lambda Q, V: self.functions.energy(Q, V)
+                             - self.functions.energy(Q, np.zeros_like(V)), (q, v), ("q", "v"), ())
 
 
 def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = None,
@@ -208,4 +263,4 @@ def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
     return fast if fast is not None else Dynamics(symbolic(), equations)
 
 
-__all__ = ["Dynamics", "model_dynamics", "recursive_dynamics"]
+__all__ = ["Dynamics", "model_dynamics", "recursive_dynamics", "solve_positive", "warn_undefined"]

@@ -31,7 +31,7 @@ from ..errors import InputError
 from ..model.model import Model
 from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters
-from .joint_space import Dynamics
+from .joint_space import Dynamics, warn_undefined
 from .tree_module import module_source, tree_key
 
 
@@ -125,8 +125,6 @@ class RecursiveDynamics(Dynamics):
     def _call(self, function, *arrays):
         try:
             return function(*arrays, self._P)
-        except np.linalg.LinAlgError:
-            raise
         except ValueError as exc:
             if "batch shapes" in str(exc):  # broadcast in numpy, then one C call
                 arrays = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in arrays))
@@ -138,51 +136,65 @@ class RecursiveDynamics(Dynamics):
     def mass_matrix(self, q):
         """M(q), shape (..., n, n)."""
         try:
-            return self._mass(q, self._P)
+            out = self._mass(q, self._P)
         except ValueError:
-            return self._call(self._mass, q)
+            out = self._call(self._mass, q)
+        return out if out.__class__ is not tuple else _reported(*out, 2)
 
     def bias_forces(self, q, v):
         """C(q, q_dot) q_dot + g(q), shape (..., n)."""
         try:
-            return self._bias(q, v, self._P)
+            out = self._bias(q, v, self._P)
         except ValueError:
-            return self._call(self._bias, q, v)
+            out = self._call(self._bias, q, v)
+        return out if out.__class__ is not tuple else _reported(*out, 1)
 
     def gravity(self, q):
         """g(q), shape (..., n)."""
         try:
-            return self._gravity(q, self._P)
+            out = self._gravity(q, self._P)
         except ValueError:
-            return self._call(self._gravity, q)
+            out = self._call(self._gravity, q)
+        return out if out.__class__ is not tuple else _reported(*out, 1)
 
     def inverse_dynamics(self, q, v, a):
         """tau = M a + C q_dot + g, shape (..., n)."""
         try:
-            return self._inverse(q, v, a, self._P)
+            out = self._inverse(q, v, a, self._P)
         except ValueError:
-            return self._call(self._inverse, q, v, a)
+            out = self._call(self._inverse, q, v, a)
+        return out if out.__class__ is not tuple else _reported(*out, 1)
 
     def forward_dynamics(self, q, v, tau):
         """q_ddot = M^-1 (tau - C q_dot - g), shape (..., n)."""
         try:
-            return self._forward(q, v, tau, self._P)
+            out = self._forward(q, v, tau, self._P)
         except ValueError:
-            return self._call(self._forward, q, v, tau)
+            out = self._call(self._forward, q, v, tau)
+        return out if out.__class__ is not tuple else _reported(*out, 1)
 
     def kinetic_energy(self, q, v):
         """T in J, shape (...)."""
         try:
-            return self._kinetic(q, v, self._P)
+            out = self._kinetic(q, v, self._P)
         except ValueError:
-            return self._call(self._kinetic, q, v)
+            out = self._call(self._kinetic, q, v)
+        return out if out.__class__ is not tuple else _reported(*out, 0)
 
     def potential_energy(self, q):
         """V in J, shape (...)."""
         try:
-            return self._potential(q, self._P)
+            out = self._potential(q, self._P)
         except ValueError:
-            return self._call(self._potential, q)
+            out = self._call(self._potential, q)
+        return out if out.__class__ is not tuple else _reported(*out, 0)
+
+
+def _reported(out: np.ndarray, count: int, tail: int):
+    """The module's (output, count of NaN rows), ``tail`` the axes of one state's output: one
+    DynamicsWarning, and the output."""
+    warn_undefined(count, int(np.prod(out.shape[:out.ndim - tail], dtype=np.int64)), stacklevel=4)
+    return out
 
 
 __all__ = ["RecursiveDynamics", "applicable_tree"]

@@ -20,12 +20,12 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import InputError, ModelError
+from ..errors import ModelError
 from ..model.model import Model
 from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters
 from .joint_models import joint_model
-from .joint_space import Dynamics
+from .joint_space import Dynamics, solve_positive
 
 
 def _cross(a, b):
@@ -131,22 +131,6 @@ class RecursiveNumpyDynamics(Dynamics):
 
     def __repr__(self) -> str:
         return f"RecursiveNumpyDynamics(coordinates={list(self.coordinates)})"
-
-    # -- inputs ------------------------------------------------------------------------------
-
-    def _flat(self, arrays, fields):
-        """(N, n) float arrays broadcast against each other, and the batch shape."""
-        out = []
-        for value, field in zip(arrays, fields, strict=True):
-            array = np.asarray(value, dtype=float)
-            if array.ndim == 0 or array.shape[-1] != self.n:
-                shape = "()" if array.ndim == 0 else str(array.shape)
-                raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) "
-                                 f"along the last axis, got shape {shape}", field=field)
-            out.append(array)
-        batch = np.broadcast_shapes(*(x.shape[:-1] for x in out))
-        count = int(np.prod(batch, dtype=np.int64))
-        return [np.broadcast_to(x, batch + (self.n,)).reshape(count, self.n) for x in out], batch
 
     # -- the recursions on flat batches --------------------------------------------------------
 
@@ -321,38 +305,36 @@ class RecursiveNumpyDynamics(Dynamics):
 
     def mass_matrix(self, q):
         """M(q), shape (..., n, n)."""
-        (Q,), batch = self._flat((q,), ("q",))
-        return self._composite_rigid_body(Q).reshape(batch + (self.n, self.n))
+        return self._guarded(self._composite_rigid_body, (q,), ("q",), (self.n, self.n))
 
     def bias_forces(self, q, v):
         """C(q, q_dot) q_dot + g(q), shape (..., n)."""
-        (Q, V), batch = self._flat((q, v), ("q", "v"))
-        return self._newton_euler(Q, V, None).reshape(batch + (self.n,))
+        return self._guarded(lambda Q, V: self._newton_euler(Q, V, None), (q, v), ("q", "v"),
+                             (self.n,))
 
     def gravity(self, q):
         """g(q), shape (..., n)."""
-        (Q,), batch = self._flat((q,), ("q",))
-        return self._newton_euler(Q, None, None).reshape(batch + (self.n,))
+        return self._guarded(lambda Q: self._newton_euler(Q, None, None), (q,), ("q",),
+                             (self.n,))
 
     def inverse_dynamics(self, q, v, a):
         """tau = M a + C q_dot + g, shape (..., n)."""
-        (Q, V, A), batch = self._flat((q, v, a), ("q", "v", "a"))
-        return self._newton_euler(Q, V, A).reshape(batch + (self.n,))
+        return self._guarded(self._newton_euler, (q, v, a), ("q", "v", "a"), (self.n,))
 
     def forward_dynamics(self, q, v, tau):
-        """q_ddot = M^-1 (tau - C q_dot - g), shape (..., n)."""
-        (Q, V, TAU), batch = self._flat((q, v, tau), ("q", "v", "tau"))
-        return self._forward(Q, V, TAU).reshape(batch + (self.n,))
+        """q_ddot = M^-1 (tau - C q_dot - g), shape (..., n); NaN where M is not positive
+        definite."""
+        return self._guarded(lambda Q, V, TAU: solve_positive(
+            self._composite_rigid_body(Q), TAU - self._newton_euler(Q, V, None)),
+            (q, v, tau), ("q", "v", "tau"), (self.n,), forward=True)
 
     def kinetic_energy(self, q, v):
         """T in J, shape (...)."""
-        (Q, V), batch = self._flat((q, v), ("q", "v"))
-        return self._kinetic(Q, V).reshape(batch)
+        return self._guarded(self._kinetic, (q, v), ("q", "v"), ())
 
     def potential_energy(self, q):
         """V in J, shape (...)."""
-        (Q,), batch = self._flat((q,), ("q",))
-        return self._potential(Q).reshape(batch)
+        return self._guarded(self._potential, (q,), ("q",), ())
 
     def numeric_system(self):
         """The NumericSystem over these functions (M, f = -b, energy, accelerations, rhs), as

@@ -187,6 +187,11 @@ def _header(P: str, name: str, coordinates: list[str], parameters: list[str]) ->
 #define {P.upper()}_N {n}
 #define {P.upper()}_NP {max(len(parameters), 1)}
 
+/* C linkage in C++: a C++ controller includes this header and links the C object. */
+#ifdef __cplusplus
+extern "C" {{
+#endif
+
 /* The model's parameter values (SI). */
 extern const double {P}_parameters[{P.upper()}_NP];
 
@@ -205,6 +210,10 @@ int {P}_forward_dynamics(const double *q, const double *v, const double *tau, co
 /* Kinetic and potential energy (J). */
 double {P}_kinetic_energy(const double *q, const double *v, const double *p);
 double {P}_potential_energy(const double *q, const double *p);
+
+#ifdef __cplusplus
+}}
+#endif
 
 #endif
 """

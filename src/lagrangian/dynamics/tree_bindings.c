@@ -1,4 +1,7 @@
-/* ---- batched bindings: each input (..., N) or (N,), outputs shaped like the largest ---- */
+/* ---- batched bindings: each input (..., N) or (N,), outputs shaped like the largest ----
+   A state whose inputs are not all finite, or (forward dynamics) whose M is not positive
+   definite, gives NaN in its own output row and is counted; the other states are computed as
+   alone. With none such the output array is returned, else (output, count). */
 enum { RT_MASS, RT_BIAS, RT_GRAVITY, RT_INVERSE, RT_FORWARD, RT_KINETIC, RT_POTENTIAL };
 static const char *rt_names[] = {"q", "v", "third"};
 #if defined(__unix__) || defined(__APPLE__)
@@ -19,8 +22,26 @@ typedef struct {
     npy_intp step[3];
     const double *x0, *x1, *x2, *p;
     double *y;
-    npy_intp k0, k1, failed;
+    npy_intp k0, k1, bad;
 } rt_job;
+
+/* Whether state k's inputs are all finite. */
+static inline int rt_finite(int nin, const npy_intp *step, const double *x0, const double *x1,
+                            const double *x2, npy_intp k)
+{
+    for (int j = 0; j < nin; j++) {
+        const double *x = (j == 0 ? x0 : j == 1 ? x1 : x2) + k * step[j];
+        for (int i = 0; i < LG_N; i++)
+            if (!isfinite(x[i])) return 0;
+    }
+    return 1;
+}
+
+/* NaN over state k's output row. */
+static inline void rt_blank(double *y, int size, npy_intp k)
+{
+    for (int i = 0; i < size; i++) y[k * size + i] = NAN;
+}
 
 static void *rt_run(void *argument)
 {
@@ -29,7 +50,7 @@ static void *rt_run(void *argument)
     const npy_intp *step = job->step;
     const double *x0 = job->x0, *x1 = job->x1, *x2 = job->x2, *p = job->p;
     double *y = job->y;
-    npy_intp failed = -1, count = job->k1, k = job->k0;
+    npy_intp bad = 0, count = job->k1, k = job->k0;
     (void)nin; (void)size;
 #if RT_VECTOR
     /* LG_LANES states at a time through the vector variants, the rest one by one */
@@ -51,29 +72,43 @@ static void *rt_run(void *argument)
         case RT_KINETIC: rt4_kinetic_energy(in[0], in[1], p, out4); break;
         case RT_POTENTIAL: rt4_potential_energy(in[0], p, out4); break;
         }
-        for (int l = 0; l < LG_LANES; l++)
+        for (int l = 0; l < LG_LANES; l++) {
+            int fine = 1;
             for (int i = 0; i < size; i++) {
                 const double x = out4[i][l];
                 y[(k + l) * size + i] = x;
-                if (kind == RT_FORWARD && !isfinite(x) && failed < 0) failed = k + l;
+                if (kind == RT_FORWARD && !isfinite(x)) fine = 0;
             }
+            if (!fine || !rt_finite(nin, step, x0, x1, x2, k + l)) {
+                rt_blank(y, size, k + l);
+                bad++;
+            }
+        }
     }
 #endif
     for (; k < count; k++) {
         const double *a0 = x0 + k * step[0], *a1 = x1 + k * step[1], *a2 = x2 + k * step[2];
+        if (!rt_finite(nin, step, x0, x1, x2, k)) {
+            rt_blank(y, size, k);
+            bad++;
+            continue;
+        }
         switch (kind) {
         case RT_MASS: rt_mass_matrix(a0, p, y + k * LG_N * LG_N); break;
         case RT_BIAS: rt_bias_forces(a0, a1, p, y + k * LG_N); break;
         case RT_GRAVITY: rt_gravity(a0, p, y + k * LG_N); break;
         case RT_INVERSE: rt_inverse_dynamics(a0, a1, a2, p, y + k * LG_N); break;
         case RT_FORWARD:
-            if (rt_forward_dynamics(a0, a1, a2, p, y + k * LG_N) && failed < 0) failed = k;
+            if (rt_forward_dynamics(a0, a1, a2, p, y + k * LG_N)) {
+                rt_blank(y, size, k);
+                bad++;
+            }
             break;
         case RT_KINETIC: y[k] = rt_kinetic_energy(a0, a1, p); break;
         case RT_POTENTIAL: y[k] = rt_potential_energy(a0, p); break;
         }
     }
-    job->failed = failed;
+    job->bad = bad;
     return NULL;
 }
 
@@ -161,7 +196,7 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
                       t == parts - 1 || (t + 1) * share > count ? count : (t + 1) * share, -1};
         jobs[t] = job;
     }
-    npy_intp failed = -1;
+    npy_intp bad = 0;
     NPY_BEGIN_THREADS_DEF;
     if (count > 16) NPY_BEGIN_THREADS;
     /* the batch in parts on threads of their own (the functions keep no state), this thread
@@ -179,13 +214,11 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
 #else
     for (int t = 0; t < parts; t++) rt_run(&jobs[t]);
 #endif
-    for (int t = 0; t < parts; t++)
-        if (jobs[t].failed >= 0 && (failed < 0 || jobs[t].failed < failed)) failed = jobs[t].failed;
+    for (int t = 0; t < parts; t++) bad += jobs[t].bad;
     if (count > 16) NPY_END_THREADS;
-    if (failed >= 0) {
-        PyErr_Format(lg_LinAlgError, "the mass matrix is not positive definite (state %zd)",
-                     (Py_ssize_t)failed);
-        Py_CLEAR(out);
+    if (bad > 0) {
+        PyObject *pair = Py_BuildValue("(Nn)", out, (Py_ssize_t)bad);
+        out = pair;  /* the pair owns the array (N), or NULL with the error set */
     }
 done:
     for (int i = 0; i < 3; i++) Py_XDECREF(in[i]);

@@ -205,6 +205,13 @@ class Model:
     # A robot read from URDF keeps its tree in numbers (model/tree.py) for recursive dynamics;
     # not part of the model's identity (equal models with and without it are equal).
     kinematic_tree: KinematicTree | None = field(default=None, compare=False, repr=False)
+    # A robot read from URDF: (coordinate name, the file's joint name) for each coordinate,
+    # since joint names are made identifiers ("joint_8.0" -> "joint_8_0"); () otherwise.
+    source_names: tuple[tuple[str, str], ...] = field(default=(), compare=False, repr=False)
+    # ... and its joints' velocity (rad/s or m/s) and effort (N m or N) limits, None where the
+    # file gives none (or 0): (coordinate name, velocity, effort).
+    source_ratings: tuple[tuple[str, float | None, float | None], ...] = field(
+        default=(), compare=False, repr=False)
 
     @property
     def q(self) -> tuple[sp.Symbol, ...]:

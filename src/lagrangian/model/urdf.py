@@ -3,7 +3,9 @@
 URDF is read by yourdfpy (meshes, visual and collision elements are never loaded). Each
 revolute, continuous or prismatic joint that is neither locked nor a mimic is a coordinate named
 after it (rad or m); its actuator is the generalized force ``tau_<joint>`` (N m, or N for a
-prismatic joint), a parameter of value 0. Gravity is g = 9.81 m/s^2 along -z. A link's frame is
+prismatic joint), a parameter of value 0. Gravity is g = 9.81 m/s^2 along -z (gravity.py turns
+it). The file's joint names and limits are kept (Model.source_names, source_ratings; the
+position limits as the coordinates' ranges). A link's frame is
 
     R_child = R_parent R_origin(rpy) R_axis(angle),  x_child = x_parent + R_parent xyz (+ d axis)
 
@@ -44,9 +46,11 @@ GRAVITY = 9.81  # m/s^2, along -z
 _SNAP = 1e-14
 
 
-def read_urdf(path, lock: Mapping[str, float] | None = None) -> Model:
-    """Load a URDF file as a model; ``lock`` freezes joints at values (rad or m) by name."""
-    return parse_urdf(read_text_file(path), source=str(path), lock=lock)
+def read_urdf(path, lock: Mapping[str, float] | None = None,
+              payload: Mapping[str, object] | None = None) -> Model:
+    """Load a URDF file as a model; ``lock`` freezes joints at values (rad or m) by name,
+    ``payload`` adds point masses to links (urdf_payload.py)."""
+    return parse_urdf(read_text_file(path), source=str(path), lock=lock, payload=payload)
 
 
 def example_urdf(name: str):
@@ -58,13 +62,17 @@ def example_urdf(name: str):
 
 
 def parse_urdf(text: str, *, source: str = "<urdf>",
-               lock: Mapping[str, float] | None = None) -> Model:
-    """The model of a URDF document (see the module docstring for what each element becomes)."""
-    robot = _parse(text, source)
+               lock: Mapping[str, float] | None = None,
+               payload: Mapping[str, object] | None = None) -> Model:
+    """The model of a URDF document (see the module docstring for what each element becomes);
+    ``payload`` {link: mass or (mass, (x, y, z))} adds point masses (urdf_payload.py)."""
+    from .urdf_payload import payload_values
+
+    robot = _parse(text, source, payload_values(payload) if payload else None)
     return _Tree(robot, source).model(dict(lock or {}))
 
 
-def _parse(text: str, source: str):
+def _parse(text: str, source: str, payloads=None):
     require_extra("urdf", ("lxml", "yourdfpy"), "reading a URDF robot")
     from lxml import etree
 
@@ -74,6 +82,11 @@ def _parse(text: str, source: str):
     except etree.XMLSyntaxError as exc:
         raise ModelError(f"not well-formed XML ({exc})", source=source) from None
     _check_inertials(root, source)
+    if payloads:
+        from .urdf_payload import add_payloads
+
+        add_payloads(root, payloads, source)
+        data = etree.tostring(root)
     import yourdfpy
 
     try:
@@ -308,7 +321,24 @@ class _Tree:
         bodies = tuple(self._bodies(root, order, position))
         model = builder.build_model()
         tree = self._tree(root, order, position, names, bodies)
-        return replace(model, rigid_bodies=bodies, kinematic_tree=tree)
+        return replace(model, rigid_bodies=bodies, kinematic_tree=tree,
+                       source_names=tuple((name, joint) for joint, name in names.items()),
+                       source_ratings=tuple((name, *self._ratings(joint))
+                                            for joint, name in names.items()))
+
+    def _ratings(self, name: str) -> tuple[float | None, float | None]:
+        """A joint's velocity and effort limits (positive numbers, else None)."""
+        limit = self.by_name[name].limit
+
+        def positive(value):
+            try:
+                value = float(value)
+            except (TypeError, ValueError):
+                return None
+            return value if math.isfinite(value) and value > 0 else None
+
+        return (None, None) if limit is None else (positive(limit.velocity),
+                                                   positive(limit.effort))
 
     def _positions(self, lock: dict[str, float], names: dict[str, str]):
         """Each movable joint's position (angle or distance) and rate as expressions in q."""

@@ -8,13 +8,25 @@ from typing import Any
 import numpy as np
 
 
-def dynamics_document(coordinates, values: Mapping[str, Any]) -> dict[str, Any]:
-    """The `dynamics --json` document: every array as nested lists, SI units."""
+def dynamics_document(coordinates, values: Mapping[str, Any],
+                      joint_names: Mapping[str, str] | None = None) -> dict[str, Any]:
+    """The `dynamics --json` document: every array as nested lists, SI units; NaN (a state
+    without dynamics, DynamicsWarning) as null; ``joint_names`` (coordinate -> the URDF's
+    joint name, {} for a model file) under that key."""
     document: dict[str, Any] = {"coordinates": list(coordinates)}
+    if joint_names is not None:
+        document["joint_names"] = dict(joint_names)
     for key, value in values.items():
         array = np.asarray(value, dtype=float)
-        document[key] = array.tolist() if array.ndim else float(array)
+        listed = array.tolist() if array.ndim else float(array)
+        document[key] = _nan_as_null(listed)
     return document
+
+
+def _nan_as_null(value):
+    if isinstance(value, list):
+        return [_nan_as_null(x) for x in value]
+    return None if value != value else value
 
 
 _TITLES = {

@@ -43,6 +43,7 @@ def simulation_summary(result: SimulationResult) -> dict:
             name: {"given": given, "used": used}
             for name, (given, used) in result.projected_initial_state.items()
         },
+        "limits_exceeded": [dict(record) for record in result.limits_exceeded],
     }
 
 
@@ -68,6 +69,10 @@ def simulation_text(result: SimulationResult, written: dict[str, str]) -> str:
                      f"{result.invariant_drift:.2e}")
     if result.max_residual is not None:
         lines.append(f"  largest constraint residual: {result.max_residual:.2e}")
+    for r in result.limits_exceeded:
+        when = f" at t = {r['t']:.6g} s" if r["t"] is not None else ""
+        lines.append(f"  {r['quantity']} limit exceeded: joint '{r['joint']}' ({r['coordinate']}) "
+                     f"{r['value']:.6g} {r['unit']} > {r['limit']:.6g} {r['unit']}{when}")
     for path in written.values():
         lines.append(f"  wrote {path}")
     return "\n".join(lines) + "\n"

@@ -17,6 +17,7 @@ from .options import StepControl
 STATUS_MESSAGES = {
     "finished": "reached the end time",
     "stopped": "stopped by the stop condition",
+    "limit": "stopped at a joint's position limit",
     "interrupted": "interrupted",
     "failed": "integration failed",
 }
@@ -58,6 +59,9 @@ class SimulationResult:
     invariant: str = "energy"
     invariant_values: np.ndarray | None = None
     work: np.ndarray | None = None
+    # URDF velocity and effort limits exceeded (simulate.JointLimit): one dict each, with
+    # joint, coordinate, quantity, limit, value, t (None for effort) and unit
+    limits_exceeded: tuple[dict, ...] = ()
 
     @property
     def model_name(self) -> str:
@@ -77,8 +81,8 @@ class SimulationResult:
 
     @property
     def completed(self) -> bool:
-        """True when the run reached its end time or its stop condition."""
-        return self.status in (RunStatus.FINISHED, RunStatus.STOPPED)
+        """True when the run reached its end time, its stop condition or a joint's limit."""
+        return self.status in (RunStatus.FINISHED, RunStatus.STOPPED, RunStatus.LIMIT)
 
     def columns(self) -> dict[str, np.ndarray]:
         """Named columns: t, <q>, <q>_dot, energy, lambda_<c>, residual_<c>, power."""

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Mapping
-from dataclasses import replace
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -31,8 +31,8 @@ from .invariants import cumulative_work, energy_is_conserved, invariant_kind
 from .options import METHODS, SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
 
-__all__ = ["METHODS", "STATUS_MESSAGES", "SaveAt", "SimulationResult", "StepControl",
-           "StopCondition", "parse_stop_condition", "simulate"]
+__all__ = ["METHODS", "STATUS_MESSAGES", "JointLimit", "SaveAt", "SimulationResult", "StepControl",
+           "StopCondition", "parse_stop_condition", "simulate", "urdf_limits"]
 
 DEFAULT_STEP_CONTROL = StepControl()  # DOP853, rtol = atol = 1e-9
 DEFAULT_SAVE_AT = SaveAt()  # 1001 evenly spaced samples
@@ -50,6 +50,7 @@ def simulate(
     progress: Callable[[float], None] | None = None,
     functions: NumericSystem | None = None,
     compiled_loop: bool = True,
+    limits: Sequence[JointLimit] = (),
 ) -> SimulationResult:
     """Integrate from the initial state to ``t_end`` (s), saving where ``save_at`` says.
 
@@ -57,7 +58,9 @@ def simulate(
     time). ``stop`` ends the run when its condition first turns true. ``progress`` is called with
     the time reached after each step. ``compiled_loop`` allows the DOP853 loop in C where it
     applies. Failures and Ctrl-C return the partial result with ``status`` 'failed' or
-    'interrupted' and the time reached in ``message``.
+    'interrupted' and the time reached in ``message``. ``limits`` (a robot's URDF position
+    limits, JointLimit) end the run with status 'limit' when a joint reaches one, naming it;
+    velocity and effort limits exceeded are reported in ``limits_exceeded``.
     """
     model = eom.model
     start = resolve_state(model, initial, field="initial", what="coordinate or velocity (or t)")
@@ -71,6 +74,8 @@ def simulate(
     drift = DriftControl(functions, StateFunction(model, eom.velocity_bias, substitution)) \
         if functions.m else None
     event = _event(StateFunction(model, [stop.function], substitution)) if stop else None
+    beyond = _beyond(limits) if limits else None
+    positioned = [m for m in limits if m.lower is not None and m.upper is not None]
     power_terms = StateFunction(model, eom.generalized_forces, substitution)
 
     q0, v0, projected = start.q_array(), start.q_dot_array(), {}
@@ -81,7 +86,9 @@ def simulate(
     y0 = np.concatenate([q0, v0])
     began = time.perf_counter()
     run = _integrate(functions, y0, grid, step_control, event, drift, progress,
-                     compiled_loop and not functions.m and event is None)
+                     compiled_loop and not functions.m and event is None, beyond)
+    if beyond is not None and run.status == RunStatus.STOPPED:
+        run = _at_limit(run, positioned, beyond, event, functions.n)
     wall = time.perf_counter() - began
     if run.status == RunStatus.FAILED:
         run = replace(run, message=_explain_failure(functions, run))
@@ -111,6 +118,7 @@ def simulate(
         energy_conserved=energy_is_conserved(eom), t_end=float(t_end),
         stop_when=stop.text if stop else None, projected_initial_state=projected,
         kinetic_energy=kinetic, invariant=kind, invariant_values=invariant, work=work,
+        limits_exceeded=_exceeded(limits, functions.parameters, t, q_dot),
     )
 
 
@@ -135,15 +143,114 @@ def _invariant(eom, substitution, t, q, q_dot, energy, power, multipliers):
     return kind, values, cumulative_work(t, supplied)
 
 
-def _integrate(functions, y0, grid, step_control, event, drift, progress, compiled) -> LoopRun:
-    """The compiled DOP853 loop where it applies (and is there), else the scipy step loop."""
+def _integrate(functions, y0, grid, step_control, event, drift, progress, compiled,
+               beyond=None) -> LoopRun:
+    """The compiled DOP853 loop where it applies (and is there), else the scipy step loop.
+    With position limits (``beyond``) the compiled loop's samples are checked, and a run with a
+    sample at or beyond a limit is run again in the step loop, whose event finds the time the
+    joint reaches it (a touch between two samples that leaves again goes unseen there)."""
+    n = len(y0) // 2
     if compiled and step_control.method == "DOP853" and math.isinf(step_control.max_step):
         run = integrate_compiled(functions, (float(grid[0]), float(grid[-1])), y0, step_control,
                                  grid, progress)
-        if run is not None:
+        if run is not None and (beyond is None or not any(
+                beyond(y[:n], y[n:], t) >= 0 for t, y in zip(run.t[1:], run.y[1:], strict=True))):
             return run
+    if beyond is not None:
+        user = event
+        event = beyond if user is None else (
+            lambda q, v, t: max(user(q, v, t), beyond(q, v, t)))
     return integrate_steps(functions.rhs, float(grid[0]), y0, float(grid[-1]), grid,
                            step_control, event, drift, progress)
+
+
+@dataclass(frozen=True)
+class JointLimit:
+    """A URDF joint's limits on one coordinate: position (rad or m; None: none), velocity
+    (rad/s or m/s) and effort (N m or N, on its actuator parameter), as the file gives them."""
+
+    coordinate: int  # index in the model's coordinates
+    name: str  # the coordinate's name
+    joint: str  # the URDF's joint name
+    lower: float | None = None
+    upper: float | None = None
+    unit: str = "rad"
+    velocity: float | None = None
+    effort: float | None = None
+    actuator: str | None = None  # the parameter of its generalized force (tau_<joint>)
+
+
+def urdf_limits(model, positions: bool = True) -> tuple[JointLimit, ...]:
+    """A robot read from URDF: its joints' limits per coordinate (the position limits left out
+    where ``positions`` is False); () for other models."""
+    coordinates = {c.name: (i, c) for i, c in enumerate(model.coordinates)}
+    ratings = {name: (velocity, effort) for name, velocity, effort in model.source_ratings}
+    parameters = {p.name for p in model.parameters}
+    out = []
+    for name, joint in model.source_names:
+        if name not in coordinates:
+            continue
+        i, c = coordinates[name]
+        lower, upper = c.range if positions and c.range is not None else (None, None)
+        actuator = f"tau_{name}" if f"tau_{name}" in parameters else None
+        out.append(JointLimit(i, name, joint, lower, upper, c.unit,
+                              *ratings.get(name, (None, None)), actuator))
+    return tuple(out)
+
+
+def _exceeded(limits: Sequence[JointLimit], parameters: Mapping[str, float], t, q_dot
+              ) -> tuple[dict, ...]:
+    """Velocity limits exceeded on the samples (the largest |q_dot|, and when) and effort
+    limits exceeded by the actuator parameters, one record each."""
+    out = []
+    for limit in limits:
+        if limit.velocity is not None and len(t):
+            speeds = np.abs(q_dot[:, limit.coordinate])
+            k = int(np.argmax(speeds))
+            if speeds[k] > limit.velocity:
+                out.append({"joint": limit.joint, "coordinate": limit.name,
+                            "quantity": "velocity", "limit": limit.velocity,
+                            "value": float(speeds[k]), "t": float(t[k]),
+                            "unit": f"{limit.unit}/s"})
+        value = parameters.get(limit.actuator) if limit.actuator else None
+        if limit.effort is not None and value is not None and abs(value) > limit.effort:
+            out.append({"joint": limit.joint, "coordinate": limit.name, "quantity": "effort",
+                        "limit": limit.effort, "value": float(abs(value)), "t": None,
+                        "unit": "N" if limit.unit == "m" else "N m"})
+    return tuple(out)
+
+
+def _beyond(limits: Sequence[JointLimit]):
+    """h(q) = the largest distance beyond a position limit (< 0 while every joint is inside):
+    the event turns true when a joint reaches its limit; None without position limits."""
+    limits = [limit for limit in limits if limit.lower is not None and limit.upper is not None]
+    if not limits:
+        return None
+    index = np.array([limit.coordinate for limit in limits])
+    lower = np.array([limit.lower for limit in limits])
+    upper = np.array([limit.upper for limit in limits])
+
+    def beyond(q, v, t) -> float:
+        x = np.asarray(q, dtype=float)[index]
+        return float(np.max(np.maximum(lower - x, x - upper)))
+
+    return beyond
+
+
+def _at_limit(run: LoopRun, limits, beyond, event, n: int) -> LoopRun:
+    """A run the step loop stopped: at a joint's limit (status 'limit', the joint named) unless
+    the user's stop condition turned true there first."""
+    t, y = float(run.t[-1]), run.y[-1]
+    h = beyond(y[:n], y[n:], t)
+    if event is not None and event(y[:n], y[n:], t) > h:
+        return run
+    x = y[:n]
+    reached = max(limits, key=lambda m: max(m.lower - x[m.coordinate], x[m.coordinate] - m.upper))
+    side = reached.lower if x[reached.coordinate] < 0.5 * (reached.lower + reached.upper) \
+        else reached.upper
+    return replace(run, status=RunStatus.LIMIT, message=(
+        f"joint '{reached.joint}' ({reached.name}) reached its position limit {side:.6g} "
+        f"{reached.unit} at t = {t:.12g} s"))
 
 
 _TOO_LARGE = 1e100  # beyond this a step of any size overflows somewhere in the loop

@@ -146,14 +146,17 @@ class TreeKinematics:
         """The moving bodies' total mass (kg); links welded to the ground are not counted."""
         return float(sum(j.mass for j in self.tree.joints))
 
-    def center_of_mass(self, q) -> np.ndarray:
-        """The centre of mass of the moving bodies in the world (m), shape (..., 3)."""
-        Q, batch = self._q(q)
-        bodies = self._bodies(Q)
+    def _moving_mass(self) -> float:
         total = self.mass()
         if total <= 0:
             raise InputError("the robot's moving bodies have no mass: no centre of mass",
                              field="q")
+        return total
+
+    def center_of_mass(self, q) -> np.ndarray:
+        """The centre of mass of the moving bodies in the world (m), shape (..., 3)."""
+        Q, batch = self._q(q)
+        bodies, total = self._bodies(Q), self._moving_mass()
         moment = np.zeros((len(Q), 3))
         for joint, (R, p) in zip(self.tree.joints, bodies, strict=True):
             moment += joint.mass * p + R @ np.array(joint.first_moment)
@@ -162,11 +165,7 @@ class TreeKinematics:
     def center_of_mass_jacobian(self, q) -> np.ndarray:
         """J_c with c_dot = J_c q_dot (m per unit rate), shape (..., 3, n)."""
         Q, batch = self._q(q)
-        bodies = self._bodies(Q)
-        total = self.mass()
-        if total <= 0:
-            raise InputError("the robot's moving bodies have no mass: no centre of mass",
-                             field="q")
+        bodies, total = self._bodies(Q), self._moving_mass()
         J = np.zeros((len(Q), 3, self.n))
         for k, (joint, (R, p)) in enumerate(zip(self.tree.joints, bodies, strict=True)):
             if joint.mass <= 0:

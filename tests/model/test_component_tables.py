@@ -9,6 +9,7 @@ import sympy as sp
 
 import lagrangian
 from lagrangian import JointKind
+from lagrangian.check.diagnose_terms import projection_explanation
 from lagrangian.check.newton_euler import _AppliedForces
 from lagrangian.check.units import load_unit_items
 from lagrangian.derivation.energies import dissipation_terms, potential_terms
@@ -23,6 +24,8 @@ TABLES = {
     "virtual work (derivation)": (load_projection.registry, LOAD_KINDS),
     "units (check)": (load_unit_items.registry, LOAD_KINDS),
     "free bodies (Newton-Euler check)": (_AppliedForces.__dict__["add_load"].dispatcher.registry, LOAD_KINDS),
+    "diagnosis of a mis-projected load (check)": (projection_explanation.registry,
+                                                  LOAD_KINDS + ELEMENT_KINDS[1:]),
 }
 
 
@@ -73,3 +76,20 @@ def test_a_load_of_each_kind_does_its_virtual_work():
     assert load_projection(Torque("motor", tau, 2 * q), (q,), (q_dot,)) == [2 * tau]
     with pytest.raises(TypeError, match="no virtual work"):
         load_projection(object(), (q,), (q_dot,))
+
+
+def test_each_kind_explains_its_own_projection():
+    """The diagnosis names what a load's virtual work is made of, kind by kind."""
+    from lagrangian.model.model import Damper, PointForce, Torque
+    from lagrangian.model.rotations import Moment
+
+    F, L, tau, c, q, x_dot = sp.symbols("F L tau c q x_dot")
+    zero = sp.S.Zero
+    push = PointForce("push", (L * sp.sin(q), -L * sp.cos(q), zero), (F, zero, zero))
+    assert "dr = dr/dq dq = (L*cos(q), L*sin(q)) dq" in projection_explanation(push, "q", q, "")
+    assert "turns through d(angle) = (2) dq" in projection_explanation(
+        Torque("motor", tau, 2 * q), "q", q, "")
+    assert "the moment 'spin' is projected wrongly" in projection_explanation(
+        Moment("spin", "top", (zero, zero, tau), "world", (zero, zero, x_dot)), "q", q, "")
+    assert "Q = -c (rate) d(rate)/dq_dot" in projection_explanation(
+        Damper("d", c, x_dot), "q", q, "")

@@ -13,6 +13,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import singledispatch
 
 import sympy as sp
 
@@ -20,6 +21,7 @@ from ..derivation.kinematics import time_rate
 from ..derivation.virtual_work import DISSIPATION_LOAD, GIVEN_LOAD
 from ..model.expressions import format_expression as fmt
 from ..model.model import Damper, Model, PointForce, Torque
+from ..model.rotations import Moment
 from . import equivalence as eq
 
 # -- energy parts, to name a missing term ------------------------------------------------
@@ -225,25 +227,48 @@ def projection_message(model: Model, load_name: str, part: sp.Expr, name: str,
                        yours: sp.Expr) -> str:
     """Why a load's share is wrong: its dr/dq (or d(angle)/dq, d(rate)/dq_dot), its Q and yours."""
     q = model.coordinate(name).symbol
-    load = next((item for item in model.loads if item.name == load_name), None)
-    damper = next((d for d in model.dampers if d.name == load_name), None)
+    element = next((item for item in (*model.loads, *model.dampers) if item.name == load_name),
+                   None)
     tail = (f"so its generalized force is {fmt(eq.display(part))}; yours is "
             f"{fmt(eq.display(yours))} (sin for cos, lever arm or sign?).")
-    if isinstance(load, PointForce):
-        dr = ", ".join(fmt(eq.display(r.diff(q))) for r in _planar(load.point))
-        force = ", ".join(fmt(f) for f in _planar(load.force))
-        return (f"the load '{load_name}' is projected wrongly: its point moves by "
-                f"dr = dr/d{name} d{name} = ({dr}) d{name}, and dW = F . dr with "
-                f"F = ({force}), {tail}")
-    if isinstance(load, Torque):
-        return (f"the torque '{load_name}' is projected wrongly: it turns through "
-                f"d(angle) = ({fmt(eq.display(load.angle.diff(q)))}) d{name}, {tail}")
-    if isinstance(damper, Damper):
-        return (f"the damper '{load_name}' is projected wrongly: Q = -c (rate) d(rate)/"
-                f"d{name}_dot with rate = {fmt(damper.rate)}, {tail}")
+    if element is not None:
+        return projection_explanation(element, name, q, tail)
     what = {DISSIPATION_LOAD: "the dissipation D", GIVEN_LOAD: "the given generalized force"}
     return f"{what.get(load_name, repr(load_name))} is projected wrongly, {tail}"
 
+
+# one entry per kind that does virtual work (tests/model/test_component_tables.py walks them)
+@singledispatch
+def projection_explanation(element, name: str, q: sp.Symbol, tail: str) -> str:
+    """How ``element``'s virtual work projects onto coordinate ``name``, then ``tail``."""
+    raise TypeError(f"no projection message for a {type(element).__name__}")
+
+
+@projection_explanation.register
+def _(load: PointForce, name: str, q: sp.Symbol, tail: str) -> str:
+    dr = ", ".join(fmt(eq.display(r.diff(q))) for r in _planar(load.point))
+    force = ", ".join(fmt(f) for f in _planar(load.force))
+    return (f"the load '{load.name}' is projected wrongly: its point moves by "
+            f"dr = dr/d{name} d{name} = ({dr}) d{name}, and dW = F . dr with "
+            f"F = ({force}), {tail}")
+
+
+@projection_explanation.register
+def _(load: Torque, name: str, q: sp.Symbol, tail: str) -> str:
+    return (f"the torque '{load.name}' is projected wrongly: it turns through "
+            f"d(angle) = ({fmt(eq.display(load.angle.diff(q)))}) d{name}, {tail}")
+
+
+@projection_explanation.register
+def _(load: Moment, name: str, q: sp.Symbol, tail: str) -> str:
+    return (f"the moment '{load.name}' is projected wrongly: dW = M . dphi, so Q = M . "
+            f"d(omega)/d{name}_dot with omega the body's angular velocity, {tail}")
+
+
+@projection_explanation.register
+def _(damper: Damper, name: str, q: sp.Symbol, tail: str) -> str:
+    return (f"the damper '{damper.name}' is projected wrongly: Q = -c (rate) d(rate)/"
+            f"d{name}_dot with rate = {fmt(damper.rate)}, {tail}")
 
 
 def _planar(vector):

@@ -13,12 +13,15 @@ from lagrangian.check.diagnose_terms import projection_explanation
 from lagrangian.check.newton_euler import _AppliedForces
 from lagrangian.check.units import load_unit_items
 from lagrangian.derivation.energies import dissipation_terms, potential_terms
+from lagrangian.derivation.inertia import add_rotation, add_translation
 from lagrangian.derivation.virtual_work import load_projection
 from lagrangian.dynamics.joint_models import JOINT_MODELS, joint_model
 from lagrangian.model.components import COMPONENT_KINDS, ELEMENT_KINDS, LOAD_KINDS, MASS_KINDS
 from lagrangian.model.rotations import JOINT_KEYS, RotationReader
 
 TABLES = {
+    "kinetic energy, M and f, first pass (derivation)": (add_translation.registry, MASS_KINDS),
+    "kinetic energy, M and f, second pass (derivation)": (add_rotation.registry, MASS_KINDS),
     "potential energy (derivation)": (potential_terms.registry, MASS_KINDS + ELEMENT_KINDS),
     "dissipation (derivation)": (dissipation_terms.registry, MASS_KINDS + ELEMENT_KINDS),
     "virtual work (derivation)": (load_projection.registry, LOAD_KINDS),

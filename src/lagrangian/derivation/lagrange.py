@@ -17,14 +17,14 @@ from collections import defaultdict
 import sympy as sp
 
 from ..model.model import Model, multiplier_name
-from .body_jacobians import jacobian_equations, takes_jacobian_form
+from .body_jacobians import takes_jacobian_form
 from .constraints import constraint_terms
 from .energies import dissipation_terms as component_dissipation
 from .energies import potential_terms as component_potential
 from .equations import EquationsOfMotion
+from .inertia import InertiaAssembly, add_rotation, add_translation
 from .kinematics import Differentiator
 from .regularity import check_regularity
-from .rigid_bodies import rotational_equations, rotational_kinetic_energy
 from .trig import combined_terms, parts, product
 from .virtual_work import generalized_forces, load_contributions
 
@@ -115,109 +115,23 @@ def derive(model: Model, *, check: bool = True,
     acc = _Accumulator(n)
     d = Differentiator()
     sizes: dict = {}
-    unexpanded = {k for k, rigid in enumerate(model.rigid_bodies)
-                  if takes_jacobian_form(rigid, q, t, d, sizes, jacobian_form)}
-    jacobian_row, time_rate = d.row, d.rate
-    kinetic_terms: list[sp.Expr] = []
+    unexpanded = frozenset(rigid.name for rigid in model.rigid_bodies
+                           if takes_jacobian_form(rigid, q, t, d, sizes, jacobian_form))
+    jacobian_row = d.row
     potential_terms: list[sp.Expr] = [model.potential_energy]
     dissipation_terms: list[sp.Expr] = [model.dissipation]
-
     gravity = model.gravity
 
-    def varying_inertia(inertia: sp.Expr, jacobian, velocity) -> None:
-        """The Euler-Lagrange operator on 1/2 m v.v is m J_i.a + m_dot v.J_i - 1/2 dm/dq_i v.v:
-        for m(q, t) f_i gets the last two terms, which m J^T J and m J^T a_rest leave out (the
-        same with I and omega for a body's rotation)."""
-        gradient = jacobian_row(inertia, q)
-        rate = time_rate(inertia, q, q_dot, t)
-        if rate == 0 and all(g == 0 for g in gradient):
-            return
-        speed_squared = sp.Add(*(v**2 for v in velocity if v != 0))
-        for i in range(n):
-            projection = sp.Add(*(row[i] * v for row, v in zip(jacobian, velocity, strict=True)
-                                  if row[i] != 0 and v != 0))
-            term = sp.expand(gradient[i] * speed_squared / 2 - rate * projection)
-            if term != 0:
-                acc.add_force(i, term)
-
-    def translate(mass: sp.Expr, position) -> None:
-        jacobian = [jacobian_row(component, q) for component in position]
-        if gravity is not None:
-            # With a mass that depends on q, -dV/dq_i of V = -m g d.r also has g dm/dq_i d.r.
-            height = sp.Add(*(dc * r for dc, r in zip(gravity.direction, position, strict=True)
-                              if dc != 0))
-            for i, gradient in enumerate(jacobian_row(mass, q)):
-                if gradient != 0 and height != 0:
-                    acc.add_force(i, gravity.magnitude * gradient * height)
-            # Weight m g d enters as its virtual work m g d . dr/dq_i, grouped by shape like the
-            # inertia terms (so a chain shows (m1 + m2) g l1 sin(theta1)); V still shows -m g h.
-            for i in range(n):
-                lever = sp.Add(*(dc * row[i] for dc, row in zip(gravity.direction, jacobian,
-                                                                 strict=True)
-                                 if dc != 0 and row[i] != 0))
-                if lever != 0:
-                    acc.forcing[i][gravity.magnitude * lever].append(mass)
-        # v = J q_dot + dr/dt, reusing J rather than differentiating r again.
-        moving = [d(component, t) for component in position]
-        velocity = [
-            sp.Add(*(j * v for j, v in zip(row, q_dot, strict=True) if j != 0), r_t)
-            for row, r_t in zip(jacobian, moving, strict=True)
-        ]
-        rest = [time_rate(v, q, q_dot, t) for v in velocity]
-        acc.inertia(mass, jacobian, rest)
-        varying_inertia(mass, jacobian, velocity)
-        # T = 1/2 q_dot^T M q_dot (from the tidied M) + what a moving support adds,
-        # m (J q_dot).r_t + 1/2 m r_t.r_t, tidied like M (sin^2 + cos^2 of a spin angle).
-        half = parts(sp.Rational(1, 2))
-        items = []
-        for v, r_t in zip(velocity, moving, strict=True):
-            if r_t == 0:
-                continue
-            moved = [parts(y) for y in sp.Add.make_args(r_t)]
-            items += [product(parts(x), y) for x in sp.Add.make_args(v - r_t) for y in moved]
-            items += [product(half, product(x, y)) for x in moved for y in moved]
-        if items:
-            kinetic_terms.extend(mass * term for term in combined_terms(items))
-
-    for particle in model.particles:
-        translate(particle.mass, particle.position)
-    for body in model.bodies:
-        translate(body.mass, body.position)
-        omega = time_rate(body.angle, q, q_dot, t)
-        turning = [jacobian_row(body.angle, q)]
-        acc.inertia(body.inertia, turning, [time_rate(omega, q, q_dot, t)])
-        varying_inertia(body.inertia, turning, [omega])
-        spin = d(body.angle, t)
-        if spin != 0:
-            kinetic_terms.append(body.inertia * (omega - spin) * spin
-                                 + sp.Rational(1, 2) * body.inertia * spin**2)
-    for k, rigid in enumerate(model.rigid_bodies):
-        if k not in unexpanded:
-            translate(rigid.mass, rigid.position)
-    component_mass = (acc.mass_matrix() if model.particles or model.bodies or model.rigid_bodies
-                      else None)
-    for k, rigid in enumerate(model.rigid_bodies):
-        if k in unexpanded:
-            # M, f and the weight through the body's Jacobians; its T is printed as
-            # 1/2 m v.v + 1/2 omega^T I omega (component_mass holds none of it).
-            rigid_mass, rigid_forcing, kinetic = jacobian_equations(rigid, q, q_dot, t,
-                                                                     gravity, d)
-            kinetic_terms.append(kinetic)
-            for (i, j), entry in rigid_mass.items():
-                acc.add_mass(i, j, entry)
-            for i, entry in enumerate(rigid_forcing):
-                if entry != 0:
-                    acc.add_force(i, entry)
-            continue
-        # 1/2 omega^T I omega by the general formula written with omega's structure (after
-        # component_mass, which holds only 1/2 m v.v: the printed T shows this term as written).
-        kinetic_terms.append(rotational_kinetic_energy(rigid))
-        rotation_mass, rotation_forcing = rotational_equations(rigid, q, q_dot, t, d)
-        for (i, j), entry in rotation_mass.items():
-            acc.add_mass(i, j, entry)
-        for i, entry in enumerate(rotation_forcing):
-            if entry != 0:
-                acc.add_force(i, entry)
+    # Each mass-carrying component by its kind's table (inertia.py), in two passes: the
+    # components' printed M is taken between them (it holds no body in space's rotation).
+    assembly = InertiaAssembly(acc, d, q, q_dot, t, gravity, unexpanded)
+    carriers = (*model.particles, *model.bodies, *model.rigid_bodies)
+    for item in carriers:
+        add_translation(item, assembly)
+    component_mass = acc.mass_matrix() if carriers else None
+    for item in carriers:
+        add_rotation(item, assembly)
+    kinetic_terms = assembly.kinetic_terms
 
     for item in (*model.particles, *model.bodies, *model.rigid_bodies, *model.springs,
                  *model.dampers):

@@ -165,7 +165,9 @@ class Dynamics:
                 "C(q, q_dot) is the matrix of the Coriolis and centrifugal terms of M; this "
                 "model's velocity terms are not only those (a damper, a velocity-dependent load, "
                 "a moving support, or M changing with t): use bias_forces(q, q_dot)")
-        q, v = self._state(q, v)
+        q, v = self._vector(q, "q"), self._vector(v, "v")
+        batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
+        q, v = np.broadcast_to(q, batch + (self.n,)), np.broadcast_to(v, batch + (self.n,))
         eye = np.eye(self.n)
         ahead = self.bias_forces(q[..., None, :], v[..., None, :] + eye)
         behind = self.bias_forces(q[..., None, :], v[..., None, :] - eye)

@@ -58,7 +58,7 @@ _LEGACY_ATTRS = {"model", "compute", "points", "finished", "failed", "about"}
 
 # The packages of a study, the optional extra [sweep] (docs/dependencies.md): the engine, the
 # Dataset, and the writer of each file format.
-STUDY_MODULES = ("dask", "dask.distributed", "xarray")
+STUDY_MODULES = ("dask", "distributed", "xarray")  # dask.distributed imports even without it
 STUDY_WRITERS = {".nc": ("h5netcdf", "h5py"), ".zarr": ("zarr",)}
 
 

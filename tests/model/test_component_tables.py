@@ -11,7 +11,7 @@ import lagrangian
 from lagrangian import JointKind
 from lagrangian.check.diagnose_terms import projection_explanation
 from lagrangian.check.newton_euler import _AppliedForces
-from lagrangian.check.units import load_unit_items
+from lagrangian.check.units import unit_items
 from lagrangian.derivation.energies import dissipation_terms, potential_terms
 from lagrangian.derivation.inertia import add_rotation, add_translation
 from lagrangian.derivation.virtual_work import load_projection
@@ -25,7 +25,7 @@ TABLES = {
     "potential energy (derivation)": (potential_terms.registry, MASS_KINDS + ELEMENT_KINDS),
     "dissipation (derivation)": (dissipation_terms.registry, MASS_KINDS + ELEMENT_KINDS),
     "virtual work (derivation)": (load_projection.registry, LOAD_KINDS),
-    "units (check)": (load_unit_items.registry, LOAD_KINDS),
+    "units (check)": (unit_items.registry, MASS_KINDS + ELEMENT_KINDS + LOAD_KINDS),
     "free bodies (Newton-Euler check)": (_AppliedForces.__dict__["add_load"].dispatcher.registry, LOAD_KINDS),
     "diagnosis of a mis-projected load (check)": (projection_explanation.registry,
                                                   LOAD_KINDS + ELEMENT_KINDS[1:]),

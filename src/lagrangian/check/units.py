@@ -15,8 +15,8 @@ from functools import singledispatch
 import sympy as sp
 
 from ..model.expressions import format_expression
-from ..model.model import Model, PointForce, Torque, multiplier_name
-from ..model.rotations import Moment
+from ..model.model import Body, Damper, Model, Particle, PointForce, Spring, Torque, multiplier_name
+from ..model.rotations import Moment, RigidBody
 from ..model.units import generalized_force_unit, is_angle_unit, registry
 
 ENERGY = "J"
@@ -238,42 +238,12 @@ def check_model_units(model: Model) -> UnitsReport:
         c("D", model.dissipation, POWER, "a power (Rayleigh dissipation)")
     if model.gravity is not None:
         c("gravity.g", model.gravity.magnitude, "m/s^2", "an acceleration")
-    for particle in model.particles:
-        where = f"particles[{particle.name}]"
-        c(f"{where}.mass", particle.mass, "kg", "a mass")
-        for axis, component in zip("xyz", particle.position, strict=True):
-            c(f"{where}.position.{axis}", component, "m", "a length")
-    for body in model.bodies:
-        where = f"bodies[{body.name}]"
-        c(f"{where}.mass", body.mass, "kg", "a mass")
-        c(f"{where}.inertia", body.inertia, "kg*m^2", "a moment of inertia")
-        for axis, component in zip("xyz", body.position, strict=True):
-            c(f"{where}.position.{axis}", component, "m", "a length")
-        c(f"{where}.angle", body.angle, "", "an angle")
     # A robot read from URDF: its lengths, masses and inertias are SI numbers by the format
     # (m, kg, kg m^2), multiplied by sines of the joint angles; no symbol with a unit to judge.
-    for rigid in model.rigid_bodies if model.kinematic_tree is None else ():
-        where = f"bodies[{rigid.name}]"
-        c(f"{where}.mass", rigid.mass, "kg", "a mass")
-        for i, row in enumerate(rigid.inertia):
-            for j, entry in enumerate(row[i:], start=i):
-                c(f"{where}.inertia[{i}][{j}]", entry, "kg*m^2", "a moment of inertia")
-        for axis, component in zip("xyz", rigid.position, strict=True):
-            c(f"{where}.position.{axis}", component, "m", "a length")
-        for i, row in enumerate(rigid.rotation):  # direction cosines: angles inside
-            for j, entry in enumerate(row):
-                c(f"{where}.rotation[{i}][{j}]", entry, "", "a direction cosine")
-    for spring in model.springs:
-        where = f"springs[{spring.name}]"
-        c(f"{where}.stiffness", spring.stiffness, None)
-        c(f"{where}.potential", sp.Rational(1, 2) * spring.stiffness
-          * (spring.length - spring.rest_length) ** 2, ENERGY, "an energy")
-    for damper in model.dampers:
-        where = f"dampers[{damper.name}]"
-        c(f"{where}.dissipation", sp.Rational(1, 2) * damper.coefficient * damper.rate**2,
-          POWER, "a power")
-    for load in model.loads:
-        for item in load_unit_items(load, f"loads[{load.name}]"):
+    rigid_bodies = model.rigid_bodies if model.kinematic_tree is None else ()
+    for component in (*model.particles, *model.bodies, *rigid_bodies, *model.springs,
+                      *model.dampers, *model.loads):
+        for item in unit_items(component):
             c(*item)
     for name, value in model.generalized_forces:
         coordinate = model.coordinate(name)
@@ -286,28 +256,75 @@ def check_model_units(model: Model) -> UnitsReport:
 
 
 @singledispatch
-def load_unit_items(load, where: str) -> list[tuple]:
-    """(field, expression, expected SI unit, what it is) for each part of one applied load:
-    one table entry per load kind (tests/model/test_component_tables.py walks every kind)."""
-    raise TypeError(f"no units for a load of kind {type(load).__name__}")
+def unit_items(component) -> list[tuple]:
+    """(field, expression, expected SI unit, what it is) for each part of one component: one
+    table entry per kind (tests/model/test_component_tables.py walks every kind)."""
+    raise TypeError(f"no units for a component of kind {type(component).__name__}")
 
 
-@load_unit_items.register
-def _(load: PointForce, where: str) -> list[tuple]:
-    return [*((f"{where}.point.{axis}", r, "m", "a length")
-              for axis, r in zip("xyz", load.point, strict=True)),
+def _lengths(where: str, vector) -> list[tuple]:
+    return [(f"{where}.{axis}", r, "m", "a length") for axis, r in zip("xyz", vector, strict=True)]
+
+
+@unit_items.register
+def _(particle: Particle) -> list[tuple]:
+    where = f"particles[{particle.name}]"
+    return [(f"{where}.mass", particle.mass, "kg", "a mass"),
+            *_lengths(f"{where}.position", particle.position)]
+
+
+@unit_items.register
+def _(body: Body) -> list[tuple]:
+    where = f"bodies[{body.name}]"
+    return [(f"{where}.mass", body.mass, "kg", "a mass"),
+            (f"{where}.inertia", body.inertia, "kg*m^2", "a moment of inertia"),
+            *_lengths(f"{where}.position", body.position),
+            (f"{where}.angle", body.angle, "", "an angle")]
+
+
+@unit_items.register
+def _(rigid: RigidBody) -> list[tuple]:
+    where = f"bodies[{rigid.name}]"
+    return [(f"{where}.mass", rigid.mass, "kg", "a mass"),
+            *((f"{where}.inertia[{i}][{j}]", entry, "kg*m^2", "a moment of inertia")
+              for i, row in enumerate(rigid.inertia) for j, entry in enumerate(row[i:], start=i)),
+            *_lengths(f"{where}.position", rigid.position),
+            # direction cosines: angles inside
+            *((f"{where}.rotation[{i}][{j}]", entry, "", "a direction cosine")
+              for i, row in enumerate(rigid.rotation) for j, entry in enumerate(row))]
+
+
+@unit_items.register
+def _(spring: Spring) -> list[tuple]:
+    where = f"springs[{spring.name}]"
+    return [(f"{where}.stiffness", spring.stiffness, None),
+            (f"{where}.potential", sp.Rational(1, 2) * spring.stiffness
+             * (spring.length - spring.rest_length) ** 2, ENERGY, "an energy")]
+
+
+@unit_items.register
+def _(damper: Damper) -> list[tuple]:
+    return [(f"dampers[{damper.name}].dissipation",
+             sp.Rational(1, 2) * damper.coefficient * damper.rate**2, POWER, "a power")]
+
+
+@unit_items.register
+def _(load: PointForce) -> list[tuple]:
+    where = f"loads[{load.name}]"
+    return [*_lengths(f"{where}.point", load.point),
             *((f"{where}.force.{axis}", f, "N", "a force")
               for axis, f in zip("xyz", load.force, strict=True))]
 
 
-@load_unit_items.register
-def _(load: Moment, where: str) -> list[tuple]:
-    return [(f"{where}.moment.{axis}", m, "N*m", "a moment")
+@unit_items.register
+def _(load: Moment) -> list[tuple]:
+    return [(f"loads[{load.name}].moment.{axis}", m, "N*m", "a moment")
             for axis, m in zip("xyz", load.moment, strict=True)]
 
 
-@load_unit_items.register
-def _(load: Torque, where: str) -> list[tuple]:
+@unit_items.register
+def _(load: Torque) -> list[tuple]:
+    where = f"loads[{load.name}]"
     return [(f"{where}.torque", load.torque, "N*m", "a torque"),
             (f"{where}.angle", load.angle, "", "an angle")]
 

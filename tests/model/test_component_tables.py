@@ -10,7 +10,7 @@ import sympy as sp
 import lagrangian
 from lagrangian import JointKind
 from lagrangian.check.diagnose_terms import projection_explanation
-from lagrangian.check.newton_euler import _AppliedForces
+from lagrangian.check.newton_euler import _AppliedForces, free_body
 from lagrangian.check.units import unit_items
 from lagrangian.derivation.energies import dissipation_terms, potential_terms
 from lagrangian.derivation.inertia import add_rotation, add_translation
@@ -27,6 +27,9 @@ TABLES = {
     "virtual work (derivation)": (load_projection.registry, LOAD_KINDS),
     "units (check)": (unit_items.registry, MASS_KINDS + ELEMENT_KINDS + LOAD_KINDS),
     "free bodies (Newton-Euler check)": (_AppliedForces.__dict__["add_load"].dispatcher.registry, LOAD_KINDS),
+    "free bodies of masses (Newton-Euler check)": (free_body.registry, MASS_KINDS),
+    "free-body forces of elements (Newton-Euler check)": (
+        _AppliedForces.__dict__["add_element"].dispatcher.registry, ELEMENT_KINDS),
     "diagnosis of a mis-projected load (check)": (projection_explanation.registry,
                                                   LOAD_KINDS + ELEMENT_KINDS[1:]),
 }

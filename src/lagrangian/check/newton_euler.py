@@ -31,7 +31,7 @@ its length only still enters the virtual work, but then no reactions are reporte
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import singledispatchmethod
+from functools import singledispatch, singledispatchmethod
 
 import numpy as np
 import sympy as sp
@@ -40,8 +40,8 @@ from ..derivation.display import latex_with_rates
 from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, LagrangianError
 from ..model.expressions import format_expression as fmt
-from ..model.model import Attachment, Model, PointForce, Torque
-from ..model.rotations import Moment
+from ..model.model import Attachment, Body, Damper, Model, Particle, PointForce, Spring, Torque
+from ..model.rotations import Moment, RigidBody
 from ..model.values import resolve_parameters, resolve_state
 from . import equivalence as eq
 
@@ -269,24 +269,41 @@ class _Clock:
 
 def _free_bodies(model: Model, clock: _Clock) -> list[_FreeBody]:
     """One free body per particle and rigid body, with its accelerations a_G (and alpha)."""
-    bodies = [_FreeBody(particle.name, particle.mass, particle.position,
-                        [clock.second(r) for r in particle.position], force=[sp.S.Zero] * 3)
-              for particle in model.particles]
-    bodies += [_FreeBody(body.name, body.mass, body.position,
-                         [clock.second(r) for r in body.position], body.angle, body.inertia,
-                         clock.second(body.angle), [sp.S.Zero] * 3)
-               for body in model.bodies]
-    for rigid in model.rigid_bodies:
-        R = sp.Matrix(rigid.rotation)
-        rate = R.applyfunc(clock.first)
-        skew = R.T * rate  # omega~ in body axes
-        omega = [skew[2, 1], skew[0, 2], skew[1, 0]]
-        bodies.append(_FreeBody(rigid.name, rigid.mass, rigid.position,
-                                [clock.second(r) for r in rigid.position], force=[sp.S.Zero] * 3,
-                                rotation=R, body_inertia=sp.Matrix(rigid.inertia), omega=omega,
-                                alpha=[clock.first_with_velocities(w) for w in omega],
-                                moment3=[sp.S.Zero] * 3))
-    return bodies
+    return [free_body(item, clock)
+            for item in (*model.particles, *model.bodies, *model.rigid_bodies)]
+
+
+# one entry per mass-carrying kind (tests/model/test_component_tables.py walks every kind)
+@singledispatch
+def free_body(component, clock: _Clock) -> _FreeBody:
+    """The free body of ``component``: its mass, position and accelerations (m/s^2, rad/s^2)."""
+    raise TypeError(f"no free body for a component of kind {type(component).__name__}")
+
+
+@free_body.register
+def _(particle: Particle, clock: _Clock) -> _FreeBody:
+    return _FreeBody(particle.name, particle.mass, particle.position,
+                     [clock.second(r) for r in particle.position], force=[sp.S.Zero] * 3)
+
+
+@free_body.register
+def _(body: Body, clock: _Clock) -> _FreeBody:
+    return _FreeBody(body.name, body.mass, body.position,
+                     [clock.second(r) for r in body.position], body.angle, body.inertia,
+                     clock.second(body.angle), [sp.S.Zero] * 3)
+
+
+@free_body.register
+def _(rigid: RigidBody, clock: _Clock) -> _FreeBody:
+    R = sp.Matrix(rigid.rotation)
+    rate = R.applyfunc(clock.first)
+    skew = R.T * rate  # omega~ in body axes
+    omega = [skew[2, 1], skew[0, 2], skew[1, 0]]
+    return _FreeBody(rigid.name, rigid.mass, rigid.position,
+                     [clock.second(r) for r in rigid.position], force=[sp.S.Zero] * 3,
+                     rotation=R, body_inertia=sp.Matrix(rigid.inertia), omega=omega,
+                     alpha=[clock.first_with_velocities(w) for w in omega],
+                     moment3=[sp.S.Zero] * 3)
 
 
 class _AppliedForces:
@@ -392,41 +409,54 @@ class _AppliedForces:
     def add_springs(self) -> None:
         """Tension k (l - l0) (N) along each spring, on the ends it joins."""
         for spring in self.model.springs:
-            if spring.ends is not None:
-                # Tension k (l - l0) pulls each end towards the other along u = (r_a - r_b)/l.
-                a, b, u, length = _line(spring.ends)
-                tension = spring.stiffness * (length - spring.rest_length)
-                if not self.pull(a, b, [-tension * c for c in u]):
-                    self.unattributed.append(spring.name)
-                continue
-            self.unattributed.append(spring.name)
-            tension = spring.stiffness * (spring.length - spring.rest_length)
-            squared = _squared_separation(spring.length)
-            for i, qi in enumerate(self.model.q):
-                if squared is not None:
-                    # Force -k (l - l0) d/|d| on one end along d = r_a - r_b and the opposite on
-                    # the other: virtual work -k (l - l0)/l d.(dd/dq_i) = -k (l - l0)/l * 1/2
-                    # d|d|^2/dq_i.
-                    self.work[i].append(-tension / spring.length * squared.diff(qi) / 2)
-                else:  # a spring along its own length coordinate
-                    self.work[i].append(-tension * spring.length.diff(qi))
+            self.add_element(spring, None)
 
     def add_dampers(self, clock: _Clock) -> None:
         """Force -c l_dot (N) along each damper, on the ends it joins."""
         for damper in self.model.dampers:
-            if damper.ends is not None:
-                # -c l_dot along u on end a, with l_dot = u . d(r_a - r_b)/dt (own time derivative).
-                a, b, u, _ = _line(damper.ends)
-                separation_rate = [clock.first(pa - pb)
-                                   for pa, pb in zip(a.point, b.point, strict=True)]
-                rate = sp.Add(*(ui * di for ui, di in zip(u, separation_rate, strict=True)))
-                if not self.pull(a, b, [-damper.coefficient * rate * c for c in u]):
-                    self.unattributed.append(damper.name)
-                continue
-            self.unattributed.append(damper.name)
-            # Force -c l_dot along the line, projected by dl/dq_i = d(l_dot)/d(q_dot_i).
-            for i, c in enumerate(self.model.coordinates):
-                self.work[i].append(-damper.coefficient * damper.rate * damper.rate.diff(c.velocity))
+            self.add_element(damper, clock)
+
+    # one entry per two-point element kind (tests/model/test_component_tables.py)
+    @singledispatchmethod
+    def add_element(self, element, clock) -> None:
+        raise TypeError(f"no free-body force for an element of kind {type(element).__name__}")
+
+    @add_element.register
+    def _(self, spring: Spring, clock) -> None:
+        if spring.ends is not None:
+            # Tension k (l - l0) pulls each end towards the other along u = (r_a - r_b)/l.
+            a, b, u, length = _line(spring.ends)
+            tension = spring.stiffness * (length - spring.rest_length)
+            if not self.pull(a, b, [-tension * c for c in u]):
+                self.unattributed.append(spring.name)
+            return
+        self.unattributed.append(spring.name)
+        tension = spring.stiffness * (spring.length - spring.rest_length)
+        squared = _squared_separation(spring.length)
+        for i, qi in enumerate(self.model.q):
+            if squared is not None:
+                # Force -k (l - l0) d/|d| on one end along d = r_a - r_b and the opposite on
+                # the other: virtual work -k (l - l0)/l d.(dd/dq_i) = -k (l - l0)/l * 1/2
+                # d|d|^2/dq_i.
+                self.work[i].append(-tension / spring.length * squared.diff(qi) / 2)
+            else:  # a spring along its own length coordinate
+                self.work[i].append(-tension * spring.length.diff(qi))
+
+    @add_element.register
+    def _(self, damper: Damper, clock) -> None:
+        if damper.ends is not None:
+            # -c l_dot along u on end a, with l_dot = u . d(r_a - r_b)/dt (own time derivative).
+            a, b, u, _ = _line(damper.ends)
+            separation_rate = [clock.first(pa - pb)
+                               for pa, pb in zip(a.point, b.point, strict=True)]
+            rate = sp.Add(*(ui * di for ui, di in zip(u, separation_rate, strict=True)))
+            if not self.pull(a, b, [-damper.coefficient * rate * c for c in u]):
+                self.unattributed.append(damper.name)
+            return
+        self.unattributed.append(damper.name)
+        # Force -c l_dot along the line, projected by dl/dq_i = d(l_dot)/d(q_dot_i).
+        for i, c in enumerate(self.model.coordinates):
+            self.work[i].append(-damper.coefficient * damper.rate * damper.rate.diff(c.velocity))
 
     def add_given_generalized_forces(self) -> None:
         """V, D and generalized forces the model gives directly: no force vector to place."""

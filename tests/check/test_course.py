@@ -45,8 +45,10 @@ def test_the_set_covers_the_modules_examples_ladder_and_four_misconceptions():
 def test_every_file_of_the_set_is_package_data():
     data = tomllib.loads((ROOT / "pyproject.toml").read_text())
     patterns = data["tool"]["setuptools"]["package-data"]["lagrangian"]
-    package = ROOT / "src" / "lagrangian"
-    files = [p for p in course_folder().rglob("*") if p.is_file() and p.suffix == ".toml"]
+    # the package as imported: the source tree (editable) or the installed copy (pip install .)
+    package = Path(lagrangian.__file__).resolve().parent
+    files = [p.resolve() for p in course_folder().rglob("*")
+             if p.is_file() and p.suffix == ".toml"]
     assert len(files) == 1 + sum(len(lesson.answers) for lesson in LESSONS)
     for path in files:
         relative = path.relative_to(package).as_posix()

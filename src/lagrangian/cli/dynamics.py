@@ -44,6 +44,7 @@ def dynamics(
     """Mass matrix, bias forces C q_dot + g, gravity, inverse or forward dynamics, energies."""
     import numpy as np  # here, not at the top: --help loads no numpy (tests/cli/test_startup.py)
 
+    from .. import resolve_state
     from ..output.dynamics import dynamics_document, dynamics_text
 
     if a is not None and tau is not None:
@@ -52,7 +53,8 @@ def dynamics(
     system = load_system(model, set_, lock, gravity, payload)
     coordinates = system.model.coordinates
     n = len(coordinates)
-    qs = _vector(q, n, "--q", [c.initial or 0.0 for c in coordinates])
+    start = resolve_state(system.model)  # the model's own initial state (the library's defaults)
+    qs = _vector(q, n, "--q", list(start.q))
     if q is not None:  # --q 30,0 means 30 rad for an angle
         from .. import state_units
 
@@ -64,7 +66,7 @@ def dynamics(
 
         for line in limit_warnings(system.model, dict(zip(names, qs, strict=True)), "--q"):
             warn(line)
-    vs = _vector(v, n, "--v", [c.rate or 0.0 for c in coordinates])
+    vs = _vector(v, n, "--v", list(start.q_dot))
     f = system.dynamics()
     with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings(record=True) as seen:
         # an overflow is refused below; a state without dynamics (M not positive definite)

@@ -23,11 +23,12 @@ def kinematics(
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """A frame's placement (4 x 4) and Jacobian (6 x n), the centre of mass and its Jacobian."""
+    from .. import resolve_state
     from ..output.kinematics import kinematics_document, kinematics_text
 
     system = load_system(model, set_, lock)
     coordinates = system.model.coordinates
-    qs = _vector(q, len(coordinates), "--q", [c.initial or 0.0 for c in coordinates])
+    qs = _vector(q, len(coordinates), "--q", list(resolve_state(system.model).q))
     robot = system.dynamics().kinematics
     name = frame if frame is not None else robot.frames[-1]
     values = {"q": qs, "placement": robot.placement(qs, name),

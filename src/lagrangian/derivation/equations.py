@@ -75,7 +75,8 @@ class EquationsOfMotion:
                  *(c.expression for c in self.model.constraints)]
         if self.component_mass_matrix is not None:
             parts.append(self.component_mass_matrix)
-        symbols = set().union(*(sp.sympify(part).free_symbols for part in parts))  # sympy objects
+        # safe: sympy objects, no user text
+        symbols = set().union(*(sp.sympify(part).free_symbols for part in parts))
         return frozenset(p.name for p in self.model.parameters if p.symbol in symbols)
 
     @cached_property

@@ -31,6 +31,7 @@ from ..compile.functions import NumericSystem
 from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, DynamicsWarning, InputError, ModelError
 from ..model.model import Model
+from ..model.values import resolve_parameters
 from .frames import TreeKinematics, tree_kinematics
 
 
@@ -224,6 +225,23 @@ class Dynamics:
                              - self.functions.energy(Q, np.zeros_like(V)), (q, v), ("q", "v"), ())
 
 
+class TreeDynamics(Dynamics):
+    """The recursive algorithms of a URDF robot's kinematic tree (recursive.RecursiveDynamics in
+    generated C, recursive_numpy.RecursiveNumpyDynamics in numpy): what both keep of the model."""
+
+    _christoffel = True  # a tree's only velocity terms are M's (no dampers in the tree)
+
+    def _take_tree(self, model: Model, tree, parameters: Mapping[str, float] | None) -> None:
+        """The model, its tree, and every parameter's value (SI) by name, in the model's order."""
+        values = resolve_parameters(model, parameters)
+        self.model = model
+        self.tree = tree
+        self.coordinates = tree.coordinates
+        self.n = len(tree.coordinates)
+        self.parameters = {p.name: float(v)
+                           for p, v in zip(model.parameters, values.values, strict=True)}
+
+
 def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = None,
                        backend: str = "auto"):
     """The recursive dynamics of a URDF tree: generated C (recursive.RecursiveDynamics), or
@@ -265,4 +283,4 @@ def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
     return fast if fast is not None else Dynamics(symbolic(), equations)
 
 
-__all__ = ["Dynamics", "model_dynamics", "recursive_dynamics", "solve_positive", "warn_undefined"]
+__all__ = ["Dynamics", "TreeDynamics", "model_dynamics", "recursive_dynamics", "solve_positive", "warn_undefined"]

@@ -30,8 +30,7 @@ import numpy as np
 from ..errors import InputError
 from ..model.model import Model
 from ..model.tree import KinematicTree
-from ..model.values import resolve_parameters
-from .joint_space import Dynamics, warn_undefined
+from .joint_space import TreeDynamics, warn_undefined
 from .tree_module import module_source, tree_key
 
 
@@ -67,14 +66,12 @@ def applicable_tree(model: Model) -> KinematicTree | None:
     return tree
 
 
-class RecursiveDynamics(Dynamics):
+class RecursiveDynamics(TreeDynamics):
     """Compiled recursive dynamics of a tree, batched over leading axes (SI units).
 
     Every input is (..., n) (or (n,), broadcast against the others); outputs keep the batch
     shape. ``functions`` (lazy) is the NumericSystem over the same module (simulation).
     """
-
-    _christoffel = True  # a tree's only velocity terms are M's (no dampers in the tree)
 
     backend = "recursive"
 
@@ -83,12 +80,7 @@ class RecursiveDynamics(Dynamics):
         from ..compile import compiled
 
         names = tuple(p.name for p in model.parameters)
-        values = resolve_parameters(model, parameters)
-        self.model = model
-        self.tree = tree
-        self.coordinates = tree.coordinates
-        self.n = len(tree.coordinates)
-        self.parameters = {name: float(v) for name, v in zip(names, values.values, strict=True)}
+        self._take_tree(model, tree, parameters)
         self.parameter_values = np.array(list(self.parameters.values()), dtype=float)
         self.parameter_values.flags.writeable = False
         self.module = compiled.load_keyed(tree_key(tree, names),

@@ -23,9 +23,8 @@ import numpy as np
 from ..errors import ModelError
 from ..model.model import Model
 from ..model.tree import KinematicTree
-from ..model.values import resolve_parameters
 from .joint_models import joint_model
-from .joint_space import Dynamics, solve_positive
+from .joint_space import TreeDynamics, solve_positive
 
 
 def _cross(a, b):
@@ -99,26 +98,18 @@ class _Joint:
         self.J = np.array(joint.inertia, dtype=float)
 
 
-class RecursiveNumpyDynamics(Dynamics):
+class RecursiveNumpyDynamics(TreeDynamics):
     """Recursive dynamics of a tree in numpy, batched over leading axes (SI units).
 
     Every input is (..., n) (or (n,), broadcast against the others); outputs keep the batch
     shape. Same interface as recursive.RecursiveDynamics.
     """
 
-    _christoffel = True  # a tree's only velocity terms are M's (no dampers in the tree)
-
     backend = "recursive-numpy"
 
     def __init__(self, model: Model, tree: KinematicTree,
                  parameters: Mapping[str, float] | None = None):
-        names = tuple(p.name for p in model.parameters)
-        values = resolve_parameters(model, parameters)
-        self.model = model
-        self.tree = tree
-        self.coordinates = tree.coordinates
-        self.n = len(tree.coordinates)
-        self.parameters = {name: float(v) for name, v in zip(names, values.values, strict=True)}
+        self._take_tree(model, tree, parameters)
         missing = [name for name in (tree.gravity_parameter, *tree.actuators)
                    if name not in self.parameters]
         if missing:

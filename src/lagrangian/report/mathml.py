@@ -163,7 +163,7 @@ class MathWriter:
 
     def __call__(self, expr) -> str:
         """The MathML of ``expr`` (a sympy expression or matrix, or a number)."""
-        return serialize(self._printer._print(sp.sympify(expr)))
+        return serialize(self._printer._print(sp.sympify(expr)))  # safe: sympy objects or numbers
 
     def symbol(self, symbol: sp.Symbol) -> str:
         return self(symbol)

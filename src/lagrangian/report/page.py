@@ -112,7 +112,7 @@ class _Page:
         nodes (the benchmark bicycle's M: 32000) a formula is pages wide and costs minutes."""
         size = 0
         for expr in exprs:
-            for _ in sp.preorder_traversal(sp.sympify(expr)):
+            for _ in sp.preorder_traversal(sp.sympify(expr)):  # safe: derived sympy objects, no text
                 size += 1
                 if size > TYPESET_LIMIT:
                     return note(f"{what}: more than {TYPESET_LIMIT} terms and factors, too long "

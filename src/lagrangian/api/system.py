@@ -40,6 +40,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
 from ..derivation.regularity import require_inertia
 from ..derivation.steps import DerivationSteps
+from ..dynamics.actuators import actuated
 from ..dynamics.joint_space import model_dynamics, recursive_dynamics
 from ..dynamics.standalone import StandaloneSource
 from ..errors import InputError, LagrangianError, did_you_mean
@@ -270,16 +271,20 @@ class System:
         None (dynamics/joint_space.py)."""
         return recursive_dynamics(self.model)
 
-    def dynamics(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"):
+    def dynamics(self, parameters: Mapping[str, float] | None = None, backend: str = "auto",
+                 *, actuators: bool = False, armature: Mapping[str, float] | None = None):
         """M(q), bias C q_dot + g, g(q), inverse and forward dynamics and the energies, batched
         over leading axes (q of shape (n,) or (N, n)); a generalized force tau acts on top of
         the model's own loads (dynamics/joint_space.py). A URDF robot runs recursive algorithms in
         generated C (dynamics/recursive.py; in numpy without a compiler or with backend
-        "numpy"), the other models their derived equations."""
-        if parameters is None and backend == "auto" and self._recursive is not None:
-            return self._recursive
-        return model_dynamics(self.model, lambda: self.numeric(parameters, backend),
-                              parameters, backend, equations=self.equations_of_motion)
+        "numpy"), the other models their derived equations. ``actuators=True`` adds the URDF's
+        joint damping and friction, ``armature`` {joint: kg m^2 or kg} M's (dynamics/actuators.py)."""
+        rigid = self._recursive if parameters is None and backend == "auto" and \
+            self._recursive is not None else model_dynamics(
+                self.model, lambda: self.numeric(parameters, backend), parameters, backend,
+                equations=self.equations_of_motion)
+        return rigid if not actuators and armature is None else \
+            actuated(rigid, self.model, armature, friction=actuators)
 
     # -- equilibria, linearization and modes -----------------------------------------------------
 

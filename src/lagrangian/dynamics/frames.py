@@ -38,12 +38,12 @@ class TreeKinematics:
 
     # -- placements -----------------------------------------------------------------------------
 
-    def _q(self, q) -> tuple[np.ndarray, tuple[int, ...]]:
+    def _q(self, q, field: str = "q") -> tuple[np.ndarray, tuple[int, ...]]:
         q = np.asarray(q, dtype=float)
         if q.ndim == 0 or q.shape[-1] != self.n:
             shape = "()" if q.ndim == 0 else str(q.shape)
             raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) along the "
-                             f"last axis, got shape {shape}", field="q")
+                             f"last axis, got shape {shape}", field=field)
         batch = q.shape[:-1]
         return q.reshape(-1, self.n), batch
 
@@ -173,6 +173,24 @@ class TreeKinematics:
             centre = p + R @ (np.array(joint.first_moment) / joint.mass)
             J += joint.mass * self._point_jacobian(Q, bodies, k, centre)[:, :3]
         return (J / total).reshape(batch + (3, self.n))
+
+    # -- rates: J_dot q_dot and centroidal momentum (centroidal.py) ----------------------------
+
+    def jacobian_dot_times_v(self, q, v, frame: str,
+                             reference: str = "local_world_aligned") -> np.ndarray:
+        """J_dot q_dot: the frame's classical acceleration at q_ddot = 0, [a; w_dot] (m/s^2,
+        rad/s^2), shape (..., 6), ``reference`` as for jacobian (Pinocchio's
+        getFrameClassicalAcceleration with a = 0)."""
+        from .centroidal import jacobian_dot_times_v
+
+        return jacobian_dot_times_v(self, q, v, frame, reference)
+
+    def centroidal_momentum_matrix(self, q) -> np.ndarray:
+        """A_g with h_g = A_g q_dot, shape (..., 6, n): linear momentum, then angular momentum
+        about the centre of mass, world axes (Pinocchio's ccrba)."""
+        from .centroidal import centroidal_momentum_matrix
+
+        return centroidal_momentum_matrix(self, q)
 
 
 def tree_kinematics(tree: KinematicTree | None) -> TreeKinematics:

@@ -153,6 +153,27 @@ class Dynamics:
         """J_c with c_dot = J_c q_dot, (..., 3, n)."""
         return self.kinematics.center_of_mass_jacobian(q)
 
+    def jacobian_dot_times_v(self, q, v, frame: str,
+                             reference: str = "local_world_aligned") -> np.ndarray:
+        """J_dot q_dot: the frame's classical acceleration at q_ddot = 0 (m/s^2, rad/s^2),
+        (..., 6), as Pinocchio's getFrameClassicalAcceleration with a = 0."""
+        return self.kinematics.jacobian_dot_times_v(q, v, frame, reference)
+
+    def centroidal_momentum_matrix(self, q) -> np.ndarray:
+        """A_g with h_g = A_g q_dot (linear, then angular momentum about the centre of mass,
+        world axes), (..., 6, n), as Pinocchio's ccrba."""
+        return self.kinematics.centroidal_momentum_matrix(q)
+
+    def _with_wrenches(self, q, v, x, f_ext, forward: bool) -> np.ndarray:
+        """Inverse or forward dynamics with wrenches at frames: tau_ext = sum J^T w
+        (wrenches.py) taken from tau, or added to it."""
+        from .wrenches import wrench_forces
+
+        tau_ext = wrench_forces(self.kinematics, self._vector(q, "q"), f_ext)
+        if forward:
+            return self.forward_dynamics(q, v, self._vector(x, "tau") + tau_ext)
+        return self.inverse_dynamics(q, v, x) - tau_ext
+
     def coriolis_matrix(self, q, v) -> np.ndarray:
         """C(q, q_dot) of the Coriolis and centrifugal terms, C q_dot = bias - g, with
         C_ij = sum_k Gamma_ijk q_dot_k (M's Christoffel symbols), so that M_dot - 2 C is
@@ -197,17 +218,23 @@ class Dynamics:
         return self._guarded(lambda Q: -self.functions.forcing(Q, np.zeros_like(Q)), (q,),
                              ("q",), (self.n,))
 
-    def inverse_dynamics(self, q, v, a) -> np.ndarray:
-        """tau = M(q) a + C(q, q_dot) q_dot + g(q), shape (..., n)."""
+    def inverse_dynamics(self, q, v, a, f_ext=None) -> np.ndarray:
+        """tau = M(q) a + C(q, q_dot) q_dot + g(q) - sum J^T w, shape (..., n); ``f_ext``
+        {frame: [fx, fy, fz, mx, my, mz]} wrenches at frames (world axes, at the frame's origin;
+        N, N m), a URDF robot's only."""
+        if f_ext is not None:  # wrenches at frames (wrenches.py)
+            return self._with_wrenches(q, v, a, f_ext, forward=False)
         def compute(Q, V, A):
             mass, forcing = self.functions._parts(Q, V, 0.0)[:2]
             return np.einsum("...ij,...j->...i", mass, A) - forcing
 
         return self._guarded(compute, (q, v, a), ("q", "v", "a"), (self.n,))
 
-    def forward_dynamics(self, q, v, tau) -> np.ndarray:
-        """q_ddot = M(q)^-1 (tau - C(q, q_dot) q_dot - g(q)), shape (..., n); NaN where M is
-        not positive definite."""
+    def forward_dynamics(self, q, v, tau, f_ext=None) -> np.ndarray:
+        """q_ddot = M(q)^-1 (tau + sum J^T w - C(q, q_dot) q_dot - g(q)), shape (..., n); NaN
+        where M is not positive definite; ``f_ext`` as for inverse_dynamics."""
+        if f_ext is not None:  # wrenches at frames (wrenches.py)
+            return self._with_wrenches(q, v, tau, f_ext, forward=True)
         def compute(Q, V, TAU):
             mass, forcing = self.functions._parts(Q, V, 0.0)[:2]
             return solve_positive(mass, forcing + TAU)
@@ -283,4 +310,5 @@ def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
     return fast if fast is not None else Dynamics(symbolic(), equations)
 
 
-__all__ = ["Dynamics", "TreeDynamics", "model_dynamics", "recursive_dynamics", "solve_positive", "warn_undefined"]
+__all__ = ["Dynamics", "TreeDynamics", "model_dynamics", "recursive_dynamics", "solve_positive",
+           "warn_undefined"]

@@ -149,16 +149,20 @@ class RecursiveDynamics(TreeDynamics):
             out = self._call(self._gravity, q)
         return out if out.__class__ is not tuple else _reported(*out, 1)
 
-    def inverse_dynamics(self, q, v, a):
-        """tau = M a + C q_dot + g, shape (..., n)."""
+    def inverse_dynamics(self, q, v, a, f_ext=None):
+        """tau = M a + C q_dot + g - sum J^T w, shape (..., n) (f_ext: wrenches.py)."""
+        if f_ext is not None:  # wrenches at frames (wrenches.py)
+            return self._with_wrenches(q, v, a, f_ext, forward=False)
         try:
             out = self._inverse(q, v, a, self._P)
         except ValueError:
             out = self._call(self._inverse, q, v, a)
         return out if out.__class__ is not tuple else _reported(*out, 1)
 
-    def forward_dynamics(self, q, v, tau):
-        """q_ddot = M^-1 (tau - C q_dot - g), shape (..., n)."""
+    def forward_dynamics(self, q, v, tau, f_ext=None):
+        """q_ddot = M^-1 (tau + sum J^T w - C q_dot - g), shape (..., n) (f_ext: wrenches.py)."""
+        if f_ext is not None:  # wrenches at frames (wrenches.py)
+            return self._with_wrenches(q, v, tau, f_ext, forward=True)
         try:
             out = self._forward(q, v, tau, self._P)
         except ValueError:

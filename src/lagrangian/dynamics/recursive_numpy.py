@@ -308,13 +308,17 @@ class RecursiveNumpyDynamics(TreeDynamics):
         return self._guarded(lambda Q: self._newton_euler(Q, None, None), (q,), ("q",),
                              (self.n,))
 
-    def inverse_dynamics(self, q, v, a):
-        """tau = M a + C q_dot + g, shape (..., n)."""
+    def inverse_dynamics(self, q, v, a, f_ext=None):
+        """tau = M a + C q_dot + g - sum J^T w, shape (..., n) (f_ext: wrenches.py)."""
+        if f_ext is not None:  # wrenches at frames (wrenches.py)
+            return self._with_wrenches(q, v, a, f_ext, forward=False)
         return self._guarded(self._newton_euler, (q, v, a), ("q", "v", "a"), (self.n,))
 
-    def forward_dynamics(self, q, v, tau):
-        """q_ddot = M^-1 (tau - C q_dot - g), shape (..., n); NaN where M is not positive
-        definite."""
+    def forward_dynamics(self, q, v, tau, f_ext=None):
+        """q_ddot = M^-1 (tau + sum J^T w - C q_dot - g), shape (..., n); NaN where M is not
+        positive definite (f_ext: wrenches.py)."""
+        if f_ext is not None:  # wrenches at frames (wrenches.py)
+            return self._with_wrenches(q, v, tau, f_ext, forward=True)
         return self._guarded(lambda Q, V, TAU: solve_positive(
             self._composite_rigid_body(Q), TAU - self._newton_euler(Q, V, None)),
             (q, v, tau), ("q", "v", "tau"), (self.n,), forward=True)

@@ -212,6 +212,10 @@ class Model:
     # file gives none (or 0): (coordinate name, velocity, effort).
     source_ratings: tuple[tuple[str, float | None, float | None], ...] = field(
         default=(), compare=False, repr=False)
+    # ... and its joints' <dynamics>: (coordinate name, damping in N m s/rad or N s/m, Coulomb
+    # friction in N m or N), 0 where the file gives none; used only by dynamics(actuators=True).
+    source_dynamics: tuple[tuple[str, float, float], ...] = field(
+        default=(), compare=False, repr=False)
 
     @property
     def q(self) -> tuple[sp.Symbol, ...]:

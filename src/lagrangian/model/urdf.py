@@ -11,8 +11,9 @@ position limits as the coordinates' ranges). A link's frame is
 
 and its inertial (mass, tensor about the centre of mass in the inertial frame, that frame's
 origin and rpy) becomes a rigid body whose inertia is turned into link axes, I = R I' R^T.
-Joint damping and friction (<dynamics>) are ignored, as Pinocchio does: M, C q_dot and g are
-the rigid-body terms a controller needs.
+Joint damping and friction (<dynamics>) are kept (Model.source_dynamics) but left out of the
+equations, as Pinocchio does: M, C q_dot and g are the rigid-body terms a controller needs;
+dynamics(actuators=True) adds them (dynamics/actuators.py).
 """
 
 from __future__ import annotations
@@ -324,7 +325,23 @@ class _Tree:
         return replace(model, rigid_bodies=bodies, kinematic_tree=tree,
                        source_names=tuple((name, joint) for joint, name in names.items()),
                        source_ratings=tuple((name, *self._ratings(joint))
-                                            for joint, name in names.items()))
+                                            for joint, name in names.items()),
+                       source_dynamics=tuple((name, *self._friction(joint))
+                                             for joint, name in names.items()))
+
+    def _friction(self, name: str) -> tuple[float, float]:
+        """A joint's <dynamics> damping and Coulomb friction (0 where absent); a negative or
+        non-finite one is refused, naming the joint."""
+        dynamics = self.by_name[name].dynamics
+        values = []
+        for key in ("damping", "friction"):
+            value = getattr(dynamics, key, None) if dynamics is not None else None
+            value = 0.0 if value is None else float(value)
+            if not (math.isfinite(value) and value >= 0):
+                raise self.error(f"<dynamics {key}=\"{value:g}\"> must be a finite number >= 0",
+                                 f"joint '{name}'.dynamics.{key}")
+            values.append(value)
+        return values[0], values[1]
 
     def _ratings(self, name: str) -> tuple[float | None, float | None]:
         """A joint's velocity and effort limits (positive numbers, else None)."""

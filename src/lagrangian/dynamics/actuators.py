@@ -1,0 +1,141 @@
+"""Actuator models on top of the rigid-body dynamics, per coordinate, off unless asked for:
+
+    M' = M + diag(armature),   b' = b + d q_dot + f_c sign(q_dot)
+
+with d the viscous damping (N m s/rad or N s/m) and f_c the Coulomb friction (N m or N) of the
+URDF's <dynamics damping friction>, and the armature the rotor inertia reflected through the
+transmission (kg m^2 or kg; URDF has no standard tag for it, so it is given per joint). Then
+tau = M' a + b' and q_ddot = M'^-1 (tau - b'). sign(0) = 0: a joint at rest feels no Coulomb
+friction (no stiction model). C(q, q_dot) and g(q) stay the rigid body's (the armature is
+constant; damping and friction are not Coriolis terms).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..errors import InputError, did_you_mean_or_list
+from .joint_space import Dynamics, solve_positive
+
+
+def actuator_values(model, armature: Mapping[str, float] | None,
+                    friction: bool) -> dict[str, np.ndarray]:
+    """Per coordinate, in the model's order: damping, friction (the URDF's, when ``friction``)
+    and armature (``armature`` by coordinate or URDF joint name; 0 for the others)."""
+    coordinates = [c.name for c in model.coordinates]
+    index = {name: k for k, name in enumerate(coordinates)}
+    for coordinate, joint in model.source_names:
+        index.setdefault(joint, index[coordinate])
+    n = len(coordinates)
+    values = {"damping": np.zeros(n), "friction": np.zeros(n), "armature": np.zeros(n)}
+    if friction:
+        for coordinate, damping, coulomb in model.source_dynamics:
+            values["damping"][index[coordinate]] = damping
+            values["friction"][index[coordinate]] = coulomb
+    if armature is not None and not isinstance(armature, Mapping):
+        raise InputError("expected a mapping of joint names to rotor inertias (kg m^2 or kg), "
+                         f"got {type(armature).__name__}", field="armature")
+    for name, value in (armature or {}).items():
+        if name not in index:
+            raise InputError(f"no joint named '{name}'"
+                             f"{did_you_mean_or_list(str(name), list(index))}", field="armature")
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            raise InputError(f"the value {value!r} is not a number",
+                             field=f"armature.{name}") from None
+        if not (math.isfinite(value) and value >= 0):
+            raise InputError(f"a rotor inertia is a finite number >= 0, got {value!r}",
+                             field=f"armature.{name}")
+        values["armature"][index[name]] = value
+    return values
+
+
+class ActuatedDynamics(Dynamics):
+    """A robot's dynamics with its actuators: armature on M's diagonal, viscous damping and
+    Coulomb friction in the bias (module docstring); frames and the rest from the rigid body's
+    dynamics underneath (``rigid``)."""
+
+    def __init__(self, rigid: Dynamics, damping, friction, armature):
+        self.rigid = rigid
+        self.coordinates, self.n = rigid.coordinates, rigid.n
+        self.damping = np.array(damping, dtype=float)
+        self.friction = np.array(friction, dtype=float)
+        self.armature = np.array(armature, dtype=float)
+        self.backend = getattr(rigid, "backend", "symbolic")
+
+    def __repr__(self) -> str:
+        return f"ActuatedDynamics({self.rigid!r})"
+
+    def __getattr__(self, name):  # model, tree, parameters, numeric_system: the rigid body's
+        if name.startswith("__") or name == "rigid":
+            raise AttributeError(name)
+        return getattr(self.rigid, name)
+
+    @property
+    def actuators(self) -> dict[str, dict[str, float]]:
+        """Per coordinate: damping, friction, armature (SI)."""
+        return {c: {"damping": float(d), "friction": float(f), "armature": float(a)}
+                for c, d, f, a in zip(self.coordinates, self.damping, self.friction,
+                                      self.armature, strict=True)}
+
+    def _losses(self, v) -> np.ndarray:
+        """d q_dot + f_c sign(q_dot)."""
+        v = self._vector(v, "v")
+        return self.damping * v + self.friction * np.sign(v)
+
+    def mass_matrix(self, q) -> np.ndarray:
+        """M(q) + diag(armature), shape (..., n, n)."""
+        return self.rigid.mass_matrix(q) + np.diag(self.armature)
+
+    def bias_forces(self, q, v) -> np.ndarray:
+        """C q_dot + g + d q_dot + f_c sign(q_dot), shape (..., n)."""
+        return self.rigid.bias_forces(q, v) + self._losses(v)
+
+    def gravity(self, q) -> np.ndarray:
+        """g(q), shape (..., n)."""
+        return self.rigid.gravity(q)
+
+    def coriolis_matrix(self, q, v) -> np.ndarray:
+        """The rigid body's C(q, q_dot) (damping and friction are not in it)."""
+        return self.rigid.coriolis_matrix(q, v)
+
+    def inverse_dynamics(self, q, v, a, f_ext=None) -> np.ndarray:
+        """tau = (M + diag(armature)) a + b + d q_dot + f_c sign(q_dot) - sum J^T w."""
+        return (self.rigid.inverse_dynamics(q, v, a, f_ext) + self.armature * self._vector(a, "a")
+                + self._losses(v))
+
+    def forward_dynamics(self, q, v, tau, f_ext=None) -> np.ndarray:
+        """q_ddot = (M + diag(armature))^-1 (tau + sum J^T w - b - d q_dot - f_c sign(q_dot)),
+        NaN where that matrix is not positive definite."""
+        if f_ext is not None:
+            return self._with_wrenches(q, v, tau, f_ext, forward=True)
+
+        def compute(Q, V, TAU):
+            return solve_positive(self.rigid.mass_matrix(Q) + np.diag(self.armature),
+                                  TAU - self.rigid.bias_forces(Q, V) - self._losses(V))
+
+        return self._guarded(compute, (q, v, tau), ("q", "v", "tau"), (self.n,), forward=True)
+
+    def kinetic_energy(self, q, v) -> np.ndarray:
+        """T + 1/2 sum armature q_dot^2 (J)."""
+        v_ = self._vector(v, "v")
+        return self.rigid.kinetic_energy(q, v) + 0.5 * (self.armature * v_ * v_).sum(axis=-1)
+
+    def potential_energy(self, q) -> np.ndarray:
+        """V(q) in J."""
+        return self.rigid.potential_energy(q)
+
+
+def actuated(rigid: Dynamics, model, armature: Mapping[str, float] | None = None,
+             friction: bool = True) -> ActuatedDynamics:
+    """``rigid`` with the actuator models: the URDF's damping and friction (``friction``) and
+    the given armature."""
+    values = actuator_values(model, armature, friction)
+    return ActuatedDynamics(rigid, values["damping"], values["friction"], values["armature"])
+
+
+__all__ = ["ActuatedDynamics", "actuated", "actuator_values"]

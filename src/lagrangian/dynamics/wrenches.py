@@ -1,0 +1,57 @@
+"""External wrenches at frames as generalized forces: tau_ext = sum over frames of J^T w.
+
+A wrench is w = [f; m] (N; N m) acting on the body that carries the frame, with f applied at
+the frame's origin and both vectors in world axes (the LOCAL_WORLD_ALIGNED convention of the
+frame Jacobian, whose J^T takes it to joint space). Inverse dynamics then gives the joint
+forces with the wrench acting (tau = M a + b - tau_ext); forward dynamics adds tau_ext to tau.
+(Pinocchio's f_ext is per joint, in the joint's own axes about its origin: the same wrench is
+R_j^T f and R_j^T (m + (p - o_j) x f) there.)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..errors import InputError, did_you_mean_or_list
+
+
+def wrench_arrays(kinematics, f_ext) -> dict[str, np.ndarray]:
+    """Each frame's wrench as an array (..., 6), its name checked: one line naming
+    ``f_ext`` (an unknown frame, with a suggestion) or ``f_ext.<frame>`` (not six numbers)."""
+    if not isinstance(f_ext, Mapping):
+        raise InputError("expected a mapping of frame names to wrenches [fx, fy, fz, mx, my, "
+                         f"mz], got {type(f_ext).__name__}", field="f_ext")
+    frames = kinematics.frames
+    out = {}
+    for name, value in f_ext.items():
+        if name not in frames:
+            raise InputError(f"no frame named '{name}'{did_you_mean_or_list(str(name), frames)}",
+                             field="f_ext")
+        try:
+            array = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("a wrench is 6 numbers [fx, fy, fz, mx, my, mz] (N, N m)",
+                             field=f"f_ext.{name}") from None
+        if array.ndim == 0 or array.shape[-1] != 6:
+            shape = "()" if array.ndim == 0 else str(array.shape)
+            raise InputError("a wrench is 6 numbers [fx, fy, fz, mx, my, mz] (N, N m) along "
+                             f"the last axis, got shape {shape}", field=f"f_ext.{name}")
+        out[name] = array
+    return out
+
+
+def wrench_forces(kinematics, q, f_ext) -> np.ndarray:
+    """tau_ext = sum J_frame(q)^T w_frame (N m or N per coordinate), shape (..., n): the
+    generalized forces of wrenches at frames (world axes, at each frame's origin)."""
+    wrenches = wrench_arrays(kinematics, f_ext)
+    q = np.asarray(q, dtype=float)
+    total = np.zeros(q.shape[:-1] + (kinematics.n,))
+    for name, w in wrenches.items():
+        J = kinematics.jacobian(q, name, "local_world_aligned")
+        total = total + np.einsum("...ij,...i->...j", J, w)
+    return total
+
+
+__all__ = ["wrench_arrays", "wrench_forces"]

@@ -1,0 +1,198 @@
+"""Issue 23 for fixed-base URDF robots, against Pinocchio (skipped where it is not installed):
+J_dot q_dot of every frame in the three reference frames (getFrameClassicalAcceleration with
+a = 0), the centroidal momentum matrix (ccrba), wrenches at frames in inverse and forward
+dynamics (rnea and aba with f_ext), and the actuator models (armature against crba and aba with
+model.armature; damping and friction against the formula, computed independently)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import lagrangian
+
+pin = pytest.importorskip("pinocchio")
+pytest.importorskip("yourdfpy")
+
+from tests.dynamics.test_dynamics_pinocchio import ARM  # noqa: E402  (revolute, prismatic, fixed)
+
+REFERENCES = {"world": pin.ReferenceFrame.WORLD, "local": pin.ReferenceFrame.LOCAL,
+              "local_world_aligned": pin.ReferenceFrame.LOCAL_WORLD_ALIGNED}
+# the first joint damped and with Coulomb friction
+DAMPED = ARM.replace('velocity="1"/></joint>',
+                     'velocity="1"/><dynamics damping="0.3" friction="0.2"/></joint>', 1)
+
+
+@pytest.fixture(scope="module")
+def system(tmp_path_factory):
+    path = tmp_path_factory.mktemp("reach") / "spatial.urdf"
+    path.write_text(DAMPED)
+    return lagrangian.load(path)
+
+
+@pytest.fixture(scope="module")
+def model():
+    return pin.buildModelFromXML(DAMPED)
+
+
+def _frame_id(model, name):
+    for kind in (pin.FrameType.BODY, pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT):
+        if model.existFrame(name, kind):
+            return model.getFrameId(name, kind)
+    raise AssertionError(f"Pinocchio has no frame {name}")
+
+
+def _states(count=5, seed=13):
+    rng = np.random.default_rng(seed)
+    return tuple(rng.uniform(-1, 1, (count, 3)) for _ in range(4))
+
+
+def test_jacobian_dot_times_v_of_every_frame_agrees_with_pinocchio(system, model):
+    arm = system.dynamics(backend="numpy")
+    data = model.createData()
+    q, v, _, _ = _states()
+    for name in arm.frames:
+        frame_id = _frame_id(model, name)
+        for ref, pin_ref in REFERENCES.items():
+            ours = arm.jacobian_dot_times_v(q, v, name, ref)
+            assert ours.shape == (len(q), 6)
+            for k in range(len(q)):
+                pin.forwardKinematics(model, data, q[k], v[k], np.zeros(3))
+                pin.updateFramePlacements(model, data)
+                expected = pin.getFrameClassicalAcceleration(model, data, frame_id, pin_ref)
+                np.testing.assert_allclose(ours[k], expected.vector, atol=1e-12,
+                                           err_msg=f"{name} {ref}")
+    one = arm.jacobian_dot_times_v(q[0], v[0], "tool")  # one state: (6,)
+    np.testing.assert_allclose(one, arm.jacobian_dot_times_v(q, v, "tool")[0], atol=1e-15)
+
+
+def test_jacobian_dot_is_the_derivative_of_the_jacobian(system):
+    """d/dt (J(q) q_dot) along q(t) = q + t q_dot at q_ddot = 0 by central differences: the
+    law, without Pinocchio."""
+    arm = system.dynamics(backend="numpy")
+    q, v, _, _ = _states(1, seed=4)
+    h = 1e-6
+    ahead = arm.jacobian(q[0] + h * v[0], "tool") @ v[0]
+    behind = arm.jacobian(q[0] - h * v[0], "tool") @ v[0]
+    np.testing.assert_allclose(arm.jacobian_dot_times_v(q[0], v[0], "tool"),
+                               (ahead - behind) / (2 * h), atol=1e-8)
+
+
+def test_centroidal_momentum_matrix_agrees_with_ccrba(system, model):
+    arm = system.dynamics()
+    data = model.createData()
+    q, v, _, _ = _states()
+    Ag = arm.centroidal_momentum_matrix(q)
+    assert Ag.shape == (len(q), 6, 3)
+    for k in range(len(q)):
+        pin.ccrba(model, data, q[k], v[k])
+        np.testing.assert_allclose(Ag[k], data.Ag, atol=1e-12)
+        np.testing.assert_allclose(Ag[k] @ v[k], data.hg.vector, atol=1e-12)
+    # the linear rows are the total mass times the centre of mass Jacobian
+    np.testing.assert_allclose(Ag[:, :3], arm.kinematics.mass() * arm.center_of_mass_jacobian(q),
+                               atol=1e-12)
+
+
+def _pinocchio_wrenches(model, data, q, wrenches):
+    """The world-aligned wrenches at frames as Pinocchio's f_ext: per joint, in its own axes,
+    about its origin."""
+    pin.forwardKinematics(model, data, q)
+    pin.updateFramePlacements(model, data)
+    f_ext = [pin.Force.Zero() for _ in range(model.njoints)]
+    for name, w in wrenches.items():
+        frame_id = _frame_id(model, name)
+        joint = model.frames[frame_id].parentJoint
+        R, o = data.oMi[joint].rotation, data.oMi[joint].translation
+        p = data.oMf[frame_id].translation
+        f_ext[joint] += pin.Force(R.T @ w[:3], R.T @ (w[3:] + np.cross(p - o, w[:3])))
+    return f_ext
+
+
+@pytest.mark.parametrize("backend", ["numpy", "auto"])
+def test_wrenches_at_frames_agree_with_rnea_and_aba(system, model, backend):
+    arm = system.dynamics(backend=backend)
+    data = model.createData()
+    q, v, a, tau = _states()
+    rng = np.random.default_rng(2)
+    wrenches = {"tool": rng.uniform(-5, 5, 6), "b": rng.uniform(-5, 5, 6),
+                "j3": rng.uniform(-5, 5, 6), "base": rng.uniform(-5, 5, 6)}
+    inverse = arm.inverse_dynamics(q, v, a, f_ext=wrenches)
+    forward = arm.forward_dynamics(q, v, tau, f_ext=wrenches)
+    for k in range(len(q)):
+        f_ext = _pinocchio_wrenches(model, data, q[k], wrenches)
+        np.testing.assert_allclose(inverse[k], pin.rnea(model, data, q[k], v[k], a[k], f_ext),
+                                   atol=1e-12)
+        np.testing.assert_allclose(forward[k], pin.aba(model, data, q[k], v[k], tau[k], f_ext),
+                                   atol=1e-12)
+    # a batch of wrenches, one per state
+    batch = {"tool": rng.uniform(-5, 5, (len(q), 6))}
+    each = [arm.inverse_dynamics(q[k], v[k], a[k], f_ext={"tool": batch["tool"][k]})
+            for k in range(len(q))]
+    np.testing.assert_allclose(arm.inverse_dynamics(q, v, a, f_ext=batch), each, atol=1e-12)
+
+
+def test_bad_wrenches_are_refused_in_one_line(system):
+    arm = system.dynamics()
+    zero = np.zeros(3)
+    with pytest.raises(lagrangian.InputError, match="no frame named 'tol'; did you mean 'tool'") \
+            as caught:
+        arm.inverse_dynamics(zero, zero, zero, f_ext={"tol": np.zeros(6)})
+    assert caught.value.field == "f_ext"
+    with pytest.raises(lagrangian.InputError, match="6 numbers") as caught:
+        arm.forward_dynamics(zero, zero, zero, f_ext={"tool": [1.0, 2.0]})
+    assert caught.value.field == "f_ext.tool"
+    with pytest.raises(lagrangian.InputError, match="mapping"):
+        arm.inverse_dynamics(zero, zero, zero, f_ext=[1, 2, 3, 4, 5, 6])
+
+
+@pytest.mark.parametrize("backend", ["numpy", "auto"])
+def test_actuators_armature_damping_and_friction(system, model, backend):
+    armature = {"j1": 0.1, "j3": 0.05}
+    rigid = system.dynamics(backend=backend)
+    assert rigid.bias_forces(np.zeros(3), np.ones(3)).shape == (3,)  # off by default
+    f = system.dynamics(backend=backend, actuators=True, armature=armature)
+    assert f.actuators["j1"] == {"damping": 0.3, "friction": 0.2, "armature": 0.1}
+    model = model.copy()
+    model.armature = np.array([0.1, 0.0, 0.05])
+    data = model.createData()
+    q, v, a, tau = _states()
+    d, c, arm = np.array([0.3, 0, 0]), np.array([0.2, 0, 0]), np.array([0.1, 0, 0.05])
+    mass = f.mass_matrix(q)
+    forward, inverse = f.forward_dynamics(q, v, tau), f.inverse_dynamics(q, v, a)
+    for k in range(len(q)):
+        m = pin.crba(model, data, q[k]).copy()
+        m = np.triu(m) + np.triu(m, 1).T
+        np.testing.assert_allclose(mass[k], m, atol=1e-12)
+        # Pinocchio's aba with the armature, the losses moved into tau
+        losses = d * v[k] + c * np.sign(v[k])
+        np.testing.assert_allclose(forward[k], pin.aba(model, data, q[k], v[k], tau[k] - losses),
+                                   atol=1e-12)
+        # independently: (M + diag(armature))^-1 (tau - b - d q_dot - f sign q_dot)
+        M = rigid.mass_matrix(q[k]) + np.diag(arm)
+        b = rigid.bias_forces(q[k], v[k])
+        np.testing.assert_allclose(forward[k], np.linalg.solve(M, tau[k] - b - losses),
+                                   atol=1e-12)
+        np.testing.assert_allclose(inverse[k], M @ a[k] + b + losses, atol=1e-12)
+    # only the armature: no damping
+    only = system.dynamics(backend=backend, armature={"j2": 0.2})
+    assert only.actuators["j1"]["damping"] == 0.0
+    np.testing.assert_allclose(only.mass_matrix(q[0]) - rigid.mass_matrix(q[0]),
+                               np.diag([0, 0.2, 0]), atol=1e-15)
+    # frames come through
+    np.testing.assert_allclose(f.jacobian(q[0], "tool"), rigid.jacobian(q[0], "tool"))
+
+
+def test_bad_armature_is_refused_in_one_line(system):
+    with pytest.raises(lagrangian.InputError, match="no joint named 'j4'") as caught:
+        system.dynamics(armature={"j4": 0.1})
+    assert caught.value.field == "armature"
+    with pytest.raises(lagrangian.InputError, match=">= 0") as caught:
+        system.dynamics(armature={"j1": -1.0})
+    assert caught.value.field == "armature.j1"
+
+
+def test_negative_damping_in_a_urdf_is_refused_naming_the_joint(tmp_path):
+    path = tmp_path / "bad.urdf"
+    path.write_text(DAMPED.replace('damping="0.3"', 'damping="-0.3"'))
+    with pytest.raises(lagrangian.ModelError, match="joint 'j1'.dynamics.damping"):
+        lagrangian.load(path)

@@ -47,6 +47,8 @@ FLAG_OF_FIELD = {
     "csv": "--csv",
     "frame": "--frame",
     "reference": "--reference",
+    "f_ext": "--wrench",
+    "armature": "--armature",
 }
 
 SET_HELP = "Override a parameter: NAME=VALUE; repeat, or join with commas (m=2,L=0.5)."

@@ -13,6 +13,17 @@ from . import app
 from .common import GRAVITY_HELP, PAYLOAD_HELP, load_system, print_json, warn, warn_bare_angles
 
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
+WRENCH_HELP = ("URDF: a wrench on a frame, FRAME=fx,fy,fz,mx,my,mz (N, N m; world axes, at the "
+               "frame's origin), acting in --a and --tau; repeatable.")
+ARMATURE_HELP = "URDF: a joint's rotor inertia, JOINT=VALUE (kg m^2, or kg); repeatable."
+
+
+def _wrenches(texts: list[str]) -> dict[str, list[float]]:
+    """--wrench FRAME=fx,fy,fz,mx,my,mz as {frame: six numbers}."""
+    from .common import assignments
+
+    return {name: _vector(value, 6, f"--wrench {name}", [])
+            for name, value in assignments(texts, "--wrench")}
 
 
 def _vector(text: str | None, n: int, flag: str, default: list[float]) -> list[float]:
@@ -38,6 +49,9 @@ def dynamics(
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
     payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    wrench: Annotated[list[str], typer.Option("--wrench", help=WRENCH_HELP)] = [],  # noqa: B006
+    actuators: Annotated[bool, typer.Option("--actuators", help="URDF: add each joint's <dynamics> damping (viscous) and friction (Coulomb) to the bias forces.")] = False,  # noqa: E501
+    armature: Annotated[list[str], typer.Option("--armature", help=ARMATURE_HELP)] = [],  # noqa: B006
     coriolis: Annotated[bool, typer.Option("--coriolis", help="Also print C(q, q_dot), the matrix of the Coriolis and centrifugal terms (M_dot - 2C skew).")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
@@ -50,6 +64,15 @@ def dynamics(
     if a is not None and tau is not None:
         raise InputError("--a (inverse dynamics) and --tau (forward dynamics) ask for two "
                          "things; give one")
+    if wrench and a is None and tau is None:
+        raise InputError("a wrench acts in inverse (--a) or forward (--tau) dynamics; give one",
+                         field="--wrench")
+    from .. import parse_quantity
+    from .common import assignments
+
+    wrenches = _wrenches(wrench)
+    rotors = {name: parse_quantity(text, None, f"--armature {name}")
+              for name, text in assignments(armature, "--armature")}
     system = load_system(model, set_, lock, gravity, payload)
     coordinates = system.model.coordinates
     n = len(coordinates)
@@ -67,7 +90,7 @@ def dynamics(
         for line in limit_warnings(system.model, dict(zip(names, qs, strict=True)), "--q"):
             warn(line)
     vs = _vector(v, n, "--v", list(start.q_dot))
-    f = system.dynamics()
+    f = system.dynamics(actuators=actuators, armature=rotors or None)
     with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings(record=True) as seen:
         # an overflow is refused below; a state without dynamics (M not positive definite)
         # is a DynamicsWarning and NaN, reported in one line
@@ -76,10 +99,12 @@ def dynamics(
                   "bias_forces": f.bias_forces(qs, vs), "gravity": f.gravity(qs)}
         if a is not None:
             values["a"] = _vector(a, n, "--a", [])
-            values["inverse_dynamics"] = f.inverse_dynamics(qs, vs, values["a"])
+            values["inverse_dynamics"] = f.inverse_dynamics(qs, vs, values["a"],
+                                                            f_ext=wrenches or None)
         if tau is not None:
             values["tau"] = _vector(tau, n, "--tau", [])
-            values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"])
+            values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"],
+                                                            f_ext=wrenches or None)
         if coriolis:
             values["coriolis_matrix"] = f.coriolis_matrix(qs, vs)
         values["kinetic_energy"] = f.kinetic_energy(qs, vs)
@@ -99,7 +124,12 @@ def dynamics(
                                   "(a number beyond floating point, or a state outside the "
                                   "model's domain)")
     names = [c.name for c in coordinates]
+    extra = {}
+    if wrenches:
+        extra["wrenches"] = wrenches
+    if actuators or rotors:
+        extra["actuators"] = f.actuators
     if json_:
-        print_json(dynamics_document(names, values, system.joint_names))
+        print_json({**dynamics_document(names, values, system.joint_names), **extra})
     else:
         typer.echo(dynamics_text(names, values), nl=False)

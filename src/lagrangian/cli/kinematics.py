@@ -1,5 +1,7 @@
-"""`lagrangian kinematics ROBOT.urdf --q ... --frame NAME [--reference ...] [--json]`: a frame's
-placement and Jacobian and the centre of mass of a URDF robot at one configuration."""
+"""`lagrangian kinematics ROBOT.urdf --q ... --frame NAME [--reference ...] [--v ...]
+[--centroidal] [--json]`: a frame's placement and Jacobian and the centre of mass of a URDF robot
+at one configuration; with --v also J_dot q_dot, with --centroidal the centroidal momentum
+matrix (and with --v the momentum h_g = A_g q_dot)."""
 
 from __future__ import annotations
 
@@ -17,6 +19,8 @@ def kinematics(
     model: Annotated[str, typer.Argument(help="URDF robot (file or built-in example name).")],
     frame: Annotated[str | None, typer.Option("--frame", help="A link or joint frame (default: the last link).")] = None,  # noqa: E501
     q: Annotated[str | None, typer.Option("--q", help="Coordinates, comma-separated in the model's order (default: the initial values).")] = None,  # noqa: E501
+    v: Annotated[str | None, typer.Option("--v", help="Velocities, comma-separated: also print J_dot q_dot, the frame's acceleration at q_ddot = 0.")] = None,  # noqa: E501
+    centroidal: Annotated[bool, typer.Option("--centroidal", help="Also print the centroidal momentum matrix A_g (and with --v the momentum A_g q_dot).")] = False,  # noqa: E501
     reference: Annotated[str, typer.Option("--reference", help="The Jacobian's frame: local_world_aligned (the origin's velocity in world axes), local or world, as Pinocchio's.")] = "local_world_aligned",  # noqa: E501
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
@@ -35,6 +39,14 @@ def kinematics(
               "jacobian": robot.jacobian(qs, name, reference),
               "center_of_mass": robot.center_of_mass(qs),
               "center_of_mass_jacobian": robot.center_of_mass_jacobian(qs)}
+    vs = None if v is None else _vector(v, len(coordinates), "--v", [])
+    if vs is not None:
+        values["v"] = vs
+        values["jacobian_dot_times_v"] = robot.jacobian_dot_times_v(qs, vs, name, reference)
+    if centroidal:
+        values["centroidal_momentum_matrix"] = robot.centroidal_momentum_matrix(qs)
+        if vs is not None:
+            values["centroidal_momentum"] = values["centroidal_momentum_matrix"] @ vs
     names = [c.name for c in coordinates]
     if json_:
         print_json(kinematics_document(names, name, reference, values))

@@ -11,7 +11,9 @@ import numpy as np
 def kinematics_document(coordinates, frame: str, reference: str,
                         values: Mapping[str, Any]) -> dict[str, Any]:
     """The `kinematics --json` document: the frame, the reference of its Jacobian and every array
-    as nested lists (SI: m, rad)."""
+    as nested lists (SI: m, rad): q, placement, jacobian, center_of_mass,
+    center_of_mass_jacobian; with --v also v and jacobian_dot_times_v (6); with --centroidal
+    centroidal_momentum_matrix (6 x n) and, with --v, centroidal_momentum (6)."""
     document: dict[str, Any] = {"coordinates": list(coordinates), "frame": frame,
                                 "reference": reference}
     for key, value in values.items():
@@ -23,7 +25,11 @@ _TITLES = {
     "q": "q", "placement": "placement (rotation | origin in m) in the world",
     "jacobian": "Jacobian [v; w] = J q_dot (linear rows first)",
     "center_of_mass": "centre of mass (m, world)",
-    "center_of_mass_jacobian": "centre-of-mass Jacobian",
+    "center_of_mass_jacobian": "centre-of-mass Jacobian", "v": "q_dot",
+    "jacobian_dot_times_v": "J_dot q_dot: [a; w_dot] at q_ddot = 0 (m/s^2, rad/s^2)",
+    "centroidal_momentum_matrix": "centroidal momentum matrix A_g (linear rows first; angular "
+                                  "about the centre of mass, world axes)",
+    "centroidal_momentum": "centroidal momentum h_g = A_g q_dot (kg m/s, kg m^2/s)",
 }
 
 
@@ -33,7 +39,7 @@ def kinematics_text(coordinates, frame: str, reference: str, values: Mapping[str
     for key, value in values.items():
         array = np.asarray(value, dtype=float)
         title = _TITLES.get(key, key)
-        if key == "jacobian":
+        if key in ("jacobian", "jacobian_dot_times_v"):
             title += f", reference {reference}"
         lines.append(f"{title}:")
         rows = array[None] if array.ndim == 1 else array

@@ -70,7 +70,7 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
         parse_model,
         read_model,
     )
-    from .errors import DynamicsWarning
+    from .errors import DynamicsWarning, ModelWarning
 
 __version__ = "0.1.0"
 
@@ -105,6 +105,7 @@ __all__ = [
     "LinearModel",
     "LoadContribution",
     "MissingExtraError",
+    "ModelWarning",
     "ModalAnalysis",
     "Mode",
     "Model",
@@ -165,6 +166,7 @@ _SYMPY_NAMES = frozenset({"cos", "exp", "sin", "sqrt", "tan"})
 # (not through the API, so that `lagrangian examples` starts without sympy or numpy).
 _HOMES = {
     "DynamicsWarning": ("errors", "DynamicsWarning"),
+    "ModelWarning": ("errors", "ModelWarning"),
     "parse_quantity": ("model.units", "parse_quantity"),
     "state_units": ("model.values", "state_units"),
     "resolve_state": ("model.values", "resolve_state"),

@@ -118,6 +118,23 @@ class DerivationError(LagrangianError):
     """The model is well formed but its equations cannot be formed (singular mass matrix, ...)."""
 
 
+def lock_hint(joints) -> str:
+    """The message for URDF joints that move no mass, naming the fix (lock)."""
+    listed = ", ".join(f"'{j}'" for j in joints)
+    flags = " ".join(f"--lock {j}=0" for j in joints)
+    locks = ", ".join(f"'{j}': 0.0" for j in joints)
+    many = len(joints) > 1
+    return (f"singular mass matrix: URDF joint{'s' if many else ''} {listed} move"
+            f"{'' if many else 's'} no mass (every link below carries none), so no acceleration "
+            f"is defined for {'them' if many else 'it'}; freeze {'them' if many else 'it'} at a "
+            f"value: {flags} (Python: load(path, lock={{{locks}}}))")
+
+
+class ModelWarning(UserWarning):
+    """A model was read with something left out that cannot change its results (a URDF link
+    fixed to the root with an inertia that is not physical); one line, printed by the CLI."""
+
+
 class DynamicsWarning(UserWarning):
     """Some states of a batch have no dynamics (an input not finite, or for forward dynamics a
     mass matrix that is not positive definite): their output rows are NaN, the others exact.

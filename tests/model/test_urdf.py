@@ -284,3 +284,51 @@ def test_two_link_arm_agrees_with_the_newton_euler_crosscheck():
     # an independent, force-based derivation of the same URDF bodies
     report = lagrangian.load("two_link_arm").crosscheck()
     assert report.passed
+
+
+def test_what_example_robot_data_taught_is_refused_or_warned_in_words(tmp_path, cli):
+    """Issue 23: a floating joint on the root names the fixed-base fix; an unphysical inertia on
+    a link fixed to the root (TIAGo's antennas) is a warning, the dynamics those of the robot
+    without it; joints that move no mass (Romeo's hands) name --lock; an empty <robot> (ur3.urdf)
+    says so, with no Python exception's name."""
+    floating = write(tmp_path, robot(link("world"), link("a", 1.0), link("b", 1.0),
+                                     joint("free", "world", "a", kind="floating"),
+                                     joint("j", "a", "b")), "floating.urdf")
+    with pytest.raises(ModelError, match="on the root link 'world' makes a floating base.*"
+                                         "remove it and link 'world'"):
+        lagrangian.load(floating)
+    bad = ('<link name="antenna"><inertial><mass value="0.1"/><inertia ixx="1" ixy="0" ixz="0" '
+           'iyy="-1" iyz="0" izz="1"/></inertial></link>')
+    plain = [link("base"), link("a", 1.0, (0.3, 0, 0)), joint("j1", "base", "a", axis="0 -1 0")]
+    antenna = write(tmp_path, robot(*plain, bad, joint("fix", "base", "antenna", kind="fixed")),
+                    "antenna.urdf")
+    with pytest.warns(lagrangian.ModelWarning, match="link 'antenna'.inertial: the inertia "
+                                                     "tensor is not positive semidefinite; "
+                                                     "ignored.*fixed to the root"):
+        warned = lagrangian.load(antenna).dynamics(backend="numpy")
+    reference = lagrangian.load(write(tmp_path, robot(*plain), "plain.urdf")).dynamics(
+        backend="numpy")
+    assert warned.mass_matrix([0.4]) == pytest.approx(reference.mass_matrix([0.4]), rel=1e-15)
+    result = cli("dynamics", str(antenna), "--q", "0.4")
+    assert result.code == 0
+    assert result.err.startswith("warning: ") and "fixed to the root" in result.err
+    moving = write(tmp_path, robot(*plain, bad, joint("j2", "a", "antenna")), "moving.urdf")
+    with pytest.raises(ModelError, match="link 'antenna'.inertial: the inertia tensor is not "
+                                         "positive semidefinite"):
+        lagrangian.load(moving)
+    hand = write(tmp_path, robot(*plain, link("hand"), joint("grip", "a", "hand")), "hand.urdf")
+    with pytest.raises(LagrangianError, match="URDF joint 'grip' moves no mass.*--lock grip=0 "
+                                              r"\(Python: load\(path, lock=\{'grip': 0.0\}\)\)"):
+        lagrangian.load(hand).dynamics()
+    locked = lagrangian.load(hand, lock={"grip": 0.0}).dynamics()
+    assert locked.mass_matrix([0.4]) == pytest.approx(reference.mass_matrix([0.4]), rel=1e-15)
+    empty = tmp_path / "empty.urdf"
+    empty.write_text('<?xml version="1.0"?>\n<robot xmlns:xacro="http://wiki.ros.org/xacro">'
+                     "</robot>")
+    with pytest.raises(ModelError, match="the <robot> holds no <link>: an empty robot") as info:
+        lagrangian.load(empty)
+    assert "KeyError" not in str(info.value)
+    nameless = tmp_path / "nameless.urdf"
+    nameless.write_text('<robot><link name="a"/></robot>')
+    with pytest.raises(ModelError, match="the <robot> element has no name"):
+        lagrangian.load(nameless)

@@ -5,12 +5,13 @@ from __future__ import annotations
 import json
 import re
 import sys
+import warnings
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
 import typer
 
-from ..errors import InputError, LagrangianError, ModelError
+from ..errors import InputError, LagrangianError, ModelError, ModelWarning
 
 if TYPE_CHECKING:
     from .. import EquationsOfMotion, System
@@ -85,7 +86,15 @@ def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = 
     locked = {name: parse_quantity(text, None, f"--lock {name}")
               for name, text in assignments(lock, "--lock")}
     carried = payloads(payload)
-    system = load(model, lock=locked, payload=carried) if locked or carried else load(model)
+    with warnings.catch_warnings(record=True) as seen:  # what the reader left out, one line each
+        warnings.simplefilter("always", ModelWarning)
+        system = load(model, lock=locked, payload=carried) if locked or carried else load(model)
+    for warning in seen:
+        if issubclass(warning.category, ModelWarning):
+            warn(str(warning.message))
+        else:
+            warnings.warn_explicit(warning.message, warning.category, warning.filename,
+                                   warning.lineno)
     if gravity is not None:
         parts = [part.strip() for part in gravity.split(",")]
         if len(parts) != 3:

@@ -95,7 +95,7 @@ def check_regularity(model: Model, mass_matrix: sp.MatrixBase, jacobian: sp.Matr
         # commands that integrate or linearize in time refuse it (require_inertia).
         return
     if missing and not m:
-        raise DerivationError(_missing_message(missing))
+        raise DerivationError(_missing_message(missing, model))
     values = random_state(model)
     try:
         M = numeric_matrix(mass_matrix, values)
@@ -111,7 +111,7 @@ def check_regularity(model: Model, mass_matrix: sp.MatrixBase, jacobian: sp.Matr
         system = M
     if _rank(system) < system.shape[0]:
         if missing:
-            raise DerivationError(_missing_message(missing))
+            raise DerivationError(_missing_message(missing, model))
         null = np.linalg.svd(system)[2][-1][:n]
         involved = [names[i] for i in np.flatnonzero(np.abs(null) > 1e-6 * np.abs(null).max())]
         raise DerivationError(
@@ -122,7 +122,11 @@ def check_regularity(model: Model, mass_matrix: sp.MatrixBase, jacobian: sp.Matr
         )
 
 
-def _missing_message(missing: list[str]) -> str:
+def _missing_message(missing: list[str], model: Model) -> str:
+    if model.source_names:  # a URDF robot: the joints carry massless links; lock is the fix
+        from ..errors import lock_hint
+
+        return lock_hint([dict(model.source_names).get(c, c) for c in missing])
     listed = ", ".join(f"'{name}'" for name in missing)
     return (
         f"singular mass matrix: the kinetic energy does not contain the velocity of {listed}, "

@@ -298,7 +298,25 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
                                 "slower per call than compiled C")
     if dynamics is None:
         dynamics = RecursiveNumpyDynamics(model, tree, parameters)
-    return dynamics if dynamics.regular() else None
+    if dynamics.regular():
+        return dynamics
+    _refuse_massless_joints(model, dynamics)
+    return None
+
+
+def _refuse_massless_joints(model: Model, dynamics) -> None:
+    """Joints whose column of M is zero (they carry only massless links, Romeo's hands): one
+    line naming them and the fix, lock, before a long derivation would find the same."""
+    from ..errors import lock_hint
+
+    rng = np.random.default_rng(1)
+    M = dynamics.mass_matrix(rng.uniform(-np.pi, np.pi, (3, dynamics.n)))
+    diagonal = np.abs(np.diagonal(M, axis1=-2, axis2=-1)).max(axis=0)
+    idle = [c for c, d in zip(dynamics.coordinates, diagonal, strict=True)
+            if not d > 1e-14 * max(1.0, float(diagonal.max()))]
+    if idle:
+        joints = dict(model.source_names)
+        raise DerivationError(lock_hint([joints.get(c, c) for c in idle]))
 
 
 def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],

@@ -23,6 +23,7 @@ import io
 import keyword
 import math
 import re
+import warnings
 from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
@@ -30,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
-from ..errors import ModelError, did_you_mean, require_extra
+from ..errors import ModelError, ModelWarning, did_you_mean, require_extra
 from ..kinds import JointKind
 from .builder import ModelBuilder
 from .expressions import RESERVED
@@ -82,6 +83,7 @@ def _parse(text: str, source: str, payloads=None):
         root = etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True))
     except etree.XMLSyntaxError as exc:
         raise ModelError(f"not well-formed XML ({exc})", source=source) from None
+    _check_robot(root, source)
     _check_inertials(root, source)
     if payloads:
         from .urdf_payload import add_payloads
@@ -97,9 +99,23 @@ def _parse(text: str, source: str, payloads=None):
                                       load_meshes=False, load_collision_meshes=False,
                                       build_collision_scene_graph=False)
     except Exception as exc:  # yourdfpy's own errors are plain exceptions of many kinds
-        raise ModelError(f"not a URDF robot ({type(exc).__name__}: {exc})",
-                         source=source) from None
+        reason = (f"an element lacks its {exc} attribute" if isinstance(exc, KeyError)
+                  else " ".join(str(exc).split())[:200] or "unreadable")
+        raise ModelError(f"not a URDF robot ({reason})", source=source) from None
     return urdf.robot
+
+
+def _check_robot(root, source: str) -> None:
+    """The document is a named <robot> with links: what yourdfpy needs before it can say why."""
+    if root.tag != "robot":
+        raise ModelError(f"the root element is <{root.tag}>, not <robot>: not a URDF robot",
+                         source=source)
+    if root.find("link") is None:
+        raise ModelError("the <robot> holds no <link>: an empty robot (is this the output of a "
+                         "xacro file that needed arguments?)", source=source)
+    if not root.get("name"):
+        raise ModelError("the <robot> element has no name (write <robot name=\"...\">)",
+                         source=source)
 
 
 def _check_inertials(root, source: str) -> None:
@@ -224,8 +240,15 @@ class _Tree:
     def _check_tree(self) -> tuple[str, dict[str, list]]:
         parent_of: dict[str, object] = {}
         children: dict[str, list] = {}
+        carried = {j.child for j in self.joints}
         for joint in self.joints:
             where = f"joint '{joint.name}'"
+            if joint.type == "floating" and joint.parent not in carried:
+                raise self.error(
+                    f"floating joints are not supported yet: this one on the root link "
+                    f"'{joint.parent}' makes a floating base (six free coordinates); to load the "
+                    f"robot on a fixed base, remove it and link '{joint.parent}' (link "
+                    f"'{joint.child}' becomes the root, fixed in the world)", where)
             if joint.type not in SUPPORTED:
                 raise self.error(
                     f"{joint.type} joints are not supported yet (use revolute, continuous, "
@@ -317,7 +340,8 @@ class _Tree:
             builder.add_generalized_force(name, tau, field=field)
         if not names:
             raise self.error("no joint left to move: a model needs at least one revolute, "
-                             "continuous or prismatic joint that is not locked")
+                             "continuous or prismatic joint that is not locked (a drone's body "
+                             "alone is a floating base: not supported yet)")
         position = self._positions(lock, names)
         bodies = tuple(self._bodies(root, order, position))
         model = builder.build_model()
@@ -435,13 +459,19 @@ class _Tree:
                                dtype=float)
             turn = where[:3, :3]
             tensor = turn @ tensor @ turn.T  # about the centre of mass, in link axes
-            if np.linalg.eigvalsh(0.5 * (tensor + tensor.T))[0] < -1e-12 * max(
-                    1.0, float(np.abs(tensor).max())):
+            physical = np.linalg.eigvalsh(0.5 * (tensor + tensor.T))[0] >= -1e-12 * max(
+                1.0, float(np.abs(tensor).max()))
+            if not moves[name]:  # fixed to the ground: no kinetic energy, a constant potential
+                if not physical:  # TIAGo's antennas: it cannot change the dynamics
+                    warnings.warn(ModelWarning(
+                        f"{self.source}: {field}: the inertia tensor is not positive "
+                        "semidefinite; ignored, since the link is fixed to the root and "
+                        "changes no dynamics"), stacklevel=2)
+                continue
+            if not physical:
                 raise self.error("the inertia tensor is not positive semidefinite", field)
             center = apply(frame.rotation, _vector(where[:3, 3]))
             position_ = tuple(o + c for o, c in zip(frame.origin, center, strict=True))
-            if not moves[name]:
-                continue  # fixed to the ground: no kinetic energy, a constant potential
             bodies.append(RigidBody(name, _number(mass), _matrix(0.5 * (tensor + tensor.T)),
                                     position_, frame.rotation, frame.origin,
                                     frame.angular_velocity, parents[name]))

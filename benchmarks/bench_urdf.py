@@ -3,6 +3,13 @@ forward dynamics and energies, per call and in batches of 10^4 states, and the t
 file to compiled functions (cold and from the cache).
 
     python benchmarks/bench_urdf.py [ur5|panda|xarm7 ...] [--states 100] [--symbolic numpy|c]
+    python benchmarks/bench_urdf.py --reach [ur5|panda|xarm7 ...]
+
+``--reach`` times issue 23's functions instead, on the last link's frame: J_dot q_dot against
+forwardKinematics(q, v, 0) + getFrameClassicalAcceleration (LOCAL_WORLD_ALIGNED), the
+centroidal momentum matrix against ccrba, and inverse and forward dynamics with a wrench at that
+frame against rnea and aba with f_ext (Pinocchio given its per-joint f_ext ready made; ours
+taking the frame's wrench), per call and for 10^4 states (Pinocchio in a Python loop).
 
 Needs the bench extra (pin, example-robot-data). The Panda's finger joints are locked at 0.
 Default: ``arm.dynamics()``, the recursive algorithms in generated C (dynamics/recursive.py);
@@ -183,6 +190,98 @@ def bench(name: str, symbolic: str | None, states: int, timing: bool = True) -> 
         print(f"    {label:<20} {t_ours * 1e3:9.2f} {t_pin * 1e3:9.2f} {t_pin / t_ours:7.1f}")
 
 
+def _frame_id(model, name):
+    import pinocchio as pin
+
+    for kind in (pin.FrameType.BODY, pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT):
+        if model.existFrame(name, kind):
+            return model.getFrameId(name, kind)
+    raise KeyError(name)
+
+
+def bench_reach(name: str, states: int, timing: bool = True) -> None:
+    """Issue 23: J_dot q_dot, A_g, wrenches in ID and FD, against Pinocchio."""
+    import pinocchio as pin
+
+    relpath, lock = ROBOTS[name]
+    path = robots_folder() / relpath
+    f = lagrangian.load(path, lock=lock).dynamics()
+    model = pin.buildModelFromUrdf(str(path))
+    if lock:
+        model = pin.buildReducedModel(model, [model.getJointId(j) for j in lock],
+                                      pin.neutral(model))
+    data = model.createData()
+    n = f.n
+    frame = next(x for x in reversed(f.frames) if model.existFrame(x))
+    fid = _frame_id(model, frame)
+    joint = model.frames[fid].parentJoint
+    lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    rng = np.random.default_rng(0)
+    q, v, a, tau = (rng.uniform(-1, 1, (states, n)) for _ in range(4))
+    w = rng.uniform(-5, 5, 6)
+
+    def f_ext(qk):
+        pin.forwardKinematics(model, data, qk)
+        pin.updateFramePlacements(model, data)
+        R, o = data.oMi[joint].rotation, data.oMi[joint].translation
+        p = data.oMf[fid].translation
+        forces = [pin.Force.Zero() for _ in range(model.njoints)]
+        forces[joint] = pin.Force(R.T @ w[:3], R.T @ (w[3:] + np.cross(p - o, w[:3])))
+        return forces
+
+    def drift(qk, vk):
+        pin.forwardKinematics(model, data, qk, vk, np.zeros(n))
+        return pin.getFrameClassicalAcceleration(model, data, fid, lwa).vector
+
+    wrench = {frame: w}
+    ours = {"Jdot v": f.jacobian_dot_times_v(q, v, frame), "A_g": f.centroidal_momentum_matrix(q),
+            "ID f_ext": f.inverse_dynamics(q, v, a, f_ext=wrench),
+            "FD f_ext": f.forward_dynamics(q, v, tau, f_ext=wrench)}
+    errors = dict.fromkeys(ours, 0.0)
+    for k in range(states):
+        forces = f_ext(q[k])
+        theirs = {"Jdot v": drift(q[k], v[k]), "A_g": pin.ccrba(model, data, q[k], v[k]).copy(),
+                  "ID f_ext": pin.rnea(model, data, q[k], v[k], a[k], forces),
+                  "FD f_ext": pin.aba(model, data, q[k], v[k], tau[k], forces)}
+        for key in errors:
+            errors[key] = max(errors[key], relative(ours[key][k], theirs[key]))
+    print(f"\n{name} (n = {n}), frame {frame}: max relative error vs Pinocchio over {states} "
+          "states: " + ", ".join(f"{k} {e:.1e}" for k, e in errors.items()))
+    if not timing:
+        return
+    q0, v0, a0, t0 = q[0].copy(), v[0].copy(), a[0].copy(), tau[0].copy()
+    forces0 = f_ext(q0)
+    rows = [("Jdot v / classical acc", lambda: f.jacobian_dot_times_v(q0, v0, frame),
+             lambda: drift(q0, v0)),
+            ("A_g / ccrba", lambda: f.centroidal_momentum_matrix(q0),
+             lambda: pin.ccrba(model, data, q0, v0)),
+            ("ID f_ext / rnea f_ext", lambda: f.inverse_dynamics(q0, v0, a0, f_ext=wrench),
+             lambda: pin.rnea(model, data, q0, v0, a0, forces0)),
+            ("FD f_ext / aba f_ext", lambda: f.forward_dynamics(q0, v0, t0, f_ext=wrench),
+             lambda: pin.aba(model, data, q0, v0, t0, forces0))]
+    print(f"  per call (us): ours, Pinocchio, ratio pin/ours; load average {load_average()}")
+    for label, mine, theirs in rows:
+        t_ours, t_pin = side_by_side(mine, theirs, number=500)
+        print(f"    {label:<24} {t_ours * 1e6:9.2f} {t_pin * 1e6:9.2f} {t_pin / t_ours:7.2f}")
+    big = 10_000
+    Q, V, A = (rng.uniform(-1, 1, (big, n)) for _ in range(3))
+    print(f"  batch of {big} (ms): ours one call, Pinocchio Python loop, ratio; "
+          f"load average {load_average()}")
+    for label, mine, theirs in [
+            ("Jdot v", lambda: f.jacobian_dot_times_v(Q, V, frame),
+             lambda: [drift(x, y) for x, y in zip(Q, V, strict=True)]),
+            ("A_g", lambda: f.centroidal_momentum_matrix(Q),
+             lambda: [pin.ccrba(model, data, x, y) for x, y in zip(Q, V, strict=True)]),
+            ("ID f_ext", lambda: f.inverse_dynamics(Q, V, A, f_ext=wrench),
+             lambda: [pin.rnea(model, data, x, y, z, forces0)
+                      for x, y, z in zip(Q, V, A, strict=True)]),
+            ("FD f_ext", lambda: f.forward_dynamics(Q, V, A, f_ext=wrench),
+             lambda: [pin.aba(model, data, x, y, z, forces0)
+                      for x, y, z in zip(Q, V, A, strict=True)])]:
+        t_ours, t_pin = side_by_side(mine, theirs, 3, 1)
+        print(f"    {label:<24} {t_ours * 1e3:9.2f} {t_pin * 1e3:9.2f} {t_pin / t_ours:7.1f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("robots", nargs="*", default=["ur5", "panda", "xarm7"])
@@ -190,9 +289,14 @@ def main() -> None:
                         help="time the derived equations with this backend instead")
     parser.add_argument("--states", type=int, default=100)
     parser.add_argument("--accuracy-only", action="store_true", help="skip the timings")
+    parser.add_argument("--reach", action="store_true",
+                        help="time J_dot q_dot, A_g and wrenches (issue 23) instead")
     args = parser.parse_args()
     for name in args.robots:
-        bench(name, args.symbolic, args.states, not args.accuracy_only)
+        if args.reach:
+            bench_reach(name, args.states, not args.accuracy_only)
+        else:
+            bench(name, args.symbolic, args.states, not args.accuracy_only)
 
 
 if __name__ == "__main__":

@@ -16,12 +16,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+from .recursive_numpy import _cross, _dot
 
 
 def _motion_cross(V, S):
     """[v; w] x [v'; w'] for (N, 6) rows."""
     v, w, sv, sw = V[:, :3], V[:, 3:], S[:, :3], S[:, 3:]
-    return np.concatenate([np.cross(w, sv) + np.cross(v, sw), np.cross(w, sw)], axis=1)
+    return np.concatenate([_cross(w, sv) + _cross(v, sw), _cross(w, sw)], axis=1)
 
 
 def spatial_motion(kinematics, Q: np.ndarray, V: np.ndarray, bodies) -> list[tuple]:
@@ -32,14 +33,11 @@ def spatial_motion(kinematics, Q: np.ndarray, V: np.ndarray, bodies) -> list[tup
     out: list[tuple[np.ndarray, np.ndarray]] = []
     for k, joint in enumerate(tree.joints):
         R, o = bodies[k]
-        s_w, s_v = kinematics._models[k].subspace(joint.axis)
+        s_v, s_w = _world_subspace(kinematics, k, joint, (R, o))
         S = np.zeros((count, 6))
+        S[:, :3] = s_v
         if s_w is not None:
-            w = R @ np.array(s_w)
-            S[:, 3:] = w
-            S[:, :3] = np.cross(o, w)  # the world origin's velocity: w x (0 - o)
-        if s_v is not None:
-            S[:, :3] += R @ np.array(s_v)
+            S[:, 3:] = s_w
         rate = (joint.multiplier * V[:, joint.coordinate])[:, None]
         if joint.parent < 0:
             velocity, drift = S * rate, np.zeros((count, 6))
@@ -72,38 +70,72 @@ def jacobian_dot_times_v(kinematics, q, v, frame: str, reference: str) -> np.nda
         return np.zeros(batch + (6,))
     velocity, drift = spatial_motion(kinematics, Q, V, bodies)[body]
     w, w_dot = velocity[:, 3:], drift[:, 3:]
-    p_dot = velocity[:, :3] + np.cross(w, p)
-    p_ddot = drift[:, :3] + np.cross(w_dot, p) + np.cross(w, p_dot)
+    p_dot = velocity[:, :3] + _cross(w, p)
+    p_ddot = drift[:, :3] + _cross(w_dot, p) + _cross(w, p_dot)
     if reference == "local":
         Rt = np.swapaxes(R, -1, -2)
         p_ddot, w_dot = (Rt @ p_ddot[..., None])[..., 0], (Rt @ w_dot[..., None])[..., 0]
     elif reference == "world":  # the point at the world's origin: p_ddot - w_dot x p - w x (w x p)
-        p_ddot = p_ddot - np.cross(w_dot, p) - np.cross(w, np.cross(w, p))
+        p_ddot = p_ddot - _cross(w_dot, p) - _cross(w, _cross(w, p))
     return np.concatenate([p_ddot, w_dot], axis=1).reshape(batch + (6,))
 
 
 def centroidal_momentum_matrix(kinematics, q) -> np.ndarray:
     """A_g with h_g = A_g q_dot, (..., 6, n): linear momentum (kg m/s per unit rate) and angular
-    momentum about the centre of mass (kg m^2/s), world axes (Pinocchio's ccrba)."""
+    momentum about the centre of mass (kg m^2/s), world axes (Pinocchio's ccrba).
+
+    By composite bodies: each subtree's mass M, first moment h and inertia I_O about the world's
+    origin (world axes) summed from the leaves up; a unit rate along S = [s_v; s_w] (at the
+    origin) gives the subtree the momentum [M s_v + s_w x h; h x s_v + I_O s_w]; then the
+    angular rows are moved to the centre of mass G: k_G = k_O - G x l."""
     Q, batch = kinematics._q(q)
-    bodies = kinematics._bodies(Q)
     kinematics._moving_mass()  # refused in one line without moving mass
-    centre = kinematics.center_of_mass(Q)
+    bodies = kinematics._bodies(Q)
+    joints = kinematics.tree.joints
+    eye = np.eye(3)
+    mass = [j.mass for j in joints]
+    first, inertia = [], []
+    for joint, (R, p) in zip(joints, bodies, strict=True):
+        m = joint.mass
+        hr = (R @ np.array(joint.first_moment)[:, None])[..., 0]
+        ph, pp = _dot(p, hr)[:, None, None], _dot(p, p)[:, None, None]
+        outer = p[:, :, None] * hr[:, None, :]
+        # J_O = R J R^T + m (|p|^2 1 - p p^T) + 2 (p.h) 1 - p h^T - h p^T (h turned into world)
+        inertia.append(R @ np.array(joint.inertia) @ np.swapaxes(R, -1, -2)
+                       + m * (pp * eye - p[:, :, None] * p[:, None, :])
+                       + 2.0 * ph * eye - outer - np.swapaxes(outer, -1, -2))
+        first.append(hr + m * p)
+    for k in reversed(range(len(joints))):
+        parent = joints[k].parent
+        if parent >= 0:
+            mass[parent] += mass[k]
+            first[parent] = first[parent] + first[k]
+            inertia[parent] = inertia[parent] + inertia[k]
     A = np.zeros((len(Q), 6, kinematics.n))
-    for k, (joint, (R, p)) in enumerate(zip(kinematics.tree.joints, bodies, strict=True)):
-        if joint.mass <= 0:
-            continue
-        m, h = joint.mass, np.array(joint.first_moment)
-        c = h / m
-        # inertia about the body's centre of mass, body axes: J_O - m (|c|^2 1 - c c^T)
-        inertia = np.array(joint.inertia) - m * (c @ c * np.eye(3) - np.outer(c, c))
-        point = p + R @ c
-        J = kinematics._point_jacobian(Q, bodies, k, point)
-        linear = m * J[:, :3]
-        A[:, :3] += linear
-        A[:, 3:] += (R @ inertia @ np.swapaxes(R, -1, -2)) @ J[:, 3:]
-        A[:, 3:] += np.cross((point - centre)[:, :, None], linear, axisa=1, axisb=1, axisc=1)
+    for k, joint in enumerate(joints):
+        s_v, s_w = _world_subspace(kinematics, k, joint, bodies[k])
+        linear = mass[k] * s_v
+        angular = _cross(first[k], s_v)
+        if s_w is not None:
+            linear = linear + _cross(s_w, first[k])
+            angular = angular + (inertia[k] @ s_w[..., None])[..., 0]
+        A[:, :3, joint.coordinate] += joint.multiplier * linear
+        A[:, 3:, joint.coordinate] += joint.multiplier * angular
+    total = sum(mass[k] for k, j in enumerate(joints) if j.parent < 0)
+    centre = sum(first[k] for k, j in enumerate(joints) if j.parent < 0) / total
+    A[:, 3:] -= np.cross(centre[:, :, None], A[:, :3], axisa=1, axisb=1, axisc=1)
     return A.reshape(batch + (6, kinematics.n))
+
+
+def _world_subspace(kinematics, k: int, joint, body):
+    """S of joint k at the world's origin in world axes: (s_v (N, 3), s_w (N, 3) or None)."""
+    R, o = body
+    s_w, s_v = kinematics._models[k].subspace(joint.axis)
+    w = None if s_w is None else R @ np.array(s_w)
+    linear = np.zeros(o.shape) if w is None else _cross(o, w)  # the origin's: w x (0 - o)
+    if s_v is not None:
+        linear = linear + R @ np.array(s_v)
+    return linear, w
 
 
 __all__ = ["centroidal_momentum_matrix", "jacobian_dot_times_v", "spatial_motion"]

@@ -44,14 +44,35 @@ def wrench_arrays(kinematics, f_ext) -> dict[str, np.ndarray]:
 
 def wrench_forces(kinematics, q, f_ext) -> np.ndarray:
     """tau_ext = sum J_frame(q)^T w_frame (N m or N per coordinate), shape (..., n): the
-    generalized forces of wrenches at frames (world axes, at each frame's origin)."""
+    generalized forces of wrenches at frames (world axes, at each frame's origin). Each wrench
+    is carried to the world's origin (m_O = m + p x f) and projected on the joint motions S
+    there: tau_j = k (s_v . f + s_w . m_O) for the joints above the frame's body."""
+    from .centroidal import _world_subspace
+    from .recursive_numpy import _cross, _dot
+
     wrenches = wrench_arrays(kinematics, f_ext)
-    q = np.asarray(q, dtype=float)
-    total = np.zeros(q.shape[:-1] + (kinematics.n,))
+    Q, batch = kinematics._q(q)
+    for w in wrenches.values():
+        batch = np.broadcast_shapes(batch, w.shape[:-1])
+    count = int(np.prod(batch, dtype=np.int64))
+    if len(Q) != count:
+        Q = np.broadcast_to(np.asarray(q, dtype=float), batch + (kinematics.n,)).reshape(
+            count, kinematics.n)
+    bodies = kinematics._bodies(Q)
+    total = np.zeros((count, kinematics.n))
     for name, w in wrenches.items():
-        J = kinematics.jacobian(q, name, "local_world_aligned")
-        total = total + np.einsum("...ij,...i->...j", J, w)
-    return total
+        body = kinematics._frame(name).body
+        if body < 0:
+            continue  # on the ground: no joint feels it
+        w = np.broadcast_to(w, batch + (6,)).reshape(count, 6)
+        p = kinematics._frame_pose(Q, bodies, name)[1]
+        force, moment = w[:, :3], w[:, 3:] + _cross(p, w[:, :3])
+        for k in kinematics._ancestors(body):
+            joint = kinematics.tree.joints[k]
+            s_v, s_w = _world_subspace(kinematics, k, joint, bodies[k])
+            share = _dot(s_v, force) + (0.0 if s_w is None else _dot(s_w, moment))
+            total[:, joint.coordinate] += joint.multiplier * share
+    return total.reshape(batch + (kinematics.n,))
 
 
 __all__ = ["wrench_arrays", "wrench_forces"]

@@ -5,7 +5,7 @@ file to compiled functions (cold and from the cache).
     python benchmarks/bench_urdf.py [ur5|panda|xarm7 ...] [--states 100] [--symbolic numpy|c]
     python benchmarks/bench_urdf.py --reach [ur5|panda|xarm7 ...]
 
-``--reach`` times issue 23's functions instead, on the last link's frame: J_dot q_dot against
+``--reach`` times issue 23's functions instead, on the last moving link's frame: J_dot q_dot against
 forwardKinematics(q, v, 0) + getFrameClassicalAcceleration (LOCAL_WORLD_ALIGNED), the
 centroidal momentum matrix against ccrba, and inverse and forward dynamics with a wrench at that
 frame against rnea and aba with f_ext (Pinocchio given its per-joint f_ext ready made; ours
@@ -212,7 +212,10 @@ def bench_reach(name: str, states: int, timing: bool = True) -> None:
                                       pin.neutral(model))
     data = model.createData()
     n = f.n
-    frame = next(x for x in reversed(f.frames) if model.existFrame(x))
+    # the last link that moves (a link frame Pinocchio has too): the tool, not a fixed base
+    moving = {x.name for x in f.tree.frames if x.body >= 0}
+    frame = next(x for x in reversed(f.frames)
+                 if x in moving and model.existFrame(x, pin.FrameType.BODY))
     fid = _frame_id(model, frame)
     joint = model.frames[fid].parentJoint
     lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED

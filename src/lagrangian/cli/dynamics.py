@@ -132,4 +132,4 @@ def dynamics(
     if json_:
         print_json({**dynamics_document(names, values, system.joint_names), **extra})
     else:
-        typer.echo(dynamics_text(names, values), nl=False)
+        typer.echo(dynamics_text(names, values, extra), nl=False)

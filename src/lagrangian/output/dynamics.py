@@ -39,7 +39,10 @@ _TITLES = {
 }
 
 
-def dynamics_text(coordinates, values: Mapping[str, Any]) -> str:
+def dynamics_text(coordinates, values: Mapping[str, Any],
+                  extra: Mapping[str, Any] | None = None) -> str:
+    """The values, one titled block each; ``extra``: the wrenches at frames and the actuator
+    models the values include (`--wrench`, `--actuators`, `--armature`)."""
     names = list(coordinates)
     width = max(len(n) for n in names)
     lines = [f"Coordinates: {', '.join(names)} (SI: rad or m; tau in N m or N)"]
@@ -54,4 +57,13 @@ def dynamics_text(coordinates, values: Mapping[str, Any]) -> str:
         else:
             lines.append(f"{title}:")
             lines += ["  " + "  ".join(f"{x: .9g}" for x in row) for row in array]
+    for frame, wrench in (extra or {}).get("wrenches", {}).items():
+        lines.append(f"wrench at {frame} (N, N m; world axes, at its origin): "
+                     + " ".join(f"{x:.9g}" for x in wrench))
+    actuators = (extra or {}).get("actuators")
+    if actuators:
+        lines.append("actuators: damping (N m s/rad or N s/m), friction (N m or N), armature "
+                     "(kg m^2 or kg):")
+        lines += [f"  {n:<{width}}  {a['damping']: .9g}  {a['friction']: .9g}  "
+                  f"{a['armature']: .9g}" for n, a in actuators.items()]
     return "\n".join(lines) + "\n"

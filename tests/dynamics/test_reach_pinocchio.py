@@ -196,3 +196,15 @@ def test_negative_damping_in_a_urdf_is_refused_naming_the_joint(tmp_path):
     path.write_text(DAMPED.replace('damping="0.3"', 'damping="-0.3"'))
     with pytest.raises(lagrangian.ModelError, match="joint 'j1'.dynamics.damping"):
         lagrangian.load(path)
+
+
+def test_actuated_dynamics_offers_no_rigid_simulation(system):
+    """A simulation over the rigid body's functions would leave the actuators out: not offered."""
+    f = system.dynamics(actuators=True)
+    assert f.tree is system.dynamics().tree
+    assert not hasattr(f, "numeric_system")
+    # energy: the rotor's 1/2 I_a q_dot^2 on top of the links'
+    rotor = system.dynamics(armature={"j2": 0.2})
+    v = np.array([0.3, -1.0, 0.5])
+    assert rotor.kinetic_energy(np.zeros(3), v) == pytest.approx(
+        system.dynamics().kinetic_energy(np.zeros(3), v) + 0.5 * 0.2 * 1.0, rel=1e-14)

@@ -70,10 +70,14 @@ class ActuatedDynamics(Dynamics):
     def __repr__(self) -> str:
         return f"ActuatedDynamics({self.rigid!r})"
 
-    def __getattr__(self, name):  # model, tree, parameters, numeric_system: the rigid body's
-        if name.startswith("__") or name == "rigid":
-            raise AttributeError(name)
-        return getattr(self.rigid, name)
+    # what is the rigid body's unchanged; not its numeric_system (simulation), which would
+    # leave the actuators out
+    _SHARED = frozenset({"model", "tree", "parameters", "regular"})
+
+    def __getattr__(self, name):
+        if name in ActuatedDynamics._SHARED:
+            return getattr(self.__dict__["rigid"], name)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     @property
     def actuators(self) -> dict[str, dict[str, float]]:

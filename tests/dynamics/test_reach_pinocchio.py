@@ -47,8 +47,9 @@ def _states(count=5, seed=13):
     return tuple(rng.uniform(-1, 1, (count, 3)) for _ in range(4))
 
 
-def test_jacobian_dot_times_v_of_every_frame_agrees_with_pinocchio(system, model):
-    arm = system.dynamics(backend="numpy")
+@pytest.mark.parametrize("backend", ["numpy", "auto"])  # numpy; compiled C (numpy without one)
+def test_jacobian_dot_times_v_of_every_frame_agrees_with_pinocchio(system, model, backend):
+    arm = system.dynamics(backend=backend)
     data = model.createData()
     q, v, _, _ = _states()
     for name in arm.frames:
@@ -78,8 +79,9 @@ def test_jacobian_dot_is_the_derivative_of_the_jacobian(system):
                                (ahead - behind) / (2 * h), atol=1e-8)
 
 
-def test_centroidal_momentum_matrix_agrees_with_ccrba(system, model):
-    arm = system.dynamics()
+@pytest.mark.parametrize("backend", ["numpy", "auto"])
+def test_centroidal_momentum_matrix_agrees_with_ccrba(system, model, backend):
+    arm = system.dynamics(backend=backend)
     data = model.createData()
     q, v, _, _ = _states()
     Ag = arm.centroidal_momentum_matrix(q)

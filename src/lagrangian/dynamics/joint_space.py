@@ -33,6 +33,7 @@ from ..errors import DerivationError, DynamicsWarning, InputError, ModelError
 from ..model.model import Model
 from ..model.values import resolve_parameters
 from .frames import TreeKinematics, tree_kinematics
+from .reach_c import REFERENCE_INDEX
 
 
 def warn_undefined(count: int, total: int, stacklevel: int = 4) -> None:
@@ -157,16 +158,54 @@ class Dynamics:
                              reference: str = "local_world_aligned") -> np.ndarray:
         """J_dot q_dot: the frame's classical acceleration at q_ddot = 0 (m/s^2, rad/s^2),
         (..., 6), as Pinocchio's getFrameClassicalAcceleration with a = 0."""
+        fast = self._reach if self._reach is not None else self._reach_kernel()
+        if fast:
+            try:
+                return fast.drift(q, v, fast.frame_index[frame], REFERENCE_INDEX[reference])
+            except (KeyError, ValueError, TypeError):
+                pass  # numpy below broadcasts, or names the fault in one line
         return self.kinematics.jacobian_dot_times_v(q, v, frame, reference)
 
     def centroidal_momentum_matrix(self, q) -> np.ndarray:
         """A_g with h_g = A_g q_dot (linear, then angular momentum about the centre of mass,
         world axes), (..., 6, n), as Pinocchio's ccrba."""
+        fast = self._reach if self._reach is not None else self._reach_kernel()
+        if fast and fast.massive:
+            try:
+                return fast.centroidal(q)
+            except (ValueError, TypeError):
+                pass
         return self.kinematics.centroidal_momentum_matrix(q)
+
+    # the compiled kernel of the three functions above (reach_c.py): None until asked, then
+    # the kernel, or False (not the C backend, or no compiler)
+    _reach = None
+
+    def _reach_kernel(self):
+        self._reach = False
+        if getattr(self, "backend", None) == "recursive":
+            from .reach_c import ReachKernel, reach_module
+
+            module = reach_module(self.tree)
+            if module is not None:
+                self._reach = ReachKernel(module, self.tree, self.kinematics.mass() > 0)
+        return self._reach
 
     def _with_wrenches(self, q, v, x, f_ext, forward: bool) -> np.ndarray:
         """Inverse or forward dynamics with wrenches at frames: tau_ext = sum J^T w
-        (wrenches.py) taken from tau, or added to it."""
+        (wrenches.py) taken from tau, or added to it; in compiled C where it can be."""
+        fast = self._reach if self._reach is not None else self._reach_kernel()
+        if fast:
+            try:
+                if forward:
+                    tau = np.array(x, dtype=float)  # our own copy, added to in place
+                    fast.add_wrenches(q, f_ext, tau, 1.0)
+                    return self.forward_dynamics(q, v, tau)
+                tau = self.inverse_dynamics(q, v, x)
+                fast.add_wrenches(q, f_ext, tau, -1.0)
+                return tau
+            except (KeyError, ValueError, TypeError, AttributeError):
+                pass  # numpy below broadcasts, or names the fault in one line
         from .wrenches import wrench_forces
 
         tau_ext = wrench_forces(self.kinematics, self._vector(q, "q"), f_ext)

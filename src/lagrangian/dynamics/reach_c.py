@@ -1,0 +1,100 @@
+"""J_dot q_dot, the centroidal momentum matrix and wrenches' generalized forces in compiled C
+(reach_kernel.c over the tree's numbers written as static tables), for the C backend's speed
+per call; centroidal.py and wrenches.py are the same formulas in numpy, used without a compiler
+and to name every bad input."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+
+from ..model.tree import KinematicTree
+from .joint_models import joint_model
+
+_KERNEL = Path(__file__).with_name("reach_kernel.c")
+REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
+
+
+def _table(name: str, ctype: str, rows) -> str:
+    """A static const C array of numbers (repr: exact doubles)."""
+    rows = list(rows)
+    body = ", ".join("{" + ", ".join(repr(float(x)) if ctype == "double" else str(int(x))
+                                     for x in row) + "}" if isinstance(row, (list, tuple))
+                     else (repr(float(row)) if ctype == "double" else str(int(row)))
+                     for row in rows)
+    width = f"[{len(rows[0])}]" if rows and isinstance(rows[0], (list, tuple)) else ""
+    return f"static const {ctype} {name}[{max(len(rows), 1)}]{width} = {{{body}}};"
+
+
+def kernel_source(tree: KinematicTree):
+    """The module's C: the tables, then reach_kernel.c."""
+    from ..compile.codegen import GeneratedSource
+
+    joints, frames = tree.joints, tree.frames
+    flat = [[x for row in j.rotation for x in row] for j in joints]
+    models = [joint_model(j.kind) for j in joints]
+    source = "\n".join([
+        "/* lagrangian: frame accelerations, centroidal momentum and wrenches of a tree */",
+        "#define PY_SSIZE_T_CLEAN",
+        "#include <Python.h>",
+        "#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION",
+        "#include <numpy/arrayobject.h>",
+        "#include <math.h>",
+        f"#define RK_NB {len(joints)}",
+        f"#define RK_N {len(tree.coordinates)}",
+        f"#define RK_NF {len(frames)}",
+        _table("rk_parent", "int", [j.parent for j in joints]),
+        _table("rk_coord", "int", [j.coordinate for j in joints]),
+        _table("rk_turns", "int", [m.turns for m in models]),
+        _table("rk_slides", "int", [m.slides for m in models]),
+        _table("rk_mult", "double", [j.multiplier for j in joints]),
+        _table("rk_off", "double", [j.offset for j in joints]),
+        _table("rk_R0", "double", flat),
+        _table("rk_t0", "double", [list(j.translation) for j in joints]),
+        _table("rk_u", "double", [list(j.axis) for j in joints]),
+        _table("rk_m", "double", [j.mass for j in joints]),
+        _table("rk_h", "double", [list(j.first_moment) for j in joints]),
+        _table("rk_J", "double", [[x for row in j.inertia for x in row] for j in joints]),
+        _table("rk_fbody", "int", [f.body for f in frames]),
+        _table("rk_fR", "double", [[x for row in f.rotation for x in row] for f in frames]),
+        _table("rk_ft", "double", [list(f.translation) for f in frames]),
+        _KERNEL.read_text(encoding="utf-8"),
+    ])
+    return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
+
+
+def reach_module(tree: KinematicTree):
+    """The compiled module of this tree (cached on disk by its numbers and this generator),
+    or None where no compiler works."""
+    from ..compile import compiled
+
+    here = Path(__file__)
+    generator = hashlib.sha256(_KERNEL.read_bytes() + here.read_bytes()).hexdigest()
+    key = "\n".join(["reach", generator, repr(tree), repr(tree.frames)])
+    try:
+        return compiled.load_keyed(key, lambda: kernel_source(tree), native=True)
+    except compiled.BackendUnavailable:
+        return None
+
+
+class ReachKernel:
+    """The compiled functions with frames by name; inputs of one batch shape (..., n)."""
+
+    def __init__(self, module, tree: KinematicTree, massive: bool):
+        self.module = module
+        self.frame_index = {f.name: k for k, f in enumerate(tree.frames)}
+        self.massive = massive  # moving mass: a centre of mass, so A_g
+
+        self.drift, self.centroidal = module.drift, module.centroidal
+
+    def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> None:
+        """out += sign sum J^T w over the frames, in place (out of q's shape); ValueError or
+        KeyError where the inputs are not plain (the numpy path then names the fault)."""
+        wrench = self.module.wrench
+        for name, w in wrenches.items():
+            wrench(q, self.frame_index[name], w, out, sign)
+
+
+__all__ = ["REFERENCE_INDEX", "ReachKernel", "kernel_source", "reach_module"]

@@ -210,3 +210,40 @@ def test_actuated_dynamics_offers_no_rigid_simulation(system):
     v = np.array([0.3, -1.0, 0.5])
     assert rotor.kinetic_energy(np.zeros(3), v) == pytest.approx(
         system.dynamics().kinetic_energy(np.zeros(3), v) + 0.5 * 0.2 * 1.0, rel=1e-14)
+
+
+def test_the_compiled_path_names_bad_input_and_broadcasts_like_numpy(system):
+    arm, slow = system.dynamics(), system.dynamics(backend="numpy")
+    q, v, a, _ = _states()
+    with pytest.raises(lagrangian.InputError, match="no frame named 'tol'") as caught:
+        arm.jacobian_dot_times_v(q[0], v[0], "tol")
+    assert caught.value.field == "frame"
+    with pytest.raises(lagrangian.InputError, match="unknown reference"):
+        arm.jacobian_dot_times_v(q[0], v[0], "tool", "global")
+    with pytest.raises(lagrangian.InputError, match="expected 3 values") as caught:
+        arm.centroidal_momentum_matrix(np.zeros(4))
+    assert caught.value.field == "q"
+    with pytest.raises(lagrangian.InputError, match="expected 3 values") as caught:
+        arm.jacobian_dot_times_v(q[0], np.zeros(2), "tool")
+    assert caught.value.field == "v"
+    # one configuration, many rates; one wrench for many states
+    np.testing.assert_allclose(arm.jacobian_dot_times_v(q[0], v, "tool"),
+                               slow.jacobian_dot_times_v(q[0], v, "tool"), atol=1e-13)
+    w = {"tool": np.arange(6.0)}
+    np.testing.assert_allclose(arm.inverse_dynamics(q, v, a, f_ext=w),
+                               slow.inverse_dynamics(q, v, a, f_ext=w), atol=1e-12)
+    np.testing.assert_allclose(arm.inverse_dynamics(q[0], v[0], a, f_ext=w),
+                               slow.inverse_dynamics(q[0], v[0], a, f_ext=w), atol=1e-12)
+    assert arm.inverse_dynamics(q[0], v[0], a[0], f_ext={}).shape == (3,)
+
+
+def test_a_robot_without_moving_mass_has_no_centroidal_momentum(tmp_path):
+    path = tmp_path / "light.urdf"
+    path.write_text('<robot name="r"><link name="a"/><link name="b"/><joint name="j" '
+                    'type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
+                    '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
+    kinematics = lagrangian.load(path).model.kinematic_tree
+    from lagrangian.dynamics.frames import TreeKinematics
+
+    with pytest.raises(lagrangian.InputError, match="no mass"):
+        TreeKinematics(kinematics).centroidal_momentum_matrix(np.zeros(1))

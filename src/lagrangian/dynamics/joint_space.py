@@ -170,7 +170,7 @@ class Dynamics:
         """A_g with h_g = A_g q_dot (linear, then angular momentum about the centre of mass,
         world axes), (..., 6, n), as Pinocchio's ccrba."""
         fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast and fast.massive:
+        if fast and fast.centroidal is not None:
             try:
                 return fast.centroidal(q)
             except (ValueError, TypeError):

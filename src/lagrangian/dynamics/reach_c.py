@@ -85,9 +85,9 @@ class ReachKernel:
     def __init__(self, module, tree: KinematicTree, massive: bool):
         self.module = module
         self.frame_index = {f.name: k for k, f in enumerate(tree.frames)}
-        self.massive = massive  # moving mass: a centre of mass, so A_g
-
-        self.drift, self.centroidal = module.drift, module.centroidal
+        self.drift = module.drift
+        # A_g needs a centre of mass: moving mass (else numpy refuses it in one line)
+        self.centroidal = module.centroidal if massive else None
 
     def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> None:
         """out += sign sum J^T w over the frames, in place (out of q's shape); ValueError or

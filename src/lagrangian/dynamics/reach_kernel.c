@@ -168,10 +168,11 @@ static void rk_centroidal(const double *q, double *out)
         double m = rk_m[i];
         rk_apply(R[i], rk_h[i], hr);
         rk_matmul(R[i], rk_J[i], RJ);
-        for (int a = 0; a < 3; a++)  /* R J R^T */
-            for (int c = 0; c < 3; c++)
-                T[3 * a + c] = RJ[3 * a] * R[i][3 * c] + RJ[3 * a + 1] * R[i][3 * c + 1]
-                               + RJ[3 * a + 2] * R[i][3 * c + 2];
+        for (int a = 0; a < 3; a++)  /* R J R^T, symmetric: the upper triangle, mirrored */
+            for (int c = a; c < 3; c++)
+                T[3 * c + a] = T[3 * a + c] = RJ[3 * a] * R[i][3 * c]
+                                              + RJ[3 * a + 1] * R[i][3 * c + 1]
+                                              + RJ[3 * a + 2] * R[i][3 * c + 2];
         double pp = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
         double ph = p[0] * hr[0] + p[1] * hr[1] + p[2] * hr[2];
         for (int a = 0; a < 3; a++)

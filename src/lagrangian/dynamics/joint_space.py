@@ -169,10 +169,12 @@ class Dynamics:
     def centroidal_momentum_matrix(self, q) -> np.ndarray:
         """A_g with h_g = A_g q_dot (linear, then angular momentum about the centre of mass,
         world axes), (..., 6, n), as Pinocchio's ccrba."""
-        fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast and fast.centroidal is not None:
+        fast = self._reach
+        if fast is None:
+            fast = self._reach_kernel()
+        if fast:
             try:
-                return fast.centroidal(q)
+                return fast.centroidal(q)  # None without moving mass: TypeError, then below
             except (ValueError, TypeError):
                 pass
         return self.kinematics.centroidal_momentum_matrix(q)

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..model.tree import KinematicTree
 from .joint_models import joint_model
+from .tree_c import _SINCOS
 
 _KERNEL = Path(__file__).with_name("reach_kernel.c")
 REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
@@ -26,6 +27,19 @@ def _table(name: str, ctype: str, rows) -> str:
                      for row in rows)
     width = f"[{len(rows[0])}]" if rows and isinstance(rows[0], (list, tuple)) else ""
     return f"static const {ctype} {name}[{max(len(rows), 1)}]{width} = {{{body}}};"
+
+
+def _turn_tables(joints) -> list[str]:
+    """R0 u u^T, R0 (1 - u u^T) and R0 [u]x per joint: R0 Rot(u, th) = P + cos th C + sin th S."""
+    P, C, S = [], [], []
+    for j in joints:
+        R0, u = np.array(j.rotation, dtype=float), np.array(j.axis, dtype=float)
+        uu = np.outer(u, u)
+        skew = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
+        P.append((R0 @ uu).ravel().tolist())
+        C.append((R0 @ (np.eye(3) - uu)).ravel().tolist())
+        S.append((R0 @ skew).ravel().tolist())
+    return [_table("rk_P", "double", P), _table("rk_C", "double", C), _table("rk_S", "double", S)]
 
 
 def kernel_source(tree: KinematicTree):
@@ -52,6 +66,7 @@ def kernel_source(tree: KinematicTree):
         _table("rk_mult", "double", [j.multiplier for j in joints]),
         _table("rk_off", "double", [j.offset for j in joints]),
         _table("rk_R0", "double", flat),
+        *_turn_tables(joints),
         _table("rk_t0", "double", [list(j.translation) for j in joints]),
         _table("rk_u", "double", [list(j.axis) for j in joints]),
         _table("rk_m", "double", [j.mass for j in joints]),
@@ -60,6 +75,7 @@ def kernel_source(tree: KinematicTree):
         _table("rk_fbody", "int", [f.body for f in frames]),
         _table("rk_fR", "double", [[x for row in f.rotation for x in row] for f in frames]),
         _table("rk_ft", "double", [list(f.translation) for f in frames]),
+        _SINCOS,
         _KERNEL.read_text(encoding="utf-8"),
     ])
     return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
@@ -71,7 +87,8 @@ def reach_module(tree: KinematicTree):
     from ..compile import compiled
 
     here = Path(__file__)
-    generator = hashlib.sha256(_KERNEL.read_bytes() + here.read_bytes()).hexdigest()
+    generator = hashlib.sha256(_KERNEL.read_bytes() + here.read_bytes()
+                               + here.with_name("tree_c.py").read_bytes()).hexdigest()
     key = "\n".join(["reach", generator, repr(tree), repr(tree.frames)])
     try:
         return compiled.load_keyed(key, lambda: kernel_source(tree), native=True)

@@ -44,19 +44,10 @@ static void rk_bodies(const double *q, double (*R)[9], double (*o)[3])
         double Rl[9], pl[3] = {rk_t0[i][0], rk_t0[i][1], rk_t0[i][2]};
         const double *u = rk_u[i];
         if (rk_turns[i]) {
+            /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
             double c, s;
-#ifdef __GLIBC__
-            sincos(th, &s, &c);  /* one call for both: libm's cost is most of a small tree's */
-#else
-            s = sin(th); c = cos(th);
-#endif
-            double k = 1.0 - c, Rot[9];
-            Rot[0] = k * u[0] * u[0] + c;        Rot[1] = k * u[0] * u[1] - s * u[2];
-            Rot[2] = k * u[0] * u[2] + s * u[1]; Rot[3] = k * u[1] * u[0] + s * u[2];
-            Rot[4] = k * u[1] * u[1] + c;        Rot[5] = k * u[1] * u[2] - s * u[0];
-            Rot[6] = k * u[2] * u[0] - s * u[1]; Rot[7] = k * u[2] * u[1] + s * u[0];
-            Rot[8] = k * u[2] * u[2] + c;
-            rk_matmul(rk_R0[i], Rot, Rl);
+            lg_sincos(th, &s, &c);  /* inline (tree_c.py): a libm call costs a body's work */
+            for (int j = 0; j < 9; j++) Rl[j] = rk_P[i][j] + c * rk_C[i][j] + s * rk_S[i][j];
         } else {
             for (int j = 0; j < 9; j++) Rl[j] = rk_R0[i][j];
         }
@@ -239,7 +230,15 @@ static void rk_wrench(const double *q, int f, const double *w, double *out)
 
 static PyArrayObject *rk_input(PyObject *x, int last, const char *name)
 {
-    PyArrayObject *a = (PyArrayObject *)PyArray_FROMANY(x, NPY_DOUBLE, 1, 0, NPY_ARRAY_IN_ARRAY);
+    PyArrayObject *a;
+    if (PyArray_CheckExact(x) && PyArray_TYPE((PyArrayObject *)x) == NPY_DOUBLE
+            && PyArray_IS_C_CONTIGUOUS((PyArrayObject *)x) && PyArray_ISALIGNED((PyArrayObject *)x)
+            && PyArray_NDIM((PyArrayObject *)x) >= 1) {
+        a = (PyArrayObject *)x;  /* the usual case: taken as it is, no conversion */
+        Py_INCREF(a);
+    } else {
+        a = (PyArrayObject *)PyArray_FROMANY(x, NPY_DOUBLE, 1, 0, NPY_ARRAY_IN_ARRAY);
+    }
     if (!a) return NULL;
     int nd = PyArray_NDIM(a);
     if (PyArray_DIMS(a)[nd - 1] != last) {

@@ -233,15 +233,16 @@ def test_without_a_compiler_the_urdf_tree_runs_in_numpy(tmp_path, no_compiler):
     assert np.ptp(f.kinetic_energy(qs, vs)) > 0.1  # it did move
 
 
-def test_massless_branch_is_left_to_the_symbolic_path(tmp_path, no_compiler):
-    """A joint that carries no mass makes M singular at every state: no numpy recursions (as
-    no C), the derived equations (whose checks name the joint) instead."""
+def test_massless_branch_is_refused_naming_the_lock(tmp_path, no_compiler):
+    """A joint that carries no mass makes M singular at every state: refused at once by the
+    recursions (no derivation to wait for), naming the joint and the fix, lock (issue 23)."""
     text = URDF.robot(URDF.link("base"), URDF.link("a", 1.0, (0.3, 0, 0)), URDF.link("b"),
                       URDF.joint("j1", "base", "a", axis="0 -1 0"),
                       URDF.joint("j2", "a", "b", xyz="0.6 0 0", axis="0 -1 0"))
     from lagrangian.dynamics.joint_space import recursive_dynamics
 
     system = arm(tmp_path, text)
-    assert recursive_dynamics(system.model, backend="numpy") is None
+    with pytest.raises(DerivationError, match="URDF joint 'j2' moves no mass.*--lock j2=0"):
+        recursive_dynamics(system.model, backend="numpy")
     with pytest.raises(DerivationError, match="singular mass matrix.*'j2'"):
         system.dynamics()

@@ -247,3 +247,37 @@ def test_a_robot_without_moving_mass_has_no_centroidal_momentum(tmp_path):
 
     with pytest.raises(lagrangian.InputError, match="no mass"):
         TreeKinematics(kinematics).centroidal_momentum_matrix(np.zeros(1))
+
+
+def test_a_joint_of_more_than_one_coordinate_is_refused_not_miscounted(system):
+    """The walks give each joint one column: a tree with any other joint (a floating base's
+    free flyer, stood in for here by a spherical joint) is refused in one line, never summed
+    wrong."""
+    from dataclasses import replace
+
+    from lagrangian.dynamics.actuators import actuated
+    from lagrangian.dynamics.frames import TreeKinematics
+
+    tree = system.model.kinematic_tree
+    odd = replace(tree, joints=(replace(tree.joints[0], kind="spherical"), *tree.joints[1:]))
+    kinematics = TreeKinematics.__new__(TreeKinematics)
+    kinematics.tree, kinematics.n = odd, 3
+    for call in (lambda: kinematics.jacobian_dot_times_v(np.zeros(3), np.zeros(3), "tool"),
+                 lambda: kinematics.centroidal_momentum_matrix(np.zeros(3))):
+        with pytest.raises(lagrangian.InputError, match="floating base: not yet"):
+            call()
+    from lagrangian.dynamics.wrenches import wrench_forces
+
+    with pytest.raises(lagrangian.InputError, match="floating base: not yet"):
+        wrench_forces(kinematics, np.zeros(3), {"tool": np.zeros(6)})
+
+    class Rigid:
+        pass
+
+    rigid = Rigid()
+    rigid.tree = odd
+    with pytest.raises(lagrangian.InputError, match="actuator models of a floating base"):
+        actuated(rigid, system.model, friction=True)
+    from lagrangian.dynamics.reach_c import reach_module
+
+    assert reach_module(odd) is None

@@ -138,6 +138,11 @@ def actuated(rigid: Dynamics, model, armature: Mapping[str, float] | None = None
              friction: bool = True) -> ActuatedDynamics:
     """``rigid`` with the actuator models: the URDF's damping and friction (``friction``) and
     the given armature."""
+    tree = getattr(rigid, "tree", None)
+    if tree is not None:
+        from .centroidal import require_fixed_base
+
+        require_fixed_base(tree, "actuator models", "actuators")
     values = actuator_values(model, armature, friction)
     return ActuatedDynamics(rigid, values["damping"], values["friction"], values["armature"])
 

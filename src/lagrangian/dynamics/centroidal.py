@@ -16,7 +16,19 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+from ..kinds import JointKind
 from .recursive_numpy import _cross, _dot
+
+# the joints these walks take: one coordinate each (a floating base's free flyer is six)
+ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
+
+
+def require_fixed_base(tree, what: str, field: str = "q") -> None:
+    """Refused in one line for a tree with a joint of more than one coordinate (a floating
+    base): these walks give each joint one column, and would be wrong there."""
+    if any(JointKind(j.kind) not in ONE_DOF for j in tree.joints):
+        raise InputError(f"{what} of a floating base: not yet (a fixed-base robot's only)",
+                         field=field)
 
 
 def _motion_cross(V, S):
@@ -55,6 +67,7 @@ def jacobian_dot_times_v(kinematics, q, v, frame: str, reference: str) -> np.nda
     getFrameClassicalAcceleration with a = 0)."""
     from .frames import REFERENCES
 
+    require_fixed_base(kinematics.tree, "J_dot q_dot")
     if reference not in REFERENCES:
         raise InputError(f"unknown reference '{reference}'; use one of "
                          f"{', '.join(REFERENCES)}", field="reference")
@@ -88,6 +101,7 @@ def centroidal_momentum_matrix(kinematics, q) -> np.ndarray:
     origin (world axes) summed from the leaves up; a unit rate along S = [s_v; s_w] (at the
     origin) gives the subtree the momentum [M s_v + s_w x h; h x s_v + I_O s_w]; then the
     angular rows are moved to the centre of mass G: k_G = k_O - G x l."""
+    require_fixed_base(kinematics.tree, "the centroidal momentum matrix")
     Q, batch = kinematics._q(q)
     kinematics._moving_mass()  # refused in one line without moving mass
     bodies = kinematics._bodies(Q)

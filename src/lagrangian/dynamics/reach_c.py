@@ -85,7 +85,10 @@ def reach_module(tree: KinematicTree):
     """The compiled module of this tree (cached on disk by its numbers and this generator),
     or None where no compiler works."""
     from ..compile import compiled
+    from .centroidal import ONE_DOF
 
+    if any(j.kind not in ONE_DOF for j in tree.joints):
+        return None  # a floating base: numpy's walks refuse it in one line
     here = Path(__file__)
     generator = hashlib.sha256(_KERNEL.read_bytes() + here.read_bytes()
                                + here.with_name("tree_c.py").read_bytes()).hexdigest()

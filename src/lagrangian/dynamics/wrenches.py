@@ -47,9 +47,10 @@ def wrench_forces(kinematics, q, f_ext) -> np.ndarray:
     generalized forces of wrenches at frames (world axes, at each frame's origin). Each wrench
     is carried to the world's origin (m_O = m + p x f) and projected on the joint motions S
     there: tau_j = k (s_v . f + s_w . m_O) for the joints above the frame's body."""
-    from .centroidal import _world_subspace
+    from .centroidal import _world_subspace, require_fixed_base
     from .recursive_numpy import _cross, _dot
 
+    require_fixed_base(kinematics.tree, "wrenches at frames", "f_ext")
     wrenches = wrench_arrays(kinematics, f_ext)
     Q, batch = kinematics._q(q)
     for w in wrenches.values():

@@ -16,8 +16,15 @@ from lagrangian.derivation.energies import dissipation_terms, potential_terms
 from lagrangian.derivation.inertia import add_rotation, add_translation
 from lagrangian.derivation.virtual_work import load_projection
 from lagrangian.dynamics.joint_models import JOINT_MODELS, joint_model
-from lagrangian.model.components import COMPONENT_KINDS, ELEMENT_KINDS, LOAD_KINDS, MASS_KINDS
+from lagrangian.model.components import (
+    COMPONENT_KINDS,
+    CONSTRAINT_KINDS,
+    ELEMENT_KINDS,
+    LOAD_KINDS,
+    MASS_KINDS,
+)
 from lagrangian.model.rotations import JOINT_KEYS, RotationReader
+from lagrangian.output.drawing import NOT_DRAWN, draw
 
 TABLES = {
     "kinetic energy, M and f, first pass (derivation)": (add_translation.registry, MASS_KINDS),
@@ -32,6 +39,7 @@ TABLES = {
         _AppliedForces.__dict__["add_element"].dispatcher.registry, ELEMENT_KINDS),
     "diagnosis of a mis-projected load (check)": (projection_explanation.registry,
                                                   LOAD_KINDS + ELEMENT_KINDS[1:]),
+    "drawing (output)": (draw.registry, COMPONENT_KINDS),
 }
 
 
@@ -40,6 +48,14 @@ def test_every_kind_has_its_entry(table):
     registry, kinds = TABLES[table]
     missing = [kind.__name__ for kind in kinds if kind not in registry]
     assert not missing, f"{table} has no entry for {missing}"
+
+
+def test_only_kinds_without_a_position_are_drawn_by_nothing():
+    """A kind is drawn unless it is deliberately listed as not drawn: loads and constraints,
+    which have no position of their own (a rolling contact draws its wheel)."""
+    assert set(NOT_DRAWN) == set(LOAD_KINDS) | set(CONSTRAINT_KINDS[:1])
+    drawn = [kind for kind in COMPONENT_KINDS if kind not in NOT_DRAWN]
+    assert set(drawn) == set(MASS_KINDS + ELEMENT_KINDS + CONSTRAINT_KINDS[1:])
 
 
 def test_the_kinds_are_each_named_once():

@@ -25,6 +25,18 @@ class ConstraintKind(StrEnum):
     VELOCITY = "velocity"
 
 
+class LoadStepKind(StrEnum):
+    """What a step of derive --steps finds the virtual work of: a point force, a torque, a moment
+    on a body in space, a damper, the dissipation function D, or generalized forces given."""
+
+    FORCE = "force"
+    TORQUE = "torque"
+    MOMENT = "moment"
+    DAMPER = "damper"
+    DISSIPATION = "dissipation"
+    GIVEN = "given"
+
+
 class InvariantKind(StrEnum):
     """What a run monitors: T + V, the Jacobi integral h, or the work balance h - h0 - int P dt."""
 
@@ -51,4 +63,4 @@ class Backend(StrEnum):
     NUMPY = "numpy"
 
 
-__all__ = ["Backend", "ConstraintKind", "InvariantKind", "JointKind", "RunStatus"]
+__all__ = ["Backend", "ConstraintKind", "InvariantKind", "JointKind", "LoadStepKind", "RunStatus"]

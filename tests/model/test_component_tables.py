@@ -16,6 +16,7 @@ from lagrangian.derivation.energies import dissipation_terms, potential_terms
 from lagrangian.derivation.inertia import add_rotation, add_translation
 from lagrangian.derivation.virtual_work import load_projection
 from lagrangian.dynamics.joint_models import JOINT_MODELS, joint_model
+from lagrangian.kinds import LoadStepKind
 from lagrangian.model.components import (
     COMPONENT_KINDS,
     CONSTRAINT_KINDS,
@@ -25,6 +26,7 @@ from lagrangian.model.components import (
 )
 from lagrangian.model.rotations import JOINT_KEYS, RotationReader
 from lagrangian.output.drawing import NOT_DRAWN, draw
+from lagrangian.output.steps import LOAD_LATEX, LOAD_TEXT
 
 TABLES = {
     "kinetic energy, M and f, first pass (derivation)": (add_translation.registry, MASS_KINDS),
@@ -56,6 +58,13 @@ def test_only_kinds_without_a_position_are_drawn_by_nothing():
     assert set(NOT_DRAWN) == set(LOAD_KINDS) | set(CONSTRAINT_KINDS[:1])
     drawn = [kind for kind in COMPONENT_KINDS if kind not in NOT_DRAWN]
     assert set(drawn) == set(MASS_KINDS + ELEMENT_KINDS + CONSTRAINT_KINDS[1:])
+
+
+@pytest.mark.parametrize("table", [LOAD_TEXT, LOAD_LATEX], ids=["text", "LaTeX"])
+def test_every_kind_of_load_step_is_written(table):
+    """derive --steps writes each load's virtual work by a table keyed by the kind of load."""
+    missing = [str(kind) for kind in LoadStepKind if kind not in table]
+    assert not missing, f"derive --steps writes no {missing}"
 
 
 def test_the_kinds_are_each_named_once():

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from ..kinds import LoadStepKind
 from ..model.model import Damper, Model, PointForce, Torque
 from ..model.notation import latex_printer
 from ..model.rotations import Moment
@@ -43,7 +44,7 @@ class LoadStep:
     and delta W = ``virtual_work`` (J) = sum_i ``shares`` Q_i delta q_i."""
 
     load: str
-    kind: str                            # force, torque, moment, damper, dissipation, given
+    kind: LoadStepKind                   # force, torque, moment, damper, dissipation, given
     acts_at: tuple[sp.Expr, ...]         # the point r, the angle, the damper's rate; () if none
     displacement: tuple[sp.Expr, ...]    # delta r, delta(angle) or delta(length); () if none
     work_form: sp.Expr | None            # delta W as the load writes it (F . delta r, tau d angle)
@@ -177,25 +178,25 @@ def _load_steps(eom: EquationsOfMotion, variations, d: Differentiator) -> list[L
         displacement: tuple = ()
         form = None
         if isinstance(load, PointForce):
-            kind, acts_at = "force", tuple(load.point)
+            kind, acts_at = LoadStepKind.FORCE, tuple(load.point)
             displacement = tuple(moved(r, q) for r in load.point)
             form = sp.Add(*(f * dr for f, dr in zip(load.force, displacement, strict=True)))
         elif isinstance(load, Torque):
-            kind, acts_at = "torque", (load.angle,)
+            kind, acts_at = LoadStepKind.TORQUE, (load.angle,)
             displacement = (moved(load.angle, q),)
             form = load.torque * displacement[0]
         elif isinstance(load, Moment):
             # delta phi_k = sum_i d omega_k/d q_dot_i delta q_i, in the axes the moment is given in
-            kind = "moment"
+            kind = LoadStepKind.MOMENT
             displacement = tuple(moved(w, q_dot) for w in load.angular_velocity)
             form = sp.Add(*(m * dp for m, dp in zip(load.moment, displacement, strict=True)))
         elif isinstance(damper, Damper):
             # the rate l_dot is linear in q_dot: delta l = sum_i d l_dot/d q_dot_i delta q_i
-            kind, acts_at = "damper", (damper.rate,)
+            kind, acts_at = LoadStepKind.DAMPER, (damper.rate,)
             displacement = (moved(damper.rate, q_dot),)
             form = -damper.coefficient * damper.rate * displacement[0]
         else:
-            kind = "dissipation" if name == DISSIPATION_LOAD else "given"
+            kind = LoadStepKind.DISSIPATION if name == DISSIPATION_LOAD else LoadStepKind.GIVEN
         steps.append(LoadStep(name, kind, acts_at, displacement, form, work, tuple(shares)))
     return steps
 

@@ -10,7 +10,7 @@ import sympy as sp
 import lagrangian
 from lagrangian import JointKind
 from lagrangian.check.diagnose_terms import projection_explanation
-from lagrangian.check.newton_euler import _AppliedForces, free_body
+from lagrangian.check.free_bodies import _AppliedForces, free_body
 from lagrangian.check.units import unit_items
 from lagrangian.derivation.energies import dissipation_terms, potential_terms
 from lagrangian.derivation.inertia import add_rotation, add_translation

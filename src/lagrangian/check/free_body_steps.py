@@ -21,7 +21,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..model.model import Model
 from ..model.notation import latex_symbol_names
 from . import equivalence as eq
-from .newton_euler import (
+from .free_bodies import (
     _AppliedForces,
     _Clock,
     _free_bodies,

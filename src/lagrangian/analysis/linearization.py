@@ -55,8 +55,36 @@ def state_matrix(from_position: np.ndarray, from_velocity: np.ndarray) -> np.nda
 
 
 
+class SecondOrderForm:
+    """M z_ddot + C z_dot + K z: the names both linear models give their matrices (numbers in
+    LinearModel, sympy matrices in SymbolicLinearModel; SI units). Each holds mass_matrix,
+    damping_matrix and stiffness_matrix."""
+
+    @property
+    def M(self):
+        return self.mass_matrix
+
+    @property
+    def C(self):
+        return self.damping_matrix
+
+    @property
+    def K(self):
+        return self.stiffness_matrix
+
+    @property
+    def gyroscopic_matrix(self):
+        """G = (C - C^T)/2: the skew, energy-neutral part of C."""
+        return (self.damping_matrix - self.damping_matrix.T) / 2
+
+    @property
+    def dissipation_matrix(self):
+        """(C + C^T)/2: the symmetric, energy-removing part of C."""
+        return (self.damping_matrix + self.damping_matrix.T) / 2
+
+
 @dataclass(frozen=True)
-class LinearModel:
+class LinearModel(SecondOrderForm):
     """M z_ddot + C z_dot + K z = B_q u about an equilibrium, and x_dot = A x + B u, x = [z; z_dot].
 
     ``coordinates`` name z: all coordinates of an unconstrained model, else the independent ones
@@ -86,28 +114,6 @@ class LinearModel:
     # H dq + G dq_dot = 0 as rows over the state (dq, dq_dot). A keeps H dq + G dq_dot constant,
     # so the motions of the system are the invariant subspace where it is zero.
     state_constraints: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-
-    @property
-    def M(self) -> np.ndarray:
-        return self.mass_matrix
-
-    @property
-    def C(self) -> np.ndarray:
-        return self.damping_matrix
-
-    @property
-    def K(self) -> np.ndarray:
-        return self.stiffness_matrix
-
-    @property
-    def gyroscopic_matrix(self) -> np.ndarray:
-        """G = (C - C^T)/2: the skew, energy-neutral part of C."""
-        return (self.damping_matrix - self.damping_matrix.T) / 2
-
-    @property
-    def dissipation_matrix(self) -> np.ndarray:
-        """(C + C^T)/2: the symmetric, energy-removing part of C."""
-        return (self.damping_matrix + self.damping_matrix.T) / 2
 
     @property
     def constrained(self) -> bool:
@@ -312,7 +318,7 @@ SYMBOLIC_MAX_COORDINATES = 6
 
 
 @dataclass(frozen=True)
-class SymbolicLinearModel:
+class SymbolicLinearModel(SecondOrderForm):
     """M, C, K as sympy matrices at an equilibrium, parameters kept as symbols."""
 
     coordinates: tuple[str, ...]

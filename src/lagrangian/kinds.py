@@ -37,6 +37,50 @@ class LoadStepKind(StrEnum):
     GIVEN = "given"
 
 
+class FindingStatus(StrEnum):
+    """The verdict on one item of a checked answer: as ours, equal to ours in another form,
+    wrong, or a note that judges nothing."""
+
+    CORRECT = "correct"
+    EQUIVALENT = "equivalent"
+    WRONG = "wrong"
+    NOTE = "note"
+
+
+class DistributionKind(StrEnum):
+    """How an ensemble draws a parameter: normal(mean, standard deviation) or uniform(low, high)."""
+
+    NORMAL = "normal"
+    UNIFORM = "uniform"
+
+
+class FreeBodyKind(StrEnum):
+    """What a free body of the Newton-Euler check is: a particle (m a = F), a planar body (and
+    I alpha = M), or a body in space (Euler's equations)."""
+
+    PARTICLE = "particle"
+    BODY = "body"
+    BODY_IN_SPACE = "body in space"
+
+
+class ModeKind(StrEnum):
+    """How a mode moves: oscillating, overdamped (real eigenvalues, zeta >= 1), rigid-body (zero
+    frequency, neutral) or divergent (grows without oscillating)."""
+
+    OSCILLATING = "oscillating"
+    OVERDAMPED = "overdamped"
+    RIGID_BODY = "rigid-body"
+    DIVERGENT = "divergent"
+
+
+class CrossingKind(StrEnum):
+    """Which eigenvalues cross Re = 0 as the speed changes: a complex pair (a bicycle's weave) or
+    a real one (its capsize)."""
+
+    OSCILLATORY = "oscillatory"
+    REAL = "real"
+
+
 class InvariantKind(StrEnum):
     """What a run monitors: T + V, the Jacobi integral h, or the work balance h - h0 - int P dt."""
 
@@ -63,4 +107,5 @@ class Backend(StrEnum):
     NUMPY = "numpy"
 
 
-__all__ = ["Backend", "ConstraintKind", "InvariantKind", "JointKind", "LoadStepKind", "RunStatus"]
+__all__ = ["Backend", "ConstraintKind", "CrossingKind", "DistributionKind", "FindingStatus",
+           "FreeBodyKind", "InvariantKind", "JointKind", "LoadStepKind", "ModeKind", "RunStatus"]

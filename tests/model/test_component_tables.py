@@ -4,6 +4,7 @@ torsion spring, a helical joint) fails here until each stage knows it."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 import sympy as sp
 
@@ -65,6 +66,37 @@ def test_every_kind_of_load_step_is_written(table):
     """derive --steps writes each load's virtual work by a table keyed by the kind of load."""
     missing = [str(kind) for kind in LoadStepKind if kind not in table]
     assert not missing, f"derive --steps writes no {missing}"
+
+
+def test_every_kind_of_result_is_written():
+    """The tables the output keys by a kind enum name every member: a new status or kind is
+    written, not dropped to a default."""
+    from lagrangian.kinds import CrossingKind, FindingStatus, FreeBodyKind
+    from lagrangian.output.check import _MARK
+    from lagrangian.output.crosscheck_steps import _INERTIAL_SHARE
+    from lagrangian.output.speed_form import _NAMES
+
+    for table, kinds in ((_MARK, FindingStatus), (_INERTIAL_SHARE, FreeBodyKind),
+                         (_NAMES, CrossingKind)):
+        assert set(table) == set(kinds)
+
+
+def test_a_misspelled_status_or_kind_is_an_error():
+    from lagrangian.analysis.study import Distribution
+    from lagrangian.check.diagnose import Finding
+
+    assert Finding("V", "correct", None, "V matches.").status == "correct"
+    with pytest.raises(ValueError, match="corect"):
+        Finding("V", "corect", None, "V matches.")
+    with pytest.raises(ValueError, match="gaussian"):
+        Distribution("gaussian", 0.0, 1.0)
+    from lagrangian.analysis.speed_form import SpeedSweep
+
+    sweep = SpeedSweep(np.zeros(0), np.zeros((0, 0)), (), ())
+    assert sweep.speed_of("oscillatory") is None
+    with pytest.raises(lagrangian.InputError, match="oscillatory, real, got 'weave'") as error:
+        sweep.speed_of("weave")
+    assert error.value.field == "kind"
 
 
 def test_the_kinds_are_each_named_once():

@@ -15,6 +15,7 @@ from lagrangian.check.free_bodies import _AppliedForces, free_body
 from lagrangian.check.units import unit_items
 from lagrangian.derivation.energies import dissipation_terms, potential_terms
 from lagrangian.derivation.inertia import add_rotation, add_translation
+from lagrangian.derivation.steps import load_working
 from lagrangian.derivation.virtual_work import load_projection
 from lagrangian.dynamics.joint_models import JOINT_MODELS, joint_model
 from lagrangian.kinds import LoadStepKind
@@ -43,6 +44,8 @@ TABLES = {
     "diagnosis of a mis-projected load (check)": (projection_explanation.registry,
                                                   LOAD_KINDS + ELEMENT_KINDS[1:]),
     "drawing (output)": (draw.registry, COMPONENT_KINDS),
+    "virtual work step by step (derive --steps)": (load_working.registry,
+                                                   LOAD_KINDS + ELEMENT_KINDS[1:]),
 }
 
 

@@ -59,11 +59,12 @@ from ..simulation.simulate import (
     simulate,
     urdf_limits,
 )
+from .control import ControlMethods
 from .modes import ModalAnalysis
 from .simulation import Simulation
 
 
-class System:
+class System(ControlMethods):
     """A mechanical system described in generalized coordinates.
 
     >>> import lagrangian
@@ -187,6 +188,8 @@ class System:
         atol: float = 1e-9,
         samples: int = 1001,
         limits: bool = True,
+        controller=None,
+        inputs: Sequence[str] | None = None,
     ) -> Simulation:
         """Integrate the equations of motion to ``t_end`` (s); returns a Simulation.
 
@@ -198,7 +201,9 @@ class System:
         are kept on Phi = 0 by projection (see docs/simulation.md). A robot read from URDF
         stops with status 'limit' when a joint reaches its position limit, naming it
         (``limits=False`` ignores them); velocity and effort limits exceeded are reported
-        either way (``summary()["limits_exceeded"]``).
+        either way (``summary()["limits_exceeded"]``). ``controller`` (t, q, q_dot) -> u adds
+        generalized forces, or B u for named ``inputs`` (its own ``inputs`` where it has them,
+        as lagrangian.control's controllers do), to the model's own: docs/control.md.
         """
         require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
@@ -209,7 +214,8 @@ class System:
         result = simulate(self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
                           progress=progress, functions=self._numeric,
-                          limits=urdf_limits(self._model, positions=limits))
+                          limits=urdf_limits(self._model, positions=limits), controller=controller,
+                          inputs=getattr(controller, "inputs", ()) if inputs is None else inputs)
         return Simulation.of(result)
 
     # -- standalone C for a controller -----------------------------------------------------------

@@ -62,6 +62,10 @@ class SimulationResult:
     # URDF velocity and effort limits exceeded (simulate.JointLimit): one dict each, with
     # joint, coordinate, quantity, limit, value, t (None for effort) and unit
     limits_exceeded: tuple[dict, ...] = ()
+    # under a controller (simulation/control.py): its output u at each sample (N, r), and the
+    # names of its entries (the inputs, or the coordinates for generalized forces)
+    controls: np.ndarray | None = None
+    control_names: tuple[str, ...] = ()
 
     @property
     def model_name(self) -> str:
@@ -97,6 +101,8 @@ class SimulationResult:
         for i, name in enumerate(self.constraint_names):
             out[f"residual_{name}"] = self.residuals[:, i]
         out["power"] = self.power
+        for i, name in enumerate(self.control_names):
+            out[f"control_{name}"] = self.controls[:, i]
         if self.invariant == InvariantKind.JACOBI_INTEGRAL and self.invariant_values is not None:
             out["jacobi_integral"] = self.invariant_values
         elif self.invariant == InvariantKind.WORK_BALANCE and self.balance is not None:

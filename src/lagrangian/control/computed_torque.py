@@ -42,6 +42,13 @@ class ComputedTorque:
         mass = self.dynamics.mass_matrix(q)
         return mass @ command + self.dynamics.bias_forces(q, v)
 
+    def summary(self) -> dict:
+        """JSON-ready: coordinates, gains, the error dynamics' eigenvalues (re, im)."""
+        return {"coordinates": list(self.coordinates), "Kp": self.Kp.tolist(),
+                "Kd": self.Kd.tolist(),
+                "closed_loop_eigenvalues": [[float(v.real), float(v.imag)]
+                                            for v in self.error_eigenvalues]}
+
     def __repr__(self) -> str:
         return f"ComputedTorque(coordinates={list(self.coordinates)})"
 

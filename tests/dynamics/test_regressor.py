@@ -110,3 +110,36 @@ def test_bad_regressor_requests_are_one_line_errors():
         dynamics.regressor([0.1], [0.0], [0.0])
     with pytest.raises(InputError, match="tolerance"):
         dynamics.base_parameters(["m"], tolerance=2.0)
+
+
+def test_regressor_command_agrees_with_the_dynamics_command(cli):
+    """Y pi from `regressor` is the inverse dynamics `dynamics --a` prints, for the named
+    masses of a model file and for a URDF arm's 10 parameters per body."""
+    import json
+
+    for model, extra in (("double_pendulum", ["--parameters", "m1,m2"]), ("two_link_arm", [])):
+        state = ["--q", "0.3,-0.7", "--v", "1.5,0.2", "--a", "0.4,-2"]
+        result = cli("regressor", model, *state, *extra, "--base", "--json")
+        assert result.code == 0, result.err
+        document = json.loads(result.out)
+        Y, pi = np.array(document["regressor"]), np.array(document["values"])
+        inverse = json.loads(cli("dynamics", model, *state, "--json").out)["inverse_dynamics"]
+        np.testing.assert_allclose(Y @ pi, inverse, atol=1e-12)
+        base = document["base"]
+        combination = np.array(base["combination"])
+        kept = [document["parameters"].index(name) for name in base["names"]]
+        np.testing.assert_allclose(Y[:, kept] @ (combination @ pi), inverse, atol=1e-10)
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["pendulum", "--parameters", "L"], "error: --parameters: T, V and the forces must be linear"),
+    (["pendulum"], "error: --parameters: name the parameters"),
+    (["pendulum", "--parameters", "m", "--base", "--tolerance", "3"],
+     "error: --tolerance: the tolerance must lie between 0 and 1"),
+    (["pendulum", "--parameters", "m", "--q", "1,2"], "error: --q: expected 1 comma-separated"),
+])
+def test_regressor_command_refuses_bad_input_in_one_line(cli, flags, message):
+    result = cli("regressor", *flags)
+    assert result.code == 2
+    assert result.err.strip().startswith(message), result.err
+    assert len(result.err.strip().splitlines()) == 1

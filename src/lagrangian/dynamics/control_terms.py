@@ -1,5 +1,6 @@
 """What a controller or an identification asks of Dynamics beyond M and the bias: the
-torque regressor Y (tau = Y pi), the inertial parameters pi, a minimal identifiable set;
+derivatives of inverse and forward dynamics (derivatives.py), the torque regressor Y
+(tau = Y pi), the inertial parameters pi, a minimal identifiable set;
 mixed into joint_space.Dynamics (every path, a URDF tree's and a model file's)."""
 
 from __future__ import annotations
@@ -72,3 +73,50 @@ class ControlTerms:
         v, a = rng.uniform(-1.0, 1.0, (2, count, self.n))
         stacked = np.asarray(compute(q, v, a)).reshape(count * self.n, len(names))
         return BaseParameters(names, stacked, tolerance)
+
+    # -- derivatives (derivatives.py) ------------------------------------------------------------
+
+    def _inverse_derivatives(self):
+        found = self.__dict__.get("_derivatives")
+        if found is None:
+            tree = getattr(self, "tree", None)
+            if tree is not None:
+                from .derivatives import tree_inverse_dynamics_derivatives
+
+                g = self.parameters[tree.gravity_parameter]
+
+                def found(Q, V, A):
+                    return tree_inverse_dynamics_derivatives(tree, g, Q, V, A)
+            else:
+                from .derivatives import ModelDerivatives
+
+                if self._equations is None:
+                    raise InputError("this dynamics object was built without its equations",
+                                     field="q")
+                found = ModelDerivatives(self._equations(), dict(self.functions.parameters))
+            self.__dict__["_derivatives"] = found
+        return found
+
+    def inverse_dynamics_derivatives(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
+        """(d tau/dq, d tau/dq_dot) of tau = M(q) q_ddot + C q_dot + g, (..., n, n) each (row
+        i: tau_i), as Pinocchio's computeRNEADerivatives: a model file's from its derived M and
+        f, a URDF tree's by the complex step through Newton-Euler (exact to rounding)."""
+        compute = self._inverse_derivatives()
+        n = self.n
+        both = self._guarded(lambda Q, V, A: np.concatenate(compute(Q, V, A), axis=-1),
+                             (q, v, a), ("q", "v", "a"), (n, 2 * n))
+        return both[..., :n], both[..., n:]
+
+    def forward_dynamics_derivatives(self, q, v, tau) -> tuple[np.ndarray, np.ndarray,
+                                                               np.ndarray]:
+        """(d q_ddot/dq, d q_ddot/dq_dot, d q_ddot/d tau), (..., n, n) each, as Pinocchio's
+        computeABADerivatives: -M^-1 d tau/dq and -M^-1 d tau/dq_dot at q_ddot = FD(q, q_dot,
+        tau), and M^-1."""
+        q, v, tau = self._vector(q, "q"), self._vector(v, "v"), self._vector(tau, "tau")
+        batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1], tau.shape[:-1])
+        q = np.broadcast_to(q, batch + (self.n,))
+        v = np.broadcast_to(v, batch + (self.n,))
+        acceleration = self.forward_dynamics(q, v, tau)
+        by_position, by_velocity = self.inverse_dynamics_derivatives(q, v, acceleration)
+        inverse = np.linalg.inv(self.mass_matrix(q))
+        return -inverse @ by_position, -inverse @ by_velocity, inverse

@@ -30,9 +30,9 @@ PARAMETERS_PER_BODY = ("m", "mc_x", "mc_y", "mc_z", "I_xx", "I_xy", "I_yy", "I_x
 _INERTIA_ENTRIES = ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2))
 
 
-def _cross_matrix(x) -> np.ndarray:
+def cross_matrix(x) -> np.ndarray:
     """[x]x for x (N, 3): (N, 3, 3) with [x]x y = x cross y."""
-    out = np.zeros(x.shape[:-1] + (3, 3))
+    out = np.zeros(x.shape[:-1] + (3, 3), dtype=np.result_type(x, float))
     out[..., 0, 1], out[..., 0, 2], out[..., 1, 2] = -x[..., 2], x[..., 1], -x[..., 0]
     out[..., 1, 0], out[..., 2, 0], out[..., 2, 1] = x[..., 2], -x[..., 1], x[..., 0]
     return out
@@ -56,15 +56,16 @@ def tree_parameter_names(tree) -> tuple[str, ...]:
     return tuple(f"{p}@{joint.name}" for joint in tree.joints for p in PARAMETERS_PER_BODY)
 
 
-def tree_regressor(tree, gravity: float, Q: np.ndarray, V: np.ndarray, A: np.ndarray
-                   ) -> np.ndarray:
-    """Y (N, n, 10 * bodies) over flat batches Q, V, A (N, n): tau = Y pi."""
-    count, n = Q.shape
-    joints = tree.joints
+def tree_motion(tree, gravity: float, Q, V, A):
+    """The forward pass of Newton-Euler over flat batches (N, n), real or complex (the
+    complex step of derivatives.py): each body's placement (R, p) in its parent, motion
+    subspace (s_w, s_v), and angular velocity w, angular acceleration dw and linear
+    acceleration a of its origin (gravity included: the ground accelerates up by g), body axes."""
+    count = len(Q)
     up = -gravity * np.array(tree.gravity_direction, dtype=float)
-    placements, spaces = [], []
-    w, dw, acc = [], [], []
-    for joint in joints:
+    placements, spaces, w, dw, acc = [], [], [], [], []
+    dtype = np.result_type(Q, V, A, float)
+    for joint in tree.joints:
         model = joint_model(joint.kind)
         u = np.array(joint.axis, dtype=float)
         theta = joint.multiplier * Q[:, joint.coordinate] + joint.offset
@@ -77,7 +78,7 @@ def tree_regressor(tree, gravity: float, Q: np.ndarray, V: np.ndarray, A: np.nda
         spaces.append((s_w, s_v))
         RT = np.swapaxes(R, -1, -2)
         if joint.parent < 0:  # the ground at rest, accelerating up by g
-            w_in = dw_in = np.zeros((count, 3))
+            w_in = dw_in = np.zeros((count, 3), dtype=dtype)
             a_i = np.einsum("nij,j->ni", RT, up)
         else:
             wl, dwl, al = w[joint.parent], dw[joint.parent], acc[joint.parent]
@@ -95,6 +96,15 @@ def tree_regressor(tree, gravity: float, Q: np.ndarray, V: np.ndarray, A: np.nda
         w.append(w_i)
         dw.append(dw_i)
         acc.append(a_i)
+    return placements, spaces, w, dw, acc
+
+
+def tree_regressor(tree, gravity: float, Q: np.ndarray, V: np.ndarray, A: np.ndarray
+                   ) -> np.ndarray:
+    """Y (N, n, 10 * bodies) over flat batches Q, V, A (N, n): tau = Y pi."""
+    count, n = Q.shape
+    joints = tree.joints
+    placements, spaces, w, dw, acc = tree_motion(tree, gravity, Q, V, A)
     Y = np.zeros((count, n, 10 * len(joints)))
     for i in range(len(joints)):
         force, moment = _basis_wrenches(w[i], dw[i], acc[i])
@@ -112,7 +122,7 @@ def tree_regressor(tree, gravity: float, Q: np.ndarray, V: np.ndarray, A: np.nda
                 break
             R, p = placements[k]
             force = R @ force
-            moment = R @ moment + _cross_matrix(p) @ force
+            moment = R @ moment + cross_matrix(p) @ force
             k = joint.parent
     return Y
 
@@ -123,7 +133,7 @@ def _basis_wrenches(w, dw, a):
     count = len(w)
     force = np.zeros((count, 3, 10))
     moment = np.zeros((count, 3, 10))
-    W, DW, Acc = _cross_matrix(w), _cross_matrix(dw), _cross_matrix(a)
+    W, DW, Acc = cross_matrix(w), cross_matrix(dw), cross_matrix(a)
     force[:, :, 0] = a  # m
     force[:, :, 1:4] = DW + W @ W  # f = dw x h + w x (w x h)
     moment[:, :, 1:4] = -Acc  # n = h x a

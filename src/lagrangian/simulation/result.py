@@ -66,6 +66,7 @@ class SimulationResult:
     # names of its entries (the inputs, or the coordinates for generalized forces)
     controls: np.ndarray | None = None
     control_names: tuple[str, ...] = ()
+    control_forces: np.ndarray | None = None  # B u: the generalized forces it added (N, n)
 
     @property
     def model_name(self) -> str:

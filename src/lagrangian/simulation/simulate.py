@@ -136,6 +136,7 @@ def simulate(
         kinetic_energy=kinetic, invariant=kind, invariant_values=invariant, work=work,
         limits_exceeded=_exceeded(limits, functions.parameters, t, q_dot),
         controls=controls, control_names=() if loop is None else loop.names,
+        control_forces=forces,
     )
 
 

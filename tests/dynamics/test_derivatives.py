@@ -113,3 +113,24 @@ def test_derivatives_refuse_bad_shapes_in_one_line():
     assert caught.value.field == "q" and "\n" not in str(caught.value)
     with pytest.raises(lagrangian.InputError, match="expected 2 values"):
         dynamics.forward_dynamics_derivatives([0.1, 0.2], [0, 0], [0])
+
+
+def test_dynamics_command_prints_the_derivatives(cli):
+    """`dynamics --derivatives --json`: the pendulum's d tau/dq = m g L cos q and
+    d q_ddot/d tau = 1/(m L^2); without --a or --tau, one line."""
+    import json
+
+    result = cli("dynamics", "pendulum", "--q", "0.4", "--v", "1", "--a", "2", "--derivatives",
+                 "--json")
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    assert document["dtau_dq"][0][0] == pytest.approx(9.81 * 0.5 * np.cos(0.4), rel=1e-13)
+    assert document["dtau_dv"] == [[0.0]]
+    forward = json.loads(cli("dynamics", "pendulum", "--q", "0.4", "--tau", "1",
+                             "--derivatives", "--json").out)
+    assert forward["dqdd_dtau"][0][0] == pytest.approx(4.0, rel=1e-13)
+    assert forward["dqdd_dq"][0][0] == pytest.approx(-9.81 / 0.5 * np.cos(0.4), rel=1e-13)
+    bad = cli("dynamics", "pendulum", "--derivatives")
+    assert bad.code == 2 and bad.err.strip() == (
+        "error: --derivatives: needs --a (inverse dynamics) or --tau (forward dynamics) to "
+        "differentiate")

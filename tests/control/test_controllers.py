@@ -147,3 +147,19 @@ def test_bad_controllers_and_designs_are_refused_in_one_line(cart_pole, upright)
         cart_pole.simulate(1, controller=lambda t, q, v: 0.0, inputs=["G"])
     with pytest.raises(InputError, match="three arrays"):
         computed_torque(cart_pole, lambda t: (np.zeros(3), np.zeros(2), np.zeros(2)), 1, 1)
+
+
+def test_a_constant_motor_torque_on_a_constrained_crank_does_work_tau_delta_theta():
+    """The slider-crank (two loop constraints, multipliers) driven by a constant torque on the
+    crank through ``inputs=["theta"]``: E(t) - E0 = tau (theta(t) - theta0), and the run stays
+    on its constraints."""
+    crank = lagrangian.load("slider_crank")
+    torque = 2.0
+    run = crank.simulate(0.5, controller=lambda t, q, v: torque, inputs=["theta"], samples=101,
+                         rtol=1e-11, atol=1e-12)
+    assert run.status == "finished" and run.control_names == ("theta",)
+    np.testing.assert_allclose(run.energy - run.energy[0], torque * (run.q[:, 0] - run.q[0, 0]),
+                               atol=1e-7)
+    assert run.max_residual < 1e-8
+    assert run.control_forces.shape == (101, 3)
+    np.testing.assert_allclose(run.control_forces[:, 0], torque)

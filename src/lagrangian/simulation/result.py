@@ -26,7 +26,8 @@ STATUS_MESSAGES = {
 @dataclass(frozen=True, repr=False)
 class SimulationResult:
     """Sampled trajectory t (s), q, q_dot, energy T + V (J), power of non-conservative loads
-    Q . q_dot (W), multipliers lambda and constraint residuals, with run statistics.
+    Q . q_dot (W; a controller's B u . q_dot included), multipliers lambda and constraint
+    residuals, with run statistics.
 
     ``invariant`` names the monitored quantity: "energy" (T + V), "jacobi_integral" (h, in
     ``invariant_values``) or "work_balance" (h - h0 - ``work``, the work int P dt done on the

@@ -70,6 +70,7 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
         parse_model,
         read_model,
     )
+    from .control import computed_torque, lqr
     from .errors import DynamicsWarning
 
 __version__ = "0.1.0"
@@ -153,6 +154,8 @@ __all__ = [
     "resolve_state",
     "speed_sweep",
     "state_units",
+    "lqr",
+    "computed_torque",
     "cos",
     "exp",
     "sin",
@@ -186,6 +189,8 @@ _HOMES = {
     "course_folder": ("check.course", "course_folder"),
     "course_lessons": ("check.course", "course_lessons"),
     "check_report_path": ("report.page", "check_report_path"),
+    "lqr": ("control.lqr", "lqr"),
+    "computed_torque": ("control.computed_torque", "computed_torque"),
 }
 
 

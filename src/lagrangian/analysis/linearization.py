@@ -22,7 +22,7 @@ from ..derivation.kinematics import jacobian_row
 from ..errors import DerivationError, ModelError
 from ..kinds import ConstraintKind
 from ..model.expressions import as_expression
-from ..model.model import Model
+from ..model.inputs import input_parameter
 from ..model.values import ParameterValues, resolve_parameters, resolve_state
 
 # Relative singular-value threshold for the rank of the constraint Jacobian.
@@ -275,7 +275,7 @@ def input_columns(
     point[model.time] = sp.Float(float(t))
     names = [c.name for c in model.coordinates]
     for k, name in enumerate(inputs):
-        symbol = _input_parameter(model, name)
+        symbol = input_parameter(model, name)
         if symbol is None:
             columns[names.index(name), k] = 1.0
             continue
@@ -284,32 +284,6 @@ def input_columns(
                 d = f.diff(symbol).xreplace(at_rest).xreplace(values).xreplace(point)
                 columns[i, k] = float(sp.N(d))
     return columns
-
-
-def _input_parameter(model: Model, name: str) -> sp.Symbol | None:
-    """The parameter an input name stands for; None for a generalized force on a coordinate."""
-    for p in model.parameters:
-        if p.name == name:
-            return p.symbol
-    for load in model.loads:
-        if load.name == name:
-            magnitude = (load.force if hasattr(load, "force") else
-                         load.moment if hasattr(load, "moment") else (load.torque,))
-            symbols = {s for e in magnitude for s in as_expression(e).free_symbols}
-            owned = sorted((p for p in model.parameters if p.symbol in symbols),
-                           key=lambda p: p.name)
-            if len(owned) != 1:
-                listed = ", ".join(p.name for p in owned) or "none"
-                raise ModelError(
-                    f"load '{name}' must contain exactly one parameter to serve as an input "
-                    f"(it has: {listed}); name the parameter instead", field="inputs")
-            return owned[0].symbol
-    if name in {c.name for c in model.coordinates}:
-        return None
-    known = [p.name for p in model.parameters] + [ld.name for ld in model.loads] + \
-        [c.name for c in model.coordinates]
-    raise ModelError(f"'{name}' is not a parameter, load or coordinate of this model "
-                     f"(inputs may be any of: {', '.join(known)})", field="inputs")
 
 
 # -- symbolic linear matrices for small models ------------------------------------------------

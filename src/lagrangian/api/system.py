@@ -59,11 +59,13 @@ from ..simulation.simulate import (
     simulate,
     urdf_limits,
 )
+from .control import ControlMethods
 from .modes import ModalAnalysis
+from .options import run_options
 from .simulation import Simulation
 
 
-class System:
+class System(ControlMethods):
     """A mechanical system described in generalized coordinates.
 
     >>> import lagrangian
@@ -187,6 +189,8 @@ class System:
         atol: float = 1e-9,
         samples: int = 1001,
         limits: bool = True,
+        controller=None,
+        inputs: Sequence[str] | None = None,
     ) -> Simulation:
         """Integrate the equations of motion to ``t_end`` (s); returns a Simulation.
 
@@ -198,18 +202,21 @@ class System:
         are kept on Phi = 0 by projection (see docs/simulation.md). A robot read from URDF
         stops with status 'limit' when a joint reaches its position limit, naming it
         (``limits=False`` ignores them); velocity and effort limits exceeded are reported
-        either way (``summary()["limits_exceeded"]``).
+        either way (``summary()["limits_exceeded"]``). ``controller`` (t, q, q_dot) -> u adds
+        generalized forces, or B u for named ``inputs`` (its own ``inputs`` where it has them,
+        as lagrangian.control's controllers do), to the model's own: docs/control.md.
         """
         require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
-        step_control, save_at = _options(step_control, save_at, method, rtol, atol, samples,
+        step_control, save_at = run_options(step_control, save_at, method, rtol, atol, samples,
                                          1001)
         stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) \
             else stop_when
         result = simulate(self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
                           progress=progress, functions=self._numeric,
-                          limits=urdf_limits(self._model, positions=limits))
+                          limits=urdf_limits(self._model, positions=limits), controller=controller,
+                          inputs=getattr(controller, "inputs", ()) if inputs is None else inputs)
         return Simulation.of(result)
 
     # -- standalone C for a controller -----------------------------------------------------------
@@ -417,7 +424,7 @@ class System:
         if compute == "simulate":
             if t_end is None:
                 raise InputError("a simulation study needs t_end (s)", field="t_end")
-            step, save = _options(step_control, save_at, method, rtol, atol, samples, 201)
+            step, save = run_options(step_control, save_at, method, rtol, atol, samples, 201)
             if isinstance(stop_when, StopCondition):
                 stop_when = stop_when.text
             if stop_when is not None:
@@ -526,33 +533,6 @@ class System:
         eom = self.equations_of_motion()
         names = latex_symbol_names(self._model)
         return rf"$L = {sp.latex(eom.lagrangian, symbol_names=names)}$"
-
-
-def _options(step_control: StepControl | None, save_at: SaveAt | None, method: str,
-             rtol: float, atol: float, samples: int, samples_default: int
-             ) -> tuple[StepControl, SaveAt]:
-    """The option values from the option types or the plain keywords (a thin shim), never
-    both: a plain keyword that differs from its default beside its option type is refused."""
-    plain = {"method": (method, "DOP853"), "rtol": (rtol, 1e-9), "atol": (atol, 1e-9)}
-    if step_control is not None:
-        if not isinstance(step_control, StepControl):
-            raise InputError("step_control must be a lagrangian.StepControl",
-                             field="step_control")
-        both = [k for k, (value, default) in plain.items() if value != default]
-        if both:
-            raise InputError(f"give {', '.join(both)} in step_control or as a keyword, not both",
-                             field="step_control")
-    else:
-        step_control = StepControl(method, rtol, atol)
-    if save_at is not None:
-        if not isinstance(save_at, SaveAt):
-            raise InputError("save_at must be a lagrangian.SaveAt", field="save_at")
-        if samples != samples_default:
-            raise InputError("give samples in save_at or as a keyword, not both",
-                             field="save_at")
-    else:
-        save_at = SaveAt(samples)
-    return step_control, save_at
 
 
 class SystemBuilder(ModelBuilder):

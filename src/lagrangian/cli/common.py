@@ -47,6 +47,14 @@ FLAG_OF_FIELD = {
     "csv": "--csv",
     "frame": "--frame",
     "reference": "--reference",
+    "controller": "--control",
+    "linear_model": "--control",
+    "inputs": "--inputs",
+    "Q": "--Q",
+    "R": "--R",
+    "Kp": "--kp",
+    "Kd": "--kd",
+    "q_des": "--about",
 }
 
 SET_HELP = "Override a parameter: NAME=VALUE; repeat, or join with commas (m=2,L=0.5)."

@@ -39,6 +39,7 @@ def dynamics(
     payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
     coriolis: Annotated[bool, typer.Option("--coriolis", help="Also print C(q, q_dot), the matrix of the Coriolis and centrifugal terms (M_dot - 2C skew).")] = False,  # noqa: E501
+    derivatives: Annotated[bool, typer.Option("--derivatives", help="With --a: d tau/dq and d tau/dq_dot; with --tau: d q_ddot/dq, d q_ddot/dq_dot and d q_ddot/d tau.")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Mass matrix, bias forces C q_dot + g, gravity, inverse or forward dynamics, energies."""
@@ -50,6 +51,9 @@ def dynamics(
     if a is not None and tau is not None:
         raise InputError("--a (inverse dynamics) and --tau (forward dynamics) ask for two "
                          "things; give one")
+    if derivatives and a is None and tau is None:
+        raise InputError("needs --a (inverse dynamics) or --tau (forward dynamics) to "
+                         "differentiate", field="--derivatives")
     system = load_system(model, set_, lock, gravity, payload)
     coordinates = system.model.coordinates
     n = len(coordinates)
@@ -77,9 +81,15 @@ def dynamics(
         if a is not None:
             values["a"] = _vector(a, n, "--a", [])
             values["inverse_dynamics"] = f.inverse_dynamics(qs, vs, values["a"])
+            if derivatives:
+                values["dtau_dq"], values["dtau_dv"] = (  # + 0.0: no -0 printed
+                    x + 0.0 for x in f.inverse_dynamics_derivatives(qs, vs, values["a"]))
         if tau is not None:
             values["tau"] = _vector(tau, n, "--tau", [])
             values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"])
+            if derivatives:
+                values["dqdd_dq"], values["dqdd_dv"], values["dqdd_dtau"] = (
+                    x + 0.0 for x in f.forward_dynamics_derivatives(qs, vs, values["tau"]))
         if coriolis:
             values["coriolis_matrix"] = f.coriolis_matrix(qs, vs)
         values["kinetic_energy"] = f.kinetic_energy(qs, vs)

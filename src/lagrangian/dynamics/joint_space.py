@@ -32,6 +32,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, DynamicsWarning, InputError, ModelError
 from ..model.model import Model
 from ..model.values import resolve_parameters
+from .control_terms import ControlTerms
 from .frames import TreeKinematics, tree_kinematics
 
 
@@ -62,7 +63,7 @@ def solve_positive(mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
 
 
-class Dynamics:
+class Dynamics(ControlTerms):
     """Joint-space dynamics, batched over leading axes (SI units): M(q), the bias
     C(q, q_dot) q_dot + g(q), g(q), inverse and forward dynamics and the energies. The one type
     every path returns: this class evaluates the derived equations (a NumericSystem), and the

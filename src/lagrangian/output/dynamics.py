@@ -36,6 +36,9 @@ _TITLES = {
     "inverse_dynamics": "inverse dynamics tau = M q_ddot + C q_dot + g",
     "forward_dynamics": "forward dynamics q_ddot = M^-1 (tau - C q_dot - g)",
     "kinetic_energy": "kinetic energy T (J)", "potential_energy": "potential energy V (J)",
+    "dtau_dq": "d tau/dq (row i: tau_i)", "dtau_dv": "d tau/dq_dot",
+    "dqdd_dq": "d q_ddot/dq (row i: q_ddot_i)", "dqdd_dv": "d q_ddot/dq_dot",
+    "dqdd_dtau": "d q_ddot/d tau = M^-1",
 }
 
 

@@ -69,8 +69,9 @@ class Dynamics:
     recursive algorithms of a URDF tree (recursive.RecursiveDynamics in C,
     recursive_numpy.RecursiveNumpyDynamics in numpy) are its subclasses."""
 
-    coordinates: tuple[str, ...]
-    n: int
+    coordinates: tuple[str, ...]  # the configuration's names (nq of them)
+    n: int  # the velocity's numbers: M is n x n (nv; nq = n but for a floating base)
+    velocity_names: tuple[str, ...] | None = None  # where they differ from the coordinates
 
     # whether f's velocity terms are -C(q, q_dot) q_dot of M's Christoffel symbols (a tree's
     # recursions: always; the derived equations: checked once, on first use)
@@ -86,11 +87,27 @@ class Dynamics:
         self.n = functions.n
         self._equations = equations
 
+    @property
+    def nq(self) -> int:
+        """The configuration's numbers (n + 7 for a floating base: its position and quaternion)."""
+        return len(self.coordinates)
+
+    @property
+    def nv(self) -> int:
+        """The velocity's numbers (n + 6 for a floating base: its twist)."""
+        return self.n
+
+    def _width(self, field: str) -> tuple[int, tuple[str, ...]]:
+        if field == "q" or self.velocity_names is None:
+            return len(self.coordinates), self.coordinates
+        return self.n, self.velocity_names
+
     def _vector(self, value, field: str) -> np.ndarray:
         array = np.asarray(value, dtype=float)
-        if array.ndim == 0 or array.shape[-1] != self.n:
+        width, names = self._width(field)
+        if array.ndim == 0 or array.shape[-1] != width:
             shape = "()" if array.ndim == 0 else str(array.shape)
-            raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) along "
+            raise InputError(f"expected {width} values ({', '.join(names)}) along "
                              f"the last axis, got shape {shape}", field=field)
         return array
 
@@ -101,10 +118,15 @@ class Dynamics:
         arrays = [self._vector(x, f) for x, f in zip(arrays, fields, strict=True)]
         batch = np.broadcast_shapes(*(x.shape[:-1] for x in arrays))
         total = int(np.prod(batch, dtype=np.int64))
-        flat = [np.broadcast_to(x, batch + (self.n,)).reshape(total, self.n) for x in arrays]
+        flat = [np.broadcast_to(x, batch + x.shape[-1:]).reshape(total, x.shape[-1])
+                for x in arrays]
         good = np.ones(total, dtype=bool)
         for x in flat:
             good &= np.isfinite(x).all(axis=-1)
+        if self.velocity_names is not None and fields[0] == "q":  # a floating base's quaternion
+            from .free_flyer import check_quaternions
+
+            check_quaternions(flat[0][good])
         if good.all():
             out = np.asarray(compute(*flat), dtype=float).reshape((total,) + tail)
         else:
@@ -168,7 +190,7 @@ class Dynamics:
                 "a moving support, or M changing with t): use bias_forces(q, q_dot)")
         q, v = self._vector(q, "q"), self._vector(v, "v")
         batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
-        q, v = np.broadcast_to(q, batch + (self.n,)), np.broadcast_to(v, batch + (self.n,))
+        q, v = np.broadcast_to(q, batch + q.shape[-1:]), np.broadcast_to(v, batch + (self.n,))
         eye = np.eye(self.n)
         ahead = self.bias_forces(q[..., None, :], v[..., None, :] + eye)
         behind = self.bias_forces(q[..., None, :], v[..., None, :] - eye)
@@ -238,6 +260,12 @@ class TreeDynamics(Dynamics):
         self.tree = tree
         self.coordinates = tree.coordinates
         self.n = len(tree.coordinates)
+        if tree.floating_base:  # Pinocchio's layout: the base's numbers first (free_flyer.py)
+            from .free_flyer import BASE_CONFIGURATION, BASE_VELOCITY
+
+            self.coordinates = BASE_CONFIGURATION + tree.coordinates
+            self.velocity_names = BASE_VELOCITY + tree.coordinates
+            self.n += 6
         self.parameters = {p.name: float(v)
                            for p, v in zip(model.parameters, values.values, strict=True)}
 
@@ -259,6 +287,11 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
     if tree is None:
         return None
     dynamics = None
+    if tree.floating_base:  # the generated C has a fixed base: a floating one runs in numpy
+        if backend == "c":
+            raise InputError("a floating base's dynamics run in numpy (the generated C has a "
+                             "fixed base): use backend 'numpy' or 'auto'", field="backend")
+        return RecursiveNumpyDynamics(model, tree, parameters)  # no symbolic path to fall to
     if backend != "numpy":
         try:
             dynamics = RecursiveDynamics(model, tree, parameters)
@@ -283,4 +316,5 @@ def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
     return fast if fast is not None else Dynamics(symbolic(), equations)
 
 
-__all__ = ["Dynamics", "TreeDynamics", "model_dynamics", "recursive_dynamics", "solve_positive", "warn_undefined"]
+__all__ = ["Dynamics", "TreeDynamics", "model_dynamics", "recursive_dynamics", "solve_positive",
+           "warn_undefined"]

@@ -113,10 +113,10 @@ def derive(model: Model, *, check: bool = True,
     """
     tree = model.kinematic_tree
     if tree is not None and tree.floating_base:  # its base moves by a quaternion, not by q
-        raise ModelError("a floating-base robot has no equations in its joint coordinates: its "
-                         "dynamics and kinematics are computed by the recursive algorithms "
-                         "(dynamics, kinematics); derive it with a fixed base (no "
-                         "floating_base)", field="floating_base")
+        raise ModelError("a floating-base robot has no equations in its joint coordinates "
+                         "(derive, simulate, modes and the other symbolic commands need them): "
+                         "use dynamics(), its kinematics and integrate(q, v, dt), or load it "
+                         "with a fixed base", field="floating_base")
     q, q_dot, t = model.q, model.q_dot, model.time
     n = len(q)
     acc = _Accumulator(n)

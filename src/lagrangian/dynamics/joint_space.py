@@ -175,6 +175,37 @@ class Dynamics:
         """J_c with c_dot = J_c q_dot, (..., 3, n)."""
         return self.kinematics.center_of_mass_jacobian(q)
 
+    # -- the configuration space: a floating base's is a manifold (free_flyer.py) ---------------
+
+    def integrate(self, q, v, dt: float = 1.0) -> np.ndarray:
+        """q (+) v dt: the configuration reached moving at velocity v for dt s, (..., nq); a
+        floating base moves along its twist (SE(3)'s exponential) and its quaternion comes
+        back normalized, the joints by q + v dt."""
+        q, v = self._vector(q, "q"), self._vector(v, "v") * float(dt)
+        batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
+        Q = np.broadcast_to(q, batch + q.shape[-1:]).reshape(-1, q.shape[-1])
+        V = np.broadcast_to(v, batch + v.shape[-1:]).reshape(-1, v.shape[-1])
+        if self.velocity_names is None:
+            return (Q + V).reshape(batch + q.shape[-1:])
+        from .free_flyer import check_quaternions, integrate
+
+        check_quaternions(Q)
+        return integrate(Q, V).reshape(batch + q.shape[-1:])
+
+    def difference(self, q0, q1) -> np.ndarray:
+        """v with q0 (+) v = q1 (integrate's inverse for dt = 1), (..., nv)."""
+        q0, q1 = self._vector(q0, "q"), self._vector(q1, "q")
+        batch = np.broadcast_shapes(q0.shape[:-1], q1.shape[:-1])
+        Q0, Q1 = (np.broadcast_to(x, batch + x.shape[-1:]).reshape(-1, x.shape[-1])
+                  for x in (q0, q1))
+        if self.velocity_names is None:
+            return (Q1 - Q0).reshape(batch + (self.n,))
+        from .free_flyer import check_quaternions, difference
+
+        check_quaternions(Q0)
+        check_quaternions(Q1)
+        return difference(Q0, Q1).reshape(batch + (self.n,))
+
     def coriolis_matrix(self, q, v) -> np.ndarray:
         """C(q, q_dot) of the Coriolis and centrifugal terms, C q_dot = bias - g, with
         C_ij = sum_k Gamma_ijk q_dot_k (M's Christoffel symbols), so that M_dot - 2 C is

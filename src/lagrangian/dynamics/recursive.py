@@ -79,6 +79,9 @@ class RecursiveDynamics(TreeDynamics):
                  parameters: Mapping[str, float] | None = None):
         from ..compile import compiled
 
+        if tree.floating_base:  # recursive_dynamics sends it to numpy
+            raise InputError("the generated C of a tree has a fixed base; a floating base runs "
+                             "in numpy (backend 'numpy')", field="backend")
         names = tuple(p.name for p in model.parameters)
         self._take_tree(model, tree, parameters)
         self.parameter_values = np.array(list(self.parameters.values()), dtype=float)

@@ -18,6 +18,7 @@ import sympy as sp
 
 from ..compile.codegen import CodegenError, CPrinter, c_block, c_comment_text
 from ..derivation.equations import EquationsOfMotion
+from ..errors import ModelError
 from ..model.model import Model
 from ..model.tree import KinematicTree
 
@@ -248,6 +249,9 @@ def standalone_for(model: Model, equations: Callable[[], EquationsOfMotion],
     from .recursive import applicable_tree
 
     tree = applicable_tree(model)
+    if tree is not None and tree.floating_base:
+        raise ModelError("standalone C is written for a fixed base; a floating base's dynamics "
+                         "run in numpy (dynamics()) for now", field="floating_base")
     if tree is not None:
         return standalone_tree_c(model, tree, values, prefix)
     return standalone_c(equations(), values, prefix)

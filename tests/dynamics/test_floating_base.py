@@ -268,6 +268,8 @@ def test_bad_input_is_refused_in_one_line(tmp_path):
         system.simulate(0.1)
     with pytest.raises(lagrangian.InputError, match="fixed base"):
         system.dynamics(backend="c")
+    with pytest.raises(lagrangian.DerivationError, match="floating base"):
+        robot.coriolis_matrix(q, np.zeros(9))
     with pytest.raises(lagrangian.ModelError, match="floating base"):
         system.to_c()
     bad = tmp_path / "bad.urdf"

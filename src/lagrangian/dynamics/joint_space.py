@@ -214,6 +214,11 @@ class Dynamics:
         Exact: the velocity terms are quadratic in q_dot, so column j is
         (bias(q, q_dot + e_j) - bias(q, q_dot - e_j)) / 4. Refused where the model's velocity
         terms are not M's (a damper, a gyroscopic load, a moving support, M changing with t)."""
+        if self.velocity_names is not None:  # Christoffel symbols of quasi-velocities: not M's
+            raise DerivationError(
+                "C(q, v) of a floating base is not yet given: its twist is not the rate of its "
+                "coordinates, so M's Christoffel symbols do not make M_dot - 2C skew-symmetric; "
+                "use bias_forces(q, v)")
         if not self._velocity_terms_are_christoffel():
             raise DerivationError(
                 "C(q, q_dot) is the matrix of the Coriolis and centrifugal terms of M; this "

@@ -347,7 +347,9 @@ class _Tree:
             builder.add_generalized_force(name, tau, field=field)
         if not names:
             raise self.error("no joint left to move: a model needs at least one revolute, "
-                             "continuous or prismatic joint that is not locked")
+                             "continuous or prismatic joint that is not locked"
+                             + (" (a lone floating body: not yet)" if floating_base or any(
+                                 j.type == "floating" for j in order) else ""))
         position = self._positions(lock, names)
         bodies = tuple(self._bodies(root, order, position))
         model = builder.build_model()

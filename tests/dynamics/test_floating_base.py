@@ -7,6 +7,7 @@ Pinocchio."""
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -124,7 +125,7 @@ def test_floating_robots_match_pinocchio(robot):
     if not path.is_file():
         pytest.skip(f"{robot} is not in this example-robot-data")
     model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
-    ours = lagrangian.load(path, floating_base=True).dynamics()
+    ours = lagrangian.load(path, floating_base=True).dynamics(backend="numpy")
     assert ours.coordinates[:7] == ("base_x", "base_y", "base_z", "base_qx", "base_qy",
                                     "base_qz", "base_qw")
     assert ours.velocity_names[:6] == ("base_vx", "base_vy", "base_vz", "base_wx", "base_wy",
@@ -175,21 +176,25 @@ def test_solo_frames_match_pinocchio():
 
     path = _robots() / "solo_description/robots/solo12.urdf"
     model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
-    ours = lagrangian.load(path, floating_base=True).dynamics()
+    ours = lagrangian.load(path, floating_base=True).dynamics(backend="numpy")
     assert "root_joint" in ours.frames and "base_link" in ours.frames
     _compare_frames(model, ours)
 
 
-def test_a_urdf_floating_joint_is_the_free_flyer(tmp_path):
+@pytest.mark.parametrize("backend", ["numpy", "auto"])  # auto: generated C where it compiles
+def test_a_urdf_floating_joint_is_the_free_flyer(tmp_path, backend):
     """A URDF floating joint (with an origin of its own) is read as Pinocchio reads it."""
     pin = pytest.importorskip("pinocchio")
     path = tmp_path / "hopper.urdf"
     path.write_text(FLOATING_URDF)
     model = pin.buildModelFromXML(FLOATING_URDF)
-    ours = lagrangian.load(path).dynamics()
+    ours = lagrangian.load(path).dynamics(backend=backend)
     assert (ours.nq, ours.nv, ours.tree.joints[0].name) == (10, 9, "free")
-    _compare_dynamics(model, ours)
+    _compare_dynamics(model, ours, states=6)  # beyond the vector lanes of the C batch
     _compare_frames(model, ours)
+    with pytest.raises(lagrangian.InputError, match="norm 3") as info:
+        ours.forward_dynamics(np.r_[0, 0, 0, 0, 0, 0, 3.0, 0, 0, 0], np.zeros(9), np.zeros(9))
+    assert info.value.field == "q"
 
 
 def test_integrate_and_difference_match_pinocchio(tmp_path):
@@ -220,7 +225,7 @@ def test_newton_for_the_whole_robot(tmp_path):
     path = tmp_path / "hopper.urdf"
     path.write_text(FLOATING_URDF)
     for gravity in ((0.0, 0.0, -9.81), (1.0, -2.0, -3.0)):
-        robot = lagrangian.load(path, gravity=gravity).dynamics()
+        robot = lagrangian.load(path, gravity=gravity).dynamics(backend="numpy")
         rng = np.random.default_rng(2)
         q = robot.integrate(np.r_[0, 0, 0, 0, 0, 0, 1, 0, 0, 0], rng.uniform(-1, 1, (5, 9)))
         tau = np.concatenate([np.zeros((5, 6)), rng.uniform(-5, 5, (5, 3))], axis=1)
@@ -266,12 +271,8 @@ def test_bad_input_is_refused_in_one_line(tmp_path):
         system.equations_of_motion()
     with pytest.raises(lagrangian.LagrangianError, match="floating"):
         system.simulate(0.1)
-    with pytest.raises(lagrangian.InputError, match="fixed base"):
-        system.dynamics(backend="c")
     with pytest.raises(lagrangian.DerivationError, match="floating base"):
         robot.coriolis_matrix(q, np.zeros(9))
-    with pytest.raises(lagrangian.ModelError, match="floating base"):
-        system.to_c()
     bad = tmp_path / "bad.urdf"
     bad.write_text(FLOATING_URDF.replace('name="knee" type="revolute"', 'name="knee" type="floating"'))
     with pytest.raises(lagrangian.ModelError, match="its parent must be the root link 'world'"):
@@ -292,10 +293,13 @@ def test_command_prints_the_layout_and_refuses_a_bad_quaternion(cli, tmp_path):
     assert document["q"][:7] == [0, 0, 0, 0, 0, 0, 1] and len(document["mass_matrix"]) == 9
     bad = cli("dynamics", str(path), "--q", "0,0,0,0,0,0,0.5,0,0,0")
     assert bad.code == 2 and bad.err.startswith("error: --q: the base quaternion")
-    result = cli("kinematics", "two_link_arm", "--floating-base", "--frame", "fore", "--json")
+    result = cli("kinematics", str(path), "--frame", "foot", "--json")
     assert result.code == 0, result.err
     document = json.loads(result.out)
-    assert (document["nq"], document["nv"], len(document["jacobian"][0])) == (9, 8, 8)
+    assert (document["nq"], document["nv"], len(document["jacobian"][0])) == (10, 9, 9)
+    # base_vx (m/s along the trunk's own x) moves the foot along the trunk's x in the world
+    trunk = lagrangian.load(path).dynamics().placement(document["q"], "trunk")
+    np.testing.assert_allclose(np.array(document["jacobian"])[:3, 0], trunk[:3, 0], atol=1e-12)
 
 
 @pytest.mark.slow
@@ -307,10 +311,14 @@ def test_every_floating_robot_of_example_robot_data_matches_pinocchio():
 
     files = sorted(_robots().glob("*/urdf/*.urdf")) + sorted(_robots().glob("*/robots/*.urdf"))
     compared = []
+    for robot in ("solo_description/robots/solo12.urdf", "talos_data/robots/talos_reduced.urdf"):
+        path = _robots() / robot  # and two in generated C
+        model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+        _compare_dynamics(model, lagrangian.load(path, floating_base=True).dynamics(backend="c"))
     for path in files:
         try:
             model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
-            ours = lagrangian.load(path, floating_base=True).dynamics()
+            ours = lagrangian.load(path, floating_base=True).dynamics(backend="numpy")
         except Exception:  # noqa: BLE001 - refused by either: the fixed-base tests judge that
             continue
         if (ours.nq, ours.nv) != (model.nq, model.nv):
@@ -319,3 +327,38 @@ def test_every_floating_robot_of_example_robot_data_matches_pinocchio():
         compared.append(path.name)
     print(f"{len(compared)} robots compared: {', '.join(compared)}")
     assert len(compared) >= 25
+
+
+@pytest.mark.skipif(not (shutil.which("cc") or shutil.which("gcc")), reason="no C compiler")
+def test_standalone_c_of_a_floating_base(tmp_path):
+    """The standalone C (C99, libm) of the hopper takes q of HOPPER_NQ = 10 and v of
+    HOPPER_N = 9 and gives the numpy recursions' numbers."""
+    import ctypes
+    import subprocess
+
+    from lagrangian.output.files import write_c
+
+    path = tmp_path / "hopper.urdf"
+    path.write_text(FLOATING_URDF)
+    system = lagrangian.load(path)
+    code = system.to_c()
+    assert "#define HOPPER_N 9\n#define HOPPER_NQ 10" in code.header
+    write_c(code, tmp_path / "gen")
+    library = tmp_path / "hopper.so"
+    subprocess.run([shutil.which("cc") or shutil.which("gcc"), "-std=c99", "-O2", "-Wall",
+                    "-Werror", "-pedantic", "-shared", "-fPIC", str(tmp_path / "gen/hopper.c"),
+                    "-o", str(library), "-lm"], check=True)
+    c = ctypes.CDLL(str(library))
+    params = (ctypes.c_double * 4).in_dll(c, "hopper_parameters")
+    ours = system.dynamics(backend="numpy")
+    rng = np.random.default_rng(8)
+    q = ours.integrate(np.r_[0.1, 0.2, 0.3, 0, 0, 0, 1, 0.2, -0.4, 0.05], rng.uniform(-1, 1, 9))
+    v, tau = rng.uniform(-1, 1, 9), rng.uniform(-1, 1, 9)
+    Q, V, TAU = ((ctypes.c_double * len(x))(*x) for x in (q, v, tau))
+    M, out = (ctypes.c_double * 81)(), (ctypes.c_double * 9)()
+    c.hopper_mass_matrix(Q, params, M)
+    _close(np.array(M).reshape(9, 9), ours.mass_matrix(q))
+    c.hopper_bias_forces(Q, V, params, out)
+    _close(np.array(out), ours.bias_forces(q, v))
+    assert c.hopper_forward_dynamics(Q, V, TAU, params, out) == 0
+    _close(np.array(out), ours.forward_dynamics(q, v, tau))

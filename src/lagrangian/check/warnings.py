@@ -58,8 +58,8 @@ def fixed_root_warnings(model: Model) -> list[str]:
         return []
     return [f"the root link '{tree.root_link}' (with the links welded to it) carries "
             f"{tree.root_mass:.6g} kg and no joint of the URDF fixes it: loaded with a fixed "
-            "base, bolted to the world (a robot that walks or flies: dynamics or kinematics "
-            "--floating-base, load(path, floating_base=True))"]
+            "base, bolted to the world (a robot that walks or flies: dynamics, kinematics or "
+            "codegen --floating-base, load(path, floating_base=True))"]
 
 
 def setting_warnings(eom: EquationsOfMotion, names: Iterable[str]) -> list[str]:

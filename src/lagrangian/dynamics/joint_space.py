@@ -323,11 +323,6 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
     if tree is None:
         return None
     dynamics = None
-    if tree.floating_base:  # the generated C has a fixed base: a floating one runs in numpy
-        if backend == "c":
-            raise InputError("a floating base's dynamics run in numpy (the generated C has a "
-                             "fixed base): use backend 'numpy' or 'auto'", field="backend")
-        return RecursiveNumpyDynamics(model, tree, parameters)  # no symbolic path to fall to
     if backend != "numpy":
         try:
             dynamics = RecursiveDynamics(model, tree, parameters)
@@ -340,7 +335,8 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
                                 "slower per call than compiled C")
     if dynamics is None:
         dynamics = RecursiveNumpyDynamics(model, tree, parameters)
-    return dynamics if dynamics.regular() else None
+    # a floating base has no symbolic path to fall to: NaN rows where M is singular
+    return dynamics if tree.floating_base or dynamics.regular() else None
 
 
 def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],

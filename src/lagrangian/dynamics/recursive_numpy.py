@@ -374,12 +374,17 @@ class RecursiveNumpyDynamics(TreeDynamics):
         from ..compile.functions import NumericSystem
 
         if self.tree.floating_base:
-            raise ModelError("simulate and the equations' numeric functions integrate q_dot = v; "
-                             "a floating base's configuration holds a quaternion (nq = n + 7, "
-                             "nv = n + 6): use dynamics() and its integrate(q, v, dt)")
+            raise floating_refusal()
         return NumericSystem(coordinates=self.coordinates, constraint_names=(),
                              constraint_kinds=(), parameters=dict(self.parameters),
                              _kernel=_TreeKernel(self))
+
+
+def floating_refusal() -> ModelError:
+    """Why a floating base has no NumericSystem (simulate)."""
+    return ModelError("simulate and the equations' numeric functions integrate q_dot = v; a "
+                      "floating base's configuration holds a quaternion (nq = n + 7, nv = n + 6): "
+                      "use dynamics() and its integrate(q, v, dt)", field="floating_base")
 
 
 def _spatial_inertia(m, h, J, count: int) -> np.ndarray:

@@ -79,7 +79,8 @@ def _close_forward(ours, theirs, mass, bias, tau):
     humanoid's hands: 1e7 rad/s^2 from 1e-7 kg m^2), and M q_ddot + b = tau to 1e-12."""
     scale = max(1.0, np.abs(theirs).max()) * max(1.0, np.linalg.cond(mass) / 1e4)
     np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-12 * scale)
-    force = max(1.0, np.abs(tau).max(), np.abs(bias).max(), np.abs(mass @ ours).max())
+    # the backward error of a solve, against |M| |q_ddot| (not |M q_ddot|, which cancels)
+    force = max(1.0, np.abs(tau).max(), np.abs(bias).max(), (np.abs(mass) @ np.abs(ours)).max())
     np.testing.assert_allclose(mass @ ours + bias, tau, rtol=0, atol=1e-12 * force)
 
 

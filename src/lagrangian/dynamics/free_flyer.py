@@ -162,15 +162,6 @@ def difference(Q0: np.ndarray, Q1: np.ndarray) -> np.ndarray:
     return np.concatenate([twist, Q1[:, 7:] - Q0[:, 7:]], -1)
 
 
-def check_layout(Q: np.ndarray, V: np.ndarray, nq: int, nv: int) -> None:
-    if Q.shape[-1] != nq:
-        raise InputError(f"expected {nq} values along the last axis, got {Q.shape[-1]}",
-                         field="q")
-    if V.shape[-1] != nv:
-        raise InputError(f"expected {nv} values along the last axis, got {V.shape[-1]}",
-                         field="v")
-
-
 __all__ = ["BASE_CONFIGURATION", "BASE_VELOCITY", "QUATERNION_TOLERANCE", "FreeFlyerModel",
            "check_quaternions", "difference", "exp6", "integrate", "log6", "matrix_quaternion",
            "quaternion_matrix"]

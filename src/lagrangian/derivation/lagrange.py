@@ -116,7 +116,7 @@ def derive(model: Model, *, check: bool = True,
         raise ModelError("a floating-base robot has no equations in its joint coordinates "
                          "(derive, simulate, modes and the other symbolic commands need them): "
                          "use dynamics(), its kinematics and integrate(q, v, dt), or load it "
-                         "with a fixed base", field="floating_base")
+                         "with a fixed base")
     q, q_dot, t = model.q, model.q_dot, model.time
     n = len(q)
     acc = _Accumulator(n)

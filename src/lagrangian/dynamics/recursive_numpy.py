@@ -384,7 +384,7 @@ def floating_refusal() -> ModelError:
     """Why a floating base has no NumericSystem (simulate)."""
     return ModelError("simulate and the equations' numeric functions integrate q_dot = v; a "
                       "floating base's configuration holds a quaternion (nq = n + 7, nv = n + 6): "
-                      "use dynamics() and its integrate(q, v, dt)", field="floating_base")
+                      "use dynamics() and its integrate(q, v, dt)")
 
 
 def _spatial_inertia(m, h, J, count: int) -> np.ndarray:

@@ -553,30 +553,30 @@ class SystemBuilder(ModelBuilder):
 
 
 def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None,
-         gravity: Sequence[float] | None = None, payload: Mapping[str, object] | None = None
-         ) -> System:
+         gravity: Sequence[float] | None = None, payload: Mapping[str, object] | None = None,
+         floating_base: bool = False) -> System:
     """Load a model file (TOML), a robot (URDF: ``lock`` freezes joints by name, rad or m;
     ``payload`` {link: mass, or (mass, (x, y, z))} fixes point masses (kg, m in the link's
-    frame) to links, as an edited URDF would), or a built-in example by name (see
+    frame) to links, as an edited URDF would; ``floating_base`` frees its root link, nq = n + 7,
+    nv = n + 6: dynamics and kinematics only), or a built-in example by name (see
     ``examples()``); ``gravity`` (g_x, g_y, g_z) in m/s^2 turns the model's gravity
     (System.with_gravity)."""
-    system = _load(path_or_example, lock, payload)
+    system = _load(path_or_example, lock, payload, floating_base)
     return system if gravity is None else system.with_gravity(gravity)
 
 
-def _load(path_or_example: str | Path, lock, payload) -> System:
+def _load(path_or_example: str | Path, lock, payload, floating_base) -> System:
     path = Path(path_or_example)
-    if path.suffix.lower() == ".urdf":
-        return System(read_urdf(path, lock, payload))
-    urdf = None if path.exists() else example_urdf(str(path_or_example))
+    urdf = path if path.suffix.lower() == ".urdf" else (
+        None if path.exists() else example_urdf(str(path_or_example)))
     if urdf is not None:
-        return System(replace(read_urdf(urdf, lock, payload),
-                              source=f"example:{path_or_example}"))
-    if payload:
-        raise InputError("only a URDF model has links to carry a payload", field="payload")
-    if lock:
-
-        raise InputError("only a URDF model has joints to lock", field="lock")
+        model = read_urdf(urdf, lock, payload, floating_base)
+        return System(model if urdf is path else replace(model, source=f"example:{path}"))
+    for name, given, what in (("payload", payload, "links to carry a payload"),
+                              ("lock", lock, "joints to lock"),
+                              ("floating_base", floating_base, "a base to float")):
+        if given:
+            raise InputError(f"only a URDF model has {what}", field=name)
     if path.exists() or path.suffix == ".toml" or len(path.parts) > 1:
         return System(read_model(path))
     model = read_model(example_path(str(path_or_example)))

@@ -20,11 +20,20 @@ from .regressor import (
 )
 
 
+def _refuse_floating(tree, what: str) -> None:
+    # the complex-step Newton-Euler and the per-body regressor walk joints of one coordinate
+    # each; a free flyer's seven numbers and six rates are not theirs
+    if tree is not None and getattr(tree, "floating_base", False):
+        raise InputError(f"the {what} of a floating base are not given yet (fixed-base robots "
+                         "only); load it without floating_base=True", field="q")
+
+
 class ControlTerms:
     """Regressor and parameters (a mixin of joint_space.Dynamics; SI units)."""
 
     def _regressor_of(self, parameters: Sequence[str] | None):
         tree = getattr(self, "tree", None)
+        _refuse_floating(tree, "regressor")
         if tree is not None:
             if parameters is not None:
                 raise InputError("a robot's regressor is over its bodies' 10 inertial "
@@ -80,6 +89,7 @@ class ControlTerms:
         found = self.__dict__.get("_derivatives")
         if found is None:
             tree = getattr(self, "tree", None)
+            _refuse_floating(tree, "derivatives of the dynamics")
             if tree is not None:
                 from .derivatives import tree_inverse_dynamics_derivatives
 

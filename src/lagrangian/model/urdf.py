@@ -36,7 +36,7 @@ from .expressions import RESERVED
 from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
-from .tree import KinematicTree, TreeFrame, TreeJoint
+from .tree import KinematicTree, TreeFrame, TreeJoint, TreeLink, link_inertias
 
 MOVABLE = ("revolute", "continuous", "prismatic")
 SUPPORTED = (*MOVABLE, "fixed")
@@ -464,24 +464,19 @@ class _Tree:
                 else:
                     anchor[joint.child] = (body, rotation @ _axis_rotation(axis, theta),
                                            translation)
-        inertias = [[0.0, np.zeros(3), np.zeros((3, 3))] for _ in joints]
+        links = []
         for name, (body, turn, shift) in anchor.items():
             inertial = self.links[name].inertial
-            if body < 0 or _carries_nothing(inertial):
-                continue
-            mass = float(inertial.mass or 0.0)
-            where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
-                               dtype=float)
-            tensor = np.asarray(inertial.inertia if inertial.inertia is not None
+            carries = not _carries_nothing(inertial)
+            where = np.asarray(inertial.origin if carries and inertial.origin is not None
+                               else np.eye(4), dtype=float)
+            tensor = np.asarray(inertial.inertia if carries and inertial.inertia is not None
                                 else np.zeros((3, 3)), dtype=float)
-            tensor = 0.5 * (tensor + tensor.T)
-            tensor = turn @ (_snapped(where[:3, :3]) @ tensor @ _snapped(where[:3, :3]).T) @ turn.T
-            center = shift + turn @ _snapped(where[:3, 3])
-            # about the body's origin: J_O = I_C + m (|c|^2 1 - c c^T), h = m c
-            inertias[body][0] += mass
-            inertias[body][1] += mass * center
-            inertias[body][2] += tensor + mass * (center @ center * np.eye(3)
-                                                  - np.outer(center, center))
+            links.append(TreeLink(name, body, turn, shift,
+                                  float(inertial.mass or 0.0) if carries else 0.0,
+                                  _snapped(where[:3, 3]), _snapped(where[:3, :3]),
+                                  0.5 * (tensor + tensor.T)))
+        inertias = link_inertias(links, len(joints))
 
         def vector(a):
             return tuple(float(x) for x in a)
@@ -497,6 +492,9 @@ class _Tree:
                    for joint in order if joint.name not in by_link and joint.child in by_link]
         return KinematicTree(
             frames=tuple(frames),
+            links=tuple(TreeLink(k.name, k.body, matrix(k.rotation), vector(k.translation),
+                                 k.mass, vector(k.com), matrix(k.com_rotation),
+                                 matrix(k.inertia)) for k in links),
             joints=tuple(TreeJoint(
                 name=j["name"], parent=j["parent"], kind=j["kind"], rotation=matrix(j["rotation"]),
                 translation=vector(j["translation"]), axis=vector(j["axis"]),

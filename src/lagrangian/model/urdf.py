@@ -36,6 +36,7 @@ from .expressions import RESERVED
 from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
+from .lazy_bodies import LAZY_ABOVE, LazyBodies
 from .tree import KinematicTree, TreeFrame, TreeJoint, TreeLink, link_inertias
 
 MOVABLE = ("revolute", "continuous", "prismatic")
@@ -318,9 +319,14 @@ class _Tree:
             raise self.error("no joint left to move: a model needs at least one revolute, "
                              "continuous or prismatic joint that is not locked")
         position = self._positions(lock, names)
-        bodies = tuple(self._bodies(root, order, position))
         model = builder.build_model()
-        tree = self._tree(root, order, position, names, bodies)
+        if len(names) > LAZY_ABOVE:  # a long chain: its symbolic bodies when first asked for
+            tree = self._tree(root, order, position, names, ())
+            bodies = self._lazy_bodies(root, order, position, tree)
+            tree = replace(tree, rigid_bodies=bodies)
+        else:
+            bodies = tuple(self._bodies(root, order, position))
+            tree = self._tree(root, order, position, names, bodies)
         return replace(model, rigid_bodies=bodies, kinematic_tree=tree,
                        source_names=tuple((name, joint) for joint, name in names.items()),
                        source_ratings=tuple((name, *self._ratings(joint))
@@ -406,21 +412,7 @@ class _Tree:
             inertial = link.inertial
             if _carries_nothing(inertial):
                 continue
-            field = f"link '{name}'.inertial"
-            mass = float(inertial.mass or 0.0)
-            tensor = np.asarray(inertial.inertia if inertial.inertia is not None
-                                else np.zeros((3, 3)), dtype=float)
-            if not math.isfinite(mass) or mass < 0:
-                raise self.error(f"the mass {mass} is negative or not finite", field)
-            if not np.all(np.isfinite(tensor)):
-                raise self.error("the inertia tensor has an entry that is not finite", field)
-            where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
-                               dtype=float)
-            turn = where[:3, :3]
-            tensor = turn @ tensor @ turn.T  # about the centre of mass, in link axes
-            if np.linalg.eigvalsh(0.5 * (tensor + tensor.T))[0] < -1e-12 * max(
-                    1.0, float(np.abs(tensor).max())):
-                raise self.error("the inertia tensor is not positive semidefinite", field)
+            mass, tensor, where = self._inertial(name)
             center = apply(frame.rotation, _vector(where[:3, 3]))
             position_ = tuple(o + c for o, c in zip(frame.origin, center, strict=True))
             if not moves[name]:
@@ -430,6 +422,43 @@ class _Tree:
                                     frame.angular_velocity, parents[name]))
         return bodies
 
+
+    def _inertial(self, name: str):
+        """A link's mass (kg), inertia tensor about its centre of mass in link axes (kg m^2)
+        and inertial origin (4 x 4), checked."""
+        inertial = self.links[name].inertial
+        field = f"link '{name}'.inertial"
+        mass = float(inertial.mass or 0.0)
+        tensor = np.asarray(inertial.inertia if inertial.inertia is not None
+                            else np.zeros((3, 3)), dtype=float)
+        if not math.isfinite(mass) or mass < 0:
+            raise self.error(f"the mass {mass} is negative or not finite", field)
+        if not np.all(np.isfinite(tensor)):
+            raise self.error("the inertia tensor has an entry that is not finite", field)
+        where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
+                           dtype=float)
+        turn = where[:3, :3]
+        tensor = turn @ tensor @ turn.T  # about the centre of mass, in link axes
+        if np.linalg.eigvalsh(0.5 * (tensor + tensor.T))[0] < -1e-12 * max(
+                1.0, float(np.abs(tensor).max())):
+            raise self.error("the inertia tensor is not positive semidefinite", field)
+        return mass, tensor, where
+
+    def _lazy_bodies(self, root: str, order, position, tree: KinematicTree) -> LazyBodies:
+        """The symbolic bodies of a large tree, built when first read (model/lazy_bodies.py),
+        every check of _bodies made now."""
+        for joint in order:
+            if joint.type in MOVABLE:
+                axis = np.asarray(joint.axis if joint.axis is not None else (1, 0, 0), float)
+                norm = float(np.linalg.norm(axis))
+                if not math.isfinite(norm) or norm == 0:
+                    raise self.error("the axis has zero length", f"joint '{joint.name}'.axis")
+        count = 0
+        for link in tree.links:
+            if not _carries_nothing(self.links[link.name].inertial):
+                self._inertial(link.name)
+                count += link.body >= 0
+        return LazyBodies(lambda: self._bodies(root, order, position), count)
 
     def _tree(self, root: str, order, position, names: dict[str, str], bodies) -> KinematicTree:
         """The same robot as numbers for the recursive algorithms (model/tree.py)."""

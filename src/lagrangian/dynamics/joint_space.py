@@ -255,6 +255,7 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
     INERTIAL_FIELDS: mass, com_x, ..., ixx, ...), as if the URDF had been edited."""
     from ..compile.compiled import BackendUnavailable
     from ..compile.functions import tell_numpy_fallback
+    from ..model.urdf_payload import PREFIX as PAYLOAD_PREFIX
     from .compact_kernel import COMPACT_ABOVE, CompactDynamics
     from .inertials import split_inertials
     from .recursive import RecursiveDynamics, applicable_tree
@@ -272,8 +273,10 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
         tree = inertials
     dynamics = None
     if backend != "numpy":
+        # a link's inertial set here, or a payload: the compact kernel takes them at run time
         compact = kernel == "compact" or (kernel == "auto" and (
-            inertials or len(tree.joints) > COMPACT_ABOVE))
+            inertials or len(tree.joints) > COMPACT_ABOVE
+            or any(link.name.startswith(PAYLOAD_PREFIX) for link in tree.links)))
         try:
             dynamics = (CompactDynamics if compact else RecursiveDynamics)(model, tree, parameters)
         except BackendUnavailable as exc:

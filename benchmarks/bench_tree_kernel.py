@@ -124,6 +124,14 @@ def measure(name: str, path: str, lock: dict) -> dict:
             "batch_ours_ms": min(batch_ours) * 1e3, "batch_pin_ms": min(batch_pin) * 1e3}
 
 
+def _per_call(system, n: int):
+    """Forward dynamics and M per call (s): (unrolled, compact) each."""
+    u, c = system.dynamics(kernel="unrolled"), system.dynamics(kernel="compact")
+    q = np.linspace(-1, 1, n)
+    return (best_pair(lambda: u.forward_dynamics(q, q, q), lambda: c.forward_dynamics(q, q, q)),
+            best_pair(lambda: u.mass_matrix(q), lambda: c.mass_matrix(q)))
+
+
 def threshold(sizes: list[int]) -> None:
     print(" n  unrolled cold s | FD unrolled / compact us | M unrolled / compact us")
     with tempfile.TemporaryDirectory() as folder:
@@ -131,11 +139,7 @@ def threshold(sizes: list[int]) -> None:
             path = Path(folder) / f"chain{n}.urdf"
             path.write_text(chain_urdf(n))
             cold = first_result(str(path), {}, "unrolled")
-            system = lagrangian.load(path)
-            u, c = system.dynamics(kernel="unrolled"), system.dynamics(kernel="compact")
-            q = np.linspace(-1, 1, n)
-            fd = best_pair(lambda: u.forward_dynamics(q, q, q), lambda: c.forward_dynamics(q, q, q))
-            m = best_pair(lambda: u.mass_matrix(q), lambda: c.mass_matrix(q))
+            fd, m = _per_call(lagrangian.load(path), n)
             print(f"{n:3d} {cold:8.1f} | {fd[0] * 1e6:7.2f} {fd[1] * 1e6:7.2f} | "
                   f"{m[0] * 1e6:7.2f} {m[1] * 1e6:7.2f}", flush=True)
 

@@ -33,10 +33,10 @@ from ..errors import ModelError, did_you_mean, require_extra
 from ..kinds import JointKind
 from .builder import ModelBuilder
 from .expressions import RESERVED
+from .lazy_bodies import LAZY_ABOVE, LazyBodies
 from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
-from .lazy_bodies import LAZY_ABOVE, LazyBodies
 from .tree import KinematicTree, TreeFrame, TreeJoint, TreeLink, link_inertias
 
 MOVABLE = ("revolute", "continuous", "prismatic")

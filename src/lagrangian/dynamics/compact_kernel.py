@@ -16,8 +16,9 @@ The description ``D`` (float64, contiguous), built by ``describe``:
       33:40 spare (a free-flyer's velocity index would go here).
 
 A new joint kind is a new code in JOINT_CODES and its cases in tree_kernel.c (tk_place for the
-placement, tk_subspace for S); the recursions themselves ask only for those. The module's cache
-key is its source alone, never the tree's numbers.
+placement, tk_subspace for S); the recursions themselves ask only for those. The module (tree_kernel.c,
+then its Python bindings tree_kernel_bindings.c) is keyed by its source alone, never the tree's
+numbers.
 """
 
 from __future__ import annotations
@@ -37,7 +38,13 @@ from .recursive import RecursiveDynamics
 HEADER, STRIDE = 8, 40
 JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1}
 
-_SOURCE = Path(__file__).with_name("tree_kernel.c")
+# the recursions, then the batched Python bindings (one translation unit)
+_SOURCES = tuple(Path(__file__).with_name(name)
+                 for name in ("tree_kernel.c", "tree_kernel_bindings.c"))
+
+
+def _source() -> str:
+    return "\n".join(path.read_text(encoding="utf-8") for path in _SOURCES)
 
 # Trees of more moving bodies than this get the compact kernel; smaller ones the unrolled
 # module of tree_c.py, faster per call while its compile time stays short (measured:
@@ -71,7 +78,7 @@ def kernel_key() -> str:
     """The module's key: its C source (and this file), never a tree."""
     here = Path(__file__)
     return "compact-tree-kernel\n" + hashlib.sha256(
-        _SOURCE.read_bytes() + here.read_bytes()).hexdigest()
+        b"".join(path.read_bytes() for path in (*_SOURCES, here))).hexdigest()
 
 
 def kernel_module():
@@ -80,7 +87,7 @@ def kernel_module():
     from ..compile.codegen import GeneratedSource
 
     return compiled.load_keyed(kernel_key(), lambda: GeneratedSource(
-        source=_SOURCE.read_text(encoding="utf-8"), parameters=(), n=0, m=0), native=True)
+        source=_source(), parameters=(), n=0, m=0), native=True)
 
 
 class CompactDynamics(RecursiveDynamics):

@@ -47,9 +47,10 @@ def _source() -> str:
     return "\n".join(path.read_text(encoding="utf-8") for path in _SOURCES)
 
 # Trees of more moving bodies than this get the compact kernel; smaller ones the unrolled
-# module of tree_c.py, faster per call while its compile time stays short (measured:
-# docs/benchmarks.md, benchmarks/bench_tree_kernel.py).
-COMPACT_ABOVE = 24
+# module of tree_c.py: about 2x faster per call and, up to tree_emitter.VECTOR_LIMIT, several
+# states per vector operation in a batch, while its cold compile stays under ~20 s (measured:
+# docs/benchmarks.md, benchmarks/bench_tree_kernel.py --threshold).
+COMPACT_ABOVE = 16
 
 
 def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:

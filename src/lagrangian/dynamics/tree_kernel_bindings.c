@@ -28,7 +28,10 @@ static void *tk_run(void *argument)
     tk_job *job = (tk_job *)argument;
     const tk_tree *t = job->tree;
     const int n = t->n, size = job->size;
-    double *W = malloc(((size_t)t->nb * TW_STRIDE + (size_t)n * n) * sizeof(double));
+    /* scratch: on the stack for a small tree (a call on one state costs no malloc) */
+    double small[4096];
+    const size_t need = (size_t)t->nb * TW_STRIDE + (size_t)n * n;
+    double *W = need <= 4096 ? small : malloc(need * sizeof(double));
     if (!W) { job->failed = 1; return NULL; }
     double *L = W + (size_t)t->nb * TW_STRIDE;
     npy_intp bad = 0;
@@ -60,7 +63,7 @@ static void *tk_run(void *argument)
             bad++;
         }
     }
-    free(W);
+    if (W != small) free(W);
     job->bad = bad;
     return NULL;
 }

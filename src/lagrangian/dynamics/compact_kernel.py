@@ -32,7 +32,7 @@ import numpy as np
 
 from ..kinds import JointKind
 from ..model.model import Model
-from ..model.tree import KinematicTree
+from ..model.tree import KinematicTree, TreeJoint
 from .recursive import RecursiveDynamics
 
 HEADER, STRIDE = 8, 40
@@ -72,6 +72,26 @@ def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray
         r[20], r[21:24], r[24:33] = j.mass, j.first_moment, np.ravel(j.inertia)
     D.flags.writeable = False
     return D
+
+
+def joints_of(D: np.ndarray) -> tuple[TreeJoint, ...]:
+    """The bodies of a description as TreeJoints (names left empty): what the numpy twin
+    (recursive_numpy.py) reads, so that both compute from the same array."""
+    kinds = {code: kind for kind, code in JOINT_CODES.items()}
+    nb, n = int(D[0]), int(D[1])
+    out = []
+    for i in range(nb):
+        r = D[HEADER + n + i * STRIDE:HEADER + n + (i + 1) * STRIDE]
+
+        def matrix(a):
+            return tuple(tuple(float(x) for x in row) for row in np.reshape(a, (3, 3)))
+
+        out.append(TreeJoint(name="", parent=int(r[0]), kind=kinds[int(r[1])],
+                             rotation=matrix(r[5:14]), translation=tuple(map(float, r[14:17])),
+                             axis=tuple(map(float, r[17:20])), coordinate=int(r[2]),
+                             multiplier=float(r[3]), offset=float(r[4]), mass=float(r[20]),
+                             first_moment=tuple(map(float, r[21:24])), inertia=matrix(r[24:33])))
+    return tuple(out)
 
 
 @lru_cache(maxsize=1)
@@ -157,4 +177,5 @@ class _CompactKernel:
         return np.concatenate([y[n:], qdd])
 
 
-__all__ = ["COMPACT_ABOVE", "CompactDynamics", "JOINT_CODES", "describe", "kernel_module"]
+__all__ = ["COMPACT_ABOVE", "CompactDynamics", "JOINT_CODES", "describe", "joints_of",
+           "kernel_module"]

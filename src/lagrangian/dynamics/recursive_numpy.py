@@ -23,6 +23,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model.model import Model
 from ..model.tree import KinematicTree
+from .compact_kernel import describe, joints_of
 from .joint_models import joint_model
 from .joint_space import TreeDynamics, solve_positive
 
@@ -118,7 +119,8 @@ class RecursiveNumpyDynamics(TreeDynamics):
         self._actuators = np.array([self.parameters[a] for a in tree.actuators], dtype=float)
         # the ground accelerates up by g: every body feels gravity (Newton-Euler's trick)
         self._up = -self._g * np.array(tree.gravity_direction, dtype=float)
-        self._joints = [_Joint(j) for j in tree.joints]
+        # the bodies as the compact C kernel reads them (compact_kernel.describe): one description
+        self._joints = [_Joint(j) for j in joints_of(describe(tree, self.parameters))]
 
     def __repr__(self) -> str:
         return f"RecursiveNumpyDynamics(coordinates={list(self.coordinates)})"

@@ -132,6 +132,15 @@ def test_bad_link_parameters_are_refused_in_one_line(robots, name, value, words)
     assert "\n" not in str(caught.value)
 
 
+def test_a_link_left_without_mass_is_named(robots):
+    arm, _ = robots
+    weightless = {"c.mass": 0.0, "tool.mass": 0.0}  # the prismatic joint then moves nothing
+    weightless.update({f"{link}.{i}": 0.0 for link in ("c", "tool")
+                       for i in ("ixx", "iyy", "izz")})
+    with pytest.raises(InputError, match="not positive definite"):
+        arm.dynamics(parameters=weightless)
+
+
 def test_a_model_without_links_refuses_them():
     with pytest.raises(InputError, match="robot read from URDF"):
         lagrangian.load("double_pendulum").dynamics(parameters={"bob.mass": 2.0})

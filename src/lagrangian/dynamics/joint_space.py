@@ -288,7 +288,12 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
                                 "slower per call than compiled C")
     if dynamics is None:
         dynamics = RecursiveNumpyDynamics(model, tree, parameters)
-    return dynamics if dynamics.regular() else None
+    if dynamics.regular():
+        return dynamics
+    if inertials:  # the derived equations know no link parameters: say what is wrong here
+        raise InputError("with these link inertials the mass matrix is not positive definite "
+                         "(a joint that moves no mass)", field="parameters")
+    return None
 
 
 def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],

@@ -11,7 +11,7 @@ enum { TK_MASSM, TK_BIAS, TK_GRAVITY, TK_INVERSE, TK_FORWARD, TK_KINETIC, TK_POT
 #define TK_PTHREADS 0
 #endif
 #define TK_MAX_THREADS 8
-#define TK_THREAD_WORK 200000  /* body-states per thread before another is worth starting */
+#define TK_THREAD_WORK 8192  /* body-states (about 1 ms) per thread before another starts */
 
 typedef struct {
     const tk_tree *tree;

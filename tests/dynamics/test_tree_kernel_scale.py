@@ -64,3 +64,25 @@ def test_a_200_joint_chain_gives_forward_dynamics_in_seconds(tmp_path, monkeypat
                                atol=1e-12)
     # the symbolic bodies wait until asked for (model/lazy_bodies.py), then are all there
     assert len(f.model.rigid_bodies) == 200
+
+
+def test_lazy_bodies_are_the_bodies_built_at_once(tmp_path, monkeypatch):
+    """A tree of more than LAZY_ABOVE bodies builds its symbolic bodies on first use: the same
+    bodies as a load that builds them at once; a bad link is still refused at load."""
+    from lagrangian.errors import ModelError
+    from lagrangian.model import urdf
+    from lagrangian.model.lazy_bodies import LAZY_ABOVE, LazyBodies
+
+    n = LAZY_ABOVE + 1
+    path = tmp_path / "snake.urdf"
+    path.write_text(snake_urdf(n))
+    lazy = lagrangian.load(path).model
+    assert isinstance(lazy.rigid_bodies, LazyBodies) and len(lazy.rigid_bodies) == n
+    monkeypatch.setattr(urdf, "LAZY_ABOVE", 10 * n)
+    eager = lagrangian.load(path).model
+    assert isinstance(eager.rigid_bodies, tuple)
+    assert lazy.rigid_bodies == eager.rigid_bodies  # built now, body by body equal
+    monkeypatch.setattr(urdf, "LAZY_ABOVE", LAZY_ABOVE)
+    path.write_text(snake_urdf(n).replace('<mass value="0.5"/>', '<mass value="-0.5"/>', 1))
+    with pytest.raises(ModelError, match="negative"):
+        lagrangian.load(path)

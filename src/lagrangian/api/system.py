@@ -277,16 +277,22 @@ class System(ControlMethods):
         None (dynamics/joint_space.py)."""
         return recursive_dynamics(self.model)
 
-    def dynamics(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"):
+    def dynamics(self, parameters: Mapping[str, float] | None = None, backend: str = "auto",
+                 kernel: str = "auto"):
         """M(q), bias C q_dot + g, g(q), inverse and forward dynamics and the energies, batched
         over leading axes (q of shape (n,) or (N, n)); a generalized force tau acts on top of
         the model's own loads (dynamics/joint_space.py). A URDF robot runs recursive algorithms in
         generated C (dynamics/recursive.py; in numpy without a compiler or with backend
-        "numpy"), the other models their derived equations."""
-        if parameters is None and backend == "auto" and self._recursive is not None:
+        "numpy"), the other models their derived equations. A URDF robot's ``parameters`` may
+        set a link's inertial (``{"tool0.mass": 2.5}``, dynamics/inertials.py) without a
+        rebuild; ``kernel`` "unrolled" (the tree's own code), "compact" (one module for every
+        tree) or "auto" (by the tree's size, dynamics/compact_kernel.py)."""
+        if parameters is None and backend == "auto" and kernel == "auto" \
+                and self._recursive is not None:
             return self._recursive
         return model_dynamics(self.model, lambda: self.numeric(parameters, backend),
-                              parameters, backend, equations=self.equations_of_motion)
+                              parameters, backend, equations=self.equations_of_motion,
+                              kernel=kernel)
 
     # -- equilibria, linearization and modes -----------------------------------------------------
 

@@ -182,7 +182,7 @@ def comma_separated(settings: Iterable[str]) -> list[str]:
     return [part for setting in settings for part in _NEXT_ASSIGNMENT.split(setting)]
 
 
-_NEXT_ASSIGNMENT = re.compile(r",(?=\s*[A-Za-z_][A-Za-z0-9_]*\s*=)")
+_NEXT_ASSIGNMENT = re.compile(r",(?=\s*[A-Za-z_][A-Za-z0-9_.\-]*\s*=)")  # link.mass= too
 
 
 def payloads(settings: Iterable[str]) -> dict[str, tuple[float, tuple[float, ...]]]:

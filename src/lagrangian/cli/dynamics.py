@@ -35,6 +35,28 @@ def _vector(text: str | None, n: int, flag: str, default: list[float]) -> list[f
     return [parse_quantity(p, None, flag) for p in parts]
 
 
+_LINK_UNITS = {"mass": "kg", "com_x": "m", "com_y": "m", "com_z": "m"}
+
+
+def _link_settings(settings: list[str]) -> tuple[list[str], dict[str, float | str]]:
+    """--set entries split: the model's parameters (NAME=VALUE), and a link's inertial
+    (LINK.FIELD=VALUE, read in SI by the field's unit; a name the library refuses by itself)."""
+    from .. import parse_quantity
+    from .common import assignments, comma_separated
+
+    own, inertials = [], {}
+    for setting in comma_separated(settings):
+        name = setting.partition("=")[0].strip()
+        if "." not in name:
+            own.append(setting)
+            continue
+        ((name, text),) = assignments([setting], "--set")
+        field = name.rpartition(".")[2]
+        unit = _LINK_UNITS.get(field, "kg*m^2" if field[:1] == "i" and len(field) == 3 else None)
+        inertials[name] = parse_quantity(text, unit, f"--set {name}") if unit else text
+    return own, inertials
+
+
 @app.command()
 def dynamics(
     model: Annotated[str, typer.Argument(help="Model file (TOML or URDF) or built-in example name.")],
@@ -46,7 +68,7 @@ def dynamics(
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
     payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
     floating_base: Annotated[bool, typer.Option("--floating-base", help=FLOATING_HELP)] = False,
-    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE; a URDF link's inertial LINK.mass, LINK.com_x (y, z), LINK.ixx (ixy, ixz, iyy, iyz, izz), SI.")] = [],  # noqa: B006,E501
     coriolis: Annotated[bool, typer.Option("--coriolis", help="Also print C(q, q_dot), the matrix of the Coriolis and centrifugal terms (M_dot - 2C skew).")] = False,  # noqa: E501
     derivatives: Annotated[bool, typer.Option("--derivatives", help="With --a: d tau/dq and d tau/dq_dot; with --tau: d q_ddot/dq, d q_ddot/dq_dot and d q_ddot/d tau.")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
@@ -63,7 +85,8 @@ def dynamics(
     if derivatives and a is None and tau is None:
         raise InputError("needs --a (inverse dynamics) or --tau (forward dynamics) to "
                          "differentiate", field="--derivatives")
-    system = load_system(model, set_, lock, gravity, payload, floating_base)
+    own, inertials = _link_settings(set_)
+    system = load_system(model, own, lock, gravity, payload, floating_base)
     coordinates = system.model.coordinates
     start = resolve_state(system.model)  # the model's own initial state (the library's defaults)
     names_q, names_v, base_q, base_v = base_layout(system)
@@ -82,7 +105,8 @@ def dynamics(
             warn(line)
     n = len(names_v)
     vs = _vector(v, n, "--v", base_v + list(start.q_dot))
-    f = system.dynamics()
+    # a link's inertial (--set fore.mass=3) is a runtime parameter of the robot's dynamics
+    f = system.dynamics(parameters=inertials) if inertials else system.dynamics()
     with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings(record=True) as seen:
         # an overflow is refused below; a state without dynamics (M not positive definite)
         # is a DynamicsWarning and NaN, reported in one line

@@ -308,25 +308,45 @@ class TreeDynamics(Dynamics):
 
 
 def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = None,
-                       backend: str = "auto"):
-    """The recursive dynamics of a URDF tree: generated C (recursive.RecursiveDynamics), or
-    numpy (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with backend
-    "auto", where no compiler works; None where they do not apply: not a bare tree, or a mass
-    matrix that is not positive definite (the symbolic path names the joints)."""
+                       backend: str = "auto", kernel: str = "auto"):
+    """The recursive dynamics of a URDF tree: compiled C (recursive.RecursiveDynamics, the
+    tree's own unrolled module, or compact_kernel.CompactDynamics, one module for every tree:
+    ``kernel`` "unrolled", "compact" or "auto" by the tree's size and whether a link's inertial
+    is set), or numpy (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with
+    backend "auto", where no compiler works; None where they do not apply: not a bare tree, or
+    a mass matrix that is not positive definite (the symbolic path names the joints).
+
+    ``parameters`` may set a link's inertial by ``<link>.<field>`` (model/tree.py
+    INERTIAL_FIELDS: mass, com_x, ..., ixx, ...), as if the URDF had been edited."""
     from ..compile.compiled import BackendUnavailable
     from ..compile.functions import tell_numpy_fallback
+    from ..model.urdf_payload import PREFIX as PAYLOAD_PREFIX
+    from .compact_kernel import COMPACT_ABOVE, CompactDynamics
+    from .inertials import split_inertials
     from .recursive import RecursiveDynamics, applicable_tree
     from .recursive_numpy import RecursiveNumpyDynamics
 
+    if kernel not in ("auto", "unrolled", "compact"):
+        raise InputError(f"unknown kernel {kernel!r} (auto, unrolled or compact)", field="kernel")
     if backend not in ("auto", "c", "numpy"):
         return None
     tree = applicable_tree(model)
+    parameters, inertials = split_inertials(tree, parameters)
     if tree is None:
         return None
+    if inertials:
+        tree = inertials
     dynamics = None
     if backend != "numpy":
+        # a link's inertial set here, or a payload: the compact kernel takes them at run time
+        if kernel == "compact" and tree.floating_base:
+            raise InputError("the compact kernel takes fixed-base trees only (a floating base "
+                             "runs in the unrolled module)", field="kernel")
+        compact = not tree.floating_base and (kernel == "compact" or (kernel == "auto" and (
+            inertials or len(tree.joints) > COMPACT_ABOVE
+            or any(link.name.startswith(PAYLOAD_PREFIX) for link in tree.links))))
         try:
-            dynamics = RecursiveDynamics(model, tree, parameters)
+            dynamics = (CompactDynamics if compact else RecursiveDynamics)(model, tree, parameters)
         except BackendUnavailable as exc:
             if backend == "c":
                 raise
@@ -336,16 +356,22 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
                                 "slower per call than compiled C")
     if dynamics is None:
         dynamics = RecursiveNumpyDynamics(model, tree, parameters)
-    # a floating base has no symbolic path to fall to: NaN rows where M is singular
-    return dynamics if tree.floating_base or dynamics.regular() else None
+    if tree.floating_base or dynamics.regular():
+        # a floating base has no symbolic path to fall to: NaN rows where M is singular
+        return dynamics
+    if inertials:  # the derived equations know no link parameters: say what is wrong here
+        raise InputError("with these link inertials the mass matrix is not positive definite "
+                         "(a joint that moves no mass)", field="parameters")
+    return None
 
 
 def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
                    parameters: Mapping[str, float] | None = None, backend: str = "auto",
-                   equations: Callable[[], EquationsOfMotion] | None = None):
+                   equations: Callable[[], EquationsOfMotion] | None = None,
+                   kernel: str = "auto"):
     """Recursive dynamics where they apply, else Dynamics over ``symbolic()`` (the numeric
     functions of the derived equations; ``equations()`` gives them for coriolis_matrix)."""
-    fast = recursive_dynamics(model, parameters, backend)
+    fast = recursive_dynamics(model, parameters, backend, kernel)
     return fast if fast is not None else Dynamics(symbolic(), equations)
 
 

@@ -78,6 +78,7 @@ class RecursiveDynamics(TreeDynamics):
     """
 
     backend = "recursive"
+    kernel = "unrolled"  # the straight-line module of this tree (compact_kernel.py: "compact")
 
     def __init__(self, model: Model, tree: KinematicTree,
                  parameters: Mapping[str, float] | None = None):

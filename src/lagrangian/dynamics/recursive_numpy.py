@@ -27,6 +27,7 @@ from ..errors import ModelError
 from ..kinds import JointKind
 from ..model.model import Model
 from ..model.tree import KinematicTree
+from .compact_kernel import describe, joints_of
 from .joint_models import joint_model
 from .joint_space import TreeDynamics, solve_positive
 
@@ -126,7 +127,10 @@ class RecursiveNumpyDynamics(TreeDynamics):
                                    + [self.parameters[a] for a in tree.actuators], dtype=float)
         # the ground accelerates up by g: every body feels gravity (Newton-Euler's trick)
         self._up = -self._g * np.array(tree.gravity_direction, dtype=float)
-        self._joints = [_Joint(j, tree) for j in tree.joints]
+        # the bodies as the compact C kernel reads them (compact_kernel.describe): one
+        # description; a floating base (a joint that kernel does not take) from the tree itself
+        joints = tree.joints if tree.floating_base else joints_of(describe(tree, self.parameters))
+        self._joints = [_Joint(j, tree) for j in joints]
 
     def __repr__(self) -> str:
         return f"RecursiveNumpyDynamics(coordinates={list(self.coordinates)})"

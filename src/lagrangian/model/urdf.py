@@ -40,10 +40,11 @@ from ..errors import ModelError, did_you_mean, require_extra
 from ..kinds import JointKind
 from .builder import ModelBuilder
 from .expressions import RESERVED
+from .lazy_bodies import LAZY_ABOVE, LazyBodies
 from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
-from .tree import KinematicTree, TreeFrame, TreeJoint
+from .tree import KinematicTree, TreeFrame, TreeJoint, TreeLink, link_inertias
 
 MOVABLE = ("revolute", "continuous", "prismatic")
 SUPPORTED = (*MOVABLE, "fixed")
@@ -351,9 +352,14 @@ class _Tree:
                              + (" (a lone floating body: not yet)" if floating_base or any(
                                  j.type == "floating" for j in order) else ""))
         position = self._positions(lock, names)
-        bodies = tuple(self._bodies(root, order, position))
         model = builder.build_model()
-        tree = self._tree(root, order, position, names, bodies, floating_base)
+        if len(names) > LAZY_ABOVE:  # a long chain: its symbolic bodies when first asked for
+            tree = self._tree(root, order, position, names, (), floating_base)
+            bodies = self._lazy_bodies(root, order, position, tree)
+            tree = replace(tree, rigid_bodies=bodies)
+        else:
+            bodies = tuple(self._bodies(root, order, position))
+            tree = self._tree(root, order, position, names, bodies, floating_base)
         return replace(model, rigid_bodies=bodies, kinematic_tree=tree,
                        source_names=tuple((name, joint) for joint, name in names.items()),
                        source_ratings=tuple((name, *self._ratings(joint))
@@ -439,21 +445,7 @@ class _Tree:
             inertial = link.inertial
             if _carries_nothing(inertial):
                 continue
-            field = f"link '{name}'.inertial"
-            mass = float(inertial.mass or 0.0)
-            tensor = np.asarray(inertial.inertia if inertial.inertia is not None
-                                else np.zeros((3, 3)), dtype=float)
-            if not math.isfinite(mass) or mass < 0:
-                raise self.error(f"the mass {mass} is negative or not finite", field)
-            if not np.all(np.isfinite(tensor)):
-                raise self.error("the inertia tensor has an entry that is not finite", field)
-            where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
-                               dtype=float)
-            turn = where[:3, :3]
-            tensor = turn @ tensor @ turn.T  # about the centre of mass, in link axes
-            if np.linalg.eigvalsh(0.5 * (tensor + tensor.T))[0] < -1e-12 * max(
-                    1.0, float(np.abs(tensor).max())):
-                raise self.error("the inertia tensor is not positive semidefinite", field)
+            mass, tensor, where = self._inertial(name)
             center = apply(frame.rotation, _vector(where[:3, 3]))
             position_ = tuple(o + c for o, c in zip(frame.origin, center, strict=True))
             if not moves[name]:
@@ -463,6 +455,43 @@ class _Tree:
                                     frame.angular_velocity, parents[name]))
         return bodies
 
+
+    def _inertial(self, name: str):
+        """A link's mass (kg), inertia tensor about its centre of mass in link axes (kg m^2)
+        and inertial origin (4 x 4), checked."""
+        inertial = self.links[name].inertial
+        field = f"link '{name}'.inertial"
+        mass = float(inertial.mass or 0.0)
+        tensor = np.asarray(inertial.inertia if inertial.inertia is not None
+                            else np.zeros((3, 3)), dtype=float)
+        if not math.isfinite(mass) or mass < 0:
+            raise self.error(f"the mass {mass} is negative or not finite", field)
+        if not np.all(np.isfinite(tensor)):
+            raise self.error("the inertia tensor has an entry that is not finite", field)
+        where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
+                           dtype=float)
+        turn = where[:3, :3]
+        tensor = turn @ tensor @ turn.T  # about the centre of mass, in link axes
+        if np.linalg.eigvalsh(0.5 * (tensor + tensor.T))[0] < -1e-12 * max(
+                1.0, float(np.abs(tensor).max())):
+            raise self.error("the inertia tensor is not positive semidefinite", field)
+        return mass, tensor, where
+
+    def _lazy_bodies(self, root: str, order, position, tree: KinematicTree) -> LazyBodies:
+        """The symbolic bodies of a large tree, built when first read (model/lazy_bodies.py),
+        every check of _bodies made now."""
+        for joint in order:
+            if joint.type in MOVABLE:
+                axis = np.asarray(joint.axis if joint.axis is not None else (1, 0, 0), float)
+                norm = float(np.linalg.norm(axis))
+                if not math.isfinite(norm) or norm == 0:
+                    raise self.error("the axis has zero length", f"joint '{joint.name}'.axis")
+        count = 0
+        for link in tree.links:
+            if not _carries_nothing(self.links[link.name].inertial):
+                self._inertial(link.name)
+                count += link.body >= 0
+        return LazyBodies(lambda: self._bodies(root, order, position), count)
 
     def _tree(self, root: str, order, position, names: dict[str, str], bodies,
               floating_base: bool = False) -> KinematicTree:
@@ -509,28 +538,20 @@ class _Tree:
                 else:
                     anchor[joint.child] = (body, rotation @ _axis_rotation(axis, theta),
                                            translation)
-        inertias = [[0.0, np.zeros(3), np.zeros((3, 3))] for _ in joints]
-        held = 0.0  # the mass welded to a fixed root
+        links = []
         for name, (body, turn, shift) in anchor.items():
             inertial = self.links[name].inertial
-            if _carries_nothing(inertial):
-                continue
-            mass = float(inertial.mass or 0.0)
-            if body < 0:
-                held += mass
-                continue
-            where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
-                               dtype=float)
-            tensor = np.asarray(inertial.inertia if inertial.inertia is not None
+            carries = not _carries_nothing(inertial)
+            where = np.asarray(inertial.origin if carries and inertial.origin is not None
+                               else np.eye(4), dtype=float)
+            tensor = np.asarray(inertial.inertia if carries and inertial.inertia is not None
                                 else np.zeros((3, 3)), dtype=float)
-            tensor = 0.5 * (tensor + tensor.T)
-            tensor = turn @ (_snapped(where[:3, :3]) @ tensor @ _snapped(where[:3, :3]).T) @ turn.T
-            center = shift + turn @ _snapped(where[:3, 3])
-            # about the body's origin: J_O = I_C + m (|c|^2 1 - c c^T), h = m c
-            inertias[body][0] += mass
-            inertias[body][1] += mass * center
-            inertias[body][2] += tensor + mass * (center @ center * np.eye(3)
-                                                  - np.outer(center, center))
+            links.append(TreeLink(name, body, turn, shift,
+                                  float(inertial.mass or 0.0) if carries else 0.0,
+                                  _snapped(where[:3, 3]), _snapped(where[:3, :3]),
+                                  0.5 * (tensor + tensor.T)))
+        inertias = link_inertias(links, len(joints))
+        held = sum(link.mass for link in links if link.body < 0)  # the mass welded to a fixed root
 
         def vector(a):
             return tuple(float(x) for x in a)
@@ -548,6 +569,9 @@ class _Tree:
             frames.append(dataclasses.replace(by_link[root], name="root_joint"))
         return KinematicTree(
             frames=tuple(frames),
+            links=tuple(TreeLink(k.name, k.body, matrix(k.rotation), vector(k.translation),
+                                 k.mass, vector(k.com), matrix(k.com_rotation),
+                                 matrix(k.inertia)) for k in links),
             joints=tuple(TreeJoint(
                 name=j["name"], parent=j["parent"], kind=j["kind"], rotation=matrix(j["rotation"]),
                 translation=vector(j["translation"]), axis=vector(j["axis"]),

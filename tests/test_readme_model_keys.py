@@ -76,6 +76,9 @@ ANSWER_MEANINGS = {
     "linearized": "`about = { theta = 0 }`, one equation per coordinate (per independent "
                   "coordinate of a constrained model; any factor; in q or in its deviation from "
                   "`about`)",
+    "statics": "`at = { theta = \"30deg\" }` and each load magnitude solved for (a parameter: "
+               "`F = \"7.48 N\"`), optionally reactions `lambda_<constraint>`: `statics "
+               "--solve-for`, item `statics.F`",
     "equilibria": "`theta = [\"0\", \"pi\"]` positions, any order (several coordinates: the i-th "
                   "entries make the i-th equilibrium)",
 }

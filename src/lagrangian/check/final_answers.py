@@ -1,5 +1,6 @@
 """Verdicts on the final answers of an answer file: M, C, K, natural frequencies and damping
-ratios, mode shapes, linearized equations, generalized forces at a configuration, equilibria.
+ratios, mode shapes, linearized equations, generalized forces at a configuration, equilibria,
+statics loads.
 
 Ours come from the project's analysis (linearize, modes, generalized_forces_at, equilibria),
 through the System's public methods. A decimal number the student wrote is accepted when our
@@ -33,11 +34,12 @@ from .final_reading import (
     agrees,
     read_final_answers,
 )
+from .final_statics import STATICS_CODES, check_statics
 
 FINAL_CODES = (
     "matrix_entry", "frequency_wrong", "frequency_count", "damping_ratio_wrong",
     "mode_shape_wrong", "linear_coefficient", "linear_offset", "not_linearized",
-    "generalized_force_value", "equilibrium_wrong", "equilibrium_missing",
+    "generalized_force_value", "equilibrium_wrong", "equilibrium_missing", *STATICS_CODES,
 )
 SHAPE_SLACK = 1e-6  # relative to the largest component: eigenvectors are computed numerically
 
@@ -50,6 +52,7 @@ class Analysis(Protocol):
     def modes(self, about=None, *, steady=None): ...
     def equilibria(self): ...
     def generalized_forces_at(self, configuration, parameters=None): ...
+    def statics(self, configuration, solve_for, parameters=None): ...
 
 
 def check_final_answers(system: Analysis, answer: Answer) -> list[Finding]:
@@ -90,6 +93,7 @@ class _FinalChecker:
         if final.forces or final.equilibria:
             statics = AtRest(self.system, final)
             findings += statics.forces() + statics.equilibria()
+        findings += check_statics(self.system, final, self.source)
         return findings
 
     def guarded(self, table: str, method) -> list[Finding]:

@@ -4,7 +4,10 @@ student writes), an equilibrium that moves with the parameters, and many coordin
 
 from __future__ import annotations
 
+import math
+
 import pytest
+import sympy as sp
 from check_helpers import check_text, finding, system
 
 from lagrangian import ModelError, SystemBuilder
@@ -142,3 +145,31 @@ def test_ten_mass_chain_linearized_about_its_sagged_equilibrium():
     line = finding(ten.check(parse_answer(wrong, ten.model, source="<t>")), "linearized.x4")
     assert line.code == "linear_coefficient" and "coefficient of x4 is k = 2 in yours, ours is 4" \
         in line.message
+
+
+# -- a pendulum pushed sideways: its equilibrium tan(theta0) = F/(m g) moves with F ----------
+
+def pushed():
+    b = SystemBuilder("pushed pendulum")
+    theta = b.coordinate("theta", unit="rad", initial=0.4)
+    m, L, g, F = (b.parameter(n, v, u) for n, v, u in (("m", 1.0, "kg"), ("L", 0.5, "m"),
+                                                        ("g", 9.81, "m/s^2"), ("F", 5.0, "N")))
+    b.set_gravity(g, (0, -1))
+    bob = (L * sp.sin(theta), -L * sp.cos(theta))
+    b.add_particle("bob", m, bob)
+    b.add_force("push", bob, (F, 0))
+    return b.build()
+
+
+def test_matrices_and_equation_about_an_equilibrium_that_moves_with_a_parameter():
+    # K = m g L cos(theta0) + F L sin(theta0) = L sqrt((m g)^2 + F^2), M = m L^2
+    system = pushed()
+    theta0 = math.atan2(5.0, 9.81)
+    text = (f'[linearized]\nabout = {{ theta = {theta0!r} }}\n'
+            'theta = "m*L^2*theta_ddot + L*sqrt((m*g)^2 + F^2)*(theta - atan(F/(m*g))) = 0"\n'
+            '[matrices]\nM = [["m*L^2"]]\nK = [["L*sqrt((m*g)^2 + F^2)"]]\n')
+    report = system.check(parse_answer(text, system.model, source="<t>"))
+    assert report.verdict == "correct", report
+    wrong = text.replace('K = [["L*sqrt', 'K = [["2*L*sqrt')
+    found = system.check(parse_answer(wrong, system.model, source="<t>"))
+    assert finding(found, "K").code == "matrix_entry"

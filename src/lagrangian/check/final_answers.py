@@ -24,7 +24,7 @@ from ..model.expressions import parse_expression
 from . import equivalence as eq
 from .diagnose import Finding
 from .final_at_rest import AtRest
-from .final_linear import check_linearized
+from .final_linear import check_linearized, exact_linear
 from .final_reading import (
     FREQUENCY_KINDS,
     SLACK,
@@ -139,14 +139,10 @@ class _FinalChecker:
         return self._equilibrium
 
     def symbolic(self):
-        """Exact M, C, K about the equilibrium (None where only numbers can be had)."""
+        """Exact M, C, K about the equilibrium (None where only numbers can be had: constraints,
+        many coordinates, an equilibrium that moves with the parameters)."""
         equilibrium = self.equilibrium()  # not an equilibrium: refused (ModelError)
-        if self.model.constraints:
-            return None
-        try:
-            return self.system.linearize(equilibrium, symbolic=True)
-        except ModelError:  # more coordinates than the symbolic linearization takes
-            return None
+        return exact_linear(self, equilibrium)
 
     # -- matrices --------------------------------------------------------------------------
 
@@ -161,8 +157,7 @@ class _FinalChecker:
                         for name, _ in self.final.matrices]
             ours = {"M": sp.Matrix(numeric.M), "C": sp.Matrix(numeric.C), "K": sp.Matrix(numeric.K)}
         else:
-            ours = {"M": linear.mass_matrix, "C": linear.damping_matrix,
-                    "K": linear.stiffness_matrix}
+            ours = {"M": linear.M, "C": linear.C, "K": linear.K}
         index = [self.names.index(n) for n in self.order]
         findings = []
         for name, rows in self.final.matrices:

@@ -57,7 +57,7 @@ def check_linearized(checker) -> list[Finding]:
                         "model has velocity constraints", None)
                 for name, _ in checker.final.linearized]
     chosen = _independent(checker, linear)
-    ours = _exact(checker, equilibrium) if len(chosen) == len(model.coordinates) else None
+    ours = exact_linear(checker, equilibrium) if len(chosen) == len(model.coordinates) else None
     ours = ours or _numeric(linear, chosen)
     return [_equation(checker, name, entry, ours) for name, entry in checker.final.linearized]
 
@@ -93,7 +93,7 @@ def _independent(checker, linear) -> tuple[str, ...]:
     return chosen
 
 
-def _exact(checker, equilibrium: dict[str, float]) -> Ours | None:
+def exact_linear(checker, equilibrium: dict[str, float]) -> Ours | None:
     """Exact M, C, K of an unconstrained model at an equilibrium that is one for every value of
     the parameters (0, pi: not m g / k written as a number); None otherwise."""
     model = checker.model
@@ -101,8 +101,8 @@ def _exact(checker, equilibrium: dict[str, float]) -> Ours | None:
         return None
     point = {c.symbol: sp.nsimplify(equilibrium[c.name], [sp.pi], tolerance=1e-12,
                                     rational=False) for c in model.coordinates}
-    if any(v.atoms(sp.Float) for v in point.values()):
-        return None
+    if any(v.atoms(sp.Float) or sp.count_ops(v) > 4 for v in point.values()):
+        return None  # not 0, pi/2, -3*pi/4, 1/2: a number the parameters may have made
     eom = checker.system.equations_of_motion()
     at_rest = {v: sp.S.Zero for v in model.q_dot}
     forcing = [as_expression(e) for e in eom.forcing]

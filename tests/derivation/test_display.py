@@ -60,6 +60,10 @@ def test_the_reports_show_dots():
     shows_dots(damped.crosscheck_steps())
     for reaction in lagrangian.load("cartesian_pendulum").crosscheck().reactions:
         shows_dots(reaction)
+    shows_dots(damped.modes())
+    shows_dots(damped.generalized_forces_at({"x": 0.1, "x_dot": 0.2}))
+    link = lagrangian.load("virtual_work_link")
+    shows_dots(link.statics({"theta": 0.5}, "F", {"m": 0.0}))
 
 
 def test_a_displayed_expression_is_the_plain_one(cart):

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from ..kinds import FindingStatus
 from .diagnose import CheckReport, Finding
 
 
@@ -75,7 +76,7 @@ def hinted(report: CheckReport) -> CheckReport:
 
 
 def _hinted(finding: Finding) -> Finding:
-    if finding.status == "correct":
+    if finding.status == FindingStatus.CORRECT:
         return replace(finding, expected=None)
     hint = hint_for(finding.code)
     return replace(finding, message=f"{hint.question} {hint.correction}", expected=None)

@@ -41,12 +41,22 @@ FLAG_OF_FIELD = {
     "fps": "--fps",
     "mode": "--mode",
     "lock": "--lock",
+    "floating_base": "--floating-base",
+    "q": "--q",
     "keep": "--keep",
     "speed": "--speed",
     "out": "--out",
     "csv": "--csv",
     "frame": "--frame",
     "reference": "--reference",
+    "controller": "--control",
+    "linear_model": "--control",
+    "inputs": "--inputs",
+    "Q": "--Q",
+    "R": "--R",
+    "Kp": "--kp",
+    "Kd": "--kd",
+    "q_des": "--about",
 }
 
 SET_HELP = "Override a parameter: NAME=VALUE; repeat, or join with commas (m=2,L=0.5)."
@@ -58,6 +68,9 @@ FPS_HELP = "Frames a second of the animation (1 to 120)."
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
 PAYLOAD_HELP = ("URDF: a point mass fixed to a link, LINK=MASS[@X,Y,Z] (kg; m in the link's "
                 "frame, default its origin); repeatable.")
+FLOATING_HELP = ("URDF: a free-flyer joint under the root link (a robot that walks or flies): q is "
+                 "the base's x,y,z and quaternion qx,qy,qz,qw, then the joints; v the base's "
+                 "twist vx..wz in its own axes, then the joint rates.")
 GRAVITY_HELP = ("Gravity as a vector in world axes, GX,GY,GZ in m/s^2 (default: the model's; "
                 "a URDF's is 0,0,-9.81).")
 
@@ -74,7 +87,8 @@ def in_flags(error: LagrangianError) -> LagrangianError:
 
 
 def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = (),
-                gravity: str | None = None, payload: Iterable[str] = ()) -> System:
+                gravity: str | None = None, payload: Iterable[str] = (),
+                floating_base: bool = False) -> System:
     """The system of a model file or built-in example, with --set overrides applied (and a
     URDF's joints frozen by --lock NAME=VALUE, its gravity turned by --gravity GX,GY,GZ; a
     later --set g=... rescales that vector's magnitude)."""
@@ -83,7 +97,9 @@ def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = 
     locked = {name: parse_quantity(text, None, f"--lock {name}")
               for name, text in assignments(lock, "--lock")}
     carried = payloads(payload)
-    system = load(model, lock=locked, payload=carried) if locked or carried else load(model)
+    freed = {"floating_base": True} if floating_base else {}
+    system = load(model, lock=locked, payload=carried, **freed) if locked or carried or freed \
+        else load(model)
     if gravity is not None:
         parts = [part.strip() for part in gravity.split(",")]
         if len(parts) != 3:

@@ -10,7 +10,15 @@ import typer
 
 from ..errors import DerivationError, DynamicsWarning, InputError
 from . import app
-from .common import GRAVITY_HELP, PAYLOAD_HELP, load_system, print_json, warn, warn_bare_angles
+from .common import (
+    FLOATING_HELP,
+    GRAVITY_HELP,
+    PAYLOAD_HELP,
+    load_system,
+    print_json,
+    warn,
+    warn_bare_angles,
+)
 
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
 
@@ -37,8 +45,10 @@ def dynamics(
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
     payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
+    floating_base: Annotated[bool, typer.Option("--floating-base", help=FLOATING_HELP)] = False,
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
     coriolis: Annotated[bool, typer.Option("--coriolis", help="Also print C(q, q_dot), the matrix of the Coriolis and centrifugal terms (M_dot - 2C skew).")] = False,  # noqa: E501
+    derivatives: Annotated[bool, typer.Option("--derivatives", help="With --a: d tau/dq and d tau/dq_dot; with --tau: d q_ddot/dq, d q_ddot/dq_dot and d q_ddot/d tau.")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Mass matrix, bias forces C q_dot + g, gravity, inverse or forward dynamics, energies."""
@@ -50,23 +60,28 @@ def dynamics(
     if a is not None and tau is not None:
         raise InputError("--a (inverse dynamics) and --tau (forward dynamics) ask for two "
                          "things; give one")
-    system = load_system(model, set_, lock, gravity, payload)
+    if derivatives and a is None and tau is None:
+        raise InputError("needs --a (inverse dynamics) or --tau (forward dynamics) to "
+                         "differentiate", field="--derivatives")
+    system = load_system(model, set_, lock, gravity, payload, floating_base)
     coordinates = system.model.coordinates
-    n = len(coordinates)
     start = resolve_state(system.model)  # the model's own initial state (the library's defaults)
-    qs = _vector(q, n, "--q", list(start.q))
+    names_q, names_v, base_q, base_v = base_layout(system)
+    qs = _vector(q, len(names_q), "--q", base_q + list(start.q))
     if q is not None:  # --q 30,0 means 30 rad for an angle
         from .. import state_units
 
         names = [c.name for c in coordinates]
-        texts = [part.strip() for part in q.split(",")]
+        texts = [part.strip() for part in q.split(",")][len(base_q):]
+        joints = qs[len(base_q):]
         warn_bare_angles("--q", zip(names, texts, strict=True), state_units(system.model),
-                         dict(zip(names, qs, strict=True)))
+                         dict(zip(names, joints, strict=True)))
         from .. import limit_warnings
 
-        for line in limit_warnings(system.model, dict(zip(names, qs, strict=True)), "--q"):
+        for line in limit_warnings(system.model, dict(zip(names, joints, strict=True)), "--q"):
             warn(line)
-    vs = _vector(v, n, "--v", list(start.q_dot))
+    n = len(names_v)
+    vs = _vector(v, n, "--v", base_v + list(start.q_dot))
     f = system.dynamics()
     with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings(record=True) as seen:
         # an overflow is refused below; a state without dynamics (M not positive definite)
@@ -77,9 +92,15 @@ def dynamics(
         if a is not None:
             values["a"] = _vector(a, n, "--a", [])
             values["inverse_dynamics"] = f.inverse_dynamics(qs, vs, values["a"])
+            if derivatives:
+                values["dtau_dq"], values["dtau_dv"] = (  # + 0.0: no -0 printed
+                    x + 0.0 for x in f.inverse_dynamics_derivatives(qs, vs, values["a"]))
         if tau is not None:
             values["tau"] = _vector(tau, n, "--tau", [])
             values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"])
+            if derivatives:
+                values["dqdd_dq"], values["dqdd_dv"], values["dqdd_dtau"] = (
+                    x + 0.0 for x in f.forward_dynamics_derivatives(qs, vs, values["tau"]))
         if coriolis:
             values["coriolis_matrix"] = f.coriolis_matrix(qs, vs)
         values["kinetic_energy"] = f.kinetic_energy(qs, vs)
@@ -98,8 +119,18 @@ def dynamics(
             raise DerivationError(f"the {key.replace('_', ' ')} is not finite at this state "
                                   "(a number beyond floating point, or a state outside the "
                                   "model's domain)")
-    names = [c.name for c in coordinates]
+    velocities = names_v if base_q else None
     if json_:
-        print_json(dynamics_document(names, values, system.joint_names))
+        print_json(dynamics_document(names_q, values, system.joint_names, velocities))
     else:
-        typer.echo(dynamics_text(names, values), nl=False)
+        typer.echo(dynamics_text(names_q, values, velocities), nl=False)
+
+
+def base_layout(system):
+    """The names of q and v, and a floating base's default numbers before the joints' (at the
+    world's origin, unturned, at rest): none for a fixed base."""
+    joints = [c.name for c in system.model.coordinates]
+    if not getattr(system.model.kinematic_tree, "floating_base", False):
+        return joints, joints, [], []
+    f = system.dynamics()
+    return list(f.coordinates), list(f.velocity_names), [0.0] * 6 + [1.0], [0.0] * 6

@@ -53,8 +53,8 @@ def report(
                     "sections": [{"section": s.key, "title": s.title, "status": s.status}
                                  for s in page.sections]})
         return
-    shown = sum(s.status == "shown" for s in page.sections)
+    shown = sum(s.shown for s in page.sections)
     lines = [f"Report of {page.model_name} written to {out} ({shown} of {len(page.sections)} "
              "sections shown)"]
-    lines += [f"  {s.title}: {s.status}" for s in page.sections if s.status != "shown"]
+    lines += [f"  {s.title}: {s.status}" for s in page.sections if not s.shown]
     typer.echo("\n".join(lines))

@@ -5,7 +5,10 @@ Each moving body hangs from its parent body (or the ground) by one revolute or p
     R = R_0 Rot(u, theta),  p = t_0           (revolute: child axes -> parent axes, origin in parent)
     R = R_0,                p = t_0 + R_0 u theta   (prismatic)
 
-with theta = k q[c] + offset (k = 1, offset = 0 except for a mimic joint). Fixed and locked
+with theta = k q[c] + offset (k = 1, offset = 0 except for a mimic joint). A floating base is a
+free-flyer joint at the root (joints[0], parent -1, kind free_flyer): the base link's body, moved
+by the configuration's first 7 numbers (position, quaternion x y z w) and the velocity's first 6
+(dynamics/free_flyer.py); the other joints' numbers follow, q[7 + c] and v[6 + c]. Fixed and locked
 joints are folded into R_0, t_0 of the next joint down, and the links they carry into the
 inertia of the moving body above them. A body's inertia is (m, h = m c, J_O): mass (kg), first
 moment about its frame's origin (kg m) and inertia tensor about that origin (kg m^2), in its
@@ -72,6 +75,25 @@ class KinematicTree:
     # Every link and joint frame, for placements and Jacobians (dynamics/frames.py); not part of
     # the tree's identity (the dynamics, and the compiled module's key, do not depend on them).
     frames: tuple[TreeFrame, ...] = field(default=(), compare=False, repr=False)
+    # The root link and the mass (kg) welded to it that a fixed base holds still (a legged
+    # robot's trunk), for the note that names floating_base; not part of the dynamics.
+    root_link: str = field(default="", compare=False, repr=False)
+    root_mass: float = field(default=0.0, compare=False, repr=False)
+
+    @property
+    def floating_base(self) -> bool:
+        """Whether the root body moves freely (a free-flyer joint first)."""
+        return bool(self.joints) and self.joints[0].kind == JointKind.FREE_FLYER
+
+    @property
+    def base_nq(self) -> int:
+        """Configuration numbers before the joints' own: 7 for a floating base, else 0."""
+        return 7 if self.floating_base else 0
+
+    @property
+    def base_nv(self) -> int:
+        """Velocity numbers before the joints' own: 6 for a floating base, else 0."""
+        return 6 if self.floating_base else 0
 
 
 __all__ = ["KinematicTree", "TreeFrame", "TreeJoint"]

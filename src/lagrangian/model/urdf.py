@@ -13,6 +13,13 @@ and its inertial (mass, tensor about the centre of mass in the inertial frame, t
 origin and rpy) becomes a rigid body whose inertia is turned into link axes, I = R I' R^T.
 Joint damping and friction (<dynamics>) are ignored, as Pinocchio does: M, C q_dot and g are
 the rigid-body terms a controller needs.
+
+The root link is bolted to the world unless ``floating_base``: then a free-flyer joint carries it
+(its kinematic tree's first joint, dynamics/free_flyer.py), as Pinocchio's
+``buildModelFromUrdf(path, JointModelFreeFlyer())``. A URDF ``floating`` joint from the root link
+is read the same way (its origin the free flyer's placement). A floating base lives in the tree
+only: the model's coordinates and rigid bodies are the joints', and deriving its equations is
+refused (derivation/lagrange.py).
 """
 
 from __future__ import annotations
@@ -47,10 +54,11 @@ _SNAP = 1e-14
 
 
 def read_urdf(path, lock: Mapping[str, float] | None = None,
-              payload: Mapping[str, object] | None = None) -> Model:
+              payload: Mapping[str, object] | None = None, floating_base: bool = False) -> Model:
     """Load a URDF file as a model; ``lock`` freezes joints at values (rad or m) by name,
-    ``payload`` adds point masses to links (urdf_payload.py)."""
-    return parse_urdf(read_text_file(path), source=str(path), lock=lock, payload=payload)
+    ``payload`` adds point masses to links (urdf_payload.py), ``floating_base`` frees the root."""
+    return parse_urdf(read_text_file(path), source=str(path), lock=lock, payload=payload,
+                      floating_base=floating_base)
 
 
 def example_urdf(name: str):
@@ -63,13 +71,14 @@ def example_urdf(name: str):
 
 def parse_urdf(text: str, *, source: str = "<urdf>",
                lock: Mapping[str, float] | None = None,
-               payload: Mapping[str, object] | None = None) -> Model:
+               payload: Mapping[str, object] | None = None,
+               floating_base: bool = False) -> Model:
     """The model of a URDF document (see the module docstring for what each element becomes);
     ``payload`` {link: mass or (mass, (x, y, z))} adds point masses (urdf_payload.py)."""
     from .urdf_payload import payload_values
 
     robot = _parse(text, source, payload_values(payload) if payload else None)
-    return _Tree(robot, source).model(dict(lock or {}))
+    return _Tree(robot, source).model(dict(lock or {}), bool(floating_base))
 
 
 def _parse(text: str, source: str, payloads=None):
@@ -225,10 +234,10 @@ class _Tree:
         children: dict[str, list] = {}
         for joint in self.joints:
             where = f"joint '{joint.name}'"
-            if joint.type not in SUPPORTED:
+            if joint.type not in SUPPORTED and joint.type != "floating":
                 raise self.error(
                     f"{joint.type} joints are not supported yet (use revolute, continuous, "
-                    "prismatic or fixed)" if joint.type in ("floating", "planar")
+                    "prismatic or fixed)" if joint.type == "planar"
                     else f"unknown joint type {joint.type!r} (use revolute, continuous, "
                     f"prismatic or fixed){did_you_mean(str(joint.type), SUPPORTED)}", where)
             for role, link in (("parent", joint.parent), ("child", joint.child)):
@@ -257,10 +266,32 @@ class _Tree:
             lost = next(j for j in self.joints if j.child not in reached)
             raise self.error("its links form a closed loop, unreachable from the root link "
                              f"'{roots[0]}' (URDF describes trees only)", f"joint '{lost.name}'")
+        self._check_floating(roots[0], children)
         return roots[0], children
 
-    def model(self, lock: dict[str, float]) -> Model:
+    def _check_floating(self, root: str, children: dict[str, list]) -> None:
+        """A floating joint frees the whole robot: the one movable joint of the root link, as
+        the free flyer at the tree's root (Pinocchio's layout puts it first)."""
+        for joint in self.joints:
+            if joint.type != "floating":
+                continue
+            where = f"joint '{joint.name}'"
+            if joint.parent != root:
+                raise self.error(f"a floating joint frees the robot's base: its parent must be "
+                                 f"the root link '{root}', not '{joint.parent}'", where)
+            others = [j.name for j in children[root] if j is not joint and j.type != "fixed"]
+            if others:
+                raise self.error(f"the root link '{root}' also moves joint '{others[0]}': a "
+                                 "floating joint must be the root link's only moving joint",
+                                 where)
+
+    def model(self, lock: dict[str, float], floating_base: bool = False) -> Model:
         root, children = self._check_tree()
+        if floating_base and any(j.type == "floating" for j in self.joints):
+            floating = next(j.name for j in self.joints if j.type == "floating")
+            raise ModelError(f"the URDF's joint '{floating}' already floats the base; "
+                             "floating_base would add a second free flyer above it",
+                             field="floating_base")
         order = []  # joints from the root down, depth first in document order
         stack = list(reversed(children.get(root, [])))
         while stack:
@@ -316,11 +347,13 @@ class _Tree:
             builder.add_generalized_force(name, tau, field=field)
         if not names:
             raise self.error("no joint left to move: a model needs at least one revolute, "
-                             "continuous or prismatic joint that is not locked")
+                             "continuous or prismatic joint that is not locked"
+                             + (" (a lone floating body: not yet)" if floating_base or any(
+                                 j.type == "floating" for j in order) else ""))
         position = self._positions(lock, names)
         bodies = tuple(self._bodies(root, order, position))
         model = builder.build_model()
-        tree = self._tree(root, order, position, names, bodies)
+        tree = self._tree(root, order, position, names, bodies, floating_base)
         return replace(model, rigid_bodies=bodies, kinematic_tree=tree,
                        source_names=tuple((name, joint) for joint, name in names.items()),
                        source_ratings=tuple((name, *self._ratings(joint))
@@ -431,17 +464,29 @@ class _Tree:
         return bodies
 
 
-    def _tree(self, root: str, order, position, names: dict[str, str], bodies) -> KinematicTree:
+    def _tree(self, root: str, order, position, names: dict[str, str], bodies,
+              floating_base: bool = False) -> KinematicTree:
         """The same robot as numbers for the recursive algorithms (model/tree.py)."""
         index = {joint: i for i, joint in enumerate(names)}
         coordinate = {symbol: index[joint] for joint, symbol in names.items()}
         anchor = {root: (-1, np.eye(3), np.zeros(3))}  # link -> (moving body, R, t in it)
         joints: list[dict] = []
+        free = dict(parent=-1, kind=JointKind.FREE_FLYER, axis=np.zeros(3), coordinate=-1,
+                    multiplier=1.0, offset=0.0)  # the free flyer: its numbers come first
+        if floating_base:  # Pinocchio's name for the root joint it adds
+            joints.append(dict(free, name="root_joint", rotation=np.eye(3),
+                               translation=np.zeros(3)))
+            anchor[root] = (0, np.eye(3), np.zeros(3))
         for joint in order:
             body, turn, shift = anchor[joint.parent]
             origin = np.eye(4) if joint.origin is None else np.asarray(joint.origin, float)
             rotation = _snapped(turn @ _snapped(origin[:3, :3]))
             translation = shift + turn @ _snapped(origin[:3, 3])
+            if joint.type == "floating":  # the root link's only moving joint (_check_floating)
+                joints.append(dict(free, name=joint.name, rotation=rotation,
+                                   translation=translation))
+                anchor[joint.child] = (len(joints) - 1, np.eye(3), np.zeros(3))
+                continue
             if joint.type not in MOVABLE:
                 anchor[joint.child] = (body, rotation, translation)
                 continue
@@ -465,11 +510,15 @@ class _Tree:
                     anchor[joint.child] = (body, rotation @ _axis_rotation(axis, theta),
                                            translation)
         inertias = [[0.0, np.zeros(3), np.zeros((3, 3))] for _ in joints]
+        held = 0.0  # the mass welded to a fixed root
         for name, (body, turn, shift) in anchor.items():
             inertial = self.links[name].inertial
-            if body < 0 or _carries_nothing(inertial):
+            if _carries_nothing(inertial):
                 continue
             mass = float(inertial.mass or 0.0)
+            if body < 0:
+                held += mass
+                continue
             where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
                                dtype=float)
             tensor = np.asarray(inertial.inertia if inertial.inertia is not None
@@ -495,6 +544,8 @@ class _Tree:
         by_link = {f.name: f for f in frames}
         frames += [dataclasses.replace(by_link[joint.child], name=joint.name)
                    for joint in order if joint.name not in by_link and joint.child in by_link]
+        if floating_base and "root_joint" not in by_link:
+            frames.append(dataclasses.replace(by_link[root], name="root_joint"))
         return KinematicTree(
             frames=tuple(frames),
             joints=tuple(TreeJoint(
@@ -506,7 +557,7 @@ class _Tree:
             coordinates=tuple(names.values()), gravity_parameter="g",
             gravity_direction=(0.0, 0.0, -1.0),
             actuators=tuple(f"tau_{name}" for name in names.values()),
-            rigid_bodies=tuple(bodies))
+            rigid_bodies=tuple(bodies), root_link=root, root_mass=held)
 
 
 def _carries_nothing(inertial) -> bool:

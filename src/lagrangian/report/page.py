@@ -31,6 +31,8 @@ DEFAULT_T_END = 10.0  # s: the simulation's length when none is given
 _LONG_SOURCE = 20_000  # characters of model file shown before it is folded away
 TYPESET_LIMIT = 2500  # nodes of the expressions in one formula (the largest example but one: 133)
 
+SHOWN = "shown"  # the status of a section on the page; any other is why it is left out
+
 
 @dataclass(frozen=True)
 class Section:
@@ -40,6 +42,11 @@ class Section:
     key: str
     title: str
     status: str
+
+    @property
+    def shown(self) -> bool:
+        """The section is on the page (its status is "shown", not a reason it is left out)."""
+        return self.status == SHOWN
 
 
 @dataclass(frozen=True)
@@ -63,7 +70,7 @@ class Report:
                 'style="width: 100%; height: 48rem; border: 1px solid #ccc"></iframe>')
 
     def __repr__(self) -> str:
-        shown = sum(s.status == "shown" for s in self.sections)
+        shown = sum(s.shown for s in self.sections)
         return f"Report({self.model_name!r}, {shown} of {len(self.sections)} sections shown)"
 
 
@@ -229,7 +236,7 @@ def _model_section(c: _Page) -> tuple[Markup, str]:
         summary = element("summary", f"{where} ({len(text.splitlines())} lines)")
         parts.append(element("details", summary, element("pre", element("code", text)),
                              open=None if folded else "open"))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def _value(value) -> str:
@@ -259,7 +266,7 @@ def _energy_section(c: _Page) -> tuple[Markup, str]:
             "Dissipation function (W)", c.letter("D"), c.write(c.readable(D)))))
     parts.append(c.typeset("Lagrangian L = T - V", [T, V], lambda: c.formula(
         "Lagrangian (J)", c.letter("L"), c.write(c.readable(T) - c.readable(V)))))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def _forces_section(c: _Page) -> tuple[Markup, str]:
@@ -284,7 +291,7 @@ def _forces_section(c: _Page) -> tuple[Markup, str]:
         name = _force_name(c, co.symbol)
         parts.append(c.typeset(f"Q of {co.name}", [q], lambda q=q, name=name:
                                c.formula(None, name, c.write(c.readable(q)))))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def _force_name(c: _Page, coordinate: sp.Symbol) -> str:
@@ -341,7 +348,7 @@ def _equations_section(c: _Page) -> tuple[Markup, str]:
         parts.append(c.typeset("The constraint Jacobian", [A], lambda: c.formula(
             None, "<msub>" + mi("\u03a6") + mi("q") + "</msub>", mo("="),
             c.write(sp.Matrix(A.rows, A.cols, [c.readable(x) for x in A])))))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def _convention() -> str:

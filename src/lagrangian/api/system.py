@@ -513,15 +513,17 @@ class System(ControlMethods):
 
     # -- the report page ---------------------------------------------------------------------
 
-    def report(self, answer=None, *, t_end: float | None = None, progress=None):
+    def report(self, answer=None, *, t_end: float | None = None, progress=None, size=None,
+               fps=None):
         """One self-contained HTML page (report/page.py): the model and its drawing, T, V, L,
         the generalized forces per load, the equations, equilibria, modes (each drawn moving), a
         simulation of ``t_end`` s (default 10), the units check and, given ``answer`` (as in
-        ``check``), the check's findings. Returns a Report: ``.html``, ``.save(path)``; it shows
-        itself in Jupyter."""
+        ``check``), the check's findings; ``size`` ("WxH" pixels) and ``fps`` of its animations.
+        Returns a Report: ``.html``, ``.save(path)``; it shows itself in Jupyter."""
         from ..report.page import build_report
 
-        return build_report(self, answer=answer, t_end=t_end, progress=progress)
+        return build_report(self, answer=answer, t_end=t_end, progress=progress, size=size,
+                            fps=fps)
 
     def to_latex(self, standalone: bool = False) -> str:
         """The derivation as LaTeX (amsmath), as ``derive --format latex``: M q_ddot

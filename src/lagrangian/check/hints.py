@@ -51,6 +51,11 @@ HINTS: dict[str, Hint] = {
     "equation_equivalent": Hint("An equivalent form", "Is mine ours multiplied through or "
                                 "combined with another equation?",
                                 "Equivalent equations give the same motion; yours is fine."),
+    "statics_load": _FORCE,
+    "statics_potential": _SIGN,
+    "statics_value": Hint("A load that holds it", "Is δW = 0 for every admissible δq, with "
+                          "every load's, weight's and spring's virtual work?",
+                          "Ideal reactions do no virtual work; sum the rest and solve."),
     "units_mismatch": Hint("Units", "Does every term have the same units (T and V in J, Q in J "
                            "per unit of its coordinate)?", "Check each term's units."),
 }

@@ -21,9 +21,19 @@ from ..kinds import LoadStepKind
 from ..model.model import Damper, Model, PointForce, Torque
 from ..model.notation import latex_printer
 from ..model.rotations import Moment
+from .display import model_scalar
 from .equations import EquationsOfMotion
 from .kinematics import Differentiator
 from .virtual_work import DISSIPATION_LOAD
+
+
+def _dotted(step) -> None:
+    """Every expression of a step shown with its rates dotted in Jupyter (equal to itself)."""
+    for name, value in vars(step).items():
+        if isinstance(value, sp.Basic):
+            object.__setattr__(step, name, model_scalar(value))
+        elif isinstance(value, tuple) and all(isinstance(v, sp.Basic) for v in value):
+            object.__setattr__(step, name, tuple(model_scalar(v) for v in value))
 
 
 @dataclass(frozen=True)
@@ -37,6 +47,9 @@ class CoordinateStep:
     generalized_force: sp.Expr   # Q_i (N or N m)
     multiplier_terms: sp.Expr    # (Phi_q^T lambda)_i
     equation: sp.Expr            # momentum_rate - force_gradient - Q_i + multiplier terms (= 0)
+
+    def __post_init__(self):
+        _dotted(self)
 
 
 @dataclass(frozen=True)
@@ -52,6 +65,9 @@ class LoadStep:
     virtual_work: sp.Expr                # sum_i Q_i delta q_i
     shares: tuple[tuple[str, sp.Expr], ...]
 
+    def __post_init__(self):
+        _dotted(self)
+
 
 @dataclass(frozen=True)
 class ConstraintStep:
@@ -62,6 +78,9 @@ class ConstraintStep:
     expression: sp.Expr
     jacobian: tuple[sp.Expr, ...]
     multiplier: sp.Symbol
+
+    def __post_init__(self):
+        _dotted(self)
 
 
 @dataclass(frozen=True)
@@ -76,6 +95,9 @@ class DerivationSteps:
     coordinates: tuple[CoordinateStep, ...]
     loads: tuple[LoadStep, ...]
     constraints: tuple[ConstraintStep, ...]
+
+    def __post_init__(self):
+        _dotted(self)
 
     def coordinate(self, name: str) -> CoordinateStep:
         for step in self.coordinates:

@@ -17,14 +17,18 @@ from ..model.expressions import format_expression, tree_size
 from ..model.notation import latex_symbol_names
 
 SMALL = 400  # nodes: a step this small has its common factors taken out before it is grouped
+# nodes: a larger step (the Whipple bicycle's run to 48000; every other example's below 300) is
+# no working to follow by hand: text and LaTeX give its size instead, unless full (--steps-full)
+STEP_NODES = 1000
 
 
 class _Form:
     """The readable form of a step (derivation/readable.py: equal, grouped by products of the
     rates and of the delta q)."""
 
-    def __init__(self, steps: DerivationSteps):
+    def __init__(self, steps: DerivationSteps, full: bool = True):
         model = steps.model
+        self.full, self.summarized = full, 0
         self.rates = frozenset([*model.q_dot, *model.q_ddot, *steps.variations,
                                 *(c.multiplier for c in steps.constraints)])
         self.ranges = {c.symbol: tuple(c.range) for c in model.coordinates if c.range}
@@ -36,7 +40,18 @@ class _Form:
             expr = sp.factor_terms(expr)
         return readable(expr, self.rates, self.ranges)
 
+    def size(self, expr) -> str | None:
+        """'412 terms, 38760 nodes' for a step too large to print (counted), else None."""
+        expr = sp.sympify(expr)  # safe: a sympy object or a number
+        if self.full or tree_size(expr, STEP_NODES) <= STEP_NODES:
+            return None
+        self.summarized += 1
+        return f"{len(sp.Add.make_args(expr))} terms, {tree_size(expr)} nodes"
+
     def text(self, expr) -> str:
+        size = self.size(expr)
+        if size is not None:
+            return f"<{size}: derive --steps-full prints it>"
         return format_expression(self(expr))
 
 
@@ -54,9 +69,10 @@ def _force_name(model) -> str:
 # -- text ---------------------------------------------------------------------------------------
 
 
-def steps_text(steps: DerivationSteps) -> str:
-    """The working as text: L, each coordinate's derivatives, each load's virtual work."""
-    model, form = steps.model, _Form(steps)
+def steps_text(steps: DerivationSteps, *, full: bool = False) -> str:
+    """The working as text: L, each coordinate's derivatives, each load's virtual work; a step
+    over STEP_NODES nodes as its size, unless ``full``."""
+    model, form = steps.model, _Form(steps, full)
     lag, force = _lagrangian_name(model), _force_name(model)
     label = {"L": "L = T - V", "(T - V)": "T - V"}.get(lag, "Lagrangian T - V")
     lines = ["Steps (Lagrange's method, each derived from L = T - V):",
@@ -87,6 +103,9 @@ def steps_text(steps: DerivationSteps) -> str:
             lines.append(f"    {k.constraint} ({k.kind}): {written} = "
                          f"{form.text(k.expression)} = 0")
             lines.append(f"      Phi_q row = [{row}]   multiplier {k.multiplier}")
+    if form.summarized:
+        lines.insert(1, f"  ({form.summarized} steps over {STEP_NODES} nodes are given by their "
+                        "size; derive --steps-full prints every step)")
     return "\n".join(lines) + "\n"
 
 
@@ -189,9 +208,10 @@ def steps_document(steps: DerivationSteps) -> dict[str, Any]:
 # -- LaTeX --------------------------------------------------------------------------------------
 
 
-def steps_latex(steps: DerivationSteps) -> str:
-    """The working as an amsmath align block, to follow `derive --format latex`."""
-    model, form = steps.model, _Form(steps)
+def steps_latex(steps: DerivationSteps, *, full: bool = False) -> str:
+    """The working as an amsmath align block, to follow `derive --format latex`; a step over
+    STEP_NODES nodes as its size, unless ``full``."""
+    model, form = steps.model, _Form(steps, full)
     symbol_names = latex_symbol_names(model)
     symbol_names.update({v: rf"\delta {sp.latex(c.symbol)}"
                          for c, v in zip(model.coordinates, steps.variations, strict=True)})
@@ -203,6 +223,10 @@ def steps_latex(steps: DerivationSteps) -> str:
     L = r"\mathcal{L}" if "L" in names else "L"
     Q = r"\mathcal{Q}" if "Q" in names else "Q"
     def tex(expr) -> str:
+        entries = list(expr) if isinstance(expr, sp.MatrixBase) else [expr]
+        sizes = [size for size in map(form.size, entries) if size is not None]
+        if sizes:
+            return rf"\text{{({'; '.join(sizes)}: derive --steps-full prints it)}}"
         if isinstance(expr, sp.MatrixBase):
             return printer(sp.ImmutableMatrix(expr.rows, expr.cols, [form(e) for e in expr]))
         return printer(form(expr))

@@ -89,8 +89,9 @@ class _Page:
     """What the sections share: the system (duck-typed: api.System), its math writer and the
     equations, derived once."""
 
-    def __init__(self, system):
+    def __init__(self, system, size: tuple[int, int] | None = None, fps: float | None = None):
         self.system = system
+        self.size, self.fps = size, fps  # of the animations (None: the page's defaults)
         self.model = system.model
         self.write = MathWriter(self.model)
         self.urdf = self.model.kinematic_tree is not None
@@ -134,17 +135,21 @@ class _Page:
 
 
 def build_report(system, *, answer=None, t_end: float | None = None,
-                 progress: Callable[[str], None] | None = None) -> Report:
+                 progress: Callable[[str], None] | None = None, size: object = None,
+                 fps: object = None) -> Report:
     """The report of ``system`` (an api.System): ``answer`` (a path, dict or Answer) adds the
-    check of a hand derivation; ``t_end`` (s) sets the simulation's length (default 10 s).
-    An unreadable answer is refused before any work."""
+    check of a hand derivation; ``t_end`` (s) sets the simulation's length (default 10 s);
+    ``size`` ("WxH" or (width, height) pixels) and ``fps`` set every animation's frames, as
+    for ``modes --animate``. An unreadable answer or a bad size is refused before any work."""
+    from ..output.media import check_fps, check_size
     from . import sections as numeric
 
+    size, fps = check_size(size), None if fps is None else check_fps(fps)
     if t_end is not None and not (np.isfinite(float(t_end)) and float(t_end) > 0):
         raise ModelError(f"the simulation's length must be a positive number of seconds, got "
                          f"{t_end!r}", field="t_end")
     checked = system.check(answer) if answer is not None else None
-    context = _Page(system)
+    context = _Page(system, size, fps)
     builders = [
         ("model", "Model", _model_section),
         ("energy", "Energies and the Lagrangian", _energy_section),

@@ -96,8 +96,8 @@ def _mode_animations(c, analysis) -> Markup:
                                                   "oscillate, so there is no motion to show.")))
             continue
         try:
-            gif = mode_gif(c.model, analysis, mode, i) if drawable else \
-                coordinate_mode_gif(analysis, mode, i, _units(c))
+            gif = mode_gif(c.model, analysis, mode, i, size=c.size, fps=c.fps) if drawable \
+                else coordinate_mode_gif(analysis, mode, i, _units(c), size=c.size, fps=c.fps)
         except LagrangianError as exc:
             figures.append(note(f"Mode {i}: no animation ({exc})."))
             continue
@@ -129,7 +129,7 @@ def simulation_section(c, t_end: float) -> tuple[Markup, str]:
     parts.append(element("figure", image(data_uri(figure_png(figure), "image/png"),
                                          "the coordinates and the energy over time")))
     if c.model.particles or c.model.bodies or c.model.rigid_bodies:
-        gif = simulation_gif(simulation)
+        gif = simulation_gif(simulation, size=c.size, fps=c.fps)
         parts.append(element("figure", image(data_uri(gif, "image/gif"), "the simulated motion",
                                              class_="animation"),
                              element("figcaption", "The simulated motion, looping.")))

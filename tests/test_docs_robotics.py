@@ -39,7 +39,8 @@ def wall_gravity(q1, q2, g=9.81):
 
 
 def test_the_command_lines(cli):
-    gravity, equilibria, as_json, show, beyond, stops, through, payload = commands("robotics-cli")
+    (gravity, equilibria, as_json, show, beyond, stops, through, payload,
+     inertial) = commands("robotics-cli")
     result = cli(*gravity)
     assert result.code == 0, result.err
     for value in wall_gravity(0.3, 0.5):
@@ -63,6 +64,8 @@ def test_the_command_lines(cli):
         assert record["quantity"] == "velocity" and record["value"] > record["limit"] == 5.0
     M = np.array(json.loads(cli(*payload, "--json").out)["mass_matrix"])
     assert M[1, 1] == pytest.approx(0.34 + 2.0 * 0.5**2, rel=1e-12)  # M22 + m r^2
+    M = np.array(json.loads(cli(*inertial, "--json").out)["mass_matrix"])
+    assert M[1, 1] == pytest.approx(0.1 + 3.5 * 0.4**2, rel=1e-12)  # I_C + m r^2, m = 3.5 kg
 
 
 def test_the_python():
@@ -78,6 +81,7 @@ def test_the_python():
     a = scope["a"]
     assert np.isnan(a[17]).all() and np.isfinite(np.delete(a, 17, axis=0)).all()
     assert scope["bad"].count == 1 and scope["bad"].total == 10_000
+    assert scope["M_heavy"][1, 1] == pytest.approx(0.1 + 3.5 * 0.4**2, rel=1e-12)
 
 
 @pytest.mark.skipif(shutil.which("g++") is None or shutil.which("gcc") is None,

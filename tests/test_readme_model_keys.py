@@ -73,8 +73,12 @@ ANSWER_MEANINGS = {
                    "order; `zeta = [...]` damping ratios in ascending frequency",
     "mode_shapes": "`shapes = [[1, 1], [1, -1]]`, one per mode in ascending frequency, any scale "
                    "and sign",
-    "linearized": "`about = { theta = 0 }`, one equation per coordinate (any factor; in q or in "
-                  "its deviation from `about`)",
+    "linearized": "`about = { theta = 0 }`, one equation per coordinate (per independent "
+                  "coordinate of a constrained model; any factor; in q or in its deviation from "
+                  "`about`)",
+    "statics": "`at = { theta = \"30deg\" }` and each load magnitude solved for (a parameter: "
+               "`F = \"7.48 N\"`), optionally reactions `lambda_<constraint>`: `statics "
+               "--solve-for`, item `statics.F`",
     "equilibria": "`theta = [\"0\", \"pi\"]` positions, any order (several coordinates: the i-th "
                   "entries make the i-th equilibrium)",
 }

@@ -70,6 +70,7 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
         parse_model,
         read_model,
     )
+    from .control import computed_torque, lqr
     from .errors import DynamicsWarning, ModelWarning
 
 __version__ = "0.1.0"
@@ -148,11 +149,14 @@ __all__ = [
     "example_summary",
     "example_text",
     "parse_quantity",
+    "parse_steady_rates",
     "parse_stop_condition",
     "physical_warnings",
     "resolve_state",
     "speed_sweep",
     "state_units",
+    "lqr",
+    "computed_torque",
     "cos",
     "exp",
     "sin",
@@ -178,6 +182,7 @@ _HOMES = {
     "SIMULATION_METHODS": ("simulation.options", "METHODS"),
     "parse_stop_condition": ("simulation.events", "parse_stop_condition"),
     "speed_sweep": ("analysis.speed_form", "speed_sweep"),
+    "parse_steady_rates": ("analysis.steady", "parse_steady_rates"),
     "MAX_STUDY_POINTS": ("analysis.study", "MAX_STUDY_POINTS"),
     "bare_angle_warnings": ("check.warnings", "bare_angle_warnings"),
     "limit_warnings": ("check.warnings", "limit_warnings"),
@@ -186,6 +191,8 @@ _HOMES = {
     "course_folder": ("check.course", "course_folder"),
     "course_lessons": ("check.course", "course_lessons"),
     "check_report_path": ("report.page", "check_report_path"),
+    "lqr": ("control.lqr", "lqr"),
+    "computed_torque": ("control.computed_torque", "computed_torque"),
 }
 
 

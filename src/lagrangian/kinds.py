@@ -9,13 +9,17 @@ from enum import StrEnum
 
 class JointKind(StrEnum):
     """How a joint moves its body, in model files and URDF alike: about its axis (revolute),
-    along it (prismatic), by a rotation sequence (spherical) or not at all (fixed). A kinematic
-    tree moves its bodies by the one-degree-of-freedom kinds (dynamics/joint_models.py)."""
+    along it (prismatic), by a rotation sequence (spherical), not at all (fixed) or freely in
+    space (free_flyer: a URDF robot's floating base). A kinematic tree moves its bodies by the
+    one-degree-of-freedom kinds and the free flyer at its root (dynamics/joint_models.py)."""
 
     REVOLUTE = "revolute"
     PRISMATIC = "prismatic"
     SPHERICAL = "spherical"
     FIXED = "fixed"
+    # a URDF robot's floating base (dynamics/free_flyer.py): six degrees of freedom, in a tree
+    # only (a model file's body moves by its coordinates)
+    FREE_FLYER = "free_flyer"
 
 
 class ConstraintKind(StrEnum):
@@ -23,6 +27,62 @@ class ConstraintKind(StrEnum):
 
     HOLONOMIC = "holonomic"
     VELOCITY = "velocity"
+
+
+class LoadStepKind(StrEnum):
+    """What a step of derive --steps finds the virtual work of: a point force, a torque, a moment
+    on a body in space, a damper, the dissipation function D, or generalized forces given."""
+
+    FORCE = "force"
+    TORQUE = "torque"
+    MOMENT = "moment"
+    DAMPER = "damper"
+    DISSIPATION = "dissipation"
+    GIVEN = "given"
+
+
+class FindingStatus(StrEnum):
+    """The verdict on one item of a checked answer: as ours, equal to ours in another form,
+    wrong, or a note that judges nothing."""
+
+    CORRECT = "correct"
+    EQUIVALENT = "equivalent"
+    WRONG = "wrong"
+    NOTE = "note"
+
+
+class DistributionKind(StrEnum):
+    """How an ensemble draws a parameter: normal(mean, standard deviation) or uniform(low, high)."""
+
+    NORMAL = "normal"
+    UNIFORM = "uniform"
+
+
+class FreeBodyKind(StrEnum):
+    """What a free body of the Newton-Euler check is: a particle (m a = F), a planar body (and
+    I alpha = M), or a body in space (Euler's equations)."""
+
+    PARTICLE = "particle"
+    BODY = "body"
+    BODY_IN_SPACE = "body in space"
+
+
+class ModeKind(StrEnum):
+    """How a mode moves: oscillating, overdamped (real eigenvalues, zeta >= 1), rigid-body (zero
+    frequency, neutral) or divergent (grows without oscillating)."""
+
+    OSCILLATING = "oscillating"
+    OVERDAMPED = "overdamped"
+    RIGID_BODY = "rigid-body"
+    DIVERGENT = "divergent"
+
+
+class CrossingKind(StrEnum):
+    """Which eigenvalues cross Re = 0 as the speed changes: a complex pair (a bicycle's weave) or
+    a real one (its capsize)."""
+
+    OSCILLATORY = "oscillatory"
+    REAL = "real"
 
 
 class InvariantKind(StrEnum):
@@ -51,4 +111,5 @@ class Backend(StrEnum):
     NUMPY = "numpy"
 
 
-__all__ = ["Backend", "ConstraintKind", "InvariantKind", "JointKind", "RunStatus"]
+__all__ = ["Backend", "ConstraintKind", "CrossingKind", "DistributionKind", "FindingStatus",
+           "FreeBodyKind", "InvariantKind", "JointKind", "LoadStepKind", "ModeKind", "RunStatus"]

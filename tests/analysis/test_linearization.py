@@ -199,3 +199,17 @@ def test_double_pendulum_state_matrix_agrees_with_sympy_mechanics():
     expected = np.array(A.subs(values), dtype=float)
     ours = lagrangian.load("double_pendulum").linearize(about={"theta1": 0, "theta2": 0})
     np.testing.assert_allclose(ours.A, expected, atol=1e-12)
+
+
+def test_both_linear_models_split_C_the_same_way():
+    """The Lorentz force q v x B does no work: its C is all gyroscopic, exactly (symbolic) and in
+    numbers, and neither model has a dissipative part."""
+    system = lagrangian.load("charged_particle")
+    exact = system.linearize(about={"x": 0, "y": 0}, symbolic=True)
+    q, B = sp.symbols("q B")
+    assert exact.gyroscopic_matrix == exact.C == sp.Matrix([[0, -B * q], [B * q, 0]])
+    assert exact.dissipation_matrix == sp.zeros(2, 2)
+    assert exact.M == exact.mass_matrix and exact.K == exact.stiffness_matrix
+    numeric = system.linearize(about={"x": 0, "y": 0})
+    np.testing.assert_allclose(numeric.dissipation_matrix, 0, atol=1e-12)
+    np.testing.assert_allclose(numeric.gyroscopic_matrix, numeric.C)

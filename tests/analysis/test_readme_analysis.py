@@ -30,3 +30,20 @@ def test_readme_python_examples_run(capsys):
     assert "[1.         1.73205081]" in printed
     assert "20.4375 0.8333333333333334" in printed
     assert "Matrix([[0, 0], [0, -g*l*m]])" in printed
+
+
+def test_steady_rates_are_read_as_the_command_line_writes_them(capsys):
+    """600 rpm is 20 pi rad/s; an expression in the parameters is kept for the analysis; a
+    quantity in the wrong units names the field."""
+    import lagrangian
+
+    code = re.search(r"```python\n(import lagrangian\n\ncoin = .*?)```", section(), re.S)
+    assert code
+    exec(compile(code.group(1), "analysis", "exec"), {})  # noqa: S102 (our own documentation)
+    assert "{'spin_dot': 62.83185307179586, 'x_dot': 'sqrt(g*r/3)'}" in capsys.readouterr().out
+    coin = lagrangian.load("rolling_coin").model
+    rates = lagrangian.parse_steady_rates(coin, {"spin_dot": "600rpm"})
+    assert rates["spin_dot"] == pytest.approx(20 * 3.141592653589793, rel=1e-15)
+    with pytest.raises(lagrangian.InputError, match="not in units compatible") as error:
+        lagrangian.parse_steady_rates(coin, {"spin_dot": "3 N"})
+    assert error.value.field == "steady.spin_dot"

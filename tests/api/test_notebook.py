@@ -83,3 +83,10 @@ def test_modes_show_the_table_as_math_and_the_shapes_as_a_figure(executed):
     _png(data)
     assert r"\omega" in data["text/latex"] and "4.429" in data["text/latex"]  # sqrt(g/L)
     assert "data:image/png;base64," in data["text/html"]
+
+
+def test_one_equation_and_the_lagrangian_show_their_rates_dotted(executed):
+    equation = _result(executed[5])["text/latex"]
+    assert r"\ddot{\theta}" in equation and "_{dot}" not in equation and "_{ddot}" not in equation
+    lagrangian_ = _result(executed[6])["text/latex"]
+    assert r"\dot{\theta}^{2}" in lagrangian_ and "_{dot}" not in lagrangian_

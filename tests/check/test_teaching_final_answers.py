@@ -43,7 +43,7 @@ def test_commands_print_what_the_page_shows(tmp_path, monkeypatch, capsys):
             assert exit_info.value.code == (0 if "verdict: correct" in shown else 1)
             assert capsys.readouterr().out == shown, command
             checked += 1
-    assert checked == 3
+    assert checked == 5
 
 
 def test_python_example_runs(capsys):

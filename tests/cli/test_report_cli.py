@@ -81,3 +81,41 @@ def test_a_urdf_robot_with_a_locked_joint(cli, tmp_path):
     assert statuses["equations"] == "not applicable: URDF" and statuses["modes"] == "shown"
     page = out.read_text(encoding="utf-8")
     assert "shoulder" in page and "<td>elbow</td>" not in page  # one coordinate left
+
+
+def _gifs(page: str):
+    import re
+    from base64 import b64decode
+    from io import BytesIO
+
+    from PIL import Image
+
+    return [Image.open(BytesIO(b64decode(data)))
+            for data in re.findall(r'src="data:image/gif;base64,([^"]+)"', page)]
+
+
+def test_size_and_fps_set_every_animation_on_the_page(cli, tmp_path):
+    # as modes --animate: --size WxH pixels and --fps frames a second (GIF frames last 1/fps s)
+    out = tmp_path / "r.html"
+    code, _, stderr = cli("report", "double_pendulum", "--out", str(out), "--t-end", "1",
+                          "--size", "240x180", "--fps", "10")
+    assert code == 0, stderr
+    gifs = _gifs(out.read_text(encoding="utf-8"))
+    assert len(gifs) == 3  # two modes and the simulation
+    for gif in gifs:
+        assert gif.size == (240, 180) and gif.info["duration"] == 100
+    assert [gif.n_frames for gif in gifs] == [20, 20, 11]  # a period in 2 s; 1 s of run
+    # a model of energies only: each coordinate on its track, one period in 1.6 s
+    code, _, stderr = cli("report", "two_mass", "--out", str(out), "--t-end", "0.1",
+                          "--size", "300x200", "--fps", "10")
+    assert code == 0, stderr
+    gifs = _gifs(out.read_text(encoding="utf-8"))
+    assert [(g.size, g.n_frames, g.info["duration"]) for g in gifs] == [((300, 200), 16, 100)] * 2
+
+
+def test_bad_size_and_fps_are_refused_as_for_modes(cli, tmp_path):
+    out = str(tmp_path / "r.html")
+    _refused(cli("report", "pendulum", "--out", out, "--size", "big"), "--size", "WIDTHxHEIGHT")
+    _refused(cli("report", "pendulum", "--out", out, "--size", "5x5"), "--size", "between")
+    _refused(cli("report", "pendulum", "--out", out, "--fps", "0"), "--fps", "1 to 120")
+    assert list(tmp_path.iterdir()) == []

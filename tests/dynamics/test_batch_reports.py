@@ -70,6 +70,7 @@ def backends(tmp_path):
     robot, radial = _robot(tmp_path), _radial(tmp_path)
     eom = radial.equations_of_motion()
     return {"recursive C": robot.dynamics(backend="c"),
+            "recursive C compact": robot.dynamics(backend="c", kernel="compact"),
             "recursive numpy": robot.dynamics(backend="numpy"),
             "derived C": Dynamics(numeric(eom, backend="c")),
             "derived numpy": Dynamics(numeric(eom, backend="numpy"))}
@@ -79,7 +80,8 @@ def _call(f, name, inputs, rows):
     return getattr(f, name)(*(rows[k] for k in inputs))
 
 
-@pytest.mark.parametrize("backend", ["recursive C", "recursive numpy", "derived C", "derived numpy"])
+@pytest.mark.parametrize("backend", ["recursive C", "recursive C compact", "recursive numpy",
+                                     "derived C", "derived numpy"])
 def test_a_state_not_finite_is_nan_in_its_row_the_others_exact(tmp_path, backend):
     f = backends(tmp_path)[backend]
     rng = np.random.default_rng(3)
@@ -106,8 +108,9 @@ def test_a_state_not_finite_is_nan_in_its_row_the_others_exact(tmp_path, backend
                 np.testing.assert_array_equal(out[k], alone, err_msg=name)
 
 
-def test_ten_thousand_states_with_one_nan(tmp_path):
-    f = backends(tmp_path)["recursive C"]
+@pytest.mark.parametrize("backend", ["recursive C", "recursive C compact"])
+def test_ten_thousand_states_with_one_nan(tmp_path, backend):
+    f = backends(tmp_path)[backend]
     rng = np.random.default_rng(9)
     q, v, tau = (rng.uniform(0.2, 1.5, (10_000, 2)) for _ in range(3))
     q[4321, 0] = np.nan
@@ -119,7 +122,8 @@ def test_ten_thousand_states_with_one_nan(tmp_path):
     np.testing.assert_allclose(np.einsum("kij,kj->ki", M, a[:100]) + b, tau[:100], rtol=1e-10)
 
 
-@pytest.mark.parametrize("backend", ["recursive C", "recursive numpy", "derived C", "derived numpy"])
+@pytest.mark.parametrize("backend", ["recursive C", "recursive C compact", "recursive numpy",
+                                     "derived C", "derived numpy"])
 def test_a_state_whose_mass_matrix_is_singular_is_nan_in_forward_dynamics(tmp_path, backend):
     f = backends(tmp_path)[backend]
     q = np.array([[0.3, 0.7], [0.0, 0.0], [1.1, -0.4]])  # row 1: elbow 0 or x = 0, M singular

@@ -48,12 +48,14 @@ def _dynamics(system, backend):
         from lagrangian.dynamics.joint_space import Dynamics
 
         return Dynamics(numeric(system.equations_of_motion(), backend="numpy"))
+    if backend in ("unrolled", "compact"):  # the C kernel: the tree's own, or for every tree
+        return system.dynamics(kernel=backend)
     return system.dynamics(backend=backend)
 
 
 @pytest.mark.slow
 # derived equations; recursive numpy; recursive C (numpy without a compiler)
-@pytest.mark.parametrize("backend", ["symbolic", "numpy", "auto"])
+@pytest.mark.parametrize("backend", ["symbolic", "numpy", "unrolled", "compact"])
 def test_spatial_arm_matches_pinocchio(tmp_path, backend):
     path = tmp_path / "spatial.urdf"
     path.write_text(ARM)
@@ -134,7 +136,7 @@ def test_panda_numpy_fallback_matches_pinocchio(monkeypatch, tmp_path):
                                              rel=1e-9, abs=1e-9)
 
 
-@pytest.mark.parametrize("backend", ["symbolic", "numpy", "auto"])
+@pytest.mark.parametrize("backend", ["symbolic", "numpy", "unrolled", "compact"])
 def test_tilted_gravity_matches_pinocchios_model_gravity(tmp_path, backend):
     """A wall-mounted or sloped arm: load(path, gravity=...) against Pinocchio's model.gravity."""
     path = tmp_path / "spatial.urdf"

@@ -66,11 +66,20 @@ TREE = ('<?xml version="1.0"?><robot name="turret">' + "".join([
 ]) + "</robot>")
 
 
-@pytest.fixture(scope="module")
-def tree(tmp_path_factory):
+@pytest.fixture(scope="module", params=["unrolled", "compact"])
+def tree(tmp_path_factory, request):
+    """The turret, its dynamics on each kernel: the tree's own unrolled module, or the compact
+    kernel (dynamics/compact_kernel.py) for every tree (the size threshold set below 0)."""
+    from lagrangian.dynamics import compact_kernel
+
     path = tmp_path_factory.mktemp("tree") / "turret.urdf"
     path.write_text(TREE)
-    return lagrangian.load(path, lock={"grip": 0.01})
+    with pytest.MonkeyPatch.context() as patch:
+        if request.param == "compact":
+            patch.setattr(compact_kernel, "COMPACT_ABOVE", -1)
+        system = lagrangian.load(path, lock={"grip": 0.01})
+        assert system.dynamics().kernel == request.param or not compiled.available()
+        yield system
 
 
 def states(n, count=6, seed=3):
@@ -106,8 +115,10 @@ def no_mimic(tmp_path_factory):
 
 @needs_c
 @pytest.mark.parametrize("which", ["tree", "no_mimic"])
-def test_laws_of_the_recursive_functions(which, request):
-    f = request.getfixturevalue(which).dynamics()
+def test_laws_of_the_recursive_functions(which, tree, no_mimic):
+    kernel = tree.dynamics().kernel  # each kernel, by the tree fixture's parameter
+    f = {"tree": tree, "no_mimic": no_mimic}[which].dynamics(kernel=kernel)
+    assert f.kernel == kernel
     assert isinstance(f, RecursiveDynamics)
     n = f.n
     q, v, a, _ = states(n, count=4, seed=11)
@@ -264,11 +275,14 @@ def test_parameters_and_what_the_tree_does_not_describe(tree):
 @needs_c
 def test_simulation_runs_on_the_recursive_module(tree):
     system = tree.numeric()
-    assert system.backend == "c"
+    # the compact module has no DOP853 loop of its own: scipy steps it
+    assert system.backend == {"unrolled": "c", "compact": "compact"}[tree.dynamics().kernel]
     q, v = np.array([0.1, 0.2, 0.3, 0.04]), np.array([0.5, -0.2, 0.1, 0.0])
     accelerations, _ = system.accelerations_and_multipliers(q, v)
     np.testing.assert_allclose(accelerations, tree.dynamics().forward_dynamics(q, v, np.zeros(4)),
                                rtol=1e-12)
+    run = tree.simulate(t_end=0.2)
+    assert run.completed
 
 
 @needs_c

@@ -4,20 +4,31 @@ torsion spring, a helical joint) fails here until each stage knows it."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 import sympy as sp
 
 import lagrangian
 from lagrangian import JointKind
 from lagrangian.check.diagnose_terms import projection_explanation
-from lagrangian.check.newton_euler import _AppliedForces, free_body
+from lagrangian.check.free_bodies import _AppliedForces, free_body
 from lagrangian.check.units import unit_items
 from lagrangian.derivation.energies import dissipation_terms, potential_terms
 from lagrangian.derivation.inertia import add_rotation, add_translation
+from lagrangian.derivation.steps import load_working
 from lagrangian.derivation.virtual_work import load_projection
 from lagrangian.dynamics.joint_models import JOINT_MODELS, joint_model
-from lagrangian.model.components import COMPONENT_KINDS, ELEMENT_KINDS, LOAD_KINDS, MASS_KINDS
+from lagrangian.kinds import LoadStepKind
+from lagrangian.model.components import (
+    COMPONENT_KINDS,
+    CONSTRAINT_KINDS,
+    ELEMENT_KINDS,
+    LOAD_KINDS,
+    MASS_KINDS,
+)
 from lagrangian.model.rotations import JOINT_KEYS, RotationReader
+from lagrangian.output.drawing import NOT_DRAWN, draw
+from lagrangian.output.steps import LOAD_LATEX, LOAD_TEXT
 
 TABLES = {
     "kinetic energy, M and f, first pass (derivation)": (add_translation.registry, MASS_KINDS),
@@ -32,6 +43,9 @@ TABLES = {
         _AppliedForces.__dict__["add_element"].dispatcher.registry, ELEMENT_KINDS),
     "diagnosis of a mis-projected load (check)": (projection_explanation.registry,
                                                   LOAD_KINDS + ELEMENT_KINDS[1:]),
+    "drawing (output)": (draw.registry, COMPONENT_KINDS),
+    "virtual work step by step (derive --steps)": (load_working.registry,
+                                                   LOAD_KINDS + ELEMENT_KINDS[1:]),
 }
 
 
@@ -40,6 +54,52 @@ def test_every_kind_has_its_entry(table):
     registry, kinds = TABLES[table]
     missing = [kind.__name__ for kind in kinds if kind not in registry]
     assert not missing, f"{table} has no entry for {missing}"
+
+
+def test_only_kinds_without_a_position_are_drawn_by_nothing():
+    """A kind is drawn unless it is deliberately listed as not drawn: loads and constraints,
+    which have no position of their own (a rolling contact draws its wheel)."""
+    assert set(NOT_DRAWN) == set(LOAD_KINDS) | set(CONSTRAINT_KINDS[:1])
+    drawn = [kind for kind in COMPONENT_KINDS if kind not in NOT_DRAWN]
+    assert set(drawn) == set(MASS_KINDS + ELEMENT_KINDS + CONSTRAINT_KINDS[1:])
+
+
+@pytest.mark.parametrize("table", [LOAD_TEXT, LOAD_LATEX], ids=["text", "LaTeX"])
+def test_every_kind_of_load_step_is_written(table):
+    """derive --steps writes each load's virtual work by a table keyed by the kind of load."""
+    missing = [str(kind) for kind in LoadStepKind if kind not in table]
+    assert not missing, f"derive --steps writes no {missing}"
+
+
+def test_every_kind_of_result_is_written():
+    """The tables the output keys by a kind enum name every member: a new status or kind is
+    written, not dropped to a default."""
+    from lagrangian.kinds import CrossingKind, FindingStatus, FreeBodyKind
+    from lagrangian.output.check import _MARK
+    from lagrangian.output.crosscheck_steps import _INERTIAL_SHARE
+    from lagrangian.output.speed_form import _NAMES
+
+    for table, kinds in ((_MARK, FindingStatus), (_INERTIAL_SHARE, FreeBodyKind),
+                         (_NAMES, CrossingKind)):
+        assert set(table) == set(kinds)
+
+
+def test_a_misspelled_status_or_kind_is_an_error():
+    from lagrangian.analysis.study import Distribution
+    from lagrangian.check.diagnose import Finding
+
+    assert Finding("V", "correct", None, "V matches.").status == "correct"
+    with pytest.raises(ValueError, match="corect"):
+        Finding("V", "corect", None, "V matches.")
+    with pytest.raises(ValueError, match="gaussian"):
+        Distribution("gaussian", 0.0, 1.0)
+    from lagrangian.analysis.speed_form import SpeedSweep
+
+    sweep = SpeedSweep(np.zeros(0), np.zeros((0, 0)), (), ())
+    assert sweep.speed_of("oscillatory") is None
+    with pytest.raises(lagrangian.InputError, match="oscillatory, real, got 'weave'") as error:
+        sweep.speed_of("weave")
+    assert error.value.field == "kind"
 
 
 def test_the_kinds_are_each_named_once():

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+import pytest
 import sympy as sp
 
 from lagrangian import SystemBuilder
@@ -84,3 +85,43 @@ position = ["L*sin(theta)", "-L*cos(theta)"]
         code, out, err = cli(*args)
         assert code == 0, err
         assert not CONTROLS & set(out + err), args
+
+
+# -- large models: a step over STEP_NODES nodes is given by its size (--steps-full prints it) --
+
+def test_a_step_too_large_to_follow_is_given_by_its_size(monkeypatch):
+    import lagrangian
+    from lagrangian.output import steps as steps_module
+
+    steps = lagrangian.load("double_pendulum").steps()
+    full = steps_text(steps, full=True)
+    assert steps_text(steps) == full  # every step of the examples is under the limit
+    monkeypatch.setattr(steps_module, "STEP_NODES", 20)
+    short = steps_text(steps)
+    assert "steps over 20 nodes are given by their size; derive --steps-full prints" in short
+    assert "nodes: derive --steps-full prints it>" in short
+    assert steps_text(steps, full=True) == full
+    assert len(short) < len(full)
+    assert r"nodes: derive --steps-full prints it)}" in steps_latex(steps)
+    document = json.dumps(steps_document(steps))
+    assert "nodes" not in document and "derive --steps-full" not in document  # always complete
+
+
+def test_steps_full_flag(cli):
+    code, out, err = cli("derive", "double_pendulum", "--steps-full")
+    assert code == 0, err
+    assert out == cli("derive", "double_pendulum", "--steps").out
+
+
+@pytest.mark.slow
+def test_the_bicycle_steps_are_a_few_pages_not_megabytes(cli):
+    # the cheap proxy of size and time: the characters the working adds to derive's output
+    # (2.75 million before the cap, its printing 13 s of the 14)
+    plain = cli("derive", "whipple_bicycle").out
+    code, out, err = cli("derive", "whipple_bicycle", "--steps")
+    assert code == 0, err
+    assert out.startswith(plain)
+    working = out[len(plain):]
+    assert len(working) < 50_000
+    assert working.count("derive --steps-full prints it>") >= 25
+    assert "dL/dthetaR_dot = IRyy*(psi_dot*sin(phi) + thetaR_dot + theta_dot)" in working

@@ -183,6 +183,11 @@ def test_bad_input_is_refused_before_any_work(tmp_path):
         pendulum.report(t_end=-1)
     with pytest.raises(ModelError):
         pendulum.report(answer=tmp_path / "missing.toml")
+    for bad, field in (({"size": "huge"}, "size"), ({"size": (10, 10)}, "size"),
+                       ({"fps": 0}, "fps"), ({"fps": "fast"}, "fps")):
+        with pytest.raises(ModelError) as error:
+            pendulum.report(**bad)
+        assert error.value.field == field
 
 
 def test_save_writes_atomically_and_only_where_we_may(double_pendulum, tmp_path):

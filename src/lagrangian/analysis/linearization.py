@@ -22,7 +22,7 @@ from ..derivation.kinematics import jacobian_row
 from ..errors import DerivationError, ModelError
 from ..kinds import ConstraintKind
 from ..model.expressions import as_expression
-from ..model.model import Model
+from ..model.inputs import input_parameter
 from ..model.values import ParameterValues, resolve_parameters, resolve_state
 
 # Relative singular-value threshold for the rank of the constraint Jacobian.
@@ -55,8 +55,36 @@ def state_matrix(from_position: np.ndarray, from_velocity: np.ndarray) -> np.nda
 
 
 
+class SecondOrderForm:
+    """M z_ddot + C z_dot + K z: the names both linear models give their matrices (numbers in
+    LinearModel, sympy matrices in SymbolicLinearModel; SI units). Each holds mass_matrix,
+    damping_matrix and stiffness_matrix."""
+
+    @property
+    def M(self):
+        return self.mass_matrix
+
+    @property
+    def C(self):
+        return self.damping_matrix
+
+    @property
+    def K(self):
+        return self.stiffness_matrix
+
+    @property
+    def gyroscopic_matrix(self):
+        """G = (C - C^T)/2: the skew, energy-neutral part of C."""
+        return (self.damping_matrix - self.damping_matrix.T) / 2
+
+    @property
+    def dissipation_matrix(self):
+        """(C + C^T)/2: the symmetric, energy-removing part of C."""
+        return (self.damping_matrix + self.damping_matrix.T) / 2
+
+
 @dataclass(frozen=True)
-class LinearModel:
+class LinearModel(SecondOrderForm):
     """M z_ddot + C z_dot + K z = B_q u about an equilibrium, and x_dot = A x + B u, x = [z; z_dot].
 
     ``coordinates`` name z: all coordinates of an unconstrained model, else the independent ones
@@ -86,28 +114,6 @@ class LinearModel:
     # H dq + G dq_dot = 0 as rows over the state (dq, dq_dot). A keeps H dq + G dq_dot constant,
     # so the motions of the system are the invariant subspace where it is zero.
     state_constraints: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-
-    @property
-    def M(self) -> np.ndarray:
-        return self.mass_matrix
-
-    @property
-    def C(self) -> np.ndarray:
-        return self.damping_matrix
-
-    @property
-    def K(self) -> np.ndarray:
-        return self.stiffness_matrix
-
-    @property
-    def gyroscopic_matrix(self) -> np.ndarray:
-        """G = (C - C^T)/2: the skew, energy-neutral part of C."""
-        return (self.damping_matrix - self.damping_matrix.T) / 2
-
-    @property
-    def dissipation_matrix(self) -> np.ndarray:
-        """(C + C^T)/2: the symmetric, energy-removing part of C."""
-        return (self.damping_matrix + self.damping_matrix.T) / 2
 
     @property
     def constrained(self) -> bool:
@@ -269,7 +275,7 @@ def input_columns(
     point[model.time] = sp.Float(float(t))
     names = [c.name for c in model.coordinates]
     for k, name in enumerate(inputs):
-        symbol = _input_parameter(model, name)
+        symbol = input_parameter(model, name)
         if symbol is None:
             columns[names.index(name), k] = 1.0
             continue
@@ -280,39 +286,13 @@ def input_columns(
     return columns
 
 
-def _input_parameter(model: Model, name: str) -> sp.Symbol | None:
-    """The parameter an input name stands for; None for a generalized force on a coordinate."""
-    for p in model.parameters:
-        if p.name == name:
-            return p.symbol
-    for load in model.loads:
-        if load.name == name:
-            magnitude = (load.force if hasattr(load, "force") else
-                         load.moment if hasattr(load, "moment") else (load.torque,))
-            symbols = {s for e in magnitude for s in as_expression(e).free_symbols}
-            owned = sorted((p for p in model.parameters if p.symbol in symbols),
-                           key=lambda p: p.name)
-            if len(owned) != 1:
-                listed = ", ".join(p.name for p in owned) or "none"
-                raise ModelError(
-                    f"load '{name}' must contain exactly one parameter to serve as an input "
-                    f"(it has: {listed}); name the parameter instead", field="inputs")
-            return owned[0].symbol
-    if name in {c.name for c in model.coordinates}:
-        return None
-    known = [p.name for p in model.parameters] + [ld.name for ld in model.loads] + \
-        [c.name for c in model.coordinates]
-    raise ModelError(f"'{name}' is not a parameter, load or coordinate of this model "
-                     f"(inputs may be any of: {', '.join(known)})", field="inputs")
-
-
 # -- symbolic linear matrices for small models ------------------------------------------------
 
 SYMBOLIC_MAX_COORDINATES = 6
 
 
 @dataclass(frozen=True)
-class SymbolicLinearModel:
+class SymbolicLinearModel(SecondOrderForm):
     """M, C, K as sympy matrices at an equilibrium, parameters kept as symbols."""
 
     coordinates: tuple[str, ...]

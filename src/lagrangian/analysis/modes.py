@@ -17,6 +17,7 @@ import numpy as np
 import sympy as sp
 
 from ..errors import DerivationError
+from ..kinds import ModeKind
 from .linearization import LinearModel
 
 # Eigenvalues smaller than this fraction of the largest are zero (rigid-body modes).
@@ -52,12 +53,12 @@ class Mode:
         return 2 * math.pi / self.frequency if self.frequency > 0 else None
 
     @property
-    def kind(self) -> str:
+    def kind(self) -> ModeKind:
         """'oscillating', 'rigid-body', 'divergent' (grows without oscillating) or 'overdamped'."""
         if self.frequency > 0:
-            return "overdamped" if (self.damping_ratio or 0) >= 1 and all(
-                abs(s.imag) == 0 for s in self.eigenvalues) else "oscillating"
-        return "divergent" if self.growth_rate > 0 else "rigid-body"
+            return ModeKind.OVERDAMPED if (self.damping_ratio or 0) >= 1 and all(
+                abs(s.imag) == 0 for s in self.eigenvalues) else ModeKind.OSCILLATING
+        return ModeKind.DIVERGENT if self.growth_rate > 0 else ModeKind.RIGID_BODY
 
     def __repr__(self) -> str:
         shape = ", ".join(f"{k}={v:.4g}" for k, v in self.shape.items())

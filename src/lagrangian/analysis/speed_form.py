@@ -27,7 +27,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..derivation.equations import EquationsOfMotion
-from ..errors import DerivationError, ModelError, did_you_mean
+from ..errors import DerivationError, InputError, ModelError, did_you_mean
+from ..kinds import CrossingKind
 from ..model.model import velocity_name
 from ..model.values import ParameterValues, resolve_parameters
 from .linearization import LinearModel, state_matrix
@@ -267,7 +268,7 @@ class Crossing:
     (for that eigenvalue)."""
 
     speed: float
-    kind: str
+    kind: CrossingKind
     frequency: float
     stabilizing: bool
 
@@ -284,6 +285,9 @@ class SpeedSweep:
     def speed_of(self, kind: str, stabilizing: bool | None = None) -> float | None:
         """The first crossing of ``kind`` ("oscillatory": the weave speed of a bicycle; "real":
         its capsize speed), None where there is none."""
+        if kind not in set(CrossingKind):
+            raise InputError(f"expected one of {', '.join(CrossingKind)}, got {kind!r}",
+                             field="kind")
         for c in self.crossings:
             if c.kind == kind and (stabilizing is None or c.stabilizing == stabilizing):
                 return c.speed
@@ -340,7 +344,7 @@ def speed_sweep(form: SpeedForm, speeds: Sequence[float], tolerance: float = 1e-
         values = form.eigenvalues(at)
         nearest = values[np.argmin(np.abs(values.real))]
         oscillatory = abs(nearest.imag) > 1e-6
-        crossings.append(Crossing(float(at), "oscillatory" if oscillatory else "real",
+        crossings.append(Crossing(float(at), CrossingKind.OSCILLATORY if oscillatory else CrossingKind.REAL,
                                   float(abs(nearest.imag)), cb < ca))
     stable = []
     start = None

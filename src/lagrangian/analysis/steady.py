@@ -15,6 +15,7 @@ perturbation is eliminated with that constraint differentiated once, which adds 
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -24,12 +25,13 @@ import sympy as sp
 from ..compile.lambdified import StateFunction
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import Differentiator
-from ..errors import DerivationError, ModelError, did_you_mean
+from ..errors import DerivationError, InputError, ModelError, did_you_mean
 from ..kinds import ConstraintKind
 from ..model.expressions import as_expression
-from ..model.model import velocity_name
+from ..model.model import Model, velocity_name
 from ..model.rotations import gimbal_lock
-from ..model.values import ParameterValues, resolve_parameters, resolve_state
+from ..model.units import parse_quantity
+from ..model.values import ParameterValues, resolve_parameters, resolve_state, state_units
 from .linearization import LinearModel, state_matrix
 
 FIELD = "steady"
@@ -64,6 +66,31 @@ def steady_rates(eom: EquationsOfMotion, steady: Mapping[str, float | str],
         rates[velocities[name]] = rate
     if not rates:
         raise ModelError("name at least one steady rate (e.g. psi_dot=10)", field=FIELD)
+    return rates
+
+
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def parse_steady_rates(model: Model, written: Mapping[str, str]) -> dict[str, float | str]:
+    """Steady rates as written (``{"psi_dot": "600rpm"}``, ``{"thetaR_dot": "-v/rR"}``): each a
+    quantity in its velocity's unit (rad/s, m/s), else, when the text names a parameter, the text
+    itself, which ``steady_rates`` reads as an expression in the parameters. A name that is not
+    a velocity is kept as given, for ``steady_rates`` to refuse by name. A bad quantity that
+    names no parameter raises InputError (field ``steady.NAME``)."""
+    units = state_units(model)
+    parameters = {p.name for p in model.parameters}
+    rates: dict[str, float | str] = {}
+    for name, text in written.items():
+        if name not in units:
+            rates[name] = text
+            continue
+        try:
+            rates[name] = parse_quantity(text, units[name], f"{FIELD}.{name}")
+        except ModelError as error:
+            if not parameters & set(_NAME.findall(text)):
+                raise InputError(error.message, field=error.field) from None
+            rates[name] = text
     return rates
 
 
@@ -324,5 +351,5 @@ def steady_linear_model(
     )
 
 
-__all__ = ["SteadyFunctions", "SteadyPoint", "steady_functions", "steady_linear_model", "steady_point",
-           "steady_rates"]
+__all__ = ["SteadyFunctions", "SteadyPoint", "parse_steady_rates", "steady_functions",
+           "steady_linear_model", "steady_point", "steady_rates"]

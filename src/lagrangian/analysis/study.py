@@ -16,6 +16,7 @@ import numpy as np
 
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
+from ..kinds import DistributionKind
 from ..model.values import resolve_state
 
 COMPUTES = ("modes", "equilibria", "simulate", "speeds")
@@ -25,19 +26,22 @@ NOT_COMPUTED = "not computed"
 # -- distributions of an ensemble: a small grammar, read without evaluating anything -----------
 
 _NUMBER = r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*"
-_DISTRIBUTION = re.compile(rf"^\s*(normal|uniform)\s*\({_NUMBER},{_NUMBER}\)\s*$")
+_DISTRIBUTION = re.compile(rf"^\s*({'|'.join(DistributionKind)})\s*\({_NUMBER},{_NUMBER}\)\s*$")
 
 
 @dataclass(frozen=True)
 class Distribution:
     """normal(mean, standard deviation) or uniform(low, high), in SI units."""
 
-    kind: str
+    kind: DistributionKind
     a: float
     b: float
 
+    def __post_init__(self):
+        object.__setattr__(self, "kind", DistributionKind(self.kind))
+
     def draw(self, rng: np.random.Generator, size: int) -> np.ndarray:
-        if self.kind == "normal":
+        if self.kind == DistributionKind.NORMAL:
             return rng.normal(self.a, self.b, size)
         return rng.uniform(self.a, self.b, size)
 
@@ -54,9 +58,9 @@ def parse_distribution(text: str, field: str = "sample") -> Distribution:
     kind, a, b = match.group(1), float(match.group(2)), float(match.group(3))
     if not (math.isfinite(a) and math.isfinite(b)):
         raise ModelError(f"the numbers of {text!r} must be finite", field=field)
-    if kind == "normal" and b < 0:
+    if kind == DistributionKind.NORMAL and b < 0:
         raise ModelError(f"the standard deviation of {text!r} must not be negative", field=field)
-    if kind == "uniform" and not b > a:
+    if kind == DistributionKind.UNIFORM and not b > a:
         raise ModelError(f"uniform(LOW, HIGH) needs LOW < HIGH, got {text!r}", field=field)
     return Distribution(kind, a, b)
 

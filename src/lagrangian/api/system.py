@@ -60,11 +60,13 @@ from ..simulation.simulate import (
     simulate,
     urdf_limits,
 )
+from .control import ControlMethods
 from .modes import ModalAnalysis
+from .options import run_options
 from .simulation import Simulation
 
 
-class System:
+class System(ControlMethods):
     """A mechanical system described in generalized coordinates.
 
     >>> import lagrangian
@@ -188,6 +190,8 @@ class System:
         atol: float = 1e-9,
         samples: int = 1001,
         limits: bool = True,
+        controller=None,
+        inputs: Sequence[str] | None = None,
     ) -> Simulation:
         """Integrate the equations of motion to ``t_end`` (s); returns a Simulation.
 
@@ -199,18 +203,21 @@ class System:
         are kept on Phi = 0 by projection (see docs/simulation.md). A robot read from URDF
         stops with status 'limit' when a joint reaches its position limit, naming it
         (``limits=False`` ignores them); velocity and effort limits exceeded are reported
-        either way (``summary()["limits_exceeded"]``).
+        either way (``summary()["limits_exceeded"]``). ``controller`` (t, q, q_dot) -> u adds
+        generalized forces, or B u for named ``inputs`` (its own ``inputs`` where it has them,
+        as lagrangian.control's controllers do), to the model's own: docs/control.md.
         """
         require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
-        step_control, save_at = _options(step_control, save_at, method, rtol, atol, samples,
+        step_control, save_at = run_options(step_control, save_at, method, rtol, atol, samples,
                                          1001)
         stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) \
             else stop_when
         result = simulate(self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
                           progress=progress, functions=self._numeric,
-                          limits=urdf_limits(self._model, positions=limits))
+                          limits=urdf_limits(self._model, positions=limits), controller=controller,
+                          inputs=getattr(controller, "inputs", ()) if inputs is None else inputs)
         return Simulation.of(result)
 
     # -- standalone C for a controller -----------------------------------------------------------
@@ -272,17 +279,25 @@ class System:
         return recursive_dynamics(self.model)
 
     def dynamics(self, parameters: Mapping[str, float] | None = None, backend: str = "auto",
-                 *, actuators: bool = False, armature: Mapping[str, float] | None = None):
+                 kernel: str = "auto", *, actuators: bool = False,
+                 armature: Mapping[str, float] | None = None):
         """M(q), bias C q_dot + g, g(q), inverse and forward dynamics and the energies, batched
         over leading axes (q of shape (n,) or (N, n)); a generalized force tau acts on top of
         the model's own loads (dynamics/joint_space.py). A URDF robot runs recursive algorithms in
         generated C (dynamics/recursive.py; in numpy without a compiler or with backend
-        "numpy"), the other models their derived equations. ``actuators=True`` adds the URDF's
-        joint damping and friction, ``armature`` {joint: kg m^2 or kg} M's (dynamics/actuators.py)."""
-        rigid = self._recursive if parameters is None and backend == "auto" and \
-            self._recursive is not None else model_dynamics(
-                self.model, lambda: self.numeric(parameters, backend), parameters, backend,
-                equations=self.equations_of_motion)
+        "numpy"), the other models their derived equations. A URDF robot's ``parameters`` may
+        set a link's inertial (``{"tool0.mass": 2.5}``, dynamics/inertials.py) without a
+        rebuild; ``kernel`` "unrolled" (the tree's own code), "compact" (one module for every
+        tree) or "auto" (by the tree's size, dynamics/compact_kernel.py). ``actuators=True``
+        adds the URDF's joint damping and friction, ``armature`` {joint: kg m^2 or kg} to M
+        (dynamics/actuators.py)."""
+        if parameters is None and backend == "auto" and kernel == "auto" \
+                and self._recursive is not None:
+            rigid = self._recursive
+        else:
+            rigid = model_dynamics(self.model, lambda: self.numeric(parameters, backend),
+                                   parameters, backend, equations=self.equations_of_motion,
+                                   kernel=kernel)
         return rigid if not actuators and armature is None else \
             actuated(rigid, self.model, armature, friction=actuators)
 
@@ -422,7 +437,7 @@ class System:
         if compute == "simulate":
             if t_end is None:
                 raise InputError("a simulation study needs t_end (s)", field="t_end")
-            step, save = _options(step_control, save_at, method, rtol, atol, samples, 201)
+            step, save = run_options(step_control, save_at, method, rtol, atol, samples, 201)
             if isinstance(stop_when, StopCondition):
                 stop_when = stop_when.text
             if stop_when is not None:
@@ -505,15 +520,17 @@ class System:
 
     # -- the report page ---------------------------------------------------------------------
 
-    def report(self, answer=None, *, t_end: float | None = None, progress=None):
+    def report(self, answer=None, *, t_end: float | None = None, progress=None, size=None,
+               fps=None):
         """One self-contained HTML page (report/page.py): the model and its drawing, T, V, L,
         the generalized forces per load, the equations, equilibria, modes (each drawn moving), a
         simulation of ``t_end`` s (default 10), the units check and, given ``answer`` (as in
-        ``check``), the check's findings. Returns a Report: ``.html``, ``.save(path)``; it shows
-        itself in Jupyter."""
+        ``check``), the check's findings; ``size`` ("WxH" pixels) and ``fps`` of its animations.
+        Returns a Report: ``.html``, ``.save(path)``; it shows itself in Jupyter."""
         from ..report.page import build_report
 
-        return build_report(self, answer=answer, t_end=t_end, progress=progress)
+        return build_report(self, answer=answer, t_end=t_end, progress=progress, size=size,
+                            fps=fps)
 
     def to_latex(self, standalone: bool = False) -> str:
         """The derivation as LaTeX (amsmath), as ``derive --format latex``: M q_ddot
@@ -531,33 +548,6 @@ class System:
         eom = self.equations_of_motion()
         names = latex_symbol_names(self._model)
         return rf"$L = {sp.latex(eom.lagrangian, symbol_names=names)}$"
-
-
-def _options(step_control: StepControl | None, save_at: SaveAt | None, method: str,
-             rtol: float, atol: float, samples: int, samples_default: int
-             ) -> tuple[StepControl, SaveAt]:
-    """The option values from the option types or the plain keywords (a thin shim), never
-    both: a plain keyword that differs from its default beside its option type is refused."""
-    plain = {"method": (method, "DOP853"), "rtol": (rtol, 1e-9), "atol": (atol, 1e-9)}
-    if step_control is not None:
-        if not isinstance(step_control, StepControl):
-            raise InputError("step_control must be a lagrangian.StepControl",
-                             field="step_control")
-        both = [k for k, (value, default) in plain.items() if value != default]
-        if both:
-            raise InputError(f"give {', '.join(both)} in step_control or as a keyword, not both",
-                             field="step_control")
-    else:
-        step_control = StepControl(method, rtol, atol)
-    if save_at is not None:
-        if not isinstance(save_at, SaveAt):
-            raise InputError("save_at must be a lagrangian.SaveAt", field="save_at")
-        if samples != samples_default:
-            raise InputError("give samples in save_at or as a keyword, not both",
-                             field="save_at")
-    else:
-        save_at = SaveAt(samples)
-    return step_control, save_at
 
 
 class SystemBuilder(ModelBuilder):
@@ -578,30 +568,30 @@ class SystemBuilder(ModelBuilder):
 
 
 def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None,
-         gravity: Sequence[float] | None = None, payload: Mapping[str, object] | None = None
-         ) -> System:
+         gravity: Sequence[float] | None = None, payload: Mapping[str, object] | None = None,
+         floating_base: bool = False) -> System:
     """Load a model file (TOML), a robot (URDF: ``lock`` freezes joints by name, rad or m;
     ``payload`` {link: mass, or (mass, (x, y, z))} fixes point masses (kg, m in the link's
-    frame) to links, as an edited URDF would), or a built-in example by name (see
+    frame) to links, as an edited URDF would; ``floating_base`` frees its root link, nq = n + 7,
+    nv = n + 6: dynamics and kinematics only), or a built-in example by name (see
     ``examples()``); ``gravity`` (g_x, g_y, g_z) in m/s^2 turns the model's gravity
     (System.with_gravity)."""
-    system = _load(path_or_example, lock, payload)
+    system = _load(path_or_example, lock, payload, floating_base)
     return system if gravity is None else system.with_gravity(gravity)
 
 
-def _load(path_or_example: str | Path, lock, payload) -> System:
+def _load(path_or_example: str | Path, lock, payload, floating_base) -> System:
     path = Path(path_or_example)
-    if path.suffix.lower() == ".urdf":
-        return System(read_urdf(path, lock, payload))
-    urdf = None if path.exists() else example_urdf(str(path_or_example))
+    urdf = path if path.suffix.lower() == ".urdf" else (
+        None if path.exists() else example_urdf(str(path_or_example)))
     if urdf is not None:
-        return System(replace(read_urdf(urdf, lock, payload),
-                              source=f"example:{path_or_example}"))
-    if payload:
-        raise InputError("only a URDF model has links to carry a payload", field="payload")
-    if lock:
-
-        raise InputError("only a URDF model has joints to lock", field="lock")
+        model = read_urdf(urdf, lock, payload, floating_base)
+        return System(model if urdf is path else replace(model, source=f"example:{path}"))
+    for name, given, what in (("payload", payload, "links to carry a payload"),
+                              ("lock", lock, "joints to lock"),
+                              ("floating_base", floating_base, "a base to float")):
+        if given:
+            raise InputError(f"only a URDF model has {what}", field=name)
     if path.exists() or path.suffix == ".toml" or len(path.parts) > 1:
         return System(read_model(path))
     model = read_model(example_path(str(path_or_example)))

@@ -17,6 +17,7 @@ from typing import Any
 
 from ..derivation.equations import EquationsOfMotion
 from ..errors import LagrangianError
+from ..kinds import FindingStatus
 from ..model.answer import read_answer
 from .diagnose import CheckReport, check_answer
 from .hints import hinted
@@ -131,10 +132,10 @@ def summary(result: AnswerResult) -> str:
     findings = result.report.findings
     if not findings:
         return "no items to check"
-    named = [f"{f.item}: {f.code or f.status}" + (" (equivalent)" if f.status == "equivalent"
+    named = [f"{f.item}: {f.code or f.status}" + (" (equivalent)" if f.status == FindingStatus.EQUIVALENT
                                                    else "")
-             for f in findings if f.status != "correct"]
-    right = sum(f.status == "correct" for f in findings)
+             for f in findings if f.status != FindingStatus.CORRECT]
+    right = sum(f.status == FindingStatus.CORRECT for f in findings)
     if right:
         named.append(f"{right} item(s) ok" if named else f"all {right} item(s) ok")
     return "; ".join(named)

@@ -14,6 +14,7 @@ import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
 from ..errors import misspelled
+from ..kinds import FindingStatus
 from ..model.answer import Answer, answer_names
 from ..model.expressions import as_expression
 from ..model.expressions import format_expression as fmt
@@ -48,10 +49,13 @@ class Finding:
     """The verdict on one item; ``code`` is None when correct, ``expected`` our version."""
 
     item: str
-    status: str
+    status: FindingStatus
     code: str | None
     message: str
     expected: str | None = None
+
+    def __post_init__(self):  # "correct" as written, checked: a misspelled status is an error
+        object.__setattr__(self, "status", FindingStatus(self.status))
 
 
 @dataclass(frozen=True)
@@ -64,7 +68,8 @@ class CheckReport:
 
     @property
     def verdict(self) -> str:
-        return "incorrect" if any(f.status == "wrong" for f in self.findings) else "correct"
+        return "incorrect" if any(f.status == FindingStatus.WRONG for f in self.findings) \
+            else "correct"
 
     @property
     def correct(self) -> bool:

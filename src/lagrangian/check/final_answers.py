@@ -1,5 +1,6 @@
 """Verdicts on the final answers of an answer file: M, C, K, natural frequencies and damping
-ratios, mode shapes, linearized equations, generalized forces at a configuration, equilibria.
+ratios, mode shapes, linearized equations, generalized forces at a configuration, equilibria,
+statics loads.
 
 Ours come from the project's analysis (linearize, modes, generalized_forces_at, equilibria),
 through the System's public methods. A decimal number the student wrote is accepted when our
@@ -23,6 +24,7 @@ from ..model.expressions import parse_expression
 from . import equivalence as eq
 from .diagnose import Finding
 from .final_at_rest import AtRest
+from .final_linear import check_linearized, exact_linear
 from .final_reading import (
     FREQUENCY_KINDS,
     SLACK,
@@ -32,11 +34,12 @@ from .final_reading import (
     agrees,
     read_final_answers,
 )
+from .final_statics import STATICS_CODES, check_statics
 
 FINAL_CODES = (
     "matrix_entry", "frequency_wrong", "frequency_count", "damping_ratio_wrong",
     "mode_shape_wrong", "linear_coefficient", "linear_offset", "not_linearized",
-    "generalized_force_value", "equilibrium_wrong", "equilibrium_missing",
+    "generalized_force_value", "equilibrium_wrong", "equilibrium_missing", *STATICS_CODES,
 )
 SHAPE_SLACK = 1e-6  # relative to the largest component: eigenvectors are computed numerically
 
@@ -49,6 +52,7 @@ class Analysis(Protocol):
     def modes(self, about=None, *, steady=None): ...
     def equilibria(self): ...
     def generalized_forces_at(self, configuration, parameters=None): ...
+    def statics(self, configuration, solve_for, parameters=None): ...
 
 
 def check_final_answers(system: Analysis, answer: Answer) -> list[Finding]:
@@ -85,10 +89,11 @@ class _FinalChecker:
         if final.frequencies or final.damping_ratios or final.mode_shapes:
             findings += self.guarded("frequencies", self.modes)
         if final.linearized:
-            findings += self.guarded("linearized", self.linearized)
+            findings += self.guarded("linearized", lambda: check_linearized(self))
         if final.forces or final.equilibria:
             statics = AtRest(self.system, final)
             findings += statics.forces() + statics.equilibria()
+        findings += check_statics(self.system, final, self.source)
         return findings
 
     def guarded(self, table: str, method) -> list[Finding]:
@@ -134,14 +139,10 @@ class _FinalChecker:
         return self._equilibrium
 
     def symbolic(self):
-        """Exact M, C, K about the equilibrium (None where only numbers can be had)."""
+        """Exact M, C, K about the equilibrium (None where only numbers can be had: constraints,
+        many coordinates, an equilibrium that moves with the parameters)."""
         equilibrium = self.equilibrium()  # not an equilibrium: refused (ModelError)
-        if self.model.constraints:
-            return None
-        try:
-            return self.system.linearize(equilibrium, symbolic=True)
-        except ModelError:  # more coordinates than the symbolic linearization takes
-            return None
+        return exact_linear(self, equilibrium)
 
     # -- matrices --------------------------------------------------------------------------
 
@@ -156,8 +157,7 @@ class _FinalChecker:
                         for name, _ in self.final.matrices]
             ours = {"M": sp.Matrix(numeric.M), "C": sp.Matrix(numeric.C), "K": sp.Matrix(numeric.K)}
         else:
-            ours = {"M": linear.mass_matrix, "C": linear.damping_matrix,
-                    "K": linear.stiffness_matrix}
+            ours = {"M": linear.M, "C": linear.C, "K": linear.K}
         index = [self.names.index(n) for n in self.order]
         findings = []
         for name, rows in self.final.matrices:
@@ -286,68 +286,6 @@ class _FinalChecker:
                        f"shape[{i}] = {text} is not ours ({self.order and ', '.join(self.order)}"
                        f" = {expected} at {mode.frequency:.6g} rad/s) at any scale or sign, "
                        f"compared {precision}. Does it solve (K - omega^2 M) phi = 0?", expected)
-
-    # -- linearized equations --------------------------------------------------------------
-
-    def linearized(self) -> list[Finding]:
-        linear = self.symbolic()
-        if linear is None:
-            return [Finding(f"linearized.{name}", "note", None, "not checked: exact linear "
-                            "matrices are available for small unconstrained models only", None)
-                    for name, _ in self.final.linearized]
-        q0 = {c.symbol: linear.equilibrium[c.name] for c in self.model.coordinates}
-        about = ", ".join(f"{k} = {fmt(v)}" for k, v in linear.equilibrium.items())
-        return [self.linear_equation(name, entry, linear, q0, about)
-                for name, entry in self.final.linearized]
-
-    def linear_equation(self, name, entry: Entry, linear, q0, about) -> Finding:
-        model, item = self.model, f"linearized.{name}"
-        i = self.names.index(name)
-        unknowns = [*model.q_ddot, *model.q_dot, *model.q]
-        ours = [*linear.mass_matrix.row(i), *linear.damping_matrix.row(i),
-                *linear.stiffness_matrix.row(i)]
-        expected = f"{fmt(sp.Add(*(c * u for c, u in zip(ours, unknowns, strict=True))))} = 0"
-        user = entry.value
-        if not eq.is_linear([user], unknowns, self.random):
-            return Finding(item, "wrong", "not_linearized",
-                           f"your equation is not linear in {', '.join(map(str, unknowns))}: "
-                           f"about {about}, keep only first-order terms (sin(theta) ~ theta, "
-                           "cos(theta) ~ 1, products of small quantities dropped).", expected)
-        mine = [user.diff(u) for u in unknowns]
-        points = self.random if entry.relative is None else self.valued
-        zero = [eq.zero(c, points) for c in ours]
-        best, best_scale = [], None
-        for k in range(len(ours)):
-            if zero[k] or eq.zero(mine[k], points):
-                continue
-            scale = mine[k] / ours[k]
-            wrong = [j for j in range(len(ours))
-                     if not self.same(Entry(entry.text, mine[j], relative=entry.relative),
-                                      scale * ours[j])]
-            if best_scale is None or len(wrong) < len(best):
-                best, best_scale = wrong, scale
-        if best_scale is None:
-            return Finding(item, "wrong", "linear_coefficient",
-                           "your equation has no term in common with ours.", expected)
-        if best:
-            named = "; ".join(f"the coefficient of {unknowns[j]} is {fmt(eq.display(mine[j]))} "
-                              f"in yours, ours is {fmt(eq.display(best_scale * ours[j]))}"
-                              for j in best[:4])
-            return Finding(item, "wrong", "linear_coefficient",
-                           f"{named} (ours scaled to match your other terms; about {about}).",
-                           expected)
-        offset = user.xreplace(dict.fromkeys(unknowns, 0))
-        absolute = offset + sum((c * q0[q] for c, q in zip(mine[-len(model.q):], model.q,
-                                                            strict=True)), sp.S.Zero)
-        if eq.zero(absolute, points) or eq.zero(offset, points):
-            form = ("" if eq.zero(absolute, points) else
-                    " (read in the deviations from the equilibrium)")
-            return Finding(item, "correct", None, f"the linearization of ours about {about}, up "
-                           f"to a factor{form}.", None)
-        return Finding(item, "wrong", "linear_offset",
-                       f"your equation is not zero at the equilibrium {about}: its constant "
-                       f"term is {fmt(eq.display(offset))}. Write it in the coordinates or in "
-                       "their deviations from the equilibrium.", expected)
 
 
 def _shown(entry: Entry) -> str:

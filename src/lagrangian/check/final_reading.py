@@ -1,5 +1,5 @@
 """The final answers of an answer file read: matrices, frequencies, mode shapes, linearized
-equations, generalized forces at a configuration, equilibria (tables of ANSWER.toml that
+equations, generalized forces at a configuration, equilibria, statics loads (tables of ANSWER.toml that
 model/answer.py keeps as written); errors name the file, the table and the field.
 
 A decimal number keeps the precision it was written with: "4.43 rad/s" is 3 significant figures,
@@ -18,7 +18,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..model.answer import FREQUENCY_KEYS, MATRICES
-from ..model.model import Model
+from ..model.model import Model, multiplier_name
 from ..model.reader import check_known_keys
 from ..model.units import generalized_force_unit, parse_quantity
 
@@ -78,11 +78,13 @@ class FinalAnswers:
     forces_at: tuple[tuple[str, float], ...] | None = None
     forces: tuple[tuple[str, Written], ...] = ()
     equilibria: tuple[tuple[str, tuple[Written, ...]], ...] = ()
+    statics_at: tuple[tuple[str, float], ...] | None = None  # [statics] at (SI)
+    statics: tuple[tuple[str, Written], ...] = ()  # load magnitudes, then reactions lambda_<c>
 
     @property
     def is_empty(self) -> bool:
         return not (self.matrices or self.frequencies or self.damping_ratios or self.mode_shapes
-                    or self.linearized or self.forces or self.equilibria)
+                    or self.linearized or self.forces or self.equilibria or self.statics)
 
 
 SLACK = 1e-9  # relative: a value that rounds to the written one, up to float rounding
@@ -168,6 +170,8 @@ def read_final_answers(data: Mapping, model: Model,
         fields.update(reader.forces(forces))
     if "equilibria" in data:
         fields["equilibria"] = reader.equilibria(_table(data, "equilibria", source))
+    if "statics" in data:
+        fields.update(reader.statics(_table(data, "statics", source)))
     return FinalAnswers(order=tuple(order), **fields)
 
 
@@ -345,6 +349,28 @@ class _Reader:
             raise self.fail(f"give each coordinate's positions ({', '.join(self.order)} = "
                             f"[...])", "equilibria")
         return tuple(result)
+
+    def statics(self, table: Mapping) -> dict:
+        """[statics]: at = { theta = "40deg" } and each load magnitude solved for (a parameter,
+        "148 N"), optionally the reactions (lambda_<constraint>, SI or with a unit)."""
+        model = self.model
+        parameters = {p.name: p.unit for p in model.parameters}
+        reactions = [multiplier_name(c.name) for c in model.constraints]
+        _known(table, ("at", *parameters, *reactions), "statics", self.source,
+               what="key, parameter or multiplier")
+        if "at" not in table:
+            raise self.fail("give the configuration as at = { coordinate = value, ... } "
+                            "(coordinates left out follow the constraints)", "statics.at")
+        at = self._configuration(table["at"], "statics.at")
+        loads = [(name, read_written(table[name], unit or None, f"statics.{name}", self.source))
+                 for name, unit in parameters.items() if name in table]
+        if not loads:
+            raise self.fail("give each load magnitude you solved for as a parameter of the model "
+                            f"with its value (one of: {', '.join(parameters) or 'none'})",
+                            "statics")
+        loads += [(name, read_written(table[name], None, f"statics.{name}", self.source))
+                  for name in reactions if name in table]
+        return {"statics_at": at, "statics": tuple(loads)}
 
 
 def _order(value: object, coordinates: list[str], source: str) -> list[str]:

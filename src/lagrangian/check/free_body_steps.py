@@ -18,10 +18,11 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
+from ..kinds import FreeBodyKind
 from ..model.model import Model
 from ..model.notation import latex_symbol_names
 from . import equivalence as eq
-from .newton_euler import (
+from .free_bodies import (
     _AppliedForces,
     _Clock,
     _free_bodies,
@@ -45,7 +46,7 @@ class FreeBodyStep:
     """One free body: m a_G = sum F + R and, for a planar body, I alpha = sum M_G + M_R."""
 
     body: str
-    kind: str                             # particle, body, body in space
+    kind: FreeBodyKind                    # particle, body, body in space
     mass: sp.Expr
     acceleration: tuple[sp.Expr, ...]     # a_G (m/s^2), by d^2 r_G/dt^2
     forces: tuple[AppliedForce, ...]
@@ -183,8 +184,8 @@ def crosscheck_steps(eom: EquationsOfMotion) -> CrosscheckSteps:
     steps = []
     for fb in bodies:
         reaction = tuple(fb.mass * a - f for a, f in zip(fb.acceleration, fb.force, strict=True))
-        kind = "body in space" if fb.rotation is not None else \
-            "body" if fb.angle is not None else "particle"
+        kind = FreeBodyKind.BODY_IN_SPACE if fb.rotation is not None else \
+            FreeBodyKind.BODY if fb.angle is not None else FreeBodyKind.PARTICLE
         planar = fb.angle is not None and fb.rotation is None
         steps.append(FreeBodyStep(
             fb.name, kind, fb.mass, tuple(fb.acceleration), tuple(recorder.placed[fb.name]),

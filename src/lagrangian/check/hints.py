@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from ..kinds import FindingStatus
 from .diagnose import CheckReport, Finding
 
 
@@ -50,6 +51,11 @@ HINTS: dict[str, Hint] = {
     "equation_equivalent": Hint("An equivalent form", "Is mine ours multiplied through or "
                                 "combined with another equation?",
                                 "Equivalent equations give the same motion; yours is fine."),
+    "statics_load": _FORCE,
+    "statics_potential": _SIGN,
+    "statics_value": Hint("A load that holds it", "Is δW = 0 for every admissible δq, with "
+                          "every load's, weight's and spring's virtual work?",
+                          "Ideal reactions do no virtual work; sum the rest and solve."),
     "units_mismatch": Hint("Units", "Does every term have the same units (T and V in J, Q in J "
                            "per unit of its coordinate)?", "Check each term's units."),
 }
@@ -70,7 +76,7 @@ def hinted(report: CheckReport) -> CheckReport:
 
 
 def _hinted(finding: Finding) -> Finding:
-    if finding.status == "correct":
+    if finding.status == FindingStatus.CORRECT:
         return replace(finding, expected=None)
     hint = hint_for(finding.code)
     return replace(finding, message=f"{hint.question} {hint.correction}", expected=None)

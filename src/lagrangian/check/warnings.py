@@ -30,6 +30,7 @@ def model_warnings(model: Model, eom: EquationsOfMotion | None = None) -> list[s
             (eom is None or "g" not in eom.parameters_used):
         lines.append("parameter 'g' is declared but the model has no [gravity]: the potential "
                      "holds no weight (add a [gravity] table, or remove g)")
+    lines += fixed_root_warnings(model)
     if model.kinematic_tree is None:  # a URDF robot's numbers are SI by the format
         try:
             report = check_model_units(model)
@@ -46,6 +47,19 @@ def model_warnings(model: Model, eom: EquationsOfMotion | None = None) -> list[s
             lines.append(f"units: {len(issues) - MOST_UNIT_LINES} more inconsistent terms "
                          "(see `units`)")
     return lines
+
+
+def fixed_root_warnings(model: Model) -> list[str]:
+    """A URDF robot loaded with a fixed base whose root link carries mass that no joint of the
+    file fixes (a root named 'world' is the file's own word for the ground): a legged robot's
+    trunk, probably meant to float."""
+    tree = model.kinematic_tree
+    if tree is None or tree.floating_base or tree.root_mass <= 0 or tree.root_link == "world":
+        return []
+    return [f"the root link '{tree.root_link}' (with the links welded to it) carries "
+            f"{tree.root_mass:.6g} kg and no joint of the URDF fixes it: loaded with a fixed "
+            "base, bolted to the world (a robot that walks or flies: dynamics, kinematics or "
+            "codegen --floating-base, load(path, floating_base=True))"]
 
 
 def setting_warnings(eom: EquationsOfMotion, names: Iterable[str]) -> list[str]:

@@ -10,7 +10,7 @@ import typer
 from ..errors import InputError, ModelError
 from ..output.files import write_c
 from . import app
-from .common import GRAVITY_HELP, PAYLOAD_HELP, load_system
+from .common import FLOATING_HELP, GRAVITY_HELP, PAYLOAD_HELP, load_system
 
 LANGUAGES = ("c",)
 
@@ -24,6 +24,7 @@ def codegen(
     lock: Annotated[list[str], typer.Option("--lock", help="URDF: freeze a joint, NAME=VALUE.")] = [],  # noqa: B006
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
     payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
+    floating_base: Annotated[bool, typer.Option("--floating-base", help=FLOATING_HELP)] = False,
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
 ) -> None:
     """Write M(q), bias C q_dot + g, gravity, inverse and forward dynamics and the energies as
@@ -33,7 +34,7 @@ def codegen(
     directory = Path(out)
     if directory.exists() and not directory.is_dir():
         raise InputError("exists and is not a directory", field=f"--out {out}")
-    system = load_system(model, set_, lock, gravity, payload)
+    system = load_system(model, set_, lock, gravity, payload, floating_base)
     if any(v is None for v in system.parameters.values()):
         missing = [k for k, v in system.parameters.items() if v is None]
         raise InputError(f"parameters without a value: {', '.join(missing)} (give them with --set)",

@@ -42,6 +42,8 @@ FLAG_OF_FIELD = {
     "fps": "--fps",
     "mode": "--mode",
     "lock": "--lock",
+    "floating_base": "--floating-base",
+    "q": "--q",
     "keep": "--keep",
     "speed": "--speed",
     "out": "--out",
@@ -50,6 +52,14 @@ FLAG_OF_FIELD = {
     "reference": "--reference",
     "f_ext": "--wrench",
     "armature": "--armature",
+    "controller": "--control",
+    "linear_model": "--control",
+    "inputs": "--inputs",
+    "Q": "--Q",
+    "R": "--R",
+    "Kp": "--kp",
+    "Kd": "--kd",
+    "q_des": "--about",
 }
 
 SET_HELP = "Override a parameter: NAME=VALUE; repeat, or join with commas (m=2,L=0.5)."
@@ -61,6 +71,9 @@ FPS_HELP = "Frames a second of the animation (1 to 120)."
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
 PAYLOAD_HELP = ("URDF: a point mass fixed to a link, LINK=MASS[@X,Y,Z] (kg; m in the link's "
                 "frame, default its origin); repeatable.")
+FLOATING_HELP = ("URDF: a free-flyer joint under the root link (a robot that walks or flies): q is "
+                 "the base's x,y,z and quaternion qx,qy,qz,qw, then the joints; v the base's "
+                 "twist vx..wz in its own axes, then the joint rates.")
 GRAVITY_HELP = ("Gravity as a vector in world axes, GX,GY,GZ in m/s^2 (default: the model's; "
                 "a URDF's is 0,0,-9.81).")
 
@@ -77,7 +90,8 @@ def in_flags(error: LagrangianError) -> LagrangianError:
 
 
 def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = (),
-                gravity: str | None = None, payload: Iterable[str] = ()) -> System:
+                gravity: str | None = None, payload: Iterable[str] = (),
+                floating_base: bool = False) -> System:
     """The system of a model file or built-in example, with --set overrides applied (and a
     URDF's joints frozen by --lock NAME=VALUE, its gravity turned by --gravity GX,GY,GZ; a
     later --set g=... rescales that vector's magnitude)."""
@@ -86,9 +100,11 @@ def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = 
     locked = {name: parse_quantity(text, None, f"--lock {name}")
               for name, text in assignments(lock, "--lock")}
     carried = payloads(payload)
+    freed = {"floating_base": True} if floating_base else {}
     with warnings.catch_warnings(record=True) as seen:  # what the reader left out, one line each
         warnings.simplefilter("always", ModelWarning)
-        system = load(model, lock=locked, payload=carried) if locked or carried else load(model)
+        system = load(model, lock=locked, payload=carried, **freed) \
+            if locked or carried or freed else load(model)
     for warning in seen:
         if issubclass(warning.category, ModelWarning):
             warn(str(warning.message))
@@ -177,7 +193,7 @@ def comma_separated(settings: Iterable[str]) -> list[str]:
     return [part for setting in settings for part in _NEXT_ASSIGNMENT.split(setting)]
 
 
-_NEXT_ASSIGNMENT = re.compile(r",(?=\s*[A-Za-z_][A-Za-z0-9_]*\s*=)")
+_NEXT_ASSIGNMENT = re.compile(r",(?=\s*[A-Za-z_][A-Za-z0-9_.\-]*\s*=)")  # link.mass= too
 
 
 def payloads(settings: Iterable[str]) -> dict[str, tuple[float, tuple[float, ...]]]:

@@ -26,6 +26,7 @@ def derive(
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     steps: Annotated[bool, typer.Option("--steps", help="Show the working: dL/dq_dot, its d/dt, dL/dq, Q and each load's virtual work (a 'steps' key in JSON).")] = False,  # noqa: E501
+    steps_full: Annotated[bool, typer.Option("--steps-full", help="--steps with every step printed, however large (a step over 1000 nodes is otherwise given by its size; the JSON is always complete).")] = False,  # noqa: E501
     standalone: Annotated[bool, typer.Option("--standalone", help="With --format latex: a complete document for pdflatex (title, amsmath), not a fragment.")] = False,  # noqa: E501
 ) -> None:
     """Derive the equations of motion by Lagrange's method."""
@@ -38,7 +39,7 @@ def derive(
     if standalone and (json_ or format is not Format.latex):
         raise InputError("--standalone writes a LaTeX document; give it with --format latex",
                          field="--standalone")
-    working = eom.steps() if steps else None
+    working = eom.steps() if steps or steps_full else None
     if json_ or format is Format.json:
         document = derivation_document(eom)
         if working is not None:
@@ -52,7 +53,7 @@ def derive(
             from ..output.steps import steps_latex
 
             end = "\\end{document}"
-            working_latex = steps_latex(working)
+            working_latex = steps_latex(working, full=steps_full)
             latex = (latex.replace(end, working_latex + end) if standalone and end in latex
                      else latex + working_latex)
         typer.echo(latex, nl=False)
@@ -61,4 +62,4 @@ def derive(
         if working is not None:
             from ..output.steps import steps_text
 
-            typer.echo("\n" + steps_text(working), nl=False)
+            typer.echo("\n" + steps_text(working, full=steps_full), nl=False)

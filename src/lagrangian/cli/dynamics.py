@@ -10,7 +10,15 @@ import typer
 
 from ..errors import DerivationError, DynamicsWarning, InputError
 from . import app
-from .common import GRAVITY_HELP, PAYLOAD_HELP, load_system, print_json, warn, warn_bare_angles
+from .common import (
+    FLOATING_HELP,
+    GRAVITY_HELP,
+    PAYLOAD_HELP,
+    load_system,
+    print_json,
+    warn,
+    warn_bare_angles,
+)
 
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
 WRENCH_HELP = ("URDF: a wrench on a frame, FRAME=fx,fy,fz,mx,my,mz (N, N m; world axes, at the "
@@ -38,6 +46,28 @@ def _vector(text: str | None, n: int, flag: str, default: list[float]) -> list[f
     return [parse_quantity(p, None, flag) for p in parts]
 
 
+_LINK_UNITS = {"mass": "kg", "com_x": "m", "com_y": "m", "com_z": "m"}
+
+
+def _link_settings(settings: list[str]) -> tuple[list[str], dict[str, float | str]]:
+    """--set entries split: the model's parameters (NAME=VALUE), and a link's inertial
+    (LINK.FIELD=VALUE, read in SI by the field's unit; a name the library refuses by itself)."""
+    from .. import parse_quantity
+    from .common import assignments, comma_separated
+
+    own, inertials = [], {}
+    for setting in comma_separated(settings):
+        name = setting.partition("=")[0].strip()
+        if "." not in name:
+            own.append(setting)
+            continue
+        ((name, text),) = assignments([setting], "--set")
+        field = name.rpartition(".")[2]
+        unit = _LINK_UNITS.get(field, "kg*m^2" if field[:1] == "i" and len(field) == 3 else None)
+        inertials[name] = parse_quantity(text, unit, f"--set {name}") if unit else text
+    return own, inertials
+
+
 @app.command()
 def dynamics(
     model: Annotated[str, typer.Argument(help="Model file (TOML or URDF) or built-in example name.")],
@@ -48,11 +78,13 @@ def dynamics(
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
     payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
-    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
+    floating_base: Annotated[bool, typer.Option("--floating-base", help=FLOATING_HELP)] = False,
+    set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE; a URDF link's inertial LINK.mass, LINK.com_x (y, z), LINK.ixx (ixy, ixz, iyy, iyz, izz), SI.")] = [],  # noqa: B006,E501
     wrench: Annotated[list[str], typer.Option("--wrench", help=WRENCH_HELP)] = [],  # noqa: B006
     actuators: Annotated[bool, typer.Option("--actuators", help="URDF: add each joint's <dynamics> damping (viscous) and friction (Coulomb) to the bias forces.")] = False,  # noqa: E501
     armature: Annotated[list[str], typer.Option("--armature", help=ARMATURE_HELP)] = [],  # noqa: B006
     coriolis: Annotated[bool, typer.Option("--coriolis", help="Also print C(q, q_dot), the matrix of the Coriolis and centrifugal terms (M_dot - 2C skew).")] = False,  # noqa: E501
+    derivatives: Annotated[bool, typer.Option("--derivatives", help="With --a: d tau/dq and d tau/dq_dot; with --tau: d q_ddot/dq, d q_ddot/dq_dot and d q_ddot/d tau.")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Mass matrix, bias forces C q_dot + g, gravity, inverse or forward dynamics, energies."""
@@ -67,30 +99,41 @@ def dynamics(
     if wrench and a is None and tau is None:
         raise InputError("a wrench acts in inverse (--a) or forward (--tau) dynamics; give one",
                          field="--wrench")
+    if derivatives and a is None and tau is None:
+        raise InputError("needs --a (inverse dynamics) or --tau (forward dynamics) to "
+                         "differentiate", field="--derivatives")
+    if derivatives and (wrench or actuators or armature):
+        raise InputError("the derivatives are the rigid body's: without --wrench, --actuators "
+                         "or --armature (not yet)", field="--derivatives")
     from .. import parse_quantity
     from .common import assignments
 
     wrenches = _wrenches(wrench)
     rotors = {name: parse_quantity(text, None, f"--armature {name}")
               for name, text in assignments(armature, "--armature")}
-    system = load_system(model, set_, lock, gravity, payload)
+    own, inertials = _link_settings(set_)
+    system = load_system(model, own, lock, gravity, payload, floating_base)
     coordinates = system.model.coordinates
-    n = len(coordinates)
     start = resolve_state(system.model)  # the model's own initial state (the library's defaults)
-    qs = _vector(q, n, "--q", list(start.q))
+    names_q, names_v, base_q, base_v = base_layout(system)
+    qs = _vector(q, len(names_q), "--q", base_q + list(start.q))
     if q is not None:  # --q 30,0 means 30 rad for an angle
         from .. import state_units
 
         names = [c.name for c in coordinates]
-        texts = [part.strip() for part in q.split(",")]
+        texts = [part.strip() for part in q.split(",")][len(base_q):]
+        joints = qs[len(base_q):]
         warn_bare_angles("--q", zip(names, texts, strict=True), state_units(system.model),
-                         dict(zip(names, qs, strict=True)))
+                         dict(zip(names, joints, strict=True)))
         from .. import limit_warnings
 
-        for line in limit_warnings(system.model, dict(zip(names, qs, strict=True)), "--q"):
+        for line in limit_warnings(system.model, dict(zip(names, joints, strict=True)), "--q"):
             warn(line)
-    vs = _vector(v, n, "--v", list(start.q_dot))
-    f = system.dynamics(actuators=actuators, armature=rotors or None)
+    n = len(names_v)
+    vs = _vector(v, n, "--v", base_v + list(start.q_dot))
+    # a link's inertial (--set fore.mass=3) is a runtime parameter of the robot's dynamics
+    f = system.dynamics(parameters=inertials or None, actuators=actuators,
+                        armature=rotors or None)
     with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings(record=True) as seen:
         # an overflow is refused below; a state without dynamics (M not positive definite)
         # is a DynamicsWarning and NaN, reported in one line
@@ -101,10 +144,16 @@ def dynamics(
             values["a"] = _vector(a, n, "--a", [])
             values["inverse_dynamics"] = f.inverse_dynamics(qs, vs, values["a"],
                                                             f_ext=wrenches or None)
+            if derivatives:
+                values["dtau_dq"], values["dtau_dv"] = (  # + 0.0: no -0 printed
+                    x + 0.0 for x in f.inverse_dynamics_derivatives(qs, vs, values["a"]))
         if tau is not None:
             values["tau"] = _vector(tau, n, "--tau", [])
             values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"],
                                                             f_ext=wrenches or None)
+            if derivatives:
+                values["dqdd_dq"], values["dqdd_dv"], values["dqdd_dtau"] = (
+                    x + 0.0 for x in f.forward_dynamics_derivatives(qs, vs, values["tau"]))
         if coriolis:
             values["coriolis_matrix"] = f.coriolis_matrix(qs, vs)
         values["kinetic_energy"] = f.kinetic_energy(qs, vs)
@@ -123,13 +172,24 @@ def dynamics(
             raise DerivationError(f"the {key.replace('_', ' ')} is not finite at this state "
                                   "(a number beyond floating point, or a state outside the "
                                   "model's domain)")
-    names = [c.name for c in coordinates]
+    velocities = names_v if base_q else None
     extra = {}
     if wrenches:
         extra["wrenches"] = wrenches
     if actuators or rotors:
         extra["actuators"] = f.actuators
     if json_:
-        print_json({**dynamics_document(names, values, system.joint_names), **extra})
+        print_json({**dynamics_document(names_q, values, system.joint_names, velocities),
+                    **extra})
     else:
-        typer.echo(dynamics_text(names, values, extra), nl=False)
+        typer.echo(dynamics_text(names_q, values, velocities, extra), nl=False)
+
+
+def base_layout(system):
+    """The names of q and v, and a floating base's default numbers before the joints' (at the
+    world's origin, unturned, at rest): none for a fixed base."""
+    joints = [c.name for c in system.model.coordinates]
+    if not getattr(system.model.kinematic_tree, "floating_base", False):
+        return joints, joints, [], []
+    f = system.dynamics()
+    return list(f.coordinates), list(f.velocity_names), [0.0] * 6 + [1.0], [0.0] * 6

@@ -10,8 +10,8 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import load_system, print_json
-from .dynamics import LOCK_HELP, _vector
+from .common import FLOATING_HELP, load_system, print_json
+from .dynamics import LOCK_HELP, _vector, base_layout
 
 
 @app.command()
@@ -23,6 +23,7 @@ def kinematics(
     centroidal: Annotated[bool, typer.Option("--centroidal", help="Also print the centroidal momentum matrix A_g (and with --v the momentum A_g q_dot).")] = False,  # noqa: E501
     reference: Annotated[str, typer.Option("--reference", help="The Jacobian's frame: local_world_aligned (the origin's velocity in world axes), local or world, as Pinocchio's.")] = "local_world_aligned",  # noqa: E501
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
+    floating_base: Annotated[bool, typer.Option("--floating-base", help=FLOATING_HELP)] = False,
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
@@ -30,16 +31,16 @@ def kinematics(
     from .. import resolve_state
     from ..output.kinematics import kinematics_document, kinematics_text
 
-    system = load_system(model, set_, lock)
-    coordinates = system.model.coordinates
-    qs = _vector(q, len(coordinates), "--q", list(resolve_state(system.model).q))
+    system = load_system(model, set_, lock, floating_base=floating_base)
+    names, velocities, base_q, _ = base_layout(system)
+    qs = _vector(q, len(names), "--q", base_q + list(resolve_state(system.model).q))
     robot = system.dynamics().kinematics
     name = frame if frame is not None else robot.frames[-1]
     values = {"q": qs, "placement": robot.placement(qs, name),
               "jacobian": robot.jacobian(qs, name, reference),
               "center_of_mass": robot.center_of_mass(qs),
               "center_of_mass_jacobian": robot.center_of_mass_jacobian(qs)}
-    vs = None if v is None else _vector(v, len(coordinates), "--v", [])
+    vs = None if v is None else _vector(v, len(velocities), "--v", [])
     if vs is not None:
         values["v"] = vs
         values["jacobian_dot_times_v"] = robot.jacobian_dot_times_v(qs, vs, name, reference)
@@ -47,8 +48,8 @@ def kinematics(
         values["centroidal_momentum_matrix"] = robot.centroidal_momentum_matrix(qs)
         if vs is not None:
             values["centroidal_momentum"] = values["centroidal_momentum_matrix"] @ vs
-    names = [c.name for c in coordinates]
+    velocities = velocities if base_q else None
     if json_:
-        print_json(kinematics_document(names, name, reference, values))
+        print_json(kinematics_document(names, name, reference, values, velocities))
     else:
-        typer.echo(kinematics_text(names, name, reference, values), nl=False)
+        typer.echo(kinematics_text(names, name, reference, values, velocities), nl=False)

@@ -33,22 +33,14 @@ STEADY_HELP = ("Steady motion: a cyclic coordinate's constant rate, NAME_dot=VAL
 
 
 def steady_assignments(system, settings: list[str]) -> dict[str, float | str]:
-    """--steady NAME_dot=VALUE: a quantity (10, 600rpm), else the text, which the library reads
-    as an expression in the parameters (-v/rR) or refuses by name."""
-    import re
+    """--steady NAME_dot=VALUE: the library reads each as a quantity (10, 600rpm) or as an
+    expression in the parameters (-v/rR), or refuses it (lagrangian.parse_steady_rates)."""
+    from .. import parse_steady_rates, state_units
+    from .common import assignments, comma_separated, warn_bare_angles
 
-    from ..errors import ModelError
-    from .common import assignments, comma_separated
-
-    parameters = {p.name for p in system.model.parameters}
-    rates: dict[str, float | str] = {}
-    for name, text in assignments(comma_separated(settings), "--steady"):
-        try:
-            rates |= state_assignments(system, [f"{name}={text}"], "--steady")
-        except ModelError:
-            if not parameters & set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", text)):
-                raise
-            rates[name] = text
+    pairs = assignments(comma_separated(settings), "--steady")
+    rates = parse_steady_rates(system.model, dict(pairs))
+    warn_bare_angles("--steady", pairs, state_units(system.model), rates)
     return rates
 
 

@@ -47,6 +47,13 @@ def simulate(
     fps: Annotated[int | None, typer.Option("--fps", help=FPS_HELP + " Default 20.")] = None,
     stop_when: Annotated[str | None, typer.Option("--stop-when", help="Stop when a condition turns true, e.g. \"theta < 0\".")] = None,  # noqa: E501
     ignore_limits: Annotated[bool, typer.Option("--ignore-limits", help="URDF: run through the joints' position limits (by default a joint reaching one ends the run, status 'limit').")] = False,  # noqa: E501
+    control: Annotated[str | None, typer.Option("--control", help="Close the loop: lqr (about --about, inputs --inputs, weights --Q, --R) or computed-torque (to the configuration --about, gains --kp, --kd).")] = None,  # noqa: E501
+    about: Annotated[list[str], typer.Option("--about", help="--control: the equilibrium (lqr) or target (computed-torque), NAME=VALUE; others solved for or at their initial values.")] = [],  # noqa: B006,E501
+    control_inputs: Annotated[list[str], typer.Option("--inputs", help="--control lqr: the loads, parameters or coordinates it drives (F); repeat, or separate by commas.")] = [],  # noqa: B006,E501
+    q_weight: Annotated[str, typer.Option("--Q", help="--control lqr: state weight, a number or the diagonal (x then x_dot), comma-separated.")] = "1",  # noqa: E501
+    r_weight: Annotated[str, typer.Option("--R", help="--control lqr: input weight, a number or the diagonal.")] = "1",  # noqa: E501
+    kp: Annotated[str, typer.Option("--kp", help="--control computed-torque: position gain (1/s^2), a number or the diagonal.")] = "100",  # noqa: E501
+    kd: Annotated[str, typer.Option("--kd", help="--control computed-torque: rate gain (1/s), a number or the diagonal.")] = "20",  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
@@ -60,6 +67,7 @@ def simulate(
         check_size,
         check_view,
     )
+    from ..output.control import controller_text
     from ..output.files import check_output_path, partial_path
     from ..output.plots import check_plot_path
     from ..output.simulation import projection_warning, simulation_document, simulation_text
@@ -98,12 +106,14 @@ def simulate(
             check_output_path(path, field, inputs=inputs)
     if animate is not None:  # free, or an animation this project wrote: never another file
         check_animation_target(animate)
+    controller = _controller(system, control, about, control_inputs, q_weight, r_weight, kp, kd)
 
     with _Progress(end) as progress:
         simulation = system.simulate(
             end, initial=start, method=step_control.method,
             rtol=step_control.rtol, atol=step_control.atol, samples=save_at.samples,
             stop_when=stop, progress=progress.update, limits=not ignore_limits,
+            controller=controller,
         )
     warning = projection_warning(simulation)
     if warning:
@@ -128,9 +138,14 @@ def simulate(
         written["animate"] = str(target)
 
     if json_:
-        print_json(simulation_document(simulation, written))
+        document = simulation_document(simulation, written)
+        if controller is not None:
+            document["control"] = {"kind": control, **controller.summary()}
+        print_json(document)
     else:
         typer.echo(simulation_text(simulation, written), nl=False)
+        if controller is not None:
+            typer.echo(controller_text(controller))
     if simulation.status == RunStatus.FAILED:
         saved = f"; partial result saved to {', '.join(written.values())}" if written else ""
         typer.echo(f"error: integration failed: {simulation.message}{saved}", err=True)
@@ -139,6 +154,47 @@ def simulate(
         saved = f"; partial result saved to {', '.join(written.values())}" if written else ""
         typer.echo(f"{simulation.message}{saved}", err=True)
         raise SystemExit(130)
+
+
+def _controller(system, control, about, inputs, q_weight, r_weight, kp, kd):
+    """The controller --control names, built by lagrangian.control; None without --control."""
+    from .. import computed_torque, lqr
+    from ..errors import InputError
+    given = {"--about": about, "--inputs": inputs, "--Q": q_weight != "1", "--R": r_weight != "1",
+             "--kp": kp != "100", "--kd": kd != "20"}
+    used = {None: (), "lqr": ("--about", "--inputs", "--Q", "--R"),
+            "computed-torque": ("--about", "--kp", "--kd")}
+    if control not in used:
+        raise InputError(f"unknown controller {control!r} (lqr or computed-torque)",
+                         field="controller")
+    stray = [flag for flag, value in given.items() if value and flag not in used[control]]
+    if stray:
+        raise InputError(f"{stray[0]} is not used by "
+                         f"{'--control ' + control if control else 'a run without --control'}",
+                         field="controller")
+    if control is None:
+        return None
+    point = state_assignments(system, about, "--about") or None
+    if control == "lqr":
+        names = [name.strip() for text in inputs for name in text.split(",") if name.strip()]
+        if not names:
+            raise InputError("--control lqr needs --inputs: the loads or coordinates it drives",
+                             field="inputs")
+        model = system.linearize(point, inputs=names)
+        return lqr(model, _numbers(q_weight, "Q"), _numbers(r_weight, "R"))
+    return computed_torque(system, point or {}, _numbers(kp, "Kp"), _numbers(kd, "Kd"))
+
+
+def _numbers(text: str, field: str):
+    """A number or a comma-separated diagonal."""
+    from ..errors import InputError
+
+    try:
+        values = [float(part) for part in text.split(",")]
+    except ValueError:
+        raise InputError(f"expected a number or comma-separated numbers, got {text!r}",
+                         field=field) from None
+    return values[0] if len(values) == 1 else values
 
 
 class _Progress:

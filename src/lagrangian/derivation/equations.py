@@ -10,7 +10,7 @@ import sympy as sp
 from ..kinds import InvariantKind
 from ..model.model import Model
 from ..model.notation import join_terms, model_latex_printer
-from .display import ModelMatrix
+from .display import ModelMatrix, model_scalar
 
 
 @dataclass(frozen=True)
@@ -51,6 +51,8 @@ class EquationsOfMotion:
         for name in ("mass_matrix", "forcing", "generalized_forces", "constraint_jacobian",
                      "velocity_bias", "acceleration_rhs", "multipliers"):
             object.__setattr__(self, name, ModelMatrix.of(getattr(self, name)))
+        for name in ("potential_energy", "dissipation"):  # and the scalars: theta_dot as a dot
+            object.__setattr__(self, name, model_scalar(getattr(self, name)))
 
     @cached_property
     def kinetic_energy(self) -> sp.Expr:
@@ -64,7 +66,7 @@ class EquationsOfMotion:
                       for i in range(n) if mass[i, i] != 0]
             terms += [mass[i, j] * q_dot[i] * q_dot[j]
                       for i in range(n) for j in range(i + 1, n) if mass[i, j] != 0]
-        return sp.Add(*terms)
+        return model_scalar(sp.Add(*terms))
 
     @cached_property
     def parameters_used(self) -> frozenset[str]:
@@ -100,15 +102,15 @@ class EquationsOfMotion:
 
     @property
     def coordinates(self) -> sp.ImmutableMatrix:
-        return sp.ImmutableMatrix(self.model.q)
+        return ModelMatrix.of(sp.ImmutableMatrix(self.model.q))
 
     @property
     def velocities(self) -> sp.ImmutableMatrix:
-        return sp.ImmutableMatrix(self.model.q_dot)
+        return ModelMatrix.of(sp.ImmutableMatrix(self.model.q_dot))
 
     @property
     def acceleration_symbols(self) -> sp.ImmutableMatrix:
-        return sp.ImmutableMatrix(self.model.q_ddot)
+        return ModelMatrix.of(sp.ImmutableMatrix(self.model.q_ddot))
 
     @property
     def constraint_names(self) -> tuple[str, ...]:
@@ -117,7 +119,7 @@ class EquationsOfMotion:
     @property
     def lagrangian(self) -> sp.Expr:
         """L = T - V (J)."""
-        return self.kinetic_energy - self.potential_energy
+        return model_scalar(self.kinetic_energy - self.potential_energy)
 
     # -- what is conserved, and the work that changes it --------------------------------------
 
@@ -125,7 +127,7 @@ class EquationsOfMotion:
     def jacobi_integral(self) -> sp.Expr:
         """h = q_dot . dL/dq_dot - L (J); T + V when T is quadratic in q_dot and V has no q_dot."""
         L, q_dot = self.lagrangian, self.model.q_dot
-        return sp.Add(*(v * L.diff(v) for v in q_dot if v in L.free_symbols)) - L
+        return model_scalar(sp.Add(*(v * L.diff(v) for v in q_dot if v in L.free_symbols)) - L)
 
     @cached_property
     def explicit_time_power(self) -> sp.Expr:
@@ -143,7 +145,7 @@ class EquationsOfMotion:
         terms.append(self.explicit_time_power)
         terms += [lam * b for lam, b in zip(self.multipliers, self.velocity_bias, strict=True)
                   if b != 0]
-        return sp.Add(*terms)
+        return model_scalar(sp.Add(*terms))
 
     @cached_property
     def invariant_kind(self) -> str:
@@ -172,7 +174,7 @@ class EquationsOfMotion:
     def invariant(self) -> sp.Expr:
         """The monitored quantity (J): T + V for 'energy', the Jacobi integral h otherwise."""
         if self.invariant_kind == InvariantKind.ENERGY:
-            return self.kinetic_energy + self.potential_energy
+            return model_scalar(self.kinetic_energy + self.potential_energy)
         return self.jacobi_integral
 
     # -- statics ----------------------------------------------------------------------------

@@ -16,6 +16,7 @@ from collections import defaultdict
 
 import sympy as sp
 
+from ..errors import ModelError
 from ..model.model import Model, multiplier_name
 from .body_jacobians import takes_jacobian_form
 from .constraints import constraint_terms
@@ -110,6 +111,12 @@ def derive(model: Model, *, check: bool = True,
     Jacobians, unexpanded (True), term by term (False), or by the size of their expanded
     kinematics (None; see body_jacobians.py). Every other body takes the term-by-term path.
     """
+    tree = model.kinematic_tree
+    if tree is not None and tree.floating_base:  # its base moves by a quaternion, not by q
+        raise ModelError("a floating-base robot has no equations in its joint coordinates "
+                         "(derive, simulate, modes and the other symbolic commands need them): "
+                         "use dynamics(), its kinematics and integrate(q, v, dt), or load it "
+                         "with a fixed base")
     q, q_dot, t = model.q, model.q_dot, model.time
     n = len(q)
     acc = _Accumulator(n)

@@ -13,15 +13,27 @@ work delta W = sum_i Q_i delta q_i.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import singledispatch
 
 import sympy as sp
 
+from ..kinds import LoadStepKind
 from ..model.model import Damper, Model, PointForce, Torque
 from ..model.notation import latex_printer
 from ..model.rotations import Moment
+from .display import model_scalar
 from .equations import EquationsOfMotion
 from .kinematics import Differentiator
 from .virtual_work import DISSIPATION_LOAD
+
+
+def _dotted(step) -> None:
+    """Every expression of a step shown with its rates dotted in Jupyter (equal to itself)."""
+    for name, value in vars(step).items():
+        if isinstance(value, sp.Basic):
+            object.__setattr__(step, name, model_scalar(value))
+        elif isinstance(value, tuple) and all(isinstance(v, sp.Basic) for v in value):
+            object.__setattr__(step, name, tuple(model_scalar(v) for v in value))
 
 
 @dataclass(frozen=True)
@@ -36,6 +48,9 @@ class CoordinateStep:
     multiplier_terms: sp.Expr    # (Phi_q^T lambda)_i
     equation: sp.Expr            # momentum_rate - force_gradient - Q_i + multiplier terms (= 0)
 
+    def __post_init__(self):
+        _dotted(self)
+
 
 @dataclass(frozen=True)
 class LoadStep:
@@ -43,12 +58,15 @@ class LoadStep:
     and delta W = ``virtual_work`` (J) = sum_i ``shares`` Q_i delta q_i."""
 
     load: str
-    kind: str                            # force, torque, moment, damper, dissipation, given
+    kind: LoadStepKind                   # force, torque, moment, damper, dissipation, given
     acts_at: tuple[sp.Expr, ...]         # the point r, the angle, the damper's rate; () if none
     displacement: tuple[sp.Expr, ...]    # delta r, delta(angle) or delta(length); () if none
     work_form: sp.Expr | None            # delta W as the load writes it (F . delta r, tau d angle)
     virtual_work: sp.Expr                # sum_i Q_i delta q_i
     shares: tuple[tuple[str, sp.Expr], ...]
+
+    def __post_init__(self):
+        _dotted(self)
 
 
 @dataclass(frozen=True)
@@ -60,6 +78,9 @@ class ConstraintStep:
     expression: sp.Expr
     jacobian: tuple[sp.Expr, ...]
     multiplier: sp.Symbol
+
+    def __post_init__(self):
+        _dotted(self)
 
 
 @dataclass(frozen=True)
@@ -74,6 +95,9 @@ class DerivationSteps:
     coordinates: tuple[CoordinateStep, ...]
     loads: tuple[LoadStep, ...]
     constraints: tuple[ConstraintStep, ...]
+
+    def __post_init__(self):
+        _dotted(self)
 
     def coordinate(self, name: str) -> CoordinateStep:
         for step in self.coordinates:
@@ -172,33 +196,53 @@ def _load_steps(eom: EquationsOfMotion, variations, d: Differentiator) -> list[L
     steps = []
     for name, shares in by_load.items():
         work = sp.Add(*(value * variations[names.index(c)] for c, value in shares))
-        load, damper = loads.get(name), dampers.get(name)
-        acts_at: tuple = ()
-        displacement: tuple = ()
-        form = None
-        if isinstance(load, PointForce):
-            kind, acts_at = "force", tuple(load.point)
-            displacement = tuple(moved(r, q) for r in load.point)
-            form = sp.Add(*(f * dr for f, dr in zip(load.force, displacement, strict=True)))
-        elif isinstance(load, Torque):
-            kind, acts_at = "torque", (load.angle,)
-            displacement = (moved(load.angle, q),)
-            form = load.torque * displacement[0]
-        elif isinstance(load, Moment):
-            # delta phi_k = sum_i d omega_k/d q_dot_i delta q_i, in the axes the moment is given in
-            kind = "moment"
-            displacement = tuple(moved(w, q_dot) for w in load.angular_velocity)
-            form = sp.Add(*(m * dp for m, dp in zip(load.moment, displacement, strict=True)))
-        elif isinstance(damper, Damper):
-            # the rate l_dot is linear in q_dot: delta l = sum_i d l_dot/d q_dot_i delta q_i
-            kind, acts_at = "damper", (damper.rate,)
-            displacement = (moved(damper.rate, q_dot),)
-            form = -damper.coefficient * damper.rate * displacement[0]
+        component = loads.get(name, dampers.get(name))
+        if component is not None:
+            kind, acts_at, displacement, form = load_working(component, q, q_dot, moved)
         else:
-            kind = "dissipation" if name == DISSIPATION_LOAD else "given"
+            kind, acts_at, displacement, form = (
+                LoadStepKind.DISSIPATION if name == DISSIPATION_LOAD else LoadStepKind.GIVEN,
+                (), (), None)
         steps.append(LoadStep(name, kind, acts_at, displacement, form, work, tuple(shares)))
     return steps
 
 
 __all__ = ["ConstraintStep", "CoordinateStep", "DerivationSteps", "LoadStep", "derivation_steps",
            "variation_symbols"]
+
+
+# one entry per load kind and Damper (tests/model/test_component_tables.py walks every kind)
+@singledispatch
+def load_working(component, q, q_dot, moved) -> tuple[LoadStepKind, tuple, tuple, sp.Expr]:
+    """A load's kind, what it acts on, the virtual displacement of that (``moved(expr, x)`` is
+    sum_i d expr/d x_i delta q_i) and delta W as the load writes it (J)."""
+    raise TypeError(f"no virtual work for a component of kind {type(component).__name__}")
+
+
+@load_working.register
+def _(load: PointForce, q, q_dot, moved):
+    displacement = tuple(moved(r, q) for r in load.point)  # delta r
+    form = sp.Add(*(f * dr for f, dr in zip(load.force, displacement, strict=True)))
+    return LoadStepKind.FORCE, tuple(load.point), displacement, form
+
+
+@load_working.register
+def _(load: Torque, q, q_dot, moved):
+    displacement = (moved(load.angle, q),)  # delta(angle)
+    return LoadStepKind.TORQUE, (load.angle,), displacement, load.torque * displacement[0]
+
+
+@load_working.register
+def _(load: Moment, q, q_dot, moved):
+    # delta phi_k = sum_i d omega_k/d q_dot_i delta q_i, in the axes the moment is given in
+    displacement = tuple(moved(w, q_dot) for w in load.angular_velocity)
+    form = sp.Add(*(m * dp for m, dp in zip(load.moment, displacement, strict=True)))
+    return LoadStepKind.MOMENT, (), displacement, form
+
+
+@load_working.register
+def _(damper: Damper, q, q_dot, moved):
+    # the rate l_dot is linear in q_dot: delta l = sum_i d l_dot/d q_dot_i delta q_i
+    displacement = (moved(damper.rate, q_dot),)
+    form = -damper.coefficient * damper.rate * displacement[0]
+    return LoadStepKind.DAMPER, (damper.rate,), displacement, form

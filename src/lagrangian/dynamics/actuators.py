@@ -133,6 +133,16 @@ class ActuatedDynamics(Dynamics):
         """V(q) in J."""
         return self.rigid.potential_energy(q)
 
+    def _rigid_only(self, *args, **kwargs):
+        """Derivatives and the regressor are the rigid body's: with actuators they would leave
+        the damping, friction and armature out, so they are refused in one line."""
+        raise InputError("derivatives and the inertial regressor are the rigid body's: call "
+                         "them on dynamics() without actuators or armature (not yet with them)",
+                         field="actuators")
+
+    inverse_dynamics_derivatives = forward_dynamics_derivatives = _rigid_only
+    regressor = inertial_parameters = base_parameters = _rigid_only
+
 
 def actuated(rigid: Dynamics, model, armature: Mapping[str, float] | None = None,
              friction: bool = True) -> ActuatedDynamics:

@@ -6,6 +6,8 @@ Built on the joint models (joint_models.py): a joint moves its body by the motio
 S = (s_w, s_v) per unit of joint variable, so the Jacobian's column of a coordinate is, summed
 over the joints it drives (theta = k q + offset), k times S carried to the frame:
 angular s_w and linear s_v + s_w x (p - o), in world axes (p the frame's origin, o the joint's).
+A floating base (free_flyer.py) takes q of nq = n + 7 and gives Jacobians of nv = n + 6 columns:
+its six first, S = 1 in the base's axes.
 """
 
 from __future__ import annotations
@@ -13,7 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError, did_you_mean_or_list
+from ..kinds import JointKind
 from ..model.tree import KinematicTree
+from .free_flyer import BASE_CONFIGURATION, check_quaternions
 from .joint_models import joint_model
 
 REFERENCES = ("world", "local", "local_world_aligned")
@@ -26,8 +30,8 @@ class TreeKinematics:
 
     def __init__(self, tree: KinematicTree):
         self.tree = tree
-        self.n = len(tree.coordinates)
-        self.coordinates = tree.coordinates
+        self.n = len(tree.coordinates) + tree.base_nv  # the velocity's numbers (Jacobian columns)
+        self.coordinates = (BASE_CONFIGURATION if tree.floating_base else ()) + tree.coordinates
         self._frames = {f.name: f for f in tree.frames}
         self._models = [joint_model(j.kind) for j in tree.joints]
 
@@ -40,21 +44,29 @@ class TreeKinematics:
 
     def _q(self, q, field: str = "q") -> tuple[np.ndarray, tuple[int, ...]]:
         q = np.asarray(q, dtype=float)
-        if q.ndim == 0 or q.shape[-1] != self.n:
+        nq = len(self.coordinates)
+        if q.ndim == 0 or q.shape[-1] != nq:
             shape = "()" if q.ndim == 0 else str(q.shape)
-            raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) along the "
+            raise InputError(f"expected {nq} values ({', '.join(self.coordinates)}) along the "
                              f"last axis, got shape {shape}", field=field)
         batch = q.shape[:-1]
-        return q.reshape(-1, self.n), batch
+        if self.tree.floating_base:
+            check_quaternions(q.reshape(-1, nq))
+        return q.reshape(-1, nq), batch
 
     def _bodies(self, Q: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
         """Each body's rotation (N, 3, 3: body -> world) and origin (N, 3: m, world)."""
         count = len(Q)
         world = []
         for joint, model in zip(self.tree.joints, self._models, strict=True):
-            theta = joint.multiplier * Q[:, joint.coordinate] + joint.offset
-            R, p = model.placement_arrays(np.array(joint.rotation), np.array(joint.translation),
-                                          np.array(joint.axis), theta)
+            if joint.kind == JointKind.FREE_FLYER:
+                R, p = model.placement_arrays(np.array(joint.rotation),
+                                              np.array(joint.translation), Q[:, :7])
+            else:
+                theta = joint.multiplier * Q[:, self.tree.base_nq + joint.coordinate] + joint.offset
+                R, p = model.placement_arrays(np.array(joint.rotation),
+                                              np.array(joint.translation), np.array(joint.axis),
+                                              theta)
             R = np.broadcast_to(R, (count, 3, 3))
             p = np.broadcast_to(p, (count, 3))
             if joint.parent < 0:
@@ -106,15 +118,20 @@ class TreeKinematics:
         for k in self._ancestors(body):
             joint = self.tree.joints[k]
             R, o = bodies[k]
-            s_w, s_v = self._models[k].subspace(joint.axis)
-            column = np.zeros((len(Q), 6))
-            if s_w is not None:
-                w = R @ np.array(s_w)
-                column[:, 3:] += w
-                column[:, :3] += np.cross(w, point - o)
-            if s_v is not None:
-                column[:, :3] += R @ np.array(s_v)
-            J[:, :, joint.coordinate] += joint.multiplier * column
+            if joint.kind == JointKind.FREE_FLYER:  # six columns, the base's own
+                columns, first = self._models[k].columns(), 0
+            else:
+                columns = [self._models[k].subspace(joint.axis)]
+                first = self.tree.base_nv + joint.coordinate
+            for c, (s_w, s_v) in enumerate(columns):
+                column = np.zeros((len(Q), 6))
+                if s_w is not None:
+                    w = R @ np.array(s_w)
+                    column[:, 3:] += w
+                    column[:, :3] += np.cross(w, point - o)
+                if s_v is not None:
+                    column[:, :3] += R @ np.array(s_v)
+                J[:, :, first + c] += joint.multiplier * column
         return J
 
     def jacobian(self, q, frame: str, reference: str = "local_world_aligned") -> np.ndarray:

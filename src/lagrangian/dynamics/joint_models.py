@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kinds import JointKind
+from .free_flyer import FreeFlyerModel
 
 
 class _Terms(Protocol):  # the emitter's arithmetic (tree_emitter._Emitter)
@@ -34,6 +35,8 @@ class JointModel:
     kind: JointKind
     turns: bool
     slides: bool
+    nq: int = 1  # configuration numbers (a free flyer's: 7, free_flyer.py)
+    nv: int = 1  # velocity numbers
 
     def subspace(self, axis) -> tuple[list | None, list | None]:
         """S = (s_w, s_v): angular and linear velocity of the body per unit rate (None: zero)."""
@@ -65,14 +68,16 @@ class JointModel:
         return R, p
 
 
-JOINT_MODELS: dict[JointKind, JointModel] = {
+JOINT_MODELS: dict[JointKind, JointModel | FreeFlyerModel] = {
     JointKind.REVOLUTE: JointModel(JointKind.REVOLUTE, turns=True, slides=False),
     JointKind.PRISMATIC: JointModel(JointKind.PRISMATIC, turns=False, slides=True),
+    # a floating base: only at a tree's root, and only in numpy and frames.py (recursive.py)
+    JointKind.FREE_FLYER: FreeFlyerModel(),
 }
 
 
-def joint_model(kind: JointKind) -> JointModel:
-    """The model of a joint kind that a kinematic tree can move (one degree of freedom)."""
+def joint_model(kind: JointKind) -> JointModel | FreeFlyerModel:
+    """The model of a joint kind that a kinematic tree can move."""
     try:
         return JOINT_MODELS[JointKind(kind)]
     except KeyError:

@@ -32,6 +32,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, DynamicsWarning, InputError, ModelError
 from ..model.model import Model
 from ..model.values import resolve_parameters
+from .control_terms import ControlTerms
 from .frames import TreeKinematics, tree_kinematics
 from .reach_c import REFERENCE_INDEX
 
@@ -63,15 +64,16 @@ def solve_positive(mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
 
 
-class Dynamics:
+class Dynamics(ControlTerms):
     """Joint-space dynamics, batched over leading axes (SI units): M(q), the bias
     C(q, q_dot) q_dot + g(q), g(q), inverse and forward dynamics and the energies. The one type
     every path returns: this class evaluates the derived equations (a NumericSystem), and the
     recursive algorithms of a URDF tree (recursive.RecursiveDynamics in C,
     recursive_numpy.RecursiveNumpyDynamics in numpy) are its subclasses."""
 
-    coordinates: tuple[str, ...]
-    n: int
+    coordinates: tuple[str, ...]  # the configuration's names (nq of them)
+    n: int  # the velocity's numbers: M is n x n (nv; nq = n but for a floating base)
+    velocity_names: tuple[str, ...] | None = None  # where they differ from the coordinates
 
     # whether f's velocity terms are -C(q, q_dot) q_dot of M's Christoffel symbols (a tree's
     # recursions: always; the derived equations: checked once, on first use)
@@ -87,11 +89,27 @@ class Dynamics:
         self.n = functions.n
         self._equations = equations
 
+    @property
+    def nq(self) -> int:
+        """The configuration's numbers (n + 7 for a floating base: its position and quaternion)."""
+        return len(self.coordinates)
+
+    @property
+    def nv(self) -> int:
+        """The velocity's numbers (n + 6 for a floating base: its twist)."""
+        return self.n
+
+    def _width(self, field: str) -> tuple[int, tuple[str, ...]]:
+        if field == "q" or self.velocity_names is None:
+            return len(self.coordinates), self.coordinates
+        return self.n, self.velocity_names
+
     def _vector(self, value, field: str) -> np.ndarray:
         array = np.asarray(value, dtype=float)
-        if array.ndim == 0 or array.shape[-1] != self.n:
+        width, names = self._width(field)
+        if array.ndim == 0 or array.shape[-1] != width:
             shape = "()" if array.ndim == 0 else str(array.shape)
-            raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) along "
+            raise InputError(f"expected {width} values ({', '.join(names)}) along "
                              f"the last axis, got shape {shape}", field=field)
         return array
 
@@ -102,10 +120,15 @@ class Dynamics:
         arrays = [self._vector(x, f) for x, f in zip(arrays, fields, strict=True)]
         batch = np.broadcast_shapes(*(x.shape[:-1] for x in arrays))
         total = int(np.prod(batch, dtype=np.int64))
-        flat = [np.broadcast_to(x, batch + (self.n,)).reshape(total, self.n) for x in arrays]
+        flat = [np.broadcast_to(x, batch + x.shape[-1:]).reshape(total, x.shape[-1])
+                for x in arrays]
         good = np.ones(total, dtype=bool)
         for x in flat:
             good &= np.isfinite(x).all(axis=-1)
+        if self.velocity_names is not None and fields[0] == "q":  # a floating base's quaternion
+            from .free_flyer import check_quaternions
+
+            check_quaternions(flat[0][good])
         if good.all():
             out = np.asarray(compute(*flat), dtype=float).reshape((total,) + tail)
         else:
@@ -185,7 +208,7 @@ class Dynamics:
 
     def _reach_kernel(self):
         self._reach = False
-        if getattr(self, "backend", None) == "recursive":
+        if getattr(self, "backend", None) in ("recursive", "compact"):  # compiled C backends
             from .reach_c import ReachKernel, reach_module
 
             module = reach_module(self.tree)
@@ -214,6 +237,36 @@ class Dynamics:
         if forward:
             return self.forward_dynamics(q, v, self._vector(x, "tau") + tau_ext)
         return self.inverse_dynamics(q, v, x) - tau_ext
+    # -- the configuration space: a floating base's is a manifold (free_flyer.py) ---------------
+
+    def integrate(self, q, v, dt: float = 1.0) -> np.ndarray:
+        """q (+) v dt: the configuration reached moving at velocity v for dt s, (..., nq); a
+        floating base moves along its twist (SE(3)'s exponential) and its quaternion comes
+        back normalized, the joints by q + v dt."""
+        q, v = self._vector(q, "q"), self._vector(v, "v") * float(dt)
+        batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
+        Q = np.broadcast_to(q, batch + q.shape[-1:]).reshape(-1, q.shape[-1])
+        V = np.broadcast_to(v, batch + v.shape[-1:]).reshape(-1, v.shape[-1])
+        if self.velocity_names is None:
+            return (Q + V).reshape(batch + q.shape[-1:])
+        from .free_flyer import check_quaternions, integrate
+
+        check_quaternions(Q)
+        return integrate(Q, V).reshape(batch + q.shape[-1:])
+
+    def difference(self, q0, q1) -> np.ndarray:
+        """v with q0 (+) v = q1 (integrate's inverse for dt = 1), (..., nv)."""
+        q0, q1 = self._vector(q0, "q"), self._vector(q1, "q")
+        batch = np.broadcast_shapes(q0.shape[:-1], q1.shape[:-1])
+        Q0, Q1 = (np.broadcast_to(x, batch + x.shape[-1:]).reshape(-1, x.shape[-1])
+                  for x in (q0, q1))
+        if self.velocity_names is None:
+            return (Q1 - Q0).reshape(batch + (self.n,))
+        from .free_flyer import check_quaternions, difference
+
+        check_quaternions(Q0)
+        check_quaternions(Q1)
+        return difference(Q0, Q1).reshape(batch + (self.n,))
 
     def coriolis_matrix(self, q, v) -> np.ndarray:
         """C(q, q_dot) of the Coriolis and centrifugal terms, C q_dot = bias - g, with
@@ -223,6 +276,11 @@ class Dynamics:
         Exact: the velocity terms are quadratic in q_dot, so column j is
         (bias(q, q_dot + e_j) - bias(q, q_dot - e_j)) / 4. Refused where the model's velocity
         terms are not M's (a damper, a gyroscopic load, a moving support, M changing with t)."""
+        if self.velocity_names is not None:  # Christoffel symbols of quasi-velocities: not M's
+            raise DerivationError(
+                "C(q, v) of a floating base is not yet given: its twist is not the rate of its "
+                "coordinates, so M's Christoffel symbols do not make M_dot - 2C skew-symmetric; "
+                "use bias_forces(q, v)")
         if not self._velocity_terms_are_christoffel():
             raise DerivationError(
                 "C(q, q_dot) is the matrix of the Coriolis and centrifugal terms of M; this "
@@ -230,7 +288,7 @@ class Dynamics:
                 "a moving support, or M changing with t): use bias_forces(q, q_dot)")
         q, v = self._vector(q, "q"), self._vector(v, "v")
         batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
-        q, v = np.broadcast_to(q, batch + (self.n,)), np.broadcast_to(v, batch + (self.n,))
+        q, v = np.broadcast_to(q, batch + q.shape[-1:]), np.broadcast_to(v, batch + (self.n,))
         eye = np.eye(self.n)
         ahead = self.bias_forces(q[..., None, :], v[..., None, :] + eye)
         behind = self.bias_forces(q[..., None, :], v[..., None, :] - eye)
@@ -306,30 +364,56 @@ class TreeDynamics(Dynamics):
         self.tree = tree
         self.coordinates = tree.coordinates
         self.n = len(tree.coordinates)
+        if tree.floating_base:  # Pinocchio's layout: the base's numbers first (free_flyer.py)
+            from .free_flyer import BASE_CONFIGURATION, BASE_VELOCITY
+
+            self.coordinates = BASE_CONFIGURATION + tree.coordinates
+            self.velocity_names = BASE_VELOCITY + tree.coordinates
+            self.n += 6
         self.parameters = {p.name: float(v)
                            for p, v in zip(model.parameters, values.values, strict=True)}
 
 
 def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = None,
-                       backend: str = "auto"):
-    """The recursive dynamics of a URDF tree: generated C (recursive.RecursiveDynamics), or
-    numpy (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with backend
-    "auto", where no compiler works; None where they do not apply: not a bare tree, or a mass
-    matrix that is not positive definite (the symbolic path names the joints)."""
+                       backend: str = "auto", kernel: str = "auto"):
+    """The recursive dynamics of a URDF tree: compiled C (recursive.RecursiveDynamics, the
+    tree's own unrolled module, or compact_kernel.CompactDynamics, one module for every tree:
+    ``kernel`` "unrolled", "compact" or "auto" by the tree's size and whether a link's inertial
+    is set), or numpy (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with
+    backend "auto", where no compiler works; None where they do not apply: not a bare tree, or
+    a mass matrix that is not positive definite (the symbolic path names the joints).
+
+    ``parameters`` may set a link's inertial by ``<link>.<field>`` (model/tree.py
+    INERTIAL_FIELDS: mass, com_x, ..., ixx, ...), as if the URDF had been edited."""
     from ..compile.compiled import BackendUnavailable
     from ..compile.functions import tell_numpy_fallback
+    from ..model.urdf_payload import PREFIX as PAYLOAD_PREFIX
+    from .compact_kernel import COMPACT_ABOVE, CompactDynamics
+    from .inertials import split_inertials
     from .recursive import RecursiveDynamics, applicable_tree
     from .recursive_numpy import RecursiveNumpyDynamics
 
+    if kernel not in ("auto", "unrolled", "compact"):
+        raise InputError(f"unknown kernel {kernel!r} (auto, unrolled or compact)", field="kernel")
     if backend not in ("auto", "c", "numpy"):
         return None
     tree = applicable_tree(model)
+    parameters, inertials = split_inertials(tree, parameters)
     if tree is None:
         return None
+    if inertials:
+        tree = inertials
     dynamics = None
     if backend != "numpy":
+        # a link's inertial set here, or a payload: the compact kernel takes them at run time
+        if kernel == "compact" and tree.floating_base:
+            raise InputError("the compact kernel takes fixed-base trees only (a floating base "
+                             "runs in the unrolled module)", field="kernel")
+        compact = not tree.floating_base and (kernel == "compact" or (kernel == "auto" and (
+            inertials or len(tree.joints) > COMPACT_ABOVE
+            or any(link.name.startswith(PAYLOAD_PREFIX) for link in tree.links))))
         try:
-            dynamics = RecursiveDynamics(model, tree, parameters)
+            dynamics = (CompactDynamics if compact else RecursiveDynamics)(model, tree, parameters)
         except BackendUnavailable as exc:
             if backend == "c":
                 raise
@@ -339,8 +423,12 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
                                 "slower per call than compiled C")
     if dynamics is None:
         dynamics = RecursiveNumpyDynamics(model, tree, parameters)
-    if dynamics.regular():
+    if tree.floating_base or dynamics.regular():
+        # a floating base has no symbolic path to fall to: NaN rows where M is singular
         return dynamics
+    if inertials:  # the derived equations know no link parameters: say what is wrong here
+        raise InputError("with these link inertials the mass matrix is not positive definite "
+                         "(a joint that moves no mass)", field="parameters")
     _refuse_massless_joints(model, dynamics)
     return None
 
@@ -362,10 +450,11 @@ def _refuse_massless_joints(model: Model, dynamics) -> None:
 
 def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
                    parameters: Mapping[str, float] | None = None, backend: str = "auto",
-                   equations: Callable[[], EquationsOfMotion] | None = None):
+                   equations: Callable[[], EquationsOfMotion] | None = None,
+                   kernel: str = "auto"):
     """Recursive dynamics where they apply, else Dynamics over ``symbolic()`` (the numeric
     functions of the derived equations; ``equations()`` gives them for coriolis_matrix)."""
-    fast = recursive_dynamics(model, parameters, backend)
+    fast = recursive_dynamics(model, parameters, backend, kernel)
     return fast if fast is not None else Dynamics(symbolic(), equations)
 
 

@@ -14,6 +14,10 @@ shared):
   of the mass matrix of a 7-joint arm;
 - kinetic energy 1/2 sum (m v.v + 2 v.(w x h) + w.J_O w), potential energy m g height.
 
+A floating base (free_flyer.py) takes q of nq = n + 7 numbers and v, a, tau of nv = n + 6 (the
+module's RT_NQ and LG_N); its quaternion's norm is checked before the C call, the C uses its
+unit rotation.
+
 Units SI. Gravity g (a runtime parameter) along the tree's direction; each coordinate's actuator
 parameter tau_<joint> acts as a load, as in the symbolic equations (b = C q_dot + g - tau_p).
 The same functions are written as standalone C99 (standalone.py) and, with the Python bindings
@@ -74,6 +78,7 @@ class RecursiveDynamics(TreeDynamics):
     """
 
     backend = "recursive"
+    kernel = "unrolled"  # the straight-line module of this tree (compact_kernel.py: "compact")
 
     def __init__(self, model: Model, tree: KinematicTree,
                  parameters: Mapping[str, float] | None = None):
@@ -92,12 +97,20 @@ class RecursiveDynamics(TreeDynamics):
         self._inverse, self._forward = m.inverse_dynamics, m.forward_dynamics
         self._kinetic, self._potential = m.kinetic_energy, m.potential_energy
         self._P = P
+        if tree.floating_base:  # its quaternion checked first (free_flyer.py), then the C
+            self._mass, self._bias, self._gravity, self._inverse, self._forward, self._kinetic, \
+                self._potential = (_checking_quaternion(f) for f in (
+                    self._mass, self._bias, self._gravity, self._inverse, self._forward,
+                    self._kinetic, self._potential))
 
     def regular(self) -> bool:
         """Whether M is positive definite at a few random states (a massless branch is not)."""
         rng = np.random.default_rng(0)
+        q = rng.uniform(-np.pi, np.pi, (3, self.nq))
+        if self.tree.floating_base:
+            q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
         try:
-            np.linalg.cholesky(self.mass_matrix(rng.uniform(-np.pi, np.pi, (3, self.n))))
+            np.linalg.cholesky(self.mass_matrix(q))
         except np.linalg.LinAlgError:
             return False
         return True
@@ -107,6 +120,10 @@ class RecursiveDynamics(TreeDynamics):
         symbolic path gives it; simulation uses it."""
         from ..compile.functions import CKernel, NumericSystem
 
+        if self.tree.floating_base:
+            from .recursive_numpy import floating_refusal
+
+            raise floating_refusal()
         return NumericSystem(coordinates=self.coordinates, constraint_names=(),
                              constraint_kinds=(), parameters=dict(self.parameters),
                              _kernel=CKernel(self.module, self.parameter_values))
@@ -119,10 +136,13 @@ class RecursiveDynamics(TreeDynamics):
             return function(*arrays, self._P)
         except ValueError as exc:
             if "batch shapes" in str(exc):  # broadcast in numpy, then one C call
-                arrays = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in arrays))
-                return function(*(np.ascontiguousarray(x) for x in arrays), self._P)
+                arrays = [np.asarray(x, dtype=float) for x in arrays]
+                batch = np.broadcast_shapes(*(x.shape[:-1] for x in arrays))
+                return function(*(np.ascontiguousarray(np.broadcast_to(x, batch + x.shape[-1:]))
+                                  for x in arrays), self._P)
             field = str(exc).split(":")[0]
-            raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) "
+            width, names = self._width(field)
+            raise InputError(f"expected {width} values ({', '.join(names)}) "
                              "along the last axis", field=field) from None
 
     def mass_matrix(self, q):
@@ -184,6 +204,26 @@ class RecursiveDynamics(TreeDynamics):
         except ValueError:
             out = self._call(self._potential, q)
         return out if out.__class__ is not tuple else _reported(*out, 0)
+
+
+def _checking_quaternion(function):
+    """The module's function, refusing a base quaternion of the wrong norm first (one line)."""
+    from .free_flyer import QUATERNION_TOLERANCE, check_quaternions
+
+    low, high = (1 - QUATERNION_TOLERANCE) ** 2, (1 + QUATERNION_TOLERANCE) ** 2
+
+    def checked(q, *rest):
+        Q = q if q.__class__ is np.ndarray else np.asarray(q, dtype=float)
+        if Q.ndim == 1 and Q.shape[0] >= 7:  # one state: |q|^2 in plain floats (a microsecond)
+            x, y, z, w = Q[3:7].tolist()
+            if low <= x * x + y * y + z * z + w * w <= high:
+                return function(q, *rest)
+        if Q.ndim and Q.shape[-1] >= 7:  # a wrong width is the module's to name
+            flat = Q.reshape(-1, Q.shape[-1])
+            check_quaternions(flat[np.isfinite(flat).all(axis=-1)])
+        return function(q, *rest)
+
+    return checked
 
 
 def _reported(out: np.ndarray, count: int, tail: int):

@@ -9,6 +9,9 @@ states (N, 3) or (N, 3, 3), the bodies visited in Python:
 - forward dynamics by M = L L^T (Cholesky, also with mimic joints): q_ddot = M^-1 (tau - b);
 - kinetic energy 1/2 sum (m v.v + 2 v.(w x h) + w.J_O w), potential energy m g height.
 
+A floating base (a free flyer at the root, free_flyer.py) takes q of nq = n + 7 numbers and v, a,
+tau of nv = n + 6: its body moves by its own twist, and its share of tau is the wrench on it.
+
 Unlike the fully expanded equations (whose lambdified expression trees grow too deep for a
 7-joint arm), the cost grows with the number of bodies (CRBA: with bodies x depth). Units SI;
 gravity g and the actuator parameters tau_<joint> as in recursive.py (b = C q_dot + g - tau_p).
@@ -21,8 +24,10 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import ModelError
+from ..kinds import JointKind
 from ..model.model import Model
 from ..model.tree import KinematicTree
+from .compact_kernel import describe, joints_of
 from .joint_models import joint_model
 from .joint_space import TreeDynamics, solve_positive
 
@@ -79,16 +84,19 @@ def _project(j, moment, force):
 class _Joint:
     """One joint's constants as arrays."""
 
-    def __init__(self, joint):
+    def __init__(self, joint, tree: KinematicTree):
         self.parent = joint.parent
         self.model = joint_model(joint.kind)
+        self.free = joint.kind == JointKind.FREE_FLYER  # a floating base: numbers 0..6 of q
         self.coordinate = joint.coordinate
+        self.iq = tree.base_nq + joint.coordinate  # its number in q, and in v, a and tau
+        self.iv = tree.base_nv + joint.coordinate
         self.multiplier = joint.multiplier
         self.offset = joint.offset
         self.R0 = np.array(joint.rotation, dtype=float)
         self.t0 = np.array(joint.translation, dtype=float)
         self.u = np.array(joint.axis, dtype=float)
-        s_w, s_v = self.model.subspace(self.u)  # the motion per unit rate (None: zero)
+        s_w, s_v = (None, None) if self.free else self.model.subspace(self.u)  # per unit rate
         self.s_w = None if s_w is None else np.array(s_w)
         self.s_v = None if s_v is None else np.array(s_v)
         self.m = float(joint.mass)
@@ -115,10 +123,14 @@ class RecursiveNumpyDynamics(TreeDynamics):
         if missing:
             raise ModelError(f"the tree's parameters {missing} are not the model's")
         self._g = self.parameters[tree.gravity_parameter]
-        self._actuators = np.array([self.parameters[a] for a in tree.actuators], dtype=float)
+        self._actuators = np.array([0.0] * tree.base_nv  # no actuator drives a floating base
+                                   + [self.parameters[a] for a in tree.actuators], dtype=float)
         # the ground accelerates up by g: every body feels gravity (Newton-Euler's trick)
         self._up = -self._g * np.array(tree.gravity_direction, dtype=float)
-        self._joints = [_Joint(j) for j in tree.joints]
+        # the bodies as the compact C kernel reads them (compact_kernel.describe): one
+        # description; a floating base (a joint that kernel does not take) from the tree itself
+        joints = tree.joints if tree.floating_base else joints_of(describe(tree, self.parameters))
+        self._joints = [_Joint(j, tree) for j in joints]
 
     def __repr__(self) -> str:
         return f"RecursiveNumpyDynamics(coordinates={list(self.coordinates)})"
@@ -130,7 +142,11 @@ class RecursiveNumpyDynamics(TreeDynamics):
         its parent ((N, 3) or constant) and [p]x (p x y = [p]x y, y x p = [p]x^T y)."""
         placements = []
         for j in self._joints:
-            theta = j.multiplier * Q[:, j.coordinate] + j.offset
+            if j.free:
+                R, p = j.model.placement_arrays(j.R0, j.t0, Q[:, :7])
+                placements.append((R, p, _skew_batch(p)))
+                continue
+            theta = j.multiplier * Q[:, j.iq] + j.offset
             R, p = j.model.placement_arrays(j.R0, j.t0, j.u, theta)
             placements.append((R, p, j.P0 if p is j.t0 else _skew_batch(p)))
         return placements
@@ -143,6 +159,17 @@ class RecursiveNumpyDynamics(TreeDynamics):
         w, dw, acc, f, n = [], [], [], [], []
         for i, j in enumerate(self._joints):
             R, p, P = placements[i]
+            if j.free:  # the floating base: its twist (v, w) and its derivative, in its axes
+                w.append(zero if V is None else V[:, 3:6])
+                dw.append(zero if A is None else A[:, 3:6])
+                # the origin's acceleration: v_dot + w x v, and up by g (gravity's trick)
+                acc.append(_apply_transpose(R, np.broadcast_to(self._up, (count, 3)))
+                           + (0.0 if A is None else A[:, :3])
+                           + (0.0 if V is None else _cross(V[:, 3:6], V[:, :3])))
+                f.append(j.m * acc[i] - _apply(j.H, dw[i]) - _cross(w[i], _apply(j.H, w[i])))
+                n.append(_apply(j.J, dw[i]) + _cross(w[i], _apply(j.J, w[i]))
+                         + _apply(j.H, acc[i]))
+                continue
             if j.parent < 0:  # the ground: at rest, accelerating up by g
                 w_in = dw_in = zero
                 a_i = _apply_transpose(R, np.broadcast_to(self._up, (count, 3)))
@@ -153,7 +180,7 @@ class RecursiveNumpyDynamics(TreeDynamics):
                 # a + dw x p + w x (w x p), with y x p = [p]x^T y
                 a_i = _apply_transpose(R, al + _apply_transpose(P, dwl)
                                        + _cross(wl, _apply_transpose(P, wl)))
-            rate = None if V is None else j.multiplier * V[:, j.coordinate, None]
+            rate = None if V is None else j.multiplier * V[:, j.iv, None]
             w_i, dw_i = w_in, dw_in
             if rate is not None and j.s_w is not None:
                 w_i = w_in + rate * j.s_w
@@ -161,7 +188,7 @@ class RecursiveNumpyDynamics(TreeDynamics):
             if rate is not None and j.s_v is not None:
                 a_i = a_i + 2.0 * _cross(w_i, rate * j.s_v)
             if A is not None:
-                accel = j.multiplier * A[:, j.coordinate, None]
+                accel = j.multiplier * A[:, j.iv, None]
                 if j.s_w is not None:
                     dw_i = dw_i + accel * j.s_w
                 if j.s_v is not None:
@@ -176,7 +203,11 @@ class RecursiveNumpyDynamics(TreeDynamics):
         tau = np.zeros((count, self.n))
         for i in reversed(range(len(self._joints))):
             j = self._joints[i]
-            tau[:, j.coordinate] += j.multiplier * _project(j, n[i], f[i])
+            if j.free:  # the wrench on the base, force then moment, in its axes
+                tau[:, :3] += f[i]
+                tau[:, 3:6] += n[i]
+                continue
+            tau[:, j.iv] += j.multiplier * _project(j, n[i], f[i])
             if j.parent >= 0:
                 R, p, P = placements[i]
                 force = _apply(R, f[i])
@@ -196,6 +227,9 @@ class RecursiveNumpyDynamics(TreeDynamics):
         eye = np.eye(3)
         for i in reversed(range(len(joints))):
             j = joints[i]
+            if j.free:  # the floating base: the composite inertia itself, [[m, -[h]x], [[h]x, J]]
+                M[:, :6, :6] += _spatial_inertia(mass[i], h[i], J[i], count)
+                continue
             # unit rate along S: f = m s_v + s_w x h, n = J s_w + h x s_v
             force, moment = np.zeros(3), np.zeros(3)
             if j.s_w is not None:
@@ -204,7 +238,7 @@ class RecursiveNumpyDynamics(TreeDynamics):
                 force, moment = force + mass[i] * j.s_v, moment + np.cross(h[i], j.s_v)
             force = np.broadcast_to(force, (count, 3))
             moment = np.broadcast_to(moment, (count, 3))
-            ci, ki = j.coordinate, j.multiplier
+            ci, ki = j.iv, j.multiplier
             M[:, ci, ci] += ki * ki * _project(j, moment, force)
             k = i
             while joints[k].parent >= 0:
@@ -213,9 +247,14 @@ class RecursiveNumpyDynamics(TreeDynamics):
                 moment = _apply(R, moment) + _apply(P, force)
                 k = joints[k].parent
                 ancestor = joints[k]
+                if ancestor.free:  # the base's six numbers: S = 1, (force, moment)
+                    entry = ki * np.concatenate([force, moment], axis=-1)
+                    M[:, ci, :6] += entry
+                    M[:, :6, ci] += entry
+                    continue
                 entry = ki * ancestor.multiplier * _project(ancestor, moment, force)
-                M[:, ci, ancestor.coordinate] += entry
-                M[:, ancestor.coordinate, ci] += entry
+                M[:, ci, ancestor.iv] += entry
+                M[:, ancestor.iv, ci] += entry
             if j.parent >= 0:  # the composite inertia of body i, moved into its parent's axes
                 R, p, _ = placements[i]
                 hr = _apply(R, h[i])
@@ -237,8 +276,12 @@ class RecursiveNumpyDynamics(TreeDynamics):
         w, vel = [], []
         for i, j in enumerate(self._joints):
             R, p, P = placements[i]
+            if j.free:  # the floating base's own twist
+                w.append(V[:, 3:6])
+                vel.append(V[:, :3])
+                continue
             wl, vl = (zero, zero) if j.parent < 0 else (w[j.parent], vel[j.parent])
-            rate = (j.multiplier * V[:, j.coordinate])[:, None]
+            rate = (j.multiplier * V[:, j.iv])[:, None]
             w_i = _apply_transpose(R, wl)
             v_i = _apply_transpose(R, vl + _apply_transpose(P, wl))
             if j.s_w is not None:
@@ -291,8 +334,10 @@ class RecursiveNumpyDynamics(TreeDynamics):
     def regular(self) -> bool:
         """Whether M is positive definite at a few random states (a massless branch is not)."""
         rng = np.random.default_rng(0)
-        return all(_positive_definite(m)
-                   for m in self.mass_matrix(rng.uniform(-np.pi, np.pi, (3, self.n))))
+        q = rng.uniform(-np.pi, np.pi, (3, self.nq))
+        if self.tree.floating_base:
+            q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
+        return all(_positive_definite(m) for m in self.mass_matrix(q))
 
     def mass_matrix(self, q):
         """M(q), shape (..., n, n)."""
@@ -336,9 +381,31 @@ class RecursiveNumpyDynamics(TreeDynamics):
         the symbolic path gives it; simulation uses it."""
         from ..compile.functions import NumericSystem
 
+        if self.tree.floating_base:
+            raise floating_refusal()
         return NumericSystem(coordinates=self.coordinates, constraint_names=(),
                              constraint_kinds=(), parameters=dict(self.parameters),
                              _kernel=_TreeKernel(self))
+
+
+def floating_refusal() -> ModelError:
+    """Why a floating base has no NumericSystem (simulate)."""
+    return ModelError("simulate and the equations' numeric functions integrate q_dot = v; a "
+                      "floating base's configuration holds a quaternion (nq = n + 7, nv = n + 6): "
+                      "use dynamics() and its integrate(q, v, dt)")
+
+
+def _spatial_inertia(m, h, J, count: int) -> np.ndarray:
+    """A body's 6 x 6 inertia about its origin, linear rows first: (f, n) = I (v, w) with
+    f = m v - [h]x w, n = [h]x v + J w; (count, 6, 6)."""
+    h = np.broadcast_to(h, (count, 3))
+    H = _skew_batch(h)
+    out = np.zeros((count, 6, 6))
+    out[:, :3, :3] = m * np.eye(3) if np.ndim(m) == 0 else np.asarray(m)[:, None, None] * np.eye(3)
+    out[:, :3, 3:] = -H
+    out[:, 3:, :3] = H
+    out[:, 3:, 3:] = J
+    return out
 
 
 def _positive_definite(matrix) -> bool:

@@ -1,9 +1,13 @@
 """The recursions over a robot's kinematic tree, written against the emitter: joint
 kinematics, Newton-Euler inverse dynamics, the composite-rigid-body mass matrix, articulated-body
-(or Cholesky) forward dynamics and the energies (SI units)."""
+(or Cholesky) forward dynamics and the energies (SI units).
+
+A floating base (a free flyer first, free_flyer.py) takes q and v with its 7 and 6 numbers
+first: the joints read q[7:] and v[6:] by their coordinate, the base its own (_free_*)."""
 
 from __future__ import annotations
 
+from ..kinds import JointKind
 from ..model.tree import KinematicTree
 from .joint_models import joint_model
 from .tree_emitter import Term, _Emitter, _Layout
@@ -24,10 +28,33 @@ def _rotation(E: _Emitter, joint, c: Term, s: Term):
     return R
 
 
+def _free(joint) -> bool:
+    return joint.kind == JointKind.FREE_FLYER
+
+
+def _free_placement(E: _Emitter, joint, q):
+    """The floating base's R = R_0 R(quaternion) and p = t_0 + R_0 (x, y, z): the rotation of
+    the quaternion made unit (2 / |q|^2 in place of 2)."""
+    x, y, z, w = q[3:7]
+    s = E.div(2.0, E.sum([E.mul(c, c) for c in (x, y, z, w)]))
+    xx, yy, zz = E.mul(x, x), E.mul(y, y), E.mul(z, z)
+    xy, xz, yz = E.mul(x, y), E.mul(x, z), E.mul(y, z)
+    wx, wy, wz = E.mul(w, x), E.mul(w, y), E.mul(w, z)
+    Rq = [[E.sub(1.0, E.mul(s, E.add(yy, zz))), E.mul(s, E.sub(xy, wz)), E.mul(s, E.add(xz, wy))],
+          [E.mul(s, E.add(xy, wz)), E.sub(1.0, E.mul(s, E.add(xx, zz))), E.mul(s, E.sub(yz, wx))],
+          [E.mul(s, E.sub(xz, wy)), E.mul(s, E.add(yz, wx)), E.sub(1.0, E.mul(s, E.add(xx, yy)))]]
+    R0 = [list(row) for row in joint.rotation]
+    return E.matmul(R0, Rq), E.vadd(list(joint.translation), E.apply(R0, list(q[:3])))
+
+
 def _kinematics(E: _Emitter, tree: KinematicTree, q):
     """Each body's rotation R (body -> parent axes) and origin p (in its parent), as terms."""
     placements = []
+    base, q = q, q[tree.base_nq:]  # the joints' own numbers
     for joint in tree.joints:
+        if _free(joint):
+            placements.append(_free_placement(E, joint, base))
+            continue
         theta = E.add(E.mul(q[joint.coordinate], joint.multiplier), joint.offset)
         placements.append(joint_model(joint.kind).placement_terms(E, joint, theta, _rotation))
     return placements
@@ -59,26 +86,32 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
     g = layout.gravity
     up = [E.mul(g, -d) for d in tree.gravity_direction]  # the ground accelerates up by g
     w, dw, acc, f, n = [], [], [], [], []
+    (vb, v), (ab, a) = (v[:tree.base_nv], v[tree.base_nv:]), (a[:tree.base_nv], a[tree.base_nv:])
     for i, joint in enumerate(tree.joints):
         R, p = placements[i]
-        if joint.parent < 0:
+        if _free(joint):  # the base: its twist (v, w) and its derivative; origin v_dot + w x v
+            w_i, dw_i = list(vb[3:]), list(ab[3:])
+            a_i = E.vadd(E.apply_transpose(R, up), E.vadd(list(ab[:3]), E.cross(w_i, list(vb[:3]))))
+        elif joint.parent < 0:
             wl, dwl, al = [0.0] * 3, [0.0] * 3, up
         else:
             wl, dwl, al = w[joint.parent], dw[joint.parent], acc[joint.parent]
-        s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
-        rate = E.mul(v[joint.coordinate], joint.multiplier)
-        accel = E.mul(a[joint.coordinate], joint.multiplier)
-        w_in = E.apply_transpose(R, wl)
-        dw_in = E.apply_transpose(R, dwl)
-        origin = E.vadd(al, E.vadd(E.cross(dwl, p), E.cross(wl, E.cross(wl, p))))
-        a_i = E.apply_transpose(R, origin)
-        w_i, dw_i = w_in, dw_in
-        if s_w is not None:  # turning: w += rate s_w, dw += w_in x rate s_w + accel s_w
-            w_i = E.vadd(w_in, E.scale(rate, s_w))
-            dw_i = E.vadd(dw_in, E.vadd(E.cross(w_in, E.scale(rate, s_w)), E.scale(accel, s_w)))
-        if s_v is not None:  # sliding: the Coriolis term 2 w x rate s_v and accel s_v
-            a_i = E.vadd(a_i, E.vadd(E.scale(2.0, E.cross(w_i, E.scale(rate, s_v))),
-                                     E.scale(accel, s_v)))
+        if not _free(joint):
+            s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
+            rate = E.mul(v[joint.coordinate], joint.multiplier)
+            accel = E.mul(a[joint.coordinate], joint.multiplier)
+            w_in = E.apply_transpose(R, wl)
+            dw_in = E.apply_transpose(R, dwl)
+            origin = E.vadd(al, E.vadd(E.cross(dwl, p), E.cross(wl, E.cross(wl, p))))
+            a_i = E.apply_transpose(R, origin)
+            w_i, dw_i = w_in, dw_in
+            if s_w is not None:  # turning: w += rate s_w, dw += w_in x rate s_w + accel s_w
+                w_i = E.vadd(w_in, E.scale(rate, s_w))
+                dw_i = E.vadd(dw_in, E.vadd(E.cross(w_in, E.scale(rate, s_w)),
+                                            E.scale(accel, s_w)))
+            if s_v is not None:  # sliding: the Coriolis term 2 w x rate s_v and accel s_v
+                a_i = E.vadd(a_i, E.vadd(E.scale(2.0, E.cross(w_i, E.scale(rate, s_v))),
+                                         E.scale(accel, s_v)))
         w.append(w_i)
         dw.append(dw_i)
         acc.append(a_i)
@@ -88,8 +121,12 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
         n.append(E.vadd(E.vadd(E.apply(J, dw_i), E.cross(w_i, E.apply(J, w_i))),
                         E.cross(h, a_i)))
     tau_full: list[Term] = [0.0] * len(tree.joints)
+    base: list[Term] = []
     for i in reversed(range(len(tree.joints))):
         joint = tree.joints[i]
+        if _free(joint):  # the wrench on the base, force then moment, in its axes
+            base = f[i] + n[i]
+            continue
         tau_full[i] = _project(E, joint_model(joint.kind).subspace(joint.axis), n[i], f[i])
         if joint.parent >= 0:
             R, p = placements[i]
@@ -97,10 +134,12 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
             f[joint.parent] = E.vadd(f[joint.parent], force)
             n[joint.parent] = E.vadd(n[joint.parent],
                                      E.vadd(E.apply(R, n[i]), E.cross(p, force)))
-    tau: list[Term] = [0.0] * layout.n
+    tau: list[Term] = [0.0] * (layout.n - tree.base_nv)
     for i, joint in enumerate(tree.joints):
-        tau[joint.coordinate] = E.add(tau[joint.coordinate], E.mul(tau_full[i], joint.multiplier))
-    return [E.sub(t, actuator) for t, actuator in zip(tau, layout.actuators, strict=True)]
+        if not _free(joint):
+            tau[joint.coordinate] = E.add(tau[joint.coordinate],
+                                          E.mul(tau_full[i], joint.multiplier))
+    return base + [E.sub(t, actuator) for t, actuator in zip(tau, layout.actuators, strict=True)]
 
 
 def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
@@ -110,9 +149,16 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
     mass = [j.mass for j in tree.joints]
     h = [list(j.first_moment) for j in tree.joints]
     J = [[list(r) for r in j.inertia] for j in tree.joints]
-    full = {}
+    full, base, coupling, first = {}, {}, {}, tree.base_nv  # coupling: a joint's wrench on the base
     for i in reversed(range(nb)):
         joint = tree.joints[i]
+        if _free(joint):  # the composite inertia of the whole robot, [[m, -[h]x], [[h]x, J]]
+            m, (hx, hy, hz) = mass[i], h[i]
+            block = [[m, 0.0, 0.0], [0.0, m, 0.0], [0.0, 0.0, m],
+                     [0.0, E.neg(hz), hy, J[i][0][0]], [hz, 0.0, E.neg(hx), J[i][1][0], J[i][1][1]],
+                     [E.neg(hy), hx, 0.0, J[i][2][0], J[i][2][1], J[i][2][2]]]
+            base = {(r, c): x for r, row in enumerate(block) for c, x in enumerate(row)}
+            continue
         subspace = joint_model(joint.kind).subspace(joint.axis)
         force, moment = _unit_rate_wrench(E, subspace, mass[i], h[i], J[i])
         full[i, i] = _project(E, subspace, moment, force)
@@ -123,6 +169,9 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
             moment = E.vadd(E.apply(R, moment), E.cross(p, force))
             k = tree.joints[k].parent
             ancestor = tree.joints[k]
+            if _free(ancestor):  # S = 1: the wrench itself, force then moment
+                coupling[i] = force + moment
+                continue
             full[i, k] = _project(E, joint_model(ancestor.kind).subspace(ancestor.axis), moment,
                                   force)
         parent = joint.parent
@@ -147,14 +196,19 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
                     J[parent][r][c] = J[parent][c][r] = entry
             h[parent] = E.vadd(h[parent], E.vadd(hr, E.scale(mass[i], p)))
             mass[parent] = mass[parent] + mass[i]
-    entries = {}
+    entries = dict(base)
     for (i, k), value in full.items():
         a, b = tree.joints[i], tree.joints[k]
         for (r, c, x) in ((a.coordinate, b.coordinate, value),) + (
                 ((b.coordinate, a.coordinate, value),) if i != k else ()):
             if r >= c:
-                entries[r, c] = E.add(entries.get((r, c), 0.0),
-                                      E.mul(x, a.multiplier * b.multiplier))
+                entries[first + r, first + c] = E.add(entries.get((first + r, first + c), 0.0),
+                                                      E.mul(x, a.multiplier * b.multiplier))
+    for i, wrench in coupling.items():  # rows of the joints, the base's six columns
+        joint = tree.joints[i]
+        for c, x in enumerate(wrench):
+            r = first + joint.coordinate
+            entries[r, c] = E.add(entries.get((r, c), 0.0), E.mul(x, joint.multiplier))
     return entries
 
 
@@ -162,7 +216,8 @@ def _articulated(tree: KinematicTree) -> bool:
     """Whether the articulated-body algorithm applies: each coordinate drives one joint, as
     its angle or distance (no mimic joint)."""
     used = [j.coordinate for j in tree.joints]
-    return len(set(used)) == len(used) and all(j.multiplier == 1.0 for j in tree.joints)
+    return len(set(used)) == len(used) and all(j.multiplier == 1.0 for j in tree.joints) \
+        and not tree.floating_base  # a six-number root: M = L L^T instead
 
 
 def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, tau):
@@ -295,8 +350,13 @@ def _sandwich(E: _Emitter, R, X, symmetric: bool):
 def _velocities(E: _Emitter, tree: KinematicTree, q, v):
     placements = _kinematics(E, tree, q)
     w, vel = [], []
+    base, v = v[:tree.base_nv], v[tree.base_nv:]
     for i, joint in enumerate(tree.joints):
         R, p = placements[i]
+        if _free(joint):  # the base's own twist
+            w.append(list(base[3:]))
+            vel.append(list(base[:3]))
+            continue
         wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
                                                                  vel[joint.parent])
         rate = E.mul(v[joint.coordinate], joint.multiplier)

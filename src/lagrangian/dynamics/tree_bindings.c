@@ -16,6 +16,9 @@ static const char *rt_names[] = {"q", "v", "third"};
 #ifndef LG_LANES
 #define LG_LANES 1
 #endif
+/* the numbers of input j: q has RT_NQ (LG_N + 1 for a floating base's quaternion), v, a and
+   tau LG_N */
+#define RT_WIDTH(j) ((j) == 0 ? RT_NQ : LG_N)
 
 typedef struct {
     int kind, nin, size;
@@ -31,7 +34,7 @@ static inline int rt_finite(int nin, const npy_intp *step, const double *x0, con
 {
     for (int j = 0; j < nin; j++) {
         const double *x = (j == 0 ? x0 : j == 1 ? x1 : x2) + k * step[j];
-        for (int i = 0; i < LG_N; i++)
+        for (int i = 0; i < RT_WIDTH(j); i++)
             if (!isfinite(x[i])) return 0;
     }
     return 1;
@@ -55,11 +58,11 @@ static void *rt_run(void *argument)
 #if RT_VECTOR
     /* LG_LANES states at a time through the vector variants, the rest one by one */
     for (; k + LG_LANES <= count && (kind != RT_FORWARD || RT_VECTOR_FORWARD); k += LG_LANES) {
-        lg_v4 in[3][LG_N], out4[LG_N * LG_N];
+        lg_v4 in[3][RT_NQ], out4[LG_N * LG_N];
         for (int j = 0; j < nin; j++) {
             const double *x = j == 0 ? x0 : j == 1 ? x1 : x2;
             for (int l = 0; l < LG_LANES; l++)
-                for (int i = 0; i < LG_N; i++) in[j][i][l] = x[(k + l) * step[j] + i];
+                for (int i = 0; i < RT_WIDTH(j); i++) in[j][i][l] = x[(k + l) * step[j] + i];
         }
         switch (kind) {
         case RT_MASS: rt4_mass_matrix(in[0], p, out4); break;
@@ -150,26 +153,28 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
         in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
         if (!in[i]) goto done;
         int nd = PyArray_NDIM(in[i]);
-        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != LG_N) {
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != RT_WIDTH(i)) {
             PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
-                         i == 2 ? (kind == RT_FORWARD ? "tau" : "a") : rt_names[i], LG_N);
+                         i == 2 ? (kind == RT_FORWARD ? "tau" : "a") : rt_names[i],
+                         RT_WIDTH(i));
             goto done;
         }
-        if (PyArray_SIZE(in[i]) > PyArray_SIZE(in[base])) base = i;
+        if (PyArray_SIZE(in[i]) / RT_WIDTH(i) > PyArray_SIZE(in[base]) / RT_WIDTH(base))
+            base = i;
     }
-    npy_intp count = PyArray_SIZE(in[base]) / LG_N;
+    npy_intp count = PyArray_SIZE(in[base]) / RT_WIDTH(base);
     int nd = PyArray_NDIM(in[base]);
     for (int i = 0; i < nin; i++) {
-        if (PyArray_SIZE(in[i]) == LG_N && PyArray_NDIM(in[i]) == 1) {
-            step[i] = count > 1 ? 0 : LG_N;
+        if (PyArray_SIZE(in[i]) == RT_WIDTH(i) && PyArray_NDIM(in[i]) == 1) {
+            step[i] = count > 1 ? 0 : RT_WIDTH(i);
             continue;
         }
-        if (PyArray_NDIM(in[i]) != nd
-            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), nd * sizeof(npy_intp))) {
+        if (PyArray_NDIM(in[i]) != nd  /* the batch axes, all but the last */
+            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp))) {
             PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
             goto done;
         }
-        step[i] = LG_N;
+        step[i] = RT_WIDTH(i);
     }
     P = lg_doubles(args[nin], LG_NP, "parameters");
     if (!P) goto done;

@@ -44,7 +44,7 @@ def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix:
     the compiled module's batches)."""
     layout = _Layout(tree, parameters)
     n = layout.n
-    q, v, a = _inputs("q", n), _inputs("v", n), _inputs("a", n)
+    q, v, a = _inputs("q", layout.nq), _inputs("v", n), _inputs("a", n)
     zeros = [0.0] * n
     P, S = prefix, storage
     R = "const double *restrict"

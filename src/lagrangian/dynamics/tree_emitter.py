@@ -212,4 +212,5 @@ class _Layout:
             raise ModelError(f"the tree's parameters {missing} are not the model's")
         self.gravity = f"p[{index[tree.gravity_parameter]}]"
         self.actuators = [f"p[{index[name]}]" for name in tree.actuators]
-        self.n = len(tree.coordinates)
+        self.n = len(tree.coordinates) + tree.base_nv  # v's numbers (q has base_nq before)
+        self.nq = len(tree.coordinates) + tree.base_nq

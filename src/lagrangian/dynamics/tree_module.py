@@ -33,7 +33,7 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
     template.c (simulation, accelerations), and batched bindings for each function."""
     from ..compile.codegen import TEMPLATE, GeneratedSource
 
-    n = len(tree.coordinates)
+    n = len(tree.coordinates) + tree.base_nv  # v's numbers; q's are RT_NQ (a floating base)
     # two-state vector variants for batches of arms; a long chain's code is big enough that
     # compiling it twice costs minutes, so there the batch runs the scalar functions
     functions = dynamics_functions(tree, parameters, "rt", vector=n <= VECTOR_LIMIT)
@@ -41,6 +41,7 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
         f"/* lagrangian: recursive dynamics of a tree of {len(tree.joints)} bodies, {n} "
         "coordinates */",
         f"#define LG_N {n}",
+        f"#define RT_NQ {n + tree.base_nq - tree.base_nv}",
         "#define LG_M 0",
         f"#define LG_NP {len(parameters)}",
         "#define PY_SSIZE_T_CLEAN",

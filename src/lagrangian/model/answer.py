@@ -3,10 +3,11 @@
 Tables: ``[energy]`` T, V, D; ``[generalized_forces]`` one entry per coordinate;
 ``[equations]`` one entry per coordinate, ``"lhs = rhs"`` or an expression equal to zero;
 ``[multipliers]`` ``count`` or ``names``; the final answers (``[matrices]``, ``[frequencies]``,
-``[mode_shapes]``, ``[linearized]``, ``[generalized_forces]`` with ``at``, ``[equilibria]``) are
-kept as written here and read where they are checked (check/final_reading.py). Names that the
-model does not know (a reaction force ``N``, a tension ``T_rod``) are kept as *foreign symbols*,
-so the checker can say why they do not belong, instead of failing to parse.
+``[mode_shapes]``, ``[linearized]``, ``[generalized_forces]`` with ``at``, ``[equilibria]``,
+``[statics]``) are kept as written here and read where they are checked
+(check/final_reading.py). Names that the model does not know (a reaction force ``N``, a
+tension ``T_rod``) are kept as *foreign symbols*, so the checker can say why they do not
+belong, instead of failing to parse.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from .reader import check_known_keys, load_toml, read_text_file
 from .tokens import plain_names
 
 # Final answers: results to compare with the analysis (check/final_answers.py).
-FINAL_TABLES = ("matrices", "frequencies", "mode_shapes", "linearized", "equilibria")
+FINAL_TABLES = ("matrices", "frequencies", "mode_shapes", "linearized", "equilibria", "statics")
 MATRICES = ("M", "K", "C")
 FREQUENCY_KEYS = ("omega", "f", "period", "zeta")
 TABLES = ("energy", "generalized_forces", "equations", "multipliers", *FINAL_TABLES,
@@ -48,7 +49,8 @@ def answer_file_schema() -> dict[str, tuple[frozenset[str], frozenset[str]]]:
             "frequencies": (none, frozenset(FREQUENCY_KEYS)),
             "mode_shapes": (frozenset({"shapes"}), none),
             "linearized": (frozenset({"about"}), coordinate),
-            "equilibria": (none, coordinate)}
+            "equilibria": (none, coordinate),
+            "statics": (frozenset({"at"}), frozenset({"<parameter>", "lambda_<constraint>"}))}
 
 
 @dataclass(frozen=True)

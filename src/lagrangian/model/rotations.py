@@ -30,12 +30,14 @@ AXES: dict[str, Vector] = {
     "y": (sp.S.Zero, sp.S.One, sp.S.Zero),
     "z": (sp.S.Zero, sp.S.Zero, sp.S.One),
 }
-JOINT_TYPES = tuple(JointKind)  # each compares equal to its word in a model file
+# each compares equal to its word in a model file (a free flyer is a URDF robot's base only)
+JOINT_TYPES = tuple(k for k in JointKind if k is not JointKind.FREE_FLYER)
 JOINT_KEYS = {  # the required and optional keys of each kind's table
     JointKind.REVOLUTE: ({"type", "axis", "angle"}, {"at"}),
     JointKind.PRISMATIC: ({"type", "axis", "distance"}, {"at"}),
     JointKind.SPHERICAL: ({"type", "rotation"}, {"at"}),
     JointKind.FIXED: ({"type"}, {"at", "rotation"}),
+    JointKind.FREE_FLYER: ({"type"}, set()),  # refused by JOINT_TYPES before its keys are read
 }
 # Exact numbers up to this size (numerator and denominator) stay exact in a unit vector; others
 # are taken as floats: the exact length of (1e-290, 0, -1) cost 5-30 s of factoring.
@@ -320,9 +322,15 @@ class RotationReader:
             return frame
         return self.sequence(frame, value["rotation"], f"{field}.rotation")
 
+    def _free(self, frame: Frame, value: Mapping, field: str) -> Frame:
+        raise self.error("a free_flyer joint is a URDF robot's floating base "
+                         "(load(path, floating_base=True)); a body of a model file moves by its "
+                         "coordinates", f"{field}.type")
+
     # one entry per JointKind (tests/model/test_component_tables.py checks none is missing)
     _JOINT_FRAMES = {JointKind.REVOLUTE: _revolute, JointKind.PRISMATIC: _prismatic,
-                     JointKind.SPHERICAL: _turned, JointKind.FIXED: _turned}
+                     JointKind.SPHERICAL: _turned, JointKind.FIXED: _turned,
+                     JointKind.FREE_FLYER: _free}
 
     def inertia(self, value: object, field: str, values: Mapping[sp.Symbol, float]) -> Matrix3:
         """Principal [Ixx, Iyy, Izz] or a symmetric 3x3 tensor (kg m^2), about the centre of mass

@@ -5,7 +5,10 @@ Each moving body hangs from its parent body (or the ground) by one revolute or p
     R = R_0 Rot(u, theta),  p = t_0           (revolute: child axes -> parent axes, origin in parent)
     R = R_0,                p = t_0 + R_0 u theta   (prismatic)
 
-with theta = k q[c] + offset (k = 1, offset = 0 except for a mimic joint). Fixed and locked
+with theta = k q[c] + offset (k = 1, offset = 0 except for a mimic joint). A floating base is a
+free-flyer joint at the root (joints[0], parent -1, kind free_flyer): the base link's body, moved
+by the configuration's first 7 numbers (position, quaternion x y z w) and the velocity's first 6
+(dynamics/free_flyer.py); the other joints' numbers follow, q[7 + c] and v[6 + c]. Fixed and locked
 joints are folded into R_0, t_0 of the next joint down, and the links they carry into the
 inertia of the moving body above them. A body's inertia is (m, h = m c, J_O): mass (kg), first
 moment about its frame's origin (kg m) and inertia tensor about that origin (kg m^2), in its
@@ -57,6 +60,78 @@ class TreeFrame:
 
 
 @dataclass(frozen=True)
+class TreeLink:
+    """A link's inertial as the URDF gives it, and where the link sits on a moving body: mass
+    (kg), centre of mass ``com`` in the link's frame (m), the inertial frame's axes
+    ``com_rotation`` (inertial -> link axes) and the inertia tensor about the centre of mass in
+    those axes (kg m^2); the link's frame is ``rotation``, ``translation`` in the body's axes.
+    The body inertias of the tree are these links' sums (``link_inertias``)."""
+
+    name: str
+    body: int
+    rotation: Matrix3x3
+    translation: Vector3
+    mass: float
+    com: Vector3
+    com_rotation: Matrix3x3
+    inertia: Matrix3x3
+
+
+INERTIAL_FIELDS = ("mass", "com_x", "com_y", "com_z", "ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+
+
+def link_inertias(links, count: int):
+    """Each moving body's (m, h = m c, J_O) summed over its links, numpy (count bodies)."""
+    import numpy as np
+
+    out = [[0.0, np.zeros(3), np.zeros((3, 3))] for _ in range(count)]
+    for link in links:
+        if link.body < 0:
+            continue
+        turn, shift = np.array(link.rotation), np.array(link.translation)
+        axes = np.array(link.com_rotation)
+        tensor = np.array(link.inertia)
+        tensor = turn @ (axes @ tensor @ axes.T) @ turn.T
+        center = shift + turn @ np.array(link.com)
+        mass = float(link.mass)
+        # about the body's origin: J_O = I_C + m (|c|^2 1 - c c^T), h = m c
+        out[link.body][0] += mass
+        out[link.body][1] += mass * center
+        out[link.body][2] += tensor + mass * (center @ center * np.eye(3)
+                                              - np.outer(center, center))
+    return out
+
+
+def with_link_inertials(tree: KinematicTree, values) -> KinematicTree:
+    """The tree with some links' inertials replaced: ``values`` {(link, field): number}, field
+    one of INERTIAL_FIELDS (the URDF's <mass>, <origin xyz> and <inertia>), as if the file had
+    been edited; every body's inertia summed anew from its links."""
+    from dataclasses import replace
+
+    by_name = {link.name: link for link in tree.links}
+    for (name, field_), value in values.items():
+        link = by_name[name]
+        if field_ == "mass":
+            link = replace(link, mass=float(value))
+        elif field_.startswith("com_"):
+            com = list(link.com)
+            com["xyz".index(field_[-1])] = float(value)
+            link = replace(link, com=tuple(com))
+        else:
+            r, c = "xyz".index(field_[1]), "xyz".index(field_[2])
+            rows = [list(row) for row in link.inertia]
+            rows[r][c] = rows[c][r] = float(value)
+            link = replace(link, inertia=tuple(tuple(row) for row in rows))
+        by_name[name] = link
+    links = tuple(by_name[link.name] for link in tree.links)
+    inertias = link_inertias(links, len(tree.joints))
+    joints = tuple(replace(j, mass=float(m), first_moment=tuple(float(x) for x in h),
+                           inertia=tuple(tuple(float(x) for x in row) for row in 0.5 * (J + J.T)))
+                   for j, (m, h, J) in zip(tree.joints, inertias, strict=True))
+    return replace(tree, joints=joints, links=links, rigid_bodies=tree.rigid_bodies)
+
+
+@dataclass(frozen=True)
 class KinematicTree:
     """The moving bodies of a robot, gravity g along ``gravity_direction`` (world axes, unit),
     and for each coordinate the parameter whose value is its actuator force (tau_<joint>)."""
@@ -72,6 +147,29 @@ class KinematicTree:
     # Every link and joint frame, for placements and Jacobians (dynamics/frames.py); not part of
     # the tree's identity (the dynamics, and the compiled module's key, do not depend on them).
     frames: tuple[TreeFrame, ...] = field(default=(), compare=False, repr=False)
+    # Every link with an inertial (TreeLink): its mass, centre of mass and inertia are the
+    # dynamics' runtime parameters (`<link>.mass`, ...); the joints' numbers are their sums.
+    links: tuple[TreeLink, ...] = field(default=(), compare=False, repr=False)
+    # The root link and the mass (kg) welded to it that a fixed base holds still (a legged
+    # robot's trunk), for the note that names floating_base; not part of the dynamics.
+    root_link: str = field(default="", compare=False, repr=False)
+    root_mass: float = field(default=0.0, compare=False, repr=False)
+
+    @property
+    def floating_base(self) -> bool:
+        """Whether the root body moves freely (a free-flyer joint first)."""
+        return bool(self.joints) and self.joints[0].kind == JointKind.FREE_FLYER
+
+    @property
+    def base_nq(self) -> int:
+        """Configuration numbers before the joints' own: 7 for a floating base, else 0."""
+        return 7 if self.floating_base else 0
+
+    @property
+    def base_nv(self) -> int:
+        """Velocity numbers before the joints' own: 6 for a floating base, else 0."""
+        return 6 if self.floating_base else 0
 
 
-__all__ = ["KinematicTree", "TreeFrame", "TreeJoint"]
+__all__ = ["INERTIAL_FIELDS", "KinematicTree", "TreeFrame", "TreeJoint", "TreeLink",
+           "link_inertias", "with_link_inertials"]

@@ -14,6 +14,13 @@ origin and rpy) becomes a rigid body whose inertia is turned into link axes, I =
 Joint damping and friction (<dynamics>) are kept (Model.source_dynamics) but left out of the
 equations, as Pinocchio does: M, C q_dot and g are the rigid-body terms a controller needs;
 dynamics(actuators=True) adds them (dynamics/actuators.py).
+
+The root link is bolted to the world unless ``floating_base``: then a free-flyer joint carries it
+(its kinematic tree's first joint, dynamics/free_flyer.py), as Pinocchio's
+``buildModelFromUrdf(path, JointModelFreeFlyer())``. A URDF ``floating`` joint from the root link
+is read the same way (its origin the free flyer's placement). A floating base lives in the tree
+only: the model's coordinates and rigid bodies are the joints', and deriving its equations is
+refused (derivation/lagrange.py).
 """
 
 from __future__ import annotations
@@ -35,10 +42,11 @@ from ..errors import ModelError, ModelWarning, did_you_mean, require_extra
 from ..kinds import JointKind
 from .builder import ModelBuilder
 from .expressions import RESERVED
+from .lazy_bodies import LAZY_ABOVE, LazyBodies
 from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
-from .tree import KinematicTree, TreeFrame, TreeJoint
+from .tree import KinematicTree, TreeFrame, TreeJoint, TreeLink, link_inertias
 
 MOVABLE = ("revolute", "continuous", "prismatic")
 SUPPORTED = (*MOVABLE, "fixed")
@@ -49,10 +57,11 @@ _SNAP = 1e-14
 
 
 def read_urdf(path, lock: Mapping[str, float] | None = None,
-              payload: Mapping[str, object] | None = None) -> Model:
+              payload: Mapping[str, object] | None = None, floating_base: bool = False) -> Model:
     """Load a URDF file as a model; ``lock`` freezes joints at values (rad or m) by name,
-    ``payload`` adds point masses to links (urdf_payload.py)."""
-    return parse_urdf(read_text_file(path), source=str(path), lock=lock, payload=payload)
+    ``payload`` adds point masses to links (urdf_payload.py), ``floating_base`` frees the root."""
+    return parse_urdf(read_text_file(path), source=str(path), lock=lock, payload=payload,
+                      floating_base=floating_base)
 
 
 def example_urdf(name: str):
@@ -65,13 +74,14 @@ def example_urdf(name: str):
 
 def parse_urdf(text: str, *, source: str = "<urdf>",
                lock: Mapping[str, float] | None = None,
-               payload: Mapping[str, object] | None = None) -> Model:
+               payload: Mapping[str, object] | None = None,
+               floating_base: bool = False) -> Model:
     """The model of a URDF document (see the module docstring for what each element becomes);
     ``payload`` {link: mass or (mass, (x, y, z))} adds point masses (urdf_payload.py)."""
     from .urdf_payload import payload_values
 
     robot = _parse(text, source, payload_values(payload) if payload else None)
-    return _Tree(robot, source).model(dict(lock or {}))
+    return _Tree(robot, source).model(dict(lock or {}), bool(floating_base))
 
 
 def _parse(text: str, source: str, payloads=None):
@@ -240,19 +250,12 @@ class _Tree:
     def _check_tree(self) -> tuple[str, dict[str, list]]:
         parent_of: dict[str, object] = {}
         children: dict[str, list] = {}
-        carried = {j.child for j in self.joints}
         for joint in self.joints:
             where = f"joint '{joint.name}'"
-            if joint.type == "floating" and joint.parent not in carried:
-                raise self.error(
-                    f"floating joints are not supported yet: this one on the root link "
-                    f"'{joint.parent}' makes a floating base (six free coordinates); to load the "
-                    f"robot on a fixed base, remove it and link '{joint.parent}' (link "
-                    f"'{joint.child}' becomes the root, fixed in the world)", where)
-            if joint.type not in SUPPORTED:
+            if joint.type not in SUPPORTED and joint.type != "floating":
                 raise self.error(
                     f"{joint.type} joints are not supported yet (use revolute, continuous, "
-                    "prismatic or fixed)" if joint.type in ("floating", "planar")
+                    "prismatic or fixed)" if joint.type == "planar"
                     else f"unknown joint type {joint.type!r} (use revolute, continuous, "
                     f"prismatic or fixed){did_you_mean(str(joint.type), SUPPORTED)}", where)
             for role, link in (("parent", joint.parent), ("child", joint.child)):
@@ -281,10 +284,32 @@ class _Tree:
             lost = next(j for j in self.joints if j.child not in reached)
             raise self.error("its links form a closed loop, unreachable from the root link "
                              f"'{roots[0]}' (URDF describes trees only)", f"joint '{lost.name}'")
+        self._check_floating(roots[0], children)
         return roots[0], children
 
-    def model(self, lock: dict[str, float]) -> Model:
+    def _check_floating(self, root: str, children: dict[str, list]) -> None:
+        """A floating joint frees the whole robot: the one movable joint of the root link, as
+        the free flyer at the tree's root (Pinocchio's layout puts it first)."""
+        for joint in self.joints:
+            if joint.type != "floating":
+                continue
+            where = f"joint '{joint.name}'"
+            if joint.parent != root:
+                raise self.error(f"a floating joint frees the robot's base: its parent must be "
+                                 f"the root link '{root}', not '{joint.parent}'", where)
+            others = [j.name for j in children[root] if j is not joint and j.type != "fixed"]
+            if others:
+                raise self.error(f"the root link '{root}' also moves joint '{others[0]}': a "
+                                 "floating joint must be the root link's only moving joint",
+                                 where)
+
+    def model(self, lock: dict[str, float], floating_base: bool = False) -> Model:
         root, children = self._check_tree()
+        if floating_base and any(j.type == "floating" for j in self.joints):
+            floating = next(j.name for j in self.joints if j.type == "floating")
+            raise ModelError(f"the URDF's joint '{floating}' already floats the base; "
+                             "floating_base would add a second free flyer above it",
+                             field="floating_base")
         order = []  # joints from the root down, depth first in document order
         stack = list(reversed(children.get(root, [])))
         while stack:
@@ -340,12 +365,18 @@ class _Tree:
             builder.add_generalized_force(name, tau, field=field)
         if not names:
             raise self.error("no joint left to move: a model needs at least one revolute, "
-                             "continuous or prismatic joint that is not locked (a drone's body "
-                             "alone is a floating base: not supported yet)")
+                             "continuous or prismatic joint that is not locked"
+                             + (" (a lone floating body: not yet)" if floating_base or any(
+                                 j.type == "floating" for j in order) else ""))
         position = self._positions(lock, names)
-        bodies = tuple(self._bodies(root, order, position))
         model = builder.build_model()
-        tree = self._tree(root, order, position, names, bodies)
+        if len(names) > LAZY_ABOVE:  # a long chain: its symbolic bodies when first asked for
+            tree = self._tree(root, order, position, names, (), floating_base)
+            bodies = self._lazy_bodies(root, order, position, tree)
+            tree = replace(tree, rigid_bodies=bodies)
+        else:
+            bodies = tuple(self._bodies(root, order, position))
+            tree = self._tree(root, order, position, names, bodies, floating_base)
         return replace(model, rigid_bodies=bodies, kinematic_tree=tree,
                        source_names=tuple((name, joint) for joint, name in names.items()),
                        source_ratings=tuple((name, *self._ratings(joint))
@@ -447,48 +478,83 @@ class _Tree:
             inertial = link.inertial
             if _carries_nothing(inertial):
                 continue
-            field = f"link '{name}'.inertial"
-            mass = float(inertial.mass or 0.0)
-            tensor = np.asarray(inertial.inertia if inertial.inertia is not None
-                                else np.zeros((3, 3)), dtype=float)
-            if not math.isfinite(mass) or mass < 0:
-                raise self.error(f"the mass {mass} is negative or not finite", field)
-            if not np.all(np.isfinite(tensor)):
-                raise self.error("the inertia tensor has an entry that is not finite", field)
-            where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
-                               dtype=float)
-            turn = where[:3, :3]
-            tensor = turn @ tensor @ turn.T  # about the centre of mass, in link axes
-            physical = np.linalg.eigvalsh(0.5 * (tensor + tensor.T))[0] >= -1e-12 * max(
-                1.0, float(np.abs(tensor).max()))
-            if not moves[name]:  # fixed to the ground: no kinetic energy, a constant potential
-                if not physical:  # TIAGo's antennas: it cannot change the dynamics
-                    warnings.warn(ModelWarning(
-                        f"{self.source}: {field}: the inertia tensor is not positive "
-                        "semidefinite; ignored, since the link is fixed to the root and "
-                        "changes no dynamics"), stacklevel=2)
-                continue
-            if not physical:
-                raise self.error("the inertia tensor is not positive semidefinite", field)
+            mass, tensor, where = self._inertial(name, fixed=not moves[name])
             center = apply(frame.rotation, _vector(where[:3, 3]))
             position_ = tuple(o + c for o, c in zip(frame.origin, center, strict=True))
+            if not moves[name]:
+                continue  # fixed to the ground: no kinetic energy, a constant potential
             bodies.append(RigidBody(name, _number(mass), _matrix(0.5 * (tensor + tensor.T)),
                                     position_, frame.rotation, frame.origin,
                                     frame.angular_velocity, parents[name]))
         return bodies
 
 
-    def _tree(self, root: str, order, position, names: dict[str, str], bodies) -> KinematicTree:
+    def _inertial(self, name: str, fixed: bool = False):
+        """A link's mass (kg), inertia tensor about its centre of mass in link axes (kg m^2)
+        and inertial origin (4 x 4), checked; ``fixed``: the link is welded to a fixed root,
+        where an unphysical tensor changes no dynamics (TIAGo's antennas): a ModelWarning."""
+        inertial = self.links[name].inertial
+        field = f"link '{name}'.inertial"
+        mass = float(inertial.mass or 0.0)
+        tensor = np.asarray(inertial.inertia if inertial.inertia is not None
+                            else np.zeros((3, 3)), dtype=float)
+        if not math.isfinite(mass) or mass < 0:
+            raise self.error(f"the mass {mass} is negative or not finite", field)
+        if not np.all(np.isfinite(tensor)):
+            raise self.error("the inertia tensor has an entry that is not finite", field)
+        where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
+                           dtype=float)
+        turn = where[:3, :3]
+        tensor = turn @ tensor @ turn.T  # about the centre of mass, in link axes
+        if np.linalg.eigvalsh(0.5 * (tensor + tensor.T))[0] < -1e-12 * max(
+                1.0, float(np.abs(tensor).max())):
+            if not fixed:
+                raise self.error("the inertia tensor is not positive semidefinite", field)
+            warnings.warn(ModelWarning(
+                f"{self.source}: {field}: the inertia tensor is not positive semidefinite; "
+                "ignored, since the link is fixed to the root and changes no dynamics"),
+                stacklevel=2)
+        return mass, tensor, where
+
+    def _lazy_bodies(self, root: str, order, position, tree: KinematicTree) -> LazyBodies:
+        """The symbolic bodies of a large tree, built when first read (model/lazy_bodies.py),
+        every check of _bodies made now."""
+        for joint in order:
+            if joint.type in MOVABLE:
+                axis = np.asarray(joint.axis if joint.axis is not None else (1, 0, 0), float)
+                norm = float(np.linalg.norm(axis))
+                if not math.isfinite(norm) or norm == 0:
+                    raise self.error("the axis has zero length", f"joint '{joint.name}'.axis")
+        count = 0
+        for link in tree.links:
+            if not _carries_nothing(self.links[link.name].inertial):
+                self._inertial(link.name, fixed=link.body < 0)
+                count += link.body >= 0
+        return LazyBodies(lambda: self._bodies(root, order, position), count)
+
+    def _tree(self, root: str, order, position, names: dict[str, str], bodies,
+              floating_base: bool = False) -> KinematicTree:
         """The same robot as numbers for the recursive algorithms (model/tree.py)."""
         index = {joint: i for i, joint in enumerate(names)}
         coordinate = {symbol: index[joint] for joint, symbol in names.items()}
         anchor = {root: (-1, np.eye(3), np.zeros(3))}  # link -> (moving body, R, t in it)
         joints: list[dict] = []
+        free = dict(parent=-1, kind=JointKind.FREE_FLYER, axis=np.zeros(3), coordinate=-1,
+                    multiplier=1.0, offset=0.0)  # the free flyer: its numbers come first
+        if floating_base:  # Pinocchio's name for the root joint it adds
+            joints.append(dict(free, name="root_joint", rotation=np.eye(3),
+                               translation=np.zeros(3)))
+            anchor[root] = (0, np.eye(3), np.zeros(3))
         for joint in order:
             body, turn, shift = anchor[joint.parent]
             origin = np.eye(4) if joint.origin is None else np.asarray(joint.origin, float)
             rotation = _snapped(turn @ _snapped(origin[:3, :3]))
             translation = shift + turn @ _snapped(origin[:3, 3])
+            if joint.type == "floating":  # the root link's only moving joint (_check_floating)
+                joints.append(dict(free, name=joint.name, rotation=rotation,
+                                   translation=translation))
+                anchor[joint.child] = (len(joints) - 1, np.eye(3), np.zeros(3))
+                continue
             if joint.type not in MOVABLE:
                 anchor[joint.child] = (body, rotation, translation)
                 continue
@@ -511,24 +577,20 @@ class _Tree:
                 else:
                     anchor[joint.child] = (body, rotation @ _axis_rotation(axis, theta),
                                            translation)
-        inertias = [[0.0, np.zeros(3), np.zeros((3, 3))] for _ in joints]
+        links = []
         for name, (body, turn, shift) in anchor.items():
             inertial = self.links[name].inertial
-            if body < 0 or _carries_nothing(inertial):
-                continue
-            mass = float(inertial.mass or 0.0)
-            where = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4),
-                               dtype=float)
-            tensor = np.asarray(inertial.inertia if inertial.inertia is not None
+            carries = not _carries_nothing(inertial)
+            where = np.asarray(inertial.origin if carries and inertial.origin is not None
+                               else np.eye(4), dtype=float)
+            tensor = np.asarray(inertial.inertia if carries and inertial.inertia is not None
                                 else np.zeros((3, 3)), dtype=float)
-            tensor = 0.5 * (tensor + tensor.T)
-            tensor = turn @ (_snapped(where[:3, :3]) @ tensor @ _snapped(where[:3, :3]).T) @ turn.T
-            center = shift + turn @ _snapped(where[:3, 3])
-            # about the body's origin: J_O = I_C + m (|c|^2 1 - c c^T), h = m c
-            inertias[body][0] += mass
-            inertias[body][1] += mass * center
-            inertias[body][2] += tensor + mass * (center @ center * np.eye(3)
-                                                  - np.outer(center, center))
+            links.append(TreeLink(name, body, turn, shift,
+                                  float(inertial.mass or 0.0) if carries else 0.0,
+                                  _snapped(where[:3, 3]), _snapped(where[:3, :3]),
+                                  0.5 * (tensor + tensor.T)))
+        inertias = link_inertias(links, len(joints))
+        held = sum(link.mass for link in links if link.body < 0)  # the mass welded to a fixed root
 
         def vector(a):
             return tuple(float(x) for x in a)
@@ -542,8 +604,13 @@ class _Tree:
         by_link = {f.name: f for f in frames}
         frames += [dataclasses.replace(by_link[joint.child], name=joint.name)
                    for joint in order if joint.name not in by_link and joint.child in by_link]
+        if floating_base and "root_joint" not in by_link:
+            frames.append(dataclasses.replace(by_link[root], name="root_joint"))
         return KinematicTree(
             frames=tuple(frames),
+            links=tuple(TreeLink(k.name, k.body, matrix(k.rotation), vector(k.translation),
+                                 k.mass, vector(k.com), matrix(k.com_rotation),
+                                 matrix(k.inertia)) for k in links),
             joints=tuple(TreeJoint(
                 name=j["name"], parent=j["parent"], kind=j["kind"], rotation=matrix(j["rotation"]),
                 translation=vector(j["translation"]), axis=vector(j["axis"]),
@@ -553,7 +620,7 @@ class _Tree:
             coordinates=tuple(names.values()), gravity_parameter="g",
             gravity_direction=(0.0, 0.0, -1.0),
             actuators=tuple(f"tau_{name}" for name in names.values()),
-            rigid_bodies=tuple(bodies))
+            rigid_bodies=tuple(bodies), root_link=root, root_mass=held)
 
 
 def _carries_nothing(inertial) -> bool:

@@ -10,10 +10,12 @@ from ..check.diagnose import CheckReport
 from ..check.newton_euler import CrosscheckReport
 from ..check.units import UnitsReport
 from ..errors import ModelError
+from ..kinds import FindingStatus
 from ..model.expressions import format_expression as fmt
 from .files import atomic_write, check_output_path
 
-_MARK = {"correct": "ok", "equivalent": "equivalent", "wrong": "WRONG", "note": "note"}
+_MARK = {FindingStatus.CORRECT: "ok", FindingStatus.EQUIVALENT: "equivalent",
+         FindingStatus.WRONG: "WRONG", FindingStatus.NOTE: "note"}
 
 
 def check_document(report: CheckReport) -> dict[str, Any]:
@@ -36,7 +38,7 @@ def check_text(report: CheckReport) -> str:
         code = f" [{f.code}]" if f.code else ""
         lines.append(f"  {f.item}: {_MARK.get(f.status, f.status)}{code}")
         lines.append(f"      {f.message}")
-        if f.expected is not None and f.status != "correct":
+        if f.expected is not None and f.status != FindingStatus.CORRECT:
             lines.append(f"      expected: {f.expected}")
     lines.append(f"verdict: {report.verdict}")
     return "\n".join(lines) + "\n"
@@ -62,7 +64,7 @@ def class_text(report: ClassReport) -> str:
         lines.append(f"  {row['file']:<{width}}  {row['verdict']:<10}  {findings}")
         if report.hints_only and result.report is not None:  # the question, once per finding
             lines += [f"      {f.item}: {f.message}" for f in result.report.findings
-                      if f.status != "correct"]
+                      if f.status != FindingStatus.CORRECT]
     lines.append(", ".join(f"{n} {v}" for v, n in report.counts.items()))
     return "\n".join(lines) + "\n"
 

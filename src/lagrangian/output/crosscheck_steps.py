@@ -14,10 +14,18 @@ import sympy as sp
 from ..check import equivalence as eq
 from ..check.free_body_steps import CrosscheckSteps, FreeBodyStep
 from ..derivation.readable import readable
+from ..kinds import FreeBodyKind
 from ..model.expressions import format_expression
 
 LONGEST = 240  # characters of one expression in the text; the JSON has every one whole
 _AXES = ("x", "y", "z")
+
+# m a_G (and I alpha) projected, as each kind of free body writes it
+_INERTIAL_SHARE = {
+    FreeBodyKind.PARTICLE: "m a_G . dr_G/d{q}",
+    FreeBodyKind.BODY: "m a_G . dr_G/d{q} + I alpha dangle/d{q}",
+    FreeBodyKind.BODY_IN_SPACE: "m a_G . dr_G/d{q} + (I alpha + omega x I omega) . domega/d{q}_dot",
+}
 
 
 @functools.lru_cache(maxsize=2048)
@@ -44,7 +52,7 @@ def _text(expr) -> str:
 
 
 def _planar(steps: CrosscheckSteps) -> bool:
-    return all(b.kind != "body in space" and b.acceleration[2] == 0
+    return all(b.kind != FreeBodyKind.BODY_IN_SPACE and b.acceleration[2] == 0
                and all(f.force[2] == 0 for f in b.forces) for b in steps.bodies)
 
 
@@ -74,9 +82,7 @@ def crosscheck_steps_text(steps: CrosscheckSteps) -> str:
         q = p.coordinate
         lines.append(f"  [{q}]")
         for body, value in p.inertial:
-            share = {"particle": f"m a_G . dr_G/d{q}",
-                     "body": f"m a_G . dr_G/d{q} + I alpha dangle/d{q}"}.get(
-                kinds[body], f"m a_G . dr_G/d{q} + (I alpha + omega x I omega) . domega/d{q}_dot")
+            share = _INERTIAL_SHARE[kinds[body]].format(q=q)
             lines.append(f"    {body}: {share} = {_text(value)}")
         lines += [f"    {source}: F . dr/d{p.coordinate} = {_text(value)}"
                   for source, value in p.work]
@@ -106,7 +112,7 @@ def _body_lines(b: FreeBodyStep, axes, planar: bool) -> list[str]:
     lines.append(f"      reaction R = {_vector(b.reaction, planar)}"
                  + (f", M_R = {_text(b.reaction_moment)}" if b.reaction_moment is not None
                     else ""))
-    if b.kind == "body in space":
+    if b.kind == FreeBodyKind.BODY_IN_SPACE:
         lines.append("      (its rotation: Euler's equations in body axes, I alpha + omega x "
                      "I omega = M_G + M_R, in the projection below)")
     return lines

@@ -9,11 +9,15 @@ import numpy as np
 
 
 def dynamics_document(coordinates, values: Mapping[str, Any],
-                      joint_names: Mapping[str, str] | None = None) -> dict[str, Any]:
+                      joint_names: Mapping[str, str] | None = None,
+                      velocities=None) -> dict[str, Any]:
     """The `dynamics --json` document: every array as nested lists, SI units; NaN (a state
     without dynamics, DynamicsWarning) as null; ``joint_names`` (coordinate -> the URDF's
-    joint name, {} for a model file) under that key."""
+    joint name, {} for a model file) under that key. A floating base adds ``nq``, ``nv`` and
+    ``velocities``, the names of v (``coordinates`` are q's)."""
     document: dict[str, Any] = {"coordinates": list(coordinates)}
+    if velocities is not None:
+        document.update(nq=len(coordinates), nv=len(velocities), velocities=list(velocities))
     if joint_names is not None:
         document["joint_names"] = dict(joint_names)
     for key, value in values.items():
@@ -36,16 +40,24 @@ _TITLES = {
     "inverse_dynamics": "inverse dynamics tau = M q_ddot + C q_dot + g",
     "forward_dynamics": "forward dynamics q_ddot = M^-1 (tau - C q_dot - g)",
     "kinetic_energy": "kinetic energy T (J)", "potential_energy": "potential energy V (J)",
+    "dtau_dq": "d tau/dq (row i: tau_i)", "dtau_dv": "d tau/dq_dot",
+    "dqdd_dq": "d q_ddot/dq (row i: q_ddot_i)", "dqdd_dv": "d q_ddot/dq_dot",
+    "dqdd_dtau": "d q_ddot/d tau = M^-1",
 }
 
 
-def dynamics_text(coordinates, values: Mapping[str, Any],
+def dynamics_text(coordinates, values: Mapping[str, Any], velocities=None,
                   extra: Mapping[str, Any] | None = None) -> str:
-    """The values, one titled block each; ``extra``: the wrenches at frames and the actuator
-    models the values include (`--wrench`, `--actuators`, `--armature`)."""
+    """``velocities``: the names of v, a and tau where they are not q's (a floating base);
+    ``extra``: the wrenches at frames and the actuator models the values include (`--wrench`,
+    `--actuators`, `--armature`)."""
     names = list(coordinates)
-    width = max(len(n) for n in names)
+    rates = names if velocities is None else list(velocities)
+    width = max(len(n) for n in names + rates)
     lines = [f"Coordinates: {', '.join(names)} (SI: rad or m; tau in N m or N)"]
+    if velocities is not None:
+        lines.append(f"Velocities: {', '.join(rates)} (the base's twist in its own axes: m/s, "
+                     "rad/s; its tau is the wrench on it: N, N m)")
     for key, value in values.items():
         array = np.asarray(value, dtype=float)
         title = _TITLES.get(key, key)
@@ -53,7 +65,8 @@ def dynamics_text(coordinates, values: Mapping[str, Any],
             lines.append(f"{title}: {float(array):.9g}")
         elif array.ndim == 1:
             lines.append(f"{title}:")
-            lines += [f"  {n:<{width}}  {x: .9g}" for n, x in zip(names, array, strict=True)]
+            labels = names if key == "q" else rates
+            lines += [f"  {n:<{width}}  {x: .9g}" for n, x in zip(labels, array, strict=True)]
         else:
             lines.append(f"{title}:")
             lines += ["  " + "  ".join(f"{x: .9g}" for x in row) for row in array]

@@ -8,14 +8,17 @@ from typing import Any
 import numpy as np
 
 
-def kinematics_document(coordinates, frame: str, reference: str,
-                        values: Mapping[str, Any]) -> dict[str, Any]:
+def kinematics_document(coordinates, frame: str, reference: str, values: Mapping[str, Any],
+                        velocities=None) -> dict[str, Any]:
     """The `kinematics --json` document: the frame, the reference of its Jacobian and every array
     as nested lists (SI: m, rad): q, placement, jacobian, center_of_mass,
     center_of_mass_jacobian; with --v also v and jacobian_dot_times_v (6); with --centroidal
-    centroidal_momentum_matrix (6 x n) and, with --v, centroidal_momentum (6)."""
+    centroidal_momentum_matrix (6 x n) and, with --v, centroidal_momentum (6); a floating base
+    adds ``nq``, ``nv`` and ``velocities`` (the names of the Jacobian's columns)."""
     document: dict[str, Any] = {"coordinates": list(coordinates), "frame": frame,
                                 "reference": reference}
+    if velocities is not None:
+        document.update(nq=len(coordinates), nv=len(velocities), velocities=list(velocities))
     for key, value in values.items():
         document[key] = np.asarray(value, dtype=float).tolist()
     return document
@@ -33,9 +36,12 @@ _TITLES = {
 }
 
 
-def kinematics_text(coordinates, frame: str, reference: str, values: Mapping[str, Any]) -> str:
+def kinematics_text(coordinates, frame: str, reference: str, values: Mapping[str, Any],
+                    velocities=None) -> str:
     names = list(coordinates)
     lines = [f"Frame {frame}; coordinates {', '.join(names)} (SI: rad or m)"]
+    if velocities is not None:  # a floating base: the Jacobian's columns are v's
+        lines.append(f"Velocities (the Jacobian's columns): {', '.join(velocities)}")
     for key, value in values.items():
         array = np.asarray(value, dtype=float)
         title = _TITLES.get(key, key)

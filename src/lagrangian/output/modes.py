@@ -12,6 +12,7 @@ import numpy as np
 from ..analysis.equilibria import Equilibria
 from ..analysis.modes import ModalAnalysis, Mode
 from ..errors import ModelError
+from ..kinds import ModeKind
 from .files import atomic_write
 from .plots import notebook_figure, plain_text
 
@@ -166,13 +167,13 @@ def modes_text(analysis: ModalAnalysis) -> str:
 
 def _kind_note(mode: Mode) -> str:
     kind = mode.kind
-    if kind == "divergent":
+    if kind == ModeKind.DIVERGENT:
         return "(unstable: grows without oscillating)"
-    if kind == "rigid-body":
+    if kind == ModeKind.RIGID_BODY:
         return "(rigid-body: zero frequency)"
     if mode.growth_rate > 0:
         return "(unstable: growing oscillation)"
-    if kind == "overdamped":
+    if kind == ModeKind.OVERDAMPED:
         return "(overdamped)"
     return ""
 

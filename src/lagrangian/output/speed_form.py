@@ -11,11 +11,12 @@ import numpy as np
 
 from ..analysis.speed_form import SpeedForm, SpeedSweep
 from ..errors import ModelError
+from ..kinds import CrossingKind
 from .files import atomic_write
 
 PLOT_DPI = 100
-_NAMES = {"oscillatory": "oscillatory (a complex pair; the weave of a bicycle)",
-          "real": "real (the capsize of a bicycle)"}
+_NAMES = {CrossingKind.OSCILLATORY: "oscillatory (a complex pair; the weave of a bicycle)",
+          CrossingKind.REAL: "real (the capsize of a bicycle)"}
 
 
 def _rows(matrix: np.ndarray) -> list[list[float]]:
@@ -77,7 +78,7 @@ def speed_form_text(model: str, form: SpeedForm, sweep: SpeedSweep) -> str:
         lines.append("No eigenvalue's real part crosses zero in this range.")
     for c in sweep.crossings:
         turn = "stable above" if c.stabilizing else "unstable above"
-        extra = f", {c.frequency:.6g} rad/s" if c.kind == "oscillatory" else ""
+        extra = f", {c.frequency:.6g} rad/s" if c.kind == CrossingKind.OSCILLATORY else ""
         lines.append(f"Re = 0 at {form.speed} = {c.speed:.10g}: {_NAMES[c.kind]}{extra}; "
                      f"{turn}")
     for lo, hi in sweep.stable:
@@ -129,7 +130,7 @@ def speed_sweep_figure(form: SpeedForm, sweep: SpeedSweep):
     for lo, hi in sweep.stable:
         axes.axvspan(lo, hi, color="tab:green", alpha=0.12)
     for c in sweep.crossings:
-        label = "weave" if c.kind == "oscillatory" else "capsize"
+        label = "weave" if c.kind == CrossingKind.OSCILLATORY else "capsize"
         axes.axvline(c.speed, color="gray", linestyle="--", linewidth=0.8)
         axes.annotate(f"{label} {c.speed:.3f}", (c.speed, 0), textcoords="offset points",
                       xytext=(3, 8), fontsize=8)

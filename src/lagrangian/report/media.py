@@ -86,11 +86,17 @@ def drawing_png(model: Model, q: np.ndarray) -> bytes:
     return _png(frame)
 
 
-def simulation_gif(result) -> bytes:
-    """The simulated run as an endlessly looping GIF, in real time where the frames allow."""
-    animation = mechanism_animation(result, fps=SIMULATION_FPS, max_frames=SIMULATION_FRAMES)
-    frames = list(animation.frame_images(dpi=HTML_DPI))
-    return gif_bytes(frames, playback_rate(animation.times, SIMULATION_FPS))
+def simulation_gif(result, *, size: tuple[int, int] | None = None,
+                   fps: float | None = None) -> bytes:
+    """The simulated run as an endlessly looping GIF, in real time where the frames allow;
+    ``size`` (width, height) in pixels, ``fps`` frames a second (the same stretch of the run
+    is shown at any rate: at most SIMULATION_FRAMES frames at SIMULATION_FPS)."""
+    rate = SIMULATION_FPS if fps is None else fps
+    animation = mechanism_animation(result, fps=rate, size=size,
+                                    max_frames=max(2, round(SIMULATION_FRAMES * rate
+                                                            / SIMULATION_FPS)))
+    frames = list(animation.frame_images(dpi=None if size else HTML_DPI))
+    return gif_bytes(frames, playback_rate(animation.times, rate))
 
 
 def mode_motion(model: Model, analysis: ModalAnalysis, mode: Mode, index: int) -> Motion:
@@ -144,20 +150,24 @@ def _amplitude(model: Model, q0: np.ndarray, shape: np.ndarray) -> float:
     return float(min(MODE_REACH * span / moved, cap))
 
 
-def mode_gif(model: Model, analysis: ModalAnalysis, mode: Mode, index: int) -> bytes:
+def mode_gif(model: Model, analysis: ModalAnalysis, mode: Mode, index: int, *,
+             size: tuple[int, int] | None = None, fps: float | None = None) -> bytes:
     """Mode ``index`` (1-based) drawn moving over one period, as a looping GIF: the modes
-    command's own animation (output/mode_animation.py), one period in MODE_CYCLE seconds."""
+    command's own animation (output/mode_animation.py), one period in MODE_CYCLE seconds;
+    ``size`` (width, height) in pixels (default 320 x 320), ``fps`` frames a second."""
     from ..output.mode_animation import mode_animation
 
-    fps = round(MODE_FRAMES / MODE_CYCLE)
-    animation = mode_animation(analysis, model, mode=index, fps=fps, size=(320, 320))
+    fps = round(MODE_FRAMES / MODE_CYCLE) if fps is None else fps
+    animation = mode_animation(analysis, model, mode=index, fps=fps, size=size or (320, 320))
     return gif_bytes(list(animation.frame_images()), fps)
 
 
-def coordinate_mode_gif(analysis: ModalAnalysis, mode: Mode, index: int, units: dict) -> bytes:
+def coordinate_mode_gif(analysis: ModalAnalysis, mode: Mode, index: int, units: dict, *,
+                        size: tuple[int, int] | None = None, fps: float | None = None) -> bytes:
     """A model given by its energies has nothing to draw: mode ``index`` (1-based) shown as each
     coordinate's dot moving along its own track, q_i = Re(phi_i e^(i theta)) over one period
-    (largest +-1), so in phase and out of phase read at a glance."""
+    (largest +-1), so in phase and out of phase read at a glance; ``size`` in pixels, ``fps``
+    frames a second (one period in MODE_CYCLE seconds)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -167,7 +177,9 @@ def coordinate_mode_gif(analysis: ModalAnalysis, mode: Mode, index: int, units: 
     shape = np.array([complex(_shape_entry(mode, analysis, n)) for n in names])
     shape = shape / (np.max(np.abs(shape)) or 1.0)
     rows = len(names)
-    figure = Figure(figsize=(5, 1.2 + 0.55 * rows), dpi=HTML_DPI, layout="constrained")
+    inches = (5, 1.2 + 0.55 * rows) if size is None else (size[0] / HTML_DPI, size[1] / HTML_DPI)
+    count = MODE_FRAMES if fps is None else int(min(240, max(8, round(fps * MODE_CYCLE))))
+    figure = Figure(figsize=inches, dpi=HTML_DPI, layout="constrained")
     FigureCanvasAgg(figure)
     ax = figure.add_subplot()
     ax.set_xlim(-1.3, 1.3)
@@ -181,8 +193,8 @@ def coordinate_mode_gif(analysis: ModalAnalysis, mode: Mode, index: int, units: 
     ax.set_title(f"mode {index}: each coordinate's motion (a: the largest amplitude)",
                  fontsize=9)
     frames = []
-    for theta in 2 * np.pi * np.arange(MODE_FRAMES) / MODE_FRAMES:
+    for theta in 2 * np.pi * np.arange(count) / count:
         dots.set_xdata(np.real(shape * np.exp(1j * theta)))
         figure.canvas.draw()
         frames.append(np.asarray(figure.canvas.buffer_rgba())[..., :3].copy())
-    return gif_bytes(frames, MODE_FRAMES / MODE_CYCLE)
+    return gif_bytes(frames, count / MODE_CYCLE)

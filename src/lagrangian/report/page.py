@@ -31,6 +31,8 @@ DEFAULT_T_END = 10.0  # s: the simulation's length when none is given
 _LONG_SOURCE = 20_000  # characters of model file shown before it is folded away
 TYPESET_LIMIT = 2500  # nodes of the expressions in one formula (the largest example but one: 133)
 
+SHOWN = "shown"  # the status of a section on the page; any other is why it is left out
+
 
 @dataclass(frozen=True)
 class Section:
@@ -40,6 +42,11 @@ class Section:
     key: str
     title: str
     status: str
+
+    @property
+    def shown(self) -> bool:
+        """The section is on the page (its status is "shown", not a reason it is left out)."""
+        return self.status == SHOWN
 
 
 @dataclass(frozen=True)
@@ -63,7 +70,7 @@ class Report:
                 'style="width: 100%; height: 48rem; border: 1px solid #ccc"></iframe>')
 
     def __repr__(self) -> str:
-        shown = sum(s.status == "shown" for s in self.sections)
+        shown = sum(s.shown for s in self.sections)
         return f"Report({self.model_name!r}, {shown} of {len(self.sections)} sections shown)"
 
 
@@ -82,8 +89,9 @@ class _Page:
     """What the sections share: the system (duck-typed: api.System), its math writer and the
     equations, derived once."""
 
-    def __init__(self, system):
+    def __init__(self, system, size: tuple[int, int] | None = None, fps: float | None = None):
         self.system = system
+        self.size, self.fps = size, fps  # of the animations (None: the page's defaults)
         self.model = system.model
         self.write = MathWriter(self.model)
         self.urdf = self.model.kinematic_tree is not None
@@ -127,17 +135,21 @@ class _Page:
 
 
 def build_report(system, *, answer=None, t_end: float | None = None,
-                 progress: Callable[[str], None] | None = None) -> Report:
+                 progress: Callable[[str], None] | None = None, size: object = None,
+                 fps: object = None) -> Report:
     """The report of ``system`` (an api.System): ``answer`` (a path, dict or Answer) adds the
-    check of a hand derivation; ``t_end`` (s) sets the simulation's length (default 10 s).
-    An unreadable answer is refused before any work."""
+    check of a hand derivation; ``t_end`` (s) sets the simulation's length (default 10 s);
+    ``size`` ("WxH" or (width, height) pixels) and ``fps`` set every animation's frames, as
+    for ``modes --animate``. An unreadable answer or a bad size is refused before any work."""
+    from ..output.media import check_fps, check_size
     from . import sections as numeric
 
+    size, fps = check_size(size), None if fps is None else check_fps(fps)
     if t_end is not None and not (np.isfinite(float(t_end)) and float(t_end) > 0):
         raise ModelError(f"the simulation's length must be a positive number of seconds, got "
                          f"{t_end!r}", field="t_end")
     checked = system.check(answer) if answer is not None else None
-    context = _Page(system)
+    context = _Page(system, size, fps)
     builders = [
         ("model", "Model", _model_section),
         ("energy", "Energies and the Lagrangian", _energy_section),
@@ -224,7 +236,7 @@ def _model_section(c: _Page) -> tuple[Markup, str]:
         summary = element("summary", f"{where} ({len(text.splitlines())} lines)")
         parts.append(element("details", summary, element("pre", element("code", text)),
                              open=None if folded else "open"))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def _value(value) -> str:
@@ -254,7 +266,7 @@ def _energy_section(c: _Page) -> tuple[Markup, str]:
             "Dissipation function (W)", c.letter("D"), c.write(c.readable(D)))))
     parts.append(c.typeset("Lagrangian L = T - V", [T, V], lambda: c.formula(
         "Lagrangian (J)", c.letter("L"), c.write(c.readable(T) - c.readable(V)))))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def _forces_section(c: _Page) -> tuple[Markup, str]:
@@ -279,7 +291,7 @@ def _forces_section(c: _Page) -> tuple[Markup, str]:
         name = _force_name(c, co.symbol)
         parts.append(c.typeset(f"Q of {co.name}", [q], lambda q=q, name=name:
                                c.formula(None, name, c.write(c.readable(q)))))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def _force_name(c: _Page, coordinate: sp.Symbol) -> str:
@@ -336,7 +348,7 @@ def _equations_section(c: _Page) -> tuple[Markup, str]:
         parts.append(c.typeset("The constraint Jacobian", [A], lambda: c.formula(
             None, "<msub>" + mi("\u03a6") + mi("q") + "</msub>", mo("="),
             c.write(sp.Matrix(A.rows, A.cols, [c.readable(x) for x in A])))))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def _convention() -> str:

@@ -7,6 +7,7 @@ not apply returns one line saying why.
 from __future__ import annotations
 
 from ..errors import LagrangianError
+from ..kinds import FindingStatus
 from .html import Markup, element, image, join, note, number, paragraph, table
 from .media import (
     MODE_CYCLE,
@@ -17,6 +18,7 @@ from .media import (
     mode_gif,
     simulation_gif,
 )
+from .page import SHOWN
 
 
 def _where(values: dict[str, float], units: dict[str, str]) -> str:
@@ -54,7 +56,7 @@ def equilibria_section(c) -> tuple[Markup, str]:
     if found.singular:
         parts.append(note("Also at rest where a rotation sequence is singular (gimbal lock): "
                           + "; ".join(_where(p, units) for p in found.singular)))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def modes_section(c) -> tuple[Markup, str]:
@@ -81,7 +83,7 @@ def modes_section(c) -> tuple[Markup, str]:
                                                   "image/png"), "mode shapes, one panel each")))
     parts.append(element("h3", "Each mode, moving"))
     parts.append(_mode_animations(c, analysis))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def _mode_animations(c, analysis) -> Markup:
@@ -94,8 +96,8 @@ def _mode_animations(c, analysis) -> Markup:
                                                   "oscillate, so there is no motion to show.")))
             continue
         try:
-            gif = mode_gif(c.model, analysis, mode, i) if drawable else \
-                coordinate_mode_gif(analysis, mode, i, _units(c))
+            gif = mode_gif(c.model, analysis, mode, i, size=c.size, fps=c.fps) if drawable \
+                else coordinate_mode_gif(analysis, mode, i, _units(c), size=c.size, fps=c.fps)
         except LagrangianError as exc:
             figures.append(note(f"Mode {i}: no animation ({exc})."))
             continue
@@ -127,13 +129,13 @@ def simulation_section(c, t_end: float) -> tuple[Markup, str]:
     parts.append(element("figure", image(data_uri(figure_png(figure), "image/png"),
                                          "the coordinates and the energy over time")))
     if c.model.particles or c.model.bodies or c.model.rigid_bodies:
-        gif = simulation_gif(simulation)
+        gif = simulation_gif(simulation, size=c.size, fps=c.fps)
         parts.append(element("figure", image(data_uri(gif, "image/gif"), "the simulated motion",
                                              class_="animation"),
                              element("figcaption", "The simulated motion, looping.")))
     else:
         parts.append(note("No animation: the model is given by its energies only."))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def units_section(c) -> tuple[Markup, str]:
@@ -151,7 +153,7 @@ def units_section(c) -> tuple[Markup, str]:
     if report.unchecked:
         parts.append(note("Parameters without a unit are not judged: "
                           + ", ".join(report.unchecked)))
-    return join(parts), "shown"
+    return join(parts), SHOWN
 
 
 def check_section(c, report) -> tuple[Markup, str]:
@@ -159,9 +161,10 @@ def check_section(c, report) -> tuple[Markup, str]:
         return note("No answer given: `lagrangian report MODEL --answer ANSWER.toml` (or "
                     "System.report(answer=...)) checks a hand derivation here."), \
             "not applicable: no answer"
-    rows = [(f.item, element("span", f.status, class_="good" if f.status in
-                             ("correct", "equivalent") else "bad" if f.status == "wrong" else None),
-             f.code or "", f.message, "" if f.expected is None or f.status == "correct"
+    good, bad = (FindingStatus.CORRECT, FindingStatus.EQUIVALENT), FindingStatus.WRONG
+    rows = [(f.item, element("span", f.status, class_="good" if f.status in good
+                             else "bad" if f.status == bad else None),
+             f.code or "", f.message, "" if f.expected is None or f.status == FindingStatus.CORRECT
              else f.expected) for f in report.findings]
     verdict = element("span", report.verdict, class_="good" if report.passed else "bad")
     parts = [paragraph(f"{report.answer} against {report.model}: ", verdict)]
@@ -169,4 +172,4 @@ def check_section(c, report) -> tuple[Markup, str]:
         parts.append(table(["item", "status", "code", "finding", "expected"], rows))
     else:
         parts.append(note("The answer has no items to check."))
-    return join(parts), "shown"
+    return join(parts), SHOWN

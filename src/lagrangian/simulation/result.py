@@ -26,7 +26,8 @@ STATUS_MESSAGES = {
 @dataclass(frozen=True, repr=False)
 class SimulationResult:
     """Sampled trajectory t (s), q, q_dot, energy T + V (J), power of non-conservative loads
-    Q . q_dot (W), multipliers lambda and constraint residuals, with run statistics.
+    Q . q_dot (W; a controller's B u . q_dot included), multipliers lambda and constraint
+    residuals, with run statistics.
 
     ``invariant`` names the monitored quantity: "energy" (T + V), "jacobi_integral" (h, in
     ``invariant_values``) or "work_balance" (h - h0 - ``work``, the work int P dt done on the
@@ -62,6 +63,11 @@ class SimulationResult:
     # URDF velocity and effort limits exceeded (simulate.JointLimit): one dict each, with
     # joint, coordinate, quantity, limit, value, t (None for effort) and unit
     limits_exceeded: tuple[dict, ...] = ()
+    # under a controller (simulation/control.py): its output u at each sample (N, r), and the
+    # names of its entries (the inputs, or the coordinates for generalized forces)
+    controls: np.ndarray | None = None
+    control_names: tuple[str, ...] = ()
+    control_forces: np.ndarray | None = None  # B u: the generalized forces it added (N, n)
 
     @property
     def model_name(self) -> str:
@@ -97,6 +103,8 @@ class SimulationResult:
         for i, name in enumerate(self.constraint_names):
             out[f"residual_{name}"] = self.residuals[:, i]
         out["power"] = self.power
+        for i, name in enumerate(self.control_names):
+            out[f"control_{name}"] = self.controls[:, i]
         if self.invariant == InvariantKind.JACOBI_INTEGRAL and self.invariant_values is not None:
             out["jacobi_integral"] = self.invariant_values
         elif self.invariant == InvariantKind.WORK_BALANCE and self.balance is not None:

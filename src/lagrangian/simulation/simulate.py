@@ -24,6 +24,7 @@ from ..errors import InputError
 from ..kinds import InvariantKind, RunStatus
 from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state
+from .control import Controller, ControlLoop
 from .drift import DriftControl
 from .events import StopCondition, parse_stop_condition
 from .integration_loops import LoopRun, integrate_compiled, integrate_steps
@@ -51,6 +52,8 @@ def simulate(
     functions: NumericSystem | None = None,
     compiled_loop: bool = True,
     limits: Sequence[JointLimit] = (),
+    controller: Controller | None = None,
+    inputs: Sequence[str] = (),
 ) -> SimulationResult:
     """Integrate from the initial state to ``t_end`` (s), saving where ``save_at`` says.
 
@@ -60,7 +63,9 @@ def simulate(
     applies. Failures and Ctrl-C return the partial result with ``status`` 'failed' or
     'interrupted' and the time reached in ``message``. ``limits`` (a robot's URDF position
     limits, JointLimit) end the run with status 'limit' when a joint reaches one, naming it;
-    velocity and effort limits exceeded are reported in ``limits_exceeded``.
+    velocity and effort limits exceeded are reported in ``limits_exceeded``. ``controller``
+    (t, q, q_dot) -> u adds generalized forces (or, with ``inputs``, B u: simulation/control.py)
+    to the model's own, in the scipy loop.
     """
     model = eom.model
     start = resolve_state(model, initial, field="initial", what="coordinate or velocity (or t)")
@@ -82,11 +87,16 @@ def simulate(
     if drift is not None:
         q0, v0, projected = _project_start(drift, start)
 
+    loop = None
+    if controller is not None:
+        loop = ControlLoop(functions, controller, inputs, eom, substitution)
+        loop.output(start.t, q0, v0)  # a wrong shape refused before the run
     grid = np.linspace(start.t, t_end, save_at.samples)
     y0 = np.concatenate([q0, v0])
     began = time.perf_counter()
     run = _integrate(functions, y0, grid, step_control, event, drift, progress,
-                     compiled_loop and not functions.m and event is None, beyond)
+                     compiled_loop and not functions.m and event is None and loop is None, beyond,
+                     rhs=None if loop is None else loop.rhs)
     if beyond is not None and run.status == RunStatus.STOPPED:
         run = _at_limit(run, positioned, beyond, event, functions.n)
     wall = time.perf_counter() - began
@@ -102,37 +112,49 @@ def simulate(
     energy = functions.energy(q, q_dot, t)
     kinetic = energy - functions.energy(q, np.zeros_like(q_dot), t)  # T: E less its q_dot = 0 part
     power = np.einsum("ki,ki->k", power_terms(q, q_dot, t), q_dot)
+    controls = forces = None
+    if loop is not None:  # the controller's work enters the balance
+        controls, forces = loop.on_samples(t, q, q_dot)
+        power = power + np.einsum("ki,ki->k", forces, q_dot)
     if functions.m:
         with np.errstate(all="ignore"):
-            _, multipliers = functions.accelerations_and_multipliers(q, q_dot, t)
+            _, multipliers = functions.accelerations_and_multipliers(q, q_dot, t) \
+                if loop is None else (None, loop.multipliers(t, q, q_dot, forces))
         residuals = functions.constraint_residual(q, q_dot, t)
     else:
         multipliers = residuals = np.zeros((len(t), 0))
-    kind, invariant, work = _invariant(eom, substitution, t, q, q_dot, energy, power, multipliers)
+    kind, invariant, work = _invariant(eom, substitution, t, q, q_dot, energy, power, multipliers,
+                                       controlled=loop is not None)
     return SimulationResult(
         model=model, coordinates=functions.coordinates,
         constraint_names=functions.constraint_names, parameters=dict(functions.parameters),
         t=t, q=q, q_dot=q_dot, energy=energy, power=power, multipliers=multipliers,
         residuals=residuals, step_control=step_control, status=run.status, message=run.message,
         steps=run.steps, nfev=run.nfev, wall_time=wall, backend=run.backend,
-        energy_conserved=energy_is_conserved(eom), t_end=float(t_end),
+        energy_conserved=energy_is_conserved(eom) and loop is None, t_end=float(t_end),
         stop_when=stop.text if stop else None, projected_initial_state=projected,
         kinetic_energy=kinetic, invariant=kind, invariant_values=invariant, work=work,
         limits_exceeded=_exceeded(limits, functions.parameters, t, q_dot),
+        controls=controls, control_names=() if loop is None else loop.names,
+        control_forces=forces,
     )
 
 
-def _invariant(eom, substitution, t, q, q_dot, energy, power, multipliers):
+def _invariant(eom, substitution, t, q, q_dot, energy, power, multipliers, controlled=False):
     """(kind, the monitored quantity on the samples, the work done on the system up to each
     sample or None): T + V, the Jacobi integral h, or h with int P dt for a work balance, where
-    P = Q . q_dot - dL/dt + lambda . b (b: the velocity bias of moving constraints)."""
+    P = Q . q_dot - dL/dt + lambda . b (b: the velocity bias of moving constraints). Under a
+    controller (its power in ``power``) every kind becomes a work balance."""
     kind = invariant_kind(eom)
     if kind == InvariantKind.ENERGY:
+        if controlled:
+            return InvariantKind.WORK_BALANCE, energy, cumulative_work(t, power)
         return kind, energy, None
     model = eom.model
     values = StateFunction(model, [eom.jacobi_integral], substitution)(q, q_dot, t)[:, 0]
-    if kind == InvariantKind.JACOBI_INTEGRAL:
+    if kind == InvariantKind.JACOBI_INTEGRAL and not controlled:
         return kind, values, None
+    kind = InvariantKind.WORK_BALANCE
     supplied = np.array(power, dtype=float)
     if eom.explicit_time_power != 0:
         supplied = supplied + StateFunction(model, [eom.explicit_time_power],
@@ -144,7 +166,7 @@ def _invariant(eom, substitution, t, q, q_dot, energy, power, multipliers):
 
 
 def _integrate(functions, y0, grid, step_control, event, drift, progress, compiled,
-               beyond=None) -> LoopRun:
+               beyond=None, rhs=None) -> LoopRun:
     """The compiled DOP853 loop where it applies (and is there), else the scipy step loop.
     With position limits (``beyond``) the compiled loop's samples are checked, and a run with a
     sample at or beyond a limit is run again in the step loop, whose event finds the time the
@@ -160,7 +182,7 @@ def _integrate(functions, y0, grid, step_control, event, drift, progress, compil
         user = event
         event = beyond if user is None else (
             lambda q, v, t: max(user(q, v, t), beyond(q, v, t)))
-    return integrate_steps(functions.rhs, float(grid[0]), y0, float(grid[-1]), grid,
+    return integrate_steps(rhs or functions.rhs, float(grid[0]), y0, float(grid[-1]), grid,
                            step_control, event, drift, progress)
 
 

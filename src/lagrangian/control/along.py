@@ -1,0 +1,58 @@
+"""Linearization along a trajectory: x_dot = A(t) x + B(t) u about a run's saved samples, x =
+[q; q_dot], from the derivatives of forward dynamics (dynamics/derivatives.py) at each sample,
+with the controller's generalized forces of that run held in place (SI units)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+
+
+@dataclass(frozen=True, repr=False)
+class TrajectoryLinearization:
+    """A(t) (N, 2n, 2n) and B(t) (N, 2n, r) at the run's sample times t (N,): the variation
+    dx_dot = A dx + B du of x = [q; q_dot] about the run, u the generalized forces on
+    ``inputs`` (coordinates) on top of the run's own."""
+
+    t: np.ndarray
+    A: np.ndarray
+    B: np.ndarray
+    state_names: tuple[str, ...]
+    inputs: tuple[str, ...]
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def __repr__(self) -> str:
+        return (f"TrajectoryLinearization({len(self.t)} samples, states="
+                f"{list(self.state_names)}, inputs={list(self.inputs)})")
+
+
+def linearize_along(dynamics, simulation, inputs=None) -> TrajectoryLinearization:
+    """A(t), B(t) of ``dynamics`` (System.dynamics(): unconstrained) about ``simulation``'s
+    samples; ``inputs`` names the coordinates whose generalized forces are u (default all)."""
+    names = tuple(dynamics.coordinates)
+    if tuple(simulation.coordinates) != names:
+        raise InputError("the simulation is not of this system (its coordinates are "
+                         f"{', '.join(simulation.coordinates)})", field="simulation")
+    inputs = names if inputs is None else tuple(inputs)
+    unknown = [name for name in inputs if name not in names]
+    if unknown:
+        raise InputError(f"'{unknown[0]}' is not a coordinate (inputs along a run are the "
+                         f"generalized forces on: {', '.join(names)})", field="inputs")
+    q, v = np.asarray(simulation.q, dtype=float), np.asarray(simulation.q_dot, dtype=float)
+    forces = simulation.control_forces
+    tau = np.zeros_like(q) if forces is None else np.asarray(forces, dtype=float)
+    by_position, by_velocity, by_force = dynamics.forward_dynamics_derivatives(q, v, tau)
+    count, n = q.shape
+    A = np.zeros((count, 2 * n, 2 * n))
+    A[:, :n, n:] = np.eye(n)
+    A[:, n:, :n], A[:, n:, n:] = by_position, by_velocity
+    columns = [names.index(name) for name in inputs]
+    B = np.zeros((count, 2 * n, len(columns)))
+    B[:, n:, :] = by_force[:, :, columns]
+    return TrajectoryLinearization(np.asarray(simulation.t, dtype=float), A, B,
+                                   (*names, *(f"{c}_dot" for c in names)), inputs)

@@ -1,0 +1,103 @@
+"""Computed torque (feedback linearization) over a system's own dynamics:
+tau = M(q) (q_ddot_d + Kd (q_dot_d - q_dot) + Kp (q_d - q)) + C(q, q_dot) q_dot + g(q).
+
+On the model it was computed from, the error e = q_d - q then obeys e_ddot + Kd e_dot + Kp e = 0
+exactly: with Kp = w^2 I and Kd = 2 w I (critical damping) each joint's error is
+(e0 + (e0_dot + w e0) t) exp(-w t). Units SI (rad or m; tau in N m or N; gains 1/s^2, 1/s).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from .gains import square_matrix
+
+
+@dataclass(frozen=True, repr=False)
+class ComputedTorque:
+    """The computed-torque law as a controller (t, q, q_dot) -> tau (one generalized force per
+    coordinate) for System.simulate; ``reference(t)`` gives (q_d, q_dot_d, q_ddot_d)."""
+
+    dynamics: object
+    coordinates: tuple[str, ...]
+    Kp: np.ndarray
+    Kd: np.ndarray
+    reference: Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
+    inputs: tuple[str, ...] = ()  # generalized forces on every coordinate
+
+    @property
+    def error_eigenvalues(self) -> np.ndarray:
+        """The eigenvalues of the error dynamics [[0, I], [-Kp, -Kd]] (1/s)."""
+        n = len(self.coordinates)
+        return np.linalg.eigvals(np.block([[np.zeros((n, n)), np.eye(n)], [-self.Kp, -self.Kd]]))
+
+    def __call__(self, t, q, q_dot) -> np.ndarray:
+        q_d, v_d, a_d = self.reference(t)
+        q, v = np.asarray(q, dtype=float), np.asarray(q_dot, dtype=float)
+        command = a_d + self.Kd @ (v_d - v) + self.Kp @ (q_d - q)
+        mass = self.dynamics.mass_matrix(q)
+        return mass @ command + self.dynamics.bias_forces(q, v)
+
+    def summary(self) -> dict:
+        """JSON-ready: coordinates, gains, the error dynamics' eigenvalues (re, im)."""
+        return {"coordinates": list(self.coordinates), "Kp": self.Kp.tolist(),
+                "Kd": self.Kd.tolist(),
+                "closed_loop_eigenvalues": [[float(v.real), float(v.imag)]
+                                            for v in self.error_eigenvalues]}
+
+    def __repr__(self) -> str:
+        return f"ComputedTorque(coordinates={list(self.coordinates)})"
+
+
+def computed_torque(system, q_des, Kp, Kd) -> ComputedTorque:
+    """Computed torque on ``system`` (its dynamics(): an unconstrained model or a URDF robot).
+    ``q_des`` is the reference: a configuration held still (an array in the coordinates' order,
+    or name -> value, the others at the model's initial values), or a callable t -> (q_d,
+    q_dot_d, q_ddot_d); ``Kp`` (1/s^2) and ``Kd`` (1/s) are numbers, diagonals or matrices,
+    positive definite."""
+    dynamics = system.dynamics()
+    names = tuple(dynamics.coordinates)
+    n = len(names)
+    Kp = square_matrix(Kp, n, "Kp", definite=True)
+    Kd = square_matrix(Kd, n, "Kd", definite=True)
+    reference = _reference(q_des, names, system)
+    return ComputedTorque(dynamics, names, Kp, Kd, reference)
+
+
+def _reference(q_des, names: tuple[str, ...], system):
+    """t -> (q_d, q_dot_d, q_ddot_d), each (n,), checked once at t = 0."""
+    n = len(names)
+    if callable(q_des):
+        def reference(t):
+            value = q_des(t)
+            if not (isinstance(value, tuple | list) and len(value) == 3):
+                raise InputError("a reference callable must return (q_d, q_dot_d, q_ddot_d)",
+                                 field="q_des")
+            parts = tuple(np.asarray(x, dtype=float) for x in value)
+            if any(x.shape != (n,) for x in parts):
+                raise InputError(f"a reference callable must return three arrays of {n} "
+                                 f"values ({', '.join(names)}), got shapes "
+                                 f"{[x.shape for x in parts]}", field="q_des")
+            return parts
+
+        reference(0.0)
+        return reference
+    if isinstance(q_des, Mapping):
+        from ..model.values import resolve_state
+
+        start = resolve_state(system.model, dict(q_des), field="q_des", velocities=False,
+                              time=False)
+        target = np.asarray(start.q, dtype=float)
+    else:
+        target = np.asarray(q_des, dtype=float)
+        if target.shape != (n,):
+            raise InputError(f"expected {n} values ({', '.join(names)}), got shape "
+                             f"{target.shape}", field="q_des")
+    if not np.all(np.isfinite(target)):
+        raise InputError("the reference must be finite", field="q_des")
+    zero = np.zeros(n)
+    return lambda t: (target, zero, zero)

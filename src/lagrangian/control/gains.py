@@ -1,0 +1,31 @@
+"""Weight and gain matrices as a user writes them: a number (times I), a diagonal, or a matrix."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+
+
+def square_matrix(value, size: int, field: str, *, definite: bool = False) -> np.ndarray:
+    """A size x size symmetric matrix from a number, a diagonal of ``size`` numbers or a
+    matrix; positive semidefinite (``definite``: positive definite), finite."""
+    array = np.asarray(value, dtype=float)
+    if array.ndim == 0:
+        array = array * np.eye(size)
+    elif array.ndim == 1 and array.shape == (size,):
+        array = np.diag(array)
+    if array.shape != (size, size):
+        raise InputError(f"expected a number, {size} diagonal entries or a {size} x {size} "
+                         f"matrix, got shape {np.shape(value)}", field=field)
+    if not np.all(np.isfinite(array)):
+        raise InputError("entries must be finite numbers", field=field)
+    scale = max(float(np.abs(array).max()), 1e-300)
+    if not np.allclose(array, array.T, rtol=0, atol=1e-12 * scale):
+        raise InputError("the matrix must be symmetric", field=field)
+    smallest = float(np.linalg.eigvalsh((array + array.T) / 2).min()) if size else 1.0
+    if smallest < -1e-12 * scale or (definite and smallest <= 1e-12 * scale):
+        kind = "positive definite" if definite else "positive semidefinite"
+        raise InputError(f"the matrix must be {kind} (its smallest eigenvalue is "
+                         f"{smallest:.3g})", field=field)
+    return (array + array.T) / 2

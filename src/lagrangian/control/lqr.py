@@ -1,0 +1,130 @@
+"""The linear-quadratic regulator about a linear model x_dot = A x + B u (analysis/linearization.py):
+u = -K x minimizes int (x^T Q x + u^T R u) dt, K = R^-1 B^T S with S from the continuous
+algebraic Riccati equation A^T S + S A - S B R^-1 B^T S + Q = 0 (scipy's solver).
+
+x = [z - z0; z_dot] in the linear model's coordinates z about its equilibrium z0 (SI units).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..analysis.linearization import LinearModel
+from ..errors import InputError
+from .gains import square_matrix
+
+# A mode counts as unstable (needs the inputs) when its real part is above -this x |A|.
+_MARGINAL = 1e-9
+
+
+@dataclass(frozen=True, repr=False)
+class LQR:
+    """The regulator u = -K x and what it promises: the closed-loop eigenvalues eig(A - B K)
+    (1/s). Called as (t, q, q_dot) -> u (one value per input), it is a controller for
+    System.simulate; ``inputs`` tells simulate what u drives."""
+
+    K: np.ndarray
+    S: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    A: np.ndarray
+    B: np.ndarray
+    inputs: tuple[str, ...]
+    state_names: tuple[str, ...]
+    equilibrium: dict[str, float]
+    _positions: np.ndarray  # index of each z in the model's coordinates
+    _origin: np.ndarray  # z0
+
+    @property
+    def gain(self) -> np.ndarray:
+        return self.K
+
+    @property
+    def closed_loop(self) -> np.ndarray:
+        """A - B K."""
+        return self.A - self.B @ self.K
+
+    @property
+    def closed_loop_eigenvalues(self) -> np.ndarray:
+        """eig(A - B K) (1/s), the least stable first."""
+        values = np.linalg.eigvals(self.closed_loop)
+        return values[np.lexsort((values.imag, -values.real))]
+
+    def state(self, q, q_dot) -> np.ndarray:
+        """x = [z - z0; z_dot] from the model's q and q_dot, shape (..., 2p)."""
+        q, v = np.asarray(q, dtype=float), np.asarray(q_dot, dtype=float)
+        return np.concatenate([q[..., self._positions] - self._origin,
+                               v[..., self._positions]], axis=-1)
+
+    def __call__(self, t, q, q_dot) -> np.ndarray:
+        """u = -K x (the inputs' units: N, N m, or the parameter's)."""
+        return -(self.K @ self.state(q, q_dot))
+
+    def summary(self) -> dict:
+        """JSON-ready: inputs, states, K, closed-loop eigenvalues (re, im)."""
+        return {"inputs": list(self.inputs), "states": list(self.state_names),
+                "equilibrium": dict(self.equilibrium), "K": self.K.tolist(),
+                "closed_loop_eigenvalues": [[float(v.real), float(v.imag)]
+                                            for v in self.closed_loop_eigenvalues]}
+
+    def __repr__(self) -> str:
+        slowest = self.closed_loop_eigenvalues[0]
+        return (f"LQR(inputs={list(self.inputs)}, states={list(self.state_names)}, "
+                f"slowest closed-loop eigenvalue {slowest:.4g} 1/s)\nK =\n{self.K}")
+
+
+def lqr(linear_model: LinearModel, Q, R) -> LQR:
+    """The LQR about ``linear_model`` (System.linearize(about, inputs=[...]) or a modal
+    analysis' ``linear_model``): weights Q on x = [z - z0; z_dot] (number, diagonal or
+    matrix, positive semidefinite) and R on u (positive definite). Refused in one line when
+    (A, B) is not stabilizable or Q leaves an unstable mode unweighted."""
+    import scipy.linalg
+
+    model = getattr(linear_model, "linear_model", linear_model)  # a ModalAnalysis too
+    if not isinstance(model, LinearModel):
+        raise InputError("lqr takes a LinearModel (System.linearize(about, inputs=[...]))",
+                         field="linear_model")
+    if model.steady or model.state_constraints.size:
+        raise InputError("lqr needs a linear model about an equilibrium, not a steady motion",
+                         field="linear_model")
+    A, B = np.asarray(model.A, dtype=float), np.asarray(model.B, dtype=float)
+    size, width = A.shape[0], B.shape[1]
+    if width == 0:
+        raise InputError("the linear model has no inputs: linearize(..., inputs=[...]) names "
+                         "the loads or coordinates the controller drives", field="linear_model")
+    Q = square_matrix(Q, size, "Q")
+    R = square_matrix(R, width, "R", definite=True)
+    _require_stabilizable(A, B, model.inputs)
+    try:
+        S = scipy.linalg.solve_continuous_are(A, B, Q, R)
+    except (np.linalg.LinAlgError, ValueError) as exc:
+        raise InputError(f"no stabilizing Riccati solution ({exc}); Q must weigh every "
+                         "unstable mode", field="Q") from None
+    K = np.linalg.solve(R, B.T @ S)
+    closed = np.linalg.eigvals(A - B @ K)
+    if not np.all(closed.real < 0):
+        raise InputError("the Riccati solution does not stabilize (A, B): Q must weigh every "
+                         "unstable mode", field="Q")
+    names = list(model.user_coordinates)
+    positions = np.array([names.index(c) for c in model.coordinates], dtype=int)
+    origin = np.array([model.equilibrium[c] for c in model.coordinates], dtype=float)
+    return LQR(K=K, S=S, Q=Q, R=R, A=A, B=B, inputs=tuple(model.inputs),
+               state_names=tuple(model.state_names), equilibrium=dict(model.equilibrium),
+               _positions=positions, _origin=origin)
+
+
+def _require_stabilizable(A: np.ndarray, B: np.ndarray, inputs) -> None:
+    """The PBH test: every mode with Re(lambda) >= 0 is moved by B (rank [A - lambda I, B] = n)."""
+    size = A.shape[0]
+    scale = max(float(np.abs(A).max()), 1.0)
+    for value in np.linalg.eigvals(A):
+        if value.real < -_MARGINAL * scale:
+            continue
+        pencil = np.hstack([A - value * np.eye(size), B.astype(complex)])
+        singular = np.linalg.svd(pencil, compute_uv=False)
+        if singular[-1] <= 1e-9 * max(singular[0], 1e-300):
+            raise InputError(f"(A, B) is not stabilizable: the mode with eigenvalue "
+                             f"{value:.4g} 1/s is not moved by the inputs "
+                             f"({', '.join(inputs)})", field="linear_model")

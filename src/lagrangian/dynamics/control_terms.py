@@ -1,0 +1,132 @@
+"""What a controller or an identification asks of Dynamics beyond M and the bias: the
+derivatives of inverse and forward dynamics (derivatives.py), the torque regressor Y
+(tau = Y pi), the inertial parameters pi, a minimal identifiable set;
+mixed into joint_space.Dynamics (every path, a URDF tree's and a model file's)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..errors import InputError
+from .regressor import (
+    BASE_TOLERANCE,
+    BaseParameters,
+    ModelRegressor,
+    tree_parameter_names,
+    tree_parameters,
+    tree_regressor,
+)
+
+
+def _refuse_floating(tree, what: str) -> None:
+    # the complex-step Newton-Euler and the per-body regressor walk joints of one coordinate
+    # each; a free flyer's seven numbers and six rates are not theirs
+    if tree is not None and getattr(tree, "floating_base", False):
+        raise InputError(f"the {what} of a floating base are not given yet (fixed-base robots "
+                         "only); load it without floating_base=True", field="q")
+
+
+class ControlTerms:
+    """Regressor and parameters (a mixin of joint_space.Dynamics; SI units)."""
+
+    def _regressor_of(self, parameters: Sequence[str] | None):
+        tree = getattr(self, "tree", None)
+        _refuse_floating(tree, "regressor")
+        if tree is not None:
+            if parameters is not None:
+                raise InputError("a robot's regressor is over its bodies' 10 inertial "
+                                 "parameters each; parameters=[...] is for model files",
+                                 field="parameters")
+            g = self.parameters[tree.gravity_parameter]
+            return (lambda Q, V, A: tree_regressor(tree, g, Q, V, A),
+                    tree_parameter_names(tree), tree_parameters(tree))
+        if parameters is None:
+            raise InputError("name the parameters the model's T and V are linear in: "
+                             "regressor(q, v, a, parameters=[...])", field="parameters")
+        if self._equations is None:
+            raise InputError("this dynamics object was built without its equations",
+                             field="parameters")
+        names = [parameters] if isinstance(parameters, str) else list(parameters)
+        found = ModelRegressor(self._equations(), names, dict(self.functions.parameters))
+        return found, found.names, found.values
+
+    def regressor(self, q, v, a, parameters: Sequence[str] | None = None) -> np.ndarray:
+        """Y with tau = Y pi (inverse dynamics, the actuator parameters aside), shape
+        (..., n, k). A URDF robot: 10 parameters per moving body in Pinocchio's order
+        (m, m c_x, m c_y, m c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz about the body's joint
+        frame; see ``parameter_names``). A model file: the named ``parameters``, in which T and
+        V must be linear."""
+        compute, names, _ = self._regressor_of(parameters)
+        return self._guarded(compute, (q, v, a), ("q", "v", "a"), (self.n, len(names)))
+
+    def parameter_names(self, parameters: Sequence[str] | None = None) -> tuple[str, ...]:
+        """The names of pi's entries ('m@panda_joint1', ...; a model file's own names)."""
+        return tuple(self._regressor_of(parameters)[1])
+
+    def inertial_parameters(self, parameters: Sequence[str] | None = None) -> np.ndarray:
+        """pi: the model's own values of the regressor's parameters (SI)."""
+        return np.array(self._regressor_of(parameters)[2], dtype=float)
+
+    def base_parameters(self, parameters: Sequence[str] | None = None, *,
+                        tolerance: float = BASE_TOLERANCE, states: int | None = None,
+                        seed: int = 0) -> BaseParameters:
+        """A minimal identifiable set by QR with column pivoting of Y stacked over ``states``
+        random states (default 20 per parameter; q in [-pi, pi], rates in [-1, 1]): a column
+        is kept where |R_kk| > ``tolerance`` |R_00| (default 1e-8)."""
+        compute, names, _ = self._regressor_of(parameters)
+        count = states if states is not None else max(20 * len(names) // max(self.n, 1), 20)
+        rng = np.random.default_rng(seed)
+        q = rng.uniform(-np.pi, np.pi, (count, self.n))
+        v, a = rng.uniform(-1.0, 1.0, (2, count, self.n))
+        stacked = np.asarray(compute(q, v, a)).reshape(count * self.n, len(names))
+        return BaseParameters(names, stacked, tolerance)
+
+    # -- derivatives (derivatives.py) ------------------------------------------------------------
+
+    def _inverse_derivatives(self):
+        found = self.__dict__.get("_derivatives")
+        if found is None:
+            tree = getattr(self, "tree", None)
+            _refuse_floating(tree, "derivatives of the dynamics")
+            if tree is not None:
+                from .derivatives import tree_inverse_dynamics_derivatives
+
+                g = self.parameters[tree.gravity_parameter]
+
+                def found(Q, V, A):
+                    return tree_inverse_dynamics_derivatives(tree, g, Q, V, A)
+            else:
+                from .derivatives import ModelDerivatives
+
+                if self._equations is None:
+                    raise InputError("this dynamics object was built without its equations",
+                                     field="q")
+                found = ModelDerivatives(self._equations(), dict(self.functions.parameters))
+            self.__dict__["_derivatives"] = found
+        return found
+
+    def inverse_dynamics_derivatives(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
+        """(d tau/dq, d tau/dq_dot) of tau = M(q) q_ddot + C q_dot + g, (..., n, n) each (row
+        i: tau_i), as Pinocchio's computeRNEADerivatives: a model file's from its derived M and
+        f, a URDF tree's by the complex step through Newton-Euler (exact to rounding)."""
+        compute = self._inverse_derivatives()
+        n = self.n
+        both = self._guarded(lambda Q, V, A: np.concatenate(compute(Q, V, A), axis=-1),
+                             (q, v, a), ("q", "v", "a"), (n, 2 * n))
+        return both[..., :n], both[..., n:]
+
+    def forward_dynamics_derivatives(self, q, v, tau) -> tuple[np.ndarray, np.ndarray,
+                                                               np.ndarray]:
+        """(d q_ddot/dq, d q_ddot/dq_dot, d q_ddot/d tau), (..., n, n) each, as Pinocchio's
+        computeABADerivatives: -M^-1 d tau/dq and -M^-1 d tau/dq_dot at q_ddot = FD(q, q_dot,
+        tau), and M^-1."""
+        q, v, tau = self._vector(q, "q"), self._vector(v, "v"), self._vector(tau, "tau")
+        batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1], tau.shape[:-1])
+        q = np.broadcast_to(q, batch + (self.n,))
+        v = np.broadcast_to(v, batch + (self.n,))
+        acceleration = self.forward_dynamics(q, v, tau)
+        by_position, by_velocity = self.inverse_dynamics_derivatives(q, v, acceleration)
+        inverse = np.linalg.inv(self.mass_matrix(q))
+        return -inverse @ by_position, -inverse @ by_velocity, inverse

@@ -1,0 +1,514 @@
+/* The compact tree kernel: the recursions of tree_algorithms.py as loops over a tree given at
+   run time as one array of doubles (its layout in compact_kernel.py), compiled once for every
+   tree. Units SI. Each body i hangs from parent(i) < i (or the ground, -1) by one joint:
+   R = R0 Rot(u, theta) (revolute) or R0 (prismatic), p = t0 (+ R0 u theta), with
+   theta = k q[c] + offset; R turns body axes into parent axes, p is the origin in the parent. */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
+#include <numpy/arrayobject.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TK_HEADER 8     /* nb, n, gravity vector g*dir (3, world axes), mimic flag, 2 spare */
+#define TK_STRIDE 40    /* numbers per body record */
+/* a body record's fields */
+#define TK_PARENT 0
+#define TK_KIND 1       /* 0 revolute, 1 prismatic (a free-flyer would be a new code) */
+#define TK_COORD 2
+#define TK_MULT 3
+#define TK_OFFSET 4
+#define TK_R0 5         /* 9, row-major */
+#define TK_T0 14        /* 3 */
+#define TK_AXIS 17      /* 3 */
+#define TK_MASS 20
+#define TK_H 21         /* 3: first moment m c about the body origin */
+#define TK_J 24         /* 9: inertia about the body origin */
+/* a body's scratch */
+#define TW_STRIDE 96
+#define TW_R 0
+#define TW_P 9
+#define TW_A 12         /* 6-vectors and 6x6 matrices of the algorithms from here */
+
+typedef struct { int nb, n, mimic; const double *g, *tau0, *body; } tk_tree;
+
+static inline void tk_cross(const double *a, const double *b, double *c)
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static inline void tk_apply(const double *R, const double *x, double *y)  /* y = R x */
+{
+    for (int i = 0; i < 3; i++) y[i] = R[3 * i] * x[0] + R[3 * i + 1] * x[1] + R[3 * i + 2] * x[2];
+}
+
+static inline void tk_apply_t(const double *R, const double *x, double *y)  /* y = R^T x */
+{
+    for (int i = 0; i < 3; i++) y[i] = R[i] * x[0] + R[3 + i] * x[1] + R[6 + i] * x[2];
+}
+
+static inline double tk_dot(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline void tk_sandwich(const double *R, const double *A, double *out)  /* R A R^T */
+{
+    double T[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            T[3 * i + j] = R[3 * i] * A[j] + R[3 * i + 1] * A[3 + j] + R[3 * i + 2] * A[6 + j];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            out[3 * i + j] = T[3 * i] * R[3 * j] + T[3 * i + 1] * R[3 * j + 1]
+                             + T[3 * i + 2] * R[3 * j + 2];
+}
+
+static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
+{
+    if (size < TK_HEADER) return -1;
+    t->nb = (int)d[0];
+    t->n = (int)d[1];
+    t->mimic = d[5] != 0.0;
+    t->g = d + 2;
+    t->tau0 = d + TK_HEADER;
+    t->body = d + TK_HEADER + t->n;
+    if (t->nb < 1 || t->n < 1 || size != TK_HEADER + t->n + (Py_ssize_t)t->nb * TK_STRIDE)
+        return -1;
+    for (int i = 0; i < t->nb; i++) {
+        const double *b = t->body + i * TK_STRIDE;
+        if (!(b[TK_PARENT] >= -1 && b[TK_PARENT] < i) || !(b[TK_COORD] >= 0 && b[TK_COORD] < t->n)
+            || !(b[TK_KIND] == 0 || b[TK_KIND] == 1))
+            return -1;
+    }
+    return 0;
+}
+
+/* Each body's R and p for the configuration q (into the scratch W). */
+static void tk_place(const tk_tree *t, const double *q, double *W)
+{
+    for (int i = 0; i < t->nb; i++) {
+        const double *b = t->body + i * TK_STRIDE;
+        double *R = W + i * TW_STRIDE + TW_R, *p = W + i * TW_STRIDE + TW_P;
+        const double *R0 = b + TK_R0, *u = b + TK_AXIS;
+        const double theta = b[TK_MULT] * q[(int)b[TK_COORD]] + b[TK_OFFSET];
+        if (b[TK_KIND] == 0) {
+            /* Rot(u, theta) = c 1 + s [u]x + (1 - c) u u^T */
+            const double s = sin(theta), c = cos(theta), k = 1.0 - c;
+            const double E[9] = {c + k * u[0] * u[0], k * u[0] * u[1] - s * u[2],
+                                 k * u[0] * u[2] + s * u[1], k * u[1] * u[0] + s * u[2],
+                                 c + k * u[1] * u[1], k * u[1] * u[2] - s * u[0],
+                                 k * u[2] * u[0] - s * u[1], k * u[2] * u[1] + s * u[0],
+                                 c + k * u[2] * u[2]};
+            for (int r = 0; r < 3; r++)
+                for (int col = 0; col < 3; col++)
+                    R[3 * r + col] = R0[3 * r] * E[col] + R0[3 * r + 1] * E[3 + col]
+                                     + R0[3 * r + 2] * E[6 + col];
+            memcpy(p, b + TK_T0, 3 * sizeof(double));
+        } else {
+            double Ru[3];
+            memcpy(R, R0, 9 * sizeof(double));
+            tk_apply(R0, u, Ru);
+            for (int r = 0; r < 3; r++) p[r] = b[TK_T0 + r] + Ru[r] * theta;
+        }
+    }
+}
+
+/* S = (s_w, s_v) per unit rate of q (the multiplier k included). */
+static inline void tk_subspace(const double *b, double *sw, double *sv)
+{
+    const double k = b[TK_MULT];
+    for (int r = 0; r < 3; r++) {
+        sw[r] = b[TK_KIND] == 0 ? k * b[TK_AXIS + r] : 0.0;
+        sv[r] = b[TK_KIND] == 1 ? k * b[TK_AXIS + r] : 0.0;
+    }
+}
+
+/* Recursive Newton-Euler: tau = M a + C v + g - tau0 (v, a NULL: zero). */
+static void tk_inverse(const tk_tree *t, const double *q, const double *v, const double *a,
+                       double *W, double *tau)
+{
+    tk_place(t, q, W);
+    for (int i = 0; i < t->n; i++) tau[i] = -t->tau0[i];
+    for (int i = 0; i < t->nb; i++) {
+        const double *b = t->body + i * TK_STRIDE;
+        double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
+        double *om = w + TW_A, *dom = om + 3, *acc = om + 6, *f = om + 9, *nn = om + 12;
+        const int parent = (int)b[TK_PARENT], c = (int)b[TK_COORD];
+        double sw[3], sv[3], x[3], y[3];
+        tk_subspace(b, sw, sv);
+        if (parent < 0) {
+            const double up[3] = {-t->g[0], -t->g[1], -t->g[2]};  /* the ground accelerates up */
+            for (int r = 0; r < 3; r++) om[r] = dom[r] = 0.0;
+            tk_apply_t(R, up, acc);
+        } else {
+            const double *pw = W + parent * TW_STRIDE + TW_A, *pdw = pw + 3, *pa = pw + 6;
+            double z[3];
+            tk_apply_t(R, pw, om);
+            tk_apply_t(R, pdw, dom);
+            /* a_parent + dw x p + w x (w x p) */
+            tk_cross(pdw, p, x);
+            tk_cross(pw, p, y);
+            tk_cross(pw, y, z);
+            for (int r = 0; r < 3; r++) x[r] += pa[r] + z[r];
+            tk_apply_t(R, x, acc);
+        }
+        const double rate = v ? v[c] : 0.0, accel = a ? a[c] : 0.0;
+        if (rate != 0.0) {
+            double ws[3] = {rate * sw[0], rate * sw[1], rate * sw[2]};
+            tk_cross(om, ws, x);
+            for (int r = 0; r < 3; r++) { om[r] += ws[r]; dom[r] += x[r]; }
+            double vs[3] = {rate * sv[0], rate * sv[1], rate * sv[2]};
+            tk_cross(om, vs, x);
+            for (int r = 0; r < 3; r++) acc[r] += 2.0 * x[r];
+        }
+        for (int r = 0; r < 3; r++) { dom[r] += accel * sw[r]; acc[r] += accel * sv[r]; }
+        /* f = m a + dw x h + w x (w x h), n = J dw + w x J w + h x a (about the origin) */
+        const double m = b[TK_MASS], *h = b + TK_H, *J = b + TK_J;
+        double wh[3], z[3];
+        tk_cross(dom, h, x);
+        tk_cross(om, h, wh);
+        tk_cross(om, wh, z);
+        for (int r = 0; r < 3; r++) f[r] = m * acc[r] + x[r] + z[r];
+        tk_apply(J, dom, nn);
+        tk_apply(J, om, y);
+        tk_cross(om, y, x);
+        tk_cross(h, acc, z);
+        for (int r = 0; r < 3; r++) nn[r] += x[r] + z[r];
+    }
+    for (int i = t->nb - 1; i >= 0; i--) {
+        const double *b = t->body + i * TK_STRIDE;
+        double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
+        double *f = w + TW_A + 9, *nn = w + TW_A + 12, sw[3], sv[3];
+        tk_subspace(b, sw, sv);
+        tau[(int)b[TK_COORD]] += tk_dot(sw, nn) + tk_dot(sv, f);
+        const int parent = (int)b[TK_PARENT];
+        if (parent >= 0) {
+            double *pf = W + parent * TW_STRIDE + TW_A + 9, *pn = pf + 3, F[3], N[3], x[3];
+            tk_apply(R, f, F);
+            tk_apply(R, nn, N);
+            tk_cross(p, F, x);
+            for (int r = 0; r < 3; r++) { pf[r] += F[r]; pn[r] += N[r] + x[r]; }
+        }
+    }
+}
+
+/* M by the composite-rigid-body algorithm (row-major n x n). */
+static void tk_mass(const tk_tree *t, const double *q, double *W, double *M)
+{
+    const int n = t->n;
+    tk_place(t, q, W);
+    memset(M, 0, (size_t)n * n * sizeof(double));
+    for (int i = 0; i < t->nb; i++) {  /* composite inertias start as the bodies' own */
+        double *c = W + i * TW_STRIDE + TW_A;
+        const double *b = t->body + i * TK_STRIDE;
+        memcpy(c, b + TK_MASS, 13 * sizeof(double));
+    }
+    for (int i = t->nb - 1; i >= 0; i--) {
+        const double *b = t->body + i * TK_STRIDE;
+        double *w = W + i * TW_STRIDE, *c = w + TW_A;
+        const double m = c[0], *h = c + 1, *J = c + 4;
+        const int ci = (int)b[TK_COORD];
+        double sw[3], sv[3], force[3], moment[3], x[3];
+        tk_subspace(b, sw, sv);
+        /* the composite's wrench for a unit rate: f = m s_v + s_w x h, n = J s_w + h x s_v */
+        tk_cross(sw, h, x);
+        for (int r = 0; r < 3; r++) force[r] = m * sv[r] + x[r];
+        tk_apply(J, sw, moment);
+        tk_cross(h, sv, x);
+        for (int r = 0; r < 3; r++) moment[r] += x[r];
+        M[ci * n + ci] += tk_dot(sw, moment) + tk_dot(sv, force);
+        for (int k = i; (int)t->body[k * TK_STRIDE + TK_PARENT] >= 0;) {
+            const double *wk = W + k * TW_STRIDE;
+            double F[3], N[3];
+            tk_apply(wk + TW_R, force, F);
+            tk_apply(wk + TW_R, moment, N);
+            tk_cross(wk + TW_P, F, x);
+            for (int r = 0; r < 3; r++) { force[r] = F[r]; moment[r] = N[r] + x[r]; }
+            k = (int)t->body[k * TK_STRIDE + TK_PARENT];
+            const double *bk = t->body + k * TK_STRIDE;
+            double kw[3], kv[3];
+            tk_subspace(bk, kw, kv);
+            const double e = tk_dot(kw, moment) + tk_dot(kv, force);
+            const int ck = (int)bk[TK_COORD];
+            M[ci * n + ck] += e;
+            M[ck * n + ci] += e;
+        }
+        const int parent = (int)b[TK_PARENT];
+        if (parent >= 0) {  /* the composite moved into the parent's axes */
+            const double *R = w + TW_R, *p = w + TW_P;
+            double *pc = W + parent * TW_STRIDE + TW_A, hr[3], S[9];
+            tk_apply(R, h, hr);
+            tk_sandwich(R, J, S);
+            const double ph = tk_dot(p, hr), pp = tk_dot(p, p);
+            /* J' = R J R^T + m (|p|^2 1 - p p^T) + 2 (p.h) 1 - p h^T - h p^T */
+            for (int r = 0; r < 3; r++)
+                for (int col = 0; col < 3; col++)
+                    pc[4 + 3 * r + col] += S[3 * r + col]
+                        + (r == col ? m * pp + 2.0 * ph : 0.0)
+                        - m * p[r] * p[col] - p[r] * hr[col] - hr[r] * p[col];
+            for (int r = 0; r < 3; r++) pc[1 + r] += hr[r] + m * p[r];
+            pc[0] += m;
+        }
+    }
+}
+
+/* The articulated-body algorithm (no mimic joints: each coordinate drives one body); -1 where
+   a joint's articulated inertia is not positive (a massless branch). Spatial vectors are
+   (angular, linear) at the body's origin in its axes. */
+static int tk_forward_aba(const tk_tree *t, const double *q, const double *v,
+                          const double *tau, double *W, double *qdd)
+{
+    tk_place(t, q, W);
+    /* scratch per body after R, p: V 6, C 6, A 6, IA 36, PA 6, U 6, D, u */
+    enum { V = TW_A, C = V + 6, A = C + 6, IA = A + 6, PA = IA + 36, U = PA + 6, D = U + 6,
+           UU = D + 1 };
+    for (int i = 0; i < t->nb; i++) {
+        const double *b = t->body + i * TK_STRIDE;
+        double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
+        double sw[3], sv[3], x[3];
+        const int parent = (int)b[TK_PARENT];
+        tk_subspace(b, sw, sv);
+        const double rate = v[(int)b[TK_COORD]];
+        double *vw = w + V, *vv = w + V + 3;
+        if (parent < 0) {
+            for (int r = 0; r < 3; r++) vw[r] = vv[r] = 0.0;
+        } else {
+            const double *pv = W + parent * TW_STRIDE + V;
+            tk_cross(pv, p, x);
+            for (int r = 0; r < 3; r++) x[r] += pv[3 + r];
+            tk_apply_t(R, pv, vw);
+            tk_apply_t(R, x, vv);
+        }
+        /* c = v x (S rate), with the parent's part: (w x s_w, w x s_v + v_l x s_w) rate */
+        double *cw = w + C, *cv = w + C + 3, y[3];
+        tk_cross(vw, sw, cw);
+        tk_cross(vw, sv, x);
+        tk_cross(vv, sw, y);
+        for (int r = 0; r < 3; r++) {
+            cw[r] *= rate;
+            cv[r] = (x[r] + y[r]) * rate;
+            vw[r] += rate * sw[r];
+            vv[r] += rate * sv[r];
+        }
+        /* IA = I, pA = v x* I v: I v = (J w + h x v, m v + w x h) */
+        const double m = b[TK_MASS], *h = b + TK_H, *J = b + TK_J;
+        double *In = w + IA, *pa = w + PA, Iw[3], Iv[3], z[3];
+        for (int r = 0; r < 3; r++)
+            for (int col = 0; col < 3; col++) {
+                In[6 * r + col] = J[3 * r + col];
+                In[6 * (r + 3) + col + 3] = r == col ? m : 0.0;
+            }
+        /* [[J, [h]x], [[h]x^T, m 1]] */
+        const double H[9] = {0.0, -h[2], h[1], h[2], 0.0, -h[0], -h[1], h[0], 0.0};
+        for (int r = 0; r < 3; r++)
+            for (int col = 0; col < 3; col++) {
+                In[6 * r + col + 3] = H[3 * r + col];
+                In[6 * (r + 3) + col] = H[3 * col + r];
+            }
+        tk_apply(J, vw, Iw);
+        tk_cross(h, vv, x);
+        for (int r = 0; r < 3; r++) Iw[r] += x[r];
+        tk_cross(vw, h, x);
+        for (int r = 0; r < 3; r++) Iv[r] = m * vv[r] + x[r];
+        /* v x* (n, f) = (w x n + v x f, w x f) */
+        tk_cross(vw, Iw, x);
+        tk_cross(vv, Iv, z);
+        tk_cross(vw, Iv, y);
+        for (int r = 0; r < 3; r++) { pa[r] = x[r] + z[r]; pa[3 + r] = y[r]; }
+    }
+    for (int i = t->nb - 1; i >= 0; i--) {
+        const double *b = t->body + i * TK_STRIDE;
+        double *w = W + i * TW_STRIDE, *In = w + IA, *pa = w + PA, *U_ = w + U;
+        double S[6];
+        tk_subspace(b, S, S + 3);
+        for (int r = 0; r < 6; r++) {
+            double s = 0.0;
+            for (int k = 0; k < 6; k++) s += In[6 * r + k] * S[k];
+            U_[r] = s;
+        }
+        double d = 0.0, su = 0.0;
+        for (int r = 0; r < 6; r++) { d += S[r] * U_[r]; su += S[r] * pa[r]; }
+        const int c = (int)b[TK_COORD];
+        const double u = tau[c] + t->tau0[c] - su;
+        if (!(d > 0.0)) return -1;
+        w[D] = d;
+        w[UU] = u;
+        const int parent = (int)b[TK_PARENT];
+        if (parent < 0) continue;
+        /* Ia = IA - U U^T / D, pa' = pA + Ia c + U u / D, then X^T into the parent */
+        double Ia[36], pv[6];
+        const double inv = 1.0 / d;
+        for (int r = 0; r < 6; r++)
+            for (int k = 0; k < 6; k++) Ia[6 * r + k] = In[6 * r + k] - U_[r] * U_[k] * inv;
+        const double *cc = w + C;
+        for (int r = 0; r < 6; r++) {
+            double s = pa[r] + U_[r] * u * inv;
+            for (int k = 0; k < 6; k++) s += Ia[6 * r + k] * cc[k];
+            pv[r] = s;
+        }
+        const double *R = w + TW_R, *p = w + TW_P;
+        double *PI = W + parent * TW_STRIDE + IA, *Pp = W + parent * TW_STRIDE + PA;
+        /* blocks A, B, C' of Ia rotated into parent axes, then shifted by p (P = [p]x):
+           A + P B^T - B P - P C P, B + P C, C */
+        double Ab[9], Bb[9], Cb[9], Ar[9], Br[9], Cr[9];
+        for (int r = 0; r < 3; r++)
+            for (int k = 0; k < 3; k++) {
+                Ab[3 * r + k] = Ia[6 * r + k];
+                Bb[3 * r + k] = Ia[6 * r + k + 3];
+                Cb[3 * r + k] = Ia[6 * (r + 3) + k + 3];
+            }
+        tk_sandwich(R, Ab, Ar);
+        tk_sandwich(R, Bb, Br);
+        tk_sandwich(R, Cb, Cr);
+        double PC[9], BP[9], PCP[9], PBt[9];
+        for (int k = 0; k < 3; k++) {  /* column k of P X is p x (column k of X) */
+            double col[3], out[3];
+            for (int r = 0; r < 3; r++) col[r] = Cr[3 * r + k];
+            tk_cross(p, col, out);
+            for (int r = 0; r < 3; r++) PC[3 * r + k] = out[r];
+            for (int r = 0; r < 3; r++) col[r] = Br[3 * k + r];  /* column k of B^T */
+            tk_cross(p, col, out);
+            for (int r = 0; r < 3; r++) PBt[3 * r + k] = out[r];
+        }
+        for (int r = 0; r < 3; r++) {  /* row r of X P is -(p x row r of X) ... = row x p */
+            double row[3], out[3];
+            for (int k = 0; k < 3; k++) row[k] = Br[3 * r + k];
+            tk_cross(row, p, out);
+            for (int k = 0; k < 3; k++) BP[3 * r + k] = out[k];
+            for (int k = 0; k < 3; k++) row[k] = PC[3 * r + k];
+            tk_cross(row, p, out);
+            for (int k = 0; k < 3; k++) PCP[3 * r + k] = out[k];
+        }
+        for (int r = 0; r < 3; r++)
+            for (int k = 0; k < 3; k++) {
+                const double a = Ar[3 * r + k] + PBt[3 * r + k] - BP[3 * r + k] - PCP[3 * r + k];
+                const double bb = Br[3 * r + k] + PC[3 * r + k];
+                PI[6 * r + k] += a;
+                PI[6 * r + k + 3] += bb;
+                PI[6 * (k + 3) + r] += bb;
+                PI[6 * (r + 3) + k + 3] += Cr[3 * r + k];
+            }
+        double F[3], N[3], x[3];
+        tk_apply(R, pv + 3, F);
+        tk_apply(R, pv, N);
+        tk_cross(p, F, x);
+        for (int r = 0; r < 3; r++) { Pp[r] += N[r] + x[r]; Pp[3 + r] += F[r]; }
+    }
+    for (int i = 0; i < t->nb; i++) {
+        const double *b = t->body + i * TK_STRIDE;
+        double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P, *ac = w + A;
+        const int parent = (int)b[TK_PARENT];
+        double x[3], S[6];
+        if (parent < 0) {  /* the ground accelerates up by g: (0, -g) */
+            const double up[3] = {-t->g[0], -t->g[1], -t->g[2]};
+            for (int r = 0; r < 3; r++) ac[r] = 0.0;
+            tk_apply_t(R, up, ac + 3);
+        } else {
+            const double *pa = W + parent * TW_STRIDE + A;
+            tk_cross(pa, p, x);
+            for (int r = 0; r < 3; r++) x[r] += pa[3 + r];
+            tk_apply_t(R, pa, ac);
+            tk_apply_t(R, x, ac + 3);
+        }
+        for (int r = 0; r < 6; r++) ac[r] += w[C + r];
+        tk_subspace(b, S, S + 3);
+        double s = 0.0;
+        for (int r = 0; r < 6; r++) s += w[U + r] * ac[r];
+        const double x_dd = (w[UU] - s) / w[D];
+        qdd[(int)b[TK_COORD]] = x_dd;
+        for (int r = 0; r < 6; r++) ac[r] += S[r] * x_dd;
+    }
+    for (int i = 0; i < t->n; i++)
+        if (!isfinite(qdd[i])) return -1;
+    return 0;
+}
+
+/* q_ddot = M^-1 (tau - b) by Cholesky (a tree with mimic joints); -1 where M is not positive
+   definite. L needs n * n numbers. */
+static int tk_forward_cholesky(const tk_tree *t, const double *q, const double *v,
+                               const double *tau, double *W, double *L, double *qdd)
+{
+    const int n = t->n;
+    tk_mass(t, q, W, L);
+    tk_inverse(t, q, v, NULL, W, qdd);
+    for (int i = 0; i < n; i++) qdd[i] = tau[i] - qdd[i];
+    for (int j = 0; j < n; j++) {
+        double d = L[j * n + j];
+        for (int k = 0; k < j; k++) d -= L[j * n + k] * L[j * n + k];
+        if (!(d > 0.0)) return -1;
+        d = sqrt(d);
+        L[j * n + j] = d;
+        const double inv = 1.0 / d;
+        for (int i = j + 1; i < n; i++) {
+            double s = L[i * n + j];
+            for (int k = 0; k < j; k++) s -= L[i * n + k] * L[j * n + k];
+            L[i * n + j] = s * inv;
+        }
+    }
+    for (int i = 0; i < n; i++) {
+        double s = qdd[i];
+        for (int k = 0; k < i; k++) s -= L[i * n + k] * qdd[k];
+        qdd[i] = s / L[i * n + i];
+    }
+    for (int i = n - 1; i >= 0; i--) {
+        double s = qdd[i];
+        for (int k = i + 1; k < n; k++) s -= L[k * n + i] * qdd[k];
+        qdd[i] = s / L[i * n + i];
+    }
+    for (int i = 0; i < n; i++)
+        if (!isfinite(qdd[i])) return -1;
+    return 0;
+}
+
+/* T = 1/2 sum (m v.v + 2 v.(w x h) + w.J w) */
+static double tk_kinetic(const tk_tree *t, const double *q, const double *v, double *W)
+{
+    tk_place(t, q, W);
+    double total = 0.0;
+    for (int i = 0; i < t->nb; i++) {
+        const double *b = t->body + i * TK_STRIDE;
+        double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
+        double *om = w + TW_A, *vel = om + 3, sw[3], sv[3], x[3];
+        const int parent = (int)b[TK_PARENT];
+        tk_subspace(b, sw, sv);
+        if (parent < 0) {
+            for (int r = 0; r < 3; r++) om[r] = vel[r] = 0.0;
+        } else {
+            const double *pw = W + parent * TW_STRIDE + TW_A;
+            tk_cross(pw, p, x);
+            for (int r = 0; r < 3; r++) x[r] += pw[3 + r];
+            tk_apply_t(R, pw, om);
+            tk_apply_t(R, x, vel);
+        }
+        const double rate = v[(int)b[TK_COORD]];
+        for (int r = 0; r < 3; r++) { om[r] += rate * sw[r]; vel[r] += rate * sv[r]; }
+        double Jw[3], wh[3];
+        tk_apply(b + TK_J, om, Jw);
+        tk_cross(om, b + TK_H, wh);
+        total += b[TK_MASS] * tk_dot(vel, vel) + 2.0 * tk_dot(vel, wh) + tk_dot(om, Jw);
+    }
+    return 0.5 * total;
+}
+
+/* V = -sum (m g.r + g.h), g the gravity vector in each body's axes, r its origin */
+static double tk_potential(const tk_tree *t, const double *q, double *W)
+{
+    tk_place(t, q, W);
+    double total = 0.0;
+    for (int i = 0; i < t->nb; i++) {
+        const double *b = t->body + i * TK_STRIDE;
+        double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P, *gb = w + TW_A;
+        const int parent = (int)b[TK_PARENT];
+        const double *gl = parent < 0 ? t->g : W + parent * TW_STRIDE + TW_A;
+        const double height = parent < 0 ? 0.0 : W[parent * TW_STRIDE + TW_A + 3];
+        gb[3] = height + tk_dot(gl, p);  /* g . r of this origin */
+        tk_apply_t(R, gl, gb);
+        total -= b[TK_MASS] * gb[3] + tk_dot(gb, b + TK_H);
+    }
+    return total;
+}
+

@@ -1,0 +1,234 @@
+/* ---- batched bindings: f(Q[, V[, X]], D), each input (..., n) or (n,), D the tree ----
+   As tree_bindings.c: a state whose inputs are not all finite, or (forward dynamics) without
+   a finite result, gives NaN in its own row and is counted; with none such the output array
+   is returned, else (output, count). Batches run on threads. */
+enum { TK_MASSM, TK_BIAS, TK_GRAVITY, TK_INVERSE, TK_FORWARD, TK_KINETIC, TK_POTENTIAL };
+#if defined(__unix__) || defined(__APPLE__)
+#define TK_PTHREADS 1
+#include <pthread.h>
+#include <unistd.h>
+#else
+#define TK_PTHREADS 0
+#endif
+#define TK_MAX_THREADS 8
+#define TK_THREAD_WORK 8192  /* body-states (about 1 ms) per thread before another starts */
+
+typedef struct {
+    const tk_tree *tree;
+    int kind, nin, size;
+    npy_intp step[3];
+    const double *x[3];
+    double *y;
+    npy_intp k0, k1, bad;
+    int failed;
+} tk_job;
+
+static void *tk_run(void *argument)
+{
+    tk_job *job = (tk_job *)argument;
+    const tk_tree *t = job->tree;
+    const int n = t->n, size = job->size;
+    /* scratch: on the stack for a small tree (a call on one state costs no malloc) */
+    double small[4096];
+    const size_t need = (size_t)t->nb * TW_STRIDE + (size_t)n * n;
+    double *W = need <= 4096 ? small : malloc(need * sizeof(double));
+    if (!W) { job->failed = 1; return NULL; }
+    double *L = W + (size_t)t->nb * TW_STRIDE;
+    npy_intp bad = 0;
+    for (npy_intp k = job->k0; k < job->k1; k++) {
+        const double *a[3] = {NULL, NULL, NULL};
+        int fine = 1;
+        for (int j = 0; j < job->nin; j++) {
+            a[j] = job->x[j] + k * job->step[j];
+            for (int i = 0; i < n; i++)
+                if (!isfinite(a[j][i])) fine = 0;
+        }
+        double *y = job->y + k * size;
+        if (fine) {
+            switch (job->kind) {
+            case TK_MASSM: tk_mass(t, a[0], W, y); break;
+            case TK_BIAS: tk_inverse(t, a[0], a[1], NULL, W, y); break;
+            case TK_GRAVITY: tk_inverse(t, a[0], NULL, NULL, W, y); break;
+            case TK_INVERSE: tk_inverse(t, a[0], a[1], a[2], W, y); break;
+            case TK_FORWARD:
+                fine = (t->mimic ? tk_forward_cholesky(t, a[0], a[1], a[2], W, L, y)
+                        : tk_forward_aba(t, a[0], a[1], a[2], W, y)) == 0;
+                break;
+            case TK_KINETIC: y[0] = tk_kinetic(t, a[0], a[1], W); break;
+            case TK_POTENTIAL: y[0] = tk_potential(t, a[0], W); break;
+            }
+        }
+        if (!fine) {
+            for (int i = 0; i < size; i++) y[i] = NAN;
+            bad++;
+        }
+    }
+    if (W != small) free(W);
+    job->bad = bad;
+    return NULL;
+}
+
+static int tk_threads(npy_intp count, int nb)
+{
+#if TK_PTHREADS
+    static int cap = 0;
+    if (cap == 0) {
+        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+        const char *env = getenv("LAGRANGIAN_THREADS");
+        long asked = env && *env ? strtol(env, NULL, 10) : cpus;
+        if (asked < 1) asked = 1;
+        if (cpus < 1) cpus = 1;
+        cap = (int)(asked < cpus ? asked : cpus);
+        if (cap > TK_MAX_THREADS) cap = TK_MAX_THREADS;
+    }
+    npy_intp parts = count * nb / TK_THREAD_WORK;
+    if (parts > count) parts = count;
+    if (parts > cap) parts = cap;
+    return parts < 1 ? 1 : (int)parts;
+#else
+    (void)count; (void)nb;
+    return 1;
+#endif
+}
+
+static const char *tk_names[] = {"q", "v", "third"};
+
+static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int kind)
+{
+    PyArrayObject *in[3] = {NULL, NULL, NULL}, *D = NULL;
+    PyObject *out = NULL;
+    npy_intp step[3] = {0, 0, 0};
+    tk_tree tree;
+    if (nargs != nin + 1) {
+        PyErr_Format(PyExc_TypeError, "expected %d arguments", nin + 1);
+        return NULL;
+    }
+    D = (PyArrayObject *)PyArray_FROMANY(args[nin], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
+    if (!D) return NULL;
+    if (tk_open((const double *)PyArray_DATA(D), PyArray_SIZE(D), &tree)) {
+        PyErr_SetString(PyExc_TypeError, "tree: not a tree description (compact_kernel.py)");
+        goto done;
+    }
+    const int n = tree.n;
+    int base = 0;
+    for (int i = 0; i < nin; i++) {
+        in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
+        if (!in[i]) goto done;
+        int nd = PyArray_NDIM(in[i]);
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != n) {
+            PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
+                         i == 2 ? (kind == TK_FORWARD ? "tau" : "a") : tk_names[i], n);
+            goto done;
+        }
+        if (PyArray_SIZE(in[i]) > PyArray_SIZE(in[base])) base = i;
+    }
+    npy_intp count = PyArray_SIZE(in[base]) / n;
+    int nd = PyArray_NDIM(in[base]);
+    for (int i = 0; i < nin; i++) {
+        if (PyArray_SIZE(in[i]) == n && PyArray_NDIM(in[i]) == 1) {
+            step[i] = count > 1 ? 0 : n;
+            continue;
+        }
+        if (PyArray_NDIM(in[i]) != nd
+            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), nd * sizeof(npy_intp))) {
+            PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
+            goto done;
+        }
+        step[i] = n;
+    }
+    npy_intp dims[NPY_MAXDIMS];
+    memcpy(dims, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
+    int od = nd - 1;
+    if (kind == TK_MASSM) { dims[od++] = n; dims[od++] = n; }
+    else if (kind != TK_KINETIC && kind != TK_POTENTIAL) dims[od++] = n;
+    out = PyArray_SimpleNew(od, dims, NPY_DOUBLE);
+    if (!out) goto done;
+    const int size = kind == TK_MASSM ? n * n : (kind == TK_KINETIC || kind == TK_POTENTIAL) ? 1 : n;
+    tk_job jobs[TK_MAX_THREADS];
+    const int parts = tk_threads(count, tree.nb);
+    const npy_intp share = (count + parts - 1) / parts;
+    for (int t = 0; t < parts; t++) {
+        tk_job job = {&tree, kind, nin, size, {step[0], step[1], step[2]},
+                      {(const double *)PyArray_DATA(in[0]),
+                       nin > 1 ? (const double *)PyArray_DATA(in[1]) : NULL,
+                       nin > 2 ? (const double *)PyArray_DATA(in[2]) : NULL},
+                      (double *)PyArray_DATA((PyArrayObject *)out),
+                      t * share < count ? t * share : count,
+                      (t + 1) * share < count ? (t + 1) * share : count, 0, 0};
+        jobs[t] = job;
+    }
+    npy_intp bad = 0;
+    int failed = 0;
+    NPY_BEGIN_THREADS_DEF;
+    if (count * tree.nb > 64) NPY_BEGIN_THREADS;
+#if TK_PTHREADS
+    pthread_t threads[TK_MAX_THREADS];
+    int started[TK_MAX_THREADS] = {0};
+    for (int t = 0; t < parts - 1; t++)
+        started[t] = pthread_create(&threads[t], NULL, tk_run, &jobs[t]) == 0;
+    tk_run(&jobs[parts - 1]);
+    for (int t = 0; t < parts - 1; t++) {
+        if (started[t]) pthread_join(threads[t], NULL);
+        else tk_run(&jobs[t]);
+    }
+#else
+    for (int t = 0; t < parts; t++) tk_run(&jobs[t]);
+#endif
+    for (int t = 0; t < parts; t++) { bad += jobs[t].bad; failed |= jobs[t].failed; }
+    if (count * tree.nb > 64) NPY_END_THREADS;
+    if (failed) {
+        Py_CLEAR(out);
+        PyErr_NoMemory();
+        goto done;
+    }
+    if (bad > 0) {
+        PyObject *pair = Py_BuildValue("(Nn)", out, (Py_ssize_t)bad);
+        out = pair;  /* the pair owns the array (N), or NULL with the error set */
+    }
+done:
+    for (int i = 0; i < 3; i++) Py_XDECREF(in[i]);
+    Py_XDECREF(D);
+    return out;
+}
+
+#define TK_WRAP(name, nin, kind) \
+    static PyObject *tk_py_##name(PyObject *self, PyObject *const *args, Py_ssize_t nargs) \
+    { (void)self; return tk_batch(args, nargs, nin, kind); }
+TK_WRAP(mass_matrix, 1, TK_MASSM)
+TK_WRAP(bias_forces, 2, TK_BIAS)
+TK_WRAP(gravity, 1, TK_GRAVITY)
+TK_WRAP(inverse_dynamics, 3, TK_INVERSE)
+TK_WRAP(forward_dynamics, 3, TK_FORWARD)
+TK_WRAP(kinetic_energy, 2, TK_KINETIC)
+TK_WRAP(potential_energy, 1, TK_POTENTIAL)
+
+#define TK_METHOD(name, doc) \
+    {#name, (PyCFunction)(void (*)(void))tk_py_##name, METH_FASTCALL, doc}
+static PyMethodDef tk_methods[] = {
+    TK_METHOD(mass_matrix, "(Q, D) -> M"),
+    TK_METHOD(bias_forces, "(Q, V, D) -> b"),
+    TK_METHOD(gravity, "(Q, D) -> g"),
+    TK_METHOD(inverse_dynamics, "(Q, V, A, D) -> tau"),
+    TK_METHOD(forward_dynamics, "(Q, V, TAU, D) -> q_ddot"),
+    TK_METHOD(kinetic_energy, "(Q, V, D) -> T"),
+    TK_METHOD(potential_energy, "(Q, D) -> V"),
+    {NULL, NULL, 0, NULL},
+};
+
+#define TK_STR_(x) #x
+#define TK_STR(x) TK_STR_(x)
+#define TK_PASTE_(a, b) a##b
+#define TK_PASTE(a, b) TK_PASTE_(a, b)
+static struct PyModuleDef tk_module = {PyModuleDef_HEAD_INIT, TK_STR(LG_MODULE), NULL, -1,
+                                       tk_methods};
+
+PyMODINIT_FUNC TK_PASTE(PyInit_, LG_MODULE)(void)
+{
+    import_array();
+    PyObject *m = PyModule_Create(&tk_module);
+    if (m) {
+        PyModule_AddIntConstant(m, "header", TK_HEADER);
+        PyModule_AddIntConstant(m, "stride", TK_STRIDE);
+    }
+    return m;
+}

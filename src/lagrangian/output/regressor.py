@@ -1,0 +1,48 @@
+"""The regressor at one state (`regressor`): the JSON document and its text."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+
+def regressor_document(coordinates, names, values, Y, base=None) -> dict[str, Any]:
+    """coordinates, parameters (names and the model's values pi), the regressor Y (n x k
+    nested lists, tau = Y pi), tau; with ``base`` its names, tolerance and combination
+    (beta = combination pi). SI units."""
+    Y = np.asarray(Y, dtype=float)
+    document: dict[str, Any] = {
+        "coordinates": list(coordinates),
+        "parameters": list(names),
+        "values": [float(x) for x in values],
+        "regressor": Y.tolist(),
+        "tau": (Y @ np.asarray(values, dtype=float)).tolist(),
+    }
+    if base is not None:
+        document["base"] = {"tolerance": base.tolerance, "names": list(base.base_names),
+                            "combination": base.combination.tolist(),
+                            "values": base.values(values).tolist(),
+                            "description": base.describe()}
+    return document
+
+
+def regressor_text(document: dict[str, Any]) -> str:
+    """The parameters with their values, Y row by row, tau; the base set when present."""
+    names = document["parameters"]
+    lines = [f"Coordinates: {', '.join(document['coordinates'])}; tau = Y pi "
+             f"({len(names)} parameters, SI)"]
+    lines.append("parameters pi:")
+    width = max(len(n) for n in names)
+    lines += [f"  {n:<{width}}  {x: .9g}" for n, x in zip(names, document["values"], strict=True)]
+    lines.append("regressor Y (one row per coordinate):")
+    lines += ["  " + "  ".join(f"{x: .6g}" for x in row) for row in document["regressor"]]
+    lines.append("tau = Y pi:")
+    lines += [f"  {c}  {x: .9g}" for c, x in zip(document["coordinates"], document["tau"],
+                                                 strict=True)]
+    base = document.get("base")
+    if base is not None:
+        lines.append(f"base parameters ({len(base['names'])} of {len(names)}, tolerance "
+                     f"{base['tolerance']:g}), beta = each line's combination:")
+        lines += [f"  {line}" for line in base["description"]]
+    return "\n".join(lines) + "\n"

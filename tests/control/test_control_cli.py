@@ -1,0 +1,45 @@
+"""simulate --control: the cart-pole balanced by LQR from the command line (JSON with K and the
+promised eigenvalues), computed torque to a target, and bad flags refused in one line."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+
+def test_lqr_from_the_command_line_balances_the_cart_pole(cli):
+    result = cli("simulate", "cart_pendulum", "--t-end", "10", "--initial", "theta=3.0",
+                 "--control", "lqr", "--about", "theta=pi", "--inputs", "F",
+                 "--Q", "1,10,1,1", "--R", "0.1", "--json")
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    control = document["control"]
+    assert control["kind"] == "lqr" and control["inputs"] == ["F"]
+    assert all(re < 0 for re, _ in control["closed_loop_eigenvalues"])
+    final = document["final_state"]
+    assert final["theta"] == pytest.approx(np.pi, abs=1e-3)
+    assert final["x"] == pytest.approx(0.0, abs=1e-2)
+    text = cli("simulate", "cart_pendulum", "--t-end", "1", "--control", "computed-torque",
+               "--about", "x=0.3", "--kp", "25", "--kd", "10")
+    assert text.code == 0, text.err
+    assert "controller: computed torque on x, theta; closed-loop eigenvalues (1/s): -5" in text.out
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--control", "pid"], "error: --control: unknown controller 'pid'"),
+    (["--Q", "3"], "error: --control: --Q is not used by a run without --control"),
+    (["--control", "lqr", "--about", "theta=pi"], "error: --inputs: --control lqr needs --inputs"),
+    (["--control", "lqr", "--about", "theta=pi", "--inputs", "F", "--R", "0"],
+     "error: --R: the matrix must be positive definite"),
+    (["--control", "lqr", "--about", "theta=pi", "--inputs", "F", "--Q", "1,2"],
+     "error: --Q: expected a number, 4 diagonal entries or a 4 x 4 matrix"),
+    (["--control", "lqr", "--about", "theta=pi", "--inputs", "F", "--R", "a"],
+     "error: --R: expected a number or comma-separated numbers"),
+])
+def test_bad_control_flags_are_one_line_errors(cli, flags, message):
+    result = cli("simulate", "cart_pendulum", "--t-end", "1", *flags)
+    assert result.code == 2
+    assert result.err.strip().startswith(message), result.err
+    assert len(result.err.strip().splitlines()) == 1

@@ -1,0 +1,50 @@
+"""System.linearize_along: A(t), B(t) at a run's samples, against the pendulum's closed form and
+against the run itself (a perturbed run's difference follows the transition matrix of A(t))."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+import lagrangian
+from lagrangian.errors import InputError
+
+
+def test_pendulum_along_a_swing_is_the_closed_form():
+    """x = (theta, theta_dot): A = [[0, 1], [-g/L cos theta(t), 0]], B = [[0], [1/(m L^2)]]."""
+    pendulum = lagrangian.load("pendulum")
+    run = pendulum.simulate(2, initial={"theta": 1.0}, samples=51)
+    along = pendulum.linearize_along(run)
+    assert along.A.shape == (51, 2, 2) and along.B.shape == (51, 2, 1)
+    m, L, g = 1.0, 0.5, 9.81
+    np.testing.assert_allclose(along.A[:, 1, 0], -g / L * np.cos(run.q[:, 0]), rtol=1e-12)
+    np.testing.assert_allclose(along.A[:, 0, 1], 1.0)
+    np.testing.assert_allclose(along.B[:, 1, 0], 1 / (m * L**2), rtol=1e-12)
+
+
+def test_a_perturbed_double_pendulum_follows_the_transition_matrix_of_a_of_t():
+    system = lagrangian.load("double_pendulum")
+    start = {"theta1": 0.8, "theta2": -0.4}
+    run = system.simulate(1, initial=start, samples=2001, rtol=1e-12, atol=1e-12)
+    along = system.linearize_along(run)
+    transition = np.eye(4)
+    for k in range(len(run.t) - 1):  # midpoint exponentials: second order in the spacing
+        step = (along.A[k] + along.A[k + 1]) / 2 * (run.t[k + 1] - run.t[k])
+        transition = scipy.linalg.expm(step) @ transition
+    delta = 1e-6 * np.array([1.0, -0.5, 0.3, 0.2])
+    moved = system.simulate(1, initial={"theta1": 0.8 + delta[0], "theta2": -0.4 + delta[1],
+                                        "theta1_dot": delta[2], "theta2_dot": delta[3]},
+                            samples=2001, rtol=1e-12, atol=1e-12)
+    difference = np.concatenate([moved.q[-1] - run.q[-1], moved.q_dot[-1] - run.q_dot[-1]])
+    assert np.linalg.norm(difference - transition @ delta) < 1e-3 * np.linalg.norm(difference)
+
+
+def test_linearize_along_refuses_a_foreign_run_and_unknown_inputs():
+    pendulum = lagrangian.load("pendulum")
+    run = lagrangian.load("double_pendulum").simulate(0.1, samples=3)
+    with pytest.raises(InputError, match="not of this system") as caught:
+        pendulum.linearize_along(run)
+    assert caught.value.field == "simulation"
+    with pytest.raises(InputError, match="'phi' is not a coordinate"):
+        pendulum.linearize_along(pendulum.simulate(0.1, samples=3), inputs=["phi"])

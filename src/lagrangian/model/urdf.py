@@ -25,7 +25,6 @@ refused (derivation/lagrange.py).
 
 from __future__ import annotations
 
-import dataclasses
 import io
 import keyword
 import math
@@ -39,21 +38,17 @@ import numpy as np
 import sympy as sp
 
 from ..errors import ModelError, ModelWarning, did_you_mean, require_extra
-from ..kinds import JointKind
 from .builder import ModelBuilder
 from .expressions import RESERVED
 from .lazy_bodies import LAZY_ABOVE, LazyBodies
 from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
-from .tree import KinematicTree, TreeFrame, TreeJoint, TreeLink, link_inertias
+from .tree import KinematicTree
+from .urdf_tree import MOVABLE, SNAP, carries_nothing, numeric_tree
 
-MOVABLE = ("revolute", "continuous", "prismatic")
 SUPPORTED = (*MOVABLE, "fixed")
 GRAVITY = 9.81  # m/s^2, along -z
-# Entries of a rotation within this of 0 or +-1 are taken as exact: cos(pi/2) = 6e-17 in a
-# URDF's rpy would otherwise keep every product it enters.
-_SNAP = 1e-14
 
 
 def read_urdf(path, lock: Mapping[str, float] | None = None,
@@ -163,9 +158,9 @@ def _number(x: float) -> sp.Expr:
     x = float(x)
     if not math.isfinite(x):
         raise ValueError(x)
-    if abs(x) < _SNAP:
+    if abs(x) < SNAP:
         return sp.S.Zero
-    if abs(x - round(x)) < _SNAP and abs(x) < 1e6:
+    if abs(x - round(x)) < SNAP and abs(x) < 1e6:
         return sp.Integer(round(x))
     text = repr(x)
     if len(text) <= 8 and "e" not in text:
@@ -371,12 +366,12 @@ class _Tree:
         position = self._positions(lock, names)
         model = builder.build_model()
         if len(names) > LAZY_ABOVE:  # a long chain: its symbolic bodies when first asked for
-            tree = self._tree(root, order, position, names, (), floating_base)
+            tree = numeric_tree(self.links, root, order, position, names, (), floating_base)
             bodies = self._lazy_bodies(root, order, position, tree)
             tree = replace(tree, rigid_bodies=bodies)
         else:
             bodies = tuple(self._bodies(root, order, position))
-            tree = self._tree(root, order, position, names, bodies, floating_base)
+            tree = numeric_tree(self.links, root, order, position, names, bodies, floating_base)
         return replace(model, rigid_bodies=bodies, kinematic_tree=tree,
                        source_names=tuple((name, joint) for joint, name in names.items()),
                        source_ratings=tuple((name, *self._ratings(joint))
@@ -476,7 +471,7 @@ class _Tree:
         for name, frame in frames.items():
             link = self.links[name]
             inertial = link.inertial
-            if _carries_nothing(inertial):
+            if carries_nothing(inertial):
                 continue
             mass, tensor, where = self._inertial(name, fixed=not moves[name])
             center = apply(frame.rotation, _vector(where[:3, 3]))
@@ -527,130 +522,10 @@ class _Tree:
                     raise self.error("the axis has zero length", f"joint '{joint.name}'.axis")
         count = 0
         for link in tree.links:
-            if not _carries_nothing(self.links[link.name].inertial):
+            if not carries_nothing(self.links[link.name].inertial):
                 self._inertial(link.name, fixed=link.body < 0)
                 count += link.body >= 0
         return LazyBodies(lambda: self._bodies(root, order, position), count)
-
-    def _tree(self, root: str, order, position, names: dict[str, str], bodies,
-              floating_base: bool = False) -> KinematicTree:
-        """The same robot as numbers for the recursive algorithms (model/tree.py)."""
-        index = {joint: i for i, joint in enumerate(names)}
-        coordinate = {symbol: index[joint] for joint, symbol in names.items()}
-        anchor = {root: (-1, np.eye(3), np.zeros(3))}  # link -> (moving body, R, t in it)
-        joints: list[dict] = []
-        free = dict(parent=-1, kind=JointKind.FREE_FLYER, axis=np.zeros(3), coordinate=-1,
-                    multiplier=1.0, offset=0.0)  # the free flyer: its numbers come first
-        if floating_base:  # Pinocchio's name for the root joint it adds
-            joints.append(dict(free, name="root_joint", rotation=np.eye(3),
-                               translation=np.zeros(3)))
-            anchor[root] = (0, np.eye(3), np.zeros(3))
-        for joint in order:
-            body, turn, shift = anchor[joint.parent]
-            origin = np.eye(4) if joint.origin is None else np.asarray(joint.origin, float)
-            rotation = _snapped(turn @ _snapped(origin[:3, :3]))
-            translation = shift + turn @ _snapped(origin[:3, 3])
-            if joint.type == "floating":  # the root link's only moving joint (_check_floating)
-                joints.append(dict(free, name=joint.name, rotation=rotation,
-                                   translation=translation))
-                anchor[joint.child] = (len(joints) - 1, np.eye(3), np.zeros(3))
-                continue
-            if joint.type not in MOVABLE:
-                anchor[joint.child] = (body, rotation, translation)
-                continue
-            axis = np.asarray(joint.axis if joint.axis is not None else (1, 0, 0), float)
-            axis = _snapped(axis / float(np.linalg.norm(axis)))
-            angle = position(joint)[0]
-            if angle.free_symbols:  # k q + offset with one coordinate q
-                (symbol,) = angle.free_symbols
-                k = float(angle.diff(symbol))
-                offset = float(angle.subs(symbol, 0))
-                joints.append(dict(name=joint.name, parent=body, kind=_KIND[joint.type],
-                                   rotation=rotation, translation=translation, axis=axis,
-                                   coordinate=coordinate[str(symbol)], multiplier=k,
-                                   offset=offset))
-                anchor[joint.child] = (len(joints) - 1, np.eye(3), np.zeros(3))
-            else:  # locked, or a mimic of a locked joint: a fixed joint at that value
-                theta = float(angle)
-                if joint.type == "prismatic":
-                    anchor[joint.child] = (body, rotation, translation + rotation @ axis * theta)
-                else:
-                    anchor[joint.child] = (body, rotation @ _axis_rotation(axis, theta),
-                                           translation)
-        links = []
-        for name, (body, turn, shift) in anchor.items():
-            inertial = self.links[name].inertial
-            carries = not _carries_nothing(inertial)
-            where = np.asarray(inertial.origin if carries and inertial.origin is not None
-                               else np.eye(4), dtype=float)
-            tensor = np.asarray(inertial.inertia if carries and inertial.inertia is not None
-                                else np.zeros((3, 3)), dtype=float)
-            links.append(TreeLink(name, body, turn, shift,
-                                  float(inertial.mass or 0.0) if carries else 0.0,
-                                  _snapped(where[:3, 3]), _snapped(where[:3, :3]),
-                                  0.5 * (tensor + tensor.T)))
-        inertias = link_inertias(links, len(joints))
-        held = sum(link.mass for link in links if link.body < 0)  # the mass welded to a fixed root
-
-        def vector(a):
-            return tuple(float(x) for x in a)
-
-        def matrix(a):
-            return tuple(vector(row) for row in a)
-
-        # every link's frame on its moving body, and each joint's frame (its child link's)
-        frames = [TreeFrame(name, body, matrix(turn), vector(shift))
-                  for name, (body, turn, shift) in anchor.items()]
-        by_link = {f.name: f for f in frames}
-        frames += [dataclasses.replace(by_link[joint.child], name=joint.name)
-                   for joint in order if joint.name not in by_link and joint.child in by_link]
-        if floating_base and "root_joint" not in by_link:
-            frames.append(dataclasses.replace(by_link[root], name="root_joint"))
-        return KinematicTree(
-            frames=tuple(frames),
-            links=tuple(TreeLink(k.name, k.body, matrix(k.rotation), vector(k.translation),
-                                 k.mass, vector(k.com), matrix(k.com_rotation),
-                                 matrix(k.inertia)) for k in links),
-            joints=tuple(TreeJoint(
-                name=j["name"], parent=j["parent"], kind=j["kind"], rotation=matrix(j["rotation"]),
-                translation=vector(j["translation"]), axis=vector(j["axis"]),
-                coordinate=j["coordinate"], multiplier=j["multiplier"], offset=j["offset"],
-                mass=m, first_moment=vector(h), inertia=matrix(0.5 * (J + J.T)))
-                for j, (m, h, J) in zip(joints, inertias, strict=True)),
-            coordinates=tuple(names.values()), gravity_parameter="g",
-            gravity_direction=(0.0, 0.0, -1.0),
-            actuators=tuple(f"tau_{name}" for name in names.values()),
-            rigid_bodies=tuple(bodies), root_link=root, root_mass=held)
-
-
-def _carries_nothing(inertial) -> bool:
-    """No inertial, or mass and inertia tensor both zero: a link with mass 0 but a tensor (the
-    Bolt biped's feet) still turns with inertia, as Pinocchio keeps it."""
-    if inertial is None:
-        return True
-    tensor = inertial.inertia if inertial.inertia is not None else np.zeros((3, 3))
-    return not inertial.mass and not np.any(np.asarray(tensor, dtype=float))
-
-
-_KIND = {"revolute": JointKind.REVOLUTE, "continuous": JointKind.REVOLUTE,
-         "prismatic": JointKind.PRISMATIC}
-
-
-def _snapped(a) -> np.ndarray:
-    """Entries within _SNAP of an integer made that integer (as _number does for the symbols)."""
-    a = np.array(a, dtype=float)
-    near = np.abs(a - np.round(a)) < _SNAP
-    a[near] = np.round(a[near])
-    return a
-
-
-def _axis_rotation(axis, angle: float) -> np.ndarray:
-    """Rot(u, angle) by Rodrigues' formula."""
-    x = np.asarray(axis, float)
-    cross = np.array([[0, -x[2], x[1]], [x[2], 0, -x[0]], [-x[1], x[0], 0]])
-    return math.cos(angle) * np.eye(3) + math.sin(angle) * cross \
-        + (1 - math.cos(angle)) * np.outer(x, x)
-
 
 def _turned(frame: Frame, rotation) -> Frame:
     """The frame turned by a constant rotation (given in its own axes)."""

@@ -244,19 +244,21 @@ class TreeDynamics(Dynamics):
 
 def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = None,
                        backend: str = "auto"):
-    """The recursive dynamics of a URDF tree: generated C (recursive.RecursiveDynamics), or
+    """The recursive dynamics of a URDF tree, or of a model file's tree of rigid bodies on
+    joints (at least TREE_PATH_BODIES of them): generated C (recursive.RecursiveDynamics), or
     numpy (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with backend
     "auto", where no compiler works; None where they do not apply: not a bare tree, or a mass
     matrix that is not positive definite (the symbolic path names the joints)."""
     from ..compile.compiled import BackendUnavailable
     from ..compile.functions import tell_numpy_fallback
-    from .recursive import RecursiveDynamics, applicable_tree
+    from .recursive import TREE_PATH_BODIES, RecursiveDynamics, applicable_tree
     from .recursive_numpy import RecursiveNumpyDynamics
 
     if backend not in ("auto", "c", "numpy"):
         return None
-    tree = applicable_tree(model)
-    if tree is None:
+    tree = applicable_tree(model, parameters)
+    # a model file's small tree keeps its derived equations (quick to compile, as written)
+    if tree is None or (model.kinematic_tree is None and len(tree.joints) < TREE_PATH_BODIES):
         return None
     dynamics = None
     if backend != "numpy":
@@ -283,4 +285,5 @@ def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
     return fast if fast is not None else Dynamics(symbolic(), equations)
 
 
-__all__ = ["Dynamics", "TreeDynamics", "model_dynamics", "recursive_dynamics", "solve_positive", "warn_undefined"]
+__all__ = ["Dynamics", "TreeDynamics", "model_dynamics", "recursive_dynamics", "solve_positive",
+           "warn_undefined"]

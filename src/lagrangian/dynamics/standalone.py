@@ -247,7 +247,9 @@ def standalone_for(model: Model, equations: Callable[[], EquationsOfMotion],
     else from the equations ``equations()`` derives."""
     from .recursive import applicable_tree
 
-    tree = applicable_tree(model)
+    # a URDF tree only: a model file's tree has its masses folded in as numbers, which the
+    # standalone C's parameter array could not change
+    tree = applicable_tree(model, bodies=False)
     if tree is not None:
         return standalone_tree_c(model, tree, values, prefix)
     return standalone_c(equations(), values, prefix)

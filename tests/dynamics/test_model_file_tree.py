@@ -196,3 +196,36 @@ def test_a_small_model_file_tree_keeps_its_derived_equations():
     assert system._recursive is None
     assert lagrangian.System(chain(TREE_PATH_BODIES).build_model()).dynamics(
         backend="numpy").backend == "recursive-numpy"
+
+
+def test_a_tree_simulates_and_has_modes_without_deriving():
+    """Energy kept over a run, the work of an actuator balanced, and the modes of the hanging
+    chain equal to those of the derived equations (K from the tree's g by differences)."""
+    n = TREE_PATH_BODIES
+    system = lagrangian.System(chain(n).build_model())
+    run = system.simulate(1.0, initial={"q0": 0.4, "q3": -0.3})
+    assert run.status == "finished" and run.invariant == "energy"
+    energy = run.energy
+    assert np.abs(energy - energy[0]).max() < 1e-7 * np.abs(energy).max()
+    modes = system.modes(about={f"q{i}": 0.0 for i in range(n)})
+    assert "_equations" not in system.__dict__  # nothing derived
+    from lagrangian.compile.at_rest import AtRestFunctions
+    from lagrangian.dynamics.tree_at_rest import TreeAtRest
+
+    q = np.random.default_rng(4).uniform(-1, 1, (3, n))
+    tree, derived = (TreeAtRest(system.dynamics()).evaluate(q),
+                     AtRestFunctions(system.equations_of_motion()).evaluate(q))
+    for key in ("mass", "forcing", "stiffness", "damping"):
+        assert np.allclose(tree[key], derived[key], rtol=1e-9, atol=1e-9), key
+    frequencies = [m.frequency for m in modes.modes]
+    assert np.all(np.diff(frequencies) >= 0) and frequencies[0] > 0
+
+
+def test_an_actuator_on_a_tree_does_work_that_balances():
+    b = chain(TREE_PATH_BODIES)
+    b.parameter("tau", 2.0)
+    b.add_generalized_force("q0", "tau")
+    run = lagrangian.System(b.build_model()).simulate(1.0)
+    assert run.invariant == "work_balance"
+    h, work = run.invariant_values, run.work
+    assert np.abs(h - h[0] - work).max() < 1e-6 * np.abs(work).max()

@@ -42,6 +42,7 @@ from ..derivation.regularity import require_inertia
 from ..derivation.steps import DerivationSteps
 from ..dynamics.joint_space import model_dynamics, recursive_dynamics
 from ..dynamics.standalone import StandaloneSource
+from ..dynamics.tree_at_rest import TreeAtRest
 from ..errors import InputError, LagrangianError, did_you_mean
 from ..model.answer import Answer, answer_from_mapping, read_answer
 from ..model.builder import ModelBuilder
@@ -200,16 +201,18 @@ class System:
         (``limits=False`` ignores them); velocity and effort limits exceeded are reported
         either way (``summary()["limits_exceeded"]``).
         """
-        require_inertia(self.equations_of_motion(), "simulate")
+        tree = self._recursive is not None  # the tree's recursions: nothing to derive
+        if not tree:
+            require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
         step_control, save_at = _options(step_control, save_at, method, rtol, atol, samples,
                                          1001)
         stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) \
             else stop_when
-        result = simulate(self.equations_of_motion(), t_end, initial=start,
+        result = simulate(None if tree else self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
                           progress=progress, functions=self._numeric,
-                          limits=urdf_limits(self._model, positions=limits))
+                          limits=urdf_limits(self._model, positions=limits), model=self._model)
         return Simulation.of(result)
 
     # -- standalone C for a controller -----------------------------------------------------------
@@ -284,14 +287,18 @@ class System:
     # -- equilibria, linearization and modes -----------------------------------------------------
 
     @cached_property
-    def _static_functions(self) -> AtRestFunctions:
-        """Compiled functions at rest, built once per System (parameters are fixed per System)."""
+    def _static_functions(self) -> AtRestFunctions | TreeAtRest:
+        """Compiled functions at rest, built once per System (parameters are fixed per System):
+        a tree's from its recursions (nothing derived), else from the derived equations."""
+        if self._recursive is not None:
+            return TreeAtRest(self._recursive)
         return AtRestFunctions(self.equations_of_motion())
 
     def equilibria(self) -> Equilibria:
         """Configurations of rest, f(q, 0) = Phi_q^T lambda with Phi(q) = 0, each with its stability."""
         functions = self._static_functions
-        statics = not self.equations_of_motion().has_inertia
+        # a tree's M is positive definite (checked when its recursions were taken)
+        statics = self._recursive is None and not self.equations_of_motion().has_inertia
 
         def stable(q, multipliers) -> bool:
             if statics:  # no inertia: stable where the potential has a minimum
@@ -321,9 +328,11 @@ class System:
             return steady_linear_model(self.equations_of_motion(), about, steady)
         if symbolic:
             return symbolic_linear_model(self.equations_of_motion(), dict(about or {}))
-        functions = self._static_functions
-        q, multipliers = resolve_equilibrium(functions, about)
         inputs = tuple(inputs)
+        # inputs are columns of the derived equations' generalized forces
+        functions = self._static_functions if not inputs or self._recursive is None \
+            else AtRestFunctions(self.equations_of_motion())
+        q, multipliers = resolve_equilibrium(functions, about)
         columns = input_columns(functions.eom, q, inputs, functions.parameters) if inputs else None
         return linear_model_at(functions, q, multipliers, inputs=inputs, input_columns=columns)
 
@@ -333,7 +342,8 @@ class System:
         about a steady motion (``steady``: velocity name -> constant rate). A model with a
         [steady] table (a bicycle: it has no upright equilibrium at rest) is taken about that
         steady motion when neither ``about`` nor ``steady`` is given."""
-        require_inertia(self.equations_of_motion(), "modes")
+        if self._recursive is None:  # a tree's M is positive definite (checked)
+            require_inertia(self.equations_of_motion(), "modes")
         default = self._model.steady_motion
         if steady is None and about is None and default is not None:
             steady, about = dict(default.rates), dict(default.about) or None

@@ -229,3 +229,18 @@ def test_an_actuator_on_a_tree_does_work_that_balances():
     assert run.invariant == "work_balance"
     h, work = run.invariant_values, run.work
     assert np.abs(h - h[0] - work).max() < 1e-6 * np.abs(work).max()
+
+
+def test_a_chain_too_large_to_compile_that_is_no_bare_tree_is_refused_before_the_work():
+    from lagrangian.compile.functions import MAX_COMPILED_ROTATIONS
+
+    b = chain(MAX_COMPILED_ROTATIONS + 2)
+    b.add_potential_energy("q0**2")  # an energy of its own: not a bare tree
+    system = lagrangian.System(b.build_model())
+    started = time.perf_counter()
+    for call in (system.numeric, system.modes, lambda: system.simulate(1.0)):
+        with pytest.raises(ModelError, match=f"{MAX_COMPILED_ROTATIONS + 1} elementary "
+                           "rotations.*too large to compile") as error:
+            call()
+        assert f"link{MAX_COMPILED_ROTATIONS}" in str(error.value)
+    assert time.perf_counter() - started < 10

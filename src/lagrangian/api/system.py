@@ -35,7 +35,7 @@ from ..check.newton_euler import CrosscheckReport, crosscheck
 from ..check.units import UnitsReport, check_model_units
 from ..compile.at_rest import AtRestFunctions
 from ..compile.codegen import CodegenError
-from ..compile.functions import NumericSystem, numeric
+from ..compile.functions import NumericSystem, numeric, refuse_large_chain
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
 from ..derivation.regularity import require_inertia
@@ -203,6 +203,7 @@ class System:
         """
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
         if not tree:
+            refuse_large_chain(self.model)  # before deriving what could not be compiled
             require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
         step_control, save_at = _options(step_control, save_at, method, rtol, atol, samples,
@@ -256,16 +257,20 @@ class System:
         """
         if parameters is None and backend == "auto":
             return self._numeric
-        fast = recursive_dynamics(self.model, parameters, backend)  # a URDF tree: no derivation
+        fast = recursive_dynamics(self.model, parameters, backend)  # a tree: no derivation
         if fast is not None:
             return fast.numeric_system()
+        refuse_large_chain(self.model)  # before deriving what could not be compiled
         return numeric(self.equations_of_motion(), parameters, backend=backend)
 
     @cached_property
     def _numeric(self) -> NumericSystem:
         """The default numeric system, compiled once per System (its parameters are fixed)."""
         fast = self._recursive
-        return fast.numeric_system() if fast is not None else numeric(self.equations_of_motion())
+        if fast is not None:
+            return fast.numeric_system()
+        refuse_large_chain(self.model)  # before deriving what could not be compiled
+        return numeric(self.equations_of_motion())
 
     @cached_property
     def _recursive(self):
@@ -292,6 +297,7 @@ class System:
         a tree's from its recursions (nothing derived), else from the derived equations."""
         if self._recursive is not None:
             return TreeAtRest(self._recursive)
+        refuse_large_chain(self.model)
         return AtRestFunctions(self.equations_of_motion())
 
     def equilibria(self) -> Equilibria:
@@ -343,6 +349,7 @@ class System:
         [steady] table (a bicycle: it has no upright equilibrium at rest) is taken about that
         steady motion when neither ``about`` nor ``steady`` is given."""
         if self._recursive is None:  # a tree's M is positive definite (checked)
+            refuse_large_chain(self.model)
             require_inertia(self.equations_of_motion(), "modes")
         default = self._model.steady_motion
         if steady is None and about is None and default is not None:

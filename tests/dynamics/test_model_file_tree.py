@@ -244,3 +244,23 @@ def test_a_chain_too_large_to_compile_that_is_no_bare_tree_is_refused_before_the
             call()
         assert f"link{MAX_COMPILED_ROTATIONS}" in str(error.value)
     assert time.perf_counter() - started < 10
+
+
+def test_the_documented_chain_runs_and_shows_the_physics():
+    import re
+    from pathlib import Path
+
+    import docs_blocks  # tests/docs_blocks.py
+
+    text = docs_blocks.block("tree-model-file")
+    code = re.findall(r"```python\n(.*?)```", text, re.S)[0]
+    scope: dict = {}
+    exec(compile(code, str(Path(docs_blocks.block_file("tree-model-file"))), "exec"), scope)
+    n = scope["n"]
+    assert isinstance(scope["snake"].dynamics(), RecursiveDynamics)
+    expected = sum(k + 0.5 for k in range(n)) * 9.81
+    assert scope["held"] == pytest.approx(expected, rel=1e-12)
+    assert f"{expected:.1f} N m" in code
+    energy = scope["run"].energy
+    assert np.abs(energy - energy[0]).max() < 1e-9 * np.abs(energy).max()
+    assert scope["lowest"] > 0

@@ -264,3 +264,39 @@ def test_the_documented_chain_runs_and_shows_the_physics():
     energy = scope["run"].energy
     assert np.abs(energy - energy[0]).max() < 1e-9 * np.abs(energy).max()
     assert scope["lowest"] > 0
+
+
+def chain_file(n: int) -> str:
+    """The chain of ``chain(n)`` as a model file."""
+    lines = [f'name = "{n}-body chain"', "", "[coordinates]"]
+    lines += [f'q{i} = {{ unit = "rad", initial = {0.2 if i == 0 else 0.0} }}' for i in range(n)]
+    lines += ["", "[parameters]", 'g = { value = 9.81, unit = "m/s^2" }', "",
+              "[gravity]", 'g = "g"', "direction = [0, 0, -1]", ""]
+    for i in range(n):
+        at = ", at = [0, 0, -1]" if i else ""
+        lines += ["[[bodies]]", f'name = "link{i}"', "mass = 1.0", "inertia = [0.1, 0.1, 0.02]",
+                  "center = [0, 0, -0.5]", *([f'parent = "link{i - 1}"'] if i else []),
+                  f'joint = {{ type = "revolute", axis = "{"xy"[i % 2]}", angle = "q{i}"{at} }}',
+                  ""]
+    return "\n".join(lines)
+
+
+def test_the_command_line_runs_a_model_files_tree_and_refuses_a_chain_too_deep(cli, tmp_path):
+    import json
+
+    path = tmp_path / "chain.toml"
+    path.write_text(chain_file(TREE_PATH_BODIES))
+    result = cli("simulate", str(path), "--t-end", "1", "--json")
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    assert document["status"] == "finished" and document["energy_conserved"]
+    assert document["relative_energy_drift"] < 1e-9
+    result = cli("modes", str(path), "--json")
+    assert result.code == 0, result.err
+    assert all(mode["frequency"] > 0 for mode in json.loads(result.out)["modes"])
+    deep = tmp_path / "deep.toml"
+    deep.write_text(chain_file(MAX_CHAIN_ROTATIONS + 1))
+    result = cli("derive", str(deep))
+    assert result.code == 2
+    (line,) = result.err.strip().splitlines()
+    assert line.startswith("error: ") and f"at most {MAX_CHAIN_ROTATIONS}" in line

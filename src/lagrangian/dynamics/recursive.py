@@ -38,27 +38,24 @@ from .tree_module import module_source, tree_key
 TREE_PATH_BODIES = 6
 
 
-def applicable_tree(model: Model, parameters: Mapping[str, float] | None = None, *,
-                    bodies: bool = True) -> KinematicTree | None:
+def applicable_tree(model: Model, parameters: Mapping[str, float] | None = None
+                    ) -> KinematicTree | None:
     """The model's kinematic tree when it describes the model's whole dynamics (a robot read
-    from URDF and not edited since: only its rigid bodies, gravity and the actuator forces; or,
-    with ``bodies``, a model file's rigid bodies on revolute and prismatic joints, in numbers at
-    ``parameters`` over the model's values), else None, so that nothing else a model holds is
-    ever left out."""
+    from URDF and not edited since: only its rigid bodies, gravity and the actuator forces; or
+    a model file's rigid bodies on revolute and prismatic joints, in numbers at ``parameters``
+    over the model's values), else None, so that nothing else a model holds is ever left out."""
     tree = model.kinematic_tree
     if tree is None:
-        if not bodies or not model.rigid_bodies or any(b.joint is None
-                                                       for b in model.rigid_bodies):
+        if not model.rigid_bodies or any(b.joint is None for b in model.rigid_bodies):
             return None
         from ..model.values import resolve_parameters
 
         values = resolve_parameters(model, parameters, require=False)
         if any(v is None for v in values.values):
             return None
-        tree = body_tree(model, dict(zip((p.symbol for p in model.parameters), values.values,
+        # built from the model itself: its bodies, gravity and forces are checked there
+        return body_tree(model, dict(zip((p.symbol for p in model.parameters), values.values,
                                          strict=True)))
-        if tree is None:
-            return None
     if (model.particles or model.bodies or model.springs or model.dampers or model.loads
             or model.constraints or model.definitions
             or model.kinetic_energy != 0 or model.potential_energy != 0

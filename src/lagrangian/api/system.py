@@ -61,7 +61,7 @@ from ..simulation.simulate import (
     urdf_limits,
 )
 from .modes import ModalAnalysis
-from .simulation import Simulation
+from .simulation import Simulation, run_options
 
 
 class System:
@@ -206,8 +206,8 @@ class System:
             refuse_large_chain(self.model)  # before deriving what could not be compiled
             require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
-        step_control, save_at = _options(step_control, save_at, method, rtol, atol, samples,
-                                         1001)
+        step_control, save_at = run_options(step_control, save_at, method, rtol, atol, samples,
+                                            1001)
         stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) \
             else stop_when
         result = simulate(None if tree else self.equations_of_motion(), t_end, initial=start,
@@ -434,7 +434,7 @@ class System:
         if compute == "simulate":
             if t_end is None:
                 raise InputError("a simulation study needs t_end (s)", field="t_end")
-            step, save = _options(step_control, save_at, method, rtol, atol, samples, 201)
+            step, save = run_options(step_control, save_at, method, rtol, atol, samples, 201)
             if isinstance(stop_when, StopCondition):
                 stop_when = stop_when.text
             if stop_when is not None:
@@ -543,33 +543,6 @@ class System:
         eom = self.equations_of_motion()
         names = latex_symbol_names(self._model)
         return rf"$L = {sp.latex(eom.lagrangian, symbol_names=names)}$"
-
-
-def _options(step_control: StepControl | None, save_at: SaveAt | None, method: str,
-             rtol: float, atol: float, samples: int, samples_default: int
-             ) -> tuple[StepControl, SaveAt]:
-    """The option values from the option types or the plain keywords (a thin shim), never
-    both: a plain keyword that differs from its default beside its option type is refused."""
-    plain = {"method": (method, "DOP853"), "rtol": (rtol, 1e-9), "atol": (atol, 1e-9)}
-    if step_control is not None:
-        if not isinstance(step_control, StepControl):
-            raise InputError("step_control must be a lagrangian.StepControl",
-                             field="step_control")
-        both = [k for k, (value, default) in plain.items() if value != default]
-        if both:
-            raise InputError(f"give {', '.join(both)} in step_control or as a keyword, not both",
-                             field="step_control")
-    else:
-        step_control = StepControl(method, rtol, atol)
-    if save_at is not None:
-        if not isinstance(save_at, SaveAt):
-            raise InputError("save_at must be a lagrangian.SaveAt", field="save_at")
-        if samples != samples_default:
-            raise InputError("give samples in save_at or as a keyword, not both",
-                             field="save_at")
-    else:
-        save_at = SaveAt(samples)
-    return step_control, save_at
 
 
 class SystemBuilder(ModelBuilder):

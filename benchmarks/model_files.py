@@ -69,3 +69,41 @@ def mass_spring_damper_chain(n: int) -> str:
                   "[[dampers]]", f'name = "damper{i}"', f'coefficient = "c{i}"',
                   f'rate = "{rate}"', ""]
     return "\n".join(lines)
+
+
+def spatial_chain(n: int) -> str:
+    """The chain of benchmarks/bench_spatial_chain.py as a model file: n rigid bodies (1 kg,
+    inertia (0.1, 0.1, 0.02) kg m^2 about the centre, 0.5 m below the joint) on revolute joints
+    about x, y, x, ... each 1 m below the last, gravity -g z."""
+    lines = [f'name = "{n}-body spatial chain"', "", "[coordinates]"]
+    lines += [f'q{i} = {{ unit = "rad", initial = {0.1 if i < 2 else 0.0}, rate = 0.0 }}'
+              for i in range(n)]
+    lines += ["", "[parameters]", 'g = { value = 9.81, unit = "m/s^2" }']
+    lines += [f'm{i} = {{ value = 1.0, unit = "kg" }}' for i in range(n)]
+    lines += ["", "[gravity]", 'g = "g"', "direction = [0, 0, -1]", ""]
+    for i in range(n):
+        at = ', at = [0, 0, -1]' if i else ""
+        lines += ["[[bodies]]", f'name = "link{i}"', f'mass = "m{i}"',
+                  "inertia = [0.1, 0.1, 0.02]", "center = [0, 0, -0.5]"]
+        if i:
+            lines.append(f'parent = "link{i - 1}"')
+        lines += [f'joint = {{ type = "revolute", axis = "{"xy"[i % 2]}", angle = "q{i}"{at} }}',
+                  ""]
+    return "\n".join(lines)
+
+
+def spatial_chain_urdf(n: int) -> str:
+    """The same chain as a URDF (for Pinocchio): link i's frame at its joint."""
+    parts = ['<robot name="chain">', '<link name="base"/>']
+    for i in range(n):
+        parts.append(f'<link name="link{i}"><inertial><origin xyz="0 0 -0.5"/><mass value="1"/>'
+                     '<inertia ixx="0.1" iyy="0.1" izz="0.02" ixy="0" ixz="0" iyz="0"/>'
+                     '</inertial></link>')
+        parent = "base" if i == 0 else f"link{i - 1}"
+        z = 0 if i == 0 else -1
+        axis = "1 0 0" if i % 2 == 0 else "0 1 0"
+        parts.append(f'<joint name="q{i}" type="revolute"><parent link="{parent}"/>'
+                     f'<child link="link{i}"/><origin xyz="0 0 {z}"/><axis xyz="{axis}"/>'
+                     '<limit lower="-10" upper="10" effort="100" velocity="100"/></joint>')
+    parts.append("</robot>")
+    return "\n".join(parts)

@@ -73,3 +73,29 @@ def test_a_cpp_controller_links_a_derived_models_header(tmp_path):
     system = lagrangian.load("pendulum")  # M = m L^2 = 1 * 0.5^2
     M = _mass_matrix_from_cpp(system, "pendulum", [0.7], tmp_path)
     assert M[0, 0] == pytest.approx(0.25, rel=1e-15)
+
+
+@pytest.mark.skipif(_missing() is not None, reason=str(_missing()))
+def test_a_cpp_controller_links_a_model_files_tree(tmp_path):
+    """A chain of bodies on joints from a model file: the tree's C, its masses folded in as
+    numbers, only gravity and the generalized force left in the parameter array."""
+    from lagrangian.dynamics.recursive import TREE_PATH_BODIES
+
+    b = lagrangian.SystemBuilder("chain")
+    b.set_gravity(b.parameter("g", 9.81), (0, 0, -1))
+    b.parameter("tau", 0.5)
+    for i in range(TREE_PATH_BODIES):
+        b.coordinate(f"q{i}", unit="rad")
+        b.parameter(f"m{i}", 1.0 + i)
+        joint = {"type": "revolute", "axis": "xy"[i % 2], "angle": f"q{i}"}
+        if i:
+            joint["at"] = [0, 0, -1]
+        b.add_rigid_body(f"link{i}", f"m{i}", [0.1, 0.1, 0.02],
+                         parent=f"link{i - 1}" if i else None, joint=joint, center=[0, 0, -0.5])
+    b.add_generalized_force("q0", "tau")
+    system = b.build()
+    code = system.to_c(prefix="chain")
+    assert "#define CHAIN_NP 2" in code.header
+    q = [float(x) for x in np.linspace(-1.0, 1.0, TREE_PATH_BODIES)]
+    M = _mass_matrix_from_cpp(system, "chain", q, tmp_path)
+    np.testing.assert_allclose(M, system.dynamics().mass_matrix(q), rtol=1e-12, atol=1e-12)

@@ -83,3 +83,4 @@ class Simulation(SimulationResult):
     def _inputs(self) -> tuple[Path, ...]:
         source = self.model.source
         return (Path(source),) if source and not source.startswith("example:") else ()
+

@@ -35,7 +35,7 @@ from ..check.newton_euler import CrosscheckReport, crosscheck
 from ..check.units import UnitsReport, check_model_units
 from ..compile.at_rest import AtRestFunctions
 from ..compile.codegen import CodegenError
-from ..compile.functions import NumericSystem, numeric
+from ..compile.functions import NumericSystem, numeric, refuse_large_chain
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
 from ..derivation.regularity import require_inertia
@@ -43,6 +43,7 @@ from ..derivation.steps import DerivationSteps
 from ..dynamics.actuators import actuated
 from ..dynamics.joint_space import model_dynamics, recursive_dynamics
 from ..dynamics.standalone import StandaloneSource
+from ..dynamics.tree_at_rest import TreeAtRest
 from ..errors import InputError, LagrangianError, did_you_mean
 from ..model.answer import Answer, answer_from_mapping, read_answer
 from ..model.builder import ModelBuilder
@@ -207,17 +208,21 @@ class System(ControlMethods):
         generalized forces, or B u for named ``inputs`` (its own ``inputs`` where it has them,
         as lagrangian.control's controllers do), to the model's own: docs/control.md.
         """
-        require_inertia(self.equations_of_motion(), "simulate")
+        tree = self._recursive is not None  # the tree's recursions: nothing to derive
+        if not tree:
+            refuse_large_chain(self.model)  # before deriving what could not be compiled
+            require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
         step_control, save_at = run_options(step_control, save_at, method, rtol, atol, samples,
                                          1001)
         stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) \
             else stop_when
-        result = simulate(self.equations_of_motion(), t_end, initial=start,
+        result = simulate(None if tree else self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
                           progress=progress, functions=self._numeric,
                           limits=urdf_limits(self._model, positions=limits), controller=controller,
-                          inputs=getattr(controller, "inputs", ()) if inputs is None else inputs)
+                          inputs=getattr(controller, "inputs", ()) if inputs is None else inputs,
+                          model=self._model)
         return Simulation.of(result)
 
     # -- standalone C for a controller -----------------------------------------------------------
@@ -261,16 +266,20 @@ class System(ControlMethods):
         """
         if parameters is None and backend == "auto":
             return self._numeric
-        fast = recursive_dynamics(self.model, parameters, backend)  # a URDF tree: no derivation
+        fast = recursive_dynamics(self.model, parameters, backend)  # a tree: no derivation
         if fast is not None:
             return fast.numeric_system()
+        refuse_large_chain(self.model)  # before deriving what could not be compiled
         return numeric(self.equations_of_motion(), parameters, backend=backend)
 
     @cached_property
     def _numeric(self) -> NumericSystem:
         """The default numeric system, compiled once per System (its parameters are fixed)."""
         fast = self._recursive
-        return fast.numeric_system() if fast is not None else numeric(self.equations_of_motion())
+        if fast is not None:
+            return fast.numeric_system()
+        refuse_large_chain(self.model)  # before deriving what could not be compiled
+        return numeric(self.equations_of_motion())
 
     @cached_property
     def _recursive(self):
@@ -304,14 +313,19 @@ class System(ControlMethods):
     # -- equilibria, linearization and modes -----------------------------------------------------
 
     @cached_property
-    def _static_functions(self) -> AtRestFunctions:
-        """Compiled functions at rest, built once per System (parameters are fixed per System)."""
+    def _static_functions(self) -> AtRestFunctions | TreeAtRest:
+        """Compiled functions at rest, built once per System (parameters are fixed per System):
+        a tree's from its recursions (nothing derived), else from the derived equations."""
+        if self._recursive is not None:
+            return TreeAtRest(self._recursive)
+        refuse_large_chain(self.model)
         return AtRestFunctions(self.equations_of_motion())
 
     def equilibria(self) -> Equilibria:
         """Configurations of rest, f(q, 0) = Phi_q^T lambda with Phi(q) = 0, each with its stability."""
         functions = self._static_functions
-        statics = not self.equations_of_motion().has_inertia
+        # a tree's M is positive definite (checked when its recursions were taken)
+        statics = self._recursive is None and not self.equations_of_motion().has_inertia
 
         def stable(q, multipliers) -> bool:
             if statics:  # no inertia: stable where the potential has a minimum
@@ -341,9 +355,11 @@ class System(ControlMethods):
             return steady_linear_model(self.equations_of_motion(), about, steady)
         if symbolic:
             return symbolic_linear_model(self.equations_of_motion(), dict(about or {}))
-        functions = self._static_functions
-        q, multipliers = resolve_equilibrium(functions, about)
         inputs = tuple(inputs)
+        # inputs are columns of the derived equations' generalized forces
+        functions = self._static_functions if not inputs or self._recursive is None \
+            else AtRestFunctions(self.equations_of_motion())
+        q, multipliers = resolve_equilibrium(functions, about)
         columns = input_columns(functions.eom, q, inputs, functions.parameters) if inputs else None
         return linear_model_at(functions, q, multipliers, inputs=inputs, input_columns=columns)
 
@@ -353,7 +369,9 @@ class System(ControlMethods):
         about a steady motion (``steady``: velocity name -> constant rate). A model with a
         [steady] table (a bicycle: it has no upright equilibrium at rest) is taken about that
         steady motion when neither ``about`` nor ``steady`` is given."""
-        require_inertia(self.equations_of_motion(), "modes")
+        if self._recursive is None:  # a tree's M is positive definite (checked)
+            refuse_large_chain(self.model)
+            require_inertia(self.equations_of_motion(), "modes")
         default = self._model.steady_motion
         if steady is None and about is None and default is not None:
             steady, about = dict(default.rates), dict(default.about) or None

@@ -96,6 +96,11 @@ def describe(q) -> str:
     return text.replace("**", "^")
 
 
+# Past this many issues a repeated sub-expression's issues are not listed again (the report
+# shows the first few and counts the rest).
+MAX_REPEATED_ISSUES = 10_000
+
+
 class DimensionChecker:
     """Walks a sympy expression, returning its dimension and collecting inconsistencies."""
 
@@ -103,6 +108,7 @@ class DimensionChecker:
         self.units = units
         self.issues: list[UnitIssue] = []
         self._one = registry().Quantity(1)
+        self._memo: dict = {}
 
     def check(self, item: str, expression: sp.Expr, expected: str | None = None,
               what: str = "") -> None:
@@ -122,6 +128,23 @@ class DimensionChecker:
                     f"{format_expression(term)} has {describe(dim)}"))
 
     def dimension(self, expr: sp.Expr, item: str):
+        """The dimension of ``expr`` (None: unknown), its issues recorded. Memoized per
+        sub-expression and item, its issues recorded again on each repeat (as the walk without
+        the memo would): a chain of bodies shares each rotation's entries down the chain, whose
+        walk without it grew like 3^depth (the 20-body chain took minutes)."""
+        key = (expr, item)
+        found = self._memo.get(key)
+        if found is not None:
+            dim, issues = found
+            if len(self.issues) < MAX_REPEATED_ISSUES:
+                self.issues.extend(issues)
+            return dim
+        start = len(self.issues)
+        dim = self._dimension(expr, item)
+        self._memo[key] = (dim, self.issues[start:])
+        return dim
+
+    def _dimension(self, expr: sp.Expr, item: str):
         if expr.is_Number or expr in (sp.pi, sp.E) or expr.is_NumberSymbol:
             return self._one
         if isinstance(expr, sp.Symbol):

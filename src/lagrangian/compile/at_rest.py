@@ -21,6 +21,7 @@ from ..kinds import ConstraintKind
 from ..model.expressions import as_expression
 from ..model.model import Model
 from ..model.values import ParameterValues, resolve_parameters
+from .functions import refuse_large_chain
 from .lambdified import numpy_function
 
 
@@ -37,6 +38,7 @@ class AtRestFunctions:
                  parameters: Mapping[str, float] | ParameterValues | None = None, *,
                  parametric: bool = False):
         model = eom.model
+        refuse_large_chain(model)
         self.model = model
         self.eom = eom
         self.parametric = parametric

@@ -18,6 +18,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..model.model import Model, multiplier_name
+from ..model.rotations import MAX_CHAIN_ROTATIONS
 from .body_jacobians import takes_jacobian_form
 from .constraints import constraint_terms
 from .energies import dissipation_terms as component_dissipation
@@ -117,6 +118,7 @@ def derive(model: Model, *, check: bool = True,
                          "(derive, simulate, modes and the other symbolic commands need them): "
                          "use dynamics(), its kinematics and integrate(q, v, dt), or load it "
                          "with a fixed base")
+    refuse_deep_chain(model)
     q, q_dot, t = model.q, model.q_dot, model.time
     n = len(q)
     acc = _Accumulator(n)
@@ -189,6 +191,18 @@ def derive(model: Model, *, check: bool = True,
         acceleration_rhs=gamma,
         multipliers=multipliers,
     )
+
+
+def refuse_deep_chain(model: Model) -> None:
+    """Refuse, before any work, a chain of bodies too deep to derive symbolically (the size
+    named in one line); its numbers go down the tree (dynamics/recursive.py) instead."""
+    deep = next((b for b in model.rigid_bodies if b.depth > MAX_CHAIN_ROTATIONS), None)
+    if deep is not None:
+        raise ModelError(
+            f"body '{deep.name}' is {deep.depth} elementary rotations from the ground (at most "
+            f"{MAX_CHAIN_ROTATIONS} to derive: the symbolic equations of a longer chain take "
+            "minutes; its dynamics, simulation and modes use the recursive algorithms)",
+            field=f"body '{deep.name}'.joint", source=model.source)
 
 
 def _general_lagrangian(acc: _Accumulator, d: Differentiator, L: sp.Expr, q, q_dot, t) -> None:

@@ -59,10 +59,10 @@ def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray
     n, nb = len(tree.coordinates), len(tree.joints)
     D = np.zeros(HEADER + n + nb * STRIDE)
     D[0], D[1] = nb, n
-    D[2:5] = float(parameters[tree.gravity_parameter]) * np.array(tree.gravity_direction)
+    D[2:5] = float(parameters.get(tree.gravity_parameter, 0.0)) * np.array(tree.gravity_direction)
     drives = np.bincount([j.coordinate for j in tree.joints], minlength=n)
     D[5] = float(not np.all(drives == 1))
-    D[HEADER:HEADER + n] = [float(parameters[a]) for a in tree.actuators]
+    D[HEADER:HEADER + n] = [float(parameters.get(a, 0.0)) for a in tree.actuators]  # None: 0
     for i, j in enumerate(tree.joints):
         r = D[HEADER + n + i * STRIDE:HEADER + n + (i + 1) * STRIDE]
         r[0], r[1], r[2] = j.parent, JOINT_CODES[JointKind(j.kind)], j.coordinate

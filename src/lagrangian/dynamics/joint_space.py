@@ -376,30 +376,32 @@ class TreeDynamics(Dynamics):
 
 def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = None,
                        backend: str = "auto", kernel: str = "auto"):
-    """The recursive dynamics of a URDF tree: compiled C (recursive.RecursiveDynamics, the
+    """The recursive dynamics of a URDF tree, or of a model file's tree of rigid bodies on
+    joints (at least TREE_PATH_BODIES of them): compiled C (recursive.RecursiveDynamics, the
     tree's own unrolled module, or compact_kernel.CompactDynamics, one module for every tree:
     ``kernel`` "unrolled", "compact" or "auto" by the tree's size and whether a link's inertial
     is set), or numpy (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with
     backend "auto", where no compiler works; None where they do not apply: not a bare tree, or
     a mass matrix that is not positive definite (the symbolic path names the joints).
 
-    ``parameters`` may set a link's inertial by ``<link>.<field>`` (model/tree.py
+    ``parameters`` may set a URDF link's inertial by ``<link>.<field>`` (model/tree.py
     INERTIAL_FIELDS: mass, com_x, ..., ixx, ...), as if the URDF had been edited."""
     from ..compile.compiled import BackendUnavailable
     from ..compile.functions import tell_numpy_fallback
     from ..model.urdf_payload import PREFIX as PAYLOAD_PREFIX
     from .compact_kernel import COMPACT_ABOVE, CompactDynamics
     from .inertials import split_inertials
-    from .recursive import RecursiveDynamics, applicable_tree
+    from .recursive import TREE_PATH_BODIES, RecursiveDynamics, applicable_tree
     from .recursive_numpy import RecursiveNumpyDynamics
 
     if kernel not in ("auto", "unrolled", "compact"):
         raise InputError(f"unknown kernel {kernel!r} (auto, unrolled or compact)", field="kernel")
     if backend not in ("auto", "c", "numpy"):
         return None
-    tree = applicable_tree(model)
-    parameters, inertials = split_inertials(tree, parameters)
-    if tree is None:
+    parameters, inertials = split_inertials(model.kinematic_tree, parameters)
+    tree = applicable_tree(model, parameters)
+    # a model file's small tree keeps its derived equations (quick to compile, as written)
+    if tree is None or (model.kinematic_tree is None and len(tree.joints) < TREE_PATH_BODIES):
         return None
     if inertials:
         tree = inertials

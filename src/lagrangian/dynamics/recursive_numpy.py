@@ -119,12 +119,13 @@ class RecursiveNumpyDynamics(TreeDynamics):
                  parameters: Mapping[str, float] | None = None):
         self._take_tree(model, tree, parameters)
         missing = [name for name in (tree.gravity_parameter, *tree.actuators)
-                   if name not in self.parameters]
+                   if name is not None and name not in self.parameters]
         if missing:
             raise ModelError(f"the tree's parameters {missing} are not the model's")
-        self._g = self.parameters[tree.gravity_parameter]
+        self._g = self.parameters.get(tree.gravity_parameter, 0.0)  # None: no gravity
         self._actuators = np.array([0.0] * tree.base_nv  # no actuator drives a floating base
-                                   + [self.parameters[a] for a in tree.actuators], dtype=float)
+                                   + [self.parameters.get(a, 0.0) for a in tree.actuators],
+                                   dtype=float)
         # the ground accelerates up by g: every body feels gravity (Newton-Euler's trick)
         self._up = -self._g * np.array(tree.gravity_direction, dtype=float)
         # the bodies as the compact C kernel reads them (compact_kernel.describe): one

@@ -226,13 +226,16 @@ double {P}_potential_energy(const double *q, const double *p);
 
 
 def standalone_tree_c(model: Model, tree: KinematicTree, values: dict[str, float],
-                      prefix: str | None = None) -> StandaloneSource:
+                      prefix: str | None = None, parameters: list[str] | None = None
+                      ) -> StandaloneSource:
     """The same API for a URDF tree by the recursive algorithms (recursive.py): composite rigid
     body M, Newton-Euler inverse dynamics, Cholesky forward dynamics; code linear in the
-    number of bodies (M quadratic) instead of the expanded equations."""
+    number of bodies (M quadratic) instead of the expanded equations. ``parameters``: the
+    names in the C's parameter array (default: the model's)."""
     from .tree_c import dynamics_functions
 
-    parameters = [p.name for p in model.parameters]
+    if parameters is None:
+        parameters = [p.name for p in model.parameters]
     P = prefix or c_prefix(model.name)
     coordinates, velocities = list(tree.coordinates), None
     if tree.floating_base:  # Pinocchio's layout: the base's numbers first (free_flyer.py)
@@ -257,11 +260,19 @@ def standalone_for(model: Model, equations: Callable[[], EquationsOfMotion],
                    values: dict[str, float], prefix: str | None = None) -> StandaloneSource:
     """Standalone C of a model: recursive for a URDF tree where that applies (no derivation),
     else from the equations ``equations()`` derives."""
-    from .recursive import applicable_tree
+    from ..compile.functions import refuse_large_chain
+    from .recursive import TREE_PATH_BODIES, applicable_tree
 
-    tree = applicable_tree(model)
-    if tree is not None:
+    tree = applicable_tree(model, values)
+    if tree is not None and model.kinematic_tree is not None:
         return standalone_tree_c(model, tree, values, prefix)
+    if tree is not None and len(tree.joints) >= TREE_PATH_BODIES:
+        # a model file's tree has its masses, inertias and placements folded in as numbers:
+        # only gravity and the generalized forces stay in the parameter array
+        runtime = list(dict.fromkeys(name for name in (tree.gravity_parameter, *tree.actuators)
+                                     if name is not None))
+        return standalone_tree_c(model, tree, values, prefix, runtime)
+    refuse_large_chain(model)
     return standalone_c(equations(), values, prefix)
 
 

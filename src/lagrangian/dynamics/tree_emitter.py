@@ -207,10 +207,14 @@ class _Layout:
     def __init__(self, tree: KinematicTree, parameters: tuple[str, ...]):
         self.tree = tree
         index = {name: k for k, name in enumerate(parameters)}
-        missing = [name for name in (tree.gravity_parameter, *tree.actuators) if name not in index]
+        missing = [name for name in (tree.gravity_parameter, *tree.actuators)
+                   if name is not None and name not in index]
         if missing:
             raise ModelError(f"the tree's parameters {missing} are not the model's")
-        self.gravity = f"p[{index[tree.gravity_parameter]}]"
-        self.actuators = [f"p[{index[name]}]" for name in tree.actuators]
+        # no gravity, or no force on a coordinate: the number 0, folded away
+        self.gravity = 0.0 if tree.gravity_parameter is None else \
+            f"p[{index[tree.gravity_parameter]}]"
+        self.actuators = [0.0 if name is None else f"p[{index[name]}]"
+                          for name in tree.actuators]
         self.n = len(tree.coordinates) + tree.base_nv  # v's numbers (q has base_nq before)
         self.nq = len(tree.coordinates) + tree.base_nq

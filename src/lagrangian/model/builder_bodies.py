@@ -9,13 +9,13 @@ from typing import Self
 import sympy as sp
 
 from ..errors import did_you_mean
+from ..kinds import JointKind
 from .model import (
     Vector,
 )
 from .rotations import (
     GROUND,
-    MAX_CHAIN_ROTATIONS,
-    MAX_SEQUENCE_ROTATIONS,
+    BodyJoint,
     Frame,
     Moment,
     RigidBody,
@@ -87,13 +87,8 @@ class RigidBodiesMixin:
                                   "or 'position' alone", f"{field}.center")
         own = _elementary_rotations(joint if joint is not None else {"rotation": rotation})
         rotations = own + (self._rotations.get(parent, 0) if parent is not None else 0)
-        # one sequence too long is said as such, by the reader, before any work
-        if rotations > MAX_CHAIN_ROTATIONS and own <= MAX_SEQUENCE_ROTATIONS:
-            raise self._error(f"body '{name}' is {rotations} elementary rotations from the "
-                              f"ground (at most {MAX_CHAIN_ROTATIONS}: a longer chain of rotating "
-                              "bodies takes minutes to derive symbolically; a URDF robot uses the "
-                              "recursive algorithms instead)", f"{field}.joint" if joint is not None
-                              else f"{field}.rotation")
+        # A chain deeper than MAX_CHAIN_ROTATIONS is refused by derive (its symbolic equations
+        # take minutes), not here: its dynamics, simulation and modes go down the tree.
         self._rotations[name] = rotations
         if joint is not None:
             frame = reader.joint(frame, joint, f"{field}.joint")
@@ -118,6 +113,7 @@ class RigidBodiesMixin:
                           sp.S.Zero)
                   for o, row in zip(frame.origin, frame.rotation, strict=True)),
             frame.rotation, frame.origin, frame.angular_velocity, parent, frame.singularities,
+            self._body_joint(reader, joint, offset, f"{field}.joint"), rotations,
         )
         self._frames[name] = frame
         self._rigid_bodies.append(body)
@@ -143,6 +139,20 @@ class RigidBodiesMixin:
             [e for row in target.rotation for e in row], name, f"{field}.body", "rotation")
         self._loads.append(Moment(name, body, self.vector(moment, f"{field}.moment"), axes, omega))
         return self
+
+    def _body_joint(self, reader: RotationReader, joint: Mapping | None, center: Vector,
+                    field: str) -> BodyJoint | None:
+        """A revolute or prismatic joint as read (already checked by reader.joint), for the
+        body's tree; None for any other way of placing a body."""
+        if joint is None or joint.get("type") not in (JointKind.REVOLUTE, JointKind.PRISMATIC):
+            return None
+        kind = JointKind(joint["type"])
+        at = (self.vector(joint["at"], f"{field}.at", velocities=False) if "at" in joint
+              else (sp.S.Zero,) * 3)
+        key = "angle" if kind == JointKind.REVOLUTE else "distance"
+        return BodyJoint(kind, at, reader.axis(joint["axis"], f"{field}.axis"),
+                         self.expression(joint[key], f"{field}.{key}", velocities=False),
+                         tuple(center))
 
     def _rotation_reader(self) -> RotationReader:
         def angle(value, field):

@@ -47,6 +47,21 @@ _ZERO: Vector = (sp.S.Zero, sp.S.Zero, sp.S.Zero)
 
 
 @dataclass(frozen=True)
+class BodyJoint:
+    """The one-degree-of-freedom joint that carries a body (a model file's revolute or prismatic
+    ``joint``), kept beside the frames it made so that the body's tree can be read in numbers
+    (model/tree.body_tree): origin ``at`` (m, parent axes), unit ``axis`` (joint axes = parent
+    axes), the joint ``variable`` (rad or m, an expression in q), and the body's centre of mass
+    ``center`` (m, body axes, from the joint)."""
+
+    kind: JointKind
+    at: Vector
+    axis: Vector
+    variable: sp.Expr
+    center: Vector
+
+
+@dataclass(frozen=True)
 class RigidBody:
     """A rigid body in space: mass (kg), inertia tensor about its centre of mass in body axes
     (kg m^2), centre of mass r (m, world axes), rotation R (body -> world), origin of its body
@@ -63,6 +78,10 @@ class RigidBody:
     # Each three-angle sequence on the way to this body: (its description, the angle names, the
     # determinant of the map from the angle rates to omega, zero at gimbal lock).
     singularities: tuple[tuple[str, tuple[str, ...], sp.Expr], ...] = ()
+    # The revolute or prismatic joint that carries it (None: a rotation sequence, a fixed or
+    # spherical joint, a URDF link), and its elementary rotations from the ground.
+    joint: BodyJoint | None = None
+    depth: int = 0
 
     def world_angular_velocity(self) -> Vector:
         """omega in world axes, R omega_body (rad/s)."""
@@ -411,6 +430,6 @@ def gimbal_lock(bodies: Sequence[RigidBody], point: Mapping[sp.Symbol, float],
     return None
 
 
-__all__ = ["AXES", "GROUND", "MAX_CHAIN_ROTATIONS", "MAX_SEQUENCE_ROTATIONS", "Frame", "Moment",
+__all__ = ["AXES", "GROUND", "BodyJoint", "MAX_CHAIN_ROTATIONS", "MAX_SEQUENCE_ROTATIONS", "Frame", "Moment",
            "RigidBody", "RotationReader", "apply", "gimbal_lock", "axis_rotation", "compose",
            "rotate", "translate", "transpose"]

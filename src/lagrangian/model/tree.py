@@ -14,11 +14,17 @@ inertia of the moving body above them. A body's inertia is (m, h = m c, J_O): ma
 moment about its frame's origin (kg m) and inertia tensor about that origin (kg m^2), in its
 own axes: additive, so the links fixed to one body simply sum. Recursive algorithms (composite
 rigid body, Newton-Euler) run on this tree without the expanded equations.
+
+A model file's (or ModelBuilder's) rigid bodies on revolute and prismatic joints give the same
+tree (body_tree), its numbers taken from the parameter values: one joint type for both.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+
+import sympy as sp
 
 from ..kinds import JointKind
 
@@ -171,5 +177,91 @@ class KinematicTree:
         return 6 if self.floating_base else 0
 
 
-__all__ = ["INERTIAL_FIELDS", "KinematicTree", "TreeFrame", "TreeJoint", "TreeLink",
+_IDENTITY: Matrix3x3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+def body_tree(model, values: Mapping[sp.Symbol, float]) -> KinematicTree | None:
+    """The kinematic tree of a model whose only components are rigid bodies on revolute and
+    prismatic joints (constant mass and inertia, no t), gravity along a fixed direction with a
+    parameter for its magnitude, and at most one parameter per coordinate as its generalized
+    force; numbers from ``values`` (parameter symbol -> SI value). None where the model holds
+    anything else, so that nothing it holds is ever left out."""
+    if (not model.rigid_bodies or model.particles or model.bodies or model.springs
+            or model.dampers or model.loads or model.constraints or model.contacts
+            or model.kinetic_energy != 0 or model.potential_energy != 0
+            or model.dissipation != 0 or model.kinematic_tree is not None):
+        return None
+    names = {p.symbol: p.name for p in model.parameters}
+    gravity_parameter, direction = None, (0.0, 0.0, 0.0)
+    if model.gravity is not None:
+        gravity_parameter = names.get(model.gravity.magnitude)
+        direction = _numbers(model.gravity.direction, values)
+        if gravity_parameter is None or direction is None:
+            return None
+    forces: dict[str, list] = {}
+    for coordinate, force in model.generalized_forces:
+        forces.setdefault(coordinate, []).append(force)
+    actuators = []
+    for c in model.coordinates:
+        given = forces.get(c.name, [])
+        if len(given) > 1 or (given and given[0] not in names):
+            return None
+        actuators.append(names[given[0]] if given else None)
+    index = {b.name: k for k, b in enumerate(model.rigid_bodies)}
+    coordinates = {symbol: k for k, symbol in enumerate(model.q)}
+    joints = []
+    for body in model.rigid_bodies:
+        joint = _tree_joint(body, index, coordinates, model.time, values)
+        if joint is None:
+            return None
+        joints.append(joint)
+    return KinematicTree(joints=tuple(joints), coordinates=tuple(c.name for c in model.coordinates),
+                         gravity_parameter=gravity_parameter, gravity_direction=direction,
+                         actuators=tuple(actuators), rigid_bodies=model.rigid_bodies)
+
+
+def _tree_joint(body, index, coordinates, time, values) -> TreeJoint | None:
+    """One body on its joint in numbers, or None where it is not on a revolute or prismatic
+    joint driven by one coordinate (theta = k q + offset), or its inertia is not constant."""
+    joint = body.joint
+    if joint is None or (body.parent is not None and body.parent not in index):
+        return None
+    driving = [s for s in joint.variable.free_symbols if s in coordinates]
+    if len(driving) != 1 or time in joint.variable.free_symbols:
+        return None
+    q = driving[0]
+    slope = sp.diff(joint.variable, q)
+    multiplier = _number(slope, values)
+    offset = _number(joint.variable.xreplace({q: sp.S.Zero}), values)
+    mass = _number(body.mass, values)
+    center = _numbers(joint.center, values)
+    at, axis = _numbers(joint.at, values), _numbers(joint.axis, values)
+    inertia = [_numbers(row, values) for row in body.inertia]
+    if (None in (multiplier, offset, mass, center, at, axis) or None in inertia
+            or q in slope.free_symbols or multiplier == 0):
+        return None
+    # J_O = I_c + m (|c|^2 E - c c^T): the inertia about the joint's origin (parallel axes)
+    c2 = sum(x * x for x in center)
+    about_origin = tuple(tuple(inertia[i][j] + mass * ((c2 if i == j else 0.0) - center[i] * center[j])
+                               for j in range(3)) for i in range(3))
+    return TreeJoint(name=body.name, parent=-1 if body.parent is None else index[body.parent],
+                     kind=joint.kind, rotation=_IDENTITY, translation=at, axis=axis,
+                     coordinate=coordinates[q], multiplier=multiplier, offset=offset, mass=mass,
+                     first_moment=tuple(mass * x for x in center), inertia=about_origin)
+
+
+def _number(expr, values) -> float | None:
+    try:
+        value = float(expr.xreplace(values) if isinstance(expr, sp.Basic) else expr)
+    except (TypeError, ValueError):
+        return None
+    return value if value == value and abs(value) != float("inf") else None
+
+
+def _numbers(vector, values) -> tuple | None:
+    found = tuple(_number(x, values) for x in vector)
+    return None if None in found else found
+
+
+__all__ = ["INERTIAL_FIELDS", "KinematicTree", "TreeFrame", "TreeJoint", "TreeLink", "body_tree",
            "link_inertias", "with_link_inertials"]

@@ -22,6 +22,7 @@ from ..compile.lambdified import StateFunction
 from ..derivation.equations import EquationsOfMotion
 from ..errors import InputError
 from ..kinds import InvariantKind, RunStatus
+from ..model.model import Model
 from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state
 from .control import Controller, ControlLoop
@@ -40,7 +41,7 @@ DEFAULT_SAVE_AT = SaveAt()  # 1001 evenly spaced samples
 
 
 def simulate(
-    eom: EquationsOfMotion,
+    eom: EquationsOfMotion | None,
     t_end: float,
     *,
     initial: Mapping[str, float] | State | None = None,
@@ -54,6 +55,7 @@ def simulate(
     limits: Sequence[JointLimit] = (),
     controller: Controller | None = None,
     inputs: Sequence[str] = (),
+    model: Model | None = None,
 ) -> SimulationResult:
     """Integrate from the initial state to ``t_end`` (s), saving where ``save_at`` says.
 
@@ -66,8 +68,14 @@ def simulate(
     velocity and effort limits exceeded are reported in ``limits_exceeded``. ``controller``
     (t, q, q_dot) -> u adds generalized forces (or, with ``inputs``, B u: simulation/control.py)
     to the model's own, in the scipy loop.
+
+    ``eom`` None: the run of a kinematic tree's recursive algorithms (``functions``, of
+    ``model``), with nothing derived: no constraints, no explicit t, T quadratic in q_dot, and
+    the model's generalized forces its only loads.
     """
-    model = eom.model
+    if eom is None and (model is None or functions is None or functions.m):
+        raise ValueError("a run without equations needs the model and a tree's functions")
+    model = eom.model if eom is not None else model
     start = resolve_state(model, initial, field="initial", what="coordinate or velocity (or t)")
     if not (math.isfinite(t_end) and t_end > start.t):
         raise InputError(f"the end time ({t_end} s) must be after the start time ({start.t} s)",
@@ -81,7 +89,8 @@ def simulate(
     event = _event(StateFunction(model, [stop.function], substitution)) if stop else None
     beyond = _beyond(limits) if limits else None
     positioned = [m for m in limits if m.lower is not None and m.upper is not None]
-    power_terms = StateFunction(model, eom.generalized_forces, substitution)
+    forces = eom.generalized_forces if eom is not None else _tree_forces(model)
+    power_terms = StateFunction(model, forces, substitution)
 
     q0, v0, projected = start.q_array(), start.q_dot_array(), {}
     if drift is not None:
@@ -112,32 +121,49 @@ def simulate(
     energy = functions.energy(q, q_dot, t)
     kinetic = energy - functions.energy(q, np.zeros_like(q_dot), t)  # T: E less its q_dot = 0 part
     power = np.einsum("ki,ki->k", power_terms(q, q_dot, t), q_dot)
-    controls = forces = None
+    controls = control_forces = None
     if loop is not None:  # the controller's work enters the balance
-        controls, forces = loop.on_samples(t, q, q_dot)
-        power = power + np.einsum("ki,ki->k", forces, q_dot)
+        controls, control_forces = loop.on_samples(t, q, q_dot)
+        power = power + np.einsum("ki,ki->k", control_forces, q_dot)
     if functions.m:
         with np.errstate(all="ignore"):
             _, multipliers = functions.accelerations_and_multipliers(q, q_dot, t) \
-                if loop is None else (None, loop.multipliers(t, q, q_dot, forces))
+                if loop is None else (None, loop.multipliers(t, q, q_dot, control_forces))
         residuals = functions.constraint_residual(q, q_dot, t)
     else:
         multipliers = residuals = np.zeros((len(t), 0))
-    kind, invariant, work = _invariant(eom, substitution, t, q, q_dot, energy, power, multipliers,
-                                       controlled=loop is not None)
+    if eom is not None:
+        kind, invariant, work = _invariant(eom, substitution, t, q, q_dot, energy, power,
+                                           multipliers, controlled=loop is not None)
+        conserved = energy_is_conserved(eom) and loop is None
+    else:  # a tree: h = T + V, changed only by the generalized forces' (and controller's) work
+        working = loop is not None or any(float(f.xreplace(substitution)) != 0 for f in forces)
+        kind = InvariantKind.WORK_BALANCE if working else InvariantKind.ENERGY
+        invariant, work = energy, (cumulative_work(t, power) if working else None)
+        conserved = not working
     return SimulationResult(
         model=model, coordinates=functions.coordinates,
         constraint_names=functions.constraint_names, parameters=dict(functions.parameters),
         t=t, q=q, q_dot=q_dot, energy=energy, power=power, multipliers=multipliers,
         residuals=residuals, step_control=step_control, status=run.status, message=run.message,
         steps=run.steps, nfev=run.nfev, wall_time=wall, backend=run.backend,
-        energy_conserved=energy_is_conserved(eom) and loop is None, t_end=float(t_end),
+        energy_conserved=conserved, t_end=float(t_end),
         stop_when=stop.text if stop else None, projected_initial_state=projected,
         kinetic_energy=kinetic, invariant=kind, invariant_values=invariant, work=work,
         limits_exceeded=_exceeded(limits, functions.parameters, t, q_dot),
         controls=controls, control_names=() if loop is None else loop.names,
-        control_forces=forces,
+        control_forces=control_forces,
     )
+
+
+def _tree_forces(model: Model) -> list:
+    """Each coordinate's generalized force (N m or N): the sum of the model's, 0 where none."""
+    import sympy as sp
+
+    given: dict[str, list] = {}
+    for coordinate, force in model.generalized_forces:
+        given.setdefault(coordinate, []).append(force)
+    return [sp.Add(*given.get(c.name, [])) for c in model.coordinates]
 
 
 def _invariant(eom, substitution, t, q, q_dot, energy, power, multipliers, controlled=False):

@@ -26,13 +26,6 @@ from ..analysis.modes import is_stable, modal_analysis
 from ..analysis.speed_form import SpeedForm, SpeedSweep, speed_form, speed_sweep
 from ..analysis.statics import StaticsReport, solve_statics
 from ..analysis.steady import steady_linear_model
-from ..check.classroom import ClassReport, check_class
-from ..check.diagnose import CheckReport, check_answer
-from ..check.final_answers import check_final_answers
-from ..check.free_body_steps import CrosscheckSteps, crosscheck_steps
-from ..check.hints import hinted
-from ..check.newton_euler import CrosscheckReport, crosscheck
-from ..check.units import UnitsReport, check_model_units
 from ..compile.at_rest import AtRestFunctions
 from ..compile.codegen import CodegenError
 from ..compile.functions import NumericSystem, numeric, refuse_large_chain
@@ -45,7 +38,6 @@ from ..dynamics.joint_space import model_dynamics, recursive_dynamics
 from ..dynamics.standalone import StandaloneSource
 from ..dynamics.tree_at_rest import TreeAtRest
 from ..errors import InputError, LagrangianError, did_you_mean
-from ..model.answer import Answer, answer_from_mapping, read_answer
 from ..model.builder import ModelBuilder
 from ..model.examples import example_path
 from ..model.model import Model
@@ -61,13 +53,14 @@ from ..simulation.simulate import (
     simulate,
     urdf_limits,
 )
+from .checking import CheckMethods
 from .control import ControlMethods
 from .modes import ModalAnalysis
 from .options import run_options
 from .simulation import Simulation
 
 
-class System(ControlMethods):
+class System(CheckMethods, ControlMethods):
     """A mechanical system described in generalized coordinates.
 
     >>> import lagrangian
@@ -145,6 +138,13 @@ class System(ControlMethods):
         from ..model.gravity import with_gravity
 
         return System(with_gravity(self._model, gravity))
+
+    @property
+    def runs_on_tree(self) -> bool:
+        """Whether simulate, equilibria, modes and dynamics run on the kinematic tree's
+        recursions (a URDF robot, a model file's large tree of bodies on joints): nothing is
+        derived for them."""
+        return self._recursive is not None
 
     def equations_of_motion(self) -> EquationsOfMotion:
         """M q_ddot + Phi_q^T lambda = f by Lagrange's method (derived once, then cached)."""
@@ -487,54 +487,6 @@ class System(ControlMethods):
         if set_parameters and eom is not None:
             lines += setting_warnings(eom, set_parameters)
         return lines
-
-    # -- checking a hand derivation: check, crosscheck, check_units --------------------------------
-
-    def check(self, answer, *, hints_only: bool = False) -> CheckReport:
-        """Verdicts and diagnoses on a hand derivation: a path to ANSWER.toml, its tables as a
-        dict ({"energy": {"V": "..."}}), or an Answer.
-
-        Returns a CheckReport (``verdict``, ``findings`` with item, status, code, message,
-        expected); items written differently but equivalently are accepted. Final answers
-        (``[matrices]``, ``[frequencies]``, ``[mode_shapes]``, ``[linearized]``,
-        ``[generalized_forces]`` with ``at``, ``[equilibria]``) are compared with this system's
-        linearize, modes, generalized_forces_at and equilibria, numbers to their written precision.
-        ``hints_only``: no expected expression or value, the module's diagnostic question instead.
-        """
-        if isinstance(answer, Mapping):
-            answer = answer_from_mapping(answer, self._model, source="<answer>")
-        elif not isinstance(answer, Answer):
-            answer = read_answer(answer, self._model)
-        report = check_answer(self.equations_of_motion(), answer)
-        if answer.final_tables:
-            # final answers (M, K, omega, shapes, ...) come from this system's own analysis
-            report = replace(report, findings=report.findings
-                             + tuple(check_final_answers(self, answer)))
-        return hinted(report) if hints_only else report
-
-    def check_many(self, answers, *, hints_only: bool = False) -> ClassReport:
-        """Grade a class: every answer file named in ``answers`` (paths, globs, folders of
-        *.toml, or one such name) checked against this model, derived once. A file that cannot
-        be read is a result with its error. Returns a ClassReport (``results``, ``counts``,
-        ``records()`` one per file per item, ``csv_text()``; a table in a notebook)."""
-        named = [answers] if isinstance(answers, str | Path) else list(answers)
-        return check_class(self.equations_of_motion(), named, hints_only=hints_only,
-                           exclude=[self._model.source] if self._model.source else [],
-                           final=lambda answer: check_final_answers(self, answer))
-
-    def crosscheck(self) -> CrosscheckReport:
-        """Newton-Euler (free bodies, reactions eliminated) vs Lagrange, coordinate by
-        coordinate, with the reaction force on each body (N; moment about the centre, N m)."""
-        return crosscheck(self.equations_of_motion())
-
-    def crosscheck_steps(self) -> CrosscheckSteps:
-        """The working of crosscheck: each body's free-body equations (m a_G = sum F + R,
-        I alpha = sum M_G + M_R) and their projection onto dr/dq_i, coordinate by coordinate."""
-        return crosscheck_steps(self.equations_of_motion())
-
-    def check_units(self) -> UnitsReport:
-        """Every dimensionally inconsistent term of the model (T, V: J; D: W; Q: J per unit of q)."""
-        return check_model_units(self._model)
 
     # -- the report page ---------------------------------------------------------------------
 

@@ -74,7 +74,8 @@ def simulate(
     from ..output.tables import check_table_path
 
     system = load_system(model, set_, lock, gravity, payload)
-    warn_if_unphysical(system.equations_of_motion())
+    if not system.runs_on_tree:  # a tree's masses are checked as it is read; nothing derived
+        warn_if_unphysical(system.equations_of_motion())
     end = parse_quantity(t_end, "s", "--t-end")
     # Everything the user typed is checked (by the library) before the integration starts.
     start = resolve_state(system.model, state_assignments(system, initial, "--initial"),

@@ -386,7 +386,11 @@ class _Tree:
         values = []
         for key in ("damping", "friction"):
             value = getattr(dynamics, key, None) if dynamics is not None else None
-            value = 0.0 if value is None else float(value)
+            try:  # yourdfpy keeps the attribute's text where it is not a number ("")
+                value = 0.0 if value is None else float(value)
+            except (TypeError, ValueError):
+                raise self.error(f"<dynamics {key}=\"{value}\"> is not a number",
+                                 f"joint '{name}'.dynamics.{key}") from None
             if not (math.isfinite(value) and value >= 0):
                 raise self.error(f"<dynamics {key}=\"{value:g}\"> must be a finite number >= 0",
                                  f"joint '{name}'.dynamics.{key}")

@@ -1,0 +1,129 @@
+"""Frames of a model file (dynamics/model_frames.py): the double pendulum's bobs and centre of
+mass against their closed forms, a rigid body's angular Jacobian against the derivative of its
+rotation, and a model-file spatial chain against the same chain read as a URDF (frames.py)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import lagrangian
+from lagrangian.errors import InputError
+
+BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+L1, L2, M1, M2 = 1.5, 0.7, 2.0, 1.0
+REFERENCES = ("world", "local", "local_world_aligned")
+
+
+@pytest.fixture(scope="module")
+def pendulum():
+    return lagrangian.load("double_pendulum").dynamics(
+        {"l1": L1, "l2": L2, "m1": M1, "m2": M2, "g": 9.81})
+
+
+def test_double_pendulum_bob_and_its_jacobian_are_the_closed_form(pendulum):
+    rng = np.random.default_rng(3)
+    q, v = rng.uniform(-3, 3, (7, 2)), rng.uniform(-2, 2, (7, 2))
+    s1, c1, s2, c2 = np.sin(q[:, 0]), np.cos(q[:, 0]), np.sin(q[:, 1]), np.cos(q[:, 1])
+    T = pendulum.placement(q, "bob2")
+    assert T.shape == (7, 4, 4)
+    assert np.allclose(T[:, :3, :3], np.eye(3), atol=1e-15)  # a point: the world's axes
+    assert np.allclose(T[:, :3, 3], np.stack([L1 * s1 + L2 * s2, -L1 * c1 - L2 * c2,
+                                              0 * s1], axis=1), atol=1e-14)
+    J = pendulum.jacobian(q, "bob2")
+    assert J.shape == (7, 6, 2)
+    assert np.allclose(J[:, 0], np.stack([L1 * c1, L2 * c2], axis=1), atol=1e-14)
+    assert np.allclose(J[:, 1], np.stack([L1 * s1, L2 * s2], axis=1), atol=1e-14)
+    assert np.allclose(J[:, 2:], 0.0)
+    # the bob's acceleration at rest rates' second derivative: -l w^2 toward each pivot
+    a = pendulum.jacobian_dot_times_v(q, v, "bob2")
+    w1, w2 = v[:, 0] ** 2, v[:, 1] ** 2
+    assert np.allclose(a[:, 0], -L1 * s1 * w1 - L2 * s2 * w2, atol=1e-13)
+    assert np.allclose(a[:, 1], L1 * c1 * w1 + L2 * c2 * w2, atol=1e-13)
+    assert np.allclose(a[:, 2:], 0.0)
+
+
+def test_double_pendulum_centre_of_mass_by_hand(pendulum):
+    q = np.array([0.4, -1.1])
+    r1 = L1 * np.array([np.sin(q[0]), -np.cos(q[0]), 0.0])
+    r2 = r1 + L2 * np.array([np.sin(q[1]), -np.cos(q[1]), 0.0])
+    assert np.allclose(pendulum.center_of_mass(q), (M1 * r1 + M2 * r2) / (M1 + M2), atol=1e-15)
+    J1 = L1 * np.array([[np.cos(q[0]), 0.0], [np.sin(q[0]), 0.0], [0.0, 0.0]])
+    J2 = J1 + L2 * np.array([[0.0, np.cos(q[1])], [0.0, np.sin(q[1])], [0.0, 0.0]])
+    assert np.allclose(pendulum.center_of_mass_jacobian(q), (M1 * J1 + M2 * J2) / (M1 + M2),
+                       atol=1e-15)
+
+
+def test_rigid_body_angular_jacobian_is_the_rotation_rate():
+    """R^T R_dot = [w_local]x and R_dot R^T = [w_world]x, R_dot by central differences."""
+    top = lagrangian.load("heavy_top").dynamics()
+    frame = top.frames[0]
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        q, v = rng.uniform(0.3, 1.2, 3), rng.uniform(-2, 2, 3)
+        h = 1e-6
+        R = top.placement(q, frame)[:3, :3]
+        R_dot = (top.placement(q + h * v, frame) - top.placement(q - h * v, frame))[:3, :3] / (2 * h)
+        local = R.T @ R_dot
+        world = R_dot @ R.T
+        w_local = top.jacobian(q, frame, "local")[3:] @ v
+        w_world = top.jacobian(q, frame, "local_world_aligned")[3:] @ v
+        assert np.allclose(local, -local.T, atol=1e-8)
+        assert np.allclose([local[2, 1], local[0, 2], local[1, 0]], w_local, atol=1e-8)
+        assert np.allclose([world[2, 1], world[0, 2], world[1, 0]], w_world, atol=1e-8)
+
+
+@pytest.mark.parametrize("n", [3, 6])  # derived equations; the tree's recursions (6 bodies)
+def test_model_file_chain_agrees_with_the_same_chain_as_urdf(tmp_path, n):
+    pytest.importorskip("yourdfpy")
+    sys.path.insert(0, str(BENCHMARKS))
+    try:
+        from model_files import spatial_chain, spatial_chain_urdf
+    finally:
+        sys.path.remove(str(BENCHMARKS))
+    (tmp_path / "chain.toml").write_text(spatial_chain(n), encoding="utf-8")
+    (tmp_path / "chain.urdf").write_text(spatial_chain_urdf(n), encoding="utf-8")
+    model = lagrangian.load(str(tmp_path / "chain.toml")).dynamics()
+    urdf = lagrangian.load(str(tmp_path / "chain.urdf")).dynamics()
+    rng = np.random.default_rng(n)
+    q, v = rng.uniform(-2, 2, (5, n)), rng.uniform(-2, 2, (5, n))
+    for frame in (f"link{i}" for i in range(n)):
+        assert np.abs(model.placement(q, frame) - urdf.placement(q, frame)).max() < 1e-12
+        for reference in REFERENCES:
+            assert np.abs(model.jacobian(q, frame, reference)
+                          - urdf.jacobian(q, frame, reference)).max() < 1e-12
+            assert np.abs(model.jacobian_dot_times_v(q, v, frame, reference)
+                          - urdf.jacobian_dot_times_v(q, v, frame, reference)).max() < 1e-12
+    assert np.abs(model.center_of_mass(q) - urdf.center_of_mass(q)).max() < 1e-12
+    assert np.abs(model.center_of_mass_jacobian(q) - urdf.center_of_mass_jacobian(q)).max() < 1e-12
+
+
+def test_bad_frames_and_shapes_are_refused_in_one_line(pendulum):
+    with pytest.raises(InputError, match=r"no frame named 'bob3'; did you mean 'bob2'") as e:
+        pendulum.placement([0.1, 0.2], "bob3")
+    assert e.value.field == "frame"
+    with pytest.raises(InputError, match="expected 2 values") as e:
+        pendulum.jacobian([0.1, 0.2, 0.3], "bob1")
+    with pytest.raises(InputError, match="unknown reference"):
+        pendulum.jacobian([0.1, 0.2], "bob1", "global")
+    with pytest.raises(InputError, match="not yet"):
+        pendulum.centroidal_momentum_matrix([0.1, 0.2])
+
+
+def test_cli_frames_of_a_model_file(cli):
+    import json
+
+    result = cli("kinematics", "double_pendulum", "--q", "0.3,-0.4", "--frame", "bob2",
+                 "--v", "1,0", "--json")
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    p = np.array(document["placement"])[:3, 3]
+    assert np.allclose(p, [np.sin(0.3) + np.sin(-0.4), -np.cos(0.3) - np.cos(-0.4), 0.0])
+    assert np.allclose(document["jacobian_dot_times_v"][:2], [-np.sin(0.3), np.cos(0.3)])
+    bad = cli("kinematics", "double_pendulum", "--frame", "bob")
+    assert bad.code == 2
+    assert bad.err.strip().startswith("error: --frame: no frame named 'bob'")
+    assert len(bad.err.strip().splitlines()) == 1

@@ -127,3 +127,38 @@ def test_cli_frames_of_a_model_file(cli):
     assert bad.code == 2
     assert bad.err.strip().startswith("error: --frame: no frame named 'bob'")
     assert len(bad.err.strip().splitlines()) == 1
+
+
+def test_a_force_on_a_bob_is_its_jacobian_transpose(pendulum):
+    """A force f at bob2 does virtual work f . dr: Q = [l1 (c1 fx + s1 fy), l2 (c2 fx + s2 fy)];
+    a moment on a point does none."""
+    q, v, a = np.array([0.3, -0.8]), np.array([0.5, 1.0]), np.array([0.1, -0.2])
+    f = np.array([2.0, -3.0, 0.0])
+    expected = np.array([L1 * (np.cos(q[0]) * f[0] + np.sin(q[0]) * f[1]),
+                         L2 * (np.cos(q[1]) * f[0] + np.sin(q[1]) * f[1])])
+    wrench = {"bob2": [*f, 0.0, 0.0, 5.0]}
+    tau = pendulum.inverse_dynamics(q, v, a, f_ext=wrench)
+    assert np.allclose(pendulum.inverse_dynamics(q, v, a) - tau, expected, atol=1e-12)
+    assert np.allclose(pendulum.forward_dynamics(q, v, tau, f_ext=wrench), a, atol=1e-12)
+
+
+def test_docs_example_runs_and_its_command_is_the_closed_form(capsys, cli):
+    import json
+    import re
+
+    from tests.docs_blocks import block
+
+    text = block("model-frames")
+    code = re.findall(r"```python\n(.*?)```", text, re.S)[0]
+    exec(compile(code, "model-frames", "exec"), {})
+    assert "('bob1', 'bob2')" in capsys.readouterr().out
+    command = re.findall(r"\$ lagrangian (.*)", text)[0].split()
+    result = cli(*command)
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    q1, q2 = 0.3, -0.4  # l1 = l2 = 1 m; the bob moves at l1 per rad of q1, across the rod
+    assert document["frame"] == "bob2" and document["coordinates"] == ["theta1", "theta2"]
+    assert np.allclose(np.array(document["jacobian"])[:2],
+                       [[np.cos(q1), np.cos(q2)], [np.sin(q1), np.sin(q2)]], atol=1e-12)
+    assert np.allclose(document["center_of_mass"],
+                       [np.sin(q1) + np.sin(q2) / 2, -np.cos(q1) - np.cos(q2) / 2, 0.0])

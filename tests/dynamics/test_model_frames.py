@@ -162,3 +162,26 @@ def test_docs_example_runs_and_its_command_is_the_closed_form(capsys, cli):
                        [[np.cos(q1), np.cos(q2)], [np.sin(q1), np.sin(q2)]], atol=1e-12)
     assert np.allclose(document["center_of_mass"],
                        [np.sin(q1) + np.sin(q2) / 2, -np.cos(q1) - np.cos(q2) / 2, 0.0])
+
+
+def test_planar_body_turns_about_z_and_moves_across_its_arm():
+    """A uniform link pinned at the origin: its centre at L/2 (sin t, -cos t), its axes turned
+    by t; in its own axes the centre moves at L/2 per rad along its x, and w = t_dot about z."""
+    link = lagrangian.load("virtual_work_link").dynamics()
+    theta, half = 0.5, 0.25
+    T = link.placement([theta], "link")
+    c, s = np.cos(theta), np.sin(theta)
+    assert np.allclose(T[:3, :3], [[c, -s, 0], [s, c, 0], [0, 0, 1]], atol=1e-15)
+    assert np.allclose(T[:3, 3], [half * s, -half * c, 0.0], atol=1e-15)
+    assert np.allclose(link.jacobian([theta], "link", "local")[:, 0], [half, 0, 0, 0, 0, 1])
+    # the point at the world's origin moving with the link is the pin: at rest
+    assert np.allclose(link.jacobian([theta], "link", "world")[:3, 0], 0.0, atol=1e-15)
+
+
+def test_frames_that_move_with_time_are_refused_in_one_line():
+    shaken = lagrangian.load("support_pendulum").dynamics()
+    with pytest.raises(InputError, match="moves with t") as e:
+        shaken.placement([0.1], "bob")
+    assert e.value.field == "frame"
+    with pytest.raises(InputError, match="kinematic tree or a model file's particles"):
+        lagrangian.load("pendulum").dynamics().placement([0.1], "bob")

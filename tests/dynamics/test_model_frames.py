@@ -99,6 +99,8 @@ def test_model_file_chain_agrees_with_the_same_chain_as_urdf(tmp_path, n):
                           - urdf.jacobian_dot_times_v(q, v, frame, reference)).max() < 1e-12
     assert np.abs(model.center_of_mass(q) - urdf.center_of_mass(q)).max() < 1e-12
     assert np.abs(model.center_of_mass_jacobian(q) - urdf.center_of_mass_jacobian(q)).max() < 1e-12
+    assert np.abs(model.kinematics.centroidal_momentum_matrix(q)
+                  - urdf.centroidal_momentum_matrix(q)).max() < 1e-12
 
 
 def test_bad_frames_and_shapes_are_refused_in_one_line(pendulum):
@@ -109,8 +111,6 @@ def test_bad_frames_and_shapes_are_refused_in_one_line(pendulum):
         pendulum.jacobian([0.1, 0.2, 0.3], "bob1")
     with pytest.raises(InputError, match="unknown reference"):
         pendulum.jacobian([0.1, 0.2], "bob1", "global")
-    with pytest.raises(InputError, match="not yet"):
-        pendulum.centroidal_momentum_matrix([0.1, 0.2])
 
 
 def test_cli_frames_of_a_model_file(cli):
@@ -185,3 +185,18 @@ def test_frames_that_move_with_time_are_refused_in_one_line():
     assert e.value.field == "frame"
     with pytest.raises(InputError, match="kinematic tree or a model file's particles"):
         lagrangian.load("pendulum").dynamics().placement([0.1], "bob")
+
+
+def test_centroidal_momentum_by_hand(pendulum):
+    """Two bobs: l = sum m r_dot, k_G = sum m (r - c) x r_dot; a lone link: k_G = I theta_dot."""
+    q, v = np.array([0.4, -1.1]), np.array([0.7, -0.3])
+    s1, c1, s2, c2 = np.sin(q[0]), np.cos(q[0]), np.sin(q[1]), np.cos(q[1])
+    r1, r2 = L1 * np.array([s1, -c1, 0]), L1 * np.array([s1, -c1, 0]) + L2 * np.array([s2, -c2, 0])
+    u1 = L1 * np.array([c1, s1, 0]) * v[0]
+    u2 = u1 + L2 * np.array([c2, s2, 0]) * v[1]
+    c = (M1 * r1 + M2 * r2) / (M1 + M2)
+    h = pendulum.centroidal_momentum_matrix(q) @ v
+    assert np.allclose(h[:3], M1 * u1 + M2 * u2, atol=1e-13)
+    assert np.allclose(h[3:], M1 * np.cross(r1 - c, u1) + M2 * np.cross(r2 - c, u2), atol=1e-13)
+    link = lagrangian.load("virtual_work_link").dynamics()  # m = 1 kg, L = 0.5 m
+    assert np.allclose(link.centroidal_momentum_matrix([0.5])[3:, 0], [0, 0, 0.5**2 / 12])

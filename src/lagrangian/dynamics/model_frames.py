@@ -59,6 +59,7 @@ class ModelKinematics:
         for component in (*model.particles, *model.bodies, *model.rigid_bodies):
             self._sources.setdefault(component.name, component)
         self._centre: StateFunction | None = None
+        self._momentum = None  # (StateFunction, parts) of centroidal_momentum_matrix
 
     @property
     def frames(self) -> tuple[str, ...]:
@@ -214,8 +215,69 @@ class ModelKinematics:
         return self._centre_values(Q)[:, 3:].reshape(batch + (3, self.n))
 
     def centroidal_momentum_matrix(self, q) -> np.ndarray:
-        raise InputError("the centroidal momentum matrix of a model file: not yet (a URDF "
-                         "robot's only)", field="q")
+        """A_g with h_g = A_g q_dot, shape (..., 6, n): linear momentum sum m J_r (kg m/s per
+        unit rate), then angular momentum about the centre of mass c, world axes:
+        sum m (r - c) x J_r, plus I J_w of each body (I about its centre: a planar body's
+        about z, a rigid body's R I_body R^T)."""
+        Q, batch = self._q(q)
+        count, n = len(Q), self.n
+        if self._momentum is None:
+            self._momentum = self._momentum_parts()
+        function, parts = self._momentum
+        values = function(Q, np.zeros_like(Q), 0.0)
+        total = sum(m for m, *_ in parts)
+        if not total > 0:
+            raise InputError("the model's particles and bodies have no mass: no centroidal "
+                             "momentum", field="q")
+        centre = np.zeros((count, 3))
+        rows = []
+        at = 0
+        for m, kind, inertia in parts:
+            r, J = values[:, at:at + 3], values[:, at + 3:at + 3 + 3 * n].reshape(count, 3, n)
+            at += 3 + 3 * n
+            centre += m * r
+            turn = None
+            if kind == "planar":  # I about z times d(angle)/dq
+                turn = np.zeros((count, 3, n))
+                turn[:, 2] = inertia * values[:, at:at + n]
+                at += n
+            elif kind == "rigid":  # R I R^T J_w (world axes)
+                R = values[:, at:at + 9].reshape(count, 3, 3)
+                Jw = values[:, at + 9:at + 9 + 3 * n].reshape(count, 3, n)
+                at += 9 + 3 * n
+                turn = R @ inertia @ np.swapaxes(R, -1, -2) @ Jw
+            rows.append((m, r, J, turn))
+        centre /= total
+        A = np.zeros((count, 6, n))
+        for m, r, J, turn in rows:
+            A[:, :3] += m * J
+            A[:, 3:] += m * np.cross((r - centre)[:, :, None], J, axisa=1, axisb=1, axisc=1)
+            if turn is not None:
+                A[:, 3:] += turn
+        return A.reshape(batch + (6, n))
+
+    def _momentum_parts(self):
+        """One function of q giving, per massive component, r (3) and J_r (3 n); a planar
+        body's d(angle)/dq (n), a rigid body's R (9) and J_w (3 n, world); and per component
+        (mass, kind, inertia) in numbers (kg, kg m^2)."""
+        d, q, q_dot = self._d, self.model.q, self.model.q_dot
+        exprs, parts = [], []
+        for c in (*self.model.particles, *self.model.bodies, *self.model.rigid_bodies):
+            r = [self._put(x) for x in _three(c.position)]
+            exprs += [*r, *(x for row in (d.row(x, q) for x in r) for x in row)]
+            if isinstance(c, Particle):
+                parts.append((float(self._put(c.mass)), "point", None))
+            elif isinstance(c, Body):
+                exprs += d.row(self._put(c.angle), q)
+                parts.append((float(self._put(c.mass)), "planar", float(self._put(c.inertia))))
+            else:
+                frame = self._frame(c.name)
+                exprs += [*frame.rotation,
+                          *(x for row in (d.row(w, q_dot) for w in frame.omega) for x in row)]
+                inertia = np.array([[float(self._put(x)) for x in row] for row in c.inertia])
+                parts.append((float(self._put(c.mass)), "rigid", inertia))
+        self._no_time(exprs, "the centroidal momentum", "q")
+        return StateFunction(self.model, exprs), parts
 
 
 def _check_reference(reference: str) -> None:

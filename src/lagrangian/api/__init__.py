@@ -22,6 +22,7 @@ from ..derivation.equations import EquationsOfMotion, LoadContribution
 from ..derivation.steps import DerivationSteps
 from ..dynamics.frames import TreeKinematics
 from ..dynamics.joint_space import Dynamics
+from ..dynamics.model_frames import ModelKinematics
 from ..dynamics.standalone import StandaloneSource
 from ..errors import DerivationError, InputError, LagrangianError, MissingExtraError, ModelError
 from ..kinds import Backend, ConstraintKind, InvariantKind, JointKind, RunStatus
@@ -43,6 +44,7 @@ __all__ = [
     # entry points
     "System",
     "TreeKinematics",
+    "ModelKinematics",
     "SystemBuilder",
     "course_lessons",
     "examples",

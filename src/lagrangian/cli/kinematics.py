@@ -1,7 +1,8 @@
-"""`lagrangian kinematics ROBOT.urdf --q ... --frame NAME [--reference ...] [--v ...]
+"""`lagrangian kinematics MODEL --q ... --frame NAME [--reference ...] [--v ...]
 [--centroidal] [--json]`: a frame's placement and Jacobian and the centre of mass of a URDF robot
-at one configuration; with --v also J_dot q_dot, with --centroidal the centroidal momentum
-matrix (and with --v the momentum h_g = A_g q_dot)."""
+(its links and joints) or a model file (its particles and bodies) at one configuration; with
+--v also J_dot q_dot, with --centroidal the centroidal momentum matrix (and with --v the
+momentum h_g = A_g q_dot)."""
 
 from __future__ import annotations
 
@@ -16,8 +17,8 @@ from .dynamics import LOCK_HELP, _vector, base_layout
 
 @app.command()
 def kinematics(
-    model: Annotated[str, typer.Argument(help="URDF robot (file or built-in example name).")],
-    frame: Annotated[str | None, typer.Option("--frame", help="A link or joint frame (default: the last link).")] = None,  # noqa: E501
+    model: Annotated[str, typer.Argument(help="URDF robot or model file (file or built-in example name).")],
+    frame: Annotated[str | None, typer.Option("--frame", help="A link or joint frame, or a model file's particle or body (default: the last).")] = None,  # noqa: E501
     q: Annotated[str | None, typer.Option("--q", help="Coordinates, comma-separated in the model's order (default: the initial values).")] = None,  # noqa: E501
     v: Annotated[str | None, typer.Option("--v", help="Velocities, comma-separated: also print J_dot q_dot, the frame's acceleration at q_ddot = 0.")] = None,  # noqa: E501
     centroidal: Annotated[bool, typer.Option("--centroidal", help="Also print the centroidal momentum matrix A_g (and with --v the momentum A_g q_dot).")] = False,  # noqa: E501

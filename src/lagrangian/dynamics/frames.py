@@ -211,11 +211,12 @@ class TreeKinematics:
 
 
 def tree_kinematics(tree: KinematicTree | None) -> TreeKinematics:
-    """The kinematics of a URDF robot's tree; refused in one line for a model without one."""
+    """The kinematics of a URDF robot's tree; refused in one line for a model without one (a
+    model file's particles and bodies: model_frames.py)."""
     if tree is None or not tree.frames:
-        raise InputError("frames, Jacobians and the centre of mass are computed for a URDF "
-                         "robot's kinematic tree; this model has none (a model file's bodies: "
-                         "not yet)", field="frame")
+        raise InputError("frames, Jacobians and the centre of mass are those of a URDF "
+                         "robot's kinematic tree or a model file's particles and bodies; this "
+                         "model has neither (energies alone name no point)", field="frame")
     return TreeKinematics(tree)
 
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -34,6 +35,9 @@ from ..model.model import Model
 from ..model.values import resolve_parameters
 from .control_terms import ControlTerms
 from .frames import TreeKinematics, tree_kinematics
+
+if TYPE_CHECKING:
+    from .model_frames import ModelKinematics
 from .reach_c import REFERENCE_INDEX
 
 
@@ -147,13 +151,27 @@ class Dynamics(ControlTerms):
     # -- frames, Jacobians and the centre of mass (a URDF robot's tree: frames.py) --------------
 
     @property
-    def kinematics(self) -> TreeKinematics:
+    def kinematics(self) -> TreeKinematics | ModelKinematics:
         """Placements, frame Jacobians and the centre of mass of the robot's kinematic tree
         (refused in one line for a model without one)."""
         found = self.__dict__.get("_tree_kinematics")
         if found is None:
-            found = self.__dict__["_tree_kinematics"] = tree_kinematics(getattr(self, "tree", None))
+            found = self.__dict__["_tree_kinematics"] = self._frames_source()
         return found
+
+    def _frames_source(self):
+        """A URDF tree's frames (frames.py), else a model file's points and bodies from its own
+        expressions (model_frames.py), at this object's parameter values."""
+        tree = getattr(self, "tree", None)
+        model = getattr(self, "model", None)
+        if (tree is None or not tree.frames) and model is not None \
+                and model.kinematic_tree is None and (model.particles or model.bodies
+                                                      or model.rigid_bodies):
+            from .model_frames import ModelKinematics
+
+            values = getattr(self, "parameters", None) or self.functions.parameters
+            return ModelKinematics(model, values)
+        return tree_kinematics(tree)
 
     @property
     def frames(self) -> tuple[str, ...]:
@@ -457,7 +475,11 @@ def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
     """Recursive dynamics where they apply, else Dynamics over ``symbolic()`` (the numeric
     functions of the derived equations; ``equations()`` gives them for coriolis_matrix)."""
     fast = recursive_dynamics(model, parameters, backend, kernel)
-    return fast if fast is not None else Dynamics(symbolic(), equations)
+    if fast is not None:
+        return fast
+    dynamics = Dynamics(symbolic(), equations)
+    dynamics.model = model  # for its frames (model_frames.py)
+    return dynamics
 
 
 __all__ = ["Dynamics", "TreeDynamics", "model_dynamics", "recursive_dynamics", "solve_positive",

@@ -50,7 +50,9 @@ def wrench_forces(kinematics, q, f_ext) -> np.ndarray:
     from .centroidal import _world_subspace, require_fixed_base
     from .recursive_numpy import _cross, _dot
 
-    require_fixed_base(kinematics.tree, "wrenches at frames", "f_ext")
+    tree = getattr(kinematics, "tree", None)
+    if tree is not None:
+        require_fixed_base(tree, "wrenches at frames", "f_ext")
     wrenches = wrench_arrays(kinematics, f_ext)
     Q, batch = kinematics._q(q)
     for w in wrenches.values():
@@ -59,6 +61,12 @@ def wrench_forces(kinematics, q, f_ext) -> np.ndarray:
     if len(Q) != count:
         Q = np.broadcast_to(np.asarray(q, dtype=float), batch + (kinematics.n,)).reshape(
             count, kinematics.n)
+    if tree is None:  # a model file's frames (model_frames.py): J^T w from their Jacobians
+        total = np.zeros((count, kinematics.n))
+        for name, w in wrenches.items():
+            w = np.broadcast_to(w, batch + (6,)).reshape(count, 6)
+            total += np.einsum("nij,ni->nj", kinematics.jacobian(Q, name), w)
+        return total.reshape(batch + (kinematics.n,))
     bodies = kinematics._bodies(Q)
     total = np.zeros((count, kinematics.n))
     for name, w in wrenches.items():

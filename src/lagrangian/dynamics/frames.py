@@ -139,22 +139,14 @@ class TreeKinematics:
         unit rate), then angular (rad/s). ``reference``: "local_world_aligned" (the frame
         origin's velocity and w, in world axes), "local" (the same in the frame's axes) or
         "world" (the velocity of the point at the world's origin moving with the frame)."""
-        if reference not in REFERENCES:
-            raise InputError(f"unknown reference '{reference}'; use one of "
-                             f"{', '.join(REFERENCES)}", field="reference")
+        check_reference(reference)
         Q, batch = self._q(q)
         bodies = self._bodies(Q)
         R, p = self._frame_pose(Q, bodies, frame)
         body = self._frame(frame).body
         if body < 0:
             return np.zeros(batch + (6, self.n))
-        J = self._point_jacobian(Q, bodies, body, p)
-        if reference == "local":
-            Rt = np.swapaxes(R, -1, -2)
-            J = np.concatenate([Rt @ J[:, :3], Rt @ J[:, 3:]], axis=1)
-        elif reference == "world":  # v(0) = v(p) + w x (0 - p)
-            J = J.copy()
-            J[:, :3] += np.cross(J[:, 3:], -p[:, :, None], axisa=1, axisb=1, axisc=1)
+        J = expressed(self._point_jacobian(Q, bodies, body, p), R, p, reference)
         return J.reshape(batch + (6, self.n))
 
     # -- centre of mass -------------------------------------------------------------------------
@@ -210,6 +202,26 @@ class TreeKinematics:
         return centroidal_momentum_matrix(self, q)
 
 
+def check_reference(reference: str) -> None:
+    """A frame Jacobian's reference is one of REFERENCES, else one line naming it."""
+    if reference not in REFERENCES:
+        raise InputError(f"unknown reference '{reference}'; use one of "
+                         f"{', '.join(REFERENCES)}", field="reference")
+
+
+def expressed(J: np.ndarray, R: np.ndarray, p: np.ndarray, reference: str) -> np.ndarray:
+    """A batch of frame Jacobians (N, 6, n) at the origin p in world axes (local_world_aligned)
+    expressed in ``reference``: in the frame's axes R (local), or for the point at the world's
+    origin moving with the frame (world: v(0) = v(p) + w x (0 - p))."""
+    if reference == "local":
+        Rt = np.swapaxes(R, -1, -2)
+        return np.concatenate([Rt @ J[:, :3], Rt @ J[:, 3:]], axis=1)
+    if reference == "world":
+        J = J.copy()
+        J[:, :3] += np.cross(J[:, 3:], -p[:, :, None], axisa=1, axisb=1, axisc=1)
+    return J
+
+
 def tree_kinematics(tree: KinematicTree | None) -> TreeKinematics:
     """The kinematics of a URDF robot's tree; refused in one line for a model without one (a
     model file's particles and bodies: model_frames.py)."""
@@ -220,4 +232,4 @@ def tree_kinematics(tree: KinematicTree | None) -> TreeKinematics:
     return TreeKinematics(tree)
 
 
-__all__ = ["REFERENCES", "TreeKinematics", "tree_kinematics"]
+__all__ = ["REFERENCES", "TreeKinematics", "check_reference", "expressed", "tree_kinematics"]

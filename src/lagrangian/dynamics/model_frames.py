@@ -22,8 +22,8 @@ from ..derivation.kinematics import Differentiator
 from ..errors import InputError, did_you_mean_or_list
 from ..model.model import Body, Model, Particle
 from ..model.rotations import apply
+from .frames import check_reference, expressed
 
-REFERENCES = ("world", "local", "local_world_aligned")
 _ZERO = sp.S.Zero
 
 
@@ -141,22 +141,16 @@ class ModelKinematics:
     def jacobian(self, q, frame: str, reference: str = "local_world_aligned") -> np.ndarray:
         """J with [v; w] = J q_dot for the frame, shape (..., 6, n), references as frames.py's
         TreeKinematics.jacobian (m/s and rad/s per unit rate)."""
-        _check_reference(reference)
+        check_reference(reference)
         Q, batch = self._q(q)
         R, p, J = self._pose(Q, frame)
-        if reference == "local":
-            Rt = np.swapaxes(R, -1, -2)
-            J = np.concatenate([Rt @ J[:, :3], Rt @ J[:, 3:]], axis=1)
-        elif reference == "world":  # v(0) = v(p) + w x (0 - p)
-            J = J.copy()
-            J[:, :3] += np.cross(J[:, 3:], -p[:, :, None], axisa=1, axisb=1, axisc=1)
-        return J.reshape(batch + (6, self.n))
+        return expressed(J, R, p, reference).reshape(batch + (6, self.n))
 
     def jacobian_dot_times_v(self, q, v, frame: str,
                              reference: str = "local_world_aligned") -> np.ndarray:
         """J_dot q_dot: the frame's classical acceleration at q_ddot = 0, [a; w_dot] (m/s^2,
         rad/s^2), shape (..., 6), ``reference`` as for jacobian."""
-        _check_reference(reference)
+        check_reference(reference)
         q, v = np.asarray(q, dtype=float), np.asarray(v, dtype=float)
         self._q(q), self._q(v, "v")
         batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
@@ -278,12 +272,6 @@ class ModelKinematics:
                 parts.append((float(self._put(c.mass)), "rigid", inertia))
         self._no_time(exprs, "the centroidal momentum", "q")
         return StateFunction(self.model, exprs), parts
-
-
-def _check_reference(reference: str) -> None:
-    if reference not in REFERENCES:
-        raise InputError(f"unknown reference '{reference}'; use one of "
-                         f"{', '.join(REFERENCES)}", field="reference")
 
 
 __all__ = ["ModelKinematics"]

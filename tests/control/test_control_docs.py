@@ -32,6 +32,11 @@ def _run(name: str, capsys) -> list[str]:
     return capsys.readouterr().out.strip().splitlines()
 
 
+def test_lqr_from_modes_section(capsys):
+    theta, x = map(float, _run("control-lqr-modes", capsys)[-1].split())
+    assert theta == pytest.approx(np.pi, abs=1e-3) and x == pytest.approx(0, abs=1e-2)
+
+
 def test_lqr_section(capsys, cli):
     lines = _run("control-lqr", capsys)
     theta, x = map(float, lines[-1].split())

@@ -67,6 +67,15 @@ def test_derivatives_section(capsys, cli):
     assert np.array(document["dtau_dq"]).shape == (2, 2)
 
 
+def test_along_section(cli):
+    result = cli(*_command("control-along"))
+    assert result.code == 0, result.err
+    along = json.loads(result.out)["linearize_along"]
+    A = np.array(along["A"])
+    assert A.shape == (51, 2, 2)
+    assert A[0, 1, 0] == pytest.approx(-9.81 / 0.5 * np.cos(1.0), rel=1e-9)  # -g/L cos theta
+
+
 def test_regressor_section(capsys, cli):
     count, error = _run("control-regressor", capsys)[-1].split()
     assert int(count) >= 2 and float(error) < 0.05

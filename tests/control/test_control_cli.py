@@ -43,3 +43,28 @@ def test_bad_control_flags_are_one_line_errors(cli, flags, message):
     assert result.code == 2
     assert result.err.strip().startswith(message), result.err
     assert len(result.err.strip().splitlines()) == 1
+
+
+def test_linearize_along_from_the_command_line_is_the_pendulum_closed_form(cli):
+    """x = (theta, theta_dot): A(t) = [[0, 1], [-g/L cos theta(t), 0]], B = [[0], [1/(m L^2)]]."""
+    result = cli("simulate", "pendulum", "--t-end", "1", "--initial", "theta=1.0",
+                 "--samples", "11", "--linearize-along", "--json")
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    along = document["linearize_along"]
+    assert along["states"] == ["theta", "theta_dot"] and along["inputs"] == ["theta"]
+    A, B = np.array(along["A"]), np.array(along["B"])
+    assert A.shape == (11, 2, 2) and B.shape == (11, 2, 1) and len(along["t"]) == 11
+    import lagrangian
+
+    theta = lagrangian.load("pendulum").simulate(1, initial={"theta": 1.0}, samples=11).q[:, 0]
+    m, L, g = 1.0, 0.5, 9.81
+    np.testing.assert_allclose(A[:, 1, 0], -g / L * np.cos(theta), rtol=1e-6)
+    assert A[0, 1, 0] == pytest.approx(-g / L * np.cos(1.0), rel=1e-9)
+    np.testing.assert_allclose(B[:, 1, 0], 1 / (m * L**2), rtol=1e-12)
+    text = cli("simulate", "pendulum", "--t-end", "1", "--linearize-along")
+    assert text.code == 0 and "linearized along the run: A(t) 2 x 2, B(t) 2 x 1" in text.out
+    refused = cli("simulate", "cartesian_pendulum", "--t-end", "1", "--linearize-along")
+    assert refused.code == 2
+    assert refused.err.strip() == ("error: --linearize-along: needs a model without constraints "
+                                   "(this one has 1: rod)")

@@ -32,6 +32,11 @@ def _run(name: str, capsys) -> list[str]:
     return capsys.readouterr().out.strip().splitlines()
 
 
+def test_lqr_from_modes_section(capsys):
+    theta, x = map(float, _run("control-lqr-modes", capsys)[-1].split())
+    assert theta == pytest.approx(np.pi, abs=1e-3) and x == pytest.approx(0, abs=1e-2)
+
+
 def test_lqr_section(capsys, cli):
     lines = _run("control-lqr", capsys)
     theta, x = map(float, lines[-1].split())
@@ -60,6 +65,15 @@ def test_derivatives_section(capsys, cli):
     assert result.code == 0, result.err
     document = json.loads(result.out)
     assert np.array(document["dtau_dq"]).shape == (2, 2)
+
+
+def test_along_section(cli):
+    result = cli(*_command("control-along"))
+    assert result.code == 0, result.err
+    along = json.loads(result.out)["linearize_along"]
+    A = np.array(along["A"])
+    assert A.shape == (51, 2, 2)
+    assert A[0, 1, 0] == pytest.approx(-9.81 / 0.5 * np.cos(1.0), rel=1e-9)  # -g/L cos theta
 
 
 def test_regressor_section(capsys, cli):

@@ -163,3 +163,17 @@ def test_a_constant_motor_torque_on_a_constrained_crank_does_work_tau_delta_thet
     assert run.max_residual < 1e-8
     assert run.control_forces.shape == (101, 3)
     np.testing.assert_allclose(run.control_forces[:, 0], torque)
+
+
+def test_lqr_from_the_modes_linearization_is_the_same_and_balances(cart_pole, upright):
+    """modes(about, inputs=["F"]) carries the same A, B as linearize: the same K, and it
+    balances the nonlinear cart-pole; without inputs lqr refuses in one line naming both."""
+    modal = cart_pole.modes(UPRIGHT, inputs=["F"])
+    from_modes = lqr(modal, [1, 10, 1, 1], 0.1)
+    assert from_modes.K == pytest.approx(lqr(upright, [1, 10, 1, 1], 0.1).K, rel=1e-10)
+    assert lqr(modal.linear_model, [1, 10, 1, 1], 0.1).K == pytest.approx(from_modes.K)
+    run = cart_pole.simulate(10, initial={"theta": np.pi - 0.1}, controller=from_modes,
+                             samples=201)
+    assert np.abs(from_modes.state(run.q[-1], run.q_dot[-1])).max() < 1e-2
+    with pytest.raises(InputError, match="modes"):
+        lqr(cart_pole.modes(UPRIGHT), [1, 10, 1, 1], 0.1)

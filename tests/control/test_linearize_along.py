@@ -48,3 +48,13 @@ def test_linearize_along_refuses_a_foreign_run_and_unknown_inputs():
     assert caught.value.field == "simulation"
     with pytest.raises(InputError, match="'phi' is not a coordinate"):
         pendulum.linearize_along(pendulum.simulate(0.1, samples=3), inputs=["phi"])
+
+
+def test_linearize_along_refuses_a_constrained_model_in_one_line():
+    from lagrangian.errors import ModelError
+
+    system = lagrangian.load("cartesian_pendulum")
+    with pytest.raises(ModelError, match=r"linearize_along needs a model without constraints "
+                                         r"\(this one has 1: rod\)") as caught:
+        system.linearize_along(system.simulate(0.1, samples=3))
+    assert caught.value.field == "constraints" and "\n" not in str(caught.value)

@@ -364,18 +364,20 @@ class System(CheckMethods, ControlMethods):
         return linear_model_at(functions, q, multipliers, inputs=inputs, input_columns=columns)
 
     def modes(self, about: Mapping[str, float] | None = None, *,
-              steady: Mapping[str, float] | None = None) -> ModalAnalysis:
+              steady: Mapping[str, float] | None = None,
+              inputs: Sequence[str] = ()) -> ModalAnalysis:
         """Natural frequencies (rad/s), damping ratios and mode shapes about an equilibrium, or
         about a steady motion (``steady``: velocity name -> constant rate). A model with a
         [steady] table (a bicycle: it has no upright equilibrium at rest) is taken about that
-        steady motion when neither ``about`` nor ``steady`` is given."""
+        steady motion when neither ``about`` nor ``steady`` is given. ``inputs`` (as in
+        linearize) give its ``linear_model`` a B, so lqr(modes, Q, R) can use it."""
         if self._recursive is None:  # a tree's M is positive definite (checked)
             refuse_large_chain(self.model)
             require_inertia(self.equations_of_motion(), "modes")
         default = self._model.steady_motion
         if steady is None and about is None and default is not None:
             steady, about = dict(default.rates), dict(default.about) or None
-        return ModalAnalysis.of(modal_analysis(self.linearize(about, steady=steady),
+        return ModalAnalysis.of(modal_analysis(self.linearize(about, inputs, steady=steady),
                                                self._model.name), self._model)
 
     def speed_form(self, steady: Mapping[str, float | str] | None = None,

@@ -26,6 +26,11 @@ class TrajectoryLinearization:
     def __len__(self) -> int:
         return len(self.t)
 
+    def summary(self) -> dict:
+        """JSON-ready: t (s), the states, the inputs, A (N x 2n x 2n) and B (N x 2n x r)."""
+        return {"t": self.t.tolist(), "states": list(self.state_names),
+                "inputs": list(self.inputs), "A": self.A.tolist(), "B": self.B.tolist()}
+
     def __repr__(self) -> str:
         return (f"TrajectoryLinearization({len(self.t)} samples, states="
                 f"{list(self.state_names)}, inputs={list(self.inputs)})")

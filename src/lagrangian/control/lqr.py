@@ -92,8 +92,9 @@ def lqr(linear_model: LinearModel, Q, R) -> LQR:
     A, B = np.asarray(model.A, dtype=float), np.asarray(model.B, dtype=float)
     size, width = A.shape[0], B.shape[1]
     if width == 0:
-        raise InputError("the linear model has no inputs: linearize(..., inputs=[...]) names "
-                         "the loads or coordinates the controller drives", field="linear_model")
+        raise InputError("the linear model has no inputs: System.linearize(about, inputs=[...]) "
+                         "or System.modes(about, inputs=[...]) names the loads, parameters or "
+                         "coordinates the controller drives", field="linear_model")
     Q = square_matrix(Q, size, "Q")
     R = square_matrix(R, width, "R", definite=True)
     _require_stabilizable(A, B, model.inputs)

@@ -50,6 +50,12 @@ def floating_start(dynamics, model, initial: Mapping[str, float] | None
     joints = {}
     for name, value in given.items():
         target = q_base if name in q_base else v_base if name in v_base else joints
+        if target is not joints:
+            try:
+                value = float(value)
+            except (TypeError, ValueError):
+                raise InputError(f"{name}: {value!r} is not a number (SI units)",
+                                 field="initial") from None
         target[name] = value
     try:
         start = resolve_state(model, joints, field="initial",

@@ -41,3 +41,24 @@ def test_command_gives_the_forward_dynamics_of_a_free_robot(cli):
                                atol=1e-12)
     np.testing.assert_allclose(robot.center_of_mass_jacobian(q) @ accel, 0, atol=1e-12)
     assert abs(accel[6]) > 1  # the shoulder does turn
+
+
+def test_simulate_example_falls_at_g(capsys):
+    """The simulate example: from rest the centre of mass falls g t^2 / 2, |quaternion| = 1."""
+    code = re.findall(r"```python\n(.*?)```", block("floating-base-simulate"), re.S)[0]
+    exec(compile(code, str(block_file("floating-base")), "exec"), {})
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "(11, 9) (11, 8)"
+    assert float(lines[1]) == pytest.approx(-0.5 * 9.81 * 0.25, abs=1e-6)
+    assert float(lines[2]) == 0.0
+
+
+def test_simulate_command_runs(cli):
+    command = re.findall(r"\$ lagrangian (.*)", block("floating-base-simulate"))[0].split()
+    result = cli(*command)
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    assert document["status"] == "finished"
+    assert abs(document["final_state"]["base_qw"] ** 2 + document["final_state"]["base_qx"] ** 2
+               + document["final_state"]["base_qy"] ** 2
+               + document["final_state"]["base_qz"] ** 2 - 1) < 1e-12

@@ -209,6 +209,9 @@ class System(CheckMethods, ControlMethods):
         as lagrangian.control's controllers do), to the model's own: docs/control.md.
         """
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
+        if tree and self._floating:  # q (+) v dt on SE(3): api/floating_simulation.py
+            return self._simulate_floating(t_end, initial, step_control, save_at, stop_when,
+                                           controller, method, rtol, atol, samples)
         if not tree:
             refuse_large_chain(self.model)  # before deriving what could not be compiled
             require_inertia(self.equations_of_motion(), "simulate")
@@ -224,6 +227,22 @@ class System(CheckMethods, ControlMethods):
                           inputs=getattr(controller, "inputs", ()) if inputs is None else inputs,
                           model=self._model)
         return Simulation.of(result)
+
+    @property
+    def _floating(self) -> bool:
+        tree = getattr(self._model, "kinematic_tree", None)
+        return bool(tree is not None and tree.floating_base)
+
+    def _simulate_floating(self, t_end, initial, step_control, save_at, stop_when, controller,
+                           method, rtol, atol, samples) -> Simulation:
+        from .floating_simulation import simulate_floating
+
+        for name, value in (("stop_when", stop_when), ("controller", controller)):
+            if value is not None:
+                raise InputError(f"{name} is not yet taken for a floating base", field=name)
+        step_control, save_at = run_options(step_control, save_at, method, rtol, atol, samples,
+                                            1001)
+        return Simulation.of(simulate_floating(self, t_end, initial, step_control, save_at))
 
     # -- standalone C for a controller -----------------------------------------------------------
 

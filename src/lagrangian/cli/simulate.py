@@ -12,6 +12,7 @@ import typer
 from .. import SIMULATION_METHODS as METHODS  # light: the names only, no scipy
 from . import app
 from .common import (
+    FLOATING_HELP,
     FPS_HELP,
     GRAVITY_HELP,
     LOCK_HELP,
@@ -35,6 +36,7 @@ def simulate(
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
     payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
+    floating_base: Annotated[bool, typer.Option("--floating-base", help=FLOATING_HELP)] = False,
     method: Annotated[str, typer.Option("--method", help=f"Integrator: {', '.join(METHODS)}.")] = "DOP853",
     rtol: Annotated[float, typer.Option("--rtol", help="Relative tolerance.")] = 1e-9,
     atol: Annotated[float, typer.Option("--atol", help="Absolute tolerance.")] = 1e-9,
@@ -74,13 +76,15 @@ def simulate(
     from ..output.simulation import projection_warning, simulation_document, simulation_text
     from ..output.tables import check_table_path
 
-    system = load_system(model, set_, lock, gravity, payload)
+    system = load_system(model, set_, lock, gravity, payload, floating_base)
+    floating = getattr(system.model.kinematic_tree, "floating_base", False)
     if not system.runs_on_tree:  # a tree's masses are checked as it is read; nothing derived
         warn_if_unphysical(system.equations_of_motion())
     end = parse_quantity(t_end, "s", "--t-end")
     # Everything the user typed is checked (by the library) before the integration starts.
-    start = resolve_state(system.model, state_assignments(system, initial, "--initial"),
-                          field="initial")
+    start = state_assignments(system, initial, "--initial")
+    if not floating:  # a floating base's names (base_x .. base_wz) are judged by simulate
+        start = resolve_state(system.model, start, field="initial")
     step_control = StepControl(method, rtol, atol)
     save_at = SaveAt(samples)
     stop = parse_stop_condition(stop_when, system.model) if stop_when is not None else None

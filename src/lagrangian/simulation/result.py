@@ -68,6 +68,17 @@ class SimulationResult:
     controls: np.ndarray | None = None
     control_names: tuple[str, ...] = ()
     control_forces: np.ndarray | None = None  # B u: the generalized forces it added (N, n)
+    # a floating base's velocity names (nv = n + 6: its twist, then the joints), q of nq = n + 7
+    velocity_names: tuple[str, ...] | None = None
+
+    @property
+    def rate_names(self) -> tuple[str, ...]:
+        """The velocity columns' names: <q>_dot, or a floating base's twist (base_vx ..
+        base_wz) then <joint>_dot."""
+        if self.velocity_names is None:
+            return tuple(f"{name}_dot" for name in self.coordinates)
+        return tuple(name if name not in self.coordinates else f"{name}_dot"
+                     for name in self.velocity_names)
 
     @property
     def model_name(self) -> str:
@@ -95,8 +106,8 @@ class SimulationResult:
         out: dict[str, np.ndarray] = {"t": self.t}
         for i, name in enumerate(self.coordinates):
             out[name] = self.q[:, i]
-        for i, name in enumerate(self.coordinates):
-            out[f"{name}_dot"] = self.q_dot[:, i]
+        for i, name in enumerate(self.rate_names):
+            out[name] = self.q_dot[:, i]
         out["energy"] = self.energy
         for i, name in enumerate(self.constraint_names):
             out[f"lambda_{name}"] = self.multipliers[:, i]
@@ -148,8 +159,8 @@ class SimulationResult:
         state = {"t": float(self.t[-1])}
         for i, name in enumerate(self.coordinates):
             state[name] = float(self.q[-1, i])
-        for i, name in enumerate(self.coordinates):
-            state[f"{name}_dot"] = float(self.q_dot[-1, i])
+        for i, name in enumerate(self.rate_names):
+            state[name] = float(self.q_dot[-1, i])
         return state
 
     @property

@@ -1,0 +1,168 @@
+"""simulate for a floating base: y = [q (nq = n + 7), v (nv = n + 6)] integrated on the manifold.
+
+q_dot from v by the free flyer's kinematics (position rate R v_lin, quaternion rate
+1/2 q (x) (0, omega)), v_dot by the tree's forward dynamics; the quaternion is renormalized
+after each accepted step (scipy's stepped loop; the compiled DOP853 loop takes q_dot = v only).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..errors import InputError, did_you_mean
+from ..kinds import InvariantKind, RunStatus
+from ..model.values import resolve_state
+from ..simulation.invariants import cumulative_work
+from ..simulation.options import SaveAt, StepControl
+from ..simulation.result import STATUS_MESSAGES, SimulationResult
+
+
+def configuration_rate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """q_dot (nq) of a floating-base state: base position rate R v_lin (m/s, world axes),
+    quaternion rate 1/2 q (x) (0, omega) (x y z w; omega in base axes, rad/s), joint rates v."""
+    from ..dynamics.free_flyer import quaternion_matrix
+
+    x, y, z, w = q[3:7]
+    wx, wy, wz = v[3:6]
+    rate = np.empty(len(q))
+    rate[:3] = quaternion_matrix(q[None, 3:7])[0] @ v[:3]
+    rate[3:7] = 0.5 * np.array([w * wx + y * wz - z * wy,
+                                w * wy + z * wx - x * wz,
+                                w * wz + x * wy - y * wx,
+                                -x * wx - y * wy - z * wz])
+    rate[7:] = v[6:]
+    return rate
+
+
+def floating_start(dynamics, model, initial: Mapping[str, float] | None
+                   ) -> tuple[float, np.ndarray, np.ndarray]:
+    """(t0, q0, v0) from ``initial``: the base's names (base_x .. base_qw, base_vx .. base_wz),
+    the joints' as for a fixed base; the base at rest at the origin unless given (SI)."""
+    from ..dynamics.free_flyer import check_quaternions
+
+    given = dict(initial or {})
+    base_q, base_v = dynamics.coordinates[:7], dynamics.velocity_names[:6]
+    q_base = dict(zip(base_q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0), strict=True))
+    v_base = dict.fromkeys(base_v, 0.0)
+    joints = {}
+    for name, value in given.items():
+        target = q_base if name in q_base else v_base if name in v_base else joints
+        if target is not joints:
+            try:
+                value = float(value)
+            except (TypeError, ValueError):
+                raise InputError(f"{name}: {value!r} is not a number (SI units)",
+                                 field="initial") from None
+        target[name] = value
+    try:
+        start = resolve_state(model, joints, field="initial",
+                              what="coordinate or velocity (or t)")
+    except InputError:
+        raise
+    except Exception as exc:  # a base name misspelled: name the base's too
+        unknown = next((k for k in joints if k != "t" and k not in
+                        {c.name for c in model.coordinates}
+                        | {f"{c.name}_dot" for c in model.coordinates}), None)
+        if unknown is None:
+            raise
+        known = [*base_q, *base_v, *(c.name for c in model.coordinates), "t"]
+        raise InputError(f"'{unknown}' is not a coordinate or velocity of this floating-base "
+                         f"robot{did_you_mean(unknown, known)}", field="initial") from exc
+    q0 = np.array([float(q_base[k]) for k in base_q] + list(start.q_array()))
+    v0 = np.array([float(v_base[k]) for k in base_v] + list(start.q_dot_array()))
+    check_quaternions(q0[None], field="initial")
+    q0[3:7] /= np.linalg.norm(q0[3:7])
+    return start.t, q0, v0
+
+
+def simulate_floating(system, t_end: float, initial, step_control: StepControl,
+                      save_at: SaveAt) -> SimulationResult:
+    """Integrate a floating-base robot to ``t_end`` (s) with the model's own loads (its
+    tau_<joint> parameters) and gravity; the quaternion kept of norm 1 after every step."""
+    from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
+
+    dynamics = system.dynamics()
+    model = system.model
+    t0, q0, v0 = floating_start(dynamics, model, initial)
+    if not (np.isfinite(t_end) and t_end > t0):
+        raise InputError(f"the end time ({t_end} s) must be after the start time ({t0} s)",
+                         field="t_end")
+    nq, nv = dynamics.nq, dynamics.nv
+    zero = np.zeros(nv)
+    evaluations = [0]
+
+    def rhs(_t, y):
+        evaluations[0] += 1
+        q, v = y[:nq].copy(), y[nq:]
+        # a step's stages leave the unit sphere by the step's error: the dynamics read R(q/|q|)
+        q[3:7] /= np.linalg.norm(q[3:7])
+        return np.concatenate([configuration_rate(q, v), dynamics.forward_dynamics(q, v, zero)])
+
+    solvers = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF,
+               "LSODA": LSODA}
+    solver_class = solvers.get(step_control.method, DOP853)
+    options = {} if step_control.max_step is None else {"max_step": step_control.max_step}
+    grid = np.linspace(t0, t_end, save_at.samples)
+    solver = solver_class(rhs, t0, np.concatenate([q0, v0]), t_end, rtol=step_control.rtol,
+                          atol=step_control.atol, **options)
+    samples = [np.concatenate([q0, v0])]
+    k, steps, status, message = 1, 0, RunStatus.FINISHED, STATUS_MESSAGES["finished"]
+    began = time.perf_counter()
+    try:
+        while k < len(grid):
+            message_of_step = solver.step()
+            steps += 1
+            if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
+                status = RunStatus.FAILED
+                message = f"the step failed at t = {solver.t:.6g} s: {message_of_step}"
+                break
+            dense = solver.dense_output()
+            while k < len(grid) and grid[k] <= solver.t:
+                y = dense(grid[k])
+                y[3:7] /= np.linalg.norm(y[3:7])  # the sample on the unit sphere too
+                samples.append(y)
+                k += 1
+            # the accepted state back on the unit sphere: |q| drifts by the step's error only
+            solver.y[3:7] /= np.linalg.norm(solver.y[3:7])
+            if solver.status == "finished" and k < len(grid):
+                samples.append(solver.y.copy())
+                k += 1
+    except KeyboardInterrupt:
+        status, message = RunStatus.INTERRUPTED, f"interrupted at t = {solver.t:.6g} s"
+    wall = time.perf_counter() - began
+    Y = np.array(samples)
+    t = grid[:len(Y)]
+    q, v = Y[:, :nq], Y[:, nq:]
+    kinetic = dynamics.kinetic_energy(q, v)
+    energy = kinetic + dynamics.potential_energy(q)
+    own = _joint_forces(model, system.parameters)  # the model's tau_<joint>: on the joints
+    power = v[:, 6:] @ own
+    working = bool(np.any(own != 0))
+    kind = InvariantKind.WORK_BALANCE if working else InvariantKind.ENERGY
+    return SimulationResult(
+        model=model, coordinates=tuple(dynamics.coordinates), constraint_names=(),
+        parameters=dict(system.parameters), t=t, q=q, q_dot=v, energy=energy, power=power,
+        multipliers=np.zeros((len(t), 0)), residuals=np.zeros((len(t), 0)),
+        step_control=step_control, status=status, message=message, steps=steps,
+        nfev=evaluations[0], wall_time=wall, backend=f"scipy {solver_class.__name__}",
+        energy_conserved=not working, t_end=float(t_end), kinetic_energy=kinetic,
+        invariant=kind, invariant_values=energy,
+        work=cumulative_work(t, power) if working else None,
+        velocity_names=tuple(dynamics.velocity_names))
+
+
+def _joint_forces(model, parameters: Mapping[str, float]) -> np.ndarray:
+    """Each joint's generalized force from the model's loads (N m or N) at the parameter
+    values; a robot's are constant (tau_<joint> parameters)."""
+    import sympy as sp
+
+    given: dict[str, list] = {}
+    for coordinate, force in model.generalized_forces:
+        given.setdefault(coordinate, []).append(force)
+    values = {p.symbol: parameters[p.name] for p in model.parameters
+              if parameters.get(p.name) is not None}
+    return np.array([float(sp.Add(*given.get(c.name, [])).xreplace(values))
+                     for c in model.coordinates])

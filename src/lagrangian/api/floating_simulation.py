@@ -103,7 +103,10 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
 
     solvers = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF,
                "LSODA": LSODA}
-    solver_class = solvers.get(step_control.method, DOP853)
+    if step_control.method not in solvers:  # StepControl knows more than scipy steps here
+        raise InputError(f"a floating base integrates with {', '.join(solvers)}, not "
+                         f"{step_control.method}", field="method")
+    solver_class = solvers[step_control.method]
     options = {} if step_control.max_step is None else {"max_step": step_control.max_step}
     grid = np.linspace(t0, t_end, save_at.samples)
     solver = solver_class(rhs, t0, np.concatenate([q0, v0]), t_end, rtol=step_control.rtol,

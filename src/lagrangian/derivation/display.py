@@ -74,7 +74,7 @@ class _ModelScalar:
         if self is other:
             return True
         if not isinstance(other, sp.Basic):
-            return self._do_eq_sympify(other)
+            return self._do_eq_sympify(other)  # safe: sympy's strict path, never parses text
         if getattr(type(other), "_plain", type(other)) is not self._plain:
             return False
         return self._hashable_content() == other._hashable_content()

@@ -29,7 +29,7 @@ _ZERO = sp.S.Zero
 
 def _three(vector) -> list[sp.Expr]:
     """A position of 2 or 3 components as 3 (a planar model's z = 0)."""
-    items = [sp.sympify(x) for x in vector]
+    items = [sp.sympify(x) for x in vector]  # safe: the model's own sympy objects and numbers
     return items + [_ZERO] * (3 - len(items))
 
 
@@ -67,7 +67,7 @@ class ModelKinematics:
         return tuple(self._sources)
 
     def _put(self, expr) -> sp.Expr:
-        return sp.sympify(expr).xreplace(self._values)
+        return sp.sympify(expr).xreplace(self._values)  # safe: a model expression, not text
 
     def _q(self, q, field: str = "q") -> tuple[np.ndarray, tuple[int, ...]]:
         q = np.asarray(q, dtype=float)
@@ -78,7 +78,8 @@ class ModelKinematics:
         return q.reshape(-1, self.n), q.shape[:-1]
 
     def _no_time(self, exprs, what: str, field: str = "frame") -> None:
-        if any(self.model.time in sp.sympify(e).free_symbols for e in exprs):
+        if any(self.model.time in sp.sympify(e).free_symbols  # safe: model expressions
+               for e in exprs):
             raise InputError(f"{what} moves with t (a prescribed motion): frames and Jacobians "
                              "of a model file are for q alone; not yet", field=field)
 

@@ -77,8 +77,8 @@ class EquationsOfMotion:
                  *(c.expression for c in self.model.constraints)]
         if self.component_mass_matrix is not None:
             parts.append(self.component_mass_matrix)
-        # safe: sympy objects, no user text
-        symbols = set().union(*(sp.sympify(part).free_symbols for part in parts))
+        symbols = set().union(*(sp.sympify(part).free_symbols  # safe: sympy objects, no text
+                                for part in parts))
         return frozenset(p.name for p in self.model.parameters if p.symbol in symbols)
 
     @cached_property

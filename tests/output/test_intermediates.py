@@ -153,3 +153,15 @@ def test_derive_expand_flag(cli, tmp_path):
     assert len(named) < 60_000 < 300_000 < len(expanded)
     code, out, err = cli("derive", str(path), "--json", "--expand")
     assert code == 0 and "intermediates" not in json.loads(out)
+
+
+def test_the_documented_example():
+    import re
+
+    from docs_blocks import block
+
+    code = re.findall(r"```python\n(.*?)```", block("deep-chain"), re.S)[0]
+    scope: dict = {}
+    exec(compile(code, "docs/readability.md", "exec"), scope)
+    assert "Intermediate quantities" in scope["named"] and len(scope["named"]) < 60_000
+    assert "Intermediate" not in scope["full"] and len(scope["full"]) > 300_000

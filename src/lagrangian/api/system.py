@@ -533,6 +533,14 @@ class System(CheckMethods, ControlMethods):
         return derivation_latex(self.equations_of_motion(), standalone=standalone,
                                 expand=expand)
 
+    def to_text(self, expand: bool = False) -> str:
+        """The derivation as ``derive`` prints it: T, V, L, the equations, Q, M and f in the
+        model-file grammar. Large equations (a deep chain of bodies) are written in named
+        intermediate quantities, listed first, unless ``expand``."""
+        from ..output.derivation import derivation_text
+
+        return derivation_text(self.equations_of_motion(), expand=expand)
+
     def __repr__(self) -> str:
         names = ", ".join(c.name for c in self._model.coordinates)
         return f"System({self._model.name!r}, coordinates=[{names}])"

@@ -306,8 +306,9 @@ def assert_refused_in_one_line(code: int, out: str, err: str) -> None:
 # -- the arguments of each cell ---------------------------------------------------------------
 
 def _answer_file(cli, model: str, folder: Path) -> Path | None:
-    """The model's own derivation as an answer file (T, V, D, Q, equations, multipliers)."""
-    code, out, _ = cli("derive", model, "--json")
+    """The model's own derivation as an answer file (T, V, D, Q, equations, multipliers),
+    written out in the model's names (--expand: no intermediate quantities)."""
+    code, out, _ = cli("derive", model, "--json", "--expand")
     if code != 0:
         return None
     d = json.loads(out)

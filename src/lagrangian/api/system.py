@@ -523,13 +523,23 @@ class System(CheckMethods, ControlMethods):
         return build_report(self, answer=answer, t_end=t_end, progress=progress, size=size,
                             fps=fps)
 
-    def to_latex(self, standalone: bool = False) -> str:
+    def to_latex(self, standalone: bool = False, expand: bool = False) -> str:
         """The derivation as LaTeX (amsmath), as ``derive --format latex``: M q_ddot
         (+ Phi_q^T lambda) = f per coordinate, long rows broken; with ``standalone`` a complete
-        document for pdflatex titled with the model's name."""
+        document for pdflatex titled with the model's name. Large equations (a deep chain of
+        bodies) are written in named intermediate quantities, listed first, unless ``expand``."""
         from ..output.derivation import derivation_latex
 
-        return derivation_latex(self.equations_of_motion(), standalone=standalone)
+        return derivation_latex(self.equations_of_motion(), standalone=standalone,
+                                expand=expand)
+
+    def to_text(self, expand: bool = False) -> str:
+        """The derivation as ``derive`` prints it: T, V, L, the equations, Q, M and f in the
+        model-file grammar. Large equations (a deep chain of bodies) are written in named
+        intermediate quantities, listed first, unless ``expand``."""
+        from ..output.derivation import derivation_text
+
+        return derivation_text(self.equations_of_motion(), expand=expand)
 
     def __repr__(self) -> str:
         names = ", ".join(c.name for c in self._model.coordinates)

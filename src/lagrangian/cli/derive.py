@@ -28,6 +28,7 @@ def derive(
     steps: Annotated[bool, typer.Option("--steps", help="Show the working: dL/dq_dot, its d/dt, dL/dq, Q and each load's virtual work (a 'steps' key in JSON).")] = False,  # noqa: E501
     steps_full: Annotated[bool, typer.Option("--steps-full", help="--steps with every step printed, however large (a step over 1000 nodes is otherwise given by its size; the JSON is always complete).")] = False,  # noqa: E501
     standalone: Annotated[bool, typer.Option("--standalone", help="With --format latex: a complete document for pdflatex (title, amsmath), not a fragment.")] = False,  # noqa: E501
+    expand: Annotated[bool, typer.Option("--expand", help="Write every expression out in full, however large (large equations, a deep chain of bodies, are otherwise written in named intermediate quantities listed first).")] = False,  # noqa: E501
 ) -> None:
     """Derive the equations of motion by Lagrange's method."""
     from ..output.derivation import derivation_document, derivation_latex, derivation_text
@@ -41,14 +42,14 @@ def derive(
                          field="--standalone")
     working = eom.steps() if steps or steps_full else None
     if json_ or format is Format.json:
-        document = derivation_document(eom)
+        document = derivation_document(eom, expand=expand)
         if working is not None:
             from ..output.steps import steps_document
 
             document["steps"] = steps_document(working)
         print_json(document)
     elif format is Format.latex:
-        latex = derivation_latex(eom, standalone=standalone)
+        latex = derivation_latex(eom, standalone=standalone, expand=expand)
         if working is not None:
             from ..output.steps import steps_latex
 
@@ -58,7 +59,7 @@ def derive(
                      else latex + working_latex)
         typer.echo(latex, nl=False)
     else:
-        typer.echo(derivation_text(eom), nl=False)
+        typer.echo(derivation_text(eom, expand=expand), nl=False)
         if working is not None:
             from ..output.steps import steps_text
 

@@ -15,6 +15,7 @@ import sympy as sp
 from ..model.model import Body, Gravity, Particle
 from ..model.rotations import RigidBody
 from .body_jacobians import jacobian_equations
+from .chains import add_chain_inertia, particle_chains
 from .kinematics import Differentiator
 from .rigid_bodies import rotational_equations, rotational_kinetic_energy
 from .trig import combined_terms, parts, product
@@ -32,6 +33,16 @@ class InertiaAssembly:
         self.gravity = gravity
         self.unexpanded = unexpanded  # rigid bodies taken through their Jacobians, by name
         self.kinetic_terms: list[sp.Expr] = []
+        self.chained: frozenset[str] = frozenset()  # particles added through their chain
+
+    def add_chains(self, particles) -> None:
+        """Particles in a chain (an n-link pendulum) by its segments (chains.py), before the
+        first pass, which then passes them by."""
+        segments = particle_chains(particles, self.q, self.q_dot, self.t, self.d)
+        if segments:
+            add_chain_inertia(segments, self.acc, self.d, self.q, self.q_dot, self.t,
+                              self.gravity)
+            self.chained = frozenset(s.particle.name for s in segments)
 
     def varying_inertia(self, inertia: sp.Expr, jacobian, velocity) -> None:
         """The Euler-Lagrange operator on 1/2 m v.v is m J_i.a + m_dot v.J_i - 1/2 dm/dq_i v.v:
@@ -108,7 +119,8 @@ def add_translation(component, assembly: InertiaAssembly) -> None:
 
 @add_translation.register
 def _(particle: Particle, assembly: InertiaAssembly) -> None:
-    assembly.translate(particle.mass, particle.position)
+    if particle.name not in assembly.chained:
+        assembly.translate(particle.mass, particle.position)
 
 
 @add_translation.register

@@ -44,6 +44,7 @@ class _Accumulator:
         self.forcing = [defaultdict(list) for _ in range(n)]
         self._dots: dict[tuple, sp.Expr] = {}
         self._collected: dict[tuple[int, int], sp.Expr] = {}  # M entries already summed
+        self._sums: dict[tuple, sp.Expr] = {}  # sums of coefficients, see _collect
 
     def add_force(self, i: int, expr: sp.Expr) -> None:
         self.forcing[i][expr].append(sp.S.One)
@@ -91,17 +92,28 @@ class _Accumulator:
             for j in range(i, n):
                 entry = self._collected.get((i, j))
                 if entry is None:
-                    entry = self._collected[(i, j)] = _collect(self.mass[i][j])
+                    entry = self._collected[(i, j)] = _collect(self.mass[i][j], self._sums)
                 mass[i][j] = mass[j][i] = entry
         return sp.ImmutableMatrix(mass)
 
     def forcing_vector(self) -> sp.ImmutableMatrix:
-        return sp.ImmutableMatrix(self.n, 1, [_collect(terms) for terms in self.forcing])
+        return sp.ImmutableMatrix(self.n, 1, [_collect(terms, self._sums) for terms in self.forcing])
 
 
-def _collect(groups: dict[sp.Expr, list[sp.Expr]]) -> sp.Expr:
-    return sp.Add(*(term if coefficients == [sp.S.One] else term * sp.Add(*coefficients)
-                    for term, coefficients in groups.items()))
+def _collect(groups: dict[sp.Expr, list[sp.Expr]], sums: dict[tuple, sp.Expr]) -> sp.Expr:
+    """sum of term * (sum of its coefficients); ``sums`` keeps each sum of coefficients formed
+    (a chain gives the same m_k + ... + m_n to many terms of many entries)."""
+    items = []
+    for term, coefficients in groups.items():
+        if coefficients == [sp.S.One]:
+            items.append(term)
+            continue
+        key = tuple(coefficients)
+        total = sums.get(key)
+        if total is None:
+            total = sums[key] = sp.Add(*coefficients)
+        items.append(term * total)
+    return sp.Add(*items)
 
 
 def derive(model: Model, *, check: bool = True,
@@ -135,6 +147,7 @@ def derive(model: Model, *, check: bool = True,
     # components' printed M is taken between them (it holds no body in space's rotation).
     assembly = InertiaAssembly(acc, d, q, q_dot, t, gravity, unexpanded)
     carriers = (*model.particles, *model.bodies, *model.rigid_bodies)
+    assembly.add_chains(model.particles)
     for item in carriers:
         add_translation(item, assembly)
     component_mass = acc.mass_matrix() if carriers else None

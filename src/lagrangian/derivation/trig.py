@@ -48,7 +48,10 @@ def parts(term: sp.Expr) -> Parts:
 
 def product(a: Parts, b: Parts) -> Parts:
     """The parts of the product of two decomposed terms."""
-    return (a[0] * b[0], _merge(a[1], b[1]), _merge(a[2], b[2]), _merge(a[3], b[3]))
+    x, y = a[0], b[0]
+    # most coefficients are 1: skip sympy's number product (a chain forms O(n^2) of these)
+    coefficient = y if x is sp.S.One else x if y is sp.S.One else x * y
+    return (coefficient, _merge(a[1], b[1]), _merge(a[2], b[2]), _merge(a[3], b[3]))
 
 
 def _merge(x: tuple, y: tuple) -> tuple:
@@ -145,7 +148,18 @@ def _difference(coefficient, rest: tuple, function, a: sp.Expr, b: sp.Expr) -> s
     if _KEY(b) < _KEY(a):  # write the difference in sorted order
         a, b = b, a
         coefficient = -coefficient if function is sp.sin else coefficient
-    return sp.Mul(coefficient, *rest, function(a - b, evaluate=False))
+    return sp.Mul(coefficient, *rest, _of_difference(function, a, b))
+
+
+@lru_cache(maxsize=1 << 16)
+def _of_difference(function, a: sp.Expr, b: sp.Expr) -> sp.Expr:
+    # a chain's f_k meets sin(theta_j - theta_k) for every j, and M the cos of the same angles
+    return function(_minus(a, b), evaluate=False)
+
+
+@lru_cache(maxsize=1 << 16)
+def _minus(a: sp.Expr, b: sp.Expr) -> sp.Expr:
+    return a - b
 
 
 def _take(index, key, used, exclude):

@@ -1,7 +1,9 @@
 """The derivation (`derive`): text for a terminal, the JSON document, and LaTeX for a paper.
 
 Text and JSON write expressions in the model-file grammar (readable, copyable, and read back by
-``parse_expression``); LaTeX uses the model's symbol names.
+``parse_expression``); LaTeX uses the model's symbol names. Equations too large to print written
+out (a deep chain of bodies) are written in named intermediate quantities, listed first
+(derivation/intermediates.py); ``expand=True`` (derive --expand) writes them out all the same.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from typing import Any
 import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
+from ..derivation.intermediates import Intermediates, intermediates, is_large, with_entries
 from ..derivation.readable import readable, readable_matrix
 from ..model.expressions import format_expression
 from ..model.units import generalized_force_unit
@@ -22,12 +25,21 @@ class _Display:
     """The readable form of the derivation's expressions (derivation/readable.py: equal to the
     derived ones, grouped by products of the rates), as text in the model-file grammar."""
 
-    def __init__(self, eom: EquationsOfMotion):
+    def __init__(self, eom: EquationsOfMotion, expand: bool = False):
         model = eom.model
         self.rates = frozenset([*model.q_dot, *model.q_ddot, *eom.multipliers])
         self.ranges = {c.symbol: tuple(c.range) for c in model.coordinates if c.range}
+        self.intermediates = None if expand else _named(eom)
 
     def form(self, expr) -> sp.Expr:
+        if self.intermediates is not None:
+            found = self.intermediates.reduced.get(expr)
+            if found is not None:
+                return found
+        return readable(expr, self.rates, self.ranges)
+
+    def plain(self, expr) -> sp.Expr:
+        """The readable form in the model's own names (constraints: read by the modes)."""
         return readable(expr, self.rates, self.ranges)
 
     def lagrangian(self, eom: EquationsOfMotion) -> sp.Expr:
@@ -42,16 +54,52 @@ class _Display:
         for i in range(M.rows):
             terms = [self.form(M[i, j]) * a for j, a in enumerate(eom.model.q_ddot)
                      if M[i, j] != 0]
-            terms += [self.form(A[k, i]) * eom.multipliers[k] for k in range(A.rows)
+            terms += [self.plain(A[k, i]) * eom.multipliers[k] for k in range(A.rows)
                       if A[k, i] != 0]
             rows.append(sp.Add(*terms) - self.form(f[i]))
         return rows
 
-    def matrix(self, matrix) -> sp.ImmutableMatrix:
+    def matrix(self, matrix, plain: bool = False) -> sp.ImmutableMatrix:
+        if self.intermediates is not None and not plain:
+            return sp.ImmutableMatrix(matrix.rows, matrix.cols, [self.form(v) for v in matrix])
         return readable_matrix(matrix, self.rates, self.ranges)
 
-    def __call__(self, expr) -> str:
-        return format_expression(self.form(expr))
+    def definitions(self) -> list[tuple[str, str]]:
+        """(name, text) of each intermediate quantity, in order (none for small equations)."""
+        if self.intermediates is None:
+            return []
+        return [(str(symbol), format_expression(expr))
+                for symbol, expr in self.intermediates.definitions]
+
+    def __call__(self, expr, plain: bool = False) -> str:
+        return format_expression(self.plain(expr) if plain else self.form(expr))
+
+
+def printed_expressions(eom: EquationsOfMotion) -> list[sp.Expr]:
+    """Every expression derive prints but the constraints' (the Lagrangian is T - V of the
+    printed T and V; Phi, Phi_q and gamma stay in the model's names)."""
+    exprs = [eom.kinetic_energy, eom.potential_energy, eom.dissipation, *eom.mass_matrix,
+             *eom.forcing, *eom.generalized_forces,
+             *(c.expression for c in eom.load_contributions)]
+    return exprs if eom.accelerations is None else [*exprs, *eom.accelerations]
+
+
+def _named(eom: EquationsOfMotion) -> Intermediates | None:
+    """The intermediate quantities where the equations written out would be large, else None."""
+    exprs = printed_expressions(eom)
+    if not is_large(exprs):
+        return None
+    model = eom.model
+    taken = {p.name for p in model.parameters} | {str(s) for s in eom.multipliers}
+    for c in model.coordinates:
+        taken |= {c.name, c.velocity.name, c.acceleration.name}
+    named = intermediates(model, exprs, taken)
+    names = [c.name for c in model.coordinates]
+    M = eom.mass_matrix
+    entries = [(f"M_{names[i]}_{names[j]}", M[i, j]) for i in range(M.rows)
+               for j in range(i, M.cols) if M[i, j] != 0]
+    entries += [(f"f_{name}", value) for name, value in zip(names, eom.forcing, strict=True)]
+    return with_entries(named, entries, taken)
 
 
 # -- text ---------------------------------------------------------------------------------------
@@ -100,12 +148,24 @@ def _latex_letters(model) -> dict[str, str]:
 
 
 
-def derivation_text(eom: EquationsOfMotion) -> str:
+def derivation_text(eom: EquationsOfMotion, expand: bool = False) -> str:
+    """The `derive` text; ``expand``: every expression written out, however large."""
     model = eom.model
-    fmt = _Display(eom)
+    fmt = _Display(eom, expand)
     lines = [model.name, "=" * len(model.name)]
     coordinates = ", ".join(f"{c.name} [{c.unit or '1'}]" for c in model.coordinates)
     lines += [f"Coordinates: {coordinates}", ""]
+    named = fmt.definitions()
+    if named:
+        lines.append(f"Intermediate quantities ({len(named)}; each in the ones before it, and "
+                     "the equations below in them; derive --expand writes them out).")
+        lines.append("Bodies by number (R rotation, omega angular velocity in body axes, o "
+                     "origin, p centre of mass, v, a its velocity, acceleration at q_ddot = 0; "
+                     "d/dt as dR, vo, alpha):")
+        lines.append("  " + ", ".join(f"{k} {b.name}" for k, b in
+                                       enumerate(model.rigid_bodies, start=1)))
+        lines += [f"  {name} = {text}" for name, text in named]
+        lines.append("")
     label = _labels(model)
     lines += [f"{label['T']} = {fmt(eom.kinetic_energy)}",
               f"{label['V']} = {fmt(eom.potential_energy)}"]
@@ -137,14 +197,16 @@ def derivation_text(eom: EquationsOfMotion) -> str:
     if model.constraints:
         lines += ["", f"Constraints ({len(model.constraints)}, one multiplier each):"]
         for k, constraint in enumerate(model.constraints):
-            lines.append(f"  {constraint.name} ({constraint.kind}): {fmt(constraint.expression)}"
-                         f" = 0   multiplier {eom.multipliers[k]}")
+            lines.append(f"  {constraint.name} ({constraint.kind}): "
+                         f"{fmt(constraint.expression, plain=True)} = 0   "
+                         f"multiplier {eom.multipliers[k]}")
         lines.append("Constraint Jacobian Phi_q:")
         for i in range(eom.constraint_jacobian.rows):
-            lines.append("  [" + ", ".join(fmt(v) for v in eom.constraint_jacobian.row(i)) + "]")
+            lines.append("  [" + ", ".join(fmt(v, plain=True)
+                                           for v in eom.constraint_jacobian.row(i)) + "]")
         lines.append("Acceleration level, Phi_q q_ddot = gamma:")
         for constraint, gamma in zip(model.constraints, eom.acceleration_rhs, strict=True):
-            lines.append(f"  {constraint.name}: gamma = {fmt(gamma)}")
+            lines.append(f"  {constraint.name}: gamma = {fmt(gamma, plain=True)}")
 
     if eom.accelerations is not None:
         lines += ["", "Accelerations:"]
@@ -165,7 +227,7 @@ def _rows(eom: EquationsOfMotion, fmt: _Display) -> list[str]:
         for j, c in enumerate(model.coordinates):
             terms.append(_product_text(fmt.form(eom.mass_matrix[i, j]), c.acceleration))
         for k in range(eom.multipliers.rows):
-            terms.append(_product_text(fmt.form(eom.constraint_jacobian[k, i]),
+            terms.append(_product_text(fmt.plain(eom.constraint_jacobian[k, i]),
                                        eom.multipliers[k]))
         text = ""
         for term in filter(None, terms):
@@ -197,11 +259,13 @@ def _product_text(coefficient: sp.Expr, unknown: sp.Symbol) -> str:
 # -- JSON ---------------------------------------------------------------------------------------
 
 
-def derivation_document(eom: EquationsOfMotion) -> dict[str, Any]:
-    """The `derive --format json` document."""
+def derivation_document(eom: EquationsOfMotion, expand: bool = False) -> dict[str, Any]:
+    """The `derive --format json` document; where the equations are large, an "intermediates"
+    list of {"name", "expression"} that the other expressions are written in (not with
+    ``expand``)."""
     model = eom.model
     names = [c.name for c in model.coordinates]
-    text = _Display(eom)
+    text = _Display(eom, expand)
     document: dict[str, Any] = {
         "name": model.name,
         "convention": CONVENTION,
@@ -229,14 +293,17 @@ def derivation_document(eom: EquationsOfMotion) -> dict[str, Any]:
         },
         "accelerations_note": eom.accelerations_note,
     }
+    named = text.definitions()
+    if named:
+        document["intermediates"] = [{"name": n, "expression": e} for n, e in named]
     if model.constraints:
         document["constraints"] = {
             "names": [c.name for c in model.constraints],
             "kinds": [c.kind for c in model.constraints],
             "multipliers": [str(s) for s in eom.multipliers],
-            "jacobian": [[text(v) for v in eom.constraint_jacobian.row(i)]
+            "jacobian": [[text(v, plain=True) for v in eom.constraint_jacobian.row(i)]
                          for i in range(eom.constraint_jacobian.rows)],
-            "acceleration_rhs": [text(v) for v in eom.acceleration_rhs],
+            "acceleration_rhs": [text(v, plain=True) for v in eom.acceleration_rhs],
         }
     return document
 
@@ -244,9 +311,10 @@ def derivation_document(eom: EquationsOfMotion) -> dict[str, Any]:
 # -- LaTeX --------------------------------------------------------------------------------------
 
 
-def derivation_latex(eom: EquationsOfMotion, standalone: bool = False) -> str:
+def derivation_latex(eom: EquationsOfMotion, standalone: bool = False,
+                     expand: bool = False) -> str:
     """LaTeX (amsmath) ready to paste into a paper, or with ``standalone`` a complete document
     for pdflatex (output/latex.py: M q_ddot = f per coordinate, long rows broken)."""
     from .latex import handout_latex  # it builds on _Display above
 
-    return handout_latex(eom, standalone=standalone)
+    return handout_latex(eom, standalone=standalone, expand=expand)

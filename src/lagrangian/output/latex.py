@@ -295,10 +295,11 @@ def _joined(terms: Terms, continued: bool) -> str:
 
 
 class _Handout:
-    def __init__(self, eom: EquationsOfMotion, width: float = LINE_WIDTH_PT):
+    def __init__(self, eom: EquationsOfMotion, width: float = LINE_WIDTH_PT,
+                 expand: bool = False):
         self.eom, self.model = eom, eom.model
         self.printer = model_latex_printer(eom.model)
-        self.display = _Display(eom)
+        self.display = _Display(eom, expand)
         self.breaker = _Breaker(self.printer, width)
         self.width = width
         self.letters = _latex_letters(eom.model)
@@ -327,6 +328,16 @@ class _Handout:
             rows += self.row(f"{k['Q']}_{{{self.tex(c.symbol)}}}", form(total))
         return _environment("align", rows, notag=True)
 
+    def intermediates(self) -> list[str]:
+        """The named quantities the rest is written in (large equations only), one a row."""
+        named = self.display.intermediates
+        if named is None:
+            return []
+        rows = []
+        for symbol, expr in named.definitions:
+            rows += self.row(self.tex(symbol), expr)
+        return _environment("align*", rows)
+
     def coordinate_rows(self) -> list[str]:
         """``q = (q_1, q_2, ...)``, continued on further rows when too long for one."""
         names = [self.tex(c.symbol) for c in self.model.coordinates]
@@ -347,7 +358,7 @@ class _Handout:
         the right side f_i, each in its readable form."""
         eom, form = self.eom, self.display.form
         pairs = [(form(eom.mass_matrix[i, j]), a) for j, a in enumerate(self.model.q_ddot)]
-        pairs += [(form(eom.constraint_jacobian[k, i]), eom.multipliers[k])
+        pairs += [(self.display.plain(eom.constraint_jacobian[k, i]), eom.multipliers[k])
                   for k in range(eom.constraint_jacobian.rows)]
         return pairs, form(eom.forcing[i])
 
@@ -380,9 +391,10 @@ class _Handout:
                     f"{rows[-1]} {tag}", r"\end{align}"]
         return out
 
-    def matrix(self, label: str, matrix: sp.MatrixBase, symmetric: bool = False) -> list[str]:
+    def matrix(self, label: str, matrix: sp.MatrixBase, symmetric: bool = False,
+               plain: bool = False) -> list[str]:
         """``label &= [matrix]``, or its nonzero entries one per row when too wide."""
-        form = self.display.matrix(matrix)
+        form = self.display.matrix(matrix, plain)
         entries = [[self.tex(v) for v in form.row(i)] for i in range(form.rows)]
         room = self.width - 10.0 * (form.cols - 1) - 12.0 - estimated_width(label)
         if all(fits(entry, room) for row in entries for entry in row) and sum(
@@ -403,8 +415,8 @@ class _Handout:
         rows = self.matrix(k["M"], eom.mass_matrix, symmetric=True)
         rows += self.matrix(k["f"], eom.forcing)
         if self.model.constraints:
-            rows += self.matrix(r"\Phi_q", eom.constraint_jacobian)
-            rows += self.matrix(r"\gamma", eom.acceleration_rhs)
+            rows += self.matrix(r"\Phi_q", eom.constraint_jacobian, plain=True)
+            rows += self.matrix(r"\gamma", eom.acceleration_rhs, plain=True)
         return _environment("align*", rows)
 
 
@@ -423,22 +435,27 @@ _PREAMBLE = r"""\documentclass[10pt,a4paper]{article}
 """
 
 
-def handout_latex(eom: EquationsOfMotion, standalone: bool = False) -> str:
+def handout_latex(eom: EquationsOfMotion, standalone: bool = False,
+                  expand: bool = False) -> str:
     """The derivation as LaTeX (amsmath): a fragment to paste into a paper, or with
-    ``standalone`` a complete document for pdflatex, titled with the model's name."""
+    ``standalone`` a complete document for pdflatex, titled with the model's name; large
+    equations in named intermediate quantities, unless ``expand``."""
     try:
-        return _handout_latex(eom, standalone)
+        return _handout_latex(eom, standalone, expand)
     finally:
         _width_within.cache_clear()  # the texts measured belong to this document only
 
 
-def _handout_latex(eom: EquationsOfMotion, standalone: bool) -> str:
-    handout = _Handout(eom, STANDALONE_WIDTH_PT if standalone else LINE_WIDTH_PT)
+def _handout_latex(eom: EquationsOfMotion, standalone: bool, expand: bool) -> str:
+    handout = _Handout(eom, STANDALONE_WIDTH_PT if standalone else LINE_WIDTH_PT, expand)
     name = escape_text(eom.model.name)
     k = handout.letters
     constraint = r" + \Phi_q^T \lambda" if eom.model.constraints else ""
     convention = rf"{k['M']} \ddot{{\mathbf{{q}}}}{constraint} = {k['f']}"
+    named = handout.intermediates()
     blocks = [
+        *([("Intermediate quantities (each in the ones before it; the rest is written in "
+            "them)", named)] if named else []),
         ("Energies, Lagrangian and generalized forces", handout.definitions()),
         (rf"Equations of motion, ${convention}$, one per coordinate", handout.equations()),
         ("Mass matrix and forcing" + (", constraints" if eom.model.constraints else ""),

@@ -8,9 +8,11 @@ Per size: ``seconds`` from reading the file to the first rhs call (load, the tre
 C generated and compiled, M(q) and f(q, q_dot) evaluated once), ``peak MB`` the largest
 resident set of the process or of a compiler it ran (ru_maxrss), ``rhs us`` one call of
 ``System.numeric().rhs(t, y)`` from Python (best of 5 x 2000), then ``simulate`` (2 s of motion,
-module cached) and ``modes`` about the hanging chain. With --pinocchio n: the same chain written
-as a URDF, Pinocchio's ``aba`` timed in the same process (best of 5 x 2000 from Python),
-after checking that the two forward dynamics agree at random states.
+module cached) and ``modes`` about the hanging chain; ``crosscheck`` (sizes up to
+--crosscheck) is the whole command ``lagrangian crosscheck chain.toml`` in a fresh process
+(start-up, load, Lagrange's equations, Newton-Euler and the comparison). With --pinocchio n:
+the same chain written as a URDF, Pinocchio's ``aba`` timed in the same process (best of
+5 x 2000 from Python), after checking that the two forward dynamics agree at random states.
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ def _peak_mb() -> float:
     return max(own, children) / 1024
 
 
-def _child(n: int, pinocchio: bool) -> None:
+def _child(n: int, pinocchio: bool, crosscheck: bool) -> None:
     import numpy as np
 
     import lagrangian
@@ -69,6 +71,13 @@ def _child(n: int, pinocchio: bool) -> None:
     modes = system.modes(about={f"q{i}": 0.0 for i in range(n)})
     report["modes_s"] = time.perf_counter() - started
     report["lowest_hz"] = modes.modes[0].frequency / (2 * np.pi)
+    if crosscheck:
+        started = time.perf_counter()
+        done = subprocess.run([sys.executable, "-c", "from lagrangian.cli import main; main()",
+                               "crosscheck", str(path)], capture_output=True, text=True)
+        report["crosscheck_s"] = time.perf_counter() - started
+        report["crosscheck_agree"] = done.returncode == 0 and done.stdout.rstrip().endswith(
+            "agree") and "DIFFER" not in done.stdout
     if pinocchio:
         import pinocchio as pin
 
@@ -89,28 +98,33 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--sizes", default="20,50,100")
     parser.add_argument("--pinocchio", type=int, default=20)
+    parser.add_argument("--crosscheck", type=int, default=20,
+                        help="time the crosscheck command for sizes up to this")
     parser.add_argument("--limit", type=float, default=900.0)
     parser.add_argument("--child", type=int)
     args = parser.parse_args()
     if args.child:
-        _child(args.child, args.child == args.pinocchio)
+        _child(args.child, args.child == args.pinocchio, args.child <= args.crosscheck)
         return
     print(f"load average at start: {os.getloadavg()[0]:.2f}")
     print("| n | model -> rhs (s) | peak (MB) | rhs (µs) | Pinocchio aba (µs) | simulate 2 s (s) "
-          "| energy drift | modes (s) |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| energy drift | modes (s) | crosscheck (s) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for n in (int(s) for s in args.sizes.split(",")):
         try:
             out = subprocess.run([sys.executable, __file__, "--child", str(n), "--pinocchio",
-                                  str(args.pinocchio)], capture_output=True, text=True,
+                                  str(args.pinocchio), "--crosscheck", str(args.crosscheck)],
+                                 capture_output=True, text=True,
                                  timeout=args.limit, check=True).stdout
         except subprocess.TimeoutExpired:
-            print(f"| {n} | > {args.limit:g} | | | | | | |", flush=True)
+            print(f"| {n} | > {args.limit:g} | | | | | | | |", flush=True)
             continue
         r = json.loads(out.strip().splitlines()[-1])
         aba = f"{r['aba_us']:.2f}" if "aba_us" in r else ""
+        cross = (f"{r['crosscheck_s']:.1f}" + ("" if r["crosscheck_agree"] else " (FAILED)")
+                 if "crosscheck_s" in r else "")
         print(f"| {n} | {r['seconds']:.1f} | {r['peak_mb']:.0f} | {r['rhs_us']:.2f} | {aba} "
-              f"| {r['simulate_s']:.2f} | {r['energy_drift']:.1e} | {r['modes_s']:.2f} |",
+              f"| {r['simulate_s']:.2f} | {r['energy_drift']:.1e} | {r['modes_s']:.2f} | {cross} |",
               flush=True)
     print(f"load average at end: {os.getloadavg()[0]:.2f}")
 

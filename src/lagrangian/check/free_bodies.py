@@ -152,6 +152,13 @@ class _AppliedForces:
             dr = [r.diff(qi) for r in point]
             self.work[i].append(sp.Add(*(f * d for f, d in zip(force, dr, strict=True))))
 
+    def turn(self, moment, holder: _FreeBody) -> None:
+        """The virtual work M . d omega/d q_dot_i of a moment (world axes) on a body in space."""
+        omega = list(holder.rotation * sp.Matrix(holder.omega))  # world axes
+        for i, c in enumerate(self.model.coordinates):
+            self.work[i].append(sp.Add(*(m * w.diff(c.velocity)
+                                         for m, w in zip(moment, omega, strict=True))))
+
     def place(self, force, point, holder: _FreeBody) -> None:
         """Add ``force`` acting at ``point`` to ``holder``: force, and moment about G for a body."""
         holder.force = [a + b for a, b in zip(holder.force, force, strict=True)]
@@ -218,10 +225,7 @@ class _AppliedForces:
         holder = next(fb for fb in self.bodies if fb.name == load.body)
         world = list(holder.rotation * sp.Matrix(load.moment)) \
             if load.axes == "body" else list(load.moment)
-        omega = list(holder.rotation * sp.Matrix(holder.omega))  # world axes
-        for i, c in enumerate(self.model.coordinates):
-            self.work[i].append(sp.Add(*(m * w.diff(c.velocity)
-                                         for m, w in zip(world, omega, strict=True))))
+        self.turn(world, holder)
         holder.moment3 = [a + b for a, b in zip(holder.moment3, world, strict=True)]
 
     @add_load.register

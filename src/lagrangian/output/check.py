@@ -127,6 +127,8 @@ READABLE_REACTION = 240
 def _reaction_line(label: str, value, number: float | None) -> str:
     text = fmt(value)
     unit = "N m" if label.startswith("M") else "N"
+    if number is not None and getattr(value, "is_Float", False):  # formed with numbers
+        return f"      {label} = {number:.6g} {unit} at the initial state"
     if len(text) <= READABLE_REACTION or number is None:
         return f"      {label} = {text}"
     return (f"      {label} = {number:.6g} {unit} at the initial state (its expression, "

@@ -57,6 +57,16 @@ def test_computed_torque_section(capsys, cli):
     assert final["elbow"] == pytest.approx(0.2, abs=1e-2)
 
 
+@pytest.mark.slow
+def test_computed_torque_on_the_panda_section(capsys):
+    pin = pytest.importorskip("pinocchio")
+    from pathlib import Path
+    if not any((p / "share/example-robot-data/robots").is_dir()
+               for p in Path(pin.__file__).parents):
+        pytest.skip("example-robot-data is not installed")
+    assert _run("control-computed-torque-panda", capsys)[-1] == "True"
+
+
 def test_derivatives_section(capsys, cli):
     lines = _run("control-derivatives", capsys)
     assert float(lines[0].strip("[] ")) == pytest.approx(9.81 * 0.5 * np.cos(0.4), rel=1e-9)

@@ -51,6 +51,7 @@ def test_simulate_example_falls_at_g(capsys):
     assert lines[0] == "(11, 9) (11, 8)"
     assert float(lines[1]) == pytest.approx(-0.5 * 9.81 * 0.25, abs=1e-6)
     assert float(lines[2]) == 0.0
+    assert lines[3] == "(11, 9)"  # a controller's joint torques on the floating base
 
 
 def test_simulate_command_runs(cli):

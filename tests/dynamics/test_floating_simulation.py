@@ -122,3 +122,58 @@ def test_a_quaternion_off_norm_one_is_refused(robot):
     assert error.value.field == "initial"
     with pytest.raises(InputError, match="base_qq"):
         robot.simulate(0.1, initial={"base_qq": 0.5})
+
+
+def test_joint_torques_of_a_controller_are_internal_and_do_their_work(robot):
+    """A PD law on the joints, gravity off: joint torques are internal forces, so the linear
+    momentum and the angular momentum about the CoM stay constant while the joints settle,
+    and T(t) - T(0) is the controller's work (summed from the samples: dense ones)."""
+    weightless = robot.with_parameters(g=0.0)
+    target = np.array([0.5, 0.2])
+
+    def pd(t, q, v):
+        return 0.5 * (target - q[7:]) - 0.05 * v[6:]
+
+    run = weightless.simulate(3.0, initial=START, controller=pd, rtol=1e-11, atol=1e-11,
+                              samples=6001)
+    assert run.status == "finished"
+    dynamics = weightless.dynamics()
+    momentum = _momentum(dynamics, run.q, run.q_dot)
+    assert np.abs(momentum - momentum[0]).max() < 1e-8 * np.abs(momentum[0]).max()
+    kinetic = dynamics.kinetic_energy(run.q, run.q_dot)
+    assert np.abs(kinetic - kinetic[0] - run.work).max() < 1e-5 * kinetic[0]
+    # the damping takes the joints' rates (2 rad/s at the start) down
+    assert np.abs(run.q_dot[-1, 6:]).max() < 0.1 * np.abs(run.q_dot[0, 6:]).max()
+
+
+def test_a_wrench_on_the_base_accelerates_the_centre_of_mass_by_f_over_m(robot):
+    """All nv entries: a world-fixed force F at the base origin (given in base axes each
+    call), gravity off: m c'' = F whatever the tumbling."""
+    from lagrangian.dynamics.free_flyer import quaternion_matrix
+
+    weightless = robot.with_parameters(g=0.0)
+    force = np.array([1.2, -0.6, 2.1])
+
+    def thruster(t, q, v):
+        R = quaternion_matrix(q[None, 3:7])[0]
+        return np.concatenate([R.T @ force, np.zeros(3), np.zeros(2)])
+
+    run = weightless.simulate(0.8, initial=START, controller=thruster, rtol=1e-11, atol=1e-11,
+                              samples=41)
+    dynamics = weightless.dynamics()
+    com = dynamics.center_of_mass(run.q)
+    h0 = _momentum(dynamics, run.q[:1], run.q_dot[:1])[0]
+    t = run.t - run.t[0]
+    expected = com[0] + np.outer(t, h0[:3] / 4.2) + 0.5 * np.outer(t * t, force / 4.2)
+    assert np.abs(com - expected).max() < 1e-8
+
+
+def test_a_controller_of_the_wrong_shape_is_one_line(robot):
+    with pytest.raises(InputError, match=r"shape \(3,\); expected \(2,\) joint torques or \(8,\)"
+                       ) as caught:
+        robot.simulate(0.1, initial=START, controller=lambda t, q, v: np.zeros(3))
+    assert caught.value.field == "controller" and "\n" not in str(caught.value)
+    with pytest.raises(InputError, match="callable"):
+        robot.simulate(0.1, initial=START, controller=2.0)
+    with pytest.raises(InputError, match="not finite"):
+        robot.simulate(0.1, initial=START, controller=lambda t, q, v: np.full(2, np.nan))

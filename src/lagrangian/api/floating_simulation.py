@@ -78,10 +78,37 @@ def floating_start(dynamics, model, initial: Mapping[str, float] | None
     return start.t, q0, v0
 
 
+class FloatingControl:
+    """A controller's generalized forces on a floating base: (t, q, v) -> u with u the n joint
+    torques (N m or N; the base unactuated, as a legged robot's), or all nv = n + 6 entries
+    with the base's wrench first (force, then moment, base axes: a thruster, a drone)."""
+
+    def __init__(self, controller, nv: int):
+        if not callable(controller):
+            raise InputError("the controller must be a callable (t, q, v) -> u",
+                             field="controller")
+        self.controller, self.nv = controller, nv
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        u = np.asarray(self.controller(t, q, v), dtype=float)
+        joints = self.nv - 6
+        if u.shape == (joints,):
+            u = np.concatenate([np.zeros(6), u])
+        elif u.shape != (self.nv,):
+            raise InputError(f"the controller returned shape {u.shape}; expected ({joints},) "
+                             f"joint torques or ({self.nv},) with the base's wrench first",
+                             field="controller")
+        if not np.all(np.isfinite(u)):
+            raise InputError(f"the controller returned a value that is not finite at "
+                             f"t = {t:.9g} s", field="controller")
+        return u
+
+
 def simulate_floating(system, t_end: float, initial, step_control: StepControl,
-                      save_at: SaveAt) -> SimulationResult:
+                      save_at: SaveAt, controller=None) -> SimulationResult:
     """Integrate a floating-base robot to ``t_end`` (s) with the model's own loads (its
-    tau_<joint> parameters) and gravity; the quaternion kept of norm 1 after every step."""
+    tau_<joint> parameters), gravity and a ``controller``'s forces (FloatingControl); the
+    quaternion kept of norm 1 after every step."""
     from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
     dynamics = system.dynamics()
@@ -92,14 +119,16 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
                          field="t_end")
     nq, nv = dynamics.nq, dynamics.nv
     zero = np.zeros(nv)
+    control = None if controller is None else FloatingControl(controller, nv)
     evaluations = [0]
 
-    def rhs(_t, y):
+    def rhs(t, y):
         evaluations[0] += 1
         q, v = y[:nq].copy(), y[nq:]
         # a step's stages leave the unit sphere by the step's error: the dynamics read R(q/|q|)
         q[3:7] /= np.linalg.norm(q[3:7])
-        return np.concatenate([configuration_rate(q, v), dynamics.forward_dynamics(q, v, zero)])
+        tau = zero if control is None else control(t, q, v)
+        return np.concatenate([configuration_rate(q, v), dynamics.forward_dynamics(q, v, tau)])
 
     solvers = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF,
                "LSODA": LSODA}
@@ -143,7 +172,10 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     energy = kinetic + dynamics.potential_energy(q)
     own = _joint_forces(model, system.parameters)  # the model's tau_<joint>: on the joints
     power = v[:, 6:] @ own
-    working = bool(np.any(own != 0))
+    if control is not None:  # the controller's power at the samples: the work balance
+        power = power + np.einsum("ij,ij->i", v, np.array([control(ti, qi, vi) for ti, qi, vi
+                                                             in zip(t, q, v, strict=True)]))
+    working = bool(np.any(own != 0)) or control is not None
     kind = InvariantKind.WORK_BALANCE if working else InvariantKind.ENERGY
     return SimulationResult(
         model=model, coordinates=tuple(dynamics.coordinates), constraint_names=(),

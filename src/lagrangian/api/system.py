@@ -206,7 +206,9 @@ class System(CheckMethods, ControlMethods):
         (``limits=False`` ignores them); velocity and effort limits exceeded are reported
         either way (``summary()["limits_exceeded"]``). ``controller`` (t, q, q_dot) -> u adds
         generalized forces, or B u for named ``inputs`` (its own ``inputs`` where it has them,
-        as lagrangian.control's controllers do), to the model's own: docs/control.md.
+        as lagrangian.control's controllers do), to the model's own: docs/control.md. On a
+        floating base u is the n joint torques or all n + 6 entries, the base's wrench first
+        (docs/floating-base.md).
         """
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
         if tree and self._floating:  # q (+) v dt on SE(3): api/floating_simulation.py
@@ -237,12 +239,12 @@ class System(CheckMethods, ControlMethods):
                            method, rtol, atol, samples) -> Simulation:
         from .floating_simulation import simulate_floating
 
-        for name, value in (("stop_when", stop_when), ("controller", controller)):
-            if value is not None:
-                raise InputError(f"{name} is not yet taken for a floating base", field=name)
+        if stop_when is not None:
+            raise InputError("stop_when is not yet taken for a floating base", field="stop_when")
         step_control, save_at = run_options(step_control, save_at, method, rtol, atol, samples,
                                             1001)
-        return Simulation.of(simulate_floating(self, t_end, initial, step_control, save_at))
+        return Simulation.of(simulate_floating(self, t_end, initial, step_control, save_at,
+                                               controller))
 
     # -- standalone C for a controller -----------------------------------------------------------
 

@@ -271,3 +271,44 @@ def test_commands_on_a_floating_base(cli):
         bad = cli(args[0], str(path), "--floating-base", *args[1:])
         assert bad.code == 2 and bad.err.startswith(start), bad.err
         assert len(bad.err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("backend", ["numpy", "auto"])  # auto: reach_kernel.c where it compiles
+def test_the_hopper_in_both_backends(tmp_path, backend):
+    """The compiled kernel (free flyer as body 0) and numpy give Pinocchio's C(q, v), J_dot v of
+    every frame and A_g for a URDF floating joint with an origin of its own, over a batch; a
+    bad quaternion is refused in one line on either path."""
+    import pinocchio as pin
+
+    path = tmp_path / "hopper.urdf"
+    path.write_text(FLOATING_URDF)
+    model = pin.buildModelFromXML(FLOATING_URDF)
+    data = model.createData()
+    ours = lagrangian.load(path).dynamics(backend=backend)
+    iq, iv = _layout(model, ours)
+    q, v = _states(model, 5)
+    C = ours.coriolis_matrix(q[:, iq], v[:, iv])
+    A = ours.centroidal_momentum_matrix(q[:, iq])
+    drift = {(name, ref): ours.jacobian_dot_times_v(q[:, iq], v[:, iv], name, ref)
+             for name in ours.frames for ref in REFERENCES}
+    for k in range(5):
+        _close(C[k], pin.computeCoriolisMatrix(model, data, q[k], v[k])[np.ix_(iv, iv)])
+        _close(A[k], pin.ccrba(model, data, q[k], v[k])[:, iv])
+        pin.forwardKinematics(model, data, q[k], v[k], np.zeros(model.nv))
+        pin.updateFramePlacements(model, data)
+        for (name, ref), ours_k in drift.items():
+            reference = getattr(pin.ReferenceFrame, ref.upper())
+            _close(ours_k[k], pin.getFrameClassicalAcceleration(
+                model, data, _pinocchio_frame(model, name), reference).vector)
+    if getattr(ours, "backend", None) == "recursive":  # compiled: so is the reach kernel
+        from lagrangian.dynamics.reach_c import ReachKernel
+
+        assert isinstance(ours._reach, ReachKernel) and ours._reach.coriolis is not None
+    bad = np.r_[q[0, iq][:6], 2.0 * q[0, iq][6], q[0, iq][7:]]
+    bad[3:7] *= 2.0 / np.linalg.norm(bad[3:7])
+    for call in (lambda: ours.coriolis_matrix(bad, v[0, iv]),
+                 lambda: ours.centroidal_momentum_matrix(bad),
+                 lambda: ours.jacobian_dot_times_v(bad, v[0, iv], "foot"),
+                 lambda: ours.inverse_dynamics(bad, v[0, iv], v[0, iv], f_ext={"foot": [0] * 6})):
+        with pytest.raises(lagrangian.InputError, match="norm 2"):
+            call()

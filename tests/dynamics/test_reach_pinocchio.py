@@ -277,7 +277,7 @@ def test_a_joint_of_more_than_one_coordinate_is_refused_not_miscounted(system):
 
 def test_the_compact_kernel_link_inertials_and_a_floating_base(system, tmp_path):
     """The same numbers on the compact kernel; a link's inertial given as a parameter is the
-    edited URDF's; a floating base's functions are the numpy walks', its actuators the joints'."""
+    edited URDF's; a floating base's functions take nv numbers, its actuators are the joints'."""
     q, v, a, _ = _states()
     unrolled, compact = system.dynamics(), system.dynamics(kernel="compact")
     np.testing.assert_allclose(compact.centroidal_momentum_matrix(q),
@@ -298,8 +298,8 @@ def test_the_compact_kernel_link_inertials_and_a_floating_base(system, tmp_path)
     floating = lagrangian.load(path, floating_base=True).dynamics(actuators=True)
     nq, nv = len(floating.coordinates), floating.n
     q0 = np.r_[np.zeros(6), 1.0, np.zeros(nq - 7)]
-    # a floating base takes the numpy walks (the compiled kernel is a fixed base's); they are
-    # checked against Pinocchio in test_floating_reach.py: here, the widths and the actuators
+    # a floating base's functions are checked against Pinocchio in test_floating_reach.py:
+    # here, the widths and the actuators
     assert floating.centroidal_momentum_matrix(q0).shape == (6, nv)
     assert floating.jacobian_dot_times_v(q0, np.zeros(nv), "tool").shape == (6,)
     assert floating.inverse_dynamics(q0, np.zeros(nv), np.zeros(nv),

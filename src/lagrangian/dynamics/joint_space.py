@@ -298,6 +298,12 @@ class Dynamics(ControlTerms):
         A floating base's twist is not the rate of its coordinates: there C is the tree's
         spatial factorization (coriolis_tree.py), M_dot - 2C skew along q (+) v dt, (..., nv, nv)."""
         if self.velocity_names is not None:  # quasi-velocities: Pinocchio's factorization
+            fast = self._reach if self._reach is not None else self._reach_kernel()
+            if fast and fast.coriolis is not None:  # compiled (reach_kernel.c)
+                try:
+                    return fast.coriolis(q, v)
+                except (ValueError, TypeError):
+                    pass  # numpy below broadcasts, or names the fault in one line
             from .coriolis_tree import coriolis_matrix
 
             return self._guarded(lambda Q, V: coriolis_matrix(self.kinematics, Q, V), (q, v),

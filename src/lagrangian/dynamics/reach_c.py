@@ -1,7 +1,7 @@
-"""J_dot q_dot, the centroidal momentum matrix and wrenches' generalized forces in compiled C
-(reach_kernel.c over the tree's numbers written as static tables), for the C backend's speed
-per call; centroidal.py and wrenches.py are the same formulas in numpy, used without a compiler
-and to name every bad input."""
+"""J_dot q_dot, the centroidal momentum matrix, wrenches' generalized forces and a floating
+base's C(q, v) in compiled C (reach_kernel.c over the tree's numbers written as static tables),
+for the C backend's speed per call; centroidal.py, wrenches.py and coriolis_tree.py are the same
+formulas in numpy, used without a compiler and to name every bad input."""
 
 from __future__ import annotations
 
@@ -58,11 +58,13 @@ def kernel_source(tree: KinematicTree):
         "#include <math.h>",
         f"#define RK_NB {len(joints)}",
         f"#define RK_N {len(tree.coordinates)}",
+        f"#define RK_FB {int(tree.floating_base)}",
         f"#define RK_NF {len(frames)}",
         _table("rk_parent", "int", [j.parent for j in joints]),
         _table("rk_coord", "int", [j.coordinate for j in joints]),
-        _table("rk_turns", "int", [m.turns for m in models]),
-        _table("rk_slides", "int", [m.slides for m in models]),
+        # a free flyer neither turns nor slides about an axis (body 0, read by RK_FREE)
+        _table("rk_turns", "int", [getattr(m, "turns", False) for m in models]),
+        _table("rk_slides", "int", [getattr(m, "slides", False) for m in models]),
         _table("rk_mult", "double", [j.multiplier for j in joints]),
         _table("rk_off", "double", [j.offset for j in joints]),
         _table("rk_R0", "double", flat),
@@ -87,8 +89,9 @@ def reach_module(tree: KinematicTree):
     from ..compile import compiled
     from .centroidal import ONE_DOF
 
-    if any(j.kind not in ONE_DOF for j in tree.joints):
-        return None  # a floating base: numpy's walks refuse it in one line
+    free = tree.floating_base  # a free flyer: body 0 only (RK_FREE)
+    if any(j.kind not in ONE_DOF for j in tree.joints[int(free):]):
+        return None  # a joint the kernel does not know: numpy's walks refuse it in one line
     here = Path(__file__)
     generator = hashlib.sha256(_KERNEL.read_bytes() + here.read_bytes()
                                + here.with_name("tree_c.py").read_bytes()).hexdigest()
@@ -108,11 +111,23 @@ class ReachKernel:
         self.drift = module.drift
         # A_g needs a centre of mass: moving mass (else numpy refuses it in one line)
         self.centroidal = module.centroidal if massive else None
+        self.coriolis = None  # a fixed base's C is M's Christoffel symbols (joint_space.py)
+        if tree.floating_base:  # the base's quaternion checked first, in one line
+            from .recursive import _checking_quaternion
+
+            self.drift = _checking_quaternion(module.drift)
+            self.centroidal = _checking_quaternion(module.centroidal) if massive else None
+            self.coriolis = _checking_quaternion(module.coriolis)
+        self._floating = tree.floating_base
 
     def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> None:
         """out += sign sum J^T w over the frames, in place (out of q's shape); ValueError or
         KeyError where the inputs are not plain (the numpy path then names the fault)."""
         wrench = self.module.wrench
+        if self._floating:
+            from .recursive import _checking_quaternion
+
+            wrench = _checking_quaternion(wrench)
         for name, w in wrenches.items():
             wrench(q, self.frame_index[name], w, out, sign)
 

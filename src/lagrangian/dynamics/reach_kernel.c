@@ -1,7 +1,15 @@
-/* J_dot q_dot of a frame, the centroidal momentum matrix and a wrench's generalized forces,
- * over the tree tables that reach_c.py writes above this text (rk_* arrays, RK_NB bodies,
- * RK_N coordinates, RK_NF frames). The same formulas as centroidal.py and wrenches.py:
- * spatial velocities at the world's origin in world axes, [v; w]. */
+/* J_dot q_dot of a frame, the centroidal momentum matrix, a wrench's generalized forces and
+ * C(q, v), over the tree tables that reach_c.py writes above this text (rk_* arrays, RK_NB
+ * bodies, RK_N joint coordinates, RK_NF frames; RK_FB 1 for a floating base: body 0 on a free
+ * flyer, q of RK_NQ = 7 + RK_N numbers and v of RK_NV = 6 + RK_N). The same formulas as
+ * centroidal.py, wrenches.py and coriolis_tree.py: spatial velocities at the world's origin in
+ * world axes, [v; w]. */
+
+#define RK_BQ (RK_FB ? 7 : 0)
+#define RK_BV (RK_FB ? 6 : 0)
+#define RK_NQ (RK_BQ + RK_N)
+#define RK_NV (RK_BV + RK_N)
+#define RK_FREE(i) (RK_FB && (i) == 0)
 
 #define RK_STR_(x) #x
 #define RK_STR(x) RK_STR_(x)
@@ -40,10 +48,21 @@ static inline void rk_matmul(const double *A, const double *B, double *out)
 static void rk_bodies(const double *q, double (*R)[9], double (*o)[3])
 {
     for (int i = 0; i < RK_NB; i++) {
-        double th = rk_mult[i] * q[rk_coord[i]] + rk_off[i];
+        double th = RK_FREE(i) ? 0.0 : rk_mult[i] * q[RK_BQ + rk_coord[i]] + rk_off[i];
         double Rl[9], pl[3] = {rk_t0[i][0], rk_t0[i][1], rk_t0[i][2]};
         const double *u = rk_u[i];
-        if (rk_turns[i]) {
+        if (RK_FREE(i)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
+            double x = q[3], y = q[4], z = q[5], w = q[6], Rq[9], d[3];
+            double k = 1.0 / (x * x + y * y + z * z + w * w);
+            Rq[0] = 1 - 2 * k * (y * y + z * z); Rq[1] = 2 * k * (x * y - z * w);
+            Rq[2] = 2 * k * (x * z + y * w); Rq[3] = 2 * k * (x * y + z * w);
+            Rq[4] = 1 - 2 * k * (x * x + z * z); Rq[5] = 2 * k * (y * z - x * w);
+            Rq[6] = 2 * k * (x * z - y * w); Rq[7] = 2 * k * (y * z + x * w);
+            Rq[8] = 1 - 2 * k * (x * x + y * y);
+            rk_matmul(rk_R0[i], Rq, Rl);
+            rk_apply(rk_R0[i], q, d);
+            for (int j = 0; j < 3; j++) pl[j] += d[j];
+        } else if (rk_turns[i]) {
             /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
             double c, s;
             lg_sincos(th, &s, &c);  /* inline (tree_c.py): a libm call costs a body's work */
@@ -85,6 +104,20 @@ static inline void rk_subspace(int i, double (*R)[9], double (*o)[3], double *S)
     for (int j = 0; j < 3; j++) { S[j] = v[j]; S[3 + j] = w[j]; }
 }
 
+/* a free flyer's six columns at the world's origin, world axes (S = 1 in the base's axes):
+ * S[c] = [R e_c; 0], S[3 + c] = [o x R e_c; R e_c] */
+static inline void rk_free_columns(const double *R, const double *o, double (*S)[6])
+{
+    for (int c = 0; c < 3; c++) {
+        double w[3] = {R[c], R[3 + c], R[6 + c]}, v[3];
+        rk_cross(o, w, v);
+        for (int j = 0; j < 3; j++) {
+            S[c][j] = w[j]; S[c][3 + j] = 0.0;
+            S[3 + c][j] = v[j]; S[3 + c][3 + j] = w[j];
+        }
+    }
+}
+
 /* the frame's rotation (frame -> world) and origin */
 static inline void rk_frame(int f, double (*R)[9], double (*o)[3], double *Rf, double *p)
 {
@@ -109,7 +142,17 @@ static void rk_drift(const double *q, const double *qd, int f, int ref, double *
     if (b < 0) return;
     rk_bodies(q, R, o);
     for (int i = 0; i <= b; i++) {
-        double S[6], c[6], rate = rk_mult[i] * qd[rk_coord[i]];
+        if (RK_FREE(i)) {  /* V = S v_base; no drift of its own (V x V = 0) */
+            double F[6][6];
+            rk_free_columns(R[0], o[0], F);
+            for (int j = 0; j < 6; j++) {
+                V[0][j] = 0.0;
+                A[0][j] = 0.0;
+                for (int c = 0; c < 6; c++) V[0][j] += F[c][j] * qd[c];
+            }
+            continue;
+        }
+        double S[6], c[6], rate = rk_mult[i] * qd[RK_BV + rk_coord[i]];
         int p = rk_parent[i];
         rk_subspace(i, R, o, S);
         for (int j = 0; j < 6; j++) {
@@ -152,7 +195,7 @@ static void rk_centroidal(const double *q, double *out)
 {
     double R[RK_NB][9], o[RK_NB][3], M[RK_NB], h[RK_NB][3], Ic[RK_NB][9];
     rk_bodies(q, R, o);
-    for (int j = 0; j < 6 * RK_N; j++) out[j] = 0.0;
+    for (int j = 0; j < 6 * RK_NV; j++) out[j] = 0.0;
     for (int i = 0; i < RK_NB; i++) {
         double hr[3], T[9], RJ[9];
         const double *p = o[i];
@@ -188,30 +231,41 @@ static void rk_centroidal(const double *q, double *out)
     }
     for (int j = 0; j < 3; j++) G[j] /= total;
     for (int i = 0; i < RK_NB; i++) {
-        double S[6], l[3], k[3], t[3];
-        rk_subspace(i, R, o, S);
-        rk_cross(S + 3, h[i], l);
-        rk_cross(h[i], S, k);
-        rk_apply(Ic[i], S + 3, t);
-        for (int j = 0; j < 3; j++) { l[j] += M[i] * S[j]; k[j] += t[j]; }
-        int c = rk_coord[i];
-        for (int j = 0; j < 3; j++) {
-            out[j * RK_N + c] += rk_mult[i] * l[j];
-            out[(3 + j) * RK_N + c] += rk_mult[i] * k[j];
+        double F[6][6], l[3], k[3], t[3];
+        int columns = 1, first = RK_BV + rk_coord[i];
+        double mult = rk_mult[i];
+        if (RK_FREE(i)) {
+            rk_free_columns(R[0], o[0], F);
+            columns = 6, first = 0, mult = 1.0;
+        } else {
+            rk_subspace(i, R, o, F[0]);
+        }
+        for (int col = 0; col < columns; col++) {
+            const double *S = F[col];
+            rk_cross(S + 3, h[i], l);
+            rk_cross(h[i], S, k);
+            rk_apply(Ic[i], S + 3, t);
+            for (int j = 0; j < 3; j++) { l[j] += M[i] * S[j]; k[j] += t[j]; }
+            int c = first + col;
+            for (int j = 0; j < 3; j++) {
+                out[j * RK_NV + c] += mult * l[j];
+                out[(3 + j) * RK_NV + c] += mult * k[j];
+            }
         }
     }
-    for (int c = 0; c < RK_N; c++) {  /* k_G = k_O - G x l */
-        double l[3] = {out[c], out[RK_N + c], out[2 * RK_N + c]}, t[3];
+    for (int c = 0; c < RK_NV; c++) {  /* k_G = k_O - G x l */
+        double l[3] = {out[c], out[RK_NV + c], out[2 * RK_NV + c]}, t[3];
         rk_cross(G, l, t);
-        for (int j = 0; j < 3; j++) out[(3 + j) * RK_N + c] -= t[j];
+        for (int j = 0; j < 3; j++) out[(3 + j) * RK_NV + c] -= t[j];
     }
 }
 
-/* tau (RK_N) of the wrench w = [f; m] at frame f's origin, world axes: sum k S^T [f; m + p x f] */
+/* tau (RK_NV) of the wrench w = [f; m] at frame f's origin, world axes: sum k S^T [f; m + p x f]
+ * (a free flyer's six: the force and the moment about the base's origin, base axes) */
 static void rk_wrench(const double *q, int f, const double *w, double *out)
 {
     double R[RK_NB][9], o[RK_NB][3], Rf[9], p[3], m[3];
-    for (int j = 0; j < RK_N; j++) out[j] = 0.0;
+    for (int j = 0; j < RK_NV; j++) out[j] = 0.0;
     int b = rk_fbody[f];
     if (b < 0) return;
     rk_bodies(q, R, o);
@@ -220,9 +274,147 @@ static void rk_wrench(const double *q, int f, const double *w, double *out)
     for (int j = 0; j < 3; j++) m[j] += w[3 + j];
     for (int i = b; i >= 0; i = rk_parent[i]) {
         double S[6];
+        if (RK_FREE(i)) {  /* R^T f and R^T (m_O - o x f) */
+            double t[3], n[3];
+            rk_cross(o[0], w, t);
+            for (int j = 0; j < 3; j++) n[j] = m[j] - t[j];
+            rk_apply_t(R[0], w, out);
+            rk_apply_t(R[0], n, out + 3);
+            continue;
+        }
         rk_subspace(i, R, o, S);
-        out[rk_coord[i]] += rk_mult[i] * (S[0] * w[0] + S[1] * w[1] + S[2] * w[2]
-                                          + S[3] * m[0] + S[4] * m[1] + S[5] * m[2]);
+        out[RK_BV + rk_coord[i]] += rk_mult[i] * (S[0] * w[0] + S[1] * w[1] + S[2] * w[2]
+                                                  + S[3] * m[0] + S[4] * m[1] + S[5] * m[2]);
+    }
+}
+
+/* -- C(q, v) by Pinocchio's spatial factorization (coriolis_tree.py) ----------------------- */
+
+/* out = A B for 6 x 6 row-major matrices */
+static inline void rk_mul6(const double *A, const double *B, double *out)
+{
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++) {
+            double t = 0.0;
+            for (int k = 0; k < 6; k++) t += A[6 * i + k] * B[6 * k + j];
+            out[6 * i + j] = t;
+        }
+}
+
+/* V x s for motions [v; w]: [w x s_v + v x s_w; w x s_w] */
+static inline void rk_motion_cross(const double *V, const double *s, double *out)
+{
+    double a[3], b[3], c[3];
+    rk_cross(V + 3, s, a);
+    rk_cross(V, s + 3, b);
+    rk_cross(V + 3, s + 3, c);
+    for (int j = 0; j < 3; j++) { out[j] = a[j] + b[j]; out[3 + j] = c[j]; }
+}
+
+/* a body's workspace: its world columns S and their rates V x S (column-major, up to six),
+ * its spatial inertia In and Bm (6 x 6 row-major; summed over the subtree going up), V */
+typedef struct { double S[6][6], dS[6][6], In[36], Bm[36], V[6]; int columns, first; } rk_cbody;
+
+static void rk_coriolis(const double *q, const double *qd, double *C, rk_cbody *body)
+{
+    double R[RK_NB][9], o[RK_NB][3];
+    rk_bodies(q, R, o);
+    for (int j = 0; j < RK_NV * RK_NV; j++) C[j] = 0.0;
+    for (int i = 0; i < RK_NB; i++) {
+        rk_cbody *bi = body + i;
+        int p = rk_parent[i];
+        if (RK_FREE(i)) {
+            rk_free_columns(R[0], o[0], bi->S);
+            bi->columns = 6, bi->first = 0;
+        } else {
+            rk_subspace(i, R, o, bi->S[0]);
+            for (int j = 0; j < 6; j++) bi->S[0][j] *= rk_mult[i];
+            bi->columns = 1, bi->first = RK_BV + rk_coord[i];
+        }
+        for (int j = 0; j < 6; j++) bi->V[j] = p < 0 ? 0.0 : body[p].V[j];
+        for (int c = 0; c < bi->columns; c++)
+            for (int j = 0; j < 6; j++) bi->V[j] += bi->S[c][j] * qd[bi->first + c];
+        for (int c = 0; c < bi->columns; c++) rk_motion_cross(bi->V, bi->S[c], bi->dS[c]);
+        /* In: the inertia at the world's origin: [[m 1, -[h]x], [[h]x, J_O]] (as rk_centroidal's) */
+        double hr[3], RJ[9], h[3], m = rk_m[i], *In = bi->In;
+        const double *x = o[i];
+        rk_apply(R[i], rk_h[i], hr);
+        rk_matmul(R[i], rk_J[i], RJ);
+        double pp = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+        double ph = x[0] * hr[0] + x[1] * hr[1] + x[2] * hr[2];
+        for (int j = 0; j < 3; j++) h[j] = hr[j] + m * x[j];
+        for (int a = 0; a < 3; a++)
+            for (int c = 0; c < 3; c++)
+                In[6 * (3 + a) + 3 + c] = RJ[3 * a] * R[i][3 * c] + RJ[3 * a + 1] * R[i][3 * c + 1]
+                                         + RJ[3 * a + 2] * R[i][3 * c + 2] - m * x[a] * x[c]
+                                         - x[a] * hr[c] - hr[a] * x[c]
+                                         + (a == c ? m * pp + 2.0 * ph : 0.0);
+        double H[9] = {0.0, -h[2], h[1], h[2], 0.0, -h[0], -h[1], h[0], 0.0};
+        for (int a = 0; a < 3; a++)
+            for (int c = 0; c < 3; c++) {
+                In[6 * a + c] = a == c ? m : 0.0;
+                In[6 * a + 3 + c] = -H[3 * a + c];
+                In[6 * (3 + a) + c] = H[3 * a + c];
+            }
+        /* Bm = 1/2 (V x* I - I V x) + 1/2 (I V) x-bar; V x* = -(V x)^T */
+        double X[36] = {0.0}, Xs[36], XI[36], IX[36], f[6];
+        const double *v = bi->V, *w = bi->V + 3;
+        double W[9] = {0.0, -w[2], w[1], w[2], 0.0, -w[0], -w[1], w[0], 0.0};
+        double Vv[9] = {0.0, -v[2], v[1], v[2], 0.0, -v[0], -v[1], v[0], 0.0};
+        for (int a = 0; a < 3; a++)
+            for (int c = 0; c < 3; c++) {
+                X[6 * a + c] = X[6 * (3 + a) + 3 + c] = W[3 * a + c];
+                X[6 * a + 3 + c] = Vv[3 * a + c];
+            }
+        for (int a = 0; a < 6; a++)
+            for (int c = 0; c < 6; c++) Xs[6 * a + c] = -X[6 * c + a];
+        rk_mul6(Xs, In, XI);
+        rk_mul6(In, X, IX);
+        for (int a = 0; a < 6; a++) {
+            f[a] = 0.0;
+            for (int c = 0; c < 6; c++) f[a] += In[6 * a + c] * v[c];
+        }
+        for (int j = 0; j < 36; j++) bi->Bm[j] = 0.5 * (XI[j] - IX[j]);
+        /* (f x-bar) = [[0, -[f]x], [-[f]x, -[n]x]] */
+        double Fx[9] = {0.0, -f[2], f[1], f[2], 0.0, -f[0], -f[1], f[0], 0.0};
+        double Nx[9] = {0.0, -f[5], f[4], f[5], 0.0, -f[3], -f[4], f[3], 0.0};
+        for (int a = 0; a < 3; a++)
+            for (int c = 0; c < 3; c++) {
+                bi->Bm[6 * a + 3 + c] -= 0.5 * Fx[3 * a + c];
+                bi->Bm[6 * (3 + a) + c] -= 0.5 * Fx[3 * a + c];
+                bi->Bm[6 * (3 + a) + 3 + c] -= 0.5 * Nx[3 * a + c];
+            }
+    }
+    for (int i = RK_NB - 1; i >= 0; i--) {
+        rk_cbody *bi = body + i;
+        double own[6][6], rowI[6][6], rowB[6][6];  /* I S_dot + B S; S^T I, S^T B per column */
+        for (int c = 0; c < bi->columns; c++)
+            for (int a = 0; a < 6; a++) {
+                double t = 0.0, u = 0.0, z = 0.0;
+                for (int k = 0; k < 6; k++) {
+                    t += bi->In[6 * a + k] * bi->dS[c][k] + bi->Bm[6 * a + k] * bi->S[c][k];
+                    u += bi->S[c][k] * bi->In[6 * k + a];
+                    z += bi->S[c][k] * bi->Bm[6 * k + a];
+                }
+                own[c][a] = t, rowI[c][a] = u, rowB[c][a] = z;
+            }
+        for (int a = i; a >= 0; a = rk_parent[a]) {
+            const rk_cbody *ba = body + a;
+            for (int ca = 0; ca < ba->columns; ca++)
+                for (int ci = 0; ci < bi->columns; ci++) {
+                    double t = 0.0;  /* C[a, i] = S_a^T (I^c_i S_dot_i + B^c_i S_i) */
+                    for (int k = 0; k < 6; k++) t += ba->S[ca][k] * own[ci][k];
+                    C[(ba->first + ca) * RK_NV + bi->first + ci] += t;
+                    if (a == i) continue;
+                    t = 0.0;  /* C[i, a] = S_i^T (I^c_i S_dot_a + B^c_i S_a) */
+                    for (int k = 0; k < 6; k++)
+                        t += rowI[ci][k] * ba->dS[ca][k] + rowB[ci][k] * ba->S[ca][k];
+                    C[(bi->first + ci) * RK_NV + ba->first + ca] += t;
+                }
+        }
+        int p = rk_parent[i];
+        if (p >= 0)
+            for (int j = 0; j < 36; j++) { body[p].In[j] += bi->In[j]; body[p].Bm[j] += bi->Bm[j]; }
     }
 }
 
@@ -278,16 +470,17 @@ static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t n
     int f = (int)PyLong_AsLong(args[2]), ref = (int)PyLong_AsLong(args[3]);
     if (PyErr_Occurred()) return NULL;
     if (f < 0 || f >= RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
-    PyArrayObject *Q = rk_input(args[0], RK_N, "q");
+    PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
     if (!Q) return NULL;
-    PyArrayObject *V = rk_input(args[1], RK_N, "v");
+    PyArrayObject *V = rk_input(args[1], RK_NV, "v");
     if (!V || !rk_same_batch(Q, V, "v")) { Py_DECREF(Q); Py_XDECREF(V); return NULL; }
     PyObject *out = rk_output(Q, 6, 0);
     if (out) {
-        npy_intp count = PyArray_SIZE(Q) / RK_N;
+        npy_intp count = PyArray_SIZE(Q) / RK_NQ;
         const double *q = PyArray_DATA(Q), *v = PyArray_DATA(V);
         double *y = PyArray_DATA((PyArrayObject *)out);
-        for (npy_intp k = 0; k < count; k++) rk_drift(q + k * RK_N, v + k * RK_N, f, ref, y + 6 * k);
+        for (npy_intp k = 0; k < count; k++)
+            rk_drift(q + k * RK_NQ, v + k * RK_NV, f, ref, y + 6 * k);
     }
     Py_DECREF(Q); Py_DECREF(V);
     return out;
@@ -297,21 +490,21 @@ static PyObject *rk_py_centroidal(PyObject *self, PyObject *const *args, Py_ssiz
 {
     (void)self;
     if (nargs != 1) { PyErr_SetString(PyExc_TypeError, "centroidal(Q)"); return NULL; }
-    PyArrayObject *Q = rk_input(args[0], RK_N, "q");
+    PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
     if (!Q) return NULL;
-    PyObject *out = rk_output(Q, 6, RK_N);
+    PyObject *out = rk_output(Q, 6, RK_NV);
     if (out) {
-        npy_intp count = PyArray_SIZE(Q) / RK_N;
+        npy_intp count = PyArray_SIZE(Q) / RK_NQ;
         const double *q = PyArray_DATA(Q);
         double *y = PyArray_DATA((PyArrayObject *)out);
-        for (npy_intp k = 0; k < count; k++) rk_centroidal(q + k * RK_N, y + 6 * RK_N * k);
+        for (npy_intp k = 0; k < count; k++) rk_centroidal(q + k * RK_NQ, y + 6 * RK_NV * k);
     }
     Py_DECREF(Q);
     return out;
 }
 
 /* wrench(Q, frame, W, OUT, sign): OUT += sign J^T w, in place (OUT float64, contiguous, of
- * Q's shape); W (6,) for every state or one row per state */
+ * Q's batch and RK_NV wide); W (6,) for every state or one row per state */
 static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
@@ -322,7 +515,7 @@ static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t 
     if (f < 0 || f >= RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
     if (!PyArray_Check(args[3])) { PyErr_SetString(PyExc_ValueError, "out: not an array"); return NULL; }
     PyArrayObject *out = (PyArrayObject *)args[3];
-    PyArrayObject *Q = rk_input(args[0], RK_N, "q");
+    PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
     if (!Q) return NULL;
     PyArrayObject *W = rk_input(args[2], 6, "f_ext");
     if (!W) { Py_DECREF(Q); return NULL; }
@@ -330,26 +523,50 @@ static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t 
     if ((!shared && !rk_same_batch(Q, W, "f_ext"))
             || PyArray_TYPE(out) != NPY_DOUBLE || !PyArray_ISCARRAY(out)
             || PyArray_NDIM(out) != PyArray_NDIM(Q)
-            || !PyArray_CompareLists(PyArray_DIMS(out), PyArray_DIMS(Q), PyArray_NDIM(Q))) {
-        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "out: not of q's shape");
+            || !PyArray_CompareLists(PyArray_DIMS(out), PyArray_DIMS(Q), PyArray_NDIM(Q) - 1)
+            || PyArray_DIMS(out)[PyArray_NDIM(Q) - 1] != RK_NV) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "out: not of q's batch, nv wide");
         Py_DECREF(Q); Py_DECREF(W);
         return NULL;
     }
-    npy_intp count = PyArray_SIZE(Q) / RK_N;
+    npy_intp count = PyArray_SIZE(Q) / RK_NQ;
     const double *q = PyArray_DATA(Q), *w = PyArray_DATA(W);
-    double *y = PyArray_DATA(out), tau[RK_N];
+    double *y = PyArray_DATA(out), tau[RK_NV];
     for (npy_intp k = 0; k < count; k++) {
-        rk_wrench(q + k * RK_N, f, w + (shared ? 0 : 6 * k), tau);
-        for (int j = 0; j < RK_N; j++) y[RK_N * k + j] += sign * tau[j];
+        rk_wrench(q + k * RK_NQ, f, w + (shared ? 0 : 6 * k), tau);
+        for (int j = 0; j < RK_NV; j++) y[RK_NV * k + j] += sign * tau[j];
     }
     Py_DECREF(Q); Py_DECREF(W);
     Py_RETURN_NONE;
+}
+
+static PyObject *rk_py_coriolis(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 2) { PyErr_SetString(PyExc_TypeError, "coriolis(Q, V)"); return NULL; }
+    PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
+    if (!Q) return NULL;
+    PyArrayObject *V = rk_input(args[1], RK_NV, "v");
+    if (!V || !rk_same_batch(Q, V, "v")) { Py_DECREF(Q); Py_XDECREF(V); return NULL; }
+    rk_cbody *work = PyMem_Malloc(sizeof(rk_cbody) * RK_NB);
+    PyObject *out = work ? rk_output(Q, RK_NV, RK_NV) : PyErr_NoMemory();
+    if (out) {
+        npy_intp count = PyArray_SIZE(Q) / RK_NQ;
+        const double *q = PyArray_DATA(Q), *v = PyArray_DATA(V);
+        double *y = PyArray_DATA((PyArrayObject *)out);
+        for (npy_intp k = 0; k < count; k++)
+            rk_coriolis(q + k * RK_NQ, v + k * RK_NV, y + RK_NV * RK_NV * k, work);
+    }
+    PyMem_Free(work);
+    Py_DECREF(Q); Py_DECREF(V);
+    return out;
 }
 
 static PyMethodDef rk_methods[] = {
     {"drift", (PyCFunction)(void (*)(void))rk_py_drift, METH_FASTCALL, "(Q, V, frame, ref) -> [a; w_dot]"},
     {"centroidal", (PyCFunction)(void (*)(void))rk_py_centroidal, METH_FASTCALL, "(Q) -> A_g"},
     {"wrench", (PyCFunction)(void (*)(void))rk_py_wrench, METH_FASTCALL, "(Q, frame, W, OUT, sign): OUT += sign J^T w"},
+    {"coriolis", (PyCFunction)(void (*)(void))rk_py_coriolis, METH_FASTCALL, "(Q, V) -> C(q, v)"},
     {NULL, NULL, 0, NULL},
 };
 

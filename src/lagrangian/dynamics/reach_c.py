@@ -118,16 +118,14 @@ class ReachKernel:
             self.drift = _checking_quaternion(module.drift)
             self.centroidal = _checking_quaternion(module.centroidal) if massive else None
             self.coriolis = _checking_quaternion(module.coriolis)
-        self._floating = tree.floating_base
+        self._wrench = module.wrench
+        if tree.floating_base:
+            self._wrench = _checking_quaternion(module.wrench)
 
     def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> None:
         """out += sign sum J^T w over the frames, in place (out of q's shape); ValueError or
         KeyError where the inputs are not plain (the numpy path then names the fault)."""
-        wrench = self.module.wrench
-        if self._floating:
-            from .recursive import _checking_quaternion
-
-            wrench = _checking_quaternion(wrench)
+        wrench = self._wrench
         for name, w in wrenches.items():
             wrench(q, self.frame_index[name], w, out, sign)
 

@@ -290,17 +290,6 @@ static void rk_wrench(const double *q, int f, const double *w, double *out)
 
 /* -- C(q, v) by Pinocchio's spatial factorization (coriolis_tree.py) ----------------------- */
 
-/* out = A B for 6 x 6 row-major matrices */
-static inline void rk_mul6(const double *A, const double *B, double *out)
-{
-    for (int i = 0; i < 6; i++)
-        for (int j = 0; j < 6; j++) {
-            double t = 0.0;
-            for (int k = 0; k < 6; k++) t += A[6 * i + k] * B[6 * k + j];
-            out[6 * i + j] = t;
-        }
-}
-
 /* V x s for motions [v; w]: [w x s_v + v x s_w; w x s_w] */
 static inline void rk_motion_cross(const double *V, const double *s, double *out)
 {
@@ -356,25 +345,25 @@ static void rk_coriolis(const double *q, const double *qd, double *C, rk_cbody *
                 In[6 * a + 3 + c] = -H[3 * a + c];
                 In[6 * (3 + a) + c] = H[3 * a + c];
             }
-        /* Bm = 1/2 (V x* I - I V x) + 1/2 (I V) x-bar; V x* = -(V x)^T */
-        double X[36] = {0.0}, Xs[36], XI[36], IX[36], f[6];
+        /* Bm = 1/2 (V x* I - I V x) + 1/2 (I V) x-bar, V x* = -(V x)^T = [[[w]x, 0], [[v]x, [w]x]];
+         * I symmetric, so I V x = -(V x* I)^T: one product, XI = V x* I, column by column */
+        double XI[36], f[6];
         const double *v = bi->V, *w = bi->V + 3;
-        double W[9] = {0.0, -w[2], w[1], w[2], 0.0, -w[0], -w[1], w[0], 0.0};
-        double Vv[9] = {0.0, -v[2], v[1], v[2], 0.0, -v[0], -v[1], v[0], 0.0};
-        for (int a = 0; a < 3; a++)
-            for (int c = 0; c < 3; c++) {
-                X[6 * a + c] = X[6 * (3 + a) + 3 + c] = W[3 * a + c];
-                X[6 * a + 3 + c] = Vv[3 * a + c];
-            }
-        for (int a = 0; a < 6; a++)
-            for (int c = 0; c < 6; c++) Xs[6 * a + c] = -X[6 * c + a];
-        rk_mul6(Xs, In, XI);
-        rk_mul6(In, X, IX);
+        for (int c = 0; c < 6; c++) {
+            double top[3] = {In[c], In[6 + c], In[12 + c]}, bottom[3] = {In[18 + c], In[24 + c],
+                                                                            In[30 + c]};
+            double a1[3], a2[3], a3[3];
+            rk_cross(w, top, a1);
+            rk_cross(v, top, a2);
+            rk_cross(w, bottom, a3);
+            for (int j = 0; j < 3; j++) { XI[6 * j + c] = a1[j]; XI[6 * (3 + j) + c] = a2[j] + a3[j]; }
+        }
         for (int a = 0; a < 6; a++) {
             f[a] = 0.0;
             for (int c = 0; c < 6; c++) f[a] += In[6 * a + c] * v[c];
         }
-        for (int j = 0; j < 36; j++) bi->Bm[j] = 0.5 * (XI[j] - IX[j]);
+        for (int a = 0; a < 6; a++)
+            for (int c = 0; c < 6; c++) bi->Bm[6 * a + c] = 0.5 * (XI[6 * a + c] + XI[6 * c + a]);
         /* (f x-bar) = [[0, -[f]x], [-[f]x, -[n]x]] */
         double Fx[9] = {0.0, -f[2], f[1], f[2], 0.0, -f[0], -f[1], f[0], 0.0};
         double Nx[9] = {0.0, -f[5], f[4], f[5], 0.0, -f[3], -f[4], f[3], 0.0};

@@ -48,71 +48,73 @@ def interleaved(ours, theirs, calls: int = 300, rounds: int = 7) -> tuple[float,
     return a, b
 
 
-def main() -> None:
+def measure(ours, theirs, Q, V, A, count: int) -> tuple[float, float, float, float]:
+    """Seconds: one call of ours and of Pinocchio's (interleaved), 10^4 states in one call of
+    ours and in a loop of Pinocchio's."""
+    one_ours, one_theirs = interleaved(lambda: ours(Q[0], V[0], A[0]), lambda: theirs(0))
+    batch_ours = best(lambda: ours(Q, V, A), 1, 3)
+    batch_theirs = best(lambda: [theirs(k) for k in range(count)], 1, 3)
+    return one_ours, one_theirs, batch_ours, batch_theirs
+
+
+def bench_robot(name: str, foot: str, count: int = 10_000) -> None:
     import pinocchio as pin
 
+    path = robots_folder() / name
+    model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    data = model.createData()
+    robot = lagrangian.load(path, floating_base=True).dynamics(backend="c")
+    order = [j.name for j in robot.tree.joints[1:]]  # ours in the URDF's order
+    iq = np.r_[np.arange(7), [model.idx_qs[model.getJointId(j)] for j in order]]
+    iv = np.r_[np.arange(6), [model.idx_vs[model.getJointId(j)] for j in order]]
+    rng = np.random.default_rng(0)
+    q = np.array([pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+                  for _ in range(count)])
+    v, a = rng.uniform(-1, 1, (2, count, model.nv))
+    Q, V, A = (np.ascontiguousarray(x) for x in (q[:, iq], v[:, iv], a[:, iv]))
+    frame = model.getFrameId(foot)
+    joint = model.frames[frame].parentJoint
+    wrench = np.array([0.0, 0.0, 50.0, 0.0, 0.0, 0.0])  # 50 N up at the foot, world axes
+    f_ext = {foot: wrench}
+    # the same wrench as Pinocchio's f_ext (the joint's axes, about its origin), at state 0
+    pin.framesForwardKinematics(model, data, q[0])
+    forces = pin.StdVec_Force()
+    for _ in range(model.njoints):
+        forces.append(pin.Force.Zero())
+    placement = data.oMi[joint]
+    arm = data.oMf[frame].translation - placement.translation
+    forces[joint] = pin.Force(placement.rotation.T @ wrench[:3],
+                              placement.rotation.T @ np.cross(arm, wrench[:3]))
+
+    def drift(k):
+        pin.forwardKinematics(model, data, q[k], v[k], 0 * v[k])
+        pin.updateFramePlacement(model, data, frame)
+        return pin.getFrameClassicalAcceleration(model, data, frame,
+                                                 pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+
+    cases = {
+        "coriolis_matrix": (lambda x, y, z: robot.coriolis_matrix(x, y),
+                            lambda k: pin.computeCoriolisMatrix(model, data, q[k], v[k])),
+        "jacobian_dot_times_v": (lambda x, y, z: robot.jacobian_dot_times_v(x, y, foot), drift),
+        "centroidal_momentum_matrix": (lambda x, y, z: robot.centroidal_momentum_matrix(x),
+                                       lambda k: pin.ccrba(model, data, q[k], v[k])),
+        "inverse_dynamics f_ext": (lambda x, y, z: robot.inverse_dynamics(x, y, z, f_ext=f_ext),
+                                   lambda k: pin.rnea(model, data, q[k], v[k], a[k], forces)),
+    }
+    print(f"{path.name}: nq {model.nq}, nv {model.nv}")
+    print("  function: one call ours / Pinocchio us (ratio Pinocchio/ours); "
+          "10^4 states ours / Pinocchio loop ms (ratio)")
+    for label, (ours, theirs) in cases.items():
+        one_ours, one_theirs, batch_ours, batch_theirs = measure(ours, theirs, Q, V, A, count)
+        print(f"  {label}: {one_ours * 1e6:.2f} / {one_theirs * 1e6:.2f} "
+              f"({one_theirs / one_ours:.2f}x); {batch_ours * 1e3:.1f} / "
+              f"{batch_theirs * 1e3:.1f} ({batch_theirs / batch_ours:.1f}x)")
+
+
+def main() -> None:
     print(f"load average {load_average()}")
     for name, foot in ROBOTS:
-        path = robots_folder() / name
-        model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
-        data = model.createData()
-        robot = lagrangian.load(path, floating_base=True).dynamics(backend="c")
-        order = [j.name for j in robot.tree.joints[1:]]  # ours in the URDF's order
-        iq = np.r_[np.arange(7), [model.idx_qs[model.getJointId(j)] for j in order]]
-        iv = np.r_[np.arange(6), [model.idx_vs[model.getJointId(j)] for j in order]]
-        rng = np.random.default_rng(0)
-        count = 10_000
-        q = np.array([pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
-                      for _ in range(count)])
-        v, a = rng.uniform(-1, 1, (2, count, model.nv))
-        Q, V, A = np.ascontiguousarray(q[:, iq]), np.ascontiguousarray(v[:, iv]), \
-            np.ascontiguousarray(a[:, iv])
-        frame = model.getFrameId(foot)
-        joint = model.frames[frame].parentJoint
-        wrench = np.array([0.0, 0.0, 50.0, 0.0, 0.0, 0.0])  # 50 N up at the foot, world axes
-        f_ext = {foot: wrench}
-
-        def theirs_wrench(k):  # the same wrench as Pinocchio's f_ext (joint axes, its origin)
-            pin.framesForwardKinematics(model, data, q[k])
-            forces = pin.StdVec_Force()
-            for _ in range(model.njoints):
-                forces.append(pin.Force.Zero())
-            M = data.oMi[joint]
-            arm = data.oMf[frame].translation - M.translation
-            forces[joint] = pin.Force(M.rotation.T @ wrench[:3],
-                                      M.rotation.T @ np.cross(arm, wrench[:3]))
-            return forces
-
-        forces0 = theirs_wrench(0)
-
-        def drift(k):
-            pin.forwardKinematics(model, data, q[k], v[k], 0 * v[k])
-            pin.updateFramePlacement(model, data, frame)
-            return pin.getFrameClassicalAcceleration(model, data, frame,
-                                                     pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-
-        cases = {
-            "coriolis_matrix": (lambda x, y, z: robot.coriolis_matrix(x, y),
-                                lambda k: pin.computeCoriolisMatrix(model, data, q[k], v[k])),
-            "jacobian_dot_times_v": (lambda x, y, z: robot.jacobian_dot_times_v(x, y, foot),
-                                     drift),
-            "centroidal_momentum_matrix": (lambda x, y, z: robot.centroidal_momentum_matrix(x),
-                                           lambda k: pin.ccrba(model, data, q[k], v[k])),
-            "inverse_dynamics f_ext": (
-                lambda x, y, z: robot.inverse_dynamics(x, y, z, f_ext=f_ext),
-                lambda k: pin.rnea(model, data, q[k], v[k], a[k], forces0)),
-        }
-        print(f"{path.name}: nq {model.nq}, nv {model.nv}")
-        print("  function: one call ours / Pinocchio us (ratio Pinocchio/ours); "
-              "10^4 states ours / Pinocchio loop ms (ratio)")
-        for label, (ours, theirs) in cases.items():
-            one_ours, one_theirs = interleaved(lambda: ours(Q[0], V[0], A[0]),
-                                               lambda: theirs(0))
-            batch_ours = best(lambda: ours(Q, V, A), 1, 3)
-            batch_theirs = best(lambda: [theirs(k) for k in range(count)], 1, 3)
-            print(f"  {label}: {one_ours * 1e6:.2f} / {one_theirs * 1e6:.2f} "
-                  f"({one_theirs / one_ours:.2f}x); {batch_ours * 1e3:.1f} / "
-                  f"{batch_theirs * 1e3:.1f} ({batch_theirs / batch_ours:.1f}x)")
+        bench_robot(name, foot)
     print(f"load average {load_average()}")
 
 

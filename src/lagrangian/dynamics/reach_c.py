@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model.tree import KinematicTree
+from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import joint_model
 from .tree_c import _SINCOS
 
@@ -59,6 +60,9 @@ def kernel_source(tree: KinematicTree):
         f"#define RK_NB {len(joints)}",
         f"#define RK_N {len(tree.coordinates)}",
         f"#define RK_FB {int(tree.floating_base)}",
+        # |quaternion|^2 within (1 -+ QUATERNION_TOLERANCE)^2, else numpy names the fault
+        f"#define RK_QLOW {(1 - QUATERNION_TOLERANCE) ** 2!r}",
+        f"#define RK_QHIGH {(1 + QUATERNION_TOLERANCE) ** 2!r}",
         f"#define RK_NF {len(frames)}",
         _table("rk_parent", "int", [j.parent for j in joints]),
         _table("rk_coord", "int", [j.coordinate for j in joints]),
@@ -111,21 +115,14 @@ class ReachKernel:
         self.drift = module.drift
         # A_g needs a centre of mass: moving mass (else numpy refuses it in one line)
         self.centroidal = module.centroidal if massive else None
-        self.coriolis = None  # a fixed base's C is M's Christoffel symbols (joint_space.py)
-        if tree.floating_base:  # the base's quaternion checked first, in one line
-            from .recursive import _checking_quaternion
-
-            self.drift = _checking_quaternion(module.drift)
-            self.centroidal = _checking_quaternion(module.centroidal) if massive else None
-            self.coriolis = _checking_quaternion(module.coriolis)
-        self._wrench = module.wrench
-        if tree.floating_base:
-            self._wrench = _checking_quaternion(module.wrench)
+        # a fixed base's C is M's Christoffel symbols (joint_space.py); a floating base's here
+        self.coriolis = module.coriolis if tree.floating_base else None
 
     def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> None:
-        """out += sign sum J^T w over the frames, in place (out of q's shape); ValueError or
-        KeyError where the inputs are not plain (the numpy path then names the fault)."""
-        wrench = self._wrench
+        """out += sign sum J^T w over the frames, in place (out: q's batch, nv wide); ValueError or
+        KeyError where the inputs are not plain or a base quaternion is off (the numpy path then
+        names the fault)."""
+        wrench = self.module.wrench
         for name, w in wrenches.items():
             wrench(q, self.frame_index[name], w, out, sign)
 

@@ -430,6 +430,26 @@ static PyArrayObject *rk_input(PyObject *x, int last, const char *name)
     return a;
 }
 
+/* a floating base's quaternions (entries 3..6 of each state) of norm within the tolerance (or
+ * not finite: that row's NaN is the caller's); else ValueError, and numpy names the state */
+static int rk_unit_quaternions(PyArrayObject *Q)
+{
+#if RK_FB
+    npy_intp count = PyArray_SIZE(Q) / RK_NQ;
+    const double *q = PyArray_DATA(Q);
+    for (npy_intp k = 0; k < count; k++, q += RK_NQ) {
+        double n2 = q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6];
+        if (n2 < RK_QLOW || n2 > RK_QHIGH) {
+            PyErr_SetString(PyExc_ValueError, "q: the base quaternion is not of unit norm");
+            return 0;
+        }
+    }
+#else
+    (void)Q;
+#endif
+    return 1;
+}
+
 static PyObject *rk_output(PyArrayObject *like, int tail0, int tail1)
 {
     npy_intp dims[NPY_MAXDIMS];
@@ -461,6 +481,7 @@ static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t n
     if (f < 0 || f >= RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
     PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
     if (!Q) return NULL;
+    if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
     PyArrayObject *V = rk_input(args[1], RK_NV, "v");
     if (!V || !rk_same_batch(Q, V, "v")) { Py_DECREF(Q); Py_XDECREF(V); return NULL; }
     PyObject *out = rk_output(Q, 6, 0);
@@ -481,6 +502,7 @@ static PyObject *rk_py_centroidal(PyObject *self, PyObject *const *args, Py_ssiz
     if (nargs != 1) { PyErr_SetString(PyExc_TypeError, "centroidal(Q)"); return NULL; }
     PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
     if (!Q) return NULL;
+    if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
     PyObject *out = rk_output(Q, 6, RK_NV);
     if (out) {
         npy_intp count = PyArray_SIZE(Q) / RK_NQ;
@@ -506,6 +528,7 @@ static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t 
     PyArrayObject *out = (PyArrayObject *)args[3];
     PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
     if (!Q) return NULL;
+    if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
     PyArrayObject *W = rk_input(args[2], 6, "f_ext");
     if (!W) { Py_DECREF(Q); return NULL; }
     int shared = PyArray_NDIM(W) == 1;
@@ -535,6 +558,7 @@ static PyObject *rk_py_coriolis(PyObject *self, PyObject *const *args, Py_ssize_
     if (nargs != 2) { PyErr_SetString(PyExc_TypeError, "coriolis(Q, V)"); return NULL; }
     PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
     if (!Q) return NULL;
+    if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
     PyArrayObject *V = rk_input(args[1], RK_NV, "v");
     if (!V || !rk_same_batch(Q, V, "v")) { Py_DECREF(Q); Py_XDECREF(V); return NULL; }
     rk_cbody *work = PyMem_Malloc(sizeof(rk_cbody) * RK_NB);

@@ -304,7 +304,8 @@ static inline void rk_motion_cross(const double *V, const double *s, double *out
  * its spatial inertia In and Bm (6 x 6 row-major; summed over the subtree going up), V */
 typedef struct { double S[6][6], dS[6][6], In[36], Bm[36], V[6]; int columns, first; } rk_cbody;
 
-static void rk_coriolis(const double *q, const double *qd, double *C, rk_cbody *body)
+static void rk_coriolis(const double *restrict q, const double *restrict qd, double *restrict C,
+                        rk_cbody *restrict body)
 {
     double R[RK_NB][9], o[RK_NB][3];
     rk_bodies(q, R, o);

@@ -1,6 +1,7 @@
-"""Frame placements and Jacobians in the standalone C of `codegen --lang c` (C99, libm only),
-compiled with -std=c99 -pedantic -Werror, against Pinocchio's updateFramePlacements and
-getFrameJacobian in the three references: a floating base (a URDF floating joint with an origin
+"""Frame placements, Jacobians, J_dot v and the centre of mass in the standalone C of `codegen
+--lang c` (C99, libm only), compiled with -std=c99 -pedantic -Werror, against Pinocchio's
+updateFramePlacements, getFrameJacobian and getFrameClassicalAcceleration (a = 0) in the three
+references, centerOfMass and jacobianCenterOfMass: a floating base (a URDF floating joint with an origin
 of its own) and a fixed arm; a frame name that is not a C identifier reaches C only escaped."""
 
 from __future__ import annotations
@@ -53,11 +54,22 @@ def test_standalone_frames_match_pinocchio(tmp_path, urdf):
     if floating:
         assert 'foot "*/ \\ \u00e9' in ours.frames
     place, jacobian = c[f"{prefix}_frame_placement"], c[f"{prefix}_frame_jacobian"]
+    drift = c[f"{prefix}_frame_jacobian_dot_times_v"]
     pointer = ctypes.c_void_p
+    rng = np.random.default_rng(2)
     for _ in range(3):
         q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
-        ours_q = np.ascontiguousarray(q[iq])
-        pin.forwardKinematics(model, data, q)
+        v = rng.uniform(-1, 1, model.nv)
+        ours_q, ours_v = np.ascontiguousarray(q[iq]), np.ascontiguousarray(v[iv])
+        centre, centre_jacobian = np.zeros(3), np.zeros(3 * model.nv)
+        c[f"{prefix}_center_of_mass"](ours_q.ctypes.data_as(pointer),
+                                      centre.ctypes.data_as(pointer))
+        c[f"{prefix}_center_of_mass_jacobian"](ours_q.ctypes.data_as(pointer),
+                                               centre_jacobian.ctypes.data_as(pointer))
+        _close(centre, pin.centerOfMass(model, data, q))
+        _close(centre_jacobian.reshape(3, model.nv),
+               pin.jacobianCenterOfMass(model, data, q)[:, iv])
+        pin.forwardKinematics(model, data, q, v, np.zeros(model.nv))
         pin.updateFramePlacements(model, data)
         pin.computeJointJacobians(model, data, q)
         for k, name in enumerate(ours.frames):
@@ -71,6 +83,11 @@ def test_standalone_frames_match_pinocchio(tmp_path, urdf):
                 expected = pin.getFrameJacobian(model, data, frame,
                                                 getattr(pin.ReferenceFrame, ref.upper()))
                 _close(J.reshape(6, model.nv), expected[:, iv])
+                a = np.zeros(6)
+                drift(ours_q.ctypes.data_as(pointer), ours_v.ctypes.data_as(pointer), k, r,
+                      a.ctypes.data_as(pointer))
+                _close(a, pin.getFrameClassicalAcceleration(
+                    model, data, frame, getattr(pin.ReferenceFrame, ref.upper())).vector)
 
 
 def test_the_documented_c_program(cli, tmp_path, monkeypatch):

@@ -2,8 +2,10 @@
 added to standalone.py's tree source: ``<P>_frame_placement(q, frame, T)`` (4 x 4, row-major:
 rotation and origin in m, world) and ``<P>_frame_jacobian(q, frame, reference, J)`` (6 x N,
 row-major, linear rows first; reference 0 world, 1 local, 2 local_world_aligned, as
-Pinocchio's), the frames by index in ``<P>_frame_names``: frames.py's formulas over the tree's
-numbers written as static tables, a floating base's free flyer as body 0.
+Pinocchio's), ``<P>_frame_jacobian_dot_times_v(q, v, frame, reference, out)`` (the classical
+acceleration at a = 0) and ``<P>_center_of_mass(q, c)`` with its Jacobian, the frames by index
+in ``<P>_frame_names``: frames.py's and centroidal.py's formulas over the tree's numbers written
+as static tables, a floating base's free flyer as body 0.
 """
 
 from __future__ import annotations
@@ -40,6 +42,14 @@ void {P}_frame_placement(const double *q, int frame, double *T);
    world (the point at the world's origin moving with the frame), 1 local (the frame's origin,
    its axes), 2 local_world_aligned (its origin, world axes), as Pinocchio's ReferenceFrame. */
 void {P}_frame_jacobian(const double *q, int frame, int reference, double *J);
+/* J_dot v: the frame's classical acceleration at a = 0, out = [a; w_dot] (m/s^2, rad/s^2),
+   reference as for the Jacobian (Pinocchio's getFrameClassicalAcceleration). */
+void {P}_frame_jacobian_dot_times_v(const double *q, const double *v, int frame, int reference,
+                                    double *out);
+/* The moving bodies' centre of mass in the world, c (3, m), and its Jacobian, Jc row-major
+   3 x {U}_N (c_dot = Jc v); NaN without moving mass. */
+void {P}_center_of_mass(const double *q, double *c);
+void {P}_center_of_mass_jacobian(const double *q, double *Jc);
 """
 
 
@@ -58,6 +68,8 @@ def frame_functions(P: str, tree: KinematicTree) -> str:
         _table("fr_R0", "double", [[x for row in j.rotation for x in row] for j in joints]),
         _table("fr_t0", "double", [list(j.translation) for j in joints]),
         _table("fr_u", "double", [list(j.axis) for j in joints]),
+        _table("fr_m", "double", [j.mass for j in joints]),
+        _table("fr_h", "double", [list(j.first_moment) for j in joints]),
         _table("fr_fbody", "int", [f.body for f in frames] or [-1]),
         _table("fr_fR", "double", [[x for row in f.rotation for x in row] for f in frames]
                or [[1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0]]),
@@ -216,6 +228,135 @@ void {P}_frame_jacobian(const double *q, int frame, int reference, double *J)
                 J[j * FR_NV + c] = Rf[j] * lin[0] + Rf[3 + j] * lin[1] + Rf[6 + j] * lin[2];
                 J[(3 + j) * FR_NV + c] = Rf[j] * w[0] + Rf[3 + j] * w[1] + Rf[6 + j] * w[2];
             }}
+        }}
+    }}
+}}
+
+/* joint i's world columns at the origin, [v; w] each (a free flyer's six, else one, its
+   multiplier in), and the first velocity number; returns the count */
+static int fr_columns(int i, double (*R)[9], double (*o)[3], double (*S)[6], int *first)
+{{
+    if (FR_FB && i == 0) {{
+        for (int c = 0; c < 3; c++) {{
+            double e[3] = {{R[0][c], R[0][3 + c], R[0][6 + c]}}, v[3];
+            fr_cross(o[0], e, v);
+            for (int j = 0; j < 3; j++) {{
+                S[c][j] = e[j]; S[c][3 + j] = 0.0;
+                S[3 + c][j] = v[j]; S[3 + c][3 + j] = e[j];
+            }}
+        }}
+        *first = 0;
+        return 6;
+    }}
+    double v[3] = {{0.0, 0.0, 0.0}}, w[3] = {{0.0, 0.0, 0.0}};
+    if (fr_turns[i]) {{
+        fr_apply(R[i], fr_u[i], w);
+        fr_cross(o[i], w, v);
+    }}
+    if (fr_slides[i]) {{
+        double d[3];
+        fr_apply(R[i], fr_u[i], d);
+        for (int j = 0; j < 3; j++) v[j] += d[j];
+    }}
+    for (int j = 0; j < 3; j++) {{ S[0][j] = fr_mult[i] * v[j]; S[0][3 + j] = fr_mult[i] * w[j]; }}
+    *first = FR_BV + fr_coord[i];
+    return 1;
+}}
+
+void {P}_frame_jacobian_dot_times_v(const double *q, const double *v, int frame, int reference,
+                                    double *out)
+{{
+    double R[FR_NB][9], o[FR_NB][3], V[FR_NB][6], A[FR_NB][6], Rf[9], p[3];
+    int b = fr_fbody[frame];
+    for (int j = 0; j < 6; j++) out[j] = 0.0;
+    if (b < 0) return;
+    fr_bodies(q, R, o);
+    fr_frame(frame, R, o, Rf, p);
+    for (int i = 0; i <= b; i++) {{  /* V_i = V_parent + S v, A_i = A_parent + V_i x (S v) */
+        double S[6][6], m[6] = {{0.0, 0.0, 0.0, 0.0, 0.0, 0.0}}, t1[3], t2[3], t3[3];
+        int first, count = fr_columns(i, R, o, S, &first), parent = fr_parent[i];
+        for (int c = 0; c < count; c++)
+            for (int j = 0; j < 6; j++) m[j] += S[c][j] * v[first + c];
+        for (int j = 0; j < 6; j++) {{
+            V[i][j] = (parent < 0 ? 0.0 : V[parent][j]) + m[j];
+            A[i][j] = parent < 0 ? 0.0 : A[parent][j];
+        }}
+        fr_cross(V[i] + 3, m, t1);
+        fr_cross(V[i], m + 3, t2);
+        fr_cross(V[i] + 3, m + 3, t3);
+        for (int j = 0; j < 3; j++) {{ A[i][j] += t1[j] + t2[j]; A[i][3 + j] += t3[j]; }}
+    }}
+    /* the frame's origin: p_dot = v_O + w x p, p_ddot = a_O + w_dot x p + w x p_dot */
+    const double *w = V[b] + 3, *wd = A[b] + 3;
+    double pd[3], pdd[3], t[3];
+    fr_cross(w, p, t);
+    for (int j = 0; j < 3; j++) pd[j] = V[b][j] + t[j];
+    fr_cross(wd, p, t);
+    for (int j = 0; j < 3; j++) pdd[j] = A[b][j] + t[j];
+    fr_cross(w, pd, t);
+    for (int j = 0; j < 3; j++) pdd[j] += t[j];
+    if (reference == 0) {{  /* the point at the world's origin: p_ddot - w_dot x p - w x (w x p) */
+        double wp[3], wwp[3];
+        fr_cross(wd, p, t);
+        fr_cross(w, p, wp);
+        fr_cross(w, wp, wwp);
+        for (int j = 0; j < 3; j++) {{ out[j] = pdd[j] - t[j] - wwp[j]; out[3 + j] = wd[j]; }}
+    }} else if (reference == 1) {{
+        for (int j = 0; j < 3; j++) {{
+            out[j] = Rf[j] * pdd[0] + Rf[3 + j] * pdd[1] + Rf[6 + j] * pdd[2];
+            out[3 + j] = Rf[j] * wd[0] + Rf[3 + j] * wd[1] + Rf[6 + j] * wd[2];
+        }}
+    }} else {{
+        for (int j = 0; j < 3; j++) {{ out[j] = pdd[j]; out[3 + j] = wd[j]; }}
+    }}
+}}
+
+/* each subtree's mass and first moment about the world's origin (world axes), leaves first */
+static double fr_subtrees(const double *q, double (*R)[9], double (*o)[3], double *M,
+                          double (*H)[3])
+{{
+    double total = 0.0;
+    fr_bodies(q, R, o);
+    for (int i = 0; i < FR_NB; i++) {{
+        double hr[3];
+        fr_apply(R[i], fr_h[i], hr);
+        M[i] = fr_m[i];
+        for (int j = 0; j < 3; j++) H[i][j] = hr[j] + fr_m[i] * o[i][j];
+        total += fr_m[i];
+    }}
+    for (int i = FR_NB - 1; i >= 0; i--) {{
+        int parent = fr_parent[i];
+        if (parent < 0) continue;
+        M[parent] += M[i];
+        for (int j = 0; j < 3; j++) H[parent][j] += H[i][j];
+    }}
+    return total;
+}}
+
+void {P}_center_of_mass(const double *q, double *c)
+{{
+    double R[FR_NB][9], o[FR_NB][3], M[FR_NB], H[FR_NB][3];
+    double total = fr_subtrees(q, R, o, M, H);
+    for (int j = 0; j < 3; j++) {{
+        c[j] = 0.0;
+        for (int i = 0; i < FR_NB; i++)
+            if (fr_parent[i] < 0) c[j] += H[i][j];
+        c[j] = total > 0.0 ? c[j] / total : NAN;
+    }}
+}}
+
+void {P}_center_of_mass_jacobian(const double *q, double *Jc)
+{{
+    double R[FR_NB][9], o[FR_NB][3], M[FR_NB], H[FR_NB][3];
+    double total = fr_subtrees(q, R, o, M, H);
+    for (int j = 0; j < 3 * FR_NV; j++) Jc[j] = 0.0;
+    for (int i = 0; i < FR_NB; i++) {{  /* a unit rate moves the subtree: M s_v + s_w x H */
+        double S[6][6], t[3];
+        int first, count = fr_columns(i, R, o, S, &first);
+        for (int c = 0; c < count; c++) {{
+            fr_cross(S[c] + 3, H[i], t);
+            for (int j = 0; j < 3; j++)
+                Jc[j * FR_NV + first + c] += (M[i] * S[c][j] + t[j]) / (total > 0.0 ? total : NAN);
         }}
     }}
 }}

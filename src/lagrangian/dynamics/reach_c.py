@@ -15,7 +15,9 @@ from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import joint_model
 from .tree_c import _SINCOS
 
-_KERNEL = Path(__file__).with_name("reach_kernel.c")
+# the walks, C(q, v), then the Python bindings: one module's C, in this order
+_KERNELS = tuple(Path(__file__).with_name(name)
+                 for name in ("reach_kernel.c", "reach_coriolis.c", "reach_bindings.c"))
 REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
 
 
@@ -44,7 +46,7 @@ def _turn_tables(joints) -> list[str]:
 
 
 def kernel_source(tree: KinematicTree):
-    """The module's C: the tables, then reach_kernel.c."""
+    """The module's C: the tables, then reach_kernel.c, reach_coriolis.c, reach_bindings.c."""
     from ..compile.codegen import GeneratedSource
 
     joints, frames = tree.joints, tree.frames
@@ -82,7 +84,7 @@ def kernel_source(tree: KinematicTree):
         _table("rk_fR", "double", [[x for row in f.rotation for x in row] for f in frames]),
         _table("rk_ft", "double", [list(f.translation) for f in frames]),
         _SINCOS,
-        _KERNEL.read_text(encoding="utf-8"),
+        *(path.read_text(encoding="utf-8") for path in _KERNELS),
     ])
     return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
 
@@ -97,7 +99,8 @@ def reach_module(tree: KinematicTree):
     if any(j.kind not in ONE_DOF for j in tree.joints[int(free):]):
         return None  # a joint the kernel does not know: numpy's walks refuse it in one line
     here = Path(__file__)
-    generator = hashlib.sha256(_KERNEL.read_bytes() + here.read_bytes()
+    generator = hashlib.sha256(b"".join(path.read_bytes() for path in _KERNELS)
+                               + here.read_bytes()
                                + here.with_name("tree_c.py").read_bytes()).hexdigest()
     key = "\n".join(["reach", generator, repr(tree), repr(tree.frames)])
     try:

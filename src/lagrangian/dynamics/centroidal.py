@@ -57,11 +57,15 @@ def world_columns(kinematics, k: int, joint, body) -> tuple[np.ndarray, list[int
 
 def velocity_array(kinematics, v, field: str = "v") -> np.ndarray:
     """v as an array of nv numbers along the last axis, else one line naming ``field``."""
+    from .free_flyer import BASE_VELOCITY
+
     v = np.asarray(v, dtype=float)
     if v.ndim == 0 or v.shape[-1] != kinematics.n:
+        tree = kinematics.tree
+        names = (BASE_VELOCITY if tree.floating_base else ()) + tuple(tree.coordinates)
         shape = "()" if v.ndim == 0 else str(v.shape)
-        raise InputError(f"expected {kinematics.n} values along the last axis, got shape "
-                         f"{shape}", field=field)
+        raise InputError(f"expected {kinematics.n} values ({', '.join(names)}) along the last "
+                         f"axis, got shape {shape}", field=field)
     return v
 
 

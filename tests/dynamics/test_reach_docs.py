@@ -72,3 +72,34 @@ def test_bad_wrenches_and_armatures_are_one_line(cli, arguments, message):
 def test_a_wrench_needs_inverse_or_forward_dynamics(cli):
     result = cli("dynamics", "two_link_arm", "--wrench", "fore=0,0,1,0,0,0")
     assert result.code == 2 and "error: --wrench: a wrench acts in" in result.err
+
+
+def test_floating_example_runs_and_obeys_newton(capsys):
+    """The floating-reach block: C v = b - g, a push's linear momentum rate is the push."""
+    code = re.findall(r"```python\n(.*?)```", block("floating-reach"), re.S)[0]
+    exec(compile(code, "floating-reach", "exec"), {})
+    assert capsys.readouterr().out.splitlines() == [
+        "True", "(6,)", "[ 0.  0. 10.]", "['shoulder', 'elbow']"]
+
+
+def test_floating_commands_print_the_library_numbers(cli):
+    kinematics, dynamics = (line.split() for line in re.findall(r"\$ lagrangian (.*)",
+                                                                 block("floating-reach")))
+    arm = lagrangian.load("two_link_arm", floating_base=True).dynamics()
+    q = np.array([0, 0, 0, 0, 0, 0.6, 0.8, 0.3, 0.5])
+    v = np.array([0.1, 0, -0.2, 0.3, 0, 0.5, 1.0, 2.0])
+    result = cli(*kinematics)
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    Ag = np.array(document["centroidal_momentum_matrix"])
+    assert Ag.shape == (6, 8)
+    np.testing.assert_allclose(Ag, arm.centroidal_momentum_matrix(q), atol=1e-12)
+    # the linear momentum is m times the centre of mass's velocity
+    np.testing.assert_allclose(Ag[:3] @ v, arm.kinematics.mass()
+                               * np.array(document["center_of_mass_jacobian"]) @ v, atol=1e-12)
+    np.testing.assert_allclose(document["jacobian_dot_times_v"],
+                               arm.jacobian_dot_times_v(q, v, "fore"), atol=1e-12)
+    result = cli(*dynamics)
+    assert result.code == 0, result.err
+    C = np.array(json.loads(result.out)["coriolis_matrix"])
+    np.testing.assert_allclose(C @ v, arm.bias_forces(q, v) - arm.gravity(q), atol=1e-12)

@@ -250,12 +250,11 @@ def test_a_robot_without_moving_mass_has_no_centroidal_momentum(tmp_path):
 
 
 def test_a_joint_of_more_than_one_coordinate_is_refused_not_miscounted(system):
-    """The walks give each joint one column: a tree with any other joint (a floating base's
-    free flyer, stood in for here by a spherical joint) is refused in one line, never summed
-    wrong."""
+    """The walks give each joint its own columns (one, or a free flyer's six): a tree with a
+    joint they do not know (a spherical one here) is refused in one line, never summed wrong."""
     from dataclasses import replace
 
-    from lagrangian.dynamics.actuators import actuated
+    from lagrangian.dynamics.coriolis_tree import coriolis_matrix
     from lagrangian.dynamics.frames import TreeKinematics
 
     tree = system.model.kinematic_tree
@@ -263,21 +262,14 @@ def test_a_joint_of_more_than_one_coordinate_is_refused_not_miscounted(system):
     kinematics = TreeKinematics.__new__(TreeKinematics)
     kinematics.tree, kinematics.n = odd, 3
     for call in (lambda: kinematics.jacobian_dot_times_v(np.zeros(3), np.zeros(3), "tool"),
-                 lambda: kinematics.centroidal_momentum_matrix(np.zeros(3))):
-        with pytest.raises(lagrangian.InputError, match="floating base: not yet"):
+                 lambda: kinematics.centroidal_momentum_matrix(np.zeros(3)),
+                 lambda: coriolis_matrix(kinematics, np.zeros(3), np.zeros(3))):
+        with pytest.raises(lagrangian.InputError, match="spherical joint: not yet"):
             call()
     from lagrangian.dynamics.wrenches import wrench_forces
 
-    with pytest.raises(lagrangian.InputError, match="floating base: not yet"):
+    with pytest.raises(lagrangian.InputError, match="spherical joint: not yet"):
         wrench_forces(kinematics, np.zeros(3), {"tool": np.zeros(6)})
-
-    class Rigid:
-        pass
-
-    rigid = Rigid()
-    rigid.tree = odd
-    with pytest.raises(lagrangian.InputError, match="actuator models of a floating base"):
-        actuated(rigid, system.model, friction=True)
     from lagrangian.dynamics.reach_c import reach_module
 
     assert reach_module(odd) is None
@@ -285,7 +277,7 @@ def test_a_joint_of_more_than_one_coordinate_is_refused_not_miscounted(system):
 
 def test_the_compact_kernel_link_inertials_and_a_floating_base(system, tmp_path):
     """The same numbers on the compact kernel; a link's inertial given as a parameter is the
-    edited URDF's; a floating base is refused in one line (not yet), never miscounted."""
+    edited URDF's; a floating base's functions take nv numbers, its actuators are the joints'."""
     q, v, a, _ = _states()
     unrolled, compact = system.dynamics(), system.dynamics(kernel="compact")
     np.testing.assert_allclose(compact.centroidal_momentum_matrix(q),
@@ -303,14 +295,14 @@ def test_the_compact_kernel_link_inertials_and_a_floating_base(system, tmp_path)
                                edited.centroidal_momentum_matrix(q), atol=1e-12)
     path = tmp_path / "spatial.urdf"
     path.write_text(DAMPED)
-    floating = lagrangian.load(path, floating_base=True).dynamics()
+    floating = lagrangian.load(path, floating_base=True).dynamics(actuators=True)
     nq, nv = len(floating.coordinates), floating.n
     q0 = np.r_[np.zeros(6), 1.0, np.zeros(nq - 7)]
-    for call in (lambda: floating.centroidal_momentum_matrix(q0),
-                 lambda: floating.jacobian_dot_times_v(q0, np.zeros(nv), "tool"),
-                 lambda: floating.inverse_dynamics(q0, np.zeros(nv), np.zeros(nv),
-                                                   f_ext={"tool": np.zeros(6)})):
-        with pytest.raises(lagrangian.InputError, match="floating base: not yet"):
-            call()
-    with pytest.raises(lagrangian.InputError, match="actuator models of a floating base"):
-        lagrangian.load(path, floating_base=True).dynamics(actuators=True)
+    # a floating base's functions are checked against Pinocchio in test_floating_reach.py:
+    # here, the widths and the actuators
+    assert floating.centroidal_momentum_matrix(q0).shape == (6, nv)
+    assert floating.jacobian_dot_times_v(q0, np.zeros(nv), "tool").shape == (6,)
+    assert floating.inverse_dynamics(q0, np.zeros(nv), np.zeros(nv),
+                                     f_ext={"tool": np.zeros(6)}).shape == (nv,)
+    assert list(floating.actuators) == list(floating.velocity_names[6:])
+    assert floating.actuators["j1"] == {"damping": 0.3, "friction": 0.2, "armature": 0.0}

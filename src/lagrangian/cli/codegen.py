@@ -28,7 +28,8 @@ def codegen(
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
 ) -> None:
     """Write M(q), bias C q_dot + g, gravity, inverse and forward dynamics and the energies as
-    standalone C (no Python, no allocation, libm only) for embedding in a controller."""
+    standalone C (no Python, no allocation, libm only) for embedding in a controller; a URDF
+    robot's frames too (placements, Jacobians, J_dot v, centre of mass)."""
     if lang.lower() not in LANGUAGES:
         raise InputError(f"unknown language {lang!r}: use c", field="--lang")
     directory = Path(out)

@@ -7,7 +7,8 @@ URDF's <dynamics damping friction>, and the armature the rotor inertia reflected
 transmission (kg m^2 or kg; URDF has no standard tag for it, so it is given per joint). Then
 tau = M' a + b' and q_ddot = M'^-1 (tau - b'). sign(0) = 0: a joint at rest feels no Coulomb
 friction (no stiction model). C(q, q_dot) and g(q) stay the rigid body's (the armature is
-constant; damping and friction are not Coriolis terms).
+constant; damping and friction are not Coriolis terms). On a floating base they act on the
+joints only: the base's six numbers have no actuator.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import InputError, did_you_mean_or_list
+from .free_flyer import BASE_VELOCITY
 from .joint_space import Dynamics, solve_positive
 
 
@@ -62,6 +64,7 @@ class ActuatedDynamics(Dynamics):
     def __init__(self, rigid: Dynamics, damping, friction, armature):
         self.rigid = rigid
         self.coordinates, self.n = rigid.coordinates, rigid.n
+        self.velocity_names = rigid.velocity_names  # a floating base's nv = n + 6
         self.damping = np.array(damping, dtype=float)
         self.friction = np.array(friction, dtype=float)
         self.armature = np.array(armature, dtype=float)
@@ -81,10 +84,13 @@ class ActuatedDynamics(Dynamics):
 
     @property
     def actuators(self) -> dict[str, dict[str, float]]:
-        """Per coordinate: damping, friction, armature (SI)."""
+        """Per joint coordinate: damping, friction, armature (SI); a floating base's six
+        numbers have none."""
+        names = self.velocity_names or self.coordinates
+        base = 0 if self.velocity_names is None else len(BASE_VELOCITY)  # the twist's six
         return {c: {"damping": float(d), "friction": float(f), "armature": float(a)}
-                for c, d, f, a in zip(self.coordinates, self.damping, self.friction,
-                                      self.armature, strict=True)}
+                for c, d, f, a in list(zip(names, self.damping, self.friction, self.armature,
+                                           strict=True))[base:]}
 
     def _losses(self, v) -> np.ndarray:
         """d q_dot + f_c sign(q_dot)."""
@@ -148,13 +154,10 @@ def actuated(rigid: Dynamics, model, armature: Mapping[str, float] | None = None
              friction: bool = True) -> ActuatedDynamics:
     """``rigid`` with the actuator models: the URDF's damping and friction (``friction``) and
     the given armature."""
-    tree = getattr(rigid, "tree", None)
-    if tree is not None:
-        from .centroidal import require_fixed_base
-
-        require_fixed_base(tree, "actuator models", "actuators")
     values = actuator_values(model, armature, friction)
-    return ActuatedDynamics(rigid, values["damping"], values["friction"], values["armature"])
+    base = rigid.n - len(values["damping"])  # a floating base's six: no actuator there
+    return ActuatedDynamics(rigid, *(np.concatenate([np.zeros(base), values[key]])
+                                     for key in ("damping", "friction", "armature")))
 
 
 __all__ = ["ActuatedDynamics", "actuated", "actuator_values"]

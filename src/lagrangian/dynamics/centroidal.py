@@ -8,7 +8,9 @@ Spatial velocities are taken at the world's origin in world axes, V = [v_O; w] (
 velocity of the body point passing the origin): V_k = V_parent + S_k theta_dot_k, and at
 q_ddot = 0 the spatial acceleration A_k = A_parent + (V_k x S_k) theta_dot_k, with
 [v; w] x [v'; w'] = [w x v' + v x w'; w x w']. A point p of the body then has p_dot =
-v_O + w x p and p_ddot = a_O + w_dot x p + w x p_dot.
+v_O + w x p and p_ddot = a_O + w_dot x p + w x p_dot. A floating base's free flyer gives six
+columns (S = 1 in the base's axes, world_columns) and, its S moving with its own body, no drift
+of its own (V x V = 0).
 """
 
 from __future__ import annotations
@@ -19,16 +21,52 @@ from ..errors import InputError
 from ..kinds import JointKind
 from .recursive_numpy import _cross, _dot
 
-# the joints these walks take: one coordinate each (a floating base's free flyer is six)
+# the joints of one coordinate each (the compiled kernel of reach_c.py takes only these)
 ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
+# the joints these walks take: those, and a floating base's free flyer (six columns)
+WALKED = (*ONE_DOF, JointKind.FREE_FLYER)
 
 
-def require_fixed_base(tree, what: str, field: str = "q") -> None:
-    """Refused in one line for a tree with a joint of more than one coordinate (a floating
-    base): these walks give each joint one column, and would be wrong there."""
-    if any(JointKind(j.kind) not in ONE_DOF for j in tree.joints):
-        raise InputError(f"{what} of a floating base: not yet (a fixed-base robot's only)",
-                         field=field)
+def require_known_joints(tree, what: str, field: str = "q") -> None:
+    """Refused in one line for a tree with a joint these walks do not know (their columns
+    would be miscounted): revolute, prismatic and a floating base's free flyer are known."""
+    odd = sorted({str(j.kind) for j in tree.joints if j.kind not in WALKED})
+    if odd:
+        raise InputError(f"{what} of a tree with a {', '.join(odd)} joint: not yet (revolute, "
+                         "prismatic and a floating base's free flyer only)", field=field)
+
+
+def world_columns(kinematics, k: int, joint, body) -> tuple[np.ndarray, list[int]]:
+    """Joint k's motion subspace at the world's origin in world axes, (N, 6, c) with linear
+    rows first and the multiplier in, and the c velocity numbers it drives: a free flyer's six
+    (S = 1 in the base's axes: [R e; 0] and [p x R e; R e]), else the joint's one column."""
+    R, o = body
+    if joint.kind == JointKind.FREE_FLYER:
+        S = np.zeros((len(o), 6, 6))
+        S[:, :3, :3] = R
+        S[:, 3:, 3:] = R
+        S[:, :3, 3:] = np.cross(o[:, :, None], R, axisa=1, axisb=1, axisc=1)
+        return S, list(range(6))
+    s_v, s_w = _world_subspace(kinematics, k, joint, body)
+    S = np.zeros((len(o), 6, 1))
+    S[:, :3, 0] = s_v
+    if s_w is not None:
+        S[:, 3:, 0] = s_w
+    return joint.multiplier * S, [kinematics.tree.base_nv + joint.coordinate]
+
+
+def velocity_array(kinematics, v, field: str = "v") -> np.ndarray:
+    """v as an array of nv numbers along the last axis, else one line naming ``field``."""
+    from .free_flyer import BASE_VELOCITY
+
+    v = np.asarray(v, dtype=float)
+    if v.ndim == 0 or v.shape[-1] != kinematics.n:
+        tree = kinematics.tree
+        names = (BASE_VELOCITY if tree.floating_base else ()) + tuple(tree.coordinates)
+        shape = "()" if v.ndim == 0 else str(v.shape)
+        raise InputError(f"expected {kinematics.n} values ({', '.join(names)}) along the last "
+                         f"axis, got shape {shape}", field=field)
+    return v
 
 
 def _motion_cross(V, S):
@@ -44,19 +82,14 @@ def spatial_motion(kinematics, Q: np.ndarray, V: np.ndarray, bodies) -> list[tup
     count = len(Q)
     out: list[tuple[np.ndarray, np.ndarray]] = []
     for k, joint in enumerate(tree.joints):
-        R, o = bodies[k]
-        s_v, s_w = _world_subspace(kinematics, k, joint, (R, o))
-        S = np.zeros((count, 6))
-        S[:, :3] = s_v
-        if s_w is not None:
-            S[:, 3:] = s_w
-        rate = (joint.multiplier * V[:, joint.coordinate])[:, None]
+        S, index = world_columns(kinematics, k, joint, bodies[k])
+        motion = (S @ V[:, index, None])[..., 0]  # S q_dot of this joint
         if joint.parent < 0:
-            velocity, drift = S * rate, np.zeros((count, 6))
+            velocity, drift = motion, np.zeros((count, 6))
         else:
             velocity, drift = out[joint.parent]
-            velocity = velocity + S * rate
-        out.append((velocity, drift + _motion_cross(velocity, S) * rate))
+            velocity = velocity + motion
+        out.append((velocity, drift + _motion_cross(velocity, motion)))
     return out
 
 
@@ -67,14 +100,14 @@ def jacobian_dot_times_v(kinematics, q, v, frame: str, reference: str) -> np.nda
     getFrameClassicalAcceleration with a = 0)."""
     from .frames import REFERENCES
 
-    require_fixed_base(kinematics.tree, "J_dot q_dot")
+    require_known_joints(kinematics.tree, "J_dot q_dot")
     if reference not in REFERENCES:
         raise InputError(f"unknown reference '{reference}'; use one of "
                          f"{', '.join(REFERENCES)}", field="reference")
-    n = kinematics.n
-    q, v = kinematics._q(q)[0].reshape(np.shape(q)), kinematics._q(v, "v")[0].reshape(np.shape(v))
+    n, nq = kinematics.n, len(kinematics.coordinates)
+    q, v = kinematics._q(q)[0].reshape(np.shape(q)), velocity_array(kinematics, v)
     batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
-    Q = np.broadcast_to(q, batch + (n,)).reshape(-1, n)
+    Q = np.broadcast_to(q, batch + (nq,)).reshape(-1, nq)
     V = np.broadcast_to(v, batch + (n,)).reshape(-1, n)
     bodies = kinematics._bodies(Q)
     R, p = kinematics._frame_pose(Q, bodies, frame)
@@ -101,7 +134,7 @@ def centroidal_momentum_matrix(kinematics, q) -> np.ndarray:
     origin (world axes) summed from the leaves up; a unit rate along S = [s_v; s_w] (at the
     origin) gives the subtree the momentum [M s_v + s_w x h; h x s_v + I_O s_w]; then the
     angular rows are moved to the centre of mass G: k_G = k_O - G x l."""
-    require_fixed_base(kinematics.tree, "the centroidal momentum matrix")
+    require_known_joints(kinematics.tree, "the centroidal momentum matrix")
     Q, batch = kinematics._q(q)
     kinematics._moving_mass()  # refused in one line without moving mass
     bodies = kinematics._bodies(Q)
@@ -127,14 +160,13 @@ def centroidal_momentum_matrix(kinematics, q) -> np.ndarray:
             inertia[parent] = inertia[parent] + inertia[k]
     A = np.zeros((len(Q), 6, kinematics.n))
     for k, joint in enumerate(joints):
-        s_v, s_w = _world_subspace(kinematics, k, joint, bodies[k])
-        linear = mass[k] * s_v
-        angular = _cross(first[k], s_v)
-        if s_w is not None:
-            linear = linear + _cross(s_w, first[k])
-            angular = angular + (inertia[k] @ s_w[..., None])[..., 0]
-        A[:, :3, joint.coordinate] += joint.multiplier * linear
-        A[:, 3:, joint.coordinate] += joint.multiplier * angular
+        S, index = world_columns(kinematics, k, joint, bodies[k])
+        s_v, s_w = np.swapaxes(S[:, :3], 1, 2), np.swapaxes(S[:, 3:], 1, 2)  # (N, c, 3)
+        h = first[k][:, None, :]
+        linear = mass[k] * s_v + _cross(s_w, h)
+        angular = _cross(h, s_v) + s_w @ np.swapaxes(inertia[k], 1, 2)
+        A[:, :3, index] += np.swapaxes(linear, 1, 2)
+        A[:, 3:, index] += np.swapaxes(angular, 1, 2)
     total = sum(mass[k] for k, j in enumerate(joints) if j.parent < 0)
     centre = sum(first[k] for k, j in enumerate(joints) if j.parent < 0) / total
     A[:, 3:] -= np.cross(centre[:, :, None], A[:, :3], axisa=1, axisb=1, axisc=1)
@@ -152,4 +184,5 @@ def _world_subspace(kinematics, k: int, joint, body):
     return linear, w
 
 
-__all__ = ["centroidal_momentum_matrix", "jacobian_dot_times_v", "spatial_motion"]
+__all__ = ["ONE_DOF", "WALKED", "centroidal_momentum_matrix", "jacobian_dot_times_v",
+           "require_known_joints", "spatial_motion", "velocity_array", "world_columns"]

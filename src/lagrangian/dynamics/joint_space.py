@@ -293,12 +293,21 @@ class Dynamics(ControlTerms):
 
         Exact: the velocity terms are quadratic in q_dot, so column j is
         (bias(q, q_dot + e_j) - bias(q, q_dot - e_j)) / 4. Refused where the model's velocity
-        terms are not M's (a damper, a gyroscopic load, a moving support, M changing with t)."""
-        if self.velocity_names is not None:  # Christoffel symbols of quasi-velocities: not M's
-            raise DerivationError(
-                "C(q, v) of a floating base is not yet given: its twist is not the rate of its "
-                "coordinates, so M's Christoffel symbols do not make M_dot - 2C skew-symmetric; "
-                "use bias_forces(q, v)")
+        terms are not M's (a damper, a gyroscopic load, a moving support, M changing with t).
+
+        A floating base's twist is not the rate of its coordinates: there C is the tree's
+        spatial factorization (coriolis_tree.py), M_dot - 2C skew along q (+) v dt, (..., nv, nv)."""
+        if self.velocity_names is not None:  # quasi-velocities: Pinocchio's factorization
+            fast = self._reach if self._reach is not None else self._reach_kernel()
+            if fast and fast.coriolis is not None:  # compiled (reach_kernel.c)
+                try:
+                    return fast.coriolis(q, v)
+                except (ValueError, TypeError):
+                    pass  # numpy below broadcasts, or names the fault in one line
+            from .coriolis_tree import coriolis_matrix
+
+            return self._guarded(lambda Q, V: coriolis_matrix(self.kinematics, Q, V), (q, v),
+                                 ("q", "v"), (self.n, self.n))
         if not self._velocity_terms_are_christoffel():
             raise DerivationError(
                 "C(q, q_dot) is the matrix of the Coriolis and centrifugal terms of M; this "

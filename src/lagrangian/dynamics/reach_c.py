@@ -1,7 +1,7 @@
-"""J_dot q_dot, the centroidal momentum matrix and wrenches' generalized forces in compiled C
-(reach_kernel.c over the tree's numbers written as static tables), for the C backend's speed
-per call; centroidal.py and wrenches.py are the same formulas in numpy, used without a compiler
-and to name every bad input."""
+"""J_dot q_dot, the centroidal momentum matrix, wrenches' generalized forces and a floating
+base's C(q, v) in compiled C (reach_kernel.c over the tree's numbers written as static tables),
+for the C backend's speed per call; centroidal.py, wrenches.py and coriolis_tree.py are the same
+formulas in numpy, used without a compiler and to name every bad input."""
 
 from __future__ import annotations
 
@@ -11,10 +11,13 @@ from pathlib import Path
 import numpy as np
 
 from ..model.tree import KinematicTree
+from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import joint_model
 from .tree_c import _SINCOS
 
-_KERNEL = Path(__file__).with_name("reach_kernel.c")
+# the walks, C(q, v), then the Python bindings: one module's C, in this order
+_KERNELS = tuple(Path(__file__).with_name(name)
+                 for name in ("reach_kernel.c", "reach_coriolis.c", "reach_bindings.c"))
 REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
 
 
@@ -43,7 +46,7 @@ def _turn_tables(joints) -> list[str]:
 
 
 def kernel_source(tree: KinematicTree):
-    """The module's C: the tables, then reach_kernel.c."""
+    """The module's C: the tables, then reach_kernel.c, reach_coriolis.c, reach_bindings.c."""
     from ..compile.codegen import GeneratedSource
 
     joints, frames = tree.joints, tree.frames
@@ -58,11 +61,16 @@ def kernel_source(tree: KinematicTree):
         "#include <math.h>",
         f"#define RK_NB {len(joints)}",
         f"#define RK_N {len(tree.coordinates)}",
+        f"#define RK_FB {int(tree.floating_base)}",
+        # |quaternion|^2 within (1 -+ QUATERNION_TOLERANCE)^2, else numpy names the fault
+        f"#define RK_QLOW {(1 - QUATERNION_TOLERANCE) ** 2!r}",
+        f"#define RK_QHIGH {(1 + QUATERNION_TOLERANCE) ** 2!r}",
         f"#define RK_NF {len(frames)}",
         _table("rk_parent", "int", [j.parent for j in joints]),
         _table("rk_coord", "int", [j.coordinate for j in joints]),
-        _table("rk_turns", "int", [m.turns for m in models]),
-        _table("rk_slides", "int", [m.slides for m in models]),
+        # a free flyer neither turns nor slides about an axis (body 0, read by RK_FREE)
+        _table("rk_turns", "int", [getattr(m, "turns", False) for m in models]),
+        _table("rk_slides", "int", [getattr(m, "slides", False) for m in models]),
         _table("rk_mult", "double", [j.multiplier for j in joints]),
         _table("rk_off", "double", [j.offset for j in joints]),
         _table("rk_R0", "double", flat),
@@ -76,7 +84,7 @@ def kernel_source(tree: KinematicTree):
         _table("rk_fR", "double", [[x for row in f.rotation for x in row] for f in frames]),
         _table("rk_ft", "double", [list(f.translation) for f in frames]),
         _SINCOS,
-        _KERNEL.read_text(encoding="utf-8"),
+        *(path.read_text(encoding="utf-8") for path in _KERNELS),
     ])
     return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
 
@@ -87,10 +95,12 @@ def reach_module(tree: KinematicTree):
     from ..compile import compiled
     from .centroidal import ONE_DOF
 
-    if any(j.kind not in ONE_DOF for j in tree.joints):
-        return None  # a floating base: numpy's walks refuse it in one line
+    free = tree.floating_base  # a free flyer: body 0 only (RK_FREE)
+    if any(j.kind not in ONE_DOF for j in tree.joints[int(free):]):
+        return None  # a joint the kernel does not know: numpy's walks refuse it in one line
     here = Path(__file__)
-    generator = hashlib.sha256(_KERNEL.read_bytes() + here.read_bytes()
+    generator = hashlib.sha256(b"".join(path.read_bytes() for path in _KERNELS)
+                               + here.read_bytes()
                                + here.with_name("tree_c.py").read_bytes()).hexdigest()
     key = "\n".join(["reach", generator, repr(tree), repr(tree.frames)])
     try:
@@ -108,10 +118,13 @@ class ReachKernel:
         self.drift = module.drift
         # A_g needs a centre of mass: moving mass (else numpy refuses it in one line)
         self.centroidal = module.centroidal if massive else None
+        # a fixed base's C is M's Christoffel symbols (joint_space.py); a floating base's here
+        self.coriolis = module.coriolis if tree.floating_base else None
 
     def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> None:
-        """out += sign sum J^T w over the frames, in place (out of q's shape); ValueError or
-        KeyError where the inputs are not plain (the numpy path then names the fault)."""
+        """out += sign sum J^T w over the frames, in place (out: q's batch, nv wide); ValueError or
+        KeyError where the inputs are not plain or a base quaternion is off (the numpy path then
+        names the fault)."""
         wrench = self.module.wrench
         for name, w in wrenches.items():
             wrench(q, self.frame_index[name], w, out, sign)

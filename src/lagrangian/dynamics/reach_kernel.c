@@ -1,7 +1,15 @@
-/* J_dot q_dot of a frame, the centroidal momentum matrix and a wrench's generalized forces,
- * over the tree tables that reach_c.py writes above this text (rk_* arrays, RK_NB bodies,
- * RK_N coordinates, RK_NF frames). The same formulas as centroidal.py and wrenches.py:
- * spatial velocities at the world's origin in world axes, [v; w]. */
+/* J_dot q_dot of a frame, the centroidal momentum matrix, a wrench's generalized forces and
+ * C(q, v), over the tree tables that reach_c.py writes above this text (rk_* arrays, RK_NB
+ * bodies, RK_N joint coordinates, RK_NF frames; RK_FB 1 for a floating base: body 0 on a free
+ * flyer, q of RK_NQ = 7 + RK_N numbers and v of RK_NV = 6 + RK_N). The same formulas as
+ * centroidal.py, wrenches.py and coriolis_tree.py: spatial velocities at the world's origin in
+ * world axes, [v; w]. */
+
+#define RK_BQ (RK_FB ? 7 : 0)
+#define RK_BV (RK_FB ? 6 : 0)
+#define RK_NQ (RK_BQ + RK_N)
+#define RK_NV (RK_BV + RK_N)
+#define RK_FREE(i) (RK_FB && (i) == 0)
 
 #define RK_STR_(x) #x
 #define RK_STR(x) RK_STR_(x)
@@ -40,10 +48,21 @@ static inline void rk_matmul(const double *A, const double *B, double *out)
 static void rk_bodies(const double *q, double (*R)[9], double (*o)[3])
 {
     for (int i = 0; i < RK_NB; i++) {
-        double th = rk_mult[i] * q[rk_coord[i]] + rk_off[i];
+        double th = RK_FREE(i) ? 0.0 : rk_mult[i] * q[RK_BQ + rk_coord[i]] + rk_off[i];
         double Rl[9], pl[3] = {rk_t0[i][0], rk_t0[i][1], rk_t0[i][2]};
         const double *u = rk_u[i];
-        if (rk_turns[i]) {
+        if (RK_FREE(i)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
+            double x = q[3], y = q[4], z = q[5], w = q[6], Rq[9], d[3];
+            double k = 1.0 / (x * x + y * y + z * z + w * w);
+            Rq[0] = 1 - 2 * k * (y * y + z * z); Rq[1] = 2 * k * (x * y - z * w);
+            Rq[2] = 2 * k * (x * z + y * w); Rq[3] = 2 * k * (x * y + z * w);
+            Rq[4] = 1 - 2 * k * (x * x + z * z); Rq[5] = 2 * k * (y * z - x * w);
+            Rq[6] = 2 * k * (x * z - y * w); Rq[7] = 2 * k * (y * z + x * w);
+            Rq[8] = 1 - 2 * k * (x * x + y * y);
+            rk_matmul(rk_R0[i], Rq, Rl);
+            rk_apply(rk_R0[i], q, d);
+            for (int j = 0; j < 3; j++) pl[j] += d[j];
+        } else if (rk_turns[i]) {
             /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
             double c, s;
             lg_sincos(th, &s, &c);  /* inline (tree_c.py): a libm call costs a body's work */
@@ -85,6 +104,20 @@ static inline void rk_subspace(int i, double (*R)[9], double (*o)[3], double *S)
     for (int j = 0; j < 3; j++) { S[j] = v[j]; S[3 + j] = w[j]; }
 }
 
+/* a free flyer's six columns at the world's origin, world axes (S = 1 in the base's axes):
+ * S[c] = [R e_c; 0], S[3 + c] = [o x R e_c; R e_c] */
+static inline void rk_free_columns(const double *R, const double *o, double (*S)[6])
+{
+    for (int c = 0; c < 3; c++) {
+        double w[3] = {R[c], R[3 + c], R[6 + c]}, v[3];
+        rk_cross(o, w, v);
+        for (int j = 0; j < 3; j++) {
+            S[c][j] = w[j]; S[c][3 + j] = 0.0;
+            S[3 + c][j] = v[j]; S[3 + c][3 + j] = w[j];
+        }
+    }
+}
+
 /* the frame's rotation (frame -> world) and origin */
 static inline void rk_frame(int f, double (*R)[9], double (*o)[3], double *Rf, double *p)
 {
@@ -109,7 +142,17 @@ static void rk_drift(const double *q, const double *qd, int f, int ref, double *
     if (b < 0) return;
     rk_bodies(q, R, o);
     for (int i = 0; i <= b; i++) {
-        double S[6], c[6], rate = rk_mult[i] * qd[rk_coord[i]];
+        if (RK_FREE(i)) {  /* V = S v_base; no drift of its own (V x V = 0) */
+            double F[6][6];
+            rk_free_columns(R[0], o[0], F);
+            for (int j = 0; j < 6; j++) {
+                V[0][j] = 0.0;
+                A[0][j] = 0.0;
+                for (int c = 0; c < 6; c++) V[0][j] += F[c][j] * qd[c];
+            }
+            continue;
+        }
+        double S[6], c[6], rate = rk_mult[i] * qd[RK_BV + rk_coord[i]];
         int p = rk_parent[i];
         rk_subspace(i, R, o, S);
         for (int j = 0; j < 6; j++) {
@@ -152,7 +195,7 @@ static void rk_centroidal(const double *q, double *out)
 {
     double R[RK_NB][9], o[RK_NB][3], M[RK_NB], h[RK_NB][3], Ic[RK_NB][9];
     rk_bodies(q, R, o);
-    for (int j = 0; j < 6 * RK_N; j++) out[j] = 0.0;
+    for (int j = 0; j < 6 * RK_NV; j++) out[j] = 0.0;
     for (int i = 0; i < RK_NB; i++) {
         double hr[3], T[9], RJ[9];
         const double *p = o[i];
@@ -188,30 +231,41 @@ static void rk_centroidal(const double *q, double *out)
     }
     for (int j = 0; j < 3; j++) G[j] /= total;
     for (int i = 0; i < RK_NB; i++) {
-        double S[6], l[3], k[3], t[3];
-        rk_subspace(i, R, o, S);
-        rk_cross(S + 3, h[i], l);
-        rk_cross(h[i], S, k);
-        rk_apply(Ic[i], S + 3, t);
-        for (int j = 0; j < 3; j++) { l[j] += M[i] * S[j]; k[j] += t[j]; }
-        int c = rk_coord[i];
-        for (int j = 0; j < 3; j++) {
-            out[j * RK_N + c] += rk_mult[i] * l[j];
-            out[(3 + j) * RK_N + c] += rk_mult[i] * k[j];
+        double F[6][6], l[3], k[3], t[3];
+        int columns = 1, first = RK_BV + rk_coord[i];
+        double mult = rk_mult[i];
+        if (RK_FREE(i)) {
+            rk_free_columns(R[0], o[0], F);
+            columns = 6, first = 0, mult = 1.0;
+        } else {
+            rk_subspace(i, R, o, F[0]);
+        }
+        for (int col = 0; col < columns; col++) {
+            const double *S = F[col];
+            rk_cross(S + 3, h[i], l);
+            rk_cross(h[i], S, k);
+            rk_apply(Ic[i], S + 3, t);
+            for (int j = 0; j < 3; j++) { l[j] += M[i] * S[j]; k[j] += t[j]; }
+            int c = first + col;
+            for (int j = 0; j < 3; j++) {
+                out[j * RK_NV + c] += mult * l[j];
+                out[(3 + j) * RK_NV + c] += mult * k[j];
+            }
         }
     }
-    for (int c = 0; c < RK_N; c++) {  /* k_G = k_O - G x l */
-        double l[3] = {out[c], out[RK_N + c], out[2 * RK_N + c]}, t[3];
+    for (int c = 0; c < RK_NV; c++) {  /* k_G = k_O - G x l */
+        double l[3] = {out[c], out[RK_NV + c], out[2 * RK_NV + c]}, t[3];
         rk_cross(G, l, t);
-        for (int j = 0; j < 3; j++) out[(3 + j) * RK_N + c] -= t[j];
+        for (int j = 0; j < 3; j++) out[(3 + j) * RK_NV + c] -= t[j];
     }
 }
 
-/* tau (RK_N) of the wrench w = [f; m] at frame f's origin, world axes: sum k S^T [f; m + p x f] */
+/* tau (RK_NV) of the wrench w = [f; m] at frame f's origin, world axes: sum k S^T [f; m + p x f]
+ * (a free flyer's six: the force and the moment about the base's origin, base axes) */
 static void rk_wrench(const double *q, int f, const double *w, double *out)
 {
     double R[RK_NB][9], o[RK_NB][3], Rf[9], p[3], m[3];
-    for (int j = 0; j < RK_N; j++) out[j] = 0.0;
+    for (int j = 0; j < RK_NV; j++) out[j] = 0.0;
     int b = rk_fbody[f];
     if (b < 0) return;
     rk_bodies(q, R, o);
@@ -220,143 +274,16 @@ static void rk_wrench(const double *q, int f, const double *w, double *out)
     for (int j = 0; j < 3; j++) m[j] += w[3 + j];
     for (int i = b; i >= 0; i = rk_parent[i]) {
         double S[6];
+        if (RK_FREE(i)) {  /* R^T f and R^T (m_O - o x f) */
+            double t[3], n[3];
+            rk_cross(o[0], w, t);
+            for (int j = 0; j < 3; j++) n[j] = m[j] - t[j];
+            rk_apply_t(R[0], w, out);
+            rk_apply_t(R[0], n, out + 3);
+            continue;
+        }
         rk_subspace(i, R, o, S);
-        out[rk_coord[i]] += rk_mult[i] * (S[0] * w[0] + S[1] * w[1] + S[2] * w[2]
-                                          + S[3] * m[0] + S[4] * m[1] + S[5] * m[2]);
+        out[RK_BV + rk_coord[i]] += rk_mult[i] * (S[0] * w[0] + S[1] * w[1] + S[2] * w[2]
+                                                  + S[3] * m[0] + S[4] * m[1] + S[5] * m[2]);
     }
-}
-
-/* -- Python bindings: arrays (..., n) of float64, one output row per state ------------------ */
-
-static PyArrayObject *rk_input(PyObject *x, int last, const char *name)
-{
-    PyArrayObject *a;
-    if (PyArray_CheckExact(x) && PyArray_TYPE((PyArrayObject *)x) == NPY_DOUBLE
-            && PyArray_IS_C_CONTIGUOUS((PyArrayObject *)x) && PyArray_ISALIGNED((PyArrayObject *)x)
-            && PyArray_NDIM((PyArrayObject *)x) >= 1) {
-        a = (PyArrayObject *)x;  /* the usual case: taken as it is, no conversion */
-        Py_INCREF(a);
-    } else {
-        a = (PyArrayObject *)PyArray_FROMANY(x, NPY_DOUBLE, 1, 0, NPY_ARRAY_IN_ARRAY);
-    }
-    if (!a) return NULL;
-    int nd = PyArray_NDIM(a);
-    if (PyArray_DIMS(a)[nd - 1] != last) {
-        PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis", name, last);
-        Py_DECREF(a);
-        return NULL;
-    }
-    return a;
-}
-
-static PyObject *rk_output(PyArrayObject *like, int tail0, int tail1)
-{
-    npy_intp dims[NPY_MAXDIMS];
-    int nd = PyArray_NDIM(like) - 1;
-    for (int k = 0; k < nd; k++) dims[k] = PyArray_DIMS(like)[k];
-    dims[nd++] = tail0;
-    if (tail1) dims[nd++] = tail1;
-    return PyArray_SimpleNew(nd, dims, NPY_DOUBLE);
-}
-
-static int rk_same_batch(PyArrayObject *a, PyArrayObject *b, const char *name)
-{
-    int nd = PyArray_NDIM(a);
-    if (PyArray_NDIM(b) != nd) goto bad;
-    for (int k = 0; k < nd - 1; k++)
-        if (PyArray_DIMS(a)[k] != PyArray_DIMS(b)[k]) goto bad;
-    return 1;
-bad:
-    PyErr_Format(PyExc_ValueError, "%s: batch shapes differ", name);
-    return 0;
-}
-
-static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    (void)self;
-    if (nargs != 4) { PyErr_SetString(PyExc_TypeError, "drift(Q, V, frame, ref)"); return NULL; }
-    int f = (int)PyLong_AsLong(args[2]), ref = (int)PyLong_AsLong(args[3]);
-    if (PyErr_Occurred()) return NULL;
-    if (f < 0 || f >= RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
-    PyArrayObject *Q = rk_input(args[0], RK_N, "q");
-    if (!Q) return NULL;
-    PyArrayObject *V = rk_input(args[1], RK_N, "v");
-    if (!V || !rk_same_batch(Q, V, "v")) { Py_DECREF(Q); Py_XDECREF(V); return NULL; }
-    PyObject *out = rk_output(Q, 6, 0);
-    if (out) {
-        npy_intp count = PyArray_SIZE(Q) / RK_N;
-        const double *q = PyArray_DATA(Q), *v = PyArray_DATA(V);
-        double *y = PyArray_DATA((PyArrayObject *)out);
-        for (npy_intp k = 0; k < count; k++) rk_drift(q + k * RK_N, v + k * RK_N, f, ref, y + 6 * k);
-    }
-    Py_DECREF(Q); Py_DECREF(V);
-    return out;
-}
-
-static PyObject *rk_py_centroidal(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    (void)self;
-    if (nargs != 1) { PyErr_SetString(PyExc_TypeError, "centroidal(Q)"); return NULL; }
-    PyArrayObject *Q = rk_input(args[0], RK_N, "q");
-    if (!Q) return NULL;
-    PyObject *out = rk_output(Q, 6, RK_N);
-    if (out) {
-        npy_intp count = PyArray_SIZE(Q) / RK_N;
-        const double *q = PyArray_DATA(Q);
-        double *y = PyArray_DATA((PyArrayObject *)out);
-        for (npy_intp k = 0; k < count; k++) rk_centroidal(q + k * RK_N, y + 6 * RK_N * k);
-    }
-    Py_DECREF(Q);
-    return out;
-}
-
-/* wrench(Q, frame, W, OUT, sign): OUT += sign J^T w, in place (OUT float64, contiguous, of
- * Q's shape); W (6,) for every state or one row per state */
-static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    (void)self;
-    if (nargs != 5) { PyErr_SetString(PyExc_TypeError, "wrench(Q, frame, W, OUT, sign)"); return NULL; }
-    int f = (int)PyLong_AsLong(args[1]);
-    double sign = PyFloat_AsDouble(args[4]);
-    if (PyErr_Occurred()) return NULL;
-    if (f < 0 || f >= RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
-    if (!PyArray_Check(args[3])) { PyErr_SetString(PyExc_ValueError, "out: not an array"); return NULL; }
-    PyArrayObject *out = (PyArrayObject *)args[3];
-    PyArrayObject *Q = rk_input(args[0], RK_N, "q");
-    if (!Q) return NULL;
-    PyArrayObject *W = rk_input(args[2], 6, "f_ext");
-    if (!W) { Py_DECREF(Q); return NULL; }
-    int shared = PyArray_NDIM(W) == 1;
-    if ((!shared && !rk_same_batch(Q, W, "f_ext"))
-            || PyArray_TYPE(out) != NPY_DOUBLE || !PyArray_ISCARRAY(out)
-            || PyArray_NDIM(out) != PyArray_NDIM(Q)
-            || !PyArray_CompareLists(PyArray_DIMS(out), PyArray_DIMS(Q), PyArray_NDIM(Q))) {
-        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "out: not of q's shape");
-        Py_DECREF(Q); Py_DECREF(W);
-        return NULL;
-    }
-    npy_intp count = PyArray_SIZE(Q) / RK_N;
-    const double *q = PyArray_DATA(Q), *w = PyArray_DATA(W);
-    double *y = PyArray_DATA(out), tau[RK_N];
-    for (npy_intp k = 0; k < count; k++) {
-        rk_wrench(q + k * RK_N, f, w + (shared ? 0 : 6 * k), tau);
-        for (int j = 0; j < RK_N; j++) y[RK_N * k + j] += sign * tau[j];
-    }
-    Py_DECREF(Q); Py_DECREF(W);
-    Py_RETURN_NONE;
-}
-
-static PyMethodDef rk_methods[] = {
-    {"drift", (PyCFunction)(void (*)(void))rk_py_drift, METH_FASTCALL, "(Q, V, frame, ref) -> [a; w_dot]"},
-    {"centroidal", (PyCFunction)(void (*)(void))rk_py_centroidal, METH_FASTCALL, "(Q) -> A_g"},
-    {"wrench", (PyCFunction)(void (*)(void))rk_py_wrench, METH_FASTCALL, "(Q, frame, W, OUT, sign): OUT += sign J^T w"},
-    {NULL, NULL, 0, NULL},
-};
-
-static struct PyModuleDef rk_module = {PyModuleDef_HEAD_INIT, RK_STR(LG_MODULE), NULL, -1, rk_methods};
-
-PyMODINIT_FUNC RK_PASTE(PyInit_, LG_MODULE)(void)
-{
-    import_array();
-    return PyModule_Create(&rk_module);
 }

@@ -5,7 +5,8 @@ the frame's origin and both vectors in world axes (the LOCAL_WORLD_ALIGNED conve
 frame Jacobian, whose J^T takes it to joint space). Inverse dynamics then gives the joint
 forces with the wrench acting (tau = M a + b - tau_ext); forward dynamics adds tau_ext to tau.
 (Pinocchio's f_ext is per joint, in the joint's own axes about its origin: the same wrench is
-R_j^T f and R_j^T (m + (p - o_j) x f) there.)
+R_j^T f and R_j^T (m + (p - o_j) x f) there.) On a floating base the base's six numbers take
+the wrench carried to the base: its force and its moment about the base's origin, base axes.
 """
 
 from __future__ import annotations
@@ -46,21 +47,22 @@ def wrench_forces(kinematics, q, f_ext) -> np.ndarray:
     """tau_ext = sum J_frame(q)^T w_frame (N m or N per coordinate), shape (..., n): the
     generalized forces of wrenches at frames (world axes, at each frame's origin). Each wrench
     is carried to the world's origin (m_O = m + p x f) and projected on the joint motions S
-    there: tau_j = k (s_v . f + s_w . m_O) for the joints above the frame's body."""
-    from .centroidal import _world_subspace, require_fixed_base
-    from .recursive_numpy import _cross, _dot
+    there: tau_j = k (s_v . f + s_w . m_O) for the joints above the frame's body (a free
+    flyer's six columns S: its force and moment about the base's origin, base axes)."""
+    from .centroidal import require_known_joints, world_columns
+    from .recursive_numpy import _cross
 
     tree = getattr(kinematics, "tree", None)
     if tree is not None:
-        require_fixed_base(tree, "wrenches at frames", "f_ext")
+        require_known_joints(tree, "wrenches at frames", "f_ext")
     wrenches = wrench_arrays(kinematics, f_ext)
     Q, batch = kinematics._q(q)
     for w in wrenches.values():
         batch = np.broadcast_shapes(batch, w.shape[:-1])
     count = int(np.prod(batch, dtype=np.int64))
     if len(Q) != count:
-        Q = np.broadcast_to(np.asarray(q, dtype=float), batch + (kinematics.n,)).reshape(
-            count, kinematics.n)
+        nq = Q.shape[-1]
+        Q = np.broadcast_to(np.asarray(q, dtype=float), batch + (nq,)).reshape(count, nq)
     if tree is None:  # a model file's frames (model_frames.py): J^T w from their Jacobians
         total = np.zeros((count, kinematics.n))
         for name, w in wrenches.items():
@@ -75,12 +77,10 @@ def wrench_forces(kinematics, q, f_ext) -> np.ndarray:
             continue  # on the ground: no joint feels it
         w = np.broadcast_to(w, batch + (6,)).reshape(count, 6)
         p = kinematics._frame_pose(Q, bodies, name)[1]
-        force, moment = w[:, :3], w[:, 3:] + _cross(p, w[:, :3])
+        at_origin = np.concatenate([w[:, :3], w[:, 3:] + _cross(p, w[:, :3])], axis=1)
         for k in kinematics._ancestors(body):
-            joint = kinematics.tree.joints[k]
-            s_v, s_w = _world_subspace(kinematics, k, joint, bodies[k])
-            share = _dot(s_v, force) + (0.0 if s_w is None else _dot(s_w, moment))
-            total[:, joint.coordinate] += joint.multiplier * share
+            S, index = world_columns(kinematics, k, kinematics.tree.joints[k], bodies[k])
+            total[:, index] += (at_origin[:, None, :] @ S)[:, 0]  # S^T [f; m_O]
     return total.reshape(batch + (kinematics.n,))
 
 

@@ -1,0 +1,122 @@
+"""A floating base's C(q, v), J_dot v, centroidal momentum matrix and inverse dynamics with a
+wrench at a foot, ours (the compiled reach kernel) beside Pinocchio's free flyer, per Python
+call of one state and for a batch of 10^4 states against a Python loop of Pinocchio calls.
+
+    python benchmarks/bench_floating_reach.py
+
+Needs the bench extra (pin, example-robot-data). Each per-call figure is the best of 7 rounds
+of 300 calls, ours and Pinocchio's rounds alternating in one process; each batch figure the
+best of 3 (one call of ours on 10^4 states, a loop of 10^4 Pinocchio calls). The load average
+is printed before and after.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+import lagrangian
+
+sys.path.insert(0, str(Path(__file__).parent))
+from bench_urdf import load_average, robots_folder  # noqa: E402 (the sibling benchmark's)
+
+ROBOTS = (("solo_description/robots/solo12.urdf", "FL_FOOT"),
+          ("talos_data/robots/talos_reduced.urdf", "left_sole_link"))
+
+
+def best(function, calls: int, rounds: int) -> float:
+    """Best seconds per call of function() over ``rounds`` rounds of ``calls`` calls."""
+    out = float("inf")
+    for _ in range(rounds):
+        start = time.perf_counter()
+        for _ in range(calls):
+            function()
+        out = min(out, (time.perf_counter() - start) / calls)
+    return out
+
+
+def interleaved(ours, theirs, calls: int = 300, rounds: int = 7) -> tuple[float, float]:
+    """Best seconds per call of each, their rounds alternating."""
+    ours(), theirs()
+    a = b = float("inf")
+    for _ in range(rounds):
+        a = min(a, best(ours, calls, 1))
+        b = min(b, best(theirs, calls, 1))
+    return a, b
+
+
+def measure(ours, theirs, Q, V, A, count: int) -> tuple[float, float, float, float]:
+    """Seconds: one call of ours and of Pinocchio's (interleaved), 10^4 states in one call of
+    ours and in a loop of Pinocchio's."""
+    one_ours, one_theirs = interleaved(lambda: ours(Q[0], V[0], A[0]), lambda: theirs(0))
+    batch_ours = best(lambda: ours(Q, V, A), 1, 3)
+    batch_theirs = best(lambda: [theirs(k) for k in range(count)], 1, 3)
+    return one_ours, one_theirs, batch_ours, batch_theirs
+
+
+def bench_robot(name: str, foot: str, count: int = 10_000) -> None:
+    import pinocchio as pin
+
+    path = robots_folder() / name
+    model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    data = model.createData()
+    robot = lagrangian.load(path, floating_base=True).dynamics(backend="c")
+    order = [j.name for j in robot.tree.joints[1:]]  # ours in the URDF's order
+    iq = np.r_[np.arange(7), [model.idx_qs[model.getJointId(j)] for j in order]]
+    iv = np.r_[np.arange(6), [model.idx_vs[model.getJointId(j)] for j in order]]
+    rng = np.random.default_rng(0)
+    q = np.array([pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+                  for _ in range(count)])
+    v, a = rng.uniform(-1, 1, (2, count, model.nv))
+    Q, V, A = (np.ascontiguousarray(x) for x in (q[:, iq], v[:, iv], a[:, iv]))
+    frame = model.getFrameId(foot)
+    joint = model.frames[frame].parentJoint
+    wrench = np.array([0.0, 0.0, 50.0, 0.0, 0.0, 0.0])  # 50 N up at the foot, world axes
+    f_ext = {foot: wrench}
+    # the same wrench as Pinocchio's f_ext (the joint's axes, about its origin), at state 0
+    pin.framesForwardKinematics(model, data, q[0])
+    forces = pin.StdVec_Force()
+    for _ in range(model.njoints):
+        forces.append(pin.Force.Zero())
+    placement = data.oMi[joint]
+    arm = data.oMf[frame].translation - placement.translation
+    forces[joint] = pin.Force(placement.rotation.T @ wrench[:3],
+                              placement.rotation.T @ np.cross(arm, wrench[:3]))
+
+    def drift(k):
+        pin.forwardKinematics(model, data, q[k], v[k], 0 * v[k])
+        pin.updateFramePlacement(model, data, frame)
+        return pin.getFrameClassicalAcceleration(model, data, frame,
+                                                 pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+
+    cases = {
+        "coriolis_matrix": (lambda x, y, z: robot.coriolis_matrix(x, y),
+                            lambda k: pin.computeCoriolisMatrix(model, data, q[k], v[k])),
+        "jacobian_dot_times_v": (lambda x, y, z: robot.jacobian_dot_times_v(x, y, foot), drift),
+        "centroidal_momentum_matrix": (lambda x, y, z: robot.centroidal_momentum_matrix(x),
+                                       lambda k: pin.ccrba(model, data, q[k], v[k])),
+        "inverse_dynamics f_ext": (lambda x, y, z: robot.inverse_dynamics(x, y, z, f_ext=f_ext),
+                                   lambda k: pin.rnea(model, data, q[k], v[k], a[k], forces)),
+    }
+    print(f"{path.name}: nq {model.nq}, nv {model.nv}")
+    print("  function: one call ours / Pinocchio us (ratio Pinocchio/ours); "
+          "10^4 states ours / Pinocchio loop ms (ratio)")
+    for label, (ours, theirs) in cases.items():
+        one_ours, one_theirs, batch_ours, batch_theirs = measure(ours, theirs, Q, V, A, count)
+        print(f"  {label}: {one_ours * 1e6:.2f} / {one_theirs * 1e6:.2f} "
+              f"({one_theirs / one_ours:.2f}x); {batch_ours * 1e3:.1f} / "
+              f"{batch_theirs * 1e3:.1f} ({batch_theirs / batch_ours:.1f}x)")
+
+
+def main() -> None:
+    print(f"load average {load_average()}")
+    for name, foot in ROBOTS:
+        bench_robot(name, foot)
+    print(f"load average {load_average()}")
+
+
+if __name__ == "__main__":
+    main()

@@ -363,6 +363,21 @@ def _holder(point, bodies: list[_FreeBody], model: Model, points: eq.Points) -> 
     return None
 
 
+def carried(model: Model) -> dict[str, list[str]]:
+    """Each body in space's name -> itself and every body it carries (the subtree it heads)."""
+    children: dict[str | None, list[str]] = {}
+    for body in model.rigid_bodies:
+        children.setdefault(body.parent, []).append(body.name)
+
+    def subtree(name: str) -> list[str]:  # depth first, without recursion (deep chains)
+        found, stack = [], [name]
+        while stack:
+            found.append(stack.pop())
+            stack.extend(reversed(children.get(found[-1], [])))
+        return found
+    return {body.name: subtree(body.name) for body in model.rigid_bodies}
+
+
 def _line(ends: tuple[Attachment, Attachment]):
     """(end a, end b, unit vector from b to a, distance) of a two-point element."""
     a, b = ends

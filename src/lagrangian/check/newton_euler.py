@@ -52,6 +52,7 @@ from .free_bodies import (
     _FreeBody,
     _projected_equations,
     _require_free_bodies,
+    carried,
 )
 
 SYMBOLIC_REACTIONS_MAX_UNKNOWNS = 3
@@ -272,17 +273,11 @@ def _joint_reactions(model: Model, bodies: list[_FreeBody]):
     it heads of m a_G - F (N) and, about J in world axes, (r_G - r_J) x (m a_G - F) +
     R (I alpha + omega x I omega) - M_G (N m)."""
     free = {fb.name: fb for fb in bodies}
-    children: dict[str | None, list[str]] = {}
-    for body in model.rigid_bodies:
-        children.setdefault(body.parent, []).append(body.name)
-
-    def subtree(name: str) -> list[str]:
-        return [name] + [d for child in children.get(name, []) for d in subtree(child)]
-
+    subtrees = carried(model)
     for body in model.rigid_bodies:
         joint = sp.Matrix(body.origin)
         force, moment = sp.zeros(3, 1), sp.zeros(3, 1)
-        for name in subtree(body.name):
+        for name in subtrees[body.name]:
             fb = free[name]
             inertial = sp.Matrix([fb.mass * a - f for a, f in zip(fb.acceleration, fb.force,
                                                                   strict=True)])

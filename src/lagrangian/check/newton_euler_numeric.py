@@ -26,7 +26,14 @@ from ..errors import LagrangianError
 from ..model.model import Model
 from ..model.values import resolve_parameters, resolve_state
 from . import equivalence as eq
-from .free_bodies import _AppliedForces, _Clock, _FreeBody, _require_free_bodies, free_body
+from .free_bodies import (
+    _AppliedForces,
+    _Clock,
+    _FreeBody,
+    _require_free_bodies,
+    carried,
+    free_body,
+)
 from .jets import JetEvaluator, UnsupportedExpression
 from .newton_euler import CoordinateAgreement, CrosscheckReport, Reaction
 
@@ -303,17 +310,11 @@ def _reactions(model: Model, lanes: _Lanes, bodies: list[_FreeBody]):
             labels.append("M_z")
         yield Reaction(fb.name, tuple(labels), tuple(sp.Float(c) for c in components),
                        tuple(components))
-    children: dict[str | None, list[str]] = {}
-    for body in model.rigid_bodies:
-        children.setdefault(body.parent, []).append(body.name)
-
-    def subtree(name: str) -> list[str]:
-        return [name] + [d for child in children.get(name, []) for d in subtree(child)]
-
+    subtrees = carried(model)
     for body in model.rigid_bodies:
         joint = np.array([value(c) for c in body.origin])
         force, moment = np.zeros(3), np.zeros(3)
-        for name in subtree(body.name):
+        for name in subtrees[body.name]:
             fb, k = number[name], kept[name]
             inertial = k["mass"][0] * k["acceleration"][:, 0] - np.array([value(c) for c in
                                                                          fb.force])

@@ -74,3 +74,39 @@ V = "1/2*k*x^2"
 """)
     report = check_model_units(model)
     assert report.consistent and report.unchecked == ("m",)
+
+
+FORGOT_L = """
+name = "forgot L"
+[coordinates]
+theta = "rad"
+[parameters]
+m = { value = 1.0, unit = "kg" }
+L = { value = 0.5, unit = "m" }
+[[particles]]
+name = "bob"
+mass = "m"
+position = ["L*sin(theta)", "%s"]
+"""
+
+
+def test_geometry_in_bare_numbers_is_si_metres_but_a_forgotten_length_is_caught():
+    """A chain whose joints and centres are bare numbers (SI metres, as in a URDF) is not a
+    flood of 'no units' warnings; a model that names its length L in x and forgets it in y
+    is still told so."""
+    b = lagrangian.SystemBuilder("numbers")
+    b.parameter("g", 9.81, unit="m/s^2")
+    b.set_gravity("g", (0, 0, -1))
+    parent = None
+    for i in range(3):
+        b.coordinate(f"q{i}", "rad")
+        joint = {"type": "revolute", "axis": "xy"[i % 2], "angle": f"q{i}"}
+        if parent:
+            joint["at"] = [0, 0, -1]
+        b.add_rigid_body(f"link{i}", 1.0, [0.1, 0.1, 0.02], parent=parent, joint=joint,
+                         center=[0, 0, -0.5])
+        parent = f"link{i}"
+    assert check_model_units(b.build().model).consistent
+    wrong = check_model_units(lagrangian.parse_model(FORGOT_L % "-cos(theta)"))
+    assert [i.item for i in wrong.issues] == ["particles[bob].position.y"]
+    assert check_model_units(lagrangian.parse_model(FORGOT_L % "-L*cos(theta)")).consistent

@@ -264,10 +264,18 @@ def check_model_units(model: Model) -> UnitsReport:
     # A robot read from URDF: its lengths, masses and inertias are SI numbers by the format
     # (m, kg, kg m^2), multiplied by sines of the joint angles; no symbol with a unit to judge.
     rigid_bodies = model.rigid_bodies if model.kinematic_tree is None else ()
-    for component in (*model.particles, *model.bodies, *rigid_bodies, *model.springs,
-                      *model.dampers, *model.loads):
-        for item in unit_items(component):
-            c(*item)
+    items = [item for component in (*model.particles, *model.bodies, *rigid_bodies,
+                                    *model.springs, *model.dampers, *model.loads)
+             for item in unit_items(component)]
+    # A model whose positions never name a length (center = [0, 0, -0.5], turned by angles)
+    # writes its geometry in SI metres by the format, as a URDF does: nothing to judge there.
+    # One that names a length somewhere (L in x) is judged everywhere (y = -cos(theta) is wrong).
+    numbers_only = not any(_names_a_length(item[1], checker.units) for item in items
+                           if item[2] == "m")
+    for item in items:
+        if numbers_only and item[2] == "m" and _numbers_and_angles(item[1], checker.units):
+            continue
+        c(*item)
     for name, value in model.generalized_forces:
         coordinate = model.coordinate(name)
         c(f"Q[{name}]", value, generalized_force_unit(coordinate.unit),
@@ -283,6 +291,19 @@ def unit_items(component) -> list[tuple]:
     """(field, expression, expected SI unit, what it is) for each part of one component: one
     table entry per kind (tests/model/test_component_tables.py walks every kind)."""
     raise TypeError(f"no units for a component of kind {type(component).__name__}")
+
+
+def _numbers_and_angles(expr, units) -> bool:
+    """Whether ``expr`` holds no symbol but dimensionless ones (angles), and one at least."""
+    symbols = getattr(expr, "free_symbols", set())
+    return bool(symbols) and all(units.get(s) is not None and units[s].dimensionless
+                                 for s in symbols)
+
+
+def _names_a_length(expr, units) -> bool:
+    """Whether ``expr`` holds a symbol whose unit has a length in it (m, m/s, ...)."""
+    return any(units.get(s) is not None and "[length]" in units[s].dimensionality
+               for s in getattr(expr, "free_symbols", ()))
 
 
 def _lengths(where: str, vector) -> list[tuple]:

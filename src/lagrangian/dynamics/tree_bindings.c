@@ -55,9 +55,11 @@ static void *rt_run(void *argument)
     double *y = job->y;
     npy_intp bad = 0, count = job->k1, k = job->k0;
     (void)nin; (void)size;
-#if RT_VECTOR
-    /* LG_LANES states at a time through the vector variants, the rest one by one */
-    for (; k + LG_LANES <= count && (kind != RT_FORWARD || RT_VECTOR_FORWARD); k += LG_LANES) {
+#if RT_VECTOR || RT_VECTOR_FORWARD
+    /* LG_LANES states at a time through the vector variants (every function's, or forward
+       dynamics' alone), the rest one by one */
+    for (; k + LG_LANES <= count && (kind == RT_FORWARD ? RT_VECTOR_FORWARD : RT_VECTOR);
+         k += LG_LANES) {
         lg_v4 in[3][RT_NQ], out4[LG_N * LG_N];
         for (int j = 0; j < nin; j++) {
             const double *x = j == 0 ? x0 : j == 1 ? x1 : x2;
@@ -65,15 +67,18 @@ static void *rt_run(void *argument)
                 for (int i = 0; i < RT_WIDTH(j); i++) in[j][i][l] = x[(k + l) * step[j] + i];
         }
         switch (kind) {
+#if RT_VECTOR
         case RT_MASS: rt4_mass_matrix(in[0], p, out4); break;
         case RT_BIAS: rt4_bias_forces(in[0], in[1], p, out4); break;
         case RT_GRAVITY: rt4_gravity(in[0], p, out4); break;
         case RT_INVERSE: rt4_inverse_dynamics(in[0], in[1], in[2], p, out4); break;
+        case RT_KINETIC: rt4_kinetic_energy(in[0], in[1], p, out4); break;
+        case RT_POTENTIAL: rt4_potential_energy(in[0], p, out4); break;
+#endif
 #if RT_VECTOR_FORWARD
         case RT_FORWARD: rt4_forward_dynamics(in[0], in[1], in[2], p, out4); break;
 #endif
-        case RT_KINETIC: rt4_kinetic_energy(in[0], in[1], p, out4); break;
-        case RT_POTENTIAL: rt4_potential_energy(in[0], p, out4); break;
+        default: break;
         }
         for (int l = 0; l < LG_LANES; l++) {
             int fine = 1;
@@ -176,6 +181,25 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
         }
         step[i] = RT_WIDTH(i);
     }
+#if RT_FLOATING
+    /* a floating base: each finite state's quaternion q[3..6] unit to RT_QUATERNION_TOLERANCE
+       (free_flyer.py), here rather than in Python (a microsecond a call); the caller names the
+       state and the norm */
+    {
+        const double *xq = (const double *)PyArray_DATA(in[0]);
+        const npy_intp states = step[0] ? count : 1;
+        for (npy_intp k = 0; k < states; k++) {
+            const double *x = xq + k * step[0];
+            int finite = 1;
+            for (int i = 0; i < RT_NQ; i++) finite &= isfinite(x[i]) != 0;
+            const double norm = sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6]);
+            if (finite && !(fabs(norm - 1.0) <= RT_QUATERNION_TOLERANCE)) {
+                PyErr_SetString(PyExc_ValueError, "q: the base quaternion is not unit");
+                goto done;
+            }
+        }
+    }
+#endif
     P = lg_doubles(args[nin], LG_NP, "parameters");
     if (!P) goto done;
     npy_intp dims[NPY_MAXDIMS];

@@ -25,7 +25,8 @@ typedef struct {
     npy_intp step[3];
     const double *x0, *x1, *x2, *p;
     double *y;
-    npy_intp k0, k1, bad;
+    npy_intp count, bad;  /* the batch's states; how many came out NaN */
+    npy_intp *next;  /* the first state no thread has taken yet (shared by the threads) */
 } rt_job;
 
 /* Whether state k's inputs are all finite. */
@@ -46,14 +47,14 @@ static inline void rt_blank(double *y, int size, npy_intp k)
     for (int i = 0; i < size; i++) y[k * size + i] = NAN;
 }
 
-static void *rt_run(void *argument)
+/* States k..count - 1 of the job; gives how many came out NaN. */
+static npy_intp rt_range(const rt_job *job, npy_intp k, npy_intp count)
 {
-    rt_job *job = (rt_job *)argument;
     const int kind = job->kind, nin = job->nin, size = job->size;
     const npy_intp *step = job->step;
     const double *x0 = job->x0, *x1 = job->x1, *x2 = job->x2, *p = job->p;
     double *y = job->y;
-    npy_intp bad = 0, count = job->k1, k = job->k0;
+    npy_intp bad = 0;
     (void)nin; (void)size;
 #if RT_VECTOR || RT_VECTOR_FORWARD
     /* LG_LANES states at a time through the vector variants (every function's, or forward
@@ -116,6 +117,27 @@ static void *rt_run(void *argument)
         case RT_POTENTIAL: y[k] = rt_potential_energy(a0, p); break;
         }
     }
+    return bad;
+}
+
+/* A thread's work: blocks of RT_BLOCK states taken in turn from the shared counter until
+   none is left, so that a thread slowed by the machine's other work (a shared processor)
+   takes fewer rather than holding the others up. */
+#define RT_BLOCK 64  /* a multiple of LG_LANES: only the batch's last states run one by one */
+static void *rt_run(void *argument)
+{
+    rt_job *job = (rt_job *)argument;
+    npy_intp bad = 0;
+    for (;;) {
+#if RT_PTHREADS
+        const npy_intp k = __atomic_fetch_add(job->next, RT_BLOCK, __ATOMIC_RELAXED);
+#else
+        const npy_intp k = *job->next;
+        *job->next += RT_BLOCK;
+#endif
+        if (k >= job->count) break;
+        bad += rt_range(job, k, k + RT_BLOCK < job->count ? k + RT_BLOCK : job->count);
+    }
     job->bad = bad;
     return NULL;
 }
@@ -144,6 +166,20 @@ static int rt_threads(npy_intp count)
 #endif
 }
 
+/* An argument as C-ordered doubles: an array that already is one taken as it is (the common
+   call, a fraction of a microsecond less than the general conversion), else converted. */
+static PyArrayObject *rt_doubles(PyObject *x)
+{
+    if (PyArray_CheckExact(x)) {
+        PyArrayObject *a = (PyArrayObject *)x;
+        if (PyArray_TYPE(a) == NPY_DOUBLE && PyArray_ISCARRAY_RO(a) && PyArray_ISNOTSWAPPED(a)) {
+            Py_INCREF(x);
+            return a;
+        }
+    }
+    return (PyArrayObject *)PyArray_FROMANY(x, NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
+}
+
 static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int kind)
 {
     PyArrayObject *in[3] = {NULL, NULL, NULL}, *P = NULL;
@@ -155,7 +191,7 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     }
     int base = 0;
     for (int i = 0; i < nin; i++) {
-        in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
+        in[i] = rt_doubles(args[i]);
         if (!in[i]) goto done;
         int nd = PyArray_NDIM(in[i]);
         if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != RT_WIDTH(i)) {
@@ -218,18 +254,17 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
                      : (kind == RT_KINETIC || kind == RT_POTENTIAL) ? 1 : LG_N;
     rt_job jobs[RT_MAX_THREADS];
     int parts = rt_threads(count);
-    npy_intp share = (count / parts + LG_LANES - 1) / LG_LANES * LG_LANES;
+    npy_intp next = 0;
     for (int t = 0; t < parts; t++) {
-        rt_job job = {kind, nin, size, {step[0], step[1], step[2]}, x0, x1, x2, p, y,
-                      t * share < count ? t * share : count,
-                      t == parts - 1 || (t + 1) * share > count ? count : (t + 1) * share, -1};
+        rt_job job = {kind, nin, size, {step[0], step[1], step[2]}, x0, x1, x2, p, y, count, 0,
+                      &next};
         jobs[t] = job;
     }
     npy_intp bad = 0;
     NPY_BEGIN_THREADS_DEF;
     if (count > 16) NPY_BEGIN_THREADS;
-    /* the batch in parts on threads of their own (the functions keep no state), this thread
-       taking the last part; a thread that cannot start leaves its part to this one */
+    /* the batch on threads of their own (the functions keep no state), this thread one of
+       them; a thread that cannot start leaves its blocks to the others */
 #if RT_PTHREADS
     pthread_t threads[RT_MAX_THREADS];
     int started[RT_MAX_THREADS] = {0};

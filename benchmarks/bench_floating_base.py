@@ -113,7 +113,9 @@ def main() -> None:
             backend="numpy").tree.joints[1:]]
         iq = np.r_[np.arange(7), [model.idx_qs[model.getJointId(j)] for j in order]]
         iv = np.r_[np.arange(6), [model.idx_vs[model.getJointId(j)] for j in order]]
-        q, v, tau = q[:, iq], v[:, iv], tau[:, iv]
+        # C-ordered, as a user's arrays are (a column selection is Fortran-ordered: converted
+        # on every call)
+        q, v, tau = (np.ascontiguousarray(x) for x in (q[:, iq], v[:, iv], tau[:, iv]))
         print(f"{path.name}: nq {model.nq}, nv {model.nv}; microseconds per state")
         for backend in ("c", "numpy"):
             robot = lagrangian.load(path, floating_base=True).dynamics(backend=backend)

@@ -116,12 +116,7 @@ class RecursiveDynamics(TreeDynamics):
         self._mass, self._bias, self._gravity = m.mass_matrix, m.bias_forces, m.gravity
         self._inverse, self._forward = m.inverse_dynamics, m.forward_dynamics
         self._kinetic, self._potential = m.kinetic_energy, m.potential_energy
-        self._P = P
-        if tree.floating_base:  # its quaternion checked first (free_flyer.py), then the C
-            self._mass, self._bias, self._gravity, self._inverse, self._forward, self._kinetic, \
-                self._potential = (_checking_quaternion(f) for f in (
-                    self._mass, self._bias, self._gravity, self._inverse, self._forward,
-                    self._kinetic, self._potential))
+        self._P = P  # a floating base's quaternion: the module checks its norm (ValueError)
 
     def regular(self) -> bool:
         """Whether M is positive definite at a few random states (a massless branch is not)."""
@@ -155,11 +150,14 @@ class RecursiveDynamics(TreeDynamics):
         try:
             return function(*arrays, self._P)
         except ValueError as exc:
+            if str(exc).startswith("q: the base quaternion"):  # the module's check: say more
+                return function(_unit_quaternions(arrays[0]), *arrays[1:], self._P)
             if "batch shapes" in str(exc):  # broadcast in numpy, then one C call
                 arrays = [np.asarray(x, dtype=float) for x in arrays]
                 batch = np.broadcast_shapes(*(x.shape[:-1] for x in arrays))
-                return function(*(np.ascontiguousarray(np.broadcast_to(x, batch + x.shape[-1:]))
-                                  for x in arrays), self._P)
+                return self._call(function, *(
+                    np.ascontiguousarray(np.broadcast_to(x, batch + x.shape[-1:]))
+                    for x in arrays))
             field = str(exc).split(":")[0]
             width, names = self._width(field)
             raise InputError(f"expected {width} values ({', '.join(names)}) "
@@ -226,24 +224,17 @@ class RecursiveDynamics(TreeDynamics):
         return out if out.__class__ is not tuple else _reported(*out, 0)
 
 
-def _checking_quaternion(function):
-    """The module's function, refusing a base quaternion of the wrong norm first (one line)."""
-    from .free_flyer import QUATERNION_TOLERANCE, check_quaternions
+def _unit_quaternions(q) -> np.ndarray:
+    """q with its base quaternions refused in one line (free_flyer.check_quaternions: which
+    state, what norm) where the module refused them, else (a norm within rounding of the
+    tolerance) made unit."""
+    from .free_flyer import check_quaternions
 
-    low, high = (1 - QUATERNION_TOLERANCE) ** 2, (1 + QUATERNION_TOLERANCE) ** 2
-
-    def checked(q, *rest):
-        Q = q if q.__class__ is np.ndarray else np.asarray(q, dtype=float)
-        if Q.ndim == 1 and Q.shape[0] >= 7:  # one state: |q|^2 in plain floats (a microsecond)
-            x, y, z, w = Q[3:7].tolist()
-            if low <= x * x + y * y + z * z + w * w <= high:
-                return function(q, *rest)
-        if Q.ndim and Q.shape[-1] >= 7:  # a wrong width is the module's to name
-            flat = Q.reshape(-1, Q.shape[-1])
-            check_quaternions(flat[np.isfinite(flat).all(axis=-1)])
-        return function(q, *rest)
-
-    return checked
+    Q = np.array(q, dtype=float)
+    flat = Q.reshape(-1, Q.shape[-1])
+    check_quaternions(flat[np.isfinite(flat).all(axis=-1)])
+    flat[:, 3:7] /= np.linalg.norm(flat[:, 3:7], axis=-1, keepdims=True)
+    return flat.reshape(Q.shape)
 
 
 def _reported(out: np.ndarray, count: int, tail: int):

@@ -11,6 +11,7 @@ from ..kinds import JointKind
 from ..model.tree import KinematicTree
 from .joint_models import joint_model
 from .tree_emitter import Term, _Emitter, _Layout
+from .tree_floating import free_root_acceleration, free_root_motion
 
 
 def _rotation(E: _Emitter, joint, c: Term, s: Term):
@@ -214,37 +215,45 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
 
 def _articulated(tree: KinematicTree) -> bool:
     """Whether the articulated-body algorithm applies: each coordinate drives one joint, as
-    its angle or distance (no mimic joint)."""
-    used = [j.coordinate for j in tree.joints]
-    return len(set(used)) == len(used) and all(j.multiplier == 1.0 for j in tree.joints) \
-        and not tree.floating_base  # a six-number root: M = L L^T instead
+    its angle or distance (no mimic joint); a floating base's free flyer is the root's."""
+    joints = [j for j in tree.joints if not _free(j)]
+    used = [j.coordinate for j in joints]
+    return len(set(used)) == len(used) and all(j.multiplier == 1.0 for j in joints)
 
 
 def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, tau):
     """Articulated-body algorithm (Featherstone): q_ddot for q, q_dot and tau (on top of the
     actuator parameters), O(n). Spatial vectors in body axes about the body's origin: motion
-    (w, v), force (n, f); inertia blocks [[A, B], [B^T, C]] with n = A w + B v, f = B^T w + C v."""
+    (w, v), force (n, f); inertia blocks [[A, B], [B^T, C]] with n = A w + B v, f = B^T w + C v.
+    A floating base (the root, S = 1) is solved by its 6 x 6 articulated inertia
+    (tree_floating.py); its 6 numbers come first in v, tau and q_ddot."""
     placements = _kinematics(E, tree, q)
     nb = len(tree.joints)
+    first = tree.base_nv
+    base_v, base_tau, v, tau = v[:first], tau[:first], v[first:], tau[first:]
     w, vel, c, A, B, C, pn, pf = [], [], [], [], [], [], [], []
     for i, joint in enumerate(tree.joints):
         R, p = placements[i]
-        s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
-        rate = v[joint.coordinate]
-        wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
-                                                                 vel[joint.parent])
-        w_i = E.apply_transpose(R, wl)
-        v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
-        if s_w is not None:
-            w_i = E.vadd(w_i, E.scale(rate, s_w))
-        if s_v is not None:
-            v_i = E.vadd(v_i, E.scale(rate, s_v))
-        # (w, v) x S q_dot = (w x s_w q_dot, w x s_v q_dot + v x s_w q_dot)
         zero = [0.0] * 3
-        cw = zero if s_w is None else E.cross(w_i, E.scale(rate, s_w))
-        cv = E.vadd(zero if s_v is None else E.cross(w_i, E.scale(rate, s_v)),
-                    zero if s_w is None else E.cross(v_i, E.scale(rate, s_w)))
-        c.append((cw, cv))
+        if _free(joint):  # the base's own twist; S = 1 is constant, so no bias motion
+            w_i, v_i = free_root_motion(base_v)
+            c.append((zero, zero))
+        else:
+            s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
+            rate = v[joint.coordinate]
+            wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
+                                                                     vel[joint.parent])
+            w_i = E.apply_transpose(R, wl)
+            v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
+            if s_w is not None:
+                w_i = E.vadd(w_i, E.scale(rate, s_w))
+            if s_v is not None:
+                v_i = E.vadd(v_i, E.scale(rate, s_v))
+            # (w, v) x S q_dot = (w x s_w q_dot, w x s_v q_dot + v x s_w q_dot)
+            cw = zero if s_w is None else E.cross(w_i, E.scale(rate, s_w))
+            cv = E.vadd(zero if s_v is None else E.cross(w_i, E.scale(rate, s_v)),
+                        zero if s_w is None else E.cross(v_i, E.scale(rate, s_w)))
+            c.append((cw, cv))
         w.append(w_i)
         vel.append(v_i)
         m, h, J = joint.mass, list(joint.first_moment), [list(r) for r in joint.inertia]
@@ -261,6 +270,8 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
     U, D, uu = [None] * nb, [None] * nb, [None] * nb
     for i in reversed(range(nb)):
         joint = tree.joints[i]
+        if _free(joint):  # the root: solved in the forward pass below
+            continue
         s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
         zero = [0.0] * 3
         # U = IA S: Un = A s_w + B s_v, Uf = B^T s_w + C s_v
@@ -314,6 +325,10 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
     qdd: list[Term] = [0.0] * layout.n
     for i, joint in enumerate(tree.joints):
         R, p = placements[i]
+        if _free(joint):
+            (acc_w[i], acc_v[i]), qdd[:first] = free_root_acceleration(
+                E, R, A[i], B[i], C[i], pn[i], pf[i], base_tau, up)
+            continue
         if joint.parent < 0:
             aw_l, av_l = [0.0] * 3, up
         else:
@@ -323,7 +338,7 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
         av = E.vadd(E.apply_transpose(R, E.vadd(av_l, E.cross(aw_l, p))), cv)
         Un, Uf = U[i]
         x = E.div(E.sub(uu[i], E.add(E.dot(Un, aw), E.dot(Uf, av))), D[i])
-        qdd[joint.coordinate] = x
+        qdd[first + joint.coordinate] = x
         s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
         if s_w is not None:
             aw = E.vadd(aw, E.scale(x, s_w))

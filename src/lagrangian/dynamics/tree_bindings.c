@@ -25,7 +25,8 @@ typedef struct {
     npy_intp step[3];
     const double *x0, *x1, *x2, *p;
     double *y;
-    npy_intp k0, k1, bad;
+    npy_intp count, bad;  /* the batch's states; how many came out NaN */
+    npy_intp *next;  /* the first state no thread has taken yet (shared by the threads) */
 } rt_job;
 
 /* Whether state k's inputs are all finite. */
@@ -46,18 +47,20 @@ static inline void rt_blank(double *y, int size, npy_intp k)
     for (int i = 0; i < size; i++) y[k * size + i] = NAN;
 }
 
-static void *rt_run(void *argument)
+/* States k..count - 1 of the job; gives how many came out NaN. */
+static npy_intp rt_range(const rt_job *job, npy_intp k, npy_intp count)
 {
-    rt_job *job = (rt_job *)argument;
     const int kind = job->kind, nin = job->nin, size = job->size;
     const npy_intp *step = job->step;
     const double *x0 = job->x0, *x1 = job->x1, *x2 = job->x2, *p = job->p;
     double *y = job->y;
-    npy_intp bad = 0, count = job->k1, k = job->k0;
+    npy_intp bad = 0;
     (void)nin; (void)size;
-#if RT_VECTOR
-    /* LG_LANES states at a time through the vector variants, the rest one by one */
-    for (; k + LG_LANES <= count && (kind != RT_FORWARD || RT_VECTOR_FORWARD); k += LG_LANES) {
+#if RT_VECTOR || RT_VECTOR_FORWARD
+    /* LG_LANES states at a time through the vector variants (every function's, or forward
+       dynamics' alone), the rest one by one */
+    for (; k + LG_LANES <= count && (kind == RT_FORWARD ? RT_VECTOR_FORWARD : RT_VECTOR);
+         k += LG_LANES) {
         lg_v4 in[3][RT_NQ], out4[LG_N * LG_N];
         for (int j = 0; j < nin; j++) {
             const double *x = j == 0 ? x0 : j == 1 ? x1 : x2;
@@ -65,15 +68,18 @@ static void *rt_run(void *argument)
                 for (int i = 0; i < RT_WIDTH(j); i++) in[j][i][l] = x[(k + l) * step[j] + i];
         }
         switch (kind) {
+#if RT_VECTOR
         case RT_MASS: rt4_mass_matrix(in[0], p, out4); break;
         case RT_BIAS: rt4_bias_forces(in[0], in[1], p, out4); break;
         case RT_GRAVITY: rt4_gravity(in[0], p, out4); break;
         case RT_INVERSE: rt4_inverse_dynamics(in[0], in[1], in[2], p, out4); break;
+        case RT_KINETIC: rt4_kinetic_energy(in[0], in[1], p, out4); break;
+        case RT_POTENTIAL: rt4_potential_energy(in[0], p, out4); break;
+#endif
 #if RT_VECTOR_FORWARD
         case RT_FORWARD: rt4_forward_dynamics(in[0], in[1], in[2], p, out4); break;
 #endif
-        case RT_KINETIC: rt4_kinetic_energy(in[0], in[1], p, out4); break;
-        case RT_POTENTIAL: rt4_potential_energy(in[0], p, out4); break;
+        default: break;
         }
         for (int l = 0; l < LG_LANES; l++) {
             int fine = 1;
@@ -111,6 +117,27 @@ static void *rt_run(void *argument)
         case RT_POTENTIAL: y[k] = rt_potential_energy(a0, p); break;
         }
     }
+    return bad;
+}
+
+/* A thread's work: blocks of RT_BLOCK states taken in turn from the shared counter until
+   none is left, so that a thread slowed by the machine's other work (a shared processor)
+   takes fewer rather than holding the others up. */
+#define RT_BLOCK 64  /* a multiple of LG_LANES: only the batch's last states run one by one */
+static void *rt_run(void *argument)
+{
+    rt_job *job = (rt_job *)argument;
+    npy_intp bad = 0;
+    for (;;) {
+#if RT_PTHREADS
+        const npy_intp k = __atomic_fetch_add(job->next, RT_BLOCK, __ATOMIC_RELAXED);
+#else
+        const npy_intp k = *job->next;
+        *job->next += RT_BLOCK;
+#endif
+        if (k >= job->count) break;
+        bad += rt_range(job, k, k + RT_BLOCK < job->count ? k + RT_BLOCK : job->count);
+    }
     job->bad = bad;
     return NULL;
 }
@@ -139,6 +166,20 @@ static int rt_threads(npy_intp count)
 #endif
 }
 
+/* An argument as C-ordered doubles: an array that already is one taken as it is (the common
+   call, a fraction of a microsecond less than the general conversion), else converted. */
+static PyArrayObject *rt_doubles(PyObject *x)
+{
+    if (PyArray_CheckExact(x)) {
+        PyArrayObject *a = (PyArrayObject *)x;
+        if (PyArray_TYPE(a) == NPY_DOUBLE && PyArray_ISCARRAY_RO(a) && PyArray_ISNOTSWAPPED(a)) {
+            Py_INCREF(x);
+            return a;
+        }
+    }
+    return (PyArrayObject *)PyArray_FROMANY(x, NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
+}
+
 static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int kind)
 {
     PyArrayObject *in[3] = {NULL, NULL, NULL}, *P = NULL;
@@ -150,7 +191,7 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     }
     int base = 0;
     for (int i = 0; i < nin; i++) {
-        in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
+        in[i] = rt_doubles(args[i]);
         if (!in[i]) goto done;
         int nd = PyArray_NDIM(in[i]);
         if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != RT_WIDTH(i)) {
@@ -176,6 +217,25 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
         }
         step[i] = RT_WIDTH(i);
     }
+#if RT_FLOATING
+    /* a floating base: each finite state's quaternion q[3..6] unit to RT_QUATERNION_TOLERANCE
+       (free_flyer.py), here rather than in Python (a microsecond a call); the caller names the
+       state and the norm */
+    {
+        const double *xq = (const double *)PyArray_DATA(in[0]);
+        const npy_intp states = step[0] ? count : 1;
+        for (npy_intp k = 0; k < states; k++) {
+            const double *x = xq + k * step[0];
+            int finite = 1;
+            for (int i = 0; i < RT_NQ; i++) finite &= isfinite(x[i]) != 0;
+            const double norm = sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6]);
+            if (finite && !(fabs(norm - 1.0) <= RT_QUATERNION_TOLERANCE)) {
+                PyErr_SetString(PyExc_ValueError, "q: the base quaternion is not unit");
+                goto done;
+            }
+        }
+    }
+#endif
     P = lg_doubles(args[nin], LG_NP, "parameters");
     if (!P) goto done;
     npy_intp dims[NPY_MAXDIMS];
@@ -194,18 +254,17 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
                      : (kind == RT_KINETIC || kind == RT_POTENTIAL) ? 1 : LG_N;
     rt_job jobs[RT_MAX_THREADS];
     int parts = rt_threads(count);
-    npy_intp share = (count / parts + LG_LANES - 1) / LG_LANES * LG_LANES;
+    npy_intp next = 0;
     for (int t = 0; t < parts; t++) {
-        rt_job job = {kind, nin, size, {step[0], step[1], step[2]}, x0, x1, x2, p, y,
-                      t * share < count ? t * share : count,
-                      t == parts - 1 || (t + 1) * share > count ? count : (t + 1) * share, -1};
+        rt_job job = {kind, nin, size, {step[0], step[1], step[2]}, x0, x1, x2, p, y, count, 0,
+                      &next};
         jobs[t] = job;
     }
     npy_intp bad = 0;
     NPY_BEGIN_THREADS_DEF;
     if (count > 16) NPY_BEGIN_THREADS;
-    /* the batch in parts on threads of their own (the functions keep no state), this thread
-       taking the last part; a thread that cannot start leaves its part to this one */
+    /* the batch on threads of their own (the functions keep no state), this thread one of
+       them; a thread that cannot start leaves its blocks to the others */
 #if RT_PTHREADS
     pthread_t threads[RT_MAX_THREADS];
     int started[RT_MAX_THREADS] = {0};

@@ -37,11 +37,13 @@ static inline void lg_sincos(double x, double *sine, double *cosine)
 
 
 def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix: str,
-                       storage: str = "static ", vector: bool = False) -> str:
+                       storage: str = "static ", vector: bool = False,
+                       vector_forward: bool = False) -> str:
     """C99 functions <prefix>_mass_matrix, _bias_forces, _gravity, _inverse_dynamics,
     _forward_dynamics, _kinetic_energy, _potential_energy (the standalone API); with
     ``vector``, also <prefix>4_<name> on LG_LANES states at once (GCC/Clang vector extensions, for
-    the compiled module's batches)."""
+    the compiled module's batches); with ``vector_forward``, <prefix>4_forward_dynamics alone (a
+    floating base's batches: one function compiled twice, not seven)."""
     layout = _Layout(tree, parameters)
     n = layout.n
     q, v, a = _inputs("q", layout.nq), _inputs("v", n), _inputs("a", n)
@@ -92,7 +94,8 @@ def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix:
         E = _Emitter()
         try:
             qdd = _forward_dynamics(E, tree, layout, q, v, tau_in)
-            candidates.append((E.count([(f"qdd[{i}]", x) for i, x in enumerate(qdd)]), E, qdd))
+            candidates.append((E.count([(f"qdd[{i}]", x) for i, x in enumerate(qdd)]), E, qdd,
+                               "the articulated-body algorithm"))
         except ZeroDivisionError:  # a joint that moves no mass: singular at every state
             pass
     if n <= 24:
@@ -101,22 +104,26 @@ def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix:
             mass = _mass_matrix(E, tree, layout, q)
             bias = _inverse_dynamics(E, tree, layout, q, v, zeros)
             qdd = _cholesky_solve(E, mass, [E.sub(t, b) for t, b in zip(tau_in, bias, strict=True)])
-            candidates.append((E.count([(f"qdd[{i}]", x) for i, x in enumerate(qdd)]), E, qdd))
+            candidates.append((E.count([(f"qdd[{i}]", x) for i, x in enumerate(qdd)]), E, qdd,
+                               "M = L L^T"))
         except ZeroDivisionError:
             pass
     qdd = None
     if candidates:
-        _, E, qdd = min(candidates, key=lambda c: c[0])
+        _, E, qdd, algorithm = min(candidates, key=lambda c: c[0])
     if qdd is not None:
+        sections.append(f"/* forward dynamics: {algorithm}, straight-line */")
         check = "".join(f"    if (!isfinite(qdd[{i}])) return -1;\n" for i in range(n))
         function(f"int {P}_forward_dynamics({R} q, {R} v, {R} tau, {R} p, double *restrict qdd)",
                  E, [(f"qdd[{i}]", x) for i, x in enumerate(qdd)], check + "    return 0;\n")
         straight.append(("forward_dynamics", ("q", "v", "tau"), E, list(enumerate(qdd))))
     else:
         sections.append(_cholesky_forward(P, S, R, n))
-    if vector:
+    if vector or vector_forward:
         sections.append(_VECTOR)
         for name, inputs, E, outs in straight:
+            if not vector and name != "forward_dynamics":
+                continue
             body = E.body([(f"out[{k}]", t) for k, t in outs], vector=True)
             if name == "mass_matrix":
                 body += "\n" + "".join(f"    out[{c * n + r}] = out[{r * n + c}];\n"

@@ -9,6 +9,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from ..model.tree import KinematicTree
+from .free_flyer import QUATERNION_TOLERANCE
 from .tree_c import dynamics_functions
 from .tree_emitter import VECTOR_LIMIT
 
@@ -36,13 +37,18 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
     n = len(tree.coordinates) + tree.base_nv  # v's numbers; q's are RT_NQ (a floating base)
     # two-state vector variants for batches of arms; a long chain's code is big enough that
     # compiling it twice costs minutes, so there the batch runs the scalar functions
-    functions = dynamics_functions(tree, parameters, "rt", vector=n <= VECTOR_LIMIT)
+    # a floating base's forward dynamics (the articulated-body algorithm, linear in the bodies)
+    # on lanes at any size: the batches that simulate and plan walking robots
+    functions = dynamics_functions(tree, parameters, "rt", vector=n <= VECTOR_LIMIT,
+                                   vector_forward=tree.floating_base)
     source = "\n".join([
         f"/* lagrangian: recursive dynamics of a tree of {len(tree.joints)} bodies, {n} "
         "coordinates */",
         f"#define LG_N {n}",
         f"#define RT_NQ {n + tree.base_nq - tree.base_nv}",
         "#define LG_M 0",
+        f"#define RT_FLOATING {int(tree.floating_base)}",
+        f"#define RT_QUATERNION_TOLERANCE {QUATERNION_TOLERANCE!r}",
         f"#define LG_NP {len(parameters)}",
         "#define PY_SSIZE_T_CLEAN",
         "#include <Python.h>",
@@ -89,8 +95,8 @@ static void lg_residual(const double *restrict q, const double *restrict v, doub
 def _generator_key() -> str:
     """The tree generator itself: a change to any of its files is a new module."""
     here = Path(__file__).parent
-    files = ("tree_emitter.py", "tree_algorithms.py", "joint_models.py", "tree_c.py",
-             "tree_module.py", "tree_bindings.c")
+    files = ("tree_emitter.py", "tree_algorithms.py", "tree_floating.py", "joint_models.py",
+             "tree_c.py", "tree_module.py", "tree_bindings.c")
     return hashlib.sha256(b"".join((here / f).read_bytes() for f in files)).hexdigest()
 
 

@@ -83,14 +83,38 @@ class ControlTerms:
         stacked = np.asarray(compute(q, v, a)).reshape(count * self.n, len(names))
         return BaseParameters(names, stacked, tolerance)
 
-    # -- derivatives (derivatives.py) ------------------------------------------------------------
+    # -- derivatives (derivatives_c.py, derivatives.py) -------------------------------------------
+
+    def _derivatives_kernel(self):
+        """(inverse, forward, P) of the tree's compiled derivatives (derivatives_c.py), or None:
+        a compiled backend's fixed-base tree of revolute and prismatic joints only; the numpy
+        backend, a model file and a floating base keep derivatives.py."""
+        found = self.__dict__.get("_derivatives_c", False)
+        if found is False:
+            found = None
+            tree = getattr(self, "tree", None)
+            if tree is not None and getattr(self, "module", None) is not None:
+                from .derivatives_c import applies, derivatives_module, runtime_values
+
+                module = derivatives_module(tree) if applies(tree) else None
+                if module is not None:
+                    found = (module.inverse_derivatives, module.forward_derivatives,
+                             runtime_values(tree, self.parameters))
+            self.__dict__["_derivatives_c"] = found
+        return found
 
     def _inverse_derivatives(self):
         found = self.__dict__.get("_derivatives")
         if found is None:
             tree = getattr(self, "tree", None)
             _refuse_floating(tree, "derivatives of the dynamics")
-            if tree is not None:
+            fast = self._derivatives_kernel()
+            if fast is not None:
+                inverse, _, P = fast
+
+                def found(Q, V, A):
+                    return inverse(Q, V, A, P)[:2]
+            elif tree is not None:
                 from .derivatives import tree_inverse_dynamics_derivatives
 
                 g = self.parameters[tree.gravity_parameter]
@@ -109,8 +133,17 @@ class ControlTerms:
 
     def inverse_dynamics_derivatives(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
         """(d tau/dq, d tau/dq_dot) of tau = M(q) q_ddot + C q_dot + g, (..., n, n) each (row
-        i: tau_i), as Pinocchio's computeRNEADerivatives: a model file's from its derived M and
-        f, a URDF tree's by the complex step through Newton-Euler (exact to rounding)."""
+        i: tau_i), as Pinocchio's computeRNEADerivatives: a URDF tree's analytic in compiled C
+        (derivatives_c.py; the complex step through Newton-Euler without a compiler, exact to
+        rounding), a model file's from its derived M and f."""
+        fast = self._derivatives_kernel()
+        if fast is not None:  # one C call; a bad input goes the guarded way to be named
+            try:
+                out = fast[0](q, v, a, fast[2])
+            except (ValueError, TypeError):
+                pass
+            else:
+                return out if len(out) == 2 else _reported(out)
         compute = self._inverse_derivatives()
         n = self.n
         both = self._guarded(lambda Q, V, A: np.concatenate(compute(Q, V, A), axis=-1),
@@ -122,6 +155,14 @@ class ControlTerms:
         """(d q_ddot/dq, d q_ddot/dq_dot, d q_ddot/d tau), (..., n, n) each, as Pinocchio's
         computeABADerivatives: -M^-1 d tau/dq and -M^-1 d tau/dq_dot at q_ddot = FD(q, q_dot,
         tau), and M^-1."""
+        fast = self._derivatives_kernel()
+        if fast is not None:
+            try:
+                out = fast[1](q, v, tau, fast[2])
+            except (ValueError, TypeError):
+                pass
+            else:
+                return out if len(out) == 3 else _reported(out)
         q, v, tau = self._vector(q, "q"), self._vector(v, "v"), self._vector(tau, "tau")
         batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1], tau.shape[:-1])
         q = np.broadcast_to(q, batch + (self.n,))
@@ -130,3 +171,13 @@ class ControlTerms:
         by_position, by_velocity = self.inverse_dynamics_derivatives(q, v, acceleration)
         inverse = np.linalg.inv(self.mass_matrix(q))
         return -inverse @ by_position, -inverse @ by_velocity, inverse
+
+
+def _reported(out: tuple) -> tuple:
+    """The C's (outputs..., count of NaN rows): one DynamicsWarning at the user's call, and the
+    outputs."""
+    from .joint_space import warn_undefined
+
+    first = out[0]
+    warn_undefined(out[-1], first.size // max(first.shape[-1] ** 2, 1), stacklevel=4)
+    return out[:-1]

@@ -1,0 +1,130 @@
+"""The derivatives of a tree's dynamics in compiled C: d tau/dq, d tau/dq_dot of Newton-Euler
+and d q_ddot/dq, d q_ddot/dq_dot, M^-1 of forward dynamics (derivatives_kernel.c: analytic,
+O(n^2) per state, a batch in one call on threads), over the tree's numbers written as static
+tables, one module per tree (cached on disk by its numbers). Gravity and the actuator parameters
+tau_<joint> are given at run time. Fixed-base trees of revolute and prismatic joints; the
+complex step of derivatives.py is the fallback (and the check). Units SI."""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from ..model.tree import KinematicTree
+from .joint_models import JOINT_MODELS
+from .tree_c import _SINCOS
+
+_KERNEL = Path(__file__).with_name("derivatives_kernel.c")
+
+
+def _table(name: str, ctype: str, rows) -> str:
+    """A static const C array (exact doubles by repr), rows of numbers or numbers."""
+    rows = list(rows)
+    number = (lambda x: repr(float(x))) if ctype == "double" else (lambda x: str(int(x)))
+    nested = bool(rows) and isinstance(rows[0], (list, tuple))
+    body = ", ".join("{" + ", ".join(map(number, row)) + "}" if nested else number(row)
+                     for row in rows)
+    width = f"[{len(rows[0])}]" if nested else ""
+    return f"static const {ctype} {name}[{max(len(rows), 1)}]{width} = {{{body}}};"
+
+
+def _flat(matrix) -> list[float]:
+    return [float(x) for row in matrix for x in row]
+
+
+def _pairs(tree: KinematicTree) -> list[tuple[int, int]]:
+    """(k, j) for every body k and each j on its path to the ground, k itself first."""
+    out = []
+    for k in range(len(tree.joints)):
+        j = k
+        while j >= 0:
+            out.append((k, j))
+            j = tree.joints[j].parent
+    return out
+
+
+def kernel_source(tree: KinematicTree):
+    """The module's C: the tree's tables, then derivatives_kernel.c."""
+    from ..compile.codegen import GeneratedSource
+
+    joints = tree.joints
+    P, C, S = [], [], []
+    for j in joints:  # R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x
+        R0, u = np.array(j.rotation, dtype=float), np.array(j.axis, dtype=float)
+        uu = np.outer(u, u)
+        skew = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
+        P.append((R0 @ uu).ravel().tolist())
+        C.append((R0 @ (np.eye(3) - uu)).ravel().tolist())
+        S.append((R0 @ skew).ravel().tolist())
+    models = [JOINT_MODELS[j.kind] for j in joints]
+    pairs = _pairs(tree)
+    source = "\n".join([
+        "/* lagrangian: the derivatives of a tree's inverse and forward dynamics */",
+        "#define PY_SSIZE_T_CLEAN",
+        "#include <Python.h>",
+        "#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION",
+        "#include <numpy/arrayobject.h>",
+        "#include <math.h>",
+        "#include <string.h>",
+        f"#define DK_NB {len(joints)}",
+        f"#define DK_N {len(tree.coordinates)}",
+        f"#define DK_NP {len(pairs)}",
+        _table("dk_parent", "int", [j.parent for j in joints]),
+        _table("dk_coord", "int", [j.coordinate for j in joints]),
+        _table("dk_turns", "int", [m.turns for m in models]),
+        _table("dk_slides", "int", [m.slides for m in models]),
+        _table("dk_pair", "int", [list(p) for p in pairs]),
+        _table("dk_mult", "double", [j.multiplier for j in joints]),
+        _table("dk_off", "double", [j.offset for j in joints]),
+        _table("dk_R0", "double", [_flat(j.rotation) for j in joints]),
+        _table("dk_P", "double", P), _table("dk_C", "double", C), _table("dk_Sk", "double", S),
+        _table("dk_t0", "double", [list(j.translation) for j in joints]),
+        _table("dk_u", "double", [list(j.axis) for j in joints]),
+        _table("dk_m", "double", [j.mass for j in joints]),
+        _table("dk_h", "double", [list(j.first_moment) for j in joints]),
+        _table("dk_J", "double", [_flat(j.inertia) for j in joints]),
+        _SINCOS,
+        _KERNEL.read_text(encoding="utf-8"),
+    ])
+    return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
+
+
+def applies(tree: KinematicTree | None) -> bool:
+    """Whether the kernel takes this tree: a fixed base of revolute and prismatic joints."""
+    return (tree is not None and not tree.floating_base and bool(tree.joints)
+            and all(j.kind in JOINT_MODELS for j in tree.joints))
+
+
+def derivatives_module(tree: KinematicTree):
+    """The compiled module of this tree (built once, then from the verified cache), or None
+    where no compiler works or the kernel does not take the tree."""
+    from ..compile import compiled
+
+    if not applies(tree):
+        return None
+    here = Path(__file__)
+    generator = hashlib.sha256(_KERNEL.read_bytes() + here.read_bytes()
+                               + here.with_name("tree_c.py").read_bytes()).hexdigest()
+    key = "\n".join(["derivatives", generator, repr(tree)])
+    try:
+        return compiled.load_keyed(key, lambda: kernel_source(tree), native=True)
+    except compiled.BackendUnavailable:
+        return None
+
+
+def runtime_values(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
+    """P = [g times the tree's direction (m/s^2, 3), tau_<joint> (N m or N, one per
+    coordinate; 0 where none)], read-only."""
+    g = float(parameters.get(tree.gravity_parameter, 0.0) or 0.0) \
+        if tree.gravity_parameter is not None else 0.0
+    actuators = [float(parameters.get(a, 0.0) or 0.0) if a is not None else 0.0
+                 for a in tree.actuators]
+    P = np.concatenate([g * np.array(tree.gravity_direction, dtype=float), actuators])
+    P.flags.writeable = False
+    return P
+
+
+__all__ = ["applies", "derivatives_module", "kernel_source", "runtime_values"]

@@ -1,0 +1,533 @@
+/* d tau/dq, d tau/dq_dot of recursive Newton-Euler and d q_ddot/dq, d q_ddot/dq_dot, M^-1 of
+ * forward dynamics, over the tree tables that derivatives_c.py writes above this text (dk_*
+ * arrays, DK_NB bodies, DK_N coordinates, DK_NP ancestor pairs). Analytic, O(n^2) per state.
+ *
+ * Spatial vectors at the world's origin in world axes, linear part first: a motion [v; w], a
+ * force [f; n]. A body's joint column S (theta_dot = k q_dot[c]); v_i = v_p + S theta_dot,
+ * a_i = a_p + S theta_ddot + (v_p x S) theta_dot (a of the ground: -g), f_i = I a + v x* I v.
+ * Turning joint j by d theta moves its subtree rigidly about S_j while its parent's v_p, a_p
+ * stay: with dv_j = v_p x S_j and psi_j = a_p x S_j + v_p x dv_j, a body i below j gets
+ *   d f_i / d theta_j     = S_j x* f_i + I_i psi_j + B_i dv_j,
+ *   d f_i / d theta_dot_j = I_i (2 dv_j) + B_i S_j,   B_i x = v x* I x - I (v x x) + x x* I v,
+ * so that, with composite (subtree) sums Ic, Bc, F (the rigid turn S_j x* cancels on the rows
+ * of the subtree):
+ *   row k below j (k in j's subtree):  d tau_k/d theta_j = S_k . (Ic_k psi_j + Bc_k dv_j)
+ *   row k above j (k a strict ancestor): S_k . (S_j x* F_j + Ic_j psi_j + Bc_j dv_j),
+ * likewise for theta_dot, and M_kj = S_k . Ic_k S_j. B = [[0, -2[l]x], [0, A]] with l the
+ * linear momentum and A = [w]x J_O - J_O [w]x - [v]x[c]x - [c]x[v]x - [n]x (n the angular
+ * momentum about the origin, c = m x_G): 12 numbers, additive over a subtree. */
+
+#define DK_STR_(x) #x
+#define DK_STR(x) DK_STR_(x)
+#define DK_PASTE_(a, b) a##b
+#define DK_PASTE(a, b) DK_PASTE_(a, b)
+
+static inline void dk_cross(const double *a, const double *b, double *out)
+{
+    double x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2],
+           z = a[0] * b[1] - a[1] * b[0];
+    out[0] = x; out[1] = y; out[2] = z;
+}
+
+static inline void dk_apply(const double *R, const double *x, double *out)
+{
+    double a = R[0] * x[0] + R[1] * x[1] + R[2] * x[2], b = R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
+           c = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
+    out[0] = a; out[1] = b; out[2] = c;
+}
+
+static inline void dk_matmul(const double *A, const double *B, double *out)
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            out[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+
+/* motion x motion: [w x yv + v x yw; w x yw] */
+static inline void dk_mcross(const double *x, const double *y, double *out)
+{
+    double a[3], b[3], c[3];
+    dk_cross(x + 3, y, a);
+    dk_cross(x, y + 3, b);
+    dk_cross(x + 3, y + 3, c);
+    for (int j = 0; j < 3; j++) { out[j] = a[j] + b[j]; out[3 + j] = c[j]; }
+}
+
+/* motion x* force: [w x f; v x f + w x n] */
+static inline void dk_fcross(const double *x, const double *f, double *out)
+{
+    double a[3], b[3], c[3];
+    dk_cross(x + 3, f, a);
+    dk_cross(x, f, b);
+    dk_cross(x + 3, f + 3, c);
+    for (int j = 0; j < 3; j++) { out[j] = a[j]; out[3 + j] = b[j] + c[j]; }
+}
+
+static inline double dk_dot6(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
+}
+
+/* A spatial inertia at the world's origin: mass m, c = m x_G (3), J_O (3 x 3, symmetric). */
+typedef struct { double m, c[3], J[9]; } dk_inertia;
+
+/* I x: [m v + w x c; c x v + J w] */
+static inline void dk_iapply(const dk_inertia *Y, const double *x, double *out)
+{
+    double a[3], b[3], Jw[3];
+    dk_cross(x + 3, Y->c, a);
+    dk_cross(Y->c, x, b);
+    dk_apply(Y->J, x + 3, Jw);
+    for (int j = 0; j < 3; j++) { out[j] = Y->m * x[j] + a[j]; out[3 + j] = b[j] + Jw[j]; }
+}
+
+typedef struct {
+    double S[DK_NB][6], dv[DK_NB][6], psi[DK_NB][6];
+    double F[DK_NB][6];             /* f_i, then the subtree's sum */
+    dk_inertia Y[DK_NB];            /* the body's, then the subtree's */
+    double L[DK_NB][3], A[DK_NB][9];  /* B's 12 numbers, the body's then the subtree's */
+    double r1[DK_NB][6], r2[DK_NB][3];  /* Ic_k S_k and the angular part of Bc_k^T S_k */
+    double Phi[DK_NB][6], Psi[DK_NB][6];
+} dk_work;
+
+/* The forward pass: placements, S, v, a, dv, psi, f and B of every body. */
+static void dk_forward(const double *q, const double *qd, const double *qdd, const double *g,
+                       dk_work *w)
+{
+    double R[DK_NB][9], o[DK_NB][3], V[DK_NB][6], Acc[DK_NB][6];
+    for (int i = 0; i < DK_NB; i++) {
+        double th = dk_mult[i] * q[dk_coord[i]] + dk_off[i];
+        double Rl[9], pl[3] = {dk_t0[i][0], dk_t0[i][1], dk_t0[i][2]};
+        if (dk_turns[i]) {
+            /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
+            double c, s;
+            lg_sincos(th, &s, &c);
+            for (int j = 0; j < 9; j++) Rl[j] = dk_P[i][j] + c * dk_C[i][j] + s * dk_Sk[i][j];
+        } else {
+            for (int j = 0; j < 9; j++) Rl[j] = dk_R0[i][j];
+        }
+        if (dk_slides[i]) {
+            double d[3];
+            dk_apply(dk_R0[i], dk_u[i], d);
+            for (int j = 0; j < 3; j++) pl[j] += th * d[j];
+        }
+        int p = dk_parent[i];
+        if (p < 0) {
+            for (int j = 0; j < 9; j++) R[i][j] = Rl[j];
+            for (int j = 0; j < 3; j++) o[i][j] = pl[j];
+        } else {
+            double d[3];
+            dk_matmul(R[p], Rl, R[i]);
+            dk_apply(R[p], pl, d);
+            for (int j = 0; j < 3; j++) o[i][j] = o[p][j] + d[j];
+        }
+        /* S: [o x a; a] turning about the world axis a, [a; 0] sliding along it */
+        double *S = w->S[i], axis[3];
+        dk_apply(R[i], dk_u[i], axis);
+        if (dk_turns[i]) {
+            dk_cross(o[i], axis, S);
+            for (int j = 0; j < 3; j++) S[3 + j] = axis[j];
+        } else {
+            for (int j = 0; j < 3; j++) { S[j] = axis[j]; S[3 + j] = 0.0; }
+        }
+        double vp[6] = {0, 0, 0, 0, 0, 0}, ap[6] = {-g[0], -g[1], -g[2], 0, 0, 0};
+        if (p >= 0)
+            for (int j = 0; j < 6; j++) { vp[j] = V[p][j]; ap[j] = Acc[p][j]; }
+        double rate = dk_mult[i] * qd[dk_coord[i]], accel = dk_mult[i] * qdd[dk_coord[i]];
+        double t[6];
+        dk_mcross(vp, S, w->dv[i]);
+        dk_mcross(ap, S, w->psi[i]);
+        dk_mcross(vp, w->dv[i], t);
+        for (int j = 0; j < 6; j++) {
+            w->psi[i][j] += t[j];
+            V[i][j] = vp[j] + S[j] * rate;
+            Acc[i][j] = ap[j] + S[j] * accel + w->dv[i][j] * rate;
+        }
+        /* the inertia at the world's origin: c = R h + m o, J_O = R J R^T shifted by o */
+        dk_inertia *Y = &w->Y[i];
+        double hr[3], RJ[9], m = dk_m[i];
+        const double *po = o[i];
+        dk_apply(R[i], dk_h[i], hr);
+        dk_matmul(R[i], dk_J[i], RJ);
+        double pp = po[0] * po[0] + po[1] * po[1] + po[2] * po[2];
+        double ph = po[0] * hr[0] + po[1] * hr[1] + po[2] * hr[2];
+        for (int a = 0; a < 3; a++)
+            for (int b = a; b < 3; b++) {
+                double T = RJ[3 * a] * R[i][3 * b] + RJ[3 * a + 1] * R[i][3 * b + 1]
+                           + RJ[3 * a + 2] * R[i][3 * b + 2];
+                T += -m * po[a] * po[b] - po[a] * hr[b] - hr[a] * po[b]
+                     + (a == b ? m * pp + 2.0 * ph : 0.0);
+                Y->J[3 * a + b] = Y->J[3 * b + a] = T;
+            }
+        Y->m = m;
+        for (int j = 0; j < 3; j++) Y->c[j] = hr[j] + m * po[j];
+        /* momentum h = I v, force f = I a + v x* h */
+        double h[6], Ia[6], vh[6];
+        dk_iapply(Y, V[i], h);
+        dk_iapply(Y, Acc[i], Ia);
+        dk_fcross(V[i], h, vh);
+        for (int j = 0; j < 6; j++) w->F[i][j] = Ia[j] + vh[j];
+        /* B: L = l, A = X + X^T - (c v^T + v c^T) + 2 (v.c) 1 - [n]x, X = [w]x J_O */
+        const double *vl = V[i], *vw = V[i] + 3, *c = Y->c;
+        double X[9], cv = vl[0] * c[0] + vl[1] * c[1] + vl[2] * c[2];
+        for (int b = 0; b < 3; b++) {
+            double col[3] = {Y->J[b], Y->J[3 + b], Y->J[6 + b]}, r[3];
+            dk_cross(vw, col, r);
+            X[b] = r[0]; X[3 + b] = r[1]; X[6 + b] = r[2];
+        }
+        double *A = w->A[i];
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                A[3 * a + b] = X[3 * a + b] + X[3 * b + a] - c[a] * vl[b] - vl[a] * c[b]
+                               + (a == b ? 2.0 * cv : 0.0);
+        const double *n = h + 3;
+        A[1] += n[2]; A[2] -= n[1]; A[3] -= n[2]; A[5] += n[0]; A[6] += n[1]; A[7] -= n[0];
+        for (int j = 0; j < 3; j++) w->L[i][j] = h[j];
+    }
+}
+
+/* Bc x for the subtree's B: [-2 L x x_w; A x_w] */
+static inline void dk_bapply(const double *L, const double *A, const double *x, double *out)
+{
+    double t[3];
+    dk_cross(L, x + 3, t);
+    dk_apply(A, x + 3, out + 3);
+    for (int j = 0; j < 3; j++) out[j] = -2.0 * t[j];
+}
+
+/* The backward pass: subtree sums and each body's row (r1, r2) and column (Phi, Psi) vectors,
+ * tau by body into tau (DK_NB) when asked. */
+static void dk_backward(dk_work *w, double *tau)
+{
+    for (int i = DK_NB - 1; i >= 0; i--) {
+        const dk_inertia *Y = &w->Y[i];
+        const double *S = w->S[i];
+        double t[6], u[6], x[6];
+        dk_iapply(Y, S, w->r1[i]);
+        /* Bc^T S (angular part): 2 L x s_v + A^T s_w */
+        double *r2 = w->r2[i];
+        dk_cross(w->L[i], S, r2);
+        for (int j = 0; j < 3; j++)
+            r2[j] = 2.0 * r2[j] + w->A[i][j] * S[3] + w->A[i][3 + j] * S[4]
+                    + w->A[i][6 + j] * S[5];
+        dk_fcross(S, w->F[i], t);
+        dk_iapply(Y, w->psi[i], u);
+        dk_bapply(w->L[i], w->A[i], w->dv[i], x);
+        for (int j = 0; j < 6; j++) w->Phi[i][j] = t[j] + u[j] + x[j];
+        dk_iapply(Y, w->dv[i], u);
+        dk_bapply(w->L[i], w->A[i], S, x);
+        for (int j = 0; j < 6; j++) w->Psi[i][j] = 2.0 * u[j] + x[j];
+        if (tau) tau[i] = dk_dot6(S, w->F[i]);
+        int p = dk_parent[i];
+        if (p >= 0) {
+            dk_inertia *P = &w->Y[p];
+            P->m += Y->m;
+            for (int j = 0; j < 3; j++) { P->c[j] += Y->c[j]; w->L[p][j] += w->L[i][j]; }
+            for (int j = 0; j < 9; j++) { P->J[j] += Y->J[j]; w->A[p][j] += w->A[i][j]; }
+            for (int j = 0; j < 6; j++) w->F[p][j] += w->F[i][j];
+        }
+    }
+}
+
+/* M (DK_N x DK_N); with dq, dv also d tau/dq and d tau/dq_dot, from the pairs (k below or at
+ * j), each entry scattered to the coordinates with the joints' multipliers */
+static void dk_pairs(const dk_work *w, double *M, double *dq, double *dv)
+{
+    for (int j = 0; j < DK_N * DK_N; j++) M[j] = 0.0;
+    if (dq)
+        for (int j = 0; j < DK_N * DK_N; j++) { dq[j] = 0.0; dv[j] = 0.0; }
+    for (int e = 0; e < DK_NP; e++) {
+        const int k = dk_pair[e][0], j = dk_pair[e][1];
+        const int ck = dk_coord[k], cj = dk_coord[j];
+        const double kk = dk_mult[k] * dk_mult[j];
+        const double mkj = kk * dk_dot6(w->r1[k], w->S[j]);
+        M[ck * DK_N + cj] += mkj;
+        if (k != j) M[cj * DK_N + ck] += mkj;
+        if (!dq) continue;
+        const double *r1 = w->r1[k], *r2 = w->r2[k];
+        dq[ck * DK_N + cj] += kk * (dk_dot6(r1, w->psi[j]) + r2[0] * w->dv[j][3]
+                                    + r2[1] * w->dv[j][4] + r2[2] * w->dv[j][5]);
+        dv[ck * DK_N + cj] += kk * (2.0 * dk_dot6(r1, w->dv[j]) + r2[0] * w->S[j][3]
+                                    + r2[1] * w->S[j][4] + r2[2] * w->S[j][5]);
+        if (k != j) {
+            dq[cj * DK_N + ck] += kk * dk_dot6(w->S[j], w->Phi[k]);
+            dv[cj * DK_N + ck] += kk * dk_dot6(w->S[j], w->Psi[k]);
+        }
+    }
+}
+
+/* (d tau/dq, d tau/dq_dot) at one state; g (3) the gravity vector (m/s^2). */
+static void dk_inverse(const double *q, const double *qd, const double *qdd, const double *g,
+                       double *dq, double *dv)
+{
+    dk_work w;
+    double M[DK_N * DK_N];
+    dk_forward(q, qd, qdd, g, &w);
+    dk_backward(&w, NULL);
+    dk_pairs(&w, M, dq, dv);
+}
+
+/* L L^T = M in place (lower triangle); 0 where M is not positive definite */
+static int dk_cholesky(double *M)
+{
+    for (int j = 0; j < DK_N; j++) {
+        double d = M[j * DK_N + j];
+        for (int k = 0; k < j; k++) d -= M[j * DK_N + k] * M[j * DK_N + k];
+        if (!(d > 0.0)) return 0;
+        d = sqrt(d);
+        M[j * DK_N + j] = d;
+        for (int i = j + 1; i < DK_N; i++) {
+            double s = M[i * DK_N + j];
+            for (int k = 0; k < j; k++) s -= M[i * DK_N + k] * M[j * DK_N + k];
+            M[i * DK_N + j] = s / d;
+        }
+    }
+    return 1;
+}
+
+/* x = M^-1 b from the factor L (b overwritten) */
+static void dk_solve(const double *L, double *b)
+{
+    for (int i = 0; i < DK_N; i++) {
+        double s = b[i];
+        for (int k = 0; k < i; k++) s -= L[i * DK_N + k] * b[k];
+        b[i] = s / L[i * DK_N + i];
+    }
+    for (int i = DK_N - 1; i >= 0; i--) {
+        double s = b[i];
+        for (int k = i + 1; k < DK_N; k++) s -= L[k * DK_N + i] * b[k];
+        b[i] = s / L[i * DK_N + i];
+    }
+}
+
+/* (d q_ddot/dq, d q_ddot/dq_dot, M^-1) at one state; P = [g (3), tau_<joint> (DK_N)];
+ * 0 where M is not positive definite */
+static int dk_forward_derivatives(const double *q, const double *qd, const double *tau,
+                                  const double *P, double *aq, double *av, double *Minv)
+{
+    dk_work w;
+    double M[DK_N * DK_N], dq[DK_N * DK_N], dv[DK_N * DK_N], taub[DK_NB], b[DK_N];
+    double zero[DK_N];
+    for (int j = 0; j < DK_N; j++) zero[j] = 0.0;
+    /* q_ddot = M^-1 (tau + tau_p - b), b from Newton-Euler at q_ddot = 0 */
+    dk_forward(q, qd, zero, P, &w);
+    dk_backward(&w, taub);
+    dk_pairs(&w, M, NULL, NULL);
+    for (int j = 0; j < DK_N; j++) b[j] = tau[j] + P[3 + j];
+    for (int i = 0; i < DK_NB; i++) b[dk_coord[i]] -= dk_mult[i] * taub[i];
+    if (!dk_cholesky(M)) return 0;
+    dk_solve(M, b);
+    dk_inverse(q, qd, b, P, dq, dv);
+    /* M^-1 column by column, then -M^-1 d tau/dq, -M^-1 d tau/dq_dot */
+    for (int c = 0; c < DK_N; c++) {
+        double e[DK_N];
+        for (int j = 0; j < DK_N; j++) e[j] = j == c ? 1.0 : 0.0;
+        dk_solve(M, e);
+        for (int j = 0; j < DK_N; j++) Minv[j * DK_N + c] = e[j];
+    }
+    for (int i = 0; i < DK_N; i++)
+        for (int j = 0; j < DK_N; j++) {
+            double x = 0.0, y = 0.0;
+            for (int k = 0; k < DK_N; k++) {
+                x += Minv[i * DK_N + k] * dq[k * DK_N + j];
+                y += Minv[i * DK_N + k] * dv[k * DK_N + j];
+            }
+            aq[i * DK_N + j] = -x;
+            av[i * DK_N + j] = -y;
+        }
+    return 1;
+}
+
+/* -- Python bindings: (Q, V, X, P) with Q, V, X (..., DK_N) float64 (or (DK_N,), shared by
+ * the batch), P = [g (3), tau_<joint> (DK_N)]; outputs (..., DK_N, DK_N) each, as a tuple,
+ * with the count of NaN rows appended where a state's inputs are not all finite (or, forward,
+ * its M is not positive definite). A batch runs in parts on threads. ------------------------ */
+
+#if defined(__unix__) || defined(__APPLE__)
+#define DK_PTHREADS 1
+#include <pthread.h>
+#include <unistd.h>
+#else
+#define DK_PTHREADS 0
+#endif
+#define DK_MAX_THREADS 8
+#define DK_THREAD_STATES 512
+
+typedef struct {
+    int forward;
+    npy_intp step[3], k0, k1, bad;
+    const double *x[3], *p;
+    double *y[3];
+} dk_job;
+
+static void *dk_run(void *argument)
+{
+    dk_job *job = (dk_job *)argument;
+    const int size = DK_N * DK_N;
+    npy_intp bad = 0;
+    for (npy_intp k = job->k0; k < job->k1; k++) {
+        const double *a0 = job->x[0] + k * job->step[0], *a1 = job->x[1] + k * job->step[1],
+                     *a2 = job->x[2] + k * job->step[2];
+        double *y0 = job->y[0] + k * size, *y1 = job->y[1] + k * size;
+        int fine = 1;
+        for (int i = 0; i < DK_N; i++)
+            if (!isfinite(a0[i]) || !isfinite(a1[i]) || !isfinite(a2[i])) fine = 0;
+        if (fine) {
+            if (job->forward)
+                fine = dk_forward_derivatives(a0, a1, a2, job->p, y0, y1, job->y[2] + k * size);
+            else
+                dk_inverse(a0, a1, a2, job->p, y0, y1);
+        }
+        if (!fine) {
+            for (int o = 0; o < 2 + job->forward; o++)
+                for (int i = 0; i < size; i++) job->y[o][k * size + i] = NAN;
+            bad++;
+        }
+    }
+    job->bad = bad;
+    return NULL;
+}
+
+static int dk_threads(npy_intp count)
+{
+#if DK_PTHREADS
+    static int cap = 0;
+    if (cap == 0) {
+        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+        const char *env = getenv("LAGRANGIAN_THREADS");
+        long asked = env && *env ? strtol(env, NULL, 10) : cpus;
+        if (asked < 1) asked = 1;
+        if (cpus < 1) cpus = 1;
+        cap = (int)(asked < cpus ? asked : cpus);
+        if (cap > DK_MAX_THREADS) cap = DK_MAX_THREADS;
+    }
+    npy_intp parts = count / DK_THREAD_STATES;
+    if (parts > cap) parts = cap;
+    return parts < 1 ? 1 : (int)parts;
+#else
+    (void)count;
+    return 1;
+#endif
+}
+
+static const char *dk_names[2][3] = {{"q", "v", "a"}, {"q", "v", "tau"}};
+
+static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int forward)
+{
+    PyArrayObject *in[3] = {NULL, NULL, NULL}, *P = NULL;
+    PyObject *out[3] = {NULL, NULL, NULL}, *result = NULL;
+    npy_intp step[3] = {0, 0, 0};
+    const int nout = 2 + forward;
+    if (nargs != 4) {
+        PyErr_SetString(PyExc_TypeError, "expected (Q, V, X, P)");
+        return NULL;
+    }
+    int base = 0;
+    for (int i = 0; i < 3; i++) {
+        in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
+        if (!in[i]) goto done;
+        int nd = PyArray_NDIM(in[i]);
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != DK_N) {
+            PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
+                         dk_names[forward][i], DK_N);
+            goto done;
+        }
+        if (PyArray_SIZE(in[i]) > PyArray_SIZE(in[base])) base = i;
+    }
+    npy_intp count = PyArray_SIZE(in[base]) / DK_N;
+    int nd = PyArray_NDIM(in[base]);
+    for (int i = 0; i < 3; i++) {
+        if (PyArray_NDIM(in[i]) == 1) {  /* one state, shared by the batch */
+            step[i] = count > 1 ? 0 : DK_N;
+            continue;
+        }
+        if (PyArray_NDIM(in[i]) != nd
+            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp))) {
+            PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
+            goto done;
+        }
+        step[i] = DK_N;
+    }
+    P = (PyArrayObject *)PyArray_FROMANY(args[3], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
+    if (!P) goto done;
+    if (PyArray_SIZE(P) != 3 + DK_N) {
+        PyErr_SetString(PyExc_ValueError, "parameters: expected g (3) and the actuators");
+        goto done;
+    }
+    npy_intp dims[NPY_MAXDIMS];
+    memcpy(dims, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
+    dims[nd - 1] = DK_N;
+    dims[nd] = DK_N;
+    for (int o = 0; o < nout; o++) {
+        out[o] = PyArray_SimpleNew(nd + 1, dims, NPY_DOUBLE);
+        if (!out[o]) goto done;
+    }
+    dk_job jobs[DK_MAX_THREADS];
+    int parts = dk_threads(count);
+    npy_intp share = count / parts;
+    for (int t = 0; t < parts; t++) {
+        dk_job job = {forward, {step[0], step[1], step[2]}, t * share,
+                      t == parts - 1 ? count : (t + 1) * share, 0,
+                      {PyArray_DATA(in[0]), PyArray_DATA(in[1]), PyArray_DATA(in[2])},
+                      PyArray_DATA(P),
+                      {PyArray_DATA((PyArrayObject *)out[0]), PyArray_DATA((PyArrayObject *)out[1]),
+                       forward ? PyArray_DATA((PyArrayObject *)out[2]) : NULL}};
+        jobs[t] = job;
+    }
+    npy_intp bad = 0;
+    NPY_BEGIN_THREADS_DEF;
+    if (count > 16) NPY_BEGIN_THREADS;
+#if DK_PTHREADS
+    pthread_t threads[DK_MAX_THREADS];
+    int started[DK_MAX_THREADS] = {0};
+    for (int t = 0; t < parts - 1; t++)
+        started[t] = pthread_create(&threads[t], NULL, dk_run, &jobs[t]) == 0;
+    dk_run(&jobs[parts - 1]);
+    for (int t = 0; t < parts - 1; t++) {
+        if (started[t]) pthread_join(threads[t], NULL);
+        else dk_run(&jobs[t]);
+    }
+#else
+    for (int t = 0; t < parts; t++) dk_run(&jobs[t]);
+#endif
+    for (int t = 0; t < parts; t++) bad += jobs[t].bad;
+    if (count > 16) NPY_END_THREADS;
+    if (bad > 0)
+        result = forward ? Py_BuildValue("(OOOn)", out[0], out[1], out[2], (Py_ssize_t)bad)
+                         : Py_BuildValue("(OOn)", out[0], out[1], (Py_ssize_t)bad);
+    else
+        result = forward ? PyTuple_Pack(3, out[0], out[1], out[2])
+                         : PyTuple_Pack(2, out[0], out[1]);
+done:
+    for (int i = 0; i < 3; i++) { Py_XDECREF(in[i]); Py_XDECREF(out[i]); }
+    Py_XDECREF(P);
+    return result;
+}
+
+static PyObject *dk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    return dk_batch(args, nargs, 0);
+}
+
+static PyObject *dk_py_forward(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    return dk_batch(args, nargs, 1);
+}
+
+static PyMethodDef dk_methods[] = {
+    {"inverse_derivatives", (PyCFunction)(void (*)(void))dk_py_inverse, METH_FASTCALL,
+     "(Q, V, A, P) -> (d tau/dq, d tau/dq_dot[, count of NaN rows])"},
+    {"forward_derivatives", (PyCFunction)(void (*)(void))dk_py_forward, METH_FASTCALL,
+     "(Q, V, TAU, P) -> (d q_ddot/dq, d q_ddot/dq_dot, M^-1[, count of NaN rows])"},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef dk_module = {PyModuleDef_HEAD_INIT, DK_STR(LG_MODULE), NULL, -1, dk_methods};
+
+PyMODINIT_FUNC DK_PASTE(PyInit_, LG_MODULE)(void)
+{
+    import_array();
+    return PyModule_Create(&dk_module);
+}

@@ -1,0 +1,130 @@
+"""The derivatives of a tree's dynamics in compiled C (dynamics/derivatives_c.py): against
+Pinocchio's computeRNEADerivatives / computeABADerivatives, the complex step through our
+numpy Newton-Euler (derivatives.py), and central differences of our own inverse and forward
+dynamics, on a branched tree with a mimic joint, a tilted prismatic axis and a massless link;
+batches, NaN rows and bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_dynamics_pinocchio import ARM
+from test_recursive_dynamics import TREE
+
+import lagrangian
+from lagrangian.compile import compiled
+
+needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler")
+
+
+@pytest.fixture(scope="module")
+def turret(tmp_path_factory):
+    path = tmp_path_factory.mktemp("tree") / "turret.urdf"
+    path.write_text(TREE)
+    return lagrangian.load(path, lock={"grip": 0.01})
+
+
+def _states(n, count, seed):
+    rng = np.random.default_rng(seed)
+    return rng.uniform(-1.5, 1.5, (3, count, n))
+
+
+@needs_c
+def test_compiled_derivatives_are_the_complex_steps_on_a_branched_tree_with_a_mimic(turret):
+    fast, slow = turret.dynamics(), turret.dynamics(backend="numpy")
+    assert fast._derivatives_kernel() is not None and slow._derivatives_kernel() is None
+    q, v, a = _states(fast.n, 6, 1)
+    for ours, theirs in zip(fast.inverse_dynamics_derivatives(q, v, a),
+                            slow.inverse_dynamics_derivatives(q, v, a), strict=True):
+        np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-11)
+    for ours, theirs in zip(fast.forward_dynamics_derivatives(q, v, a),
+                            slow.forward_dynamics_derivatives(q, v, a), strict=True):
+        np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-9)
+
+
+@needs_c
+def test_compiled_derivatives_agree_with_central_differences_of_our_dynamics(turret):
+    """An actuator parameter tau_<joint> set (a load: it moves q_ddot, not d tau) and gravity
+    changed: d tau/dq, d tau/dq_dot of inverse dynamics, d q_ddot/dq, d q_ddot/dq_dot,
+    d q_ddot/d tau of forward dynamics, each column by central differences (error ~ h^2)."""
+    plain = turret.dynamics()
+    load = plain.tree.actuators[0]
+    dynamics = turret.dynamics(parameters={load: 0.7, plain.tree.gravity_parameter: 3.0})
+    assert dynamics._derivatives_kernel() is not None
+    n = dynamics.n
+    q, v, a = _states(n, 1, 2)[:, 0]
+    dq, dv = dynamics.inverse_dynamics_derivatives(q, v, a)
+    fq, fv, ftau = dynamics.forward_dynamics_derivatives(q, v, a)
+    h = 1e-6
+    for k in range(n):
+        e = h * np.eye(n)[k]
+        for ours, f, args in ((dq, dynamics.inverse_dynamics, lambda s: (q + s, v, a)),
+                              (dv, dynamics.inverse_dynamics, lambda s: (q, v + s, a)),
+                              (fq, dynamics.forward_dynamics, lambda s: (q + s, v, a)),
+                              (fv, dynamics.forward_dynamics, lambda s: (q, v + s, a)),
+                              (ftau, dynamics.forward_dynamics, lambda s: (q, v, a + s))):
+            central = (f(*args(e)) - f(*args(-e))) / (2 * h)
+            np.testing.assert_allclose(ours[:, k], central, rtol=0, atol=2e-6)
+
+
+@needs_c
+def test_compiled_derivatives_of_a_spatial_arm_are_pinocchios(tmp_path):
+    pin = pytest.importorskip("pinocchio")
+    pytest.importorskip("yourdfpy")
+    path = tmp_path / "spatial.urdf"
+    path.write_text(ARM)
+    ours = lagrangian.load(path).dynamics()
+    assert ours._derivatives_kernel() is not None
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    q, v, a = _states(model.nv, 5, 3)
+    dq, dv = ours.inverse_dynamics_derivatives(q, v, a)
+    fq, fv, ftau = ours.forward_dynamics_derivatives(q, v, a)
+    for k in range(5):
+        pq, pv, _ = pin.computeRNEADerivatives(model, data, q[k], v[k], a[k])
+        np.testing.assert_allclose(dq[k], pq, rtol=0, atol=1e-10)
+        np.testing.assert_allclose(dv[k], pv, rtol=0, atol=1e-10)
+        pin.computeABADerivatives(model, data, q[k], v[k], a[k])
+        np.testing.assert_allclose(fq[k], data.ddq_dq, rtol=0, atol=1e-10)
+        np.testing.assert_allclose(fv[k], data.ddq_dv, rtol=0, atol=1e-10)
+        Minv = np.triu(data.Minv) + np.triu(data.Minv, 1).T
+        np.testing.assert_allclose(ftau[k], Minv, rtol=0, atol=1e-10)
+
+
+@needs_c
+def test_compiled_batches_broadcast_and_report_nan_rows(turret):
+    dynamics = turret.dynamics()
+    n = dynamics.n
+    q, v, a = _states(n, 4, 5)
+    one = [dynamics.inverse_dynamics_derivatives(q[k], v[k], a[k]) for k in range(4)]
+    together = dynamics.inverse_dynamics_derivatives(q, v, a)
+    for k in range(4):
+        np.testing.assert_array_equal(together[0][k], one[k][0])
+        np.testing.assert_array_equal(together[1][k], one[k][1])
+    # one q for a batch of rates; a (2, 2) batch keeps its shape
+    shared = dynamics.inverse_dynamics_derivatives(q[0], v, a)
+    np.testing.assert_allclose(shared[0][1], dynamics.inverse_dynamics_derivatives(
+        q[0], v[1], a[1])[0], rtol=0, atol=0)
+    assert dynamics.forward_dynamics_derivatives(q.reshape(2, 2, n), v.reshape(2, 2, n),
+                                                 a.reshape(2, 2, n))[2].shape == (2, 2, n, n)
+    bad = q.copy()
+    bad[2, 0] = np.nan
+    with pytest.warns(lagrangian.DynamicsWarning, match="1 of 4 states"):
+        dq, dv = dynamics.inverse_dynamics_derivatives(bad, v, a)
+    assert np.isnan(dq[2]).all() and np.isnan(dv[2]).all()
+    np.testing.assert_array_equal(dq[[0, 1, 3]], together[0][[0, 1, 3]])
+    with pytest.warns(lagrangian.DynamicsWarning, match="1 of 4 states"):
+        fq, _, ftau = dynamics.forward_dynamics_derivatives(bad, v, a)
+    assert np.isnan(fq[2]).all() and np.isfinite(ftau[[0, 1, 3]]).all()
+
+
+@needs_c
+def test_compiled_derivatives_refuse_bad_shapes_in_one_line(turret):
+    dynamics = turret.dynamics()
+    n = dynamics.n
+    with pytest.raises(lagrangian.InputError, match=f"expected {n} values") as caught:
+        dynamics.inverse_dynamics_derivatives(np.zeros(n + 1), np.zeros(n), np.zeros(n))
+    assert caught.value.field == "q" and "\n" not in str(caught.value)
+    with pytest.raises(lagrangian.InputError, match=f"expected {n} values") as caught:
+        dynamics.forward_dynamics_derivatives(np.zeros(n), np.zeros(n), [0.0])
+    assert caught.value.field == "tau"

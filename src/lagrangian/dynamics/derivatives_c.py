@@ -15,9 +15,35 @@ import numpy as np
 
 from ..model.tree import KinematicTree
 from .joint_models import JOINT_MODELS
-from .tree_c import _SINCOS
+from .tree_c import _SINCOS, _VECTOR
 
 _KERNEL = Path(__file__).with_name("derivatives_kernel.c")
+
+# the kernel's core on one state, then on LG_LANES states at once (derivatives_kernel.c)
+_SCALAR = """#define DK_T double
+#define DK_FN(name) dk_##name
+#define DK_C(x) (x)
+#define DK_SINCOS lg_sincos
+#define DK_SQRT sqrt
+#define DK_FAILED(d) (!((d) > 0.0))"""
+_LANES = """#undef DK_T
+#undef DK_FN
+#undef DK_C
+#undef DK_SINCOS
+#undef DK_SQRT
+#undef DK_FAILED
+#define DK_T lg_v4
+#define DK_FN(name) dk4_##name
+#define DK_C(x) LG_V4(x)
+#define DK_SINCOS lg_vsincos
+#define DK_SQRT lg_vsqrt
+#define DK_FAILED(d) dk4_failed(d)
+static inline int dk4_failed(lg_v4 d)
+{
+    int bits = 0;
+    for (int l = 0; l < LG_LANES; l++) bits |= !(d[l] > 0.0) << l;
+    return bits;
+}"""
 
 
 def _table(name: str, ctype: str, rows) -> str:
@@ -61,6 +87,9 @@ def kernel_source(tree: KinematicTree):
         S.append((R0 @ skew).ravel().tolist())
     models = [JOINT_MODELS[j.kind] for j in joints]
     pairs = _pairs(tree)
+    text = _KERNEL.read_text(encoding="utf-8")
+    head, rest = text.split("/* DK_CORE_BEGIN */")
+    core, bindings = rest.split("/* DK_CORE_END */")
     source = "\n".join([
         "/* lagrangian: the derivatives of a tree's inverse and forward dynamics */",
         "#define PY_SSIZE_T_CLEAN",
@@ -83,11 +112,13 @@ def kernel_source(tree: KinematicTree):
         _table("dk_P", "double", P), _table("dk_C", "double", C), _table("dk_Sk", "double", S),
         _table("dk_t0", "double", [list(j.translation) for j in joints]),
         _table("dk_u", "double", [list(j.axis) for j in joints]),
+        _table("dk_R0u", "double", [(np.array(j.rotation, dtype=float)
+                                     @ np.array(j.axis, dtype=float)).tolist() for j in joints]),
         _table("dk_m", "double", [j.mass for j in joints]),
         _table("dk_h", "double", [list(j.first_moment) for j in joints]),
         _table("dk_J", "double", [_flat(j.inertia) for j in joints]),
-        _SINCOS,
-        _KERNEL.read_text(encoding="utf-8"),
+        _SINCOS, _VECTOR,
+        head, _SCALAR, core, _LANES, core, bindings,
     ])
     return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
 

@@ -22,21 +22,35 @@
 #define DK_PASTE_(a, b) a##b
 #define DK_PASTE(a, b) DK_PASTE_(a, b)
 
-static inline void dk_cross(const double *a, const double *b, double *out)
+
+/* The core below is emitted twice by derivatives_c.py: on one state (dk_*, DK_T double) and on
+ * LG_LANES states at once (dk4_*, DK_T lg_v4, GCC/Clang vector extensions). DK_FN(name) names a
+ * function, DK_C(x) a constant as a DK_T, DK_SINCOS and DK_SQRT the functions of a DK_T, and
+ * DK_FAILED(d) the lanes (as bits) where !(d > 0). */
+/* DK_CORE_BEGIN */
+static inline void DK_FN(cross)(const DK_T *a, const DK_T *b, DK_T *out)
 {
-    double x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2],
-           z = a[0] * b[1] - a[1] * b[0];
+    DK_T x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2],
+         z = a[0] * b[1] - a[1] * b[0];
     out[0] = x; out[1] = y; out[2] = z;
 }
 
-static inline void dk_apply(const double *R, const double *x, double *out)
+static inline void DK_FN(apply)(const DK_T *R, const DK_T *x, DK_T *out)
 {
-    double a = R[0] * x[0] + R[1] * x[1] + R[2] * x[2], b = R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
-           c = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
+    DK_T a = R[0] * x[0] + R[1] * x[1] + R[2] * x[2], b = R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
+         c = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
     out[0] = a; out[1] = b; out[2] = c;
 }
 
-static inline void dk_matmul(const double *A, const double *B, double *out)
+/* A B with B a table's (doubles) */
+static inline void DK_FN(matmul_c)(const DK_T *A, const double *B, DK_T *out)
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            out[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+
+static inline void DK_FN(matmul)(const DK_T *A, const DK_T *B, DK_T *out)
 {
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
@@ -44,183 +58,196 @@ static inline void dk_matmul(const double *A, const double *B, double *out)
 }
 
 /* motion x motion: [w x yv + v x yw; w x yw] */
-static inline void dk_mcross(const double *x, const double *y, double *out)
+static inline void DK_FN(mcross)(const DK_T *x, const DK_T *y, DK_T *out)
 {
-    double a[3], b[3], c[3];
-    dk_cross(x + 3, y, a);
-    dk_cross(x, y + 3, b);
-    dk_cross(x + 3, y + 3, c);
+    DK_T a[3], b[3], c[3];
+    DK_FN(cross)(x + 3, y, a);
+    DK_FN(cross)(x, y + 3, b);
+    DK_FN(cross)(x + 3, y + 3, c);
     for (int j = 0; j < 3; j++) { out[j] = a[j] + b[j]; out[3 + j] = c[j]; }
 }
 
 /* motion x* force: [w x f; v x f + w x n] */
-static inline void dk_fcross(const double *x, const double *f, double *out)
+static inline void DK_FN(fcross)(const DK_T *x, const DK_T *f, DK_T *out)
 {
-    double a[3], b[3], c[3];
-    dk_cross(x + 3, f, a);
-    dk_cross(x, f, b);
-    dk_cross(x + 3, f + 3, c);
+    DK_T a[3], b[3], c[3];
+    DK_FN(cross)(x + 3, f, a);
+    DK_FN(cross)(x, f, b);
+    DK_FN(cross)(x + 3, f + 3, c);
     for (int j = 0; j < 3; j++) { out[j] = a[j]; out[3 + j] = b[j] + c[j]; }
 }
 
-static inline double dk_dot6(const double *a, const double *b)
+static inline DK_T DK_FN(dot6)(const DK_T *a, const DK_T *b)
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
 }
 
-/* A spatial inertia at the world's origin: mass m, c = m x_G (3), J_O (3 x 3, symmetric). */
-typedef struct { double m, c[3], J[9]; } dk_inertia;
-
-/* I x: [m v + w x c; c x v + J w] */
-static inline void dk_iapply(const dk_inertia *Y, const double *x, double *out)
+static inline DK_T DK_FN(dot3)(const DK_T *a, const DK_T *b)
 {
-    double a[3], b[3], Jw[3];
-    dk_cross(x + 3, Y->c, a);
-    dk_cross(Y->c, x, b);
-    dk_apply(Y->J, x + 3, Jw);
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* A spatial inertia at the world's origin: mass m, c = m x_G (3), J_O (3 x 3, symmetric). */
+typedef struct { DK_T m, c[3], J[9]; } DK_FN(inertia);
+
+/* Y x: [m v + w x c; c x v + J w] */
+static inline void DK_FN(iapply)(const DK_FN(inertia) *Y, const DK_T *x, DK_T *out)
+{
+    DK_T a[3], b[3], Jw[3];
+    DK_FN(cross)(x + 3, Y->c, a);
+    DK_FN(cross)(Y->c, x, b);
+    DK_FN(apply)(Y->J, x + 3, Jw);
     for (int j = 0; j < 3; j++) { out[j] = Y->m * x[j] + a[j]; out[3 + j] = b[j] + Jw[j]; }
 }
 
 typedef struct {
-    double S[DK_NB][6], dv[DK_NB][6], psi[DK_NB][6];
-    double F[DK_NB][6];             /* f_i, then the subtree's sum */
-    dk_inertia Y[DK_NB];            /* the body's, then the subtree's */
-    double L[DK_NB][3], A[DK_NB][9];  /* B's 12 numbers, the body's then the subtree's */
-    double r1[DK_NB][6], r2[DK_NB][3];  /* Ic_k S_k and the angular part of Bc_k^T S_k */
-    double Phi[DK_NB][6], Psi[DK_NB][6];
-} dk_work;
+    DK_T S[DK_NB][6], dv[DK_NB][6], psi[DK_NB][6];
+    DK_T F[DK_NB][6];                 /* f_i, then the subtree's sum */
+    DK_FN(inertia) Y[DK_NB];          /* the body's, then the subtree's */
+    DK_T L[DK_NB][3], A[DK_NB][9];    /* B's 12 numbers, the body's then the subtree's */
+    DK_T r1[DK_NB][6], r2[DK_NB][3];  /* Ic_k S_k and the angular part of Bc_k^T S_k */
+    DK_T Phi[DK_NB][6], Psi[DK_NB][6];
+} DK_FN(work);
 
 /* The forward pass: placements, S, v, a, dv, psi, f and B of every body. */
-static void dk_forward(const double *q, const double *qd, const double *qdd, const double *g,
-                       dk_work *w)
+static void DK_FN(forward)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
+                           DK_FN(work) *w)
 {
-    double R[DK_NB][9], o[DK_NB][3], V[DK_NB][6], Acc[DK_NB][6];
+    DK_T R[DK_NB][9], o[DK_NB][3], V[DK_NB][6], Acc[DK_NB][6];
     for (int i = 0; i < DK_NB; i++) {
-        double th = dk_mult[i] * q[dk_coord[i]] + dk_off[i];
-        double Rl[9], pl[3] = {dk_t0[i][0], dk_t0[i][1], dk_t0[i][2]};
+        DK_T th = dk_mult[i] * q[dk_coord[i]] + dk_off[i];
+        DK_T Rl[9], pl[3];
+        for (int j = 0; j < 3; j++) pl[j] = DK_C(dk_t0[i][j]);
         if (dk_turns[i]) {
             /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
-            double c, s;
-            lg_sincos(th, &s, &c);
+            DK_T c, s;
+            DK_SINCOS(th, &s, &c);
             for (int j = 0; j < 9; j++) Rl[j] = dk_P[i][j] + c * dk_C[i][j] + s * dk_Sk[i][j];
         } else {
-            for (int j = 0; j < 9; j++) Rl[j] = dk_R0[i][j];
+            for (int j = 0; j < 9; j++) Rl[j] = DK_C(dk_R0[i][j]);
         }
-        if (dk_slides[i]) {
-            double d[3];
-            dk_apply(dk_R0[i], dk_u[i], d);
-            for (int j = 0; j < 3; j++) pl[j] += th * d[j];
-        }
+        if (dk_slides[i])
+            for (int j = 0; j < 3; j++) pl[j] += th * dk_R0u[i][j];
         int p = dk_parent[i];
+        DK_T axis[3];
         if (p < 0) {
             for (int j = 0; j < 9; j++) R[i][j] = Rl[j];
             for (int j = 0; j < 3; j++) o[i][j] = pl[j];
         } else {
-            double d[3];
-            dk_matmul(R[p], Rl, R[i]);
-            dk_apply(R[p], pl, d);
+            DK_T d[3];
+            DK_FN(matmul)(R[p], Rl, R[i]);
+            DK_FN(apply)(R[p], pl, d);
             for (int j = 0; j < 3; j++) o[i][j] = o[p][j] + d[j];
         }
+        /* the world axis R u: R's column when u is a table's unit vector along x, y or z */
+        for (int j = 0; j < 3; j++)
+            axis[j] = R[i][3 * j] * dk_u[i][0] + R[i][3 * j + 1] * dk_u[i][1]
+                      + R[i][3 * j + 2] * dk_u[i][2];
         /* S: [o x a; a] turning about the world axis a, [a; 0] sliding along it */
-        double *S = w->S[i], axis[3];
-        dk_apply(R[i], dk_u[i], axis);
+        DK_T *S = w->S[i];
         if (dk_turns[i]) {
-            dk_cross(o[i], axis, S);
+            DK_FN(cross)(o[i], axis, S);
             for (int j = 0; j < 3; j++) S[3 + j] = axis[j];
         } else {
-            for (int j = 0; j < 3; j++) { S[j] = axis[j]; S[3 + j] = 0.0; }
+            for (int j = 0; j < 3; j++) { S[j] = axis[j]; S[3 + j] = DK_C(0.0); }
         }
-        double vp[6] = {0, 0, 0, 0, 0, 0}, ap[6] = {-g[0], -g[1], -g[2], 0, 0, 0};
-        if (p >= 0)
-            for (int j = 0; j < 6; j++) { vp[j] = V[p][j]; ap[j] = Acc[p][j]; }
-        double rate = dk_mult[i] * qd[dk_coord[i]], accel = dk_mult[i] * qdd[dk_coord[i]];
-        double t[6];
-        dk_mcross(vp, S, w->dv[i]);
-        dk_mcross(ap, S, w->psi[i]);
-        dk_mcross(vp, w->dv[i], t);
+        DK_T vp[6], ap[6];
+        for (int j = 0; j < 6; j++) {
+            vp[j] = p >= 0 ? V[p][j] : DK_C(0.0);
+            ap[j] = p >= 0 ? Acc[p][j] : DK_C(j < 3 ? -g[j] : 0.0);
+        }
+        DK_T rate = dk_mult[i] * qd[dk_coord[i]], accel = dk_mult[i] * qdd[dk_coord[i]];
+        DK_T t[6];
+        DK_FN(mcross)(vp, S, w->dv[i]);
+        DK_FN(mcross)(ap, S, w->psi[i]);
+        DK_FN(mcross)(vp, w->dv[i], t);
         for (int j = 0; j < 6; j++) {
             w->psi[i][j] += t[j];
             V[i][j] = vp[j] + S[j] * rate;
             Acc[i][j] = ap[j] + S[j] * accel + w->dv[i][j] * rate;
         }
         /* the inertia at the world's origin: c = R h + m o, J_O = R J R^T shifted by o */
-        dk_inertia *Y = &w->Y[i];
-        double hr[3], RJ[9], m = dk_m[i];
-        const double *po = o[i];
-        dk_apply(R[i], dk_h[i], hr);
-        dk_matmul(R[i], dk_J[i], RJ);
-        double pp = po[0] * po[0] + po[1] * po[1] + po[2] * po[2];
-        double ph = po[0] * hr[0] + po[1] * hr[1] + po[2] * hr[2];
+        DK_FN(inertia) *Y = &w->Y[i];
+        DK_T hr[3], RJ[9];
+        const double m = dk_m[i];
+        const DK_T *po = o[i];
+        for (int j = 0; j < 3; j++)
+            hr[j] = R[i][3 * j] * dk_h[i][0] + R[i][3 * j + 1] * dk_h[i][1]
+                    + R[i][3 * j + 2] * dk_h[i][2];
+        DK_FN(matmul_c)(R[i], dk_J[i], RJ);
+        DK_T pp = DK_FN(dot3)(po, po), ph = DK_FN(dot3)(po, hr);
         for (int a = 0; a < 3; a++)
             for (int b = a; b < 3; b++) {
-                double T = RJ[3 * a] * R[i][3 * b] + RJ[3 * a + 1] * R[i][3 * b + 1]
-                           + RJ[3 * a + 2] * R[i][3 * b + 2];
-                T += -m * po[a] * po[b] - po[a] * hr[b] - hr[a] * po[b]
-                     + (a == b ? m * pp + 2.0 * ph : 0.0);
+                DK_T T = RJ[3 * a] * R[i][3 * b] + RJ[3 * a + 1] * R[i][3 * b + 1]
+                         + RJ[3 * a + 2] * R[i][3 * b + 2]
+                         - m * po[a] * po[b] - po[a] * hr[b] - hr[a] * po[b];
+                if (a == b) T += m * pp + 2.0 * ph;
                 Y->J[3 * a + b] = Y->J[3 * b + a] = T;
             }
-        Y->m = m;
+        Y->m = DK_C(m);
         for (int j = 0; j < 3; j++) Y->c[j] = hr[j] + m * po[j];
-        /* momentum h = I v, force f = I a + v x* h */
-        double h[6], Ia[6], vh[6];
-        dk_iapply(Y, V[i], h);
-        dk_iapply(Y, Acc[i], Ia);
-        dk_fcross(V[i], h, vh);
-        for (int j = 0; j < 6; j++) w->F[i][j] = Ia[j] + vh[j];
+        /* momentum h = Y v, force f = Y a + v x* h */
+        DK_T h[6], Ya[6], vh[6];
+        DK_FN(iapply)(Y, V[i], h);
+        DK_FN(iapply)(Y, Acc[i], Ya);
+        DK_FN(fcross)(V[i], h, vh);
+        for (int j = 0; j < 6; j++) w->F[i][j] = Ya[j] + vh[j];
         /* B: L = l, A = X + X^T - (c v^T + v c^T) + 2 (v.c) 1 - [n]x, X = [w]x J_O */
-        const double *vl = V[i], *vw = V[i] + 3, *c = Y->c;
-        double X[9], cv = vl[0] * c[0] + vl[1] * c[1] + vl[2] * c[2];
+        const DK_T *vl = V[i], *vw = V[i] + 3, *c = Y->c;
+        DK_T X[9], cv = DK_FN(dot3)(vl, c);
         for (int b = 0; b < 3; b++) {
-            double col[3] = {Y->J[b], Y->J[3 + b], Y->J[6 + b]}, r[3];
-            dk_cross(vw, col, r);
+            DK_T col[3] = {Y->J[b], Y->J[3 + b], Y->J[6 + b]}, r[3];
+            DK_FN(cross)(vw, col, r);
             X[b] = r[0]; X[3 + b] = r[1]; X[6 + b] = r[2];
         }
-        double *A = w->A[i];
+        DK_T *A = w->A[i];
         for (int a = 0; a < 3; a++)
             for (int b = 0; b < 3; b++)
-                A[3 * a + b] = X[3 * a + b] + X[3 * b + a] - c[a] * vl[b] - vl[a] * c[b]
-                               + (a == b ? 2.0 * cv : 0.0);
-        const double *n = h + 3;
+                A[3 * a + b] = X[3 * a + b] + X[3 * b + a] - c[a] * vl[b] - vl[a] * c[b];
+        for (int a = 0; a < 3; a++) A[4 * a] += 2.0 * cv;
+        const DK_T *n = h + 3;
         A[1] += n[2]; A[2] -= n[1]; A[3] -= n[2]; A[5] += n[0]; A[6] += n[1]; A[7] -= n[0];
         for (int j = 0; j < 3; j++) w->L[i][j] = h[j];
     }
 }
 
 /* Bc x for the subtree's B: [-2 L x x_w; A x_w] */
-static inline void dk_bapply(const double *L, const double *A, const double *x, double *out)
+static inline void DK_FN(bapply)(const DK_T *L, const DK_T *A, const DK_T *x, DK_T *out)
 {
-    double t[3];
-    dk_cross(L, x + 3, t);
-    dk_apply(A, x + 3, out + 3);
+    DK_T t[3];
+    DK_FN(cross)(L, x + 3, t);
+    DK_FN(apply)(A, x + 3, out + 3);
     for (int j = 0; j < 3; j++) out[j] = -2.0 * t[j];
 }
 
-/* The backward pass: subtree sums and each body's row (r1, r2) and column (Phi, Psi) vectors,
- * tau by body into tau (DK_NB) when asked. */
-static void dk_backward(dk_work *w, double *tau)
+/* The backward pass: subtree sums and each body's row (r1, r2) and column (Phi, Psi) vectors
+ * (the columns only with ``columns``), tau by body into tau (DK_NB) when asked. */
+static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns)
 {
     for (int i = DK_NB - 1; i >= 0; i--) {
-        const dk_inertia *Y = &w->Y[i];
-        const double *S = w->S[i];
-        double t[6], u[6], x[6];
-        dk_iapply(Y, S, w->r1[i]);
-        /* Bc^T S (angular part): 2 L x s_v + A^T s_w */
-        double *r2 = w->r2[i];
-        dk_cross(w->L[i], S, r2);
-        for (int j = 0; j < 3; j++)
-            r2[j] = 2.0 * r2[j] + w->A[i][j] * S[3] + w->A[i][3 + j] * S[4]
-                    + w->A[i][6 + j] * S[5];
-        dk_fcross(S, w->F[i], t);
-        dk_iapply(Y, w->psi[i], u);
-        dk_bapply(w->L[i], w->A[i], w->dv[i], x);
-        for (int j = 0; j < 6; j++) w->Phi[i][j] = t[j] + u[j] + x[j];
-        dk_iapply(Y, w->dv[i], u);
-        dk_bapply(w->L[i], w->A[i], S, x);
-        for (int j = 0; j < 6; j++) w->Psi[i][j] = 2.0 * u[j] + x[j];
-        if (tau) tau[i] = dk_dot6(S, w->F[i]);
+        const DK_FN(inertia) *Y = &w->Y[i];
+        const DK_T *S = w->S[i];
+        DK_FN(iapply)(Y, S, w->r1[i]);
+        if (tau) tau[i] = DK_FN(dot6)(S, w->F[i]);
+        if (columns) {
+            DK_T t[6], u[6], x[6];
+            /* Bc^T S (angular part): 2 L x s_v + A^T s_w */
+            DK_T *r2 = w->r2[i];
+            DK_FN(cross)(w->L[i], S, r2);
+            for (int j = 0; j < 3; j++)
+                r2[j] = 2.0 * r2[j] + w->A[i][j] * S[3] + w->A[i][3 + j] * S[4]
+                        + w->A[i][6 + j] * S[5];
+            DK_FN(fcross)(S, w->F[i], t);
+            DK_FN(iapply)(Y, w->psi[i], u);
+            DK_FN(bapply)(w->L[i], w->A[i], w->dv[i], x);
+            for (int j = 0; j < 6; j++) w->Phi[i][j] = t[j] + u[j] + x[j];
+            DK_FN(iapply)(Y, w->dv[i], u);
+            DK_FN(bapply)(w->L[i], w->A[i], S, x);
+            for (int j = 0; j < 6; j++) w->Psi[i][j] = 2.0 * u[j] + x[j];
+        }
         int p = dk_parent[i];
         if (p >= 0) {
-            dk_inertia *P = &w->Y[p];
+            DK_FN(inertia) *P = &w->Y[p];
             P->m += Y->m;
             for (int j = 0; j < 3; j++) { P->c[j] += Y->c[j]; w->L[p][j] += w->L[i][j]; }
             for (int j = 0; j < 9; j++) { P->J[j] += Y->J[j]; w->A[p][j] += w->A[i][j]; }
@@ -229,105 +256,137 @@ static void dk_backward(dk_work *w, double *tau)
     }
 }
 
-/* M (DK_N x DK_N); with dq, dv also d tau/dq and d tau/dq_dot, from the pairs (k below or at
- * j), each entry scattered to the coordinates with the joints' multipliers */
-static void dk_pairs(const dk_work *w, double *M, double *dq, double *dv)
+/* M (DK_N x DK_N) when asked, or d tau/dq and d tau/dq_dot, from the pairs (k below or at j),
+ * each entry scattered to the coordinates with the joints' multipliers */
+static void DK_FN(pairs)(const DK_FN(work) *w, DK_T *M, DK_T *dq, DK_T *dv)
 {
-    for (int j = 0; j < DK_N * DK_N; j++) M[j] = 0.0;
+    if (M)
+        for (int j = 0; j < DK_N * DK_N; j++) M[j] = DK_C(0.0);
     if (dq)
-        for (int j = 0; j < DK_N * DK_N; j++) { dq[j] = 0.0; dv[j] = 0.0; }
+        for (int j = 0; j < DK_N * DK_N; j++) { dq[j] = DK_C(0.0); dv[j] = DK_C(0.0); }
     for (int e = 0; e < DK_NP; e++) {
         const int k = dk_pair[e][0], j = dk_pair[e][1];
         const int ck = dk_coord[k], cj = dk_coord[j];
         const double kk = dk_mult[k] * dk_mult[j];
-        const double mkj = kk * dk_dot6(w->r1[k], w->S[j]);
-        M[ck * DK_N + cj] += mkj;
-        if (k != j) M[cj * DK_N + ck] += mkj;
+        const DK_T *r1 = w->r1[k];
+        if (M) {
+            const DK_T mkj = kk * DK_FN(dot6)(r1, w->S[j]);
+            M[ck * DK_N + cj] += mkj;
+            if (k != j) M[cj * DK_N + ck] += mkj;
+        }
         if (!dq) continue;
-        const double *r1 = w->r1[k], *r2 = w->r2[k];
-        dq[ck * DK_N + cj] += kk * (dk_dot6(r1, w->psi[j]) + r2[0] * w->dv[j][3]
-                                    + r2[1] * w->dv[j][4] + r2[2] * w->dv[j][5]);
-        dv[ck * DK_N + cj] += kk * (2.0 * dk_dot6(r1, w->dv[j]) + r2[0] * w->S[j][3]
-                                    + r2[1] * w->S[j][4] + r2[2] * w->S[j][5]);
+        const DK_T *r2 = w->r2[k];
+        dq[ck * DK_N + cj] += kk * (DK_FN(dot6)(r1, w->psi[j]) + DK_FN(dot3)(r2, w->dv[j] + 3));
+        dv[ck * DK_N + cj] += kk * (2.0 * DK_FN(dot6)(r1, w->dv[j])
+                                    + DK_FN(dot3)(r2, w->S[j] + 3));
         if (k != j) {
-            dq[cj * DK_N + ck] += kk * dk_dot6(w->S[j], w->Phi[k]);
-            dv[cj * DK_N + ck] += kk * dk_dot6(w->S[j], w->Psi[k]);
+            dq[cj * DK_N + ck] += kk * DK_FN(dot6)(w->S[j], w->Phi[k]);
+            dv[cj * DK_N + ck] += kk * DK_FN(dot6)(w->S[j], w->Psi[k]);
         }
     }
 }
 
-/* (d tau/dq, d tau/dq_dot) at one state; g (3) the gravity vector (m/s^2). */
-static void dk_inverse(const double *q, const double *qd, const double *qdd, const double *g,
-                       double *dq, double *dv)
+/* (d tau/dq, d tau/dq_dot) at one state (lane); g (3) the gravity vector (m/s^2). */
+static void DK_FN(inverse)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
+                           DK_T *dq, DK_T *dv)
 {
-    dk_work w;
-    double M[DK_N * DK_N];
-    dk_forward(q, qd, qdd, g, &w);
-    dk_backward(&w, NULL);
-    dk_pairs(&w, M, dq, dv);
+    DK_FN(work) w;
+    DK_FN(forward)(q, qd, qdd, g, &w);
+    DK_FN(backward)(&w, NULL, 1);
+    DK_FN(pairs)(&w, NULL, dq, dv);
 }
 
-/* L L^T = M in place (lower triangle); 0 where M is not positive definite */
-static int dk_cholesky(double *M)
+/* L L^T = M in place (lower triangle); the lanes (bits) where M is not positive definite */
+static int DK_FN(cholesky)(DK_T *M)
 {
+    int failed = 0;
     for (int j = 0; j < DK_N; j++) {
-        double d = M[j * DK_N + j];
+        DK_T d = M[j * DK_N + j];
         for (int k = 0; k < j; k++) d -= M[j * DK_N + k] * M[j * DK_N + k];
-        if (!(d > 0.0)) return 0;
-        d = sqrt(d);
+        failed |= DK_FAILED(d);
+        d = DK_SQRT(d);
         M[j * DK_N + j] = d;
+        const DK_T inverse = 1.0 / d;
         for (int i = j + 1; i < DK_N; i++) {
-            double s = M[i * DK_N + j];
+            DK_T s = M[i * DK_N + j];
             for (int k = 0; k < j; k++) s -= M[i * DK_N + k] * M[j * DK_N + k];
-            M[i * DK_N + j] = s / d;
+            M[i * DK_N + j] = s * inverse;
         }
     }
-    return 1;
+    return failed;
 }
 
 /* x = M^-1 b from the factor L (b overwritten) */
-static void dk_solve(const double *L, double *b)
+static void DK_FN(solve)(const DK_T *L, DK_T *b)
 {
     for (int i = 0; i < DK_N; i++) {
-        double s = b[i];
+        DK_T s = b[i];
         for (int k = 0; k < i; k++) s -= L[i * DK_N + k] * b[k];
         b[i] = s / L[i * DK_N + i];
     }
     for (int i = DK_N - 1; i >= 0; i--) {
-        double s = b[i];
+        DK_T s = b[i];
         for (int k = i + 1; k < DK_N; k++) s -= L[k * DK_N + i] * b[k];
         b[i] = s / L[i * DK_N + i];
     }
 }
 
-/* (d q_ddot/dq, d q_ddot/dq_dot, M^-1) at one state; P = [g (3), tau_<joint> (DK_N)];
- * 0 where M is not positive definite */
-static int dk_forward_derivatives(const double *q, const double *qd, const double *tau,
-                                  const double *P, double *aq, double *av, double *Minv)
+/* (d q_ddot/dq, d q_ddot/dq_dot, M^-1) at one state (lane); P = [g (3), tau_<joint> (DK_N)];
+ * the lanes (bits) where M is not positive definite */
+static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T *tau,
+                                      const double *P, DK_T *aq, DK_T *av, DK_T *Minv)
 {
-    dk_work w;
-    double M[DK_N * DK_N], dq[DK_N * DK_N], dv[DK_N * DK_N], taub[DK_NB], b[DK_N];
-    double zero[DK_N];
-    for (int j = 0; j < DK_N; j++) zero[j] = 0.0;
+    DK_FN(work) w;
+    DK_T M[DK_N * DK_N], dq[DK_N * DK_N], dv[DK_N * DK_N], taub[DK_NB], b[DK_N], zero[DK_N];
+    /* the bodies' own f, inertia and B: the backward pass sums them in place */
+    DK_T F[DK_NB][6], L[DK_NB][3], A[DK_NB][9];
+    DK_FN(inertia) Y[DK_NB];
+    for (int j = 0; j < DK_N; j++) zero[j] = DK_C(0.0);
     /* q_ddot = M^-1 (tau + tau_p - b), b from Newton-Euler at q_ddot = 0 */
-    dk_forward(q, qd, zero, P, &w);
-    dk_backward(&w, taub);
-    dk_pairs(&w, M, NULL, NULL);
+    DK_FN(forward)(q, qd, zero, P, &w);
+    memcpy(F, w.F, sizeof F);
+    memcpy(L, w.L, sizeof L);
+    memcpy(A, w.A, sizeof A);
+    memcpy(Y, w.Y, sizeof Y);
+    DK_FN(backward)(&w, taub, 0);
+    DK_FN(pairs)(&w, M, NULL, NULL);
     for (int j = 0; j < DK_N; j++) b[j] = tau[j] + P[3 + j];
     for (int i = 0; i < DK_NB; i++) b[dk_coord[i]] -= dk_mult[i] * taub[i];
-    if (!dk_cholesky(M)) return 0;
-    dk_solve(M, b);
-    dk_inverse(q, qd, b, P, dq, dv);
+    int failed = DK_FN(cholesky)(M);
+    DK_FN(solve)(M, b);
+    /* at q_ddot = b: each body's acceleration grows by da = da_p + S theta_ddot, so psi by
+       da_p x S and f by Y da (the rest of the forward pass does not see q_ddot) */
+    memcpy(w.F, F, sizeof F);
+    memcpy(w.L, L, sizeof L);
+    memcpy(w.A, A, sizeof A);
+    memcpy(w.Y, Y, sizeof Y);
+    DK_T da[DK_NB][6];
+    for (int i = 0; i < DK_NB; i++) {
+        const int p = dk_parent[i];
+        const DK_T accel = dk_mult[i] * b[dk_coord[i]];
+        DK_T t[6], u[6];
+        if (p >= 0) {
+            DK_FN(mcross)(da[p], w.S[i], t);
+            for (int j = 0; j < 6; j++) { w.psi[i][j] += t[j]; da[i][j] = da[p][j]; }
+        } else {
+            for (int j = 0; j < 6; j++) da[i][j] = DK_C(0.0);
+        }
+        for (int j = 0; j < 6; j++) da[i][j] += w.S[i][j] * accel;
+        DK_FN(iapply)(&w.Y[i], da[i], u);
+        for (int j = 0; j < 6; j++) w.F[i][j] += u[j];
+    }
+    DK_FN(backward)(&w, NULL, 1);
+    DK_FN(pairs)(&w, NULL, dq, dv);
     /* M^-1 column by column, then -M^-1 d tau/dq, -M^-1 d tau/dq_dot */
     for (int c = 0; c < DK_N; c++) {
-        double e[DK_N];
-        for (int j = 0; j < DK_N; j++) e[j] = j == c ? 1.0 : 0.0;
-        dk_solve(M, e);
+        DK_T e[DK_N];
+        for (int j = 0; j < DK_N; j++) e[j] = DK_C(j == c ? 1.0 : 0.0);
+        DK_FN(solve)(M, e);
         for (int j = 0; j < DK_N; j++) Minv[j * DK_N + c] = e[j];
     }
     for (int i = 0; i < DK_N; i++)
         for (int j = 0; j < DK_N; j++) {
-            double x = 0.0, y = 0.0;
+            DK_T x = DK_C(0.0), y = DK_C(0.0);
             for (int k = 0; k < DK_N; k++) {
                 x += Minv[i * DK_N + k] * dq[k * DK_N + j];
                 y += Minv[i * DK_N + k] * dv[k * DK_N + j];
@@ -335,8 +394,9 @@ static int dk_forward_derivatives(const double *q, const double *qd, const doubl
             aq[i * DK_N + j] = -x;
             av[i * DK_N + j] = -y;
         }
-    return 1;
+    return failed;
 }
+/* DK_CORE_END */
 
 /* -- Python bindings: (Q, V, X, P) with Q, V, X (..., DK_N) float64 (or (DK_N,), shared by
  * the batch), P = [g (3), tau_<joint> (DK_N)]; outputs (..., DK_N, DK_N) each, as a tuple,
@@ -360,26 +420,60 @@ typedef struct {
     double *y[3];
 } dk_job;
 
+/* Whether state k's inputs are all finite. */
+static inline int dk_finite(const dk_job *job, npy_intp k)
+{
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < DK_N; i++)
+            if (!isfinite(job->x[j][k * job->step[j] + i])) return 0;
+    return 1;
+}
+
 static void *dk_run(void *argument)
 {
     dk_job *job = (dk_job *)argument;
-    const int size = DK_N * DK_N;
-    npy_intp bad = 0;
-    for (npy_intp k = job->k0; k < job->k1; k++) {
+    const int size = DK_N * DK_N, nout = 2 + job->forward;
+    npy_intp bad = 0, k = job->k0;
+    /* LG_LANES states at a time through the dk4_ functions, the rest one by one */
+    for (; k + LG_LANES <= job->k1; k += LG_LANES) {
+        lg_v4 in[3][DK_N], out[3][DK_N * DK_N];
+        for (int j = 0; j < 3; j++)
+            for (int l = 0; l < LG_LANES; l++)
+                for (int i = 0; i < DK_N; i++) in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
+        int failed = 0;
+        if (job->forward)
+            failed = dk4_forward_derivatives(in[0], in[1], in[2], job->p, out[0], out[1], out[2]);
+        else
+            dk4_inverse(in[0], in[1], in[2], job->p, out[0], out[1]);
+        /* x - x is NaN for an infinite or NaN x: the lanes with an input not finite */
+        lg_v4 spoilt = LG_V4(0.0);
+        for (int j = 0; j < 3; j++)
+            for (int i = 0; i < DK_N; i++) spoilt += in[j][i] - in[j][i];
+        for (int l = 0; l < LG_LANES; l++) {
+            const int fine = !((failed >> l) & 1) && spoilt[l] == 0.0;
+            bad += !fine;
+            for (int o = 0; o < nout; o++) {
+                double *y = job->y[o] + (k + l) * size;
+                if (fine)
+                    for (int i = 0; i < size; i++) y[i] = out[o][i][l];
+                else
+                    for (int i = 0; i < size; i++) y[i] = NAN;
+            }
+        }
+    }
+    for (; k < job->k1; k++) {
         const double *a0 = job->x[0] + k * job->step[0], *a1 = job->x[1] + k * job->step[1],
                      *a2 = job->x[2] + k * job->step[2];
         double *y0 = job->y[0] + k * size, *y1 = job->y[1] + k * size;
-        int fine = 1;
-        for (int i = 0; i < DK_N; i++)
-            if (!isfinite(a0[i]) || !isfinite(a1[i]) || !isfinite(a2[i])) fine = 0;
+        int fine = dk_finite(job, k);
         if (fine) {
             if (job->forward)
-                fine = dk_forward_derivatives(a0, a1, a2, job->p, y0, y1, job->y[2] + k * size);
+                fine = !dk_forward_derivatives(a0, a1, a2, job->p, y0, y1, job->y[2] + k * size);
             else
                 dk_inverse(a0, a1, a2, job->p, y0, y1);
         }
         if (!fine) {
-            for (int o = 0; o < 2 + job->forward; o++)
+            for (int o = 0; o < nout; o++)
                 for (int i = 0; i < size; i++) job->y[o][k * size + i] = NAN;
             bad++;
         }
@@ -464,10 +558,10 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int forward)
     }
     dk_job jobs[DK_MAX_THREADS];
     int parts = dk_threads(count);
-    npy_intp share = count / parts;
+    npy_intp share = (count / parts + LG_LANES - 1) / LG_LANES * LG_LANES;
     for (int t = 0; t < parts; t++) {
-        dk_job job = {forward, {step[0], step[1], step[2]}, t * share,
-                      t == parts - 1 ? count : (t + 1) * share, 0,
+        dk_job job = {forward, {step[0], step[1], step[2]}, t * share < count ? t * share : count,
+                      t == parts - 1 || (t + 1) * share > count ? count : (t + 1) * share, 0,
                       {PyArray_DATA(in[0]), PyArray_DATA(in[1]), PyArray_DATA(in[2])},
                       PyArray_DATA(P),
                       {PyArray_DATA((PyArrayObject *)out[0]), PyArray_DATA((PyArrayObject *)out[1]),

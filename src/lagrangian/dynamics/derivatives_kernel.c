@@ -296,8 +296,9 @@ static void DK_FN(inverse)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const
     DK_FN(pairs)(&w, NULL, dq, dv);
 }
 
-/* L L^T = M in place (lower triangle); the lanes (bits) where M is not positive definite */
-static int DK_FN(cholesky)(DK_T *M)
+/* L L^T = M in place (lower triangle), 1 / L_jj into inverse; the lanes (bits) where M is not
+ * positive definite */
+static int DK_FN(cholesky)(DK_T *M, DK_T *inverse)
 {
     int failed = 0;
     for (int j = 0; j < DK_N; j++) {
@@ -306,28 +307,28 @@ static int DK_FN(cholesky)(DK_T *M)
         failed |= DK_FAILED(d);
         d = DK_SQRT(d);
         M[j * DK_N + j] = d;
-        const DK_T inverse = 1.0 / d;
+        inverse[j] = 1.0 / d;
         for (int i = j + 1; i < DK_N; i++) {
             DK_T s = M[i * DK_N + j];
             for (int k = 0; k < j; k++) s -= M[i * DK_N + k] * M[j * DK_N + k];
-            M[i * DK_N + j] = s * inverse;
+            M[i * DK_N + j] = s * inverse[j];
         }
     }
     return failed;
 }
 
-/* x = M^-1 b from the factor L (b overwritten) */
-static void DK_FN(solve)(const DK_T *L, DK_T *b)
+/* x = M^-1 b from the factor L and 1 / L_jj (b overwritten); b zero above ``first`` */
+static void DK_FN(solve)(const DK_T *L, const DK_T *inverse, DK_T *b, int first)
 {
-    for (int i = 0; i < DK_N; i++) {
+    for (int i = first; i < DK_N; i++) {
         DK_T s = b[i];
-        for (int k = 0; k < i; k++) s -= L[i * DK_N + k] * b[k];
-        b[i] = s / L[i * DK_N + i];
+        for (int k = first; k < i; k++) s -= L[i * DK_N + k] * b[k];
+        b[i] = s * inverse[i];
     }
     for (int i = DK_N - 1; i >= 0; i--) {
         DK_T s = b[i];
         for (int k = i + 1; k < DK_N; k++) s -= L[k * DK_N + i] * b[k];
-        b[i] = s / L[i * DK_N + i];
+        b[i] = s * inverse[i];
     }
 }
 
@@ -352,8 +353,9 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     DK_FN(pairs)(&w, M, NULL, NULL);
     for (int j = 0; j < DK_N; j++) b[j] = tau[j] + P[3 + j];
     for (int i = 0; i < DK_NB; i++) b[dk_coord[i]] -= dk_mult[i] * taub[i];
-    int failed = DK_FN(cholesky)(M);
-    DK_FN(solve)(M, b);
+    DK_T diagonal[DK_N];
+    int failed = DK_FN(cholesky)(M, diagonal);
+    DK_FN(solve)(M, diagonal, b, 0);
     /* at q_ddot = b: each body's acceleration grows by da = da_p + S theta_ddot, so psi by
        da_p x S and f by Y da (the rest of the forward pass does not see q_ddot) */
     memcpy(w.F, F, sizeof F);
@@ -381,7 +383,7 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     for (int c = 0; c < DK_N; c++) {
         DK_T e[DK_N];
         for (int j = 0; j < DK_N; j++) e[j] = DK_C(j == c ? 1.0 : 0.0);
-        DK_FN(solve)(M, e);
+        DK_FN(solve)(M, diagonal, e, c);
         for (int j = 0; j < DK_N; j++) Minv[j * DK_N + c] = e[j];
     }
     for (int i = 0; i < DK_N; i++)

@@ -8,15 +8,20 @@ Needs the bench extra (pin, example-robot-data). The Panda's finger joints are l
 - Per call: one state through ``dynamics().inverse_dynamics_derivatives`` (and
   ``forward_dynamics_derivatives``, ``regressor``) against ``computeRNEADerivatives``
   (``computeABADerivatives``, ``computeJointTorqueRegressor``) through Pinocchio's Python
-  bindings, best of 5 runs of 200 calls, interleaved in one process.
-- Batch: one call on N states (ours) against a Python loop of N Pinocchio calls, best of 3.
+  bindings: 200 calls from Python (argument checks and the output arrays included), ours and
+  Pinocchio's taking turns, the best of 7 rounds each.
+- Batch: one call on N states (ours: one C call, on up to LAGRANGIAN_THREADS threads, default
+  the processors) against a Python loop of N Pinocchio calls, taking turns, best of 3 each.
 - Agreement: the largest absolute difference over 20 random states.
+- The machine's load average before and after, and its processor count, are printed with the
+  figures: on a shared machine both sides slow down, not always alike.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import time
 
 import numpy as np
@@ -25,13 +30,15 @@ from bench_urdf import ROBOTS, robots_folder
 import lagrangian
 
 
-def best(function, repeat: int) -> float:
-    times = []
+def interleaved(first, second, repeat: int) -> tuple[float, float]:
+    """The best wall time of each of two functions over ``repeat`` rounds, taking turns."""
+    times: tuple[list[float], list[float]] = ([], [])
     for _ in range(repeat):
-        began = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - began)
-    return min(times)
+        for function, out in ((first, times[0]), (second, times[1])):
+            began = time.perf_counter()
+            function()
+            out.append(time.perf_counter() - began)
+    return min(times[0]), min(times[1])
 
 
 def main() -> None:
@@ -60,23 +67,36 @@ def main() -> None:
         "regressor": (lambda Q, V, A: ours.regressor(Q, V, A),
                       lambda Q, V, A: pin.computeJointTorqueRegressor(model, data, Q, V, A)),
     }
-    report = {"robot": args.robot, "states": args.states}
+    report = {"robot": args.robot, "states": args.states, "cpus": os.cpu_count(),
+              "threads": os.environ.get("LAGRANGIAN_THREADS", "processors"),
+              "load_average_before": os.getloadavg()}
     for name, (mine, theirs) in pairs.items():
-        ours_call = best(lambda m=mine: [m(q[k], v[k], a[k]) for k in range(200)], 5) / 200
-        pin_call = best(lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(200)], 5) / 200
-        ours_batch = best(lambda m=mine: m(q, v, a), 3)
-        pin_batch = best(lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(args.states)], 3)
+        mine(q[:8], v[:8], a[:8])  # compiled (and cached) before the clock starts
+        ours_call, pin_call = (t / 200 for t in interleaved(
+            lambda m=mine: [m(q[k], v[k], a[k]) for k in range(200)],
+            lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(200)], 7))
+        ours_batch, pin_batch = interleaved(
+            lambda m=mine: m(q, v, a),
+            lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(args.states)], 3)
         report[name] = {"ours_per_call_us": ours_call * 1e6, "pinocchio_per_call_us": pin_call * 1e6,
                         "ours_batch_s": ours_batch, "pinocchio_loop_s": pin_batch,
                         "per_call_speedup": pin_call / ours_call,
                         "batch_speedup": pin_batch / ours_batch}
+    report["load_average_after"] = os.getloadavg()
     dq, dv = ours.inverse_dynamics_derivatives(q[:20], v[:20], a[:20])
+    fq, fv, ftau = ours.forward_dynamics_derivatives(q[:20], v[:20], a[:20])
     Y = ours.regressor(q[:20], v[:20], a[:20])
-    worst = {"rnea_derivatives": 0.0, "regressor": 0.0}
+    worst = {"rnea_derivatives": 0.0, "aba_derivatives": 0.0, "regressor": 0.0}
     for k in range(20):
         pq, pv, _ = pin.computeRNEADerivatives(model, data, q[k], v[k], a[k])
         worst["rnea_derivatives"] = max(worst["rnea_derivatives"], np.abs(dq[k] - pq).max(),
                                         np.abs(dv[k] - pv).max())
+        pin.computeABADerivatives(model, data, q[k], v[k], a[k])
+        minv = np.triu(data.Minv) + np.triu(data.Minv, 1).T
+        worst["aba_derivatives"] = max(worst["aba_derivatives"],
+                                       np.abs(fq[k] - data.ddq_dq).max(),
+                                       np.abs(fv[k] - data.ddq_dv).max(),
+                                       np.abs(ftau[k] - minv).max())
         worst["regressor"] = max(worst["regressor"], np.abs(
             Y[k] - pin.computeJointTorqueRegressor(model, data, q[k], v[k], a[k])).max())
     report["max_abs_difference"] = worst

@@ -317,12 +317,12 @@ static int DK_FN(cholesky)(DK_T *M, DK_T *inverse)
     return failed;
 }
 
-/* x = M^-1 b from the factor L and 1 / L_jj (b overwritten); b zero above ``first`` */
-static void DK_FN(solve)(const DK_T *L, const DK_T *inverse, DK_T *b, int first)
+/* x = M^-1 b from the factor L and 1 / L_jj (b overwritten) */
+static void DK_FN(solve)(const DK_T *L, const DK_T *inverse, DK_T *b)
 {
-    for (int i = first; i < DK_N; i++) {
+    for (int i = 0; i < DK_N; i++) {
         DK_T s = b[i];
-        for (int k = first; k < i; k++) s -= L[i * DK_N + k] * b[k];
+        for (int k = 0; k < i; k++) s -= L[i * DK_N + k] * b[k];
         b[i] = s * inverse[i];
     }
     for (int i = DK_N - 1; i >= 0; i--) {
@@ -355,7 +355,7 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     for (int i = 0; i < DK_NB; i++) b[dk_coord[i]] -= dk_mult[i] * taub[i];
     DK_T diagonal[DK_N];
     int failed = DK_FN(cholesky)(M, diagonal);
-    DK_FN(solve)(M, diagonal, b, 0);
+    DK_FN(solve)(M, diagonal, b);
     /* at q_ddot = b: each body's acceleration grows by da = da_p + S theta_ddot, so psi by
        da_p x S and f by Y da (the rest of the forward pass does not see q_ddot) */
     memcpy(w.F, F, sizeof F);
@@ -379,23 +379,36 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     }
     DK_FN(backward)(&w, NULL, 1);
     DK_FN(pairs)(&w, NULL, dq, dv);
-    /* M^-1 column by column, then -M^-1 d tau/dq, -M^-1 d tau/dq_dot */
-    for (int c = 0; c < DK_N; c++) {
-        DK_T e[DK_N];
-        for (int j = 0; j < DK_N; j++) e[j] = DK_C(j == c ? 1.0 : 0.0);
-        DK_FN(solve)(M, diagonal, e, c);
-        for (int j = 0; j < DK_N; j++) Minv[j * DK_N + c] = e[j];
+    /* M^-1 = L^-T L^-1: X = L^-1 row by row (the columns of a row independent: no chain of
+       dependent operations as in solving column by column), then X^T X; then -M^-1 d tau/dq,
+       -M^-1 d tau/dq_dot */
+    DK_T X[DK_N * DK_N];
+    for (int i = 0; i < DK_N; i++) {
+        for (int c = 0; c < i; c++) {
+            DK_T s = DK_C(0.0);
+            for (int k = c; k < i; k++) s -= M[i * DK_N + k] * X[k * DK_N + c];
+            X[i * DK_N + c] = s * diagonal[i];
+        }
+        X[i * DK_N + i] = diagonal[i];
     }
     for (int i = 0; i < DK_N; i++)
-        for (int j = 0; j < DK_N; j++) {
-            DK_T x = DK_C(0.0), y = DK_C(0.0);
-            for (int k = 0; k < DK_N; k++) {
-                x += Minv[i * DK_N + k] * dq[k * DK_N + j];
-                y += Minv[i * DK_N + k] * dv[k * DK_N + j];
-            }
-            aq[i * DK_N + j] = -x;
-            av[i * DK_N + j] = -y;
+        for (int j = 0; j <= i; j++) {
+            DK_T s = DK_C(0.0);
+            for (int k = i; k < DK_N; k++) s += X[k * DK_N + i] * X[k * DK_N + j];
+            Minv[i * DK_N + j] = Minv[j * DK_N + i] = s;
         }
+    for (int i = 0; i < DK_N; i++) {  /* rows as sums of rows: independent along j */
+        DK_T x[DK_N], y[DK_N];
+        for (int j = 0; j < DK_N; j++) { x[j] = DK_C(0.0); y[j] = DK_C(0.0); }
+        for (int k = 0; k < DK_N; k++) {
+            const DK_T m = Minv[i * DK_N + k];
+            for (int j = 0; j < DK_N; j++) {
+                x[j] -= m * dq[k * DK_N + j];
+                y[j] -= m * dv[k * DK_N + j];
+            }
+        }
+        for (int j = 0; j < DK_N; j++) { aq[i * DK_N + j] = x[j]; av[i * DK_N + j] = y[j]; }
+    }
     return failed;
 }
 /* DK_CORE_END */
@@ -511,7 +524,7 @@ static const char *dk_names[2][3] = {{"q", "v", "a"}, {"q", "v", "tau"}};
 static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int forward)
 {
     PyArrayObject *in[3] = {NULL, NULL, NULL}, *P = NULL;
-    PyObject *out[3] = {NULL, NULL, NULL}, *result = NULL;
+    PyObject *out[3] = {NULL, NULL, NULL}, *block = NULL, *result = NULL;
     npy_intp step[3] = {0, 0, 0};
     const int nout = 2 + forward;
     if (nargs != 4) {
@@ -550,12 +563,17 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int forward)
         PyErr_SetString(PyExc_ValueError, "parameters: expected g (3) and the actuators");
         goto done;
     }
+    /* the outputs as views of one block (nout, ..., DK_N, DK_N): one allocation (two large
+       ones of a size freed and asked again each call cost glibc a trim and fresh pages) */
     npy_intp dims[NPY_MAXDIMS];
-    memcpy(dims, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
-    dims[nd - 1] = DK_N;
+    dims[0] = nout;
+    memcpy(dims + 1, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
     dims[nd] = DK_N;
+    dims[nd + 1] = DK_N;
+    block = PyArray_SimpleNew(nd + 2, dims, NPY_DOUBLE);
+    if (!block) goto done;
     for (int o = 0; o < nout; o++) {
-        out[o] = PyArray_SimpleNew(nd + 1, dims, NPY_DOUBLE);
+        out[o] = PySequence_GetItem(block, o);
         if (!out[o]) goto done;
     }
     dk_job jobs[DK_MAX_THREADS];
@@ -596,6 +614,7 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int forward)
                          : PyTuple_Pack(2, out[0], out[1]);
 done:
     for (int i = 0; i < 3; i++) { Py_XDECREF(in[i]); Py_XDECREF(out[i]); }
+    Py_XDECREF(block);
     Py_XDECREF(P);
     return result;
 }

@@ -149,3 +149,21 @@ def test_dynamics_command_gives_the_compiled_derivatives(tmp_path, cli):
     pq, pv, _ = pin.computeRNEADerivatives(model, data, np.array(q), np.array(v), np.array(a))
     np.testing.assert_allclose(document["dtau_dq"], pq, rtol=0, atol=1e-10)
     np.testing.assert_allclose(document["dtau_dv"], pv, rtol=0, atol=1e-10)
+
+
+@needs_c
+def test_compiled_regressor_is_the_numpy_one_and_gives_tau(turret):
+    """Y pi is inverse dynamics (the actuator parameters aside); Y equals the numpy regressor
+    (derivatives.py's path) on the branched tree with its mimic joint; a NaN row is reported."""
+    fast, slow = turret.dynamics(), turret.dynamics(backend="numpy")
+    q, v, a = _states(fast.n, 6, 7)
+    Y = fast.regressor(q, v, a)
+    np.testing.assert_allclose(Y, slow.regressor(q, v, a), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(Y @ fast.inertial_parameters(), fast.inverse_dynamics(q, v, a),
+                               rtol=0, atol=1e-11)
+    np.testing.assert_allclose(fast.regressor(q[0], v[0], a[0]), Y[0], rtol=0, atol=1e-12)
+    bad = v.copy()
+    bad[1, 0] = np.inf
+    with pytest.warns(lagrangian.DynamicsWarning, match="1 of 6 states"):
+        Y = fast.regressor(q, bad, a)
+    assert np.isnan(Y[1]).all() and np.isfinite(Y[[0, 2, 3, 4, 5]]).all()

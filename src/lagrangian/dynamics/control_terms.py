@@ -39,6 +39,11 @@ class ControlTerms:
                 raise InputError("a robot's regressor is over its bodies' 10 inertial "
                                  "parameters each; parameters=[...] is for model files",
                                  field="parameters")
+            fast = self._derivatives_kernel()
+            if fast is not None:  # compiled C (derivatives_c.py)
+                compute, P = fast[2], fast[3]
+                return (lambda Q, V, A: compute(Q, V, A, P),
+                        tree_parameter_names(tree), tree_parameters(tree))
             g = self.parameters[tree.gravity_parameter]
             return (lambda Q, V, A: tree_regressor(tree, g, Q, V, A),
                     tree_parameter_names(tree), tree_parameters(tree))
@@ -58,6 +63,14 @@ class ControlTerms:
         (m, m c_x, m c_y, m c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz about the body's joint
         frame; see ``parameter_names``). A model file: the named ``parameters``, in which T and
         V must be linear."""
+        fast = self._derivatives_kernel() if parameters is None else None
+        if fast is not None:  # one C call; a bad input goes the guarded way to be named
+            try:
+                out = fast[2](q, v, a, fast[3])
+            except (ValueError, TypeError):
+                pass
+            else:
+                return out if out.__class__ is not tuple else _reported(out)[0]
         compute, names, _ = self._regressor_of(parameters)
         return self._guarded(compute, (q, v, a), ("q", "v", "a"), (self.n, len(names)))
 
@@ -86,7 +99,7 @@ class ControlTerms:
     # -- derivatives (derivatives_c.py, derivatives.py) -------------------------------------------
 
     def _derivatives_kernel(self):
-        """(inverse, forward, P) of the tree's compiled derivatives (derivatives_c.py), or None:
+        """(inverse, forward, regressor, P) of the tree's compiled module (derivatives_c.py), or None:
         a compiled backend's fixed-base tree of revolute and prismatic joints only; the numpy
         backend, a model file and a floating base keep derivatives.py."""
         found = self.__dict__.get("_derivatives_c", False)
@@ -99,7 +112,7 @@ class ControlTerms:
                 module = derivatives_module(tree) if applies(tree) else None
                 if module is not None:
                     found = (module.inverse_derivatives, module.forward_derivatives,
-                             runtime_values(tree, self.parameters))
+                             module.regressor, runtime_values(tree, self.parameters))
             self.__dict__["_derivatives_c"] = found
         return found
 
@@ -110,7 +123,7 @@ class ControlTerms:
             _refuse_floating(tree, "derivatives of the dynamics")
             fast = self._derivatives_kernel()
             if fast is not None:
-                inverse, _, P = fast
+                inverse, P = fast[0], fast[3]
 
                 def found(Q, V, A):
                     return inverse(Q, V, A, P)[:2]
@@ -139,7 +152,7 @@ class ControlTerms:
         fast = self._derivatives_kernel()
         if fast is not None:  # one C call; a bad input goes the guarded way to be named
             try:
-                out = fast[0](q, v, a, fast[2])
+                out = fast[0](q, v, a, fast[3])
             except (ValueError, TypeError):
                 pass
             else:
@@ -158,7 +171,7 @@ class ControlTerms:
         fast = self._derivatives_kernel()
         if fast is not None:
             try:
-                out = fast[1](q, v, tau, fast[2])
+                out = fast[1](q, v, tau, fast[3])
             except (ValueError, TypeError):
                 pass
             else:
@@ -179,5 +192,5 @@ def _reported(out: tuple) -> tuple:
     from .joint_space import warn_undefined
 
     first = out[0]
-    warn_undefined(out[-1], first.size // max(first.shape[-1] ** 2, 1), stacklevel=4)
+    warn_undefined(out[-1], int(np.prod(first.shape[:-2], dtype=np.int64)), stacklevel=4)
     return out[:-1]

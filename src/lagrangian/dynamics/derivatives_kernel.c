@@ -109,11 +109,15 @@ typedef struct {
     DK_T Phi[DK_NB][6], Psi[DK_NB][6];
 } DK_FN(work);
 
-/* The forward pass: placements, S, v, a, dv, psi, f and B of every body. */
-static void DK_FN(forward)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
-                           DK_FN(work) *w)
+/* Each body's placement (R: body -> world, origin o), velocity and acceleration at the world's
+ * origin (a of the ground: -g). */
+typedef struct { DK_T R[DK_NB][9], o[DK_NB][3], V[DK_NB][6], Acc[DK_NB][6]; } DK_FN(motion);
+
+/* The forward pass's kinematics: placements, S, v, a, dv and psi of every body. */
+static void DK_FN(kinematics)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
+                              DK_FN(work) *w, DK_FN(motion) *k)
 {
-    DK_T R[DK_NB][9], o[DK_NB][3], V[DK_NB][6], Acc[DK_NB][6];
+    DK_T (*R)[9] = k->R, (*o)[3] = k->o, (*V)[6] = k->V, (*Acc)[6] = k->Acc;
     for (int i = 0; i < DK_NB; i++) {
         DK_T th = dk_mult[i] * q[dk_coord[i]] + dk_off[i];
         DK_T Rl[9], pl[3];
@@ -166,6 +170,17 @@ static void DK_FN(forward)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const
             V[i][j] = vp[j] + S[j] * rate;
             Acc[i][j] = ap[j] + S[j] * accel + w->dv[i][j] * rate;
         }
+    }
+}
+
+/* The forward pass: the kinematics, then each body's f and B. */
+static void DK_FN(forward)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
+                           DK_FN(work) *w)
+{
+    DK_FN(motion) k;
+    DK_FN(kinematics)(q, qd, qdd, g, w, &k);
+    DK_T (*R)[9] = k.R, (*o)[3] = k.o, (*V)[6] = k.V, (*Acc)[6] = k.Acc;
+    for (int i = 0; i < DK_NB; i++) {
         /* the inertia at the world's origin: c = R h + m o, J_O = R J R^T shifted by o */
         DK_FN(inertia) *Y = &w->Y[i];
         DK_T hr[3], RJ[9];
@@ -411,6 +426,73 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     }
     return failed;
 }
+/* Y (DK_N x 10 DK_NB, row-major) with tau = Y pi, pi = [m, m c, I_xx, I_xy, I_yy, I_xz, I_yz,
+ * I_zz] per body about its origin in its axes (Pinocchio's order): body i's wrench at its origin
+ * per parameter, from its angular velocity w, angular acceleration dw and its origin's
+ * acceleration ac (gravity in), in its axes: m [ac; 0], h [(dw x + w x w x) h; h x ac],
+ * J [0; J dw + w x J w]; each paired with S_k of every joint k at or above it, in its axes. */
+static void DK_FN(regressor)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
+                             DK_T *Y)
+{
+    DK_FN(work) w;
+    DK_FN(motion) k;
+    DK_FN(kinematics)(q, qd, qdd, g, &w, &k);
+    for (int j = 0; j < DK_N * 10 * DK_NB; j++) Y[j] = DK_C(0.0);
+    for (int i = 0; i < DK_NB; i++) {
+        const DK_T *R = k.R[i], *o = k.o[i], *V = k.V[i], *Acc = k.Acc[i];
+        DK_T vo[3], ac[3], t[3], wl[3], dwl[3], al[3], ww[3];
+        /* the origin's velocity v + w x o and classical acceleration a + dw x o + w x vo */
+        DK_FN(cross)(V + 3, o, t);
+        for (int j = 0; j < 3; j++) vo[j] = V[j] + t[j];
+        DK_FN(cross)(Acc + 3, o, t);
+        for (int j = 0; j < 3; j++) ac[j] = Acc[j] + t[j];
+        DK_FN(cross)(V + 3, vo, t);
+        for (int j = 0; j < 3; j++) ac[j] += t[j];
+        for (int j = 0; j < 3; j++) {  /* into the body's axes: R^T x */
+            wl[j] = R[j] * V[3] + R[3 + j] * V[4] + R[6 + j] * V[5];
+            dwl[j] = R[j] * Acc[3] + R[3 + j] * Acc[4] + R[6 + j] * Acc[5];
+            al[j] = R[j] * ac[0] + R[3 + j] * ac[1] + R[6 + j] * ac[2];
+        }
+        /* the columns: f (3) and n (3) per parameter */
+        DK_T Fh[3][3], Nh[3][3], Nj[6][3];
+        for (int c = 0; c < 3; c++) {  /* h = e_c: (dw x + w x w x) e_c, e_c x ac */
+            DK_T e[3] = {DK_C(0.0), DK_C(0.0), DK_C(0.0)}, x[3], y[3];
+            e[c] = DK_C(1.0);
+            DK_FN(cross)(dwl, e, x);
+            DK_FN(cross)(wl, e, y);
+            DK_FN(cross)(wl, y, t);
+            for (int j = 0; j < 3; j++) Fh[c][j] = x[j] + t[j];
+            DK_FN(cross)(e, al, Nh[c]);
+        }
+        /* J's six entries: J dw + w x J w for J = E_rc + E_cr */
+        static const int rows[6] = {0, 0, 1, 0, 1, 2}, cols[6] = {0, 1, 1, 2, 2, 2};
+        for (int p = 0; p < 6; p++) {
+            DK_T Jd[3] = {DK_C(0.0), DK_C(0.0), DK_C(0.0)}, Jw[3] = {DK_C(0.0), DK_C(0.0), DK_C(0.0)};
+            const int r = rows[p], c = cols[p];
+            Jd[r] += dwl[c]; Jw[r] += wl[c];
+            if (r != c) { Jd[c] += dwl[r]; Jw[c] += wl[r]; }
+            DK_FN(cross)(wl, Jw, ww);
+            for (int j = 0; j < 3; j++) Nj[p][j] = Jd[j] + ww[j];
+        }
+        for (int kk = i; kk >= 0; kk = dk_parent[kk]) {
+            /* S_k at body i's origin in its axes: [R^T (s_v + s_w x o); R^T s_w] */
+            const DK_T *S = w.S[kk];
+            DK_T sv[3], sl[3], sw[3];
+            DK_FN(cross)(S + 3, o, t);
+            for (int j = 0; j < 3; j++) sv[j] = S[j] + t[j];
+            for (int j = 0; j < 3; j++) {
+                sl[j] = R[j] * sv[0] + R[3 + j] * sv[1] + R[6 + j] * sv[2];
+                sw[j] = R[j] * S[3] + R[3 + j] * S[4] + R[6 + j] * S[5];
+            }
+            DK_T *row = Y + dk_coord[kk] * 10 * DK_NB + 10 * i;
+            const double mult = dk_mult[kk];
+            row[0] += mult * DK_FN(dot3)(sl, al);
+            for (int c = 0; c < 3; c++)
+                row[1 + c] += mult * (DK_FN(dot3)(sl, Fh[c]) + DK_FN(dot3)(sw, Nh[c]));
+            for (int p = 0; p < 6; p++) row[4 + p] += mult * DK_FN(dot3)(sw, Nj[p]);
+        }
+    }
+}
 /* DK_CORE_END */
 
 /* -- Python bindings: (Q, V, X, P) with Q, V, X (..., DK_N) float64 (or (DK_N,), shared by
@@ -429,7 +511,7 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
 #define DK_THREAD_STATES 512
 
 typedef struct {
-    int forward;
+    int kind;
     npy_intp step[3], k0, k1, bad;
     const double *x[3], *p;
     double *y[3];
@@ -444,22 +526,30 @@ static inline int dk_finite(const dk_job *job, npy_intp k)
     return 1;
 }
 
+enum { DK_INVERSE, DK_FORWARD, DK_REGRESSOR };
+#define DK_SIZE(kind) ((kind) == DK_REGRESSOR ? DK_N * 10 * DK_NB : DK_N * DK_N)
+#define DK_OUTPUTS(kind) ((kind) == DK_INVERSE ? 2 : (kind) == DK_FORWARD ? 3 : 1)
+#define DK_SPACE (3 * DK_N * DK_N > DK_N * 10 * DK_NB ? 3 * DK_N * DK_N : DK_N * 10 * DK_NB)
+
 static void *dk_run(void *argument)
 {
     dk_job *job = (dk_job *)argument;
-    const int size = DK_N * DK_N, nout = 2 + job->forward;
+    const int kind = job->kind, size = DK_SIZE(kind), nout = DK_OUTPUTS(kind);
     npy_intp bad = 0, k = job->k0;
     /* LG_LANES states at a time through the dk4_ functions, the rest one by one */
     for (; k + LG_LANES <= job->k1; k += LG_LANES) {
-        lg_v4 in[3][DK_N], out[3][DK_N * DK_N];
+        lg_v4 in[3][DK_N], out[DK_SPACE];
         for (int j = 0; j < 3; j++)
             for (int l = 0; l < LG_LANES; l++)
                 for (int i = 0; i < DK_N; i++) in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
         int failed = 0;
-        if (job->forward)
-            failed = dk4_forward_derivatives(in[0], in[1], in[2], job->p, out[0], out[1], out[2]);
+        if (kind == DK_FORWARD)
+            failed = dk4_forward_derivatives(in[0], in[1], in[2], job->p, out, out + size,
+                                             out + 2 * size);
+        else if (kind == DK_INVERSE)
+            dk4_inverse(in[0], in[1], in[2], job->p, out, out + size);
         else
-            dk4_inverse(in[0], in[1], in[2], job->p, out[0], out[1]);
+            dk4_regressor(in[0], in[1], in[2], job->p, out);
         /* x - x is NaN for an infinite or NaN x: the lanes with an input not finite */
         lg_v4 spoilt = LG_V4(0.0);
         for (int j = 0; j < 3; j++)
@@ -469,8 +559,9 @@ static void *dk_run(void *argument)
             bad += !fine;
             for (int o = 0; o < nout; o++) {
                 double *y = job->y[o] + (k + l) * size;
+                const lg_v4 *x = out + o * size;
                 if (fine)
-                    for (int i = 0; i < size; i++) y[i] = out[o][i][l];
+                    for (int i = 0; i < size; i++) y[i] = x[i][l];
                 else
                     for (int i = 0; i < size; i++) y[i] = NAN;
             }
@@ -479,13 +570,16 @@ static void *dk_run(void *argument)
     for (; k < job->k1; k++) {
         const double *a0 = job->x[0] + k * job->step[0], *a1 = job->x[1] + k * job->step[1],
                      *a2 = job->x[2] + k * job->step[2];
-        double *y0 = job->y[0] + k * size, *y1 = job->y[1] + k * size;
+        double *y0 = job->y[0] + k * size;
         int fine = dk_finite(job, k);
         if (fine) {
-            if (job->forward)
-                fine = !dk_forward_derivatives(a0, a1, a2, job->p, y0, y1, job->y[2] + k * size);
+            if (kind == DK_FORWARD)
+                fine = !dk_forward_derivatives(a0, a1, a2, job->p, y0, job->y[1] + k * size,
+                                               job->y[2] + k * size);
+            else if (kind == DK_INVERSE)
+                dk_inverse(a0, a1, a2, job->p, y0, job->y[1] + k * size);
             else
-                dk_inverse(a0, a1, a2, job->p, y0, y1);
+                dk_regressor(a0, a1, a2, job->p, y0);
         }
         if (!fine) {
             for (int o = 0; o < nout; o++)
@@ -519,14 +613,13 @@ static int dk_threads(npy_intp count)
 #endif
 }
 
-static const char *dk_names[2][3] = {{"q", "v", "a"}, {"q", "v", "tau"}};
-
-static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int forward)
+static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
 {
+    const char *names[3] = {"q", "v", kind == DK_FORWARD ? "tau" : "a"};
     PyArrayObject *in[3] = {NULL, NULL, NULL}, *P = NULL;
     PyObject *out[3] = {NULL, NULL, NULL}, *block = NULL, *result = NULL;
     npy_intp step[3] = {0, 0, 0};
-    const int nout = 2 + forward;
+    const int nout = DK_OUTPUTS(kind);
     if (nargs != 4) {
         PyErr_SetString(PyExc_TypeError, "expected (Q, V, X, P)");
         return NULL;
@@ -538,7 +631,7 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int forward)
         int nd = PyArray_NDIM(in[i]);
         if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != DK_N) {
             PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
-                         dk_names[forward][i], DK_N);
+                         names[i], DK_N);
             goto done;
         }
         if (PyArray_SIZE(in[i]) > PyArray_SIZE(in[base])) base = i;
@@ -564,12 +657,13 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int forward)
         goto done;
     }
     /* the outputs as views of one block (nout, ..., DK_N, DK_N): one allocation (two large
-       ones of a size freed and asked again each call cost glibc a trim and fresh pages) */
+       ones of a size freed and asked again each call cost glibc a trim and fresh pages);
+       the regressor's (..., DK_N, 10 DK_NB) */
     npy_intp dims[NPY_MAXDIMS];
     dims[0] = nout;
     memcpy(dims + 1, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
     dims[nd] = DK_N;
-    dims[nd + 1] = DK_N;
+    dims[nd + 1] = kind == DK_REGRESSOR ? 10 * DK_NB : DK_N;
     block = PyArray_SimpleNew(nd + 2, dims, NPY_DOUBLE);
     if (!block) goto done;
     for (int o = 0; o < nout; o++) {
@@ -580,12 +674,13 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int forward)
     int parts = dk_threads(count);
     npy_intp share = (count / parts + LG_LANES - 1) / LG_LANES * LG_LANES;
     for (int t = 0; t < parts; t++) {
-        dk_job job = {forward, {step[0], step[1], step[2]}, t * share < count ? t * share : count,
+        dk_job job = {kind, {step[0], step[1], step[2]}, t * share < count ? t * share : count,
                       t == parts - 1 || (t + 1) * share > count ? count : (t + 1) * share, 0,
                       {PyArray_DATA(in[0]), PyArray_DATA(in[1]), PyArray_DATA(in[2])},
                       PyArray_DATA(P),
-                      {PyArray_DATA((PyArrayObject *)out[0]), PyArray_DATA((PyArrayObject *)out[1]),
-                       forward ? PyArray_DATA((PyArrayObject *)out[2]) : NULL}};
+                      {PyArray_DATA((PyArrayObject *)out[0]),
+                       nout > 1 ? PyArray_DATA((PyArrayObject *)out[1]) : NULL,
+                       nout > 2 ? PyArray_DATA((PyArrayObject *)out[2]) : NULL}};
         jobs[t] = job;
     }
     npy_intp bad = 0;
@@ -606,12 +701,19 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int forward)
 #endif
     for (int t = 0; t < parts; t++) bad += jobs[t].bad;
     if (count > 16) NPY_END_THREADS;
-    if (bad > 0)
-        result = forward ? Py_BuildValue("(OOOn)", out[0], out[1], out[2], (Py_ssize_t)bad)
-                         : Py_BuildValue("(OOn)", out[0], out[1], (Py_ssize_t)bad);
+    if (kind == DK_REGRESSOR) {
+        if (bad > 0)
+            result = Py_BuildValue("(On)", out[0], (Py_ssize_t)bad);
+        else {
+            result = out[0];
+            Py_INCREF(result);
+        }
+    } else if (bad > 0)
+        result = nout == 3 ? Py_BuildValue("(OOOn)", out[0], out[1], out[2], (Py_ssize_t)bad)
+                           : Py_BuildValue("(OOn)", out[0], out[1], (Py_ssize_t)bad);
     else
-        result = forward ? PyTuple_Pack(3, out[0], out[1], out[2])
-                         : PyTuple_Pack(2, out[0], out[1]);
+        result = nout == 3 ? PyTuple_Pack(3, out[0], out[1], out[2])
+                           : PyTuple_Pack(2, out[0], out[1]);
 done:
     for (int i = 0; i < 3; i++) { Py_XDECREF(in[i]); Py_XDECREF(out[i]); }
     Py_XDECREF(block);
@@ -622,13 +724,19 @@ done:
 static PyObject *dk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
-    return dk_batch(args, nargs, 0);
+    return dk_batch(args, nargs, DK_INVERSE);
 }
 
 static PyObject *dk_py_forward(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
-    return dk_batch(args, nargs, 1);
+    return dk_batch(args, nargs, DK_FORWARD);
+}
+
+static PyObject *dk_py_regressor(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    return dk_batch(args, nargs, DK_REGRESSOR);
 }
 
 static PyMethodDef dk_methods[] = {
@@ -636,6 +744,8 @@ static PyMethodDef dk_methods[] = {
      "(Q, V, A, P) -> (d tau/dq, d tau/dq_dot[, count of NaN rows])"},
     {"forward_derivatives", (PyCFunction)(void (*)(void))dk_py_forward, METH_FASTCALL,
      "(Q, V, TAU, P) -> (d q_ddot/dq, d q_ddot/dq_dot, M^-1[, count of NaN rows])"},
+    {"regressor", (PyCFunction)(void (*)(void))dk_py_regressor, METH_FASTCALL,
+     "(Q, V, A, P) -> Y (or (Y, count of NaN rows)), tau = Y pi"},
     {NULL, NULL, 0, NULL},
 };
 

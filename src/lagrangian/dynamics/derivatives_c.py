@@ -1,7 +1,8 @@
 """The derivatives of a tree's dynamics in compiled C: d tau/dq, d tau/dq_dot of Newton-Euler
 and d q_ddot/dq, d q_ddot/dq_dot, M^-1 of forward dynamics (derivatives_kernel.c: analytic,
-O(n^2) per state, a batch in one call on threads), over the tree's numbers written as static
-tables, one module per tree (cached on disk by its numbers). Gravity and the actuator parameters
+O(n^2) per state), and the joint-torque regressor Y; a batch in one call on vector lanes and
+threads (derivatives_bindings.c), over the tree's numbers written as static tables, one module
+per tree (cached on disk by its numbers). Gravity and the actuator parameters
 tau_<joint> are given at run time. Fixed-base trees of revolute and prismatic joints; the
 complex step of derivatives.py is the fallback (and the check). Units SI."""
 
@@ -18,6 +19,7 @@ from .joint_models import JOINT_MODELS
 from .tree_c import _SINCOS, _VECTOR
 
 _KERNEL = Path(__file__).with_name("derivatives_kernel.c")
+_BINDINGS = Path(__file__).with_name("derivatives_bindings.c")
 
 # the kernel's core on one state, then on LG_LANES states at once (derivatives_kernel.c)
 _SCALAR = """#define DK_T double
@@ -89,7 +91,8 @@ def kernel_source(tree: KinematicTree):
     pairs = _pairs(tree)
     text = _KERNEL.read_text(encoding="utf-8")
     head, rest = text.split("/* DK_CORE_BEGIN */")
-    core, bindings = rest.split("/* DK_CORE_END */")
+    core = rest.split("/* DK_CORE_END */")[0]
+    bindings = _BINDINGS.read_text(encoding="utf-8")
     source = "\n".join([
         "/* lagrangian: the derivatives of a tree's inverse and forward dynamics */",
         "#define PY_SSIZE_T_CLEAN",
@@ -137,7 +140,7 @@ def derivatives_module(tree: KinematicTree):
     if not applies(tree):
         return None
     here = Path(__file__)
-    generator = hashlib.sha256(_KERNEL.read_bytes() + here.read_bytes()
+    generator = hashlib.sha256(_KERNEL.read_bytes() + _BINDINGS.read_bytes() + here.read_bytes()
                                + here.with_name("tree_c.py").read_bytes()).hexdigest()
     key = "\n".join(["derivatives", generator, repr(tree)])
     try:

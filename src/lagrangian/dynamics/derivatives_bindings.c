@@ -42,9 +42,12 @@ static void *dk_run(void *argument)
     dk_job *job = (dk_job *)argument;
     const int kind = job->kind, size = DK_SIZE(kind), nout = DK_OUTPUTS(kind);
     npy_intp bad = 0, k = job->k0;
-    /* LG_LANES states at a time through the dk4_ functions, the rest one by one */
-    for (; k + LG_LANES <= job->k1; k += LG_LANES) {
-        lg_v4 in[3][DK_N], out[DK_SPACE];
+    /* LG_LANES states at a time through the dk4_ functions, the rest one by one; the lanes'
+       outputs on the heap (a regressor's are DK_N x 10 DK_NB vectors) */
+    lg_v4 *out = job->k1 - k >= LG_LANES
+                 ? aligned_alloc(sizeof(lg_v4), DK_SPACE * sizeof(lg_v4)) : NULL;
+    for (; out && k + LG_LANES <= job->k1; k += LG_LANES) {
+        lg_v4 in[3][DK_N];
         for (int j = 0; j < 3; j++)
             for (int l = 0; l < LG_LANES; l++)
                 for (int i = 0; i < DK_N; i++) in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
@@ -93,6 +96,7 @@ static void *dk_run(void *argument)
             bad++;
         }
     }
+    free(out);
     job->bad = bad;
     return NULL;
 }

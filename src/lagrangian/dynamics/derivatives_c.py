@@ -100,6 +100,7 @@ def kernel_source(tree: KinematicTree):
         "#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION",
         "#include <numpy/arrayobject.h>",
         "#include <math.h>",
+        "#include <stdlib.h>",
         "#include <string.h>",
         f"#define DK_NB {len(joints)}",
         f"#define DK_N {len(tree.coordinates)}",
@@ -126,9 +127,17 @@ def kernel_source(tree: KinematicTree):
     return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
 
 
+# The kernel keeps a state's work on the stack (per body and n x n per output, LG_LANES states
+# at once): up to this many bodies and coordinates, about a megabyte; larger trees keep the
+# complex step of derivatives.py.
+LARGEST = 64
+
+
 def applies(tree: KinematicTree | None) -> bool:
-    """Whether the kernel takes this tree: a fixed base of revolute and prismatic joints."""
+    """Whether the kernel takes this tree: a fixed base of revolute and prismatic joints, at
+    most LARGEST bodies and coordinates."""
     return (tree is not None and not tree.floating_base and bool(tree.joints)
+            and len(tree.joints) <= LARGEST and len(tree.coordinates) <= LARGEST
             and all(j.kind in JOINT_MODELS for j in tree.joints))
 
 

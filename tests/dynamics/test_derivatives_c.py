@@ -167,3 +167,84 @@ def test_compiled_regressor_is_the_numpy_one_and_gives_tau(turret):
     with pytest.warns(lagrangian.DynamicsWarning, match="1 of 6 states"):
         Y = fast.regressor(q, bad, a)
     assert np.isnan(Y[1]).all() and np.isfinite(Y[[0, 2, 3, 4, 5]]).all()
+
+
+@needs_c
+def test_floating_base_derivatives_are_pinocchios():
+    """Solo12 on a free flyer (nq 19, nv 18): d/dq along the base's own axes, q (+) dq, as
+    Pinocchio's; to 1e-10 of each matrix's largest entry (M^-1 of the light legs is large)."""
+    pin = pytest.importorskip("pinocchio")
+    pytest.importorskip("yourdfpy")
+    path = _robots(pin) / "solo_description/robots/solo12.urdf"
+    ours = lagrangian.load(path, floating_base=True).dynamics()
+    assert ours._derivatives_kernel() is not None
+    model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    assert ours.coordinates[7:] == tuple(model.names[i] for i in range(2, model.njoints))
+    data = model.createData()
+    rng = np.random.default_rng(8)
+    count = 5
+    quaternion = rng.normal(size=(count, 4))
+    q = np.concatenate([rng.normal(size=(count, 3)),
+                        quaternion / np.linalg.norm(quaternion, axis=-1, keepdims=True),
+                        rng.uniform(-1, 1, (count, model.nq - 7))], axis=-1)
+    v, a = rng.normal(size=(2, count, model.nv))
+    dq, dv = ours.inverse_dynamics_derivatives(q, v, a)
+    fq, fv, ftau = ours.forward_dynamics_derivatives(q, v, a)
+
+    def close(mine, theirs):
+        np.testing.assert_allclose(mine, theirs, rtol=0,
+                                   atol=1e-10 * max(1.0, np.abs(theirs).max()))
+
+    for k in range(count):
+        pq, pv, _ = pin.computeRNEADerivatives(model, data, q[k], v[k], a[k])
+        close(dq[k], pq)
+        close(dv[k], pv)
+        pin.computeABADerivatives(model, data, q[k], v[k], a[k])
+        close(fq[k], data.ddq_dq)
+        close(fv[k], data.ddq_dv)
+        close(ftau[k], np.triu(data.Minv) + np.triu(data.Minv, 1).T)
+
+
+def _robots(pin):
+    from pathlib import Path
+
+    for parent in Path(pin.__file__).resolve().parents:
+        candidate = parent / "share/example-robot-data/robots"
+        if candidate.is_dir():
+            return candidate
+    pytest.skip("example-robot-data is not installed")
+
+
+@needs_c
+def test_floating_base_derivatives_agree_with_central_differences_on_the_manifold(tmp_path):
+    """The hopper of test_floating_base.py: each column of d tau/dq and d q_ddot/dq by central
+    differences along q (+) h e_k (free_flyer.integrate), of d tau/dq_dot and d q_ddot/dq_dot
+    along v; a bad quaternion is refused in one line."""
+    from test_floating_base import FLOATING_URDF
+
+    from lagrangian.dynamics.free_flyer import integrate
+
+    path = tmp_path / "hopper.urdf"
+    path.write_text(FLOATING_URDF)
+    robot = lagrangian.load(path).dynamics()
+    assert robot._derivatives_kernel() is not None
+    rng = np.random.default_rng(9)
+    quaternion = rng.normal(size=4)
+    q = np.concatenate([rng.normal(size=3), quaternion / np.linalg.norm(quaternion),
+                        rng.uniform(-1, 1, robot.nq - 7)])
+    v, a = rng.normal(size=(2, robot.nv))
+    dq, dv = robot.inverse_dynamics_derivatives(q, v, a)
+    fq, fv, _ = robot.forward_dynamics_derivatives(q, v, a)
+    h = 1e-6
+    for k in range(robot.nv):
+        e = h * np.eye(robot.nv)[k]
+        plus, minus = integrate(q[None], e[None])[0], integrate(q[None], -e[None])[0]
+        for ours, f, args in ((dq, robot.inverse_dynamics, lambda s, x: (x, v, a)),
+                              (fq, robot.forward_dynamics, lambda s, x: (x, v, a)),
+                              (dv, robot.inverse_dynamics, lambda s, x: (q, v + s, a)),
+                              (fv, robot.forward_dynamics, lambda s, x: (q, v + s, a))):
+            central = (f(*args(e, plus)) - f(*args(-e, minus))) / (2 * h)
+            np.testing.assert_allclose(ours[:, k], central, rtol=0, atol=2e-6)
+    with pytest.raises(lagrangian.InputError, match="norm 2") as caught:
+        robot.inverse_dynamics_derivatives(np.r_[q[:6], 2.0, q[7:]], v, a)
+    assert caught.value.field == "q" and "\n" not in str(caught.value)

@@ -64,7 +64,8 @@ class ControlTerms:
         frame; see ``parameter_names``). A model file: the named ``parameters``, in which T and
         V must be linear."""
         fast = self._derivatives_kernel() if parameters is None else None
-        if fast is not None:  # one C call; a bad input goes the guarded way to be named
+        if fast is not None and not self.tree.floating_base:  # one C call; a bad input goes
+            # the guarded way to be named
             try:
                 out = fast[2](q, v, a, fast[3])
             except (ValueError, TypeError):
@@ -99,9 +100,9 @@ class ControlTerms:
     # -- derivatives (derivatives_c.py, derivatives.py) -------------------------------------------
 
     def _derivatives_kernel(self):
-        """(inverse, forward, regressor, P) of the tree's compiled module (derivatives_c.py), or None:
-        a compiled backend's fixed-base tree of revolute and prismatic joints only; the numpy
-        backend, a model file and a floating base keep derivatives.py."""
+        """(inverse, forward, regressor, P) of the tree's compiled module (derivatives_c.py), or
+        None: a compiled backend's tree of revolute and prismatic joints (a floating base too,
+        but for the regressor); the numpy backend and a model file keep derivatives.py."""
         found = self.__dict__.get("_derivatives_c", False)
         if found is False:
             found = None
@@ -111,8 +112,13 @@ class ControlTerms:
 
                 module = derivatives_module(tree) if applies(tree) else None
                 if module is not None:
-                    found = (module.inverse_derivatives, module.forward_derivatives,
-                             module.regressor, runtime_values(tree, self.parameters))
+                    inverse, forward = module.inverse_derivatives, module.forward_derivatives
+                    if tree.floating_base:  # the base quaternion's norm checked first
+                        from .recursive import _checking_quaternion
+
+                        inverse, forward = (_checking_quaternion(f) for f in (inverse, forward))
+                    found = (inverse, forward, module.regressor,
+                             runtime_values(tree, self.parameters))
             self.__dict__["_derivatives_c"] = found
         return found
 
@@ -120,8 +126,9 @@ class ControlTerms:
         found = self.__dict__.get("_derivatives")
         if found is None:
             tree = getattr(self, "tree", None)
-            _refuse_floating(tree, "derivatives of the dynamics")
             fast = self._derivatives_kernel()
+            if fast is None:
+                _refuse_floating(tree, "derivatives of the dynamics")
             if fast is not None:
                 inverse, P = fast[0], fast[3]
 
@@ -147,8 +154,9 @@ class ControlTerms:
     def inverse_dynamics_derivatives(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
         """(d tau/dq, d tau/dq_dot) of tau = M(q) q_ddot + C q_dot + g, (..., n, n) each (row
         i: tau_i), as Pinocchio's computeRNEADerivatives: a URDF tree's analytic in compiled C
-        (derivatives_c.py; the complex step through Newton-Euler without a compiler, exact to
-        rounding), a model file's from its derived M and f."""
+        (derivatives_c.py; a floating base's d/dq along its own axes, q (+) dq, n = nv; the
+        complex step through Newton-Euler without a compiler, fixed base, exact to rounding), a
+        model file's from its derived M and f."""
         fast = self._derivatives_kernel()
         if fast is not None:  # one C call; a bad input goes the guarded way to be named
             try:
@@ -178,7 +186,7 @@ class ControlTerms:
                 return out if len(out) == 3 else _reported(out)
         q, v, tau = self._vector(q, "q"), self._vector(v, "v"), self._vector(tau, "tau")
         batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1], tau.shape[:-1])
-        q = np.broadcast_to(q, batch + (self.n,))
+        q = np.broadcast_to(q, batch + q.shape[-1:])
         v = np.broadcast_to(v, batch + (self.n,))
         acceleration = self.forward_dynamics(q, v, tau)
         by_position, by_velocity = self.inverse_dynamics_derivatives(q, v, acceleration)

@@ -1,8 +1,8 @@
 /* The Python bindings of derivatives_kernel.c's functions (derivatives_c.py appends this text
  * after the kernel's core, emitted on one state and on vector lanes). */
 
-/* -- Python bindings: (Q, V, X, P) with Q, V, X (..., DK_N) float64 (or (DK_N,), shared by
- * the batch), P = [g (3), tau_<joint> (DK_N)]; outputs (..., DK_N, DK_N) each, as a tuple,
+/* -- Python bindings: (Q, V, X, P) with Q, V, X (..., DK_NV) float64 (or (DK_NV,), shared by
+ * the batch), P = [g (3), tau_<joint> (DK_NV)]; outputs (..., DK_NV, DK_NV) each, as a tuple,
  * with the count of NaN rows appended where a state's inputs are not all finite (or, forward,
  * its M is not positive definite). A batch runs in parts on threads. ------------------------ */
 
@@ -16,6 +16,9 @@
 #define DK_MAX_THREADS 8
 #define DK_THREAD_STATES 512
 
+/* the numbers of input j: q DK_NQ (a floating base's 7 first), v, a and tau DK_NV */
+#define DK_WIDTH(j) ((j) == 0 ? DK_NQ : DK_NV)
+
 typedef struct {
     int kind;
     npy_intp step[3], k0, k1, bad;
@@ -27,15 +30,15 @@ typedef struct {
 static inline int dk_finite(const dk_job *job, npy_intp k)
 {
     for (int j = 0; j < 3; j++)
-        for (int i = 0; i < DK_N; i++)
+        for (int i = 0; i < DK_WIDTH(j); i++)
             if (!isfinite(job->x[j][k * job->step[j] + i])) return 0;
     return 1;
 }
 
 enum { DK_INVERSE, DK_FORWARD, DK_REGRESSOR };
-#define DK_SIZE(kind) ((kind) == DK_REGRESSOR ? DK_N * 10 * DK_NB : DK_N * DK_N)
+#define DK_SIZE(kind) ((kind) == DK_REGRESSOR ? DK_NV * 10 * DK_NB : DK_NV * DK_NV)
 #define DK_OUTPUTS(kind) ((kind) == DK_INVERSE ? 2 : (kind) == DK_FORWARD ? 3 : 1)
-#define DK_SPACE (3 * DK_N * DK_N > DK_N * 10 * DK_NB ? 3 * DK_N * DK_N : DK_N * 10 * DK_NB)
+#define DK_SPACE (3 * DK_NV * DK_NV > DK_NV * 10 * DK_NB ? 3 * DK_NV * DK_NV : DK_NV * 10 * DK_NB)
 
 static void *dk_run(void *argument)
 {
@@ -43,14 +46,15 @@ static void *dk_run(void *argument)
     const int kind = job->kind, size = DK_SIZE(kind), nout = DK_OUTPUTS(kind);
     npy_intp bad = 0, k = job->k0;
     /* LG_LANES states at a time through the dk4_ functions, the rest one by one; the lanes'
-       outputs on the heap (a regressor's are DK_N x 10 DK_NB vectors) */
+       outputs on the heap (a regressor's are DK_NV x 10 DK_NB vectors) */
     lg_v4 *out = job->k1 - k >= LG_LANES
                  ? aligned_alloc(sizeof(lg_v4), DK_SPACE * sizeof(lg_v4)) : NULL;
     for (; out && k + LG_LANES <= job->k1; k += LG_LANES) {
-        lg_v4 in[3][DK_N];
+        lg_v4 in[3][DK_NQ];
         for (int j = 0; j < 3; j++)
             for (int l = 0; l < LG_LANES; l++)
-                for (int i = 0; i < DK_N; i++) in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
+                for (int i = 0; i < DK_WIDTH(j); i++)
+                    in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
         int failed = 0;
         if (kind == DK_FORWARD)
             failed = dk4_forward_derivatives(in[0], in[1], in[2], job->p, out, out + size,
@@ -62,7 +66,7 @@ static void *dk_run(void *argument)
         /* x - x is NaN for an infinite or NaN x: the lanes with an input not finite */
         lg_v4 spoilt = LG_V4(0.0);
         for (int j = 0; j < 3; j++)
-            for (int i = 0; i < DK_N; i++) spoilt += in[j][i] - in[j][i];
+            for (int i = 0; i < DK_WIDTH(j); i++) spoilt += in[j][i] - in[j][i];
         for (int l = 0; l < LG_LANES; l++) {
             const int fine = !((failed >> l) & 1) && spoilt[l] == 0.0;
             bad += !fine;
@@ -139,18 +143,18 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
         in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
         if (!in[i]) goto done;
         int nd = PyArray_NDIM(in[i]);
-        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != DK_N) {
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != DK_WIDTH(i)) {
             PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
-                         names[i], DK_N);
+                         names[i], DK_WIDTH(i));
             goto done;
         }
-        if (PyArray_SIZE(in[i]) > PyArray_SIZE(in[base])) base = i;
+        if (PyArray_SIZE(in[i]) / DK_WIDTH(i) > PyArray_SIZE(in[base]) / DK_WIDTH(base)) base = i;
     }
-    npy_intp count = PyArray_SIZE(in[base]) / DK_N;
+    npy_intp count = PyArray_SIZE(in[base]) / DK_WIDTH(base);
     int nd = PyArray_NDIM(in[base]);
     for (int i = 0; i < 3; i++) {
         if (PyArray_NDIM(in[i]) == 1) {  /* one state, shared by the batch */
-            step[i] = count > 1 ? 0 : DK_N;
+            step[i] = count > 1 ? 0 : DK_WIDTH(i);
             continue;
         }
         if (PyArray_NDIM(in[i]) != nd
@@ -158,22 +162,22 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
             PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
             goto done;
         }
-        step[i] = DK_N;
+        step[i] = DK_WIDTH(i);
     }
     P = (PyArrayObject *)PyArray_FROMANY(args[3], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
     if (!P) goto done;
-    if (PyArray_SIZE(P) != 3 + DK_N) {
+    if (PyArray_SIZE(P) != 3 + DK_NJ) {
         PyErr_SetString(PyExc_ValueError, "parameters: expected g (3) and the actuators");
         goto done;
     }
-    /* the outputs as views of one block (nout, ..., DK_N, DK_N): one allocation (two large
+    /* the outputs as views of one block (nout, ..., DK_NV, DK_NV): one allocation (two large
        ones of a size freed and asked again each call cost glibc a trim and fresh pages);
-       the regressor's (..., DK_N, 10 DK_NB) */
+       the regressor's (..., DK_NV, 10 DK_NB) */
     npy_intp dims[NPY_MAXDIMS];
     dims[0] = nout;
     memcpy(dims + 1, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
-    dims[nd] = DK_N;
-    dims[nd + 1] = kind == DK_REGRESSOR ? 10 * DK_NB : DK_N;
+    dims[nd] = DK_NV;
+    dims[nd + 1] = kind == DK_REGRESSOR ? 10 * DK_NB : DK_NV;
     block = PyArray_SimpleNew(nd + 2, dims, NPY_DOUBLE);
     if (!block) goto done;
     for (int o = 0; o < nout; o++) {

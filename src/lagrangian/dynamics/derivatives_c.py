@@ -1,9 +1,10 @@
 """The derivatives of a tree's dynamics in compiled C: d tau/dq, d tau/dq_dot of Newton-Euler
 and d q_ddot/dq, d q_ddot/dq_dot, M^-1 of forward dynamics (derivatives_kernel.c: analytic,
-O(n^2) per state), and the joint-torque regressor Y; a batch in one call on vector lanes and
+O(n^2) per state; a floating base's q derivatives along its own axes, q (+) dq, as Pinocchio's),
+and the joint-torque regressor Y (fixed base); a batch in one call on vector lanes and
 threads (derivatives_bindings.c), over the tree's numbers written as static tables, one module
 per tree (cached on disk by its numbers). Gravity and the actuator parameters
-tau_<joint> are given at run time. Fixed-base trees of revolute and prismatic joints; the
+tau_<joint> are given at run time. Revolute and prismatic joints; the
 complex step of derivatives.py is the fallback (and the check). Units SI."""
 
 from __future__ import annotations
@@ -88,6 +89,8 @@ def kernel_source(tree: KinematicTree):
         C.append((R0 @ (np.eye(3) - uu)).ravel().tolist())
         S.append((R0 @ skew).ravel().tolist())
     models = [JOINT_MODELS[j.kind] for j in joints]
+    n = len(tree.coordinates)
+    floating = int(bool(tree.floating_base))
     pairs = _pairs(tree)
     text = _KERNEL.read_text(encoding="utf-8")
     head, rest = text.split("/* DK_CORE_BEGIN */")
@@ -103,12 +106,17 @@ def kernel_source(tree: KinematicTree):
         "#include <stdlib.h>",
         "#include <string.h>",
         f"#define DK_NB {len(joints)}",
-        f"#define DK_N {len(tree.coordinates)}",
+        f"#define DK_NJ {n}",  # the joints' coordinates; a floating base's come first:
+        f"#define DK_FF {floating}",
+        f"#define DK_QO {7 * floating}",
+        f"#define DK_VO {6 * floating}",
+        f"#define DK_NQ {n + 7 * floating}",
+        f"#define DK_NV {n + 6 * floating}",
         f"#define DK_NP {len(pairs)}",
         _table("dk_parent", "int", [j.parent for j in joints]),
         _table("dk_coord", "int", [j.coordinate for j in joints]),
-        _table("dk_turns", "int", [m.turns for m in models]),
-        _table("dk_slides", "int", [m.slides for m in models]),
+        _table("dk_turns", "int", [getattr(m, "turns", False) for m in models]),
+        _table("dk_slides", "int", [getattr(m, "slides", False) for m in models]),
         _table("dk_pair", "int", [list(p) for p in pairs]),
         _table("dk_mult", "double", [j.multiplier for j in joints]),
         _table("dk_off", "double", [j.offset for j in joints]),
@@ -134,11 +142,19 @@ LARGEST = 64
 
 
 def applies(tree: KinematicTree | None) -> bool:
-    """Whether the kernel takes this tree: a fixed base of revolute and prismatic joints, at
-    most LARGEST bodies and coordinates."""
-    return (tree is not None and not tree.floating_base and bool(tree.joints)
-            and len(tree.joints) <= LARGEST and len(tree.coordinates) <= LARGEST
-            and all(j.kind in JOINT_MODELS for j in tree.joints))
+    """Whether the kernel takes this tree: revolute and prismatic joints on a fixed base or a
+    floating one (a free flyer at the root), at most LARGEST bodies and coordinates."""
+    from ..kinds import JointKind
+
+    if tree is None or not tree.joints or len(tree.joints) > LARGEST \
+            or len(tree.coordinates) > LARGEST:
+        return False
+    kinds = [j.kind for j in tree.joints]
+    if tree.floating_base:
+        if kinds[0] != JointKind.FREE_FLYER:
+            return False
+        kinds = kinds[1:]
+    return all(k in (JointKind.REVOLUTE, JointKind.PRISMATIC) for k in kinds)
 
 
 def derivatives_module(tree: KinematicTree):

@@ -1,6 +1,6 @@
 /* d tau/dq, d tau/dq_dot of recursive Newton-Euler and d q_ddot/dq, d q_ddot/dq_dot, M^-1 of
  * forward dynamics, over the tree tables that derivatives_c.py writes above this text (dk_*
- * arrays, DK_NB bodies, DK_N coordinates, DK_NP ancestor pairs). Analytic, O(n^2) per state.
+ * arrays, DK_NB bodies, DK_NV coordinates, DK_NP ancestor pairs). Analytic, O(n^2) per state.
  *
  * Spatial vectors at the world's origin in world axes, linear part first: a motion [v; w], a
  * force [f; n]. A body's joint column S (theta_dot = k q_dot[c]); v_i = v_p + S theta_dot,
@@ -107,11 +107,52 @@ typedef struct {
     DK_T L[DK_NB][3], A[DK_NB][9];    /* B's 12 numbers, the body's then the subtree's */
     DK_T r1[DK_NB][6], r2[DK_NB][3];  /* Ic_k S_k and the angular part of Bc_k^T S_k */
     DK_T Phi[DK_NB][6], Psi[DK_NB][6];
+    /* a floating base's six columns (body 0): S, psi = -g x S, dv = v x S (its parent the
+       ground), Ic S, Bc^T S's angular part, and S . F */
+    DK_T ffS[6][6], ffpsi[6][6], ffdv[6][6], ffr1[6][6], ffr2[6][3], fftau[6];
 } DK_FN(work);
 
 /* Each body's placement (R: body -> world, origin o), velocity and acceleration at the world's
  * origin (a of the ground: -g). */
 typedef struct { DK_T R[DK_NB][9], o[DK_NB][3], V[DK_NB][6], Acc[DK_NB][6]; } DK_FN(motion);
+
+/* A floating base (body 0): q[0:3] its origin, q[3:7] its quaternion x y z w (normalized here),
+ * R = R0 R(quaternion), o = t0 + R0 q[0:3]; its velocity and acceleration in its own axes, so
+ * its columns are the world's images of the unit twists: [R e_c; 0] and [o x R e_c; R e_c]. */
+static void DK_FN(base)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
+                        DK_FN(work) *w, DK_FN(motion) *k)
+{
+    const DK_T x = q[3], y = q[4], z = q[5], r = q[6];
+    const DK_T t = 2.0 / (x * x + y * y + z * z + r * r);
+    const DK_T Rq[9] = {1.0 - t * (y * y + z * z), t * (x * y - z * r), t * (x * z + y * r),
+                        t * (x * y + z * r), 1.0 - t * (x * x + z * z), t * (y * z - x * r),
+                        t * (x * z - y * r), t * (y * z + x * r), 1.0 - t * (x * x + y * y)};
+    DK_T *R = k->R[0], *o = k->o[0], *V = k->V[0], *Acc = k->Acc[0];
+    for (int a = 0; a < 3; a++) {
+        for (int b = 0; b < 3; b++)
+            R[3 * a + b] = dk_R0[0][3 * a] * Rq[b] + dk_R0[0][3 * a + 1] * Rq[3 + b]
+                           + dk_R0[0][3 * a + 2] * Rq[6 + b];
+        o[a] = dk_t0[0][a] + dk_R0[0][3 * a] * q[0] + dk_R0[0][3 * a + 1] * q[1]
+               + dk_R0[0][3 * a + 2] * q[2];
+    }
+    for (int c = 0; c < 3; c++) {
+        DK_T *L = w->ffS[c], *A = w->ffS[3 + c];
+        for (int j = 0; j < 3; j++) { L[j] = R[3 * j + c]; L[3 + j] = DK_C(0.0); A[3 + j] = L[j]; }
+        DK_FN(cross)(o, L, A);
+    }
+    for (int j = 0; j < 6; j++) {
+        V[j] = DK_C(0.0);
+        Acc[j] = DK_C(j < 3 ? -g[j] : 0.0);
+        w->S[0][j] = w->dv[0][j] = w->psi[0][j] = DK_C(0.0);
+    }
+    for (int c = 0; c < 6; c++)
+        for (int j = 0; j < 6; j++) { V[j] += w->ffS[c][j] * qd[c]; Acc[j] += w->ffS[c][j] * qdd[c]; }
+    const DK_T ground[6] = {DK_C(-g[0]), DK_C(-g[1]), DK_C(-g[2]), DK_C(0.0), DK_C(0.0), DK_C(0.0)};
+    for (int c = 0; c < 6; c++) {
+        DK_FN(mcross)(ground, w->ffS[c], w->ffpsi[c]);
+        DK_FN(mcross)(V, w->ffS[c], w->ffdv[c]);
+    }
+}
 
 /* The forward pass's kinematics: placements, S, v, a, dv and psi of every body. */
 static void DK_FN(kinematics)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
@@ -119,7 +160,11 @@ static void DK_FN(kinematics)(const DK_T *q, const DK_T *qd, const DK_T *qdd, co
 {
     DK_T (*R)[9] = k->R, (*o)[3] = k->o, (*V)[6] = k->V, (*Acc)[6] = k->Acc;
     for (int i = 0; i < DK_NB; i++) {
-        DK_T th = dk_mult[i] * q[dk_coord[i]] + dk_off[i];
+        if (DK_FF && i == 0) {
+            DK_FN(base)(q, qd, qdd, g, w, k);
+            continue;
+        }
+        DK_T th = dk_mult[i] * q[DK_QO + dk_coord[i]] + dk_off[i];
         DK_T Rl[9], pl[3];
         for (int j = 0; j < 3; j++) pl[j] = DK_C(dk_t0[i][j]);
         if (dk_turns[i]) {
@@ -160,7 +205,8 @@ static void DK_FN(kinematics)(const DK_T *q, const DK_T *qd, const DK_T *qdd, co
             vp[j] = p >= 0 ? V[p][j] : DK_C(0.0);
             ap[j] = p >= 0 ? Acc[p][j] : DK_C(j < 3 ? -g[j] : 0.0);
         }
-        DK_T rate = dk_mult[i] * qd[dk_coord[i]], accel = dk_mult[i] * qdd[dk_coord[i]];
+        DK_T rate = dk_mult[i] * qd[DK_VO + dk_coord[i]];
+        DK_T accel = dk_mult[i] * qdd[DK_VO + dk_coord[i]];
         DK_T t[6];
         DK_FN(mcross)(vp, S, w->dv[i]);
         DK_FN(mcross)(ap, S, w->psi[i]);
@@ -260,6 +306,17 @@ static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns)
             DK_FN(bapply)(w->L[i], w->A[i], S, x);
             for (int j = 0; j < 6; j++) w->Psi[i][j] = 2.0 * u[j] + x[j];
         }
+        if (DK_FF && i == 0)  /* the base's columns, its subtree the whole tree */
+            for (int c = 0; c < 6; c++) {
+                const DK_T *T = w->ffS[c];
+                DK_FN(iapply)(Y, T, w->ffr1[c]);
+                DK_T *r2 = w->ffr2[c];
+                DK_FN(cross)(w->L[0], T, r2);
+                for (int j = 0; j < 3; j++)
+                    r2[j] = 2.0 * r2[j] + w->A[0][j] * T[3] + w->A[0][3 + j] * T[4]
+                            + w->A[0][6 + j] * T[5];
+                w->fftau[c] = DK_FN(dot6)(T, w->F[0]);
+            }
         int p = dk_parent[i];
         if (p >= 0) {
             DK_FN(inertia) *P = &w->Y[p];
@@ -271,32 +328,64 @@ static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns)
     }
 }
 
-/* M (DK_N x DK_N) when asked, or d tau/dq and d tau/dq_dot, from the pairs (k below or at j),
+/* The entries of a floating base's columns c: with body k (at or below the base: row k by
+ * Ic_k, Bc_k; column k by its Phi, Psi) or, k = 0, with its own columns. */
+static void DK_FN(base_pairs)(const DK_FN(work) *w, int k, DK_T *M, DK_T *dq, DK_T *dv)
+{
+    for (int c = 0; c < 6; c++) {
+        const DK_T *S = w->ffS[c];
+        if (k == 0) {
+            for (int r = 0; r < 6; r++) {
+                const DK_T *r1 = w->ffr1[r], *r2 = w->ffr2[r];
+                if (M) M[r * DK_NV + c] = DK_FN(dot6)(r1, S);
+                if (!dq) continue;
+                dq[r * DK_NV + c] = DK_FN(dot6)(r1, w->ffpsi[c]);
+                dv[r * DK_NV + c] = DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3);
+            }
+            continue;
+        }
+        const int ck = DK_VO + dk_coord[k];
+        const double m = dk_mult[k];
+        const DK_T *r1 = w->r1[k], *r2 = w->r2[k];
+        if (M) M[ck * DK_NV + c] = M[c * DK_NV + ck] = m * DK_FN(dot6)(r1, S);
+        if (!dq) continue;
+        dq[ck * DK_NV + c] += m * DK_FN(dot6)(r1, w->ffpsi[c]);
+        dv[ck * DK_NV + c] += m * (DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3));
+        dq[c * DK_NV + ck] += m * DK_FN(dot6)(S, w->Phi[k]);
+        dv[c * DK_NV + ck] += m * DK_FN(dot6)(S, w->Psi[k]);
+    }
+}
+
+/* M (DK_NV x DK_NV) when asked, or d tau/dq and d tau/dq_dot, from the pairs (k below or at j),
  * each entry scattered to the coordinates with the joints' multipliers */
 static void DK_FN(pairs)(const DK_FN(work) *w, DK_T *M, DK_T *dq, DK_T *dv)
 {
     if (M)
-        for (int j = 0; j < DK_N * DK_N; j++) M[j] = DK_C(0.0);
+        for (int j = 0; j < DK_NV * DK_NV; j++) M[j] = DK_C(0.0);
     if (dq)
-        for (int j = 0; j < DK_N * DK_N; j++) { dq[j] = DK_C(0.0); dv[j] = DK_C(0.0); }
+        for (int j = 0; j < DK_NV * DK_NV; j++) { dq[j] = DK_C(0.0); dv[j] = DK_C(0.0); }
     for (int e = 0; e < DK_NP; e++) {
         const int k = dk_pair[e][0], j = dk_pair[e][1];
-        const int ck = dk_coord[k], cj = dk_coord[j];
+        if (DK_FF && j == 0) {
+            DK_FN(base_pairs)(w, k, M, dq, dv);
+            continue;
+        }
+        const int ck = DK_VO + dk_coord[k], cj = DK_VO + dk_coord[j];
         const double kk = dk_mult[k] * dk_mult[j];
         const DK_T *r1 = w->r1[k];
         if (M) {
             const DK_T mkj = kk * DK_FN(dot6)(r1, w->S[j]);
-            M[ck * DK_N + cj] += mkj;
-            if (k != j) M[cj * DK_N + ck] += mkj;
+            M[ck * DK_NV + cj] += mkj;
+            if (k != j) M[cj * DK_NV + ck] += mkj;
         }
         if (!dq) continue;
         const DK_T *r2 = w->r2[k];
-        dq[ck * DK_N + cj] += kk * (DK_FN(dot6)(r1, w->psi[j]) + DK_FN(dot3)(r2, w->dv[j] + 3));
-        dv[ck * DK_N + cj] += kk * (2.0 * DK_FN(dot6)(r1, w->dv[j])
+        dq[ck * DK_NV + cj] += kk * (DK_FN(dot6)(r1, w->psi[j]) + DK_FN(dot3)(r2, w->dv[j] + 3));
+        dv[ck * DK_NV + cj] += kk * (2.0 * DK_FN(dot6)(r1, w->dv[j])
                                     + DK_FN(dot3)(r2, w->S[j] + 3));
         if (k != j) {
-            dq[cj * DK_N + ck] += kk * DK_FN(dot6)(w->S[j], w->Phi[k]);
-            dv[cj * DK_N + ck] += kk * DK_FN(dot6)(w->S[j], w->Psi[k]);
+            dq[cj * DK_NV + ck] += kk * DK_FN(dot6)(w->S[j], w->Phi[k]);
+            dv[cj * DK_NV + ck] += kk * DK_FN(dot6)(w->S[j], w->Psi[k]);
         }
     }
 }
@@ -316,17 +405,17 @@ static void DK_FN(inverse)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const
 static int DK_FN(cholesky)(DK_T *M, DK_T *inverse)
 {
     int failed = 0;
-    for (int j = 0; j < DK_N; j++) {
-        DK_T d = M[j * DK_N + j];
-        for (int k = 0; k < j; k++) d -= M[j * DK_N + k] * M[j * DK_N + k];
+    for (int j = 0; j < DK_NV; j++) {
+        DK_T d = M[j * DK_NV + j];
+        for (int k = 0; k < j; k++) d -= M[j * DK_NV + k] * M[j * DK_NV + k];
         failed |= DK_FAILED(d);
         d = DK_SQRT(d);
-        M[j * DK_N + j] = d;
+        M[j * DK_NV + j] = d;
         inverse[j] = 1.0 / d;
-        for (int i = j + 1; i < DK_N; i++) {
-            DK_T s = M[i * DK_N + j];
-            for (int k = 0; k < j; k++) s -= M[i * DK_N + k] * M[j * DK_N + k];
-            M[i * DK_N + j] = s * inverse[j];
+        for (int i = j + 1; i < DK_NV; i++) {
+            DK_T s = M[i * DK_NV + j];
+            for (int k = 0; k < j; k++) s -= M[i * DK_NV + k] * M[j * DK_NV + k];
+            M[i * DK_NV + j] = s * inverse[j];
         }
     }
     return failed;
@@ -335,29 +424,29 @@ static int DK_FN(cholesky)(DK_T *M, DK_T *inverse)
 /* x = M^-1 b from the factor L and 1 / L_jj (b overwritten) */
 static void DK_FN(solve)(const DK_T *L, const DK_T *inverse, DK_T *b)
 {
-    for (int i = 0; i < DK_N; i++) {
+    for (int i = 0; i < DK_NV; i++) {
         DK_T s = b[i];
-        for (int k = 0; k < i; k++) s -= L[i * DK_N + k] * b[k];
+        for (int k = 0; k < i; k++) s -= L[i * DK_NV + k] * b[k];
         b[i] = s * inverse[i];
     }
-    for (int i = DK_N - 1; i >= 0; i--) {
+    for (int i = DK_NV - 1; i >= 0; i--) {
         DK_T s = b[i];
-        for (int k = i + 1; k < DK_N; k++) s -= L[k * DK_N + i] * b[k];
+        for (int k = i + 1; k < DK_NV; k++) s -= L[k * DK_NV + i] * b[k];
         b[i] = s * inverse[i];
     }
 }
 
-/* (d q_ddot/dq, d q_ddot/dq_dot, M^-1) at one state (lane); P = [g (3), tau_<joint> (DK_N)];
+/* (d q_ddot/dq, d q_ddot/dq_dot, M^-1) at one state (lane); P = [g (3), tau_<joint> (DK_NV)];
  * the lanes (bits) where M is not positive definite */
 static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T *tau,
                                       const double *P, DK_T *aq, DK_T *av, DK_T *Minv)
 {
     DK_FN(work) w;
-    DK_T M[DK_N * DK_N], dq[DK_N * DK_N], dv[DK_N * DK_N], taub[DK_NB], b[DK_N], zero[DK_N];
+    DK_T M[DK_NV * DK_NV], dq[DK_NV * DK_NV], dv[DK_NV * DK_NV], taub[DK_NB], b[DK_NV], zero[DK_NV];
     /* the bodies' own f, inertia and B: the backward pass sums them in place */
     DK_T F[DK_NB][6], L[DK_NB][3], A[DK_NB][9];
     DK_FN(inertia) Y[DK_NB];
-    for (int j = 0; j < DK_N; j++) zero[j] = DK_C(0.0);
+    for (int j = 0; j < DK_NV; j++) zero[j] = DK_C(0.0);
     /* q_ddot = M^-1 (tau + tau_p - b), b from Newton-Euler at q_ddot = 0 */
     DK_FN(forward)(q, qd, zero, P, &w);
     memcpy(F, w.F, sizeof F);
@@ -366,9 +455,11 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     memcpy(Y, w.Y, sizeof Y);
     DK_FN(backward)(&w, taub, 0);
     DK_FN(pairs)(&w, M, NULL, NULL);
-    for (int j = 0; j < DK_N; j++) b[j] = tau[j] + P[3 + j];
-    for (int i = 0; i < DK_NB; i++) b[dk_coord[i]] -= dk_mult[i] * taub[i];
-    DK_T diagonal[DK_N];
+    for (int j = 0; j < DK_NV; j++) b[j] = tau[j];
+    for (int j = 0; j < DK_NJ; j++) b[DK_VO + j] += P[3 + j];
+    for (int i = DK_FF; i < DK_NB; i++) b[DK_VO + dk_coord[i]] -= dk_mult[i] * taub[i];
+    for (int c = 0; c < 6 * DK_FF; c++) b[c] -= w.fftau[c];
+    DK_T diagonal[DK_NV];
     int failed = DK_FN(cholesky)(M, diagonal);
     DK_FN(solve)(M, diagonal, b);
     /* at q_ddot = b: each body's acceleration grows by da = da_p + S theta_ddot, so psi by
@@ -380,7 +471,7 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     DK_T da[DK_NB][6];
     for (int i = 0; i < DK_NB; i++) {
         const int p = dk_parent[i];
-        const DK_T accel = dk_mult[i] * b[dk_coord[i]];
+        const DK_T accel = DK_FF && i == 0 ? DK_C(0.0) : dk_mult[i] * b[DK_VO + dk_coord[i]];
         DK_T t[6], u[6];
         if (p >= 0) {
             DK_FN(mcross)(da[p], w.S[i], t);
@@ -389,6 +480,9 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
             for (int j = 0; j < 6; j++) da[i][j] = DK_C(0.0);
         }
         for (int j = 0; j < 6; j++) da[i][j] += w.S[i][j] * accel;
+        if (DK_FF && i == 0)
+            for (int c = 0; c < 6; c++)
+                for (int j = 0; j < 6; j++) da[0][j] += w.ffS[c][j] * b[c];
         DK_FN(iapply)(&w.Y[i], da[i], u);
         for (int j = 0; j < 6; j++) w.F[i][j] += u[j];
     }
@@ -397,36 +491,36 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     /* M^-1 = L^-T L^-1: X = L^-1 row by row (the columns of a row independent: no chain of
        dependent operations as in solving column by column), then X^T X; then -M^-1 d tau/dq,
        -M^-1 d tau/dq_dot */
-    DK_T X[DK_N * DK_N];
-    for (int i = 0; i < DK_N; i++) {
+    DK_T X[DK_NV * DK_NV];
+    for (int i = 0; i < DK_NV; i++) {
         for (int c = 0; c < i; c++) {
             DK_T s = DK_C(0.0);
-            for (int k = c; k < i; k++) s -= M[i * DK_N + k] * X[k * DK_N + c];
-            X[i * DK_N + c] = s * diagonal[i];
+            for (int k = c; k < i; k++) s -= M[i * DK_NV + k] * X[k * DK_NV + c];
+            X[i * DK_NV + c] = s * diagonal[i];
         }
-        X[i * DK_N + i] = diagonal[i];
+        X[i * DK_NV + i] = diagonal[i];
     }
-    for (int i = 0; i < DK_N; i++)
+    for (int i = 0; i < DK_NV; i++)
         for (int j = 0; j <= i; j++) {
             DK_T s = DK_C(0.0);
-            for (int k = i; k < DK_N; k++) s += X[k * DK_N + i] * X[k * DK_N + j];
-            Minv[i * DK_N + j] = Minv[j * DK_N + i] = s;
+            for (int k = i; k < DK_NV; k++) s += X[k * DK_NV + i] * X[k * DK_NV + j];
+            Minv[i * DK_NV + j] = Minv[j * DK_NV + i] = s;
         }
-    for (int i = 0; i < DK_N; i++) {  /* rows as sums of rows: independent along j */
-        DK_T x[DK_N], y[DK_N];
-        for (int j = 0; j < DK_N; j++) { x[j] = DK_C(0.0); y[j] = DK_C(0.0); }
-        for (int k = 0; k < DK_N; k++) {
-            const DK_T m = Minv[i * DK_N + k];
-            for (int j = 0; j < DK_N; j++) {
-                x[j] -= m * dq[k * DK_N + j];
-                y[j] -= m * dv[k * DK_N + j];
+    for (int i = 0; i < DK_NV; i++) {  /* rows as sums of rows: independent along j */
+        DK_T x[DK_NV], y[DK_NV];
+        for (int j = 0; j < DK_NV; j++) { x[j] = DK_C(0.0); y[j] = DK_C(0.0); }
+        for (int k = 0; k < DK_NV; k++) {
+            const DK_T m = Minv[i * DK_NV + k];
+            for (int j = 0; j < DK_NV; j++) {
+                x[j] -= m * dq[k * DK_NV + j];
+                y[j] -= m * dv[k * DK_NV + j];
             }
         }
-        for (int j = 0; j < DK_N; j++) { aq[i * DK_N + j] = x[j]; av[i * DK_N + j] = y[j]; }
+        for (int j = 0; j < DK_NV; j++) { aq[i * DK_NV + j] = x[j]; av[i * DK_NV + j] = y[j]; }
     }
     return failed;
 }
-/* Y (DK_N x 10 DK_NB, row-major) with tau = Y pi, pi = [m, m c, I_xx, I_xy, I_yy, I_xz, I_yz,
+/* Y (DK_NV x 10 DK_NB, row-major) with tau = Y pi, pi = [m, m c, I_xx, I_xy, I_yy, I_xz, I_yz,
  * I_zz] per body about its origin in its axes (Pinocchio's order): body i's wrench at its origin
  * per parameter, from its angular velocity w, angular acceleration dw and its origin's
  * acceleration ac (gravity in), in its axes: m [ac; 0], h [(dw x + w x w x) h; h x ac],
@@ -437,7 +531,7 @@ static void DK_FN(regressor)(const DK_T *q, const DK_T *qd, const DK_T *qdd, con
     DK_FN(work) w;
     DK_FN(motion) k;
     DK_FN(kinematics)(q, qd, qdd, g, &w, &k);
-    for (int j = 0; j < DK_N * 10 * DK_NB; j++) Y[j] = DK_C(0.0);
+    for (int j = 0; j < DK_NV * 10 * DK_NB; j++) Y[j] = DK_C(0.0);
     for (int i = 0; i < DK_NB; i++) {
         const DK_T *R = k.R[i], *o = k.o[i], *V = k.V[i], *Acc = k.Acc[i];
         DK_T vo[3], ac[3], t[3], wl[3], dwl[3], al[3], ww[3];
@@ -474,7 +568,7 @@ static void DK_FN(regressor)(const DK_T *q, const DK_T *qd, const DK_T *qdd, con
             DK_FN(cross)(wl, Jw, ww);
             for (int j = 0; j < 3; j++) Nj[p][j] = Jd[j] + ww[j];
         }
-        for (int kk = i; kk >= 0; kk = dk_parent[kk]) {
+        for (int kk = i; kk >= DK_FF; kk = dk_parent[kk]) {  /* a base's rows: not yet */
             /* S_k at body i's origin in its axes: [R^T (s_v + s_w x o); R^T s_w] */
             const DK_T *S = w.S[kk];
             DK_T sv[3], sl[3], sw[3];
@@ -484,7 +578,7 @@ static void DK_FN(regressor)(const DK_T *q, const DK_T *qd, const DK_T *qdd, con
                 sl[j] = R[j] * sv[0] + R[3 + j] * sv[1] + R[6 + j] * sv[2];
                 sw[j] = R[j] * S[3] + R[3 + j] * S[4] + R[6 + j] * S[5];
             }
-            DK_T *row = Y + dk_coord[kk] * 10 * DK_NB + 10 * i;
+            DK_T *row = Y + (DK_VO + dk_coord[kk]) * 10 * DK_NB + 10 * i;
             const double mult = dk_mult[kk];
             row[0] += mult * DK_FN(dot3)(sl, al);
             for (int c = 0; c < 3; c++)

@@ -1,9 +1,11 @@
 """Derivatives of the dynamics and the torque regressor against Pinocchio, on a URDF arm:
 agreement, and speed per call and in batches of 10^4 states.
 
-    python benchmarks/bench_control.py [panda|ur5|xarm7] [--states 10000]
+    python benchmarks/bench_control.py [panda|ur5|xarm7|solo12] [--states 10000]
 
 Needs the bench extra (pin, example-robot-data). The Panda's finger joints are locked at 0.
+solo12 is a floating base (a free flyer at the root, nq 19, nv 18; Pinocchio's
+JointModelFreeFlyer): its derivatives only (the regressor of a floating base is not given yet).
 
 - Per call: one state through ``dynamics().inverse_dynamics_derivatives`` (and
   ``forward_dynamics_derivatives``, ``regressor``) against ``computeRNEADerivatives``
@@ -31,6 +33,8 @@ from bench_urdf import ROBOTS, robots_folder
 
 import lagrangian
 
+SOLO, SOLO_PATH = "solo12", "solo_description/robots/solo12.urdf"
+
 
 def interleaved(first, second, repeat: int, clock=time.perf_counter) -> tuple[float, float]:
     """The best time of each of two functions over ``repeat`` rounds, taking turns (``clock``:
@@ -48,20 +52,25 @@ def main() -> None:
     import pinocchio as pin
 
     parser = argparse.ArgumentParser()
-    parser.add_argument("robot", nargs="?", default="panda", choices=sorted(ROBOTS))
+    parser.add_argument("robot", nargs="?", default="panda", choices=sorted(ROBOTS) + [SOLO])
     parser.add_argument("--states", type=int, default=10_000)
     args = parser.parse_args()
-    relative, lock = ROBOTS[args.robot]
+    floating = args.robot == SOLO
+    relative, lock = (SOLO_PATH, {}) if floating else ROBOTS[args.robot]
     path = robots_folder() / relative
-    ours = lagrangian.load(path, lock=lock).dynamics()
-    model = pin.buildModelFromUrdf(str(path))
+    ours = lagrangian.load(path, lock=lock, floating_base=floating).dynamics()
+    model = (pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer()) if floating
+             else pin.buildModelFromUrdf(str(path)))
     if lock:
         model = pin.buildReducedModel(model, [model.getJointId(j) for j in lock],
                                       pin.neutral(model))
     data = model.createData()
-    n = model.nq
     rng = np.random.default_rng(0)
-    q, v, a = rng.uniform(-2, 2, (3, args.states, n))
+    q = rng.uniform(-2, 2, (args.states, model.nq))
+    v, a = rng.uniform(-2, 2, (2, args.states, model.nv))
+    if floating:  # a unit quaternion, the joints in Pinocchio's order (ours: the URDF's)
+        q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
+        assert ours.coordinates[7:] == tuple(model.names[i] for i in range(2, model.njoints))
     pairs = {
         "rnea_derivatives": (lambda Q, V, A: ours.inverse_dynamics_derivatives(Q, V, A),
                              lambda Q, V, A: pin.computeRNEADerivatives(model, data, Q, V, A)),
@@ -70,6 +79,8 @@ def main() -> None:
         "regressor": (lambda Q, V, A: ours.regressor(Q, V, A),
                       lambda Q, V, A: pin.computeJointTorqueRegressor(model, data, Q, V, A)),
     }
+    if floating:
+        del pairs["regressor"]
     report = {"robot": args.robot, "states": args.states, "cpus": os.cpu_count(),
               "threads": os.environ.get("LAGRANGIAN_THREADS", "processors"),
               "load_average_before": os.getloadavg()}
@@ -94,8 +105,9 @@ def main() -> None:
     report["load_average_after"] = os.getloadavg()
     dq, dv = ours.inverse_dynamics_derivatives(q[:20], v[:20], a[:20])
     fq, fv, ftau = ours.forward_dynamics_derivatives(q[:20], v[:20], a[:20])
-    Y = ours.regressor(q[:20], v[:20], a[:20])
+    Y = None if floating else ours.regressor(q[:20], v[:20], a[:20])
     worst = {"rnea_derivatives": 0.0, "aba_derivatives": 0.0, "regressor": 0.0}
+    relative = 0.0  # the forward derivatives' worst difference over their largest entry
     for k in range(20):
         pq, pv, _ = pin.computeRNEADerivatives(model, data, q[k], v[k], a[k])
         worst["rnea_derivatives"] = max(worst["rnea_derivatives"], np.abs(dq[k] - pq).max(),
@@ -106,9 +118,13 @@ def main() -> None:
                                        np.abs(fq[k] - data.ddq_dq).max(),
                                        np.abs(fv[k] - data.ddq_dv).max(),
                                        np.abs(ftau[k] - minv).max())
-        worst["regressor"] = max(worst["regressor"], np.abs(
-            Y[k] - pin.computeJointTorqueRegressor(model, data, q[k], v[k], a[k])).max())
+        largest = max(np.abs(data.ddq_dq).max(), np.abs(data.ddq_dv).max(), np.abs(minv).max())
+        relative = max(relative, worst["aba_derivatives"] / largest)
+        if Y is not None:
+            worst["regressor"] = max(worst["regressor"], np.abs(
+                Y[k] - pin.computeJointTorqueRegressor(model, data, q[k], v[k], a[k])).max())
     report["max_abs_difference"] = worst
+    report["aba_derivatives_relative_difference"] = relative
     print(json.dumps(report, indent=2))
 
 

@@ -248,3 +248,20 @@ def test_floating_base_derivatives_agree_with_central_differences_on_the_manifol
     with pytest.raises(lagrangian.InputError, match="norm 2") as caught:
         robot.inverse_dynamics_derivatives(np.r_[q[:6], 2.0, q[7:]], v, a)
     assert caught.value.field == "q" and "\n" not in str(caught.value)
+
+
+@needs_c
+def test_a_link_inertial_set_at_run_time_reuses_the_module(turret):
+    """`<link>.mass` and `.com_x` given to dynamics(): the same compiled module (the inertials
+    are run-time numbers), the complex step's derivatives at those inertials."""
+    plain = turret.dynamics()
+    heavier = {"left.mass": 2.5, "left.com_x": 0.3}
+    fast, slow = turret.dynamics(parameters=heavier), turret.dynamics(parameters=heavier,
+                                                                      backend="numpy")
+    assert fast._derivatives_kernel()[2].__self__ is plain._derivatives_kernel()[2].__self__
+    q, v, a = _states(fast.n, 3, 10)
+    for ours, theirs in zip(fast.inverse_dynamics_derivatives(q, v, a),
+                            slow.inverse_dynamics_derivatives(q, v, a), strict=True):
+        np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-11)
+    assert not np.allclose(fast.inverse_dynamics_derivatives(q, v, a)[0],
+                           plain.inverse_dynamics_derivatives(q, v, a)[0])

@@ -166,8 +166,9 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     }
     P = (PyArrayObject *)PyArray_FROMANY(args[3], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
     if (!P) goto done;
-    if (PyArray_SIZE(P) != 3 + DK_NJ) {
-        PyErr_SetString(PyExc_ValueError, "parameters: expected g (3) and the actuators");
+    if (PyArray_SIZE(P) != 3 + DK_NJ + 13 * DK_NB) {
+        PyErr_SetString(PyExc_ValueError,
+                        "parameters: expected g (3), the actuators and 13 per body");
         goto done;
     }
     /* the outputs as views of one block (nout, ..., DK_NV, DK_NV): one allocation (two large

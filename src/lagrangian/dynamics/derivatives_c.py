@@ -2,10 +2,10 @@
 and d q_ddot/dq, d q_ddot/dq_dot, M^-1 of forward dynamics (derivatives_kernel.c: analytic,
 O(n^2) per state; a floating base's q derivatives along its own axes, q (+) dq, as Pinocchio's),
 and the joint-torque regressor Y (fixed base); a batch in one call on vector lanes and
-threads (derivatives_bindings.c), over the tree's numbers written as static tables, one module
-per tree (cached on disk by its numbers). Gravity and the actuator parameters
-tau_<joint> are given at run time. Revolute and prismatic joints; the
-complex step of derivatives.py is the fallback (and the check). Units SI."""
+threads (derivatives_bindings.c), over the tree's joints written as static tables, one module
+per tree's kinematics (cached on disk by its numbers). Gravity, the actuator parameters
+tau_<joint> and the bodies' inertials are given at run time. Revolute and prismatic joints;
+the complex step of derivatives.py is the fallback (and the check). Units SI."""
 
 from __future__ import annotations
 
@@ -126,9 +126,6 @@ def kernel_source(tree: KinematicTree):
         _table("dk_u", "double", [list(j.axis) for j in joints]),
         _table("dk_R0u", "double", [(np.array(j.rotation, dtype=float)
                                      @ np.array(j.axis, dtype=float)).tolist() for j in joints]),
-        _table("dk_m", "double", [j.mass for j in joints]),
-        _table("dk_h", "double", [list(j.first_moment) for j in joints]),
-        _table("dk_J", "double", [_flat(j.inertia) for j in joints]),
         _SINCOS, _VECTOR,
         head, _SCALAR, core, _LANES, core, bindings,
     ])
@@ -167,7 +164,12 @@ def derivatives_module(tree: KinematicTree):
     here = Path(__file__)
     generator = hashlib.sha256(_KERNEL.read_bytes() + _BINDINGS.read_bytes() + here.read_bytes()
                                + here.with_name("tree_c.py").read_bytes()).hexdigest()
-    key = "\n".join(["derivatives", generator, repr(tree)])
+    # the joints' kinematics only: the inertials are given at run time (runtime_values), so a
+    # payload or an identification's trial inertials reuse the module
+    kinematic = [(j.parent, str(j.kind), j.rotation, j.translation, j.axis, j.coordinate,
+                  j.multiplier, j.offset) for j in tree.joints]
+    key = "\n".join(["derivatives", generator, repr(kinematic), repr(tree.coordinates),
+                     repr(bool(tree.floating_base))])
     try:
         return compiled.load_keyed(key, lambda: kernel_source(tree), native=True)
     except compiled.BackendUnavailable:
@@ -176,12 +178,15 @@ def derivatives_module(tree: KinematicTree):
 
 def runtime_values(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
     """P = [g times the tree's direction (m/s^2, 3), tau_<joint> (N m or N, one per
-    coordinate; 0 where none)], read-only."""
+    coordinate; 0 where none), then per body m (kg), h = m c (kg m, 3) and J_O (kg m^2, 9,
+    about its origin in its axes)], read-only."""
     g = float(parameters.get(tree.gravity_parameter, 0.0) or 0.0) \
         if tree.gravity_parameter is not None else 0.0
     actuators = [float(parameters.get(a, 0.0) or 0.0) if a is not None else 0.0
                  for a in tree.actuators]
-    P = np.concatenate([g * np.array(tree.gravity_direction, dtype=float), actuators])
+    inertials = [[j.mass, *j.first_moment, *_flat(j.inertia)] for j in tree.joints]
+    P = np.concatenate([g * np.array(tree.gravity_direction, dtype=float), actuators,
+                        np.ravel(np.array(inertials, dtype=float))])
     P.flags.writeable = False
     return P
 

@@ -230,12 +230,13 @@ static void DK_FN(forward)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const
         /* the inertia at the world's origin: c = R h + m o, J_O = R J R^T shifted by o */
         DK_FN(inertia) *Y = &w->Y[i];
         DK_T hr[3], RJ[9];
-        const double m = dk_m[i];
+        /* the body's inertial, given at run time: P = [g, tau_<joint>, (m, h, J_O) per body] */
+        const double *inertial = g + 3 + DK_NJ + 13 * i, m = inertial[0];
         const DK_T *po = o[i];
         for (int j = 0; j < 3; j++)
-            hr[j] = R[i][3 * j] * dk_h[i][0] + R[i][3 * j + 1] * dk_h[i][1]
-                    + R[i][3 * j + 2] * dk_h[i][2];
-        DK_FN(matmul_c)(R[i], dk_J[i], RJ);
+            hr[j] = R[i][3 * j] * inertial[1] + R[i][3 * j + 1] * inertial[2]
+                    + R[i][3 * j + 2] * inertial[3];
+        DK_FN(matmul_c)(R[i], inertial + 4, RJ);
         DK_T pp = DK_FN(dot3)(po, po), ph = DK_FN(dot3)(po, hr);
         for (int a = 0; a < 3; a++)
             for (int b = a; b < 3; b++) {

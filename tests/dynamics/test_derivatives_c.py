@@ -68,6 +68,7 @@ def test_compiled_derivatives_agree_with_central_differences_of_our_dynamics(tur
 
 
 @needs_c
+@pytest.mark.slow  # a module of its own to compile (tens of seconds on a shared machine)
 def test_compiled_derivatives_of_a_spatial_arm_are_pinocchios(tmp_path):
     pin = pytest.importorskip("pinocchio")
     pytest.importorskip("yourdfpy")
@@ -170,6 +171,7 @@ def test_compiled_regressor_is_the_numpy_one_and_gives_tau(turret):
 
 
 @needs_c
+@pytest.mark.slow  # a module of its own to compile (tens of seconds on a shared machine)
 def test_floating_base_derivatives_are_pinocchios():
     """Solo12 on a free flyer (nq 19, nv 18): d/dq along the base's own axes, q (+) dq, as
     Pinocchio's; to 1e-10 of each matrix's largest entry (M^-1 of the light legs is large)."""

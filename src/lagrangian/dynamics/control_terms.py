@@ -39,6 +39,11 @@ class ControlTerms:
                 raise InputError("a robot's regressor is over its bodies' 10 inertial "
                                  "parameters each; parameters=[...] is for model files",
                                  field="parameters")
+            fast = self._derivatives_kernel()
+            if fast is not None:  # compiled C (derivatives_c.py)
+                compute, P = fast[2], fast[3]
+                return (lambda Q, V, A: compute(Q, V, A, P),
+                        tree_parameter_names(tree), tree_parameters(tree))
             g = self.parameters[tree.gravity_parameter]
             return (lambda Q, V, A: tree_regressor(tree, g, Q, V, A),
                     tree_parameter_names(tree), tree_parameters(tree))
@@ -58,6 +63,15 @@ class ControlTerms:
         (m, m c_x, m c_y, m c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz about the body's joint
         frame; see ``parameter_names``). A model file: the named ``parameters``, in which T and
         V must be linear."""
+        fast = self._derivatives_kernel() if parameters is None else None
+        if fast is not None and not self.tree.floating_base:  # one C call; a bad input goes
+            # the guarded way to be named
+            try:
+                out = fast[2](q, v, a, fast[3])
+            except (ValueError, TypeError):
+                pass
+            else:
+                return out if out.__class__ is not tuple else _reported(out)[0]
         compute, names, _ = self._regressor_of(parameters)
         return self._guarded(compute, (q, v, a), ("q", "v", "a"), (self.n, len(names)))
 
@@ -83,14 +97,44 @@ class ControlTerms:
         stacked = np.asarray(compute(q, v, a)).reshape(count * self.n, len(names))
         return BaseParameters(names, stacked, tolerance)
 
-    # -- derivatives (derivatives.py) ------------------------------------------------------------
+    # -- derivatives (derivatives_c.py, derivatives.py) -------------------------------------------
+
+    def _derivatives_kernel(self):
+        """(inverse, forward, regressor, P) of the tree's compiled module (derivatives_c.py), or
+        None: a compiled backend's tree of revolute and prismatic joints (a floating base too,
+        but for the regressor); the numpy backend and a model file keep derivatives.py."""
+        found = self.__dict__.get("_derivatives_c", False)
+        if found is False:
+            found = None
+            tree = getattr(self, "tree", None)
+            if tree is not None and getattr(self, "module", None) is not None:
+                from .derivatives_c import applies, derivatives_module, runtime_values
+
+                module = derivatives_module(tree) if applies(tree) else None
+                if module is not None:
+                    inverse, forward = module.inverse_derivatives, module.forward_derivatives
+                    if tree.floating_base:  # the base quaternion's norm checked first
+                        from .recursive import _checking_quaternion
+
+                        inverse, forward = (_checking_quaternion(f) for f in (inverse, forward))
+                    found = (inverse, forward, module.regressor,
+                             runtime_values(tree, self.parameters))
+            self.__dict__["_derivatives_c"] = found
+        return found
 
     def _inverse_derivatives(self):
         found = self.__dict__.get("_derivatives")
         if found is None:
             tree = getattr(self, "tree", None)
-            _refuse_floating(tree, "derivatives of the dynamics")
-            if tree is not None:
+            fast = self._derivatives_kernel()
+            if fast is None:
+                _refuse_floating(tree, "derivatives of the dynamics")
+            if fast is not None:
+                inverse, P = fast[0], fast[3]
+
+                def found(Q, V, A):
+                    return inverse(Q, V, A, P)[:2]
+            elif tree is not None:
                 from .derivatives import tree_inverse_dynamics_derivatives
 
                 g = self.parameters[tree.gravity_parameter]
@@ -109,8 +153,18 @@ class ControlTerms:
 
     def inverse_dynamics_derivatives(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
         """(d tau/dq, d tau/dq_dot) of tau = M(q) q_ddot + C q_dot + g, (..., n, n) each (row
-        i: tau_i), as Pinocchio's computeRNEADerivatives: a model file's from its derived M and
-        f, a URDF tree's by the complex step through Newton-Euler (exact to rounding)."""
+        i: tau_i), as Pinocchio's computeRNEADerivatives: a URDF tree's analytic in compiled C
+        (derivatives_c.py; a floating base's d/dq along its own axes, q (+) dq, n = nv; the
+        complex step through Newton-Euler without a compiler, fixed base, exact to rounding), a
+        model file's from its derived M and f."""
+        fast = self._derivatives_kernel()
+        if fast is not None:  # one C call; a bad input goes the guarded way to be named
+            try:
+                out = fast[0](q, v, a, fast[3])
+            except (ValueError, TypeError):
+                pass
+            else:
+                return out if len(out) == 2 else _reported(out)
         compute = self._inverse_derivatives()
         n = self.n
         both = self._guarded(lambda Q, V, A: np.concatenate(compute(Q, V, A), axis=-1),
@@ -122,11 +176,29 @@ class ControlTerms:
         """(d q_ddot/dq, d q_ddot/dq_dot, d q_ddot/d tau), (..., n, n) each, as Pinocchio's
         computeABADerivatives: -M^-1 d tau/dq and -M^-1 d tau/dq_dot at q_ddot = FD(q, q_dot,
         tau), and M^-1."""
+        fast = self._derivatives_kernel()
+        if fast is not None:
+            try:
+                out = fast[1](q, v, tau, fast[3])
+            except (ValueError, TypeError):
+                pass
+            else:
+                return out if len(out) == 3 else _reported(out)
         q, v, tau = self._vector(q, "q"), self._vector(v, "v"), self._vector(tau, "tau")
         batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1], tau.shape[:-1])
-        q = np.broadcast_to(q, batch + (self.n,))
+        q = np.broadcast_to(q, batch + q.shape[-1:])
         v = np.broadcast_to(v, batch + (self.n,))
         acceleration = self.forward_dynamics(q, v, tau)
         by_position, by_velocity = self.inverse_dynamics_derivatives(q, v, acceleration)
         inverse = np.linalg.inv(self.mass_matrix(q))
         return -inverse @ by_position, -inverse @ by_velocity, inverse
+
+
+def _reported(out: tuple) -> tuple:
+    """The C's (outputs..., count of NaN rows): one DynamicsWarning at the user's call, and the
+    outputs."""
+    from .joint_space import warn_undefined
+
+    first = out[0]
+    warn_undefined(out[-1], int(np.prod(first.shape[:-2], dtype=np.int64)), stacklevel=4)
+    return out[:-1]

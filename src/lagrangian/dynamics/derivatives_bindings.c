@@ -1,0 +1,273 @@
+/* The Python bindings of derivatives_kernel.c's functions (derivatives_c.py appends this text
+ * after the kernel's core, emitted on one state and on vector lanes). */
+
+/* -- Python bindings: (Q, V, X, P) with Q, V, X (..., DK_NV) float64 (or (DK_NV,), shared by
+ * the batch), P = [g (3), tau_<joint> (DK_NV)]; outputs (..., DK_NV, DK_NV) each, as a tuple,
+ * with the count of NaN rows appended where a state's inputs are not all finite (or, forward,
+ * its M is not positive definite). A batch runs in parts on threads. ------------------------ */
+
+#if defined(__unix__) || defined(__APPLE__)
+#define DK_PTHREADS 1
+#include <pthread.h>
+#include <unistd.h>
+#else
+#define DK_PTHREADS 0
+#endif
+#define DK_MAX_THREADS 8
+#define DK_THREAD_STATES 512
+
+/* the numbers of input j: q DK_NQ (a floating base's 7 first), v, a and tau DK_NV */
+#define DK_WIDTH(j) ((j) == 0 ? DK_NQ : DK_NV)
+
+typedef struct {
+    int kind;
+    npy_intp step[3], k0, k1, bad;
+    const double *x[3], *p;
+    double *y[3];
+} dk_job;
+
+/* Whether state k's inputs are all finite. */
+static inline int dk_finite(const dk_job *job, npy_intp k)
+{
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < DK_WIDTH(j); i++)
+            if (!isfinite(job->x[j][k * job->step[j] + i])) return 0;
+    return 1;
+}
+
+enum { DK_INVERSE, DK_FORWARD, DK_REGRESSOR };
+#define DK_SIZE(kind) ((kind) == DK_REGRESSOR ? DK_NV * 10 * DK_NB : DK_NV * DK_NV)
+#define DK_OUTPUTS(kind) ((kind) == DK_INVERSE ? 2 : (kind) == DK_FORWARD ? 3 : 1)
+#define DK_SPACE (3 * DK_NV * DK_NV > DK_NV * 10 * DK_NB ? 3 * DK_NV * DK_NV : DK_NV * 10 * DK_NB)
+
+static void *dk_run(void *argument)
+{
+    dk_job *job = (dk_job *)argument;
+    const int kind = job->kind, size = DK_SIZE(kind), nout = DK_OUTPUTS(kind);
+    npy_intp bad = 0, k = job->k0;
+    /* LG_LANES states at a time through the dk4_ functions, the rest one by one; the lanes'
+       outputs on the heap (a regressor's are DK_NV x 10 DK_NB vectors) */
+    lg_v4 *out = job->k1 - k >= LG_LANES
+                 ? aligned_alloc(sizeof(lg_v4), DK_SPACE * sizeof(lg_v4)) : NULL;
+    for (; out && k + LG_LANES <= job->k1; k += LG_LANES) {
+        lg_v4 in[3][DK_NQ];
+        for (int j = 0; j < 3; j++)
+            for (int l = 0; l < LG_LANES; l++)
+                for (int i = 0; i < DK_WIDTH(j); i++)
+                    in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
+        int failed = 0;
+        if (kind == DK_FORWARD)
+            failed = dk4_forward_derivatives(in[0], in[1], in[2], job->p, out, out + size,
+                                             out + 2 * size);
+        else if (kind == DK_INVERSE)
+            dk4_inverse(in[0], in[1], in[2], job->p, out, out + size);
+        else
+            dk4_regressor(in[0], in[1], in[2], job->p, out);
+        /* x - x is NaN for an infinite or NaN x: the lanes with an input not finite */
+        lg_v4 spoilt = LG_V4(0.0);
+        for (int j = 0; j < 3; j++)
+            for (int i = 0; i < DK_WIDTH(j); i++) spoilt += in[j][i] - in[j][i];
+        for (int l = 0; l < LG_LANES; l++) {
+            const int fine = !((failed >> l) & 1) && spoilt[l] == 0.0;
+            bad += !fine;
+            for (int o = 0; o < nout; o++) {
+                double *y = job->y[o] + (k + l) * size;
+                const lg_v4 *x = out + o * size;
+                if (fine)
+                    for (int i = 0; i < size; i++) y[i] = x[i][l];
+                else
+                    for (int i = 0; i < size; i++) y[i] = NAN;
+            }
+        }
+    }
+    for (; k < job->k1; k++) {
+        const double *a0 = job->x[0] + k * job->step[0], *a1 = job->x[1] + k * job->step[1],
+                     *a2 = job->x[2] + k * job->step[2];
+        double *y0 = job->y[0] + k * size;
+        int fine = dk_finite(job, k);
+        if (fine) {
+            if (kind == DK_FORWARD)
+                fine = !dk_forward_derivatives(a0, a1, a2, job->p, y0, job->y[1] + k * size,
+                                               job->y[2] + k * size);
+            else if (kind == DK_INVERSE)
+                dk_inverse(a0, a1, a2, job->p, y0, job->y[1] + k * size);
+            else
+                dk_regressor(a0, a1, a2, job->p, y0);
+        }
+        if (!fine) {
+            for (int o = 0; o < nout; o++)
+                for (int i = 0; i < size; i++) job->y[o][k * size + i] = NAN;
+            bad++;
+        }
+    }
+    free(out);
+    job->bad = bad;
+    return NULL;
+}
+
+static int dk_threads(npy_intp count)
+{
+#if DK_PTHREADS
+    static int cap = 0;
+    if (cap == 0) {
+        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+        const char *env = getenv("LAGRANGIAN_THREADS");
+        long asked = env && *env ? strtol(env, NULL, 10) : cpus;
+        if (asked < 1) asked = 1;
+        if (cpus < 1) cpus = 1;
+        cap = (int)(asked < cpus ? asked : cpus);
+        if (cap > DK_MAX_THREADS) cap = DK_MAX_THREADS;
+    }
+    npy_intp parts = count / DK_THREAD_STATES;
+    if (parts > cap) parts = cap;
+    return parts < 1 ? 1 : (int)parts;
+#else
+    (void)count;
+    return 1;
+#endif
+}
+
+static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
+{
+    const char *names[3] = {"q", "v", kind == DK_FORWARD ? "tau" : "a"};
+    PyArrayObject *in[3] = {NULL, NULL, NULL}, *P = NULL;
+    PyObject *out[3] = {NULL, NULL, NULL}, *block = NULL, *result = NULL;
+    npy_intp step[3] = {0, 0, 0};
+    const int nout = DK_OUTPUTS(kind);
+    if (nargs != 4) {
+        PyErr_SetString(PyExc_TypeError, "expected (Q, V, X, P)");
+        return NULL;
+    }
+    int base = 0;
+    for (int i = 0; i < 3; i++) {
+        in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
+        if (!in[i]) goto done;
+        int nd = PyArray_NDIM(in[i]);
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != DK_WIDTH(i)) {
+            PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
+                         names[i], DK_WIDTH(i));
+            goto done;
+        }
+        if (PyArray_SIZE(in[i]) / DK_WIDTH(i) > PyArray_SIZE(in[base]) / DK_WIDTH(base)) base = i;
+    }
+    npy_intp count = PyArray_SIZE(in[base]) / DK_WIDTH(base);
+    int nd = PyArray_NDIM(in[base]);
+    for (int i = 0; i < 3; i++) {
+        if (PyArray_NDIM(in[i]) == 1) {  /* one state, shared by the batch */
+            step[i] = count > 1 ? 0 : DK_WIDTH(i);
+            continue;
+        }
+        if (PyArray_NDIM(in[i]) != nd
+            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp))) {
+            PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
+            goto done;
+        }
+        step[i] = DK_WIDTH(i);
+    }
+    P = (PyArrayObject *)PyArray_FROMANY(args[3], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
+    if (!P) goto done;
+    if (PyArray_SIZE(P) != 3 + DK_NJ + 13 * DK_NB) {
+        PyErr_SetString(PyExc_ValueError,
+                        "parameters: expected g (3), the actuators and 13 per body");
+        goto done;
+    }
+    /* the outputs as views of one block (nout, ..., DK_NV, DK_NV): one allocation (two large
+       ones of a size freed and asked again each call cost glibc a trim and fresh pages);
+       the regressor's (..., DK_NV, 10 DK_NB) */
+    npy_intp dims[NPY_MAXDIMS];
+    dims[0] = nout;
+    memcpy(dims + 1, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
+    dims[nd] = DK_NV;
+    dims[nd + 1] = kind == DK_REGRESSOR ? 10 * DK_NB : DK_NV;
+    block = PyArray_SimpleNew(nd + 2, dims, NPY_DOUBLE);
+    if (!block) goto done;
+    for (int o = 0; o < nout; o++) {
+        out[o] = PySequence_GetItem(block, o);
+        if (!out[o]) goto done;
+    }
+    dk_job jobs[DK_MAX_THREADS];
+    int parts = dk_threads(count);
+    npy_intp share = (count / parts + LG_LANES - 1) / LG_LANES * LG_LANES;
+    for (int t = 0; t < parts; t++) {
+        dk_job job = {kind, {step[0], step[1], step[2]}, t * share < count ? t * share : count,
+                      t == parts - 1 || (t + 1) * share > count ? count : (t + 1) * share, 0,
+                      {PyArray_DATA(in[0]), PyArray_DATA(in[1]), PyArray_DATA(in[2])},
+                      PyArray_DATA(P),
+                      {PyArray_DATA((PyArrayObject *)out[0]),
+                       nout > 1 ? PyArray_DATA((PyArrayObject *)out[1]) : NULL,
+                       nout > 2 ? PyArray_DATA((PyArrayObject *)out[2]) : NULL}};
+        jobs[t] = job;
+    }
+    npy_intp bad = 0;
+    NPY_BEGIN_THREADS_DEF;
+    if (count > 16) NPY_BEGIN_THREADS;
+#if DK_PTHREADS
+    pthread_t threads[DK_MAX_THREADS];
+    int started[DK_MAX_THREADS] = {0};
+    for (int t = 0; t < parts - 1; t++)
+        started[t] = pthread_create(&threads[t], NULL, dk_run, &jobs[t]) == 0;
+    dk_run(&jobs[parts - 1]);
+    for (int t = 0; t < parts - 1; t++) {
+        if (started[t]) pthread_join(threads[t], NULL);
+        else dk_run(&jobs[t]);
+    }
+#else
+    for (int t = 0; t < parts; t++) dk_run(&jobs[t]);
+#endif
+    for (int t = 0; t < parts; t++) bad += jobs[t].bad;
+    if (count > 16) NPY_END_THREADS;
+    if (kind == DK_REGRESSOR) {
+        if (bad > 0)
+            result = Py_BuildValue("(On)", out[0], (Py_ssize_t)bad);
+        else {
+            result = out[0];
+            Py_INCREF(result);
+        }
+    } else if (bad > 0)
+        result = nout == 3 ? Py_BuildValue("(OOOn)", out[0], out[1], out[2], (Py_ssize_t)bad)
+                           : Py_BuildValue("(OOn)", out[0], out[1], (Py_ssize_t)bad);
+    else
+        result = nout == 3 ? PyTuple_Pack(3, out[0], out[1], out[2])
+                           : PyTuple_Pack(2, out[0], out[1]);
+done:
+    for (int i = 0; i < 3; i++) { Py_XDECREF(in[i]); Py_XDECREF(out[i]); }
+    Py_XDECREF(block);
+    Py_XDECREF(P);
+    return result;
+}
+
+static PyObject *dk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    return dk_batch(args, nargs, DK_INVERSE);
+}
+
+static PyObject *dk_py_forward(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    return dk_batch(args, nargs, DK_FORWARD);
+}
+
+static PyObject *dk_py_regressor(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    return dk_batch(args, nargs, DK_REGRESSOR);
+}
+
+static PyMethodDef dk_methods[] = {
+    {"inverse_derivatives", (PyCFunction)(void (*)(void))dk_py_inverse, METH_FASTCALL,
+     "(Q, V, A, P) -> (d tau/dq, d tau/dq_dot[, count of NaN rows])"},
+    {"forward_derivatives", (PyCFunction)(void (*)(void))dk_py_forward, METH_FASTCALL,
+     "(Q, V, TAU, P) -> (d q_ddot/dq, d q_ddot/dq_dot, M^-1[, count of NaN rows])"},
+    {"regressor", (PyCFunction)(void (*)(void))dk_py_regressor, METH_FASTCALL,
+     "(Q, V, A, P) -> Y (or (Y, count of NaN rows)), tau = Y pi"},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef dk_module = {PyModuleDef_HEAD_INIT, DK_STR(LG_MODULE), NULL, -1, dk_methods};
+
+PyMODINIT_FUNC DK_PASTE(PyInit_, LG_MODULE)(void)
+{
+    import_array();
+    return PyModule_Create(&dk_module);
+}

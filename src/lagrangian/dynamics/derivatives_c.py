@@ -1,0 +1,194 @@
+"""The derivatives of a tree's dynamics in compiled C: d tau/dq, d tau/dq_dot of Newton-Euler
+and d q_ddot/dq, d q_ddot/dq_dot, M^-1 of forward dynamics (derivatives_kernel.c: analytic,
+O(n^2) per state; a floating base's q derivatives along its own axes, q (+) dq, as Pinocchio's),
+and the joint-torque regressor Y (fixed base); a batch in one call on vector lanes and
+threads (derivatives_bindings.c), over the tree's joints written as static tables, one module
+per tree's kinematics (cached on disk by its numbers). Gravity, the actuator parameters
+tau_<joint> and the bodies' inertials are given at run time. Revolute and prismatic joints;
+the complex step of derivatives.py is the fallback (and the check). Units SI."""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from ..model.tree import KinematicTree
+from .joint_models import JOINT_MODELS
+from .tree_c import _SINCOS, _VECTOR
+
+_KERNEL = Path(__file__).with_name("derivatives_kernel.c")
+_BINDINGS = Path(__file__).with_name("derivatives_bindings.c")
+
+# the kernel's core on one state, then on LG_LANES states at once (derivatives_kernel.c)
+_SCALAR = """#define DK_T double
+#define DK_FN(name) dk_##name
+#define DK_C(x) (x)
+#define DK_SINCOS lg_sincos
+#define DK_SQRT sqrt
+#define DK_FAILED(d) (!((d) > 0.0))"""
+_LANES = """#undef DK_T
+#undef DK_FN
+#undef DK_C
+#undef DK_SINCOS
+#undef DK_SQRT
+#undef DK_FAILED
+#define DK_T lg_v4
+#define DK_FN(name) dk4_##name
+#define DK_C(x) LG_V4(x)
+#define DK_SINCOS lg_vsincos
+#define DK_SQRT lg_vsqrt
+#define DK_FAILED(d) dk4_failed(d)
+static inline int dk4_failed(lg_v4 d)
+{
+    int bits = 0;
+    for (int l = 0; l < LG_LANES; l++) bits |= !(d[l] > 0.0) << l;
+    return bits;
+}"""
+
+
+def _table(name: str, ctype: str, rows) -> str:
+    """A static const C array (exact doubles by repr), rows of numbers or numbers."""
+    rows = list(rows)
+    number = (lambda x: repr(float(x))) if ctype == "double" else (lambda x: str(int(x)))
+    nested = bool(rows) and isinstance(rows[0], (list, tuple))
+    body = ", ".join("{" + ", ".join(map(number, row)) + "}" if nested else number(row)
+                     for row in rows)
+    width = f"[{len(rows[0])}]" if nested else ""
+    return f"static const {ctype} {name}[{max(len(rows), 1)}]{width} = {{{body}}};"
+
+
+def _flat(matrix) -> list[float]:
+    return [float(x) for row in matrix for x in row]
+
+
+def _pairs(tree: KinematicTree) -> list[tuple[int, int]]:
+    """(k, j) for every body k and each j on its path to the ground, k itself first."""
+    out = []
+    for k in range(len(tree.joints)):
+        j = k
+        while j >= 0:
+            out.append((k, j))
+            j = tree.joints[j].parent
+    return out
+
+
+def kernel_source(tree: KinematicTree):
+    """The module's C: the tree's tables, then derivatives_kernel.c."""
+    from ..compile.codegen import GeneratedSource
+
+    joints = tree.joints
+    P, C, S = [], [], []
+    for j in joints:  # R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x
+        R0, u = np.array(j.rotation, dtype=float), np.array(j.axis, dtype=float)
+        uu = np.outer(u, u)
+        skew = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
+        P.append((R0 @ uu).ravel().tolist())
+        C.append((R0 @ (np.eye(3) - uu)).ravel().tolist())
+        S.append((R0 @ skew).ravel().tolist())
+    models = [JOINT_MODELS[j.kind] for j in joints]
+    n = len(tree.coordinates)
+    floating = int(bool(tree.floating_base))
+    pairs = _pairs(tree)
+    text = _KERNEL.read_text(encoding="utf-8")
+    head, rest = text.split("/* DK_CORE_BEGIN */")
+    core = rest.split("/* DK_CORE_END */")[0]
+    bindings = _BINDINGS.read_text(encoding="utf-8")
+    source = "\n".join([
+        "/* lagrangian: the derivatives of a tree's inverse and forward dynamics */",
+        "#define PY_SSIZE_T_CLEAN",
+        "#include <Python.h>",
+        "#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION",
+        "#include <numpy/arrayobject.h>",
+        "#include <math.h>",
+        "#include <stdlib.h>",
+        "#include <string.h>",
+        f"#define DK_NB {len(joints)}",
+        f"#define DK_NJ {n}",  # the joints' coordinates; a floating base's come first:
+        f"#define DK_FF {floating}",
+        f"#define DK_QO {7 * floating}",
+        f"#define DK_VO {6 * floating}",
+        f"#define DK_NQ {n + 7 * floating}",
+        f"#define DK_NV {n + 6 * floating}",
+        f"#define DK_NP {len(pairs)}",
+        _table("dk_parent", "int", [j.parent for j in joints]),
+        _table("dk_coord", "int", [j.coordinate for j in joints]),
+        _table("dk_turns", "int", [getattr(m, "turns", False) for m in models]),
+        _table("dk_slides", "int", [getattr(m, "slides", False) for m in models]),
+        _table("dk_pair", "int", [list(p) for p in pairs]),
+        _table("dk_mult", "double", [j.multiplier for j in joints]),
+        _table("dk_off", "double", [j.offset for j in joints]),
+        _table("dk_R0", "double", [_flat(j.rotation) for j in joints]),
+        _table("dk_P", "double", P), _table("dk_C", "double", C), _table("dk_Sk", "double", S),
+        _table("dk_t0", "double", [list(j.translation) for j in joints]),
+        _table("dk_u", "double", [list(j.axis) for j in joints]),
+        _table("dk_R0u", "double", [(np.array(j.rotation, dtype=float)
+                                     @ np.array(j.axis, dtype=float)).tolist() for j in joints]),
+        _SINCOS, _VECTOR,
+        head, _SCALAR, core, _LANES, core, bindings,
+    ])
+    return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
+
+
+# The kernel keeps a state's work on the stack (per body and n x n per output, LG_LANES states
+# at once): up to this many bodies and coordinates, about a megabyte; larger trees keep the
+# complex step of derivatives.py.
+LARGEST = 64
+
+
+def applies(tree: KinematicTree | None) -> bool:
+    """Whether the kernel takes this tree: revolute and prismatic joints on a fixed base or a
+    floating one (a free flyer at the root), at most LARGEST bodies and coordinates."""
+    from ..kinds import JointKind
+
+    if tree is None or not tree.joints or len(tree.joints) > LARGEST \
+            or len(tree.coordinates) > LARGEST:
+        return False
+    kinds = [j.kind for j in tree.joints]
+    if tree.floating_base:
+        if kinds[0] != JointKind.FREE_FLYER:
+            return False
+        kinds = kinds[1:]
+    return all(k in (JointKind.REVOLUTE, JointKind.PRISMATIC) for k in kinds)
+
+
+def derivatives_module(tree: KinematicTree):
+    """The compiled module of this tree (built once, then from the verified cache), or None
+    where no compiler works or the kernel does not take the tree."""
+    from ..compile import compiled
+
+    if not applies(tree):
+        return None
+    here = Path(__file__)
+    generator = hashlib.sha256(_KERNEL.read_bytes() + _BINDINGS.read_bytes() + here.read_bytes()
+                               + here.with_name("tree_c.py").read_bytes()).hexdigest()
+    # the joints' kinematics only: the inertials are given at run time (runtime_values), so a
+    # payload or an identification's trial inertials reuse the module
+    kinematic = [(j.parent, str(j.kind), j.rotation, j.translation, j.axis, j.coordinate,
+                  j.multiplier, j.offset) for j in tree.joints]
+    key = "\n".join(["derivatives", generator, repr(kinematic), repr(tree.coordinates),
+                     repr(bool(tree.floating_base))])
+    try:
+        return compiled.load_keyed(key, lambda: kernel_source(tree), native=True)
+    except compiled.BackendUnavailable:
+        return None
+
+
+def runtime_values(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
+    """P = [g times the tree's direction (m/s^2, 3), tau_<joint> (N m or N, one per
+    coordinate; 0 where none), then per body m (kg), h = m c (kg m, 3) and J_O (kg m^2, 9,
+    about its origin in its axes)], read-only."""
+    g = float(parameters.get(tree.gravity_parameter, 0.0) or 0.0) \
+        if tree.gravity_parameter is not None else 0.0
+    actuators = [float(parameters.get(a, 0.0) or 0.0) if a is not None else 0.0
+                 for a in tree.actuators]
+    inertials = [[j.mass, *j.first_moment, *_flat(j.inertia)] for j in tree.joints]
+    P = np.concatenate([g * np.array(tree.gravity_direction, dtype=float), actuators,
+                        np.ravel(np.array(inertials, dtype=float))])
+    P.flags.writeable = False
+    return P
+
+
+__all__ = ["applies", "derivatives_module", "kernel_source", "runtime_values"]

@@ -1,0 +1,591 @@
+/* d tau/dq, d tau/dq_dot of recursive Newton-Euler and d q_ddot/dq, d q_ddot/dq_dot, M^-1 of
+ * forward dynamics, over the tree tables that derivatives_c.py writes above this text (dk_*
+ * arrays, DK_NB bodies, DK_NV coordinates, DK_NP ancestor pairs). Analytic, O(n^2) per state.
+ *
+ * Spatial vectors at the world's origin in world axes, linear part first: a motion [v; w], a
+ * force [f; n]. A body's joint column S (theta_dot = k q_dot[c]); v_i = v_p + S theta_dot,
+ * a_i = a_p + S theta_ddot + (v_p x S) theta_dot (a of the ground: -g), f_i = I a + v x* I v.
+ * Turning joint j by d theta moves its subtree rigidly about S_j while its parent's v_p, a_p
+ * stay: with dv_j = v_p x S_j and psi_j = a_p x S_j + v_p x dv_j, a body i below j gets
+ *   d f_i / d theta_j     = S_j x* f_i + I_i psi_j + B_i dv_j,
+ *   d f_i / d theta_dot_j = I_i (2 dv_j) + B_i S_j,   B_i x = v x* I x - I (v x x) + x x* I v,
+ * so that, with composite (subtree) sums Ic, Bc, F (the rigid turn S_j x* cancels on the rows
+ * of the subtree):
+ *   row k below j (k in j's subtree):  d tau_k/d theta_j = S_k . (Ic_k psi_j + Bc_k dv_j)
+ *   row k above j (k a strict ancestor): S_k . (S_j x* F_j + Ic_j psi_j + Bc_j dv_j),
+ * likewise for theta_dot, and M_kj = S_k . Ic_k S_j. B = [[0, -2[l]x], [0, A]] with l the
+ * linear momentum and A = [w]x J_O - J_O [w]x - [v]x[c]x - [c]x[v]x - [n]x (n the angular
+ * momentum about the origin, c = m x_G): 12 numbers, additive over a subtree. */
+
+#define DK_STR_(x) #x
+#define DK_STR(x) DK_STR_(x)
+#define DK_PASTE_(a, b) a##b
+#define DK_PASTE(a, b) DK_PASTE_(a, b)
+
+
+/* The core below is emitted twice by derivatives_c.py: on one state (dk_*, DK_T double) and on
+ * LG_LANES states at once (dk4_*, DK_T lg_v4, GCC/Clang vector extensions). DK_FN(name) names a
+ * function, DK_C(x) a constant as a DK_T, DK_SINCOS and DK_SQRT the functions of a DK_T, and
+ * DK_FAILED(d) the lanes (as bits) where !(d > 0). */
+/* DK_CORE_BEGIN */
+static inline void DK_FN(cross)(const DK_T *a, const DK_T *b, DK_T *out)
+{
+    DK_T x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2],
+         z = a[0] * b[1] - a[1] * b[0];
+    out[0] = x; out[1] = y; out[2] = z;
+}
+
+static inline void DK_FN(apply)(const DK_T *R, const DK_T *x, DK_T *out)
+{
+    DK_T a = R[0] * x[0] + R[1] * x[1] + R[2] * x[2], b = R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
+         c = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
+    out[0] = a; out[1] = b; out[2] = c;
+}
+
+/* A B with B a table's (doubles) */
+static inline void DK_FN(matmul_c)(const DK_T *A, const double *B, DK_T *out)
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            out[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+
+static inline void DK_FN(matmul)(const DK_T *A, const DK_T *B, DK_T *out)
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            out[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+
+/* motion x motion: [w x yv + v x yw; w x yw] */
+static inline void DK_FN(mcross)(const DK_T *x, const DK_T *y, DK_T *out)
+{
+    DK_T a[3], b[3], c[3];
+    DK_FN(cross)(x + 3, y, a);
+    DK_FN(cross)(x, y + 3, b);
+    DK_FN(cross)(x + 3, y + 3, c);
+    for (int j = 0; j < 3; j++) { out[j] = a[j] + b[j]; out[3 + j] = c[j]; }
+}
+
+/* motion x* force: [w x f; v x f + w x n] */
+static inline void DK_FN(fcross)(const DK_T *x, const DK_T *f, DK_T *out)
+{
+    DK_T a[3], b[3], c[3];
+    DK_FN(cross)(x + 3, f, a);
+    DK_FN(cross)(x, f, b);
+    DK_FN(cross)(x + 3, f + 3, c);
+    for (int j = 0; j < 3; j++) { out[j] = a[j]; out[3 + j] = b[j] + c[j]; }
+}
+
+static inline DK_T DK_FN(dot6)(const DK_T *a, const DK_T *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
+}
+
+static inline DK_T DK_FN(dot3)(const DK_T *a, const DK_T *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* A spatial inertia at the world's origin: mass m, c = m x_G (3), J_O (3 x 3, symmetric). */
+typedef struct { DK_T m, c[3], J[9]; } DK_FN(inertia);
+
+/* Y x: [m v + w x c; c x v + J w] */
+static inline void DK_FN(iapply)(const DK_FN(inertia) *Y, const DK_T *x, DK_T *out)
+{
+    DK_T a[3], b[3], Jw[3];
+    DK_FN(cross)(x + 3, Y->c, a);
+    DK_FN(cross)(Y->c, x, b);
+    DK_FN(apply)(Y->J, x + 3, Jw);
+    for (int j = 0; j < 3; j++) { out[j] = Y->m * x[j] + a[j]; out[3 + j] = b[j] + Jw[j]; }
+}
+
+typedef struct {
+    DK_T S[DK_NB][6], dv[DK_NB][6], psi[DK_NB][6];
+    DK_T F[DK_NB][6];                 /* f_i, then the subtree's sum */
+    DK_FN(inertia) Y[DK_NB];          /* the body's, then the subtree's */
+    DK_T L[DK_NB][3], A[DK_NB][9];    /* B's 12 numbers, the body's then the subtree's */
+    DK_T r1[DK_NB][6], r2[DK_NB][3];  /* Ic_k S_k and the angular part of Bc_k^T S_k */
+    DK_T Phi[DK_NB][6], Psi[DK_NB][6];
+    /* a floating base's six columns (body 0): S, psi = -g x S, dv = v x S (its parent the
+       ground), Ic S, Bc^T S's angular part, and S . F */
+    DK_T ffS[6][6], ffpsi[6][6], ffdv[6][6], ffr1[6][6], ffr2[6][3], fftau[6];
+} DK_FN(work);
+
+/* Each body's placement (R: body -> world, origin o), velocity and acceleration at the world's
+ * origin (a of the ground: -g). */
+typedef struct { DK_T R[DK_NB][9], o[DK_NB][3], V[DK_NB][6], Acc[DK_NB][6]; } DK_FN(motion);
+
+/* A floating base (body 0): q[0:3] its origin, q[3:7] its quaternion x y z w (normalized here),
+ * R = R0 R(quaternion), o = t0 + R0 q[0:3]; its velocity and acceleration in its own axes, so
+ * its columns are the world's images of the unit twists: [R e_c; 0] and [o x R e_c; R e_c]. */
+static void DK_FN(base)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
+                        DK_FN(work) *w, DK_FN(motion) *k)
+{
+    const DK_T x = q[3], y = q[4], z = q[5], r = q[6];
+    const DK_T t = 2.0 / (x * x + y * y + z * z + r * r);
+    const DK_T Rq[9] = {1.0 - t * (y * y + z * z), t * (x * y - z * r), t * (x * z + y * r),
+                        t * (x * y + z * r), 1.0 - t * (x * x + z * z), t * (y * z - x * r),
+                        t * (x * z - y * r), t * (y * z + x * r), 1.0 - t * (x * x + y * y)};
+    DK_T *R = k->R[0], *o = k->o[0], *V = k->V[0], *Acc = k->Acc[0];
+    for (int a = 0; a < 3; a++) {
+        for (int b = 0; b < 3; b++)
+            R[3 * a + b] = dk_R0[0][3 * a] * Rq[b] + dk_R0[0][3 * a + 1] * Rq[3 + b]
+                           + dk_R0[0][3 * a + 2] * Rq[6 + b];
+        o[a] = dk_t0[0][a] + dk_R0[0][3 * a] * q[0] + dk_R0[0][3 * a + 1] * q[1]
+               + dk_R0[0][3 * a + 2] * q[2];
+    }
+    for (int c = 0; c < 3; c++) {
+        DK_T *L = w->ffS[c], *A = w->ffS[3 + c];
+        for (int j = 0; j < 3; j++) { L[j] = R[3 * j + c]; L[3 + j] = DK_C(0.0); A[3 + j] = L[j]; }
+        DK_FN(cross)(o, L, A);
+    }
+    for (int j = 0; j < 6; j++) {
+        V[j] = DK_C(0.0);
+        Acc[j] = DK_C(j < 3 ? -g[j] : 0.0);
+        w->S[0][j] = w->dv[0][j] = w->psi[0][j] = DK_C(0.0);
+    }
+    for (int c = 0; c < 6; c++)
+        for (int j = 0; j < 6; j++) { V[j] += w->ffS[c][j] * qd[c]; Acc[j] += w->ffS[c][j] * qdd[c]; }
+    const DK_T ground[6] = {DK_C(-g[0]), DK_C(-g[1]), DK_C(-g[2]), DK_C(0.0), DK_C(0.0), DK_C(0.0)};
+    for (int c = 0; c < 6; c++) {
+        DK_FN(mcross)(ground, w->ffS[c], w->ffpsi[c]);
+        DK_FN(mcross)(V, w->ffS[c], w->ffdv[c]);
+    }
+}
+
+/* The forward pass's kinematics: placements, S, v, a, dv and psi of every body. */
+static void DK_FN(kinematics)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
+                              DK_FN(work) *w, DK_FN(motion) *k)
+{
+    DK_T (*R)[9] = k->R, (*o)[3] = k->o, (*V)[6] = k->V, (*Acc)[6] = k->Acc;
+    for (int i = 0; i < DK_NB; i++) {
+        if (DK_FF && i == 0) {
+            DK_FN(base)(q, qd, qdd, g, w, k);
+            continue;
+        }
+        DK_T th = dk_mult[i] * q[DK_QO + dk_coord[i]] + dk_off[i];
+        DK_T Rl[9], pl[3];
+        for (int j = 0; j < 3; j++) pl[j] = DK_C(dk_t0[i][j]);
+        if (dk_turns[i]) {
+            /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
+            DK_T c, s;
+            DK_SINCOS(th, &s, &c);
+            for (int j = 0; j < 9; j++) Rl[j] = dk_P[i][j] + c * dk_C[i][j] + s * dk_Sk[i][j];
+        } else {
+            for (int j = 0; j < 9; j++) Rl[j] = DK_C(dk_R0[i][j]);
+        }
+        if (dk_slides[i])
+            for (int j = 0; j < 3; j++) pl[j] += th * dk_R0u[i][j];
+        int p = dk_parent[i];
+        DK_T axis[3];
+        if (p < 0) {
+            for (int j = 0; j < 9; j++) R[i][j] = Rl[j];
+            for (int j = 0; j < 3; j++) o[i][j] = pl[j];
+        } else {
+            DK_T d[3];
+            DK_FN(matmul)(R[p], Rl, R[i]);
+            DK_FN(apply)(R[p], pl, d);
+            for (int j = 0; j < 3; j++) o[i][j] = o[p][j] + d[j];
+        }
+        /* the world axis R u: R's column when u is a table's unit vector along x, y or z */
+        for (int j = 0; j < 3; j++)
+            axis[j] = R[i][3 * j] * dk_u[i][0] + R[i][3 * j + 1] * dk_u[i][1]
+                      + R[i][3 * j + 2] * dk_u[i][2];
+        /* S: [o x a; a] turning about the world axis a, [a; 0] sliding along it */
+        DK_T *S = w->S[i];
+        if (dk_turns[i]) {
+            DK_FN(cross)(o[i], axis, S);
+            for (int j = 0; j < 3; j++) S[3 + j] = axis[j];
+        } else {
+            for (int j = 0; j < 3; j++) { S[j] = axis[j]; S[3 + j] = DK_C(0.0); }
+        }
+        DK_T vp[6], ap[6];
+        for (int j = 0; j < 6; j++) {
+            vp[j] = p >= 0 ? V[p][j] : DK_C(0.0);
+            ap[j] = p >= 0 ? Acc[p][j] : DK_C(j < 3 ? -g[j] : 0.0);
+        }
+        DK_T rate = dk_mult[i] * qd[DK_VO + dk_coord[i]];
+        DK_T accel = dk_mult[i] * qdd[DK_VO + dk_coord[i]];
+        DK_T t[6];
+        DK_FN(mcross)(vp, S, w->dv[i]);
+        DK_FN(mcross)(ap, S, w->psi[i]);
+        DK_FN(mcross)(vp, w->dv[i], t);
+        for (int j = 0; j < 6; j++) {
+            w->psi[i][j] += t[j];
+            V[i][j] = vp[j] + S[j] * rate;
+            Acc[i][j] = ap[j] + S[j] * accel + w->dv[i][j] * rate;
+        }
+    }
+}
+
+/* The forward pass: the kinematics, then each body's f and B. */
+static void DK_FN(forward)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
+                           DK_FN(work) *w)
+{
+    DK_FN(motion) k;
+    DK_FN(kinematics)(q, qd, qdd, g, w, &k);
+    DK_T (*R)[9] = k.R, (*o)[3] = k.o, (*V)[6] = k.V, (*Acc)[6] = k.Acc;
+    for (int i = 0; i < DK_NB; i++) {
+        /* the inertia at the world's origin: c = R h + m o, J_O = R J R^T shifted by o */
+        DK_FN(inertia) *Y = &w->Y[i];
+        DK_T hr[3], RJ[9];
+        /* the body's inertial, given at run time: P = [g, tau_<joint>, (m, h, J_O) per body] */
+        const double *inertial = g + 3 + DK_NJ + 13 * i, m = inertial[0];
+        const DK_T *po = o[i];
+        for (int j = 0; j < 3; j++)
+            hr[j] = R[i][3 * j] * inertial[1] + R[i][3 * j + 1] * inertial[2]
+                    + R[i][3 * j + 2] * inertial[3];
+        DK_FN(matmul_c)(R[i], inertial + 4, RJ);
+        DK_T pp = DK_FN(dot3)(po, po), ph = DK_FN(dot3)(po, hr);
+        for (int a = 0; a < 3; a++)
+            for (int b = a; b < 3; b++) {
+                DK_T T = RJ[3 * a] * R[i][3 * b] + RJ[3 * a + 1] * R[i][3 * b + 1]
+                         + RJ[3 * a + 2] * R[i][3 * b + 2]
+                         - m * po[a] * po[b] - po[a] * hr[b] - hr[a] * po[b];
+                if (a == b) T += m * pp + 2.0 * ph;
+                Y->J[3 * a + b] = Y->J[3 * b + a] = T;
+            }
+        Y->m = DK_C(m);
+        for (int j = 0; j < 3; j++) Y->c[j] = hr[j] + m * po[j];
+        /* momentum h = Y v, force f = Y a + v x* h */
+        DK_T h[6], Ya[6], vh[6];
+        DK_FN(iapply)(Y, V[i], h);
+        DK_FN(iapply)(Y, Acc[i], Ya);
+        DK_FN(fcross)(V[i], h, vh);
+        for (int j = 0; j < 6; j++) w->F[i][j] = Ya[j] + vh[j];
+        /* B: L = l, A = X + X^T - (c v^T + v c^T) + 2 (v.c) 1 - [n]x, X = [w]x J_O */
+        const DK_T *vl = V[i], *vw = V[i] + 3, *c = Y->c;
+        DK_T X[9], cv = DK_FN(dot3)(vl, c);
+        for (int b = 0; b < 3; b++) {
+            DK_T col[3] = {Y->J[b], Y->J[3 + b], Y->J[6 + b]}, r[3];
+            DK_FN(cross)(vw, col, r);
+            X[b] = r[0]; X[3 + b] = r[1]; X[6 + b] = r[2];
+        }
+        DK_T *A = w->A[i];
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                A[3 * a + b] = X[3 * a + b] + X[3 * b + a] - c[a] * vl[b] - vl[a] * c[b];
+        for (int a = 0; a < 3; a++) A[4 * a] += 2.0 * cv;
+        const DK_T *n = h + 3;
+        A[1] += n[2]; A[2] -= n[1]; A[3] -= n[2]; A[5] += n[0]; A[6] += n[1]; A[7] -= n[0];
+        for (int j = 0; j < 3; j++) w->L[i][j] = h[j];
+    }
+}
+
+/* Bc x for the subtree's B: [-2 L x x_w; A x_w] */
+static inline void DK_FN(bapply)(const DK_T *L, const DK_T *A, const DK_T *x, DK_T *out)
+{
+    DK_T t[3];
+    DK_FN(cross)(L, x + 3, t);
+    DK_FN(apply)(A, x + 3, out + 3);
+    for (int j = 0; j < 3; j++) out[j] = -2.0 * t[j];
+}
+
+/* The backward pass: subtree sums and each body's row (r1, r2) and column (Phi, Psi) vectors
+ * (the columns only with ``columns``), tau by body into tau (DK_NB) when asked. */
+static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns)
+{
+    for (int i = DK_NB - 1; i >= 0; i--) {
+        const DK_FN(inertia) *Y = &w->Y[i];
+        const DK_T *S = w->S[i];
+        DK_FN(iapply)(Y, S, w->r1[i]);
+        if (tau) tau[i] = DK_FN(dot6)(S, w->F[i]);
+        if (columns) {
+            DK_T t[6], u[6], x[6];
+            /* Bc^T S (angular part): 2 L x s_v + A^T s_w */
+            DK_T *r2 = w->r2[i];
+            DK_FN(cross)(w->L[i], S, r2);
+            for (int j = 0; j < 3; j++)
+                r2[j] = 2.0 * r2[j] + w->A[i][j] * S[3] + w->A[i][3 + j] * S[4]
+                        + w->A[i][6 + j] * S[5];
+            DK_FN(fcross)(S, w->F[i], t);
+            DK_FN(iapply)(Y, w->psi[i], u);
+            DK_FN(bapply)(w->L[i], w->A[i], w->dv[i], x);
+            for (int j = 0; j < 6; j++) w->Phi[i][j] = t[j] + u[j] + x[j];
+            DK_FN(iapply)(Y, w->dv[i], u);
+            DK_FN(bapply)(w->L[i], w->A[i], S, x);
+            for (int j = 0; j < 6; j++) w->Psi[i][j] = 2.0 * u[j] + x[j];
+        }
+        if (DK_FF && i == 0)  /* the base's columns, its subtree the whole tree */
+            for (int c = 0; c < 6; c++) {
+                const DK_T *T = w->ffS[c];
+                DK_FN(iapply)(Y, T, w->ffr1[c]);
+                DK_T *r2 = w->ffr2[c];
+                DK_FN(cross)(w->L[0], T, r2);
+                for (int j = 0; j < 3; j++)
+                    r2[j] = 2.0 * r2[j] + w->A[0][j] * T[3] + w->A[0][3 + j] * T[4]
+                            + w->A[0][6 + j] * T[5];
+                w->fftau[c] = DK_FN(dot6)(T, w->F[0]);
+            }
+        int p = dk_parent[i];
+        if (p >= 0) {
+            DK_FN(inertia) *P = &w->Y[p];
+            P->m += Y->m;
+            for (int j = 0; j < 3; j++) { P->c[j] += Y->c[j]; w->L[p][j] += w->L[i][j]; }
+            for (int j = 0; j < 9; j++) { P->J[j] += Y->J[j]; w->A[p][j] += w->A[i][j]; }
+            for (int j = 0; j < 6; j++) w->F[p][j] += w->F[i][j];
+        }
+    }
+}
+
+/* The entries of a floating base's columns c: with body k (at or below the base: row k by
+ * Ic_k, Bc_k; column k by its Phi, Psi) or, k = 0, with its own columns. */
+static void DK_FN(base_pairs)(const DK_FN(work) *w, int k, DK_T *M, DK_T *dq, DK_T *dv)
+{
+    for (int c = 0; c < 6; c++) {
+        const DK_T *S = w->ffS[c];
+        if (k == 0) {
+            for (int r = 0; r < 6; r++) {
+                const DK_T *r1 = w->ffr1[r], *r2 = w->ffr2[r];
+                if (M) M[r * DK_NV + c] = DK_FN(dot6)(r1, S);
+                if (!dq) continue;
+                dq[r * DK_NV + c] = DK_FN(dot6)(r1, w->ffpsi[c]);
+                dv[r * DK_NV + c] = DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3);
+            }
+            continue;
+        }
+        const int ck = DK_VO + dk_coord[k];
+        const double m = dk_mult[k];
+        const DK_T *r1 = w->r1[k], *r2 = w->r2[k];
+        if (M) M[ck * DK_NV + c] = M[c * DK_NV + ck] = m * DK_FN(dot6)(r1, S);
+        if (!dq) continue;
+        dq[ck * DK_NV + c] += m * DK_FN(dot6)(r1, w->ffpsi[c]);
+        dv[ck * DK_NV + c] += m * (DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3));
+        dq[c * DK_NV + ck] += m * DK_FN(dot6)(S, w->Phi[k]);
+        dv[c * DK_NV + ck] += m * DK_FN(dot6)(S, w->Psi[k]);
+    }
+}
+
+/* M (DK_NV x DK_NV) when asked, or d tau/dq and d tau/dq_dot, from the pairs (k below or at j),
+ * each entry scattered to the coordinates with the joints' multipliers */
+static void DK_FN(pairs)(const DK_FN(work) *w, DK_T *M, DK_T *dq, DK_T *dv)
+{
+    if (M)
+        for (int j = 0; j < DK_NV * DK_NV; j++) M[j] = DK_C(0.0);
+    if (dq)
+        for (int j = 0; j < DK_NV * DK_NV; j++) { dq[j] = DK_C(0.0); dv[j] = DK_C(0.0); }
+    for (int e = 0; e < DK_NP; e++) {
+        const int k = dk_pair[e][0], j = dk_pair[e][1];
+        if (DK_FF && j == 0) {
+            DK_FN(base_pairs)(w, k, M, dq, dv);
+            continue;
+        }
+        const int ck = DK_VO + dk_coord[k], cj = DK_VO + dk_coord[j];
+        const double kk = dk_mult[k] * dk_mult[j];
+        const DK_T *r1 = w->r1[k];
+        if (M) {
+            const DK_T mkj = kk * DK_FN(dot6)(r1, w->S[j]);
+            M[ck * DK_NV + cj] += mkj;
+            if (k != j) M[cj * DK_NV + ck] += mkj;
+        }
+        if (!dq) continue;
+        const DK_T *r2 = w->r2[k];
+        dq[ck * DK_NV + cj] += kk * (DK_FN(dot6)(r1, w->psi[j]) + DK_FN(dot3)(r2, w->dv[j] + 3));
+        dv[ck * DK_NV + cj] += kk * (2.0 * DK_FN(dot6)(r1, w->dv[j])
+                                    + DK_FN(dot3)(r2, w->S[j] + 3));
+        if (k != j) {
+            dq[cj * DK_NV + ck] += kk * DK_FN(dot6)(w->S[j], w->Phi[k]);
+            dv[cj * DK_NV + ck] += kk * DK_FN(dot6)(w->S[j], w->Psi[k]);
+        }
+    }
+}
+
+/* (d tau/dq, d tau/dq_dot) at one state (lane); g (3) the gravity vector (m/s^2). */
+static void DK_FN(inverse)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
+                           DK_T *dq, DK_T *dv)
+{
+    DK_FN(work) w;
+    DK_FN(forward)(q, qd, qdd, g, &w);
+    DK_FN(backward)(&w, NULL, 1);
+    DK_FN(pairs)(&w, NULL, dq, dv);
+}
+
+/* L L^T = M in place (lower triangle), 1 / L_jj into inverse; the lanes (bits) where M is not
+ * positive definite */
+static int DK_FN(cholesky)(DK_T *M, DK_T *inverse)
+{
+    int failed = 0;
+    for (int j = 0; j < DK_NV; j++) {
+        DK_T d = M[j * DK_NV + j];
+        for (int k = 0; k < j; k++) d -= M[j * DK_NV + k] * M[j * DK_NV + k];
+        failed |= DK_FAILED(d);
+        d = DK_SQRT(d);
+        M[j * DK_NV + j] = d;
+        inverse[j] = 1.0 / d;
+        for (int i = j + 1; i < DK_NV; i++) {
+            DK_T s = M[i * DK_NV + j];
+            for (int k = 0; k < j; k++) s -= M[i * DK_NV + k] * M[j * DK_NV + k];
+            M[i * DK_NV + j] = s * inverse[j];
+        }
+    }
+    return failed;
+}
+
+/* x = M^-1 b from the factor L and 1 / L_jj (b overwritten) */
+static void DK_FN(solve)(const DK_T *L, const DK_T *inverse, DK_T *b)
+{
+    for (int i = 0; i < DK_NV; i++) {
+        DK_T s = b[i];
+        for (int k = 0; k < i; k++) s -= L[i * DK_NV + k] * b[k];
+        b[i] = s * inverse[i];
+    }
+    for (int i = DK_NV - 1; i >= 0; i--) {
+        DK_T s = b[i];
+        for (int k = i + 1; k < DK_NV; k++) s -= L[k * DK_NV + i] * b[k];
+        b[i] = s * inverse[i];
+    }
+}
+
+/* (d q_ddot/dq, d q_ddot/dq_dot, M^-1) at one state (lane); P = [g (3), tau_<joint> (DK_NV)];
+ * the lanes (bits) where M is not positive definite */
+static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T *tau,
+                                      const double *P, DK_T *aq, DK_T *av, DK_T *Minv)
+{
+    DK_FN(work) w;
+    DK_T M[DK_NV * DK_NV], dq[DK_NV * DK_NV], dv[DK_NV * DK_NV], taub[DK_NB], b[DK_NV], zero[DK_NV];
+    /* the bodies' own f, inertia and B: the backward pass sums them in place */
+    DK_T F[DK_NB][6], L[DK_NB][3], A[DK_NB][9];
+    DK_FN(inertia) Y[DK_NB];
+    for (int j = 0; j < DK_NV; j++) zero[j] = DK_C(0.0);
+    /* q_ddot = M^-1 (tau + tau_p - b), b from Newton-Euler at q_ddot = 0 */
+    DK_FN(forward)(q, qd, zero, P, &w);
+    memcpy(F, w.F, sizeof F);
+    memcpy(L, w.L, sizeof L);
+    memcpy(A, w.A, sizeof A);
+    memcpy(Y, w.Y, sizeof Y);
+    DK_FN(backward)(&w, taub, 0);
+    DK_FN(pairs)(&w, M, NULL, NULL);
+    for (int j = 0; j < DK_NV; j++) b[j] = tau[j];
+    for (int j = 0; j < DK_NJ; j++) b[DK_VO + j] += P[3 + j];
+    for (int i = DK_FF; i < DK_NB; i++) b[DK_VO + dk_coord[i]] -= dk_mult[i] * taub[i];
+    for (int c = 0; c < 6 * DK_FF; c++) b[c] -= w.fftau[c];
+    DK_T diagonal[DK_NV];
+    int failed = DK_FN(cholesky)(M, diagonal);
+    DK_FN(solve)(M, diagonal, b);
+    /* at q_ddot = b: each body's acceleration grows by da = da_p + S theta_ddot, so psi by
+       da_p x S and f by Y da (the rest of the forward pass does not see q_ddot) */
+    memcpy(w.F, F, sizeof F);
+    memcpy(w.L, L, sizeof L);
+    memcpy(w.A, A, sizeof A);
+    memcpy(w.Y, Y, sizeof Y);
+    DK_T da[DK_NB][6];
+    for (int i = 0; i < DK_NB; i++) {
+        const int p = dk_parent[i];
+        const DK_T accel = DK_FF && i == 0 ? DK_C(0.0) : dk_mult[i] * b[DK_VO + dk_coord[i]];
+        DK_T t[6], u[6];
+        if (p >= 0) {
+            DK_FN(mcross)(da[p], w.S[i], t);
+            for (int j = 0; j < 6; j++) { w.psi[i][j] += t[j]; da[i][j] = da[p][j]; }
+        } else {
+            for (int j = 0; j < 6; j++) da[i][j] = DK_C(0.0);
+        }
+        for (int j = 0; j < 6; j++) da[i][j] += w.S[i][j] * accel;
+        if (DK_FF && i == 0)
+            for (int c = 0; c < 6; c++)
+                for (int j = 0; j < 6; j++) da[0][j] += w.ffS[c][j] * b[c];
+        DK_FN(iapply)(&w.Y[i], da[i], u);
+        for (int j = 0; j < 6; j++) w.F[i][j] += u[j];
+    }
+    DK_FN(backward)(&w, NULL, 1);
+    DK_FN(pairs)(&w, NULL, dq, dv);
+    /* M^-1 = L^-T L^-1: X = L^-1 row by row (the columns of a row independent: no chain of
+       dependent operations as in solving column by column), then X^T X; then -M^-1 d tau/dq,
+       -M^-1 d tau/dq_dot */
+    DK_T X[DK_NV * DK_NV];
+    for (int i = 0; i < DK_NV; i++) {
+        for (int c = 0; c < i; c++) {
+            DK_T s = DK_C(0.0);
+            for (int k = c; k < i; k++) s -= M[i * DK_NV + k] * X[k * DK_NV + c];
+            X[i * DK_NV + c] = s * diagonal[i];
+        }
+        X[i * DK_NV + i] = diagonal[i];
+    }
+    for (int i = 0; i < DK_NV; i++)
+        for (int j = 0; j <= i; j++) {
+            DK_T s = DK_C(0.0);
+            for (int k = i; k < DK_NV; k++) s += X[k * DK_NV + i] * X[k * DK_NV + j];
+            Minv[i * DK_NV + j] = Minv[j * DK_NV + i] = s;
+        }
+    for (int i = 0; i < DK_NV; i++) {  /* rows as sums of rows: independent along j */
+        DK_T x[DK_NV], y[DK_NV];
+        for (int j = 0; j < DK_NV; j++) { x[j] = DK_C(0.0); y[j] = DK_C(0.0); }
+        for (int k = 0; k < DK_NV; k++) {
+            const DK_T m = Minv[i * DK_NV + k];
+            for (int j = 0; j < DK_NV; j++) {
+                x[j] -= m * dq[k * DK_NV + j];
+                y[j] -= m * dv[k * DK_NV + j];
+            }
+        }
+        for (int j = 0; j < DK_NV; j++) { aq[i * DK_NV + j] = x[j]; av[i * DK_NV + j] = y[j]; }
+    }
+    return failed;
+}
+/* Y (DK_NV x 10 DK_NB, row-major) with tau = Y pi, pi = [m, m c, I_xx, I_xy, I_yy, I_xz, I_yz,
+ * I_zz] per body about its origin in its axes (Pinocchio's order): body i's wrench at its origin
+ * per parameter, from its angular velocity w, angular acceleration dw and its origin's
+ * acceleration ac (gravity in), in its axes: m [ac; 0], h [(dw x + w x w x) h; h x ac],
+ * J [0; J dw + w x J w]; each paired with S_k of every joint k at or above it, in its axes. */
+static void DK_FN(regressor)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
+                             DK_T *Y)
+{
+    DK_FN(work) w;
+    DK_FN(motion) k;
+    DK_FN(kinematics)(q, qd, qdd, g, &w, &k);
+    for (int j = 0; j < DK_NV * 10 * DK_NB; j++) Y[j] = DK_C(0.0);
+    for (int i = 0; i < DK_NB; i++) {
+        const DK_T *R = k.R[i], *o = k.o[i], *V = k.V[i], *Acc = k.Acc[i];
+        DK_T vo[3], ac[3], t[3], wl[3], dwl[3], al[3], ww[3];
+        /* the origin's velocity v + w x o and classical acceleration a + dw x o + w x vo */
+        DK_FN(cross)(V + 3, o, t);
+        for (int j = 0; j < 3; j++) vo[j] = V[j] + t[j];
+        DK_FN(cross)(Acc + 3, o, t);
+        for (int j = 0; j < 3; j++) ac[j] = Acc[j] + t[j];
+        DK_FN(cross)(V + 3, vo, t);
+        for (int j = 0; j < 3; j++) ac[j] += t[j];
+        for (int j = 0; j < 3; j++) {  /* into the body's axes: R^T x */
+            wl[j] = R[j] * V[3] + R[3 + j] * V[4] + R[6 + j] * V[5];
+            dwl[j] = R[j] * Acc[3] + R[3 + j] * Acc[4] + R[6 + j] * Acc[5];
+            al[j] = R[j] * ac[0] + R[3 + j] * ac[1] + R[6 + j] * ac[2];
+        }
+        /* the columns: f (3) and n (3) per parameter */
+        DK_T Fh[3][3], Nh[3][3], Nj[6][3];
+        for (int c = 0; c < 3; c++) {  /* h = e_c: (dw x + w x w x) e_c, e_c x ac */
+            DK_T e[3] = {DK_C(0.0), DK_C(0.0), DK_C(0.0)}, x[3], y[3];
+            e[c] = DK_C(1.0);
+            DK_FN(cross)(dwl, e, x);
+            DK_FN(cross)(wl, e, y);
+            DK_FN(cross)(wl, y, t);
+            for (int j = 0; j < 3; j++) Fh[c][j] = x[j] + t[j];
+            DK_FN(cross)(e, al, Nh[c]);
+        }
+        /* J's six entries: J dw + w x J w for J = E_rc + E_cr */
+        static const int rows[6] = {0, 0, 1, 0, 1, 2}, cols[6] = {0, 1, 1, 2, 2, 2};
+        for (int p = 0; p < 6; p++) {
+            DK_T Jd[3] = {DK_C(0.0), DK_C(0.0), DK_C(0.0)}, Jw[3] = {DK_C(0.0), DK_C(0.0), DK_C(0.0)};
+            const int r = rows[p], c = cols[p];
+            Jd[r] += dwl[c]; Jw[r] += wl[c];
+            if (r != c) { Jd[c] += dwl[r]; Jw[c] += wl[r]; }
+            DK_FN(cross)(wl, Jw, ww);
+            for (int j = 0; j < 3; j++) Nj[p][j] = Jd[j] + ww[j];
+        }
+        for (int kk = i; kk >= DK_FF; kk = dk_parent[kk]) {  /* a base's rows: not yet */
+            /* S_k at body i's origin in its axes: [R^T (s_v + s_w x o); R^T s_w] */
+            const DK_T *S = w.S[kk];
+            DK_T sv[3], sl[3], sw[3];
+            DK_FN(cross)(S + 3, o, t);
+            for (int j = 0; j < 3; j++) sv[j] = S[j] + t[j];
+            for (int j = 0; j < 3; j++) {
+                sl[j] = R[j] * sv[0] + R[3 + j] * sv[1] + R[6 + j] * sv[2];
+                sw[j] = R[j] * S[3] + R[3 + j] * S[4] + R[6 + j] * S[5];
+            }
+            DK_T *row = Y + (DK_VO + dk_coord[kk]) * 10 * DK_NB + 10 * i;
+            const double mult = dk_mult[kk];
+            row[0] += mult * DK_FN(dot3)(sl, al);
+            for (int c = 0; c < 3; c++)
+                row[1 + c] += mult * (DK_FN(dot3)(sl, Fh[c]) + DK_FN(dot3)(sw, Nh[c]));
+            for (int p = 0; p < 6; p++) row[4 + p] += mult * DK_FN(dot3)(sw, Nj[p]);
+        }
+    }
+}
+/* DK_CORE_END */

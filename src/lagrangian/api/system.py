@@ -206,7 +206,8 @@ class System(CheckMethods, ControlMethods):
         (``limits=False`` ignores them); velocity and effort limits exceeded are reported
         either way (``summary()["limits_exceeded"]``). ``controller`` (t, q, q_dot) -> u adds
         generalized forces, or B u for named ``inputs`` (its own ``inputs`` where it has them,
-        as lagrangian.control's controllers do), to the model's own: docs/control.md.
+        as lagrangian.control's controllers do), to the model's own; ``controller="model"`` runs
+        the model file's own [control] laws, compiled with its equations: docs/control.md.
         """
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
         if tree and self._floating:  # q (+) v dt on SE(3): api/floating_simulation.py
@@ -222,7 +223,8 @@ class System(CheckMethods, ControlMethods):
             else stop_when
         result = simulate(None if tree else self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
-                          progress=progress, functions=self._numeric,
+                          progress=progress,
+                          functions=None if isinstance(controller, str) else self._numeric,
                           limits=urdf_limits(self._model, positions=limits), controller=controller,
                           inputs=getattr(controller, "inputs", ()) if inputs is None else inputs,
                           model=self._model)

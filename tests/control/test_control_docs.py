@@ -102,3 +102,13 @@ def test_control_law_section(capsys, cli, tmp_path, monkeypatch):
 
     same = lagrangian.load(tmp_path / "pd_pendulum.toml").simulate(4, controller=pd)
     assert document["final_state"]["theta"] == pytest.approx(same.final_state["theta"], abs=1e-7)
+
+
+def test_constrained_section(capsys, cli):
+    lines = _run("control-constrained", capsys)
+    assert float(lines[0]) == pytest.approx(9.81 / 0.5, rel=1e-12)
+    assert lines[-1] == "(11, 4, 4)"
+    result = cli(*_command("control-constrained"))
+    assert result.code == 0, result.err
+    along = json.loads(result.out)["linearize_along"]
+    assert np.array(along["A"]).shape == (11, 4, 4) and along["inputs"] == ["x", "y"]

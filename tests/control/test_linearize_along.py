@@ -50,11 +50,16 @@ def test_linearize_along_refuses_a_foreign_run_and_unknown_inputs():
         pendulum.linearize_along(pendulum.simulate(0.1, samples=3), inputs=["phi"])
 
 
-def test_linearize_along_refuses_a_constrained_model_in_one_line():
-    from lagrangian.errors import ModelError
-
+def test_a_constrained_run_is_linearized_through_its_multipliers():
+    """The pendulum in Cartesian coordinates hanging at rest: A's oscillating pair is
+    +-i sqrt(g/L) at every sample (the other two eigenvalues 0: off the rod, Phi_ddot = 0)."""
     system = lagrangian.load("cartesian_pendulum")
-    with pytest.raises(ModelError, match=r"linearize_along needs a model without constraints "
-                                         r"\(this one has 1: rod\)") as caught:
-        system.linearize_along(system.simulate(0.1, samples=3))
-    assert caught.value.field == "constraints" and "\n" not in str(caught.value)
+    run = system.simulate(0.5, initial={"x": 0.0, "y": -0.5}, samples=5)
+    along = system.linearize_along(run, inputs=["x"])
+    assert along.A.shape == (5, 4, 4) and along.B.shape == (5, 4, 1)
+    for A in along.A:
+        eigenvalues = np.sort_complex(np.linalg.eigvals(A))
+        assert eigenvalues.imag.max() == pytest.approx(np.sqrt(9.81 / 0.5), rel=1e-12)
+        assert np.abs(eigenvalues.real).max() < 1e-9
+    np.testing.assert_allclose(along.B[:, 2, 0], 1.0, rtol=1e-12)  # 1/m on x, none on y
+    np.testing.assert_allclose(along.B[:, 3, 0], 0.0, atol=1e-12)

@@ -6,7 +6,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ..control.along import TrajectoryLinearization, linearize_along
-from ..errors import ModelError
 
 
 class ControlMethods:
@@ -17,12 +16,8 @@ class ControlMethods:
         """A(t), B(t) of x_dot = A x + B u (x = [q; q_dot], u the generalized forces on
         ``inputs``, default every coordinate) at ``simulation``'s saved samples, from the
         derivatives of forward dynamics (Dynamics.forward_dynamics_derivatives); a controlled
-        run's own forces are held in place. Unconstrained models (a constrained one is refused
-        in one line: its A(t) would be on the constraint manifold, not done yet)."""
-        constraints = self.model.constraints
-        if constraints:
-            raise ModelError(f"linearize_along needs a model without constraints (this one has "
-                             f"{len(constraints)}: {', '.join(c.name for c in constraints)}); "
-                             "about an equilibrium, linearize() works on the constraint "
-                             "manifold", field="constraints")
+        run's own forces are held in place. A model with constraints gives the derivatives of its
+        index-1 form (M q_ddot + Phi_q^T lambda = f + u, Phi_q q_ddot = gamma) in all n
+        coordinates: A(t) then also holds the directions off the constraints (double zero
+        eigenvalues, Phi_ddot = 0), as the run's own right-hand side does."""
         return linearize_along(self.dynamics(), simulation, inputs)

@@ -56,7 +56,7 @@ def simulate(
     r_weight: Annotated[str, typer.Option("--R", help="--control lqr: input weight, a number or the diagonal.")] = "1",  # noqa: E501
     kp: Annotated[str, typer.Option("--kp", help="--control computed-torque: position gain (1/s^2), a number or the diagonal.")] = "100",  # noqa: E501
     kd: Annotated[str, typer.Option("--kd", help="--control computed-torque: rate gain (1/s), a number or the diagonal.")] = "20",  # noqa: E501
-    along: Annotated[bool, typer.Option("--linearize-along", help="Also A(t), B(t) of x = [q; q_dot] at the saved samples (u: each coordinate's generalized force); with --json under the key linearize_along. Unconstrained models.")] = False,  # noqa: E501
+    along: Annotated[bool, typer.Option("--linearize-along", help="Also A(t), B(t) of x = [q; q_dot] at the saved samples (u: each coordinate's generalized force); with --json under the key linearize_along; a constrained model's through its multipliers.")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
@@ -113,10 +113,6 @@ def simulate(
     if animate is not None:  # free, or an animation this project wrote: never another file
         check_animation_target(animate)
     controller = _controller(system, control, about, control_inputs, q_weight, r_weight, kp, kd)
-    if along and system.model.constraints:  # refused before the run, in linearize_along's words
-        names = ", ".join(c.name for c in system.model.constraints)
-        raise InputError(f"needs a model without constraints (this one has "
-                         f"{len(system.model.constraints)}: {names})", field="--linearize-along")
 
     with _Progress(end) as progress:
         simulation = system.simulate(

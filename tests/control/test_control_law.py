@@ -144,3 +144,31 @@ def test_the_command_line_runs_the_file_law(tmp_path, cli):
         "error: --control: the model has no [control] table: no laws of its own to run"]
     result = cli("simulate", str(path), "--t-end", "1", "--control", "model", "--kp", "3")
     assert result.code == 2 and "--kp is not used by --control model" in result.err
+
+
+def test_a_gain_set_from_the_command_line_changes_the_run_without_a_warning(tmp_path, cli):
+    # the law cancels gravity: m L^2 theta'' = -Kp theta - Kd theta', so a stiffer Kp (16)
+    # with Kd = 2 sqrt(Kp m L^2) settles as (1 + w t) exp(-w t), w = sqrt(Kp / (m L^2)) = 8
+    path = tmp_path / "pd.toml"
+    path.write_text(PENDULUM + '[control]\ntheta = "m*g*L*sin(theta) - Kp*theta - '
+                    'Kd*theta_dot"\n', encoding="utf-8")
+    result = cli("simulate", str(path), "--t-end", "1", "--set", "Kp=16,Kd=4", "--control",
+                 "model", "--rtol", "1e-12", "--atol", "1e-12", "--json")
+    assert result.code == 0 and "warning" not in result.err, result.err
+    w = 8.0
+    expected = 0.3 * (1 + w) * np.exp(-w)
+    assert json.loads(result.out)["final_state"]["theta"] == pytest.approx(expected, rel=1e-7)
+
+
+def test_a_law_from_the_python_builder():
+    b = lagrangian.SystemBuilder("PD pendulum")
+    theta = b.coordinate("theta", unit="rad", initial=0.3)
+    m, L, g = b.parameter("m", 1.0), b.parameter("L", 0.5), b.parameter("g", 9.81)
+    b.add_kinetic_energy(m * L**2 * b.velocity("theta") ** 2 / 2)
+    b.add_potential_energy(-m * g * L * lagrangian.cos(theta))
+    b.add_control_law("theta", m * g * L * lagrangian.sin(theta) - 4 * theta
+                      - 2 * b.velocity("theta"))
+    run = b.build().simulate(1, controller="model", samples=11, **TIGHT)
+    w = 4.0  # Kp = 4 = m L^2 w^2, Kd = 2 = 2 m L^2 w: critically damped
+    np.testing.assert_allclose(run.q[:, 0], 0.3 * (1 + w * run.t) * np.exp(-w * run.t),
+                               atol=1e-9)

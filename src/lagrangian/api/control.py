@@ -1,11 +1,14 @@
 """System's methods for control: linearization along a run (the rest of the control API is
-lagrangian.control's controllers, taken by System.simulate)."""
+lagrangian.control's controllers, taken by System.simulate), and the model's own [control]
+laws closed into its equations once per System."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 
 from ..control.along import TrajectoryLinearization, linearize_along
+from ..model.values import resolve_parameters
+from ..simulation.simulate import model_law
 
 
 class ControlMethods:
@@ -21,3 +24,12 @@ class ControlMethods:
         coordinates: A(t) then also holds the directions off the constraints (double zero
         eigenvalues, Phi_ddot = 0), as the run's own right-hand side does."""
         return linearize_along(self.dynamics(), simulation, inputs)
+
+    def _model_law(self, controller: str):
+        """The model's [control] laws closed into its equations (controller="model"), kept."""
+        found = self.__dict__.get("_closed_loop")
+        if found is None or controller != "model":
+            eom = self.equations_of_motion()
+            substitution = resolve_parameters(self._model, None).symbol_values(self._model)
+            found = self.__dict__["_closed_loop"] = model_law(eom, controller, (), substitution)
+        return found

@@ -206,9 +206,8 @@ class System(CheckMethods, ControlMethods):
         (``limits=False`` ignores them); velocity and effort limits exceeded are reported
         either way (``summary()["limits_exceeded"]``). ``controller`` (t, q, q_dot) -> u adds
         generalized forces, or B u for named ``inputs`` (its own ``inputs`` where it has them,
-        as lagrangian.control's controllers do), to the model's own; ``controller="model"`` runs
-        the model file's own [control] laws, compiled with its equations: docs/control.md.
-        """
+        as lagrangian.control's controllers do), to the model's own; "model" runs the file's
+        [control] laws, compiled with its equations: docs/control.md."""
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
         if tree and self._floating:  # q (+) v dt on SE(3): api/floating_simulation.py
             return self._simulate_floating(t_end, initial, step_control, save_at, stop_when,
@@ -219,12 +218,12 @@ class System(CheckMethods, ControlMethods):
         start = resolve_state(self._model, initial, field="initial")
         step_control, save_at = run_options(step_control, save_at, method, rtol, atol, samples,
                                          1001)
-        stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) \
-            else stop_when
+        stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) else stop_when
+        law = isinstance(controller, str) and not tree and inputs is None
+        controller = self._model_law(controller) if law else controller  # once per System
         result = simulate(None if tree else self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
-                          progress=progress,
-                          functions=None if isinstance(controller, str) else self._numeric,
+                          progress=progress, functions=None if law else self._numeric,
                           limits=urdf_limits(self._model, positions=limits), controller=controller,
                           inputs=getattr(controller, "inputs", ()) if inputs is None else inputs,
                           model=self._model)

@@ -15,6 +15,7 @@ from dataclasses import replace
 import numpy as np
 import sympy as sp
 
+from ..compile.functions import NumericSystem, numeric
 from ..compile.lambdified import StateFunction
 from ..derivation.equations import EquationsOfMotion
 from ..errors import InputError
@@ -24,8 +25,8 @@ MODEL_LAW = "model"  # controller="model": the laws of the model's [control] tab
 
 
 class ModelLaw:
-    """The closed-loop equations of a model with a [control] table, and its u and B u on a
-    run's samples."""
+    """The closed-loop equations of a model with a [control] table, their numeric functions
+    (compiled on first use), and its u and B u on a run's samples; built once per System."""
 
     def __init__(self, eom: EquationsOfMotion, substitution: dict):
         model = eom.model
@@ -41,6 +42,19 @@ class ModelLaw:
         self.equations = replace(eom, forcing=eom.forcing + sp.ImmutableMatrix(forces))
         self._laws = StateFunction(model, laws, substitution)
         self._forces = StateFunction(model, forces, substitution)
+        self._substitution = substitution
+        self._functions: NumericSystem | None = None
+
+    def functions(self, values) -> NumericSystem:
+        """The closed-loop equations compiled (generated C, or numpy) at ``values`` (the
+        ParameterValues the law was built with)."""
+        if self._functions is None:
+            self._functions = numeric(self.equations, values)
+        return self._functions
+
+    def built_with(self, substitution: dict) -> bool:
+        """Whether this law's numbers are those of ``substitution`` (parameter values)."""
+        return substitution == self._substitution
 
     def on_samples(self, t: np.ndarray, q: np.ndarray, v: np.ndarray
                    ) -> tuple[np.ndarray, np.ndarray]:

@@ -35,7 +35,7 @@ from .options import METHODS, SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["METHODS", "STATUS_MESSAGES", "JointLimit", "SaveAt", "SimulationResult", "StepControl",
-           "StopCondition", "parse_stop_condition", "simulate", "urdf_limits"]
+           "StopCondition", "model_law", "parse_stop_condition", "simulate", "urdf_limits"]
 
 DEFAULT_STEP_CONTROL = StepControl()  # DOP853, rtol = atol = 1e-9
 DEFAULT_SAVE_AT = SaveAt()  # 1001 evenly spaced samples
@@ -87,8 +87,12 @@ def simulate(
     substitution = values.symbol_values(model)
     law = None
     if isinstance(controller, str):
-        law = _model_law(eom, controller, inputs, substitution)
-        eom, controller, functions = law.equations, None, numeric(law.equations, values)
+        controller = model_law(eom, controller, inputs, substitution)
+    if isinstance(controller, ModelLaw):  # built here, or once by the System
+        if not controller.built_with(substitution):
+            raise ValueError("a ModelLaw built for other parameter values")
+        law, controller = controller, None
+        eom, functions = law.equations, law.functions(values)
     functions = functions if functions is not None else numeric(eom, values)
     drift = DriftControl(functions, StateFunction(model, eom.velocity_bias, substitution)) \
         if functions.m else None
@@ -163,7 +167,7 @@ def simulate(
     )
 
 
-def _model_law(eom, controller: str, inputs, substitution) -> ModelLaw:
+def model_law(eom, controller: str, inputs, substitution) -> ModelLaw:
     """The model's [control] laws closed into its equations (controller="model")."""
     if controller != MODEL_LAW:
         raise InputError(f"unknown controller {controller!r}: a callable (t, q, q_dot) -> u, or "

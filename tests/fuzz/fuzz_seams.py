@@ -237,13 +237,14 @@ def control_models(draw) -> str:
     """The cart-pole with a [control] table: keys that are inputs (a coordinate, a parameter,
     a load) or not (a rate, an unknown name, an inertia, an empty or quoted key), values that
     are laws, hostile numbers, lists or tables, sometimes no table at all or a table twice."""
-    keys = st.sampled_from(["x", "theta", "F", "push", "g", "m", "x_dot", "nope", "t", '""',
-                            '"a b"', "bob"])
+    inputs = st.sampled_from(["x", "theta", "F", "push", "g"])
+    keys = st.one_of(inputs, inputs, inputs, st.sampled_from(["m", "x_dot", "nope", "t", '""',
+                                                              '"a b"', "bob"]))
     valid = st.sampled_from(["-5*x - 3*x_dot + 10*theta", "0", "sin(t) - theta_dot",
                              "-g*theta", "1e6*x", "x/theta"]).map(json.dumps)
-    laws = st.one_of(valid, valid, expressions(["x", "theta", "x_dot", "theta_dot", "t", "F", "g", "l", "m"])
-                     .map(json.dumps), _values())
-    table = draw(st.dictionaries(keys, laws, min_size=1, max_size=3))
+    names = ["x", "theta", "x_dot", "theta_dot", "t", "F", "g", "l", "m"]
+    laws = st.one_of(valid, valid, valid, valid, expressions(names).map(json.dumps), _values())
+    table = draw(st.dictionaries(keys, laws, min_size=1, max_size=2))
     lines = [f"{k} = {v}" for k, v in table.items()]
     kind = draw(st.sampled_from(["table"] * 6 + ["none", "twice", "value"]))
     text = EXAMPLE_TEXTS["cart_pendulum"]

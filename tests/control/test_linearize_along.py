@@ -63,3 +63,23 @@ def test_a_constrained_run_is_linearized_through_its_multipliers():
         assert np.abs(eigenvalues.real).max() < 1e-9
     np.testing.assert_allclose(along.B[:, 2, 0], 1.0, rtol=1e-12)  # 1/m on x, none on y
     np.testing.assert_allclose(along.B[:, 3, 0], 0.0, atol=1e-12)
+
+
+def test_a_perturbed_constrained_run_follows_the_transition_matrix_of_a_of_t():
+    """The Cartesian pendulum swinging from 0.3 m aside, and again turned by 2e-6 rad along the
+    rod's circle: the difference of the two runs is Phi(t) of A(t) times the first one."""
+    system = lagrangian.load("cartesian_pendulum")
+    L, angle = 0.5, np.arcsin(0.3 / 0.5)
+    options = {"samples": 2001, "rtol": 1e-12, "atol": 1e-12}
+    run = system.simulate(1, initial={"x": L * np.sin(angle), "y": -L * np.cos(angle)},
+                          **options)
+    moved = system.simulate(1, initial={"x": L * np.sin(angle + 2e-6),
+                                        "y": -L * np.cos(angle + 2e-6)}, **options)
+    along = system.linearize_along(run)
+    transition = np.eye(4)
+    for k in range(len(run.t) - 1):
+        step = (along.A[k] + along.A[k + 1]) / 2 * (run.t[k + 1] - run.t[k])
+        transition = scipy.linalg.expm(step) @ transition
+    delta = np.concatenate([moved.q[0] - run.q[0], [0.0, 0.0]])
+    difference = np.concatenate([moved.q[-1] - run.q[-1], moved.q_dot[-1] - run.q_dot[-1]])
+    assert np.linalg.norm(difference - transition @ delta) < 1e-4 * np.linalg.norm(difference)

@@ -83,3 +83,17 @@ def test_a_perturbed_constrained_run_follows_the_transition_matrix_of_a_of_t():
     delta = np.concatenate([moved.q[0] - run.q[0], [0.0, 0.0]])
     difference = np.concatenate([moved.q[-1] - run.q[-1], moved.q_dot[-1] - run.q_dot[-1]])
     assert np.linalg.norm(difference - transition @ delta) < 1e-4 * np.linalg.norm(difference)
+
+
+def test_explicit_time_is_read_at_each_samples_time():
+    """The pendulum on a support moving as A cos(Omega t): A(t) equals central differences of
+    the run's right-hand side at each sample's own t (not at t = 0)."""
+    system = lagrangian.load("support_pendulum")
+    run = system.simulate(2, samples=5)
+    along = system.linearize_along(run)
+    functions, h = system.numeric(), 1e-6
+    for k, t in enumerate(run.t):
+        y = np.concatenate([run.q[k], run.q_dot[k]])
+        columns = [(functions.rhs(t, y + e) - functions.rhs(t, y - e)) / (2 * h)
+                   for e in h * np.eye(len(y))]
+        np.testing.assert_allclose(along.A[k], np.stack(columns, axis=-1), atol=1e-7)

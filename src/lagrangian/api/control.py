@@ -7,6 +7,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ..control.along import TrajectoryLinearization, linearize_along
+from ..dynamics.constrained import ConstrainedDynamics
+from ..model.expressions import as_expression
 from ..model.values import resolve_parameters
 from ..simulation.simulate import model_law
 
@@ -23,7 +25,18 @@ class ControlMethods:
         index-1 form (M q_ddot + Phi_q^T lambda = f + u, Phi_q q_ddot = gamma) in all n
         coordinates: A(t) then also holds the directions off the constraints (double zero
         eigenvalues, Phi_ddot = 0), as the run's own right-hand side does."""
-        return linearize_along(self.dynamics(), simulation, inputs)
+        return linearize_along(self._dynamics_in_time(), simulation, inputs)
+
+    def _dynamics_in_time(self):
+        """dynamics(), or where a model file's equations hold t explicitly (a moving support)
+        and dynamics() would read them at t = 0, the same through dynamics/constrained.py,
+        which takes each sample's t."""
+        if self._recursive is None and not self.model.constraints:
+            eom = self.equations_of_motion()
+            parts = [*eom.mass_matrix, *eom.forcing]
+            if any(self.model.time in as_expression(e).free_symbols for e in parts):
+                return ConstrainedDynamics(self._numeric, self.equations_of_motion, self.model)
+        return self.dynamics()
 
     def _model_law(self, controller: str):
         """The model's [control] laws closed into its equations (controller="model"), kept."""

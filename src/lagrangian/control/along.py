@@ -54,8 +54,8 @@ def linearize_along(dynamics, simulation, inputs=None) -> TrajectoryLinearizatio
     forces = simulation.control_forces
     tau = np.zeros_like(q) if forces is None else np.asarray(forces, dtype=float)
     t = np.asarray(simulation.t, dtype=float)
-    # a constrained model's (dynamics/constrained.py) at each sample's time: moving constraints
-    timed = {"t": t} if getattr(dynamics, "constraint_names", ()) else {}
+    # dynamics/constrained.py's at each sample's time (moving constraints, explicit t)
+    timed = {"t": t} if getattr(dynamics, "timed", False) else {}
     by_position, by_velocity, by_force = dynamics.forward_dynamics_derivatives(q, v, tau, **timed)
     count, n = q.shape
     A = np.zeros((count, 2 * n, 2 * n))

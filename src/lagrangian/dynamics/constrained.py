@@ -24,7 +24,10 @@ from ..model.expressions import as_expression
 class ConstrainedDynamics:
     """What System.dynamics() gives for a model file with constraints: M, the DAE's forward
     dynamics (q_ddot and lambda) and forward dynamics' derivatives, batched over leading axes,
-    at time ``t`` (s; moving constraints and forces depend on it)."""
+    at time ``t`` (s; moving constraints and forces depend on it). With no constraints (m = 0,
+    K = M) the same for a model whose equations hold t explicitly (linearize_along)."""
+
+    timed = True  # every function takes t (linearize_along passes each sample's)
 
     def __init__(self, functions: NumericSystem, equations, model=None):
         self.functions = functions

@@ -87,6 +87,8 @@ def test_the_rest_of_a_constrained_models_dynamics(cli):
 
     with pytest.raises(ModelError, match="computed torque needs a model without constraints"):
         computed_torque(system, [0, -0.5], 100, 20)
+    with pytest.raises(ModelError, match="actuator models need a model without constraints"):
+        system.dynamics(actuators=True)
     result = cli("dynamics", "cartesian_pendulum", "--q", "0,-0.5", "--v", "0,0", "--tau",
                  "0,0", "--derivatives", "--json")
     assert result.code == 0, result.err

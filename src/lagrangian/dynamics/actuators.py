@@ -17,7 +17,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import InputError, did_you_mean_or_list
+from ..errors import InputError, ModelError, did_you_mean_or_list
 from .joint_space import Dynamics, solve_positive
 
 
@@ -148,6 +148,10 @@ def actuated(rigid: Dynamics, model, armature: Mapping[str, float] | None = None
              friction: bool = True) -> ActuatedDynamics:
     """``rigid`` with the actuator models: the URDF's damping and friction (``friction``) and
     the given armature."""
+    constraints = getattr(rigid, "constraint_names", ())
+    if constraints:  # (M + armature)^-1 (tau - b - losses) would leave the constraints out
+        raise ModelError(f"actuator models need a model without constraints (this one has "
+                         f"{len(constraints)}: {', '.join(constraints)})", field="actuators")
     tree = getattr(rigid, "tree", None)
     if tree is not None:
         from .centroidal import require_fixed_base

@@ -96,3 +96,17 @@ def test_the_rest_of_a_constrained_models_dynamics(cli):
 
     document = json.loads(result.out)
     assert document["dqdd_dq"][0][0] == pytest.approx(-9.81 / 0.5, rel=1e-12)
+
+
+def test_a_state_where_the_constraints_are_redundant_is_a_nan_row():
+    """At x = y = 0 the rod's Jacobian [2x, 2y] vanishes: K is singular there. That row is NaN
+    with one DynamicsWarning, the other row is the state's own result."""
+    from lagrangian.errors import DynamicsWarning
+
+    dynamics = lagrangian.load("cartesian_pendulum").dynamics()
+    q = np.array([[0.0, 0.0], [0.0, -0.5]])
+    with pytest.warns(DynamicsWarning, match="1 of 2 states") as caught:
+        by_q, _, _ = dynamics.forward_dynamics_derivatives(q, np.zeros((2, 2)), np.zeros((2, 2)))
+    assert len([w for w in caught if issubclass(w.category, DynamicsWarning)]) == 1
+    assert np.isnan(by_q[0]).all()
+    np.testing.assert_allclose(by_q[1], [[-9.81 / 0.5, 0], [0, 0]], atol=1e-12)

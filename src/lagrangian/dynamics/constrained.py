@@ -12,12 +12,14 @@ A^T lambda), so there is no inverse dynamics. Units SI.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import sympy as sp
 
 from ..compile.functions import NumericSystem
 from ..compile.lambdified import StateFunction
-from ..errors import InputError, ModelError
+from ..errors import DynamicsWarning, InputError, ModelError
 from ..model.expressions import as_expression
 
 
@@ -72,7 +74,7 @@ class ConstrainedDynamics:
         kkt[:, :n, :n], kkt[:, :n, n:], kkt[:, n:, :n] = mass, np.swapaxes(jacobian, -1, -2), \
             jacobian
         rhs = np.concatenate([forcing + TAU, gamma], axis=-1)
-        return kkt, np.linalg.solve(kkt, rhs[..., None])[..., 0]
+        return kkt, solve_rows(kkt, rhs[..., None])[..., 0]
 
     def mass_matrix(self, q, t=0.0) -> np.ndarray:
         """M(q), shape (..., n, n)."""
@@ -148,11 +150,11 @@ class ConstrainedDynamics:
                 - np.einsum("nkcj,nc->nkj", djac, lam)
             bottom = dgamma - np.einsum("nkcj,nj->nkc", djac, acc)
             rhs = np.concatenate([top, bottom], axis=-1)  # [N, k, n+m]
-            dz = np.linalg.solve(kkt, np.swapaxes(rhs, -1, -2))  # [N, n+m, k]
+            dz = solve_rows(kkt, np.swapaxes(rhs, -1, -2), warn=False)  # [N, n+m, k]
             out.append(dz[:, :n, :].reshape(batch + (n, n)))
         unit = np.zeros((count, size, n))
         unit[:, :n, :] = np.eye(n)
-        out.append(np.linalg.solve(kkt, unit)[:, :n, :].reshape(batch + (n, n)))
+        out.append(solve_rows(kkt, unit, warn=False)[:, :n, :].reshape(batch + (n, n)))
         return out[0], out[1], out[2]
 
     def _parts(self) -> dict[str, StateFunction]:
@@ -190,3 +192,26 @@ class ConstrainedDynamics:
                              "Coriolis matrix; forward dynamics and its derivatives work through "
                              "the multipliers", field="constraints")
         raise AttributeError(name)
+
+
+def solve_rows(kkt: np.ndarray, rhs: np.ndarray, warn: bool = True) -> np.ndarray:
+    """K^-1 rhs for a flat batch (N, s, s), (N, s, k): NaN in the rows whose K is singular (a
+    constraint Jacobian without full rank, an input not finite), the others exact, with one
+    DynamicsWarning counting them."""
+    try:
+        out = np.linalg.solve(kkt, rhs)
+    except np.linalg.LinAlgError:
+        out = np.full(rhs.shape, np.nan)
+        for k in range(len(kkt)):  # only on this path: find the singular rows
+            try:
+                out[k] = np.linalg.solve(kkt[k], rhs[k])
+            except np.linalg.LinAlgError:
+                pass
+    bad = ~np.isfinite(out).all(axis=(-2, -1))
+    out[bad] = np.nan
+    if bad.any() and warn:  # once per call: the first solve of a call warns
+        warnings.warn(DynamicsWarning(
+            f"{int(bad.sum())} of {len(kkt)} states have no constrained dynamics (an input not "
+            "finite, or [[M, Phi_q^T], [Phi_q, 0]] singular: redundant constraints there): "
+            "their rows are NaN", int(bad.sum()), len(kkt)), stacklevel=4)
+    return out

@@ -28,8 +28,10 @@ ANSWER_BEGIN, ANSWER_END = ("<!-- BEGIN answer-keys (generated: python "
 # What each table is for; the keys themselves come from the reader.
 MEANINGS = {
     "": "`name`, `description`: strings; `definitions`: `name = \"expression\"`, substituted "
-        "everywhere; `generalized_forces`: `coordinate = \"Q\"` added to Q; the other keys are "
-        "the tables below",
+        "everywhere; `generalized_forces`: `coordinate = \"Q\"` added to Q; `control`: "
+        "`input = \"law\"`, u(t, q, q_dot) on a coordinate's generalized force, a parameter or "
+        "a load, run by `simulate --control model` (docs/control.md); the other keys are the "
+        "tables below",
     "coordinates.<name>": "a unit string, or this table: `unit` (default m), `initial` value, "
                           "`rate` (initial q_dot), `range = [low, high]` (searched by "
                           "equilibria; a printed abs() whose sign it fixes is dropped)",

@@ -64,7 +64,9 @@ def test_linearize_along_from_the_command_line_is_the_pendulum_closed_form(cli):
     np.testing.assert_allclose(B[:, 1, 0], 1 / (m * L**2), rtol=1e-12)
     text = cli("simulate", "pendulum", "--t-end", "1", "--linearize-along")
     assert text.code == 0 and "linearized along the run: A(t) 2 x 2, B(t) 2 x 1" in text.out
-    refused = cli("simulate", "cartesian_pendulum", "--t-end", "1", "--linearize-along")
-    assert refused.code == 2
-    assert refused.err.strip() == ("error: --linearize-along: needs a model without constraints "
-                                   "(this one has 1: rod)")
+    # a constrained model's through its multipliers: at the bottom, d x_ddot/dx = -g/L
+    constrained = cli("simulate", "cartesian_pendulum", "--t-end", "1", "--initial",
+                      "x=0,y=-0.5", "--samples", "3", "--linearize-along", "--json")
+    assert constrained.code == 0, constrained.err
+    A = np.array(json.loads(constrained.out)["linearize_along"]["A"])
+    assert A.shape == (3, 4, 4) and A[0, 2, 0] == pytest.approx(-9.81 / 0.5, rel=1e-9)

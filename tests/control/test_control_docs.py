@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import docs_blocks
+import lagrangian
 
 pytest.importorskip("yourdfpy")
 
@@ -93,3 +94,31 @@ def test_regressor_section(capsys, cli):
     assert result.code == 0, result.err
     document = json.loads(result.out)
     assert document["parameters"] == ["m1", "m2"] and len(document["base"]["names"]) == 2
+
+
+def test_control_law_section(capsys, cli, tmp_path, monkeypatch):
+    compiled, stepped, same = _run("control-law", capsys)[-1].split()
+    assert same == "True" and stepped == "scipy" and compiled in ("compiled", "scipy")
+    text = re.findall(r'write_text\("""(.*?)"""\)', _python("control-law"), re.S)[0]
+    (tmp_path / "pd_pendulum.toml").write_text(text, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = cli(*_command("control-law"))
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    assert document["control"]["inputs"] == ["theta"] and "Kp" in document["control"]["laws"]["theta"]
+    # the same law as a Python callable, run through the API, ends at the same state
+    def pd(t, q, v):
+        return -4.0 * (q - 0.2 * np.sin(t)) - 2.0 * v
+
+    same = lagrangian.load(tmp_path / "pd_pendulum.toml").simulate(4, controller=pd)
+    assert document["final_state"]["theta"] == pytest.approx(same.final_state["theta"], abs=1e-7)
+
+
+def test_constrained_section(capsys, cli):
+    lines = _run("control-constrained", capsys)
+    assert float(lines[0]) == pytest.approx(9.81 / 0.5, rel=1e-12)
+    assert lines[-1] == "(11, 4, 4)"
+    result = cli(*_command("control-constrained"))
+    assert result.code == 0, result.err
+    along = json.loads(result.out)["linearize_along"]
+    assert np.array(along["A"]).shape == (11, 4, 4) and along["inputs"] == ["x", "y"]

@@ -50,11 +50,50 @@ def test_linearize_along_refuses_a_foreign_run_and_unknown_inputs():
         pendulum.linearize_along(pendulum.simulate(0.1, samples=3), inputs=["phi"])
 
 
-def test_linearize_along_refuses_a_constrained_model_in_one_line():
-    from lagrangian.errors import ModelError
-
+def test_a_constrained_run_is_linearized_through_its_multipliers():
+    """The pendulum in Cartesian coordinates hanging at rest: A's oscillating pair is
+    +-i sqrt(g/L) at every sample (the other two eigenvalues 0: off the rod, Phi_ddot = 0)."""
     system = lagrangian.load("cartesian_pendulum")
-    with pytest.raises(ModelError, match=r"linearize_along needs a model without constraints "
-                                         r"\(this one has 1: rod\)") as caught:
-        system.linearize_along(system.simulate(0.1, samples=3))
-    assert caught.value.field == "constraints" and "\n" not in str(caught.value)
+    run = system.simulate(0.5, initial={"x": 0.0, "y": -0.5}, samples=5)
+    along = system.linearize_along(run, inputs=["x"])
+    assert along.A.shape == (5, 4, 4) and along.B.shape == (5, 4, 1)
+    for A in along.A:
+        eigenvalues = np.sort_complex(np.linalg.eigvals(A))
+        assert eigenvalues.imag.max() == pytest.approx(np.sqrt(9.81 / 0.5), rel=1e-12)
+        assert np.abs(eigenvalues.real).max() < 1e-9
+    np.testing.assert_allclose(along.B[:, 2, 0], 1.0, rtol=1e-12)  # 1/m on x, none on y
+    np.testing.assert_allclose(along.B[:, 3, 0], 0.0, atol=1e-12)
+
+
+def test_a_perturbed_constrained_run_follows_the_transition_matrix_of_a_of_t():
+    """The Cartesian pendulum swinging from 0.3 m aside, and again turned by 2e-6 rad along the
+    rod's circle: the difference of the two runs is Phi(t) of A(t) times the first one."""
+    system = lagrangian.load("cartesian_pendulum")
+    L, angle = 0.5, np.arcsin(0.3 / 0.5)
+    options = {"samples": 2001, "rtol": 1e-12, "atol": 1e-12}
+    run = system.simulate(1, initial={"x": L * np.sin(angle), "y": -L * np.cos(angle)},
+                          **options)
+    moved = system.simulate(1, initial={"x": L * np.sin(angle + 2e-6),
+                                        "y": -L * np.cos(angle + 2e-6)}, **options)
+    along = system.linearize_along(run)
+    transition = np.eye(4)
+    for k in range(len(run.t) - 1):
+        step = (along.A[k] + along.A[k + 1]) / 2 * (run.t[k + 1] - run.t[k])
+        transition = scipy.linalg.expm(step) @ transition
+    delta = np.concatenate([moved.q[0] - run.q[0], [0.0, 0.0]])
+    difference = np.concatenate([moved.q[-1] - run.q[-1], moved.q_dot[-1] - run.q_dot[-1]])
+    assert np.linalg.norm(difference - transition @ delta) < 1e-4 * np.linalg.norm(difference)
+
+
+def test_explicit_time_is_read_at_each_samples_time():
+    """The pendulum on a support moving as A cos(Omega t): A(t) equals central differences of
+    the run's right-hand side at each sample's own t (not at t = 0)."""
+    system = lagrangian.load("support_pendulum")
+    run = system.simulate(2, samples=5)
+    along = system.linearize_along(run)
+    functions, h = system.numeric(), 1e-6
+    for k, t in enumerate(run.t):
+        y = np.concatenate([run.q[k], run.q_dot[k]])
+        columns = [(functions.rhs(t, y + e) - functions.rhs(t, y - e)) / (2 * h)
+                   for e in h * np.eye(len(y))]
+        np.testing.assert_allclose(along.A[k], np.stack(columns, axis=-1), atol=1e-7)

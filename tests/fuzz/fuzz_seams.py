@@ -1,6 +1,6 @@
 """Hostile inputs for the seams of issue 21, shared by tests/fuzz/test_fuzz_seams.py: URDF files
 (malformed XML, entity expansion, duplicate names, NaN/inf/negative masses and inertias, missing
-attributes), [[contacts]] and [steady] tables, names with special characters through the
+attributes), [[contacts]], [steady] and [control] tables, names with special characters through the
 generated C, sweep options and answer files for `check`. The contract is the CLI's: exit 0 (or
 a verdict, exit 1, where the command has one), or exit 2 with exactly one line `error: ...`;
 never a traceback, never a hang (each input runs under a time limit).
@@ -228,6 +228,32 @@ def steady_models(draw) -> str:
     if draw(st.integers(0, 5)) == 0:
         lines.append(f"{draw(st.sampled_from(['extra', 'rate', 'speeds']))} = 1")
     return head + "\n".join(lines) + "\n"
+
+
+# -- [control] tables -------------------------------------------------------------------------
+
+@st.composite
+def control_models(draw) -> str:
+    """The cart-pole with a [control] table: keys that are inputs (a coordinate, a parameter,
+    a load) or not (a rate, an unknown name, an inertia, an empty or quoted key), values that
+    are laws, hostile numbers, lists or tables, sometimes no table at all or a table twice."""
+    inputs = st.sampled_from(["x", "theta", "F", "push", "g"])
+    keys = st.one_of(inputs, inputs, inputs, st.sampled_from(["m", "x_dot", "nope", "t", '""',
+                                                              '"a b"', "bob"]))
+    valid = st.sampled_from(["-5*x - 3*x_dot + 10*theta", "0", "sin(t) - theta_dot",
+                             "-g*theta", "1e6*x", "x/theta"]).map(json.dumps)
+    names = ["x", "theta", "x_dot", "theta_dot", "t", "F", "g", "l", "m"]
+    laws = st.one_of(valid, valid, valid, valid, expressions(names).map(json.dumps), _values())
+    table = draw(st.dictionaries(keys, laws, min_size=1, max_size=2))
+    lines = [f"{k} = {v}" for k, v in table.items()]
+    kind = draw(st.sampled_from(["table"] * 6 + ["none", "twice", "value"]))
+    text = EXAMPLE_TEXTS["cart_pendulum"]
+    if kind == "none":
+        return text
+    if kind == "value":
+        return f"control = {draw(_values())}\n" + text  # a top-level key, not a table
+    body = "\n[control]\n" + "\n".join(lines) + "\n"
+    return text + body + (body if kind == "twice" else "")
 
 
 # -- sweep options ----------------------------------------------------------------------------

@@ -1,8 +1,9 @@
 """Fuzzing campaign for the seams of issue 21, CI budget: URDF files, [[contacts]] and [steady]
-tables, names with special characters through `codegen --lang c` (the C must never hold the raw
-name, and must compile) and `simulate`, sweep options (--vary, --workers, --members) and answer
-files through `check`. Each input: exit 0 (or `check`'s verdict 1), or exit 2 with one line
-`error: ...`; never a traceback, never a hang. Figures: docs/robustness.md.
+tables, [control] tables through `simulate --control model`, names with special characters
+through `codegen --lang c` (the C must never hold the raw name, and must compile) and `simulate`,
+sweep options (--vary, --workers, --members) and answer files through `check`. Each input: exit
+0 (or `check`'s verdict 1), or exit 2 with one line `error: ...`; never a traceback, never a
+hang. Figures: docs/robustness.md.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from fuzz_seams import (
     C_SEQUENCES,
     contact_models,
     contract,
+    control_models,
     named_model,
     run_cli,
     special_names,
@@ -82,6 +84,16 @@ def test_steady_tables_speeds(text, folder):
     path = folder / "steady.toml"
     path.write_text(text, encoding="utf-8")
     check(contract(["speeds", str(path), "--points", "3", "--json"], 30.0), text, "steady")
+
+
+@fuzz(12)
+@given(text=control_models())
+def test_control_tables_simulate(text, folder):
+    # exit 1 is simulate's verdict on a run that failed (a law that blows the state up)
+    path = folder / "control.toml"
+    path.write_text(text, encoding="utf-8")
+    check(contract(["simulate", str(path), "--t-end", "0.05", "--samples", "3", "--control",
+                    "model", "--json"], 60.0, verdicts=(0, 1)), text, "control")
 
 
 def _special(name: str) -> bool:

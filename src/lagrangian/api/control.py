@@ -1,12 +1,16 @@
 """System's methods for control: linearization along a run (the rest of the control API is
-lagrangian.control's controllers, taken by System.simulate)."""
+lagrangian.control's controllers, taken by System.simulate), and the model's own [control]
+laws closed into its equations once per System."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 
 from ..control.along import TrajectoryLinearization, linearize_along
-from ..errors import ModelError
+from ..dynamics.constrained import ConstrainedDynamics
+from ..model.expressions import as_expression
+from ..model.values import resolve_parameters
+from ..simulation.simulate import model_law
 
 
 class ControlMethods:
@@ -17,12 +21,28 @@ class ControlMethods:
         """A(t), B(t) of x_dot = A x + B u (x = [q; q_dot], u the generalized forces on
         ``inputs``, default every coordinate) at ``simulation``'s saved samples, from the
         derivatives of forward dynamics (Dynamics.forward_dynamics_derivatives); a controlled
-        run's own forces are held in place. Unconstrained models (a constrained one is refused
-        in one line: its A(t) would be on the constraint manifold, not done yet)."""
-        constraints = self.model.constraints
-        if constraints:
-            raise ModelError(f"linearize_along needs a model without constraints (this one has "
-                             f"{len(constraints)}: {', '.join(c.name for c in constraints)}); "
-                             "about an equilibrium, linearize() works on the constraint "
-                             "manifold", field="constraints")
-        return linearize_along(self.dynamics(), simulation, inputs)
+        run's own forces are held in place. A model with constraints gives the derivatives of its
+        index-1 form (M q_ddot + Phi_q^T lambda = f + u, Phi_q q_ddot = gamma) in all n
+        coordinates: A(t) then also holds the directions off the constraints (double zero
+        eigenvalues, Phi_ddot = 0), as the run's own right-hand side does."""
+        return linearize_along(self._dynamics_in_time(), simulation, inputs)
+
+    def _dynamics_in_time(self):
+        """dynamics(), or where a model file's equations hold t explicitly (a moving support)
+        and dynamics() would read them at t = 0, the same through dynamics/constrained.py,
+        which takes each sample's t."""
+        if self._recursive is None and not self.model.constraints:
+            eom = self.equations_of_motion()
+            parts = [*eom.mass_matrix, *eom.forcing]
+            if any(self.model.time in as_expression(e).free_symbols for e in parts):
+                return ConstrainedDynamics(self._numeric, self.equations_of_motion, self.model)
+        return self.dynamics()
+
+    def _model_law(self, controller: str):
+        """The model's [control] laws closed into its equations (controller="model"), kept."""
+        found = self.__dict__.get("_closed_loop")
+        if found is None or controller != "model":
+            eom = self.equations_of_motion()
+            substitution = resolve_parameters(self._model, None).symbol_values(self._model)
+            found = self.__dict__["_closed_loop"] = model_law(eom, controller, (), substitution)
+        return found

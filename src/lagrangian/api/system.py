@@ -206,25 +206,32 @@ class System(CheckMethods, ControlMethods):
         (``limits=False`` ignores them); velocity and effort limits exceeded are reported
         either way (``summary()["limits_exceeded"]``). ``controller`` (t, q, q_dot) -> u adds
         generalized forces, or B u for named ``inputs`` (its own ``inputs`` where it has them,
-        as lagrangian.control's controllers do), to the model's own: docs/control.md. On a
-        floating base u is the n joint torques or all n + 6 entries, the base's wrench first
-        (docs/floating-base.md).
-        """
+        as lagrangian.control's controllers do), to the model's own; "model" runs the file's
+        [control] laws, compiled with its equations: docs/control.md. On a floating base u
+        is the n joint torques or all n + 6 entries, the base's wrench first."""
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
         if tree and self._floating:  # q (+) v dt on SE(3): api/floating_simulation.py
-            return self._simulate_floating(t_end, initial, step_control, save_at, stop_when,
-                                           controller, method, rtol, atol, samples)
+            from .floating_simulation import simulate_floating
+
+            if stop_when is not None:
+                raise InputError("stop_when is not yet taken for a floating base",
+                                 field="stop_when")
+            step_control, save_at = run_options(step_control, save_at, method, rtol, atol,
+                                                samples, 1001)
+            return Simulation.of(simulate_floating(self, t_end, initial, step_control, save_at,
+                                                   controller))
         if not tree:
             refuse_large_chain(self.model)  # before deriving what could not be compiled
             require_inertia(self.equations_of_motion(), "simulate")
         start = resolve_state(self._model, initial, field="initial")
         step_control, save_at = run_options(step_control, save_at, method, rtol, atol, samples,
                                          1001)
-        stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) \
-            else stop_when
+        stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) else stop_when
+        law = isinstance(controller, str) and not tree and inputs is None
+        controller = self._model_law(controller) if law else controller  # once per System
         result = simulate(None if tree else self.equations_of_motion(), t_end, initial=start,
                           step_control=step_control, save_at=save_at, stop=stop,
-                          progress=progress, functions=self._numeric,
+                          progress=progress, functions=None if law else self._numeric,
                           limits=urdf_limits(self._model, positions=limits), controller=controller,
                           inputs=getattr(controller, "inputs", ()) if inputs is None else inputs,
                           model=self._model)
@@ -234,17 +241,6 @@ class System(CheckMethods, ControlMethods):
     def _floating(self) -> bool:
         tree = getattr(self._model, "kinematic_tree", None)
         return bool(tree is not None and tree.floating_base)
-
-    def _simulate_floating(self, t_end, initial, step_control, save_at, stop_when, controller,
-                           method, rtol, atol, samples) -> Simulation:
-        from .floating_simulation import simulate_floating
-
-        if stop_when is not None:
-            raise InputError("stop_when is not yet taken for a floating base", field="stop_when")
-        step_control, save_at = run_options(step_control, save_at, method, rtol, atol, samples,
-                                            1001)
-        return Simulation.of(simulate_floating(self, t_end, initial, step_control, save_at,
-                                               controller))
 
     # -- standalone C for a controller -----------------------------------------------------------
 

@@ -66,10 +66,12 @@ def setting_warnings(eom: EquationsOfMotion, names: Iterable[str]) -> list[str]:
     """A parameter given a value that no equation contains: its value changes nothing."""
     steady = eom.model.steady_motion
     speed = steady.speed if steady is not None else None
+    # a gain of the [control] laws counts: it changes every run with controller="model"
+    controlled = {str(s) for _, law in eom.model.control for s in law.free_symbols}
     return [f"'{name}' is set but appears in no equation of motion: its value changes nothing"
             + (f" here ('{name}' is the speed of the [steady] motion: `speeds`, `modes`)"
                if name == speed else "")
-            for name in names if name not in eom.parameters_used]
+            for name in names if name not in eom.parameters_used and name not in controlled]
 
 
 def bare_angle_warnings(option: str, written: Iterable[tuple[str, str]],

@@ -49,14 +49,14 @@ def simulate(
     fps: Annotated[int | None, typer.Option("--fps", help=FPS_HELP + " Default 20.")] = None,
     stop_when: Annotated[str | None, typer.Option("--stop-when", help="Stop when a condition turns true, e.g. \"theta < 0\".")] = None,  # noqa: E501
     ignore_limits: Annotated[bool, typer.Option("--ignore-limits", help="URDF: run through the joints' position limits (by default a joint reaching one ends the run, status 'limit').")] = False,  # noqa: E501
-    control: Annotated[str | None, typer.Option("--control", help="Close the loop: lqr (about --about, inputs --inputs, weights --Q, --R) or computed-torque (to the configuration --about, gains --kp, --kd).")] = None,  # noqa: E501
+    control: Annotated[str | None, typer.Option("--control", help="Close the loop: lqr (about --about, inputs --inputs, weights --Q, --R), computed-torque (to the configuration --about, gains --kp, --kd), or model (the model file's own [control] laws, compiled with its equations).")] = None,  # noqa: E501
     about: Annotated[list[str], typer.Option("--about", help="--control: the equilibrium (lqr) or target (computed-torque), NAME=VALUE; others solved for or at their initial values.")] = [],  # noqa: B006,E501
     control_inputs: Annotated[list[str], typer.Option("--inputs", help="--control lqr: the loads, parameters or coordinates it drives (F); repeat, or separate by commas.")] = [],  # noqa: B006,E501
     q_weight: Annotated[str, typer.Option("--Q", help="--control lqr: state weight, a number or the diagonal (x then x_dot), comma-separated.")] = "1",  # noqa: E501
     r_weight: Annotated[str, typer.Option("--R", help="--control lqr: input weight, a number or the diagonal.")] = "1",  # noqa: E501
     kp: Annotated[str, typer.Option("--kp", help="--control computed-torque: position gain (1/s^2), a number or the diagonal.")] = "100",  # noqa: E501
     kd: Annotated[str, typer.Option("--kd", help="--control computed-torque: rate gain (1/s), a number or the diagonal.")] = "20",  # noqa: E501
-    along: Annotated[bool, typer.Option("--linearize-along", help="Also A(t), B(t) of x = [q; q_dot] at the saved samples (u: each coordinate's generalized force); with --json under the key linearize_along. Unconstrained models.")] = False,  # noqa: E501
+    along: Annotated[bool, typer.Option("--linearize-along", help="Also A(t), B(t) of x = [q; q_dot] at the saved samples (u: each coordinate's generalized force); with --json under the key linearize_along; a constrained model's through its multipliers.")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
@@ -70,7 +70,7 @@ def simulate(
         check_size,
         check_view,
     )
-    from ..output.control import controller_text
+    from ..output.control import controller_text, law_summary, law_text
     from ..output.files import check_output_path, partial_path
     from ..output.plots import check_plot_path
     from ..output.simulation import projection_warning, simulation_document, simulation_text
@@ -113,10 +113,6 @@ def simulate(
     if animate is not None:  # free, or an animation this project wrote: never another file
         check_animation_target(animate)
     controller = _controller(system, control, about, control_inputs, q_weight, r_weight, kp, kd)
-    if along and system.model.constraints:  # refused before the run, in linearize_along's words
-        names = ", ".join(c.name for c in system.model.constraints)
-        raise InputError(f"needs a model without constraints (this one has "
-                         f"{len(system.model.constraints)}: {names})", field="--linearize-along")
 
     with _Progress(end) as progress:
         simulation = system.simulate(
@@ -150,7 +146,9 @@ def simulate(
     linearized = system.linearize_along(simulation) if along else None
     if json_:
         document = simulation_document(simulation, written)
-        if controller is not None:
+        if controller == "model":
+            document["control"] = {"kind": control, **law_summary(system.model)}
+        elif controller is not None:
             document["control"] = {"kind": control, **controller.summary()}
         if linearized is not None:
             document["linearize_along"] = linearized.summary()
@@ -158,7 +156,8 @@ def simulate(
     else:
         typer.echo(simulation_text(simulation, written), nl=False)
         if controller is not None:
-            typer.echo(controller_text(controller))
+            typer.echo(law_text(system.model) if controller == "model"
+                       else controller_text(controller))
         if linearized is not None:
             size, width = linearized.B.shape[1:]
             typer.echo(f"linearized along the run: A(t) {size} x {size}, B(t) {size} x {width} "
@@ -180,9 +179,9 @@ def _controller(system, control, about, inputs, q_weight, r_weight, kp, kd):
     given = {"--about": about, "--inputs": inputs, "--Q": q_weight != "1", "--R": r_weight != "1",
              "--kp": kp != "100", "--kd": kd != "20"}
     used = {None: (), "lqr": ("--about", "--inputs", "--Q", "--R"),
-            "computed-torque": ("--about", "--kp", "--kd")}
+            "computed-torque": ("--about", "--kp", "--kd"), "model": ()}
     if control not in used:
-        raise InputError(f"unknown controller {control!r} (lqr or computed-torque)",
+        raise InputError(f"unknown controller {control!r} (lqr, computed-torque or model)",
                          field="controller")
     stray = [flag for flag, value in given.items() if value and flag not in used[control]]
     if stray:
@@ -191,6 +190,8 @@ def _controller(system, control, about, inputs, q_weight, r_weight, kp, kd):
                          field="controller")
     if control is None:
         return None
+    if control == "model":  # the file's [control] laws: simulate checks there are some
+        return control
     point = state_assignments(system, about, "--about") or None
     if control == "lqr":
         names = [name.strip() for text in inputs for name in text.split(",") if name.strip()]

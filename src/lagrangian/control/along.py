@@ -1,5 +1,6 @@
 """Linearization along a trajectory: x_dot = A(t) x + B(t) u about a run's saved samples, x =
-[q; q_dot], from the derivatives of forward dynamics (dynamics/derivatives.py) at each sample,
+[q; q_dot], from the derivatives of forward dynamics (dynamics/derivatives.py; a constrained
+model's dynamics/constrained.py) at each sample,
 with the controller's generalized forces of that run held in place (SI units)."""
 
 from __future__ import annotations
@@ -37,8 +38,9 @@ class TrajectoryLinearization:
 
 
 def linearize_along(dynamics, simulation, inputs=None) -> TrajectoryLinearization:
-    """A(t), B(t) of ``dynamics`` (System.dynamics(): unconstrained) about ``simulation``'s
-    samples; ``inputs`` names the coordinates whose generalized forces are u (default all)."""
+    """A(t), B(t) of ``dynamics`` (System.dynamics(); a constrained model's through its
+    multipliers: A(t) of the index-1 form in all n coordinates) about ``simulation``'s samples;
+    ``inputs`` names the coordinates whose generalized forces are u (default all)."""
     names = tuple(dynamics.coordinates)
     if tuple(simulation.coordinates) != names:
         raise InputError("the simulation is not of this system (its coordinates are "
@@ -51,7 +53,10 @@ def linearize_along(dynamics, simulation, inputs=None) -> TrajectoryLinearizatio
     q, v = np.asarray(simulation.q, dtype=float), np.asarray(simulation.q_dot, dtype=float)
     forces = simulation.control_forces
     tau = np.zeros_like(q) if forces is None else np.asarray(forces, dtype=float)
-    by_position, by_velocity, by_force = dynamics.forward_dynamics_derivatives(q, v, tau)
+    t = np.asarray(simulation.t, dtype=float)
+    # dynamics/constrained.py's at each sample's time (moving constraints, explicit t)
+    timed = {"t": t} if getattr(dynamics, "timed", False) else {}
+    by_position, by_velocity, by_force = dynamics.forward_dynamics_derivatives(q, v, tau, **timed)
     count, n = q.shape
     A = np.zeros((count, 2 * n, 2 * n))
     A[:, :n, n:] = np.eye(n)
@@ -59,5 +64,5 @@ def linearize_along(dynamics, simulation, inputs=None) -> TrajectoryLinearizatio
     columns = [names.index(name) for name in inputs]
     B = np.zeros((count, 2 * n, len(columns)))
     B[:, n:, :] = by_force[:, :, columns]
-    return TrajectoryLinearization(np.asarray(simulation.t, dtype=float), A, B,
+    return TrajectoryLinearization(t, A, B,
                                    (*names, *(f"{c}_dot" for c in names)), inputs)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, ModelError
 from .gains import square_matrix
 
 
@@ -60,6 +60,10 @@ def computed_torque(system, q_des, Kp, Kd) -> ComputedTorque:
     q_dot_d, q_ddot_d); ``Kp`` (1/s^2) and ``Kd`` (1/s) are numbers, diagonals or matrices,
     positive definite."""
     dynamics = system.dynamics()
+    constraints = getattr(dynamics, "constraint_names", ())
+    if constraints:  # M q_ddot = tau - bias would ignore the constraint forces
+        raise ModelError(f"computed torque needs a model without constraints (this one has "
+                         f"{len(constraints)}: {', '.join(constraints)})", field="constraints")
     names = tuple(dynamics.coordinates)
     n = len(names)
     Kp = square_matrix(Kp, n, "Kp", definite=True)

@@ -18,7 +18,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import InputError, did_you_mean_or_list
+from ..errors import InputError, ModelError, did_you_mean_or_list
 from .free_flyer import BASE_VELOCITY
 from .joint_space import Dynamics, solve_positive
 
@@ -154,6 +154,10 @@ def actuated(rigid: Dynamics, model, armature: Mapping[str, float] | None = None
              friction: bool = True) -> ActuatedDynamics:
     """``rigid`` with the actuator models: the URDF's damping and friction (``friction``) and
     the given armature."""
+    constraints = getattr(rigid, "constraint_names", ())
+    if constraints:  # (M + armature)^-1 (tau - b - losses) would leave the constraints out
+        raise ModelError(f"actuator models need a model without constraints (this one has "
+                         f"{len(constraints)}: {', '.join(constraints)})", field="actuators")
     values = actuator_values(model, armature, friction)
     base = rigid.n - len(values["damping"])  # a floating base's six: no actuator there
     return ActuatedDynamics(rigid, *(np.concatenate([np.zeros(base), values[key]])

@@ -482,10 +482,15 @@ def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
                    equations: Callable[[], EquationsOfMotion] | None = None,
                    kernel: str = "auto"):
     """Recursive dynamics where they apply, else Dynamics over ``symbolic()`` (the numeric
-    functions of the derived equations; ``equations()`` gives them for coriolis_matrix)."""
+    functions of the derived equations; ``equations()`` gives them for coriolis_matrix), or for
+    a model with constraints constrained.ConstrainedDynamics (forward dynamics only)."""
     fast = recursive_dynamics(model, parameters, backend, kernel)
     if fast is not None:
         return fast
+    if model.constraints:  # the DAE's forward dynamics, through the multipliers
+        from .constrained import ConstrainedDynamics
+
+        return ConstrainedDynamics(symbolic(), equations, model)
     dynamics = Dynamics(symbolic(), equations)
     dynamics.model = model  # for its frames (model_frames.py)
     return dynamics

@@ -9,12 +9,14 @@ from __future__ import annotations
 import keyword
 import math
 from collections.abc import Iterable, Sequence
+from dataclasses import replace
 
 import sympy as sp
 
 from ..errors import ModelError, did_you_mean
 from .builder_bodies import RigidBodiesMixin
 from .builder_constraints import ConstraintsMixin
+from .builder_control import ControlLawsMixin
 from .builder_steady import SteadyMotionMixin
 from .contacts import (
     RollingContact,
@@ -43,7 +45,7 @@ from .model import (
 from .rotations import RigidBody, floated, unit_vector
 
 
-class ModelBuilder(RigidBodiesMixin, ConstraintsMixin, SteadyMotionMixin):
+class ModelBuilder(RigidBodiesMixin, ConstraintsMixin, SteadyMotionMixin, ControlLawsMixin):
     """Mutable shell that validates each piece as it is added and builds an immutable Model."""
 
     def __init__(self, name: str = "", description: str = "", *, source: str | None = None):
@@ -70,6 +72,7 @@ class ModelBuilder(RigidBodiesMixin, ConstraintsMixin, SteadyMotionMixin):
         self._constraints: list[Constraint] = []
         self._contacts: list[RollingContact] = []
         self._steady_motion: SteadyMotion | None = None
+        self._control: dict[str, tuple[sp.Expr, str]] = {}  # input -> (law, its field)
         self._component_names: set[str] = set()
         # Every vector given, in order: (field, components, what it places: "particle", "body"
         # or None). The first particle or body position fixes the model's dimension; every
@@ -411,7 +414,7 @@ class ModelBuilder(RigidBodiesMixin, ConstraintsMixin, SteadyMotionMixin):
         if not self._coordinates:
             raise self._error("a model needs at least one generalized coordinate", "coordinates")
         self._check_dimensions()
-        return Model(
+        model = Model(
             name=self.name or "Unnamed model",
             description=self.description,
             coordinates=tuple(self._coordinates),
@@ -433,6 +436,7 @@ class ModelBuilder(RigidBodiesMixin, ConstraintsMixin, SteadyMotionMixin):
             contacts=tuple(self._contacts),
             steady_motion=self._steady_motion,
         )
+        return replace(model, control=self._control_laws(model)) if self._control else model
 
     # -- helpers --------------------------------------------------------------------------
 

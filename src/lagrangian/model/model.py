@@ -202,6 +202,10 @@ class Model:
     contacts: tuple[RollingContact, ...] = ()
     # The steady motion `speeds` linearizes about when none is given ([steady] in the file).
     steady_motion: SteadyMotion | None = None
+    # Control laws ([control] in the file): (input name, u(q, q_dot, t)), an input being a
+    # coordinate (its generalized force), a parameter or a load; used only when a run asks
+    # for them (simulate's controller="model"), never by derive.
+    control: tuple[tuple[str, sp.Expr], ...] = ()
     # A robot read from URDF keeps its tree in numbers (model/tree.py) for recursive dynamics;
     # not part of the model's identity (equal models with and without it are equal).
     kinematic_tree: KinematicTree | None = field(default=None, compare=False, repr=False)

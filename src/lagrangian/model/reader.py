@@ -15,7 +15,7 @@ from .units import check_unit, to_si
 TOP_LEVEL = {
     "name", "description", "coordinates", "parameters", "definitions", "energy", "gravity",
     "particles", "bodies", "springs", "dampers", "loads", "generalized_forces", "constraints",
-    "contacts", "steady",
+    "contacts", "steady", "control",
 }
 COMPONENT_KEYS = {
     "particles": ({"name", "mass", "position"}, set()),
@@ -233,6 +233,9 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
             item["name"], holonomic=item.get("holonomic"), velocity=item.get("velocity"),
             field=f"constraints[{index}]",
         )
+    for key, law in _table(data, "control", source).items():
+        field = f"control.{key}"
+        builder.add_control_law(key, _string(law, field, source), field=field)
     steady = _table(data, "steady", source)
     if steady:
         check_known_keys(steady, STEADY_KEYS[0] | STEADY_KEYS[1], "steady", source)

@@ -1,7 +1,10 @@
 """A controller's summary line for ``simulate --control`` (its JSON is the controller's
-``summary()``)."""
+``summary()``), and the model's own [control] laws (``--control model``): line and JSON."""
 
 from __future__ import annotations
+
+from ..model.model import Model
+from ..model.printing import format_expression
 
 
 def controller_text(controller) -> str:
@@ -15,3 +18,15 @@ def controller_text(controller) -> str:
 
 def _complex(re: float, im: float) -> str:
     return f"{re:.4g}" if im == 0 else f"{re:.4g}{im:+.4g}j"
+
+
+def law_summary(model: Model) -> dict:
+    """JSON-ready: the inputs the model's [control] laws drive and each law as printed."""
+    return {"inputs": [name for name, _ in model.control],
+            "laws": {name: format_expression(law) for name, law in model.control}}
+
+
+def law_text(model: Model) -> str:
+    """One line: the laws of the model's [control] table, compiled with its equations."""
+    laws = "; ".join(f"{name} = {format_expression(law)}" for name, law in model.control)
+    return f"controller: the model's [control] laws, compiled with its equations: {laws}"

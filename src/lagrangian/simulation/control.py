@@ -105,26 +105,39 @@ class ControlLoop:
 
 def _input_matrix(eom: EquationsOfMotion, inputs: Sequence[str], substitution: dict
                   ) -> StateFunction:
-    """B's entries (row-major, n x r) as one compiled function: df/dp for a parameter (which
-    must enter f linearly, so that B u is exactly f(p + u) - f(p)), e_i for a coordinate."""
+    """B's entries (row-major, n x r) as one compiled function."""
+    columns = input_columns(eom, inputs)
+    entries = [columns[k][i] for i in range(len(eom.model.coordinates))
+               for k in range(len(inputs))]
+    return StateFunction(eom.model, entries, substitution)
+
+
+def input_columns(eom: EquationsOfMotion, inputs: Sequence[str], field: str = "inputs",
+                  source: str | None = None) -> list[list[sp.Expr]]:
+    """B's columns, one per input (n entries each): df/dp for a parameter (which must enter f
+    linearly, so that B u is exactly f(p + u) - f(p)), e_i for a coordinate."""
     model = eom.model
     names = [c.name for c in model.coordinates]
     forcing = [as_expression(e) for e in eom.forcing]
-    symbols = [input_parameter(model, name, field="inputs") for name in inputs]
+    symbols = [input_parameter(model, name, field=field) for name in inputs]
     columns = []
     for name, symbol in zip(inputs, symbols, strict=True):
         if symbol is None:
             columns.append([sp.S.One if i == names.index(name) else sp.S.Zero
                             for i in range(len(names))])
             continue
+        if any(symbol in as_expression(e).free_symbols for e in eom.mass_matrix):
+            raise ModelError(f"input '{name}' enters the mass matrix; an input must be a force "
+                             "or torque (a load's magnitude), not an inertia", field=field,
+                             source=source)
         column = [f.diff(symbol) for f in forcing]
         for other in (s for s in symbols if s is not None):
             if any(sp.expand(d.diff(other)) != 0 for d in column):
                 raise ModelError(f"input '{name}' does not enter the generalized forces "
                                  "linearly; a controller's input must (a load's magnitude)",
-                                 field="inputs")
+                                 field=field, source=source)
         if all(d == 0 for d in column):
-            raise ModelError(f"input '{name}' does not act on any coordinate", field="inputs")
+            raise ModelError(f"input '{name}' does not act on any coordinate", field=field,
+                             source=source)
         columns.append(column)
-    entries = [columns[k][i] for i in range(len(names)) for k in range(len(inputs))]
-    return StateFunction(model, entries, substitution)
+    return columns

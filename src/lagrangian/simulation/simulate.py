@@ -26,6 +26,7 @@ from ..model.model import Model
 from ..model.rotations import gimbal_lock
 from ..model.values import ParameterValues, State, resolve_parameters, resolve_state
 from .control import Controller, ControlLoop
+from .control_law import MODEL_LAW, ModelLaw
 from .drift import DriftControl
 from .events import StopCondition, parse_stop_condition
 from .integration_loops import LoopRun, integrate_compiled, integrate_steps
@@ -34,7 +35,7 @@ from .options import METHODS, SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["METHODS", "STATUS_MESSAGES", "JointLimit", "SaveAt", "SimulationResult", "StepControl",
-           "StopCondition", "parse_stop_condition", "simulate", "urdf_limits"]
+           "StopCondition", "model_law", "parse_stop_condition", "simulate", "urdf_limits"]
 
 DEFAULT_STEP_CONTROL = StepControl()  # DOP853, rtol = atol = 1e-9
 DEFAULT_SAVE_AT = SaveAt()  # 1001 evenly spaced samples
@@ -53,7 +54,7 @@ def simulate(
     functions: NumericSystem | None = None,
     compiled_loop: bool = True,
     limits: Sequence[JointLimit] = (),
-    controller: Controller | None = None,
+    controller: Controller | str | None = None,
     inputs: Sequence[str] = (),
     model: Model | None = None,
 ) -> SimulationResult:
@@ -67,7 +68,8 @@ def simulate(
     limits, JointLimit) end the run with status 'limit' when a joint reaches one, naming it;
     velocity and effort limits exceeded are reported in ``limits_exceeded``. ``controller``
     (t, q, q_dot) -> u adds generalized forces (or, with ``inputs``, B u: simulation/control.py)
-    to the model's own, in the scipy loop.
+    to the model's own, in the scipy loop; ``controller="model"`` closes the loop with the
+    model's own [control] laws instead, compiled with the equations (simulation/control_law.py).
 
     ``eom`` None: the run of a kinematic tree's recursive algorithms (``functions``, of
     ``model``), with nothing derived: no constraints, no explicit t, T quadratic in q_dot, and
@@ -82,8 +84,16 @@ def simulate(
                          field="t_end")
     # Everything numeric is compiled here, once, before the loop.
     values = resolve_parameters(model, parameters)
-    functions = functions if functions is not None else numeric(eom, values)
     substitution = values.symbol_values(model)
+    law = None
+    if isinstance(controller, str):
+        controller = model_law(eom, controller, inputs, substitution)
+    if isinstance(controller, ModelLaw):  # built here, or once by the System
+        if not controller.built_with(substitution):
+            raise ValueError("a ModelLaw built for other parameter values")
+        law, controller = controller, None
+        eom, functions = law.equations, law.functions(values)
+    functions = functions if functions is not None else numeric(eom, values)
     drift = DriftControl(functions, StateFunction(model, eom.velocity_bias, substitution)) \
         if functions.m else None
     event = _event(StateFunction(model, [stop.function], substitution)) if stop else None
@@ -122,8 +132,8 @@ def simulate(
     kinetic = energy - functions.energy(q, np.zeros_like(q_dot), t)  # T: E less its q_dot = 0 part
     power = np.einsum("ki,ki->k", power_terms(q, q_dot, t), q_dot)
     controls = control_forces = None
-    if loop is not None:  # the controller's work enters the balance
-        controls, control_forces = loop.on_samples(t, q, q_dot)
+    if loop is not None or law is not None:  # the controller's work enters the balance
+        controls, control_forces = (loop or law).on_samples(t, q, q_dot)
         power = power + np.einsum("ki,ki->k", control_forces, q_dot)
     if functions.m:
         with np.errstate(all="ignore"):
@@ -133,9 +143,10 @@ def simulate(
     else:
         multipliers = residuals = np.zeros((len(t), 0))
     if eom is not None:
+        controlled = loop is not None or law is not None
         kind, invariant, work = _invariant(eom, substitution, t, q, q_dot, energy, power,
-                                           multipliers, controlled=loop is not None)
-        conserved = energy_is_conserved(eom) and loop is None
+                                           multipliers, controlled=controlled)
+        conserved = energy_is_conserved(eom) and not controlled
     else:  # a tree: h = T + V, changed only by the generalized forces' (and controller's) work
         working = loop is not None or any(float(f.xreplace(substitution)) != 0 for f in forces)
         kind = InvariantKind.WORK_BALANCE if working else InvariantKind.ENERGY
@@ -151,9 +162,23 @@ def simulate(
         stop_when=stop.text if stop else None, projected_initial_state=projected,
         kinetic_energy=kinetic, invariant=kind, invariant_values=invariant, work=work,
         limits_exceeded=_exceeded(limits, functions.parameters, t, q_dot),
-        controls=controls, control_names=() if loop is None else loop.names,
+        controls=controls, control_names=(loop or law).names if controls is not None else (),
         control_forces=control_forces,
     )
+
+
+def model_law(eom, controller: str, inputs, substitution) -> ModelLaw:
+    """The model's [control] laws closed into its equations (controller="model")."""
+    if controller != MODEL_LAW:
+        raise InputError(f"unknown controller {controller!r}: a callable (t, q, q_dot) -> u, or "
+                         f"{MODEL_LAW!r} for the model's [control] laws", field="controller")
+    if eom is None:
+        raise InputError("a robot's tree has no [control] table; pass a callable",
+                         field="controller")
+    if inputs:
+        raise InputError("the [control] laws name their own inputs; leave inputs out",
+                         field="inputs")
+    return ModelLaw(eom, substitution)
 
 
 def _tree_forces(model: Model) -> list:

@@ -114,9 +114,9 @@ class ControlTerms:
                 if module is not None:
                     inverse, forward = module.inverse_derivatives, module.forward_derivatives
                     if tree.floating_base:  # the base quaternion's norm checked first
-                        from .recursive import _checking_quaternion
+                        from .free_flyer import checking_quaternions
 
-                        inverse, forward = (_checking_quaternion(f) for f in (inverse, forward))
+                        inverse, forward = (checking_quaternions(f) for f in (inverse, forward))
                     found = (inverse, forward, module.regressor,
                              runtime_values(tree, self.parameters))
             self.__dict__["_derivatives_c"] = found

@@ -15,9 +15,11 @@ from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import joint_model
 from .tree_c import _SINCOS
 
-# the walks, C(q, v), then the Python bindings: one module's C, in this order
+# the walks, C(q, v), inverse dynamics with wrenches, then the Python bindings: one
+# module's C, in this order
 _KERNELS = tuple(Path(__file__).with_name(name)
-                 for name in ("reach_kernel.c", "reach_coriolis.c", "reach_bindings.c"))
+                 for name in ("reach_kernel.c", "reach_coriolis.c", "reach_inverse.c",
+                              "reach_bindings.c"))
 REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
 
 
@@ -46,7 +48,7 @@ def _turn_tables(joints) -> list[str]:
 
 
 def kernel_source(tree: KinematicTree):
-    """The module's C: the tables, then reach_kernel.c, reach_coriolis.c, reach_bindings.c."""
+    """The module's C: the tables, then the kernels of _KERNELS in order."""
     from ..compile.codegen import GeneratedSource
 
     joints, frames = tree.joints, tree.frames
@@ -120,6 +122,45 @@ class ReachKernel:
         self.centroidal = module.centroidal if massive else None
         # a fixed base's C is M's Christoffel symbols (joint_space.py); a floating base's here
         self.coriolis = module.coriolis if tree.floating_base else None
+        self.tree = tree
+        self.up = None  # the ground's acceleration -g (m/s^2), once fused_inverse said yes
+
+    def fused_inverse(self, dynamics) -> bool:
+        """Whether inverse dynamics with wrenches may be this kernel's one pass for
+        ``dynamics``: its numbers are the dynamics' (not where a parameter sets a link's
+        inertial or an actuator's force), checked once at random states against the dynamics'
+        own inverse dynamics less J^T w (to 1e-9 relative); else the two calls stay."""
+        if self.up is not None:
+            return self.up is not False
+        tree = self.tree
+        g = dynamics.parameters.get(tree.gravity_parameter, 0.0) if tree.gravity_parameter else 0.0
+        up = -g * np.array(tree.gravity_direction, dtype=float)
+        rng = np.random.default_rng(0)
+        nv = dynamics.n
+        q = rng.uniform(-1.0, 1.0, (3, len(dynamics.coordinates)))
+        if tree.floating_base:
+            q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
+        v, a = rng.uniform(-1.0, 1.0, (2, 3, nv))
+        frames = [f.name for f in tree.frames if f.body >= 0][-1:]
+        wrenches = {name: rng.uniform(-5.0, 5.0, (3, 6)) for name in frames}
+        try:
+            fused = self.module.inverse(q, v, a, up, tuple(self.frame_index[f] for f in frames),
+                                        tuple(wrenches.values()))
+            apart = np.array(dynamics.inverse_dynamics(q, v, a), dtype=float)
+            self.add_wrenches(q, wrenches, apart, -1.0)
+        except (ValueError, TypeError, KeyError):
+            self.up = False
+            return False
+        scale = 1.0 + np.abs(apart).max()
+        self.up = up if np.abs(fused - apart).max() <= 1e-9 * scale else False
+        return self.up is not False
+
+    def inverse(self, q, v, a, wrenches) -> np.ndarray:
+        """tau = M a + b - sum J^T w in one compiled pass (after fused_inverse said yes);
+        ValueError, TypeError or KeyError where the inputs are not plain (the two calls then)."""
+        return self.module.inverse(q, v, a, self.up, tuple(self.frame_index[name]
+                                                           for name in wrenches),
+                                   tuple(wrenches.values()))
 
     def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> None:
         """out += sign sum J^T w over the frames, in place (out: q's batch, nv wide); ValueError or

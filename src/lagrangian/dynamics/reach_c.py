@@ -158,8 +158,8 @@ class ReachKernel:
     def inverse(self, q, v, a, wrenches) -> np.ndarray:
         """tau = M a + b - sum J^T w in one compiled pass (after fused_inverse said yes);
         ValueError, TypeError or KeyError where the inputs are not plain (the two calls then)."""
-        return self.module.inverse(q, v, a, self.up, tuple(self.frame_index[name]
-                                                           for name in wrenches),
+        return self.module.inverse(q, v, a, self.up, tuple(map(self.frame_index.__getitem__,
+                                                               wrenches)),
                                    tuple(wrenches.values()))
 
     def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> None:

@@ -5,29 +5,20 @@
 
 #define RK_MAX_WRENCHES 16  /* more: the bindings refuse, the caller adds J^T w one by one */
 
-/* I X for body i's spatial inertia at the world's origin, world axes (X = [a; alpha]):
- * [m a - h x alpha; h x a + J_O alpha], h = R h_i + m o, J_O as rk_centroidal's */
-static inline void rk_inertia_times(int i, const double *R, const double *o, const double *X,
-                                    double *out)
+/* I X for body i's spatial inertia about its own origin, world axes (X = [a; alpha] there):
+ * [m a - h x alpha; h x a + R J R^T alpha], h = R h_i its first moment (kg m) */
+static inline void rk_inertia_at(int i, const double *R, const double *h, const double *X,
+                                 double *out)
 {
-    const double m = rk_m[i], *a = X, *al = X + 3;
-    double hr[3], h[3], t[3], u[3];
-    rk_apply(R, rk_h[i], hr);
-    for (int j = 0; j < 3; j++) h[j] = hr[j] + m * o[j];
-    rk_apply_t(R, al, t);  /* R J R^T alpha */
+    double t[3], u[3], hxa[3], ahx[3];
+    rk_apply_t(R, X + 3, t);
     rk_apply(rk_J[i], t, u);
     rk_apply(R, u, t);
-    const double oa = o[0] * al[0] + o[1] * al[1] + o[2] * al[2];
-    const double ha = hr[0] * al[0] + hr[1] * al[1] + hr[2] * al[2];
-    const double oo = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
-    const double oh = o[0] * hr[0] + o[1] * hr[1] + o[2] * hr[2];
-    double ha_x[3], hxa[3];
-    rk_cross(al, h, ha_x);  /* -h x alpha */
-    rk_cross(h, a, hxa);
+    rk_cross(X + 3, h, ahx);  /* -h x alpha */
+    rk_cross(h, X, hxa);
     for (int j = 0; j < 3; j++) {
-        out[j] = m * a[j] + ha_x[j];
-        out[3 + j] = hxa[j] + t[j] + (m * oo + 2.0 * oh) * al[j] - m * o[j] * oa
-                     - o[j] * ha - hr[j] * oa;
+        out[j] = rk_m[i] * X[j] + ahx[j];
+        out[3 + j] = hxa[j] + t[j];
     }
 }
 
@@ -66,15 +57,26 @@ static void rk_inverse(const double *restrict q, const double *restrict qd,
             rk_motion_cross(V[i], S[i], c);  /* d/dt S = V x S: S moves with its body */
             for (int j = 0; j < 6; j++) A[i][j] += c[j] * rate;
         }
-        /* f = I A + V x* (I V), V x* [f; n] = [w x f; w x n + v x f] */
-        double IV[6], t1[3], t2[3];
-        rk_inertia_times(i, R[i], o[i], A[i], F[i]);
-        rk_inertia_times(i, R[i], o[i], V[i], IV);
-        rk_cross(V[i] + 3, IV, t1);
-        for (int j = 0; j < 3; j++) F[i][j] += t1[j];
-        rk_cross(V[i] + 3, IV + 3, t1);
-        rk_cross(V[i], IV, t2);
-        for (int j = 0; j < 3; j++) F[i][3 + j] += t1[j] + t2[j];
+        /* f = I A + V x* (I V) about the body's own origin o (its inertia without lever
+         * arms: motions there [v + w x o; w]), V x* [f; n] = [w x f; w x n + v x f], then
+         * carried to the world's origin: [f; n + o x f] */
+        double h[3], Vo[6], Ao[6], IV[6], f[6], t1[3], t2[3];
+        rk_apply(R[i], rk_h[i], h);
+        rk_cross(V[i] + 3, o[i], t1);
+        rk_cross(A[i] + 3, o[i], t2);
+        for (int j = 0; j < 3; j++) {
+            Vo[j] = V[i][j] + t1[j], Vo[3 + j] = V[i][3 + j];
+            Ao[j] = A[i][j] + t2[j], Ao[3 + j] = A[i][3 + j];
+        }
+        rk_inertia_at(i, R[i], h, Ao, f);
+        rk_inertia_at(i, R[i], h, Vo, IV);
+        rk_cross(Vo + 3, IV, t1);
+        for (int j = 0; j < 3; j++) f[j] += t1[j];
+        rk_cross(Vo + 3, IV + 3, t1);
+        rk_cross(Vo, IV, t2);
+        for (int j = 0; j < 3; j++) f[3 + j] += t1[j] + t2[j];
+        rk_cross(o[i], f, t1);
+        for (int j = 0; j < 3; j++) F[i][j] = f[j], F[i][3 + j] = f[3 + j] + t1[j];
     }
     for (int k = 0; k < nw; k++) {  /* the wrench carried to the world's origin: [f; m + p x f] */
         const int b = rk_fbody[frames[k]];

@@ -105,7 +105,7 @@ def test_inverse_dynamics_with_a_wrench_is_m_a_plus_b_less_j_transpose_w(tmp_pat
     expected = (np.einsum("nij,nj->ni", robot.mass_matrix(q), a) + robot.bias_forces(q, v)
                 - np.einsum("nij,ni->nj", robot.jacobian(q, frame), w))
     got = robot.inverse_dynamics(q, v, a, f_ext={frame: w})
-    assert robot._reach.up is not False  # the one-pass kernel, not the two calls
+    assert robot._reach.inverse  # the one-pass kernel, not the two calls
     np.testing.assert_allclose(got, expected, atol=1e-11 * (1 + np.abs(expected).max()))
 
 

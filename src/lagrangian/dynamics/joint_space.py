@@ -244,8 +244,9 @@ class Dynamics(ControlTerms):
                     tau = np.array(x, dtype=float)  # our own copy, added to in place
                     fast.add_wrenches(q, f_ext, tau, 1.0)
                     return self.forward_dynamics(q, v, tau)
-                if fast.fused_inverse(self):  # one Newton-Euler pass (reach_inverse.c)
-                    return fast.inverse(q, v, x, f_ext)
+                one_pass = fast.inverse if fast.inverse is not None else fast.fused_inverse(self)
+                if one_pass:  # one Newton-Euler pass (reach_inverse.c)
+                    return one_pass(q, v, x, f_ext)
                 tau = self.inverse_dynamics(q, v, x)
                 fast.add_wrenches(q, f_ext, tau, -1.0)
                 return tau

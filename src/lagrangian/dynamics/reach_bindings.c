@@ -282,43 +282,50 @@ static PyObject *rk_py_coriolis(PyObject *self, PyObject *const *args, Py_ssize_
     return out;
 }
 
-/* inverse(Q, V, A, UP, FRAMES, WS) -> tau: inverse dynamics less the wrenches WS[k] at frames
- * FRAMES[k] in one pass (reach_inverse.c); UP the ground's acceleration (3,), each W (6,) for
- * every state or one row per state */
+/* inverse(INDEX, UP, Q, V, A, F_EXT) -> tau: inverse dynamics less the wrenches of the dict
+ * F_EXT (frame name -> W, INDEX: frame name -> frame number) in one pass (reach_inverse.c); UP
+ * the ground's acceleration (3,), each W (6,) for every state or one row per state. KeyError or
+ * ValueError where an input is not plain (the caller's numpy path names it). */
 static PyObject *rk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
-    if (nargs != 6 || !PyTuple_Check(args[4]) || !PyTuple_Check(args[5])
-            || PyTuple_GET_SIZE(args[4]) != PyTuple_GET_SIZE(args[5])) {
-        PyErr_SetString(PyExc_TypeError, "inverse(Q, V, A, UP, FRAMES, WS)");
+    if (nargs != 6 || !PyDict_Check(args[0]) || !PyDict_Check(args[5])) {
+        PyErr_SetString(PyExc_TypeError, "inverse(INDEX, UP, Q, V, A, F_EXT)");
         return NULL;
     }
-    Py_ssize_t nw = PyTuple_GET_SIZE(args[4]);
+    Py_ssize_t nw = PyDict_Size(args[5]);
     if (nw > RK_MAX_WRENCHES) { PyErr_SetString(PyExc_ValueError, "f_ext: too many"); return NULL; }
     PyArrayObject *in[3] = {NULL, NULL, NULL}, *U = NULL, *W[RK_MAX_WRENCHES] = {NULL};
-    PyObject *out = NULL;
+    PyObject *out = NULL, *name, *value;
     int frames[RK_MAX_WRENCHES], shared[RK_MAX_WRENCHES];
     const double *w[RK_MAX_WRENCHES];
     const char *names[3] = {"q", "v", "a"};
     for (int j = 0; j < 3; j++) {
-        in[j] = rk_input(args[j], j == 0 ? RK_NQ : RK_NV, names[j]);
+        in[j] = rk_input(args[2 + j], j == 0 ? RK_NQ : RK_NV, names[j]);
         if (!in[j] || (j && !rk_same_batch(in[0], in[j], names[j]))) goto done;
     }
     if (!rk_unit_quaternions(in[0])) goto done;
-    U = rk_input(args[3], 3, "up");
+    U = rk_input(args[1], 3, "up");
     if (!U) goto done;
-    for (Py_ssize_t k = 0; k < nw; k++) {
-        frames[k] = (int)PyLong_AsLong(PyTuple_GET_ITEM(args[4], k));
+    Py_ssize_t at = 0, k = 0;
+    while (PyDict_Next(args[5], &at, &name, &value)) {
+        PyObject *number = PyDict_GetItemWithError(args[0], name);
+        if (!number) {
+            if (!PyErr_Occurred()) PyErr_SetObject(PyExc_KeyError, name);
+            goto done;
+        }
+        frames[k] = (int)PyLong_AsLong(number);
         if (PyErr_Occurred()) goto done;
         if (frames[k] < 0 || frames[k] >= RK_NF) {
             PyErr_SetString(PyExc_ValueError, "frame: out of range");
             goto done;
         }
-        W[k] = rk_input(PyTuple_GET_ITEM(args[5], k), 6, "f_ext");
+        W[k] = rk_input(value, 6, "f_ext");
         if (!W[k]) goto done;
         shared[k] = PyArray_NDIM(W[k]) == 1;
         if (!shared[k] && !rk_same_batch(in[0], W[k], "f_ext")) goto done;
         w[k] = PyArray_DATA(W[k]);
+        k++;
     }
     out = rk_output(in[0], RK_NV, 0);
     if (out) {
@@ -331,7 +338,7 @@ static PyObject *rk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t
 done:
     for (int j = 0; j < 3; j++) Py_XDECREF(in[j]);
     Py_XDECREF(U);
-    for (Py_ssize_t k = 0; k < nw; k++) Py_XDECREF(W[k]);
+    for (Py_ssize_t j = 0; j < nw; j++) Py_XDECREF(W[j]);
     return out;
 }
 
@@ -340,7 +347,7 @@ static PyMethodDef rk_methods[] = {
     {"centroidal", (PyCFunction)(void (*)(void))rk_py_centroidal, METH_FASTCALL, "(Q) -> A_g"},
     {"wrench", (PyCFunction)(void (*)(void))rk_py_wrench, METH_FASTCALL, "(Q, frame, W, OUT, sign): OUT += sign J^T w"},
     {"coriolis", (PyCFunction)(void (*)(void))rk_py_coriolis, METH_FASTCALL, "(Q, V) -> C(q, v)"},
-    {"inverse", (PyCFunction)(void (*)(void))rk_py_inverse, METH_FASTCALL, "(Q, V, A, UP, FRAMES, WS) -> tau"},
+    {"inverse", (PyCFunction)(void (*)(void))rk_py_inverse, METH_FASTCALL, "(INDEX, UP, Q, V, A, F_EXT) -> tau"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -6,6 +6,7 @@ formulas in numpy, used without a compiler and to name every bad input."""
 from __future__ import annotations
 
 import hashlib
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -123,44 +124,38 @@ class ReachKernel:
         # a fixed base's C is M's Christoffel symbols (joint_space.py); a floating base's here
         self.coriolis = module.coriolis if tree.floating_base else None
         self.tree = tree
-        self.up = None  # the ground's acceleration -g (m/s^2), once fused_inverse said yes
+        # inverse dynamics less wrenches in one pass (q, v, a, f_ext) -> tau: None until
+        # fused_inverse has asked, then the compiled function or False
+        self.inverse = None
 
-    def fused_inverse(self, dynamics) -> bool:
-        """Whether inverse dynamics with wrenches may be this kernel's one pass for
-        ``dynamics``: its numbers are the dynamics' (not where a parameter sets a link's
-        inertial or an actuator's force), checked once at random states against the dynamics'
-        own inverse dynamics less J^T w (to 1e-9 relative); else the two calls stay."""
-        if self.up is not None:
-            return self.up is not False
+    def fused_inverse(self, dynamics):
+        """Inverse dynamics less wrenches in one pass for ``dynamics`` (q, v, a, f_ext) -> tau,
+        where its numbers are the dynamics' (not where a parameter sets a link's inertial or an
+        actuator's force), checked once at random states against the dynamics' own inverse
+        dynamics less J^T w (to 1e-9 relative); else False (the two calls stay)."""
+        if self.inverse is not None:
+            return self.inverse
         tree = self.tree
         g = dynamics.parameters.get(tree.gravity_parameter, 0.0) if tree.gravity_parameter else 0.0
-        up = -g * np.array(tree.gravity_direction, dtype=float)
+        up = -g * np.array(tree.gravity_direction, dtype=float)  # the ground's acceleration
+        one_pass = partial(self.module.inverse, self.frame_index, up)
         rng = np.random.default_rng(0)
-        nv = dynamics.n
         q = rng.uniform(-1.0, 1.0, (3, len(dynamics.coordinates)))
         if tree.floating_base:
             q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
-        v, a = rng.uniform(-1.0, 1.0, (2, 3, nv))
-        frames = [f.name for f in tree.frames if f.body >= 0][-1:]
-        wrenches = {name: rng.uniform(-5.0, 5.0, (3, 6)) for name in frames}
+        v, a = rng.uniform(-1.0, 1.0, (2, 3, dynamics.n))
+        wrenches = {f.name: rng.uniform(-5.0, 5.0, (3, 6)) for f in tree.frames if f.body >= 0}
+        wrenches = dict(list(wrenches.items())[-1:])  # the last moving frame's
         try:
-            fused = self.module.inverse(q, v, a, up, tuple(self.frame_index[f] for f in frames),
-                                        tuple(wrenches.values()))
+            fused = one_pass(q, v, a, wrenches)
             apart = np.array(dynamics.inverse_dynamics(q, v, a), dtype=float)
             self.add_wrenches(q, wrenches, apart, -1.0)
         except (ValueError, TypeError, KeyError):
-            self.up = False
+            self.inverse = False
             return False
         scale = 1.0 + np.abs(apart).max()
-        self.up = up if np.abs(fused - apart).max() <= 1e-9 * scale else False
-        return self.up is not False
-
-    def inverse(self, q, v, a, wrenches) -> np.ndarray:
-        """tau = M a + b - sum J^T w in one compiled pass (after fused_inverse said yes);
-        ValueError, TypeError or KeyError where the inputs are not plain (the two calls then)."""
-        return self.module.inverse(q, v, a, self.up, tuple(map(self.frame_index.__getitem__,
-                                                               wrenches)),
-                                   tuple(wrenches.values()))
+        self.inverse = one_pass if np.abs(fused - apart).max() <= 1e-9 * scale else False
+        return self.inverse
 
     def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> None:
         """out += sign sum J^T w over the frames, in place (out: q's batch, nv wide); ValueError or

@@ -14,13 +14,38 @@ import sys
 
 import numpy as np
 import pytest
-from tests.dynamics.test_dynamics_pinocchio import ARM
 from tests.dynamics.test_floating_base import FLOATING_URDF
 
 import lagrangian
 
 pytest.importorskip("yourdfpy")
 COUNT = 700  # above two threads' worth of states (RK_THREAD_STATES = 256)
+# test_dynamics_pinocchio.py's arm (revolute, prismatic on a tilted axis, a fixed tool), here
+# so that these tests run without Pinocchio
+ARM = """<?xml version="1.0"?>
+<robot name="spatial">
+  <link name="base"/>
+  <link name="a"><inertial><origin xyz="0.05 0.02 0.3" rpy="0.1 -0.2 0.3"/><mass value="1.2"/>
+    <inertia ixx="0.02" ixy="0.001" ixz="-0.002" iyy="0.03" iyz="0.0015" izz="0.025"/></inertial></link>
+  <link name="b"><inertial><origin xyz="0.25 -0.01 0.02" rpy="0 0.4 0"/><mass value="0.8"/>
+    <inertia ixx="0.004" ixy="0.0005" ixz="0" iyy="0.02" iyz="-0.0007" izz="0.021"/></inertial></link>
+  <link name="c"><inertial><origin xyz="0.1 0 0.03"/><mass value="0.5"/>
+    <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.0025"/></inertial></link>
+  <link name="tool"><inertial><origin xyz="0 0 0.05"/><mass value="0.2"/>
+    <inertia ixx="0.0002" ixy="0" ixz="0" iyy="0.0002" iyz="0" izz="0.0001"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/>
+    <origin xyz="0 0 0.2" rpy="0 0 0.5"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="a"/><child link="b"/>
+    <origin xyz="0.03 0.04 0.5" rpy="1.5707963267948966 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="j3" type="prismatic"><parent link="b"/><child link="c"/>
+    <origin xyz="0.4 0 -0.05" rpy="0.2 0.1 -0.3"/><axis xyz="0.6 0 0.8"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="flange" type="fixed"><parent link="c"/><child link="tool"/>
+    <origin xyz="0.1 0.02 0" rpy="0 0.3 0"/></joint>
+</robot>
+"""
 
 
 def _robot(tmp_path, text: str):

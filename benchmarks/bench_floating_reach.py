@@ -6,12 +6,14 @@ call of one state and for a batch of 10^4 states against a Python loop of Pinocc
 
 Needs the bench extra (pin, example-robot-data). Each per-call figure is the best of 7 rounds
 of 300 calls, ours and Pinocchio's rounds alternating in one process; each batch figure the
-best of 3 (one call of ours on 10^4 states, a loop of 10^4 Pinocchio calls). The load average
-is printed before and after.
+best of 5, alternating too (one call of ours on 10^4 states, on as many threads as processors
+or LAGRANGIAN_THREADS allow; a loop of 10^4 Pinocchio calls). The load average is printed
+before and after, and the threads a batch may take.
 """
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from pathlib import Path
@@ -52,8 +54,8 @@ def measure(ours, theirs, Q, V, A, count: int) -> tuple[float, float, float, flo
     """Seconds: one call of ours and of Pinocchio's (interleaved), 10^4 states in one call of
     ours and in a loop of Pinocchio's."""
     one_ours, one_theirs = interleaved(lambda: ours(Q[0], V[0], A[0]), lambda: theirs(0))
-    batch_ours = best(lambda: ours(Q, V, A), 1, 3)
-    batch_theirs = best(lambda: [theirs(k) for k in range(count)], 1, 3)
+    batch_ours, batch_theirs = interleaved(lambda: ours(Q, V, A),
+                                           lambda: [theirs(k) for k in range(count)], 1, 5)
     return one_ours, one_theirs, batch_ours, batch_theirs
 
 
@@ -112,7 +114,9 @@ def bench_robot(name: str, foot: str, count: int = 10_000) -> None:
 
 
 def main() -> None:
-    print(f"load average {load_average()}")
+    threads = max(1, min(os.cpu_count() or 1, int(os.environ.get("LAGRANGIAN_THREADS") or 8), 8))
+    print(f"load average {load_average()}; a batch on up to {threads} threads "
+          f"({os.cpu_count()} processors)")
     for name, foot in ROBOTS:
         bench_robot(name, foot)
     print(f"load average {load_average()}")

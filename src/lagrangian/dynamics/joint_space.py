@@ -244,6 +244,11 @@ class Dynamics(ControlTerms):
                     tau = np.array(x, dtype=float)  # our own copy, added to in place
                     fast.add_wrenches(q, f_ext, tau, 1.0)
                     return self.forward_dynamics(q, v, tau)
+                one_pass = fast.inverse if fast.inverse is not None else fast.fused_inverse(self)
+                # one Newton-Euler pass (reach_inverse.c) for one state or a few; over many the
+                # tree module's vector lanes make its ID and then J^T w the faster
+                if one_pass and (q.__class__ is not np.ndarray or q.ndim < 2 or len(q) <= 64):
+                    return one_pass(q, v, x, f_ext)
                 tau = self.inverse_dynamics(q, v, x)
                 fast.add_wrenches(q, f_ext, tau, -1.0)
                 return tau

@@ -1,5 +1,127 @@
 /* Python bindings of reach_kernel.c and reach_coriolis.c: arrays (..., n) of float64, one
- * output row per state. */
+ * output row per state. A batch runs on threads that take blocks of RK_BLOCK states from a
+ * shared counter (as the tree module's batches), each state computed as alone. */
+
+#if defined(__unix__) || defined(__APPLE__)
+#define RK_PTHREADS 1
+#include <pthread.h>
+#include <unistd.h>
+#else
+#define RK_PTHREADS 0
+#endif
+#define RK_MAX_THREADS 8
+#define RK_THREAD_STATES 256  /* fewer per thread: starting it costs more than it saves */
+#define RK_BLOCK 64
+
+enum { RK_DRIFT, RK_CENTROIDAL, RK_WRENCH, RK_CORIOLIS, RK_INVERSE };
+
+/* one batch's inputs and output; ``next`` the shared counter of states handed out */
+typedef struct {
+    int kind, frame, ref, nw;
+    const double *q, *v, *a, *up;
+    const int *frames;
+    const double *const *w;
+    const int *wshared;
+    double sign, *y;
+    npy_intp count, *next;
+} rk_job;
+
+static void rk_state(const rk_job *job, npy_intp k, rk_cbody *work)
+{
+    const double *q = job->q + k * RK_NQ;
+    switch (job->kind) {
+    case RK_DRIFT: rk_drift(q, job->v + k * RK_NV, job->frame, job->ref, job->y + 6 * k); break;
+    case RK_CENTROIDAL: rk_centroidal(q, job->y + 6 * RK_NV * k); break;
+    case RK_WRENCH: {
+        double tau[RK_NV], *y = job->y + RK_NV * k;
+        rk_wrench(q, job->frame, job->w[0] + (job->wshared[0] ? 0 : 6 * k), tau);
+        for (int j = 0; j < RK_NV; j++) y[j] += job->sign * tau[j];
+        break;
+    }
+    case RK_CORIOLIS: rk_coriolis(q, job->v + k * RK_NV, job->y + RK_NV * RK_NV * k, work); break;
+    case RK_INVERSE: {
+        const double *w[RK_MAX_WRENCHES];
+        for (int i = 0; i < job->nw; i++) w[i] = job->w[i] + (job->wshared[i] ? 0 : 6 * k);
+        rk_inverse(q, job->v + k * RK_NV, job->a + k * RK_NV, job->up, job->nw, job->frames, w,
+                   job->y + RK_NV * k);
+        break;
+    }
+    }
+}
+
+/* a thread's work: blocks of RK_BLOCK states taken in turn until none is left, so that a
+ * thread slowed by the machine's other work takes fewer rather than holding the others up */
+static void *rk_run(void *argument)
+{
+    rk_job *job = (rk_job *)argument;
+    rk_cbody *work = NULL;
+    if (job->kind == RK_CORIOLIS && !(work = malloc(sizeof(rk_cbody) * RK_NB))) return NULL;
+    for (;;) {
+#if RK_PTHREADS
+        const npy_intp k0 = __atomic_fetch_add(job->next, RK_BLOCK, __ATOMIC_RELAXED);
+#else
+        const npy_intp k0 = *job->next;
+        *job->next += RK_BLOCK;
+#endif
+        if (k0 >= job->count) break;
+        const npy_intp k1 = k0 + RK_BLOCK < job->count ? k0 + RK_BLOCK : job->count;
+        for (npy_intp k = k0; k < k1; k++) rk_state(job, k, work);
+    }
+    free(work);
+    return NULL;
+}
+
+/* how many threads a batch of ``count`` states runs on: one per processor (at most
+ * RK_MAX_THREADS) once each has RK_THREAD_STATES states; LAGRANGIAN_THREADS caps it */
+static int rk_threads(npy_intp count)
+{
+#if RK_PTHREADS
+    static int cap = 0;
+    if (cap == 0) {
+        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+        const char *env = getenv("LAGRANGIAN_THREADS");
+        long asked = env && *env ? strtol(env, NULL, 10) : cpus;
+        if (asked < 1) asked = 1;
+        if (cpus < 1) cpus = 1;
+        cap = (int)(asked < cpus ? asked : cpus);
+        if (cap > RK_MAX_THREADS) cap = RK_MAX_THREADS;
+    }
+    npy_intp parts = count / RK_THREAD_STATES;
+    if (parts > cap) parts = cap;
+    return parts < 1 ? 1 : (int)parts;
+#else
+    (void)count;
+    return 1;
+#endif
+}
+
+/* the batch over threads, without the GIL; 0 with MemoryError set where a workspace failed */
+static int rk_batch(rk_job *job)
+{
+    npy_intp next = 0;
+    job->next = &next;
+    int parts = rk_threads(job->count);
+    rk_job jobs[RK_MAX_THREADS];
+    for (int t = 0; t < parts; t++) jobs[t] = *job;
+    NPY_BEGIN_THREADS_DEF;
+    if (job->count > 16) NPY_BEGIN_THREADS;
+#if RK_PTHREADS
+    pthread_t threads[RK_MAX_THREADS];
+    int started[RK_MAX_THREADS] = {0};
+    for (int t = 0; t < parts - 1; t++)
+        started[t] = pthread_create(&threads[t], NULL, rk_run, &jobs[t]) == 0;
+    rk_run(&jobs[parts - 1]);  /* this thread too; a thread that did not start leaves its
+                                  blocks to the others */
+    for (int t = 0; t < parts - 1; t++)
+        if (started[t]) pthread_join(threads[t], NULL);
+#else
+    rk_run(&jobs[0]);
+#endif
+    if (job->count > 16) NPY_END_THREADS;
+    /* a thread without its workspace took no block: the others took them, unless none ran */
+    if (next < job->count) { PyErr_NoMemory(); return 0; }
+    return 1;
+}
 
 static PyArrayObject *rk_input(PyObject *x, int last, const char *name)
 {
@@ -78,11 +200,10 @@ static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t n
     if (!V || !rk_same_batch(Q, V, "v")) { Py_DECREF(Q); Py_XDECREF(V); return NULL; }
     PyObject *out = rk_output(Q, 6, 0);
     if (out) {
-        npy_intp count = PyArray_SIZE(Q) / RK_NQ;
-        const double *q = PyArray_DATA(Q), *v = PyArray_DATA(V);
-        double *y = PyArray_DATA((PyArrayObject *)out);
-        for (npy_intp k = 0; k < count; k++)
-            rk_drift(q + k * RK_NQ, v + k * RK_NV, f, ref, y + 6 * k);
+        rk_job job = {.kind = RK_DRIFT, .frame = f, .ref = ref, .q = PyArray_DATA(Q),
+                      .v = PyArray_DATA(V), .y = PyArray_DATA((PyArrayObject *)out),
+                      .count = PyArray_SIZE(Q) / RK_NQ};
+        if (!rk_batch(&job)) Py_CLEAR(out);
     }
     Py_DECREF(Q); Py_DECREF(V);
     return out;
@@ -97,10 +218,9 @@ static PyObject *rk_py_centroidal(PyObject *self, PyObject *const *args, Py_ssiz
     if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
     PyObject *out = rk_output(Q, 6, RK_NV);
     if (out) {
-        npy_intp count = PyArray_SIZE(Q) / RK_NQ;
-        const double *q = PyArray_DATA(Q);
-        double *y = PyArray_DATA((PyArrayObject *)out);
-        for (npy_intp k = 0; k < count; k++) rk_centroidal(q + k * RK_NQ, y + 6 * RK_NV * k);
+        rk_job job = {.kind = RK_CENTROIDAL, .q = PyArray_DATA(Q),
+                      .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / RK_NQ};
+        if (!rk_batch(&job)) Py_CLEAR(out);
     }
     Py_DECREF(Q);
     return out;
@@ -133,14 +253,13 @@ static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t 
         Py_DECREF(Q); Py_DECREF(W);
         return NULL;
     }
-    npy_intp count = PyArray_SIZE(Q) / RK_NQ;
-    const double *q = PyArray_DATA(Q), *w = PyArray_DATA(W);
-    double *y = PyArray_DATA(out), tau[RK_NV];
-    for (npy_intp k = 0; k < count; k++) {
-        rk_wrench(q + k * RK_NQ, f, w + (shared ? 0 : 6 * k), tau);
-        for (int j = 0; j < RK_NV; j++) y[RK_NV * k + j] += sign * tau[j];
-    }
+    const double *w = PyArray_DATA(W);
+    rk_job job = {.kind = RK_WRENCH, .frame = f, .q = PyArray_DATA(Q), .w = &w,
+                  .wshared = &shared, .sign = sign, .y = PyArray_DATA(out),
+                  .count = PyArray_SIZE(Q) / RK_NQ};
+    int fine = rk_batch(&job);
     Py_DECREF(Q); Py_DECREF(W);
+    if (!fine) return NULL;
     Py_RETURN_NONE;
 }
 
@@ -153,17 +272,73 @@ static PyObject *rk_py_coriolis(PyObject *self, PyObject *const *args, Py_ssize_
     if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
     PyArrayObject *V = rk_input(args[1], RK_NV, "v");
     if (!V || !rk_same_batch(Q, V, "v")) { Py_DECREF(Q); Py_XDECREF(V); return NULL; }
-    rk_cbody *work = PyMem_Malloc(sizeof(rk_cbody) * RK_NB);
-    PyObject *out = work ? rk_output(Q, RK_NV, RK_NV) : PyErr_NoMemory();
+    PyObject *out = rk_output(Q, RK_NV, RK_NV);
     if (out) {
-        npy_intp count = PyArray_SIZE(Q) / RK_NQ;
-        const double *q = PyArray_DATA(Q), *v = PyArray_DATA(V);
-        double *y = PyArray_DATA((PyArrayObject *)out);
-        for (npy_intp k = 0; k < count; k++)
-            rk_coriolis(q + k * RK_NQ, v + k * RK_NV, y + RK_NV * RK_NV * k, work);
+        rk_job job = {.kind = RK_CORIOLIS, .q = PyArray_DATA(Q), .v = PyArray_DATA(V),
+                      .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / RK_NQ};
+        if (!rk_batch(&job)) Py_CLEAR(out);
     }
-    PyMem_Free(work);
     Py_DECREF(Q); Py_DECREF(V);
+    return out;
+}
+
+/* inverse(INDEX, UP, Q, V, A, F_EXT) -> tau: inverse dynamics less the wrenches of the dict
+ * F_EXT (frame name -> W, INDEX: frame name -> frame number) in one pass (reach_inverse.c); UP
+ * the ground's acceleration (3,), each W (6,) for every state or one row per state. KeyError or
+ * ValueError where an input is not plain (the caller's numpy path names it). */
+static PyObject *rk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 6 || !PyDict_Check(args[0]) || !PyDict_Check(args[5])) {
+        PyErr_SetString(PyExc_TypeError, "inverse(INDEX, UP, Q, V, A, F_EXT)");
+        return NULL;
+    }
+    Py_ssize_t nw = PyDict_Size(args[5]);
+    if (nw > RK_MAX_WRENCHES) { PyErr_SetString(PyExc_ValueError, "f_ext: too many"); return NULL; }
+    PyArrayObject *in[3] = {NULL, NULL, NULL}, *U = NULL, *W[RK_MAX_WRENCHES] = {NULL};
+    PyObject *out = NULL, *name, *value;
+    int frames[RK_MAX_WRENCHES], shared[RK_MAX_WRENCHES];
+    const double *w[RK_MAX_WRENCHES];
+    const char *names[3] = {"q", "v", "a"};
+    for (int j = 0; j < 3; j++) {
+        in[j] = rk_input(args[2 + j], j == 0 ? RK_NQ : RK_NV, names[j]);
+        if (!in[j] || (j && !rk_same_batch(in[0], in[j], names[j]))) goto done;
+    }
+    if (!rk_unit_quaternions(in[0])) goto done;
+    U = rk_input(args[1], 3, "up");
+    if (!U) goto done;
+    Py_ssize_t at = 0, k = 0;
+    while (PyDict_Next(args[5], &at, &name, &value)) {
+        PyObject *number = PyDict_GetItemWithError(args[0], name);
+        if (!number) {
+            if (!PyErr_Occurred()) PyErr_SetObject(PyExc_KeyError, name);
+            goto done;
+        }
+        frames[k] = (int)PyLong_AsLong(number);
+        if (PyErr_Occurred()) goto done;
+        if (frames[k] < 0 || frames[k] >= RK_NF) {
+            PyErr_SetString(PyExc_ValueError, "frame: out of range");
+            goto done;
+        }
+        W[k] = rk_input(value, 6, "f_ext");
+        if (!W[k]) goto done;
+        shared[k] = PyArray_NDIM(W[k]) == 1;
+        if (!shared[k] && !rk_same_batch(in[0], W[k], "f_ext")) goto done;
+        w[k] = PyArray_DATA(W[k]);
+        k++;
+    }
+    out = rk_output(in[0], RK_NV, 0);
+    if (out) {
+        rk_job job = {.kind = RK_INVERSE, .nw = (int)nw, .q = PyArray_DATA(in[0]),
+                      .v = PyArray_DATA(in[1]), .a = PyArray_DATA(in[2]), .up = PyArray_DATA(U),
+                      .frames = frames, .w = w, .wshared = shared,
+                      .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(in[0]) / RK_NQ};
+        if (!rk_batch(&job)) Py_CLEAR(out);
+    }
+done:
+    for (int j = 0; j < 3; j++) Py_XDECREF(in[j]);
+    Py_XDECREF(U);
+    for (Py_ssize_t j = 0; j < nw; j++) Py_XDECREF(W[j]);
     return out;
 }
 
@@ -172,6 +347,7 @@ static PyMethodDef rk_methods[] = {
     {"centroidal", (PyCFunction)(void (*)(void))rk_py_centroidal, METH_FASTCALL, "(Q) -> A_g"},
     {"wrench", (PyCFunction)(void (*)(void))rk_py_wrench, METH_FASTCALL, "(Q, frame, W, OUT, sign): OUT += sign J^T w"},
     {"coriolis", (PyCFunction)(void (*)(void))rk_py_coriolis, METH_FASTCALL, "(Q, V) -> C(q, v)"},
+    {"inverse", (PyCFunction)(void (*)(void))rk_py_inverse, METH_FASTCALL, "(INDEX, UP, Q, V, A, F_EXT) -> tau"},
     {NULL, NULL, 0, NULL},
 };
 

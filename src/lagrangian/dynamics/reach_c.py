@@ -6,6 +6,7 @@ formulas in numpy, used without a compiler and to name every bad input."""
 from __future__ import annotations
 
 import hashlib
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -15,9 +16,11 @@ from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import joint_model
 from .tree_c import _SINCOS
 
-# the walks, C(q, v), then the Python bindings: one module's C, in this order
+# the walks, C(q, v), inverse dynamics with wrenches, then the Python bindings: one
+# module's C, in this order
 _KERNELS = tuple(Path(__file__).with_name(name)
-                 for name in ("reach_kernel.c", "reach_coriolis.c", "reach_bindings.c"))
+                 for name in ("reach_kernel.c", "reach_coriolis.c", "reach_inverse.c",
+                              "reach_bindings.c"))
 REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
 
 
@@ -46,7 +49,7 @@ def _turn_tables(joints) -> list[str]:
 
 
 def kernel_source(tree: KinematicTree):
-    """The module's C: the tables, then reach_kernel.c, reach_coriolis.c, reach_bindings.c."""
+    """The module's C: the tables, then the kernels of _KERNELS in order."""
     from ..compile.codegen import GeneratedSource
 
     joints, frames = tree.joints, tree.frames
@@ -120,6 +123,39 @@ class ReachKernel:
         self.centroidal = module.centroidal if massive else None
         # a fixed base's C is M's Christoffel symbols (joint_space.py); a floating base's here
         self.coriolis = module.coriolis if tree.floating_base else None
+        self.tree = tree
+        # inverse dynamics less wrenches in one pass (q, v, a, f_ext) -> tau: None until
+        # fused_inverse has asked, then the compiled function or False
+        self.inverse = None
+
+    def fused_inverse(self, dynamics):
+        """Inverse dynamics less wrenches in one pass for ``dynamics`` (q, v, a, f_ext) -> tau,
+        where its numbers are the dynamics' (not where a parameter sets a link's inertial or an
+        actuator's force), checked once at random states against the dynamics' own inverse
+        dynamics less J^T w (to 1e-9 relative); else False (the two calls stay)."""
+        if self.inverse is not None:
+            return self.inverse
+        tree = self.tree
+        g = dynamics.parameters.get(tree.gravity_parameter, 0.0) if tree.gravity_parameter else 0.0
+        up = -g * np.array(tree.gravity_direction, dtype=float)  # the ground's acceleration
+        one_pass = partial(self.module.inverse, self.frame_index, up)
+        rng = np.random.default_rng(0)
+        q = rng.uniform(-1.0, 1.0, (3, len(dynamics.coordinates)))
+        if tree.floating_base:
+            q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
+        v, a = rng.uniform(-1.0, 1.0, (2, 3, dynamics.n))
+        wrenches = {f.name: rng.uniform(-5.0, 5.0, (3, 6)) for f in tree.frames if f.body >= 0}
+        wrenches = dict(list(wrenches.items())[-1:])  # the last moving frame's
+        try:
+            fused = one_pass(q, v, a, wrenches)
+            apart = np.array(dynamics.inverse_dynamics(q, v, a), dtype=float)
+            self.add_wrenches(q, wrenches, apart, -1.0)
+        except (ValueError, TypeError, KeyError):
+            self.inverse = False
+            return False
+        scale = 1.0 + np.abs(apart).max()
+        self.inverse = one_pass if np.abs(fused - apart).max() <= 1e-9 * scale else False
+        return self.inverse
 
     def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> None:
         """out += sign sum J^T w over the frames, in place (out: q's batch, nv wide); ValueError or

@@ -44,48 +44,64 @@ static inline void rk_matmul(const double *A, const double *B, double *out)
             out[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
 }
 
-/* each body's rotation (body -> world) and origin (m, world) */
+/* body i's rotation (body -> world) and origin (m, world), its parent's already known */
+static inline void rk_body(const double *q, int i, double (*R)[9], double (*o)[3])
+{
+    double th = RK_FREE(i) ? 0.0 : rk_mult[i] * q[RK_BQ + rk_coord[i]] + rk_off[i];
+    double Rl[9], pl[3] = {rk_t0[i][0], rk_t0[i][1], rk_t0[i][2]};
+    const double *u = rk_u[i];
+    if (RK_FREE(i)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
+        double x = q[3], y = q[4], z = q[5], w = q[6], Rq[9], d[3];
+        double k = 1.0 / (x * x + y * y + z * z + w * w);
+        Rq[0] = 1 - 2 * k * (y * y + z * z); Rq[1] = 2 * k * (x * y - z * w);
+        Rq[2] = 2 * k * (x * z + y * w); Rq[3] = 2 * k * (x * y + z * w);
+        Rq[4] = 1 - 2 * k * (x * x + z * z); Rq[5] = 2 * k * (y * z - x * w);
+        Rq[6] = 2 * k * (x * z - y * w); Rq[7] = 2 * k * (y * z + x * w);
+        Rq[8] = 1 - 2 * k * (x * x + y * y);
+        rk_matmul(rk_R0[i], Rq, Rl);
+        rk_apply(rk_R0[i], q, d);
+        for (int j = 0; j < 3; j++) pl[j] += d[j];
+    } else if (rk_turns[i]) {
+        /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
+        double c, s;
+        lg_sincos(th, &s, &c);  /* inline (tree_c.py): a libm call costs a body's work */
+        for (int j = 0; j < 9; j++) Rl[j] = rk_P[i][j] + c * rk_C[i][j] + s * rk_S[i][j];
+    } else {
+        for (int j = 0; j < 9; j++) Rl[j] = rk_R0[i][j];
+    }
+    if (rk_slides[i]) {
+        double d[3];
+        rk_apply(rk_R0[i], u, d);
+        for (int j = 0; j < 3; j++) pl[j] += th * d[j];
+    }
+    int p = rk_parent[i];
+    if (p < 0) {
+        for (int j = 0; j < 9; j++) R[i][j] = Rl[j];
+        for (int j = 0; j < 3; j++) o[i][j] = pl[j];
+    } else {
+        double d[3];
+        rk_matmul(R[p], Rl, R[i]);
+        rk_apply(R[p], pl, d);
+        for (int j = 0; j < 3; j++) o[i][j] = o[p][j] + d[j];
+    }
+}
+
+/* every body's rotation and origin */
 static void rk_bodies(const double *q, double (*R)[9], double (*o)[3])
 {
-    for (int i = 0; i < RK_NB; i++) {
-        double th = RK_FREE(i) ? 0.0 : rk_mult[i] * q[RK_BQ + rk_coord[i]] + rk_off[i];
-        double Rl[9], pl[3] = {rk_t0[i][0], rk_t0[i][1], rk_t0[i][2]};
-        const double *u = rk_u[i];
-        if (RK_FREE(i)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
-            double x = q[3], y = q[4], z = q[5], w = q[6], Rq[9], d[3];
-            double k = 1.0 / (x * x + y * y + z * z + w * w);
-            Rq[0] = 1 - 2 * k * (y * y + z * z); Rq[1] = 2 * k * (x * y - z * w);
-            Rq[2] = 2 * k * (x * z + y * w); Rq[3] = 2 * k * (x * y + z * w);
-            Rq[4] = 1 - 2 * k * (x * x + z * z); Rq[5] = 2 * k * (y * z - x * w);
-            Rq[6] = 2 * k * (x * z - y * w); Rq[7] = 2 * k * (y * z + x * w);
-            Rq[8] = 1 - 2 * k * (x * x + y * y);
-            rk_matmul(rk_R0[i], Rq, Rl);
-            rk_apply(rk_R0[i], q, d);
-            for (int j = 0; j < 3; j++) pl[j] += d[j];
-        } else if (rk_turns[i]) {
-            /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
-            double c, s;
-            lg_sincos(th, &s, &c);  /* inline (tree_c.py): a libm call costs a body's work */
-            for (int j = 0; j < 9; j++) Rl[j] = rk_P[i][j] + c * rk_C[i][j] + s * rk_S[i][j];
-        } else {
-            for (int j = 0; j < 9; j++) Rl[j] = rk_R0[i][j];
-        }
-        if (rk_slides[i]) {
-            double d[3];
-            rk_apply(rk_R0[i], u, d);
-            for (int j = 0; j < 3; j++) pl[j] += th * d[j];
-        }
-        int p = rk_parent[i];
-        if (p < 0) {
-            for (int j = 0; j < 9; j++) R[i][j] = Rl[j];
-            for (int j = 0; j < 3; j++) o[i][j] = pl[j];
-        } else {
-            double d[3];
-            rk_matmul(R[p], Rl, R[i]);
-            rk_apply(R[p], pl, d);
-            for (int j = 0; j < 3; j++) o[i][j] = o[p][j] + d[j];
-        }
-    }
+    for (int i = 0; i < RK_NB; i++) rk_body(q, i, R, o);
+}
+
+/* the bodies from the root out to body b (b itself last) into path, their number returned;
+ * only theirs are placed: a frame's J_dot v and J^T w need no other body */
+static int rk_path(const double *q, int b, int *path, double (*R)[9], double (*o)[3])
+{
+    int depth = 0;
+    for (int i = b; i >= 0; i = rk_parent[i]) depth++;
+    int k = depth;
+    for (int i = b; i >= 0; i = rk_parent[i]) path[--k] = i;
+    for (k = 0; k < depth; k++) rk_body(q, path[k], R, o);
+    return depth;
 }
 
 /* S of body i's joint at the world's origin, world axes: [s_v; s_w] */
@@ -140,8 +156,9 @@ static void rk_drift(const double *q, const double *qd, int f, int ref, double *
     int b = rk_fbody[f];
     for (int j = 0; j < 6; j++) out[j] = 0.0;
     if (b < 0) return;
-    rk_bodies(q, R, o);
-    for (int i = 0; i <= b; i++) {
+    int path[RK_NB], depth = rk_path(q, b, path, R, o);
+    for (int k = 0; k < depth; k++) {
+        const int i = path[k];
         if (RK_FREE(i)) {  /* V = S v_base; no drift of its own (V x V = 0) */
             double F[6][6];
             rk_free_columns(R[0], o[0], F);
@@ -268,7 +285,8 @@ static void rk_wrench(const double *q, int f, const double *w, double *out)
     for (int j = 0; j < RK_NV; j++) out[j] = 0.0;
     int b = rk_fbody[f];
     if (b < 0) return;
-    rk_bodies(q, R, o);
+    int path[RK_NB];
+    rk_path(q, b, path, R, o);
     rk_frame(f, R, o, Rf, p);
     rk_cross(p, w, m);
     for (int j = 0; j < 3; j++) m[j] += w[3 + j];

@@ -157,3 +157,9 @@ def test_the_documented_deep_crosscheck_runs():
     exec(compile(code, "docs/readability.md", "exec"), scope)
     assert scope["report"].agree
     assert scope["top"].at_initial_state[2] == pytest.approx(12 * 2.0 * 9.81, rel=1e-12)
+
+
+def test_the_working_of_a_deep_chain_is_refused_in_one_line(cli, tmp_path):
+    path = _chain_file(tmp_path, 8)
+    code, _, err = cli("crosscheck", str(path), "--steps")
+    assert code == 2 and "without --steps" in err and len(err.strip().splitlines()) == 1

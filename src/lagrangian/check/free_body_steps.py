@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
+from ..errors import DerivationError
 from ..kinds import FreeBodyKind
 from ..model.model import Model
 from ..model.notation import latex_symbol_names
@@ -176,6 +177,12 @@ def crosscheck_steps(eom: EquationsOfMotion) -> CrosscheckSteps:
     """Newton-Euler's free-body equations of ``eom.model`` and how they map to Lagrange's."""
     model = eom.model
     _require_free_bodies(model)
+    from .newton_euler_numeric import NUMERIC_ABOVE, wants_numeric
+    if wants_numeric(model):  # its symbolic working would take hours and print megabytes
+        raise DerivationError(
+            f"the free-body working is written for at most {NUMERIC_ABOVE} coordinates with "
+            f"bodies in space; this model has {len(model.q)}, so crosscheck forms Newton-Euler "
+            "with numbers instead: run it without --steps")
     points = eq.random_points(model)
     clock = _Clock(model)
     bodies = _free_bodies(model, clock)

@@ -162,4 +162,4 @@ def test_the_documented_deep_crosscheck_runs():
 def test_the_working_of_a_deep_chain_is_refused_in_one_line(cli, tmp_path):
     path = _chain_file(tmp_path, 8)
     code, _, err = cli("crosscheck", str(path), "--steps")
-    assert code == 2 and "without --steps" in err and len(err.strip().splitlines()) == 1
+    assert code == 2 and "with numbers instead" in err and len(err.strip().splitlines()) == 1

@@ -182,7 +182,7 @@ def crosscheck_steps(eom: EquationsOfMotion) -> CrosscheckSteps:
         raise DerivationError(
             f"the free-body working is written for at most {NUMERIC_ABOVE} coordinates with "
             f"bodies in space; this model has {len(model.q)}, so crosscheck forms Newton-Euler "
-            "with numbers instead: run it without --steps")
+            "with numbers instead, without a working to print")
     points = eq.random_points(model)
     clock = _Clock(model)
     bodies = _free_bodies(model, clock)

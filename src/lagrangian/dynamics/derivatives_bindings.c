@@ -19,11 +19,17 @@
 /* the numbers of input j: q DK_NQ (a floating base's 7 first), v, a and tau DK_NV */
 #define DK_WIDTH(j) ((j) == 0 ? DK_NQ : DK_NV)
 
+/* The states a thread takes at a time from the batch's shared counter (a multiple of
+   LG_LANES): the threads share the batch as they go, so one slowed by the machine's other work
+   does not hold the call back with half the batch. */
+#define DK_CHUNK 128
+
 typedef struct {
     int kind;
     npy_intp step[3], k0, k1, bad;
     const double *x[3], *p;
     double *y[3];
+    npy_intp *next;  /* the batch's first state not yet taken (shared), or NULL: k0 to k1 */
 } dk_job;
 
 /* Whether state k's inputs are all finite. */
@@ -40,16 +46,13 @@ enum { DK_INVERSE, DK_FORWARD, DK_REGRESSOR };
 #define DK_OUTPUTS(kind) ((kind) == DK_INVERSE ? 2 : (kind) == DK_FORWARD ? 3 : 1)
 #define DK_SPACE (3 * DK_NV * DK_NV > DK_NV * 10 * DK_NB ? 3 * DK_NV * DK_NV : DK_NV * 10 * DK_NB)
 
-static void *dk_run(void *argument)
+/* States k0 to k1 of the job: LG_LANES at a time through the dk4_ functions (out: their
+   outputs, or NULL), the rest one by one; the count of NaN rows. */
+static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
 {
-    dk_job *job = (dk_job *)argument;
     const int kind = job->kind, size = DK_SIZE(kind), nout = DK_OUTPUTS(kind);
-    npy_intp bad = 0, k = job->k0;
-    /* LG_LANES states at a time through the dk4_ functions, the rest one by one; the lanes'
-       outputs on the heap (a regressor's are DK_NV x 10 DK_NB vectors) */
-    lg_v4 *out = job->k1 - k >= LG_LANES
-                 ? aligned_alloc(sizeof(lg_v4), DK_SPACE * sizeof(lg_v4)) : NULL;
-    for (; out && k + LG_LANES <= job->k1; k += LG_LANES) {
+    npy_intp bad = 0;
+    for (; out && k + LG_LANES <= k1; k += LG_LANES) {
         lg_v4 in[3][DK_NQ];
         for (int j = 0; j < 3; j++)
             for (int l = 0; l < LG_LANES; l++)
@@ -80,7 +83,7 @@ static void *dk_run(void *argument)
             }
         }
     }
-    for (; k < job->k1; k++) {
+    for (; k < k1; k++) {
         const double *a0 = job->x[0] + k * job->step[0], *a1 = job->x[1] + k * job->step[1],
                      *a2 = job->x[2] + k * job->step[2];
         double *y0 = job->y[0] + k * size;
@@ -100,6 +103,24 @@ static void *dk_run(void *argument)
             bad++;
         }
     }
+    return bad;
+}
+
+static void *dk_run(void *argument)
+{
+    dk_job *job = (dk_job *)argument;
+    /* the lanes' outputs on the heap (a regressor's are DK_NV x 10 DK_NB vectors) */
+    lg_v4 *out = job->k1 - job->k0 >= LG_LANES
+                 ? aligned_alloc(sizeof(lg_v4), DK_SPACE * sizeof(lg_v4)) : NULL;
+    npy_intp bad = 0;
+    if (!job->next)
+        bad = dk_range(job, job->k0, job->k1, out);
+    else
+        for (;;) {
+            const npy_intp k = __atomic_fetch_add(job->next, DK_CHUNK, __ATOMIC_RELAXED);
+            if (k >= job->k1) break;
+            bad += dk_range(job, k, k + DK_CHUNK < job->k1 ? k + DK_CHUNK : job->k1, out);
+        }
     free(out);
     job->bad = bad;
     return NULL;
@@ -187,15 +208,15 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     }
     dk_job jobs[DK_MAX_THREADS];
     int parts = dk_threads(count);
-    npy_intp share = (count / parts + LG_LANES - 1) / LG_LANES * LG_LANES;
+    npy_intp next = 0;  /* the threads take DK_CHUNK states at a time from here */
     for (int t = 0; t < parts; t++) {
-        dk_job job = {kind, {step[0], step[1], step[2]}, t * share < count ? t * share : count,
-                      t == parts - 1 || (t + 1) * share > count ? count : (t + 1) * share, 0,
+        dk_job job = {kind, {step[0], step[1], step[2]}, 0, count, 0,
                       {PyArray_DATA(in[0]), PyArray_DATA(in[1]), PyArray_DATA(in[2])},
                       PyArray_DATA(P),
                       {PyArray_DATA((PyArrayObject *)out[0]),
                        nout > 1 ? PyArray_DATA((PyArrayObject *)out[1]) : NULL,
-                       nout > 2 ? PyArray_DATA((PyArrayObject *)out[2]) : NULL}};
+                       nout > 2 ? PyArray_DATA((PyArrayObject *)out[2]) : NULL},
+                      parts > 1 ? &next : NULL};
         jobs[t] = job;
     }
     npy_intp bad = 0;

@@ -6,14 +6,8 @@
  * with the count of NaN rows appended where a state's inputs are not all finite (or, forward,
  * its M is not positive definite). A batch runs in parts on threads. ------------------------ */
 
-#if defined(__unix__) || defined(__APPLE__)
-#define DK_PTHREADS 1
-#include <pthread.h>
-#include <unistd.h>
-#else
-#define DK_PTHREADS 0
-#endif
-#define DK_MAX_THREADS 8
+#define DK_PTHREADS LG_PTHREADS  /* batch_threads.c, above this text */
+#define DK_MAX_THREADS LG_MAX_THREADS
 #define DK_THREAD_STATES 512
 
 /* the numbers of input j: q DK_NQ (a floating base's 7 first), v, a and tau DK_NV */
@@ -126,27 +120,8 @@ static void *dk_run(void *argument)
     return NULL;
 }
 
-static int dk_threads(npy_intp count)
-{
-#if DK_PTHREADS
-    static int cap = 0;
-    if (cap == 0) {
-        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-        const char *env = getenv("LAGRANGIAN_THREADS");
-        long asked = env && *env ? strtol(env, NULL, 10) : cpus;
-        if (asked < 1) asked = 1;
-        if (cpus < 1) cpus = 1;
-        cap = (int)(asked < cpus ? asked : cpus);
-        if (cap > DK_MAX_THREADS) cap = DK_MAX_THREADS;
-    }
-    npy_intp parts = count / DK_THREAD_STATES;
-    if (parts > cap) parts = cap;
-    return parts < 1 ? 1 : (int)parts;
-#else
-    (void)count;
-    return 1;
-#endif
-}
+/* how many threads a batch of ``count`` states runs on (batch_threads.c) */
+static int dk_threads(npy_intp count) { return lg_threads(count, DK_THREAD_STATES); }
 
 static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
 {

@@ -52,6 +52,13 @@ static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
             for (int l = 0; l < LG_LANES; l++)
                 for (int i = 0; i < DK_WIDTH(j); i++)
                     in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
+        /* the rows these states will fill, fetched for writing while the kernel computes: a
+           batch's outputs are fresh memory, and its stores would otherwise each wait for it */
+        for (int o = 0; o < nout; o++) {
+            const char *y = (const char *)(job->y[o] + k * size);
+            for (size_t b = 0; b < LG_LANES * size * sizeof(double); b += 64)
+                __builtin_prefetch(y + b, 1, 2);
+        }
         int failed = 0;
         if (kind == DK_FORWARD)
             failed = dk4_forward_derivatives(in[0], in[1], in[2], job->p, out, out + size,

@@ -4,7 +4,7 @@
 /* -- Python bindings: (Q, V, X, P) with Q, V, X (..., DK_NV) float64 (or (DK_NV,), shared by
  * the batch), P = [g (3), tau_<joint> (DK_NV)]; outputs (..., DK_NV, DK_NV) each, as a tuple,
  * with the count of NaN rows appended where a state's inputs are not all finite (or, forward,
- * its M is not positive definite). A batch runs in parts on threads. ------------------------ */
+ * its M is not positive definite). A batch runs on threads taking DK_CHUNK states at a time. */
 
 #define DK_PTHREADS LG_PTHREADS  /* batch_threads.c, above this text */
 #define DK_MAX_THREADS LG_MAX_THREADS

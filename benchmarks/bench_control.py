@@ -13,7 +13,8 @@ JointModelFreeFlyer): its derivatives only (the regressor of a floating base is 
   bindings: 200 calls from Python (argument checks and the output arrays included), ours and
   Pinocchio's taking turns, the best of 7 rounds each.
 - Batch: one call on N states (ours: one C call, on up to LAGRANGIAN_THREADS threads, default
-  the processors) against a Python loop of N Pinocchio calls, taking turns, best of 3 each.
+  the processors) against a Python loop of N Pinocchio calls, taking turns, best of 7 each (a
+  shared machine's other work slows single rounds of either side).
 - Batch CPU time: the same, timed by this process's CPU time (all threads summed), which a
   shared machine's other work disturbs less than the wall clock.
 - Agreement: the largest absolute difference over 20 random states.
@@ -91,7 +92,7 @@ def main() -> None:
             lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(200)], 7))
         ours_batch, pin_batch = interleaved(
             lambda m=mine: m(q, v, a),
-            lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(args.states)], 3)
+            lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(args.states)], 7)
         ours_cpu, pin_cpu = interleaved(
             lambda m=mine: m(q, v, a),
             lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(args.states)], 3,

@@ -4,26 +4,26 @@
 /* -- Python bindings: (Q, V, X, P) with Q, V, X (..., DK_NV) float64 (or (DK_NV,), shared by
  * the batch), P = [g (3), tau_<joint> (DK_NV)]; outputs (..., DK_NV, DK_NV) each, as a tuple,
  * with the count of NaN rows appended where a state's inputs are not all finite (or, forward,
- * its M is not positive definite). A batch runs in parts on threads. ------------------------ */
+ * its M is not positive definite). A batch runs on threads taking DK_CHUNK states at a time. */
 
-#if defined(__unix__) || defined(__APPLE__)
-#define DK_PTHREADS 1
-#include <pthread.h>
-#include <unistd.h>
-#else
-#define DK_PTHREADS 0
-#endif
-#define DK_MAX_THREADS 8
+#define DK_PTHREADS LG_PTHREADS  /* batch_threads.c, above this text */
+#define DK_MAX_THREADS LG_MAX_THREADS
 #define DK_THREAD_STATES 512
 
 /* the numbers of input j: q DK_NQ (a floating base's 7 first), v, a and tau DK_NV */
 #define DK_WIDTH(j) ((j) == 0 ? DK_NQ : DK_NV)
+
+/* The states a thread takes at a time from the batch's shared counter (a multiple of
+   LG_LANES): the threads share the batch as they go, so one slowed by the machine's other work
+   does not hold the call back with half the batch. */
+#define DK_CHUNK 128
 
 typedef struct {
     int kind;
     npy_intp step[3], k0, k1, bad;
     const double *x[3], *p;
     double *y[3];
+    npy_intp *next;  /* the batch's first state not yet taken (shared), or NULL: k0 to k1 */
 } dk_job;
 
 /* Whether state k's inputs are all finite. */
@@ -40,21 +40,25 @@ enum { DK_INVERSE, DK_FORWARD, DK_REGRESSOR };
 #define DK_OUTPUTS(kind) ((kind) == DK_INVERSE ? 2 : (kind) == DK_FORWARD ? 3 : 1)
 #define DK_SPACE (3 * DK_NV * DK_NV > DK_NV * 10 * DK_NB ? 3 * DK_NV * DK_NV : DK_NV * 10 * DK_NB)
 
-static void *dk_run(void *argument)
+/* States k0 to k1 of the job: LG_LANES at a time through the dk4_ functions (out: their
+   outputs, or NULL), the rest one by one; the count of NaN rows. */
+static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
 {
-    dk_job *job = (dk_job *)argument;
     const int kind = job->kind, size = DK_SIZE(kind), nout = DK_OUTPUTS(kind);
-    npy_intp bad = 0, k = job->k0;
-    /* LG_LANES states at a time through the dk4_ functions, the rest one by one; the lanes'
-       outputs on the heap (a regressor's are DK_NV x 10 DK_NB vectors) */
-    lg_v4 *out = job->k1 - k >= LG_LANES
-                 ? aligned_alloc(sizeof(lg_v4), DK_SPACE * sizeof(lg_v4)) : NULL;
-    for (; out && k + LG_LANES <= job->k1; k += LG_LANES) {
+    npy_intp bad = 0;
+    for (; out && k + LG_LANES <= k1; k += LG_LANES) {
         lg_v4 in[3][DK_NQ];
         for (int j = 0; j < 3; j++)
             for (int l = 0; l < LG_LANES; l++)
                 for (int i = 0; i < DK_WIDTH(j); i++)
                     in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
+        /* the rows these states will fill, fetched for writing while the kernel computes: a
+           batch's outputs are fresh memory, and its stores would otherwise each wait for it */
+        for (int o = 0; o < nout; o++) {
+            const char *y = (const char *)(job->y[o] + k * size);
+            for (size_t b = 0; b < LG_LANES * size * sizeof(double); b += 64)
+                __builtin_prefetch(y + b, 1, 2);
+        }
         int failed = 0;
         if (kind == DK_FORWARD)
             failed = dk4_forward_derivatives(in[0], in[1], in[2], job->p, out, out + size,
@@ -80,7 +84,7 @@ static void *dk_run(void *argument)
             }
         }
     }
-    for (; k < job->k1; k++) {
+    for (; k < k1; k++) {
         const double *a0 = job->x[0] + k * job->step[0], *a1 = job->x[1] + k * job->step[1],
                      *a2 = job->x[2] + k * job->step[2];
         double *y0 = job->y[0] + k * size;
@@ -100,32 +104,31 @@ static void *dk_run(void *argument)
             bad++;
         }
     }
+    return bad;
+}
+
+static void *dk_run(void *argument)
+{
+    dk_job *job = (dk_job *)argument;
+    /* the lanes' outputs on the heap (a regressor's are DK_NV x 10 DK_NB vectors) */
+    lg_v4 *out = job->k1 - job->k0 >= LG_LANES
+                 ? aligned_alloc(sizeof(lg_v4), DK_SPACE * sizeof(lg_v4)) : NULL;
+    npy_intp bad = 0;
+    if (!job->next)
+        bad = dk_range(job, job->k0, job->k1, out);
+    else
+        for (;;) {
+            const npy_intp k = __atomic_fetch_add(job->next, DK_CHUNK, __ATOMIC_RELAXED);
+            if (k >= job->k1) break;
+            bad += dk_range(job, k, k + DK_CHUNK < job->k1 ? k + DK_CHUNK : job->k1, out);
+        }
     free(out);
     job->bad = bad;
     return NULL;
 }
 
-static int dk_threads(npy_intp count)
-{
-#if DK_PTHREADS
-    static int cap = 0;
-    if (cap == 0) {
-        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-        const char *env = getenv("LAGRANGIAN_THREADS");
-        long asked = env && *env ? strtol(env, NULL, 10) : cpus;
-        if (asked < 1) asked = 1;
-        if (cpus < 1) cpus = 1;
-        cap = (int)(asked < cpus ? asked : cpus);
-        if (cap > DK_MAX_THREADS) cap = DK_MAX_THREADS;
-    }
-    npy_intp parts = count / DK_THREAD_STATES;
-    if (parts > cap) parts = cap;
-    return parts < 1 ? 1 : (int)parts;
-#else
-    (void)count;
-    return 1;
-#endif
-}
+/* how many threads a batch of ``count`` states runs on (batch_threads.c) */
+static int dk_threads(npy_intp count) { return lg_threads(count, DK_THREAD_STATES); }
 
 static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
 {
@@ -187,15 +190,15 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     }
     dk_job jobs[DK_MAX_THREADS];
     int parts = dk_threads(count);
-    npy_intp share = (count / parts + LG_LANES - 1) / LG_LANES * LG_LANES;
+    npy_intp next = 0;  /* the threads take DK_CHUNK states at a time from here */
     for (int t = 0; t < parts; t++) {
-        dk_job job = {kind, {step[0], step[1], step[2]}, t * share < count ? t * share : count,
-                      t == parts - 1 || (t + 1) * share > count ? count : (t + 1) * share, 0,
+        dk_job job = {kind, {step[0], step[1], step[2]}, 0, count, 0,
                       {PyArray_DATA(in[0]), PyArray_DATA(in[1]), PyArray_DATA(in[2])},
                       PyArray_DATA(P),
                       {PyArray_DATA((PyArrayObject *)out[0]),
                        nout > 1 ? PyArray_DATA((PyArrayObject *)out[1]) : NULL,
-                       nout > 2 ? PyArray_DATA((PyArrayObject *)out[2]) : NULL}};
+                       nout > 2 ? PyArray_DATA((PyArrayObject *)out[2]) : NULL},
+                      parts > 1 ? &next : NULL};
         jobs[t] = job;
     }
     npy_intp bad = 0;

@@ -21,6 +21,7 @@ from .tree_c import _SINCOS, _VECTOR
 
 _KERNEL = Path(__file__).with_name("derivatives_kernel.c")
 _BINDINGS = Path(__file__).with_name("derivatives_bindings.c")
+_THREADS = Path(__file__).with_name("batch_threads.c")  # the thread count, before the bindings
 
 # the kernel's core on one state, then on LG_LANES states at once (derivatives_kernel.c)
 _SCALAR = """#define DK_T double
@@ -95,7 +96,7 @@ def kernel_source(tree: KinematicTree):
     text = _KERNEL.read_text(encoding="utf-8")
     head, rest = text.split("/* DK_CORE_BEGIN */")
     core = rest.split("/* DK_CORE_END */")[0]
-    bindings = _BINDINGS.read_text(encoding="utf-8")
+    bindings = _THREADS.read_text(encoding="utf-8") + _BINDINGS.read_text(encoding="utf-8")
     source = "\n".join([
         "/* lagrangian: the derivatives of a tree's inverse and forward dynamics */",
         "#define PY_SSIZE_T_CLEAN",
@@ -162,7 +163,8 @@ def derivatives_module(tree: KinematicTree):
     if not applies(tree):
         return None
     here = Path(__file__)
-    generator = hashlib.sha256(_KERNEL.read_bytes() + _BINDINGS.read_bytes() + here.read_bytes()
+    generator = hashlib.sha256(_KERNEL.read_bytes() + _THREADS.read_bytes() + _BINDINGS.read_bytes()
+                               + here.read_bytes()
                                + here.with_name("tree_c.py").read_bytes()).hexdigest()
     # the joints' kinematics only: the inertials are given at run time (runtime_values), so a
     # payload or an identification's trial inertials reuse the module

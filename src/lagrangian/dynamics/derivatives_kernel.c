@@ -283,13 +283,15 @@ static inline void DK_FN(bapply)(const DK_T *L, const DK_T *A, const DK_T *x, DK
 }
 
 /* The backward pass: subtree sums and each body's row (r1, r2) and column (Phi, Psi) vectors
- * (the columns only with ``columns``), tau by body into tau (DK_NB) when asked. */
-static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns)
+ * (the columns, and the sums of B, only with ``columns``), tau by body into tau (DK_NB) when
+ * asked; with ``summed`` the inertias are the subtrees' already and r1 is kept (a second pass
+ * at the same q). */
+static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns, int summed)
 {
     for (int i = DK_NB - 1; i >= 0; i--) {
         const DK_FN(inertia) *Y = &w->Y[i];
         const DK_T *S = w->S[i];
-        DK_FN(iapply)(Y, S, w->r1[i]);
+        if (!summed) DK_FN(iapply)(Y, S, w->r1[i]);
         if (tau) tau[i] = DK_FN(dot6)(S, w->F[i]);
         if (columns) {
             DK_T t[6], u[6], x[6];
@@ -310,20 +312,27 @@ static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns)
         if (DK_FF && i == 0)  /* the base's columns, its subtree the whole tree */
             for (int c = 0; c < 6; c++) {
                 const DK_T *T = w->ffS[c];
-                DK_FN(iapply)(Y, T, w->ffr1[c]);
+                if (!summed) DK_FN(iapply)(Y, T, w->ffr1[c]);
+                w->fftau[c] = DK_FN(dot6)(T, w->F[0]);
+                if (!columns) continue;
                 DK_T *r2 = w->ffr2[c];
                 DK_FN(cross)(w->L[0], T, r2);
                 for (int j = 0; j < 3; j++)
                     r2[j] = 2.0 * r2[j] + w->A[0][j] * T[3] + w->A[0][3 + j] * T[4]
                             + w->A[0][6 + j] * T[5];
-                w->fftau[c] = DK_FN(dot6)(T, w->F[0]);
             }
         int p = dk_parent[i];
         if (p >= 0) {
-            DK_FN(inertia) *P = &w->Y[p];
-            P->m += Y->m;
-            for (int j = 0; j < 3; j++) { P->c[j] += Y->c[j]; w->L[p][j] += w->L[i][j]; }
-            for (int j = 0; j < 9; j++) { P->J[j] += Y->J[j]; w->A[p][j] += w->A[i][j]; }
+            if (!summed) {
+                DK_FN(inertia) *P = &w->Y[p];
+                P->m += Y->m;
+                for (int j = 0; j < 3; j++) P->c[j] += Y->c[j];
+                for (int j = 0; j < 9; j++) P->J[j] += Y->J[j];
+            }
+            if (columns) {
+                for (int j = 0; j < 3; j++) w->L[p][j] += w->L[i][j];
+                for (int j = 0; j < 9; j++) w->A[p][j] += w->A[i][j];
+            }
             for (int j = 0; j < 6; j++) w->F[p][j] += w->F[i][j];
         }
     }
@@ -397,7 +406,7 @@ static void DK_FN(inverse)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const
 {
     DK_FN(work) w;
     DK_FN(forward)(q, qd, qdd, g, &w);
-    DK_FN(backward)(&w, NULL, 1);
+    DK_FN(backward)(&w, NULL, 1, 0);
     DK_FN(pairs)(&w, NULL, dq, dv);
 }
 
@@ -444,17 +453,15 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
 {
     DK_FN(work) w;
     DK_T M[DK_NV * DK_NV], dq[DK_NV * DK_NV], dv[DK_NV * DK_NV], taub[DK_NB], b[DK_NV], zero[DK_NV];
-    /* the bodies' own f, inertia and B: the backward pass sums them in place */
-    DK_T F[DK_NB][6], L[DK_NB][3], A[DK_NB][9];
+    /* the bodies' own f and inertia: the first backward pass sums them in place (not B) */
+    DK_T F[DK_NB][6];
     DK_FN(inertia) Y[DK_NB];
     for (int j = 0; j < DK_NV; j++) zero[j] = DK_C(0.0);
     /* q_ddot = M^-1 (tau + tau_p - b), b from Newton-Euler at q_ddot = 0 */
     DK_FN(forward)(q, qd, zero, P, &w);
     memcpy(F, w.F, sizeof F);
-    memcpy(L, w.L, sizeof L);
-    memcpy(A, w.A, sizeof A);
     memcpy(Y, w.Y, sizeof Y);
-    DK_FN(backward)(&w, taub, 0);
+    DK_FN(backward)(&w, taub, 0, 0);
     DK_FN(pairs)(&w, M, NULL, NULL);
     for (int j = 0; j < DK_NV; j++) b[j] = tau[j];
     for (int j = 0; j < DK_NJ; j++) b[DK_VO + j] += P[3 + j];
@@ -465,10 +472,6 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     DK_FN(solve)(M, diagonal, b);
     /* at q_ddot = b: each body's acceleration grows by da = da_p + S theta_ddot, so psi by
        da_p x S and f by Y da (the rest of the forward pass does not see q_ddot) */
-    memcpy(w.F, F, sizeof F);
-    memcpy(w.L, L, sizeof L);
-    memcpy(w.A, A, sizeof A);
-    memcpy(w.Y, Y, sizeof Y);
     DK_T da[DK_NB][6];
     for (int i = 0; i < DK_NB; i++) {
         const int p = dk_parent[i];
@@ -484,10 +487,11 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
         if (DK_FF && i == 0)
             for (int c = 0; c < 6; c++)
                 for (int j = 0; j < 6; j++) da[0][j] += w.ffS[c][j] * b[c];
-        DK_FN(iapply)(&w.Y[i], da[i], u);
-        for (int j = 0; j < 6; j++) w.F[i][j] += u[j];
+        DK_FN(iapply)(&Y[i], da[i], u);
+        for (int j = 0; j < 6; j++) w.F[i][j] = F[i][j] + u[j];
     }
-    DK_FN(backward)(&w, NULL, 1);
+    /* the second pass: the subtrees' inertias and r1 as they are (the same q) */
+    DK_FN(backward)(&w, NULL, 1, 1);
     DK_FN(pairs)(&w, NULL, dq, dv);
     /* M^-1 = L^-T L^-1: X = L^-1 row by row (the columns of a row independent: no chain of
        dependent operations as in solving column by column), then X^T X; then -M^-1 d tau/dq,

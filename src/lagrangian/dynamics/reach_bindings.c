@@ -2,14 +2,8 @@
  * output row per state. A batch runs on threads that take blocks of RK_BLOCK states from a
  * shared counter (as the tree module's batches), each state computed as alone. */
 
-#if defined(__unix__) || defined(__APPLE__)
-#define RK_PTHREADS 1
-#include <pthread.h>
-#include <unistd.h>
-#else
-#define RK_PTHREADS 0
-#endif
-#define RK_MAX_THREADS 8
+#define RK_PTHREADS LG_PTHREADS  /* batch_threads.c, above this text */
+#define RK_MAX_THREADS LG_MAX_THREADS
 #define RK_THREAD_STATES 256  /* fewer per thread: starting it costs more than it saves */
 #define RK_BLOCK 64
 
@@ -71,29 +65,8 @@ static void *rk_run(void *argument)
     return NULL;
 }
 
-/* how many threads a batch of ``count`` states runs on: one per processor (at most
- * RK_MAX_THREADS) once each has RK_THREAD_STATES states; LAGRANGIAN_THREADS caps it */
-static int rk_threads(npy_intp count)
-{
-#if RK_PTHREADS
-    static int cap = 0;
-    if (cap == 0) {
-        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-        const char *env = getenv("LAGRANGIAN_THREADS");
-        long asked = env && *env ? strtol(env, NULL, 10) : cpus;
-        if (asked < 1) asked = 1;
-        if (cpus < 1) cpus = 1;
-        cap = (int)(asked < cpus ? asked : cpus);
-        if (cap > RK_MAX_THREADS) cap = RK_MAX_THREADS;
-    }
-    npy_intp parts = count / RK_THREAD_STATES;
-    if (parts > cap) parts = cap;
-    return parts < 1 ? 1 : (int)parts;
-#else
-    (void)count;
-    return 1;
-#endif
-}
+/* how many threads a batch of ``count`` states runs on (batch_threads.c) */
+static int rk_threads(npy_intp count) { return lg_threads(count, RK_THREAD_STATES); }
 
 /* the batch over threads, without the GIL; 0 with MemoryError set where a workspace failed */
 static int rk_batch(rk_job *job)

@@ -20,7 +20,7 @@ from .tree_c import _SINCOS
 # module's C, in this order
 _KERNELS = tuple(Path(__file__).with_name(name)
                  for name in ("reach_kernel.c", "reach_coriolis.c", "reach_inverse.c",
-                              "reach_bindings.c"))
+                              "batch_threads.c", "reach_bindings.c"))
 REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
 
 

@@ -4,14 +4,8 @@
    alone. With none such the output array is returned, else (output, count). */
 enum { RT_MASS, RT_BIAS, RT_GRAVITY, RT_INVERSE, RT_FORWARD, RT_KINETIC, RT_POTENTIAL };
 static const char *rt_names[] = {"q", "v", "third"};
-#if defined(__unix__) || defined(__APPLE__)
-#define RT_PTHREADS 1
-#include <pthread.h>
-#include <unistd.h>
-#else
-#define RT_PTHREADS 0
-#endif
-#define RT_MAX_THREADS 8
+#define RT_PTHREADS LG_PTHREADS  /* batch_threads.c, above this text */
+#define RT_MAX_THREADS LG_MAX_THREADS
 #define RT_THREAD_STATES 1024
 #ifndef LG_LANES
 #define LG_LANES 1
@@ -142,29 +136,8 @@ static void *rt_run(void *argument)
     return NULL;
 }
 
-/* How many threads a batch of ``count`` states runs on: one per processor (at most
-   RT_MAX_THREADS) once each has RT_THREAD_STATES states; LAGRANGIAN_THREADS caps it. */
-static int rt_threads(npy_intp count)
-{
-#if RT_PTHREADS
-    static int cap = 0;
-    if (cap == 0) {
-        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-        const char *env = getenv("LAGRANGIAN_THREADS");
-        long asked = env && *env ? strtol(env, NULL, 10) : cpus;
-        if (asked < 1) asked = 1;
-        if (cpus < 1) cpus = 1;
-        cap = (int)(asked < cpus ? asked : cpus);
-        if (cap > RT_MAX_THREADS) cap = RT_MAX_THREADS;
-    }
-    npy_intp parts = count / RT_THREAD_STATES;
-    if (parts > cap) parts = cap;
-    return parts < 1 ? 1 : (int)parts;
-#else
-    (void)count;
-    return 1;
-#endif
-}
+/* How many threads a batch of ``count`` states runs on (batch_threads.c). */
+static int rt_threads(npy_intp count) { return lg_threads(count, RT_THREAD_STATES); }
 
 /* An argument as C-ordered doubles: an array that already is one taken as it is (the common
    call, a fraction of a microsecond less than the general conversion), else converted. */

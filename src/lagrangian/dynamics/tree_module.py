@@ -14,7 +14,9 @@ from .tree_c import dynamics_functions
 from .tree_emitter import VECTOR_LIMIT
 
 # The Python bindings of the batched functions (threads over states, vector lanes): real C.
-_BINDINGS = "\n" + Path(__file__).with_name("tree_bindings.c").read_text(encoding="utf-8")
+# batch_threads.c first: the thread count the three compiled modules' batches share
+_BINDINGS = "\n" + "\n".join(Path(__file__).with_name(name).read_text(encoding="utf-8")
+                             for name in ("batch_threads.c", "tree_bindings.c"))
 
 _DECLARE = "\n".join(
     f"static PyObject *rt_py_{name}(PyObject *, PyObject *const *, Py_ssize_t);"
@@ -96,7 +98,7 @@ def _generator_key() -> str:
     """The tree generator itself: a change to any of its files is a new module."""
     here = Path(__file__).parent
     files = ("tree_emitter.py", "tree_algorithms.py", "tree_floating.py", "joint_models.py",
-             "tree_c.py", "tree_module.py", "tree_bindings.c")
+             "tree_c.py", "tree_module.py", "batch_threads.c", "tree_bindings.c")
     return hashlib.sha256(b"".join((here / f).read_bytes() for f in files)).hexdigest()
 
 

@@ -1,0 +1,36 @@
+/* How many threads a batch runs on, shared by the tree, reach and derivatives modules'
+ * bindings (their builders put this text before them): one per processor, at most
+ * LG_MAX_THREADS, once each thread has ``per_thread`` of the ``count`` states;
+ * LAGRANGIAN_THREADS caps it. One thread without POSIX threads. */
+
+#if defined(__unix__) || defined(__APPLE__)
+#define LG_PTHREADS 1
+#include <pthread.h>
+#include <unistd.h>
+#else
+#define LG_PTHREADS 0
+#endif
+#define LG_MAX_THREADS 8
+
+static int lg_threads(npy_intp count, npy_intp per_thread)
+{
+#if LG_PTHREADS
+    static int cap = 0;
+    if (cap == 0) {
+        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+        const char *env = getenv("LAGRANGIAN_THREADS");
+        long asked = env && *env ? strtol(env, NULL, 10) : cpus;
+        if (asked < 1) asked = 1;
+        if (cpus < 1) cpus = 1;
+        cap = (int)(asked < cpus ? asked : cpus);
+        if (cap > LG_MAX_THREADS) cap = LG_MAX_THREADS;
+    }
+    npy_intp parts = count / per_thread;
+    if (parts > cap) parts = cap;
+    return parts < 1 ? 1 : (int)parts;
+#else
+    (void)count;
+    (void)per_thread;
+    return 1;
+#endif
+}

@@ -180,9 +180,9 @@ def crosscheck_steps(eom: EquationsOfMotion) -> CrosscheckSteps:
     from .newton_euler_numeric import NUMERIC_ABOVE, wants_numeric
     if wants_numeric(model):  # its symbolic working would take hours and print megabytes
         raise DerivationError(
-            f"the free-body working is written for at most {NUMERIC_ABOVE} coordinates with "
-            f"bodies in space; this model has {len(model.q)}, so crosscheck forms Newton-Euler "
-            "with numbers instead, without a working to print")
+            f"the free-body working is written for bodies in space at most {NUMERIC_ABOVE} "
+            "elementary rotations from the ground; this model's go deeper, so crosscheck forms "
+            "Newton-Euler with numbers instead, without a working to print")
     points = eq.random_points(model)
     clock = _Clock(model)
     bodies = _free_bodies(model, clock)

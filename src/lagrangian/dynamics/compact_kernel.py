@@ -38,9 +38,10 @@ from .recursive import RecursiveDynamics
 HEADER, STRIDE = 8, 40
 JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1}
 
-# the recursions, then the batched Python bindings (one translation unit)
+# the recursions, the thread count shared with the other modules, then the batched Python
+# bindings (one translation unit)
 _SOURCES = tuple(Path(__file__).with_name(name)
-                 for name in ("tree_kernel.c", "tree_kernel_bindings.c"))
+                 for name in ("tree_kernel.c", "batch_threads.c", "tree_kernel_bindings.c"))
 
 
 def _source() -> str:

@@ -3,14 +3,8 @@
    a finite result, gives NaN in its own row and is counted; with none such the output array
    is returned, else (output, count). Batches run on threads. */
 enum { TK_MASSM, TK_BIAS, TK_GRAVITY, TK_INVERSE, TK_FORWARD, TK_KINETIC, TK_POTENTIAL };
-#if defined(__unix__) || defined(__APPLE__)
-#define TK_PTHREADS 1
-#include <pthread.h>
-#include <unistd.h>
-#else
-#define TK_PTHREADS 0
-#endif
-#define TK_MAX_THREADS 8
+#define TK_PTHREADS LG_PTHREADS  /* batch_threads.c, before this text */
+#define TK_MAX_THREADS LG_MAX_THREADS
 #define TK_THREAD_WORK 8192  /* body-states (about 1 ms) per thread before another starts */
 
 typedef struct {
@@ -68,27 +62,11 @@ static void *tk_run(void *argument)
     return NULL;
 }
 
+/* A batch's threads by its work (states times bodies), never more threads than states. */
 static int tk_threads(npy_intp count, int nb)
 {
-#if TK_PTHREADS
-    static int cap = 0;
-    if (cap == 0) {
-        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-        const char *env = getenv("LAGRANGIAN_THREADS");
-        long asked = env && *env ? strtol(env, NULL, 10) : cpus;
-        if (asked < 1) asked = 1;
-        if (cpus < 1) cpus = 1;
-        cap = (int)(asked < cpus ? asked : cpus);
-        if (cap > TK_MAX_THREADS) cap = TK_MAX_THREADS;
-    }
-    npy_intp parts = count * nb / TK_THREAD_WORK;
-    if (parts > count) parts = count;
-    if (parts > cap) parts = cap;
-    return parts < 1 ? 1 : (int)parts;
-#else
-    (void)count; (void)nb;
-    return 1;
-#endif
+    int parts = lg_threads(count * nb, TK_THREAD_WORK);
+    return parts > count ? (int)(count < 1 ? 1 : count) : parts;
 }
 
 static const char *tk_names[] = {"q", "v", "third"};

@@ -30,6 +30,18 @@ _EXPAND_POW = create_expand_pow_optimization(4)
 _COMMENT_SAFE = re.compile(r"[^A-Za-z0-9 _.,:;+=()\[\]-]")
 
 
+def c_table(name: str, ctype: str, rows) -> str:
+    """A static const C array named ``name`` (ours, never the user's) of numbers, or of rows of
+    numbers; doubles by repr, so exact."""
+    rows = list(rows)
+    number = (lambda x: repr(float(x))) if ctype == "double" else (lambda x: str(int(x)))
+    nested = bool(rows) and isinstance(rows[0], (list, tuple))
+    body = ", ".join("{" + ", ".join(map(number, row)) + "}" if nested else number(row)
+                     for row in rows)
+    width = f"[{len(rows[0])}]" if nested else ""
+    return f"static const {ctype} {name}[{max(len(rows), 1)}]{width} = {{{body}}};"
+
+
 def c_comment_text(text: object, limit: int = 60) -> str:
     """``text`` reduced to characters that are inert inside a C comment (others become '_',
     never '?', which could form a trigraph), at most ``limit`` characters: a name from a file

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..compile.codegen import c_table
 from ..model.tree import KinematicTree
 from .joint_models import JOINT_MODELS
 from .tree_c import _SINCOS, _VECTOR
@@ -48,17 +49,6 @@ static inline int dk4_failed(lg_v4 d)
     for (int l = 0; l < LG_LANES; l++) bits |= !(d[l] > 0.0) << l;
     return bits;
 }"""
-
-
-def _table(name: str, ctype: str, rows) -> str:
-    """A static const C array (exact doubles by repr), rows of numbers or numbers."""
-    rows = list(rows)
-    number = (lambda x: repr(float(x))) if ctype == "double" else (lambda x: str(int(x)))
-    nested = bool(rows) and isinstance(rows[0], (list, tuple))
-    body = ", ".join("{" + ", ".join(map(number, row)) + "}" if nested else number(row)
-                     for row in rows)
-    width = f"[{len(rows[0])}]" if nested else ""
-    return f"static const {ctype} {name}[{max(len(rows), 1)}]{width} = {{{body}}};"
 
 
 def _flat(matrix) -> list[float]:
@@ -114,18 +104,18 @@ def kernel_source(tree: KinematicTree):
         f"#define DK_NQ {n + 7 * floating}",
         f"#define DK_NV {n + 6 * floating}",
         f"#define DK_NP {len(pairs)}",
-        _table("dk_parent", "int", [j.parent for j in joints]),
-        _table("dk_coord", "int", [j.coordinate for j in joints]),
-        _table("dk_turns", "int", [getattr(m, "turns", False) for m in models]),
-        _table("dk_slides", "int", [getattr(m, "slides", False) for m in models]),
-        _table("dk_pair", "int", [list(p) for p in pairs]),
-        _table("dk_mult", "double", [j.multiplier for j in joints]),
-        _table("dk_off", "double", [j.offset for j in joints]),
-        _table("dk_R0", "double", [_flat(j.rotation) for j in joints]),
-        _table("dk_P", "double", P), _table("dk_C", "double", C), _table("dk_Sk", "double", S),
-        _table("dk_t0", "double", [list(j.translation) for j in joints]),
-        _table("dk_u", "double", [list(j.axis) for j in joints]),
-        _table("dk_R0u", "double", [(np.array(j.rotation, dtype=float)
+        c_table("dk_parent", "int", [j.parent for j in joints]),
+        c_table("dk_coord", "int", [j.coordinate for j in joints]),
+        c_table("dk_turns", "int", [getattr(m, "turns", False) for m in models]),
+        c_table("dk_slides", "int", [getattr(m, "slides", False) for m in models]),
+        c_table("dk_pair", "int", [list(p) for p in pairs]),
+        c_table("dk_mult", "double", [j.multiplier for j in joints]),
+        c_table("dk_off", "double", [j.offset for j in joints]),
+        c_table("dk_R0", "double", [_flat(j.rotation) for j in joints]),
+        c_table("dk_P", "double", P), c_table("dk_C", "double", C), c_table("dk_Sk", "double", S),
+        c_table("dk_t0", "double", [list(j.translation) for j in joints]),
+        c_table("dk_u", "double", [list(j.axis) for j in joints]),
+        c_table("dk_R0u", "double", [(np.array(j.rotation, dtype=float)
                                      @ np.array(j.axis, dtype=float)).tolist() for j in joints]),
         _SINCOS, _VECTOR,
         head, _SCALAR, core, _LANES, core, bindings,

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..compile.codegen import c_table
 from ..model.tree import KinematicTree
 from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import joint_model
@@ -24,17 +25,6 @@ _KERNELS = tuple(Path(__file__).with_name(name)
 REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
 
 
-def _table(name: str, ctype: str, rows) -> str:
-    """A static const C array of numbers (repr: exact doubles)."""
-    rows = list(rows)
-    body = ", ".join("{" + ", ".join(repr(float(x)) if ctype == "double" else str(int(x))
-                                     for x in row) + "}" if isinstance(row, (list, tuple))
-                     else (repr(float(row)) if ctype == "double" else str(int(row)))
-                     for row in rows)
-    width = f"[{len(rows[0])}]" if rows and isinstance(rows[0], (list, tuple)) else ""
-    return f"static const {ctype} {name}[{max(len(rows), 1)}]{width} = {{{body}}};"
-
-
 def _turn_tables(joints) -> list[str]:
     """R0 u u^T, R0 (1 - u u^T) and R0 [u]x per joint: R0 Rot(u, th) = P + cos th C + sin th S."""
     P, C, S = [], [], []
@@ -45,7 +35,7 @@ def _turn_tables(joints) -> list[str]:
         P.append((R0 @ uu).ravel().tolist())
         C.append((R0 @ (np.eye(3) - uu)).ravel().tolist())
         S.append((R0 @ skew).ravel().tolist())
-    return [_table("rk_P", "double", P), _table("rk_C", "double", C), _table("rk_S", "double", S)]
+    return [c_table("rk_P", "double", P), c_table("rk_C", "double", C), c_table("rk_S", "double", S)]
 
 
 def kernel_source(tree: KinematicTree):
@@ -69,23 +59,23 @@ def kernel_source(tree: KinematicTree):
         f"#define RK_QLOW {(1 - QUATERNION_TOLERANCE) ** 2!r}",
         f"#define RK_QHIGH {(1 + QUATERNION_TOLERANCE) ** 2!r}",
         f"#define RK_NF {len(frames)}",
-        _table("rk_parent", "int", [j.parent for j in joints]),
-        _table("rk_coord", "int", [j.coordinate for j in joints]),
+        c_table("rk_parent", "int", [j.parent for j in joints]),
+        c_table("rk_coord", "int", [j.coordinate for j in joints]),
         # a free flyer neither turns nor slides about an axis (body 0, read by RK_FREE)
-        _table("rk_turns", "int", [getattr(m, "turns", False) for m in models]),
-        _table("rk_slides", "int", [getattr(m, "slides", False) for m in models]),
-        _table("rk_mult", "double", [j.multiplier for j in joints]),
-        _table("rk_off", "double", [j.offset for j in joints]),
-        _table("rk_R0", "double", flat),
+        c_table("rk_turns", "int", [getattr(m, "turns", False) for m in models]),
+        c_table("rk_slides", "int", [getattr(m, "slides", False) for m in models]),
+        c_table("rk_mult", "double", [j.multiplier for j in joints]),
+        c_table("rk_off", "double", [j.offset for j in joints]),
+        c_table("rk_R0", "double", flat),
         *_turn_tables(joints),
-        _table("rk_t0", "double", [list(j.translation) for j in joints]),
-        _table("rk_u", "double", [list(j.axis) for j in joints]),
-        _table("rk_m", "double", [j.mass for j in joints]),
-        _table("rk_h", "double", [list(j.first_moment) for j in joints]),
-        _table("rk_J", "double", [[x for row in j.inertia for x in row] for j in joints]),
-        _table("rk_fbody", "int", [f.body for f in frames]),
-        _table("rk_fR", "double", [[x for row in f.rotation for x in row] for f in frames]),
-        _table("rk_ft", "double", [list(f.translation) for f in frames]),
+        c_table("rk_t0", "double", [list(j.translation) for j in joints]),
+        c_table("rk_u", "double", [list(j.axis) for j in joints]),
+        c_table("rk_m", "double", [j.mass for j in joints]),
+        c_table("rk_h", "double", [list(j.first_moment) for j in joints]),
+        c_table("rk_J", "double", [[x for row in j.inertia for x in row] for j in joints]),
+        c_table("rk_fbody", "int", [f.body for f in frames]),
+        c_table("rk_fR", "double", [[x for row in f.rotation for x in row] for f in frames]),
+        c_table("rk_ft", "double", [list(f.translation) for f in frames]),
         _SINCOS,
         *(path.read_text(encoding="utf-8") for path in _KERNELS),
     ])

@@ -10,10 +10,9 @@ as static tables, a floating base's free flyer as body 0.
 
 from __future__ import annotations
 
-from ..compile.codegen import c_comment_text
+from ..compile.codegen import c_comment_text, c_table
 from ..model.tree import KinematicTree
 from .joint_models import joint_model
-from .reach_c import _table
 
 
 def c_string(text: str) -> str:
@@ -59,21 +58,21 @@ def frame_functions(P: str, tree: KinematicTree) -> str:
     models = [joint_model(j.kind) for j in joints]
     names = ", ".join(c_string(f.name) for f in frames) or '""'
     tables = "\n".join([
-        _table("fr_parent", "int", [j.parent for j in joints]),
-        _table("fr_coord", "int", [j.coordinate for j in joints]),
-        _table("fr_turns", "int", [getattr(m, "turns", False) for m in models]),
-        _table("fr_slides", "int", [getattr(m, "slides", False) for m in models]),
-        _table("fr_mult", "double", [j.multiplier for j in joints]),
-        _table("fr_off", "double", [j.offset for j in joints]),
-        _table("fr_R0", "double", [[x for row in j.rotation for x in row] for j in joints]),
-        _table("fr_t0", "double", [list(j.translation) for j in joints]),
-        _table("fr_u", "double", [list(j.axis) for j in joints]),
-        _table("fr_m", "double", [j.mass for j in joints]),
-        _table("fr_h", "double", [list(j.first_moment) for j in joints]),
-        _table("fr_fbody", "int", [f.body for f in frames] or [-1]),
-        _table("fr_fR", "double", [[x for row in f.rotation for x in row] for f in frames]
+        c_table("fr_parent", "int", [j.parent for j in joints]),
+        c_table("fr_coord", "int", [j.coordinate for j in joints]),
+        c_table("fr_turns", "int", [getattr(m, "turns", False) for m in models]),
+        c_table("fr_slides", "int", [getattr(m, "slides", False) for m in models]),
+        c_table("fr_mult", "double", [j.multiplier for j in joints]),
+        c_table("fr_off", "double", [j.offset for j in joints]),
+        c_table("fr_R0", "double", [[x for row in j.rotation for x in row] for j in joints]),
+        c_table("fr_t0", "double", [list(j.translation) for j in joints]),
+        c_table("fr_u", "double", [list(j.axis) for j in joints]),
+        c_table("fr_m", "double", [j.mass for j in joints]),
+        c_table("fr_h", "double", [list(j.first_moment) for j in joints]),
+        c_table("fr_fbody", "int", [f.body for f in frames] or [-1]),
+        c_table("fr_fR", "double", [[x for row in f.rotation for x in row] for f in frames]
                or [[1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0]]),
-        _table("fr_ft", "double", [list(f.translation) for f in frames] or [[0.0, 0, 0]]),
+        c_table("fr_ft", "double", [list(f.translation) for f in frames] or [[0.0, 0, 0]]),
     ])
     return f"""
 /* -- frames: placements and Jacobians (standalone_frames.py) -- */

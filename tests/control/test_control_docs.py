@@ -122,3 +122,14 @@ def test_constrained_section(capsys, cli):
     assert result.code == 0, result.err
     along = json.loads(result.out)["linearize_along"]
     assert np.array(along["A"]).shape == (11, 4, 4) and along["inputs"] == ["x", "y"]
+
+
+def test_manifold_section(capsys, cli):
+    lines = _run("control-manifold", capsys)
+    assert lines[0] == "('x', 'x_dot') ('y',)"
+    result = cli(*_command("control-manifold"))
+    assert result.code == 0, result.err
+    along = json.loads(result.out)["linearize_along"]
+    assert along["states"] == ["x", "x_dot"] and along["dependent"] == ["y"]
+    for A in np.array(along["A"]):  # hanging at rest: [[0, 1], [-g/L, 0]] at every sample
+        np.testing.assert_allclose(A, [[0, 1], [-9.81 / 0.5, 0]], atol=1e-9)

@@ -21,3 +21,12 @@ def test_a_users_control_character_is_an_escape(character):
 def test_printable_text_is_kept():
     text = str(InputError("'θ̇ ×2' is not a coordinate", field="q"))
     assert text == "q: 'θ̇ ×2' is not a coordinate"
+
+
+def test_a_warning_quoting_a_users_text_is_one_line(capsys):
+    from lagrangian.cli.common import flush_warnings, warn
+
+    warn("parameter 'k\u2028\x1b[2J' is never used")
+    flush_warnings()
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "\x1b" not in err and "\u2028" not in err

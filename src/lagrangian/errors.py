@@ -57,6 +57,11 @@ _ONE_LINE = {code: f"\\u{code:04x}" if code > 255 else repr(chr(code))[1:-1]
                           *range(0x202A, 0x202F), *range(0x2066, 0x206A))}
 
 
+def one_line(text: str) -> str:
+    """``text`` with its control characters as escapes: one line, safe for a terminal."""
+    return text.translate(_ONE_LINE)
+
+
 class LagrangianError(Exception):
     """Base class for every error the library raises on bad input (CLI exit status 2)."""
 
@@ -73,7 +78,7 @@ class ModelError(LagrangianError):
     def __str__(self) -> str:
         where = ": ".join(part for part in (self.source, self.field) if part)
         text = f"{where}: {self.message}" if where else self.message
-        return text.translate(_ONE_LINE)  # a TOML key or value may hold a newline
+        return one_line(text)  # a TOML key or value may hold a newline
 
 
 class InputError(ModelError):

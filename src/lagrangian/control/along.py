@@ -38,8 +38,9 @@ class TrajectoryLinearization:
         return document
 
     def __repr__(self) -> str:
+        tied = f", dependent={list(self.dependent)}" if self.dependent else ""
         return (f"TrajectoryLinearization({len(self.t)} samples, states="
-                f"{list(self.state_names)}, inputs={list(self.inputs)})")
+                f"{list(self.state_names)}, inputs={list(self.inputs)}{tied})")
 
 
 def linearize_along(dynamics, simulation, inputs=None,

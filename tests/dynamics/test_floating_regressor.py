@@ -127,3 +127,23 @@ def test_floating_regressor_command_refuses_bad_input_in_one_line(cli, flags, me
     assert result.code == 2
     assert result.err.strip().startswith(message), result.err
     assert len(result.err.strip().splitlines()) == 1
+
+
+def test_a_large_batch_is_its_states_one_by_one(tmp_path):
+    """300 states in one call (body by body) and a few at a time (all bodies at once) give the
+    same Y, and Y pi is the inverse dynamics, a (2, 150) batch keeping its shape."""
+    path = tmp_path / "hopper.urdf"
+    path.write_text(FLOATING_URDF)
+    robot = lagrangian.load(path).dynamics(backend="numpy")
+    rng = np.random.default_rng(6)
+    q = np.concatenate([rng.uniform(-1, 1, (300, 3)), rng.normal(size=(300, 4)),
+                        rng.uniform(-2, 2, (300, 3))], axis=1)
+    q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=1, keepdims=True)
+    v, a = rng.uniform(-2, 2, (2, 300, 9))
+    Y = robot.regressor(q.reshape(2, 150, 10), v.reshape(2, 150, 9), a.reshape(2, 150, 9))
+    assert Y.shape == (2, 150, 9, 40)
+    Y = Y.reshape(300, 9, 40)
+    np.testing.assert_allclose(Y[:5], robot.regressor(q[:5], v[:5], a[:5]), rtol=0, atol=1e-13)
+    inverse = robot.inverse_dynamics(q, v, a)
+    np.testing.assert_allclose(Y @ robot.inertial_parameters(), inverse, rtol=0,
+                               atol=1e-12 * np.abs(inverse).max())

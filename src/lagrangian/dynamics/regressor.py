@@ -125,8 +125,16 @@ def tree_regressor(tree, gravity: float, Q: np.ndarray, V: np.ndarray, A: np.nda
     joints = tree.joints
     placements, spaces, w, dw, acc = tree_motion(tree, gravity, Q, V, A)
     Y = np.zeros((count, nv, 10 * len(joints)))
+    if count <= 256:  # few states: every body's basis wrenches in one call (Python's overhead
+        # is per call); many: body by body (arrays that stay in cache)
+        forces, moments = (x.reshape(len(joints), count, 3, 10) for x in _basis_wrenches(
+            *(np.concatenate(x) for x in (w, dw, acc))))
+    shifts = [cross_matrix(p) for _, p in placements]  # [p]x of each body's origin
     for i in range(len(joints)):
-        force, moment = _basis_wrenches(w[i], dw[i], acc[i])
+        if count <= 256:
+            force, moment = forces[i], moments[i]
+        else:
+            force, moment = _basis_wrenches(w[i], dw[i], acc[i])
         k = i
         while k >= 0:  # the body's wrench reaches every joint from its own to the root
             joint = joints[k]
@@ -143,9 +151,9 @@ def tree_regressor(tree, gravity: float, Q: np.ndarray, V: np.ndarray, A: np.nda
             Y[:, tree.base_nv + joint.coordinate, 10 * i:10 * i + 10] += joint.multiplier * column
             if joint.parent < 0:
                 break
-            R, p = placements[k]
+            R = placements[k][0]
             force = R @ force
-            moment = R @ moment + cross_matrix(p) @ force
+            moment = R @ moment + shifts[k] @ force
             k = joint.parent
     return Y
 

@@ -1,6 +1,6 @@
 """The torque regressor of a floating base (nv rows, the first six the wrench on the base in its
-axes): Pinocchio's computeJointTorqueRegressor on its free-flyer model for Solo12 and Talos, Y pi
-equal to our own inverse dynamics, a base parameter set of the numerical rank of stacked Y (more
+axes): Pinocchio's computeJointTorqueRegressor on its free-flyer model for Solo12, ANYmal and
+Talos, Y pi equal to our own inverse dynamics, a base parameter set of the numerical rank of stacked Y (more
 than the same robot's fixed base), the command's --floating-base, bad input in one line."""
 
 from __future__ import annotations
@@ -37,6 +37,7 @@ def _columns(model, ours):
 
 
 @pytest.mark.parametrize("robot", ["solo_description/robots/solo12.urdf",
+                                   "anymal_b_simple_description/robots/anymal.urdf",
                                    "talos_data/robots/talos_reduced.urdf"])
 def test_floating_regressor_is_pinocchios(robot):
     import pinocchio as pin

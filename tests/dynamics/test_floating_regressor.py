@@ -1,7 +1,8 @@
 """The torque regressor of a floating base (nv rows, the first six the wrench on the base in its
 axes): Pinocchio's computeJointTorqueRegressor on its free-flyer model for Solo12, ANYmal and
-Talos, Y pi equal to our own inverse dynamics, a base parameter set of the numerical rank of stacked Y (more
-than the same robot's fixed base), the command's --floating-base, bad input in one line."""
+Talos, Y pi equal to our own inverse dynamics, a base parameter set of the numerical rank of
+stacked Y (more than the same robot's fixed base), the command's --floating-base, bad input in
+one line."""
 
 from __future__ import annotations
 

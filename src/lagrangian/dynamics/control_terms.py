@@ -38,8 +38,8 @@ class ControlTerms:
                 raise InputError("a robot's regressor is over its bodies' 10 inertial "
                                  "parameters each; parameters=[...] is for model files",
                                  field="parameters")
-            # compiled C (derivatives_c.py) for a fixed base; a floating base's in numpy
-            fast = None if tree.floating_base else self._derivatives_kernel()
+            # compiled C (derivatives_c.py) where a compiler works, else numpy
+            fast = self._derivatives_kernel()
             if fast is not None:
                 compute, P = fast[2], fast[3]
                 return (lambda Q, V, A: compute(Q, V, A, P),
@@ -66,7 +66,7 @@ class ControlTerms:
         axes, force then moment (Pinocchio's layout). A model file: the named ``parameters``, in
         which T and V must be linear."""
         fast = self._derivatives_kernel() if parameters is None else None
-        if fast is not None and not self.tree.floating_base:  # one C call; a bad input goes
+        if fast is not None:  # one C call; a bad input goes
             # the guarded way to be named
             try:
                 out = fast[2](q, v, a, fast[3])
@@ -108,8 +108,8 @@ class ControlTerms:
 
     def _derivatives_kernel(self):
         """(inverse, forward, regressor, P) of the tree's compiled module (derivatives_c.py), or
-        None: a compiled backend's tree of revolute and prismatic joints (a floating base too,
-        but for the regressor); the numpy backend and a model file keep derivatives.py."""
+        None: a compiled backend's tree of revolute and prismatic joints (a floating base
+        too); the numpy backend and a model file keep derivatives.py."""
         found = self.__dict__.get("_derivatives_c", False)
         if found is False:
             found = None
@@ -120,12 +120,13 @@ class ControlTerms:
                 module = derivatives_module(tree) if applies(tree) else None
                 if module is not None:
                     inverse, forward = module.inverse_derivatives, module.forward_derivatives
+                    regressor = module.regressor
                     if tree.floating_base:  # the base quaternion's norm checked first
                         from .free_flyer import checking_quaternions
 
-                        inverse, forward = (checking_quaternions(f) for f in (inverse, forward))
-                    found = (inverse, forward, module.regressor,
-                             runtime_values(tree, self.parameters))
+                        inverse, forward, regressor = (checking_quaternions(f) for f in
+                                                       (inverse, forward, regressor))
+                    found = (inverse, forward, regressor, runtime_values(tree, self.parameters))
             self.__dict__["_derivatives_c"] = found
         return found
 

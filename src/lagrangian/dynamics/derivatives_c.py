@@ -21,6 +21,7 @@ from .joint_models import JOINT_MODELS
 from .tree_c import _SINCOS, _VECTOR
 
 _KERNEL = Path(__file__).with_name("derivatives_kernel.c")
+_REGRESSOR = Path(__file__).with_name("derivatives_regressor.c")  # the core's last part
 _BINDINGS = Path(__file__).with_name("derivatives_bindings.c")
 _THREADS = Path(__file__).with_name("batch_threads.c")  # the thread count, before the bindings
 
@@ -85,7 +86,7 @@ def kernel_source(tree: KinematicTree):
     pairs = _pairs(tree)
     text = _KERNEL.read_text(encoding="utf-8")
     head, rest = text.split("/* DK_CORE_BEGIN */")
-    core = rest.split("/* DK_CORE_END */")[0]
+    core = rest.split("/* DK_CORE_END */")[0] + _REGRESSOR.read_text(encoding="utf-8")
     bindings = _THREADS.read_text(encoding="utf-8") + _BINDINGS.read_text(encoding="utf-8")
     source = "\n".join([
         "/* lagrangian: the derivatives of a tree's inverse and forward dynamics */",

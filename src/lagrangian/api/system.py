@@ -213,13 +213,10 @@ class System(CheckMethods, ControlMethods):
         if tree and self._floating:  # q (+) v dt on SE(3): api/floating_simulation.py
             from .floating_simulation import simulate_floating
 
-            if stop_when is not None:
-                raise InputError("stop_when is not yet taken for a floating base",
-                                 field="stop_when")
             step_control, save_at = run_options(step_control, save_at, method, rtol, atol,
                                                 samples, 1001)
             return Simulation.of(simulate_floating(self, t_end, initial, step_control, save_at,
-                                                   controller))
+                                                   controller, stop_when, limits, progress))
         if not tree:
             refuse_large_chain(self.model)  # before deriving what could not be compiled
             require_inertia(self.equations_of_motion(), "simulate")

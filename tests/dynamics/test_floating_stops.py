@@ -6,9 +6,11 @@ angle at the stop, through the API and the CLI."""
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
+from tests.docs_blocks import block, block_file
 
 import lagrangian
 from lagrangian.errors import ModelError
@@ -90,3 +92,21 @@ def test_the_command_stops_at_the_height(cli, path):
               "--stop-when", "base_height < 0")
     assert bad.code == 2 and bad.err.startswith("error:") and "base_height" in bad.err
     assert "Traceback" not in bad.err
+
+
+def test_docs_example_runs(capsys):
+    """docs/floating-base.md: the fall stops at sqrt(2 h / g), the swing at the limit."""
+    code = re.findall(r"```python\n(.*?)```", block("floating-base-stop"), re.S)[0]
+    exec(compile(code, str(block_file("floating-base-stop")), "exec"), {})
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == f"stopped {np.sqrt(2 * 0.3 / 9.81):.4f}" == "stopped 0.2473"
+    assert lines[1] == "limit 3.1"
+
+
+def test_docs_command_runs(cli):
+    command = re.findall(r"\$ lagrangian (.*)", block("floating-base-stop"))[0]
+    result = cli(*[part.strip('"') for part in re.findall(r'"[^"]*"|\S+', command)])
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    assert document["status"] == "stopped"
+    assert document["t_final"] == pytest.approx(np.sqrt(2 * 0.3 / 9.81), abs=1e-9)

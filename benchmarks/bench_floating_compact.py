@@ -3,6 +3,7 @@ against the unrolled module of the same tree (tree_c.py) and Pinocchio's aba, fo
 
     python benchmarks/bench_floating_compact.py            # talos_reduced and talos_full_v2
     python benchmarks/bench_floating_compact.py --json
+    python benchmarks/bench_floating_compact.py --no-cold  # per call and batch only (warm cache)
 
 Rows, per robot and kernel: "first s" is load (URDF -> tree, floating_base=True) plus the
 first forward dynamics in a fresh process with an empty compiled-module cache (LAGRANGIAN_CACHE
@@ -72,10 +73,10 @@ def best_pair(mine, theirs, repeat=7, number=1000) -> tuple[float, float]:
     return min(ours), min(pins)
 
 
-def measure(name: str, path: Path, kernel: str) -> dict:
+def measure(name: str, path: Path, kernel: str, cold: bool = True) -> dict:
     import pinocchio as pin
 
-    first = first_result(path, kernel)
+    first = first_result(path, kernel) if cold else float("nan")
     f = lagrangian.load(path, floating_base=True).dynamics(kernel=kernel)
     model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
     data = model.createData()
@@ -115,9 +116,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--robots", default=",".join(TALOS))
+    parser.add_argument("--no-cold", action="store_true", help="leave out the cold first result")
     args = parser.parse_args()
-    rows = [measure(name, TALOS[name], kernel) for name in args.robots.split(",")
-            for kernel in ("compact", "unrolled")]
+    rows = [measure(name, TALOS[name], kernel, not args.no_cold)
+            for name in args.robots.split(",") for kernel in ("compact", "unrolled")]
     load = os.getloadavg()[0]
     if args.json:
         print(json.dumps({"load": load, "rows": rows}, indent=1))

@@ -208,7 +208,8 @@ class System(CheckMethods, ControlMethods):
         generalized forces, or B u for named ``inputs`` (its own ``inputs`` where it has them,
         as lagrangian.control's controllers do), to the model's own; "model" runs the file's
         [control] laws, compiled with its equations: docs/control.md. On a floating base u
-        is the n joint torques or all n + 6 entries, the base's wrench first."""
+        is the n joint torques or all n + 6 entries, the base's wrench first, and
+        ``stop_when`` may name the base's numbers (base_z, base_vz, ...)."""
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
         if tree and self._floating:  # q (+) v dt on SE(3): api/floating_simulation.py
             from .floating_simulation import simulate_floating

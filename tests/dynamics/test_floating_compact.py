@@ -116,6 +116,12 @@ def test_a_quaternion_of_the_wrong_norm_is_one_line(tmp_path):
     near = q[0].copy()
     near[6] = 1.0 + 1e-9
     np.testing.assert_allclose(ours.gravity(near), ours.gravity(q[0]), rtol=0, atol=1e-12)
+    with pytest.raises(lagrangian.InputError, match="norm 2"):  # one q against five v
+        ours.bias_forces(q[1], np.zeros((5, ours.nv)))
+    with pytest.warns(lagrangian.DynamicsWarning):  # a state not finite: a NaN row, not judged
+        out = ours.forward_dynamics(np.stack([q[0], np.r_[q[0, :6], np.nan, q[0, 7:]]]),
+                                    np.zeros(ours.nv), np.zeros(ours.nv))
+    assert np.isfinite(out[0]).all() and np.isnan(out[1]).all()
     with pytest.raises(lagrangian.InputError, match="10 values") as info:
         ours.gravity(np.zeros(9))
     assert info.value.field == "q"

@@ -49,8 +49,17 @@ def did_you_mean_or_list(name: str, known: Iterable[str], most: int = 24) -> str
     return f"; expected one of: {shown}"
 
 
-# control characters as escapes (a newline as \n), so every message stays one line
-_ONE_LINE = {code: repr(chr(code))[1:-1] for code in (*range(32), 127)}
+# control characters as escapes (a newline as \n), so every message stays one line and no
+# user text reaches a terminal as a command: C0, DEL and C1 (0x9b is a terminal's CSI), the
+# line and paragraph separators (str.splitlines breaks there) and the bidirectional overrides
+_ONE_LINE = {code: f"\\u{code:04x}" if code > 255 else repr(chr(code))[1:-1]
+             for code in (*range(32), *range(127, 160), 0x2028, 0x2029,
+                          *range(0x202A, 0x202F), *range(0x2066, 0x206A))}
+
+
+def one_line(text: str) -> str:
+    """``text`` with its control characters as escapes: one line, safe for a terminal."""
+    return text.translate(_ONE_LINE)
 
 
 class LagrangianError(Exception):
@@ -69,7 +78,7 @@ class ModelError(LagrangianError):
     def __str__(self) -> str:
         where = ": ".join(part for part in (self.source, self.field) if part)
         text = f"{where}: {self.message}" if where else self.message
-        return text.translate(_ONE_LINE)  # a TOML key or value may hold a newline
+        return one_line(text)  # a TOML key or value may hold a newline
 
 
 class InputError(ModelError):

@@ -96,6 +96,25 @@ def test_regressor_section(capsys, cli):
     assert document["parameters"] == ["m1", "m2"] and len(document["base"]["names"]) == 2
 
 
+def test_floating_regressor_section(capsys, cli):
+    """Y pi is the inverse dynamics; the base's six equations identify more than a fixed base
+    (two_link_arm: 24 of 30 against 6 of 20); the command's Y pi is its own tau."""
+    lines = _run("control-regressor-floating", capsys)
+    assert lines[0] == "(8, 30) True"
+    floating, fixed = map(int, lines[1].split())
+    assert floating > fixed and (floating, fixed) == (24, 6)
+    result = cli(*_command("control-regressor-floating"))
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    Y, pi = np.array(document["regressor"]), np.array(document["values"])
+    assert Y.shape == (8, 30) and len(document["velocities"]) == 8
+    assert len(document["base"]["names"]) == 24
+    inverse = json.loads(cli("dynamics", "two_link_arm", "--floating-base", "--q",
+                             "0.1,0.2,0.3,0,0,0.6,0.8,0.4,-0.7", "--a", "0,0,0,0,0,0,0,0",
+                             "--json").out)["inverse_dynamics"]
+    np.testing.assert_allclose(Y @ pi, inverse, rtol=0, atol=1e-12 * np.abs(inverse).max())
+
+
 def test_control_law_section(capsys, cli, tmp_path, monkeypatch):
     compiled, stepped, same = _run("control-law", capsys)[-1].split()
     assert same == "True" and stepped == "scipy" and compiled in ("compiled", "scipy")
@@ -122,3 +141,14 @@ def test_constrained_section(capsys, cli):
     assert result.code == 0, result.err
     along = json.loads(result.out)["linearize_along"]
     assert np.array(along["A"]).shape == (11, 4, 4) and along["inputs"] == ["x", "y"]
+
+
+def test_manifold_section(capsys, cli):
+    lines = _run("control-manifold", capsys)
+    assert lines[0] == "('x', 'x_dot') ('y',)"
+    result = cli(*_command("control-manifold"))
+    assert result.code == 0, result.err
+    along = json.loads(result.out)["linearize_along"]
+    assert along["states"] == ["x", "x_dot"] and along["dependent"] == ["y"]
+    for A in np.array(along["A"]):  # hanging at rest: [[0, 1], [-g/L, 0]] at every sample
+        np.testing.assert_allclose(A, [[0, 1], [-9.81 / 0.5, 0]], atol=1e-9)

@@ -264,10 +264,12 @@ def test_bad_input_is_refused_in_one_line(tmp_path):
         robot.bias_forces(q, np.zeros(10))
     with pytest.raises(lagrangian.InputError, match="expected 10 values"):
         robot.jacobian(np.zeros(9), "foot")
-    # the derivatives of a floating base are compiled (test_derivatives_c.py); its regressor
-    # is not given yet
-    with pytest.raises(lagrangian.InputError, match="floating base are not given yet"):
-        robot.regressor(q, np.zeros(9), np.zeros(9))
+    # the regressor checks the quaternion and the widths as the dynamics do
+    with pytest.raises(lagrangian.InputError, match="norm 0.9") as info:
+        robot.regressor(np.r_[q[:6], 0.9, q[7:]], np.zeros(9), np.zeros(9))
+    assert info.value.field == "q"
+    with pytest.raises(lagrangian.InputError, match=r"expected 10 values \(base_x"):
+        robot.regressor(q[:9], np.zeros(9), np.zeros(9))
     with pytest.raises(lagrangian.ModelError, match="already floats the base"):
         lagrangian.load(path, floating_base=True)
     with pytest.raises(lagrangian.InputError, match="only a URDF model has a base to float"):

@@ -92,7 +92,7 @@ def test_standalone_frames_match_pinocchio(tmp_path, urdf):
 
 def test_the_documented_c_program(cli, tmp_path, monkeypatch):
     """docs/robot-kinematics.md, the frames-c block: its command writes the C, its program
-    compiles with -Wall -Werror and prints the library's placement and Jacobian."""
+    compiles with -Wall -Werror and prints the library's placement, Jacobian and A_g."""
     import re
     import shlex
 
@@ -114,4 +114,7 @@ def test_the_documented_c_program(cli, tmp_path, monkeypatch):
                                atol=1e-4)
     np.testing.assert_allclose([float(x) for x in out[5:7]], arm.jacobian(q, "fore")[0],
                                atol=1e-4)
+    np.testing.assert_allclose([float(x) for x in out[7:9]],
+                               arm.centroidal_momentum_matrix(q)[4], atol=1e-4)
     assert "fore at 0.9553 0.0000 0.2955" in source and "-0.2955 0.0000" in source
+    assert "-0.9523 -0.3876" in source

@@ -173,6 +173,22 @@ def test_sweep_workers_out_of_range_refused_before_starting(workers, text):
         assert outcome.status == "refused", (value, outcome)
 
 
+@fuzz(25)
+@given(model=st.sampled_from(["cartesian_pendulum", "four_bar", "rolling_coin", "pendulum"]),
+       names=st.lists(st.one_of(st.sampled_from(["x", "y", "theta1", "theta2", "theta3",
+                                                 "auto", "theta", ",", "x,y", ""]),
+                                special_names()), min_size=1, max_size=3),
+       along=st.booleans())
+def test_independent_coordinates_of_a_linearization(model, names, along):
+    """simulate --linearize-along --independent: accepted, or one line naming --independent or
+    independent (a wrong count, an unknown name, a singular split, a velocity constraint)."""
+    args = ["simulate", model, "--t-end", "0.05", "--samples", "3", "--json"]
+    args += ["--linearize-along"] if along else []
+    for name in names:
+        args += ["--independent", name]
+    check(contract(args, 60.0), args, "independent")
+
+
 @fuzz(60)
 @given(text=answer_files())
 def test_answer_files_check(text, folder):

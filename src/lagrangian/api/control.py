@@ -16,7 +16,8 @@ from ..simulation.simulate import model_law
 class ControlMethods:
     """Mixed into System (api/system.py)."""
 
-    def linearize_along(self, simulation, inputs: Sequence[str] | None = None
+    def linearize_along(self, simulation, inputs: Sequence[str] | None = None,
+                        independent: Sequence[str] | str | None = None
                         ) -> TrajectoryLinearization:
         """A(t), B(t) of x_dot = A x + B u (x = [q; q_dot], u the generalized forces on
         ``inputs``, default every coordinate) at ``simulation``'s saved samples, from the
@@ -24,8 +25,11 @@ class ControlMethods:
         run's own forces are held in place. A model with constraints gives the derivatives of its
         index-1 form (M q_ddot + Phi_q^T lambda = f + u, Phi_q q_ddot = gamma) in all n
         coordinates: A(t) then also holds the directions off the constraints (double zero
-        eigenvalues, Phi_ddot = 0), as the run's own right-hand side does."""
-        return linearize_along(self._dynamics_in_time(), simulation, inputs)
+        eigenvalues, Phi_ddot = 0), as the run's own right-hand side does; ``independent`` (its
+        n - m independent coordinates, or "auto" for the best conditioned along the run) gives
+        A(t), B(t) on the constraint manifold instead, in x = [q_i; q_i_dot] (holonomic
+        constraints; the others follow from Phi = 0 and Phi_dot = 0)."""
+        return linearize_along(self._dynamics_in_time(), simulation, inputs, independent)
 
     def _dynamics_in_time(self):
         """dynamics(), or where a model file's equations hold t explicitly (a moving support)

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from ..errors import InputError, LagrangianError, ModelError, ModelWarning
+from ..errors import InputError, LagrangianError, ModelError, ModelWarning, one_line
 
 if TYPE_CHECKING:
     from .. import EquationsOfMotion, System
@@ -141,8 +141,8 @@ def warn(line: str) -> None:
 
 def flush_warnings() -> None:
     """Print the command's warnings on stderr, one line each (main() calls it on success)."""
-    for line in _WARNINGS:
-        typer.echo(f"warning: {line}", err=True)
+    for line in _WARNINGS:  # a warning may quote a model's names: escaped as errors are
+        typer.echo(f"warning: {one_line(line)}", err=True)
     _WARNINGS.clear()
 
 

@@ -1,5 +1,6 @@
-"""`lagrangian regressor MODEL --q ... --v ... --a ... [--parameters m1,m2] [--base]`: the
-torque regressor Y (tau = Y pi) at one state, and a minimal identifiable parameter set."""
+"""`lagrangian regressor MODEL --q ... --v ... --a ... [--parameters m1,m2] [--base]
+[--floating-base]`: the torque regressor Y (tau = Y pi) at one state, and a minimal
+identifiable parameter set."""
 
 from __future__ import annotations
 
@@ -9,8 +10,8 @@ import typer
 
 from ..errors import InputError
 from . import app
-from .common import GRAVITY_HELP, LOCK_HELP, load_system, print_json
-from .dynamics import _vector
+from .common import FLOATING_HELP, GRAVITY_HELP, LOCK_HELP, load_system, print_json
+from .dynamics import _vector, base_layout
 
 
 @app.command()
@@ -24,6 +25,7 @@ def regressor(
     tolerance: Annotated[float, typer.Option("--tolerance", help="--base: |R_kk| / |R_00| below which a column is dependent.")] = 1e-8,  # noqa: E501
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
+    floating_base: Annotated[bool, typer.Option("--floating-base", help=FLOATING_HELP)] = False,
     set_: Annotated[list[str], typer.Option("--set", help="Override a parameter: NAME=VALUE.")] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
@@ -34,11 +36,12 @@ def regressor(
     from .. import resolve_state
     from ..output.regressor import regressor_document, regressor_text
 
-    system = load_system(model, set_, lock, gravity)
-    n = len(system.model.coordinates)
+    system = load_system(model, set_, lock, gravity, floating_base=floating_base)
     start = resolve_state(system.model)
-    qs = _vector(q, n, "--q", list(start.q))
-    vs = _vector(v, n, "--v", list(start.q_dot))
+    names_q, names_v, base_q, base_v = base_layout(system)
+    n = len(names_v)
+    qs = _vector(q, len(names_q), "--q", base_q + list(start.q))
+    vs = _vector(v, n, "--v", base_v + list(start.q_dot))
     accelerations = _vector(a, n, "--a", [0.0] * n)
     names = None if parameters is None else [p.strip() for p in parameters.split(",")]
     f = system.dynamics()
@@ -50,8 +53,8 @@ def regressor(
         if exc.field not in ("parameters", "tolerance"):
             raise
         raise InputError(exc.message, field=f"--{exc.field}") from None
-    document = regressor_document([c.name for c in system.model.coordinates],
-                                  f.parameter_names(names), values, np.asarray(Y), found)
+    document = regressor_document(names_q, f.parameter_names(names), values, np.asarray(Y),
+                                  found, velocities=names_v if base_q else None)
     if json_:
         print_json(document)
     else:

@@ -57,6 +57,7 @@ def simulate(
     kp: Annotated[str, typer.Option("--kp", help="--control computed-torque: position gain (1/s^2), a number or the diagonal.")] = "100",  # noqa: E501
     kd: Annotated[str, typer.Option("--kd", help="--control computed-torque: rate gain (1/s), a number or the diagonal.")] = "20",  # noqa: E501
     along: Annotated[bool, typer.Option("--linearize-along", help="Also A(t), B(t) of x = [q; q_dot] at the saved samples (u: each coordinate's generalized force); with --json under the key linearize_along; a constrained model's through its multipliers.")] = False,  # noqa: E501
+    independent: Annotated[list[str], typer.Option("--independent", help="--linearize-along on a constrained model: A(t), B(t) on the constraint manifold in these n - m coordinates (repeat, or separate by commas; auto: the best conditioned along the run).")] = [],  # noqa: B006,E501
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
@@ -90,6 +91,9 @@ def simulate(
     # a floating base's condition may name base_x .. base_wz: simulate reads it (one line)
     stop = parse_stop_condition(stop_when, system.model) \
         if stop_when is not None and not floating else stop_when
+    if independent and not along:
+        raise InputError("it names the coordinates of --linearize-along: give both",
+                         field="--independent")
     if out is not None:
         check_table_path(out)
     if plot is not None:
@@ -145,7 +149,9 @@ def simulate(
                                fps=20 if fps is None else fps)
         written["animate"] = str(target)
 
-    linearized = system.linearize_along(simulation) if along else None
+    kept = [name.strip() for text in independent for name in text.split(",") if name.strip()]
+    linearized = None if not along else system.linearize_along(
+        simulation, independent=None if not kept else "auto" if kept == ["auto"] else kept)
     if json_:
         document = simulation_document(simulation, written)
         if controller == "model":
@@ -162,7 +168,10 @@ def simulate(
                        else controller_text(controller))
         if linearized is not None:
             size, width = linearized.B.shape[1:]
-            typer.echo(f"linearized along the run: A(t) {size} x {size}, B(t) {size} x {width} "
+            where = "" if not linearized.dependent else (
+                f" on the constraints (in {', '.join(linearized.state_names[:size // 2])}; "
+                f"{', '.join(linearized.dependent)} follow)")
+            typer.echo(f"linearized along the run{where}: A(t) {size} x {size}, B(t) {size} x {width} "
                        f"at {len(linearized)} samples (--json for the numbers)")
     if simulation.status == RunStatus.FAILED:
         saved = f"; partial result saved to {', '.join(written.values())}" if written else ""

@@ -23,24 +23,33 @@ class TrajectoryLinearization:
     B: np.ndarray
     state_names: tuple[str, ...]
     inputs: tuple[str, ...]
+    dependent: tuple[str, ...] = ()  # on the constraint manifold: the coordinates left out
 
     def __len__(self) -> int:
         return len(self.t)
 
     def summary(self) -> dict:
-        """JSON-ready: t (s), the states, the inputs, A (N x 2n x 2n) and B (N x 2n x r)."""
-        return {"t": self.t.tolist(), "states": list(self.state_names),
-                "inputs": list(self.inputs), "A": self.A.tolist(), "B": self.B.tolist()}
+        """JSON-ready: t (s), the states, the inputs, A (N x 2n x 2n) and B (N x 2n x r); on
+        the constraint manifold also the dependent coordinates left out of the states."""
+        document = {"t": self.t.tolist(), "states": list(self.state_names),
+                    "inputs": list(self.inputs), "A": self.A.tolist(), "B": self.B.tolist()}
+        if self.dependent:
+            document["dependent"] = list(self.dependent)
+        return document
 
     def __repr__(self) -> str:
+        tied = f", dependent={list(self.dependent)}" if self.dependent else ""
         return (f"TrajectoryLinearization({len(self.t)} samples, states="
-                f"{list(self.state_names)}, inputs={list(self.inputs)})")
+                f"{list(self.state_names)}, inputs={list(self.inputs)}{tied})")
 
 
-def linearize_along(dynamics, simulation, inputs=None) -> TrajectoryLinearization:
+def linearize_along(dynamics, simulation, inputs=None,
+                    independent=None) -> TrajectoryLinearization:
     """A(t), B(t) of ``dynamics`` (System.dynamics(); a constrained model's through its
-    multipliers: A(t) of the index-1 form in all n coordinates) about ``simulation``'s samples;
-    ``inputs`` names the coordinates whose generalized forces are u (default all)."""
+    multipliers: A(t) of the index-1 form in all n coordinates, or with ``independent`` (n - m
+    coordinate names, or "auto") on the constraint manifold, control/manifold.py) about
+    ``simulation``'s samples; ``inputs`` names the coordinates whose generalized forces are u
+    (default all)."""
     names = tuple(dynamics.coordinates)
     if tuple(simulation.coordinates) != names:
         raise InputError("the simulation is not of this system (its coordinates are "
@@ -64,5 +73,11 @@ def linearize_along(dynamics, simulation, inputs=None) -> TrajectoryLinearizatio
     columns = [names.index(name) for name in inputs]
     B = np.zeros((count, 2 * n, len(columns)))
     B[:, n:, :] = by_force[:, :, columns]
-    return TrajectoryLinearization(t, A, B,
-                                   (*names, *(f"{c}_dot" for c in names)), inputs)
+    if independent is None:
+        return TrajectoryLinearization(t, A, B, (*names, *(f"{c}_dot" for c in names)), inputs)
+    from .manifold import reduce_to_manifold
+
+    A, B, kept, dependent = reduce_to_manifold(
+        dynamics, TrajectoryLinearization(t, A, B, (), inputs), q, v, t, independent)
+    return TrajectoryLinearization(t, A, B, (*kept, *(f"{c}_dot" for c in kept)), inputs,
+                                   dependent)

@@ -157,6 +157,27 @@ class ConstrainedDynamics:
         out.append(solve_rows(kkt, unit, warn=False)[:, :n, :].reshape(batch + (n, n)))
         return out[0], out[1], out[2]
 
+    def constraint_rows(self, q, v, t=0.0) -> tuple[np.ndarray, np.ndarray]:
+        """(A, dc/dq) at each state, (..., m, n) each: the velocity-level constraints c = A q_dot
+        + b = 0 (Phi_q q_dot + Phi_t for a holonomic one) and their change with q."""
+        batch, Q, V, _, T = self._states(q, v, np.zeros(self.n), t)
+        n, m = self.n, self.m
+        jacobian = self.functions._parts(Q, V, T)[2].reshape(len(Q), m, n)
+        found = self.__dict__.get("_velocity_rate")
+        if found is None:
+            eom = self._equations()
+            model = eom.model
+            values = self.functions.parameters
+            substitution = {p.symbol: sp.Float(values[p.name]) for p in model.parameters
+                            if p.name in values}
+            rows = sp.Matrix(eom.constraint_jacobian) * sp.Matrix(model.q_dot) \
+                + sp.Matrix(eom.velocity_bias)
+            found = self.__dict__["_velocity_rate"] = StateFunction(
+                model, [as_expression(rows[c]).diff(x) for c in range(m) for x in model.q],
+                substitution)
+        rate = found(Q, V, T).reshape(len(Q), m, n)
+        return jacobian.reshape(batch + (m, n)), rate.reshape(batch + (m, n))
+
     def _parts(self) -> dict[str, StateFunction]:
         """The symbolic derivatives, compiled on first use."""
         if self._derivatives is None:

@@ -33,14 +33,14 @@ class ControlTerms:
 
     def _regressor_of(self, parameters: Sequence[str] | None):
         tree = getattr(self, "tree", None)
-        _refuse_floating(tree, "regressor")
         if tree is not None:
             if parameters is not None:
                 raise InputError("a robot's regressor is over its bodies' 10 inertial "
                                  "parameters each; parameters=[...] is for model files",
                                  field="parameters")
-            fast = self._derivatives_kernel()
-            if fast is not None:  # compiled C (derivatives_c.py)
+            # compiled C (derivatives_c.py) for a fixed base; a floating base's in numpy
+            fast = None if tree.floating_base else self._derivatives_kernel()
+            if fast is not None:
                 compute, P = fast[2], fast[3]
                 return (lambda Q, V, A: compute(Q, V, A, P),
                         tree_parameter_names(tree), tree_parameters(tree))
@@ -61,8 +61,10 @@ class ControlTerms:
         """Y with tau = Y pi (inverse dynamics, the actuator parameters aside), shape
         (..., n, k). A URDF robot: 10 parameters per moving body in Pinocchio's order
         (m, m c_x, m c_y, m c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz about the body's joint
-        frame; see ``parameter_names``). A model file: the named ``parameters``, in which T and
-        V must be linear."""
+        frame; see ``parameter_names``); a floating base's (q of nv + 1 numbers with its
+        quaternion, v and a of nv) has nv rows, the first six the wrench on the base in its own
+        axes, force then moment (Pinocchio's layout). A model file: the named ``parameters``, in
+        which T and V must be linear."""
         fast = self._derivatives_kernel() if parameters is None else None
         if fast is not None and not self.tree.floating_base:  # one C call; a bad input goes
             # the guarded way to be named
@@ -87,12 +89,17 @@ class ControlTerms:
                         tolerance: float = BASE_TOLERANCE, states: int | None = None,
                         seed: int = 0) -> BaseParameters:
         """A minimal identifiable set by QR with column pivoting of Y stacked over ``states``
-        random states (default 20 per parameter; q in [-pi, pi], rates in [-1, 1]): a column
-        is kept where |R_kk| > ``tolerance`` |R_00| (default 1e-8)."""
+        random states (default 20 per parameter; q in [-pi, pi], rates in [-1, 1]; a floating
+        base's position in [-1, 1] m and a random unit quaternion): a column is kept where
+        |R_kk| > ``tolerance`` |R_00| (default 1e-8)."""
         compute, names, _ = self._regressor_of(parameters)
         count = states if states is not None else max(20 * len(names) // max(self.n, 1), 20)
         rng = np.random.default_rng(seed)
-        q = rng.uniform(-np.pi, np.pi, (count, self.n))
+        q = rng.uniform(-np.pi, np.pi, (count, self.nq))
+        if getattr(getattr(self, "tree", None), "floating_base", False):
+            q[:, :3] = rng.uniform(-1.0, 1.0, (count, 3))
+            quaternion = rng.normal(size=(count, 4))  # uniform on the unit sphere
+            q[:, 3:7] = quaternion / np.linalg.norm(quaternion, axis=-1, keepdims=True)
         v, a = rng.uniform(-1.0, 1.0, (2, count, self.n))
         stacked = np.asarray(compute(q, v, a)).reshape(count * self.n, len(names))
         return BaseParameters(names, stacked, tolerance)

@@ -22,6 +22,7 @@ import sympy as sp
 
 from ..compile.lambdified import StateFunction
 from ..errors import InputError
+from ..kinds import JointKind
 from ..model.expressions import as_expression
 from .joint_models import joint_model
 
@@ -39,7 +40,10 @@ def cross_matrix(x) -> np.ndarray:
 
 
 def _cross(a, b):
-    return np.cross(a, b)
+    # by components: np.cross's axis handling costs more than the product on (N, 3) batches
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def tree_parameters(tree) -> np.ndarray:
@@ -57,18 +61,31 @@ def tree_parameter_names(tree) -> tuple[str, ...]:
 
 
 def tree_motion(tree, gravity: float, Q, V, A):
-    """The forward pass of Newton-Euler over flat batches (N, n), real or complex (the
-    complex step of derivatives.py): each body's placement (R, p) in its parent, motion
-    subspace (s_w, s_v), and angular velocity w, angular acceleration dw and linear
-    acceleration a of its origin (gravity included: the ground accelerates up by g), body axes."""
+    """The forward pass of Newton-Euler over flat batches (N, nq) and (N, nv), real or complex
+    (the complex step of derivatives.py): each body's placement (R, p) in its parent, motion
+    subspace (s_w, s_v) (None for a floating base's free flyer, whose S is 1), and angular
+    velocity w, angular acceleration dw and linear acceleration a of its origin (gravity
+    included: the ground accelerates up by g), body axes. A floating base reads q[:7], v[:6]
+    (free_flyer.py); the joints q[7 + c], v[6 + c]."""
     count = len(Q)
     up = -gravity * np.array(tree.gravity_direction, dtype=float)
     placements, spaces, w, dw, acc = [], [], [], [], []
     dtype = np.result_type(Q, V, A, float)
+    iq, iv = tree.base_nq, tree.base_nv
     for joint in tree.joints:
         model = joint_model(joint.kind)
+        if joint.kind == JointKind.FREE_FLYER:  # the base: its twist (v, w) in its own axes
+            R, p = model.placement_arrays(np.array(joint.rotation, dtype=float),
+                                          np.array(joint.translation, dtype=float), Q[:, :7])
+            placements.append((R, p))
+            spaces.append(None)
+            w.append(V[:, 3:6])
+            dw.append(A[:, 3:6])
+            # the origin's acceleration v_dot + w x v, and up by g
+            acc.append(np.einsum("nji,j->ni", R, up) + A[:, :3] + _cross(V[:, 3:6], V[:, :3]))
+            continue
         u = np.array(joint.axis, dtype=float)
-        theta = joint.multiplier * Q[:, joint.coordinate] + joint.offset
+        theta = joint.multiplier * Q[:, iq + joint.coordinate] + joint.offset
         R, p = model.placement_arrays(np.array(joint.rotation, dtype=float),
                                       np.array(joint.translation, dtype=float), u, theta)
         R = np.broadcast_to(R, (count, 3, 3))
@@ -85,8 +102,8 @@ def tree_motion(tree, gravity: float, Q, V, A):
             w_in = np.einsum("nij,nj->ni", RT, wl)
             dw_in = np.einsum("nij,nj->ni", RT, dwl)
             a_i = np.einsum("nij,nj->ni", RT, al + _cross(dwl, p) + _cross(wl, _cross(wl, p)))
-        rate = joint.multiplier * V[:, joint.coordinate, None]
-        accel = joint.multiplier * A[:, joint.coordinate, None]
+        rate = joint.multiplier * V[:, iv + joint.coordinate, None]
+        accel = joint.multiplier * A[:, iv + joint.coordinate, None]
         w_i, dw_i = w_in, dw_in
         if s_w is not None:
             w_i = w_in + rate * s_w
@@ -101,28 +118,42 @@ def tree_motion(tree, gravity: float, Q, V, A):
 
 def tree_regressor(tree, gravity: float, Q: np.ndarray, V: np.ndarray, A: np.ndarray
                    ) -> np.ndarray:
-    """Y (N, n, 10 * bodies) over flat batches Q, V, A (N, n): tau = Y pi."""
-    count, n = Q.shape
+    """Y (N, nv, 10 * bodies) over flat batches Q (N, nq), V, A (N, nv): tau = Y pi. A floating
+    base's six rows are the wrench on the base in its axes (force, then moment), as
+    Pinocchio's rnea."""
+    count, nv = V.shape
     joints = tree.joints
     placements, spaces, w, dw, acc = tree_motion(tree, gravity, Q, V, A)
-    Y = np.zeros((count, n, 10 * len(joints)))
+    Y = np.zeros((count, nv, 10 * len(joints)))
+    if count <= 256:  # few states: every body's basis wrenches in one call (Python's overhead
+        # is per call); many: body by body (arrays that stay in cache)
+        forces, moments = (x.reshape(len(joints), count, 3, 10) for x in _basis_wrenches(
+            *(np.concatenate(x) for x in (w, dw, acc))))
+    shifts = [cross_matrix(p) for _, p in placements]  # [p]x of each body's origin
     for i in range(len(joints)):
-        force, moment = _basis_wrenches(w[i], dw[i], acc[i])
+        if count <= 256:
+            force, moment = forces[i], moments[i]
+        else:
+            force, moment = _basis_wrenches(w[i], dw[i], acc[i])
         k = i
         while k >= 0:  # the body's wrench reaches every joint from its own to the root
             joint = joints[k]
+            if spaces[k] is None:  # the free flyer: S = 1, the whole wrench (the root)
+                Y[:, 0:3, 10 * i:10 * i + 10] += force
+                Y[:, 3:6, 10 * i:10 * i + 10] += moment
+                break
             s_w, s_v = spaces[k]
             column = 0.0
             if s_w is not None:
                 column = column + np.einsum("nij,i->nj", moment, s_w)
             if s_v is not None:
                 column = column + np.einsum("nij,i->nj", force, s_v)
-            Y[:, joint.coordinate, 10 * i:10 * i + 10] += joint.multiplier * column
+            Y[:, tree.base_nv + joint.coordinate, 10 * i:10 * i + 10] += joint.multiplier * column
             if joint.parent < 0:
                 break
-            R, p = placements[k]
+            R = placements[k][0]
             force = R @ force
-            moment = R @ moment + cross_matrix(p) @ force
+            moment = R @ moment + shifts[k] @ force
             k = joint.parent
     return Y
 

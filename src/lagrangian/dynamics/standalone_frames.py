@@ -3,9 +3,10 @@ added to standalone.py's tree source: ``<P>_frame_placement(q, frame, T)`` (4 x 
 rotation and origin in m, world) and ``<P>_frame_jacobian(q, frame, reference, J)`` (6 x N,
 row-major, linear rows first; reference 0 world, 1 local, 2 local_world_aligned, as
 Pinocchio's), ``<P>_frame_jacobian_dot_times_v(q, v, frame, reference, out)`` (the classical
-acceleration at a = 0) and ``<P>_center_of_mass(q, c)`` with its Jacobian, the frames by index
-in ``<P>_frame_names``: frames.py's and centroidal.py's formulas over the tree's numbers written
-as static tables, a floating base's free flyer as body 0.
+acceleration at a = 0), ``<P>_center_of_mass(q, c)`` with its Jacobian and the centroidal
+momentum matrix ``<P>_centroidal_momentum_matrix(q, Ag)`` (6 x N, as Pinocchio's ccrba), the
+frames by index in ``<P>_frame_names``: frames.py's and centroidal.py's formulas over the
+tree's numbers written as static tables, a floating base's free flyer as body 0.
 """
 
 from __future__ import annotations
@@ -49,6 +50,10 @@ void {P}_frame_jacobian_dot_times_v(const double *q, const double *v, int frame,
    3 x {U}_N (c_dot = Jc v); NaN without moving mass. */
 void {P}_center_of_mass(const double *q, double *c);
 void {P}_center_of_mass_jacobian(const double *q, double *Jc);
+/* The centroidal momentum matrix, Ag row-major 6 x {U}_N: h_g = Ag v, the linear momentum
+   (kg m/s) then the angular momentum about the centre of mass (kg m^2/s), world axes, as
+   Pinocchio's ccrba; its angular rows NaN without moving mass. */
+void {P}_centroidal_momentum_matrix(const double *q, double *Ag);
 """
 
 
@@ -69,6 +74,7 @@ def frame_functions(P: str, tree: KinematicTree) -> str:
         c_table("fr_u", "double", [list(j.axis) for j in joints]),
         c_table("fr_m", "double", [j.mass for j in joints]),
         c_table("fr_h", "double", [list(j.first_moment) for j in joints]),
+        c_table("fr_J", "double", [[x for row in j.inertia for x in row] for j in joints]),
         c_table("fr_fbody", "int", [f.body for f in frames] or [-1]),
         c_table("fr_fR", "double", [[x for row in f.rotation for x in row] for f in frames]
                or [[1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0]]),
@@ -357,6 +363,53 @@ void {P}_center_of_mass_jacobian(const double *q, double *Jc)
             for (int j = 0; j < 3; j++)
                 Jc[j * FR_NV + first + c] += (M[i] * S[c][j] + t[j]) / (total > 0.0 ? total : NAN);
         }}
+    }}
+}}
+
+void {P}_centroidal_momentum_matrix(const double *q, double *Ag)
+{{
+    double R[FR_NB][9], o[FR_NB][3], M[FR_NB], H[FR_NB][3], I[FR_NB][9], G[3];
+    double total = fr_subtrees(q, R, o, M, H);
+    for (int i = 0; i < FR_NB; i++) {{  /* J_O about the world's origin, world axes */
+        double RJ[9], hr[3], oo = 0.0, oh = 0.0;
+        fr_matmul(R[i], fr_J[i], RJ);
+        fr_apply(R[i], fr_h[i], hr);
+        for (int j = 0; j < 3; j++) {{ oo += o[i][j] * o[i][j]; oh += o[i][j] * hr[j]; }}
+        for (int a = 0; a < 3; a++)  /* R J R^T + m (|o|^2 1 - o o^T) + 2 (o.h) 1 - o h^T - h o^T */
+            for (int b = 0; b < 3; b++)
+                I[i][3 * a + b] = RJ[3 * a] * R[i][3 * b] + RJ[3 * a + 1] * R[i][3 * b + 1]
+                                  + RJ[3 * a + 2] * R[i][3 * b + 2]
+                                  + fr_m[i] * ((a == b) * oo - o[i][a] * o[i][b])
+                                  + (a == b) * 2.0 * oh - o[i][a] * hr[b] - hr[a] * o[i][b];
+    }}
+    for (int i = FR_NB - 1; i >= 0; i--)  /* the subtrees' inertias, leaves first */
+        if (fr_parent[i] >= 0)
+            for (int j = 0; j < 9; j++) I[fr_parent[i]][j] += I[i][j];
+    for (int j = 0; j < 6 * FR_NV; j++) Ag[j] = 0.0;
+    for (int i = 0; i < FR_NB; i++) {{  /* a unit rate: [M s_v + s_w x h; h x s_v + I s_w] */
+        double S[6][6], l[3], k[3], t[3];
+        int first, count = fr_columns(i, R, o, S, &first);
+        for (int c = 0; c < count; c++) {{
+            fr_cross(S[c] + 3, H[i], t);
+            for (int j = 0; j < 3; j++) l[j] = M[i] * S[c][j] + t[j];
+            fr_cross(H[i], S[c], t);
+            fr_apply(I[i], S[c] + 3, k);
+            for (int j = 0; j < 3; j++) {{
+                Ag[j * FR_NV + first + c] += l[j];
+                Ag[(3 + j) * FR_NV + first + c] += k[j] + t[j];
+            }}
+        }}
+    }}
+    for (int j = 0; j < 3; j++) {{  /* the centre of mass G */
+        G[j] = 0.0;
+        for (int i = 0; i < FR_NB; i++)
+            if (fr_parent[i] < 0) G[j] += H[i][j];
+        G[j] = total > 0.0 ? G[j] / total : NAN;
+    }}
+    for (int c = 0; c < FR_NV; c++) {{  /* about G: k_G = k_O - G x l */
+        double l[3] = {{Ag[c], Ag[FR_NV + c], Ag[2 * FR_NV + c]}}, t[3];
+        fr_cross(G, l, t);
+        for (int j = 0; j < 3; j++) Ag[(3 + j) * FR_NV + c] -= t[j];
     }}
 }}
 """

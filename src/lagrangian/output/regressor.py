@@ -7,10 +7,12 @@ from typing import Any
 import numpy as np
 
 
-def regressor_document(coordinates, names, values, Y, base=None) -> dict[str, Any]:
+def regressor_document(coordinates, names, values, Y, base=None,
+                       velocities=None) -> dict[str, Any]:
     """coordinates, parameters (names and the model's values pi), the regressor Y (n x k
     nested lists, tau = Y pi), tau; with ``base`` its names, tolerance and combination
-    (beta = combination pi). SI units."""
+    (beta = combination pi); a floating base's ``velocities``, the names of Y's rows and tau's
+    (``coordinates`` are q's). SI units."""
     Y = np.asarray(Y, dtype=float)
     document: dict[str, Any] = {
         "coordinates": list(coordinates),
@@ -19,6 +21,8 @@ def regressor_document(coordinates, names, values, Y, base=None) -> dict[str, An
         "regressor": Y.tolist(),
         "tau": (Y @ np.asarray(values, dtype=float)).tolist(),
     }
+    if velocities is not None:
+        document["velocities"] = list(velocities)
     if base is not None:
         document["base"] = {"tolerance": base.tolerance, "names": list(base.base_names),
                             "combination": base.combination.tolist(),
@@ -30,16 +34,19 @@ def regressor_document(coordinates, names, values, Y, base=None) -> dict[str, An
 def regressor_text(document: dict[str, Any]) -> str:
     """The parameters with their values, Y row by row, tau; the base set when present."""
     names = document["parameters"]
+    rows = document.get("velocities", document["coordinates"])
     lines = [f"Coordinates: {', '.join(document['coordinates'])}; tau = Y pi "
              f"({len(names)} parameters, SI)"]
+    if "velocities" in document:
+        lines.append(f"Velocities (Y's rows): {', '.join(rows)}")
     lines.append("parameters pi:")
     width = max(len(n) for n in names)
     lines += [f"  {n:<{width}}  {x: .9g}" for n, x in zip(names, document["values"], strict=True)]
-    lines.append("regressor Y (one row per coordinate):")
+    lines.append("regressor Y (one row per "
+                 f"{'velocity' if 'velocities' in document else 'coordinate'}):")
     lines += ["  " + "  ".join(f"{x: .6g}" for x in row) for row in document["regressor"]]
     lines.append("tau = Y pi:")
-    lines += [f"  {c}  {x: .9g}" for c, x in zip(document["coordinates"], document["tau"],
-                                                 strict=True)]
+    lines += [f"  {c}  {x: .9g}" for c, x in zip(rows, document["tau"], strict=True)]
     base = document.get("base")
     if base is not None:
         lines.append(f"base parameters ({len(base['names'])} of {len(names)}, tolerance "

@@ -276,8 +276,8 @@ def test_bad_input_is_refused_in_one_line(tmp_path):
         lagrangian.load("pendulum", floating_base=True)
     with pytest.raises(lagrangian.ModelError, match="no equations in its joint coordinates"):
         system.equations_of_motion()
-    with pytest.raises(lagrangian.InputError, match="not yet"):  # a floating run has no stops yet
-        system.simulate(0.1, stop_when="knee > 1")
+    with pytest.raises(lagrangian.ModelError, match="unknown name 'kneee'"):  # the stop's names
+        system.simulate(0.1, stop_when="kneee > 1")
     bad = tmp_path / "bad.urdf"
     bad.write_text(FLOATING_URDF.replace('name="knee" type="revolute"', 'name="knee" type="floating"'))
     with pytest.raises(lagrangian.ModelError, match="its parent must be the root link 'world'"):

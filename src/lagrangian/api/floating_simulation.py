@@ -3,6 +3,8 @@
 q_dot from v by the free flyer's kinematics (position rate R v_lin, quaternion rate
 1/2 q (x) (0, omega)), v_dot by the tree's forward dynamics; the quaternion is renormalized
 after each accepted step (scipy's stepped loop; the compiled DOP853 loop takes q_dot = v only).
+A stop condition (which may name the base's numbers) and the joints' position limits end the
+run as on a fixed base (simulation/simulate.py): the event located on the step's dense output.
 """
 
 from __future__ import annotations
@@ -15,9 +17,12 @@ import numpy as np
 from ..errors import InputError, did_you_mean
 from ..kinds import InvariantKind, RunStatus
 from ..model.values import resolve_state
+from ..simulation.events import StopCondition, parse_stop_condition
+from ..simulation.integration_loops import LoopRun, crossing_time
 from ..simulation.invariants import cumulative_work
 from ..simulation.options import SaveAt, StepControl
 from ..simulation.result import STATUS_MESSAGES, SimulationResult
+from ..simulation.simulate import at_limit, beyond_limits, exceeded_limits, urdf_limits
 
 
 def configuration_rate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -104,15 +109,55 @@ class FloatingControl:
         return u
 
 
+def floating_stop_condition(text: str, dynamics, model) -> StopCondition:
+    """``text`` ('base_z < 0.2', 'knee > 1') parsed with the base's names (base_x .. base_qw,
+    base_vx .. base_wz) beside the model's; one line for an unknown name."""
+    import sympy as sp
+
+    base = (*dynamics.coordinates[:7], *dynamics.velocity_names[:6])
+    return parse_stop_condition(text, model, names={name: sp.Symbol(name) for name in base})
+
+
+def _stop_event(stop: StopCondition, dynamics, model, parameters):
+    """g(q, v, t) of a stop condition (> 0 where it holds), q and v in the floating layout."""
+    import sympy as sp
+
+    from ..compile.lambdified import numpy_function
+
+    values = {p.symbol: parameters[p.name] for p in model.parameters
+              if parameters.get(p.name) is not None}
+    base_q = [sp.Symbol(name) for name in dynamics.coordinates[:7]]
+    base_v = [sp.Symbol(name) for name in dynamics.velocity_names[:6]]
+    g = numpy_function([*base_q, *model.q, *base_v, *model.q_dot, model.time],
+                       stop.function.xreplace(values))
+
+    def event(q, v, t) -> float:
+        return float(np.real(g(*q, *v, t)))
+
+    return event
+
+
+def _limit_event(limits):
+    """The joints' position-limit event (simulate.beyond_limits) on the floating layout."""
+    beyond = beyond_limits(limits)
+    return None if beyond is None else (lambda q, v, t: beyond(q[7:], v[6:], t)), beyond
+
+
 def simulate_floating(system, t_end: float, initial, step_control: StepControl,
-                      save_at: SaveAt, controller=None) -> SimulationResult:
+                      save_at: SaveAt, controller=None, stop: str | StopCondition | None = None,
+                      limits: bool = True, progress=None) -> SimulationResult:
     """Integrate a floating-base robot to ``t_end`` (s) with the model's own loads (its
     tau_<joint> parameters), gravity and a ``controller``'s forces (FloatingControl); the
-    quaternion kept of norm 1 after every step."""
+    quaternion kept of norm 1 after every step. ``stop`` ends the run where it turns true
+    (status 'stopped'), a joint reaching its URDF position limit ends it with status 'limit'
+    (``limits`` False: the joints run through them), as simulate does on a fixed base."""
     from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
     dynamics = system.dynamics()
     model = system.model
+    if isinstance(stop, str):
+        stop = floating_stop_condition(stop, dynamics, model)
+    joint_limits = urdf_limits(model, positions=limits)
     t0, q0, v0 = floating_start(dynamics, model, initial)
     if not (np.isfinite(t_end) and t_end > t0):
         raise InputError(f"the end time ({t_end} s) must be after the start time ({t0} s)",
@@ -140,9 +185,19 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     grid = np.linspace(t0, t_end, save_at.samples)
     solver = solver_class(rhs, t0, np.concatenate([q0, v0]), t_end, rtol=step_control.rtol,
                           atol=step_control.atol, **options)
-    samples = [np.concatenate([q0, v0])]
+    user = None if stop is None else _stop_event(stop, dynamics, model, system.parameters)
+    limit, beyond = _limit_event(joint_limits)
+    event = user if limit is None else limit if user is None else (
+        lambda q, v, t: max(user(q, v, t), limit(q, v, t)))
+    samples, times = [np.concatenate([q0, v0])], [t0]
     k, steps, status, message = 1, 0, RunStatus.FINISHED, STATUS_MESSAGES["finished"]
+    armed = event is not None and event(q0, v0, t0) < 0  # true at the start: not a crossing
     began = time.perf_counter()
+
+    def unit(y):  # a sample (or q) on the unit sphere too; y is dense output's own copy
+        y[3:7] /= np.linalg.norm(y[3:7])
+        return y
+
     try:
         while k < len(grid):
             message_of_step = solver.step()
@@ -152,21 +207,46 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
                 message = f"the step failed at t = {solver.t:.6g} s: {message_of_step}"
                 break
             dense = solver.dense_output()
-            while k < len(grid) and grid[k] <= solver.t:
-                y = dense(grid[k])
-                y[3:7] /= np.linalg.norm(y[3:7])  # the sample on the unit sphere too
-                samples.append(y)
-                k += 1
             # the accepted state back on the unit sphere: |q| drifts by the step's error only
             solver.y[3:7] /= np.linalg.norm(solver.y[3:7])
+            t_stop, hit = solver.t, False
+            if event is not None:
+                g_new = event(solver.y[:nq], solver.y[nq:], solver.t)
+                if armed and g_new >= 0:  # where it turns true, as the fixed base's loop
+                    t_stop = crossing_time(lambda q, v, t: event(unit(q), v, t), dense,
+                                           solver.t_old, solver.t, nq)
+                    hit = True
+                elif g_new < 0:
+                    armed = True
+            while k < len(grid) and grid[k] <= t_stop:
+                samples.append(unit(dense(grid[k])))
+                times.append(float(grid[k]))
+                k += 1
+            if hit:
+                if t_stop > times[-1]:
+                    samples.append(unit(dense(t_stop)))
+                    times.append(float(t_stop))
+                status, message = RunStatus.STOPPED, f"stop condition met at t = {t_stop:.12g} s"
+                break
             if solver.status == "finished" and k < len(grid):
                 samples.append(solver.y.copy())
+                times.append(float(grid[k]))
                 k += 1
+            if progress is not None:
+                progress(solver.t)
     except KeyboardInterrupt:
         status, message = RunStatus.INTERRUPTED, f"interrupted at t = {solver.t:.6g} s"
     wall = time.perf_counter() - began
     Y = np.array(samples)
-    t = grid[:len(Y)]
+    t = np.array(times)
+    if status == RunStatus.STOPPED and beyond is not None:  # a joint's limit, or the condition
+        y = Y[-1]
+        there = None if user is None else user(y[:nq], y[nq:], t[-1])
+        joints = LoopRun(t[-1:], np.r_[y[7:nq], y[nq + 6:]][None], status, message, steps, 0)
+        decided = at_limit(joints, [m for m in joint_limits if m.lower is not None
+                                    and m.upper is not None], beyond,
+                           None if there is None else (lambda *_: there), nq - 7)
+        status, message = decided.status, decided.message
     q, v = Y[:, :nq], Y[:, nq:]
     kinetic = dynamics.kinetic_energy(q, v)
     energy = kinetic + dynamics.potential_energy(q)
@@ -186,7 +266,9 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
         energy_conserved=not working, t_end=float(t_end), kinetic_energy=kinetic,
         invariant=kind, invariant_values=energy,
         work=cumulative_work(t, power) if working else None,
-        velocity_names=tuple(dynamics.velocity_names))
+        velocity_names=tuple(dynamics.velocity_names),
+        stop_when=stop.text if stop is not None else None,
+        limits_exceeded=exceeded_limits(joint_limits, system.parameters, t, v[:, 6:]))
 
 
 def _joint_forces(model, parameters: Mapping[str, float]) -> np.ndarray:

@@ -208,18 +208,16 @@ class System(CheckMethods, ControlMethods):
         generalized forces, or B u for named ``inputs`` (its own ``inputs`` where it has them,
         as lagrangian.control's controllers do), to the model's own; "model" runs the file's
         [control] laws, compiled with its equations: docs/control.md. On a floating base u
-        is the n joint torques or all n + 6 entries, the base's wrench first."""
+        is the n joint torques or all n + 6 entries, the base's wrench first, and
+        ``stop_when`` may name the base's numbers (base_z, base_vz, ...)."""
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
         if tree and self._floating:  # q (+) v dt on SE(3): api/floating_simulation.py
             from .floating_simulation import simulate_floating
 
-            if stop_when is not None:
-                raise InputError("stop_when is not yet taken for a floating base",
-                                 field="stop_when")
             step_control, save_at = run_options(step_control, save_at, method, rtol, atol,
                                                 samples, 1001)
             return Simulation.of(simulate_floating(self, t_end, initial, step_control, save_at,
-                                                   controller))
+                                                   controller, stop_when, limits, progress))
         if not tree:
             refuse_large_chain(self.model)  # before deriving what could not be compiled
             require_inertia(self.equations_of_motion(), "simulate")

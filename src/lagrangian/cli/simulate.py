@@ -88,7 +88,9 @@ def simulate(
         start = resolve_state(system.model, start, field="initial")
     step_control = StepControl(method, rtol, atol)
     save_at = SaveAt(samples)
-    stop = parse_stop_condition(stop_when, system.model) if stop_when is not None else None
+    # a floating base's condition may name base_x .. base_wz: simulate reads it (one line)
+    stop = parse_stop_condition(stop_when, system.model) \
+        if stop_when is not None and not floating else stop_when
     if independent and not along:
         raise InputError("it names the coordinates of --linearize-along: give both",
                          field="--independent")

@@ -4,16 +4,18 @@ mass, centre of mass or inertia changes without a rebuild.
 
 The description ``D`` (float64, contiguous), built by ``describe``:
 
-    D[0] nb bodies, D[1] n coordinates, D[2:5] the gravity vector g * direction (world axes,
-    m/s^2), D[5] 1 where a coordinate drives more or fewer than one body (mimic joints: forward
-    dynamics by Cholesky of M instead of the articulated-body algorithm), D[6:8] spare;
+    D[0] nb bodies, D[1] n joint coordinates, D[2:5] the gravity vector g * direction (world
+    axes, m/s^2), D[5] 1 where a coordinate drives more or fewer than one body (mimic joints:
+    forward dynamics by Cholesky of M instead of the articulated-body algorithm), D[6] 1 for a
+    floating base (body 0 on a free flyer: q of n + 7 numbers, v of n + 6, free_flyer.py's
+    layout), D[7] the quaternion-norm tolerance (free_flyer.QUATERNION_TOLERANCE);
     D[8:8+n] the actuator parameters tau_<joint> (N m or N), acting as loads;
     then nb records of STRIDE = 40 numbers, parent first (parent < own index):
       0 parent (-1 the ground)  1 kind code (JOINT_CODES)  2 coordinate index c
       3 multiplier k  4 offset (theta = k q[c] + offset)  5:14 R0 (joint -> parent axes,
       row-major)  14:17 t0 (m)  17:20 unit axis u (joint axes)  20 mass (kg)
       21:24 first moment h = m c about the body origin (kg m)  24:33 J_O (kg m^2, body axes)
-      33:40 spare (a free-flyer's velocity index would go here).
+      33:40 spare. A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone.
 
 A new joint kind is a new code in JOINT_CODES and its cases in tree_kernel.c (tk_place for the
 placement, tk_subspace for S); the recursions themselves ask only for those. The module (tree_kernel.c,
@@ -36,7 +38,7 @@ from ..model.tree import KinematicTree, TreeJoint
 from .recursive import RecursiveDynamics
 
 HEADER, STRIDE = 8, 40
-JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1}
+JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FREE_FLYER: 2}
 
 # the recursions, the thread count shared with the other modules, then the batched Python
 # bindings (one translation unit)
@@ -57,16 +59,19 @@ COMPACT_ABOVE = 16
 def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
     """The tree as the kernel's array D (layout above), with the parameters' values (g and the
     actuators) in SI units."""
+    from .free_flyer import QUATERNION_TOLERANCE
+
     n, nb = len(tree.coordinates), len(tree.joints)
     D = np.zeros(HEADER + n + nb * STRIDE)
     D[0], D[1] = nb, n
     D[2:5] = float(parameters.get(tree.gravity_parameter, 0.0)) * np.array(tree.gravity_direction)
-    drives = np.bincount([j.coordinate for j in tree.joints], minlength=n)
+    drives = np.bincount([j.coordinate for j in tree.joints if j.coordinate >= 0], minlength=n)
     D[5] = float(not np.all(drives == 1))
+    D[6], D[7] = float(tree.floating_base), QUATERNION_TOLERANCE
     D[HEADER:HEADER + n] = [float(parameters.get(a, 0.0)) for a in tree.actuators]  # None: 0
     for i, j in enumerate(tree.joints):
         r = D[HEADER + n + i * STRIDE:HEADER + n + (i + 1) * STRIDE]
-        r[0], r[1], r[2] = j.parent, JOINT_CODES[JointKind(j.kind)], j.coordinate
+        r[0], r[1], r[2] = j.parent, JOINT_CODES[JointKind(j.kind)], max(j.coordinate, 0)
         r[3], r[4] = j.multiplier, j.offset
         r[5:14] = np.ravel(j.rotation)
         r[14:17], r[17:20] = j.translation, j.axis
@@ -87,9 +92,11 @@ def joints_of(D: np.ndarray) -> tuple[TreeJoint, ...]:
         def matrix(a):
             return tuple(tuple(float(x) for x in row) for row in np.reshape(a, (3, 3)))
 
+        free = kinds[int(r[1])] == JointKind.FREE_FLYER
         out.append(TreeJoint(name="", parent=int(r[0]), kind=kinds[int(r[1])],
                              rotation=matrix(r[5:14]), translation=tuple(map(float, r[14:17])),
-                             axis=tuple(map(float, r[17:20])), coordinate=int(r[2]),
+                             axis=tuple(map(float, r[17:20])),
+                             coordinate=-1 if free else int(r[2]),
                              multiplier=float(r[3]), offset=float(r[4]), mass=float(r[20]),
                              first_moment=tuple(map(float, r[21:24])), inertia=matrix(r[24:33])))
     return tuple(out)
@@ -136,6 +143,10 @@ class CompactDynamics(RecursiveDynamics):
         """The NumericSystem over this kernel (M, f = -b, energy, accelerations, rhs)."""
         from ..compile.functions import NumericSystem
 
+        if self.tree.floating_base:  # q and v differ in length: simulate_floating steps it
+            from .recursive_numpy import floating_refusal
+
+            raise floating_refusal()
         return NumericSystem(coordinates=self.coordinates, constraint_names=(),
                              constraint_kinds=(), parameters=dict(self.parameters),
                              _kernel=_CompactKernel(self))

@@ -439,13 +439,11 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
         tree = inertials
     dynamics = None
     if backend != "numpy":
-        # a link's inertial set here, or a payload: the compact kernel takes them at run time
-        if kernel == "compact" and tree.floating_base:
-            raise InputError("the compact kernel takes fixed-base trees only (a floating base "
-                             "runs in the unrolled module)", field="kernel")
-        compact = not tree.floating_base and (kernel == "compact" or (kernel == "auto" and (
+        # a link's inertial set here, or a payload: the compact kernel takes them at run time;
+        # a floating base too (its free flyer is body 0 there)
+        compact = kernel == "compact" or (kernel == "auto" and (
             inertials or len(tree.joints) > COMPACT_ABOVE
-            or any(link.name.startswith(PAYLOAD_PREFIX) for link in tree.links))))
+            or any(link.name.startswith(PAYLOAD_PREFIX) for link in tree.links)))
         try:
             dynamics = (CompactDynamics if compact else RecursiveDynamics)(model, tree, parameters)
         except BackendUnavailable as exc:

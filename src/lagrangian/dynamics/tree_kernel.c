@@ -2,7 +2,10 @@
    run time as one array of doubles (its layout in compact_kernel.py), compiled once for every
    tree. Units SI. Each body i hangs from parent(i) < i (or the ground, -1) by one joint:
    R = R0 Rot(u, theta) (revolute) or R0 (prismatic), p = t0 (+ R0 u theta), with
-   theta = k q[c] + offset; R turns body axes into parent axes, p is the origin in the parent. */
+   theta = k q[c] + offset; R turns body axes into parent axes, p is the origin in the parent.
+   A floating base (header flag) is body 0 on a free flyer (kind 2, free_flyer.py): q holds
+   nq = 7 + n numbers (its position, quaternion x y z w, then the joints: q[7 + c]), v, a and
+   tau nv = 6 + n (its twist in its own axes, linear then angular, then v[6 + c]). */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
@@ -11,11 +14,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define TK_HEADER 8     /* nb, n, gravity vector g*dir (3, world axes), mimic flag, 2 spare */
+#define TK_HEADER 8     /* nb, n, gravity vector g*dir (3, world axes), mimic flag, floating
+                           flag, quaternion tolerance */
 #define TK_STRIDE 40    /* numbers per body record */
 /* a body record's fields */
 #define TK_PARENT 0
-#define TK_KIND 1       /* 0 revolute, 1 prismatic (a free-flyer would be a new code) */
+#define TK_KIND 1       /* 0 revolute, 1 prismatic, 2 free flyer (body 0 only) */
 #define TK_COORD 2
 #define TK_MULT 3
 #define TK_OFFSET 4
@@ -31,7 +35,13 @@
 #define TW_P 9
 #define TW_A 12         /* 6-vectors and 6x6 matrices of the algorithms from here */
 
-typedef struct { int nb, n, mimic; const double *g, *tau0, *body; } tk_tree;
+typedef struct {
+    int nb, n, mimic, fb, bq, bv, nq, nv;  /* bq, bv: the base's numbers before the joints' */
+    double qtol;
+    const double *g, *tau0, *body;
+} tk_tree;
+
+#define TK_FREE(b) ((b)[TK_KIND] == 2.0)
 
 static inline void tk_cross(const double *a, const double *b, double *c)
 {
@@ -73,16 +83,28 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
     t->nb = (int)d[0];
     t->n = (int)d[1];
     t->mimic = d[5] != 0.0;
+    t->fb = d[6] != 0.0;
+    t->qtol = d[7];
+    t->bq = t->fb ? 7 : 0;
+    t->bv = t->fb ? 6 : 0;
+    t->nq = t->bq + t->n;
+    t->nv = t->bv + t->n;
     t->g = d + 2;
     t->tau0 = d + TK_HEADER;
     t->body = d + TK_HEADER + t->n;
-    if (t->nb < 1 || t->n < 1 || size != TK_HEADER + t->n + (Py_ssize_t)t->nb * TK_STRIDE)
+    if (t->nb < 1 || t->n < (t->fb ? 0 : 1)
+        || size != TK_HEADER + t->n + (Py_ssize_t)t->nb * TK_STRIDE)
         return -1;
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
-        if (!(b[TK_PARENT] >= -1 && b[TK_PARENT] < i) || !(b[TK_COORD] >= 0 && b[TK_COORD] < t->n)
-            || !(b[TK_KIND] == 0 || b[TK_KIND] == 1))
+        if (!(b[TK_PARENT] >= -1 && b[TK_PARENT] < i))
             return -1;
+        if (t->fb && i == 0) {  /* the free flyer, and only it, on the ground */
+            if (!TK_FREE(b) || b[TK_PARENT] != -1) return -1;
+        } else if (!(b[TK_COORD] >= 0 && b[TK_COORD] < t->n)
+                   || !(b[TK_KIND] == 0 || b[TK_KIND] == 1)) {
+            return -1;
+        }
     }
     return 0;
 }
@@ -94,7 +116,21 @@ static void tk_place(const tk_tree *t, const double *q, double *W)
         const double *b = t->body + i * TK_STRIDE;
         double *R = W + i * TW_STRIDE + TW_R, *p = W + i * TW_STRIDE + TW_P;
         const double *R0 = b + TK_R0, *u = b + TK_AXIS;
-        const double theta = b[TK_MULT] * q[(int)b[TK_COORD]] + b[TK_OFFSET];
+        if (TK_FREE(b)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
+            const double x = q[3], y = q[4], z = q[5], s = q[6];
+            const double k = 2.0 / (x * x + y * y + z * z + s * s);
+            const double E[9] = {1 - k * (y * y + z * z), k * (x * y - z * s), k * (x * z + y * s),
+                                 k * (x * y + z * s), 1 - k * (x * x + z * z), k * (y * z - x * s),
+                                 k * (x * z - y * s), k * (y * z + x * s), 1 - k * (x * x + y * y)};
+            for (int r = 0; r < 3; r++)
+                for (int col = 0; col < 3; col++)
+                    R[3 * r + col] = R0[3 * r] * E[col] + R0[3 * r + 1] * E[3 + col]
+                                     + R0[3 * r + 2] * E[6 + col];
+            tk_apply(R0, q, p);
+            for (int r = 0; r < 3; r++) p[r] += b[TK_T0 + r];
+            continue;
+        }
+        const double theta = b[TK_MULT] * q[t->bq + (int)b[TK_COORD]] + b[TK_OFFSET];
         if (b[TK_KIND] == 0) {
             /* Rot(u, theta) = c 1 + s [u]x + (1 - c) u u^T */
             const double s = sin(theta), c = cos(theta), k = 1.0 - c;
@@ -132,7 +168,8 @@ static void tk_inverse(const tk_tree *t, const double *q, const double *v, const
                        double *W, double *tau)
 {
     tk_place(t, q, W);
-    for (int i = 0; i < t->n; i++) tau[i] = -t->tau0[i];
+    for (int i = 0; i < t->bv; i++) tau[i] = 0.0;
+    for (int i = 0; i < t->n; i++) tau[t->bv + i] = -t->tau0[i];
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
         double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
@@ -144,6 +181,14 @@ static void tk_inverse(const tk_tree *t, const double *q, const double *v, const
             const double up[3] = {-t->g[0], -t->g[1], -t->g[2]};  /* the ground accelerates up */
             for (int r = 0; r < 3; r++) om[r] = dom[r] = 0.0;
             tk_apply_t(R, up, acc);
+            if (TK_FREE(b)) {  /* the origin's acceleration a_v + w x v_v, body axes */
+                if (v) {
+                    tk_cross(v + 3, v, x);
+                    for (int r = 0; r < 3; r++) { om[r] = v[3 + r]; acc[r] += x[r]; }
+                }
+                if (a)
+                    for (int r = 0; r < 3; r++) { dom[r] = a[3 + r]; acc[r] += a[r]; }
+            }
         } else {
             const double *pw = W + parent * TW_STRIDE + TW_A, *pdw = pw + 3, *pa = pw + 6;
             double z[3];
@@ -156,7 +201,8 @@ static void tk_inverse(const tk_tree *t, const double *q, const double *v, const
             for (int r = 0; r < 3; r++) x[r] += pa[r] + z[r];
             tk_apply_t(R, x, acc);
         }
-        const double rate = v ? v[c] : 0.0, accel = a ? a[c] : 0.0;
+        const double rate = v && !TK_FREE(b) ? v[t->bv + c] : 0.0;
+        const double accel = a && !TK_FREE(b) ? a[t->bv + c] : 0.0;
         if (rate != 0.0) {
             double ws[3] = {rate * sw[0], rate * sw[1], rate * sw[2]};
             tk_cross(om, ws, x);
@@ -183,8 +229,12 @@ static void tk_inverse(const tk_tree *t, const double *q, const double *v, const
         const double *b = t->body + i * TK_STRIDE;
         double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
         double *f = w + TW_A + 9, *nn = w + TW_A + 12, sw[3], sv[3];
+        if (TK_FREE(b)) {  /* the base's wrench in its axes, force then moment */
+            for (int r = 0; r < 3; r++) { tau[r] += f[r]; tau[3 + r] += nn[r]; }
+            continue;
+        }
         tk_subspace(b, sw, sv);
-        tau[(int)b[TK_COORD]] += tk_dot(sw, nn) + tk_dot(sv, f);
+        tau[t->bv + (int)b[TK_COORD]] += tk_dot(sw, nn) + tk_dot(sv, f);
         const int parent = (int)b[TK_PARENT];
         if (parent >= 0) {
             double *pf = W + parent * TW_STRIDE + TW_A + 9, *pn = pf + 3, F[3], N[3], x[3];
@@ -199,7 +249,7 @@ static void tk_inverse(const tk_tree *t, const double *q, const double *v, const
 /* M by the composite-rigid-body algorithm (row-major n x n). */
 static void tk_mass(const tk_tree *t, const double *q, double *W, double *M)
 {
-    const int n = t->n;
+    const int n = t->nv;
     tk_place(t, q, W);
     memset(M, 0, (size_t)n * n * sizeof(double));
     for (int i = 0; i < t->nb; i++) {  /* composite inertias start as the bodies' own */
@@ -211,7 +261,18 @@ static void tk_mass(const tk_tree *t, const double *q, double *W, double *M)
         const double *b = t->body + i * TK_STRIDE;
         double *w = W + i * TW_STRIDE, *c = w + TW_A;
         const double m = c[0], *h = c + 1, *J = c + 4;
-        const int ci = (int)b[TK_COORD];
+        if (TK_FREE(b)) {  /* the whole robot's inertia: [[m 1, -[h]x], [[h]x, J]] */
+            const double H[9] = {0.0, -h[2], h[1], h[2], 0.0, -h[0], -h[1], h[0], 0.0};
+            for (int r = 0; r < 3; r++)
+                for (int col = 0; col < 3; col++) {
+                    M[r * n + col] = r == col ? m : 0.0;
+                    M[r * n + 3 + col] = -H[3 * r + col];
+                    M[(3 + r) * n + col] = H[3 * r + col];
+                    M[(3 + r) * n + 3 + col] = J[3 * r + col];
+                }
+            continue;
+        }
+        const int ci = t->bv + (int)b[TK_COORD];
         double sw[3], sv[3], force[3], moment[3], x[3];
         tk_subspace(b, sw, sv);
         /* the composite's wrench for a unit rate: f = m s_v + s_w x h, n = J s_w + h x s_v */
@@ -230,10 +291,19 @@ static void tk_mass(const tk_tree *t, const double *q, double *W, double *M)
             for (int r = 0; r < 3; r++) { force[r] = F[r]; moment[r] = N[r] + x[r]; }
             k = (int)t->body[k * TK_STRIDE + TK_PARENT];
             const double *bk = t->body + k * TK_STRIDE;
+            if (TK_FREE(bk)) {  /* the base's six columns: the wrench itself */
+                for (int r = 0; r < 3; r++) {
+                    M[ci * n + r] += force[r];  /* += : mimic joints share a column */
+                    M[r * n + ci] += force[r];
+                    M[ci * n + 3 + r] += moment[r];
+                    M[(3 + r) * n + ci] += moment[r];
+                }
+                break;
+            }
             double kw[3], kv[3];
             tk_subspace(bk, kw, kv);
             const double e = tk_dot(kw, moment) + tk_dot(kv, force);
-            const int ck = (int)bk[TK_COORD];
+            const int ck = t->bv + (int)bk[TK_COORD];
             M[ci * n + ck] += e;
             M[ck * n + ci] += e;
         }
@@ -256,6 +326,42 @@ static void tk_mass(const tk_tree *t, const double *q, double *W, double *M)
     }
 }
 
+/* The floating base's spatial acceleration a = IA^-1 (tau - pA) (angular, linear; S = 1, its
+   articulated inertia IA after every child's share, the ground's upward g in a: what its
+   children read), and q_ddot[:6] = (a_v - R^T up, a_w), linear first as v; -1 where IA is not
+   positive definite. */
+static int tk_free_acceleration(const tk_tree *t, const double *IA, const double *pA,
+                                const double *R, const double *tau, double *a, double *qdd)
+{
+    double L[36], up[3] = {-t->g[0], -t->g[1], -t->g[2]}, gb[3];
+    for (int r = 0; r < 3; r++) {  /* tau is (force, moment), a's rows (moment, force) */
+        a[r] = tau[3 + r] - pA[r];
+        a[3 + r] = tau[r] - pA[3 + r];
+    }
+    for (int j = 0; j < 6; j++) {
+        double d = IA[6 * j + j];
+        for (int k = 0; k < j; k++) d -= L[6 * j + k] * L[6 * j + k];
+        if (!(d > 0.0)) return -1;
+        L[6 * j + j] = d = sqrt(d);
+        for (int i = j + 1; i < 6; i++) {
+            double s = IA[6 * i + j];
+            for (int k = 0; k < j; k++) s -= L[6 * i + k] * L[6 * j + k];
+            L[6 * i + j] = s / d;
+        }
+    }
+    for (int i = 0; i < 6; i++) {
+        for (int k = 0; k < i; k++) a[i] -= L[6 * i + k] * a[k];
+        a[i] /= L[6 * i + i];
+    }
+    for (int i = 5; i >= 0; i--) {
+        for (int k = i + 1; k < 6; k++) a[i] -= L[6 * k + i] * a[k];
+        a[i] /= L[6 * i + i];
+    }
+    tk_apply_t(R, up, gb);
+    for (int r = 0; r < 3; r++) { qdd[r] = a[3 + r] - gb[r]; qdd[3 + r] = a[r]; }
+    return 0;
+}
+
 /* The articulated-body algorithm (no mimic joints: each coordinate drives one body); -1 where
    a joint's articulated inertia is not positive (a massless branch). Spatial vectors are
    (angular, linear) at the body's origin in its axes. */
@@ -271,10 +377,12 @@ static int tk_forward_aba(const tk_tree *t, const double *q, const double *v,
         double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
         double sw[3], sv[3], x[3];
         const int parent = (int)b[TK_PARENT];
-        tk_subspace(b, sw, sv);
-        const double rate = v[(int)b[TK_COORD]];
+        tk_subspace(b, sw, sv);  /* zero for the free flyer: its motion is v[:6] itself */
+        const double rate = TK_FREE(b) ? 0.0 : v[t->bv + (int)b[TK_COORD]];
         double *vw = w + V, *vv = w + V + 3;
-        if (parent < 0) {
+        if (TK_FREE(b)) {
+            for (int r = 0; r < 3; r++) { vw[r] = v[3 + r]; vv[r] = v[r]; }
+        } else if (parent < 0) {
             for (int r = 0; r < 3; r++) vw[r] = vv[r] = 0.0;
         } else {
             const double *pv = W + parent * TW_STRIDE + V;
@@ -324,6 +432,7 @@ static int tk_forward_aba(const tk_tree *t, const double *q, const double *v,
         const double *b = t->body + i * TK_STRIDE;
         double *w = W + i * TW_STRIDE, *In = w + IA, *pa = w + PA, *U_ = w + U;
         double S[6];
+        if (TK_FREE(b)) continue;  /* the root: solved outright below */
         tk_subspace(b, S, S + 3);
         for (int r = 0; r < 6; r++) {
             double s = 0.0;
@@ -333,7 +442,7 @@ static int tk_forward_aba(const tk_tree *t, const double *q, const double *v,
         double d = 0.0, su = 0.0;
         for (int r = 0; r < 6; r++) { d += S[r] * U_[r]; su += S[r] * pa[r]; }
         const int c = (int)b[TK_COORD];
-        const double u = tau[c] + t->tau0[c] - su;
+        const double u = tau[t->bv + c] + t->tau0[c] - su;
         if (!(d > 0.0)) return -1;
         w[D] = d;
         w[UU] = u;
@@ -403,6 +512,10 @@ static int tk_forward_aba(const tk_tree *t, const double *q, const double *v,
         double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P, *ac = w + A;
         const int parent = (int)b[TK_PARENT];
         double x[3], S[6];
+        if (TK_FREE(b)) {
+            if (tk_free_acceleration(t, w + IA, w + PA, R, tau, ac, qdd)) return -1;
+            continue;
+        }
         if (parent < 0) {  /* the ground accelerates up by g: (0, -g) */
             const double up[3] = {-t->g[0], -t->g[1], -t->g[2]};
             for (int r = 0; r < 3; r++) ac[r] = 0.0;
@@ -419,10 +532,10 @@ static int tk_forward_aba(const tk_tree *t, const double *q, const double *v,
         double s = 0.0;
         for (int r = 0; r < 6; r++) s += w[U + r] * ac[r];
         const double x_dd = (w[UU] - s) / w[D];
-        qdd[(int)b[TK_COORD]] = x_dd;
+        qdd[t->bv + (int)b[TK_COORD]] = x_dd;
         for (int r = 0; r < 6; r++) ac[r] += S[r] * x_dd;
     }
-    for (int i = 0; i < t->n; i++)
+    for (int i = 0; i < t->nv; i++)
         if (!isfinite(qdd[i])) return -1;
     return 0;
 }
@@ -432,7 +545,7 @@ static int tk_forward_aba(const tk_tree *t, const double *q, const double *v,
 static int tk_forward_cholesky(const tk_tree *t, const double *q, const double *v,
                                const double *tau, double *W, double *L, double *qdd)
 {
-    const int n = t->n;
+    const int n = t->nv;
     tk_mass(t, q, W, L);
     tk_inverse(t, q, v, NULL, W, qdd);
     for (int i = 0; i < n; i++) qdd[i] = tau[i] - qdd[i];
@@ -475,7 +588,9 @@ static double tk_kinetic(const tk_tree *t, const double *q, const double *v, dou
         double *om = w + TW_A, *vel = om + 3, sw[3], sv[3], x[3];
         const int parent = (int)b[TK_PARENT];
         tk_subspace(b, sw, sv);
-        if (parent < 0) {
+        if (TK_FREE(b)) {
+            for (int r = 0; r < 3; r++) { om[r] = v[3 + r]; vel[r] = v[r]; }
+        } else if (parent < 0) {
             for (int r = 0; r < 3; r++) om[r] = vel[r] = 0.0;
         } else {
             const double *pw = W + parent * TW_STRIDE + TW_A;
@@ -484,7 +599,7 @@ static double tk_kinetic(const tk_tree *t, const double *q, const double *v, dou
             tk_apply_t(R, pw, om);
             tk_apply_t(R, x, vel);
         }
-        const double rate = v[(int)b[TK_COORD]];
+        const double rate = TK_FREE(b) ? 0.0 : v[t->bv + (int)b[TK_COORD]];
         for (int r = 0; r < 3; r++) { om[r] += rate * sw[r]; vel[r] += rate * sv[r]; }
         double Jw[3], wh[3];
         tk_apply(b + TK_J, om, Jw);

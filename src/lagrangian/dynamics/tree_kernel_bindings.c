@@ -1,4 +1,5 @@
 /* ---- batched bindings: f(Q[, V[, X]], D), each input (..., n) or (n,), D the tree ----
+   (a floating base: Q (..., nq), the others and the outputs nv wide: tree_kernel.c)
    As tree_bindings.c: a state whose inputs are not all finite, or (forward dynamics) without
    a finite result, gives NaN in its own row and is counted; with none such the output array
    is returned, else (output, count). Batches run on threads. */
@@ -21,10 +22,10 @@ static void *tk_run(void *argument)
 {
     tk_job *job = (tk_job *)argument;
     const tk_tree *t = job->tree;
-    const int n = t->n, size = job->size;
+    const int size = job->size;
     /* scratch: on the stack for a small tree (a call on one state costs no malloc) */
     double small[4096];
-    const size_t need = (size_t)t->nb * TW_STRIDE + (size_t)n * n;
+    const size_t need = (size_t)t->nb * TW_STRIDE + (size_t)t->nv * t->nv;
     double *W = need <= 4096 ? small : malloc(need * sizeof(double));
     if (!W) { job->failed = 1; return NULL; }
     double *L = W + (size_t)t->nb * TW_STRIDE;
@@ -34,7 +35,8 @@ static void *tk_run(void *argument)
         int fine = 1;
         for (int j = 0; j < job->nin; j++) {
             a[j] = job->x[j] + k * job->step[j];
-            for (int i = 0; i < n; i++)
+            const int width = j == 0 ? t->nq : t->nv;
+            for (int i = 0; i < width; i++)
                 if (!isfinite(a[j][i])) fine = 0;
         }
         double *y = job->y + k * size;
@@ -87,33 +89,51 @@ static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
         PyErr_SetString(PyExc_TypeError, "tree: not a tree description (compact_kernel.py)");
         goto done;
     }
-    const int n = tree.n;
+    const int n = tree.nv;  /* q is nq wide (a floating base's quaternion), the rest nv */
+#define TK_WIDTH(i) ((i) == 0 ? tree.nq : n)
     int base = 0;
     for (int i = 0; i < nin; i++) {
         in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
         if (!in[i]) goto done;
         int nd = PyArray_NDIM(in[i]);
-        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != n) {
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != TK_WIDTH(i)) {
             PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
-                         i == 2 ? (kind == TK_FORWARD ? "tau" : "a") : tk_names[i], n);
+                         i == 2 ? (kind == TK_FORWARD ? "tau" : "a") : tk_names[i], TK_WIDTH(i));
             goto done;
         }
-        if (PyArray_SIZE(in[i]) > PyArray_SIZE(in[base])) base = i;
+        if (PyArray_SIZE(in[i]) / TK_WIDTH(i) > PyArray_SIZE(in[base]) / TK_WIDTH(base)) base = i;
     }
-    npy_intp count = PyArray_SIZE(in[base]) / n;
+    npy_intp count = PyArray_SIZE(in[base]) / TK_WIDTH(base);
     int nd = PyArray_NDIM(in[base]);
     for (int i = 0; i < nin; i++) {
-        if (PyArray_SIZE(in[i]) == n && PyArray_NDIM(in[i]) == 1) {
-            step[i] = count > 1 ? 0 : n;
+        if (PyArray_SIZE(in[i]) == TK_WIDTH(i) && PyArray_NDIM(in[i]) == 1) {
+            step[i] = count > 1 ? 0 : TK_WIDTH(i);
             continue;
         }
-        if (PyArray_NDIM(in[i]) != nd
-            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), nd * sizeof(npy_intp))) {
+        if (PyArray_NDIM(in[i]) != nd  /* the batch axes, all but the last */
+            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp))) {
             PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
             goto done;
         }
-        step[i] = n;
+        step[i] = TK_WIDTH(i);
     }
+    if (tree.fb) {
+        /* each finite state's quaternion q[3..6] unit to the tree's tolerance (free_flyer.py);
+           the caller names the state and the norm */
+        const double *xq = (const double *)PyArray_DATA(in[0]);
+        const npy_intp states = step[0] ? count : 1;
+        for (npy_intp k = 0; k < states; k++) {
+            const double *x = xq + k * step[0];
+            int finite = 1;
+            for (int i = 0; i < tree.nq; i++) finite &= isfinite(x[i]) != 0;
+            const double norm = sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6]);
+            if (finite && !(fabs(norm - 1.0) <= tree.qtol)) {
+                PyErr_SetString(PyExc_ValueError, "q: the base quaternion is not unit");
+                goto done;
+            }
+        }
+    }
+#undef TK_WIDTH
     npy_intp dims[NPY_MAXDIMS];
     memcpy(dims, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
     int od = nd - 1;

@@ -6,6 +6,7 @@ A run stops when its condition first turns true (a crossing of g = 0, g > 0 wher
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import sympy as sp
@@ -32,8 +33,10 @@ class StopCondition:
         return self.lhs - self.rhs if self.operator in (">", ">=") else self.rhs - self.lhs
 
 
-def parse_stop_condition(text: str, model: Model, *, field: str = "stop_when") -> StopCondition:
-    """Parse 'EXPR < EXPR' (or >, <=, >=) with the model grammar; nothing is evaluated."""
+def parse_stop_condition(text: str, model: Model, *, field: str = "stop_when",
+                         names: Mapping[str, sp.Expr] | None = None) -> StopCondition:
+    """Parse 'EXPR < EXPR' (or >, <=, >=) with the model grammar; nothing is evaluated.
+    ``names`` adds names the model does not hold (a floating base's base_x .. base_wz)."""
     if not isinstance(text, str) or not text.strip():
         raise InputError("the stop condition is empty; write e.g. 'theta < 0'", field=field)
     operators = _COMPARISON.findall(text)
@@ -47,7 +50,7 @@ def parse_stop_condition(text: str, model: Model, *, field: str = "stop_when") -
         raise InputError(f"'{operator}' is not allowed; use <, >, <= or >= (a crossing) "
                          f"in {text!r}", field=field)
     left, right = _COMPARISON.split(text)
-    names = _condition_names(model)
+    names = {**_condition_names(model), **(names or {})}
     sides = []
     for side, part in (("left", left), ("right", right)):
         if not part.strip():

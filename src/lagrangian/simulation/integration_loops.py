@@ -142,7 +142,7 @@ def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y
                 if event is not None:
                     g_new = event(solver.y[:n], solver.y[n:], solver.t)
                     if armed and g_new >= 0:
-                        t_stop, hit = _crossing(event, dense, solver.t_old, solver.t, n), True
+                        t_stop, hit = crossing_time(event, dense, solver.t_old, solver.t, n), True
                     elif g_new < 0:
                         armed = True
                 while index < len(grid) and grid[index] <= t_stop:
@@ -180,8 +180,9 @@ def _reached(solver, t0: float) -> float:
     return float(solver.t) if solver is not None else float(t0)
 
 
-def _crossing(event, dense, t_old: float, t_new: float, n: int) -> float:
-    """The time in [t_old, t_new] where the event function turns from negative to >= 0."""
+def crossing_time(event, dense, t_old: float, t_new: float, n: int) -> float:
+    """The time in [t_old, t_new] where the event function event(y[:n], y[n:], t) turns from
+    negative to >= 0 (y = [q, v]; n the length of q)."""
     def g(t):
         y = dense(t)
         return event(y[:n], y[n:], t)

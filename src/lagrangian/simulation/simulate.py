@@ -35,7 +35,8 @@ from .options import METHODS, SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["METHODS", "STATUS_MESSAGES", "JointLimit", "SaveAt", "SimulationResult", "StepControl",
-           "StopCondition", "model_law", "parse_stop_condition", "simulate", "urdf_limits"]
+           "StopCondition", "at_limit", "beyond_limits", "exceeded_limits", "model_law",
+           "parse_stop_condition", "simulate", "urdf_limits"]
 
 DEFAULT_STEP_CONTROL = StepControl()  # DOP853, rtol = atol = 1e-9
 DEFAULT_SAVE_AT = SaveAt()  # 1001 evenly spaced samples
@@ -97,7 +98,7 @@ def simulate(
     drift = DriftControl(functions, StateFunction(model, eom.velocity_bias, substitution)) \
         if functions.m else None
     event = _event(StateFunction(model, [stop.function], substitution)) if stop else None
-    beyond = _beyond(limits) if limits else None
+    beyond = beyond_limits(limits) if limits else None
     positioned = [m for m in limits if m.lower is not None and m.upper is not None]
     forces = eom.generalized_forces if eom is not None else _tree_forces(model)
     power_terms = StateFunction(model, forces, substitution)
@@ -117,7 +118,7 @@ def simulate(
                      compiled_loop and not functions.m and event is None and loop is None, beyond,
                      rhs=None if loop is None else loop.rhs)
     if beyond is not None and run.status == RunStatus.STOPPED:
-        run = _at_limit(run, positioned, beyond, event, functions.n)
+        run = at_limit(run, positioned, beyond, event, functions.n)
     wall = time.perf_counter() - began
     if run.status == RunStatus.FAILED:
         run = replace(run, message=_explain_failure(functions, run))
@@ -161,7 +162,7 @@ def simulate(
         energy_conserved=conserved, t_end=float(t_end),
         stop_when=stop.text if stop else None, projected_initial_state=projected,
         kinetic_energy=kinetic, invariant=kind, invariant_values=invariant, work=work,
-        limits_exceeded=_exceeded(limits, functions.parameters, t, q_dot),
+        limits_exceeded=exceeded_limits(limits, functions.parameters, t, q_dot),
         controls=controls, control_names=(loop or law).names if controls is not None else (),
         control_forces=control_forces,
     )
@@ -271,7 +272,7 @@ def urdf_limits(model, positions: bool = True) -> tuple[JointLimit, ...]:
     return tuple(out)
 
 
-def _exceeded(limits: Sequence[JointLimit], parameters: Mapping[str, float], t, q_dot
+def exceeded_limits(limits: Sequence[JointLimit], parameters: Mapping[str, float], t, q_dot
               ) -> tuple[dict, ...]:
     """Velocity limits exceeded on the samples (the largest |q_dot|, and when) and effort
     limits exceeded by the actuator parameters, one record each."""
@@ -293,7 +294,7 @@ def _exceeded(limits: Sequence[JointLimit], parameters: Mapping[str, float], t, 
     return tuple(out)
 
 
-def _beyond(limits: Sequence[JointLimit]):
+def beyond_limits(limits: Sequence[JointLimit]):
     """h(q) = the largest distance beyond a position limit (< 0 while every joint is inside):
     the event turns true when a joint reaches its limit; None without position limits."""
     limits = [limit for limit in limits if limit.lower is not None and limit.upper is not None]
@@ -310,7 +311,7 @@ def _beyond(limits: Sequence[JointLimit]):
     return beyond
 
 
-def _at_limit(run: LoopRun, limits, beyond, event, n: int) -> LoopRun:
+def at_limit(run: LoopRun, limits, beyond, event, n: int) -> LoopRun:
     """A run the step loop stopped: at a joint's limit (status 'limit', the joint named) unless
     the user's stop condition turned true there first."""
     t, y = float(run.t[-1]), run.y[-1]

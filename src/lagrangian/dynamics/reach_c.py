@@ -15,13 +15,27 @@ from ..compile.codegen import c_table
 from ..model.tree import KinematicTree
 from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import joint_model
-from .tree_c import _SINCOS
+from .tree_c import _SINCOS, _VECTOR
 
 # the walks, C(q, v), inverse dynamics with wrenches, then the Python bindings: one
-# module's C, in this order
+# module's C, in this order; the first three's core (from reach_kernel.c's RK_CORE_BEGIN)
+# twice, on one state and on LG_LANES states at once
 _KERNELS = tuple(Path(__file__).with_name(name)
                  for name in ("reach_kernel.c", "reach_coriolis.c", "reach_inverse.c",
                               "batch_threads.c", "reach_bindings.c"))
+_CORE = 3
+_SCALAR = """#define RK_T double
+#define RK_FN(name) rk_##name
+#define RK_C(x) (x)
+#define RK_SINCOS lg_sincos"""
+_LANES = """#undef RK_T
+#undef RK_FN
+#undef RK_C
+#undef RK_SINCOS
+#define RK_T lg_v4
+#define RK_FN(name) rk4_##name
+#define RK_C(x) LG_V4(x)
+#define RK_SINCOS lg_vsincos"""
 REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
 
 
@@ -76,9 +90,12 @@ def kernel_source(tree: KinematicTree):
         c_table("rk_fbody", "int", [f.body for f in frames]),
         c_table("rk_fR", "double", [[x for row in f.rotation for x in row] for f in frames]),
         c_table("rk_ft", "double", [list(f.translation) for f in frames]),
-        _SINCOS,
-        *(path.read_text(encoding="utf-8") for path in _KERNELS),
+        _SINCOS, _VECTOR,
     ])
+    texts = [path.read_text(encoding="utf-8") for path in _KERNELS]
+    head, first = texts[0].split("/* RK_CORE_BEGIN */")
+    core = "\n".join([first, *texts[1:_CORE]])
+    source = "\n".join([source, head, _SCALAR, core, _LANES, core, *texts[_CORE:]])
     return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
 
 

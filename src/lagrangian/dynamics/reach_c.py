@@ -52,6 +52,20 @@ def _turn_tables(joints) -> list[str]:
     return [c_table("rk_P", "double", P), c_table("rk_C", "double", C), c_table("rk_S", "double", S)]
 
 
+def _axis_tables(joints) -> list[str]:
+    """Per joint: k where its axis is +-e_k exactly (else -1), that sign, and whether its R0
+    is exactly 1: there R0 Rot(e_k, th) is a turn of two columns (reach_kernel.c's body)."""
+    axis, sign, plain = [], [], []
+    for j in joints:
+        u = [float(x) for x in j.axis]
+        k = next((k for k in range(3) if abs(u[k]) == 1.0 and u[k - 1] == u[k - 2] == 0.0), -1)
+        axis.append(k)
+        sign.append(u[k] if k >= 0 else 1.0)
+        plain.append(np.array_equal(np.array(j.rotation, dtype=float), np.eye(3)))
+    return [c_table("rk_axis", "int", axis), c_table("rk_axsign", "double", sign),
+            c_table("rk_R0id", "int", plain)]
+
+
 def kernel_source(tree: KinematicTree):
     """The module's C: the tables, then the kernels of _KERNELS in order."""
     from ..compile.codegen import GeneratedSource
@@ -82,6 +96,7 @@ def kernel_source(tree: KinematicTree):
         c_table("rk_off", "double", [j.offset for j in joints]),
         c_table("rk_R0", "double", flat),
         *_turn_tables(joints),
+        *_axis_tables(joints),
         c_table("rk_t0", "double", [list(j.translation) for j in joints]),
         c_table("rk_u", "double", [list(j.axis) for j in joints]),
         c_table("rk_m", "double", [j.mass for j in joints]),

@@ -106,6 +106,33 @@ static inline void RK_FN(body)(const RK_T *q, int i, RK_T (*R)[9], RK_T (*o)[3])
         for (int j = 0; j < 3; j++) pl[j] += d[j];
     } else {
         const RK_T th = rk_mult[i] * q[RK_BQ + rk_coord[i]] + rk_off[i];
+        if (rk_turns[i] && !rk_slides[i] && rk_axis[i] >= 0) {
+            /* about +-e_k: (R_p R0) Rot(e_k, th) turns two columns of R_p R0 (a, b, k cyclic:
+               Rot e_a = c e_a + s e_b, Rot e_b = -s e_a + c e_b), 12 products, not 45 */
+            RK_T c, s, M[9];
+            RK_SINCOS(th, &s, &c);
+            s = rk_axsign[i] * s;
+            const int k = rk_axis[i], a = (k + 1) % 3, b = (k + 2) % 3, p = rk_parent[i];
+            if (p < 0)
+                for (int j = 0; j < 9; j++) M[j] = RK_C(rk_R0[i][j]);
+            else if (rk_R0id[i])
+                for (int j = 0; j < 9; j++) M[j] = R[p][j];
+            else
+                RK_FN(matmul_v)(R[p], rk_R0[i], M);
+            for (int r = 0; r < 3; r++) {
+                R[i][3 * r + a] = c * M[3 * r + a] + s * M[3 * r + b];
+                R[i][3 * r + b] = c * M[3 * r + b] - s * M[3 * r + a];
+                R[i][3 * r + k] = M[3 * r + k];
+            }
+            if (p < 0) {
+                for (int j = 0; j < 3; j++) o[i][j] = pl[j];
+            } else {
+                RK_T d[3];
+                RK_FN(apply)(R[p], pl, d);
+                for (int j = 0; j < 3; j++) o[i][j] = o[p][j] + d[j];
+            }
+            return;
+        }
         if (rk_turns[i]) {
             /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
             RK_T c, s;

@@ -308,31 +308,34 @@ static void RK_FN(wrench)(const RK_T *q, int f, const RK_T *w, RK_T *out)
     }
 }
 
-/* A_g (6 x RK_N, row-major): composite bodies about the world's origin, then moved to G */
+/* A_g (6 x RK_NV, row-major): composite bodies about the world's origin (mass M, first
+ * moment h, rotational inertia J_O as its six numbers xx yy zz xy xz yz), each column's
+ * momentum [l; k_O] then moved to the centre of mass G: k_G = k_O - G x l */
 static void RK_FN(centroidal)(const RK_T *q, RK_T *out)
 {
-    RK_T R[RK_NB][9], o[RK_NB][3], h[RK_NB][3], Ic[RK_NB][9];
+    RK_T R[RK_NB][9], o[RK_NB][3], h[RK_NB][3], Ic[RK_NB][6];
     double M[RK_NB];
     RK_FN(bodies)(q, R, o);
     for (int j = 0; j < 6 * RK_NV; j++) out[j] = RK_C(0.0);
     for (int i = 0; i < RK_NB; i++) {
-        RK_T hr[3], T[9], RJ[9];
+        RK_T hr[3], RJ[9], T[6];
         const RK_T *p = o[i];
-        double m = rk_m[i];
+        const double m = rk_m[i];
         RK_FN(apply_v)(R[i], rk_h[i], hr);
         RK_FN(matmul_v)(R[i], rk_J[i], RJ);
-        for (int a = 0; a < 3; a++)  /* R J R^T, symmetric: the upper triangle, mirrored */
-            for (int c = a; c < 3; c++)
-                T[3 * c + a] = T[3 * a + c] = RJ[3 * a] * R[i][3 * c]
-                                              + RJ[3 * a + 1] * R[i][3 * c + 1]
-                                              + RJ[3 * a + 2] * R[i][3 * c + 2];
-        RK_T pp = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
-        RK_T ph = p[0] * hr[0] + p[1] * hr[1] + p[2] * hr[2];
-        for (int a = 0; a < 3; a++)
-            for (int c = 0; c < 3; c++)
-                Ic[i][3 * a + c] = T[3 * a + c] - m * p[a] * p[c] - p[a] * hr[c] - hr[a] * p[c]
-                                  + (a == c ? m * pp + 2.0 * ph : RK_C(0.0));
+        static const int ra[6] = {0, 1, 2, 0, 0, 1}, rc[6] = {0, 1, 2, 1, 2, 2};
+        for (int e = 0; e < 6; e++) {  /* R J R^T, symmetric */
+            const int a = ra[e], c = rc[e];
+            T[e] = RJ[3 * a] * R[i][3 * c] + RJ[3 * a + 1] * R[i][3 * c + 1]
+                   + RJ[3 * a + 2] * R[i][3 * c + 2];
+        }
         for (int j = 0; j < 3; j++) h[i][j] = hr[j] + m * p[j];
+        /* J_O = R J R^T - p h^T - hr p^T + (p.h + p.hr) 1, h = hr + m p */
+        RK_T diag = p[0] * (h[i][0] + hr[0]) + p[1] * (h[i][1] + hr[1]) + p[2] * (h[i][2] + hr[2]);
+        for (int e = 0; e < 6; e++) {
+            const int a = ra[e], c = rc[e];
+            Ic[i][e] = T[e] - p[a] * h[i][c] - hr[a] * p[c] + (e < 3 ? diag : RK_C(0.0));
+        }
         M[i] = m;
     }
     for (int i = RK_NB - 1; i >= 0; i--) {
@@ -340,7 +343,7 @@ static void RK_FN(centroidal)(const RK_T *q, RK_T *out)
         if (p < 0) continue;
         M[p] += M[i];
         for (int j = 0; j < 3; j++) h[p][j] += h[i][j];
-        for (int j = 0; j < 9; j++) Ic[p][j] += Ic[i][j];
+        for (int j = 0; j < 6; j++) Ic[p][j] += Ic[i][j];
     }
     double total = 0.0;
     RK_T G[3] = {RK_C(0.0), RK_C(0.0), RK_C(0.0)};
@@ -351,7 +354,7 @@ static void RK_FN(centroidal)(const RK_T *q, RK_T *out)
     }
     for (int j = 0; j < 3; j++) G[j] /= total;
     for (int i = 0; i < RK_NB; i++) {
-        RK_T F[6][6], l[3], k[3], t[3];
+        RK_T F[6][6];
         int columns = 1, first = RK_BV + rk_coord[i];
         double mult = rk_mult[i];
         if (RK_FREE(i)) {
@@ -360,22 +363,22 @@ static void RK_FN(centroidal)(const RK_T *q, RK_T *out)
         } else {
             RK_FN(subspace)(i, R, o, F[0]);
         }
+        const RK_T *J = Ic[i];
         for (int col = 0; col < columns; col++) {
             const RK_T *S = F[col];
-            RK_FN(cross)(S + 3, h[i], l);
+            RK_T l[3], k[3], t[3], g[3];
+            RK_FN(cross)(S + 3, h[i], l);  /* l = M s_v + s_w x h, k = h x s_v + J_O s_w */
             RK_FN(cross)(h[i], S, k);
-            RK_FN(apply)(Ic[i], S + 3, t);
+            t[0] = J[0] * S[3] + J[3] * S[4] + J[4] * S[5];
+            t[1] = J[3] * S[3] + J[1] * S[4] + J[5] * S[5];
+            t[2] = J[4] * S[3] + J[5] * S[4] + J[2] * S[5];
             for (int j = 0; j < 3; j++) { l[j] += M[i] * S[j]; k[j] += t[j]; }
-            int c = first + col;
+            RK_FN(cross)(G, l, g);
+            const int c = first + col;
             for (int j = 0; j < 3; j++) {
                 out[j * RK_NV + c] += mult * l[j];
-                out[(3 + j) * RK_NV + c] += mult * k[j];
+                out[(3 + j) * RK_NV + c] += mult * (k[j] - g[j]);
             }
         }
-    }
-    for (int c = 0; c < RK_NV; c++) {  /* k_G = k_O - G x l */
-        RK_T l[3] = {out[c], out[RK_NV + c], out[2 * RK_NV + c]}, t[3];
-        RK_FN(cross)(G, l, t);
-        for (int j = 0; j < 3; j++) out[(3 + j) * RK_NV + c] -= t[j];
     }
 }

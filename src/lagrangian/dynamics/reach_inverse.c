@@ -79,8 +79,8 @@ static void RK_FN(inverse)(const RK_T *restrict q, const RK_T *restrict qd,
     for (int k = 0; k < nw; k++) {  /* the wrench carried to the world's origin: [f; m + p x f] */
         const int b = rk_fbody[frames[k]];
         if (b < 0) continue;  /* on the ground: no joint feels it */
-        RK_T Rf[9], x[3], m[3];
-        RK_FN(frame)(frames[k], R, o, Rf, x);
+        RK_T x[3], m[3];
+        RK_FN(frame_origin)(frames[k], R, o, x);
         RK_FN(cross)(x, w[k], m);
         for (int j = 0; j < 3; j++) {
             F[b][j] -= w[k][j];

@@ -221,6 +221,15 @@ static inline void RK_FN(frame)(int f, RK_T (*R)[9], RK_T (*o)[3], RK_T *Rf, RK_
     for (int j = 0; j < 3; j++) p[j] = o[b][j] + d[j];
 }
 
+/* the frame's origin alone (J^T w and inverse dynamics need no frame rotation) */
+static inline void RK_FN(frame_origin)(int f, RK_T (*R)[9], RK_T (*o)[3], RK_T *p)
+{
+    int b = rk_fbody[f];
+    RK_T d[3];
+    RK_FN(apply_v)(R[b], rk_ft[f], d);
+    for (int j = 0; j < 3; j++) p[j] = o[b][j] + d[j];
+}
+
 /* [a; w_dot] of frame f at q_ddot = 0; ref 0 world, 1 local, 2 local_world_aligned */
 static void RK_FN(drift)(const RK_T *q, const RK_T *qd, int f, int ref, RK_T *out)
 {
@@ -283,13 +292,13 @@ static void RK_FN(drift)(const RK_T *q, const RK_T *qd, int f, int ref, RK_T *ou
  * (a free flyer's six: the force and the moment about the base's origin, base axes) */
 static void RK_FN(wrench)(const RK_T *q, int f, const RK_T *w, RK_T *out)
 {
-    RK_T R[RK_NB][9], o[RK_NB][3], Rf[9], p[3], m[3];
+    RK_T R[RK_NB][9], o[RK_NB][3], p[3], m[3];
     for (int j = 0; j < RK_NV; j++) out[j] = RK_C(0.0);
     int b = rk_fbody[f];
     if (b < 0) return;
     int path[RK_NB];
     RK_FN(path)(q, b, path, R, o);
-    RK_FN(frame)(f, R, o, Rf, p);
+    RK_FN(frame_origin)(f, R, o, p);
     RK_FN(cross)(p, w, m);
     for (int j = 0; j < 3; j++) m[j] += w[3 + j];
     for (int i = b; i >= 0; i = rk_parent[i]) {

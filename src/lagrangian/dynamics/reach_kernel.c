@@ -10,6 +10,7 @@
 #define RK_NQ (RK_BQ + RK_N)
 #define RK_NV (RK_BV + RK_N)
 #define RK_FREE(i) (RK_FB && (i) == 0)
+#define RK_UNROLL 40  /* bodies up to which the walks over them are unrolled (compile time) */
 #define RK_MAX_WRENCHES 16  /* more: the bindings refuse, the caller adds J^T w one by one */
 
 #define RK_STR_(x) #x
@@ -89,7 +90,8 @@ static inline void RK_FN(matmul_v)(const RK_T *A, const double *B, RK_T *out)
 }
 
 /* body i's rotation (body -> world) and origin (m, world), its parent's already known */
-static inline void RK_FN(body)(const RK_T *q, int i, RK_T (*R)[9], RK_T (*o)[3])
+static inline __attribute__((always_inline)) void RK_FN(body)(const RK_T *q, int i, RK_T (*R)[9],
+                                                           RK_T (*o)[3])
 {
     RK_T Rl[9], pl[3];
     for (int j = 0; j < 3; j++) pl[j] = RK_C(rk_t0[i][j]);
@@ -162,6 +164,11 @@ static inline void RK_FN(body)(const RK_T *q, int i, RK_T (*R)[9], RK_T (*o)[3])
 /* every body's rotation and origin */
 static void RK_FN(bodies)(const RK_T *q, RK_T (*R)[9], RK_T (*o)[3])
 {
+    /* unrolled on a small tree: each body's table entries (axis, parent, rotation) known to
+       the compiler, its branches gone (10-15% of A_g's time) */
+#if RK_NB <= RK_UNROLL
+#pragma GCC unroll 40
+#endif
     for (int i = 0; i < RK_NB; i++) RK_FN(body)(q, i, R, o);
 }
 

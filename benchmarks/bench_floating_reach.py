@@ -7,8 +7,9 @@ call of one state and for a batch of 10^4 states against a Python loop of Pinocc
 Needs the bench extra (pin, example-robot-data). Each per-call figure is the best of 7 rounds
 of 300 calls, ours and Pinocchio's rounds alternating in one process; each batch figure the
 best of 5, alternating too (one call of ours on 10^4 states, on as many threads as processors
-or LAGRANGIAN_THREADS allow; a loop of 10^4 Pinocchio calls). The load average is printed
-before and after, and the threads a batch may take.
+or LAGRANGIAN_THREADS allow; a loop of 10^4 Pinocchio calls), then the same by CPU time
+(time.process_time: this process's, both threads summed), which the machine's other work
+disturbs less. The load average is printed before and after, and the threads a batch may take.
 """
 
 from __future__ import annotations
@@ -29,34 +30,36 @@ ROBOTS = (("solo_description/robots/solo12.urdf", "FL_FOOT"),
           ("talos_data/robots/talos_reduced.urdf", "left_sole_link"))
 
 
-def best(function, calls: int, rounds: int) -> float:
+def best(function, calls: int, rounds: int, clock=time.perf_counter) -> float:
     """Best seconds per call of function() over ``rounds`` rounds of ``calls`` calls."""
     out = float("inf")
     for _ in range(rounds):
-        start = time.perf_counter()
+        start = clock()
         for _ in range(calls):
             function()
-        out = min(out, (time.perf_counter() - start) / calls)
+        out = min(out, (clock() - start) / calls)
     return out
 
 
-def interleaved(ours, theirs, calls: int = 300, rounds: int = 7) -> tuple[float, float]:
+def interleaved(ours, theirs, calls: int = 300, rounds: int = 7,
+                clock=time.perf_counter) -> tuple[float, float]:
     """Best seconds per call of each, their rounds alternating."""
     ours(), theirs()
     a = b = float("inf")
     for _ in range(rounds):
-        a = min(a, best(ours, calls, 1))
-        b = min(b, best(theirs, calls, 1))
+        a = min(a, best(ours, calls, 1, clock))
+        b = min(b, best(theirs, calls, 1, clock))
     return a, b
 
 
-def measure(ours, theirs, Q, V, A, count: int) -> tuple[float, float, float, float]:
+def measure(ours, theirs, Q, V, A, count: int) -> tuple[float, ...]:
     """Seconds: one call of ours and of Pinocchio's (interleaved), 10^4 states in one call of
-    ours and in a loop of Pinocchio's."""
+    ours and in a loop of Pinocchio's, by the wall clock and by CPU time."""
     one_ours, one_theirs = interleaved(lambda: ours(Q[0], V[0], A[0]), lambda: theirs(0))
-    batch_ours, batch_theirs = interleaved(lambda: ours(Q, V, A),
-                                           lambda: [theirs(k) for k in range(count)], 1, 5)
-    return one_ours, one_theirs, batch_ours, batch_theirs
+    batch = (lambda: ours(Q, V, A), lambda: [theirs(k) for k in range(count)])
+    wall = interleaved(*batch, 1, 5)
+    cpu = interleaved(*batch, 1, 5, time.process_time)
+    return one_ours, one_theirs, *wall, *cpu
 
 
 def bench_robot(name: str, foot: str, count: int = 10_000) -> None:
@@ -105,12 +108,14 @@ def bench_robot(name: str, foot: str, count: int = 10_000) -> None:
     }
     print(f"{path.name}: nq {model.nq}, nv {model.nv}")
     print("  function: one call ours / Pinocchio us (ratio Pinocchio/ours); "
-          "10^4 states ours / Pinocchio loop ms (ratio)")
+          "10^4 states ours / Pinocchio loop ms (ratio); the same by CPU time")
     for label, (ours, theirs) in cases.items():
-        one_ours, one_theirs, batch_ours, batch_theirs = measure(ours, theirs, Q, V, A, count)
+        one_ours, one_theirs, batch_ours, batch_theirs, cpu_ours, cpu_theirs = measure(
+            ours, theirs, Q, V, A, count)
         print(f"  {label}: {one_ours * 1e6:.2f} / {one_theirs * 1e6:.2f} "
               f"({one_theirs / one_ours:.2f}x); {batch_ours * 1e3:.1f} / "
-              f"{batch_theirs * 1e3:.1f} ({batch_theirs / batch_ours:.1f}x)")
+              f"{batch_theirs * 1e3:.1f} ({batch_theirs / batch_ours:.1f}x); CPU "
+              f"{cpu_ours * 1e3:.1f} / {cpu_theirs * 1e3:.1f} ({cpu_theirs / cpu_ours:.1f}x)")
 
 
 def main() -> None:

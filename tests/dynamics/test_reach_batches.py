@@ -1,6 +1,7 @@
 """Batches of the compiled reach functions (reach_bindings.c: threads taking blocks of states
-from a shared counter) equal the same states one call at a time, bit for bit (inverse dynamics
-with a wrench over many states: the tree's ID then J^T w, to 1e-12); inverse dynamics
+from a shared counter, four states at a time on vector lanes) equal the same states one call at
+a time to 1e-14 (the lanes' code may fuse a multiply-add where one state's does not; inverse
+dynamics with a wrench over many states: the tree's ID then J^T w, to 1e-12); inverse dynamics
 with wrenches in its one Newton-Euler pass (reach_inverse.c) equals M a + b - J^T w from our
 M, bias and frame Jacobian, on a fixed and a floating base, and where a parameter edits the
 dynamics the answer stays the edited robot's. (Pinocchio's agreement: test_reach_pinocchio.py,
@@ -100,11 +101,37 @@ def test_a_batch_equals_each_state_alone(tmp_path, text):
                 np.testing.assert_allclose(batches[name][k], value, rtol=0, atol=1e-12 * (
                     1 + np.abs(value).max()), err_msg=name)
             else:
-                assert np.array_equal(batches[name][k], value), name
+                _close(batches[name][k], value, name)
     few = robot.inverse_dynamics(q[:40], v[:40], a[:40], f_ext={frame: w[:40]})  # one pass
     for k in range(40):
-        assert np.array_equal(few[k], robot.inverse_dynamics(q[k], v[k], a[k],
-                                                             f_ext={frame: w[k]}))
+        _close(few[k], robot.inverse_dynamics(q[k], v[k], a[k], f_ext={frame: w[k]}), "ID")
+
+
+def _close(batch, alone, name: str) -> None:
+    """Equal to 1e-14 of the entries' size (rounding: vector lanes against one state)."""
+    np.testing.assert_allclose(batch, alone, rtol=0, atol=1e-14 * (1 + np.abs(alone).max()),
+                               err_msg=name)
+
+
+@pytest.mark.parametrize("text", [ARM, FLOATING_URDF], ids=["fixed", "floating"])
+def test_a_batch_not_a_multiple_of_the_lanes_equals_each_state(tmp_path, text):
+    """37 states: nine groups of four on the lanes, the last one alone; each as its own call."""
+    robot = _robot(tmp_path, text)
+    q, v, a, w = _states(robot, 37, seed=11)
+    frame = _frame(robot)
+    batches = _batches(robot, q, v, a, w)
+    batches["FD f_ext"] = robot.forward_dynamics(q, v, a, f_ext={frame: w})
+    for k in range(37):
+        alone = {"J_dot v": robot.jacobian_dot_times_v(q[k], v[k], frame),
+                 "A_g": robot.centroidal_momentum_matrix(q[k]),
+                 "ID f_ext": robot.inverse_dynamics(q[k], v[k], a[k], f_ext={frame: w[k]}),
+                 "ID shared f_ext": robot.inverse_dynamics(q[k], v[k], a[k],
+                                                           f_ext={frame: w[0]}),
+                 "FD f_ext": robot.forward_dynamics(q[k], v[k], a[k], f_ext={frame: w[k]})}
+        if "C" in batches:
+            alone["C"] = robot.coriolis_matrix(q[k], v[k])
+        for name, value in alone.items():
+            _close(batches[name][k], value, name)
 
 
 _ONE_THREAD = """

@@ -245,9 +245,11 @@ class Dynamics(ControlTerms):
                     fast.add_wrenches(q, f_ext, tau, 1.0)
                     return self.forward_dynamics(q, v, tau)
                 one_pass = fast.inverse if fast.inverse is not None else fast.fused_inverse(self)
-                # one Newton-Euler pass (reach_inverse.c) for one state or a few; over many the
-                # tree module's vector lanes make its ID and then J^T w the faster
-                if one_pass and (q.__class__ is not np.ndarray or q.ndim < 2 or len(q) <= 64):
+                # one Newton-Euler pass (reach_inverse.c, on vector lanes over a batch) for a
+                # floating base or a few states; over many states of a fixed base the tree
+                # module's unrolled ID and then J^T w are the faster (measured: benchmarks.md)
+                if one_pass and (self.velocity_names is not None or q.__class__ is not np.ndarray
+                                 or q.ndim < 2 or len(q) <= 64):
                     return one_pass(q, v, x, f_ext)
                 tau = self.inverse_dynamics(q, v, x)
                 fast.add_wrenches(q, f_ext, tau, -1.0)

@@ -1,11 +1,12 @@
 /* Python bindings of reach_kernel.c and reach_coriolis.c: arrays (..., n) of float64, one
  * output row per state. A batch runs on threads that take blocks of RK_BLOCK states from a
- * shared counter (as the tree module's batches), each state computed as alone. */
+ * shared counter (as the tree module's batches), LG_LANES states at a time through the rk4_
+ * functions (the same formulas on vector lanes), the block's last few one by one. */
 
 #define RK_PTHREADS LG_PTHREADS  /* batch_threads.c, above this text */
 #define RK_MAX_THREADS LG_MAX_THREADS
 #define RK_THREAD_STATES 256  /* fewer per thread: starting it costs more than it saves */
-#define RK_BLOCK 64
+#define RK_BLOCK 64  /* a multiple of LG_LANES: only the batch's last states run one by one */
 
 enum { RK_DRIFT, RK_CENTROIDAL, RK_WRENCH, RK_CORIOLIS, RK_INVERSE };
 
@@ -34,10 +35,80 @@ static void rk_state(const rk_job *job, npy_intp k, rk_cbody *work)
     }
     case RK_CORIOLIS: rk_coriolis(q, job->v + k * RK_NV, job->y + RK_NV * RK_NV * k, work); break;
     case RK_INVERSE: {
-        const double *w[RK_MAX_WRENCHES];
-        for (int i = 0; i < job->nw; i++) w[i] = job->w[i] + (job->wshared[i] ? 0 : 6 * k);
-        rk_inverse(q, job->v + k * RK_NV, job->a + k * RK_NV, job->up, job->nw, job->frames, w,
-                   job->y + RK_NV * k);
+        double w[RK_MAX_WRENCHES][6];
+        for (int i = 0; i < job->nw; i++)
+            for (int j = 0; j < 6; j++) w[i][j] = job->w[i][(job->wshared[i] ? 0 : 6 * k) + j];
+        rk_inverse(q, job->v + k * RK_NV, job->a + k * RK_NV, job->up, job->nw, job->frames,
+                   (const double (*)[6])w, job->y + RK_NV * k);
+        break;
+    }
+    }
+}
+
+/* lanes' inputs: rows k .. k + LG_LANES - 1 of x (``width`` numbers a row) as vectors */
+static inline void rk_gather(const double *x, npy_intp k, int width, lg_v4 *out)
+{
+    for (int l = 0; l < LG_LANES; l++)
+        for (int i = 0; i < width; i++) out[i][l] = x[(k + l) * width + i];
+}
+
+/* lanes' outputs into rows k .. k + LG_LANES - 1 of y (``width`` numbers a row): y = x, or
+ * y += sign x where ``add`` */
+static inline void rk_scatter(const lg_v4 *x, npy_intp k, int width, double *y, int add,
+                              double sign)
+{
+    for (int l = 0; l < LG_LANES; l++) {
+        double *row = y + (k + l) * width;
+        if (add)
+            for (int i = 0; i < width; i++) row[i] += sign * x[i][l];
+        else
+            for (int i = 0; i < width; i++) row[i] = x[i][l];
+    }
+}
+
+/* states k .. k + LG_LANES - 1 at once (rk4_*); out: RK_OUT4 vectors of room */
+#define RK_OUT4 (RK_NV * RK_NV > 6 * RK_NV ? RK_NV * RK_NV : 6 * RK_NV)
+static void rk_lanes(const rk_job *job, npy_intp k, rk4_cbody *work, lg_v4 *out)
+{
+    lg_v4 q[RK_NQ], v[RK_NV];
+    rk_gather(job->q, k, RK_NQ, q);
+    switch (job->kind) {
+    case RK_DRIFT:
+        rk_gather(job->v, k, RK_NV, v);
+        rk4_drift(q, v, job->frame, job->ref, out);
+        rk_scatter(out, k, 6, job->y, 0, 0.0);
+        break;
+    case RK_CENTROIDAL:
+        rk4_centroidal(q, out);
+        rk_scatter(out, k, 6 * RK_NV, job->y, 0, 0.0);
+        break;
+    case RK_WRENCH: {
+        lg_v4 w[6];
+        if (job->wshared[0])
+            for (int j = 0; j < 6; j++) w[j] = LG_V4(job->w[0][j]);
+        else
+            rk_gather(job->w[0], k, 6, w);
+        rk4_wrench(q, job->frame, w, out);
+        rk_scatter(out, k, RK_NV, job->y, 1, job->sign);
+        break;
+    }
+    case RK_CORIOLIS:
+        rk_gather(job->v, k, RK_NV, v);
+        rk4_coriolis(q, v, out, work);
+        rk_scatter(out, k, RK_NV * RK_NV, job->y, 0, 0.0);
+        break;
+    case RK_INVERSE: {
+        lg_v4 a[RK_NV], w[RK_MAX_WRENCHES][6];
+        rk_gather(job->v, k, RK_NV, v);
+        rk_gather(job->a, k, RK_NV, a);
+        for (int i = 0; i < job->nw; i++) {
+            if (job->wshared[i])
+                for (int j = 0; j < 6; j++) w[i][j] = LG_V4(job->w[i][j]);
+            else
+                rk_gather(job->w[i], k, 6, w[i]);
+        }
+        rk4_inverse(q, v, a, job->up, job->nw, job->frames, (const lg_v4 (*)[6])w, out);
+        rk_scatter(out, k, RK_NV, job->y, 0, 0.0);
         break;
     }
     }
@@ -49,7 +120,16 @@ static void *rk_run(void *argument)
 {
     rk_job *job = (rk_job *)argument;
     rk_cbody *work = NULL;
-    if (job->kind == RK_CORIOLIS && !(work = malloc(sizeof(rk_cbody) * RK_NB))) return NULL;
+    rk4_cbody *work4 = NULL;
+    /* the lanes' outputs and C's workspace (vectors: aligned to theirs) */
+    const size_t room = (RK_OUT4 * sizeof(lg_v4) + 63) / 64 * 64;
+    const size_t space = job->kind == RK_CORIOLIS ? (sizeof(rk4_cbody) * RK_NB + 63) / 64 * 64 : 0;
+    lg_v4 *out = job->count >= LG_LANES ? aligned_alloc(64, room + space) : NULL;
+    if (out && space) work4 = (rk4_cbody *)((char *)out + room);
+    if (job->kind == RK_CORIOLIS && !(work = malloc(sizeof(rk_cbody) * RK_NB))) {
+        free(out);
+        return NULL;
+    }
     for (;;) {
 #if RK_PTHREADS
         const npy_intp k0 = __atomic_fetch_add(job->next, RK_BLOCK, __ATOMIC_RELAXED);
@@ -59,9 +139,12 @@ static void *rk_run(void *argument)
 #endif
         if (k0 >= job->count) break;
         const npy_intp k1 = k0 + RK_BLOCK < job->count ? k0 + RK_BLOCK : job->count;
-        for (npy_intp k = k0; k < k1; k++) rk_state(job, k, work);
+        npy_intp k = k0;
+        for (; out && k + LG_LANES <= k1; k += LG_LANES) rk_lanes(job, k, work4, out);
+        for (; k < k1; k++) rk_state(job, k, work);
     }
     free(work);
+    free(out);
     return NULL;
 }
 

@@ -15,13 +15,27 @@ from ..compile.codegen import c_table
 from ..model.tree import KinematicTree
 from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import joint_model
-from .tree_c import _SINCOS
+from .tree_c import _SINCOS, _VECTOR
 
 # the walks, C(q, v), inverse dynamics with wrenches, then the Python bindings: one
-# module's C, in this order
+# module's C, in this order; the first three's core (from reach_kernel.c's RK_CORE_BEGIN)
+# twice, on one state and on LG_LANES states at once
 _KERNELS = tuple(Path(__file__).with_name(name)
                  for name in ("reach_kernel.c", "reach_coriolis.c", "reach_inverse.c",
                               "batch_threads.c", "reach_bindings.c"))
+_CORE = 3
+_SCALAR = """#define RK_T double
+#define RK_FN(name) rk_##name
+#define RK_C(x) (x)
+#define RK_SINCOS lg_sincos"""
+_LANES = """#undef RK_T
+#undef RK_FN
+#undef RK_C
+#undef RK_SINCOS
+#define RK_T lg_v4
+#define RK_FN(name) rk4_##name
+#define RK_C(x) LG_V4(x)
+#define RK_SINCOS lg_vsincos"""
 REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
 
 
@@ -36,6 +50,20 @@ def _turn_tables(joints) -> list[str]:
         C.append((R0 @ (np.eye(3) - uu)).ravel().tolist())
         S.append((R0 @ skew).ravel().tolist())
     return [c_table("rk_P", "double", P), c_table("rk_C", "double", C), c_table("rk_S", "double", S)]
+
+
+def _axis_tables(joints) -> list[str]:
+    """Per joint: k where its axis is +-e_k exactly (else -1), that sign, and whether its R0
+    is exactly 1: there R0 Rot(e_k, th) is a turn of two columns (reach_kernel.c's body)."""
+    axis, sign, plain = [], [], []
+    for j in joints:
+        u = [float(x) for x in j.axis]
+        k = next((k for k in range(3) if abs(u[k]) == 1.0 and u[k - 1] == u[k - 2] == 0.0), -1)
+        axis.append(k)
+        sign.append(u[k] if k >= 0 else 1.0)
+        plain.append(np.array_equal(np.array(j.rotation, dtype=float), np.eye(3)))
+    return [c_table("rk_axis", "int", axis), c_table("rk_axsign", "double", sign),
+            c_table("rk_R0id", "int", plain)]
 
 
 def kernel_source(tree: KinematicTree):
@@ -68,6 +96,7 @@ def kernel_source(tree: KinematicTree):
         c_table("rk_off", "double", [j.offset for j in joints]),
         c_table("rk_R0", "double", flat),
         *_turn_tables(joints),
+        *_axis_tables(joints),
         c_table("rk_t0", "double", [list(j.translation) for j in joints]),
         c_table("rk_u", "double", [list(j.axis) for j in joints]),
         c_table("rk_m", "double", [j.mass for j in joints]),
@@ -76,9 +105,12 @@ def kernel_source(tree: KinematicTree):
         c_table("rk_fbody", "int", [f.body for f in frames]),
         c_table("rk_fR", "double", [[x for row in f.rotation for x in row] for f in frames]),
         c_table("rk_ft", "double", [list(f.translation) for f in frames]),
-        _SINCOS,
-        *(path.read_text(encoding="utf-8") for path in _KERNELS),
+        _SINCOS, _VECTOR,
     ])
+    texts = [path.read_text(encoding="utf-8") for path in _KERNELS]
+    head, first = texts[0].split("/* RK_CORE_BEGIN */")
+    core = "\n".join([first, *texts[1:_CORE]])
+    source = "\n".join([source, head, _SCALAR, core, _LANES, core, *texts[_CORE:]])
     return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
 
 

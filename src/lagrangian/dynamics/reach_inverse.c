@@ -3,19 +3,17 @@
  * out, each body's force less the wrenches on it coming back, tau = S^T f. The ground
  * accelerates up (up = -g, world axes, m/s^2): every body feels gravity. */
 
-#define RK_MAX_WRENCHES 16  /* more: the bindings refuse, the caller adds J^T w one by one */
-
 /* I X for body i's spatial inertia about its own origin, world axes (X = [a; alpha] there):
  * [m a - h x alpha; h x a + R J R^T alpha], h = R h_i its first moment (kg m) */
-static inline void rk_inertia_at(int i, const double *R, const double *h, const double *X,
-                                 double *out)
+static inline void RK_FN(inertia_at)(int i, const RK_T *R, const RK_T *h, const RK_T *X,
+                                     RK_T *out)
 {
-    double t[3], u[3], hxa[3], ahx[3];
-    rk_apply_t(R, X + 3, t);
-    rk_apply(rk_J[i], t, u);
-    rk_apply(R, u, t);
-    rk_cross(X + 3, h, ahx);  /* -h x alpha */
-    rk_cross(h, X, hxa);
+    RK_T t[3], u[3], hxa[3], ahx[3];
+    RK_FN(apply_t)(R, X + 3, t);
+    RK_FN(apply_k)(rk_J[i], t, u);
+    RK_FN(apply)(R, u, t);
+    RK_FN(cross)(X + 3, h, ahx);  /* -h x alpha */
+    RK_FN(cross)(h, X, hxa);
     for (int j = 0; j < 3; j++) {
         out[j] = rk_m[i] * X[j] + ahx[j];
         out[3 + j] = hxa[j] + t[j];
@@ -25,65 +23,65 @@ static inline void rk_inertia_at(int i, const double *R, const double *h, const 
 /* tau (RK_NV) = M(q) qdd + C(q, qd) qd + g(q) - sum J_f^T w_f over the nw wrenches w_f =
  * [force; moment] at frames[f]'s origin, world axes (a floating base's six first: the force
  * and moment on the base about its origin, base axes) */
-static void rk_inverse(const double *restrict q, const double *restrict qd,
-                       const double *restrict qdd, const double *up, int nw, const int *frames,
-                       const double *const *w, double *restrict tau)
+static void RK_FN(inverse)(const RK_T *restrict q, const RK_T *restrict qd,
+                           const RK_T *restrict qdd, const double *up, int nw, const int *frames,
+                           const RK_T (*w)[6], RK_T *restrict tau)
 {
-    double R[RK_NB][9], o[RK_NB][3], V[RK_NB][6], A[RK_NB][6], F[RK_NB][6], S[RK_NB][6];
-    double base[6][6];
-    rk_bodies(q, R, o);
-    for (int j = 0; j < RK_NV; j++) tau[j] = 0.0;
+    RK_T R[RK_NB][9], o[RK_NB][3], V[RK_NB][6], A[RK_NB][6], F[RK_NB][6], S[RK_NB][6];
+    RK_T base[6][6];
+    RK_FN(bodies)(q, R, o);
+    for (int j = 0; j < RK_NV; j++) tau[j] = RK_C(0.0);
     for (int i = 0; i < RK_NB; i++) {
         const int p = rk_parent[i];
         if (RK_FREE(i)) {  /* V = S v_base, A = up + S a_base (V x S v_base = V x V = 0) */
-            rk_free_columns(R[0], o[0], base);
+            RK_FN(free_columns)(R[0], o[0], base);
             for (int j = 0; j < 6; j++) {
-                V[0][j] = 0.0;
-                A[0][j] = j < 3 ? up[j] : 0.0;
+                V[0][j] = RK_C(0.0);
+                A[0][j] = RK_C(j < 3 ? up[j] : 0.0);
                 for (int c = 0; c < 6; c++) {
                     V[0][j] += base[c][j] * qd[c];
                     A[0][j] += base[c][j] * qdd[c];
                 }
             }
         } else {
-            const double rate = rk_mult[i] * qd[RK_BV + rk_coord[i]];
-            const double accel = rk_mult[i] * qdd[RK_BV + rk_coord[i]];
-            double c[6];
-            rk_subspace(i, R, o, S[i]);
+            const RK_T rate = rk_mult[i] * qd[RK_BV + rk_coord[i]];
+            const RK_T accel = rk_mult[i] * qdd[RK_BV + rk_coord[i]];
+            RK_T c[6];
+            RK_FN(subspace)(i, R, o, S[i]);
             for (int j = 0; j < 6; j++) {
-                V[i][j] = (p < 0 ? 0.0 : V[p][j]) + S[i][j] * rate;
-                A[i][j] = (p < 0 ? (j < 3 ? up[j] : 0.0) : A[p][j]) + S[i][j] * accel;
+                V[i][j] = (p < 0 ? RK_C(0.0) : V[p][j]) + S[i][j] * rate;
+                A[i][j] = (p < 0 ? RK_C(j < 3 ? up[j] : 0.0) : A[p][j]) + S[i][j] * accel;
             }
-            rk_motion_cross(V[i], S[i], c);  /* d/dt S = V x S: S moves with its body */
+            RK_FN(motion_cross)(V[i], S[i], c);  /* d/dt S = V x S: S moves with its body */
             for (int j = 0; j < 6; j++) A[i][j] += c[j] * rate;
         }
         /* f = I A + V x* (I V) about the body's own origin o (its inertia without lever
          * arms: motions there [v + w x o; w]), V x* [f; n] = [w x f; w x n + v x f], then
          * carried to the world's origin: [f; n + o x f] */
-        double h[3], Vo[6], Ao[6], IV[6], f[6], t1[3], t2[3];
-        rk_apply(R[i], rk_h[i], h);
-        rk_cross(V[i] + 3, o[i], t1);
-        rk_cross(A[i] + 3, o[i], t2);
+        RK_T h[3], Vo[6], Ao[6], IV[6], f[6], t1[3], t2[3];
+        RK_FN(apply_v)(R[i], rk_h[i], h);
+        RK_FN(cross)(V[i] + 3, o[i], t1);
+        RK_FN(cross)(A[i] + 3, o[i], t2);
         for (int j = 0; j < 3; j++) {
             Vo[j] = V[i][j] + t1[j], Vo[3 + j] = V[i][3 + j];
             Ao[j] = A[i][j] + t2[j], Ao[3 + j] = A[i][3 + j];
         }
-        rk_inertia_at(i, R[i], h, Ao, f);
-        rk_inertia_at(i, R[i], h, Vo, IV);
-        rk_cross(Vo + 3, IV, t1);
+        RK_FN(inertia_at)(i, R[i], h, Ao, f);
+        RK_FN(inertia_at)(i, R[i], h, Vo, IV);
+        RK_FN(cross)(Vo + 3, IV, t1);
         for (int j = 0; j < 3; j++) f[j] += t1[j];
-        rk_cross(Vo + 3, IV + 3, t1);
-        rk_cross(Vo, IV, t2);
+        RK_FN(cross)(Vo + 3, IV + 3, t1);
+        RK_FN(cross)(Vo, IV, t2);
         for (int j = 0; j < 3; j++) f[3 + j] += t1[j] + t2[j];
-        rk_cross(o[i], f, t1);
+        RK_FN(cross)(o[i], f, t1);
         for (int j = 0; j < 3; j++) F[i][j] = f[j], F[i][3 + j] = f[3 + j] + t1[j];
     }
     for (int k = 0; k < nw; k++) {  /* the wrench carried to the world's origin: [f; m + p x f] */
         const int b = rk_fbody[frames[k]];
         if (b < 0) continue;  /* on the ground: no joint feels it */
-        double Rf[9], x[3], m[3];
-        rk_frame(frames[k], R, o, Rf, x);
-        rk_cross(x, w[k], m);
+        RK_T x[3], m[3];
+        RK_FN(frame_origin)(frames[k], R, o, x);
+        RK_FN(cross)(x, w[k], m);
         for (int j = 0; j < 3; j++) {
             F[b][j] -= w[k][j];
             F[b][3 + j] -= w[k][3 + j] + m[j];
@@ -92,12 +90,12 @@ static void rk_inverse(const double *restrict q, const double *restrict qd,
     for (int i = RK_NB - 1; i >= 0; i--) {
         if (RK_FREE(i)) {
             for (int c = 0; c < 6; c++) {
-                double t = 0.0;
+                RK_T t = RK_C(0.0);
                 for (int j = 0; j < 6; j++) t += base[c][j] * F[0][j];
                 tau[c] = t;
             }
         } else {
-            double t = 0.0;
+            RK_T t = RK_C(0.0);
             for (int j = 0; j < 6; j++) t += S[i][j] * F[i][j];
             tau[RK_BV + rk_coord[i]] += rk_mult[i] * t;
         }

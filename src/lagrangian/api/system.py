@@ -252,6 +252,7 @@ class System(CheckMethods, ControlMethods):
         the model's values compiled in as defaults. Write it with
         ``lagrangian.output.write_c(code, directory)``."""
         from ..dynamics.standalone import c_prefix, standalone_for
+        from ..simulation.control import input_columns  # B of a [control] table's inputs
 
         if prefix is not None and c_prefix(prefix) != prefix:
             raise InputError(f"{prefix!r} is not a C identifier (lower-case ASCII letters, digits "
@@ -268,7 +269,8 @@ class System(CheckMethods, ControlMethods):
                              "parameters=...)", field="parameters")
         system = self if not parameters else self.with_parameters(**dict(parameters))
         try:
-            return standalone_for(system.model, system.equations_of_motion, values, prefix)
+            return standalone_for(system.model, system.equations_of_motion, values, prefix,
+                                  columns=input_columns)
         except CodegenError as exc:
             raise InputError(f"cannot write C: {exc}", field="lang") from None
 

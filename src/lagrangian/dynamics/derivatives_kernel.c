@@ -21,12 +21,18 @@
 #define DK_STR(x) DK_STR_(x)
 #define DK_PASTE_(a, b) a##b
 #define DK_PASTE(a, b) DK_PASTE_(a, b)
-/* The dense loops (Cholesky, M^-1, the products) unrolled, whole up to 16 coordinates: the
-   triangular loops' trip counts are then constants, not a jump into a loop per row (3-4% of a
-   state's time on the Panda). The ancestor pairs' loop likewise: its tables' entries become
-   constants. Unrolling the loops over the bodies as well made it slower (the code's size). */
+/* The dense loops (Cholesky, M^-1, the products) unrolled whole on an arm of a few coordinates:
+   the triangular loops' trip counts are then constants, not a jump into a loop per row; the
+   ancestor pairs' loop likewise, its tables' entries then constants (3-4% of a state's time on
+   the Panda, for 1.5 times the build's time). Not on larger trees (Solo12's 18: no faster,
+   twice the build's time), nor on the loops over the bodies (slower: the code's size). */
+#if DK_NV <= 12
 #define DK_UNROLL _Pragma("GCC unroll 16")
-#define DK_UNROLL_TREE _Pragma("GCC unroll 64")
+#define DK_UNROLL_TREE _Pragma("GCC unroll 80")
+#else
+#define DK_UNROLL
+#define DK_UNROLL_TREE
+#endif
 
 
 /* The core below is emitted twice by derivatives_c.py: on one state (dk_*, DK_T double) and on

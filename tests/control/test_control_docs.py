@@ -152,3 +152,28 @@ def test_manifold_section(capsys, cli):
     assert along["states"] == ["x", "x_dot"] and along["dependent"] == ["y"]
     for A in np.array(along["A"]):  # hanging at rest: [[0, 1], [-g/L, 0]] at every sample
         np.testing.assert_allclose(A, [[0, 1], [-9.81 / 0.5, 0]], atol=1e-9)
+
+
+def test_control_law_codegen_section(cli, tmp_path, monkeypatch):
+    import shutil
+    import subprocess
+
+    compiler = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+    if compiler is None:
+        pytest.skip("no C compiler")
+    text = re.findall(r'write_text\("""(.*?)"""\)', _python("control-law"), re.S)[0]
+    (tmp_path / "pd_pendulum.toml").write_text(text, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = cli(*_command("control-law-codegen"))
+    assert result.code == 0, result.err
+    main = re.findall(r"```c\n(.*?)```", docs_blocks.block("control-law-codegen", "control.md"),
+                      re.S)[0]
+    (tmp_path / "main.c").write_text(main, encoding="utf-8")
+    subprocess.run([compiler, "-std=c99", "-pedantic", "-Wall", "-Werror", "-Igen", "main.c",
+                    "gen/pd.c", "-o", "main", "-lm"], check=True)
+    tau, a = map(float, subprocess.run(["./main"], check=True, capture_output=True,
+                                       text=True).stdout.split())
+    # theta = 0.3 at rest, t = 0: u = -Kp theta; m L^2 a = u - m g L sin(theta)
+    assert tau == pytest.approx(-4.0 * 0.3, abs=1e-6)
+    assert a == pytest.approx((tau - 9.81 * 0.5 * np.sin(0.3)) / 0.25, abs=1e-6)
+    assert f"{tau:.6f} {a:.6f}" in main  # the printed figures in the page are these

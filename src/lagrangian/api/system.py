@@ -247,9 +247,10 @@ class System(CheckMethods, ControlMethods, StudyMethods):
         """Standalone C99 (header and source, libm only, no allocation) of M(q), the bias
         C q_dot + g, g(q), inverse and forward dynamics and the energies (SI units);
         ``prefix`` names the functions (default: from the model's name), ``parameters`` override
-        the model's values compiled in as defaults. Write it with
-        ``lagrangian.output.write_c(code, directory)``."""
+        the model's values compiled in as defaults; a [control] table's laws as <prefix>_control
+        and <prefix>_control_forces. Write it with ``lagrangian.output.files.write_c(code, dir)``."""
         from ..dynamics.standalone import c_prefix, standalone_for
+        from ..simulation.control import input_columns  # B of a [control] table's inputs
 
         if prefix is not None and c_prefix(prefix) != prefix:
             raise InputError(f"{prefix!r} is not a C identifier (lower-case ASCII letters, digits "
@@ -266,7 +267,8 @@ class System(CheckMethods, ControlMethods, StudyMethods):
                              "parameters=...)", field="parameters")
         system = self if not parameters else self.with_parameters(**dict(parameters))
         try:
-            return standalone_for(system.model, system.equations_of_motion, values, prefix)
+            return standalone_for(system.model, system.equations_of_motion, values, prefix,
+                                  columns=input_columns)
         except CodegenError as exc:
             raise InputError(f"cannot write C: {exc}", field="lang") from None
 

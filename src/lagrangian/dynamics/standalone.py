@@ -265,23 +265,38 @@ const double {P}_parameters[{P.upper()}_NP] = {{{defaults}}};
 
 
 def standalone_for(model: Model, equations: Callable[[], EquationsOfMotion],
-                   values: dict[str, float], prefix: str | None = None) -> StandaloneSource:
+                   values: dict[str, float], prefix: str | None = None,
+                   columns: Callable | None = None) -> StandaloneSource:
     """Standalone C of a model: recursive for a URDF tree where that applies (no derivation),
-    else from the equations ``equations()`` derives."""
+    else from the equations ``equations()`` derives; with a [control] table, its laws as
+    <prefix>_control and <prefix>_control_forces (standalone_control.py; ``columns``: B's
+    columns of inputs on a parameter or a load, simulation.control.input_columns)."""
     from ..compile.functions import refuse_large_chain
     from .recursive import TREE_PATH_BODIES, applicable_tree
 
     tree = applicable_tree(model, values)
+    derived = None
     if tree is not None and model.kinematic_tree is not None:
-        return standalone_tree_c(model, tree, values, prefix)
-    if tree is not None and len(tree.joints) >= TREE_PATH_BODIES:
+        parameters = [p.name for p in model.parameters]
+        code = standalone_tree_c(model, tree, values, prefix)
+    elif tree is not None and len(tree.joints) >= TREE_PATH_BODIES:
         # a model file's tree has its masses, inertias and placements folded in as numbers:
         # only gravity and the generalized forces stay in the parameter array
-        runtime = list(dict.fromkeys(name for name in (tree.gravity_parameter, *tree.actuators)
-                                     if name is not None))
-        return standalone_tree_c(model, tree, values, prefix, runtime)
-    refuse_large_chain(model)
-    return standalone_c(equations(), values, prefix)
+        parameters = list(dict.fromkeys(name for name in (tree.gravity_parameter,
+                                                          *tree.actuators) if name is not None))
+        code = standalone_tree_c(model, tree, values, prefix, parameters)
+    else:
+        refuse_large_chain(model)
+        parameters, derived = [p.name for p in model.parameters], equations
+        code = standalone_c(equations(), values, prefix)
+    if not model.control:
+        return code
+    from .standalone_control import control_c, with_control
+
+    declarations, definitions = control_c(model, code.prefix, parameters, values, derived,
+                                          columns)
+    header, source = with_control(code.header, code.source, declarations, definitions)
+    return StandaloneSource(prefix=code.prefix, header=header, source=source)
 
 
 __all__ = ["StandaloneSource", "c_prefix", "standalone_c", "standalone_for", "standalone_tree_c"]

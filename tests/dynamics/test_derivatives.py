@@ -4,12 +4,11 @@ against the pendulum's closed form and central differences of our own dynamics."
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 import lagrangian
+from robot_data import robots as _robots
 
 LOCK = {"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}
 
@@ -18,12 +17,6 @@ def _symmetric(matrix):
     return np.triu(matrix) + np.triu(matrix, 1).T
 
 
-def _robots(pin) -> Path:
-    for parent in Path(pin.__file__).resolve().parents:
-        candidate = parent / "share/example-robot-data/robots"
-        if candidate.is_dir():
-            return candidate
-    pytest.skip("example-robot-data is not installed")
 
 
 def _against_pinocchio(ours, model, pin, seed):

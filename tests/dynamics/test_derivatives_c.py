@@ -13,6 +13,7 @@ from test_recursive_dynamics import TREE
 
 import lagrangian
 from lagrangian.compile import compiled
+from robot_data import robots as _robots
 
 needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler")
 
@@ -207,14 +208,6 @@ def test_floating_base_derivatives_are_pinocchios():
         close(ftau[k], np.triu(data.Minv) + np.triu(data.Minv, 1).T)
 
 
-def _robots(pin):
-    from pathlib import Path
-
-    for parent in Path(pin.__file__).resolve().parents:
-        candidate = parent / "share/example-robot-data/robots"
-        if candidate.is_dir():
-            return candidate
-    pytest.skip("example-robot-data is not installed")
 
 
 @needs_c

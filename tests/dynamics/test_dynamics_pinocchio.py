@@ -3,12 +3,11 @@ dynamics and energies of URDF arms at random states."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 import lagrangian
+from robot_data import robots as _robots
 
 pin = pytest.importorskip("pinocchio")
 pytest.importorskip("yourdfpy")
@@ -86,12 +85,6 @@ def test_spatial_arm_matches_pinocchio(tmp_path, backend):
                                              rel=1e-9, abs=1e-12)
 
 
-def _robots() -> Path:
-    for parent in Path(pin.__file__).resolve().parents:
-        candidate = parent / "share/example-robot-data/robots"
-        if candidate.is_dir():
-            return candidate
-    pytest.skip("example-robot-data is not installed")
 
 
 @pytest.mark.slow

@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import json
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import lagrangian
+from robot_data import robots as _robots
 
 pytest.importorskip("yourdfpy")
 
@@ -50,13 +50,6 @@ FLOATING_URDF = """<?xml version="1.0"?>
 REFERENCES = ("world", "local", "local_world_aligned")
 
 
-def _robots() -> Path:
-    pin = pytest.importorskip("pinocchio")
-    for parent in Path(pin.__file__).resolve().parents:
-        candidate = parent / "share/example-robot-data/robots"
-        if candidate.is_dir():
-            return candidate
-    pytest.skip("example-robot-data is not installed")
 
 
 def _layout(model, ours):

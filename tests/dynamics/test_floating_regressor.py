@@ -7,24 +7,17 @@ one line."""
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 from tests.dynamics.test_floating_base import FLOATING_URDF
 
 import lagrangian
+from robot_data import robots as _robots
 
 pytest.importorskip("yourdfpy")
 
 
-def _robots() -> Path:
-    pin = pytest.importorskip("pinocchio")
-    for parent in Path(pin.__file__).resolve().parents:
-        candidate = parent / "share/example-robot-data/robots"
-        if candidate.is_dir():
-            return candidate
-    pytest.skip("example-robot-data is not installed")
 
 
 def _columns(model, ours):

@@ -8,7 +8,6 @@ from __future__ import annotations
 import ctypes
 import shutil
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,6 +15,7 @@ from tests.dynamics.test_floating_base import FLOATING_URDF, _close, _layout
 
 import lagrangian
 from lagrangian.output.files import write_c
+from robot_data import robots as _robots
 
 pytest.importorskip("yourdfpy")
 COMPILER = shutil.which("cc") or shutil.which("gcc")
@@ -24,13 +24,6 @@ LOCK = {"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}
 POINTER = ctypes.c_void_p
 
 
-def _robots() -> Path:
-    pin = pytest.importorskip("pinocchio")
-    for parent in Path(pin.__file__).resolve().parents:
-        candidate = parent / "share/example-robot-data/robots"
-        if candidate.is_dir():
-            return candidate
-    pytest.skip("example-robot-data is not installed")
 
 
 def _library(tmp_path, system):

@@ -19,7 +19,7 @@ The description ``D`` (float64, contiguous), built by ``describe``:
 
 A new joint kind is a new code in JOINT_CODES and its cases in tree_kernel.c (tk_place for the
 placement, tk_subspace for S); the recursions themselves ask only for those. The module (tree_kernel.c,
-then its Python bindings tree_kernel_bindings.c) is keyed by its source alone, never the tree's
+tree_kernel_forward.c, then its Python bindings tree_kernel_bindings.c) is keyed by its source alone, never the tree's
 numbers.
 """
 
@@ -40,10 +40,11 @@ from .recursive import RecursiveDynamics
 HEADER, STRIDE = 8, 40
 JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FREE_FLYER: 2}
 
-# the recursions, the thread count shared with the other modules, then the batched Python
-# bindings (one translation unit)
+# the recursions (forward dynamics in a file of its own), the thread count shared with the other
+# modules, then the batched Python bindings (one translation unit)
 _SOURCES = tuple(Path(__file__).with_name(name)
-                 for name in ("tree_kernel.c", "batch_threads.c", "tree_kernel_bindings.c"))
+                 for name in ("tree_kernel.c", "tree_kernel_forward.c", "batch_threads.c",
+                              "tree_kernel_bindings.c"))
 
 
 def _source() -> str:

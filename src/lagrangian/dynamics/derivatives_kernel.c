@@ -467,22 +467,26 @@ static void DK_FN(solve)(const DK_T *L, const DK_T *inverse, DK_T *b)
     }
 }
 
-/* out = -A B (DK_NV x DK_NV each): out's rows as sums of B's rows, independent along j, one
-   product at a time (a row's sums held in registers) */
-static void DK_FN(minus_product)(const DK_T *A, const DK_T *B, DK_T *out)
+/* out1 = -A B1, out2 = -A B2 (DK_NV x DK_NV each): out's rows as sums of B's rows, independent
+   along j, one product at a time (a row's sums held in registers), both products in one pass
+   over A; B1's columns before ``first`` are 0 (a floating base's translation: out1's too) */
+static void DK_FN(minus_products)(const DK_T *A, const DK_T *B1, const DK_T *B2, DK_T *out1,
+                                  DK_T *out2, int first)
 {
     for (int i = 0; i < DK_NV; i++) {
-        DK_T x[DK_NV];
+        DK_T x[DK_NV], y[DK_NV];
         DK_UNROLL
-        for (int j = 0; j < DK_NV; j++) x[j] = DK_C(0.0);
+        for (int j = 0; j < DK_NV; j++) x[j] = y[j] = DK_C(0.0);
         DK_UNROLL
         for (int k = 0; k < DK_NV; k++) {
             const DK_T m = A[i * DK_NV + k];
             DK_UNROLL
-            for (int j = 0; j < DK_NV; j++) x[j] -= m * B[k * DK_NV + j];
+            for (int j = first; j < DK_NV; j++) x[j] -= m * B1[k * DK_NV + j];
+            DK_UNROLL
+            for (int j = 0; j < DK_NV; j++) y[j] -= m * B2[k * DK_NV + j];
         }
         DK_UNROLL
-        for (int j = 0; j < DK_NV; j++) out[i * DK_NV + j] = x[j];
+        for (int j = 0; j < DK_NV; j++) { out1[i * DK_NV + j] = x[j]; out2[i * DK_NV + j] = y[j]; }
     }
 }
 
@@ -557,8 +561,8 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
             for (int k = i; k < DK_NV; k++) s += X[k * DK_NV + i] * X[k * DK_NV + j];
             Minv[i * DK_NV + j] = Minv[j * DK_NV + i] = s;
         }
-    DK_FN(minus_product)(Minv, dq, aq);
-    DK_FN(minus_product)(Minv, dv, av);
+    /* a floating base's translation leaves tau as it is: d tau/dq's first three columns 0 */
+    DK_FN(minus_products)(Minv, dq, dv, aq, av, 3 * DK_FF);
     return failed;
 }
 /* DK_CORE_END */

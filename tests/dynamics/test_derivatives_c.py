@@ -240,9 +240,16 @@ def test_floating_base_derivatives_agree_with_central_differences_on_the_manifol
                               (fv, robot.forward_dynamics, lambda s, x: (q, v + s, a))):
             central = (f(*args(e, plus)) - f(*args(-e, minus))) / (2 * h)
             np.testing.assert_allclose(ours[:, k], central, rtol=0, atol=2e-6)
-    with pytest.raises(lagrangian.InputError, match="norm 2") as caught:
-        robot.inverse_dynamics_derivatives(np.r_[q[:6], 2.0, q[7:]], v, a)
-    assert caught.value.field == "q" and "\n" not in str(caught.value)
+    bad = np.r_[q[:6], 2.0, q[7:]]
+    batch = np.stack([q, q, q])
+    batch[1, 3:7] *= 1 + 1e-5  # off by ten times the tolerance, in the batch's second state
+    for function in (robot.inverse_dynamics_derivatives, robot.forward_dynamics_derivatives,
+                     robot.regressor):
+        with pytest.raises(lagrangian.InputError, match="norm 2") as caught:
+            function(bad, v, a)
+        assert caught.value.field == "q" and "\n" not in str(caught.value)
+        with pytest.raises(lagrangian.InputError, match="norm 1.00001 in state 1"):
+            function(batch, v, a)
 
 
 @needs_c

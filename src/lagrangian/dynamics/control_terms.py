@@ -41,7 +41,7 @@ class ControlTerms:
             # compiled C (derivatives_c.py) where a compiler works, else numpy
             fast = self._derivatives_kernel()
             if fast is not None:
-                compute, P = fast[2], fast[3]
+                compute, P = fast[5], fast[3]
                 return (lambda Q, V, A: compute(Q, V, A, P),
                         tree_parameter_names(tree), tree_parameters(tree))
             g = self.parameters[tree.gravity_parameter]
@@ -107,9 +107,10 @@ class ControlTerms:
     # -- derivatives (derivatives_c.py, derivatives.py) -------------------------------------------
 
     def _derivatives_kernel(self):
-        """(inverse, forward, regressor, P) of the tree's compiled module (derivatives_c.py), or
-        None: a compiled backend's tree of revolute and prismatic joints (a floating base
-        too); the numpy backend and a model file keep derivatives.py."""
+        """(inverse, forward, regressor, P, inverse and regressor checking a base quaternion
+        first) of the tree's compiled module (derivatives_c.py), or None: a compiled backend's
+        tree of revolute and prismatic joints (a floating base too); the numpy backend and a
+        model file keep derivatives.py."""
         found = self.__dict__.get("_derivatives_c", False)
         if found is False:
             found = None
@@ -119,14 +120,17 @@ class ControlTerms:
 
                 module = derivatives_module(tree) if applies(tree) else None
                 if module is not None:
-                    inverse, forward = module.inverse_derivatives, module.forward_derivatives
-                    regressor = module.regressor
-                    if tree.floating_base:  # the base quaternion's norm checked first
+                    # the C refuses a base quaternion of the wrong norm with a ValueError (the
+                    # calls below then take the guarded way); the guarded way's functions
+                    # name the state and the norm in one line first
+                    inverse, regressor = module.inverse_derivatives, module.regressor
+                    checked = (inverse, regressor)
+                    if tree.floating_base:
                         from .free_flyer import checking_quaternions
 
-                        inverse, forward, regressor = (checking_quaternions(f) for f in
-                                                       (inverse, forward, regressor))
-                    found = (inverse, forward, regressor, runtime_values(tree, self.parameters))
+                        checked = tuple(checking_quaternions(f) for f in checked)
+                    found = (inverse, module.forward_derivatives, regressor,
+                             runtime_values(tree, self.parameters), *checked)
             self.__dict__["_derivatives_c"] = found
         return found
 
@@ -138,7 +142,7 @@ class ControlTerms:
             if fast is None:
                 _refuse_floating(tree, "derivatives of the dynamics")
             if fast is not None:
-                inverse, P = fast[0], fast[3]
+                inverse, P = fast[4], fast[3]
 
                 def found(Q, V, A):
                     return inverse(Q, V, A, P)[:2]

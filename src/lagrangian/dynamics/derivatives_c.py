@@ -17,6 +17,7 @@ import numpy as np
 
 from ..compile.codegen import c_table
 from ..model.tree import KinematicTree
+from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import JOINT_MODELS
 from .tree_c import _SINCOS, _VECTOR
 
@@ -105,6 +106,7 @@ def kernel_source(tree: KinematicTree):
         f"#define DK_NQ {n + 7 * floating}",
         f"#define DK_NV {n + 6 * floating}",
         f"#define DK_NP {len(pairs)}",
+        f"#define DK_QTOL {QUATERNION_TOLERANCE!r}",
         c_table("dk_parent", "int", [j.parent for j in joints]),
         c_table("dk_coord", "int", [j.coordinate for j in joints]),
         c_table("dk_turns", "int", [getattr(m, "turns", False) for m in models]),
@@ -162,7 +164,7 @@ def derivatives_module(tree: KinematicTree):
     kinematic = [(j.parent, str(j.kind), j.rotation, j.translation, j.axis, j.coordinate,
                   j.multiplier, j.offset) for j in tree.joints]
     key = "\n".join(["derivatives", generator, repr(kinematic), repr(tree.coordinates),
-                     repr(bool(tree.floating_base))])
+                     repr(bool(tree.floating_base)), repr(QUATERNION_TOLERANCE)])
     try:
         return compiled.load_keyed(key, lambda: kernel_source(tree), native=True)
     except compiled.BackendUnavailable:

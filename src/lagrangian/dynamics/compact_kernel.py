@@ -18,9 +18,9 @@ The description ``D`` (float64, contiguous), built by ``describe``:
       33:40 spare. A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone.
 
 A new joint kind is a new code in JOINT_CODES and its cases in tree_kernel.c (tk_place for the
-placement, tk_subspace for S); the recursions themselves ask only for those. The module (tree_kernel.c,
-tree_kernel_forward.c, then its Python bindings tree_kernel_bindings.c) is keyed by its source alone, never the tree's
-numbers.
+placement, tk_subspace for S); the recursions themselves ask only for those. The module
+(tree_kernel.c, tree_kernel_forward.c, then its Python bindings tree_kernel_bindings.c) is keyed
+by its source alone, never the tree's numbers.
 """
 
 from __future__ import annotations

@@ -12,6 +12,22 @@
 #endif
 #define LG_MAX_THREADS 8
 
+#if LG_PTHREADS
+/* A batch's thread, on a stack of its own size: a lane's work for the largest trees is a
+   megabyte or two (eight lanes), more than some platforms' default thread stack (512 kB on
+   macOS; 2 MB on Linux where the stack limit is unlimited). 1 where it started. */
+#define LG_STACK ((size_t)16 << 20)
+static int lg_start(pthread_t *thread, void *(*run)(void *), void *job)
+{
+    pthread_attr_t attr;
+    if (pthread_attr_init(&attr) != 0) return pthread_create(thread, NULL, run, job) == 0;
+    pthread_attr_setstacksize(&attr, LG_STACK);
+    const int started = pthread_create(thread, &attr, run, job) == 0;
+    pthread_attr_destroy(&attr);
+    return started;
+}
+#endif
+
 static int lg_threads(npy_intp count, npy_intp per_thread)
 {
 #if LG_PTHREADS

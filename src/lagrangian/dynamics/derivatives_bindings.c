@@ -227,7 +227,7 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     pthread_t threads[DK_MAX_THREADS];
     int started[DK_MAX_THREADS] = {0};
     for (int t = 0; t < parts - 1; t++)
-        started[t] = pthread_create(&threads[t], NULL, dk_run, &jobs[t]) == 0;
+        started[t] = lg_start(&threads[t], dk_run, &jobs[t]);
     dk_run(&jobs[parts - 1]);
     for (int t = 0; t < parts - 1; t++) {
         if (started[t]) pthread_join(threads[t], NULL);

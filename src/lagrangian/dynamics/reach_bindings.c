@@ -165,7 +165,7 @@ static int rk_batch(rk_job *job)
     pthread_t threads[RK_MAX_THREADS];
     int started[RK_MAX_THREADS] = {0};
     for (int t = 0; t < parts - 1; t++)
-        started[t] = pthread_create(&threads[t], NULL, rk_run, &jobs[t]) == 0;
+        started[t] = lg_start(&threads[t], rk_run, &jobs[t]);
     rk_run(&jobs[parts - 1]);  /* this thread too; a thread that did not start leaves its
                                   blocks to the others */
     for (int t = 0; t < parts - 1; t++)

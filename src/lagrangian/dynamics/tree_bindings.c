@@ -242,7 +242,7 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     pthread_t threads[RT_MAX_THREADS];
     int started[RT_MAX_THREADS] = {0};
     for (int t = 0; t < parts - 1; t++)
-        started[t] = pthread_create(&threads[t], NULL, rt_run, &jobs[t]) == 0;
+        started[t] = lg_start(&threads[t], rt_run, &jobs[t]);
     rt_run(&jobs[parts - 1]);
     for (int t = 0; t < parts - 1; t++) {
         if (started[t]) pthread_join(threads[t], NULL);

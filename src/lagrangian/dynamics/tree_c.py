@@ -135,10 +135,14 @@ def dynamics_functions(tree: KinematicTree, parameters: tuple[str, ...], prefix:
 
 
 _VECTOR = r"""
-/* Several states at once, each operation on all lanes: four with AVX (a native build, see
-   compiled.NATIVE_CFLAGS), else two (one SSE2 instruction; wider vectors without AVX are split
-   through memory by the compiler, slower than scalar code). */
-#if defined(__AVX__)
+/* Several states at once, each operation on all lanes: eight with AVX-512 (a native build, see
+   compiled.NATIVE_CFLAGS; 1.1-1.6 times four lanes' batches on a Zen 4, docs/benchmarks.md),
+   four with AVX, else two (one SSE2 instruction; wider vectors without AVX are split through
+   memory by the compiler, slower than scalar code). */
+#if defined(__AVX512F__)
+#define LG_LANES 8
+typedef double lg_v4 __attribute__((vector_size(64)));
+#elif defined(__AVX__)
 #define LG_LANES 4
 typedef double lg_v4 __attribute__((vector_size(32)));
 #else

@@ -163,7 +163,7 @@ static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     pthread_t threads[TK_MAX_THREADS];
     int started[TK_MAX_THREADS] = {0};
     for (int t = 0; t < parts - 1; t++)
-        started[t] = pthread_create(&threads[t], NULL, tk_run, &jobs[t]) == 0;
+        started[t] = lg_start(&threads[t], tk_run, &jobs[t]);
     tk_run(&jobs[parts - 1]);
     for (int t = 0; t < parts - 1; t++) {
         if (started[t]) pthread_join(threads[t], NULL);

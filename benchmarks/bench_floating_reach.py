@@ -9,7 +9,10 @@ of 300 calls, ours and Pinocchio's rounds alternating in one process; each batch
 best of 5, alternating too (one call of ours on 10^4 states, on as many threads as processors
 or LAGRANGIAN_THREADS allow; a loop of 10^4 Pinocchio calls), then the same by CPU time
 (time.process_time: this process's, both threads summed), which the machine's other work
-disturbs less. The load average is printed before and after, and the threads a batch may take.
+disturbs less; then the fresh-output floor (bench_control.fresh_output_floor: allocating and
+writing once as many doubles as the batch returns) and the bound it puts on any batch's
+speed-up over Pinocchio's loop here. The load average is printed before and after, and the
+threads a batch may take.
 """
 
 from __future__ import annotations
@@ -24,7 +27,8 @@ import numpy as np
 import lagrangian
 
 sys.path.insert(0, str(Path(__file__).parent))
-from bench_urdf import load_average, robots_folder  # noqa: E402 (the sibling benchmark's)
+from bench_control import fresh_output_floor  # noqa: E402 (the sibling benchmarks')
+from bench_urdf import load_average, robots_folder  # noqa: E402
 
 ROBOTS = (("solo_description/robots/solo12.urdf", "FL_FOOT"),
           ("talos_data/robots/talos_reduced.urdf", "left_sole_link"))
@@ -59,7 +63,7 @@ def measure(ours, theirs, Q, V, A, count: int) -> tuple[float, ...]:
     batch = (lambda: ours(Q, V, A), lambda: [theirs(k) for k in range(count)])
     wall = interleaved(*batch, 1, 5)
     cpu = interleaved(*batch, 1, 5, time.process_time)
-    return one_ours, one_theirs, *wall, *cpu
+    return one_ours, one_theirs, *wall, *cpu, fresh_output_floor(ours(Q, V, A))
 
 
 def bench_robot(name: str, foot: str, count: int = 10_000) -> None:
@@ -110,12 +114,13 @@ def bench_robot(name: str, foot: str, count: int = 10_000) -> None:
     print("  function: one call ours / Pinocchio us (ratio Pinocchio/ours); "
           "10^4 states ours / Pinocchio loop ms (ratio); the same by CPU time")
     for label, (ours, theirs) in cases.items():
-        one_ours, one_theirs, batch_ours, batch_theirs, cpu_ours, cpu_theirs = measure(
+        one_ours, one_theirs, batch_ours, batch_theirs, cpu_ours, cpu_theirs, floor = measure(
             ours, theirs, Q, V, A, count)
         print(f"  {label}: {one_ours * 1e6:.2f} / {one_theirs * 1e6:.2f} "
               f"({one_theirs / one_ours:.2f}x); {batch_ours * 1e3:.1f} / "
               f"{batch_theirs * 1e3:.1f} ({batch_theirs / batch_ours:.1f}x); CPU "
-              f"{cpu_ours * 1e3:.1f} / {cpu_theirs * 1e3:.1f} ({cpu_theirs / cpu_ours:.1f}x)")
+              f"{cpu_ours * 1e3:.1f} / {cpu_theirs * 1e3:.1f} ({cpu_theirs / cpu_ours:.1f}x); "
+              f"fresh output {floor * 1e3:.1f} ms (bound {batch_theirs / floor:.0f}x)")
 
 
 def main() -> None:

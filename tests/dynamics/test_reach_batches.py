@@ -20,7 +20,7 @@ from tests.dynamics.test_floating_base import FLOATING_URDF
 import lagrangian
 
 pytest.importorskip("yourdfpy")
-COUNT = 700  # above two threads' worth of states (RK_THREAD_STATES = 256)
+COUNT = 2100  # above two threads' worth of states (RK_THREAD_STATES = 1024)
 # test_dynamics_pinocchio.py's arm (revolute, prismatic on a tilted axis, a fixed tool), here
 # so that these tests run without Pinocchio
 ARM = """<?xml version="1.0"?>

@@ -10,26 +10,10 @@ import numpy as np
 import pytest
 
 import lagrangian
+from control_models import PENDULUM
 from lagrangian.errors import InputError, ModelError
 from lagrangian.model.examples import example_path
 
-PENDULUM = """
-name = "PD pendulum"
-[coordinates]
-theta = { unit = "rad", initial = 0.3 }
-[parameters]
-m = 1.0
-L = 0.5
-g = 9.81
-Kp = 4.0
-Kd = 2.0
-a = 0.2
-[definitions]
-theta_ref = "a*sin(t)"
-[energy]
-T = "1/2*m*L^2*theta_dot^2"
-V = "-m*g*L*cos(theta)"
-"""
 TIGHT = {"rtol": 1e-12, "atol": 1e-12}
 
 

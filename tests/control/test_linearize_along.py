@@ -65,9 +65,9 @@ def test_a_constrained_run_is_linearized_through_its_multipliers():
     np.testing.assert_allclose(along.B[:, 3, 0], 0.0, atol=1e-12)
 
 
-def test_a_perturbed_constrained_run_follows_the_transition_matrix_of_a_of_t():
-    """The Cartesian pendulum swinging from 0.3 m aside, and again turned by 2e-6 rad along the
-    rod's circle: the difference of the two runs is Phi(t) of A(t) times the first one."""
+def perturbed_pendulum_runs():
+    """(system, run, moved): the Cartesian pendulum swinging from 0.3 m aside, and again turned
+    by 2e-6 rad along the rod's circle, 2001 samples over 1 s."""
     system = lagrangian.load("cartesian_pendulum")
     L, angle = 0.5, np.arcsin(0.3 / 0.5)
     options = {"samples": 2001, "rtol": 1e-12, "atol": 1e-12}
@@ -75,11 +75,23 @@ def test_a_perturbed_constrained_run_follows_the_transition_matrix_of_a_of_t():
                           **options)
     moved = system.simulate(1, initial={"x": L * np.sin(angle + 2e-6),
                                         "y": -L * np.cos(angle + 2e-6)}, **options)
-    along = system.linearize_along(run)
-    transition = np.eye(4)
-    for k in range(len(run.t) - 1):
-        step = (along.A[k] + along.A[k + 1]) / 2 * (run.t[k + 1] - run.t[k])
+    return system, run, moved
+
+
+def transition_matrix(along, t) -> np.ndarray:
+    """Phi(t[-1], t[0]) of x_dot = A(t) x, A held at its mean over each sample interval."""
+    transition = np.eye(along.A.shape[-1])
+    for k in range(len(t) - 1):
+        step = (along.A[k] + along.A[k + 1]) / 2 * (t[k + 1] - t[k])
         transition = scipy.linalg.expm(step) @ transition
+    return transition
+
+
+def test_a_perturbed_constrained_run_follows_the_transition_matrix_of_a_of_t():
+    """The perturbed pendulum's difference from the first run is Phi(t) of A(t) times the
+    first difference."""
+    system, run, moved = perturbed_pendulum_runs()
+    transition = transition_matrix(system.linearize_along(run), run.t)
     delta = np.concatenate([moved.q[0] - run.q[0], [0.0, 0.0]])
     difference = np.concatenate([moved.q[-1] - run.q[-1], moved.q_dot[-1] - run.q_dot[-1]])
     assert np.linalg.norm(difference - transition @ delta) < 1e-4 * np.linalg.norm(difference)

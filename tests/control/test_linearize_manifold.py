@@ -10,7 +10,7 @@ import json
 
 import numpy as np
 import pytest
-import scipy.linalg
+from test_linearize_along import perturbed_pendulum_runs, transition_matrix
 
 import lagrangian
 from lagrangian.errors import InputError, ModelError
@@ -79,18 +79,8 @@ def test_a_of_t_is_the_reduced_motions_derivative(name, start):
 
 
 def test_a_perturbed_run_follows_the_reduced_transition_matrix():
-    system = lagrangian.load("cartesian_pendulum")
-    L, angle = 0.5, np.arcsin(0.3 / 0.5)
-    options = {"samples": 2001, "rtol": 1e-12, "atol": 1e-12}
-    run = system.simulate(1, initial={"x": L * np.sin(angle), "y": -L * np.cos(angle)},
-                          **options)
-    moved = system.simulate(1, initial={"x": L * np.sin(angle + 2e-6),
-                                        "y": -L * np.cos(angle + 2e-6)}, **options)
-    along = system.linearize_along(run, independent=["x"])
-    transition = np.eye(2)
-    for k in range(len(run.t) - 1):
-        step = (along.A[k] + along.A[k + 1]) / 2 * (run.t[k + 1] - run.t[k])
-        transition = scipy.linalg.expm(step) @ transition
+    system, run, moved = perturbed_pendulum_runs()
+    transition = transition_matrix(system.linearize_along(run, independent=["x"]), run.t)
     delta = np.array([moved.q[0, 0] - run.q[0, 0], 0.0])
     difference = np.array([moved.q[-1, 0] - run.q[-1, 0], moved.q_dot[-1, 0] - run.q_dot[-1, 0]])
     assert np.linalg.norm(difference - transition @ delta) < 1e-4 * np.linalg.norm(difference)

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import lagrangian
+from control_models import PENDULUM
 from lagrangian.dynamics.standalone import standalone_c, standalone_tree_c
 from lagrangian.model.examples import example_path
 from lagrangian.output.files import write_c
@@ -19,23 +20,6 @@ from lagrangian.output.files import write_c
 COMPILER = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
 needs_compiler = pytest.mark.skipif(COMPILER is None, reason="no C compiler")
 
-PENDULUM = """
-name = "PD pendulum"
-[coordinates]
-theta = { unit = "rad", initial = 0.3 }
-[parameters]
-m = 1.0
-L = 0.5
-g = 9.81
-Kp = 4.0
-Kd = 2.0
-a = 0.2
-[definitions]
-theta_ref = "a*sin(t)"
-[energy]
-T = "1/2*m*L^2*theta_dot^2"
-V = "-m*g*L*cos(theta)"
-"""
 LAW = '[control]\ntheta = "-Kp*(theta - theta_ref) - Kd*theta_dot"\n'
 PUSH = '\n[control]\npush = "-5*x - 3*x_dot + 10*theta + sin(2*t)"\n'
 

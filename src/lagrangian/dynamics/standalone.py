@@ -38,6 +38,20 @@ def c_prefix(name: str) -> str:
     return text if text[0].isalpha() else "m_" + text
 
 
+def renamed_for_c(exprs, rename: dict, fault: str) -> list[sp.Expr]:
+    """The expressions (sympy's, never a user's text) in the C's own names (``rename``: q, v,
+    t and the parameters as q[i], v[i], p[k] or numbers); a symbol outside it refused,
+    ``fault`` naming what is wrong."""
+    out = []
+    for e in exprs:
+        e = sp.sympify(e)  # safe: sympy objects
+        unknown = e.free_symbols - set(rename)
+        if unknown:
+            raise CodegenError(f"{fault} {sorted(map(str, unknown))}")
+        out.append(e.xreplace(rename))
+    return out
+
+
 def standalone_c(eom: EquationsOfMotion, values: dict[str, float], prefix: str | None = None
                  ) -> StandaloneSource:
     """C99 source and header for the dynamics of ``eom`` (an unconstrained model)."""
@@ -53,14 +67,7 @@ def standalone_c(eom: EquationsOfMotion, values: dict[str, float], prefix: str |
         rename[p.symbol] = sp.Symbol(f"p[{i}]")
 
     def c_exprs(exprs):
-        out = []
-        for e in exprs:
-            e = sp.sympify(e)  # safe: sympy objects
-            unknown = e.free_symbols - set(rename)
-            if unknown:
-                raise CodegenError(f"unknown symbols {sorted(map(str, unknown))}")
-            out.append(e.xreplace(rename))
-        return out
+        return renamed_for_c(exprs, rename, "unknown symbols")
 
     printer = CPrinter()
     parts = c_block(c_exprs([*eom.mass_matrix, *eom.forcing]),

@@ -60,15 +60,9 @@ def control_c(model: Model, P: str, parameters: Sequence[str], values: Mapping[s
             rename[p.symbol] = sp.Float(float(values[p.name]))
 
     def c_exprs(exprs):
-        out = []
-        for e in exprs:
-            e = sp.sympify(e)  # safe: sympy objects
-            unknown = e.free_symbols - set(rename)
-            if unknown:
-                raise CodegenError(f"the [control] laws use unknown symbols "
-                                   f"{sorted(map(str, unknown))}")
-            out.append(e.xreplace(rename))
-        return out
+        from .standalone import renamed_for_c
+
+        return renamed_for_c(exprs, rename, "the [control] laws use unknown symbols")
 
     printer = CPrinter()
     law_code = c_block(c_exprs(laws), [f"u[{i}]" for i in range(len(laws))], printer)

@@ -28,6 +28,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from bench_urdf import side_by_side  # the sibling benchmark's: turns taken, best per call
 
 import lagrangian
 
@@ -62,17 +63,6 @@ def _states(rng, count, nq, nv):
     return q, rng.uniform(-1, 1, (count, nv)), rng.uniform(-1, 1, (count, nv))
 
 
-def best_pair(mine, theirs, repeat=7, number=1000) -> tuple[float, float]:
-    ours, pins = [], []
-    for _ in range(repeat):
-        for function, times in ((mine, ours), (theirs, pins)):
-            start = time.perf_counter()
-            for _ in range(number):
-                function()
-            times.append((time.perf_counter() - start) / number)
-    return min(ours), min(pins)
-
-
 def measure(name: str, path: Path, kernel: str, cold: bool = True) -> dict:
     import pinocchio as pin
 
@@ -93,7 +83,7 @@ def measure(name: str, path: Path, kernel: str, cold: bool = True) -> dict:
                                      .max() / np.abs(theirs).max()))
     (q,), (v,), (tau,) = _states(rng, 1, f.nq, f.nv)
     (pq,), (pv,), (ptau,) = _states(rng, 1, model.nq, model.nv)
-    ours, theirs = best_pair(lambda: f.forward_dynamics(q, v, tau),
+    ours, theirs = side_by_side(lambda: f.forward_dynamics(q, v, tau),
                              lambda: pin.aba(model, data, pq, pv, ptau))
     Q, V, TAU = _states(rng, 10_000, f.nq, f.nv)
     PQ, PV, PTAU = _states(rng, 10_000, model.nq, model.nv)

@@ -26,6 +26,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from bench_urdf import side_by_side  # the sibling benchmark's: turns taken, best per call
 
 import lagrangian
 
@@ -72,17 +73,6 @@ def first_result(path: str, lock: dict, kernel: str = "auto") -> float:
         return float(done.stdout.split()[-1])
 
 
-def best_pair(mine, theirs, repeat=7, number=1000) -> tuple[float, float]:
-    ours, pins = [], []
-    for _ in range(repeat):
-        for function, times in ((mine, ours), (theirs, pins)):
-            start = time.perf_counter()
-            for _ in range(number):
-                function()
-            times.append((time.perf_counter() - start) / number)
-    return min(ours), min(pins)
-
-
 def measure(name: str, path: str, lock: dict) -> dict:
     import pinocchio as pin
 
@@ -107,7 +97,7 @@ def measure(name: str, path: str, lock: dict) -> dict:
                                  / np.max(np.abs(theirs))))
     q, v, tau = (rng.uniform(-1, 1, n) for _ in range(3))
     number = 200 if n > 100 else 1000
-    ours, theirs = best_pair(lambda: f.forward_dynamics(q, v, tau),
+    ours, theirs = side_by_side(lambda: f.forward_dynamics(q, v, tau),
                              lambda: pin.aba(model, data, q, v, tau), number=number)
     Q, V, TAU = (rng.uniform(-1, 1, (10_000, n)) for _ in range(3))
     batch_ours, batch_pin = [], []
@@ -128,8 +118,8 @@ def _per_call(system, n: int):
     """Forward dynamics and M per call (s): (unrolled, compact) each."""
     u, c = system.dynamics(kernel="unrolled"), system.dynamics(kernel="compact")
     q = np.linspace(-1, 1, n)
-    return (best_pair(lambda: u.forward_dynamics(q, q, q), lambda: c.forward_dynamics(q, q, q)),
-            best_pair(lambda: u.mass_matrix(q), lambda: c.mass_matrix(q)))
+    return (side_by_side(lambda: u.forward_dynamics(q, q, q), lambda: c.forward_dynamics(q, q, q)),
+            side_by_side(lambda: u.mass_matrix(q), lambda: c.mass_matrix(q)))
 
 
 def threshold(sizes: list[int]) -> None:

@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from bench_urdf import side_by_side  # the sibling benchmark's: turns taken, best per call
 
 import lagrangian
 
@@ -40,17 +41,6 @@ def chain_urdf(n: int) -> str:
             '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>')
     parts.append("</robot>")
     return "".join(parts)
-
-
-def best_pair(mine, theirs, repeat=7, number=1000) -> tuple[float, float]:
-    ours, pins = [], []
-    for _ in range(repeat):
-        for function, times in ((mine, ours), (theirs, pins)):
-            start = time.perf_counter()
-            for _ in range(number):
-                function()
-            times.append((time.perf_counter() - start) / number)
-    return min(ours), min(pins)
 
 
 def relative(a, b) -> float:
@@ -84,7 +74,7 @@ def measure(n: int, folder: Path) -> dict:
             ("mass", lambda: f.mass_matrix(q), lambda: pin.crba(model, data, q)),
             ("inverse", lambda: f.inverse_dynamics(q, v, a),
              lambda: pin.rnea(model, data, q, v, a))):
-        ours, theirs_ = best_pair(mine, theirs)
+        ours, theirs_ = side_by_side(mine, theirs)
         row[f"{key}_ours_us"], row[f"{key}_pin_us"] = ours * 1e6, theirs_ * 1e6
     return row
 

@@ -24,7 +24,6 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -84,22 +83,16 @@ def measure(name: str, path: Path, kernel: str, cold: bool = True) -> dict:
     (q,), (v,), (tau,) = _states(rng, 1, f.nq, f.nv)
     (pq,), (pv,), (ptau,) = _states(rng, 1, model.nq, model.nv)
     ours, theirs = side_by_side(lambda: f.forward_dynamics(q, v, tau),
-                             lambda: pin.aba(model, data, pq, pv, ptau))
+                                lambda: pin.aba(model, data, pq, pv, ptau), number=1000)
     Q, V, TAU = _states(rng, 10_000, f.nq, f.nv)
     PQ, PV, PTAU = _states(rng, 10_000, model.nq, model.nv)
-    batch_ours, batch_pin = [], []
-    for _ in range(3):
-        start = time.perf_counter()
-        f.forward_dynamics(Q, V, TAU)
-        batch_ours.append(time.perf_counter() - start)
-        start = time.perf_counter()
-        for k in range(len(PQ)):
-            pin.aba(model, data, PQ[k], PV[k], PTAU[k])
-        batch_pin.append(time.perf_counter() - start)
+    batch_ours, batch_pin = side_by_side(  # one call of ours, a loop of Pinocchio's, best of 3
+        lambda: f.forward_dynamics(Q, V, TAU),
+        lambda: [pin.aba(model, data, PQ[k], PV[k], PTAU[k]) for k in range(len(PQ))], 3, 1)
     return {"robot": name, "kernel": f.kernel, "bodies": len(f.tree.joints), "nv": f.nv,
             "pinocchio_nv": model.nv, "first_s": first, "call_us": ours * 1e6,
-            "aba_us": theirs * 1e6, "batch_ms": min(batch_ours) * 1e3,
-            "aba_loop_ms": min(batch_pin) * 1e3, "error": error}
+            "aba_us": theirs * 1e6, "batch_ms": batch_ours * 1e3,
+            "aba_loop_ms": batch_pin * 1e3, "error": error}
 
 
 def main() -> None:

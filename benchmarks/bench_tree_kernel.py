@@ -22,7 +22,6 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -98,28 +97,23 @@ def measure(name: str, path: str, lock: dict) -> dict:
     q, v, tau = (rng.uniform(-1, 1, n) for _ in range(3))
     number = 200 if n > 100 else 1000
     ours, theirs = side_by_side(lambda: f.forward_dynamics(q, v, tau),
-                             lambda: pin.aba(model, data, q, v, tau), number=number)
+                                lambda: pin.aba(model, data, q, v, tau), number=number)
     Q, V, TAU = (rng.uniform(-1, 1, (10_000, n)) for _ in range(3))
-    batch_ours, batch_pin = [], []
-    for _ in range(3):
-        start = time.perf_counter()
-        f.forward_dynamics(Q, V, TAU)
-        batch_ours.append(time.perf_counter() - start)
-        start = time.perf_counter()
-        for k in range(len(Q)):
-            pin.aba(model, data, Q[k], V[k], TAU[k])
-        batch_pin.append(time.perf_counter() - start)
+    batch_ours, batch_pin = side_by_side(  # one call of ours, a loop of Pinocchio's, best of 3
+        lambda: f.forward_dynamics(Q, V, TAU),
+        lambda: [pin.aba(model, data, Q[k], V[k], TAU[k]) for k in range(len(Q))], 3, 1)
     return {"name": name, "n": n, "kernel": getattr(f, "kernel", "?"), "first_s": first,
             "error": error, "ours_us": ours * 1e6, "pin_us": theirs * 1e6,
-            "batch_ours_ms": min(batch_ours) * 1e3, "batch_pin_ms": min(batch_pin) * 1e3}
+            "batch_ours_ms": batch_ours * 1e3, "batch_pin_ms": batch_pin * 1e3}
 
 
 def _per_call(system, n: int):
     """Forward dynamics and M per call (s): (unrolled, compact) each."""
     u, c = system.dynamics(kernel="unrolled"), system.dynamics(kernel="compact")
     q = np.linspace(-1, 1, n)
-    return (side_by_side(lambda: u.forward_dynamics(q, q, q), lambda: c.forward_dynamics(q, q, q)),
-            side_by_side(lambda: u.mass_matrix(q), lambda: c.mass_matrix(q)))
+    return (side_by_side(lambda: u.forward_dynamics(q, q, q), lambda: c.forward_dynamics(q, q, q),
+                         number=1000),
+            side_by_side(lambda: u.mass_matrix(q), lambda: c.mass_matrix(q), number=1000))
 
 
 def threshold(sizes: list[int]) -> None:

@@ -71,17 +71,13 @@ static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
         lg_v4 spoilt = LG_V4(0.0);
         for (int j = 0; j < 3; j++)
             for (int i = 0; i < DK_WIDTH(j); i++) spoilt += in[j][i] - in[j][i];
+        for (int o = 0; o < nout; o++) lg_rows(out + o * size, size, job->y[o] + k * size);
         for (int l = 0; l < LG_LANES; l++) {
             const int fine = !((failed >> l) & 1) && spoilt[l] == 0.0;
             bad += !fine;
-            for (int o = 0; o < nout; o++) {
-                double *y = job->y[o] + (k + l) * size;
-                const lg_v4 *x = out + o * size;
-                if (fine)
-                    for (int i = 0; i < size; i++) y[i] = x[i][l];
-                else
-                    for (int i = 0; i < size; i++) y[i] = NAN;
-            }
+            if (!fine)
+                for (int o = 0; o < nout; o++)
+                    for (int i = 0; i < size; i++) job->y[o][(k + l) * size + i] = NAN;
         }
     }
     for (; k < k1; k++) {

@@ -58,12 +58,13 @@ static inline void rk_gather(const double *x, npy_intp k, int width, lg_v4 *out)
 static inline void rk_scatter(const lg_v4 *x, npy_intp k, int width, double *y, int add,
                               double sign)
 {
+    if (!add) {
+        lg_rows(x, width, y + k * width);
+        return;
+    }
     for (int l = 0; l < LG_LANES; l++) {
         double *row = y + (k + l) * width;
-        if (add)
-            for (int i = 0; i < width; i++) row[i] += sign * x[i][l];
-        else
-            for (int i = 0; i < width; i++) row[i] = x[i][l];
+        for (int i = 0; i < width; i++) row[i] += sign * x[i][l];
     }
 }
 

@@ -75,13 +75,11 @@ static npy_intp rt_range(const rt_job *job, npy_intp k, npy_intp count)
 #endif
         default: break;
         }
+        lg_rows(out4, size, y + k * size);
         for (int l = 0; l < LG_LANES; l++) {
             int fine = 1;
-            for (int i = 0; i < size; i++) {
-                const double x = out4[i][l];
-                y[(k + l) * size + i] = x;
-                if (kind == RT_FORWARD && !isfinite(x)) fine = 0;
-            }
+            if (kind == RT_FORWARD)
+                for (int i = 0; i < size; i++) fine &= isfinite(y[(k + l) * size + i]) != 0;
             if (!fine || !rt_finite(nin, step, x0, x1, x2, k + l)) {
                 rt_blank(y, size, k + l);
                 bad++;

@@ -37,10 +37,11 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
     from ..compile.codegen import TEMPLATE, GeneratedSource
 
     n = len(tree.coordinates) + tree.base_nv  # v's numbers; q's are RT_NQ (a floating base)
-    # two-state vector variants for batches of arms; a long chain's code is big enough that
-    # compiling it twice costs minutes, so there the batch runs the scalar functions
-    # a floating base's forward dynamics (the articulated-body algorithm, linear in the bodies)
-    # on lanes at any size: the batches that simulate and plan walking robots
+    # vector variants (LG_LANES states at once) for batches up to VECTOR_LIMIT coordinates; a
+    # long chain's code is big enough that compiling it twice costs minutes, so there the batch
+    # runs the scalar functions; a floating base's forward dynamics (the articulated-body
+    # algorithm, linear in the bodies) on lanes at any size: the batches that simulate and plan
+    # walking robots
     functions = dynamics_functions(tree, parameters, "rt", vector=n <= VECTOR_LIMIT,
                                    vector_forward=tree.floating_base)
     source = "\n".join([

@@ -4,9 +4,9 @@ call of one state and for a batch of 10^4 states against a Python loop of Pinocc
 
     python benchmarks/bench_floating_reach.py
 
-Needs the bench extra (pin, example-robot-data). Each per-call figure is the best of 7 rounds
-of 300 calls, ours and Pinocchio's rounds alternating in one process; each batch figure the
-best of 5, alternating too (one call of ours on 10^4 states, on as many threads as processors
+Needs the bench extra (pin, example-robot-data). Each per-call figure (one state, its arrays
+bound beforehand on both sides) is the best of 7 rounds of 300 calls, ours and Pinocchio's
+rounds alternating in one process; each batch figure the best of 5, alternating too (one call of ours on 10^4 states, on as many threads as processors
 or LAGRANGIAN_THREADS allow; a loop of 10^4 Pinocchio calls), then the same by CPU time
 (time.process_time: this process's, both threads summed), which the machine's other work
 disturbs less; then the fresh-output floor (bench_control.fresh_output_floor: allocating and
@@ -56,11 +56,14 @@ def interleaved(ours, theirs, calls: int = 300, rounds: int = 7,
     return a, b
 
 
-def measure(ours, theirs, Q, V, A, count: int) -> tuple[float, ...]:
-    """Seconds: one call of ours and of Pinocchio's (interleaved), 10^4 states in one call of
-    ours and in a loop of Pinocchio's, by the wall clock and by CPU time."""
-    one_ours, one_theirs = interleaved(lambda: ours(Q[0], V[0], A[0]), lambda: theirs(0))
-    batch = (lambda: ours(Q, V, A), lambda: [theirs(k) for k in range(count)])
+def measure(ours, theirs, Q, V, A, states, count: int) -> tuple[float, ...]:
+    """Seconds: one call of ours and of Pinocchio's (interleaved; each its first state's arrays
+    bound beforehand), 10^4 states in one call of ours and in a loop of Pinocchio's (``states``:
+    its q, v, a in its own order), by the wall clock and by CPU time."""
+    q, v, a = states
+    state, first = (Q[0], V[0], A[0]), (q[0], v[0], a[0])
+    one_ours, one_theirs = interleaved(lambda: ours(*state), lambda: theirs(*first))
+    batch = (lambda: ours(Q, V, A), lambda: [theirs(q[k], v[k], a[k]) for k in range(count)])
     wall = interleaved(*batch, 1, 5)
     cpu = interleaved(*batch, 1, 5, time.process_time)
     return one_ours, one_theirs, *wall, *cpu, fresh_output_floor(ours(Q, V, A))
@@ -95,27 +98,27 @@ def bench_robot(name: str, foot: str, count: int = 10_000) -> None:
     forces[joint] = pin.Force(placement.rotation.T @ wrench[:3],
                               placement.rotation.T @ np.cross(arm, wrench[:3]))
 
-    def drift(k):
-        pin.forwardKinematics(model, data, q[k], v[k], 0 * v[k])
+    def drift(qk, vk, ak):
+        pin.forwardKinematics(model, data, qk, vk, 0 * vk)
         pin.updateFramePlacement(model, data, frame)
         return pin.getFrameClassicalAcceleration(model, data, frame,
                                                  pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
 
     cases = {
         "coriolis_matrix": (lambda x, y, z: robot.coriolis_matrix(x, y),
-                            lambda k: pin.computeCoriolisMatrix(model, data, q[k], v[k])),
+                            lambda x, y, z: pin.computeCoriolisMatrix(model, data, x, y)),
         "jacobian_dot_times_v": (lambda x, y, z: robot.jacobian_dot_times_v(x, y, foot), drift),
         "centroidal_momentum_matrix": (lambda x, y, z: robot.centroidal_momentum_matrix(x),
-                                       lambda k: pin.ccrba(model, data, q[k], v[k])),
+                                       lambda x, y, z: pin.ccrba(model, data, x, y)),
         "inverse_dynamics f_ext": (lambda x, y, z: robot.inverse_dynamics(x, y, z, f_ext=f_ext),
-                                   lambda k: pin.rnea(model, data, q[k], v[k], a[k], forces)),
+                                   lambda x, y, z: pin.rnea(model, data, x, y, z, forces)),
     }
     print(f"{path.name}: nq {model.nq}, nv {model.nv}")
     print("  function: one call ours / Pinocchio us (ratio Pinocchio/ours); "
           "10^4 states ours / Pinocchio loop ms (ratio); the same by CPU time")
     for label, (ours, theirs) in cases.items():
         one_ours, one_theirs, batch_ours, batch_theirs, cpu_ours, cpu_theirs, floor = measure(
-            ours, theirs, Q, V, A, count)
+            ours, theirs, Q, V, A, (q, v, a), count)
         print(f"  {label}: {one_ours * 1e6:.2f} / {one_theirs * 1e6:.2f} "
               f"({one_theirs / one_ours:.2f}x); {batch_ours * 1e3:.1f} / "
               f"{batch_theirs * 1e3:.1f} ({batch_theirs / batch_ours:.1f}x); CPU "

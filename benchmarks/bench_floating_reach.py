@@ -6,13 +6,13 @@ call of one state and for a batch of 10^4 states against a Python loop of Pinocc
 
 Needs the bench extra (pin, example-robot-data). Each per-call figure (one state, its arrays
 bound beforehand on both sides) is the best of 7 rounds of 300 calls, ours and Pinocchio's
-rounds alternating in one process; each batch figure the best of 5, alternating too (one call of ours on 10^4 states, on as many threads as processors
-or LAGRANGIAN_THREADS allow; a loop of 10^4 Pinocchio calls), then the same by CPU time
-(time.process_time: this process's, both threads summed), which the machine's other work
-disturbs less; then the fresh-output floor (bench_control.fresh_output_floor: allocating and
-writing once as many doubles as the batch returns) and the bound it puts on any batch's
-speed-up over Pinocchio's loop here. The load average is printed before and after, and the
-threads a batch may take.
+rounds alternating in one process; each batch figure the best of 5, alternating too (one call of
+ours on 10^4 states, on as many threads as processors or LAGRANGIAN_THREADS allow; a loop of
+10^4 Pinocchio calls), then the same by CPU time (time.process_time: this process's, both
+threads summed), which the machine's other work disturbs less; then the fresh-output floor
+(bench_control.fresh_output_floor: allocating and writing once as many doubles as the batch
+returns) and the bound it puts on any batch's speed-up over Pinocchio's loop here. The load
+average is printed before and after, and the threads a batch may take.
 """
 
 from __future__ import annotations

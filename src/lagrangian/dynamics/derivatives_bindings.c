@@ -48,10 +48,15 @@ static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
     npy_intp bad = 0;
     for (; out && k + LG_LANES <= k1; k += LG_LANES) {
         lg_v4 in[3][DK_NQ];
-        for (int j = 0; j < 3; j++)
-            for (int l = 0; l < LG_LANES; l++)
+        for (int j = 0; j < 3; j++) {
+            if (job->step[j] == DK_WIDTH(j)) {  /* a row per state */
+                lg_lanes(job->x[j] + k * DK_WIDTH(j), DK_WIDTH(j), in[j]);
+                continue;
+            }
+            for (int l = 0; l < LG_LANES; l++)  /* one state shared by the batch */
                 for (int i = 0; i < DK_WIDTH(j); i++)
                     in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
+        }
         /* the rows these states will fill, fetched for writing while the kernel computes: a
            batch's outputs are fresh memory, and its stores would otherwise each wait for it */
         for (int o = 0; o < nout; o++) {

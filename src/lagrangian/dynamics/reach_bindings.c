@@ -49,8 +49,7 @@ static void rk_state(const rk_job *job, npy_intp k, rk_cbody *work)
 /* lanes' inputs: rows k .. k + LG_LANES - 1 of x (``width`` numbers a row) as vectors */
 static inline void rk_gather(const double *x, npy_intp k, int width, lg_v4 *out)
 {
-    for (int l = 0; l < LG_LANES; l++)
-        for (int i = 0; i < width; i++) out[i][l] = x[(k + l) * width + i];
+    lg_lanes(x + k * width, width, out);
 }
 
 /* lanes' outputs into rows k .. k + LG_LANES - 1 of y (``width`` numbers a row): y = x, or

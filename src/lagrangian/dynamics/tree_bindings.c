@@ -58,7 +58,11 @@ static npy_intp rt_range(const rt_job *job, npy_intp k, npy_intp count)
         lg_v4 in[3][RT_NQ], out4[LG_N * LG_N];
         for (int j = 0; j < nin; j++) {
             const double *x = j == 0 ? x0 : j == 1 ? x1 : x2;
-            for (int l = 0; l < LG_LANES; l++)
+            if (step[j] == RT_WIDTH(j)) {  /* a row per state */
+                lg_lanes(x + k * RT_WIDTH(j), RT_WIDTH(j), in[j]);
+                continue;
+            }
+            for (int l = 0; l < LG_LANES; l++)  /* one state shared by the batch */
                 for (int i = 0; i < RT_WIDTH(j); i++) in[j][i][l] = x[(k + l) * step[j] + i];
         }
         switch (kind) {

@@ -218,6 +218,22 @@ static inline void lg_transpose(const lg_v4 *x, lg_v4 *t)
 }
 #endif
 
+/* The inverse: the states' rows (row l: ``width`` doubles at y + l width) as lanes,
+   x[i][l] = y[l width + i] (the transpose is its own inverse). */
+static inline void lg_lanes(const double *y, int width, lg_v4 *x)
+{
+    int i = 0;
+#ifdef LG_SHUFFLE
+    for (; i + LG_LANES <= width; i += LG_LANES) {
+        lg_v4 rows[LG_LANES];
+        for (int l = 0; l < LG_LANES; l++) __builtin_memcpy(&rows[l], y + l * width + i, sizeof rows[l]);
+        lg_transpose(rows, x + i);
+    }
+#endif
+    for (int l = 0; l < LG_LANES; l++)
+        for (int j = i; j < width; j++) x[j][l] = y[l * width + j];
+}
+
 static inline void lg_rows(const lg_v4 *x, int width, double *y)
 {
     int i = 0;

@@ -2,7 +2,8 @@
 buildModelFromUrdf(path, JointModelFreeFlyer()): Solo12 (nv 18), ANYmal (nv 18) and Talos
 reduced (nv 38), generated C and numpy, per call of one state and per state of a batch of 1000;
 then forward dynamics side by side with Pinocchio's aba, interleaved: one call from Python, and a
-batch of 10^4 states (one call of ours against a Python loop of aba over the same states).
+batch of 10^4 states (one call of ours against a Python loop of aba over the same states); then
+M, bias and inverse dynamics the same way against crba, nonLinearEffects and rnea.
 
     python benchmarks/bench_floating_base.py [--robots solo12,anymal,talos_reduced]
 
@@ -75,19 +76,32 @@ def forward_side_by_side(robot, model, ours_states, pinocchio_states) -> None:
     q0, v0, t0 = q[0], v[0], tau[0]
     qp, vp, tp = pinocchio_states
 
-    def loop():
-        for k in range(BATCH):
-            pin.aba(model, data, qp[k], vp[k], tp[k])
+    def loop(function, *inputs):
+        """a Python loop of a Pinocchio function over the BATCH states"""
+        def run():
+            for k in range(BATCH):
+                function(model, data, *(x[k] for x in inputs))
+        return run
 
     one = side_by_side({"ours": lambda: robot.forward_dynamics(q0, v0, t0),
                         "module": lambda: module.forward_dynamics(q0, v0, t0, P),
                         "aba": lambda: pin.aba(model, data, qp[0], vp[0], tp[0])}, 1)
-    many = side_by_side({"ours": lambda: robot.forward_dynamics(q, v, tau), "aba loop": loop},
-                        BATCH, rounds=5)
+    many = side_by_side({"ours": lambda: robot.forward_dynamics(q, v, tau),
+                         "aba loop": loop(pin.aba, qp, vp, tp)}, BATCH, rounds=5)
+    # the other functions' batches the same way (Pinocchio's crba fills M's upper triangle only)
+    others = side_by_side({"M": lambda: robot.mass_matrix(q), "crba": loop(pin.crba, qp),
+                           "bias": lambda: robot.bias_forces(q, v),
+                           "nonLinearEffects": loop(pin.nonLinearEffects, qp, vp),
+                           "ID": lambda: robot.inverse_dynamics(q, v, tau),
+                           "rnea": loop(pin.rnea, qp, vp, tp)}, BATCH, rounds=5)
     print(f"  forward dynamics, one call: ours {one['ours']:.3g} (the module's function alone "
           f"{one['module']:.3g}), aba {one['aba']:.3g}: {one['aba'] / one['ours']:.2f}x")
     print(f"  forward dynamics, {BATCH} states: ours {many['ours']:.3g} per state, a Python "
           f"loop of aba {many['aba loop']:.3g}: {many['aba loop'] / many['ours']:.1f}x")
+    print(f"  {BATCH} states, ours / a Python loop of Pinocchio's per state: " + ", ".join(
+        f"{ours} {others[ours]:.3g} / {theirs} {others[theirs]:.3g} "
+        f"({others[theirs] / others[ours]:.1f}x)"
+        for ours, theirs in (("M", "crba"), ("bias", "nonLinearEffects"), ("ID", "rnea"))))
 
 
 def main() -> None:

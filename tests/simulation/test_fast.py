@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import time
 
 import numpy as np
@@ -135,6 +136,9 @@ def test_ctrl_c_stops_the_compiled_loop_and_keeps_what_was_computed():
     import threading
 
     functions = lagrangian.load("double_pendulum").numeric(backend="c")
+    # Python installs its Ctrl-C handler only where SIGINT came in at its default: a suite run
+    # as a background job inherits it ignored, and interrupt_main() then does nothing
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     done = threading.Event()
 
     def press_ctrl_c():  # what Ctrl-C does to the main thread; again, should one be lost
@@ -155,6 +159,8 @@ def test_ctrl_c_stops_the_compiled_loop_and_keeps_what_was_computed():
         time.sleep(0.05)  # a second press that landed after the loop stopped is raised here
     except KeyboardInterrupt:
         pass
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert result is not None, "Ctrl-C reached Python, not the compiled loop"
     assert not result.success
     assert result.message.startswith("Interrupted at t = ")

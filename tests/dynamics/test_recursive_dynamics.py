@@ -195,6 +195,19 @@ def test_a_compiler_that_refuses_the_native_flags_still_builds(tree, monkeypatch
 
 
 @needs_c
+def test_a_compiler_that_refuses_an_exactness_flag_still_builds(tree, monkeypatch, tmp_path):
+    """The robot's module asks for no fused multiply-adds and no packing of scalar code
+    (compiled.EXACT_CFLAGS); a compiler that knows only the first still builds it, with the
+    same numbers."""
+    monkeypatch.setenv("LAGRANGIAN_CACHE", str(tmp_path))
+    monkeypatch.setattr(compiled, "EXACT_CFLAGS", ("-ffp-contract=off", "-fno-such-flag"))
+    fallback = RecursiveDynamics(tree.model, applicable_tree(tree.model))
+    q, v, a, _ = states(fallback.n, count=9, seed=8)
+    np.testing.assert_allclose(fallback.inverse_dynamics(q, v, a),
+                               tree.dynamics().inverse_dynamics(q, v, a), rtol=1e-12, atol=1e-12)
+
+
+@needs_c
 def test_free_motion_keeps_energy(tree):
     """Zero torque: T + V is constant along the motion q'' = M^-1 (-C q' - g)."""
     from scipy.integrate import solve_ivp

@@ -43,6 +43,12 @@ CFLAGS = ("-O2", "-fPIC", "-shared", "-fno-math-errno", "-w")
 # vector width (AVX2 + FMA: four states per operation instead of SSE2's two) halves their time.
 # Such a module only runs on this kind of processor, so its name carries a CPU fingerprint.
 NATIVE_CFLAGS = ("-O3", "-march=native")
+# no a * b + c contracted into a fused multiply-add (which GCC and Clang do by default, in
+# places that differ between a function's scalar and vector variants), nor straight-line scalar
+# code packed into vectors (GCC then fuses pairs into vfmaddsub whatever -ffp-contract says):
+# a module whose batch rows must equal its single calls bit for bit (the robot's tree module)
+# asks for these (Clang takes the second as its -fno-slp-vectorize)
+EXACT_CFLAGS = ("-ffp-contract=off", "-fno-tree-slp-vectorize")
 
 _LOADED: dict[str, ModuleType] = {}
 
@@ -198,15 +204,21 @@ def check_compiler() -> list[str]:
     raise CompilerMissing("no C compiler found (set CC, or install gcc or clang)")
 
 
-def _compile(source: str, name: str, target: Path, native: bool = False) -> None:
+def _compile(source: str, name: str, target: Path, native: bool = False,
+             exact: bool = False) -> None:
     """Build ``target``; with ``native`` the processor's own instructions, falling back to the
-    portable flags where the compiler refuses them (e.g. no -march=native for the target)."""
-    if native:
+    portable flags where the compiler refuses them (e.g. no -march=native for the target);
+    with ``exact``, EXACT_CFLAGS after them (then the first alone, for a compiler that knows
+    no other)."""
+    extras = (EXACT_CFLAGS, EXACT_CFLAGS[:1]) if exact else ((),)
+    attempts = [(*CFLAGS, *NATIVE_CFLAGS, *extra) for extra in extras] if native else []
+    attempts += [(*CFLAGS, *extra) for extra in extras]
+    for flags in attempts[:-1]:
         try:
-            return _compile_with(source, name, target, (*CFLAGS, *NATIVE_CFLAGS))
+            return _compile_with(source, name, target, flags)
         except BackendUnavailable:
             pass
-    _compile_with(source, name, target, CFLAGS)
+    _compile_with(source, name, target, attempts[-1])
 
 
 def _compile_with(source: str, name: str, target: Path, flags: tuple[str, ...]) -> None:
@@ -297,26 +309,29 @@ def _generator_key() -> str:
                           ).hexdigest()
 
 
-def keyed_module_name(key: str, native: bool = False) -> str:
+def keyed_module_name(key: str, native: bool = False, exact: bool = False) -> str:
     """lg_<hash of the equations' key, the generator, compiler flags, Python and numpy (and,
     for a native build, the processor)>."""
     parts = [_platform_key(), _generator_key(), key]
     if native:
         parts += [" ".join(NATIVE_CFLAGS), cpu_fingerprint()]
+    if exact:
+        parts.append(" ".join(EXACT_CFLAGS))
     text = "\n".join(parts)
     return f"lg_{hashlib.sha256(text.encode()).hexdigest()[:24]}"
 
 
 def load_keyed(key: str, make_source: Callable[[], GeneratedSource],
-               native: bool = False) -> ModuleType:
+               native: bool = False, exact: bool = False) -> ModuleType:
     """The compiled module for the equations with this key: in memory, else from the on-disk
     cache (no C generated, no compiler needed), else ``make_source()`` generated and built now;
-    ``native``: for this processor's instruction set (NATIVE_CFLAGS)."""
-    return _load_or_build(keyed_module_name(key, native), make_source, native)
+    ``native``: for this processor's instruction set (NATIVE_CFLAGS); ``exact``: without fused
+    multiply-adds the compiler would choose (EXACT_CFLAGS)."""
+    return _load_or_build(keyed_module_name(key, native, exact), make_source, native, exact)
 
 
 def _load_or_build(name: str, make_source: Callable[[], GeneratedSource],
-                   native: bool = False) -> ModuleType:
+                   native: bool = False, exact: bool = False) -> ModuleType:
     """The module ``name``: in memory, else the cached file once verified, else built from
     ``make_source()`` (called only then, after the compiler is found: without one the C would
     be wasted). One process builds a module at a time (a lock file beside it)."""
@@ -338,7 +353,7 @@ def _load_or_build(name: str, make_source: Callable[[], GeneratedSource],
             if module is not None:
                 return module
             generated = make_source()
-            _compile(generated.source, name, path, native)
+            _compile(generated.source, name, path, native, exact)
     except OSError as exc:
         raise BackendUnavailable(f"cannot write the compiled-module cache {path.parent}: "
                                  f"{exc.strerror or exc} (set LAGRANGIAN_CACHE)") from None

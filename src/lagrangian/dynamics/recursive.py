@@ -108,8 +108,13 @@ class RecursiveDynamics(TreeDynamics):
         self._take_tree(model, tree, parameters)
         self.parameter_values = np.array(list(self.parameters.values()), dtype=float)
         self.parameter_values.flags.writeable = False
+        # exact: no fused multiply-adds, which the compiler places differently in the scalar
+        # and the vector functions, so that a batch's row equals its state's single call bit
+        # for bit (docs/robotics.md; with them Solo12's g differed in the last bit in 162 of
+        # 400 states); 10-20% of an arm's ID and FD on one thread
         self.module = compiled.load_keyed(tree_key(tree, names),
-                                          lambda: module_source(tree, names), native=True)
+                                          lambda: module_source(tree, names), native=True,
+                                          exact=True)
         P = self.parameter_values
         m = self.module
         # The fast path: one C call each, the parameters bound here.

@@ -51,12 +51,6 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
         f"#define RT_NQ {n + tree.base_nq - tree.base_nv}",
         "#define LG_M 0",
         f"#define RT_FLOATING {int(tree.floating_base)}",
-        # no a * b + c contracted into a fused multiply-add: the compiler places them
-        # differently in the scalar and the vector functions, and a batch's row must equal its
-        # state's single call bit for bit (docs/robotics.md; Solo12's g differed in the last
-        # bit in 162 of 400 states); 10-20% of an arm's ID and FD on one thread
-        '#pragma GCC optimize("fp-contract=off")',
-        "#pragma clang fp contract(off)",
         f"#define RT_QUATERNION_TOLERANCE {QUATERNION_TOLERANCE!r}",
         f"#define LG_NP {len(parameters)}",
         "#define PY_SSIZE_T_CLEAN",

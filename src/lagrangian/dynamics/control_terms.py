@@ -5,7 +5,8 @@ mixed into joint_space.Dynamics (every path, a URDF tree's and a model file's)."
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import NamedTuple
 
 import numpy as np
 
@@ -28,6 +29,19 @@ def _refuse_floating(tree, what: str) -> None:
                          "only); load it without floating_base=True", field="q")
 
 
+class DerivativesKernel(NamedTuple):
+    """A tree's compiled derivatives (derivatives_c.py): each function takes (Q, V, X, P); the
+    C refuses a base quaternion of the wrong norm with a ValueError, the checked ones name the
+    state and the norm in one line first (the guarded way)."""
+
+    inverse: Callable
+    forward: Callable
+    regressor: Callable
+    P: np.ndarray
+    checked_inverse: Callable
+    checked_regressor: Callable
+
+
 class ControlTerms:
     """Regressor and parameters (a mixin of joint_space.Dynamics; SI units)."""
 
@@ -41,7 +55,7 @@ class ControlTerms:
             # compiled C (derivatives_c.py) where a compiler works, else numpy
             fast = self._derivatives_kernel()
             if fast is not None:
-                compute, P = fast[5], fast[3]
+                compute, P = fast.checked_regressor, fast.P
                 return (lambda Q, V, A: compute(Q, V, A, P),
                         tree_parameter_names(tree), tree_parameters(tree))
             g = self.parameters[tree.gravity_parameter]
@@ -69,7 +83,7 @@ class ControlTerms:
         if fast is not None:  # one C call; a bad input goes
             # the guarded way to be named
             try:
-                out = fast[2](q, v, a, fast[3])
+                out = fast.regressor(q, v, a, fast.P)
             except (ValueError, TypeError):
                 pass
             else:
@@ -107,10 +121,9 @@ class ControlTerms:
     # -- derivatives (derivatives_c.py, derivatives.py) -------------------------------------------
 
     def _derivatives_kernel(self):
-        """(inverse, forward, regressor, P, inverse and regressor checking a base quaternion
-        first) of the tree's compiled module (derivatives_c.py), or None: a compiled backend's
-        tree of revolute and prismatic joints (a floating base too); the numpy backend and a
-        model file keep derivatives.py."""
+        """The tree's compiled module's DerivativesKernel (derivatives_c.py), or None: a
+        compiled backend's tree of revolute and prismatic joints (a floating base too); the
+        numpy backend and a model file keep derivatives.py."""
         found = self.__dict__.get("_derivatives_c", False)
         if found is False:
             found = None
@@ -120,17 +133,14 @@ class ControlTerms:
 
                 module = derivatives_module(tree) if applies(tree) else None
                 if module is not None:
-                    # the C refuses a base quaternion of the wrong norm with a ValueError (the
-                    # calls below then take the guarded way); the guarded way's functions
-                    # name the state and the norm in one line first
                     inverse, regressor = module.inverse_derivatives, module.regressor
                     checked = (inverse, regressor)
                     if tree.floating_base:
                         from .free_flyer import checking_quaternions
 
                         checked = tuple(checking_quaternions(f) for f in checked)
-                    found = (inverse, module.forward_derivatives, regressor,
-                             runtime_values(tree, self.parameters), *checked)
+                    found = DerivativesKernel(inverse, module.forward_derivatives, regressor,
+                                              runtime_values(tree, self.parameters), *checked)
             self.__dict__["_derivatives_c"] = found
         return found
 
@@ -142,7 +152,7 @@ class ControlTerms:
             if fast is None:
                 _refuse_floating(tree, "derivatives of the dynamics")
             if fast is not None:
-                inverse, P = fast[4], fast[3]
+                inverse, P = fast.checked_inverse, fast.P
 
                 def found(Q, V, A):
                     return inverse(Q, V, A, P)[:2]
@@ -172,7 +182,7 @@ class ControlTerms:
         fast = self._derivatives_kernel()
         if fast is not None:  # one C call; a bad input goes the guarded way to be named
             try:
-                out = fast[0](q, v, a, fast[3])
+                out = fast.inverse(q, v, a, fast.P)
             except (ValueError, TypeError):
                 pass
             else:
@@ -191,7 +201,7 @@ class ControlTerms:
         fast = self._derivatives_kernel()
         if fast is not None:
             try:
-                out = fast[1](q, v, tau, fast[3])
+                out = fast.forward(q, v, tau, fast.P)
             except (ValueError, TypeError):
                 pass
             else:

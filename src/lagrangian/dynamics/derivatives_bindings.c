@@ -169,23 +169,9 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
         step[i] = DK_WIDTH(i);
     }
 #if DK_FF
-    {
-        /* each finite state's quaternion q[3..6] unit to DK_QTOL (free_flyer.py), here rather
-           than in Python before the call (half a microsecond of a call's six); the caller
-           names the state and the norm */
-        const double *xq = (const double *)PyArray_DATA(in[0]);
-        const npy_intp states = step[0] ? count : 1;
-        for (npy_intp k = 0; k < states; k++) {
-            const double *x = xq + k * step[0];
-            int finite = 1;
-            for (int i = 0; i < DK_NQ; i++) finite &= isfinite(x[i]) != 0;
-            const double norm = sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6]);
-            if (finite && !(fabs(norm - 1.0) <= DK_QTOL)) {
-                PyErr_SetString(PyExc_ValueError, "q: the base quaternion is not unit");
-                goto done;
-            }
-        }
-    }
+    if (!lg_unit_quaternions((const double *)PyArray_DATA(in[0]), step[0] ? count : 1, step[0],
+                             DK_NQ, DK_QTOL))
+        goto done;
 #endif
     P = (PyArrayObject *)PyArray_FROMANY(args[3], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
     if (!P) goto done;

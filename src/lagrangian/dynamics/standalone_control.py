@@ -12,6 +12,7 @@ import sympy as sp
 from ..compile.codegen import CodegenError, CPrinter, c_block, c_comment_text
 from ..derivation.equations import EquationsOfMotion
 from ..model.model import Model
+from .standalone import renamed_for_c
 
 # B's columns of the inputs named, from the derived equations: simulation.control's
 # input_columns(eom, names, field=, source=), given by the caller (dynamics does not import
@@ -60,8 +61,6 @@ def control_c(model: Model, P: str, parameters: Sequence[str], values: Mapping[s
             rename[p.symbol] = sp.Float(float(values[p.name]))
 
     def c_exprs(exprs):
-        from .standalone import renamed_for_c
-
         return renamed_for_c(exprs, rename, "the [control] laws use unknown symbols")
 
     printer = CPrinter()

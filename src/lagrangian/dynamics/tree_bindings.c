@@ -193,23 +193,9 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
         step[i] = RT_WIDTH(i);
     }
 #if RT_FLOATING
-    /* a floating base: each finite state's quaternion q[3..6] unit to RT_QUATERNION_TOLERANCE
-       (free_flyer.py), here rather than in Python (a microsecond a call); the caller names the
-       state and the norm */
-    {
-        const double *xq = (const double *)PyArray_DATA(in[0]);
-        const npy_intp states = step[0] ? count : 1;
-        for (npy_intp k = 0; k < states; k++) {
-            const double *x = xq + k * step[0];
-            int finite = 1;
-            for (int i = 0; i < RT_NQ; i++) finite &= isfinite(x[i]) != 0;
-            const double norm = sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6]);
-            if (finite && !(fabs(norm - 1.0) <= RT_QUATERNION_TOLERANCE)) {
-                PyErr_SetString(PyExc_ValueError, "q: the base quaternion is not unit");
-                goto done;
-            }
-        }
-    }
+    if (!lg_unit_quaternions((const double *)PyArray_DATA(in[0]), step[0] ? count : 1, step[0],
+                             RT_NQ, RT_QUATERNION_TOLERANCE))
+        goto done;
 #endif
     P = lg_doubles(args[nin], LG_NP, "parameters");
     if (!P) goto done;

@@ -117,22 +117,9 @@ static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
         }
         step[i] = TK_WIDTH(i);
     }
-    if (tree.fb) {
-        /* each finite state's quaternion q[3..6] unit to the tree's tolerance (free_flyer.py);
-           the caller names the state and the norm */
-        const double *xq = (const double *)PyArray_DATA(in[0]);
-        const npy_intp states = step[0] ? count : 1;
-        for (npy_intp k = 0; k < states; k++) {
-            const double *x = xq + k * step[0];
-            int finite = 1;
-            for (int i = 0; i < tree.nq; i++) finite &= isfinite(x[i]) != 0;
-            const double norm = sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6]);
-            if (finite && !(fabs(norm - 1.0) <= tree.qtol)) {
-                PyErr_SetString(PyExc_ValueError, "q: the base quaternion is not unit");
-                goto done;
-            }
-        }
-    }
+    if (tree.fb && !lg_unit_quaternions((const double *)PyArray_DATA(in[0]),
+                                        step[0] ? count : 1, step[0], tree.nq, tree.qtol))
+        goto done;
 #undef TK_WIDTH
     npy_intp dims[NPY_MAXDIMS];
     memcpy(dims, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));

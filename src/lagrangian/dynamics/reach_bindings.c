@@ -22,7 +22,7 @@ typedef struct {
     npy_intp count, *next;
 } rk_job;
 
-static void rk_state(const rk_job *job, npy_intp k, rk_cbody *work)
+static void rk_state(const rk_job *job, npy_intp k, rk_cwork *work)
 {
     const double *q = job->q + k * RK_NQ;
     switch (job->kind) {
@@ -69,7 +69,7 @@ static inline void rk_scatter(const lg_v4 *x, npy_intp k, int width, double *y, 
 
 /* states k .. k + LG_LANES - 1 at once (rk4_*); out: RK_OUT4 vectors of room */
 #define RK_OUT4 (RK_NV * RK_NV > 6 * RK_NV ? RK_NV * RK_NV : 6 * RK_NV)
-static void rk_lanes(const rk_job *job, npy_intp k, rk4_cbody *work, lg_v4 *out)
+static void rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
 {
     lg_v4 q[RK_NQ], v[RK_NV];
     rk_gather(job->q, k, RK_NQ, q);
@@ -120,14 +120,14 @@ static void rk_lanes(const rk_job *job, npy_intp k, rk4_cbody *work, lg_v4 *out)
 static void *rk_run(void *argument)
 {
     rk_job *job = (rk_job *)argument;
-    rk_cbody *work = NULL;
-    rk4_cbody *work4 = NULL;
+    rk_cwork *work = NULL;
+    rk4_cwork *work4 = NULL;
     /* the lanes' outputs and C's workspace (vectors: aligned to theirs) */
     const size_t room = (RK_OUT4 * sizeof(lg_v4) + 63) / 64 * 64;
-    const size_t space = job->kind == RK_CORIOLIS ? (sizeof(rk4_cbody) * RK_NB + 63) / 64 * 64 : 0;
+    const size_t space = job->kind == RK_CORIOLIS ? (sizeof(rk4_cwork) + 63) / 64 * 64 : 0;
     lg_v4 *out = job->count >= LG_LANES ? aligned_alloc(64, room + space) : NULL;
-    if (out && space) work4 = (rk4_cbody *)((char *)out + room);
-    if (job->kind == RK_CORIOLIS && !(work = malloc(sizeof(rk_cbody) * RK_NB))) {
+    if (out && space) work4 = (rk4_cwork *)((char *)out + room);
+    if (job->kind == RK_CORIOLIS && !(work = malloc(sizeof(rk_cwork)))) {
         free(out);
         return NULL;
     }

@@ -16,13 +16,24 @@ static inline void RK_FN(motion_cross)(const RK_T *V, const RK_T *s, RK_T *out)
     for (int j = 0; j < 3; j++) { out[j] = a[j] + b[j]; out[3 + j] = c[j]; }
 }
 
-/* a body's workspace: its world columns S and their rates V x S (column-major, up to six),
- * V, and (summed over the subtree going up) its inertia m, h, J and B's l, A */
+/* a body's workspace: its world column S and its rate V x S, V, and (summed over the subtree
+ * going up) its inertia m, h, J and B's l, A; a free flyer's six columns apart (S0, dS0), so
+ * that eight lanes' workspace of a quadruped stays within a core's first-level cache (with six
+ * columns a body, Solo12's was 85 kB) */
 typedef struct {
-    RK_T S[6][6], dS[6][6], V[6], h[3], J[9], l[3], A[9];
+    RK_T S[6], dS[6], V[6], h[3], J[9], l[3], A[9];
     double m;
     int columns, first;
 } RK_FN(cbody);
+
+typedef struct {
+    RK_FN(cbody) b[RK_NB];
+    RK_T S0[6][6], dS0[6][6];
+} RK_FN(cwork);
+
+/* body i's columns and their rates, (RK_T (*)[6]): the free flyer's six or the joint's one */
+#define RK_COLUMNS(w, i) (RK_FREE(i) ? (w)->S0 : (RK_T (*)[6])(w)->b[i].S)
+#define RK_RATES(w, i) (RK_FREE(i) ? (w)->dS0 : (RK_T (*)[6])(w)->b[i].dS)
 
 /* I x = [m x_v - h x x_w; h x x_v + J x_w] */
 static inline void RK_FN(inertia_times)(const RK_FN(cbody) *b, const RK_T *x, RK_T *out)
@@ -37,26 +48,28 @@ static inline void RK_FN(inertia_times)(const RK_FN(cbody) *b, const RK_T *x, RK
 }
 
 static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_T *restrict C,
-                            RK_FN(cbody) *restrict body)
+                            RK_FN(cwork) *restrict work)
 {
+    RK_FN(cbody) *restrict body = work->b;
     RK_T R[RK_NB][9], o[RK_NB][3];
     RK_FN(bodies)(q, R, o);
     for (int j = 0; j < RK_NV * RK_NV; j++) C[j] = RK_C(0.0);
     for (int i = 0; i < RK_NB; i++) {
         RK_FN(cbody) *bi = body + i;
+        RK_T (*S)[6] = RK_COLUMNS(work, i), (*dS)[6] = RK_RATES(work, i);
         int p = rk_parent[i];
         if (RK_FREE(i)) {
-            RK_FN(free_columns)(R[0], o[0], bi->S);
+            RK_FN(free_columns)(R[0], o[0], S);
             bi->columns = 6, bi->first = 0;
         } else {
-            RK_FN(subspace)(i, R, o, bi->S[0]);
-            for (int j = 0; j < 6; j++) bi->S[0][j] *= rk_mult[i];
+            RK_FN(subspace)(i, R, o, S[0]);
+            for (int j = 0; j < 6; j++) S[0][j] *= rk_mult[i];
             bi->columns = 1, bi->first = RK_BV + rk_coord[i];
         }
         for (int j = 0; j < 6; j++) bi->V[j] = p < 0 ? RK_C(0.0) : body[p].V[j];
         for (int c = 0; c < bi->columns; c++)
-            for (int j = 0; j < 6; j++) bi->V[j] += bi->S[c][j] * qd[bi->first + c];
-        for (int c = 0; c < bi->columns; c++) RK_FN(motion_cross)(bi->V, bi->S[c], bi->dS[c]);
+            for (int j = 0; j < 6; j++) bi->V[j] += S[c][j] * qd[bi->first + c];
+        for (int c = 0; c < bi->columns; c++) RK_FN(motion_cross)(bi->V, S[c], dS[c]);
         /* the inertia at the world's origin (as centroidal's): h = R h_i + m x, J_O */
         RK_T hr[3], RJ[9];
         const double m = rk_m[i];
@@ -94,13 +107,14 @@ static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_
     }
     for (int i = RK_NB - 1; i >= 0; i--) {
         RK_FN(cbody) *bi = body + i;
+        RK_T (*Si)[6] = RK_COLUMNS(work, i), (*dSi)[6] = RK_RATES(work, i);
         /* per column: own = I S_dot + B S, rowI = (I S)^T, rowB = (B^T S)^T's angular half
            (B^T x = [0; l x x_v + A^T x_w]) */
         RK_T own[6][6], rowI[6][6], rowB[6][3];
         for (int c = 0; c < bi->columns; c++) {
-            const RK_T *s = bi->S[c];
+            const RK_T *s = Si[c];
             RK_T t[3], u[3];
-            RK_FN(inertia_times)(bi, bi->dS[c], own[c]);
+            RK_FN(inertia_times)(bi, dSi[c], own[c]);
             RK_FN(inertia_times)(bi, s, rowI[c]);
             RK_FN(cross)(bi->l, s + 3, t);  /* B s = [-l x s_w; A s_w] */
             RK_FN(cross)(bi->l, s, u);
@@ -113,16 +127,19 @@ static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_
         }
         for (int a = i; a >= 0; a = rk_parent[a]) {
             const RK_FN(cbody) *ba = body + a;
+            RK_T (*Sa)[6] = RK_COLUMNS(work, a), (*dSa)[6] = RK_RATES(work, a);
+            /* each entry of C is set once: (a, i) with a an ancestor of i or i itself, and
+               (i, a) with a a strict ancestor, never the same place */
             for (int ca = 0; ca < ba->columns; ca++)
                 for (int ci = 0; ci < bi->columns; ci++) {
                     RK_T t = RK_C(0.0);  /* C[a, i] = S_a^T (I^c_i S_dot_i + B^c_i S_i) */
-                    for (int k = 0; k < 6; k++) t += ba->S[ca][k] * own[ci][k];
-                    C[(ba->first + ca) * RK_NV + bi->first + ci] += t;
+                    for (int k = 0; k < 6; k++) t += Sa[ca][k] * own[ci][k];
+                    C[(ba->first + ca) * RK_NV + bi->first + ci] = t;
                     if (a == i) continue;
                     t = RK_C(0.0);  /* C[i, a] = S_i^T (I^c_i S_dot_a + B^c_i S_a) */
-                    for (int k = 0; k < 6; k++) t += rowI[ci][k] * ba->dS[ca][k];
-                    for (int k = 0; k < 3; k++) t += rowB[ci][k] * ba->S[ca][3 + k];
-                    C[(bi->first + ci) * RK_NV + ba->first + ca] += t;
+                    for (int k = 0; k < 6; k++) t += rowI[ci][k] * dSa[ca][k];
+                    for (int k = 0; k < 3; k++) t += rowB[ci][k] * Sa[ca][3 + k];
+                    C[(bi->first + ci) * RK_NV + ba->first + ca] = t;
                 }
         }
         int p = rk_parent[i];

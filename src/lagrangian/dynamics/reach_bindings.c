@@ -73,6 +73,13 @@ static void rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
 {
     lg_v4 q[RK_NQ], v[RK_NV];
     rk_gather(job->q, k, RK_NQ, q);
+    {
+        const int width = job->kind == RK_DRIFT ? 6 : job->kind == RK_CENTROIDAL ? 6 * RK_NV
+                          : job->kind == RK_CORIOLIS ? RK_NV * RK_NV : RK_NV;
+        const char *y = (const char *)(job->y + k * width);
+        for (size_t b = 0; b < LG_LANES * width * sizeof(double); b += 64)
+            __builtin_prefetch(y + b, 1, 2);
+    }
     switch (job->kind) {
     case RK_DRIFT:
         rk_gather(job->v, k, RK_NV, v);

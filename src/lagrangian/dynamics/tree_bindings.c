@@ -56,6 +56,10 @@ static npy_intp rt_range(const rt_job *job, npy_intp k, npy_intp count)
     for (; k + LG_LANES <= count && (kind == RT_FORWARD ? RT_VECTOR_FORWARD : RT_VECTOR);
          k += LG_LANES) {
         lg_v4 in[3][RT_NQ], out4[LG_N * LG_N];
+        /* the rows these states will fill, fetched for writing while the kernel computes
+           (as the reach and derivatives modules'): a batch's outputs are seldom in cache */
+        for (size_t b = 0; b < LG_LANES * size * sizeof(double); b += 64)
+            __builtin_prefetch((const char *)(y + k * size) + b, 1, 2);
         for (int j = 0; j < nin; j++) {
             const double *x = j == 0 ? x0 : j == 1 ? x1 : x2;
             if (step[j] == RT_WIDTH(j)) {  /* a row per state */

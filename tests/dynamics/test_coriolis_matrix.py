@@ -82,3 +82,28 @@ def test_cli_prints_c_on_request_and_refuses_it_for_a_damper(cli):
     refused = cli("dynamics", "damped_oscillator", "--coriolis")
     assert refused.code == 2 and len(refused.err.strip().splitlines()) == 1
     assert "coriolis_matrix" not in cli("dynamics", "double_pendulum", "--json").out
+
+
+def test_a_floating_base_with_a_mimic_joint(tmp_path):
+    """A mimic joint's coordinate is another joint's: the compiled C(q, v) adds both joints'
+    terms into its entries (reach_coriolis.c), as the numpy factorization does; C v = bias - g."""
+    pytest.importorskip("yourdfpy")
+    from tests.dynamics.test_reach_reports import TWO_LEGS
+
+    text = TWO_LEGS.replace(
+        '<joint name="r_knee" type="prismatic"><parent link="r_thigh"/><child link="r_shank"/>',
+        '<joint name="r_knee" type="prismatic"><parent link="r_thigh"/><child link="r_shank"/>'
+        '<mimic joint="l_knee" multiplier="-0.5" offset="0.01"/>')
+    path = tmp_path / "mimic.urdf"
+    path.write_text(text)
+    compiled = lagrangian.load(path, floating_base=True).dynamics(backend="c")
+    plain = lagrangian.load(path, floating_base=True).dynamics(backend="numpy")
+    assert compiled.n == 6 + 3  # l_hip, l_knee (r_knee's too), r_hip
+    rng = np.random.default_rng(4)
+    q = rng.uniform(-0.5, 0.5, (11, compiled.nq))
+    q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
+    v = rng.uniform(-1, 1, (11, compiled.n))
+    C = compiled.coriolis_matrix(q, v)
+    np.testing.assert_allclose(C, plain.coriolis_matrix(q, v), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.einsum("kij,kj->ki", C, v),
+                               compiled.bias_forces(q, v) - compiled.gravity(q), atol=1e-12)

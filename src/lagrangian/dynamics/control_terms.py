@@ -206,14 +206,41 @@ class ControlTerms:
                 pass
             else:
                 return out if len(out) == 3 else _reported(out)
+        from .joint_space import undefined_rows
+
         q, v, tau = self._vector(q, "q"), self._vector(v, "v"), self._vector(tau, "tau")
         batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1], tau.shape[:-1])
         q = np.broadcast_to(q, batch + q.shape[-1:])
         v = np.broadcast_to(v, batch + (self.n,))
-        acceleration = self.forward_dynamics(q, v, tau)
-        by_position, by_velocity = self.inverse_dynamics_derivatives(q, v, acceleration)
-        inverse = np.linalg.inv(self.mass_matrix(q))
-        return -inverse @ by_position, -inverse @ by_velocity, inverse
+        n = self.n
+
+        def compute():
+            acceleration = self.forward_dynamics(q, v, tau)  # NaN where M is not definite
+            by_position, by_velocity = self.inverse_dynamics_derivatives(q, v, acceleration)
+            inverse = _inverses(self.mass_matrix(q))
+            return np.concatenate([-inverse @ by_position, -inverse @ by_velocity, inverse],
+                                  axis=-1)
+
+        # one warning for the three; a state's three rows NaN together, as the C's
+        out = undefined_rows(compute, (q, v, tau), 2, results=True)
+        return out[..., :n], out[..., n:2 * n], out[..., 2 * n:]
+
+
+def _inverses(mass: np.ndarray) -> np.ndarray:
+    """M^-1 over a batch (..., n, n), NaN for a state whose M is not finite or is singular
+    (each as if alone: one such state does not fail the batch)."""
+    flat = mass.reshape((-1,) + mass.shape[-2:])
+    out = np.full(flat.shape, np.nan)
+    fine = np.isfinite(flat).all(axis=(1, 2))
+    try:
+        out[fine] = np.linalg.inv(flat[fine])
+    except np.linalg.LinAlgError:
+        for k in np.flatnonzero(fine):
+            try:
+                out[k] = np.linalg.inv(flat[k])
+            except np.linalg.LinAlgError:
+                pass
+    return out.reshape(mass.shape)
 
 
 def _reported(out: tuple) -> tuple:

@@ -49,6 +49,42 @@ def warn_undefined(count: int, total: int, stacklevel: int = 4) -> None:
         stacklevel=stacklevel)
 
 
+def reported_rows(out, bad: int, tail: int, stacklevel: int = 4):
+    """A compiled function's (output, count of NaN rows), ``tail`` the axes of one state's
+    output: one DynamicsWarning where the count is not 0, and the output."""
+    if bad:
+        total = out.size // max(1, int(np.prod(out.shape[out.ndim - tail:], dtype=np.int64)))
+        warn_undefined(bad, total, stacklevel=stacklevel)
+    return out
+
+
+def undefined_rows(compute, inputs, tail: int, stacklevel: int = 4,
+                   results: bool = False) -> np.ndarray:
+    """compute() over a batch, then NaN in the whole row of each state whose inputs are not all
+    finite (inputs: arrays (..., k) of the batch, or one state's (k,) shared by it), and with
+    ``results`` of each whose row came out not finite (a mass matrix not positive definite),
+    with one DynamicsWarning counting them: the rule of every function of a state (a NaN in
+    one leg would otherwise leave the other legs' numbers finite; the numpy paths' own
+    warnings are folded into that one)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynamicsWarning)
+        with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+            out = np.asarray(compute(), dtype=float)
+    batch = out.shape[:out.ndim - tail]
+    good = np.ones(batch, dtype=bool)
+    for x in inputs:
+        x = np.asarray(x, dtype=float)
+        if x.ndim:
+            good &= np.broadcast_to(np.isfinite(x).all(axis=-1), batch)
+    if results:
+        good &= np.isfinite(out).all(axis=tuple(range(len(batch), out.ndim)))
+    if not good.all():
+        out = np.array(out)
+        out[~good] = np.nan
+        warn_undefined(int((~good).sum()), good.size, stacklevel=stacklevel)
+    return out
+
+
 def solve_positive(mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """M^-1 rhs for a flat batch (N, n, n), (N, n) by Cholesky, NaN in the rows whose M is not
     positive definite (each row as if alone)."""
@@ -178,22 +214,25 @@ class Dynamics(ControlTerms):
         """The names of the robot's link and joint frames."""
         return self.kinematics.frames
 
+    # The functions of a state below give, as the dynamics functions do, NaN in the whole row
+    # of a state whose inputs are not all finite and one DynamicsWarning counting them.
+
     def placement(self, q, frame: str) -> np.ndarray:
         """The frame's 4 x 4 placement in the world (rotation and origin in m), (..., 4, 4)."""
-        return self.kinematics.placement(q, frame)
+        return undefined_rows(lambda: self.kinematics.placement(q, frame), (q,), 2)
 
     def jacobian(self, q, frame: str, reference: str = "local_world_aligned") -> np.ndarray:
         """The frame's 6 x n Jacobian, linear rows first, (..., 6, n); ``reference`` "world",
         "local" or "local_world_aligned" as Pinocchio's ReferenceFrame."""
-        return self.kinematics.jacobian(q, frame, reference)
+        return undefined_rows(lambda: self.kinematics.jacobian(q, frame, reference), (q,), 2)
 
     def center_of_mass(self, q) -> np.ndarray:
         """The moving bodies' centre of mass in the world (m), (..., 3)."""
-        return self.kinematics.center_of_mass(q)
+        return undefined_rows(lambda: self.kinematics.center_of_mass(q), (q,), 1)
 
     def center_of_mass_jacobian(self, q) -> np.ndarray:
         """J_c with c_dot = J_c q_dot, (..., 3, n)."""
-        return self.kinematics.center_of_mass_jacobian(q)
+        return undefined_rows(lambda: self.kinematics.center_of_mass_jacobian(q), (q,), 2)
 
     def jacobian_dot_times_v(self, q, v, frame: str,
                              reference: str = "local_world_aligned") -> np.ndarray:
@@ -202,10 +241,12 @@ class Dynamics(ControlTerms):
         fast = self._reach if self._reach is not None else self._reach_kernel()
         if fast:
             try:
-                return fast.drift(q, v, fast.frame_index[frame], REFERENCE_INDEX[reference])
+                return reported_rows(*fast.drift(q, v, fast.frame_index[frame],
+                                                 REFERENCE_INDEX[reference]), 1)
             except (KeyError, ValueError, TypeError):
                 pass  # numpy below broadcasts, or names the fault in one line
-        return self.kinematics.jacobian_dot_times_v(q, v, frame, reference)
+        return undefined_rows(
+            lambda: self.kinematics.jacobian_dot_times_v(q, v, frame, reference), (q, v), 1)
 
     def centroidal_momentum_matrix(self, q) -> np.ndarray:
         """A_g with h_g = A_g q_dot (linear, then angular momentum about the centre of mass,
@@ -214,11 +255,11 @@ class Dynamics(ControlTerms):
         if fast is None:
             fast = self._reach_kernel()
         if fast:
-            try:
-                return fast.centroidal(q)  # None without moving mass: TypeError, then below
+            try:  # None without moving mass: TypeError, then below
+                return reported_rows(*fast.centroidal(q), 2)
             except (ValueError, TypeError):
                 pass
-        return self.kinematics.centroidal_momentum_matrix(q)
+        return undefined_rows(lambda: self.kinematics.centroidal_momentum_matrix(q), (q,), 2)
 
     # the compiled kernel of the three functions above (reach_c.py): None until asked, then
     # the kernel, or False (not the C backend, or no compiler)
@@ -238,9 +279,9 @@ class Dynamics(ControlTerms):
         """Inverse or forward dynamics with wrenches at frames: tau_ext = sum J^T w
         (wrenches.py) taken from tau, or added to it; in compiled C where it can be."""
         fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast:
+        if fast and f_ext:
             try:
-                if forward:
+                if forward:  # a state not finite leaves NaN in tau, and forward dynamics warns
                     tau = np.array(x, dtype=float)  # our own copy, added to in place
                     fast.add_wrenches(q, f_ext, tau, 1.0)
                     return self.forward_dynamics(q, v, tau)
@@ -250,18 +291,25 @@ class Dynamics(ControlTerms):
                 # module's unrolled ID and then J^T w are the faster (measured: benchmarks.md)
                 if one_pass and (self.velocity_names is not None or q.__class__ is not np.ndarray
                                  or q.ndim < 2 or len(q) <= 64):
-                    return one_pass(q, v, x, f_ext)
-                tau = self.inverse_dynamics(q, v, x)
-                fast.add_wrenches(q, f_ext, tau, -1.0)
-                return tau
+                    return reported_rows(*one_pass(q, v, x, f_ext), 1, 5)
+                with warnings.catch_warnings():  # counted once, with the wrenches' states
+                    warnings.simplefilter("ignore", DynamicsWarning)
+                    tau = self.inverse_dynamics(q, v, x)
+                # the count of rows NaN after the last wrench (made NaN whole): the batch's
+                return reported_rows(tau, fast.add_wrenches(q, f_ext, tau, -1.0), 1, 5)
             except (KeyError, ValueError, TypeError, AttributeError):
                 pass  # numpy below broadcasts, or names the fault in one line
         from .wrenches import wrench_forces
 
-        tau_ext = wrench_forces(self.kinematics, self._vector(q, "q"), f_ext)
-        if forward:
-            return self.forward_dynamics(q, v, self._vector(x, "tau") + tau_ext)
-        return self.inverse_dynamics(q, v, x) - tau_ext
+        inputs = (q, v, x, *f_ext.values()) if isinstance(f_ext, Mapping) else (q, v, x)
+
+        def compute():
+            tau_ext = wrench_forces(self.kinematics, self._vector(q, "q"), f_ext)
+            if forward:
+                return self.forward_dynamics(q, v, self._vector(x, "tau") + tau_ext)
+            return self.inverse_dynamics(q, v, x) - tau_ext
+
+        return undefined_rows(compute, inputs, 1, 5)
     # -- the configuration space: a floating base's is a manifold (free_flyer.py) ---------------
 
     def integrate(self, q, v, dt: float = 1.0) -> np.ndarray:
@@ -308,7 +356,7 @@ class Dynamics(ControlTerms):
             fast = self._reach if self._reach is not None else self._reach_kernel()
             if fast and fast.coriolis is not None:  # compiled (reach_kernel.c)
                 try:
-                    return fast.coriolis(q, v)
+                    return reported_rows(*fast.coriolis(q, v), 2)
                 except (ValueError, TypeError):
                     pass  # numpy below broadcasts, or names the fault in one line
             from .coriolis_tree import coriolis_matrix
@@ -324,9 +372,13 @@ class Dynamics(ControlTerms):
         batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
         q, v = np.broadcast_to(q, batch + q.shape[-1:]), np.broadcast_to(v, batch + (self.n,))
         eye = np.eye(self.n)
-        ahead = self.bias_forces(q[..., None, :], v[..., None, :] + eye)
-        behind = self.bias_forces(q[..., None, :], v[..., None, :] - eye)
-        return np.swapaxes((ahead - behind) / 4.0, -1, -2)
+
+        def compute():
+            ahead = self.bias_forces(q[..., None, :], v[..., None, :] + eye)
+            behind = self.bias_forces(q[..., None, :], v[..., None, :] - eye)
+            return np.swapaxes((ahead - behind) / 4.0, -1, -2)
+
+        return undefined_rows(compute, (q, v), 2)
 
     def _velocity_terms_are_christoffel(self) -> bool:
         if self._christoffel is None:

@@ -1,7 +1,12 @@
 /* Python bindings of reach_kernel.c and reach_coriolis.c: arrays (..., n) of float64, one
  * output row per state. A batch runs on threads that take blocks of RK_BLOCK states from a
  * shared counter (as the tree module's batches), LG_LANES states at a time through the rk4_
- * functions (the same formulas on vector lanes), the block's last few one by one. */
+ * functions (the same formulas on vector lanes), the block's last few one by one.
+ *
+ * A state whose inputs (q, v, a, its wrenches) are not all finite gets a row of NaN, as the
+ * tree module's functions give (a NaN in one leg would otherwise leave the other legs' numbers
+ * finite); each function returns the count of such rows beside its output, for the caller's
+ * one DynamicsWarning. */
 
 #define RK_PTHREADS LG_PTHREADS  /* batch_threads.c, above this text */
 #define RK_MAX_THREADS LG_MAX_THREADS
@@ -19,12 +24,51 @@ typedef struct {
     const double *const *w;
     const int *wshared;
     double sign, *y;
-    npy_intp count, *next;
+    npy_intp count, *next, bad;  /* bad: the NaN rows this job (thread) wrote */
 } rk_job;
 
-static void rk_state(const rk_job *job, npy_intp k, rk_cwork *work)
+/* the numbers of a state's output row */
+static int rk_width(int kind)
+{
+    return kind == RK_DRIFT ? 6 : kind == RK_CENTROIDAL ? 6 * RK_NV
+           : kind == RK_CORIOLIS ? RK_NV * RK_NV : RK_NV;
+}
+
+static void rk_blank(const rk_job *job, npy_intp k)
+{
+    const int width = rk_width(job->kind);
+    for (int i = 0; i < width; i++) job->y[k * width + i] = NAN;
+}
+
+/* x - x is 0 for a finite x, NaN for an infinite or NaN one */
+static int rk_finite_row(const double *x, int width)
+{
+    double spoilt = 0.0;
+    for (int i = 0; i < width; i++) spoilt += x[i] - x[i];
+    return spoilt == 0.0;
+}
+
+/* whether state k's inputs are all finite (and, adding wrenches, its row after the sum) */
+static int rk_finite(const rk_job *job, npy_intp k)
+{
+    const int kind = job->kind;
+    int fine = rk_finite_row(job->q + k * RK_NQ, RK_NQ);
+    if (kind == RK_DRIFT || kind == RK_CORIOLIS || kind == RK_INVERSE)
+        fine &= rk_finite_row(job->v + k * RK_NV, RK_NV);
+    if (kind == RK_INVERSE) fine &= rk_finite_row(job->a + k * RK_NV, RK_NV);
+    const int nw = kind == RK_WRENCH ? 1 : kind == RK_INVERSE ? job->nw : 0;
+    for (int i = 0; i < nw; i++) fine &= rk_finite_row(job->w[i] + (job->wshared[i] ? 0 : 6 * k), 6);
+    return fine;
+}
+
+/* state k alone; 1 where its row came out NaN */
+static int rk_state(const rk_job *job, npy_intp k, rk_cwork *work)
 {
     const double *q = job->q + k * RK_NQ;
+    if (!rk_finite(job, k)) {
+        rk_blank(job, k);
+        return 1;
+    }
     switch (job->kind) {
     case RK_DRIFT: rk_drift(q, job->v + k * RK_NV, job->frame, job->ref, job->y + 6 * k); break;
     case RK_CENTROIDAL: rk_centroidal(q, job->y + 6 * RK_NV * k); break;
@@ -44,6 +88,13 @@ static void rk_state(const rk_job *job, npy_intp k, rk_cwork *work)
         break;
     }
     }
+    /* a row that was NaN before the wrench's forces were added (the caller's inverse dynamics
+       of a state not finite) stays NaN whole */
+    if (job->kind == RK_WRENCH && !rk_finite_row(job->y + RK_NV * k, RK_NV)) {
+        rk_blank(job, k);
+        return 1;
+    }
+    return 0;
 }
 
 /* lanes' inputs: rows k .. k + LG_LANES - 1 of x (``width`` numbers a row) as vectors */
@@ -67,12 +118,20 @@ static inline void rk_scatter(const lg_v4 *x, npy_intp k, int width, double *y, 
     }
 }
 
-/* states k .. k + LG_LANES - 1 at once (rk4_*); out: RK_OUT4 vectors of room */
-#define RK_OUT4 (RK_NV * RK_NV > 6 * RK_NV ? RK_NV * RK_NV : 6 * RK_NV)
-static void rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
+/* x - x summed over an input's vectors: 0 in the lanes where it is finite */
+static inline void rk_spoil(const lg_v4 *x, int width, lg_v4 *spoilt)
 {
-    lg_v4 q[RK_NQ], v[RK_NV];
+    for (int i = 0; i < width; i++) *spoilt += x[i] - x[i];
+}
+
+/* states k .. k + LG_LANES - 1 at once (rk4_*); out: RK_OUT4 vectors of room; the count of
+   NaN rows written */
+#define RK_OUT4 (RK_NV * RK_NV > 6 * RK_NV ? RK_NV * RK_NV : 6 * RK_NV)
+static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
+{
+    lg_v4 q[RK_NQ], v[RK_NV], spoilt = LG_V4(0.0);
     rk_gather(job->q, k, RK_NQ, q);
+    rk_spoil(q, RK_NQ, &spoilt);
     {
         const int width = job->kind == RK_DRIFT ? 6 : job->kind == RK_CENTROIDAL ? 6 * RK_NV
                           : job->kind == RK_CORIOLIS ? RK_NV * RK_NV : RK_NV;
@@ -83,6 +142,7 @@ static void rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
     switch (job->kind) {
     case RK_DRIFT:
         rk_gather(job->v, k, RK_NV, v);
+        rk_spoil(v, RK_NV, &spoilt);
         rk4_drift(q, v, job->frame, job->ref, out);
         rk_scatter(out, k, 6, job->y, 0, 0.0);
         break;
@@ -96,12 +156,14 @@ static void rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
             for (int j = 0; j < 6; j++) w[j] = LG_V4(job->w[0][j]);
         else
             rk_gather(job->w[0], k, 6, w);
+        rk_spoil(w, 6, &spoilt);
         rk4_wrench(q, job->frame, w, out);
         rk_scatter(out, k, RK_NV, job->y, 1, job->sign);
         break;
     }
     case RK_CORIOLIS:
         rk_gather(job->v, k, RK_NV, v);
+        rk_spoil(v, RK_NV, &spoilt);
         rk4_coriolis(q, v, out, work);
         rk_scatter(out, k, RK_NV * RK_NV, job->y, 0, 0.0);
         break;
@@ -109,17 +171,28 @@ static void rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
         lg_v4 a[RK_NV], w[RK_MAX_WRENCHES][6];
         rk_gather(job->v, k, RK_NV, v);
         rk_gather(job->a, k, RK_NV, a);
+        rk_spoil(v, RK_NV, &spoilt);
+        rk_spoil(a, RK_NV, &spoilt);
         for (int i = 0; i < job->nw; i++) {
             if (job->wshared[i])
                 for (int j = 0; j < 6; j++) w[i][j] = LG_V4(job->w[i][j]);
             else
                 rk_gather(job->w[i], k, 6, w[i]);
+            rk_spoil(w[i], 6, &spoilt);
         }
         rk4_inverse(q, v, a, job->up, job->nw, job->frames, (const lg_v4 (*)[6])w, out);
         rk_scatter(out, k, RK_NV, job->y, 0, 0.0);
         break;
     }
     }
+    int bad = 0;
+    for (int l = 0; l < LG_LANES; l++)
+        if (spoilt[l] != 0.0 || (job->kind == RK_WRENCH
+                                 && !rk_finite_row(job->y + RK_NV * (k + l), RK_NV))) {
+            rk_blank(job, k + l);
+            bad++;
+        }
+    return bad;
 }
 
 /* a thread's work: blocks of RK_BLOCK states taken in turn until none is left, so that a
@@ -133,6 +206,7 @@ static void *rk_run(void *argument)
     const size_t room = (RK_OUT4 * sizeof(lg_v4) + 63) / 64 * 64;
     const size_t space = job->kind == RK_CORIOLIS ? (sizeof(rk4_cwork) + 63) / 64 * 64 : 0;
     lg_v4 *out = job->count >= LG_LANES ? aligned_alloc(64, room + space) : NULL;
+    job->bad = 0;
     if (out && space) work4 = (rk4_cwork *)((char *)out + room);
     if (job->kind == RK_CORIOLIS && !(work = malloc(sizeof(rk_cwork)))) {
         free(out);
@@ -148,8 +222,8 @@ static void *rk_run(void *argument)
         if (k0 >= job->count) break;
         const npy_intp k1 = k0 + RK_BLOCK < job->count ? k0 + RK_BLOCK : job->count;
         npy_intp k = k0;
-        for (; out && k + LG_LANES <= k1; k += LG_LANES) rk_lanes(job, k, work4, out);
-        for (; k < k1; k++) rk_state(job, k, work);
+        for (; out && k + LG_LANES <= k1; k += LG_LANES) job->bad += rk_lanes(job, k, work4, out);
+        for (; k < k1; k++) job->bad += rk_state(job, k, work);
     }
     free(work);
     free(out);
@@ -182,6 +256,8 @@ static int rk_batch(rk_job *job)
     rk_run(&jobs[0]);
 #endif
     if (job->count > 16) NPY_END_THREADS;
+    job->bad = 0;
+    for (int t = 0; t < parts; t++) job->bad += jobs[t].bad;
     /* a thread without its workspace took no block: the others took them, unless none ran */
     if (next < job->count) { PyErr_NoMemory(); return 0; }
     return 1;
@@ -217,7 +293,7 @@ static int rk_unit_quaternions(PyArrayObject *Q)
     const double *q = PyArray_DATA(Q);
     for (npy_intp k = 0; k < count; k++, q += RK_NQ) {
         double n2 = q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6];
-        if (n2 < RK_QLOW || n2 > RK_QHIGH) {
+        if (rk_finite_row(q + 3, 4) && (n2 < RK_QLOW || n2 > RK_QHIGH)) {
             PyErr_SetString(PyExc_ValueError, "q: the base quaternion is not of unit norm");
             return 0;
         }
@@ -236,6 +312,12 @@ static PyObject *rk_output(PyArrayObject *like, int tail0, int tail1)
     dims[nd++] = tail0;
     if (tail1) dims[nd++] = tail1;
     return PyArray_SimpleNew(nd, dims, NPY_DOUBLE);
+}
+
+/* (output, count of NaN rows), or NULL with the output's error */
+static PyObject *rk_result(PyObject *out, npy_intp bad)
+{
+    return out ? Py_BuildValue("(Nn)", out, (Py_ssize_t)bad) : NULL;
 }
 
 static int rk_same_batch(PyArrayObject *a, PyArrayObject *b, const char *name)
@@ -263,14 +345,16 @@ static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t n
     PyArrayObject *V = rk_input(args[1], RK_NV, "v");
     if (!V || !rk_same_batch(Q, V, "v")) { Py_DECREF(Q); Py_XDECREF(V); return NULL; }
     PyObject *out = rk_output(Q, 6, 0);
+    npy_intp bad = 0;
     if (out) {
         rk_job job = {.kind = RK_DRIFT, .frame = f, .ref = ref, .q = PyArray_DATA(Q),
                       .v = PyArray_DATA(V), .y = PyArray_DATA((PyArrayObject *)out),
                       .count = PyArray_SIZE(Q) / RK_NQ};
         if (!rk_batch(&job)) Py_CLEAR(out);
+        bad = job.bad;
     }
     Py_DECREF(Q); Py_DECREF(V);
-    return out;
+    return rk_result(out, bad);
 }
 
 static PyObject *rk_py_centroidal(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
@@ -281,13 +365,15 @@ static PyObject *rk_py_centroidal(PyObject *self, PyObject *const *args, Py_ssiz
     if (!Q) return NULL;
     if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
     PyObject *out = rk_output(Q, 6, RK_NV);
+    npy_intp bad = 0;
     if (out) {
         rk_job job = {.kind = RK_CENTROIDAL, .q = PyArray_DATA(Q),
                       .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / RK_NQ};
         if (!rk_batch(&job)) Py_CLEAR(out);
+        bad = job.bad;
     }
     Py_DECREF(Q);
-    return out;
+    return rk_result(out, bad);
 }
 
 /* wrench(Q, frame, W, OUT, sign): OUT += sign J^T w, in place (OUT float64, contiguous, of
@@ -324,7 +410,7 @@ static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t 
     int fine = rk_batch(&job);
     Py_DECREF(Q); Py_DECREF(W);
     if (!fine) return NULL;
-    Py_RETURN_NONE;
+    return PyLong_FromSsize_t((Py_ssize_t)job.bad);
 }
 
 static PyObject *rk_py_coriolis(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
@@ -337,13 +423,15 @@ static PyObject *rk_py_coriolis(PyObject *self, PyObject *const *args, Py_ssize_
     PyArrayObject *V = rk_input(args[1], RK_NV, "v");
     if (!V || !rk_same_batch(Q, V, "v")) { Py_DECREF(Q); Py_XDECREF(V); return NULL; }
     PyObject *out = rk_output(Q, RK_NV, RK_NV);
+    npy_intp bad = 0;
     if (out) {
         rk_job job = {.kind = RK_CORIOLIS, .q = PyArray_DATA(Q), .v = PyArray_DATA(V),
                       .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / RK_NQ};
         if (!rk_batch(&job)) Py_CLEAR(out);
+        bad = job.bad;
     }
     Py_DECREF(Q); Py_DECREF(V);
-    return out;
+    return rk_result(out, bad);
 }
 
 /* inverse(INDEX, UP, Q, V, A, F_EXT) -> tau: inverse dynamics less the wrenches of the dict
@@ -361,6 +449,7 @@ static PyObject *rk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t
     if (nw > RK_MAX_WRENCHES) { PyErr_SetString(PyExc_ValueError, "f_ext: too many"); return NULL; }
     PyArrayObject *in[3] = {NULL, NULL, NULL}, *U = NULL, *W[RK_MAX_WRENCHES] = {NULL};
     PyObject *out = NULL, *name, *value;
+    npy_intp bad = 0;
     int frames[RK_MAX_WRENCHES], shared[RK_MAX_WRENCHES];
     const double *w[RK_MAX_WRENCHES];
     const char *names[3] = {"q", "v", "a"};
@@ -398,20 +487,21 @@ static PyObject *rk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t
                       .frames = frames, .w = w, .wshared = shared,
                       .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(in[0]) / RK_NQ};
         if (!rk_batch(&job)) Py_CLEAR(out);
+        bad = job.bad;
     }
 done:
     for (int j = 0; j < 3; j++) Py_XDECREF(in[j]);
     Py_XDECREF(U);
     for (Py_ssize_t j = 0; j < nw; j++) Py_XDECREF(W[j]);
-    return out;
+    return rk_result(out, bad);
 }
 
 static PyMethodDef rk_methods[] = {
-    {"drift", (PyCFunction)(void (*)(void))rk_py_drift, METH_FASTCALL, "(Q, V, frame, ref) -> [a; w_dot]"},
-    {"centroidal", (PyCFunction)(void (*)(void))rk_py_centroidal, METH_FASTCALL, "(Q) -> A_g"},
-    {"wrench", (PyCFunction)(void (*)(void))rk_py_wrench, METH_FASTCALL, "(Q, frame, W, OUT, sign): OUT += sign J^T w"},
-    {"coriolis", (PyCFunction)(void (*)(void))rk_py_coriolis, METH_FASTCALL, "(Q, V) -> C(q, v)"},
-    {"inverse", (PyCFunction)(void (*)(void))rk_py_inverse, METH_FASTCALL, "(INDEX, UP, Q, V, A, F_EXT) -> tau"},
+    {"drift", (PyCFunction)(void (*)(void))rk_py_drift, METH_FASTCALL, "(Q, V, frame, ref) -> ([a; w_dot], NaN rows)"},
+    {"centroidal", (PyCFunction)(void (*)(void))rk_py_centroidal, METH_FASTCALL, "(Q) -> (A_g, NaN rows)"},
+    {"wrench", (PyCFunction)(void (*)(void))rk_py_wrench, METH_FASTCALL, "(Q, frame, W, OUT, sign): OUT += sign J^T w; -> NaN rows"},
+    {"coriolis", (PyCFunction)(void (*)(void))rk_py_coriolis, METH_FASTCALL, "(Q, V) -> (C(q, v), NaN rows)"},
+    {"inverse", (PyCFunction)(void (*)(void))rk_py_inverse, METH_FASTCALL, "(INDEX, UP, Q, V, A, F_EXT) -> (tau, NaN rows)"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -135,7 +135,9 @@ def reach_module(tree: KinematicTree):
 
 
 class ReachKernel:
-    """The compiled functions with frames by name; inputs of one batch shape (..., n)."""
+    """The compiled functions with frames by name; inputs of one batch shape (..., n). Each
+    returns (output, count of NaN rows): a state whose inputs are not all finite gets NaN in
+    its whole row (reach_bindings.c)."""
 
     def __init__(self, module, tree: KinematicTree, massive: bool):
         self.module = module
@@ -169,7 +171,7 @@ class ReachKernel:
         wrenches = {f.name: rng.uniform(-5.0, 5.0, (3, 6)) for f in tree.frames if f.body >= 0}
         wrenches = dict(list(wrenches.items())[-1:])  # the last moving frame's
         try:
-            fused = one_pass(q, v, a, wrenches)
+            fused, _ = one_pass(q, v, a, wrenches)
             apart = np.array(dynamics.inverse_dynamics(q, v, a), dtype=float)
             self.add_wrenches(q, wrenches, apart, -1.0)
         except (ValueError, TypeError, KeyError):
@@ -179,13 +181,15 @@ class ReachKernel:
         self.inverse = one_pass if np.abs(fused - apart).max() <= 1e-9 * scale else False
         return self.inverse
 
-    def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> None:
-        """out += sign sum J^T w over the frames, in place (out: q's batch, nv wide); ValueError or
-        KeyError where the inputs are not plain or a base quaternion is off (the numpy path then
-        names the fault)."""
-        wrench = self.module.wrench
+    def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> int:
+        """out += sign sum J^T w over the frames, in place (out: q's batch, nv wide), the rows of
+        states not finite (q, a wrench, or out's row already) made NaN whole; their count.
+        ValueError or KeyError where the inputs are not plain or a base quaternion is off (the
+        numpy path then names the fault)."""
+        wrench, bad = self.module.wrench, 0
         for name, w in wrenches.items():
-            wrench(q, self.frame_index[name], w, out, sign)
+            bad = wrench(q, self.frame_index[name], w, out, sign)  # the last counts them all
+        return bad
 
 
 __all__ = ["REFERENCE_INDEX", "ReachKernel", "kernel_source", "reach_module"]

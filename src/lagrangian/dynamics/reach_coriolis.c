@@ -128,18 +128,17 @@ static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_
         for (int a = i; a >= 0; a = rk_parent[a]) {
             const RK_FN(cbody) *ba = body + a;
             RK_T (*Sa)[6] = RK_COLUMNS(work, a), (*dSa)[6] = RK_RATES(work, a);
-            /* each entry of C is set once: (a, i) with a an ancestor of i or i itself, and
-               (i, a) with a a strict ancestor, never the same place */
+            /* added to, not set: a mimic joint's coordinate is another joint's too */
             for (int ca = 0; ca < ba->columns; ca++)
                 for (int ci = 0; ci < bi->columns; ci++) {
                     RK_T t = RK_C(0.0);  /* C[a, i] = S_a^T (I^c_i S_dot_i + B^c_i S_i) */
                     for (int k = 0; k < 6; k++) t += Sa[ca][k] * own[ci][k];
-                    C[(ba->first + ca) * RK_NV + bi->first + ci] = t;
+                    C[(ba->first + ca) * RK_NV + bi->first + ci] += t;
                     if (a == i) continue;
                     t = RK_C(0.0);  /* C[i, a] = S_i^T (I^c_i S_dot_a + B^c_i S_a) */
                     for (int k = 0; k < 6; k++) t += rowI[ci][k] * dSa[ca][k];
                     for (int k = 0; k < 3; k++) t += rowB[ci][k] * Sa[ca][3 + k];
-                    C[(bi->first + ci) * RK_NV + ba->first + ca] = t;
+                    C[(bi->first + ci) * RK_NV + ba->first + ca] += t;
                 }
         }
         int p = rk_parent[i];

@@ -213,17 +213,18 @@ class ControlTerms:
         q = np.broadcast_to(q, batch + q.shape[-1:])
         v = np.broadcast_to(v, batch + (self.n,))
         n = self.n
-
-        def compute():
-            acceleration = self.forward_dynamics(q, v, tau)  # NaN where M is not definite
-            by_position, by_velocity = self.inverse_dynamics_derivatives(q, v, acceleration)
-            inverse = _inverses(self.mass_matrix(q))
-            return np.concatenate([-inverse @ by_position, -inverse @ by_velocity, inverse],
-                                  axis=-1)
-
         # one warning for the three; a state's three rows NaN together, as the C's
-        out = undefined_rows(compute, (q, v, tau), 2, results=True)
+        out = undefined_rows(self._forward_derivatives_numpy, (q, v, tau), (q, v, tau), 2,
+                             results=True)
         return out[..., :n], out[..., n:2 * n], out[..., 2 * n:]
+
+    def _forward_derivatives_numpy(self, q, v, tau) -> np.ndarray:
+        """The three side by side, (..., n, 3n), from forward dynamics, the inverse dynamics'
+        derivatives and M^-1."""
+        acceleration = self.forward_dynamics(q, v, tau)  # NaN where M is not definite
+        by_position, by_velocity = self.inverse_dynamics_derivatives(q, v, acceleration)
+        inverse = _inverses(self.mass_matrix(q))
+        return np.concatenate([-inverse @ by_position, -inverse @ by_velocity, inverse], axis=-1)
 
 
 def _inverses(mass: np.ndarray) -> np.ndarray:

@@ -49,27 +49,32 @@ def warn_undefined(count: int, total: int, stacklevel: int = 4) -> None:
         stacklevel=stacklevel)
 
 
-def reported_rows(out, bad: int, tail: int, stacklevel: int = 4):
-    """A compiled function's (output, count of NaN rows), ``tail`` the axes of one state's
-    output: one DynamicsWarning where the count is not 0, and the output."""
-    if bad:
-        total = out.size // max(1, int(np.prod(out.shape[out.ndim - tail:], dtype=np.int64)))
-        warn_undefined(bad, total, stacklevel=stacklevel)
+def reported_rows(out, tail: int, stacklevel: int = 4):
+    """A compiled reach function's output, or its (output, count of NaN rows) where there are
+    any (reach_bindings.c), ``tail`` the axes of one state's output: then one DynamicsWarning;
+    the output."""
+    if out.__class__ is not tuple:
+        return out
+    out, bad = out
+    total = out.size // max(1, int(np.prod(out.shape[out.ndim - tail:], dtype=np.int64)))
+    warn_undefined(bad, total, stacklevel=stacklevel)
     return out
 
 
-def undefined_rows(compute, inputs, tail: int, stacklevel: int = 4,
+def undefined_rows(compute, args, inputs, tail: int, stacklevel: int = 4,
                    results: bool = False) -> np.ndarray:
-    """compute() over a batch, then NaN in the whole row of each state whose inputs are not all
-    finite (inputs: arrays (..., k) of the batch, or one state's (k,) shared by it), and with
-    ``results`` of each whose row came out not finite (a mass matrix not positive definite),
-    with one DynamicsWarning counting them: the rule of every function of a state (a NaN in
-    one leg would otherwise leave the other legs' numbers finite; the numpy paths' own
-    warnings are folded into that one)."""
+    """compute(*args) over a batch, then NaN in the whole row of each state whose inputs are
+    not all finite (inputs: arrays (..., k) of the batch, or one state's (k,) shared by it),
+    and with ``results`` of each whose row came out not finite (a mass matrix not positive
+    definite), with one DynamicsWarning counting them: the rule of every function of a state (a
+    NaN in one leg would otherwise leave the other legs' numbers finite; the numpy paths' own
+    warnings are folded into that one). A function and its arguments, not a closure: a method
+    that makes a closure pays for its cells on every call, its compiled path's too (a fifth of
+    a single A_g)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynamicsWarning)
         with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-            out = np.asarray(compute(), dtype=float)
+            out = np.asarray(compute(*args), dtype=float)
     batch = out.shape[:out.ndim - tail]
     good = np.ones(batch, dtype=bool)
     for x in inputs:
@@ -219,20 +224,20 @@ class Dynamics(ControlTerms):
 
     def placement(self, q, frame: str) -> np.ndarray:
         """The frame's 4 x 4 placement in the world (rotation and origin in m), (..., 4, 4)."""
-        return undefined_rows(lambda: self.kinematics.placement(q, frame), (q,), 2)
+        return undefined_rows(self.kinematics.placement, (q, frame), (q,), 2)
 
     def jacobian(self, q, frame: str, reference: str = "local_world_aligned") -> np.ndarray:
         """The frame's 6 x n Jacobian, linear rows first, (..., 6, n); ``reference`` "world",
         "local" or "local_world_aligned" as Pinocchio's ReferenceFrame."""
-        return undefined_rows(lambda: self.kinematics.jacobian(q, frame, reference), (q,), 2)
+        return undefined_rows(self.kinematics.jacobian, (q, frame, reference), (q,), 2)
 
     def center_of_mass(self, q) -> np.ndarray:
         """The moving bodies' centre of mass in the world (m), (..., 3)."""
-        return undefined_rows(lambda: self.kinematics.center_of_mass(q), (q,), 1)
+        return undefined_rows(self.kinematics.center_of_mass, (q,), (q,), 1)
 
     def center_of_mass_jacobian(self, q) -> np.ndarray:
         """J_c with c_dot = J_c q_dot, (..., 3, n)."""
-        return undefined_rows(lambda: self.kinematics.center_of_mass_jacobian(q), (q,), 2)
+        return undefined_rows(self.kinematics.center_of_mass_jacobian, (q,), (q,), 2)
 
     def jacobian_dot_times_v(self, q, v, frame: str,
                              reference: str = "local_world_aligned") -> np.ndarray:
@@ -241,12 +246,12 @@ class Dynamics(ControlTerms):
         fast = self._reach if self._reach is not None else self._reach_kernel()
         if fast:
             try:
-                return reported_rows(*fast.drift(q, v, fast.frame_index[frame],
-                                                 REFERENCE_INDEX[reference]), 1)
+                out = fast.drift(q, v, fast.frame_index[frame], REFERENCE_INDEX[reference])
+                return out if out.__class__ is not tuple else reported_rows(out, 1)
             except (KeyError, ValueError, TypeError):
                 pass  # numpy below broadcasts, or names the fault in one line
-        return undefined_rows(
-            lambda: self.kinematics.jacobian_dot_times_v(q, v, frame, reference), (q, v), 1)
+        return undefined_rows(self.kinematics.jacobian_dot_times_v, (q, v, frame, reference),
+                              (q, v), 1)
 
     def centroidal_momentum_matrix(self, q) -> np.ndarray:
         """A_g with h_g = A_g q_dot (linear, then angular momentum about the centre of mass,
@@ -256,10 +261,11 @@ class Dynamics(ControlTerms):
             fast = self._reach_kernel()
         if fast:
             try:  # None without moving mass: TypeError, then below
-                return reported_rows(*fast.centroidal(q), 2)
+                out = fast.centroidal(q)
+                return out if out.__class__ is not tuple else reported_rows(out, 2)
             except (ValueError, TypeError):
                 pass
-        return undefined_rows(lambda: self.kinematics.centroidal_momentum_matrix(q), (q,), 2)
+        return undefined_rows(self.kinematics.centroidal_momentum_matrix, (q,), (q,), 2)
 
     # the compiled kernel of the three functions above (reach_c.py): None until asked, then
     # the kernel, or False (not the C backend, or no compiler)
@@ -291,25 +297,26 @@ class Dynamics(ControlTerms):
                 # module's unrolled ID and then J^T w are the faster (measured: benchmarks.md)
                 if one_pass and (self.velocity_names is not None or q.__class__ is not np.ndarray
                                  or q.ndim < 2 or len(q) <= 64):
-                    return reported_rows(*one_pass(q, v, x, f_ext), 1, 5)
+                    out = one_pass(q, v, x, f_ext)
+                    return out if out.__class__ is not tuple else reported_rows(out, 1, 5)
                 with warnings.catch_warnings():  # counted once, with the wrenches' states
                     warnings.simplefilter("ignore", DynamicsWarning)
                     tau = self.inverse_dynamics(q, v, x)
                 # the count of rows NaN after the last wrench (made NaN whole): the batch's
-                return reported_rows(tau, fast.add_wrenches(q, f_ext, tau, -1.0), 1, 5)
+                bad = fast.add_wrenches(q, f_ext, tau, -1.0)
+                return reported_rows((tau, bad) if bad else tau, 1, 5)
             except (KeyError, ValueError, TypeError, AttributeError):
                 pass  # numpy below broadcasts, or names the fault in one line
+        inputs = (q, v, x, *f_ext.values()) if isinstance(f_ext, Mapping) else (q, v, x)
+        return undefined_rows(self._wrenches_numpy, (q, v, x, f_ext, forward), inputs, 1, 5)
+
+    def _wrenches_numpy(self, q, v, x, f_ext, forward: bool) -> np.ndarray:
         from .wrenches import wrench_forces
 
-        inputs = (q, v, x, *f_ext.values()) if isinstance(f_ext, Mapping) else (q, v, x)
-
-        def compute():
-            tau_ext = wrench_forces(self.kinematics, self._vector(q, "q"), f_ext)
-            if forward:
-                return self.forward_dynamics(q, v, self._vector(x, "tau") + tau_ext)
-            return self.inverse_dynamics(q, v, x) - tau_ext
-
-        return undefined_rows(compute, inputs, 1, 5)
+        tau_ext = wrench_forces(self.kinematics, self._vector(q, "q"), f_ext)
+        if forward:
+            return self.forward_dynamics(q, v, self._vector(x, "tau") + tau_ext)
+        return self.inverse_dynamics(q, v, x) - tau_ext
     # -- the configuration space: a floating base's is a manifold (free_flyer.py) ---------------
 
     def integrate(self, q, v, dt: float = 1.0) -> np.ndarray:
@@ -356,7 +363,8 @@ class Dynamics(ControlTerms):
             fast = self._reach if self._reach is not None else self._reach_kernel()
             if fast and fast.coriolis is not None:  # compiled (reach_kernel.c)
                 try:
-                    return reported_rows(*fast.coriolis(q, v), 2)
+                    out = fast.coriolis(q, v)
+                    return out if out.__class__ is not tuple else reported_rows(out, 2)
                 except (ValueError, TypeError):
                     pass  # numpy below broadcasts, or names the fault in one line
             from .coriolis_tree import coriolis_matrix
@@ -371,14 +379,13 @@ class Dynamics(ControlTerms):
         q, v = self._vector(q, "q"), self._vector(v, "v")
         batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
         q, v = np.broadcast_to(q, batch + q.shape[-1:]), np.broadcast_to(v, batch + (self.n,))
+        return undefined_rows(self._christoffel_coriolis, (q, v), (q, v), 2)
+
+    def _christoffel_coriolis(self, q, v) -> np.ndarray:
         eye = np.eye(self.n)
-
-        def compute():
-            ahead = self.bias_forces(q[..., None, :], v[..., None, :] + eye)
-            behind = self.bias_forces(q[..., None, :], v[..., None, :] - eye)
-            return np.swapaxes((ahead - behind) / 4.0, -1, -2)
-
-        return undefined_rows(compute, (q, v), 2)
+        ahead = self.bias_forces(q[..., None, :], v[..., None, :] + eye)
+        behind = self.bias_forces(q[..., None, :], v[..., None, :] - eye)
+        return np.swapaxes((ahead - behind) / 4.0, -1, -2)
 
     def _velocity_terms_are_christoffel(self) -> bool:
         if self._christoffel is None:

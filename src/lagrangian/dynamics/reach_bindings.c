@@ -5,8 +5,8 @@
  *
  * A state whose inputs (q, v, a, its wrenches) are not all finite gets a row of NaN, as the
  * tree module's functions give (a NaN in one leg would otherwise leave the other legs' numbers
- * finite); each function returns the count of such rows beside its output, for the caller's
- * one DynamicsWarning. */
+ * finite); where there are such rows a function returns (output, their count), for the
+ * caller's one DynamicsWarning, else its output alone. */
 
 #define RK_PTHREADS LG_PTHREADS  /* batch_threads.c, above this text */
 #define RK_MAX_THREADS LG_MAX_THREADS
@@ -314,10 +314,12 @@ static PyObject *rk_output(PyArrayObject *like, int tail0, int tail1)
     return PyArray_SimpleNew(nd, dims, NPY_DOUBLE);
 }
 
-/* (output, count of NaN rows), or NULL with the output's error */
+/* the output where every row is defined, else (output, count of NaN rows); NULL with the
+ * output's error (a tuple only then: building it cost a single call a fifth of its time) */
 static PyObject *rk_result(PyObject *out, npy_intp bad)
 {
-    return out ? Py_BuildValue("(Nn)", out, (Py_ssize_t)bad) : NULL;
+    if (!out || !bad) return out;
+    return Py_BuildValue("(Nn)", out, (Py_ssize_t)bad);
 }
 
 static int rk_same_batch(PyArrayObject *a, PyArrayObject *b, const char *name)
@@ -497,11 +499,11 @@ done:
 }
 
 static PyMethodDef rk_methods[] = {
-    {"drift", (PyCFunction)(void (*)(void))rk_py_drift, METH_FASTCALL, "(Q, V, frame, ref) -> ([a; w_dot], NaN rows)"},
-    {"centroidal", (PyCFunction)(void (*)(void))rk_py_centroidal, METH_FASTCALL, "(Q) -> (A_g, NaN rows)"},
+    {"drift", (PyCFunction)(void (*)(void))rk_py_drift, METH_FASTCALL, "(Q, V, frame, ref) -> [a; w_dot], or ([a; w_dot], NaN rows)"},
+    {"centroidal", (PyCFunction)(void (*)(void))rk_py_centroidal, METH_FASTCALL, "(Q) -> A_g, or (A_g, NaN rows)"},
     {"wrench", (PyCFunction)(void (*)(void))rk_py_wrench, METH_FASTCALL, "(Q, frame, W, OUT, sign): OUT += sign J^T w; -> NaN rows"},
-    {"coriolis", (PyCFunction)(void (*)(void))rk_py_coriolis, METH_FASTCALL, "(Q, V) -> (C(q, v), NaN rows)"},
-    {"inverse", (PyCFunction)(void (*)(void))rk_py_inverse, METH_FASTCALL, "(INDEX, UP, Q, V, A, F_EXT) -> (tau, NaN rows)"},
+    {"coriolis", (PyCFunction)(void (*)(void))rk_py_coriolis, METH_FASTCALL, "(Q, V) -> C(q, v), or (C(q, v), NaN rows)"},
+    {"inverse", (PyCFunction)(void (*)(void))rk_py_inverse, METH_FASTCALL, "(INDEX, UP, Q, V, A, F_EXT) -> tau, or (tau, NaN rows)"},
     {NULL, NULL, 0, NULL},
 };
 

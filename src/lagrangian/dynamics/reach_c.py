@@ -136,8 +136,8 @@ def reach_module(tree: KinematicTree):
 
 class ReachKernel:
     """The compiled functions with frames by name; inputs of one batch shape (..., n). Each
-    returns (output, count of NaN rows): a state whose inputs are not all finite gets NaN in
-    its whole row (reach_bindings.c)."""
+    returns its output, or (output, count of NaN rows) where a state's inputs are not all
+    finite (its whole row NaN: reach_bindings.c)."""
 
     def __init__(self, module, tree: KinematicTree, massive: bool):
         self.module = module
@@ -171,7 +171,7 @@ class ReachKernel:
         wrenches = {f.name: rng.uniform(-5.0, 5.0, (3, 6)) for f in tree.frames if f.body >= 0}
         wrenches = dict(list(wrenches.items())[-1:])  # the last moving frame's
         try:
-            fused, _ = one_pass(q, v, a, wrenches)
+            fused = one_pass(q, v, a, wrenches)  # finite states: the output alone
             apart = np.array(dynamics.inverse_dynamics(q, v, a), dtype=float)
             self.add_wrenches(q, wrenches, apart, -1.0)
         except (ValueError, TypeError, KeyError):

@@ -6,6 +6,7 @@ mixed into joint_space.Dynamics (every path, a URDF tree's and a model file's)."
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -189,8 +190,9 @@ class ControlTerms:
                 return out if len(out) == 2 else _reported(out)
         compute = self._inverse_derivatives()
         n = self.n
-        both = self._guarded(lambda Q, V, A: np.concatenate(compute(Q, V, A), axis=-1),
-                             (q, v, a), ("q", "v", "a"), (n, 2 * n))
+        # partial, not a lambda: a closure would slow the compiled path above on every call
+        both = self._guarded(partial(_side_by_side, compute), (q, v, a), ("q", "v", "a"),
+                             (n, 2 * n))
         return both[..., :n], both[..., n:]
 
     def forward_dynamics_derivatives(self, q, v, tau) -> tuple[np.ndarray, np.ndarray,
@@ -225,6 +227,11 @@ class ControlTerms:
         by_position, by_velocity = self.inverse_dynamics_derivatives(q, v, acceleration)
         inverse = _inverses(self.mass_matrix(q))
         return np.concatenate([-inverse @ by_position, -inverse @ by_velocity, inverse], axis=-1)
+
+
+def _side_by_side(compute, Q, V, A) -> np.ndarray:
+    """compute's two (N, n, n) side by side, (N, n, 2n)."""
+    return np.concatenate(compute(Q, V, A), axis=-1)
 
 
 def _inverses(mass: np.ndarray) -> np.ndarray:

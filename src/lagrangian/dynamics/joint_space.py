@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable, Mapping
+from functools import partial
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -369,7 +370,8 @@ class Dynamics(ControlTerms):
                     pass  # numpy below broadcasts, or names the fault in one line
             from .coriolis_tree import coriolis_matrix
 
-            return self._guarded(lambda Q, V: coriolis_matrix(self.kinematics, Q, V), (q, v),
+            # partial, not a lambda: a closure over self would slow the compiled path above
+            return self._guarded(partial(coriolis_matrix, self.kinematics), (q, v),
                                  ("q", "v"), (self.n, self.n))
         if not self._velocity_terms_are_christoffel():
             raise DerivationError(

@@ -21,6 +21,10 @@ JointModelFreeFlyer): its derivatives only (the regressor of a floating base is 
   outputs hold (np.empty(...).fill(0)): what any batch returning new arrays pays before its
   arithmetic; Pinocchio's loop over it (batch_speedup_bound) is the most such a batch can reach
   here.
+- Keeping the results (pinocchio_loop_keeping_s, batch_speedup_keeping): Pinocchio's loop
+  copying each state's results into arrays of the batch's shapes, against ours again, taking
+  turns, best of 5: Pinocchio's functions return views of its one Data, so the plain loop
+  leaves only the last state's numbers, where a batch returns every state's.
 - Agreement: the largest absolute difference over 20 random states.
 - The machine's load average before and after, and its processor count, are printed with the
   figures: on a shared machine both sides slow down, not always alike.
@@ -65,6 +69,24 @@ def fresh_output_floor(outputs, repeat: int = 7) -> float:
         np.empty(size).fill(0.0)
         best = min(best, time.perf_counter() - began)
     return best
+
+
+def keeping_loop(theirs, q, v, a, like):
+    """A loop of Pinocchio's calls that keeps every state's results, copied into arrays of a
+    batch's shapes (``like``: our outputs of one state): Pinocchio's Python functions return
+    views of its one Data, so the plain loop's list holds the last state's numbers 10^4 times,
+    where a batch returns 10^4 states' (Minv's lower triangle, which Pinocchio leaves unset,
+    is not filled in)."""
+    parts = like if isinstance(like, tuple) else (like,)
+    outputs = [np.empty((len(q),) + x.shape[1:]) for x in parts]
+
+    def loop():
+        for k in range(len(q)):
+            got = theirs(q[k], v[k], a[k])
+            # computeRNEADerivatives gives M third, which ours does not return
+            for out, x in zip(outputs, got if isinstance(got, tuple) else (got,), strict=False):
+                out[k] = x
+    return loop
 
 
 def main() -> None:
@@ -116,6 +138,8 @@ def main() -> None:
             lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(args.states)], 3,
             time.process_time)
         floor = fresh_output_floor(mine(q, v, a))
+        keeping = keeping_loop(theirs, q, v, a, mine(q[:1], v[:1], a[:1]))
+        ours_again, pin_keeping = interleaved(lambda m=mine: m(q, v, a), keeping, 5)
         report[name] = {"ours_per_call_us": ours_call * 1e6, "pinocchio_per_call_us": pin_call * 1e6,
                         "ours_batch_s": ours_batch, "pinocchio_loop_s": pin_batch,
                         "ours_batch_cpu_s": ours_cpu, "pinocchio_loop_cpu_s": pin_cpu,
@@ -123,7 +147,9 @@ def main() -> None:
                         "batch_speedup": pin_batch / ours_batch,
                         "batch_cpu_speedup": pin_cpu / ours_cpu,
                         "fresh_output_s": floor,
-                        "batch_speedup_bound": pin_batch / floor}
+                        "batch_speedup_bound": pin_batch / floor,
+                        "pinocchio_loop_keeping_s": pin_keeping,
+                        "batch_speedup_keeping": pin_keeping / ours_again}
     report["load_average_after"] = os.getloadavg()
     dq, dv = ours.inverse_dynamics_derivatives(q[:20], v[:20], a[:20])
     fq, fv, ftau = ours.forward_dynamics_derivatives(q[:20], v[:20], a[:20])

@@ -84,13 +84,17 @@ def test_cli_prints_c_on_request_and_refuses_it_for_a_damper(cli):
     assert "coriolis_matrix" not in cli("dynamics", "double_pendulum", "--json").out
 
 
-def test_a_floating_base_with_a_mimic_joint(tmp_path):
-    """A mimic joint's coordinate is another joint's: the compiled C(q, v) adds both joints'
-    terms into its entries (reach_coriolis.c), as the numpy factorization does; C v = bias - g."""
+@pytest.mark.parametrize("mimic", [False, True], ids=["two legs", "a mimic knee"])
+def test_a_floating_base_with_branches_and_a_mimic_joint(tmp_path, mimic):
+    """Two legs: the compiled C(q, v) sets each entry once and zeroes those between the legs
+    (reach_coriolis.c's RK_CSET; the lanes' workspace is reused from state to state). A mimic
+    joint's coordinate is another joint's: there it adds both joints' terms into its entries.
+    Either way as the numpy factorization, with C v = bias - g, over enough states for the
+    vector lanes and the one-by-one rest."""
     pytest.importorskip("yourdfpy")
     from tests.dynamics.test_reach_reports import TWO_LEGS
 
-    text = TWO_LEGS.replace(
+    text = TWO_LEGS if not mimic else TWO_LEGS.replace(
         '<joint name="r_knee" type="prismatic"><parent link="r_thigh"/><child link="r_shank"/>',
         '<joint name="r_knee" type="prismatic"><parent link="r_thigh"/><child link="r_shank"/>'
         '<mimic joint="l_knee" multiplier="-0.5" offset="0.01"/>')
@@ -98,12 +102,14 @@ def test_a_floating_base_with_a_mimic_joint(tmp_path):
     path.write_text(text)
     compiled = lagrangian.load(path, floating_base=True).dynamics(backend="c")
     plain = lagrangian.load(path, floating_base=True).dynamics(backend="numpy")
-    assert compiled.n == 6 + 3  # l_hip, l_knee (r_knee's too), r_hip
+    assert compiled.n == 6 + (3 if mimic else 4)  # l_hip, l_knee (r_knee's too), r_hip
     rng = np.random.default_rng(4)
-    q = rng.uniform(-0.5, 0.5, (11, compiled.nq))
+    q = rng.uniform(-0.5, 0.5, (19, compiled.nq))
     q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
-    v = rng.uniform(-1, 1, (11, compiled.n))
+    v = rng.uniform(-1, 1, (19, compiled.n))
     C = compiled.coriolis_matrix(q, v)
     np.testing.assert_allclose(C, plain.coriolis_matrix(q, v), rtol=0, atol=1e-12)
+    if not mimic:  # the left knee's rows on the right leg's columns, and back
+        assert not C[:, 7, 8:].any() and not C[:, 8:, 7].any()
     np.testing.assert_allclose(np.einsum("kij,kj->ki", C, v),
                                compiled.bias_forces(q, v) - compiled.gravity(q), atol=1e-12)

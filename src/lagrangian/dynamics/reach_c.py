@@ -66,6 +66,31 @@ def _axis_tables(joints) -> list[str]:
             c_table("rk_R0id", "int", plain)]
 
 
+def _coriolis_tables(tree: KinematicTree) -> list[str]:
+    """The entries of C (row-major, nv x nv) that no body's pass sets, those of two joints on
+    different branches (reach_coriolis.c sets the others once each and zeroes only these), and
+    RK_CSET: 0 where a mimic joint shares another joint's coordinate (its entries then add
+    up: the whole of C is zeroed first)."""
+    free = tree.floating_base
+    base = 6 if free else 0
+    nv = base + len(tree.coordinates)
+    columns = [list(range(6)) if free and i == 0 else [base + j.coordinate]
+               for i, j in enumerate(tree.joints)]
+    coordinates = [j.coordinate for j in tree.joints[int(free):]]
+    shared = len(set(coordinates)) < len(coordinates)
+    written = set()
+    for i, joint in enumerate(tree.joints):
+        a = i
+        while a >= 0:  # i's ancestors and i itself
+            for r in columns[a]:
+                for c in columns[i]:
+                    written.update({(r, c), (c, r)})
+            a = tree.joints[a].parent
+    unset = [r * nv + c for r in range(nv) for c in range(nv) if (r, c) not in written]
+    return [f"#define RK_CSET {int(not shared)}", f"#define RK_NCZERO {len(unset)}",
+            c_table("rk_czero", "int", unset)]
+
+
 def kernel_source(tree: KinematicTree):
     """The module's C: the tables, then the kernels of _KERNELS in order."""
     from ..compile.codegen import GeneratedSource
@@ -105,6 +130,7 @@ def kernel_source(tree: KinematicTree):
         c_table("rk_fbody", "int", [f.body for f in frames]),
         c_table("rk_fR", "double", [[x for row in f.rotation for x in row] for f in frames]),
         c_table("rk_ft", "double", [list(f.translation) for f in frames]),
+        *_coriolis_tables(tree),
         _SINCOS, _VECTOR,
     ])
     texts = [path.read_text(encoding="utf-8") for path in _KERNELS]

@@ -47,13 +47,25 @@ static inline void RK_FN(inertia_times)(const RK_FN(cbody) *b, const RK_T *x, RK
     }
 }
 
+#ifndef RK_CPUT
+#if RK_CSET
+#define RK_CPUT(entry, value) ((entry) = (value))
+#else
+#define RK_CPUT(entry, value) ((entry) += (value))
+#endif
+#endif
+
 static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_T *restrict C,
                             RK_FN(cwork) *restrict work)
 {
     RK_FN(cbody) *restrict body = work->b;
     RK_T R[RK_NB][9], o[RK_NB][3];
     RK_FN(bodies)(q, R, o);
+#if RK_CSET  /* each entry set once below: zero only those between branches (reach_c.py) */
+    for (int j = 0; j < RK_NCZERO; j++) C[rk_czero[j]] = RK_C(0.0);
+#else  /* a mimic joint's coordinate is another joint's too: its entries add up */
     for (int j = 0; j < RK_NV * RK_NV; j++) C[j] = RK_C(0.0);
+#endif
     for (int i = 0; i < RK_NB; i++) {
         RK_FN(cbody) *bi = body + i;
         RK_T (*S)[6] = RK_COLUMNS(work, i), (*dS)[6] = RK_RATES(work, i);
@@ -128,17 +140,18 @@ static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_
         for (int a = i; a >= 0; a = rk_parent[a]) {
             const RK_FN(cbody) *ba = body + a;
             RK_T (*Sa)[6] = RK_COLUMNS(work, a), (*dSa)[6] = RK_RATES(work, a);
-            /* added to, not set: a mimic joint's coordinate is another joint's too */
+            /* (a, i) with a an ancestor of i or i itself, (i, a) with a strict ancestor:
+               never the same entry twice but where a coordinate drives two joints */
             for (int ca = 0; ca < ba->columns; ca++)
                 for (int ci = 0; ci < bi->columns; ci++) {
                     RK_T t = RK_C(0.0);  /* C[a, i] = S_a^T (I^c_i S_dot_i + B^c_i S_i) */
                     for (int k = 0; k < 6; k++) t += Sa[ca][k] * own[ci][k];
-                    C[(ba->first + ca) * RK_NV + bi->first + ci] += t;
+                    RK_CPUT(C[(ba->first + ca) * RK_NV + bi->first + ci], t);
                     if (a == i) continue;
                     t = RK_C(0.0);  /* C[i, a] = S_i^T (I^c_i S_dot_a + B^c_i S_a) */
                     for (int k = 0; k < 6; k++) t += rowI[ci][k] * dSa[ca][k];
                     for (int k = 0; k < 3; k++) t += rowB[ci][k] * Sa[ca][3 + k];
-                    C[(bi->first + ci) * RK_NV + ba->first + ca] += t;
+                    RK_CPUT(C[(bi->first + ci) * RK_NV + ba->first + ca], t);
                 }
         }
         int p = rk_parent[i];

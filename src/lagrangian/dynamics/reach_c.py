@@ -79,7 +79,7 @@ def _coriolis_tables(tree: KinematicTree) -> list[str]:
     coordinates = [j.coordinate for j in tree.joints[int(free):]]
     shared = len(set(coordinates)) < len(coordinates)
     written = set()
-    for i, joint in enumerate(tree.joints):
+    for i in range(len(tree.joints)):
         a = i
         while a >= 0:  # i's ancestors and i itself
             for r in columns[a]:

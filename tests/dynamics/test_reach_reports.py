@@ -170,3 +170,20 @@ def test_forward_derivatives_of_a_state_with_a_singular_mass_matrix_are_nan_alon
         alone = arm.forward_dynamics_derivatives(q[k], v[k], tau[k])
         for ours, one in zip((by_q, by_v, inverse), alone, strict=True):
             np.testing.assert_allclose(ours[k], one, rtol=1e-13, atol=1e-13)
+
+
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+@pytest.mark.parametrize("count", [3, 100])  # a fixed base's batch over 64: ID, then J^T w
+@pytest.mark.parametrize("floating", [False, True], ids=["fixed", "floating"])
+def test_an_empty_wrench_table_reports_as_the_dynamics(tmp_path, backend, count, floating):
+    robot = _robot(tmp_path, floating, backend)
+    q, v = np.zeros((count, len(robot.coordinates))), np.zeros((count, robot.n))
+    if floating:
+        q[:, 6] = 1.0
+    q[1, -1] = np.nan
+    for function in (robot.inverse_dynamics, robot.forward_dynamics):
+        with pytest.warns(lagrangian.DynamicsWarning) as record:
+            out = function(q, v, v, f_ext={})
+        assert len(record) == 1 and record[0].message.count == 1
+        assert np.isnan(out[1]).all() and np.isfinite(np.delete(out, 1, axis=0)).all()
+        np.testing.assert_allclose(out[0], function(q[0], v[0], v[0]), atol=1e-12)

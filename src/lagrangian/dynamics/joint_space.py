@@ -286,7 +286,7 @@ class Dynamics(ControlTerms):
         """Inverse or forward dynamics with wrenches at frames: tau_ext = sum J^T w
         (wrenches.py) taken from tau, or added to it; in compiled C where it can be."""
         fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast and f_ext:
+        if fast:
             try:
                 if forward:  # a state not finite leaves NaN in tau, and forward dynamics warns
                     tau = np.array(x, dtype=float)  # our own copy, added to in place

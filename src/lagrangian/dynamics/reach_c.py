@@ -212,9 +212,11 @@ class ReachKernel:
         states not finite (q, a wrench, or out's row already) made NaN whole; their count.
         ValueError or KeyError where the inputs are not plain or a base quaternion is off (the
         numpy path then names the fault)."""
-        wrench, bad = self.module.wrench, 0
+        wrench, bad = self.module.wrench, None
         for name, w in wrenches.items():
             bad = wrench(q, self.frame_index[name], w, out, sign)  # the last counts them all
+        if bad is None:  # no wrench: the rows NaN already (the caller's dynamics')
+            bad = int(np.isnan(out).reshape(-1, out.shape[-1]).any(axis=-1).sum())
         return bad
 
 

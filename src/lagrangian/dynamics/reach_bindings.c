@@ -132,9 +132,9 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
     lg_v4 q[RK_NQ], v[RK_NV], spoilt = LG_V4(0.0);
     rk_gather(job->q, k, RK_NQ, q);
     rk_spoil(q, RK_NQ, &spoilt);
-    {
-        const int width = job->kind == RK_DRIFT ? 6 : job->kind == RK_CENTROIDAL ? 6 * RK_NV
-                          : job->kind == RK_CORIOLIS ? RK_NV * RK_NV : RK_NV;
+    {   /* the rows these states will fill, fetched for writing while the kernel computes (as
+           the derivatives module's): a batch's outputs are seldom in cache */
+        const int width = rk_width(job->kind);
         const char *y = (const char *)(job->y + k * width);
         for (size_t b = 0; b < LG_LANES * width * sizeof(double); b += 64)
             __builtin_prefetch(y + b, 1, 2);

@@ -87,9 +87,9 @@ def test_cli_prints_c_on_request_and_refuses_it_for_a_damper(cli):
 @pytest.mark.parametrize("mimic", [False, True], ids=["two legs", "a mimic knee"])
 def test_a_floating_base_with_branches_and_a_mimic_joint(tmp_path, mimic):
     """Two legs: the compiled C(q, v) sets each entry once and zeroes those between the legs
-    (reach_coriolis.c's RK_CSET; the lanes' workspace is reused from state to state). A mimic
-    joint's coordinate is another joint's: there it adds both joints' terms into its entries.
-    Either way as the numpy factorization, with C v = bias - g, over enough states for the
+    (reach_c.py's RK_CSET; the lanes' workspace is reused from state to state), A_g each
+    column. A mimic joint's coordinate is another joint's: there both add both joints' terms
+    into their entries. Either way as numpy's, with C v = bias - g, over enough states for the
     vector lanes and the one-by-one rest."""
     pytest.importorskip("yourdfpy")
     from tests.dynamics.test_reach_reports import TWO_LEGS
@@ -111,5 +111,8 @@ def test_a_floating_base_with_branches_and_a_mimic_joint(tmp_path, mimic):
     np.testing.assert_allclose(C, plain.coriolis_matrix(q, v), rtol=0, atol=1e-12)
     if not mimic:  # the left knee's rows on the right leg's columns, and back
         assert not C[:, 7, 8:].any() and not C[:, 8:, 7].any()
+    # A_g's columns likewise: set once each, or (the mimic knee) added up
+    np.testing.assert_allclose(compiled.centroidal_momentum_matrix(q),
+                               plain.centroidal_momentum_matrix(q), rtol=0, atol=1e-12)
     np.testing.assert_allclose(np.einsum("kij,kj->ki", C, v),
                                compiled.bias_forces(q, v) - compiled.gravity(q), atol=1e-12)

@@ -70,7 +70,7 @@ def _coriolis_tables(tree: KinematicTree) -> list[str]:
     """The entries of C (row-major, nv x nv) that no body's pass sets, those of two joints on
     different branches (reach_coriolis.c sets the others once each and zeroes only these), and
     RK_CSET: 0 where a mimic joint shares another joint's coordinate (its entries then add
-    up: the whole of C is zeroed first)."""
+    up: the whole of C, and of A_g, is zeroed first)."""
     free = tree.floating_base
     base = 6 if free else 0
     nv = base + len(tree.coordinates)

@@ -47,14 +47,6 @@ static inline void RK_FN(inertia_times)(const RK_FN(cbody) *b, const RK_T *x, RK
     }
 }
 
-#ifndef RK_CPUT
-#if RK_CSET
-#define RK_CPUT(entry, value) ((entry) = (value))
-#else
-#define RK_CPUT(entry, value) ((entry) += (value))
-#endif
-#endif
-
 static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_T *restrict C,
                             RK_FN(cwork) *restrict work)
 {

@@ -13,6 +13,15 @@
 #define RK_UNROLL 40  /* bodies up to which the walks over them are unrolled (compile time) */
 #define RK_MAX_WRENCHES 16  /* more: the bindings refuse, the caller adds J^T w one by one */
 
+/* An output entry that one joint's column fills: set where no two joints share a coordinate
+ * (RK_CSET, from reach_c.py), added to where a mimic joint's coordinate is another's (the
+ * output zeroed first) */
+#if RK_CSET
+#define RK_CPUT(entry, value) ((entry) = (value))
+#else
+#define RK_CPUT(entry, value) ((entry) += (value))
+#endif
+
 #define RK_STR_(x) #x
 #define RK_STR(x) RK_STR_(x)
 #define RK_PASTE_(a, b) a##b
@@ -332,7 +341,9 @@ static void RK_FN(centroidal)(const RK_T *q, RK_T *out)
     RK_T R[RK_NB][9], o[RK_NB][3], h[RK_NB][3], Ic[RK_NB][6];
     double M[RK_NB];
     RK_FN(bodies)(q, R, o);
+#if !RK_CSET  /* else every column is one joint's, set once below */
     for (int j = 0; j < 6 * RK_NV; j++) out[j] = RK_C(0.0);
+#endif
     for (int i = 0; i < RK_NB; i++) {
         RK_T hr[3], RJ[9], T[6];
         const RK_T *p = o[i];
@@ -392,8 +403,8 @@ static void RK_FN(centroidal)(const RK_T *q, RK_T *out)
             RK_FN(cross)(G, l, g);
             const int c = first + col;
             for (int j = 0; j < 3; j++) {
-                out[j * RK_NV + c] += mult * l[j];
-                out[(3 + j) * RK_NV + c] += mult * (k[j] - g[j]);
+                RK_CPUT(out[j * RK_NV + c], mult * l[j]);
+                RK_CPUT(out[(3 + j) * RK_NV + c], mult * (k[j] - g[j]));
             }
         }
     }

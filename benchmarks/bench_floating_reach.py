@@ -2,7 +2,7 @@
 wrench at a foot, ours (the compiled reach kernel) beside Pinocchio's free flyer, per Python
 call of one state and for a batch of 10^4 states against a Python loop of Pinocchio calls.
 
-    python benchmarks/bench_floating_reach.py
+    python benchmarks/bench_floating_reach.py [--robots solo12,anymal,talos_reduced]
 
 Needs the bench extra (pin, example-robot-data). Each per-call figure (one state, its arrays
 bound beforehand on both sides) is the best of 7 rounds of 300 calls, ours and Pinocchio's
@@ -30,8 +30,10 @@ sys.path.insert(0, str(Path(__file__).parent))
 from bench_control import fresh_output_floor  # noqa: E402 (the sibling benchmarks')
 from bench_urdf import load_average, robots_folder  # noqa: E402
 
-ROBOTS = (("solo_description/robots/solo12.urdf", "FL_FOOT"),
-          ("talos_data/robots/talos_reduced.urdf", "left_sole_link"))
+ROBOTS = {"solo12": ("solo_description/robots/solo12.urdf", "FL_FOOT"),
+          "anymal": ("anymal_b_simple_description/robots/anymal.urdf", "LF_FOOT"),
+          "talos_reduced": ("talos_data/robots/talos_reduced.urdf", "left_sole_link")}
+DEFAULT = "solo12,talos_reduced"
 
 
 def best(function, calls: int, rounds: int, clock=time.perf_counter) -> float:
@@ -127,11 +129,20 @@ def bench_robot(name: str, foot: str, count: int = 10_000) -> None:
 
 
 def main() -> None:
+    import argparse
+
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--robots", default=DEFAULT,
+                        help=f"comma-separated, of {', '.join(ROBOTS)} (default {DEFAULT})")
+    names = parser.parse_args().robots.split(",")
+    unknown = [name for name in names if name not in ROBOTS]
+    if unknown:
+        parser.error(f"unknown robot {unknown[0]!r}; use {', '.join(ROBOTS)}")
     threads = max(1, min(os.cpu_count() or 1, int(os.environ.get("LAGRANGIAN_THREADS") or 8), 8))
     print(f"load average {load_average()}; a batch on up to {threads} threads "
           f"({os.cpu_count()} processors)")
-    for name, foot in ROBOTS:
-        bench_robot(name, foot)
+    for name in names:
+        bench_robot(*ROBOTS[name])
     print(f"load average {load_average()}")
 
 

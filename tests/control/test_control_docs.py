@@ -20,9 +20,9 @@ def _python(name: str) -> str:
     return re.findall(r"```python\n(.*?)```", docs_blocks.block(name, "control.md"), re.S)[0]
 
 
-def _command(name: str) -> list[str]:
+def _command(name: str, which: int = 0) -> list[str]:
     (line,) = [x for x in re.findall(r"```console\n(.*?)```", docs_blocks.block(name, "control.md"),
-                                     re.S)[0].splitlines() if x.startswith("$ ")]
+                                     re.S)[which].splitlines() if x.startswith("$ ")]
     args = shlex.split(line[2:])
     assert args[0] == "lagrangian"
     return args[1:]
@@ -141,6 +141,11 @@ def test_constrained_section(capsys, cli):
     assert result.code == 0, result.err
     along = json.loads(result.out)["linearize_along"]
     assert np.array(along["A"]).shape == (11, 4, 4) and along["inputs"] == ["x", "y"]
+    result = cli(*_command("control-constrained", 1))  # dynamics of the slider-crank
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    assert document["constraints"] == ["loop_y", "loop_x"] and len(document["multipliers"]) == 2
+    assert np.array(document["dqdd_dtau"]).shape == (3, 3)
 
 
 def test_manifold_section(capsys, cli):

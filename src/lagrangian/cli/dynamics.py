@@ -134,6 +134,7 @@ def dynamics(
     # a link's inertial (--set fore.mass=3) is a runtime parameter of the robot's dynamics
     f = system.dynamics(parameters=inertials or None, actuators=actuators,
                         armature=rotors or None)
+    constraints = tuple(getattr(f, "constraint_names", ()) or ())
     with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings(record=True) as seen:
         # an overflow is refused below; a state without dynamics (M not positive definite)
         # is a DynamicsWarning and NaN, reported in one line
@@ -151,6 +152,8 @@ def dynamics(
             values["tau"] = _vector(tau, n, "--tau", [])
             values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"],
                                                             f_ext=wrenches or None)
+            if constraints:
+                values["multipliers"] = f.multipliers(qs, vs, values["tau"])
             if derivatives:
                 values["dqdd_dq"], values["dqdd_dv"], values["dqdd_dtau"] = (
                     x + 0.0 for x in f.forward_dynamics_derivatives(qs, vs, values["tau"]))
@@ -179,10 +182,10 @@ def dynamics(
     if actuators or rotors:
         extra["actuators"] = f.actuators
     if json_:
-        print_json({**dynamics_document(names_q, values, system.joint_names, velocities),
-                    **extra})
+        print_json({**dynamics_document(names_q, values, system.joint_names, velocities,
+                                        constraints), **extra})
     else:
-        typer.echo(dynamics_text(names_q, values, velocities, extra), nl=False)
+        typer.echo(dynamics_text(names_q, values, velocities, extra, constraints), nl=False)
 
 
 def base_layout(system):

@@ -10,12 +10,15 @@ import numpy as np
 
 def dynamics_document(coordinates, values: Mapping[str, Any],
                       joint_names: Mapping[str, str] | None = None,
-                      velocities=None) -> dict[str, Any]:
+                      velocities=None, constraints=None) -> dict[str, Any]:
     """The `dynamics --json` document: every array as nested lists, SI units; NaN (a state
     without dynamics, DynamicsWarning) as null; ``joint_names`` (coordinate -> the URDF's
     joint name, {} for a model file) under that key. A floating base adds ``nq``, ``nv`` and
-    ``velocities``, the names of v (``coordinates`` are q's)."""
+    ``velocities``, the names of v (``coordinates`` are q's); a constrained model
+    ``constraints``, their names, in the order of ``multipliers``."""
     document: dict[str, Any] = {"coordinates": list(coordinates)}
+    if constraints:
+        document["constraints"] = list(constraints)
     if velocities is not None:
         document.update(nq=len(coordinates), nv=len(velocities), velocities=list(velocities))
     if joint_names is not None:
@@ -44,28 +47,43 @@ _TITLES = {
     "dqdd_dq": "d q_ddot/dq (row i: q_ddot_i)", "dqdd_dv": "d q_ddot/dq_dot",
     "dqdd_dtau": "d q_ddot/d tau = M^-1",
 }
+# A constrained model's forward dynamics is the multipliers' system, not M^-1 (tau - b)
+# (derive's convention: M q_ddot + Phi_q^T lambda = f + tau, Phi_q q_ddot = gamma)
+_CONSTRAINED_TITLES = {
+    "forward_dynamics": "forward dynamics q_ddot, with the constraints: M q_ddot + Phi_q^T "
+                        "lambda = tau - C q_dot - g, Phi_q q_ddot = gamma",
+    "multipliers": "multipliers lambda (one per constraint; Phi_q^T lambda the constraint "
+                   "forces' generalized part, taken from the left side)",
+    "dqdd_dq": "d q_ddot/dq (row i: q_ddot_i; the constrained system's)",
+    "dqdd_dv": "d q_ddot/dq_dot (the constrained system's)",
+    "dqdd_dtau": "d q_ddot/d tau (the constrained system's, not M^-1)",
+}
 
 
 def dynamics_text(coordinates, values: Mapping[str, Any], velocities=None,
-                  extra: Mapping[str, Any] | None = None) -> str:
+                  extra: Mapping[str, Any] | None = None, constraints=None) -> str:
     """``velocities``: the names of v, a and tau where they are not q's (a floating base);
     ``extra``: the wrenches at frames and the actuator models the values include (`--wrench`,
-    `--actuators`, `--armature`)."""
+    `--actuators`, `--armature`); ``constraints``: a constrained model's names (its forward
+    dynamics and derivatives are titled as the multipliers' system's, ``multipliers`` listed
+    by constraint)."""
+    titles = {**_TITLES, **_CONSTRAINED_TITLES} if constraints else _TITLES
     names = list(coordinates)
     rates = names if velocities is None else list(velocities)
-    width = max(len(n) for n in names + rates)
+    width = max(len(n) for n in names + rates + list(constraints or ()))
     lines = [f"Coordinates: {', '.join(names)} (SI: rad or m; tau in N m or N)"]
     if velocities is not None:
         lines.append(f"Velocities: {', '.join(rates)} (the base's twist in its own axes: m/s, "
                      "rad/s; its tau is the wrench on it: N, N m)")
     for key, value in values.items():
         array = np.asarray(value, dtype=float)
-        title = _TITLES.get(key, key)
+        title = titles.get(key, key)
         if array.ndim == 0:
             lines.append(f"{title}: {float(array):.9g}")
         elif array.ndim == 1:
             lines.append(f"{title}:")
-            labels = names if key == "q" else rates
+            labels = (names if key == "q" else list(constraints) if key == "multipliers"
+                      else rates)
             lines += [f"  {n:<{width}}  {x: .9g}" for n, x in zip(labels, array, strict=True)]
         else:
             lines.append(f"{title}:")

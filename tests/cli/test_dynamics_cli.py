@@ -104,3 +104,31 @@ def test_a_value_beyond_floating_point_is_refused_not_printed(cli, args, what, j
     assert result.code == 2 and result.out == ""
     assert result.err.count("\n") == 1 and result.err.startswith("error: ")
     assert what in result.err and "not finite" in result.err
+
+
+def test_titles_say_what_the_actuators_and_wrenches_add(cli, arm):
+    """With --actuators (the hinge's damping 0.3 and friction 0.1), --armature and --wrench, M,
+    the bias and the dynamics include them: the titles must say so (they printed the rigid
+    body's M q_ddot + C q_dot + g over numbers that were not that)."""
+    state = ("--q", "0.4,0.1", "--v", "1.5,-0.7")
+    code, plain, err = cli("dynamics", arm, *state, "--a", "0,0", "--json")
+    assert code == 0, err
+    loaded = ("--actuators", "--armature", "slide=0.02", "--wrench", "tip=0,0,-10,0,0,0")
+    code, out, err = cli("dynamics", arm, *state, "--a", "0,0", *loaded, "--json")
+    assert code == 0, err
+    plain, out = json.loads(plain), json.loads(out)
+    # the numbers: M + diag(armature), bias + d q_dot + f_c sign(q_dot)
+    assert out["mass_matrix"][1][1] - plain["mass_matrix"][1][1] == pytest.approx(0.02)
+    assert out["bias_forces"][0] - plain["bias_forces"][0] == pytest.approx(0.3 * 1.5 + 0.1)
+    code, text, err = cli("dynamics", arm, *state, "--a", "0,0", *loaded)
+    assert code == 0, err
+    titles = [line for line in text.splitlines() if not line.startswith(" ")]
+    assert "mass matrix M(q) + diag(armature):" in titles
+    assert "bias forces C(q, q_dot) q_dot + g(q) + d q_dot + f_c sign(q_dot):" in titles
+    assert ("inverse dynamics tau = (M + diag(armature)) q_ddot + C q_dot + g + d q_dot + "
+            "f_c sign(q_dot) - sum J^T w:") in titles
+    code, text, err = cli("dynamics", arm, *state, "--tau", "0,0", "--wrench",
+                          "tip=0,0,-10,0,0,0")
+    assert code == 0, err
+    assert "forward dynamics q_ddot = M^-1 (tau + sum J^T w - C q_dot - g):" in text
+    assert "mass matrix M(q):" in text  # no actuators: the rigid body's titles

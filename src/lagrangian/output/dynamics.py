@@ -60,6 +60,31 @@ _CONSTRAINED_TITLES = {
 }
 
 
+def _loaded_titles(actuators: bool, wrenches: bool) -> dict[str, str]:
+    """The titles whose equation the actuator models (armature on M's diagonal, viscous and
+    Coulomb friction in the bias) and wrenches at frames change: each says what was computed."""
+    if not (actuators or wrenches):
+        return {}
+    mass, losses = ("(M + diag(armature))", " + d q_dot + f_c sign(q_dot)") if actuators \
+        else ("M", "")
+    outside = " - sum J^T w" if wrenches else ""
+    titles = {
+        "inverse_dynamics": f"inverse dynamics tau = {mass} q_ddot + C q_dot + g{losses}{outside}",
+        "forward_dynamics": f"forward dynamics q_ddot = {mass}^-1 (tau"
+                            f"{' + sum J^T w' if wrenches else ''} - C q_dot - g"
+                            f"{losses.replace(' + ', ' - ')})",
+    }
+    if actuators:
+        titles.update({
+            "mass_matrix": "mass matrix M(q) + diag(armature)",
+            "bias_forces": f"bias forces C(q, q_dot) q_dot + g(q){losses}",
+            "coriolis_matrix": "Coriolis matrix C(q, q_dot) (the rigid bodies': damping and "
+                               "friction are not in it)",
+            "kinetic_energy": "kinetic energy T (J; the links', without the rotors')",
+        })
+    return titles
+
+
 def dynamics_text(coordinates, values: Mapping[str, Any], velocities=None,
                   extra: Mapping[str, Any] | None = None, constraints=None) -> str:
     """``velocities``: the names of v, a and tau where they are not q's (a floating base);
@@ -67,7 +92,9 @@ def dynamics_text(coordinates, values: Mapping[str, Any], velocities=None,
     `--actuators`, `--armature`); ``constraints``: a constrained model's names (its forward
     dynamics and derivatives are titled as the multipliers' system's, ``multipliers`` listed
     by constraint)."""
-    titles = {**_TITLES, **_CONSTRAINED_TITLES} if constraints else _TITLES
+    titles = {**_TITLES, **_CONSTRAINED_TITLES} if constraints else dict(_TITLES)
+    titles.update(_loaded_titles(bool((extra or {}).get("actuators")),
+                                 bool((extra or {}).get("wrenches"))))
     names = list(coordinates)
     rates = names if velocities is None else list(velocities)
     width = max(len(n) for n in names + rates + list(constraints or ()))

@@ -132,3 +132,14 @@ def test_titles_say_what_the_actuators_and_wrenches_add(cli, arm):
     assert code == 0, err
     assert "forward dynamics q_ddot = M^-1 (tau + sum J^T w - C q_dot - g):" in text
     assert "mass matrix M(q):" in text  # no actuators: the rigid body's titles
+
+
+def test_a_floating_base_is_titled_by_its_velocity_not_q_dot(cli):
+    """nv = nq - 1: the base's twist is not the rate of its coordinates."""
+    code, text, err = cli("dynamics", "two_link_arm", "--floating-base", "--payload",
+                          "base=50@-0.2,0.1,0", "--q", "0,0,0,0,0,0,1,0.3,0.5", "--tau",
+                          "0,0,0,0,0,0,1,0")
+    assert code == 0, err
+    titles = [line for line in text.splitlines() if not line.startswith(" ")]
+    assert "v:" in titles and "forward dynamics v_dot = M^-1 (tau - C v - g):" in titles
+    assert not any("q_dot" in line for line in titles), titles

@@ -95,6 +95,9 @@ def dynamics_text(coordinates, values: Mapping[str, Any], velocities=None,
     titles = {**_TITLES, **_CONSTRAINED_TITLES} if constraints else dict(_TITLES)
     titles.update(_loaded_titles(bool((extra or {}).get("actuators")),
                                  bool((extra or {}).get("wrenches"))))
+    if velocities is not None:  # a floating base: v is not q's rate (nv = nq - 1)
+        titles = {key: title.replace("q_ddot", "v_dot").replace("q_dot", "v")
+                  for key, title in titles.items()}
     names = list(coordinates)
     rates = names if velocities is None else list(velocities)
     width = max(len(n) for n in names + rates + list(constraints or ()))

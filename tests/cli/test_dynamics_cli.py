@@ -143,3 +143,12 @@ def test_a_floating_base_is_titled_by_its_velocity_not_q_dot(cli):
     titles = [line for line in text.splitlines() if not line.startswith(" ")]
     assert "v:" in titles and "forward dynamics v_dot = M^-1 (tau - C v - g):" in titles
     assert not any("q_dot" in line for line in titles), titles
+
+
+def test_kinematics_of_a_floating_base_is_titled_by_its_velocity(cli):
+    code, text, err = cli("kinematics", "two_link_arm", "--floating-base", "--q",
+                          "0,0,0,0,0,0,1,0.3,0.5", "--v", "0.1,0,0,0,0,0.2,1,2", "--centroidal")
+    assert code == 0, err
+    titles = [line for line in text.splitlines() if not line.startswith(" ")]
+    assert "v:" in titles and any(t.startswith("J_dot v: [a; w_dot] at v_dot = 0") for t in titles)
+    assert not any("q_dot" in line for line in titles), titles

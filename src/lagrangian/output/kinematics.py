@@ -45,6 +45,9 @@ def kinematics_text(coordinates, frame: str, reference: str, values: Mapping[str
     for key, value in values.items():
         array = np.asarray(value, dtype=float)
         title = _TITLES.get(key, key)
+        if velocities is not None:  # a floating base: v is not q's rate (nv = nq - 1)
+            title = title.replace("[v; w] = J q_dot", "J: the frame's [v; w] = J v")
+            title = title.replace("q_ddot", "v_dot").replace("q_dot", "v")
         if key in ("jacobian", "jacobian_dot_times_v"):
             title += f", reference {reference}"
         lines.append(f"{title}:")

@@ -40,12 +40,19 @@ static void rk_blank(const rk_job *job, npy_intp k)
     for (int i = 0; i < width; i++) job->y[k * width + i] = NAN;
 }
 
-/* x - x is 0 for a finite x, NaN for an infinite or NaN one */
+/* whether x[0..width) are all finite: none with every exponent bit set, by an integer OR the
+ * compiler vectorizes (a sum of x - x chains one addition after another: 60 ns of the 0.8 us
+ * of a single ID with a wrench on Solo12) */
 static int rk_finite_row(const double *x, int width)
 {
-    double spoilt = 0.0;
-    for (int i = 0; i < width; i++) spoilt += x[i] - x[i];
-    return spoilt == 0.0;
+    const unsigned long long exponent = 0x7ff0000000000000ULL;
+    unsigned long long spoilt = 0;
+    for (int i = 0; i < width; i++) {
+        unsigned long long bits;
+        __builtin_memcpy(&bits, x + i, sizeof bits);
+        spoilt |= (bits & exponent) == exponent;
+    }
+    return !spoilt;
 }
 
 /* whether state k's inputs are all finite (and, adding wrenches, its row after the sum) */

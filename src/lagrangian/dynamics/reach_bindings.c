@@ -125,10 +125,18 @@ static inline void rk_scatter(const lg_v4 *x, npy_intp k, int width, double *y, 
     }
 }
 
-/* x - x summed over an input's vectors: 0 in the lanes where it is finite */
+/* x - x summed over an input's vectors: 0 in the lanes where it is finite (two sums, so that
+   the additions do not wait one for another) */
 static inline void rk_spoil(const lg_v4 *x, int width, lg_v4 *spoilt)
 {
-    for (int i = 0; i < width; i++) *spoilt += x[i] - x[i];
+    lg_v4 odd = LG_V4(0.0);
+    int i = 0;
+    for (; i + 1 < width; i += 2) {
+        *spoilt += x[i] - x[i];
+        odd += x[i + 1] - x[i + 1];
+    }
+    if (i < width) odd += x[i] - x[i];
+    *spoilt += odd;
 }
 
 /* states k .. k + LG_LANES - 1 at once (rk4_*); out: RK_OUT4 vectors of room; the count of

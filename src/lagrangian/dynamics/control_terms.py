@@ -208,16 +208,11 @@ class ControlTerms:
                 pass
             else:
                 return out if len(out) == 3 else _reported(out)
-        from .joint_space import undefined_rows
-
-        q, v, tau = self._vector(q, "q"), self._vector(v, "v"), self._vector(tau, "tau")
-        batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1], tau.shape[:-1])
-        q = np.broadcast_to(q, batch + q.shape[-1:])
-        v = np.broadcast_to(v, batch + (self.n,))
         n = self.n
-        # one warning for the three; a state's three rows NaN together, as the C's
-        out = undefined_rows(self._forward_derivatives_numpy, (q, v, tau), (q, v, tau), 2,
-                             results=True)
+        # forward dynamics' rule: one warning for the three, a state's three rows NaN together
+        # (an input not finite, or M not positive definite), as the C's
+        out = self._guarded(self._forward_derivatives_numpy, (q, v, tau), ("q", "v", "tau"),
+                            (n, 3 * n), forward=True, quiet=True)
         return out[..., :n], out[..., n:2 * n], out[..., 2 * n:]
 
     def _forward_derivatives_numpy(self, q, v, tau) -> np.ndarray:

@@ -62,16 +62,15 @@ def reported_rows(out, tail: int, stacklevel: int = 4):
     return out
 
 
-def undefined_rows(compute, args, inputs, tail: int, stacklevel: int = 4,
-                   results: bool = False) -> np.ndarray:
+def undefined_rows(compute, args, inputs, tail: int, stacklevel: int = 4) -> np.ndarray:
     """compute(*args) over a batch, then NaN in the whole row of each state whose inputs are
     not all finite (inputs: arrays (..., k) of the batch, or one state's (k,) shared by it),
-    and with ``results`` of each whose row came out not finite (a mass matrix not positive
-    definite), with one DynamicsWarning counting them: the rule of every function of a state (a
-    NaN in one leg would otherwise leave the other legs' numbers finite; the numpy paths' own
-    warnings are folded into that one). A function and its arguments, not a closure: a method
-    that makes a closure pays for its cells on every call, its compiled path's too (a fifth of
-    a single A_g)."""
+    with one DynamicsWarning counting them: Dynamics._guarded's rule for a function that checks
+    its own arguments (a frame's name, a wrench table, named even where no state is finite),
+    so it runs on every state and a NaN in one leg, which would leave the other legs' numbers
+    finite, is blanked after; the numpy paths' own warnings are folded into that one. A
+    function and its arguments, not a closure: a method that makes a closure pays for its
+    cells on every call, its compiled path's too (a fifth of a single A_g)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynamicsWarning)
         with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
@@ -82,13 +81,18 @@ def undefined_rows(compute, args, inputs, tail: int, stacklevel: int = 4,
         x = np.asarray(x, dtype=float)
         if x.ndim:
             good &= np.broadcast_to(np.isfinite(x).all(axis=-1), batch)
-    if results:
-        good &= np.isfinite(out).all(axis=tuple(range(len(batch), out.ndim)))
     if not good.all():
         out = np.array(out)
         out[~good] = np.nan
         warn_undefined(int((~good).sum()), good.size, stacklevel=stacklevel)
     return out
+
+
+def _without_warnings(compute, *arrays):
+    """compute(*arrays) with its DynamicsWarnings held back (the caller counts the rows)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynamicsWarning)
+        return compute(*arrays)
 
 
 def solve_positive(mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -159,10 +163,14 @@ class Dynamics(ControlTerms):
                              f"the last axis, got shape {shape}", field=field)
         return array
 
-    def _guarded(self, compute, arrays, fields, tail: tuple[int, ...], forward: bool = False):
+    def _guarded(self, compute, arrays, fields, tail: tuple[int, ...], forward: bool = False,
+                 quiet: bool = False):
         """compute(*flat inputs (N, n)) -> (N, *tail) over the states whose inputs are finite,
         NaN rows for the others (and for forward dynamics, for rows without a finite result),
-        reshaped to the batch; one DynamicsWarning when any row is NaN."""
+        reshaped to the batch; one DynamicsWarning when any row is NaN. ``quiet``: compute is
+        made of this object's own functions, whose warnings that one counts."""
+        if quiet:
+            compute = partial(_without_warnings, compute)
         arrays = [self._vector(x, f) for x, f in zip(arrays, fields, strict=True)]
         batch = np.broadcast_shapes(*(x.shape[:-1] for x in arrays))
         total = int(np.prod(batch, dtype=np.int64))
@@ -378,10 +386,7 @@ class Dynamics(ControlTerms):
                 "C(q, q_dot) is the matrix of the Coriolis and centrifugal terms of M; this "
                 "model's velocity terms are not only those (a damper, a velocity-dependent load, "
                 "a moving support, or M changing with t): use bias_forces(q, q_dot)")
-        q, v = self._vector(q, "q"), self._vector(v, "v")
-        batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
-        q, v = np.broadcast_to(q, batch + q.shape[-1:]), np.broadcast_to(v, batch + (self.n,))
-        return undefined_rows(self._christoffel_coriolis, (q, v), (q, v), 2)
+        return self._guarded(self._christoffel_coriolis, (q, v), ("q", "v"), (self.n, self.n))
 
     def _christoffel_coriolis(self, q, v) -> np.ndarray:
         eye = np.eye(self.n)

@@ -51,14 +51,14 @@ def warn_undefined(count: int, total: int, stacklevel: int = 4) -> None:
 
 
 def reported_rows(out, tail: int, stacklevel: int = 4):
-    """A compiled reach function's output, or its (output, count of NaN rows) where there are
-    any (reach_bindings.c), ``tail`` the axes of one state's output: then one DynamicsWarning;
-    the output."""
+    """A compiled function's output, or its (output, count of NaN rows) where there are any
+    (the tree and reach modules), ``tail`` the axes of one state's output: then one
+    DynamicsWarning; the output."""
     if out.__class__ is not tuple:
         return out
     out, bad = out
-    total = out.size // max(1, int(np.prod(out.shape[out.ndim - tail:], dtype=np.int64)))
-    warn_undefined(bad, total, stacklevel=stacklevel)
+    warn_undefined(bad, int(np.prod(out.shape[:out.ndim - tail], dtype=np.int64)),
+                   stacklevel=stacklevel)
     return out
 
 

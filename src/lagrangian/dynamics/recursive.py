@@ -34,7 +34,7 @@ import numpy as np
 from ..errors import InputError
 from ..model.model import Model
 from ..model.tree import KinematicTree, body_tree
-from .joint_space import TreeDynamics, warn_undefined
+from .joint_space import TreeDynamics, reported_rows
 from .tree_module import module_source, tree_key
 
 # A model file's tree of at least this many bodies runs the recursions (numbers, simulation,
@@ -174,7 +174,7 @@ class RecursiveDynamics(TreeDynamics):
             out = self._mass(q, self._P)
         except ValueError:
             out = self._call(self._mass, q)
-        return out if out.__class__ is not tuple else _reported(*out, 2)
+        return out if out.__class__ is not tuple else reported_rows(out, 2)
 
     def bias_forces(self, q, v):
         """C(q, q_dot) q_dot + g(q), shape (..., n)."""
@@ -182,7 +182,7 @@ class RecursiveDynamics(TreeDynamics):
             out = self._bias(q, v, self._P)
         except ValueError:
             out = self._call(self._bias, q, v)
-        return out if out.__class__ is not tuple else _reported(*out, 1)
+        return out if out.__class__ is not tuple else reported_rows(out, 1)
 
     def gravity(self, q):
         """g(q), shape (..., n)."""
@@ -190,7 +190,7 @@ class RecursiveDynamics(TreeDynamics):
             out = self._gravity(q, self._P)
         except ValueError:
             out = self._call(self._gravity, q)
-        return out if out.__class__ is not tuple else _reported(*out, 1)
+        return out if out.__class__ is not tuple else reported_rows(out, 1)
 
     def inverse_dynamics(self, q, v, a, f_ext=None):
         """tau = M a + C q_dot + g - sum J^T w, shape (..., n) (f_ext: wrenches.py)."""
@@ -200,7 +200,7 @@ class RecursiveDynamics(TreeDynamics):
             out = self._inverse(q, v, a, self._P)
         except ValueError:
             out = self._call(self._inverse, q, v, a)
-        return out if out.__class__ is not tuple else _reported(*out, 1)
+        return out if out.__class__ is not tuple else reported_rows(out, 1)
 
     def forward_dynamics(self, q, v, tau, f_ext=None):
         """q_ddot = M^-1 (tau + sum J^T w - C q_dot - g), shape (..., n) (f_ext: wrenches.py)."""
@@ -210,7 +210,7 @@ class RecursiveDynamics(TreeDynamics):
             out = self._forward(q, v, tau, self._P)
         except ValueError:
             out = self._call(self._forward, q, v, tau)
-        return out if out.__class__ is not tuple else _reported(*out, 1)
+        return out if out.__class__ is not tuple else reported_rows(out, 1)
 
     def kinetic_energy(self, q, v):
         """T in J, shape (...)."""
@@ -218,7 +218,7 @@ class RecursiveDynamics(TreeDynamics):
             out = self._kinetic(q, v, self._P)
         except ValueError:
             out = self._call(self._kinetic, q, v)
-        return out if out.__class__ is not tuple else _reported(*out, 0)
+        return out if out.__class__ is not tuple else reported_rows(out, 0)
 
     def potential_energy(self, q):
         """V in J, shape (...)."""
@@ -226,7 +226,7 @@ class RecursiveDynamics(TreeDynamics):
             out = self._potential(q, self._P)
         except ValueError:
             out = self._call(self._potential, q)
-        return out if out.__class__ is not tuple else _reported(*out, 0)
+        return out if out.__class__ is not tuple else reported_rows(out, 0)
 
 
 def _unit_quaternions(q) -> np.ndarray:
@@ -240,13 +240,6 @@ def _unit_quaternions(q) -> np.ndarray:
     check_quaternions(flat[np.isfinite(flat).all(axis=-1)])
     flat[:, 3:7] /= np.linalg.norm(flat[:, 3:7], axis=-1, keepdims=True)
     return flat.reshape(Q.shape)
-
-
-def _reported(out: np.ndarray, count: int, tail: int):
-    """The module's (output, count of NaN rows), ``tail`` the axes of one state's output: one
-    DynamicsWarning, and the output."""
-    warn_undefined(count, int(np.prod(out.shape[:out.ndim - tail], dtype=np.int64)), stacklevel=4)
-    return out
 
 
 __all__ = ["RecursiveDynamics", "applicable_tree"]

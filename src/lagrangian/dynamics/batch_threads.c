@@ -70,3 +70,86 @@ static int lg_unit_quaternions(const double *q, npy_intp states, npy_intp step, 
     }
     return 1;
 }
+
+/* A batch's output array. A large one (LG_KEEP_MIN bytes or more) comes from blocks this module
+ * keeps: a block above glibc's largest mmap threshold (32 MB: Solo12's derivatives for 10^4
+ * states, 52 and 78 MB) is otherwise a fresh mapping on every call, its pages faulted in and
+ * zeroed by the kernel while the threads write (a third of such a batch's CPU time, measured).
+ * When the array and its views are gone, its block is kept for the next batch of about its
+ * size: at most LG_KEEP_SLOTS blocks of at most LG_KEEP_MAX bytes each, so a module holds 256 MB
+ * at most; the latest block freed replaces an older one when the slots are full. The slots are
+ * swapped atomically, not under the GIL alone. The array does not own its data (its base is the
+ * block's capsule); its contents are uninitialized, as PyArray_SimpleNew's, and the kernels
+ * write every entry. */
+#define LG_KEEP_MIN ((size_t)4 << 20)
+/* a batch's outputs of this size or more are written past the caches (tree_c.py's
+   lg_rows_streamed): larger than this machine's caches, or about to be */
+#define LG_STREAM_MIN ((size_t)16 << 20)
+#define LG_KEEP_MAX ((size_t)128 << 20)
+#define LG_KEEP_SLOTS 2
+#define LG_HEAD 64 /* the block's size before its data, which stays 64-byte aligned */
+static void *lg_kept[LG_KEEP_SLOTS];
+
+static void lg_block_free(PyObject *capsule)
+{
+    char *block = (char *)PyCapsule_GetPointer(capsule, "lagrangian.output") - LG_HEAD;
+    if (*(size_t *)block > LG_KEEP_MAX) {
+        free(block);
+        return;
+    }
+    for (int s = 0; s < LG_KEEP_SLOTS; s++) {
+        void *empty = NULL;
+        if (__atomic_compare_exchange_n(&lg_kept[s], &empty, block, 0, __ATOMIC_ACQ_REL,
+                                        __ATOMIC_ACQUIRE))
+            return;
+    }
+    /* the slots full: this block, the latest, takes the place of one kept longer (taking turns
+       among the slots), so that blocks of a size no longer asked for do not stay */
+    static unsigned turn = 0;
+    const unsigned s = __atomic_fetch_add(&turn, 1, __ATOMIC_RELAXED) % LG_KEEP_SLOTS;
+    free(__atomic_exchange_n((char **)&lg_kept[s], block, __ATOMIC_ACQ_REL));
+}
+
+/* a kept block of ``size`` to 5/4 ``size`` bytes of data, else a new one; NULL without memory */
+static char *lg_block(size_t size)
+{
+    for (int s = 0; s < LG_KEEP_SLOTS; s++) {
+        char *block = __atomic_exchange_n((char **)&lg_kept[s], NULL, __ATOMIC_ACQ_REL);
+        if (!block) continue;
+        const size_t held = *(size_t *)block;
+        if (held >= size && held - size <= size / 4) return block;
+        void *empty = NULL;  /* not this size: back to its slot, or freed if that was taken */
+        if (!__atomic_compare_exchange_n(&lg_kept[s], &empty, block, 0, __ATOMIC_ACQ_REL,
+                                         __ATOMIC_ACQUIRE))
+            free(block);
+    }
+    const size_t whole = (LG_HEAD + size + 63) & ~(size_t)63;
+    char *block = aligned_alloc(64, whole);
+    if (block) *(size_t *)block = size;
+    return block;
+}
+
+static PyObject *lg_output(int nd, npy_intp *dims)
+{
+    size_t size = sizeof(double);
+    for (int k = 0; k < nd; k++) size *= (size_t)dims[k];
+    if (size < LG_KEEP_MIN) return PyArray_SimpleNew(nd, dims, NPY_DOUBLE);
+    char *block = lg_block(size);
+    if (!block) return PyErr_NoMemory();
+    PyObject *capsule = PyCapsule_New(block + LG_HEAD, "lagrangian.output", lg_block_free);
+    if (!capsule) {
+        free(block);
+        return NULL;
+    }
+    PyObject *out = PyArray_New(&PyArray_Type, nd, dims, NPY_DOUBLE, NULL, block + LG_HEAD, 0,
+                                NPY_ARRAY_CARRAY, NULL);
+    if (!out) {
+        Py_DECREF(capsule);  /* its block back to the slots */
+        return NULL;
+    }
+    if (PyArray_SetBaseObject((PyArrayObject *)out, capsule) < 0) {  /* (steals the capsule) */
+        Py_DECREF(out);
+        return NULL;
+    }
+    return out;
+}

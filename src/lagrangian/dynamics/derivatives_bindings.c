@@ -19,7 +19,7 @@
 #define DK_CHUNK 128
 
 typedef struct {
-    int kind;
+    int kind, stream;  /* stream: the outputs stored past the caches (lg_rows_streamed) */
     npy_intp step[3], k0, k1, bad;
     const double *x[3], *p;
     double *y[3];
@@ -58,8 +58,8 @@ static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
                     in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
         }
         /* the rows these states will fill, fetched for writing while the kernel computes: a
-           batch's outputs are fresh memory, and its stores would otherwise each wait for it */
-        for (int o = 0; o < nout; o++) {
+           batch's outputs are seldom in cache, and its stores would otherwise each wait */
+        for (int o = 0; o < nout && !job->stream; o++) {
             const char *y = (const char *)(job->y[o] + k * size);
             for (size_t b = 0; b < LG_LANES * size * sizeof(double); b += 64)
                 __builtin_prefetch(y + b, 1, 2);
@@ -76,7 +76,9 @@ static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
         lg_v4 spoilt = LG_V4(0.0);
         for (int j = 0; j < 3; j++)
             for (int i = 0; i < DK_WIDTH(j); i++) spoilt += in[j][i] - in[j][i];
-        for (int o = 0; o < nout; o++) lg_rows(out + o * size, size, job->y[o] + k * size);
+        for (int o = 0; o < nout; o++)
+            if (job->stream) lg_rows_streamed(out + o * size, size, job->y[o] + k * size);
+            else lg_rows(out + o * size, size, job->y[o] + k * size);
         for (int l = 0; l < LG_LANES; l++) {
             const int fine = !((failed >> l) & 1) && spoilt[l] == 0.0;
             bad += !fine;
@@ -124,6 +126,7 @@ static void *dk_run(void *argument)
             bad += dk_range(job, k, k + DK_CHUNK < job->k1 ? k + DK_CHUNK : job->k1, out);
         }
     free(out);
+    if (job->stream) lg_stream_fence();
     job->bad = bad;
     return NULL;
 }
@@ -188,7 +191,7 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     memcpy(dims + 1, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
     dims[nd] = DK_NV;
     dims[nd + 1] = kind == DK_REGRESSOR ? 10 * DK_NB : DK_NV;
-    block = PyArray_SimpleNew(nd + 2, dims, NPY_DOUBLE);
+    block = lg_output(nd + 2, dims);
     if (!block) goto done;
     for (int o = 0; o < nout; o++) {
         out[o] = PySequence_GetItem(block, o);
@@ -198,7 +201,8 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     int parts = dk_threads(count);
     npy_intp next = 0;  /* the threads take DK_CHUNK states at a time from here */
     for (int t = 0; t < parts; t++) {
-        dk_job job = {kind, {step[0], step[1], step[2]}, 0, count, 0,
+        dk_job job = {kind, (size_t)count * nout * DK_SIZE(kind) * sizeof(double) >= LG_STREAM_MIN,
+                      {step[0], step[1], step[2]}, 0, count, 0,
                       {PyArray_DATA(in[0]), PyArray_DATA(in[1]), PyArray_DATA(in[2])},
                       PyArray_DATA(P),
                       {PyArray_DATA((PyArrayObject *)out[0]),

@@ -33,6 +33,12 @@
 #define DK_UNROLL
 #define DK_UNROLL_TREE
 #endif
+/* a row of a product held in registers (up to 24 vectors of the 32): its loops unrolled whole */
+#if DK_NV <= 24
+#define DK_UNROLL_ROW _Pragma("GCC unroll 24")
+#else
+#define DK_UNROLL_ROW
+#endif
 
 
 /* The core below is emitted twice by derivatives_c.py: on one state (dk_*, DK_T double) and on
@@ -467,27 +473,43 @@ static void DK_FN(solve)(const DK_T *L, const DK_T *inverse, DK_T *b)
     }
 }
 
-/* out1 = -A B1, out2 = -A B2 (DK_NV x DK_NV each): out's rows as sums of B's rows, independent
-   along j, one product at a time (a row's sums held in registers), both products in one pass
-   over A; B1's columns before ``first`` are 0 (a floating base's translation: out1's too) */
-static void DK_FN(minus_products)(const DK_T *A, const DK_T *B1, const DK_T *B2, DK_T *out1,
-                                  DK_T *out2, int first)
+/* out = -A B (DK_NV x DK_NV), B's columns before ``first`` 0 (a floating base's translation:
+   out's too). Row by row (a row's sums held in registers), one product at a time: two rows'
+   sums at once (36 vectors on eight lanes) spill past the 32 registers, and each step then
+   waits on a store (a fifth of Solo12's state). With DK_SPARSE, column by column over the
+   entries of B that can be nonzero (dk_rows[dk_row0[j] ..]: the coordinates on a path through
+   j's joint), A symmetric (M^-1: its row k is its column k). */
+static void DK_FN(minus_product)(const DK_T *A, const DK_T *B, DK_T *out, int first)
 {
+#if DK_SPARSE
+    for (int j = 0; j < DK_NV; j++) {
+        DK_T x[DK_NV];
+        DK_UNROLL_ROW
+        for (int i = 0; i < DK_NV; i++) x[i] = DK_C(0.0);
+        for (int e = j < first ? dk_row0[j + 1] : dk_row0[j]; e < dk_row0[j + 1]; e++) {
+            const int k = dk_rows[e];
+            const DK_T b = B[k * DK_NV + j], *a = A + k * DK_NV;
+            DK_UNROLL_ROW
+            for (int i = 0; i < DK_NV; i++) x[i] -= a[i] * b;
+        }
+        DK_UNROLL_ROW
+        for (int i = 0; i < DK_NV; i++) out[i * DK_NV + j] = x[i];
+    }
+#else
     for (int i = 0; i < DK_NV; i++) {
-        DK_T x[DK_NV], y[DK_NV];
-        DK_UNROLL
-        for (int j = 0; j < DK_NV; j++) x[j] = y[j] = DK_C(0.0);
+        DK_T x[DK_NV];
+        DK_UNROLL_ROW
+        for (int j = 0; j < DK_NV; j++) x[j] = DK_C(0.0);
         DK_UNROLL
         for (int k = 0; k < DK_NV; k++) {
             const DK_T m = A[i * DK_NV + k];
-            DK_UNROLL
-            for (int j = first; j < DK_NV; j++) x[j] -= m * B1[k * DK_NV + j];
-            DK_UNROLL
-            for (int j = 0; j < DK_NV; j++) y[j] -= m * B2[k * DK_NV + j];
+            DK_UNROLL_ROW
+            for (int j = first; j < DK_NV; j++) x[j] -= m * B[k * DK_NV + j];
         }
-        DK_UNROLL
-        for (int j = 0; j < DK_NV; j++) { out1[i * DK_NV + j] = x[j]; out2[i * DK_NV + j] = y[j]; }
+        DK_UNROLL_ROW
+        for (int j = 0; j < DK_NV; j++) out[i * DK_NV + j] = x[j];
     }
+#endif
 }
 
 /* (d q_ddot/dq, d q_ddot/dq_dot, M^-1) at one state (lane); P = [g (3), tau_<joint> (DK_NV)];
@@ -562,7 +584,8 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
             Minv[i * DK_NV + j] = Minv[j * DK_NV + i] = s;
         }
     /* a floating base's translation leaves tau as it is: d tau/dq's first three columns 0 */
-    DK_FN(minus_products)(Minv, dq, dv, aq, av, 3 * DK_FF);
+    DK_FN(minus_product)(Minv, dq, aq, 3 * DK_FF);
+    DK_FN(minus_product)(Minv, dv, av, 0);
     return failed;
 }
 /* DK_CORE_END */

@@ -18,7 +18,7 @@ enum { RK_DRIFT, RK_CENTROIDAL, RK_WRENCH, RK_CORIOLIS, RK_INVERSE };
 
 /* one batch's inputs and output; ``next`` the shared counter of states handed out */
 typedef struct {
-    int kind, frame, ref, nw;
+    int kind, frame, ref, nw, stream;  /* stream: rows stored past the caches (lg_rows_streamed) */
     const double *q, *v, *a, *up;
     const int *frames;
     const double *const *w;
@@ -110,13 +110,14 @@ static inline void rk_gather(const double *x, npy_intp k, int width, lg_v4 *out)
     lg_lanes(x + k * width, width, out);
 }
 
-/* lanes' outputs into rows k .. k + LG_LANES - 1 of y (``width`` numbers a row): y = x, or
- * y += sign x where ``add`` */
+/* lanes' outputs into rows k .. k + LG_LANES - 1 of y (``width`` numbers a row): y = x
+ * (past the caches where ``stream``), or y += sign x where ``add`` */
 static inline void rk_scatter(const lg_v4 *x, npy_intp k, int width, double *y, int add,
-                              double sign)
+                              double sign, int stream)
 {
     if (!add) {
-        lg_rows(x, width, y + k * width);
+        if (stream) lg_rows_streamed(x, width, y + k * width);
+        else lg_rows(x, width, y + k * width);
         return;
     }
     for (int l = 0; l < LG_LANES; l++) {
@@ -158,8 +159,9 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
                 __builtin_prefetch(next + b, 0, 3);
         }
     }
-    {   /* the rows these states will fill, fetched for writing while the kernel computes (as
-           the derivatives module's): a batch's outputs are seldom in cache */
+    if (!job->stream) {  /* the rows these states will fill, fetched for writing while the
+                            kernel computes (as the derivatives module's): a batch's outputs are
+                            seldom in cache */
         const int width = rk_width(job->kind);
         const char *y = (const char *)(job->y + k * width);
         for (size_t b = 0; b < LG_LANES * width * sizeof(double); b += 64)
@@ -170,11 +172,11 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
         rk_gather(job->v, k, RK_NV, v);
         rk_spoil(v, RK_NV, &spoilt);
         rk4_drift(q, v, job->frame, job->ref, out);
-        rk_scatter(out, k, 6, job->y, 0, 0.0);
+        rk_scatter(out, k, 6, job->y, 0, 0.0, job->stream);
         break;
     case RK_CENTROIDAL:
         rk4_centroidal(q, out);
-        rk_scatter(out, k, 6 * RK_NV, job->y, 0, 0.0);
+        rk_scatter(out, k, 6 * RK_NV, job->y, 0, 0.0, job->stream);
         break;
     case RK_WRENCH: {
         lg_v4 w[6];
@@ -184,14 +186,14 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
             rk_gather(job->w[0], k, 6, w);
         rk_spoil(w, 6, &spoilt);
         rk4_wrench(q, job->frame, w, out);
-        rk_scatter(out, k, RK_NV, job->y, 1, job->sign);
+        rk_scatter(out, k, RK_NV, job->y, 1, job->sign, job->stream);
         break;
     }
     case RK_CORIOLIS:
         rk_gather(job->v, k, RK_NV, v);
         rk_spoil(v, RK_NV, &spoilt);
         rk4_coriolis(q, v, out, work);
-        rk_scatter(out, k, RK_NV * RK_NV, job->y, 0, 0.0);
+        rk_scatter(out, k, RK_NV * RK_NV, job->y, 0, 0.0, job->stream);
         break;
     case RK_INVERSE: {
         lg_v4 a[RK_NV], w[RK_MAX_WRENCHES][6];
@@ -207,7 +209,7 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
             rk_spoil(w[i], 6, &spoilt);
         }
         rk4_inverse(q, v, a, job->up, job->nw, job->frames, (const lg_v4 (*)[6])w, out);
-        rk_scatter(out, k, RK_NV, job->y, 0, 0.0);
+        rk_scatter(out, k, RK_NV, job->y, 0, 0.0, job->stream);
         break;
     }
     }
@@ -253,6 +255,7 @@ static void *rk_run(void *argument)
     }
     free(work);
     free(out);
+    if (job->stream) lg_stream_fence();
     return NULL;
 }
 
@@ -264,6 +267,8 @@ static int rk_batch(rk_job *job)
 {
     npy_intp next = 0;
     job->next = &next;
+    job->stream = job->kind != RK_WRENCH
+                  && (size_t)job->count * rk_width(job->kind) * sizeof(double) >= LG_STREAM_MIN;
     int parts = rk_threads(job->count);
     rk_job jobs[RK_MAX_THREADS];
     for (int t = 0; t < parts; t++) jobs[t] = *job;
@@ -337,7 +342,7 @@ static PyObject *rk_output(PyArrayObject *like, int tail0, int tail1)
     for (int k = 0; k < nd; k++) dims[k] = PyArray_DIMS(like)[k];
     dims[nd++] = tail0;
     if (tail1) dims[nd++] = tail1;
-    return PyArray_SimpleNew(nd, dims, NPY_DOUBLE);
+    return lg_output(nd, dims);
 }
 
 /* the output where every row is defined, else (output, count of NaN rows); NULL with the

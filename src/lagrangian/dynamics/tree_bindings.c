@@ -15,7 +15,7 @@ static const char *rt_names[] = {"q", "v", "third"};
 #define RT_WIDTH(j) ((j) == 0 ? RT_NQ : LG_N)
 
 typedef struct {
-    int kind, nin, size;
+    int kind, nin, size, stream;  /* stream: rows stored past the caches (lg_rows_streamed) */
     npy_intp step[3];
     const double *x0, *x1, *x2, *p;
     double *y;
@@ -58,7 +58,7 @@ static npy_intp rt_range(const rt_job *job, npy_intp k, npy_intp count)
         lg_v4 in[3][RT_NQ], out4[LG_N * LG_N];
         /* the rows these states will fill, fetched for writing while the kernel computes
            (as the reach and derivatives modules'): a batch's outputs are seldom in cache */
-        for (size_t b = 0; b < LG_LANES * size * sizeof(double); b += 64)
+        for (size_t b = 0; !job->stream && b < LG_LANES * size * sizeof(double); b += 64)
             __builtin_prefetch((const char *)(y + k * size) + b, 1, 2);
         for (int j = 0; j < nin; j++) {
             const double *x = j == 0 ? x0 : j == 1 ? x1 : x2;
@@ -83,7 +83,8 @@ static npy_intp rt_range(const rt_job *job, npy_intp k, npy_intp count)
 #endif
         default: break;
         }
-        lg_rows(out4, size, y + k * size);
+        if (job->stream) lg_rows_streamed(out4, size, y + k * size);
+        else lg_rows(out4, size, y + k * size);
         for (int l = 0; l < LG_LANES; l++) {
             int fine = 1;
             if (kind == RT_FORWARD)
@@ -138,6 +139,9 @@ static void *rt_run(void *argument)
         if (k >= job->count) break;
         bad += rt_range(job, k, k + RT_BLOCK < job->count ? k + RT_BLOCK : job->count);
     }
+#if RT_VECTOR || RT_VECTOR_FORWARD
+    if (job->stream) lg_stream_fence();
+#endif
     job->bad = bad;
     return NULL;
 }
@@ -208,7 +212,7 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     int od = nd - 1;
     if (kind == RT_MASS) { dims[od++] = LG_N; dims[od++] = LG_N; }
     else if (kind != RT_KINETIC && kind != RT_POTENTIAL) dims[od++] = LG_N;
-    out = PyArray_SimpleNew(od, dims, NPY_DOUBLE);
+    out = lg_output(od, dims);
     if (!out) goto done;
     const double *x0 = (const double *)PyArray_DATA(in[0]);
     const double *x1 = nin > 1 ? (const double *)PyArray_DATA(in[1]) : NULL;
@@ -221,8 +225,8 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     int parts = rt_threads(count);
     npy_intp next = 0;
     for (int t = 0; t < parts; t++) {
-        rt_job job = {kind, nin, size, {step[0], step[1], step[2]}, x0, x1, x2, p, y, count, 0,
-                      &next};
+        rt_job job = {kind, nin, size, (size_t)count * size * sizeof(double) >= LG_STREAM_MIN,
+                      {step[0], step[1], step[2]}, x0, x1, x2, p, y, count, 0, &next};
         jobs[t] = job;
     }
     npy_intp bad = 0;

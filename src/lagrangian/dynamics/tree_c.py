@@ -247,6 +247,47 @@ static inline void lg_rows(const lg_v4 *x, int width, double *y)
     for (int l = 0; l < LG_LANES; l++)
         for (int j = i; j < width; j++) y[l * width + j] = x[j][l];
 }
+
+/* lg_rows for a batch whose outputs are larger than the caches (batch_threads.c's LG_STREAM_MIN):
+   the LG_LANES rows transposed into a buffer, then stored past the caches (non-temporal) into
+   y when it is 64-byte aligned. With ordinary stores each line of such an output is first read
+   from memory, then written back: Solo12's derivatives for 10^4 states, 52 and 78 MB, took
+   12-20% longer so (docs/benchmarks.md). A thread that streamed calls lg_stream_fence before
+   its results are read by another. */
+#define LG_STREAM_MAX 4096 /* doubles in the LG_LANES rows: the buffer, 32 kB */
+#if (defined(__x86_64__) || defined(__i386__)) && defined(__SSE2__) && defined(LG_SHUFFLE)
+#include <immintrin.h>
+#define LG_STREAMS 1
+#endif
+static inline void lg_rows_streamed(const lg_v4 *x, int width, double *y)
+{
+#ifdef LG_STREAMS
+    const int whole = LG_LANES * width;
+    if ((((size_t)y) & 63) == 0 && whole % 8 == 0 && whole <= LG_STREAM_MAX) {
+        double t[LG_STREAM_MAX] __attribute__((aligned(64)));
+        lg_rows(x, width, t);
+        for (int i = 0; i < whole; i += 8) {
+#if defined(__AVX512F__)
+            _mm512_stream_pd(y + i, _mm512_load_pd(t + i));
+#elif defined(__AVX__)
+            _mm256_stream_pd(y + i, _mm256_load_pd(t + i));
+            _mm256_stream_pd(y + i + 4, _mm256_load_pd(t + i + 4));
+#else
+            for (int h = 0; h < 8; h += 2) _mm_stream_pd(y + i + h, _mm_load_pd(t + i + h));
+#endif
+        }
+        return;
+    }
+#endif
+    lg_rows(x, width, y);
+}
+
+static inline void lg_stream_fence(void)
+{
+#ifdef LG_STREAMS
+    _mm_sfence();
+#endif
+}
 """
 
 

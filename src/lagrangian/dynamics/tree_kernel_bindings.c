@@ -126,7 +126,7 @@ static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     int od = nd - 1;
     if (kind == TK_MASSM) { dims[od++] = n; dims[od++] = n; }
     else if (kind != TK_KINETIC && kind != TK_POTENTIAL) dims[od++] = n;
-    out = PyArray_SimpleNew(od, dims, NPY_DOUBLE);
+    out = lg_output(od, dims);
     if (!out) goto done;
     const int size = kind == TK_MASSM ? n * n : (kind == TK_KINETIC || kind == TK_POTENTIAL) ? 1 : n;
     tk_job jobs[TK_MAX_THREADS];

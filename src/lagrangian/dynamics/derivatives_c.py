@@ -28,12 +28,15 @@ _THREADS = Path(__file__).with_name("batch_threads.c")  # the thread count, befo
 
 # the kernel's core on one state, then on LG_LANES states at once (derivatives_kernel.c)
 _SCALAR = """#define DK_T double
+#define DK_ON_LANES 0
 #define DK_FN(name) dk_##name
 #define DK_C(x) (x)
 #define DK_SINCOS lg_sincos
 #define DK_SQRT sqrt
 #define DK_FAILED(d) (!((d) > 0.0))"""
 _LANES = """#undef DK_T
+#undef DK_ON_LANES
+#define DK_ON_LANES 1
 #undef DK_FN
 #undef DK_C
 #undef DK_SINCOS
@@ -109,9 +112,9 @@ def kernel_source(tree: KinematicTree):
     pairs = _pairs(tree)
     rows = _column_rows(tree, pairs)
     starts = np.cumsum([0] + [len(r) for r in rows]).tolist()
-    # the products -M^-1 d tau/dq, -M^-1 d tau/dq_dot skip the zero entries where a quarter or
-    # more are zero (a floating base's legs: 36% fewer multiply-adds on Solo12); a denser
-    # pattern (a serial arm: none) keeps the row by row loops, unrolled whole on an arm
+    # on the lanes, the products -M^-1 d tau/dq, -M^-1 d tau/dq_dot skip the zero entries where
+    # a quarter or more are zero (a floating base's legs: 36% fewer multiply-adds on Solo12); a
+    # denser pattern (a serial arm: none) keeps the row by row loops, unrolled whole on an arm
     sparse = starts[-1] <= 0.75 * (n + 6 * floating) ** 2
     text = _KERNEL.read_text(encoding="utf-8")
     head, rest = text.split("/* DK_CORE_BEGIN */")

@@ -1,5 +1,5 @@
 """A large batch's outputs (batch_threads.c): blocks of 4 MB and more are kept when their arrays
-are gone and given to the next batch of about their size, and outputs of 16 MB and more are
+are gone and given to the next batch of about their size, and outputs of 4 MB and more are
 written past the caches. Neither may change a result: an array a caller still holds, or a view
 of one, keeps its numbers when later batches run; every row of a batch that reused a block or
 streamed its rows equals that state's call alone."""
@@ -16,9 +16,9 @@ import lagrangian
 
 pytest.importorskip("yourdfpy")
 
-# 9003 states of the floating biped (nv = 10): M and C(q, v) 7.2 MB each (kept, not streamed),
-# the forward derivatives' three outputs 21.6 MB (kept and streamed); 9003 is not a multiple of
-# the lanes, so the last states run one by one, and the second output's rows do not start on a
+# 9003 states of the floating biped (nv = 10): M and C(q, v) 7.2 MB each, the forward
+# derivatives' three outputs 21.6 MB, all kept and streamed; 9003 is not a multiple of the
+# lanes, so the last states run one by one, and the second output's rows do not start on a
 # 64-byte boundary (written without streaming).
 COUNT = 9003
 ROWS = (0, 1, 7, 8, 4500, 8999, 9000, 9002)

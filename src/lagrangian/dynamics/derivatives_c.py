@@ -33,7 +33,9 @@ _SCALAR = """#define DK_T double
 #define DK_C(x) (x)
 #define DK_SINCOS lg_sincos
 #define DK_SQRT sqrt
-#define DK_FAILED(d) (!((d) > 0.0))"""
+#define DK_MASK int
+#define DK_FAILED(d) (!((d) > 0.0))
+#define DK_BITS(mask) (mask)"""
 _LANES = """#undef DK_T
 #undef DK_ON_LANES
 #define DK_ON_LANES 1
@@ -42,16 +44,22 @@ _LANES = """#undef DK_T
 #undef DK_SINCOS
 #undef DK_SQRT
 #undef DK_FAILED
+#undef DK_MASK
+#undef DK_BITS
 #define DK_T lg_v4
 #define DK_FN(name) dk4_##name
 #define DK_C(x) LG_V4(x)
 #define DK_SINCOS lg_vsincos
 #define DK_SQRT lg_vsqrt
-#define DK_FAILED(d) dk4_failed(d)
-static inline int dk4_failed(lg_v4 d)
+/* the lanes where !(d > 0) as a vector of 0 / -1, made bits once at the end */
+typedef long long dk4_mask __attribute__((vector_size(sizeof(lg_v4))));
+#define DK_MASK dk4_mask
+#define DK_FAILED(d) (~(dk4_mask)((d) > LG_V4(0.0)))
+#define DK_BITS(mask) dk4_bits(mask)
+static inline int dk4_bits(dk4_mask mask)
 {
     int bits = 0;
-    for (int l = 0; l < LG_LANES; l++) bits |= !(d[l] > 0.0) << l;
+    for (int l = 0; l < LG_LANES; l++) bits |= (mask[l] != 0) << l;
     return bits;
 }"""
 

@@ -44,7 +44,7 @@
 /* The core below is emitted twice by derivatives_c.py: on one state (dk_*, DK_T double) and on
  * LG_LANES states at once (dk4_*, DK_T lg_v4, GCC/Clang vector extensions). DK_FN(name) names a
  * function, DK_C(x) a constant as a DK_T, DK_SINCOS and DK_SQRT the functions of a DK_T, and
- * DK_FAILED(d) the lanes (as bits) where !(d > 0). */
+ * DK_FAILED(d) the lanes where !(d > 0) as a DK_MASK, DK_BITS(mask) those lanes as bits. */
 /* DK_CORE_BEGIN */
 static inline void DK_FN(cross)(const DK_T *a, const DK_T *b, DK_T *out)
 {
@@ -357,30 +357,45 @@ static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns, int summed)
 }
 
 /* The entries of a floating base's columns c: with body k (at or below the base: row k by
- * Ic_k, Bc_k; column k by its Phi, Psi) or, k = 0, with its own columns. */
+ * Ic_k, Bc_k; column k by its Phi, Psi) or, k = 0, with its own columns. A translation column
+ * (c < 3) is [R e_c; 0], its psi 0 and its dv = [w x R e_c; 0]: their angular halves are not
+ * summed, nor d tau/dq's entries by it (0; the caller's zeros stay). */
 static void DK_FN(base_pairs)(const DK_FN(work) *w, int k, DK_T *M, DK_T *dq, DK_T *dv)
 {
+    _Pragma("GCC unroll 6")
     for (int c = 0; c < 6; c++) {
         const DK_T *S = w->ffS[c];
+        const int moves = c >= 3;  /* a turn of the base, not a translation */
         if (k == 0) {
             for (int r = 0; r < 6; r++) {
                 const DK_T *r1 = w->ffr1[r], *r2 = w->ffr2[r];
-                if (M) M[r * DK_NV + c] = DK_FN(dot6)(r1, S);
+                if (M) M[r * DK_NV + c] = moves ? DK_FN(dot6)(r1, S) : DK_FN(dot3)(r1, S);
                 if (!dq) continue;
-                dq[r * DK_NV + c] = DK_FN(dot6)(r1, w->ffpsi[c]);
-                dv[r * DK_NV + c] = DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3);
+                if (moves) {
+                    dq[r * DK_NV + c] = DK_FN(dot6)(r1, w->ffpsi[c]);
+                    dv[r * DK_NV + c] = DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3);
+                } else {
+                    dv[r * DK_NV + c] = DK_FN(dot3)(r1, w->ffdv[c]);
+                }
             }
             continue;
         }
         const int ck = DK_VO + dk_coord[k];
         const double m = dk_mult[k];
         const DK_T *r1 = w->r1[k], *r2 = w->r2[k];
-        if (M) M[ck * DK_NV + c] = M[c * DK_NV + ck] = m * DK_FN(dot6)(r1, S);
+        if (M) M[ck * DK_NV + c] = M[c * DK_NV + ck]
+                   = m * (moves ? DK_FN(dot6)(r1, S) : DK_FN(dot3)(r1, S));
         if (!dq) continue;
-        dq[ck * DK_NV + c] += m * DK_FN(dot6)(r1, w->ffpsi[c]);
-        dv[ck * DK_NV + c] += m * (DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3));
-        dq[c * DK_NV + ck] += m * DK_FN(dot6)(S, w->Phi[k]);
-        dv[c * DK_NV + ck] += m * DK_FN(dot6)(S, w->Psi[k]);
+        if (moves) {
+            dq[ck * DK_NV + c] += m * DK_FN(dot6)(r1, w->ffpsi[c]);
+            dv[ck * DK_NV + c] += m * (DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3));
+            dq[c * DK_NV + ck] += m * DK_FN(dot6)(S, w->Phi[k]);
+            dv[c * DK_NV + ck] += m * DK_FN(dot6)(S, w->Psi[k]);
+        } else {
+            dv[ck * DK_NV + c] += m * DK_FN(dot3)(r1, w->ffdv[c]);
+            dq[c * DK_NV + ck] += m * DK_FN(dot3)(S, w->Phi[k]);
+            dv[c * DK_NV + ck] += m * DK_FN(dot3)(S, w->Psi[k]);
+        }
     }
 }
 
@@ -433,7 +448,7 @@ static void DK_FN(inverse)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const
  * positive definite */
 static int DK_FN(cholesky)(DK_T *M, DK_T *inverse)
 {
-    int failed = 0;
+    DK_MASK failed = {0};
     DK_UNROLL
     for (int j = 0; j < DK_NV; j++) {
         DK_T d = M[j * DK_NV + j];
@@ -451,7 +466,7 @@ static int DK_FN(cholesky)(DK_T *M, DK_T *inverse)
             M[i * DK_NV + j] = s * inverse[j];
         }
     }
-    return failed;
+    return DK_BITS(failed);
 }
 
 /* x = M^-1 b from the factor L and 1 / L_jj (b overwritten), a column of L at a time: each

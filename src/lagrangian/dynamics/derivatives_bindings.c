@@ -57,6 +57,13 @@ static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
                 for (int i = 0; i < DK_WIDTH(j); i++)
                     in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
         }
+        /* the next group's inputs, fetched while this one computes (as the reach module's) */
+        for (int j = 0; j < 3 && k + 2 * LG_LANES <= k1; j++) {
+            if (job->step[j] != DK_WIDTH(j)) continue;
+            const char *next = (const char *)(job->x[j] + (k + LG_LANES) * DK_WIDTH(j));
+            for (size_t b = 0; b < LG_LANES * DK_WIDTH(j) * sizeof(double); b += 64)
+                __builtin_prefetch(next + b, 0, 3);
+        }
         /* the rows these states will fill, fetched for writing while the kernel computes: a
            batch's outputs are seldom in cache, and its stores would otherwise each wait */
         for (int o = 0; o < nout && !job->stream; o++) {

@@ -267,3 +267,53 @@ def test_a_link_inertial_set_at_run_time_reuses_the_module(turret):
         np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-11)
     assert not np.allclose(fast.inverse_dynamics_derivatives(q, v, a)[0],
                            plain.inverse_dynamics_derivatives(q, v, a)[0])
+
+
+@needs_c
+@pytest.mark.parametrize("floating", [False, True], ids=["fixed", "floating"])
+def test_a_branching_trees_factor_along_the_tree_gives_the_forward_derivatives(tmp_path,
+                                                                              floating):
+    """Two legs on a trunk (fixed, or on a free flyer): forward dynamics' M is factored along
+    the tree (M = L^T D L, no fill-in) and the products skip the legs' zero blocks. Fixed: the
+    complex step through numpy Newton-Euler (an independent derivation); floating: M^-1 times
+    M is the identity, and each column by central differences on the manifold."""
+    pytest.importorskip("yourdfpy")
+    from test_reach_reports import TWO_LEGS
+
+    from lagrangian.dynamics.derivatives_c import factored_along_the_tree
+    from lagrangian.dynamics.free_flyer import integrate
+
+    path = tmp_path / "biped.urdf"
+    path.write_text(TWO_LEGS)
+    robot = lagrangian.load(path, floating_base=floating).dynamics()
+    assert robot._derivatives_kernel() is not None
+    parents = factored_along_the_tree(robot.tree)
+    assert parents is not None and parents.count(5 if floating else -1) == 2  # two legs
+    rng = np.random.default_rng(12)
+    count = 11  # a group of eight lanes and three states one by one
+    q = rng.uniform(-1.0, 1.0, (count, robot.nq))
+    if floating:
+        q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
+    v, tau = rng.uniform(-1.0, 1.0, (2, count, robot.nv))
+    fq, fv, ftau = robot.forward_dynamics_derivatives(q, v, tau)
+    identity = np.einsum("kij,kjl->kil", robot.mass_matrix(q), ftau)
+    np.testing.assert_allclose(identity, np.broadcast_to(np.eye(robot.nv), identity.shape),
+                               atol=1e-11)
+    if not floating:
+        slow = lagrangian.load(path).dynamics(backend="numpy")
+        for ours, theirs in zip((fq, fv, ftau), slow.forward_dynamics_derivatives(q, v, tau),
+                                strict=True):
+            np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-9)
+        return
+    h = 1e-6
+    for k in range(robot.nv):
+        e = h * np.eye(robot.nv)[k]
+        for state in (0, 9):
+            plus, minus = integrate(q[state][None], e[None])[0], integrate(q[state][None],
+                                                                           -e[None])[0]
+            central = (robot.forward_dynamics(plus, v[state], tau[state])
+                       - robot.forward_dynamics(minus, v[state], tau[state])) / (2 * h)
+            np.testing.assert_allclose(fq[state][:, k], central, rtol=0, atol=2e-6)
+            central = (robot.forward_dynamics(q[state], v[state] + e, tau[state])
+                       - robot.forward_dynamics(q[state], v[state] - e, tau[state])) / (2 * h)
+            np.testing.assert_allclose(fv[state][:, k], central, rtol=0, atol=2e-6)

@@ -101,6 +101,97 @@ def _column_rows(tree: KinematicTree, pairs: list[tuple[int, int]]) -> list[list
     return [sorted(r) for r in rows]
 
 
+def _coordinate_parents(tree: KinematicTree) -> list[int] | None:
+    """Each velocity coordinate's parent coordinate (-1 at a root; a floating base's six a chain
+    under which its children hang), or None where the coordinates are not a tree numbered
+    parents first, one body each (a mimic joint's coordinate moves two bodies)."""
+    floating = bool(tree.floating_base)
+    n = len(tree.coordinates) + 6 * floating
+    parents = [c - 1 for c in range(6)] if floating else []
+    parents += [None] * (n - len(parents))
+    for b, joint in enumerate(tree.joints):
+        if floating and b == 0:
+            continue
+        c = 6 * floating + joint.coordinate
+        p = joint.parent
+        parent = -1 if p < 0 else 5 if floating and p == 0 \
+            else 6 * floating + tree.joints[p].coordinate
+        if parents[c] is not None or parent >= c:
+            return None
+        parents[c] = parent
+    return None if None in parents else parents
+
+
+def factored_along_the_tree(tree: KinematicTree) -> list[int] | None:
+    """The coordinates' parents where forward dynamics' M is factored along the tree (M =
+    L^T D L, no fill-in: _tree_factor) rather than by a dense Cholesky: a tree that branches
+    (two legs, or more), its coordinates one body's each, numbered parents first; else None.
+    On a chain both do the same work and the dense loops are the simpler."""
+    parents = _coordinate_parents(tree)
+    if parents is None:
+        return None
+    children = [parents.count(c) for c in range(-1, len(parents))]
+    return parents if max(children) > 1 else None
+
+
+def _tree_factor(parents: list[int]) -> str:
+    """derivatives_kernel.c's factor, solve and inverse_from_factor for M = L^T D L on this
+    tree of coordinates, written out (Featherstone's LTDL: the entries follow the parents)."""
+    n = len(parents)
+
+    def chain(c):  # c's ancestors, nearest first
+        out = []
+        while parents[c] >= 0:
+            c = parents[c]
+            out.append(c)
+        return out
+
+    def at(i, j):
+        return f"[{i * n + j}]"
+
+    lines = ["static int DK_FN(factor)(DK_T *restrict H, DK_T *restrict inverse)", "{",
+             "    DK_MASK failed = {0};"]
+    for k in reversed(range(n)):
+        lines.append(f"    {{ const DK_T d = H{at(k, k)}; failed |= DK_FAILED(d); "
+                     f"const DK_T r = 1.0 / d; inverse[{k}] = r;")
+        for i in chain(k):
+            updates = " ".join(f"H{at(i, j)} -= a * H{at(k, j)};" for j in [i, *chain(i)])
+            lines.append(f"      {{ const DK_T a = H{at(k, i)} * r; {updates} H{at(k, i)} = a; }}")
+        lines.append("    }")
+    lines += ["    return DK_BITS(failed);", "}", "",
+              "static void DK_FN(solve)(const DK_T *restrict L, const DK_T *restrict inverse, "
+              "DK_T *restrict b)", "{"]
+    for i in reversed(range(n)):
+        lines += [f"    b[{j}] -= L{at(i, j)} * b[{i}];" for j in chain(i)]
+    lines += [f"    b[{i}] *= inverse[{i}];" for i in range(n)]
+    for i in range(n):
+        if chain(i):
+            terms = " + ".join(f"L{at(i, j)} * b[{j}]" for j in chain(i))
+            lines.append(f"    b[{i}] -= {terms};")
+    lines += ["}", "",
+              "static void DK_FN(inverse_from_factor)(const DK_T *restrict L, "
+              "const DK_T *restrict inverse, DK_T *restrict Minv)", "{",
+              f"    DK_T W[{n * n}];"]
+    for i in range(n):  # W = L^-1, row by row: W_ik = -sum over m between of L_im W_mk
+        for k in chain(i):
+            terms = [f"L{at(i, k)}"] + [f"L{at(i, m)} * W{at(m, k)}"
+                                        for m in chain(i) if m != k and k in chain(m)]
+            lines.append(f"    W{at(i, k)} = -({' + '.join(terms)});")
+    for i in range(n):
+        for j in range(i + 1):
+            common = [c for c in [i, *chain(i)] if c in [j, *chain(j)]]
+
+            def w(row, k):
+                return "" if row == k else f" * W{at(row, k)}"
+
+            terms = [f"inverse[{k}]{w(i, k)}{w(j, k)}" for k in common]
+            value = " + ".join(terms) if terms else "DK_C(0.0)"
+            lines.append(f"    Minv{at(i, j)} = {value};" if i == j else
+                         f"    Minv{at(i, j)} = Minv{at(j, i)} = {value};")
+    lines.append("}")
+    return "\n".join(lines)
+
+
 def kernel_source(tree: KinematicTree):
     """The module's C: the tree's tables, then derivatives_kernel.c."""
     from ..compile.codegen import GeneratedSource
@@ -124,9 +215,11 @@ def kernel_source(tree: KinematicTree):
     # a quarter or more are zero (a floating base's legs: 36% fewer multiply-adds on Solo12); a
     # denser pattern (a serial arm: none) keeps the row by row loops, unrolled whole on an arm
     sparse = starts[-1] <= 0.75 * (n + 6 * floating) ** 2
+    parents = factored_along_the_tree(tree)
     text = _KERNEL.read_text(encoding="utf-8")
     head, rest = text.split("/* DK_CORE_BEGIN */")
     core = rest.split("/* DK_CORE_END */")[0] + _REGRESSOR.read_text(encoding="utf-8")
+    core = core.replace("DK_TREE_FACTOR", _tree_factor(parents) if parents is not None else "")
     bindings = _THREADS.read_text(encoding="utf-8") + _BINDINGS.read_text(encoding="utf-8")
     source = "\n".join([
         "/* lagrangian: the derivatives of a tree's inverse and forward dynamics */",
@@ -154,6 +247,7 @@ def kernel_source(tree: KinematicTree):
         f"#define DK_SPARSE {int(sparse)}",
         c_table("dk_row0", "int", starts),
         c_table("dk_rows", "int", [k for r in rows for k in r]),
+        f"#define DK_LTDL {int(parents is not None)}",
         c_table("dk_mult", "double", [j.multiplier for j in joints]),
         c_table("dk_off", "double", [j.offset for j in joints]),
         c_table("dk_R0", "double", [_flat(j.rotation) for j in joints]),

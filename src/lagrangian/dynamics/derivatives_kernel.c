@@ -444,9 +444,24 @@ static void DK_FN(inverse)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const
     DK_FN(pairs)(&w, NULL, dq, dv);
 }
 
+#if DK_LTDL
+/* A branching tree (a floating base's legs): M = L^T D L with L unit lower triangular and
+ * nonzero only where a column is an ancestor of its row (dk_lambda: each coordinate's parent
+ * coordinate, -1 at a root; parents numbered first), which the factor keeps (no fill-in:
+ * Featherstone, Rigid Body Dynamics Algorithms, 6.5). Its work follows the tree: Solo12's legs
+ * are factored apart, a third of the dense Cholesky's multiply-adds and no square roots.
+ * derivatives_c.py writes the three functions out for the tree, its indices constants (loops
+ * over dk_lambda's chains ran slower than the dense Cholesky): factor(H, inverse), in place
+ * (L below M's diagonal, 1 / D_k into inverse; the lanes, as bits, where M is not positive
+ * definite: some D_k not > 0); solve(L, inverse, b), x = M^-1 b in b (L^T w = b from the
+ * leaves up, D^-1, L x = w from the root); inverse_from_factor(L, inverse, Minv), M^-1 =
+ * W D^-1 W^T in both triangles, W = L^-1 (unit, nonzero where L is), entry (i, j) summed over
+ * the common ancestors of i and j. */
+DK_TREE_FACTOR
+#else
 /* L L^T = M in place (lower triangle), 1 / L_jj into inverse; the lanes (bits) where M is not
  * positive definite */
-static int DK_FN(cholesky)(DK_T *M, DK_T *inverse)
+static int DK_FN(factor)(DK_T *M, DK_T *inverse)
 {
     DK_MASK failed = {0};
     DK_UNROLL
@@ -489,6 +504,36 @@ static void DK_FN(solve)(const DK_T *L, const DK_T *inverse, DK_T *b)
         for (int k = 0; k < i; k++) b[k] -= L[i * DK_NV + k] * x;
     }
 }
+
+/* M^-1 = L^-T L^-1 (both triangles) from the factor L and 1 / L_jj: X = L^-1 row by row (the
+   columns of a row independent: no chain of dependent operations as in solving column by
+   column), then X^T X */
+static void DK_FN(inverse_from_factor)(const DK_T *M, const DK_T *diagonal, DK_T *Minv)
+{
+    DK_T X[DK_NV * DK_NV];
+    DK_UNROLL
+    for (int i = 0; i < DK_NV; i++) {
+        DK_UNROLL
+        for (int c = 0; c < i; c++) {
+            DK_T s = DK_C(0.0);
+            DK_UNROLL
+            for (int k = c; k < i; k++) s -= M[i * DK_NV + k] * X[k * DK_NV + c];
+            X[i * DK_NV + c] = s * diagonal[i];
+        }
+        X[i * DK_NV + i] = diagonal[i];
+    }
+    DK_UNROLL
+    for (int i = 0; i < DK_NV; i++)
+        DK_UNROLL
+        for (int j = 0; j <= i; j++) {
+            DK_T s = DK_C(0.0);
+            DK_UNROLL
+            for (int k = i; k < DK_NV; k++) s += X[k * DK_NV + i] * X[k * DK_NV + j];
+            Minv[i * DK_NV + j] = Minv[j * DK_NV + i] = s;
+        }
+}
+
+#endif
 
 /* out = -A B (DK_NV x DK_NV), B's columns before ``first`` 0 (a floating base's translation:
    out's too). Row by row (a row's sums held in registers), one product at a time: two rows'
@@ -552,7 +597,7 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     for (int i = DK_FF; i < DK_NB; i++) b[DK_VO + dk_coord[i]] -= dk_mult[i] * taub[i];
     for (int c = 0; c < 6 * DK_FF; c++) b[c] -= w.fftau[c];
     DK_T diagonal[DK_NV];
-    int failed = DK_FN(cholesky)(M, diagonal);
+    int failed = DK_FN(factor)(M, diagonal);
     DK_FN(solve)(M, diagonal, b);
     /* at q_ddot = b: each body's acceleration grows by da = da_p + S theta_ddot, so psi by
        da_p x S and f by Y da (the rest of the forward pass does not see q_ddot) */
@@ -577,30 +622,7 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     /* the second pass: the subtrees' inertias and r1 as they are (the same q) */
     DK_FN(backward)(&w, NULL, 1, 1);
     DK_FN(pairs)(&w, NULL, dq, dv);
-    /* M^-1 = L^-T L^-1: X = L^-1 row by row (the columns of a row independent: no chain of
-       dependent operations as in solving column by column), then X^T X; then -M^-1 d tau/dq,
-       -M^-1 d tau/dq_dot */
-    DK_T X[DK_NV * DK_NV];
-    DK_UNROLL
-    for (int i = 0; i < DK_NV; i++) {
-        DK_UNROLL
-        for (int c = 0; c < i; c++) {
-            DK_T s = DK_C(0.0);
-            DK_UNROLL
-            for (int k = c; k < i; k++) s -= M[i * DK_NV + k] * X[k * DK_NV + c];
-            X[i * DK_NV + c] = s * diagonal[i];
-        }
-        X[i * DK_NV + i] = diagonal[i];
-    }
-    DK_UNROLL
-    for (int i = 0; i < DK_NV; i++)
-        DK_UNROLL
-        for (int j = 0; j <= i; j++) {
-            DK_T s = DK_C(0.0);
-            DK_UNROLL
-            for (int k = i; k < DK_NV; k++) s += X[k * DK_NV + i] * X[k * DK_NV + j];
-            Minv[i * DK_NV + j] = Minv[j * DK_NV + i] = s;
-        }
+    DK_FN(inverse_from_factor)(M, diagonal, Minv);
     /* a floating base's translation leaves tau as it is: d tau/dq's first three columns 0 */
     DK_FN(minus_product)(Minv, dq, aq, 3 * DK_FF);
     DK_FN(minus_product)(Minv, dv, av, 0);

@@ -222,15 +222,7 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     NPY_BEGIN_THREADS_DEF;
     if (count > 16) NPY_BEGIN_THREADS;
 #if DK_PTHREADS
-    pthread_t threads[DK_MAX_THREADS];
-    int started[DK_MAX_THREADS] = {0};
-    for (int t = 0; t < parts - 1; t++)
-        started[t] = lg_start(&threads[t], dk_run, &jobs[t]);
-    dk_run(&jobs[parts - 1]);
-    for (int t = 0; t < parts - 1; t++) {
-        if (started[t]) pthread_join(threads[t], NULL);
-        else dk_run(&jobs[t]);
-    }
+    lg_run_batch(dk_run, jobs, sizeof jobs[0], parts);
 #else
     for (int t = 0; t < parts; t++) dk_run(&jobs[t]);
 #endif

@@ -275,14 +275,7 @@ static int rk_batch(rk_job *job)
     NPY_BEGIN_THREADS_DEF;
     if (job->count > 16) NPY_BEGIN_THREADS;
 #if RK_PTHREADS
-    pthread_t threads[RK_MAX_THREADS];
-    int started[RK_MAX_THREADS] = {0};
-    for (int t = 0; t < parts - 1; t++)
-        started[t] = lg_start(&threads[t], rk_run, &jobs[t]);
-    rk_run(&jobs[parts - 1]);  /* this thread too; a thread that did not start leaves its
-                                  blocks to the others */
-    for (int t = 0; t < parts - 1; t++)
-        if (started[t]) pthread_join(threads[t], NULL);
+    lg_run_batch(rk_run, jobs, sizeof jobs[0], parts);
 #else
     rk_run(&jobs[0]);
 #endif

@@ -235,15 +235,7 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     /* the batch on threads of their own (the functions keep no state), this thread one of
        them; a thread that cannot start leaves its blocks to the others */
 #if RT_PTHREADS
-    pthread_t threads[RT_MAX_THREADS];
-    int started[RT_MAX_THREADS] = {0};
-    for (int t = 0; t < parts - 1; t++)
-        started[t] = lg_start(&threads[t], rt_run, &jobs[t]);
-    rt_run(&jobs[parts - 1]);
-    for (int t = 0; t < parts - 1; t++) {
-        if (started[t]) pthread_join(threads[t], NULL);
-        else rt_run(&jobs[t]);
-    }
+    lg_run_batch(rt_run, jobs, sizeof jobs[0], parts);
 #else
     for (int t = 0; t < parts; t++) rt_run(&jobs[t]);
 #endif

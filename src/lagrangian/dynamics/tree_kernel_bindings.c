@@ -147,15 +147,7 @@ static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     NPY_BEGIN_THREADS_DEF;
     if (count * tree.nb > 64) NPY_BEGIN_THREADS;
 #if TK_PTHREADS
-    pthread_t threads[TK_MAX_THREADS];
-    int started[TK_MAX_THREADS] = {0};
-    for (int t = 0; t < parts - 1; t++)
-        started[t] = lg_start(&threads[t], tk_run, &jobs[t]);
-    tk_run(&jobs[parts - 1]);
-    for (int t = 0; t < parts - 1; t++) {
-        if (started[t]) pthread_join(threads[t], NULL);
-        else tk_run(&jobs[t]);
-    }
+    lg_run_batch(tk_run, jobs, sizeof jobs[0], parts);
 #else
     for (int t = 0; t < parts; t++) tk_run(&jobs[t]);
 #endif

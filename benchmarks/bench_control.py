@@ -18,9 +18,11 @@ JointModelFreeFlyer): its derivatives only (the regressor of a floating base is 
 - Batch CPU time: the same, timed by this process's CPU time (all threads summed), which a
   shared machine's other work disturbs less than the wall clock.
 - Fresh-output floor: the best time to allocate and write once as many doubles as a batch's
-  outputs hold (np.empty(...).fill(0)): what any batch returning new arrays pays before its
-  arithmetic; Pinocchio's loop over it (batch_speedup_bound) is the most such a batch can reach
-  here.
+  outputs hold (np.empty(...).fill(0)): what a batch returning freshly allocated arrays pays
+  before its arithmetic, and Pinocchio's loop over it (batch_speedup_bound) the most such a
+  batch can reach here. Ours pay it on their first call only: from the second, outputs of 4 MB
+  and more reuse a block the module kept (batch_threads.c), so the timed batches (best of
+  several) are past it.
 - Keeping the results (pinocchio_loop_keeping_s, batch_speedup_keeping): Pinocchio's loop
   copying each state's results into arrays of the batch's shapes, against ours again, taking
   turns, best of 5: Pinocchio's functions return views of its one Data, so the plain loop

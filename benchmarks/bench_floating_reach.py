@@ -1,6 +1,9 @@
-"""A floating base's C(q, v), J_dot v, centroidal momentum matrix and inverse dynamics with a
-wrench at a foot, ours (the compiled reach kernel) beside Pinocchio's free flyer, per Python
-call of one state and for a batch of 10^4 states against a Python loop of Pinocchio calls.
+"""A floating base's frame placement and Jacobian, centre of mass and its Jacobian, C(q, v),
+J_dot v, centroidal momentum matrix and inverse dynamics with a wrench at a foot, ours (the
+compiled reach kernel) beside Pinocchio's free flyer (forwardKinematics with
+updateFramePlacement, computeFrameJacobian, centerOfMass, jacobianCenterOfMass,
+computeCoriolisMatrix, getFrameClassicalAcceleration, ccrba, rnea with f_ext), per Python call
+of one state and for a batch of 10^4 states against a Python loop of Pinocchio calls.
 
     python benchmarks/bench_floating_reach.py [--robots solo12,anymal,talos_reduced]
 
@@ -107,7 +110,20 @@ def bench_robot(name: str, foot: str, count: int = 10_000) -> None:
         return pin.getFrameClassicalAcceleration(model, data, frame,
                                                  pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
 
+    world = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+    def placement(qk, vk, ak):
+        pin.forwardKinematics(model, data, qk)
+        return pin.updateFramePlacement(model, data, frame)
+
     cases = {
+        "placement": (lambda x, y, z: robot.placement(x, foot), placement),
+        "jacobian": (lambda x, y, z: robot.jacobian(x, foot, "local_world_aligned"),
+                     lambda x, y, z: pin.computeFrameJacobian(model, data, x, frame, world)),
+        "center_of_mass": (lambda x, y, z: robot.center_of_mass(x),
+                           lambda x, y, z: pin.centerOfMass(model, data, x)),
+        "center_of_mass_jacobian": (lambda x, y, z: robot.center_of_mass_jacobian(x),
+                                    lambda x, y, z: pin.jacobianCenterOfMass(model, data, x)),
         "coriolis_matrix": (lambda x, y, z: robot.coriolis_matrix(x, y),
                             lambda x, y, z: pin.computeCoriolisMatrix(model, data, x, y)),
         "jacobian_dot_times_v": (lambda x, y, z: robot.jacobian_dot_times_v(x, y, foot), drift),

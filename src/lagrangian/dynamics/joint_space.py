@@ -233,19 +233,47 @@ class Dynamics(ControlTerms):
 
     def placement(self, q, frame: str) -> np.ndarray:
         """The frame's 4 x 4 placement in the world (rotation and origin in m), (..., 4, 4)."""
+        fast = self._reach if self._reach is not None else self._reach_kernel()
+        if fast:
+            try:
+                out = fast.placement(q, fast.frame_index[frame])
+                return out if out.__class__ is not tuple else reported_rows(out, 2)
+            except (KeyError, ValueError, TypeError):
+                pass  # numpy below broadcasts, or names the fault in one line
         return undefined_rows(self.kinematics.placement, (q, frame), (q,), 2)
 
     def jacobian(self, q, frame: str, reference: str = "local_world_aligned") -> np.ndarray:
         """The frame's 6 x n Jacobian, linear rows first, (..., 6, n); ``reference`` "world",
         "local" or "local_world_aligned" as Pinocchio's ReferenceFrame."""
+        fast = self._reach if self._reach is not None else self._reach_kernel()
+        if fast:
+            try:
+                out = fast.jacobian(q, fast.frame_index[frame], REFERENCE_INDEX[reference])
+                return out if out.__class__ is not tuple else reported_rows(out, 2)
+            except (KeyError, ValueError, TypeError):
+                pass
         return undefined_rows(self.kinematics.jacobian, (q, frame, reference), (q,), 2)
 
     def center_of_mass(self, q) -> np.ndarray:
         """The moving bodies' centre of mass in the world (m), (..., 3)."""
+        fast = self._reach if self._reach is not None else self._reach_kernel()
+        if fast:
+            try:  # None without moving mass: TypeError, then numpy's one-line refusal
+                out = fast.center_of_mass(q)
+                return out if out.__class__ is not tuple else reported_rows(out, 1)
+            except (ValueError, TypeError):
+                pass
         return undefined_rows(self.kinematics.center_of_mass, (q,), (q,), 1)
 
     def center_of_mass_jacobian(self, q) -> np.ndarray:
         """J_c with c_dot = J_c q_dot, (..., 3, n)."""
+        fast = self._reach if self._reach is not None else self._reach_kernel()
+        if fast:
+            try:
+                out = fast.center_of_mass_jacobian(q)
+                return out if out.__class__ is not tuple else reported_rows(out, 2)
+            except (ValueError, TypeError):
+                pass
         return undefined_rows(self.kinematics.center_of_mass_jacobian, (q,), (q,), 2)
 
     def jacobian_dot_times_v(self, q, v, frame: str,
@@ -276,7 +304,7 @@ class Dynamics(ControlTerms):
                 pass
         return undefined_rows(self.kinematics.centroidal_momentum_matrix, (q,), (q,), 2)
 
-    # the compiled kernel of the three functions above (reach_c.py): None until asked, then
+    # the compiled kernel of the functions above (reach_c.py): None until asked, then
     # the kernel, or False (not the C backend, or no compiler)
     _reach = None
 

@@ -14,7 +14,8 @@
                                   on the Panda, 1000 states: 43 us on one thread, 70 on two) */
 #define RK_BLOCK 64  /* a multiple of LG_LANES: only the batch's last states run one by one */
 
-enum { RK_DRIFT, RK_CENTROIDAL, RK_WRENCH, RK_CORIOLIS, RK_INVERSE };
+enum { RK_DRIFT, RK_CENTROIDAL, RK_WRENCH, RK_CORIOLIS, RK_INVERSE, RK_PLACEMENT, RK_JACOBIAN,
+       RK_COM, RK_COM_JACOBIAN };
 
 /* one batch's inputs and output; ``next`` the shared counter of states handed out */
 typedef struct {
@@ -30,8 +31,9 @@ typedef struct {
 /* the numbers of a state's output row */
 static int rk_width(int kind)
 {
-    return kind == RK_DRIFT ? 6 : kind == RK_CENTROIDAL ? 6 * RK_NV
-           : kind == RK_CORIOLIS ? RK_NV * RK_NV : RK_NV;
+    return kind == RK_DRIFT ? 6 : kind == RK_CENTROIDAL || kind == RK_JACOBIAN ? 6 * RK_NV
+           : kind == RK_CORIOLIS ? RK_NV * RK_NV : kind == RK_PLACEMENT ? 16
+           : kind == RK_COM ? 3 : kind == RK_COM_JACOBIAN ? 3 * RK_NV : RK_NV;
 }
 
 static void rk_blank(const rk_job *job, npy_intp k)
@@ -86,6 +88,10 @@ static int rk_state(const rk_job *job, npy_intp k, rk_cwork *work)
         break;
     }
     case RK_CORIOLIS: rk_coriolis(q, job->v + k * RK_NV, job->y + RK_NV * RK_NV * k, work); break;
+    case RK_PLACEMENT: rk_placement(q, job->frame, job->y + 16 * k); break;
+    case RK_JACOBIAN: rk_jacobian(q, job->frame, job->ref, job->y + 6 * RK_NV * k); break;
+    case RK_COM: rk_com(q, job->y + 3 * k); break;
+    case RK_COM_JACOBIAN: rk_com_jacobian(q, job->y + 3 * RK_NV * k); break;
     case RK_INVERSE: {
         double w[RK_MAX_WRENCHES][6];
         for (int i = 0; i < job->nw; i++)
@@ -142,7 +148,7 @@ static inline void rk_spoil(const lg_v4 *x, int width, lg_v4 *spoilt)
 
 /* states k .. k + LG_LANES - 1 at once (rk4_*); out: RK_OUT4 vectors of room; the count of
    NaN rows written */
-#define RK_OUT4 (RK_NV * RK_NV > 6 * RK_NV ? RK_NV * RK_NV : 6 * RK_NV)
+#define RK_OUT4 (RK_NV * RK_NV > 6 * RK_NV ? RK_NV * RK_NV : 6 * RK_NV > 16 ? 6 * RK_NV : 16)
 static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
 {
     lg_v4 q[RK_NQ], v[RK_NV], spoilt = LG_V4(0.0);
@@ -177,6 +183,22 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
     case RK_CENTROIDAL:
         rk4_centroidal(q, out);
         rk_scatter(out, k, 6 * RK_NV, job->y, 0, 0.0, job->stream);
+        break;
+    case RK_PLACEMENT:
+        rk4_placement(q, job->frame, out);
+        rk_scatter(out, k, 16, job->y, 0, 0.0, job->stream);
+        break;
+    case RK_JACOBIAN:
+        rk4_jacobian(q, job->frame, job->ref, out);
+        rk_scatter(out, k, 6 * RK_NV, job->y, 0, 0.0, job->stream);
+        break;
+    case RK_COM:
+        rk4_com(q, out);
+        rk_scatter(out, k, 3, job->y, 0, 0.0, job->stream);
+        break;
+    case RK_COM_JACOBIAN:
+        rk4_com_jacobian(q, out);
+        rk_scatter(out, k, 3 * RK_NV, job->y, 0, 0.0, job->stream);
         break;
     case RK_WRENCH: {
         lg_v4 w[6];
@@ -402,6 +424,59 @@ static PyObject *rk_py_centroidal(PyObject *self, PyObject *const *args, Py_ssiz
     return rk_result(out, bad);
 }
 
+/* a function of q alone, (Q[, frame[, ref]]) -> its rows (tail0 x tail1 a state), or (rows,
+ * NaN rows) */
+static PyObject *rk_of_q(PyObject *const *args, Py_ssize_t nargs, int kind, int tail0, int tail1)
+{
+    const Py_ssize_t want = kind == RK_JACOBIAN ? 3 : kind == RK_PLACEMENT ? 2 : 1;
+    if (nargs != want) { PyErr_Format(PyExc_TypeError, "expected %d arguments", (int)want); return NULL; }
+    int f = 0, ref = 0;
+    if (want > 1) {
+        f = (int)PyLong_AsLong(args[1]);
+        if (want > 2) ref = (int)PyLong_AsLong(args[2]);
+        if (PyErr_Occurred()) return NULL;
+        if (f < 0 || f >= RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
+        if (ref < 0 || ref > 2) { PyErr_SetString(PyExc_ValueError, "reference: out of range"); return NULL; }
+    }
+    PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
+    if (!Q) return NULL;
+    if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
+    PyObject *out = rk_output(Q, tail0, tail1);
+    npy_intp bad = 0;
+    if (out) {
+        rk_job job = {.kind = kind, .frame = f, .ref = ref, .q = PyArray_DATA(Q),
+                      .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / RK_NQ};
+        if (!rk_batch(&job)) Py_CLEAR(out);
+        bad = job.bad;
+    }
+    Py_DECREF(Q);
+    return rk_result(out, bad);
+}
+
+static PyObject *rk_py_placement(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    return rk_of_q(args, nargs, RK_PLACEMENT, 4, 4);
+}
+
+static PyObject *rk_py_jacobian(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    return rk_of_q(args, nargs, RK_JACOBIAN, 6, RK_NV);
+}
+
+static PyObject *rk_py_com(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    return rk_of_q(args, nargs, RK_COM, 3, 0);
+}
+
+static PyObject *rk_py_com_jacobian(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    return rk_of_q(args, nargs, RK_COM_JACOBIAN, 3, RK_NV);
+}
+
 /* wrench(Q, frame, W, OUT, sign): OUT += sign J^T w, in place (OUT float64, contiguous, of
  * Q's batch and RK_NV wide); W (6,) for every state or one row per state */
 static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
@@ -528,6 +603,10 @@ static PyMethodDef rk_methods[] = {
     {"wrench", (PyCFunction)(void (*)(void))rk_py_wrench, METH_FASTCALL, "(Q, frame, W, OUT, sign): OUT += sign J^T w; -> NaN rows"},
     {"coriolis", (PyCFunction)(void (*)(void))rk_py_coriolis, METH_FASTCALL, "(Q, V) -> C(q, v), or (C(q, v), NaN rows)"},
     {"inverse", (PyCFunction)(void (*)(void))rk_py_inverse, METH_FASTCALL, "(INDEX, UP, Q, V, A, F_EXT) -> tau, or (tau, NaN rows)"},
+    {"placement", (PyCFunction)(void (*)(void))rk_py_placement, METH_FASTCALL, "(Q, frame) -> 4 x 4, or (4 x 4, NaN rows)"},
+    {"jacobian", (PyCFunction)(void (*)(void))rk_py_jacobian, METH_FASTCALL, "(Q, frame, ref) -> 6 x n, or (6 x n, NaN rows)"},
+    {"com", (PyCFunction)(void (*)(void))rk_py_com, METH_FASTCALL, "(Q) -> c, or (c, NaN rows)"},
+    {"com_jacobian", (PyCFunction)(void (*)(void))rk_py_com_jacobian, METH_FASTCALL, "(Q) -> J_c, or (J_c, NaN rows)"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -17,13 +17,13 @@ from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import joint_model
 from .tree_c import _SINCOS, _VECTOR
 
-# the walks, C(q, v), inverse dynamics with wrenches, then the Python bindings: one
-# module's C, in this order; the first three's core (from reach_kernel.c's RK_CORE_BEGIN)
-# twice, on one state and on LG_LANES states at once
+# the walks, frames and the centre of mass, C(q, v), inverse dynamics with wrenches, then the
+# Python bindings: one module's C, in this order; the first four's core (from reach_kernel.c's
+# RK_CORE_BEGIN) twice, on one state and on LG_LANES states at once
 _KERNELS = tuple(Path(__file__).with_name(name)
-                 for name in ("reach_kernel.c", "reach_coriolis.c", "reach_inverse.c",
-                              "batch_threads.c", "reach_bindings.c"))
-_CORE = 3
+                 for name in ("reach_kernel.c", "reach_frames.c", "reach_coriolis.c",
+                              "reach_inverse.c", "batch_threads.c", "reach_bindings.c"))
+_CORE = 4
 _SCALAR = """#define RK_T double
 #define RK_FN(name) rk_##name
 #define RK_C(x) (x)
@@ -169,8 +169,11 @@ class ReachKernel:
         self.module = module
         self.frame_index = {f.name: k for k, f in enumerate(tree.frames)}
         self.drift = module.drift
-        # A_g needs a centre of mass: moving mass (else numpy refuses it in one line)
+        self.placement, self.jacobian = module.placement, module.jacobian  # (Q, frame[, ref])
+        # A_g and the centre of mass need moving mass (else numpy refuses them in one line)
         self.centroidal = module.centroidal if massive else None
+        self.center_of_mass = module.com if massive else None
+        self.center_of_mass_jacobian = module.com_jacobian if massive else None
         # a fixed base's C is M's Christoffel symbols (joint_space.py); a floating base's here
         self.coriolis = module.coriolis if tree.floating_base else None
         self.tree = tree

@@ -1,0 +1,135 @@
+/* A frame's placement and Jacobian, the centre of mass and its Jacobian, on one state (RK_FN:
+ * in the core reach_c.py emits twice, on one state and on LG_LANES states at once), from
+ * reach_kernel.c's walks: the same numbers as frames.py's numpy, as Pinocchio's
+ * updateFramePlacement, getFrameJacobian, centerOfMass and jacobianCenterOfMass. */
+
+/* frame f's placement [[R, p], [0, 1]] (4 x 4, row-major; R frame -> world, p its origin) */
+static void RK_FN(placement)(const RK_T *q, int f, RK_T *out)
+{
+    RK_T R[RK_NB][9], o[RK_NB][3], Rf[9], p[3];
+    if (rk_fbody[f] >= 0) {
+        int path[RK_NB];
+        RK_FN(path)(q, rk_fbody[f], path, R, o);
+    }
+    RK_FN(frame)(f, R, o, Rf, p);
+    for (int a = 0; a < 3; a++) {
+        for (int c = 0; c < 3; c++) out[4 * a + c] = Rf[3 * a + c];
+        out[4 * a + 3] = p[a];
+        out[12 + a] = RK_C(0.0);
+    }
+    out[15] = RK_C(1.0);
+}
+
+/* a joint's columns at the world's origin, world axes, and the first coordinate they fill:
+ * a free flyer's six, else one (times the joint's multiplier) */
+static inline int RK_FN(columns)(int i, RK_T (*R)[9], RK_T (*o)[3], RK_T (*F)[6], int *first,
+                                 double *mult)
+{
+    if (RK_FREE(i)) {
+        RK_FN(free_columns)(R[0], o[0], F);
+        *first = 0, *mult = 1.0;
+        return 6;
+    }
+    RK_FN(subspace)(i, R, o, F[0]);
+    *first = RK_BV + rk_coord[i], *mult = rk_mult[i];
+    return 1;
+}
+
+/* frame f's Jacobian (6 x RK_NV, row-major, linear rows first): a joint's column [s_v; s_w]
+ * at the world's origin is the velocity of the point there (ref 0, world); the frame origin's
+ * is s_v + s_w x p (ref 2, local_world_aligned), in the frame's axes for ref 1 (local) */
+static void RK_FN(jacobian)(const RK_T *q, int f, int ref, RK_T *out)
+{
+    RK_T R[RK_NB][9], o[RK_NB][3], Rf[9], p[3];
+    for (int j = 0; j < 6 * RK_NV; j++) out[j] = RK_C(0.0);
+    const int b = rk_fbody[f];
+    if (b < 0) return;  /* a frame on the ground: no joint moves it */
+    int path[RK_NB], depth = RK_FN(path)(q, b, path, R, o);
+    RK_FN(frame)(f, R, o, Rf, p);
+    for (int k = 0; k < depth; k++) {
+        RK_T F[6][6];
+        int first;
+        double mult;
+        const int columns = RK_FN(columns)(path[k], R, o, F, &first, &mult);
+        for (int col = 0; col < columns; col++) {
+            const RK_T *S = F[col];
+            RK_T v[3], w[3], t[3];
+            for (int j = 0; j < 3; j++) { v[j] = S[j]; w[j] = S[3 + j]; }
+            if (ref != 0) {
+                RK_FN(cross)(w, p, t);
+                for (int j = 0; j < 3; j++) v[j] += t[j];
+            }
+            if (ref == 1) {
+                RK_FN(apply_t)(Rf, v, t);
+                for (int j = 0; j < 3; j++) v[j] = t[j];
+                RK_FN(apply_t)(Rf, w, t);
+                for (int j = 0; j < 3; j++) w[j] = t[j];
+            }
+            const int c = first + col;
+            for (int j = 0; j < 3; j++) {
+                out[j * RK_NV + c] += mult * v[j];
+                out[(3 + j) * RK_NV + c] += mult * w[j];
+            }
+        }
+    }
+}
+
+/* each body's mass and first moment about the world's origin (kg, kg m; world axes), summed
+ * over its subtree when ``subtrees``; the total mass (the bodies welded to the ground not
+ * among them) */
+static double RK_FN(moments)(const RK_T *q, RK_T (*R)[9], RK_T (*o)[3], double *mass,
+                             RK_T (*H)[3], int subtrees)
+{
+    RK_FN(bodies)(q, R, o);
+    double total = 0.0;
+    for (int i = 0; i < RK_NB; i++) {
+        RK_T hr[3];
+        RK_FN(apply_v)(R[i], rk_h[i], hr);
+        for (int j = 0; j < 3; j++) H[i][j] = rk_m[i] * o[i][j] + hr[j];
+        mass[i] = rk_m[i];
+        total += rk_m[i];
+    }
+    if (subtrees)
+        for (int i = RK_NB - 1; i >= 0; i--) {
+            const int p = rk_parent[i];
+            if (p < 0) continue;
+            mass[p] += mass[i];
+            for (int j = 0; j < 3; j++) H[p][j] += H[i][j];
+        }
+    return total;
+}
+
+/* the centre of mass (m, world): sum m_i c_i / sum m_i */
+static void RK_FN(com)(const RK_T *q, RK_T *out)
+{
+    RK_T R[RK_NB][9], o[RK_NB][3], H[RK_NB][3];
+    double mass[RK_NB];
+    const double total = RK_FN(moments)(q, R, o, mass, H, 0);
+    for (int j = 0; j < 3; j++) {
+        RK_T s = RK_C(0.0);
+        for (int i = 0; i < RK_NB; i++) s += H[i][j];
+        out[j] = s / total;
+    }
+}
+
+/* J_c (3 x RK_NV, row-major): a joint's column moves its subtree, mass M_k and first moment
+ * H_k, rigidly: M J_c's column is M_k s_v + s_w x H_k (O(n), not a point Jacobian per body) */
+static void RK_FN(com_jacobian)(const RK_T *q, RK_T *out)
+{
+    RK_T R[RK_NB][9], o[RK_NB][3], H[RK_NB][3];
+    double mass[RK_NB];
+    const double total = RK_FN(moments)(q, R, o, mass, H, 1);
+    for (int j = 0; j < 3 * RK_NV; j++) out[j] = RK_C(0.0);
+    for (int i = 0; i < RK_NB; i++) {
+        RK_T F[6][6];
+        int first;
+        double mult;
+        const int columns = RK_FN(columns)(i, R, o, F, &first, &mult);
+        for (int col = 0; col < columns; col++) {
+            RK_T l[3];
+            RK_FN(cross)(F[col] + 3, H[i], l);
+            for (int j = 0; j < 3; j++)
+                out[j * RK_NV + first + col] += mult * (mass[i] * F[col][j] + l[j]) / total;
+        }
+    }
+}

@@ -233,25 +233,31 @@ class Dynamics(ControlTerms):
 
     def placement(self, q, frame: str) -> np.ndarray:
         """The frame's 4 x 4 placement in the world (rotation and origin in m), (..., 4, 4)."""
-        fast = self._reach if self._reach is not None else self._reach_kernel()
+        fast = self._reach
+        if fast is None:
+            fast = self._reach_kernel()
         if fast:
             try:
-                out = fast.placement(q, fast.frame_index[frame])
-                return out if out.__class__ is not tuple else reported_rows(out, 2)
+                out = fast.placements[frame](q)
             except (KeyError, ValueError, TypeError):
-                pass  # numpy below broadcasts, or names the fault in one line
+                pass  # numpy below names the fault in one line
+            else:
+                return out if out.__class__ is not tuple else reported_rows(out, 2)
         return undefined_rows(self.kinematics.placement, (q, frame), (q,), 2)
 
     def jacobian(self, q, frame: str, reference: str = "local_world_aligned") -> np.ndarray:
         """The frame's 6 x n Jacobian, linear rows first, (..., 6, n); ``reference`` "world",
         "local" or "local_world_aligned" as Pinocchio's ReferenceFrame."""
-        fast = self._reach if self._reach is not None else self._reach_kernel()
+        fast = self._reach
+        if fast is None:
+            fast = self._reach_kernel()
         if fast:
             try:
-                out = fast.jacobian(q, fast.frame_index[frame], REFERENCE_INDEX[reference])
-                return out if out.__class__ is not tuple else reported_rows(out, 2)
+                out = fast.jacobians[reference][frame](q)
             except (KeyError, ValueError, TypeError):
-                pass
+                pass  # numpy below names the fault in one line
+            else:
+                return out if out.__class__ is not tuple else reported_rows(out, 2)
         return undefined_rows(self.kinematics.jacobian, (q, frame, reference), (q,), 2)
 
     def center_of_mass(self, q) -> np.ndarray:

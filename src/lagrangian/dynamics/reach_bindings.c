@@ -424,21 +424,22 @@ static PyObject *rk_py_centroidal(PyObject *self, PyObject *const *args, Py_ssiz
     return rk_result(out, bad);
 }
 
-/* a function of q alone, (Q[, frame[, ref]]) -> its rows (tail0 x tail1 a state), or (rows,
- * NaN rows) */
+/* a function of q alone, ([code, ]Q) -> its rows (tail0 x tail1 a state), or (rows, NaN
+ * rows); code = 3 frame + reference (0 world, 1 local, 2 local_world_aligned) for a frame's,
+ * first, so that the caller binds it once (a bound method: a third of what functools.partial
+ * costs a call). One state is computed here, without the batch's machinery. */
 static PyObject *rk_of_q(PyObject *const *args, Py_ssize_t nargs, int kind, int tail0, int tail1)
 {
-    const Py_ssize_t want = kind == RK_JACOBIAN ? 3 : kind == RK_PLACEMENT ? 2 : 1;
+    const Py_ssize_t want = kind == RK_JACOBIAN || kind == RK_PLACEMENT ? 2 : 1;
     if (nargs != want) { PyErr_Format(PyExc_TypeError, "expected %d arguments", (int)want); return NULL; }
     int f = 0, ref = 0;
     if (want > 1) {
-        f = (int)PyLong_AsLong(args[1]);
-        if (want > 2) ref = (int)PyLong_AsLong(args[2]);
+        const long code = PyLong_AsLong(args[0]);
         if (PyErr_Occurred()) return NULL;
-        if (f < 0 || f >= RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
-        if (ref < 0 || ref > 2) { PyErr_SetString(PyExc_ValueError, "reference: out of range"); return NULL; }
+        if (code < 0 || code >= 3L * RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
+        f = (int)(code / 3), ref = (int)(code % 3);
     }
-    PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
+    PyArrayObject *Q = rk_input(args[want - 1], RK_NQ, "q");
     if (!Q) return NULL;
     if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
     PyObject *out = rk_output(Q, tail0, tail1);
@@ -446,8 +447,9 @@ static PyObject *rk_of_q(PyObject *const *args, Py_ssize_t nargs, int kind, int 
     if (out) {
         rk_job job = {.kind = kind, .frame = f, .ref = ref, .q = PyArray_DATA(Q),
                       .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / RK_NQ};
-        if (!rk_batch(&job)) Py_CLEAR(out);
-        bad = job.bad;
+        if (job.count == 1) bad = rk_state(&job, 0, NULL);
+        else if (!rk_batch(&job)) Py_CLEAR(out);
+        else bad = job.bad;
     }
     Py_DECREF(Q);
     return rk_result(out, bad);
@@ -603,8 +605,8 @@ static PyMethodDef rk_methods[] = {
     {"wrench", (PyCFunction)(void (*)(void))rk_py_wrench, METH_FASTCALL, "(Q, frame, W, OUT, sign): OUT += sign J^T w; -> NaN rows"},
     {"coriolis", (PyCFunction)(void (*)(void))rk_py_coriolis, METH_FASTCALL, "(Q, V) -> C(q, v), or (C(q, v), NaN rows)"},
     {"inverse", (PyCFunction)(void (*)(void))rk_py_inverse, METH_FASTCALL, "(INDEX, UP, Q, V, A, F_EXT) -> tau, or (tau, NaN rows)"},
-    {"placement", (PyCFunction)(void (*)(void))rk_py_placement, METH_FASTCALL, "(Q, frame) -> 4 x 4, or (4 x 4, NaN rows)"},
-    {"jacobian", (PyCFunction)(void (*)(void))rk_py_jacobian, METH_FASTCALL, "(Q, frame, ref) -> 6 x n, or (6 x n, NaN rows)"},
+    {"placement", (PyCFunction)(void (*)(void))rk_py_placement, METH_FASTCALL, "(3 frame, Q) -> 4 x 4, or (4 x 4, NaN rows)"},
+    {"jacobian", (PyCFunction)(void (*)(void))rk_py_jacobian, METH_FASTCALL, "(3 frame + ref, Q) -> 6 x n, or (6 x n, NaN rows)"},
     {"com", (PyCFunction)(void (*)(void))rk_py_com, METH_FASTCALL, "(Q) -> c, or (c, NaN rows)"},
     {"com_jacobian", (PyCFunction)(void (*)(void))rk_py_com_jacobian, METH_FASTCALL, "(Q) -> J_c, or (J_c, NaN rows)"},
     {NULL, NULL, 0, NULL},

@@ -8,6 +8,7 @@ from __future__ import annotations
 import hashlib
 from functools import partial
 from pathlib import Path
+from types import MethodType
 
 import numpy as np
 
@@ -169,7 +170,13 @@ class ReachKernel:
         self.module = module
         self.frame_index = {f.name: k for k, f in enumerate(tree.frames)}
         self.drift = module.drift
-        self.placement, self.jacobian = module.placement, module.jacobian  # (Q, frame[, ref])
+        # by frame name (and reference): the module's function bound to the frame's code
+        # (reach_bindings.c's rk_of_q: 3 frame + reference), q its one argument
+        self.placements = {f.name: MethodType(module.placement, 3 * k)
+                           for k, f in enumerate(tree.frames)}
+        self.jacobians = {name: {f.name: MethodType(module.jacobian, 3 * k + ref)
+                                 for k, f in enumerate(tree.frames)}
+                          for name, ref in REFERENCE_INDEX.items()}
         # A_g and the centre of mass need moving mass (else numpy refuses them in one line)
         self.centroidal = module.centroidal if massive else None
         self.center_of_mass = module.com if massive else None

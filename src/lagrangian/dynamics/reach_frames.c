@@ -37,15 +37,25 @@ static inline int RK_FN(columns)(int i, RK_T (*R)[9], RK_T (*o)[3], RK_T (*F)[6]
 
 /* frame f's Jacobian (6 x RK_NV, row-major, linear rows first): a joint's column [s_v; s_w]
  * at the world's origin is the velocity of the point there (ref 0, world); the frame origin's
- * is s_v + s_w x p (ref 2, local_world_aligned), in the frame's axes for ref 1 (local) */
+ * is s_v + s_w x p (ref 2, local_world_aligned), in the frame's axes for ref 1 (local). The
+ * columns of the joints on the frame's path are set (RK_CPUT) and only the others zeroed:
+ * zeroing all first was a seventh of a batch. */
 static void RK_FN(jacobian)(const RK_T *q, int f, int ref, RK_T *out)
 {
     RK_T R[RK_NB][9], o[RK_NB][3], Rf[9], p[3];
-    for (int j = 0; j < 6 * RK_NV; j++) out[j] = RK_C(0.0);
     const int b = rk_fbody[f];
-    if (b < 0) return;  /* a frame on the ground: no joint moves it */
+    if (b < 0) {  /* a frame on the ground: no joint moves it */
+        for (int j = 0; j < 6 * RK_NV; j++) out[j] = RK_C(0.0);
+        return;
+    }
+#if RK_CSET
+    unsigned char set[RK_NV] = {0};
+#else
+    for (int j = 0; j < 6 * RK_NV; j++) out[j] = RK_C(0.0);
+#endif
     int path[RK_NB], depth = RK_FN(path)(q, b, path, R, o);
-    RK_FN(frame)(f, R, o, Rf, p);
+    if (ref == 1) RK_FN(frame)(f, R, o, Rf, p);
+    else RK_FN(frame_origin)(f, R, o, p);
     for (int k = 0; k < depth; k++) {
         RK_T F[6][6];
         int first;
@@ -67,11 +77,19 @@ static void RK_FN(jacobian)(const RK_T *q, int f, int ref, RK_T *out)
             }
             const int c = first + col;
             for (int j = 0; j < 3; j++) {
-                out[j * RK_NV + c] += mult * v[j];
-                out[(3 + j) * RK_NV + c] += mult * w[j];
+                RK_CPUT(out[j * RK_NV + c], mult * v[j]);
+                RK_CPUT(out[(3 + j) * RK_NV + c], mult * w[j]);
             }
+#if RK_CSET
+            set[c] = 1;
+#endif
         }
     }
+#if RK_CSET
+    for (int c = 0; c < RK_NV; c++)
+        if (!set[c])
+            for (int j = 0; j < 6; j++) out[j * RK_NV + c] = RK_C(0.0);
+#endif
 }
 
 /* each body's mass and first moment about the world's origin (kg, kg m; world axes), summed
@@ -119,7 +137,9 @@ static void RK_FN(com_jacobian)(const RK_T *q, RK_T *out)
     RK_T R[RK_NB][9], o[RK_NB][3], H[RK_NB][3];
     double mass[RK_NB];
     const double total = RK_FN(moments)(q, R, o, mass, H, 1);
+#if !RK_CSET  /* else every column is one joint's, set once below */
     for (int j = 0; j < 3 * RK_NV; j++) out[j] = RK_C(0.0);
+#endif
     for (int i = 0; i < RK_NB; i++) {
         RK_T F[6][6];
         int first;
@@ -129,7 +149,7 @@ static void RK_FN(com_jacobian)(const RK_T *q, RK_T *out)
             RK_T l[3];
             RK_FN(cross)(F[col] + 3, H[i], l);
             for (int j = 0; j < 3; j++)
-                out[j * RK_NV + first + col] += mult * (mass[i] * F[col][j] + l[j]) / total;
+                RK_CPUT(out[j * RK_NV + first + col], mult * (mass[i] * F[col][j] + l[j]) / total);
         }
     }
 }

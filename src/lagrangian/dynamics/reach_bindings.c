@@ -405,25 +405,6 @@ static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t n
     return rk_result(out, bad);
 }
 
-static PyObject *rk_py_centroidal(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    (void)self;
-    if (nargs != 1) { PyErr_SetString(PyExc_TypeError, "centroidal(Q)"); return NULL; }
-    PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
-    if (!Q) return NULL;
-    if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
-    PyObject *out = rk_output(Q, 6, RK_NV);
-    npy_intp bad = 0;
-    if (out) {
-        rk_job job = {.kind = RK_CENTROIDAL, .q = PyArray_DATA(Q),
-                      .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / RK_NQ};
-        if (!rk_batch(&job)) Py_CLEAR(out);
-        bad = job.bad;
-    }
-    Py_DECREF(Q);
-    return rk_result(out, bad);
-}
-
 /* a function of q alone, ([code, ]Q) -> its rows (tail0 x tail1 a state), or (rows, NaN
  * rows); code = 3 frame + reference (0 world, 1 local, 2 local_world_aligned) for a frame's,
  * first, so that the caller binds it once (a bound method: a third of what functools.partial
@@ -455,29 +436,18 @@ static PyObject *rk_of_q(PyObject *const *args, Py_ssize_t nargs, int kind, int 
     return rk_result(out, bad);
 }
 
-static PyObject *rk_py_placement(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    (void)self;
-    return rk_of_q(args, nargs, RK_PLACEMENT, 4, 4);
-}
-
-static PyObject *rk_py_jacobian(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    (void)self;
-    return rk_of_q(args, nargs, RK_JACOBIAN, 6, RK_NV);
-}
-
-static PyObject *rk_py_com(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    (void)self;
-    return rk_of_q(args, nargs, RK_COM, 3, 0);
-}
-
-static PyObject *rk_py_com_jacobian(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    (void)self;
-    return rk_of_q(args, nargs, RK_COM_JACOBIAN, 3, RK_NV);
-}
+/* the functions of q alone, each rk_of_q with its kind and a state's output shape */
+#define RK_OF_Q(name, kind, tail0, tail1)                                                      \
+    static PyObject *rk_py_##name(PyObject *self, PyObject *const *args, Py_ssize_t nargs)    \
+    {                                                                                          \
+        (void)self;                                                                            \
+        return rk_of_q(args, nargs, kind, tail0, tail1);                                       \
+    }
+RK_OF_Q(placement, RK_PLACEMENT, 4, 4)
+RK_OF_Q(jacobian, RK_JACOBIAN, 6, RK_NV)
+RK_OF_Q(com, RK_COM, 3, 0)
+RK_OF_Q(com_jacobian, RK_COM_JACOBIAN, 3, RK_NV)
+RK_OF_Q(centroidal, RK_CENTROIDAL, 6, RK_NV)
 
 /* wrench(Q, frame, W, OUT, sign): OUT += sign J^T w, in place (OUT float64, contiguous, of
  * Q's batch and RK_NV wide); W (6,) for every state or one row per state */

@@ -23,6 +23,7 @@ from .tree_c import _SINCOS, _VECTOR
 
 _KERNEL = Path(__file__).with_name("derivatives_kernel.c")
 _REGRESSOR = Path(__file__).with_name("derivatives_regressor.c")  # the core's last part
+_FACTOR = Path(__file__).with_name("derivatives_factor.c")  # at the core's DK_FACTOR line
 _BINDINGS = Path(__file__).with_name("derivatives_bindings.c")
 _THREADS = Path(__file__).with_name("batch_threads.c")  # the thread count, before the bindings
 
@@ -219,7 +220,10 @@ def kernel_source(tree: KinematicTree):
     text = _KERNEL.read_text(encoding="utf-8")
     head, rest = text.split("/* DK_CORE_BEGIN */")
     core = rest.split("/* DK_CORE_END */")[0] + _REGRESSOR.read_text(encoding="utf-8")
-    core = core.replace("DK_TREE_FACTOR", _tree_factor(parents) if parents is not None else "")
+    marker = "/* DK_FACTOR: derivatives_factor.c, here"
+    at = core.index(marker)
+    core = (core[:at] + _FACTOR.read_text(encoding="utf-8") + core[core.index("\n", at):]).replace(
+        "DK_TREE_FACTOR", _tree_factor(parents) if parents is not None else "")
     bindings = _THREADS.read_text(encoding="utf-8") + _BINDINGS.read_text(encoding="utf-8")
     source = "\n".join([
         "/* lagrangian: the derivatives of a tree's inverse and forward dynamics */",
@@ -293,7 +297,8 @@ def derivatives_module(tree: KinematicTree):
     if not applies(tree):
         return None
     here = Path(__file__)
-    generator = hashlib.sha256(_KERNEL.read_bytes() + _THREADS.read_bytes() + _BINDINGS.read_bytes()
+    generator = hashlib.sha256(_KERNEL.read_bytes() + _FACTOR.read_bytes() + _THREADS.read_bytes()
+                               + _BINDINGS.read_bytes() + _REGRESSOR.read_bytes()
                                + here.read_bytes()
                                + here.with_name("tree_c.py").read_bytes()).hexdigest()
     # the joints' kinematics only: the inertials are given at run time (runtime_values), so a

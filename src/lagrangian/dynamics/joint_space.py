@@ -238,7 +238,7 @@ class Dynamics(ControlTerms):
             fast = self._reach_kernel()
         if fast:
             try:
-                out = fast.placements[frame](q)
+                out = fast.placement(fast.placement_codes[frame], q)
             except (KeyError, ValueError, TypeError):
                 pass  # numpy below names the fault in one line
             else:
@@ -253,7 +253,7 @@ class Dynamics(ControlTerms):
             fast = self._reach_kernel()
         if fast:
             try:
-                out = fast.jacobians[reference][frame](q)
+                out = fast.jacobian(fast.jacobian_codes[reference][frame], q)
             except (KeyError, ValueError, TypeError):
                 pass  # numpy below names the fault in one line
             else:

@@ -406,9 +406,8 @@ static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t n
 }
 
 /* a function of q alone, ([code, ]Q) -> its rows (tail0 x tail1 a state), or (rows, NaN
- * rows); code = 3 frame + reference (0 world, 1 local, 2 local_world_aligned) for a frame's,
- * first, so that the caller binds it once (a bound method: a third of what functools.partial
- * costs a call). One state is computed here, without the batch's machinery. */
+ * rows); code = 3 frame + reference (0 world, 1 local, 2 local_world_aligned) for a frame's
+ * (reach_c.py's tables by name). One state is computed here, without the batch's machinery. */
 static PyObject *rk_of_q(PyObject *const *args, Py_ssize_t nargs, int kind, int tail0, int tail1)
 {
     const Py_ssize_t want = kind == RK_JACOBIAN || kind == RK_PLACEMENT ? 2 : 1;

@@ -16,6 +16,7 @@ from ..check.free_body_steps import CrosscheckSteps, FreeBodyStep
 from ..derivation.readable import readable
 from ..kinds import FreeBodyKind
 from ..model.expressions import format_expression
+from ..model.repeatable import repeatable_random
 
 LONGEST = 240  # characters of one expression in the text; the JSON has every one whole
 _AXES = ("x", "y", "z")
@@ -35,7 +36,8 @@ def _tidy(expr: sp.Expr) -> sp.Expr:
     if not eq.is_small(expr):
         return readable(expr)
     try:
-        tidied = sp.trigsimp(sp.expand(expr))
+        with repeatable_random():  # the same factoring points, and cost, in every run
+            tidied = sp.trigsimp(sp.expand(expr))
     except Exception:  # noqa: BLE001 - tidying only costs readability
         return readable(expr)
     grouped = readable(tidied)

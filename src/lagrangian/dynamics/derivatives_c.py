@@ -123,12 +123,15 @@ def _coordinate_parents(tree: KinematicTree) -> list[int] | None:
     return None if None in parents else parents
 
 
-def factored_along_the_tree(tree: KinematicTree) -> list[int] | None:
+def factored_along_the_tree(tree: KinematicTree,
+                            parents: list[int] | None = None) -> list[int] | None:
     """The coordinates' parents where forward dynamics' M is factored along the tree (M =
     L^T D L, no fill-in: _tree_factor) rather than by a dense Cholesky: a tree that branches
     (two legs, or more), its coordinates one body's each, numbered parents first; else None.
-    On a chain both do the same work and the dense loops are the simpler."""
-    parents = _coordinate_parents(tree)
+    On a chain both do the same work and the dense loops are the simpler. ``parents``:
+    _coordinate_parents(tree), where the caller has it."""
+    if parents is None:
+        parents = _coordinate_parents(tree)
     if parents is None:
         return None
     children = [parents.count(c) for c in range(-1, len(parents))]
@@ -216,7 +219,8 @@ def kernel_source(tree: KinematicTree):
     # a quarter or more are zero (a floating base's legs: 36% fewer multiply-adds on Solo12); a
     # denser pattern (a serial arm: none) keeps the row by row loops, unrolled whole on an arm
     sparse = starts[-1] <= 0.75 * (n + 6 * floating) ** 2
-    parents = factored_along_the_tree(tree)
+    one_body = _coordinate_parents(tree)  # None where a coordinate moves two bodies (mimic)
+    parents = factored_along_the_tree(tree, one_body)
     text = _KERNEL.read_text(encoding="utf-8")
     head, rest = text.split("/* DK_CORE_BEGIN */")
     core = rest.split("/* DK_CORE_END */")[0] + _REGRESSOR.read_text(encoding="utf-8")
@@ -252,7 +256,7 @@ def kernel_source(tree: KinematicTree):
         c_table("dk_row0", "int", starts),
         c_table("dk_rows", "int", [k for r in rows for k in r]),
         f"#define DK_LTDL {int(parents is not None)}",
-        f"#define DK_ONCE {int(_coordinate_parents(tree) is not None)}",
+        f"#define DK_ONCE {int(one_body is not None)}",
         c_table("dk_mult", "double", [j.multiplier for j in joints]),
         c_table("dk_off", "double", [j.offset for j in joints]),
         c_table("dk_R0", "double", [_flat(j.rotation) for j in joints]),

@@ -20,21 +20,6 @@ static void RK_FN(placement)(const RK_T *q, int f, RK_T *out)
     out[15] = RK_C(1.0);
 }
 
-/* a joint's columns at the world's origin, world axes, and the first coordinate they fill:
- * a free flyer's six, else one (times the joint's multiplier) */
-static inline int RK_FN(columns)(int i, RK_T (*R)[9], RK_T (*o)[3], RK_T (*F)[6], int *first,
-                                 double *mult)
-{
-    if (RK_FREE(i)) {
-        RK_FN(free_columns)(R[0], o[0], F);
-        *first = 0, *mult = 1.0;
-        return 6;
-    }
-    RK_FN(subspace)(i, R, o, F[0]);
-    *first = RK_BV + rk_coord[i], *mult = rk_mult[i];
-    return 1;
-}
-
 /* frame f's Jacobian (6 x RK_NV, row-major, linear rows first): a joint's column [s_v; s_w]
  * at the world's origin is the velocity of the point there (ref 0, world); the frame origin's
  * is s_v + s_w x p (ref 2, local_world_aligned), in the frame's axes for ref 1 (local). The

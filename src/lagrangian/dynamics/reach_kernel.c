@@ -222,6 +222,21 @@ static inline void RK_FN(free_columns)(const RK_T *R, const RK_T *o, RK_T (*S)[6
     }
 }
 
+/* a joint's columns at the world's origin, world axes, and the first coordinate they fill:
+ * a free flyer's six, else one (times the joint's multiplier) */
+static inline int RK_FN(columns)(int i, RK_T (*R)[9], RK_T (*o)[3], RK_T (*F)[6], int *first,
+                                 double *mult)
+{
+    if (RK_FREE(i)) {
+        RK_FN(free_columns)(R[0], o[0], F);
+        *first = 0, *mult = 1.0;
+        return 6;
+    }
+    RK_FN(subspace)(i, R, o, F[0]);
+    *first = RK_BV + rk_coord[i], *mult = rk_mult[i];
+    return 1;
+}
+
 /* the frame's rotation (frame -> world) and origin */
 static inline void RK_FN(frame)(int f, RK_T (*R)[9], RK_T (*o)[3], RK_T *Rf, RK_T *p)
 {
@@ -382,14 +397,9 @@ static void RK_FN(centroidal)(const RK_T *q, RK_T *out)
     for (int j = 0; j < 3; j++) G[j] /= total;
     for (int i = 0; i < RK_NB; i++) {
         RK_T F[6][6];
-        int columns = 1, first = RK_BV + rk_coord[i];
-        double mult = rk_mult[i];
-        if (RK_FREE(i)) {
-            RK_FN(free_columns)(R[0], o[0], F);
-            columns = 6, first = 0, mult = 1.0;
-        } else {
-            RK_FN(subspace)(i, R, o, F[0]);
-        }
+        int first;
+        double mult;
+        const int columns = RK_FN(columns)(i, R, o, F, &first, &mult);
         const RK_T *J = Ic[i];
         for (int col = 0; col < columns; col++) {
             const RK_T *S = F[col];

@@ -107,6 +107,8 @@ def test_bad_frames_and_shapes_are_refused_in_one_line(pendulum):
     with pytest.raises(InputError, match=r"no frame named 'bob3'; did you mean 'bob2'") as e:
         pendulum.placement([0.1, 0.2], "bob3")
     assert e.value.field == "frame"
+    with pytest.raises(InputError, match="named by a string, not a list") as e:
+        pendulum.placement([0.1, 0.2], ["bob1"])
     with pytest.raises(InputError, match="expected 2 values") as e:
         pendulum.jacobian([0.1, 0.2, 0.3], "bob1")
     with pytest.raises(InputError, match="unknown reference"):

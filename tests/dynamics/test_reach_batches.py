@@ -203,7 +203,7 @@ def test_compiled_frames_and_centre_of_mass_are_the_kinematics_walks(tmp_path, r
     floating = robot.velocity_names is not None
     if floating:
         q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
-    assert robot._reach.placement_codes and robot._reach.center_of_mass is not None
+    assert robot._reach.frame_index and robot._reach.center_of_mass is not None
     for frame in robot.frames:
         for ours, theirs in ((robot.placement(q, frame), walks.placement(q, frame)),
                              (robot.placement(q[7], frame), walks.placement(q[7], frame))):

@@ -220,6 +220,19 @@ def test_the_compiled_path_names_bad_input_and_broadcasts_like_numpy(system):
     assert caught.value.field == "frame"
     with pytest.raises(lagrangian.InputError, match="unknown reference"):
         arm.jacobian_dot_times_v(q[0], v[0], "tool", "global")
+    # the names looked up in C (reach_bindings.c) fall back to numpy's one-line refusals
+    for bad in ("tol", ["tool"], 3):
+        for call in (lambda f: arm.placement(q[0], f), lambda f: arm.jacobian(q[0], f)):
+            with pytest.raises(lagrangian.InputError) as caught:
+                call(bad)
+            assert caught.value.field == "frame"
+    for bad in ("global", None, 2, ["world"]):
+        with pytest.raises(lagrangian.InputError, match="unknown reference"):
+            arm.jacobian(q[0], "tool", bad)
+    # a reference spelt by a string made at run time (not the interned literal) still counts
+    built = "".join(["local_", "world_aligned"])
+    np.testing.assert_array_equal(arm.jacobian(q, "tool", built),
+                                  arm.jacobian(q, "tool", "local_world_aligned"))
     with pytest.raises(lagrangian.InputError, match="expected 3 values") as caught:
         arm.centroidal_momentum_matrix(np.zeros(4))
     assert caught.value.field == "q"

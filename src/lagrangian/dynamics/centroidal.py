@@ -98,12 +98,10 @@ def jacobian_dot_times_v(kinematics, q, v, frame: str, reference: str) -> np.nda
     "local_world_aligned" the origin's acceleration and w_dot in world axes, "local" the same in
     the frame's axes, "world" those of the body point passing the world's origin (Pinocchio's
     getFrameClassicalAcceleration with a = 0)."""
-    from .frames import REFERENCES
+    from .frames import check_reference
 
     require_known_joints(kinematics.tree, "J_dot q_dot")
-    if reference not in REFERENCES:
-        raise InputError(f"unknown reference '{reference}'; use one of "
-                         f"{', '.join(REFERENCES)}", field="reference")
+    check_reference(reference)
     n, nq = kinematics.n, len(kinematics.coordinates)
     q, v = kinematics._q(q)[0].reshape(np.shape(q)), velocity_array(kinematics, v)
     batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])

@@ -77,6 +77,9 @@ class TreeKinematics:
         return world
 
     def _frame(self, name: str):
+        if not isinstance(name, str):  # (a list would not even hash)
+            raise InputError(f"a frame is named by a string, not a {type(name).__name__}",
+                             field="frame")
         if name not in self._frames:
             raise InputError(f"no frame named '{name}'{did_you_mean_or_list(name, self._frames)}",
                              field="frame")

@@ -39,7 +39,6 @@ from .frames import TreeKinematics, tree_kinematics
 
 if TYPE_CHECKING:
     from .model_frames import ModelKinematics
-from .reach_c import REFERENCE_INDEX
 
 
 def warn_undefined(count: int, total: int, stacklevel: int = 4) -> None:
@@ -238,7 +237,7 @@ class Dynamics(ControlTerms):
             fast = self._reach_kernel()
         if fast:
             try:
-                out = fast.placement(fast.placement_codes[frame], q)
+                out = fast.placement(q, frame)
             except (KeyError, ValueError, TypeError):
                 pass  # numpy below names the fault in one line
             else:
@@ -253,7 +252,7 @@ class Dynamics(ControlTerms):
             fast = self._reach_kernel()
         if fast:
             try:
-                out = fast.jacobian(fast.jacobian_codes[reference][frame], q)
+                out = fast.jacobian(q, frame, reference)
             except (KeyError, ValueError, TypeError):
                 pass  # numpy below names the fault in one line
             else:
@@ -289,7 +288,7 @@ class Dynamics(ControlTerms):
         fast = self._reach if self._reach is not None else self._reach_kernel()
         if fast:
             try:
-                out = fast.drift(q, v, fast.frame_index[frame], REFERENCE_INDEX[reference])
+                out = fast.drift(q, v, frame, reference)
                 return out if out.__class__ is not tuple else reported_rows(out, 1)
             except (KeyError, ValueError, TypeError):
                 pass  # numpy below broadcasts, or names the fault in one line

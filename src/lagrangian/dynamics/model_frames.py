@@ -84,6 +84,9 @@ class ModelKinematics:
                              "of a model file are for q alone; not yet", field=field)
 
     def _frame(self, name: str) -> _Frame:
+        if not isinstance(name, str):  # (a list would not even hash)
+            raise InputError(f"a frame is named by a string, not a {type(name).__name__}",
+                             field="frame")
         if name not in self._sources:
             raise InputError(f"no frame named '{name}'{did_you_mean_or_list(name, self._sources)}",
                              field="frame")

@@ -380,13 +380,45 @@ bad:
     return 0;
 }
 
-static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+/* a frame named by the kernel's dict {name: frame number} (the bound functions' self); -1
+ * with KeyError (TypeError for a name not hashable) where there is none */
+static int rk_frame_named(PyObject *index, PyObject *name)
 {
-    (void)self;
-    if (nargs != 4) { PyErr_SetString(PyExc_TypeError, "drift(Q, V, frame, ref)"); return NULL; }
-    int f = (int)PyLong_AsLong(args[2]), ref = (int)PyLong_AsLong(args[3]);
-    if (PyErr_Occurred()) return NULL;
-    if (f < 0 || f >= RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
+    PyObject *number = PyDict_GetItemWithError(index, name);
+    if (!number) {
+        if (!PyErr_Occurred()) PyErr_SetObject(PyExc_KeyError, name);
+        return -1;
+    }
+    const long f = PyLong_AsLong(number);
+    if (f == -1 && PyErr_Occurred()) return -1;
+    if (f < 0 || f >= RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return -1; }
+    return (int)f;
+}
+
+/* Pinocchio's ReferenceFrame by name: 0 world, 1 local, 2 local_world_aligned; -1 with
+ * KeyError else. The names interned at import (rk_references): Python's literals are the same
+ * objects, found by their address before any comparison of text */
+static PyObject *rk_references[3];
+
+static int rk_reference_named(PyObject *name)
+{
+    for (int k = 0; k < 3; k++)
+        if (name == rk_references[k]) return k;
+    if (PyUnicode_Check(name))
+        for (int k = 0; k < 3; k++)
+            if (PyUnicode_Compare(name, rk_references[k]) == 0) return k;
+    if (!PyErr_Occurred()) PyErr_SetObject(PyExc_KeyError, name);
+    return -1;
+}
+
+/* drift(Q, V, frame, reference) bound to the frames' dict -> [a; w_dot] (or with NaN rows) */
+static PyObject *rk_py_drift(PyObject *index, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 4) { PyErr_SetString(PyExc_TypeError, "drift(Q, V, frame, reference)"); return NULL; }
+    const int f = rk_frame_named(index, args[2]);
+    if (f < 0) return NULL;
+    const int ref = rk_reference_named(args[3]);
+    if (ref < 0) return NULL;
     PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
     if (!Q) return NULL;
     if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
@@ -405,21 +437,12 @@ static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t n
     return rk_result(out, bad);
 }
 
-/* a function of q alone, ([code, ]Q) -> its rows (tail0 x tail1 a state), or (rows, NaN
- * rows); code = 3 frame + reference (0 world, 1 local, 2 local_world_aligned) for a frame's
- * (reach_c.py's tables by name). One state is computed here, without the batch's machinery. */
-static PyObject *rk_of_q(PyObject *const *args, Py_ssize_t nargs, int kind, int tail0, int tail1)
+/* a function of q alone on Q (frame f, reference ref where it has them) -> its rows (tail0 x
+ * tail1 a state), or (rows, NaN rows). One state is computed here, without the batch's
+ * machinery. */
+static PyObject *rk_of_q(PyObject *Q_in, int kind, int f, int ref, int tail0, int tail1)
 {
-    const Py_ssize_t want = kind == RK_JACOBIAN || kind == RK_PLACEMENT ? 2 : 1;
-    if (nargs != want) { PyErr_Format(PyExc_TypeError, "expected %d arguments", (int)want); return NULL; }
-    int f = 0, ref = 0;
-    if (want > 1) {
-        const long code = PyLong_AsLong(args[0]);
-        if (PyErr_Occurred()) return NULL;
-        if (code < 0 || code >= 3L * RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
-        f = (int)(code / 3), ref = (int)(code % 3);
-    }
-    PyArrayObject *Q = rk_input(args[want - 1], RK_NQ, "q");
+    PyArrayObject *Q = rk_input(Q_in, RK_NQ, "q");
     if (!Q) return NULL;
     if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
     PyObject *out = rk_output(Q, tail0, tail1);
@@ -435,18 +458,58 @@ static PyObject *rk_of_q(PyObject *const *args, Py_ssize_t nargs, int kind, int 
     return rk_result(out, bad);
 }
 
+/* placement(Q, frame) and jacobian(Q, frame, reference), bound to the frames' dict: the name
+ * looked up here, not in Python (two dict lookups and an attribute there were a sixth of a
+ * single Jacobian's call) */
+static PyObject *rk_py_placement(PyObject *index, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 2) { PyErr_SetString(PyExc_TypeError, "placement(Q, frame)"); return NULL; }
+    const int f = rk_frame_named(index, args[1]);
+    return f < 0 ? NULL : rk_of_q(args[0], RK_PLACEMENT, f, 0, 4, 4);
+}
+
+static PyObject *rk_py_jacobian(PyObject *index, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 3) { PyErr_SetString(PyExc_TypeError, "jacobian(Q, frame, reference)"); return NULL; }
+    const int f = rk_frame_named(index, args[1]);
+    if (f < 0) return NULL;
+    const int ref = rk_reference_named(args[2]);
+    return ref < 0 ? NULL : rk_of_q(args[0], RK_JACOBIAN, f, ref, 6, RK_NV);
+}
+
 /* the functions of q alone, each rk_of_q with its kind and a state's output shape */
 #define RK_OF_Q(name, kind, tail0, tail1)                                                      \
     static PyObject *rk_py_##name(PyObject *self, PyObject *const *args, Py_ssize_t nargs)    \
     {                                                                                          \
         (void)self;                                                                            \
-        return rk_of_q(args, nargs, kind, tail0, tail1);                                       \
+        if (nargs != 1) { PyErr_SetString(PyExc_TypeError, #name "(Q)"); return NULL; }       \
+        return rk_of_q(args[0], kind, 0, 0, tail0, tail1);                                     \
     }
-RK_OF_Q(placement, RK_PLACEMENT, 4, 4)
-RK_OF_Q(jacobian, RK_JACOBIAN, 6, RK_NV)
 RK_OF_Q(com, RK_COM, 3, 0)
 RK_OF_Q(com_jacobian, RK_COM_JACOBIAN, 3, RK_NV)
 RK_OF_Q(centroidal, RK_CENTROIDAL, 6, RK_NV)
+
+static PyMethodDef rk_frame_methods[] = {
+    {"placement", (PyCFunction)(void (*)(void))rk_py_placement, METH_FASTCALL, "(Q, frame) -> 4 x 4, or (4 x 4, NaN rows)"},
+    {"jacobian", (PyCFunction)(void (*)(void))rk_py_jacobian, METH_FASTCALL, "(Q, frame, reference) -> 6 x n, or (6 x n, NaN rows)"},
+    {"drift", (PyCFunction)(void (*)(void))rk_py_drift, METH_FASTCALL, "(Q, V, frame, reference) -> [a; w_dot], or ([a; w_dot], NaN rows)"},
+};
+
+/* frames(INDEX) -> (placement, jacobian, drift) bound to INDEX, a dict {frame name: frame
+ * number} (a built-in function's self: called as fast as the module's own) */
+static PyObject *rk_py_frames(PyObject *self, PyObject *index)
+{
+    (void)self;
+    if (!PyDict_Check(index)) { PyErr_SetString(PyExc_TypeError, "frames(INDEX): a dict"); return NULL; }
+    PyObject *out = PyTuple_New(3);
+    if (!out) return NULL;
+    for (int k = 0; k < 3; k++) {
+        PyObject *bound = PyCFunction_NewEx(&rk_frame_methods[k], index, NULL);
+        if (!bound) { Py_DECREF(out); return NULL; }
+        PyTuple_SET_ITEM(out, k, bound);
+    }
+    return out;
+}
 
 /* wrench(Q, frame, W, OUT, sign): OUT += sign J^T w, in place (OUT float64, contiguous, of
  * Q's batch and RK_NV wide); W (6,) for every state or one row per state */
@@ -569,13 +632,11 @@ done:
 }
 
 static PyMethodDef rk_methods[] = {
-    {"drift", (PyCFunction)(void (*)(void))rk_py_drift, METH_FASTCALL, "(Q, V, frame, ref) -> [a; w_dot], or ([a; w_dot], NaN rows)"},
+    {"frames", (PyCFunction)rk_py_frames, METH_O, "(INDEX) -> (placement, jacobian, drift) bound to INDEX {frame name: number}"},
     {"centroidal", (PyCFunction)(void (*)(void))rk_py_centroidal, METH_FASTCALL, "(Q) -> A_g, or (A_g, NaN rows)"},
     {"wrench", (PyCFunction)(void (*)(void))rk_py_wrench, METH_FASTCALL, "(Q, frame, W, OUT, sign): OUT += sign J^T w; -> NaN rows"},
     {"coriolis", (PyCFunction)(void (*)(void))rk_py_coriolis, METH_FASTCALL, "(Q, V) -> C(q, v), or (C(q, v), NaN rows)"},
     {"inverse", (PyCFunction)(void (*)(void))rk_py_inverse, METH_FASTCALL, "(INDEX, UP, Q, V, A, F_EXT) -> tau, or (tau, NaN rows)"},
-    {"placement", (PyCFunction)(void (*)(void))rk_py_placement, METH_FASTCALL, "(3 frame, Q) -> 4 x 4, or (4 x 4, NaN rows)"},
-    {"jacobian", (PyCFunction)(void (*)(void))rk_py_jacobian, METH_FASTCALL, "(3 frame + ref, Q) -> 6 x n, or (6 x n, NaN rows)"},
     {"com", (PyCFunction)(void (*)(void))rk_py_com, METH_FASTCALL, "(Q) -> c, or (c, NaN rows)"},
     {"com_jacobian", (PyCFunction)(void (*)(void))rk_py_com_jacobian, METH_FASTCALL, "(Q) -> J_c, or (J_c, NaN rows)"},
     {NULL, NULL, 0, NULL},
@@ -586,5 +647,9 @@ static struct PyModuleDef rk_module = {PyModuleDef_HEAD_INIT, RK_STR(LG_MODULE),
 PyMODINIT_FUNC RK_PASTE(PyInit_, LG_MODULE)(void)
 {
     import_array();
+    const char *references[3] = {"world", "local", "local_world_aligned"};
+    for (int k = 0; k < 3; k++)
+        if (!rk_references[k] && !(rk_references[k] = PyUnicode_InternFromString(references[k])))
+            return NULL;
     return PyModule_Create(&rk_module);
 }

@@ -25,6 +25,7 @@ _KERNELS = tuple(Path(__file__).with_name(name)
                               "reach_inverse.c", "batch_threads.c", "reach_bindings.c"))
 _CORE = 4
 _SCALAR = """#define RK_T double
+#define RK_ONE_STATE 1
 #define RK_FN(name) rk_##name
 #define RK_C(x) (x)
 #define RK_SINCOS lg_sincos"""
@@ -32,6 +33,8 @@ _LANES = """#undef RK_T
 #undef RK_FN
 #undef RK_C
 #undef RK_SINCOS
+#undef RK_ONE_STATE
+#define RK_ONE_STATE 0
 #define RK_T lg_v4
 #define RK_FN(name) rk4_##name
 #define RK_C(x) LG_V4(x)
@@ -168,14 +171,10 @@ class ReachKernel:
     def __init__(self, module, tree: KinematicTree, massive: bool):
         self.module = module
         self.frame_index = {f.name: k for k, f in enumerate(tree.frames)}
-        self.drift = module.drift
-        # (code, Q): a frame's code by name (and reference) is reach_bindings.c's rk_of_q's 3
-        # frame + reference, looked up here rather than bound to the function (a bound method
-        # or functools.partial costs a call 30-50 ns more: a tenth of the Jacobian's)
-        self.placement, self.jacobian = module.placement, module.jacobian
-        self.placement_codes = {f.name: 3 * k for k, f in enumerate(tree.frames)}
-        self.jacobian_codes = {name: {f.name: 3 * k + ref for k, f in enumerate(tree.frames)}
-                               for name, ref in REFERENCE_INDEX.items()}
+        # placement(Q, frame), jacobian(Q, frame, reference) and drift(Q, V, frame, reference)
+        # with the frame and reference looked up by name in C (reach_bindings.c): in Python the
+        # lookups cost a single Jacobian's call a sixth of its time
+        self.placement, self.jacobian, self.drift = module.frames(self.frame_index)
         # A_g and the centre of mass need moving mass (else numpy refuses them in one line)
         self.centroidal = module.centroidal if massive else None
         self.center_of_mass = module.com if massive else None

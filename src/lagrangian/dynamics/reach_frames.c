@@ -33,7 +33,7 @@ static void RK_FN(jacobian)(const RK_T *q, int f, int ref, RK_T *out)
         for (int j = 0; j < 6 * RK_NV; j++) out[j] = RK_C(0.0);
         return;
     }
-#if RK_CSET
+#if RK_CSET && !RK_ONE_STATE
     unsigned char set[RK_NV] = {0};
 #else
     for (int j = 0; j < 6 * RK_NV; j++) out[j] = RK_C(0.0);
@@ -65,12 +65,12 @@ static void RK_FN(jacobian)(const RK_T *q, int f, int ref, RK_T *out)
                 RK_CPUT(out[j * RK_NV + c], mult * v[j]);
                 RK_CPUT(out[(3 + j) * RK_NV + c], mult * w[j]);
             }
-#if RK_CSET
+#if RK_CSET && !RK_ONE_STATE
             set[c] = 1;
 #endif
         }
     }
-#if RK_CSET
+#if RK_CSET && !RK_ONE_STATE
     for (int c = 0; c < RK_NV; c++)
         if (!set[c])
             for (int j = 0; j < 6; j++) out[j * RK_NV + c] = RK_C(0.0);

@@ -112,9 +112,14 @@ static inline __attribute__((always_inline)) void RK_FN(body)(const RK_T *q, int
         Rq[4] = 1 - 2 * k * (x * x + z * z); Rq[5] = 2 * k * (y * z - x * w);
         Rq[6] = 2 * k * (x * z - y * w); Rq[7] = 2 * k * (y * z + x * w);
         Rq[8] = 1 - 2 * k * (x * x + y * y);
-        RK_FN(matmul_k)(rk_R0[i], Rq, Rl);
-        RK_FN(apply_k)(rk_R0[i], q, d);
-        for (int j = 0; j < 3; j++) pl[j] += d[j];
+        if (rk_R0id[i]) {  /* the usual free flyer, at the URDF root's own axes */
+            for (int j = 0; j < 9; j++) Rl[j] = Rq[j];
+            for (int j = 0; j < 3; j++) pl[j] += q[j];
+        } else {
+            RK_FN(matmul_k)(rk_R0[i], Rq, Rl);
+            RK_FN(apply_k)(rk_R0[i], q, d);
+            for (int j = 0; j < 3; j++) pl[j] += d[j];
+        }
     } else {
         const RK_T th = rk_mult[i] * q[RK_BQ + rk_coord[i]] + rk_off[i];
         if (rk_turns[i] && !rk_slides[i] && rk_axis[i] >= 0) {
@@ -194,7 +199,7 @@ static int RK_FN(path)(const RK_T *q, int b, int *path, RK_T (*R)[9], RK_T (*o)[
 }
 
 /* S of body i's joint at the world's origin, world axes: [s_v; s_w] */
-static inline void RK_FN(subspace)(int i, RK_T (*R)[9], RK_T (*o)[3], RK_T *S)
+static inline __attribute__((always_inline)) void RK_FN(subspace)(int i, RK_T (*R)[9], RK_T (*o)[3], RK_T *S)
 {
     RK_T d[3];
     RK_FN(apply_v)(R[i], rk_u[i], d);
@@ -210,7 +215,7 @@ static inline void RK_FN(subspace)(int i, RK_T (*R)[9], RK_T (*o)[3], RK_T *S)
 
 /* a free flyer's six columns at the world's origin, world axes (S = 1 in the base's axes):
  * S[c] = [R e_c; 0], S[3 + c] = [o x R e_c; R e_c] */
-static inline void RK_FN(free_columns)(const RK_T *R, const RK_T *o, RK_T (*S)[6])
+static inline __attribute__((always_inline)) void RK_FN(free_columns)(const RK_T *R, const RK_T *o, RK_T (*S)[6])
 {
     for (int c = 0; c < 3; c++) {
         RK_T w[3] = {R[c], R[3 + c], R[6 + c]}, v[3];
@@ -224,7 +229,7 @@ static inline void RK_FN(free_columns)(const RK_T *R, const RK_T *o, RK_T (*S)[6
 
 /* a joint's columns at the world's origin, world axes, and the first coordinate they fill:
  * a free flyer's six, else one (times the joint's multiplier) */
-static inline int RK_FN(columns)(int i, RK_T (*R)[9], RK_T (*o)[3], RK_T (*F)[6], int *first,
+static inline __attribute__((always_inline)) int RK_FN(columns)(int i, RK_T (*R)[9], RK_T (*o)[3], RK_T (*F)[6], int *first,
                                  double *mult)
 {
     if (RK_FREE(i)) {

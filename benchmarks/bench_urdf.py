@@ -5,7 +5,10 @@ file to compiled functions (cold and from the cache).
     python benchmarks/bench_urdf.py [ur5|panda|xarm7 ...] [--states 100] [--symbolic numpy|c]
     python benchmarks/bench_urdf.py --reach [ur5|panda|xarm7 ...]
 
-``--reach`` times issue 23's functions instead, on the last moving link's frame: J_dot q_dot against
+``--reach`` times issue 23's functions instead, on the last moving link's frame: its placement
+against forwardKinematics + updateFramePlacement, its Jacobian (LOCAL_WORLD_ALIGNED) against
+computeFrameJacobian, the centre of mass and its Jacobian against centerOfMass and
+jacobianCenterOfMass, C(q, v) against computeCoriolisMatrix, J_dot q_dot against
 forwardKinematics(q, v, 0) + getFrameClassicalAcceleration (LOCAL_WORLD_ALIGNED), the
 centroidal momentum matrix against ccrba, and inverse and forward dynamics with a wrench at that
 frame against rnea and aba with f_ext (Pinocchio given its per-joint f_ext ready made; ours
@@ -237,14 +240,26 @@ def bench_reach(name: str, states: int, timing: bool = True) -> None:
         pin.forwardKinematics(model, data, qk, vk, np.zeros(n))
         return pin.getFrameClassicalAcceleration(model, data, fid, lwa).vector
 
+    def placement(qk):
+        pin.forwardKinematics(model, data, qk)
+        return pin.updateFramePlacement(model, data, fid).homogeneous
+
     wrench = {frame: w}
-    ours = {"Jdot v": f.jacobian_dot_times_v(q, v, frame), "A_g": f.centroidal_momentum_matrix(q),
+    ours = {"placement": f.placement(q, frame), "jacobian": f.jacobian(q, frame),
+            "CoM": f.center_of_mass(q), "CoM J": f.center_of_mass_jacobian(q),
+            "C": f.coriolis_matrix(q, v),
+            "Jdot v": f.jacobian_dot_times_v(q, v, frame), "A_g": f.centroidal_momentum_matrix(q),
             "ID f_ext": f.inverse_dynamics(q, v, a, f_ext=wrench),
             "FD f_ext": f.forward_dynamics(q, v, tau, f_ext=wrench)}
     errors = dict.fromkeys(ours, 0.0)
     for k in range(states):
         forces = f_ext(q[k])
-        theirs = {"Jdot v": drift(q[k], v[k]), "A_g": pin.ccrba(model, data, q[k], v[k]).copy(),
+        theirs = {"placement": placement(q[k]),
+                  "jacobian": pin.computeFrameJacobian(model, data, q[k], fid, lwa),
+                  "CoM": pin.centerOfMass(model, data, q[k]).copy(),
+                  "CoM J": pin.jacobianCenterOfMass(model, data, q[k]).copy(),
+                  "C": pin.computeCoriolisMatrix(model, data, q[k], v[k]).copy(),
+                  "Jdot v": drift(q[k], v[k]), "A_g": pin.ccrba(model, data, q[k], v[k]).copy(),
                   "ID f_ext": pin.rnea(model, data, q[k], v[k], a[k], forces),
                   "FD f_ext": pin.aba(model, data, q[k], v[k], tau[k], forces)}
         for key in errors:
@@ -255,7 +270,16 @@ def bench_reach(name: str, states: int, timing: bool = True) -> None:
         return
     q0, v0, a0, t0 = q[0].copy(), v[0].copy(), a[0].copy(), tau[0].copy()
     forces0 = f_ext(q0)
-    rows = [("Jdot v / classical acc", lambda: f.jacobian_dot_times_v(q0, v0, frame),
+    rows = [("placement", lambda: f.placement(q0, frame), lambda: placement(q0)),
+            ("jacobian / computeFrameJ", lambda: f.jacobian(q0, frame),
+             lambda: pin.computeFrameJacobian(model, data, q0, fid, lwa)),
+            ("CoM / centerOfMass", lambda: f.center_of_mass(q0),
+             lambda: pin.centerOfMass(model, data, q0)),
+            ("CoM J / jacobianCoM", lambda: f.center_of_mass_jacobian(q0),
+             lambda: pin.jacobianCenterOfMass(model, data, q0)),
+            ("C / computeCoriolisM", lambda: f.coriolis_matrix(q0, v0),
+             lambda: pin.computeCoriolisMatrix(model, data, q0, v0)),
+            ("Jdot v / classical acc", lambda: f.jacobian_dot_times_v(q0, v0, frame),
              lambda: drift(q0, v0)),
             ("A_g / ccrba", lambda: f.centroidal_momentum_matrix(q0),
              lambda: pin.ccrba(model, data, q0, v0)),
@@ -272,6 +296,15 @@ def bench_reach(name: str, states: int, timing: bool = True) -> None:
     print(f"  batch of {big} (ms): ours one call, Pinocchio Python loop, ratio; the same by "
           f"CPU time (this process's, threads summed); load average {load_average()}")
     for label, mine, theirs in [
+            ("placement", lambda: f.placement(Q, frame), lambda: [placement(x) for x in Q]),
+            ("jacobian", lambda: f.jacobian(Q, frame),
+             lambda: [pin.computeFrameJacobian(model, data, x, fid, lwa) for x in Q]),
+            ("CoM", lambda: f.center_of_mass(Q),
+             lambda: [pin.centerOfMass(model, data, x) for x in Q]),
+            ("CoM J", lambda: f.center_of_mass_jacobian(Q),
+             lambda: [pin.jacobianCenterOfMass(model, data, x) for x in Q]),
+            ("C", lambda: f.coriolis_matrix(Q, V),
+             lambda: [pin.computeCoriolisMatrix(model, data, x, y) for x, y in zip(Q, V, strict=True)]),
             ("Jdot v", lambda: f.jacobian_dot_times_v(Q, V, frame),
              lambda: [drift(x, y) for x, y in zip(Q, V, strict=True)]),
             ("A_g", lambda: f.centroidal_momentum_matrix(Q),

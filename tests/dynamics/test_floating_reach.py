@@ -90,6 +90,25 @@ def test_the_tree_coriolis_matrix_is_the_christoffel_one_on_a_fixed_base():
     _close(coriolis_matrix(fixed.kinematics, q, v), fixed.coriolis_matrix(q, v))
 
 
+def test_a_fixed_base_c_compiled_is_the_christoffel_one():
+    """The compiled factorization (reach_coriolis.c) on a fixed base equals M's Christoffel C
+    from the bias forces (numpy), also with a link's mass set by a parameter, and C q_dot is
+    the bias less gravity."""
+    path = _robots() / "solo_description/robots/solo12.urdf"
+    rng = np.random.default_rng(6)
+    q, v = rng.uniform(-1, 1, (2, 5, 12))
+    for parameters in (None, {"FL_UPPER_LEG.mass": 2.5}):
+        system = lagrangian.load(path)
+        fast = system.dynamics(parameters=parameters)
+        slow = system.dynamics(parameters=parameters, backend="numpy")
+        C = fast.coriolis_matrix(q, v)
+        assert fast._reach and fast._reach.fixed_coriolis  # the compiled path, checked
+        _close(C, slow.coriolis_matrix(q, v))
+        _close(np.einsum("nij,nj->ni", C, v), slow.bias_forces(q, v) - slow.gravity(q))
+    heavier = fast.mass_matrix(q[0])
+    assert not np.allclose(heavier, lagrangian.load(path).dynamics().mass_matrix(q[0]))
+
+
 def test_frame_accelerations_and_centroidal_momentum_of_solo():
     """J_dot v of every frame of Solo12 in the three references (getFrameClassicalAcceleration
     with a = 0) and A_g (ccrba) on its floating base, to 1e-12."""

@@ -419,6 +419,17 @@ class Dynamics(ControlTerms):
                 "C(q, q_dot) is the matrix of the Coriolis and centrifugal terms of M; this "
                 "model's velocity terms are not only those (a damper, a velocity-dependent load, "
                 "a moving support, or M changing with t): use bias_forces(q, q_dot)")
+        fast = self._reach if self._reach is not None else self._reach_kernel()
+        if fast:  # a fixed tree's C by the same factorization, compiled, where checked equal
+            compiled = fast.fixed_coriolis
+            if compiled is None:
+                compiled = fast.checked_coriolis(self)
+            if compiled:
+                try:
+                    out = compiled(q, v)
+                    return out if out.__class__ is not tuple else reported_rows(out, 2)
+                except (ValueError, TypeError):
+                    pass  # numpy below broadcasts, or names the fault in one line
         return self._guarded(self._christoffel_coriolis, (q, v), ("q", "v"), (self.n, self.n))
 
     def _christoffel_coriolis(self, q, v) -> np.ndarray:

@@ -179,12 +179,36 @@ class ReachKernel:
         self.centroidal = module.centroidal if massive else None
         self.center_of_mass = module.com if massive else None
         self.center_of_mass_jacobian = module.com_jacobian if massive else None
-        # a fixed base's C is M's Christoffel symbols (joint_space.py); a floating base's here
+        # a floating base's C by Pinocchio's factorization; a fixed base's is M's Christoffel
+        # symbols (joint_space.py), which the same factorization gives: None until
+        # checked_coriolis has compared the two, then the compiled function or False
         self.coriolis = module.coriolis if tree.floating_base else None
+        self.fixed_coriolis = None if not tree.floating_base else False
         self.tree = tree
         # inverse dynamics less wrenches in one pass (q, v, a, f_ext) -> tau: None until
         # fused_inverse has asked, then the compiled function or False
         self.inverse = None
+
+    def checked_coriolis(self, dynamics):
+        """A fixed base's C(q, v) compiled (reach_coriolis.c), where it is ``dynamics``' own
+        Christoffel C (the rates of M's entries, from its bias forces), checked once at random
+        states to 1e-9 relative: not where a parameter or an actuator makes the dynamics' M
+        other than the tree's tables; else False (numpy's Christoffel C stays)."""
+        if self.fixed_coriolis is not None:
+            return self.fixed_coriolis
+        self.fixed_coriolis = False
+        rng = np.random.default_rng(0)
+        q, v = rng.uniform(-1.0, 1.0, (2, 3, dynamics.n))
+        try:
+            compiled = np.asarray(self.module.coriolis(q, v), dtype=float)
+            with np.errstate(all="ignore"):
+                christoffel = np.asarray(dynamics._christoffel_coriolis(q, v), dtype=float)
+        except (ValueError, TypeError):
+            return False
+        scale = 1.0 + np.abs(christoffel).max()
+        if np.abs(compiled - christoffel).max() <= 1e-9 * scale:
+            self.fixed_coriolis = self.module.coriolis
+        return self.fixed_coriolis
 
     def fused_inverse(self, dynamics):
         """Inverse dynamics less wrenches in one pass for ``dynamics`` (q, v, a, f_ext) -> tau,

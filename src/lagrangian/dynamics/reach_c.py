@@ -38,7 +38,7 @@ _LANES = """#undef RK_T
 #define RK_T lg_v4
 #define RK_FN(name) rk4_##name
 #define RK_C(x) LG_V4(x)
-#define RK_SINCOS lg_vsincos"""
+#define RK_SINCOS lg_vsincos_inline"""
 REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
 
 

@@ -159,7 +159,11 @@ static inline lg_v4 lg_vsqrt(lg_v4 x)
     return r;
 }
 
-static inline void lg_vsincos(lg_v4 x, lg_v4 *sine, lg_v4 *cosine)
+/* sine and cosine on every lane, always written out where called (lg_vsincos_inline: a call
+   spills every vector register the caller holds, a quarter of a frame's placement on a batch)
+   or left to the compiler (lg_vsincos: an unrolled tree's many joints) */
+static inline __attribute__((always_inline)) void lg_vsincos_inline(lg_v4 x, lg_v4 *sine,
+                                                                    lg_v4 *cosine)
 {
     int reducible = 1;
     for (int l = 0; l < LG_LANES; l++) reducible &= fabs(x[l]) < 1.0e5;
@@ -179,6 +183,11 @@ static inline void lg_vsincos(lg_v4 x, lg_v4 *sine, lg_v4 *cosine)
     const lg_u4 odd = -(k & 1), si = (lg_u4)s, ci = (lg_u4)c;
     *sine = (lg_v4)(((odd & ci) | (~odd & si)) ^ ((k & 2) << 62));
     *cosine = (lg_v4)(((odd & si) | (~odd & ci)) ^ (((k + 1) & 2) << 62));
+}
+
+static inline void lg_vsincos(lg_v4 x, lg_v4 *sine, lg_v4 *cosine)
+{
+    lg_vsincos_inline(x, sine, cosine);
 }
 
 /* The lanes' outputs as the states' rows: row l (``width`` doubles at y + l width) gets

@@ -15,9 +15,10 @@ import pytest
 import lagrangian
 from lagrangian.compile import compiled
 from lagrangian.compile.functions import numeric
-from lagrangian.dynamics.joint_space import Dynamics, recursive_dynamics
+from lagrangian.dynamics.joint_space import Dynamics
 from lagrangian.dynamics.recursive import RecursiveDynamics, applicable_tree
 from lagrangian.dynamics.recursive_numpy import RecursiveNumpyDynamics
+from lagrangian.dynamics.selection import recursive_dynamics
 from lagrangian.errors import ModelError
 
 pytest.importorskip("yourdfpy")

@@ -239,7 +239,7 @@ def test_massless_branch_is_refused_naming_the_lock(tmp_path, no_compiler):
     text = URDF.robot(URDF.link("base"), URDF.link("a", 1.0, (0.3, 0, 0)), URDF.link("b"),
                       URDF.joint("j1", "base", "a", axis="0 -1 0"),
                       URDF.joint("j2", "a", "b", xyz="0.6 0 0", axis="0 -1 0"))
-    from lagrangian.dynamics.joint_space import recursive_dynamics
+    from lagrangian.dynamics.selection import recursive_dynamics
 
     system = arm(tmp_path, text)
     with pytest.raises(DerivationError, match="URDF joint 'j2' moves no mass.*--lock j2=0"):

@@ -33,7 +33,7 @@ from ..derivation.lagrange import derive
 from ..derivation.regularity import require_inertia
 from ..derivation.steps import DerivationSteps
 from ..dynamics.actuators import actuated
-from ..dynamics.joint_space import model_dynamics, recursive_dynamics
+from ..dynamics.selection import model_dynamics, recursive_dynamics
 from ..dynamics.standalone import StandaloneSource
 from ..dynamics.tree_at_rest import TreeAtRest
 from ..errors import InputError, LagrangianError, did_you_mean

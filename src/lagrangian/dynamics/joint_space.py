@@ -12,8 +12,8 @@ terms only. Units SI (rad or m per coordinate; N m or N for tau; J for energies)
 
 A robot read from URDF (a tree of rigid bodies on revolute, prismatic and fixed joints, nothing
 added) is evaluated by recursive algorithms in generated C instead (recursive.py; in numpy,
-recursive_numpy.py, without a compiler), without deriving its equations: ``model_dynamics``
-picks that path wherever it applies.
+recursive_numpy.py, without a compiler), without deriving its equations: selection.py's
+``model_dynamics`` picks that path wherever it applies.
 
 Batches report, not fail: a state whose inputs are not all finite, or (forward dynamics) whose
 M is not positive definite, gives NaN in its own output row; every other row equals the call
@@ -518,98 +518,4 @@ class TreeDynamics(Dynamics):
                            for p, v in zip(model.parameters, values.values, strict=True)}
 
 
-def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = None,
-                       backend: str = "auto", kernel: str = "auto"):
-    """The recursive dynamics of a URDF tree, or of a model file's tree of rigid bodies on
-    joints (at least TREE_PATH_BODIES of them): compiled C (recursive.RecursiveDynamics, the
-    tree's own unrolled module, or compact_kernel.CompactDynamics, one module for every tree:
-    ``kernel`` "unrolled", "compact" or "auto" by the tree's size and whether a link's inertial
-    is set), or numpy (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with
-    backend "auto", where no compiler works; None where they do not apply: not a bare tree, or
-    a mass matrix that is not positive definite (the symbolic path names the joints).
-
-    ``parameters`` may set a URDF link's inertial by ``<link>.<field>`` (model/tree.py
-    INERTIAL_FIELDS: mass, com_x, ..., ixx, ...), as if the URDF had been edited."""
-    from ..compile.compiled import BackendUnavailable
-    from ..compile.functions import tell_numpy_fallback
-    from ..model.urdf_payload import PREFIX as PAYLOAD_PREFIX
-    from .compact_kernel import COMPACT_ABOVE, CompactDynamics
-    from .inertials import split_inertials
-    from .recursive import TREE_PATH_BODIES, RecursiveDynamics, applicable_tree
-    from .recursive_numpy import RecursiveNumpyDynamics
-
-    if kernel not in ("auto", "unrolled", "compact"):
-        raise InputError(f"unknown kernel {kernel!r} (auto, unrolled or compact)", field="kernel")
-    if backend not in ("auto", "c", "numpy"):
-        return None
-    parameters, inertials = split_inertials(model.kinematic_tree, parameters)
-    tree = applicable_tree(model, parameters)
-    # a model file's small tree keeps its derived equations (quick to compile, as written)
-    if tree is None or (model.kinematic_tree is None and len(tree.joints) < TREE_PATH_BODIES):
-        return None
-    if inertials:
-        tree = inertials
-    dynamics = None
-    if backend != "numpy":
-        # a link's inertial set here, or a payload: the compact kernel takes them at run time;
-        # a floating base too (its free flyer is body 0 there)
-        compact = kernel == "compact" or (kernel == "auto" and (
-            inertials or len(tree.joints) > COMPACT_ABOVE
-            or any(link.name.startswith(PAYLOAD_PREFIX) for link in tree.links)))
-        try:
-            dynamics = (CompactDynamics if compact else RecursiveDynamics)(model, tree, parameters)
-        except BackendUnavailable as exc:
-            if backend == "c":
-                raise
-            # the same algorithms in numpy: the expanded equations of a 7-joint arm are too
-            # deep for lambdify, the recursions are not
-            tell_numpy_fallback(exc, "the robot's recursive dynamics run in numpy, about 1000x "
-                                "slower per call than compiled C")
-    if dynamics is None:
-        dynamics = RecursiveNumpyDynamics(model, tree, parameters)
-    if tree.floating_base or dynamics.regular():
-        # a floating base has no symbolic path to fall to: NaN rows where M is singular
-        return dynamics
-    if inertials:  # the derived equations know no link parameters: say what is wrong here
-        raise InputError("with these link inertials the mass matrix is not positive definite "
-                         "(a joint that moves no mass)", field="parameters")
-    _refuse_massless_joints(model, dynamics)
-    return None
-
-
-def _refuse_massless_joints(model: Model, dynamics) -> None:
-    """Joints whose column of M is zero (they carry only massless links, Romeo's hands): one
-    line naming them and the fix, lock, before a long derivation would find the same."""
-    from ..errors import lock_hint
-
-    rng = np.random.default_rng(1)
-    M = dynamics.mass_matrix(rng.uniform(-np.pi, np.pi, (3, dynamics.n)))
-    diagonal = np.abs(np.diagonal(M, axis1=-2, axis2=-1)).max(axis=0)
-    idle = [c for c, d in zip(dynamics.coordinates, diagonal, strict=True)
-            if not d > 1e-14 * max(1.0, float(diagonal.max()))]
-    if idle:
-        joints = dict(model.source_names)
-        raise DerivationError(lock_hint([joints.get(c, c) for c in idle]))
-
-
-def model_dynamics(model: Model, symbolic: Callable[[], NumericSystem],
-                   parameters: Mapping[str, float] | None = None, backend: str = "auto",
-                   equations: Callable[[], EquationsOfMotion] | None = None,
-                   kernel: str = "auto"):
-    """Recursive dynamics where they apply, else Dynamics over ``symbolic()`` (the numeric
-    functions of the derived equations; ``equations()`` gives them for coriolis_matrix), or for
-    a model with constraints constrained.ConstrainedDynamics (forward dynamics only)."""
-    fast = recursive_dynamics(model, parameters, backend, kernel)
-    if fast is not None:
-        return fast
-    if model.constraints:  # the DAE's forward dynamics, through the multipliers
-        from .constrained import ConstrainedDynamics
-
-        return ConstrainedDynamics(symbolic(), equations, model)
-    dynamics = Dynamics(symbolic(), equations)
-    dynamics.model = model  # for its frames (model_frames.py)
-    return dynamics
-
-
-__all__ = ["Dynamics", "TreeDynamics", "model_dynamics", "recursive_dynamics", "solve_positive",
-           "warn_undefined"]
+__all__ = ["Dynamics", "TreeDynamics", "solve_positive", "warn_undefined"]

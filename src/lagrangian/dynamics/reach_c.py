@@ -18,11 +18,12 @@ from .joint_models import joint_model
 from .tree_c import _SINCOS, _VECTOR
 
 # the walks, frames and the centre of mass, C(q, v), inverse dynamics with wrenches, then the
-# Python bindings: one module's C, in this order; the first four's core (from reach_kernel.c's
-# RK_CORE_BEGIN) twice, on one state and on LG_LANES states at once
+# batches and the Python bindings: one module's C, in this order; the first four's core (from
+# reach_kernel.c's RK_CORE_BEGIN) twice, on one state and on LG_LANES states at once
 _KERNELS = tuple(Path(__file__).with_name(name)
                  for name in ("reach_kernel.c", "reach_frames.c", "reach_coriolis.c",
-                              "reach_inverse.c", "batch_threads.c", "reach_bindings.c"))
+                              "reach_inverse.c", "batch_threads.c", "reach_batch.c",
+                              "reach_bindings.c"))
 _CORE = 4
 _SCALAR = """#define RK_T double
 #define RK_ONE_STATE 1

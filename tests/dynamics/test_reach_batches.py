@@ -219,3 +219,24 @@ def test_compiled_frames_and_centre_of_mass_are_the_kinematics_walks(tmp_path, r
         v, h = rng.uniform(-1.0, 1.0, (COUNT, robot.n)), 1e-6
         central = (robot.center_of_mass(q + h * v) - robot.center_of_mass(q - h * v)) / (2 * h)
         np.testing.assert_allclose(np.einsum("kij,kj->ki", J, v), central, rtol=0, atol=1e-8)
+
+
+def test_turns_of_any_size_place_frames_as_numpy_does(tmp_path):
+    """The kernels' own sine and cosine (tree_c.py: a reduction by pi/2, the quadrant chosen
+    by selects) in every quadrant, large angles and beyond the reduction's range (libm there),
+    one state and on the lanes: placements and Jacobians equal numpy's sin and cos walks."""
+    robot = _robot(tmp_path, ARM)
+    slow = lagrangian.load(tmp_path / "robot.urdf").dynamics(backend="numpy")
+    quarter = np.pi / 2
+    angles = np.concatenate([k * quarter + np.array([-0.3, 0.0, 0.4]) for k in range(-5, 6)]
+                            + [[1000.3, -777.7, 5.0e4, -9.9e4, 2.0e5, -3.0e7]])
+    q = np.zeros((angles.size, 3))
+    q[:, 0], q[:, 1] = angles, angles[::-1]
+    for frame in ("tool", "b"):
+        fast_pose, slow_pose = robot.placement(q, frame), slow.placement(q, frame)
+        np.testing.assert_allclose(fast_pose, slow_pose, rtol=0, atol=1e-12)
+        for k in range(0, len(q), 7):  # one state at a time: the scalar kernel
+            np.testing.assert_allclose(robot.placement(q[k], frame), slow_pose[k], rtol=0,
+                                       atol=1e-12)
+        np.testing.assert_allclose(robot.jacobian(q, frame), slow.jacobian(q, frame), rtol=0,
+                                   atol=1e-12)

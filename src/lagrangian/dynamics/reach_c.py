@@ -29,7 +29,7 @@ _SCALAR = """#define RK_T double
 #define RK_ONE_STATE 1
 #define RK_FN(name) rk_##name
 #define RK_C(x) (x)
-#define RK_SINCOS lg_sincos"""
+#define RK_SINCOS lg_sincos_inline"""
 _LANES = """#undef RK_T
 #undef RK_FN
 #undef RK_C

@@ -23,15 +23,25 @@ def _inputs(name: str, n: int) -> list[str]:
 
 _SINCOS = r"""
 /* sin and cos of x (fdlibm's kernels on [-pi/4, pi/4] after a three-part reduction by pi/2;
-   libm beyond |x| = 1e5 and for NaN): within an ulp or two, no library call. */
-static inline void lg_sincos(double x, double *sine, double *cosine)
+   libm beyond |x| = 1e5 and for NaN): within an ulp or two, no library call. Always written
+   out where called (lg_sincos_inline: a single frame's placement), or left to the compiler
+   (lg_sincos: an unrolled tree's many joints). */
+static inline __attribute__((always_inline)) void lg_sincos_inline(double x, double *sine,
+                                                                  double *cosine)
 {
     if (!(fabs(x) < 1.0e5)) { *sine = sin(x); *cosine = cos(x); return; }
 """ + sincos_kernel("double") + r"""
-    const double turn[4] = {s, c, -s, -c};
+    /* the quadrant k = n mod 4 picks (s, c, -s, -c) by selects: from a table on the stack the
+       load waited on the store (a tenth of a frame's placement) */
     const long k = (long)n;
-    *sine = turn[k & 3];
-    *cosine = turn[(k + 1) & 3];
+    const double odd_s = (k & 1) ? c : s, odd_c = (k & 1) ? s : c;
+    *sine = (k & 2) ? -odd_s : odd_s;
+    *cosine = ((k + 1) & 2) ? -odd_c : odd_c;
+}
+
+static inline void lg_sincos(double x, double *sine, double *cosine)
+{
+    lg_sincos_inline(x, sine, cosine);
 }
 """
 

@@ -40,7 +40,6 @@ _LANES = """#undef RK_T
 #define RK_FN(name) rk4_##name
 #define RK_C(x) LG_V4(x)
 #define RK_SINCOS lg_vsincos_inline"""
-REFERENCE_INDEX = {"world": 0, "local": 1, "local_world_aligned": 2}
 
 
 def _turn_tables(joints) -> list[str]:
@@ -253,4 +252,4 @@ class ReachKernel:
         return bad
 
 
-__all__ = ["REFERENCE_INDEX", "ReachKernel", "kernel_source", "reach_module"]
+__all__ = ["ReachKernel", "kernel_source", "reach_module"]

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..kinds import JointKind
+from .numbers import batch_shape, float_array
 from .recursive_numpy import _cross, _dot
 
 # the joints of one coordinate each (the compiled kernel of reach_c.py takes only these)
@@ -59,7 +60,7 @@ def velocity_array(kinematics, v, field: str = "v") -> np.ndarray:
     """v as an array of nv numbers along the last axis, else one line naming ``field``."""
     from .free_flyer import BASE_VELOCITY
 
-    v = np.asarray(v, dtype=float)
+    v = float_array(v, field)
     if v.ndim == 0 or v.shape[-1] != kinematics.n:
         tree = kinematics.tree
         names = (BASE_VELOCITY if tree.floating_base else ()) + tuple(tree.coordinates)
@@ -104,7 +105,7 @@ def jacobian_dot_times_v(kinematics, q, v, frame: str, reference: str) -> np.nda
     check_reference(reference)
     n, nq = kinematics.n, len(kinematics.coordinates)
     q, v = kinematics._q(q)[0].reshape(np.shape(q)), velocity_array(kinematics, v)
-    batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
+    batch = batch_shape((q, v), ("q", "v"))
     Q = np.broadcast_to(q, batch + (nq,)).reshape(-1, nq)
     V = np.broadcast_to(v, batch + (n,)).reshape(-1, n)
     bodies = kinematics._bodies(Q)

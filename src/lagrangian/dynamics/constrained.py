@@ -21,6 +21,7 @@ from ..compile.functions import NumericSystem
 from ..compile.lambdified import StateFunction
 from ..errors import DynamicsWarning, InputError, ModelError
 from ..model.expressions import as_expression
+from .numbers import float_array
 
 
 class ConstrainedDynamics:
@@ -55,7 +56,7 @@ class ConstrainedDynamics:
     def _states(self, q, v, tau, t):
         arrays = []
         for value, field in ((q, "q"), (v, "v"), (tau, "tau")):
-            array = np.asarray(value, dtype=float)
+            array = float_array(value, field)
             if array.ndim == 0 or array.shape[-1] != self.n:
                 shape = "()" if array.ndim == 0 else str(array.shape)
                 raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) "

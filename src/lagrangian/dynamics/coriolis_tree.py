@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from .centroidal import require_known_joints, velocity_array, world_columns
+from .numbers import batch_shape
 
 
 def _skew(x: np.ndarray) -> np.ndarray:
@@ -75,7 +76,7 @@ def coriolis_matrix(kinematics, q, v) -> np.ndarray:
     require_known_joints(kinematics.tree, "C(q, v)")
     n, nq = kinematics.n, len(kinematics.coordinates)
     q, v = kinematics._q(q)[0].reshape(np.shape(q)), velocity_array(kinematics, v)
-    batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
+    batch = batch_shape((q, v), ("q", "v"))
     Q = np.broadcast_to(q, batch + (nq,)).reshape(-1, nq)
     V = np.broadcast_to(v, batch + (n,)).reshape(-1, n)
     joints = kinematics.tree.joints

@@ -19,6 +19,7 @@ from ..kinds import JointKind
 from ..model.tree import KinematicTree
 from .free_flyer import BASE_CONFIGURATION, check_quaternions
 from .joint_models import joint_model
+from .numbers import float_array
 
 REFERENCES = ("world", "local", "local_world_aligned")
 
@@ -43,7 +44,7 @@ class TreeKinematics:
     # -- placements -----------------------------------------------------------------------------
 
     def _q(self, q, field: str = "q") -> tuple[np.ndarray, tuple[int, ...]]:
-        q = np.asarray(q, dtype=float)
+        q = float_array(q, field)
         nq = len(self.coordinates)
         if q.ndim == 0 or q.shape[-1] != nq:
             shape = "()" if q.ndim == 0 else str(q.shape)

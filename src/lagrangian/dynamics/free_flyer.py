@@ -139,16 +139,19 @@ def checking_quaternions(function):
                 return function(q, *rest)
         if Q.ndim and Q.shape[-1] >= 7:  # a wrong width is the function's to name
             flat = Q.reshape(-1, Q.shape[-1])
-            check_quaternions(flat[np.isfinite(flat).all(axis=-1)])
+            check_quaternions(flat)
         return function(q, *rest)
     return checked
 
 
 def check_quaternions(Q: np.ndarray, field: str = "q") -> None:
     """Refuse, in one line, a configuration (N, nq) whose base quaternion (entries 3..6) has a
-    norm off 1 by more than QUATERNION_TOLERANCE."""
-    norms = np.linalg.norm(Q[:, 3:7], axis=-1)
-    bad = np.flatnonzero(np.abs(norms - 1.0) > QUATERNION_TOLERANCE)
+    norm off 1 by more than QUATERNION_TOLERANCE; a state whose q is not all finite is not
+    refused (its row of every function is NaN, as the compiled modules give)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        norms = np.linalg.norm(Q[:, 3:7], axis=-1)
+    finite = np.isfinite(Q).all(axis=-1)
+    bad = np.flatnonzero(finite & (np.abs(norms - 1.0) > QUATERNION_TOLERANCE))
     if bad.size:
         raise InputError(
             f"the base quaternion (base_qx, base_qy, base_qz, base_qw) has norm "

@@ -36,6 +36,7 @@ from ..model.model import Model
 from ..model.values import resolve_parameters
 from .control_terms import ControlTerms
 from .frames import TreeKinematics, tree_kinematics
+from .numbers import batch_shape, float_array
 
 if TYPE_CHECKING:
     from .model_frames import ModelKinematics
@@ -154,7 +155,7 @@ class Dynamics(ControlTerms):
         return self.n, self.velocity_names
 
     def _vector(self, value, field: str) -> np.ndarray:
-        array = np.asarray(value, dtype=float)
+        array = float_array(value, field)
         width, names = self._width(field)
         if array.ndim == 0 or array.shape[-1] != width:
             shape = "()" if array.ndim == 0 else str(array.shape)
@@ -171,7 +172,7 @@ class Dynamics(ControlTerms):
         if quiet:
             compute = partial(_without_warnings, compute)
         arrays = [self._vector(x, f) for x, f in zip(arrays, fields, strict=True)]
-        batch = np.broadcast_shapes(*(x.shape[:-1] for x in arrays))
+        batch = batch_shape(arrays, fields)
         total = int(np.prod(batch, dtype=np.int64))
         flat = [np.broadcast_to(x, batch + x.shape[-1:]).reshape(total, x.shape[-1])
                 for x in arrays]
@@ -181,7 +182,7 @@ class Dynamics(ControlTerms):
         if self.velocity_names is not None and fields[0] == "q":  # a floating base's quaternion
             from .free_flyer import check_quaternions
 
-            check_quaternions(flat[0][good])
+            check_quaternions(flat[0])
         if good.all():
             out = np.asarray(compute(*flat), dtype=float).reshape((total,) + tail)
         else:
@@ -365,8 +366,11 @@ class Dynamics(ControlTerms):
         """q (+) v dt: the configuration reached moving at velocity v for dt s, (..., nq); a
         floating base moves along its twist (SE(3)'s exponential) and its quaternion comes
         back normalized, the joints by q + v dt."""
-        q, v = self._vector(q, "q"), self._vector(v, "v") * float(dt)
-        batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
+        step = float_array(dt, "dt")
+        if step.ndim:
+            raise InputError(f"expected one number of seconds, got shape {step.shape}", field="dt")
+        q, v = self._vector(q, "q"), self._vector(v, "v") * float(step)
+        batch = batch_shape((q, v), ("q", "v"))
         Q = np.broadcast_to(q, batch + q.shape[-1:]).reshape(-1, q.shape[-1])
         V = np.broadcast_to(v, batch + v.shape[-1:]).reshape(-1, v.shape[-1])
         if self.velocity_names is None:
@@ -379,7 +383,7 @@ class Dynamics(ControlTerms):
     def difference(self, q0, q1) -> np.ndarray:
         """v with q0 (+) v = q1 (integrate's inverse for dt = 1), (..., nv)."""
         q0, q1 = self._vector(q0, "q"), self._vector(q1, "q")
-        batch = np.broadcast_shapes(q0.shape[:-1], q1.shape[:-1])
+        batch = batch_shape((q0, q1), ("q0", "q1"))
         Q0, Q1 = (np.broadcast_to(x, batch + x.shape[-1:]).reshape(-1, x.shape[-1])
                   for x in (q0, q1))
         if self.velocity_names is None:

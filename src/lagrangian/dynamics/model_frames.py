@@ -23,6 +23,7 @@ from ..errors import InputError, did_you_mean_or_list
 from ..model.model import Body, Model, Particle
 from ..model.rotations import apply
 from .frames import check_reference, expressed
+from .numbers import batch_shape, float_array
 
 _ZERO = sp.S.Zero
 
@@ -70,7 +71,7 @@ class ModelKinematics:
         return sp.sympify(expr).xreplace(self._values)  # safe: a model expression, not text
 
     def _q(self, q, field: str = "q") -> tuple[np.ndarray, tuple[int, ...]]:
-        q = np.asarray(q, dtype=float)
+        q = float_array(q, field)
         if q.ndim == 0 or q.shape[-1] != self.n:
             shape = "()" if q.ndim == 0 else str(q.shape)
             raise InputError(f"expected {self.n} values ({', '.join(self.coordinates)}) along the "
@@ -155,9 +156,9 @@ class ModelKinematics:
         """J_dot q_dot: the frame's classical acceleration at q_ddot = 0, [a; w_dot] (m/s^2,
         rad/s^2), shape (..., 6), ``reference`` as for jacobian."""
         check_reference(reference)
-        q, v = np.asarray(q, dtype=float), np.asarray(v, dtype=float)
+        q, v = float_array(q, "q"), float_array(v, "v")
         self._q(q), self._q(v, "v")
-        batch = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
+        batch = batch_shape((q, v), ("q", "v"))
         Q = np.broadcast_to(q, batch + (self.n,)).reshape(-1, self.n)
         V = np.broadcast_to(v, batch + (self.n,)).reshape(-1, self.n)
         found = self._frame(frame)

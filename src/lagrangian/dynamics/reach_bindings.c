@@ -24,8 +24,9 @@ static PyArrayObject *rk_input(PyObject *x, int last, const char *name)
     return a;
 }
 
-/* a floating base's quaternions (entries 3..6 of each state) of norm within the tolerance (or
- * not finite: that row's NaN is the caller's); else ValueError, and numpy names the state */
+/* a floating base's quaternions (entries 3..6 of each state) of norm within the tolerance, in
+ * every state whose q is all finite (the others' rows are NaN, as the tree module's rule);
+ * else ValueError, and numpy names the state */
 static int rk_unit_quaternions(PyArrayObject *Q)
 {
 #if RK_FB
@@ -33,7 +34,7 @@ static int rk_unit_quaternions(PyArrayObject *Q)
     const double *q = PyArray_DATA(Q);
     for (npy_intp k = 0; k < count; k++, q += RK_NQ) {
         double n2 = q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6];
-        if (rk_finite_row(q + 3, 4) && (n2 < RK_QLOW || n2 > RK_QHIGH)) {
+        if (rk_finite_row(q, RK_NQ) && (n2 < RK_QLOW || n2 > RK_QHIGH)) {
             PyErr_SetString(PyExc_ValueError, "q: the base quaternion is not of unit norm");
             return 0;
         }

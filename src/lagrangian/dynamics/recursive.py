@@ -35,6 +35,7 @@ from ..errors import InputError
 from ..model.model import Model
 from ..model.tree import KinematicTree, body_tree
 from .joint_space import TreeDynamics, reported_rows
+from .numbers import batch_shape, float_array
 from .tree_module import module_source, tree_key
 
 # A model file's tree of at least this many bodies runs the recursions (numbers, simulation,
@@ -152,6 +153,9 @@ class RecursiveDynamics(TreeDynamics):
         return f"RecursiveDynamics(coordinates={list(self.coordinates)})"
 
     def _call(self, function, *arrays):
+        # numbers first: text or a mapping named here, not by a field read off numpy's text
+        third = "tau" if function is self._forward else "a"
+        arrays = [float_array(x, field) for x, field in zip(arrays, ("q", "v", third), strict=False)]
         try:
             return function(*arrays, self._P)
         except ValueError as exc:
@@ -159,7 +163,7 @@ class RecursiveDynamics(TreeDynamics):
                 return function(_unit_quaternions(arrays[0]), *arrays[1:], self._P)
             if "batch shapes" in str(exc):  # broadcast in numpy, then one C call
                 arrays = [np.asarray(x, dtype=float) for x in arrays]
-                batch = np.broadcast_shapes(*(x.shape[:-1] for x in arrays))
+                batch = batch_shape(arrays, ("q", "v", third)[:len(arrays)])
                 return self._call(function, *(
                     np.ascontiguousarray(np.broadcast_to(x, batch + x.shape[-1:]))
                     for x in arrays))
@@ -172,7 +176,7 @@ class RecursiveDynamics(TreeDynamics):
         """M(q), shape (..., n, n)."""
         try:
             out = self._mass(q, self._P)
-        except ValueError:
+        except (ValueError, TypeError):
             out = self._call(self._mass, q)
         return out if out.__class__ is not tuple else reported_rows(out, 2)
 
@@ -180,7 +184,7 @@ class RecursiveDynamics(TreeDynamics):
         """C(q, q_dot) q_dot + g(q), shape (..., n)."""
         try:
             out = self._bias(q, v, self._P)
-        except ValueError:
+        except (ValueError, TypeError):
             out = self._call(self._bias, q, v)
         return out if out.__class__ is not tuple else reported_rows(out, 1)
 
@@ -188,7 +192,7 @@ class RecursiveDynamics(TreeDynamics):
         """g(q), shape (..., n)."""
         try:
             out = self._gravity(q, self._P)
-        except ValueError:
+        except (ValueError, TypeError):
             out = self._call(self._gravity, q)
         return out if out.__class__ is not tuple else reported_rows(out, 1)
 
@@ -198,7 +202,7 @@ class RecursiveDynamics(TreeDynamics):
             return self._with_wrenches(q, v, a, f_ext, forward=False)
         try:
             out = self._inverse(q, v, a, self._P)
-        except ValueError:
+        except (ValueError, TypeError):
             out = self._call(self._inverse, q, v, a)
         return out if out.__class__ is not tuple else reported_rows(out, 1)
 
@@ -208,7 +212,7 @@ class RecursiveDynamics(TreeDynamics):
             return self._with_wrenches(q, v, tau, f_ext, forward=True)
         try:
             out = self._forward(q, v, tau, self._P)
-        except ValueError:
+        except (ValueError, TypeError):
             out = self._call(self._forward, q, v, tau)
         return out if out.__class__ is not tuple else reported_rows(out, 1)
 
@@ -216,7 +220,7 @@ class RecursiveDynamics(TreeDynamics):
         """T in J, shape (...)."""
         try:
             out = self._kinetic(q, v, self._P)
-        except ValueError:
+        except (ValueError, TypeError):
             out = self._call(self._kinetic, q, v)
         return out if out.__class__ is not tuple else reported_rows(out, 0)
 
@@ -224,7 +228,7 @@ class RecursiveDynamics(TreeDynamics):
         """V in J, shape (...)."""
         try:
             out = self._potential(q, self._P)
-        except ValueError:
+        except (ValueError, TypeError):
             out = self._call(self._potential, q)
         return out if out.__class__ is not tuple else reported_rows(out, 0)
 
@@ -237,7 +241,7 @@ def _unit_quaternions(q) -> np.ndarray:
 
     Q = np.array(q, dtype=float)
     flat = Q.reshape(-1, Q.shape[-1])
-    check_quaternions(flat[np.isfinite(flat).all(axis=-1)])
+    check_quaternions(flat)
     flat[:, 3:7] /= np.linalg.norm(flat[:, 3:7], axis=-1, keepdims=True)
     return flat.reshape(Q.shape)
 

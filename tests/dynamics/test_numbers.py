@@ -47,3 +47,20 @@ def test_dynamics_functions_name_bad_arrays(backend):
             assert caught.value.field == field, (field, str(caught.value))
     with pytest.raises(InputError, match="do not broadcast"):
         arm.jacobian_dot_times_v(np.zeros((2, 2)), np.zeros((3, 2)), "fore")
+
+
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_a_bad_quaternion_is_named_by_its_state_and_a_state_not_finite_is_nan(backend):
+    robot = lagrangian.load("two_link_arm", floating_base=True).dynamics(backend=backend)
+    q = np.tile([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.3, 0.5], (3, 1))
+    q[0, 7] = np.nan  # state 0 not finite: its rows NaN, its quaternion not judged
+    q[0, 3:7] = 0.0
+    for function in (robot.mass_matrix, robot.center_of_mass,
+                     lambda x: robot.placement(x, "fore")):
+        with pytest.warns(lagrangian.DynamicsWarning):
+            out = function(q)
+        assert np.isnan(out[0]).all() and np.isfinite(out[1:]).all()
+        bad = q.copy()
+        bad[2, 6] = 0.5  # |quaternion| 0.5 in state 2
+        with pytest.raises(InputError, match="norm 0.5 in state 2"):
+            function(bad)

@@ -1,6 +1,6 @@
 """A user's q, v, a or tau as float64 numbers, or one line naming the argument: text, a
-mapping, ragged lists or None are refused as InputError, never a numpy ValueError or TypeError
-escaping from deep inside a dynamics function."""
+mapping or ragged lists are refused as InputError, never a numpy ValueError or TypeError
+escaping from deep inside a dynamics function (None reads as NaN: that state's row is NaN)."""
 
 from __future__ import annotations
 

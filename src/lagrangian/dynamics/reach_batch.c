@@ -178,27 +178,21 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
         rk_gather(job->v, k, RK_NV, v);
         rk_spoil(v, RK_NV, &spoilt);
         rk4_drift(q, v, job->frame, job->ref, out);
-        rk_scatter(out, k, 6, job->y, 0, 0.0, job->stream);
         break;
     case RK_CENTROIDAL:
         rk4_centroidal(q, out);
-        rk_scatter(out, k, 6 * RK_NV, job->y, 0, 0.0, job->stream);
         break;
     case RK_PLACEMENT:
         rk4_placement(q, job->frame, out);
-        rk_scatter(out, k, 16, job->y, 0, 0.0, job->stream);
         break;
     case RK_JACOBIAN:
         rk4_jacobian(q, job->frame, job->ref, out);
-        rk_scatter(out, k, 6 * RK_NV, job->y, 0, 0.0, job->stream);
         break;
     case RK_COM:
         rk4_com(q, out);
-        rk_scatter(out, k, 3, job->y, 0, 0.0, job->stream);
         break;
     case RK_COM_JACOBIAN:
         rk4_com_jacobian(q, out);
-        rk_scatter(out, k, 3 * RK_NV, job->y, 0, 0.0, job->stream);
         break;
     case RK_WRENCH: {
         lg_v4 w[6];
@@ -215,7 +209,6 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
         rk_gather(job->v, k, RK_NV, v);
         rk_spoil(v, RK_NV, &spoilt);
         rk4_coriolis(q, v, out, work);
-        rk_scatter(out, k, RK_NV * RK_NV, job->y, 0, 0.0, job->stream);
         break;
     case RK_INVERSE: {
         lg_v4 a[RK_NV], w[RK_MAX_WRENCHES][6];
@@ -231,10 +224,12 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
             rk_spoil(w[i], 6, &spoilt);
         }
         rk4_inverse(q, v, a, job->up, job->nw, job->frames, (const lg_v4 (*)[6])w, out);
-        rk_scatter(out, k, RK_NV, job->y, 0, 0.0, job->stream);
         break;
     }
     }
+    /* the lanes' rows out (the wrench's added in place above) */
+    if (job->kind != RK_WRENCH)
+        rk_scatter(out, k, rk_width(job->kind), job->y, 0, 0.0, job->stream);
     int bad = 0;
     for (int l = 0; l < LG_LANES; l++)
         if (spoilt[l] != 0.0 || (job->kind == RK_WRENCH

@@ -162,7 +162,6 @@ class RecursiveDynamics(TreeDynamics):
             if str(exc).startswith("q: the base quaternion"):  # the module's check: say more
                 return function(_unit_quaternions(arrays[0]), *arrays[1:], self._P)
             if "batch shapes" in str(exc):  # broadcast in numpy, then one C call
-                arrays = [np.asarray(x, dtype=float) for x in arrays]
                 batch = batch_shape(arrays, ("q", "v", third)[:len(arrays)])
                 return self._call(function, *(
                     np.ascontiguousarray(np.broadcast_to(x, batch + x.shape[-1:]))

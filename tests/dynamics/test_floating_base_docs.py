@@ -63,3 +63,13 @@ def test_simulate_command_runs(cli):
     assert abs(document["final_state"]["base_qw"] ** 2 + document["final_state"]["base_qx"] ** 2
                + document["final_state"]["base_qy"] ** 2
                + document["final_state"]["base_qz"] ** 2 - 1) < 1e-12
+
+
+def test_the_planar_base_example_runs(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code = re.findall(r"```python\n(.*?)```", block("planar-base"), re.S)[0]
+    exec(compile(code, str(block_file("planar-base")), "exec"), {})
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "('drive_x', 'drive_y', 'drive_theta', 'shaft')"
+    assert np.array(lines[1].strip("[]").split(), dtype=float).tolist() == [0, 0]
+    assert lines[2] == "True"

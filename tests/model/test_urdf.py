@@ -249,8 +249,9 @@ def test_mimic_and_lock(tmp_path):
     (robot(link("a"), link("b", 1.0), joint("j", "a", "b", kind="floating")),
      "no joint left to move: a model needs at least one revolute, continuous or prismatic "
      "joint that is not locked (a lone floating body: not yet)"),
-    (robot(link("a"), link("b", 1.0), joint("j", "a", "b", kind="planar")),
-     "joint 'j': planar joints are not supported"),
+    (robot(link("a"), link("b", 1.0), joint("j", "a", "b", kind="spherical")),
+     "joint 'j': unknown joint type 'spherical' (use revolute, continuous, prismatic, planar, "
+     "floating or fixed)"),
     (robot(link("a"), link("b", 1.0), link("c", 1.0), joint("j1", "a", "b"),
            joint("j2", "b", "c"), joint("j3", "a", "c")), "closed loop"),
     (robot(link("a"), link("b", 1.0), joint("j", "a", "zz")), "joint 'j': no link 'zz'"),

@@ -201,6 +201,8 @@ class _Tree:
         self.links = {link.name: link for link in robot.links}
         self.joints = list(robot.joints)
         self.by_name = {j.name: j for j in self.joints}
+        # a planar joint's name -> its child link (the joint's frame), once expanded
+        self.planar: dict[str, str] = {}
         self.name = robot.name or "URDF robot"
         for joint in self.joints:
             self._check_numbers(joint)
@@ -249,10 +251,9 @@ class _Tree:
             where = f"joint '{joint.name}'"
             if joint.type not in SUPPORTED and joint.type != "floating":
                 raise self.error(
-                    f"{joint.type} joints are not supported yet (use revolute, continuous, "
-                    "prismatic or fixed)" if joint.type == "planar"
-                    else f"unknown joint type {joint.type!r} (use revolute, continuous, "
-                    f"prismatic or fixed){did_you_mean(str(joint.type), SUPPORTED)}", where)
+                    f"unknown joint type {joint.type!r} (use revolute, continuous, "
+                    f"prismatic, planar, floating or fixed)"
+                    f"{did_you_mean(str(joint.type), (*SUPPORTED, 'planar', 'floating'))}", where)
             for role, link in (("parent", joint.parent), ("child", joint.child)):
                 if link not in self.links:
                     raise self.error(f"no link '{link}' for its {role}"
@@ -298,7 +299,63 @@ class _Tree:
                                  "floating joint must be the root link's only moving joint",
                                  where)
 
+    def _expand_planar(self) -> None:
+        """Each planar joint as the three one-coordinate joints it is: <name>_x and <name>_y
+        sliding along the plane's axes e1, e2 of the joint's frame, then <name>_theta turning
+        about its normal n (the URDF axis; e1 the frame axis least along n, made normal to it,
+        e2 = n x e1: x, y for n = z, as Pinocchio's JointModelPlanar), through two massless links;
+        so every stage and backend moves it (nq = nv = 3, rates the coordinates' derivatives)."""
+        import yourdfpy
+
+        planar = [j for j in self.joints if j.type == "planar"]
+        if not planar:
+            return
+        names = set(self.links) | set(self.by_name)
+
+        def fresh(name: str) -> str:
+            while name in names:
+                name += "_"
+            names.add(name)
+            return name
+
+        expanded = []
+        for joint in self.joints:
+            if joint.type != "planar":
+                expanded.append(joint)
+                continue
+            where = f"joint '{joint.name}'"
+            if joint.mimic is not None:
+                raise self.error("a planar joint cannot mimic another joint", f"{where}.mimic")
+            normal = np.asarray(joint.axis if joint.axis is not None else (0, 0, 1), float)
+            norm = float(np.linalg.norm(normal))
+            if not math.isfinite(norm) or norm == 0:
+                raise self.error("the axis (the plane's normal) has zero length", f"{where}.axis")
+            normal = normal / norm
+            first = np.eye(3)[int(np.argmin(np.abs(normal)))]
+            first = first - normal * float(first @ normal)
+            first /= float(np.linalg.norm(first))
+            second = np.cross(normal, first)
+            links = [fresh(f"{joint.name}_x_link"), fresh(f"{joint.name}_y_link")]
+            for link in links:
+                self.links[link] = yourdfpy.Link(name=link)
+            steps = (("x", "prismatic", first, joint.parent, links[0], joint.origin),
+                     ("y", "prismatic", second, links[0], links[1], None),
+                     ("theta", "continuous", normal, links[1], joint.child, None))
+            for suffix, kind, axis, parent, child, origin in steps:
+                expanded.append(yourdfpy.Joint(
+                    name=fresh(f"{joint.name}_{suffix}"), type=kind, parent=parent,
+                    child=child, origin=origin, axis=np.array(axis), dynamics=joint.dynamics))
+            self.planar[joint.name] = joint.child
+        self.joints = expanded
+        self.by_name = {j.name: j for j in self.joints}
+
     def model(self, lock: dict[str, float], floating_base: bool = False) -> Model:
+        for name in lock:
+            if self.by_name.get(name) is not None and self.by_name[name].type == "planar":
+                raise ModelError(f"joint '{name}' is planar: lock its coordinates "
+                                 f"'{name}_x', '{name}_y', '{name}_theta' one by one",
+                                 field=f"lock.{name}")
+        self._expand_planar()
         root, children = self._check_tree()
         if floating_base and any(j.type == "floating" for j in self.joints):
             floating = next(j.name for j in self.joints if j.type == "floating")
@@ -372,6 +429,11 @@ class _Tree:
         else:
             bodies = tuple(self._bodies(root, order, position))
             tree = numeric_tree(self.links, root, order, position, names, bodies, floating_base)
+        if self.planar:  # a planar joint's own name: its frame, its child link's
+            by_link = {f.name: f for f in tree.frames}
+            tree = replace(tree, frames=tree.frames + tuple(
+                replace(by_link[child], name=name) for name, child in self.planar.items()
+                if name not in by_link))
         return replace(model, rigid_bodies=bodies, kinematic_tree=tree,
                        source_names=tuple((name, joint) for joint, name in names.items()),
                        source_ratings=tuple((name, *self._ratings(joint))

@@ -1,67 +1,175 @@
 /* The Python bindings of derivatives_kernel.c's functions (derivatives_c.py appends this text
  * after the kernel's core, emitted on one state and on vector lanes). */
 
-/* -- Python bindings: (Q, V, X, P) with Q, V, X (..., DK_NV) float64 (or (DK_NV,), shared by
- * the batch), P = [g (3), tau_<joint> (DK_NV)]; outputs (..., DK_NV, DK_NV) each, as a tuple,
- * with the count of NaN rows appended where a state's inputs are not all finite (or, forward,
- * its M is not positive definite). A batch runs on threads taking DK_CHUNK states at a time. */
+/* -- Python bindings: tree(I, D) makes a tree's capsule once (derivatives_c.py's tables);
+ * the functions take (tree, Q, V, X, P) with Q, V, X (..., nq / nv) float64 (or (nq,), shared
+ * by the batch), P = [g (3), tau_<joint> (nj), 13 per body]; outputs (..., nv, nv) each, as a
+ * tuple, with the count of NaN rows appended where a state's inputs are not all finite (or,
+ * forward, its M is not positive definite). A batch runs on threads taking DK_CHUNK states at a
+ * time, each thread's work in one heap block (any tree's size, off the threads' stacks). */
 
 #define DK_PTHREADS LG_PTHREADS  /* batch_threads.c, above this text */
 #define DK_MAX_THREADS LG_MAX_THREADS
 #define DK_THREAD_STATES 512
-
-/* the numbers of input j: q DK_NQ (a floating base's 7 first), v, a and tau DK_NV */
-#define DK_WIDTH(j) ((j) == 0 ? DK_NQ : DK_NV)
+#define DK_HEADER 8  /* I's first numbers: nb, nj, ff, np, nnz, ltdl, once, sparse */
+#define DK_BODY 47   /* D's doubles per body: mult, off, R0, P, C, S (9 each), t0, u, R0 u */
 
 /* The states a thread takes at a time from the batch's shared counter (a multiple of
    LG_LANES): the threads share the batch as they go, so one slowed by the machine's other work
    does not hold the call back with half the batch. */
 #define DK_CHUNK 128
 
+static void dk_tree_free(PyObject *capsule)
+{
+    free(PyCapsule_GetPointer(capsule, "lagrangian.derivatives_tree"));
+}
+
+/* The tree of tables I (int32) and D (float64), laid out as derivatives_c.py's docstring says,
+ * copied into one block with the tree; every index checked here once (the kernel trusts them). */
+static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    PyArrayObject *table_i = NULL, *table_d = NULL;
+    PyObject *result = NULL;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "expected (I, D)");
+        return NULL;
+    }
+    table_i = (PyArrayObject *)PyArray_FROMANY(args[0], NPY_INT32, 1, 1, NPY_ARRAY_CARRAY_RO);
+    table_d = (PyArrayObject *)PyArray_FROMANY(args[1], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
+    if (!table_i || !table_d) goto done;
+    const npy_intp ni = PyArray_SIZE(table_i), nd = PyArray_SIZE(table_d);
+    const int *h = (const int *)PyArray_DATA(table_i);
+    if (ni < DK_HEADER) goto bad;
+    const long nb = h[0], nj = h[1], ff = h[2], np = h[3], nnz = h[4];
+    if (nb < 1 || nj < 0 || (ff != 0 && ff != 1) || np < nb || nnz < 0) goto bad;
+    const long nv = nj + 6 * ff;
+    const long nint = DK_HEADER + 4 * nb + 2 * np + (nv + 1) + nnz + nv;
+    if (ni != nint || nd != DK_BODY * nb) goto bad;
+    dk_tree *tree = malloc(sizeof(dk_tree) + (size_t)nint * sizeof(int)
+                           + (size_t)nd * sizeof(double));
+    if (!tree) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    double *reals = (double *)(tree + 1);  /* the doubles first: aligned after the struct */
+    int *ints = (int *)(reals + nd);
+    memcpy(reals, PyArray_DATA(table_d), (size_t)nd * sizeof(double));
+    memcpy(ints, h, (size_t)nint * sizeof(int));
+    *tree = (dk_tree){.nb = nb, .nj = nj, .ff = ff, .np = np, .nv = nv, .nq = nj + 7 * ff,
+                      .qo = 7 * ff, .vo = 6 * ff, .ltdl = h[5] != 0, .once = h[6] != 0,
+                      .sparse = h[7] != 0};
+    const int *at = ints + DK_HEADER;
+    tree->parent = at; at += nb;
+    tree->coord = at; at += nb;
+    tree->turns = at; at += nb;
+    tree->slides = at; at += nb;
+    tree->pair = (const int (*)[2])at; at += 2 * np;
+    tree->row0 = at; at += nv + 1;
+    tree->rows = at; at += nnz;
+    tree->lambda = at;
+    const double *x = reals;
+    tree->mult = x; x += nb;
+    tree->off = x; x += nb;
+    tree->R0 = (const double (*)[9])x; x += 9 * nb;
+    tree->P = (const double (*)[9])x; x += 9 * nb;
+    tree->C = (const double (*)[9])x; x += 9 * nb;
+    tree->Sk = (const double (*)[9])x; x += 9 * nb;
+    tree->t0 = (const double (*)[3])x; x += 3 * nb;
+    tree->u = (const double (*)[3])x; x += 3 * nb;
+    tree->R0u = (const double (*)[3])x;
+    int fine = tree->parent[0] == -1 && tree->row0[0] == 0 && tree->row0[nv] == nnz;
+    for (long i = 0; i < nb; i++)
+        fine &= tree->parent[i] >= -1 && tree->parent[i] < i
+                && (i < ff || (tree->coord[i] >= 0 && tree->coord[i] < nj))
+                && (ff == 0 || i == 0 || tree->parent[i] >= 0);
+    for (long e = 0; e < np; e++)
+        fine &= tree->pair[e][0] >= 0 && tree->pair[e][0] < nb && tree->pair[e][1] >= 0
+                && tree->pair[e][1] <= tree->pair[e][0];
+    for (long c = 0; c < nv; c++)
+        fine &= tree->row0[c] <= tree->row0[c + 1] && tree->lambda[c] >= -1
+                && tree->lambda[c] < c;
+    for (long e = 0; e < nnz; e++) fine &= tree->rows[e] >= 0 && tree->rows[e] < nv;
+    /* a thread's work: 120 numbers a body, 4 a coordinate and four nv x nv matrices (dk4_carve,
+       checked on a block of that size) */
+    tree->space = 120 * (size_t)nb + 4 * (size_t)nv + 4 * (size_t)nv * nv;
+    lg_v4 *probe = malloc(tree->space * sizeof(lg_v4));
+    dk4_work w;
+    fine &= probe && (size_t)(dk4_carve(tree, probe, &w) - probe) <= tree->space;
+    free(probe);
+    if (!fine) {
+        free(tree);
+        goto bad;
+    }
+    result = PyCapsule_New(tree, "lagrangian.derivatives_tree", dk_tree_free);
+    if (!result) free(tree);
+    goto done;
+bad:
+    PyErr_SetString(PyExc_ValueError, "tree: tables not laid out as derivatives_c.py's");
+done:
+    Py_XDECREF(table_i);
+    Py_XDECREF(table_d);
+    return result;
+}
+
 typedef struct {
+    const dk_tree *tree;
     int kind, stream;  /* stream: the outputs stored past the caches (lg_rows_streamed) */
     npy_intp step[3], k0, k1, bad;
     const double *x[3], *p;
     double *y[3];
     npy_intp *next;  /* the batch's first state not yet taken (shared), or NULL: k0 to k1 */
+    int nomemory;    /* the thread's work block could not be had */
 } dk_job;
+
+/* the numbers of input j: q nq (a floating base's 7 first), v, a and tau nv */
+static inline int dk_width(const dk_tree *tree, int j) { return j == 0 ? tree->nq : tree->nv; }
 
 /* Whether state k's inputs are all finite. */
 static inline int dk_finite(const dk_job *job, npy_intp k)
 {
     for (int j = 0; j < 3; j++)
-        for (int i = 0; i < DK_WIDTH(j); i++)
+        for (int i = 0; i < dk_width(job->tree, j); i++)
             if (!isfinite(job->x[j][k * job->step[j] + i])) return 0;
     return 1;
 }
 
 enum { DK_INVERSE, DK_FORWARD, DK_REGRESSOR };
-#define DK_SIZE(kind) ((kind) == DK_REGRESSOR ? DK_NV * 10 * DK_NB : DK_NV * DK_NV)
 #define DK_OUTPUTS(kind) ((kind) == DK_INVERSE ? 2 : (kind) == DK_FORWARD ? 3 : 1)
-#define DK_SPACE (3 * DK_NV * DK_NV > DK_NV * 10 * DK_NB ? 3 * DK_NV * DK_NV : DK_NV * 10 * DK_NB)
+
+/* the numbers of one output of one state */
+static inline size_t dk_size(const dk_tree *tree, int kind)
+{
+    return (size_t)tree->nv * (kind == DK_REGRESSOR ? 10 * (size_t)tree->nb : (size_t)tree->nv);
+}
 
 /* States k0 to k1 of the job: LG_LANES at a time through the dk4_ functions (out: their
-   outputs, or NULL), the rest one by one; the count of NaN rows. */
-static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
+   outputs, in: their inputs, or NULL), the rest one by one; ``space`` the work block; the
+   count of NaN rows. */
+static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out, lg_v4 *in,
+                         void *space)
 {
-    const int kind = job->kind, size = DK_SIZE(kind), nout = DK_OUTPUTS(kind);
+    const dk_tree *tree = job->tree;
+    const int kind = job->kind, nout = DK_OUTPUTS(kind), nq = tree->nq;
+    const size_t size = dk_size(tree, kind);
     npy_intp bad = 0;
     for (; out && k + LG_LANES <= k1; k += LG_LANES) {
-        lg_v4 in[3][DK_NQ];
         for (int j = 0; j < 3; j++) {
-            if (job->step[j] == DK_WIDTH(j)) {  /* a row per state */
-                lg_lanes(job->x[j] + k * DK_WIDTH(j), DK_WIDTH(j), in[j]);
+            const int width = dk_width(tree, j);
+            if (job->step[j] == width) {  /* a row per state */
+                lg_lanes(job->x[j] + k * width, width, in + j * nq);
                 continue;
             }
             for (int l = 0; l < LG_LANES; l++)  /* one state shared by the batch */
-                for (int i = 0; i < DK_WIDTH(j); i++)
-                    in[j][i][l] = job->x[j][(k + l) * job->step[j] + i];
+                for (int i = 0; i < width; i++)
+                    in[j * nq + i][l] = job->x[j][(k + l) * job->step[j] + i];
         }
         /* the next group's inputs, fetched while this one computes (as the reach module's) */
         for (int j = 0; j < 3 && k + 2 * LG_LANES <= k1; j++) {
-            if (job->step[j] != DK_WIDTH(j)) continue;
-            const char *next = (const char *)(job->x[j] + (k + LG_LANES) * DK_WIDTH(j));
-            for (size_t b = 0; b < LG_LANES * DK_WIDTH(j) * sizeof(double); b += 64)
+            const int width = dk_width(tree, j);
+            if (job->step[j] != width) continue;
+            const char *next = (const char *)(job->x[j] + (k + LG_LANES) * width);
+            for (size_t b = 0; b < LG_LANES * width * sizeof(double); b += 64)
                 __builtin_prefetch(next + b, 0, 3);
         }
         /* the rows these states will fill, fetched for writing while the kernel computes: a
@@ -73,16 +181,17 @@ static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
         }
         int failed = 0;
         if (kind == DK_FORWARD)
-            failed = dk4_forward_derivatives(in[0], in[1], in[2], job->p, out, out + size,
-                                             out + 2 * size);
+            failed = dk4_forward_derivatives(tree, space, in, in + nq, in + 2 * nq, job->p,
+                                             out, out + size, out + 2 * size);
         else if (kind == DK_INVERSE)
-            dk4_inverse(in[0], in[1], in[2], job->p, out, out + size);
+            dk4_inverse(tree, space, in, in + nq, in + 2 * nq, job->p, out, out + size);
         else
-            dk4_regressor(in[0], in[1], in[2], job->p, out);
+            dk4_regressor(tree, space, in, in + nq, in + 2 * nq, job->p, out);
         /* x - x is NaN for an infinite or NaN x: the lanes with an input not finite */
         lg_v4 spoilt = LG_V4(0.0);
         for (int j = 0; j < 3; j++)
-            for (int i = 0; i < DK_WIDTH(j); i++) spoilt += in[j][i] - in[j][i];
+            for (int i = 0; i < dk_width(tree, j); i++)
+                spoilt += in[j * nq + i] - in[j * nq + i];
         for (int o = 0; o < nout; o++)
             if (job->stream) lg_rows_streamed(out + o * size, size, job->y[o] + k * size);
             else lg_rows(out + o * size, size, job->y[o] + k * size);
@@ -91,7 +200,7 @@ static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
             bad += !fine;
             if (!fine)
                 for (int o = 0; o < nout; o++)
-                    for (int i = 0; i < size; i++) job->y[o][(k + l) * size + i] = NAN;
+                    for (size_t i = 0; i < size; i++) job->y[o][(k + l) * size + i] = NAN;
         }
     }
     for (; k < k1; k++) {
@@ -101,16 +210,16 @@ static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
         int fine = dk_finite(job, k);
         if (fine) {
             if (kind == DK_FORWARD)
-                fine = !dk_forward_derivatives(a0, a1, a2, job->p, y0, job->y[1] + k * size,
-                                               job->y[2] + k * size);
+                fine = !dk_forward_derivatives(tree, space, a0, a1, a2, job->p, y0,
+                                               job->y[1] + k * size, job->y[2] + k * size);
             else if (kind == DK_INVERSE)
-                dk_inverse(a0, a1, a2, job->p, y0, job->y[1] + k * size);
+                dk_inverse(tree, space, a0, a1, a2, job->p, y0, job->y[1] + k * size);
             else
-                dk_regressor(a0, a1, a2, job->p, y0);
+                dk_regressor(tree, space, a0, a1, a2, job->p, y0);
         }
         if (!fine) {
             for (int o = 0; o < nout; o++)
-                for (int i = 0; i < size; i++) job->y[o][k * size + i] = NAN;
+                for (size_t i = 0; i < size; i++) job->y[o][k * size + i] = NAN;
             bad++;
         }
     }
@@ -120,19 +229,31 @@ static npy_intp dk_range(const dk_job *job, npy_intp k, npy_intp k1, lg_v4 *out)
 static void *dk_run(void *argument)
 {
     dk_job *job = (dk_job *)argument;
-    /* the lanes' outputs on the heap (a regressor's are DK_NV x 10 DK_NB vectors) */
-    lg_v4 *out = job->k1 - job->k0 >= LG_LANES
-                 ? aligned_alloc(sizeof(lg_v4), DK_SPACE * sizeof(lg_v4)) : NULL;
+    const dk_tree *tree = job->tree;
+    /* one block: the work, then, with LG_LANES states or more, the lanes' outputs (a
+       regressor's are nv x 10 nb vectors) and inputs; one state's work in doubles alone */
+    const int lanes = job->k1 - job->k0 >= LG_LANES;
+    const size_t outputs = 3 * dk_size(tree, DK_FORWARD) > dk_size(tree, DK_REGRESSOR)
+                           ? 3 * dk_size(tree, DK_FORWARD) : dk_size(tree, DK_REGRESSOR);
+    const size_t bytes = lanes ? (tree->space + outputs + 3 * (size_t)tree->nq) * sizeof(lg_v4)
+                               : (tree->space * sizeof(double) + 63) & ~(size_t)63;
+    char *block = aligned_alloc(lanes ? sizeof(lg_v4) : 64, bytes);
+    job->bad = 0;
+    job->nomemory = !block;
+    if (!block) return NULL;
+    lg_v4 *out = lanes ? (lg_v4 *)block + tree->space : NULL;
+    lg_v4 *in = lanes ? out + outputs : NULL;
     npy_intp bad = 0;
     if (!job->next)
-        bad = dk_range(job, job->k0, job->k1, out);
+        bad = dk_range(job, job->k0, job->k1, out, in, block);
     else
         for (;;) {
             const npy_intp k = __atomic_fetch_add(job->next, DK_CHUNK, __ATOMIC_RELAXED);
             if (k >= job->k1) break;
-            bad += dk_range(job, k, k + DK_CHUNK < job->k1 ? k + DK_CHUNK : job->k1, out);
+            bad += dk_range(job, k, k + DK_CHUNK < job->k1 ? k + DK_CHUNK : job->k1, out, in,
+                            block);
         }
-    free(out);
+    free(block);
     if (job->stream) lg_stream_fence();
     job->bad = bad;
     return NULL;
@@ -148,27 +269,32 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     PyObject *out[3] = {NULL, NULL, NULL}, *block = NULL, *result = NULL;
     npy_intp step[3] = {0, 0, 0};
     const int nout = DK_OUTPUTS(kind);
-    if (nargs != 4) {
-        PyErr_SetString(PyExc_TypeError, "expected (Q, V, X, P)");
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "expected (tree, Q, V, X, P)");
         return NULL;
     }
+    const dk_tree *tree = PyCapsule_GetPointer(args[0], "lagrangian.derivatives_tree");
+    if (!tree) return NULL;
+    args++;
     int base = 0;
     for (int i = 0; i < 3; i++) {
         in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
         if (!in[i]) goto done;
         int nd = PyArray_NDIM(in[i]);
-        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != DK_WIDTH(i)) {
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != dk_width(tree, i)) {
             PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
-                         names[i], DK_WIDTH(i));
+                         names[i], dk_width(tree, i));
             goto done;
         }
-        if (PyArray_SIZE(in[i]) / DK_WIDTH(i) > PyArray_SIZE(in[base]) / DK_WIDTH(base)) base = i;
+        if (PyArray_SIZE(in[i]) / dk_width(tree, i)
+            > PyArray_SIZE(in[base]) / dk_width(tree, base))
+            base = i;
     }
-    npy_intp count = PyArray_SIZE(in[base]) / DK_WIDTH(base);
+    npy_intp count = PyArray_SIZE(in[base]) / dk_width(tree, base);
     int nd = PyArray_NDIM(in[base]);
     for (int i = 0; i < 3; i++) {
         if (PyArray_NDIM(in[i]) == 1) {  /* one state, shared by the batch */
-            step[i] = count > 1 ? 0 : DK_WIDTH(i);
+            step[i] = count > 1 ? 0 : dk_width(tree, i);
             continue;
         }
         if (PyArray_NDIM(in[i]) != nd
@@ -176,28 +302,26 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
             PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
             goto done;
         }
-        step[i] = DK_WIDTH(i);
+        step[i] = dk_width(tree, i);
     }
-#if DK_FF
-    if (!lg_unit_quaternions((const double *)PyArray_DATA(in[0]), step[0] ? count : 1, step[0],
-                             DK_NQ, DK_QTOL))
+    if (tree->ff && !lg_unit_quaternions((const double *)PyArray_DATA(in[0]),
+                                         step[0] ? count : 1, step[0], tree->nq, DK_QTOL))
         goto done;
-#endif
     P = (PyArrayObject *)PyArray_FROMANY(args[3], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
     if (!P) goto done;
-    if (PyArray_SIZE(P) != 3 + DK_NJ + 13 * DK_NB) {
+    if (PyArray_SIZE(P) != 3 + tree->nj + 13 * tree->nb) {
         PyErr_SetString(PyExc_ValueError,
                         "parameters: expected g (3), the actuators and 13 per body");
         goto done;
     }
-    /* the outputs as views of one block (nout, ..., DK_NV, DK_NV): one allocation (two large
-       ones of a size freed and asked again each call cost glibc a trim and fresh pages);
-       the regressor's (..., DK_NV, 10 DK_NB) */
+    /* the outputs as views of one block (nout, ..., nv, nv): one allocation (two large ones
+       of a size freed and asked again each call cost glibc a trim and fresh pages); the
+       regressor's (..., nv, 10 nb) */
     npy_intp dims[NPY_MAXDIMS];
     dims[0] = nout;
     memcpy(dims + 1, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
-    dims[nd] = DK_NV;
-    dims[nd + 1] = kind == DK_REGRESSOR ? 10 * DK_NB : DK_NV;
+    dims[nd] = tree->nv;
+    dims[nd + 1] = kind == DK_REGRESSOR ? 10 * tree->nb : tree->nv;
     block = lg_output(nd + 2, dims);
     if (!block) goto done;
     for (int o = 0; o < nout; o++) {
@@ -208,17 +332,19 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     int parts = dk_threads(count);
     npy_intp next = 0;  /* the threads take DK_CHUNK states at a time from here */
     for (int t = 0; t < parts; t++) {
-        dk_job job = {kind, (size_t)count * nout * DK_SIZE(kind) * sizeof(double) >= LG_STREAM_MIN,
+        dk_job job = {tree, kind,
+                      (size_t)count * nout * dk_size(tree, kind) * sizeof(double) >= LG_STREAM_MIN,
                       {step[0], step[1], step[2]}, 0, count, 0,
                       {PyArray_DATA(in[0]), PyArray_DATA(in[1]), PyArray_DATA(in[2])},
                       PyArray_DATA(P),
                       {PyArray_DATA((PyArrayObject *)out[0]),
                        nout > 1 ? PyArray_DATA((PyArrayObject *)out[1]) : NULL,
                        nout > 2 ? PyArray_DATA((PyArrayObject *)out[2]) : NULL},
-                      parts > 1 ? &next : NULL};
+                      parts > 1 ? &next : NULL, 0};
         jobs[t] = job;
     }
     npy_intp bad = 0;
+    int nomemory = 0;
     NPY_BEGIN_THREADS_DEF;
     if (count > 16) NPY_BEGIN_THREADS;
 #if DK_PTHREADS
@@ -226,8 +352,13 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
 #else
     for (int t = 0; t < parts; t++) dk_run(&jobs[t]);
 #endif
-    for (int t = 0; t < parts; t++) bad += jobs[t].bad;
+    for (int t = 0; t < parts; t++) { bad += jobs[t].bad; nomemory |= jobs[t].nomemory; }
     if (count > 16) NPY_END_THREADS;
+    /* a thread without its work block left its states unwritten: no numbers at all */
+    if (nomemory) {
+        PyErr_NoMemory();
+        goto done;
+    }
     if (kind == DK_REGRESSOR) {
         if (bad > 0)
             result = Py_BuildValue("(On)", out[0], (Py_ssize_t)bad);
@@ -268,11 +399,13 @@ static PyObject *dk_py_regressor(PyObject *self, PyObject *const *args, Py_ssize
 
 static PyMethodDef dk_methods[] = {
     {"inverse_derivatives", (PyCFunction)(void (*)(void))dk_py_inverse, METH_FASTCALL,
-     "(Q, V, A, P) -> (d tau/dq, d tau/dq_dot[, count of NaN rows])"},
+     "(tree, Q, V, A, P) -> (d tau/dq, d tau/dq_dot[, count of NaN rows])"},
     {"forward_derivatives", (PyCFunction)(void (*)(void))dk_py_forward, METH_FASTCALL,
-     "(Q, V, TAU, P) -> (d q_ddot/dq, d q_ddot/dq_dot, M^-1[, count of NaN rows])"},
+     "(tree, Q, V, TAU, P) -> (d q_ddot/dq, d q_ddot/dq_dot, M^-1[, count of NaN rows])"},
     {"regressor", (PyCFunction)(void (*)(void))dk_py_regressor, METH_FASTCALL,
-     "(Q, V, A, P) -> Y (or (Y, count of NaN rows)), tau = Y pi"},
+     "(tree, Q, V, A, P) -> Y (or (Y, count of NaN rows)), tau = Y pi"},
+    {"tree", (PyCFunction)(void (*)(void))dk_py_tree, METH_FASTCALL,
+     "(I, D) -> the tree's capsule, for the functions' first argument"},
     {NULL, NULL, 0, NULL},
 };
 

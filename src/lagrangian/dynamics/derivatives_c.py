@@ -1,21 +1,38 @@
 """The derivatives of a tree's dynamics in compiled C: d tau/dq, d tau/dq_dot of Newton-Euler
 and d q_ddot/dq, d q_ddot/dq_dot, M^-1 of forward dynamics (derivatives_kernel.c: analytic,
 O(n^2) per state; a floating base's q derivatives along its own axes, q (+) dq, as Pinocchio's),
-and the joint-torque regressor Y (fixed base); a batch in one call on vector lanes and
-threads (derivatives_bindings.c), over the tree's joints written as static tables, one module
-per tree's kinematics (cached on disk by its numbers). Gravity, the actuator parameters
-tau_<joint> and the bodies' inertials are given at run time. Revolute and prismatic joints;
-the complex step of derivatives.py is the fallback (and the check). Units SI."""
+and the joint-torque regressor Y; a batch in one call on vector lanes and threads
+(derivatives_bindings.c). One compiled module for every tree (keyed by its C and this file,
+never a tree's numbers): the tree is given at run time as two tables, made once per dynamics
+object, and gravity, the actuator parameters tau_<joint> and the bodies' inertials as P
+(runtime_values). Revolute and prismatic joints, a free flyer at the root; the complex step of
+derivatives.py is the fallback (and the check). Units SI.
+
+The tables (``tables``), nb bodies numbered parents first, nj joint coordinates, a floating
+base's six velocity coordinates first (nv = nj + 6 ff, nq = nj + 7 ff):
+
+    I (int32): nb, nj, ff (1: body 0 a free flyer), np pairs, nnz pattern entries, ltdl (1:
+    M factored along the tree), once (1: each coordinate one body's), sparse (1: the lanes'
+    products over the pattern); then parent[nb] (-1 the ground), coordinate[nb] (the joint's
+    index among the nj; body 0's unused on a floating base), turns[nb], slides[nb] (0 or 1),
+    pairs[np][2] (k, j: j on k's path to the ground, k itself first), row0[nv + 1] and
+    rows[nnz] (column j's rows that d tau/d(q, q_dot) can have nonzero: rows[row0[j] ..
+    row0[j + 1]], ascending), lambda[nv] (each coordinate's parent coordinate, -1 at a root).
+    D (float64), field by field, each nb records: multiplier k and offset (theta = k q + offset;
+    1 each), R0 (joint -> parent axes, row-major, 9), P, C, S (9 each: R0 Rot(u, theta) =
+    P + cos theta C + sin theta S), t0 (m, 3), the unit axis u (joint axes, 3), R0 u (3).
+"""
 
 from __future__ import annotations
 
 import hashlib
 from collections.abc import Mapping
+from functools import partial
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
-from ..compile.codegen import c_table
 from ..model.tree import KinematicTree
 from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import JOINT_MODELS
@@ -63,10 +80,6 @@ static inline int dk4_bits(dk4_mask mask)
     for (int l = 0; l < LG_LANES; l++) bits |= (mask[l] != 0) << l;
     return bits;
 }"""
-
-
-def _flat(matrix) -> list[float]:
-    return [float(x) for row in matrix for x in row]
 
 
 def _pairs(tree: KinematicTree) -> list[tuple[int, int]]:
@@ -126,10 +139,10 @@ def _coordinate_parents(tree: KinematicTree) -> list[int] | None:
 def factored_along_the_tree(tree: KinematicTree,
                             parents: list[int] | None = None) -> list[int] | None:
     """The coordinates' parents where forward dynamics' M is factored along the tree (M =
-    L^T D L, no fill-in: _tree_factor) rather than by a dense Cholesky: a tree that branches
-    (two legs, or more), its coordinates one body's each, numbered parents first; else None.
-    On a chain both do the same work and the dense loops are the simpler. ``parents``:
-    _coordinate_parents(tree), where the caller has it."""
+    L^T D L, no fill-in: derivatives_factor.c's ltdl_factor) rather than by a dense Cholesky: a
+    tree that branches (two legs, or more), its coordinates one body's each, numbered parents
+    first; else None. On a chain both do the same work and the dense loops are the simpler.
+    ``parents``: _coordinate_parents(tree), where the caller has it."""
     if parents is None:
         parents = _coordinate_parents(tree)
     if parents is None:
@@ -138,96 +151,59 @@ def factored_along_the_tree(tree: KinematicTree,
     return parents if max(children) > 1 else None
 
 
-def _tree_factor(parents: list[int]) -> str:
-    """derivatives_kernel.c's factor, solve and inverse_from_factor for M = L^T D L on this
-    tree of coordinates, written out (Featherstone's LTDL: the entries follow the parents)."""
-    n = len(parents)
-
-    def chain(c):  # c's ancestors, nearest first
-        out = []
-        while parents[c] >= 0:
-            c = parents[c]
-            out.append(c)
-        return out
-
-    def at(i, j):
-        return f"[{i * n + j}]"
-
-    lines = ["static int DK_FN(factor)(DK_T *restrict H, DK_T *restrict inverse)", "{",
-             "    DK_MASK failed = {0};"]
-    for k in reversed(range(n)):
-        lines.append(f"    {{ const DK_T d = H{at(k, k)}; failed |= DK_FAILED(d); "
-                     f"const DK_T r = 1.0 / d; inverse[{k}] = r;")
-        for i in chain(k):
-            updates = " ".join(f"H{at(i, j)} -= a * H{at(k, j)};" for j in [i, *chain(i)])
-            lines.append(f"      {{ const DK_T a = H{at(k, i)} * r; {updates} H{at(k, i)} = a; }}")
-        lines.append("    }")
-    lines += ["    return DK_BITS(failed);", "}", "",
-              "static void DK_FN(solve)(const DK_T *restrict L, const DK_T *restrict inverse, "
-              "DK_T *restrict b)", "{"]
-    for i in reversed(range(n)):
-        lines += [f"    b[{j}] -= L{at(i, j)} * b[{i}];" for j in chain(i)]
-    lines += [f"    b[{i}] *= inverse[{i}];" for i in range(n)]
-    for i in range(n):
-        if chain(i):
-            terms = " + ".join(f"L{at(i, j)} * b[{j}]" for j in chain(i))
-            lines.append(f"    b[{i}] -= {terms};")
-    lines += ["}", "",
-              "static void DK_FN(inverse_from_factor)(const DK_T *restrict L, "
-              "const DK_T *restrict inverse, DK_T *restrict Minv)", "{",
-              f"    DK_T W[{n * n}];"]
-    for i in range(n):  # W = L^-1, row by row: W_ik = -sum over m between of L_im W_mk
-        for k in chain(i):
-            terms = [f"L{at(i, k)}"] + [f"L{at(i, m)} * W{at(m, k)}"
-                                        for m in chain(i) if m != k and k in chain(m)]
-            lines.append(f"    W{at(i, k)} = -({' + '.join(terms)});")
-    for i in range(n):
-        for j in range(i + 1):
-            common = [c for c in [i, *chain(i)] if c in [j, *chain(j)]]
-
-            def w(row, k):
-                return "" if row == k else f" * W{at(row, k)}"
-
-            terms = [f"inverse[{k}]{w(i, k)}{w(j, k)}" for k in common]
-            value = " + ".join(terms) if terms else "DK_C(0.0)"
-            lines.append(f"    Minv{at(i, j)} = {value};" if i == j else
-                         f"    Minv{at(i, j)} = Minv{at(j, i)} = {value};")
-    lines.append("}")
-    return "\n".join(lines)
-
-
-def kernel_source(tree: KinematicTree):
-    """The module's C: the tree's tables, then derivatives_kernel.c."""
-    from ..compile.codegen import GeneratedSource
-
+def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
+    """The tree's I (int32) and D (float64), laid out as this module's docstring says."""
     joints = tree.joints
-    P, C, S = [], [], []
-    for j in joints:  # R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x
-        R0, u = np.array(j.rotation, dtype=float), np.array(j.axis, dtype=float)
-        uu = np.outer(u, u)
-        skew = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
-        P.append((R0 @ uu).ravel().tolist())
-        C.append((R0 @ (np.eye(3) - uu)).ravel().tolist())
-        S.append((R0 @ skew).ravel().tolist())
-    models = [JOINT_MODELS[j.kind] for j in joints]
-    n = len(tree.coordinates)
+    nb, nj = len(joints), len(tree.coordinates)
     floating = int(bool(tree.floating_base))
+    nv = nj + 6 * floating
+    R0 = np.array([j.rotation for j in joints], dtype=float).reshape(nb, 3, 3)
+    u = np.array([j.axis for j in joints], dtype=float).reshape(nb, 3)
+    uu = np.einsum("bi,bj->bij", u, u)
+    skew = np.zeros((nb, 3, 3))
+    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -u[:, 2], u[:, 1], -u[:, 0]
+    skew -= np.swapaxes(skew, 1, 2)
+    # R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x
+    P, C, S = R0 @ uu, R0 @ (np.eye(3) - uu), R0 @ skew
+    models = [JOINT_MODELS[j.kind] for j in joints]
     pairs = _pairs(tree)
     rows = _column_rows(tree, pairs)
-    starts = np.cumsum([0] + [len(r) for r in rows]).tolist()
+    starts = np.cumsum([0] + [len(r) for r in rows])
     # on the lanes, the products -M^-1 d tau/dq, -M^-1 d tau/dq_dot skip the zero entries where
     # a quarter or more are zero (a floating base's legs: 36% fewer multiply-adds on Solo12); a
-    # denser pattern (a serial arm: none) keeps the row by row loops, unrolled whole on an arm
-    sparse = starts[-1] <= 0.75 * (n + 6 * floating) ** 2
+    # denser pattern (a serial arm: none) keeps the row by row loops
+    sparse = starts[-1] <= 0.75 * nv ** 2
     one_body = _coordinate_parents(tree)  # None where a coordinate moves two bodies (mimic)
     parents = factored_along_the_tree(tree, one_body)
+    header = [nb, nj, floating, len(pairs), int(starts[-1]), int(parents is not None),
+              int(one_body is not None), int(sparse)]
+    I = np.concatenate([
+        header, [j.parent for j in joints],
+        [0 if floating and b == 0 else j.coordinate for b, j in enumerate(joints)],
+        [bool(getattr(m, "turns", False)) for m in models],
+        [bool(getattr(m, "slides", False)) for m in models],
+        np.ravel(np.array(pairs, dtype=int)), starts, [k for r in rows for k in r],
+        parents if parents is not None else [-1] * nv]).astype(np.int32)
+    D = np.concatenate([[j.multiplier for j in joints], [j.offset for j in joints],
+                        R0.ravel(), P.ravel(), C.ravel(), S.ravel(),
+                        np.array([j.translation for j in joints], dtype=float).ravel(),
+                        u.ravel(), np.einsum("bij,bj->bi", R0, u).ravel()])
+    for table in (I, D):
+        table.flags.writeable = False
+    return I, D
+
+
+def kernel_source():
+    """The module's C: derivatives_kernel.c's core on one state and on the lanes, the thread
+    count and the bindings; the same for every tree."""
+    from ..compile.codegen import GeneratedSource
+
     text = _KERNEL.read_text(encoding="utf-8")
     head, rest = text.split("/* DK_CORE_BEGIN */")
     core = rest.split("/* DK_CORE_END */")[0] + _REGRESSOR.read_text(encoding="utf-8")
     marker = "/* DK_FACTOR: derivatives_factor.c, here"
     at = core.index(marker)
-    core = (core[:at] + _FACTOR.read_text(encoding="utf-8") + core[core.index("\n", at):]).replace(
-        "DK_TREE_FACTOR", _tree_factor(parents) if parents is not None else "")
+    core = core[:at] + _FACTOR.read_text(encoding="utf-8") + core[core.index("\n", at):]
     bindings = _THREADS.read_text(encoding="utf-8") + _BINDINGS.read_text(encoding="utf-8")
     source = "\n".join([
         "/* lagrangian: the derivatives of a tree's inverse and forward dynamics */",
@@ -238,52 +214,19 @@ def kernel_source(tree: KinematicTree):
         "#include <math.h>",
         "#include <stdlib.h>",
         "#include <string.h>",
-        f"#define DK_NB {len(joints)}",
-        f"#define DK_NJ {n}",  # the joints' coordinates; a floating base's come first:
-        f"#define DK_FF {floating}",
-        f"#define DK_QO {7 * floating}",
-        f"#define DK_VO {6 * floating}",
-        f"#define DK_NQ {n + 7 * floating}",
-        f"#define DK_NV {n + 6 * floating}",
-        f"#define DK_NP {len(pairs)}",
         f"#define DK_QTOL {QUATERNION_TOLERANCE!r}",
-        c_table("dk_parent", "int", [j.parent for j in joints]),
-        c_table("dk_coord", "int", [j.coordinate for j in joints]),
-        c_table("dk_turns", "int", [getattr(m, "turns", False) for m in models]),
-        c_table("dk_slides", "int", [getattr(m, "slides", False) for m in models]),
-        c_table("dk_pair", "int", [list(p) for p in pairs]),
-        f"#define DK_SPARSE {int(sparse)}",
-        c_table("dk_row0", "int", starts),
-        c_table("dk_rows", "int", [k for r in rows for k in r]),
-        f"#define DK_LTDL {int(parents is not None)}",
-        f"#define DK_ONCE {int(one_body is not None)}",
-        c_table("dk_mult", "double", [j.multiplier for j in joints]),
-        c_table("dk_off", "double", [j.offset for j in joints]),
-        c_table("dk_R0", "double", [_flat(j.rotation) for j in joints]),
-        c_table("dk_P", "double", P), c_table("dk_C", "double", C), c_table("dk_Sk", "double", S),
-        c_table("dk_t0", "double", [list(j.translation) for j in joints]),
-        c_table("dk_u", "double", [list(j.axis) for j in joints]),
-        c_table("dk_R0u", "double", [(np.array(j.rotation, dtype=float)
-                                     @ np.array(j.axis, dtype=float)).tolist() for j in joints]),
         _SINCOS, _VECTOR,
         head, _SCALAR, core, _LANES, core, bindings,
     ])
-    return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
-
-
-# The kernel keeps a state's work on the stack (per body and n x n per output, LG_LANES states
-# at once): up to this many bodies and coordinates, about a megabyte; larger trees keep the
-# complex step of derivatives.py.
-LARGEST = 64
+    return GeneratedSource(source=source, parameters=(), n=0, m=0)
 
 
 def applies(tree: KinematicTree | None) -> bool:
     """Whether the kernel takes this tree: revolute and prismatic joints on a fixed base or a
-    floating one (a free flyer at the root), at most LARGEST bodies and coordinates."""
+    floating one (a free flyer at the root), of any size."""
     from ..kinds import JointKind
 
-    if tree is None or not tree.joints or len(tree.joints) > LARGEST \
-            or len(tree.coordinates) > LARGEST:
+    if tree is None or not tree.joints:
         return False
     kinds = [j.kind for j in tree.joints]
     if tree.floating_base:
@@ -293,28 +236,45 @@ def applies(tree: KinematicTree | None) -> bool:
     return all(k in (JointKind.REVOLUTE, JointKind.PRISMATIC) for k in kinds)
 
 
-def derivatives_module(tree: KinematicTree):
-    """The compiled module of this tree (built once, then from the verified cache), or None
-    where no compiler works or the kernel does not take the tree."""
+def engine():
+    """The one compiled module for every tree (built once per installation, then from the
+    verified cache), or None where no compiler works."""
     from ..compile import compiled
 
-    if not applies(tree):
-        return None
-    here = Path(__file__)
-    generator = hashlib.sha256(_KERNEL.read_bytes() + _FACTOR.read_bytes() + _THREADS.read_bytes()
-                               + _BINDINGS.read_bytes() + _REGRESSOR.read_bytes()
-                               + here.read_bytes()
-                               + here.with_name("tree_c.py").read_bytes()).hexdigest()
-    # the joints' kinematics only: the inertials are given at run time (runtime_values), so a
-    # payload or an identification's trial inertials reuse the module
-    kinematic = [(j.parent, str(j.kind), j.rotation, j.translation, j.axis, j.coordinate,
-                  j.multiplier, j.offset) for j in tree.joints]
-    key = "\n".join(["derivatives", generator, repr(kinematic), repr(tree.coordinates),
-                     repr(bool(tree.floating_base)), repr(QUATERNION_TOLERANCE)])
+    generated = kernel_source()
+    key = "\n".join(["derivatives", hashlib.sha256(
+        generated.source.encode() + Path(__file__).read_bytes()).hexdigest()])
     try:
-        return compiled.load_keyed(key, lambda: kernel_source(tree), native=True)
+        return compiled.load_keyed(key, lambda: generated, native=True)
     except compiled.BackendUnavailable:
         return None
+
+
+class TreeDerivatives(NamedTuple):
+    """The engine's functions bound to one tree: each takes (Q, V, X, P)."""
+
+    inverse_derivatives: partial
+    forward_derivatives: partial
+    regressor: partial
+    module: object
+
+
+def derivatives_module(tree: KinematicTree) -> TreeDerivatives | None:
+    """The engine's functions on this tree (its tables made now, once), or None where no
+    compiler works or the kernel does not take the tree."""
+    if not applies(tree):
+        return None
+    module = engine()
+    if module is None:
+        return None
+    handle = module.tree(*tables(tree))
+    return TreeDerivatives(partial(module.inverse_derivatives, handle),
+                           partial(module.forward_derivatives, handle),
+                           partial(module.regressor, handle), module)
+
+
+def _flat(matrix) -> list[float]:
+    return [float(x) for row in matrix for x in row]
 
 
 def runtime_values(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
@@ -332,4 +292,5 @@ def runtime_values(tree: KinematicTree, parameters: Mapping[str, float]) -> np.n
     return P
 
 
-__all__ = ["applies", "derivatives_module", "kernel_source", "runtime_values"]
+__all__ = ["applies", "derivatives_module", "engine", "kernel_source", "runtime_values",
+           "tables"]

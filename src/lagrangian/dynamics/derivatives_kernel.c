@@ -1,6 +1,6 @@
 /* d tau/dq, d tau/dq_dot of recursive Newton-Euler and d q_ddot/dq, d q_ddot/dq_dot, M^-1 of
- * forward dynamics, over the tree tables that derivatives_c.py writes above this text (dk_*
- * arrays, DK_NB bodies, DK_NV coordinates, DK_NP ancestor pairs). Analytic, O(n^2) per state.
+ * forward dynamics, over a tree given at run time (dk_tree below: any number of bodies, each
+ * state's work in a thread's heap block). Analytic, O(n^2) per state.
  *
  * Spatial vectors at the world's origin in world axes, linear part first: a motion [v; w], a
  * force [f; n]. A body's joint column S (theta_dot = k q_dot[c]); v_i = v_p + S theta_dot,
@@ -21,25 +21,23 @@
 #define DK_STR(x) DK_STR_(x)
 #define DK_PASTE_(a, b) a##b
 #define DK_PASTE(a, b) DK_PASTE_(a, b)
-/* The dense loops (Cholesky, M^-1, the products) unrolled whole on an arm of a few coordinates:
-   the triangular loops' trip counts are then constants, not a jump into a loop per row; the
-   ancestor pairs' loop likewise, its tables' entries then constants (3-4% of a state's time on
-   the Panda, for 1.5 times the build's time). Not on larger trees (Solo12's 18: no faster,
-   twice the build's time), nor on the loops over the bodies (slower: the code's size). */
-#if DK_NV <= 12
-#define DK_UNROLL _Pragma("GCC unroll 16")
-#define DK_UNROLL_TREE _Pragma("GCC unroll 80")
-#else
-#define DK_UNROLL
-#define DK_UNROLL_TREE
-#endif
-/* a row of a product held in registers (up to 24 vectors of the 32): its loops unrolled whole */
-#if DK_NV <= 24
-#define DK_UNROLL_ROW _Pragma("GCC unroll 24")
-#else
-#define DK_UNROLL_ROW
-#endif
 
+/* The tree, read at run time (derivatives_c.py builds its two tables, the bindings copy them
+ * here once per tree): nb bodies, nj joint coordinates, ff 1 on a floating base (body 0 a free
+ * flyer, its 7 q and 6 v first: qo, vo), nv = nj + 6 ff velocity coordinates, nq = nj + 7 ff;
+ * np ancestor pairs (k, j), j on k's path to the ground, k first; per coordinate j the rows
+ * that d tau/d(q, q_dot)_j can have nonzero (rows[row0[j] .. row0[j + 1]]), and its parent
+ * coordinate (lambda, for the factor along the tree). Per body its parent body, coordinate,
+ * whether it turns or slides, its multiplier and offset, R0, t0, its axis u (its joint's
+ * frame), R0 u and P, C, S with R0 Rot(u, th) = P + cos th C + sin th S. ``space``: the
+ * doubles of one thread's work on LG_LANES states (dk4_carve). */
+typedef struct {
+    int nb, nj, ff, np, nv, nq, qo, vo, ltdl, once, sparse;
+    const int *parent, *coord, *turns, *slides, (*pair)[2], *row0, *rows, *lambda;
+    const double *mult, *off, (*R0)[9], (*P)[9], (*C)[9], (*Sk)[9], (*t0)[3], (*u)[3],
+        (*R0u)[3];
+    size_t space;
+} dk_tree;
 
 /* The core below is emitted twice by derivatives_c.py: on one state (dk_*, DK_T double) and on
  * LG_LANES states at once (dk4_*, DK_T lg_v4, GCC/Clang vector extensions). DK_FN(name) names a
@@ -118,40 +116,62 @@ static inline void DK_FN(iapply)(const DK_FN(inertia) *Y, const DK_T *x, DK_T *o
     for (int j = 0; j < 3; j++) { out[j] = Y->m * x[j] + a[j]; out[3 + j] = b[j] + Jw[j]; }
 }
 
+/* A state's work (lane's): per body (tree->nb rows) in the thread's heap block (carve), a
+ * floating base's six columns here. */
 typedef struct {
-    DK_T S[DK_NB][6], dv[DK_NB][6], psi[DK_NB][6];
-    DK_T F[DK_NB][6];                 /* f_i, then the subtree's sum */
-    DK_FN(inertia) Y[DK_NB];          /* the body's, then the subtree's */
-    DK_T L[DK_NB][3], A[DK_NB][9];    /* B's 12 numbers, the body's then the subtree's */
-    DK_T r1[DK_NB][6], r2[DK_NB][3];  /* Ic_k S_k and the angular part of Bc_k^T S_k */
-    DK_T Phi[DK_NB][6], Psi[DK_NB][6];
+    DK_T (*S)[6], (*dv)[6], (*psi)[6];
+    DK_T (*F)[6];                 /* f_i, then the subtree's sum */
+    DK_FN(inertia) *Y;            /* the body's, then the subtree's */
+    DK_T (*L)[3], (*A)[9];        /* B's 12 numbers, the body's then the subtree's */
+    DK_T (*r1)[6], (*r2)[3];      /* Ic_k S_k and the angular part of Bc_k^T S_k */
+    DK_T (*Phi)[6], (*Psi)[6];
+    /* each body's placement (R: body -> world, origin o), velocity and acceleration at the
+       world's origin (a of the ground: -g) */
+    DK_T (*R)[9], (*o)[3], (*V)[6], (*Acc)[6];
+    /* forward dynamics' own: the bodies' f and inertia before the sums, da, tau by body;
+       per coordinate b, zeros, the factor's diagonal, a row; and four nv x nv matrices */
+    DK_T (*F0)[6], (*da)[6], *taub, *b, *zero, *diagonal, *row, *M, *dq, *dv_, *X;
+    DK_FN(inertia) *Y0;
     /* a floating base's six columns (body 0): S, psi = -g x S, dv = v x S (its parent the
        ground), Ic S, Bc^T S's angular part, and S . F */
     DK_T ffS[6][6], ffpsi[6][6], ffdv[6][6], ffr1[6][6], ffr2[6][3], fftau[6];
 } DK_FN(work);
 
-/* Each body's placement (R: body -> world, origin o), velocity and acceleration at the world's
- * origin (a of the ground: -g). */
-typedef struct { DK_T R[DK_NB][9], o[DK_NB][3], V[DK_NB][6], Acc[DK_NB][6]; } DK_FN(motion);
+/* w's rows in the block at ``at`` (sizeof(DK_T) aligned); the first DK_T past them. The block
+ * is sized once per tree (dk_tree's space, checked against this at the tree's making). */
+static DK_T *DK_FN(carve)(const dk_tree *tree, DK_T *at, DK_FN(work) *w)
+{
+    const size_t nb = tree->nb, nv = tree->nv;
+#define DK_TAKE(field, count) (w->field = (void *)at, at += (count))
+    DK_TAKE(S, 6 * nb); DK_TAKE(dv, 6 * nb); DK_TAKE(psi, 6 * nb); DK_TAKE(F, 6 * nb);
+    DK_TAKE(Y, 13 * nb); DK_TAKE(L, 3 * nb); DK_TAKE(A, 9 * nb); DK_TAKE(r1, 6 * nb);
+    DK_TAKE(r2, 3 * nb); DK_TAKE(Phi, 6 * nb); DK_TAKE(Psi, 6 * nb); DK_TAKE(R, 9 * nb);
+    DK_TAKE(o, 3 * nb); DK_TAKE(V, 6 * nb); DK_TAKE(Acc, 6 * nb); DK_TAKE(F0, 6 * nb);
+    DK_TAKE(da, 6 * nb); DK_TAKE(taub, nb); DK_TAKE(Y0, 13 * nb);
+    DK_TAKE(b, nv); DK_TAKE(zero, nv); DK_TAKE(diagonal, nv); DK_TAKE(row, nv);
+    DK_TAKE(M, nv * nv); DK_TAKE(dq, nv * nv); DK_TAKE(dv_, nv * nv); DK_TAKE(X, nv * nv);
+#undef DK_TAKE
+    return at;
+}
 
 /* A floating base (body 0): q[0:3] its origin, q[3:7] its quaternion x y z w (normalized here),
  * R = R0 R(quaternion), o = t0 + R0 q[0:3]; its velocity and acceleration in its own axes, so
  * its columns are the world's images of the unit twists: [R e_c; 0] and [o x R e_c; R e_c]. */
-static void DK_FN(base)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
-                        DK_FN(work) *w, DK_FN(motion) *k)
+static void DK_FN(base)(const dk_tree *tree, const DK_T *q, const DK_T *qd, const DK_T *qdd,
+                        const double *g, DK_FN(work) *w)
 {
     const DK_T x = q[3], y = q[4], z = q[5], r = q[6];
     const DK_T t = 2.0 / (x * x + y * y + z * z + r * r);
     const DK_T Rq[9] = {1.0 - t * (y * y + z * z), t * (x * y - z * r), t * (x * z + y * r),
                         t * (x * y + z * r), 1.0 - t * (x * x + z * z), t * (y * z - x * r),
                         t * (x * z - y * r), t * (y * z + x * r), 1.0 - t * (x * x + y * y)};
-    DK_T *R = k->R[0], *o = k->o[0], *V = k->V[0], *Acc = k->Acc[0];
+    DK_T *R = w->R[0], *o = w->o[0], *V = w->V[0], *Acc = w->Acc[0];
     for (int a = 0; a < 3; a++) {
         for (int b = 0; b < 3; b++)
-            R[3 * a + b] = dk_R0[0][3 * a] * Rq[b] + dk_R0[0][3 * a + 1] * Rq[3 + b]
-                           + dk_R0[0][3 * a + 2] * Rq[6 + b];
-        o[a] = dk_t0[0][a] + dk_R0[0][3 * a] * q[0] + dk_R0[0][3 * a + 1] * q[1]
-               + dk_R0[0][3 * a + 2] * q[2];
+            R[3 * a + b] = tree->R0[0][3 * a] * Rq[b] + tree->R0[0][3 * a + 1] * Rq[3 + b]
+                           + tree->R0[0][3 * a + 2] * Rq[6 + b];
+        o[a] = tree->t0[0][a] + tree->R0[0][3 * a] * q[0] + tree->R0[0][3 * a + 1] * q[1]
+               + tree->R0[0][3 * a + 2] * q[2];
     }
     for (int c = 0; c < 3; c++) {
         DK_T *L = w->ffS[c], *A = w->ffS[3 + c];
@@ -173,29 +193,29 @@ static void DK_FN(base)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const do
 }
 
 /* The forward pass's kinematics: placements, S, v, a, dv and psi of every body. */
-static void DK_FN(kinematics)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
-                              DK_FN(work) *w, DK_FN(motion) *k)
+static void DK_FN(kinematics)(const dk_tree *tree, const DK_T *q, const DK_T *qd,
+                              const DK_T *qdd, const double *g, DK_FN(work) *w)
 {
-    DK_T (*R)[9] = k->R, (*o)[3] = k->o, (*V)[6] = k->V, (*Acc)[6] = k->Acc;
-    for (int i = 0; i < DK_NB; i++) {
-        if (DK_FF && i == 0) {
-            DK_FN(base)(q, qd, qdd, g, w, k);
+    DK_T (*R)[9] = w->R, (*o)[3] = w->o, (*V)[6] = w->V, (*Acc)[6] = w->Acc;
+    for (int i = 0; i < tree->nb; i++) {
+        if (tree->ff && i == 0) {
+            DK_FN(base)(tree, q, qd, qdd, g, w);
             continue;
         }
-        DK_T th = dk_mult[i] * q[DK_QO + dk_coord[i]] + dk_off[i];
+        DK_T th = tree->mult[i] * q[tree->qo + tree->coord[i]] + tree->off[i];
         DK_T Rl[9], pl[3];
-        for (int j = 0; j < 3; j++) pl[j] = DK_C(dk_t0[i][j]);
-        if (dk_turns[i]) {
+        for (int j = 0; j < 3; j++) pl[j] = DK_C(tree->t0[i][j]);
+        if (tree->turns[i]) {
             /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
             DK_T c, s;
             DK_SINCOS(th, &s, &c);
-            for (int j = 0; j < 9; j++) Rl[j] = dk_P[i][j] + c * dk_C[i][j] + s * dk_Sk[i][j];
+            for (int j = 0; j < 9; j++) Rl[j] = tree->P[i][j] + c * tree->C[i][j] + s * tree->Sk[i][j];
         } else {
-            for (int j = 0; j < 9; j++) Rl[j] = DK_C(dk_R0[i][j]);
+            for (int j = 0; j < 9; j++) Rl[j] = DK_C(tree->R0[i][j]);
         }
-        if (dk_slides[i])
-            for (int j = 0; j < 3; j++) pl[j] += th * dk_R0u[i][j];
-        int p = dk_parent[i];
+        if (tree->slides[i])
+            for (int j = 0; j < 3; j++) pl[j] += th * tree->R0u[i][j];
+        int p = tree->parent[i];
         DK_T axis[3];
         if (p < 0) {
             for (int j = 0; j < 9; j++) R[i][j] = Rl[j];
@@ -208,11 +228,11 @@ static void DK_FN(kinematics)(const DK_T *q, const DK_T *qd, const DK_T *qdd, co
         }
         /* the world axis R u: R's column when u is a table's unit vector along x, y or z */
         for (int j = 0; j < 3; j++)
-            axis[j] = R[i][3 * j] * dk_u[i][0] + R[i][3 * j + 1] * dk_u[i][1]
-                      + R[i][3 * j + 2] * dk_u[i][2];
+            axis[j] = R[i][3 * j] * tree->u[i][0] + R[i][3 * j + 1] * tree->u[i][1]
+                      + R[i][3 * j + 2] * tree->u[i][2];
         /* S: [o x a; a] turning about the world axis a, [a; 0] sliding along it */
         DK_T *S = w->S[i];
-        if (dk_turns[i]) {
+        if (tree->turns[i]) {
             DK_FN(cross)(o[i], axis, S);
             for (int j = 0; j < 3; j++) S[3 + j] = axis[j];
         } else {
@@ -223,8 +243,8 @@ static void DK_FN(kinematics)(const DK_T *q, const DK_T *qd, const DK_T *qdd, co
             vp[j] = p >= 0 ? V[p][j] : DK_C(0.0);
             ap[j] = p >= 0 ? Acc[p][j] : DK_C(j < 3 ? -g[j] : 0.0);
         }
-        DK_T rate = dk_mult[i] * qd[DK_VO + dk_coord[i]];
-        DK_T accel = dk_mult[i] * qdd[DK_VO + dk_coord[i]];
+        DK_T rate = tree->mult[i] * qd[tree->vo + tree->coord[i]];
+        DK_T accel = tree->mult[i] * qdd[tree->vo + tree->coord[i]];
         DK_T t[6];
         DK_FN(mcross)(vp, S, w->dv[i]);
         DK_FN(mcross)(ap, S, w->psi[i]);
@@ -238,18 +258,17 @@ static void DK_FN(kinematics)(const DK_T *q, const DK_T *qd, const DK_T *qdd, co
 }
 
 /* The forward pass: the kinematics, then each body's f and B. */
-static void DK_FN(forward)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
-                           DK_FN(work) *w)
+static void DK_FN(forward)(const dk_tree *tree, const DK_T *q, const DK_T *qd, const DK_T *qdd,
+                           const double *g, DK_FN(work) *w)
 {
-    DK_FN(motion) k;
-    DK_FN(kinematics)(q, qd, qdd, g, w, &k);
-    DK_T (*R)[9] = k.R, (*o)[3] = k.o, (*V)[6] = k.V, (*Acc)[6] = k.Acc;
-    for (int i = 0; i < DK_NB; i++) {
+    DK_FN(kinematics)(tree, q, qd, qdd, g, w);
+    DK_T (*R)[9] = w->R, (*o)[3] = w->o, (*V)[6] = w->V, (*Acc)[6] = w->Acc;
+    for (int i = 0; i < tree->nb; i++) {
         /* the inertia at the world's origin: c = R h + m o, J_O = R J R^T shifted by o */
         DK_FN(inertia) *Y = &w->Y[i];
         DK_T hr[3], RJ[9];
         /* the body's inertial, given at run time: P = [g, tau_<joint>, (m, h, J_O) per body] */
-        const double *inertial = g + 3 + DK_NJ + 13 * i, m = inertial[0];
+        const double *inertial = g + 3 + tree->nj + 13 * i, m = inertial[0];
         const DK_T *po = o[i];
         for (int j = 0; j < 3; j++)
             hr[j] = R[i][3 * j] * inertial[1] + R[i][3 * j + 1] * inertial[2]
@@ -301,12 +320,13 @@ static inline void DK_FN(bapply)(const DK_T *L, const DK_T *A, const DK_T *x, DK
 }
 
 /* The backward pass: subtree sums and each body's row (r1, r2) and column (Phi, Psi) vectors
- * (the columns, and the sums of B, only with ``columns``), tau by body into tau (DK_NB) when
+ * (the columns, and the sums of B, only with ``columns``), tau by body into tau (nb) when
  * asked; with ``summed`` the inertias are the subtrees' already and r1 is kept (a second pass
  * at the same q). */
-static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns, int summed)
+static void DK_FN(backward)(const dk_tree *tree, DK_FN(work) *w, DK_T *tau, int columns,
+                            int summed)
 {
-    for (int i = DK_NB - 1; i >= 0; i--) {
+    for (int i = tree->nb - 1; i >= 0; i--) {
         const DK_FN(inertia) *Y = &w->Y[i];
         const DK_T *S = w->S[i];
         if (!summed) DK_FN(iapply)(Y, S, w->r1[i]);
@@ -327,7 +347,7 @@ static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns, int summed)
             DK_FN(bapply)(w->L[i], w->A[i], S, x);
             for (int j = 0; j < 6; j++) w->Psi[i][j] = 2.0 * u[j] + x[j];
         }
-        if (DK_FF && i == 0)  /* the base's columns, its subtree the whole tree */
+        if (tree->ff && i == 0)  /* the base's columns, its subtree the whole tree */
             for (int c = 0; c < 6; c++) {
                 const DK_T *T = w->ffS[c];
                 if (!summed) DK_FN(iapply)(Y, T, w->ffr1[c]);
@@ -339,7 +359,7 @@ static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns, int summed)
                     r2[j] = 2.0 * r2[j] + w->A[0][j] * T[3] + w->A[0][3 + j] * T[4]
                             + w->A[0][6 + j] * T[5];
             }
-        int p = dk_parent[i];
+        int p = tree->parent[i];
         if (p >= 0) {
             if (!summed) {
                 DK_FN(inertia) *P = &w->Y[p];
@@ -362,129 +382,142 @@ static void DK_FN(backward)(DK_FN(work) *w, DK_T *tau, int columns, int summed)
 /* The entries of a floating base's columns c: with body k (at or below the base: row k by
  * Ic_k, Bc_k; column k by its Phi, Psi) or, k = 0, with its own columns. A translation column
  * (c < 3) is [R e_c; 0], its psi 0 and its dv = [w x R e_c; 0]: their angular halves are not
- * summed, nor d tau/dq's entries by it (0; the caller's zeros stay). */
-static void DK_FN(base_pairs)(const DK_FN(work) *w, int k, DK_T *M, DK_T *dq, DK_T *dv,
-                              int fresh)
+ * summed, nor d tau/dq's entries by it (0; the caller's zeros stay). Body k's entries are
+ * summed into its coordinate's like every pair's: a mimic coordinate drives two bodies. */
+static void DK_FN(base_pairs)(const dk_tree *tree, const DK_FN(work) *w, int k, DK_T *M,
+                              DK_T *dq, DK_T *dv, int fresh)
 {
-    _Pragma("GCC unroll 6")
+    const int n = tree->nv;
     for (int c = 0; c < 6; c++) {
         const DK_T *S = w->ffS[c];
         const int moves = c >= 3;  /* a turn of the base, not a translation */
         if (k == 0) {
             for (int r = 0; r < 6; r++) {
                 const DK_T *r1 = w->ffr1[r], *r2 = w->ffr2[r];
-                if (M) M[r * DK_NV + c] = moves ? DK_FN(dot6)(r1, S) : DK_FN(dot3)(r1, S);
+                if (M) M[r * n + c] = moves ? DK_FN(dot6)(r1, S) : DK_FN(dot3)(r1, S);
                 if (!dq) continue;
                 if (moves) {
-                    dq[r * DK_NV + c] = DK_FN(dot6)(r1, w->ffpsi[c]);
-                    dv[r * DK_NV + c] = DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3);
+                    dq[r * n + c] = DK_FN(dot6)(r1, w->ffpsi[c]);
+                    dv[r * n + c] = DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3);
                 } else {
-                    dv[r * DK_NV + c] = DK_FN(dot3)(r1, w->ffdv[c]);
+                    dv[r * n + c] = DK_FN(dot3)(r1, w->ffdv[c]);
                 }
             }
             continue;
         }
-        const int ck = DK_VO + dk_coord[k];
-        const double m = dk_mult[k];
+        const int ck = tree->vo + tree->coord[k];
+        const double m = tree->mult[k];
         const DK_T *r1 = w->r1[k], *r2 = w->r2[k];
-        if (M) M[ck * DK_NV + c] = M[c * DK_NV + ck]
-                   = m * (moves ? DK_FN(dot6)(r1, S) : DK_FN(dot3)(r1, S));
+        if (M) {
+            const DK_T mkc = m * (moves ? DK_FN(dot6)(r1, S) : DK_FN(dot3)(r1, S));
+            DK_ADD(M[ck * n + c], mkc);
+            DK_ADD(M[c * n + ck], mkc);
+        }
         if (!dq) continue;
         if (moves) {
-            DK_ADD(dq[ck * DK_NV + c], m * DK_FN(dot6)(r1, w->ffpsi[c]));
-            DK_ADD(dv[ck * DK_NV + c], m * (DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3)));
-            DK_ADD(dq[c * DK_NV + ck], m * DK_FN(dot6)(S, w->Phi[k]));
-            DK_ADD(dv[c * DK_NV + ck], m * DK_FN(dot6)(S, w->Psi[k]));
+            DK_ADD(dq[ck * n + c], m * DK_FN(dot6)(r1, w->ffpsi[c]));
+            DK_ADD(dv[ck * n + c], m * (DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3)));
+            DK_ADD(dq[c * n + ck], m * DK_FN(dot6)(S, w->Phi[k]));
+            DK_ADD(dv[c * n + ck], m * DK_FN(dot6)(S, w->Psi[k]));
         } else {
-            DK_ADD(dv[ck * DK_NV + c], m * DK_FN(dot3)(r1, w->ffdv[c]));
-            DK_ADD(dq[c * DK_NV + ck], m * DK_FN(dot3)(S, w->Phi[k]));
-            DK_ADD(dv[c * DK_NV + ck], m * DK_FN(dot3)(S, w->Psi[k]));
+            DK_ADD(dv[ck * n + c], m * DK_FN(dot3)(r1, w->ffdv[c]));
+            DK_ADD(dq[c * n + ck], m * DK_FN(dot3)(S, w->Phi[k]));
+            DK_ADD(dv[c * n + ck], m * DK_FN(dot3)(S, w->Psi[k]));
         }
     }
 }
 
-/* M (DK_NV x DK_NV) when asked, or d tau/dq and d tau/dq_dot, from the pairs (k below or at j),
+/* M (nv x nv) when asked, or d tau/dq and d tau/dq_dot, from the pairs (k below or at j),
  * each entry scattered to the coordinates with the joints' multipliers: summed into zeros, or,
- * ``fresh`` (DK_ONCE: each coordinate one body's, so each entry comes from one pair), set once
- * and the entries no pair writes left as they are, for a caller that reads none of them (the
- * lanes' products over the pattern, the factor along the tree): a state's zeroing and its
+ * ``fresh`` (tree->once: each coordinate one body's, so each entry comes from one pair), set
+ * once and the entries no pair writes left as they are, for a caller that reads none of them
+ * (the lanes' products over the pattern, the factor along the tree): a state's zeroing and its
  * additions' loads spared. */
-static void DK_FN(pairs)(const DK_FN(work) *w, DK_T *M, DK_T *dq, DK_T *dv, int fresh)
+static void DK_FN(pairs)(const dk_tree *tree, const DK_FN(work) *w, DK_T *M, DK_T *dq, DK_T *dv,
+                         int fresh)
 {
+    const int n = tree->nv;
     if (M && !fresh)
-        for (int j = 0; j < DK_NV * DK_NV; j++) M[j] = DK_C(0.0);
+        for (int j = 0; j < n * n; j++) M[j] = DK_C(0.0);
     if (dq && !fresh)
-        for (int j = 0; j < DK_NV * DK_NV; j++) { dq[j] = DK_C(0.0); dv[j] = DK_C(0.0); }
-    DK_UNROLL_TREE
-    for (int e = 0; e < DK_NP; e++) {
-        const int k = dk_pair[e][0], j = dk_pair[e][1];
-        if (DK_FF && j == 0) {
-            DK_FN(base_pairs)(w, k, M, dq, dv, fresh);
+        for (int j = 0; j < n * n; j++) { dq[j] = DK_C(0.0); dv[j] = DK_C(0.0); }
+    for (int e = 0; e < tree->np; e++) {
+        const int k = tree->pair[e][0], j = tree->pair[e][1];
+        if (tree->ff && j == 0) {
+            DK_FN(base_pairs)(tree, w, k, M, dq, dv, fresh);
             continue;
         }
-        const int ck = DK_VO + dk_coord[k], cj = DK_VO + dk_coord[j];
-        const double kk = dk_mult[k] * dk_mult[j];
+        const int ck = tree->vo + tree->coord[k], cj = tree->vo + tree->coord[j];
+        const double kk = tree->mult[k] * tree->mult[j];
         const DK_T *r1 = w->r1[k];
         if (M) {
             const DK_T mkj = kk * DK_FN(dot6)(r1, w->S[j]);
-            DK_ADD(M[ck * DK_NV + cj], mkj);
-            if (k != j) DK_ADD(M[cj * DK_NV + ck], mkj);
+            DK_ADD(M[ck * n + cj], mkj);
+            if (k != j) DK_ADD(M[cj * n + ck], mkj);
         }
         if (!dq) continue;
         const DK_T *r2 = w->r2[k];
-        DK_ADD(dq[ck * DK_NV + cj],
+        DK_ADD(dq[ck * n + cj],
                kk * (DK_FN(dot6)(r1, w->psi[j]) + DK_FN(dot3)(r2, w->dv[j] + 3)));
-        DK_ADD(dv[ck * DK_NV + cj],
+        DK_ADD(dv[ck * n + cj],
                kk * (2.0 * DK_FN(dot6)(r1, w->dv[j]) + DK_FN(dot3)(r2, w->S[j] + 3)));
         if (k != j) {
-            DK_ADD(dq[cj * DK_NV + ck], kk * DK_FN(dot6)(w->S[j], w->Phi[k]));
-            DK_ADD(dv[cj * DK_NV + ck], kk * DK_FN(dot6)(w->S[j], w->Psi[k]));
+            DK_ADD(dq[cj * n + ck], kk * DK_FN(dot6)(w->S[j], w->Phi[k]));
+            DK_ADD(dv[cj * n + ck], kk * DK_FN(dot6)(w->S[j], w->Psi[k]));
         }
     }
 }
 
-/* (d tau/dq, d tau/dq_dot) at one state (lane); g (3) the gravity vector (m/s^2). */
-static void DK_FN(inverse)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
-                           DK_T *dq, DK_T *dv)
+/* (d tau/dq, d tau/dq_dot) at one state (lane); g (3) the gravity vector (m/s^2); ``space``
+ * the thread's work block. */
+static void DK_FN(inverse)(const dk_tree *tree, DK_T *space, const DK_T *q, const DK_T *qd,
+                           const DK_T *qdd, const double *g, DK_T *dq, DK_T *dv)
 {
     DK_FN(work) w;
-    DK_FN(forward)(q, qd, qdd, g, &w);
-    DK_FN(backward)(&w, NULL, 1, 0);
-    DK_FN(pairs)(&w, NULL, dq, dv, 0);
+    DK_FN(carve)(tree, space, &w);
+    DK_FN(forward)(tree, q, qd, qdd, g, &w);
+    DK_FN(backward)(tree, &w, NULL, 1, 0);
+    DK_FN(pairs)(tree, &w, NULL, dq, dv, 0);
 }
 
 /* DK_FACTOR: derivatives_factor.c, here (M's factor, its solve, M^-1, the products) */
 
-/* (d q_ddot/dq, d q_ddot/dq_dot, M^-1) at one state (lane); P = [g (3), tau_<joint> (DK_NV)];
+/* (d q_ddot/dq, d q_ddot/dq_dot, M^-1) at one state (lane); P = [g (3), tau_<joint> (nj), ...];
  * the lanes (bits) where M is not positive definite */
-static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T *tau,
-                                      const double *P, DK_T *aq, DK_T *av, DK_T *Minv)
+static int DK_FN(forward_derivatives)(const dk_tree *tree, DK_T *space, const DK_T *q,
+                                      const DK_T *qd, const DK_T *tau, const double *P,
+                                      DK_T *aq, DK_T *av, DK_T *Minv)
 {
     DK_FN(work) w;
-    DK_T M[DK_NV * DK_NV], dq[DK_NV * DK_NV], dv[DK_NV * DK_NV], taub[DK_NB], b[DK_NV], zero[DK_NV];
-    /* the bodies' own f and inertia: the first backward pass sums them in place (not B) */
-    DK_T F[DK_NB][6];
-    DK_FN(inertia) Y[DK_NB];
-    for (int j = 0; j < DK_NV; j++) zero[j] = DK_C(0.0);
+    DK_FN(carve)(tree, space, &w);
+    const int nb = tree->nb, nv = tree->nv, vo = tree->vo, ff = tree->ff;
+    DK_T *M = w.M, *dq = w.dq, *dv = w.dv_, *taub = w.taub, *b = w.b, *zero = w.zero;
+    DK_T *diagonal = w.diagonal, (*da)[6] = w.da;
+    for (int j = 0; j < nv; j++) zero[j] = DK_C(0.0);
     /* q_ddot = M^-1 (tau + tau_p - b), b from Newton-Euler at q_ddot = 0 */
-    DK_FN(forward)(q, qd, zero, P, &w);
-    memcpy(F, w.F, sizeof F);
-    memcpy(Y, w.Y, sizeof Y);
-    DK_FN(backward)(&w, taub, 0, 0);
-    DK_FN(pairs)(&w, M, NULL, NULL, DK_LTDL);
-    for (int j = 0; j < DK_NV; j++) b[j] = tau[j];
-    for (int j = 0; j < DK_NJ; j++) b[DK_VO + j] += P[3 + j];
-    for (int i = DK_FF; i < DK_NB; i++) b[DK_VO + dk_coord[i]] -= dk_mult[i] * taub[i];
-    for (int c = 0; c < 6 * DK_FF; c++) b[c] -= w.fftau[c];
-    DK_T diagonal[DK_NV];
-    int failed = DK_FN(factor)(M, diagonal);
-    DK_FN(solve)(M, diagonal, b);
+    DK_FN(forward)(tree, q, qd, zero, P, &w);
+    /* the bodies' own f and inertia: the first backward pass sums them in place (not B) */
+    memcpy(w.F0, w.F, (size_t)nb * sizeof w.F[0]);
+    memcpy(w.Y0, w.Y, (size_t)nb * sizeof w.Y[0]);
+    DK_FN(backward)(tree, &w, taub, 0, 0);
+    DK_FN(pairs)(tree, &w, M, NULL, NULL, tree->ltdl);
+    for (int j = 0; j < nv; j++) b[j] = tau[j];
+    for (int j = 0; j < tree->nj; j++) b[vo + j] += P[3 + j];
+    for (int i = ff; i < nb; i++) b[vo + tree->coord[i]] -= tree->mult[i] * taub[i];
+    for (int c = 0; c < 6 * ff; c++) b[c] -= w.fftau[c];
+    int failed;
+    if (tree->ltdl) {
+        failed = DK_FN(ltdl_factor)(tree, M, diagonal);
+        DK_FN(ltdl_solve)(tree, M, diagonal, b);
+    } else {
+        failed = DK_FN(factor)(nv, M, diagonal);
+        DK_FN(solve)(nv, M, diagonal, b);
+    }
     /* at q_ddot = b: each body's acceleration grows by da = da_p + S theta_ddot, so psi by
        da_p x S and f by Y da (the rest of the forward pass does not see q_ddot) */
-    DK_T da[DK_NB][6];
-    for (int i = 0; i < DK_NB; i++) {
-        const int p = dk_parent[i];
-        const DK_T accel = DK_FF && i == 0 ? DK_C(0.0) : dk_mult[i] * b[DK_VO + dk_coord[i]];
+    for (int i = 0; i < nb; i++) {
+        const int p = tree->parent[i];
+        const DK_T accel = ff && i == 0 ? DK_C(0.0) : tree->mult[i] * b[vo + tree->coord[i]];
         DK_T t[6], u[6];
         if (p >= 0) {
             DK_FN(mcross)(da[p], w.S[i], t);
@@ -493,19 +526,23 @@ static int DK_FN(forward_derivatives)(const DK_T *q, const DK_T *qd, const DK_T 
             for (int j = 0; j < 6; j++) da[i][j] = DK_C(0.0);
         }
         for (int j = 0; j < 6; j++) da[i][j] += w.S[i][j] * accel;
-        if (DK_FF && i == 0)
+        if (ff && i == 0)
             for (int c = 0; c < 6; c++)
                 for (int j = 0; j < 6; j++) da[0][j] += w.ffS[c][j] * b[c];
-        DK_FN(iapply)(&Y[i], da[i], u);
-        for (int j = 0; j < 6; j++) w.F[i][j] = F[i][j] + u[j];
+        DK_FN(iapply)(&w.Y0[i], da[i], u);
+        for (int j = 0; j < 6; j++) w.F[i][j] = w.F0[i][j] + u[j];
     }
     /* the second pass: the subtrees' inertias and r1 as they are (the same q) */
-    DK_FN(backward)(&w, NULL, 1, 1);
-    DK_FN(pairs)(&w, NULL, dq, dv, DK_SPARSE && DK_ON_LANES && DK_ONCE);
-    DK_FN(inverse_from_factor)(M, diagonal, Minv);
+    DK_FN(backward)(tree, &w, NULL, 1, 1);
+    const int sparse = tree->sparse && DK_ON_LANES;
+    DK_FN(pairs)(tree, &w, NULL, dq, dv, sparse && tree->once);
+    if (tree->ltdl)
+        DK_FN(ltdl_inverse)(tree, M, diagonal, w.X, Minv);
+    else
+        DK_FN(inverse_from_factor)(nv, M, diagonal, w.X, Minv);
     /* a floating base's translation leaves tau as it is: d tau/dq's first three columns 0 */
-    DK_FN(minus_product)(Minv, dq, aq, 3 * DK_FF);
-    DK_FN(minus_product)(Minv, dv, av, 0);
+    DK_FN(minus_product)(tree, sparse, Minv, dq, aq, 3 * ff, w.row);
+    DK_FN(minus_product)(tree, sparse, Minv, dv, av, 0, w.row);
     return failed;
 }
 /* DK_CORE_END */

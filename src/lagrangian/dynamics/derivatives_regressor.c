@@ -1,6 +1,6 @@
 /* The joint-torque regressor Y (tau = Y pi), part of the derivatives kernel's core (compiled on
- * one state and on LG_LANES states, after derivatives_kernel.c: its work, motion, kinematics,
- * cross and dot3). */
+ * one state and on LG_LANES states, after derivatives_kernel.c: its work, carve, kinematics,
+ * cross and dot3; its tree and work block the caller's). */
 
 /* One column S (world, at the world's origin; times mult) of a joint at or above body i,
  * paired with body i's wrench per parameter: S at body i's origin in its axes,
@@ -22,20 +22,21 @@ static inline void DK_FN(regressor_column)(const DK_T *S, double mult, const DK_
     for (int p = 0; p < 6; p++) row[4 + p] += mult * DK_FN(dot3)(sw, Nj[p]);
 }
 
-/* Y (DK_NV x 10 DK_NB, row-major) with tau = Y pi, pi = [m, m c, I_xx, I_xy, I_yy, I_xz, I_yz,
+/* Y (nv x 10 nb, row-major) with tau = Y pi, pi = [m, m c, I_xx, I_xy, I_yy, I_xz, I_yz,
  * I_zz] per body about its origin in its axes (Pinocchio's order): body i's wrench at its origin
  * per parameter, from its angular velocity w, angular acceleration dw and its origin's
  * acceleration ac (gravity in), in its axes: m [ac; 0], h [(dw x + w x w x) h; h x ac],
  * J [0; J dw + w x J w]; each paired with S_k of every joint k at or above it, in its axes. */
-static void DK_FN(regressor)(const DK_T *q, const DK_T *qd, const DK_T *qdd, const double *g,
-                             DK_T *Y)
+static void DK_FN(regressor)(const dk_tree *tree, DK_T *space, const DK_T *q, const DK_T *qd,
+                             const DK_T *qdd, const double *g, DK_T *Y)
 {
     DK_FN(work) w;
-    DK_FN(motion) k;
-    DK_FN(kinematics)(q, qd, qdd, g, &w, &k);
-    for (int j = 0; j < DK_NV * 10 * DK_NB; j++) Y[j] = DK_C(0.0);
-    for (int i = 0; i < DK_NB; i++) {
-        const DK_T *R = k.R[i], *o = k.o[i], *V = k.V[i], *Acc = k.Acc[i];
+    DK_FN(carve)(tree, space, &w);
+    DK_FN(kinematics)(tree, q, qd, qdd, g, &w);
+    const int nb = tree->nb, width = 10 * nb;
+    for (int j = 0; j < tree->nv * width; j++) Y[j] = DK_C(0.0);
+    for (int i = 0; i < nb; i++) {
+        const DK_T *R = w.R[i], *o = w.o[i], *V = w.V[i], *Acc = w.Acc[i];
         DK_T vo[3], ac[3], t[3], wl[3], dwl[3], al[3], ww[3];
         /* the origin's velocity v + w x o and classical acceleration a + dw x o + w x vo */
         DK_FN(cross)(V + 3, o, t);
@@ -70,12 +71,11 @@ static void DK_FN(regressor)(const DK_T *q, const DK_T *qd, const DK_T *qdd, con
             DK_FN(cross)(wl, Jw, ww);
             for (int j = 0; j < 3; j++) Nj[p][j] = Jd[j] + ww[j];
         }
-        for (int kk = i; kk >= DK_FF; kk = dk_parent[kk])
-            DK_FN(regressor_column)(w.S[kk], dk_mult[kk], R, o, al, Fh, Nh, Nj,
-                                    Y + (DK_VO + dk_coord[kk]) * 10 * DK_NB + 10 * i);
+        for (int kk = i; kk >= tree->ff; kk = tree->parent[kk])
+            DK_FN(regressor_column)(w.S[kk], tree->mult[kk], R, o, al, Fh, Nh, Nj,
+                                    Y + (tree->vo + tree->coord[kk]) * width + 10 * i);
         /* a floating base's rows 0..5, the wrench on it in its axes: every body hangs from it */
-        for (int c = 0; c < 6 * DK_FF; c++)
-            DK_FN(regressor_column)(w.ffS[c], 1.0, R, o, al, Fh, Nh, Nj,
-                                    Y + c * 10 * DK_NB + 10 * i);
+        for (int c = 0; c < 6 * tree->ff; c++)
+            DK_FN(regressor_column)(w.ffS[c], 1.0, R, o, al, Fh, Nh, Nj, Y + c * width + 10 * i);
     }
 }

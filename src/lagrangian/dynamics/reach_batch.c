@@ -19,6 +19,7 @@ enum { RK_DRIFT, RK_CENTROIDAL, RK_WRENCH, RK_CORIOLIS, RK_INVERSE, RK_PLACEMENT
 
 /* one batch's inputs and output; ``next`` the shared counter of states handed out */
 typedef struct {
+    const rk_model *md;
     int kind, frame, ref, nw, stream;  /* stream: rows stored past the caches (lg_rows_streamed) */
     const double *q, *v, *a, *up;
     const int *frames;
@@ -29,16 +30,16 @@ typedef struct {
 } rk_job;
 
 /* the numbers of a state's output row */
-static int rk_width(int kind)
+static int rk_width(const rk_model *md, int kind)
 {
-    return kind == RK_DRIFT ? 6 : kind == RK_CENTROIDAL || kind == RK_JACOBIAN ? 6 * RK_NV
-           : kind == RK_CORIOLIS ? RK_NV * RK_NV : kind == RK_PLACEMENT ? 16
-           : kind == RK_COM ? 3 : kind == RK_COM_JACOBIAN ? 3 * RK_NV : RK_NV;
+    return kind == RK_DRIFT ? 6 : kind == RK_CENTROIDAL || kind == RK_JACOBIAN ? 6 * md->nv
+           : kind == RK_CORIOLIS ? md->nv * md->nv : kind == RK_PLACEMENT ? 16
+           : kind == RK_COM ? 3 : kind == RK_COM_JACOBIAN ? 3 * md->nv : md->nv;
 }
 
 static void rk_blank(const rk_job *job, npy_intp k)
 {
-    const int width = rk_width(job->kind);
+    const int width = rk_width(job->md, job->kind);
     for (int i = 0; i < width; i++) job->y[k * width + i] = NAN;
 }
 
@@ -60,50 +61,56 @@ static int rk_finite_row(const double *x, int width)
 /* whether state k's inputs are all finite (and, adding wrenches, its row after the sum) */
 static int rk_finite(const rk_job *job, npy_intp k)
 {
+    const rk_model *md = job->md;
     const int kind = job->kind;
-    int fine = rk_finite_row(job->q + k * RK_NQ, RK_NQ);
+    int fine = rk_finite_row(job->q + k * md->nq, md->nq);
     if (kind == RK_DRIFT || kind == RK_CORIOLIS || kind == RK_INVERSE)
-        fine &= rk_finite_row(job->v + k * RK_NV, RK_NV);
-    if (kind == RK_INVERSE) fine &= rk_finite_row(job->a + k * RK_NV, RK_NV);
+        fine &= rk_finite_row(job->v + k * md->nv, md->nv);
+    if (kind == RK_INVERSE) fine &= rk_finite_row(job->a + k * md->nv, md->nv);
     const int nw = kind == RK_WRENCH ? 1 : kind == RK_INVERSE ? job->nw : 0;
     for (int i = 0; i < nw; i++) fine &= rk_finite_row(job->w[i] + (job->wshared[i] ? 0 : 6 * k), 6);
     return fine;
 }
 
-/* state k alone; 1 where its row came out NaN */
-static int rk_state(const rk_job *job, npy_intp k, rk_cwork *work)
+/* state k alone (in ``work``: rk_work_size bytes); 1 where its row came out NaN */
+static int rk_state(const rk_job *job, npy_intp k, rk_work *work)
 {
-    const double *q = job->q + k * RK_NQ;
+    const rk_model *md = job->md;
+    const double *q = job->q + k * md->nq;
     if (!rk_finite(job, k)) {
         rk_blank(job, k);
         return 1;
     }
     switch (job->kind) {
-    case RK_DRIFT: rk_drift(q, job->v + k * RK_NV, job->frame, job->ref, job->y + 6 * k); break;
-    case RK_CENTROIDAL: rk_centroidal(q, job->y + 6 * RK_NV * k); break;
+    case RK_DRIFT:
+        rk_drift(md, work, q, job->v + k * md->nv, job->frame, job->ref, job->y + 6 * k);
+        break;
+    case RK_CENTROIDAL: rk_centroidal(md, work, q, job->y + 6 * md->nv * k); break;
     case RK_WRENCH: {
-        double tau[RK_NV], *y = job->y + RK_NV * k;
-        rk_wrench(q, job->frame, job->w[0] + (job->wshared[0] ? 0 : 6 * k), tau);
-        for (int j = 0; j < RK_NV; j++) y[j] += job->sign * tau[j];
+        double *tau = work->x, *y = job->y + md->nv * k;  /* x: a wrench has no arrays of its own */
+        rk_wrench(md, work, q, job->frame, job->w[0] + (job->wshared[0] ? 0 : 6 * k), tau);
+        for (int j = 0; j < md->nv; j++) y[j] += job->sign * tau[j];
         break;
     }
-    case RK_CORIOLIS: rk_coriolis(q, job->v + k * RK_NV, job->y + RK_NV * RK_NV * k, work); break;
-    case RK_PLACEMENT: rk_placement(q, job->frame, job->y + 16 * k); break;
-    case RK_JACOBIAN: rk_jacobian(q, job->frame, job->ref, job->y + 6 * RK_NV * k); break;
-    case RK_COM: rk_com(q, job->y + 3 * k); break;
-    case RK_COM_JACOBIAN: rk_com_jacobian(q, job->y + 3 * RK_NV * k); break;
+    case RK_CORIOLIS:
+        rk_coriolis(md, work, q, job->v + k * md->nv, job->y + md->nv * md->nv * k);
+        break;
+    case RK_PLACEMENT: rk_placement(md, work, q, job->frame, job->y + 16 * k); break;
+    case RK_JACOBIAN: rk_jacobian(md, work, q, job->frame, job->ref, job->y + 6 * md->nv * k); break;
+    case RK_COM: rk_com(md, work, q, job->y + 3 * k); break;
+    case RK_COM_JACOBIAN: rk_com_jacobian(md, work, q, job->y + 3 * md->nv * k); break;
     case RK_INVERSE: {
         double w[RK_MAX_WRENCHES][6];
         for (int i = 0; i < job->nw; i++)
             for (int j = 0; j < 6; j++) w[i][j] = job->w[i][(job->wshared[i] ? 0 : 6 * k) + j];
-        rk_inverse(q, job->v + k * RK_NV, job->a + k * RK_NV, job->up, job->nw, job->frames,
-                   (const double (*)[6])w, job->y + RK_NV * k);
+        rk_inverse(md, work, q, job->v + k * md->nv, job->a + k * md->nv, job->up, job->nw,
+                   job->frames, (const double (*)[6])w, job->y + md->nv * k);
         break;
     }
     }
     /* a row that was NaN before the wrench's forces were added (the caller's inverse dynamics
        of a state not finite) stays NaN whole */
-    if (job->kind == RK_WRENCH && !rk_finite_row(job->y + RK_NV * k, RK_NV)) {
+    if (job->kind == RK_WRENCH && !rk_finite_row(job->y + md->nv * k, md->nv)) {
         rk_blank(job, k);
         return 1;
     }
@@ -146,53 +153,92 @@ static inline void rk_spoil(const lg_v4 *x, int width, lg_v4 *spoilt)
     *spoilt += odd;
 }
 
-/* states k .. k + LG_LANES - 1 at once (rk4_*); out: RK_OUT4 vectors of room; the count of
-   NaN rows written */
-#define RK_OUT4 (RK_NV * RK_NV > 6 * RK_NV ? RK_NV * RK_NV : 6 * RK_NV > 16 ? 6 * RK_NV : 16)
-static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
+/* a thread's workspaces: one state's, and the lanes' with their inputs q, v, a and output (of
+ * the widest row, rk_out4 vectors) */
+typedef struct {
+    rk_work one;
+    rk4_work four;
+    lg_v4 *q, *v, *a, *out;
+} rk_space;
+
+static size_t rk_out4(const rk_model *md)
 {
-    lg_v4 q[RK_NQ], v[RK_NV], spoilt = LG_V4(0.0);
-    rk_gather(job->q, k, RK_NQ, q);
-    rk_spoil(q, RK_NQ, &spoilt);
+    const size_t nv = (size_t)md->nv;
+    return nv * nv > 6 * nv ? nv * nv : 6 * nv > 16 ? 6 * nv : 16;
+}
+
+/* the bytes of a thread's workspaces (the lanes' where ``lanes``) */
+static size_t rk_space_size(const rk_model *md, int lanes)
+{
+    size_t size = RK_ROUND(rk_work_size(md));
+    if (lanes)
+        size += RK_ROUND(rk4_work_size(md))
+                + RK_ROUND((size_t)(md->nq + 2 * md->nv) * sizeof(lg_v4))
+                + RK_ROUND(rk_out4(md) * sizeof(lg_v4));
+    return size;
+}
+
+static void rk_space_at(const rk_model *md, int lanes, char *block, rk_space *space)
+{
+    rk_work_at(md, block, &space->one);
+    if (!lanes) return;
+    block += RK_ROUND(rk_work_size(md));
+    rk4_work_at(md, block, &space->four);
+    block += RK_ROUND(rk4_work_size(md));
+    space->q = (lg_v4 *)block;
+    space->v = space->q + md->nq;
+    space->a = space->v + md->nv;
+    block += RK_ROUND((size_t)(md->nq + 2 * md->nv) * sizeof(lg_v4));
+    space->out = (lg_v4 *)block;
+}
+
+/* states k .. k + LG_LANES - 1 at once (rk4_*); the count of NaN rows written */
+static int rk_lanes(const rk_job *job, npy_intp k, rk_space *space)
+{
+    const rk_model *md = job->md;
+    rk4_work *work = &space->four;
+    lg_v4 *q = space->q, *v = space->v, *out = space->out, spoilt = LG_V4(0.0);
+    rk_gather(job->q, k, md->nq, q);
+    rk_spoil(q, md->nq, &spoilt);
     if (k + 2 * LG_LANES <= job->count) {  /* the next states' q and v, fetched meanwhile: a
                                               load of this group's was a sixth of C's time */
-        const char *next = (const char *)(job->q + (k + LG_LANES) * RK_NQ);
-        for (size_t b = 0; b < LG_LANES * RK_NQ * sizeof(double); b += 64)
+        const char *next = (const char *)(job->q + (k + LG_LANES) * md->nq);
+        for (size_t b = 0; b < LG_LANES * md->nq * sizeof(double); b += 64)
             __builtin_prefetch(next + b, 0, 3);
         if (job->v && job->kind != RK_CENTROIDAL && job->kind != RK_WRENCH) {
-            next = (const char *)(job->v + (k + LG_LANES) * RK_NV);
-            for (size_t b = 0; b < LG_LANES * RK_NV * sizeof(double); b += 64)
+            next = (const char *)(job->v + (k + LG_LANES) * md->nv);
+            for (size_t b = 0; b < LG_LANES * md->nv * sizeof(double); b += 64)
                 __builtin_prefetch(next + b, 0, 3);
         }
     }
     if (!job->stream) {  /* the rows these states will fill, fetched for writing while the
                             kernel computes (as the derivatives module's): a batch's outputs are
                             seldom in cache */
-        const int width = rk_width(job->kind);
+        const int width = rk_width(md, job->kind);
         const char *y = (const char *)(job->y + k * width);
         for (size_t b = 0; b < LG_LANES * width * sizeof(double); b += 64)
             __builtin_prefetch(y + b, 1, 2);
     }
     switch (job->kind) {
     case RK_DRIFT:
-        rk_gather(job->v, k, RK_NV, v);
-        rk_spoil(v, RK_NV, &spoilt);
-        rk4_drift(q, v, job->frame, job->ref, out);
+        rk_gather(job->v, k, md->nv, v);
+        rk_spoil(v, md->nv, &spoilt);
+        rk4_drift(md, work, q, v, job->frame, job->ref, out);
         break;
     case RK_CENTROIDAL:
-        rk4_centroidal(q, out);
+        rk4_centroidal(md, work, q, out);
         break;
     case RK_PLACEMENT:
-        rk4_placement(q, job->frame, out);
+        rk4_placement(md, work, q, job->frame, out);
         break;
     case RK_JACOBIAN:
-        rk4_jacobian(q, job->frame, job->ref, out);
+        rk4_jacobian(md, work, q, job->frame, job->ref, out);
         break;
     case RK_COM:
-        rk4_com(q, out);
+        rk4_com(md, work, q, out);
         break;
     case RK_COM_JACOBIAN:
-        rk4_com_jacobian(q, out);
+        rk4_com_jacobian(md, work, q, out);
         break;
     case RK_WRENCH: {
         lg_v4 w[6];
@@ -201,21 +247,21 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
         else
             rk_gather(job->w[0], k, 6, w);
         rk_spoil(w, 6, &spoilt);
-        rk4_wrench(q, job->frame, w, out);
-        rk_scatter(out, k, RK_NV, job->y, 1, job->sign, job->stream);
+        rk4_wrench(md, work, q, job->frame, w, out);
+        rk_scatter(out, k, md->nv, job->y, 1, job->sign, job->stream);
         break;
     }
     case RK_CORIOLIS:
-        rk_gather(job->v, k, RK_NV, v);
-        rk_spoil(v, RK_NV, &spoilt);
-        rk4_coriolis(q, v, out, work);
+        rk_gather(job->v, k, md->nv, v);
+        rk_spoil(v, md->nv, &spoilt);
+        rk4_coriolis(md, work, q, v, out);
         break;
     case RK_INVERSE: {
-        lg_v4 a[RK_NV], w[RK_MAX_WRENCHES][6];
-        rk_gather(job->v, k, RK_NV, v);
-        rk_gather(job->a, k, RK_NV, a);
-        rk_spoil(v, RK_NV, &spoilt);
-        rk_spoil(a, RK_NV, &spoilt);
+        lg_v4 *a = space->a, w[RK_MAX_WRENCHES][6];
+        rk_gather(job->v, k, md->nv, v);
+        rk_gather(job->a, k, md->nv, a);
+        rk_spoil(v, md->nv, &spoilt);
+        rk_spoil(a, md->nv, &spoilt);
         for (int i = 0; i < job->nw; i++) {
             if (job->wshared[i])
                 for (int j = 0; j < 6; j++) w[i][j] = LG_V4(job->w[i][j]);
@@ -223,17 +269,17 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
                 rk_gather(job->w[i], k, 6, w[i]);
             rk_spoil(w[i], 6, &spoilt);
         }
-        rk4_inverse(q, v, a, job->up, job->nw, job->frames, (const lg_v4 (*)[6])w, out);
+        rk4_inverse(md, work, q, v, a, job->up, job->nw, job->frames, (const lg_v4 (*)[6])w, out);
         break;
     }
     }
     /* the lanes' rows out (the wrench's added in place above) */
     if (job->kind != RK_WRENCH)
-        rk_scatter(out, k, rk_width(job->kind), job->y, 0, 0.0, job->stream);
+        rk_scatter(out, k, rk_width(md, job->kind), job->y, 0, 0.0, job->stream);
     int bad = 0;
     for (int l = 0; l < LG_LANES; l++)
         if (spoilt[l] != 0.0 || (job->kind == RK_WRENCH
-                                 && !rk_finite_row(job->y + RK_NV * (k + l), RK_NV))) {
+                                 && !rk_finite_row(job->y + md->nv * (k + l), md->nv))) {
             rk_blank(job, k + l);
             bad++;
         }
@@ -245,18 +291,13 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk4_cwork *work, lg_v4 *out)
 static void *rk_run(void *argument)
 {
     rk_job *job = (rk_job *)argument;
-    rk_cwork *work = NULL;
-    rk4_cwork *work4 = NULL;
-    /* the lanes' outputs and C's workspace (vectors: aligned to theirs) */
-    const size_t room = (RK_OUT4 * sizeof(lg_v4) + 63) / 64 * 64;
-    const size_t space = job->kind == RK_CORIOLIS ? (sizeof(rk4_cwork) + 63) / 64 * 64 : 0;
-    lg_v4 *out = job->count >= LG_LANES ? aligned_alloc(64, room + space) : NULL;
+    /* on the heap, sized from the model: a large tree's lanes' work is more than a stack */
+    const int lanes = job->count >= LG_LANES;
+    rk_space space;
+    char *block = aligned_alloc(64, rk_space_size(job->md, lanes));
     job->bad = 0;
-    if (out && space) work4 = (rk4_cwork *)((char *)out + room);
-    if (job->kind == RK_CORIOLIS && !(work = malloc(sizeof(rk_cwork)))) {
-        free(out);
-        return NULL;
-    }
+    if (!block) return NULL;
+    rk_space_at(job->md, lanes, block, &space);
     for (;;) {
 #if RK_PTHREADS
         const npy_intp k0 = __atomic_fetch_add(job->next, RK_BLOCK, __ATOMIC_RELAXED);
@@ -267,11 +308,10 @@ static void *rk_run(void *argument)
         if (k0 >= job->count) break;
         const npy_intp k1 = k0 + RK_BLOCK < job->count ? k0 + RK_BLOCK : job->count;
         npy_intp k = k0;
-        for (; out && k + LG_LANES <= k1; k += LG_LANES) job->bad += rk_lanes(job, k, work4, out);
-        for (; k < k1; k++) job->bad += rk_state(job, k, work);
+        for (; lanes && k + LG_LANES <= k1; k += LG_LANES) job->bad += rk_lanes(job, k, &space);
+        for (; k < k1; k++) job->bad += rk_state(job, k, &space.one);
     }
-    free(work);
-    free(out);
+    free(block);
     if (job->stream) lg_stream_fence();
     return NULL;
 }
@@ -285,7 +325,8 @@ static int rk_batch(rk_job *job)
     npy_intp next = 0;
     job->next = &next;
     job->stream = job->kind != RK_WRENCH
-                  && (size_t)job->count * rk_width(job->kind) * sizeof(double) >= LG_STREAM_MIN;
+                  && (size_t)job->count * rk_width(job->md, job->kind) * sizeof(double)
+                     >= LG_STREAM_MIN;
     int parts = rk_threads(job->count);
     rk_job jobs[RK_MAX_THREADS];
     for (int t = 0; t < parts; t++) jobs[t] = *job;

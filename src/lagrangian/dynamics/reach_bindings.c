@@ -1,7 +1,20 @@
 /* Python bindings of reach_kernel.c's functions (frames, C(q, v), A_g, wrenches, inverse
- * dynamics): arrays (..., n) of float64 checked and handed to reach_batch.c's batches; a
- * function returns its output, or (output, count of NaN rows) where some state's inputs are
- * not all finite. */
+ * dynamics): tree(INTS, FLOATS, INDEX) reads a tree's tables once (reach_c.py's layout) into a
+ * Tree, whose methods take arrays (..., n) of float64, checked and handed to reach_batch.c's
+ * batches; a method returns its output, or (output, count of NaN rows) where some state's
+ * inputs are not all finite. */
+
+/* a tree: its model (md's arrays point into ``tables``), {frame name: frame number} */
+typedef struct {
+    PyObject_HEAD
+    rk_model md;
+    PyObject *index;
+    void *tables;
+    size_t work1;  /* one state's workspace, bytes (rk_work_size) */
+} rk_tree;
+
+#define RK_MD(self) (&((rk_tree *)(self))->md)
+#define RK_STACK_BYTES 32768  /* one state's workspace up to this on the stack (about 60 bodies) */
 
 static PyArrayObject *rk_input(PyObject *x, int last, const char *name)
 {
@@ -27,21 +40,18 @@ static PyArrayObject *rk_input(PyObject *x, int last, const char *name)
 /* a floating base's quaternions (entries 3..6 of each state) of norm within the tolerance, in
  * every state whose q is all finite (the others' rows are NaN, as the tree module's rule);
  * else ValueError, and numpy names the state */
-static int rk_unit_quaternions(PyArrayObject *Q)
+static int rk_unit_quaternions(const rk_model *md, PyArrayObject *Q)
 {
-#if RK_FB
-    npy_intp count = PyArray_SIZE(Q) / RK_NQ;
+    if (!md->fb) return 1;
+    npy_intp count = PyArray_SIZE(Q) / md->nq;
     const double *q = PyArray_DATA(Q);
-    for (npy_intp k = 0; k < count; k++, q += RK_NQ) {
+    for (npy_intp k = 0; k < count; k++, q += md->nq) {
         double n2 = q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6];
-        if (rk_finite_row(q, RK_NQ) && (n2 < RK_QLOW || n2 > RK_QHIGH)) {
+        if (rk_finite_row(q, md->nq) && (n2 < md->qlow || n2 > md->qhigh)) {
             PyErr_SetString(PyExc_ValueError, "q: the base quaternion is not of unit norm");
             return 0;
         }
     }
-#else
-    (void)Q;
-#endif
     return 1;
 }
 
@@ -75,9 +85,23 @@ bad:
     return 0;
 }
 
-/* a frame named by the kernel's dict {name: frame number} (the bound functions' self); -1
- * with KeyError (TypeError for a name not hashable) where there is none */
-static int rk_frame_named(PyObject *index, PyObject *name)
+/* one state (job->count 1) on a workspace of the stack where it fits (a small tree's: no
+ * allocation per call), else of the heap; its NaN rows, or -1 with MemoryError */
+static npy_intp rk_one(rk_job *job, size_t work1)
+{
+    _Alignas(64) char stack[RK_STACK_BYTES];
+    char *block = work1 <= sizeof stack ? stack : aligned_alloc(64, RK_ROUND(work1));
+    if (!block) { PyErr_NoMemory(); return -1; }
+    rk_work work;
+    rk_work_at(job->md, block, &work);
+    const int bad = rk_state(job, 0, &work);
+    if (block != stack) free(block);
+    return bad;
+}
+
+/* a frame named by the tree's dict {name: frame number}; -1 with KeyError (TypeError for a
+ * name not hashable) where there is none */
+static int rk_frame_named(const rk_model *md, PyObject *index, PyObject *name)
 {
     PyObject *number = PyDict_GetItemWithError(index, name);
     if (!number) {
@@ -86,7 +110,7 @@ static int rk_frame_named(PyObject *index, PyObject *name)
     }
     const long f = PyLong_AsLong(number);
     if (f == -1 && PyErr_Occurred()) return -1;
-    if (f < 0 || f >= RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return -1; }
+    if (f < 0 || f >= md->nf) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return -1; }
     return (int)f;
 }
 
@@ -106,25 +130,26 @@ static int rk_reference_named(PyObject *name)
     return -1;
 }
 
-/* drift(Q, V, frame, reference) bound to the frames' dict -> [a; w_dot] (or with NaN rows) */
-static PyObject *rk_py_drift(PyObject *index, PyObject *const *args, Py_ssize_t nargs)
+/* drift(Q, V, frame, reference) -> [a; w_dot] (or with NaN rows) */
+static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
+    const rk_model *md = RK_MD(self);
     if (nargs != 4) { PyErr_SetString(PyExc_TypeError, "drift(Q, V, frame, reference)"); return NULL; }
-    const int f = rk_frame_named(index, args[2]);
+    const int f = rk_frame_named(md, ((rk_tree *)self)->index, args[2]);
     if (f < 0) return NULL;
     const int ref = rk_reference_named(args[3]);
     if (ref < 0) return NULL;
-    PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
+    PyArrayObject *Q = rk_input(args[0], md->nq, "q");
     if (!Q) return NULL;
-    if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
-    PyArrayObject *V = rk_input(args[1], RK_NV, "v");
+    if (!rk_unit_quaternions(md, Q)) { Py_DECREF(Q); return NULL; }
+    PyArrayObject *V = rk_input(args[1], md->nv, "v");
     if (!V || !rk_same_batch(Q, V, "v")) { Py_DECREF(Q); Py_XDECREF(V); return NULL; }
     PyObject *out = rk_output(Q, 6, 0);
     npy_intp bad = 0;
     if (out) {
-        rk_job job = {.kind = RK_DRIFT, .frame = f, .ref = ref, .q = PyArray_DATA(Q),
+        rk_job job = {.md = md, .kind = RK_DRIFT, .frame = f, .ref = ref, .q = PyArray_DATA(Q),
                       .v = PyArray_DATA(V), .y = PyArray_DATA((PyArrayObject *)out),
-                      .count = PyArray_SIZE(Q) / RK_NQ};
+                      .count = PyArray_SIZE(Q) / md->nq};
         if (!rk_batch(&job)) Py_CLEAR(out);
         bad = job.bad;
     }
@@ -135,17 +160,21 @@ static PyObject *rk_py_drift(PyObject *index, PyObject *const *args, Py_ssize_t 
 /* a function of q alone on Q (frame f, reference ref where it has them) -> its rows (tail0 x
  * tail1 a state), or (rows, NaN rows). One state is computed here, without the batch's
  * machinery. */
-static PyObject *rk_of_q(PyObject *Q_in, int kind, int f, int ref, int tail0, int tail1)
+static PyObject *rk_of_q(PyObject *self, PyObject *Q_in, int kind, int f, int ref, int tail0,
+                         int tail1)
 {
-    PyArrayObject *Q = rk_input(Q_in, RK_NQ, "q");
+    const rk_model *md = RK_MD(self);
+    PyArrayObject *Q = rk_input(Q_in, md->nq, "q");
     if (!Q) return NULL;
-    if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
+    if (!rk_unit_quaternions(md, Q)) { Py_DECREF(Q); return NULL; }
     PyObject *out = rk_output(Q, tail0, tail1);
     npy_intp bad = 0;
     if (out) {
-        rk_job job = {.kind = kind, .frame = f, .ref = ref, .q = PyArray_DATA(Q),
-                      .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / RK_NQ};
-        if (job.count == 1) bad = rk_state(&job, 0, NULL);
+        rk_job job = {.md = md, .kind = kind, .frame = f, .ref = ref, .q = PyArray_DATA(Q),
+                      .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / md->nq};
+        if (job.count == 1) {
+            if ((bad = rk_one(&job, ((rk_tree *)self)->work1)) < 0) { Py_CLEAR(out); bad = 0; }
+        }
         else if (!rk_batch(&job)) Py_CLEAR(out);
         else bad = job.bad;
     }
@@ -153,74 +182,50 @@ static PyObject *rk_of_q(PyObject *Q_in, int kind, int f, int ref, int tail0, in
     return rk_result(out, bad);
 }
 
-/* placement(Q, frame) and jacobian(Q, frame, reference), bound to the frames' dict: the name
- * looked up here, not in Python (two dict lookups and an attribute there were a sixth of a
- * single Jacobian's call) */
-static PyObject *rk_py_placement(PyObject *index, PyObject *const *args, Py_ssize_t nargs)
+/* placement(Q, frame) and jacobian(Q, frame, reference): the name looked up here, not in
+ * Python (two dict lookups and an attribute there were a sixth of a single Jacobian's call) */
+static PyObject *rk_py_placement(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     if (nargs != 2) { PyErr_SetString(PyExc_TypeError, "placement(Q, frame)"); return NULL; }
-    const int f = rk_frame_named(index, args[1]);
-    return f < 0 ? NULL : rk_of_q(args[0], RK_PLACEMENT, f, 0, 4, 4);
+    const int f = rk_frame_named(RK_MD(self), ((rk_tree *)self)->index, args[1]);
+    return f < 0 ? NULL : rk_of_q(self, args[0], RK_PLACEMENT, f, 0, 4, 4);
 }
 
-static PyObject *rk_py_jacobian(PyObject *index, PyObject *const *args, Py_ssize_t nargs)
+static PyObject *rk_py_jacobian(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     if (nargs != 3) { PyErr_SetString(PyExc_TypeError, "jacobian(Q, frame, reference)"); return NULL; }
-    const int f = rk_frame_named(index, args[1]);
+    const int f = rk_frame_named(RK_MD(self), ((rk_tree *)self)->index, args[1]);
     if (f < 0) return NULL;
     const int ref = rk_reference_named(args[2]);
-    return ref < 0 ? NULL : rk_of_q(args[0], RK_JACOBIAN, f, ref, 6, RK_NV);
+    return ref < 0 ? NULL : rk_of_q(self, args[0], RK_JACOBIAN, f, ref, 6, RK_MD(self)->nv);
 }
 
 /* the functions of q alone, each rk_of_q with its kind and a state's output shape */
 #define RK_OF_Q(name, kind, tail0, tail1)                                                      \
     static PyObject *rk_py_##name(PyObject *self, PyObject *const *args, Py_ssize_t nargs)    \
     {                                                                                          \
-        (void)self;                                                                            \
         if (nargs != 1) { PyErr_SetString(PyExc_TypeError, #name "(Q)"); return NULL; }       \
-        return rk_of_q(args[0], kind, 0, 0, tail0, tail1);                                     \
+        return rk_of_q(self, args[0], kind, 0, 0, tail0, tail1);                               \
     }
 RK_OF_Q(com, RK_COM, 3, 0)
-RK_OF_Q(com_jacobian, RK_COM_JACOBIAN, 3, RK_NV)
-RK_OF_Q(centroidal, RK_CENTROIDAL, 6, RK_NV)
-
-static PyMethodDef rk_frame_methods[] = {
-    {"placement", (PyCFunction)(void (*)(void))rk_py_placement, METH_FASTCALL, "(Q, frame) -> 4 x 4, or (4 x 4, NaN rows)"},
-    {"jacobian", (PyCFunction)(void (*)(void))rk_py_jacobian, METH_FASTCALL, "(Q, frame, reference) -> 6 x n, or (6 x n, NaN rows)"},
-    {"drift", (PyCFunction)(void (*)(void))rk_py_drift, METH_FASTCALL, "(Q, V, frame, reference) -> [a; w_dot], or ([a; w_dot], NaN rows)"},
-};
-
-/* frames(INDEX) -> (placement, jacobian, drift) bound to INDEX, a dict {frame name: frame
- * number} (a built-in function's self: called as fast as the module's own) */
-static PyObject *rk_py_frames(PyObject *self, PyObject *index)
-{
-    (void)self;
-    if (!PyDict_Check(index)) { PyErr_SetString(PyExc_TypeError, "frames(INDEX): a dict"); return NULL; }
-    PyObject *out = PyTuple_New(3);
-    if (!out) return NULL;
-    for (int k = 0; k < 3; k++) {
-        PyObject *bound = PyCFunction_NewEx(&rk_frame_methods[k], index, NULL);
-        if (!bound) { Py_DECREF(out); return NULL; }
-        PyTuple_SET_ITEM(out, k, bound);
-    }
-    return out;
-}
+RK_OF_Q(com_jacobian, RK_COM_JACOBIAN, 3, RK_MD(self)->nv)
+RK_OF_Q(centroidal, RK_CENTROIDAL, 6, RK_MD(self)->nv)
 
 /* wrench(Q, frame, W, OUT, sign): OUT += sign J^T w, in place (OUT float64, contiguous, of
- * Q's batch and RK_NV wide); W (6,) for every state or one row per state */
+ * Q's batch and nv wide); W (6,) for every state or one row per state */
 static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
-    (void)self;
+    const rk_model *md = RK_MD(self);
     if (nargs != 5) { PyErr_SetString(PyExc_TypeError, "wrench(Q, frame, W, OUT, sign)"); return NULL; }
     int f = (int)PyLong_AsLong(args[1]);
     double sign = PyFloat_AsDouble(args[4]);
     if (PyErr_Occurred()) return NULL;
-    if (f < 0 || f >= RK_NF) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
+    if (f < 0 || f >= md->nf) { PyErr_SetString(PyExc_ValueError, "frame: out of range"); return NULL; }
     if (!PyArray_Check(args[3])) { PyErr_SetString(PyExc_ValueError, "out: not an array"); return NULL; }
     PyArrayObject *out = (PyArrayObject *)args[3];
-    PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
+    PyArrayObject *Q = rk_input(args[0], md->nq, "q");
     if (!Q) return NULL;
-    if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
+    if (!rk_unit_quaternions(md, Q)) { Py_DECREF(Q); return NULL; }
     PyArrayObject *W = rk_input(args[2], 6, "f_ext");
     if (!W) { Py_DECREF(Q); return NULL; }
     int shared = PyArray_NDIM(W) == 1;
@@ -228,15 +233,15 @@ static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t 
             || PyArray_TYPE(out) != NPY_DOUBLE || !PyArray_ISCARRAY(out)
             || PyArray_NDIM(out) != PyArray_NDIM(Q)
             || !PyArray_CompareLists(PyArray_DIMS(out), PyArray_DIMS(Q), PyArray_NDIM(Q) - 1)
-            || PyArray_DIMS(out)[PyArray_NDIM(Q) - 1] != RK_NV) {
+            || PyArray_DIMS(out)[PyArray_NDIM(Q) - 1] != md->nv) {
         if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "out: not of q's batch, nv wide");
         Py_DECREF(Q); Py_DECREF(W);
         return NULL;
     }
     const double *w = PyArray_DATA(W);
-    rk_job job = {.kind = RK_WRENCH, .frame = f, .q = PyArray_DATA(Q), .w = &w,
+    rk_job job = {.md = md, .kind = RK_WRENCH, .frame = f, .q = PyArray_DATA(Q), .w = &w,
                   .wshared = &shared, .sign = sign, .y = PyArray_DATA(out),
-                  .count = PyArray_SIZE(Q) / RK_NQ};
+                  .count = PyArray_SIZE(Q) / md->nq};
     int fine = rk_batch(&job);
     Py_DECREF(Q); Py_DECREF(W);
     if (!fine) return NULL;
@@ -245,18 +250,18 @@ static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t 
 
 static PyObject *rk_py_coriolis(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
-    (void)self;
+    const rk_model *md = RK_MD(self);
     if (nargs != 2) { PyErr_SetString(PyExc_TypeError, "coriolis(Q, V)"); return NULL; }
-    PyArrayObject *Q = rk_input(args[0], RK_NQ, "q");
+    PyArrayObject *Q = rk_input(args[0], md->nq, "q");
     if (!Q) return NULL;
-    if (!rk_unit_quaternions(Q)) { Py_DECREF(Q); return NULL; }
-    PyArrayObject *V = rk_input(args[1], RK_NV, "v");
+    if (!rk_unit_quaternions(md, Q)) { Py_DECREF(Q); return NULL; }
+    PyArrayObject *V = rk_input(args[1], md->nv, "v");
     if (!V || !rk_same_batch(Q, V, "v")) { Py_DECREF(Q); Py_XDECREF(V); return NULL; }
-    PyObject *out = rk_output(Q, RK_NV, RK_NV);
+    PyObject *out = rk_output(Q, md->nv, md->nv);
     npy_intp bad = 0;
     if (out) {
-        rk_job job = {.kind = RK_CORIOLIS, .q = PyArray_DATA(Q), .v = PyArray_DATA(V),
-                      .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / RK_NQ};
+        rk_job job = {.md = md, .kind = RK_CORIOLIS, .q = PyArray_DATA(Q), .v = PyArray_DATA(V),
+                      .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / md->nq};
         if (!rk_batch(&job)) Py_CLEAR(out);
         bad = job.bad;
     }
@@ -264,18 +269,19 @@ static PyObject *rk_py_coriolis(PyObject *self, PyObject *const *args, Py_ssize_
     return rk_result(out, bad);
 }
 
-/* inverse(INDEX, UP, Q, V, A, F_EXT) -> tau: inverse dynamics less the wrenches of the dict
- * F_EXT (frame name -> W, INDEX: frame name -> frame number) in one pass (reach_inverse.c); UP
- * the ground's acceleration (3,), each W (6,) for every state or one row per state. KeyError or
- * ValueError where an input is not plain (the caller's numpy path names it). */
+/* inverse(UP, Q, V, A, F_EXT) -> tau: inverse dynamics less the wrenches of the dict F_EXT
+ * (frame name -> W) in one pass (reach_inverse.c); UP the ground's acceleration (3,), each W
+ * (6,) for every state or one row per state. KeyError or ValueError where an input is not
+ * plain (the caller's numpy path names it). */
 static PyObject *rk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
-    (void)self;
-    if (nargs != 6 || !PyDict_Check(args[0]) || !PyDict_Check(args[5])) {
-        PyErr_SetString(PyExc_TypeError, "inverse(INDEX, UP, Q, V, A, F_EXT)");
+    const rk_model *md = RK_MD(self);
+    PyObject *index = ((rk_tree *)self)->index;
+    if (nargs != 5 || !PyDict_Check(args[4])) {
+        PyErr_SetString(PyExc_TypeError, "inverse(UP, Q, V, A, F_EXT)");
         return NULL;
     }
-    Py_ssize_t nw = PyDict_Size(args[5]);
+    Py_ssize_t nw = PyDict_Size(args[4]);
     if (nw > RK_MAX_WRENCHES) { PyErr_SetString(PyExc_ValueError, "f_ext: too many"); return NULL; }
     PyArrayObject *in[3] = {NULL, NULL, NULL}, *U = NULL, *W[RK_MAX_WRENCHES] = {NULL};
     PyObject *out = NULL, *name, *value;
@@ -284,25 +290,15 @@ static PyObject *rk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t
     const double *w[RK_MAX_WRENCHES];
     const char *names[3] = {"q", "v", "a"};
     for (int j = 0; j < 3; j++) {
-        in[j] = rk_input(args[2 + j], j == 0 ? RK_NQ : RK_NV, names[j]);
+        in[j] = rk_input(args[1 + j], j == 0 ? md->nq : md->nv, names[j]);
         if (!in[j] || (j && !rk_same_batch(in[0], in[j], names[j]))) goto done;
     }
-    if (!rk_unit_quaternions(in[0])) goto done;
-    U = rk_input(args[1], 3, "up");
+    if (!rk_unit_quaternions(md, in[0])) goto done;
+    U = rk_input(args[0], 3, "up");
     if (!U) goto done;
     Py_ssize_t at = 0, k = 0;
-    while (PyDict_Next(args[5], &at, &name, &value)) {
-        PyObject *number = PyDict_GetItemWithError(args[0], name);
-        if (!number) {
-            if (!PyErr_Occurred()) PyErr_SetObject(PyExc_KeyError, name);
-            goto done;
-        }
-        frames[k] = (int)PyLong_AsLong(number);
-        if (PyErr_Occurred()) goto done;
-        if (frames[k] < 0 || frames[k] >= RK_NF) {
-            PyErr_SetString(PyExc_ValueError, "frame: out of range");
-            goto done;
-        }
+    while (PyDict_Next(args[4], &at, &name, &value)) {
+        if ((frames[k] = rk_frame_named(md, index, name)) < 0) goto done;
         W[k] = rk_input(value, 6, "f_ext");
         if (!W[k]) goto done;
         shared[k] = PyArray_NDIM(W[k]) == 1;
@@ -310,12 +306,12 @@ static PyObject *rk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t
         w[k] = PyArray_DATA(W[k]);
         k++;
     }
-    out = rk_output(in[0], RK_NV, 0);
+    out = rk_output(in[0], md->nv, 0);
     if (out) {
-        rk_job job = {.kind = RK_INVERSE, .nw = (int)nw, .q = PyArray_DATA(in[0]),
+        rk_job job = {.md = md, .kind = RK_INVERSE, .nw = (int)nw, .q = PyArray_DATA(in[0]),
                       .v = PyArray_DATA(in[1]), .a = PyArray_DATA(in[2]), .up = PyArray_DATA(U),
                       .frames = frames, .w = w, .wshared = shared,
-                      .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(in[0]) / RK_NQ};
+                      .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(in[0]) / md->nq};
         if (!rk_batch(&job)) Py_CLEAR(out);
         bad = job.bad;
     }
@@ -326,14 +322,136 @@ done:
     return rk_result(out, bad);
 }
 
+#define RK_FAST(name) (PyCFunction)(void (*)(void))rk_py_##name, METH_FASTCALL
+static PyMethodDef rk_tree_methods[] = {
+    {"placement", RK_FAST(placement), "(Q, frame) -> 4 x 4, or (4 x 4, NaN rows)"},
+    {"jacobian", RK_FAST(jacobian), "(Q, frame, reference) -> 6 x nv, or (6 x nv, NaN rows)"},
+    {"drift", RK_FAST(drift), "(Q, V, frame, reference) -> [a; w_dot], or ([a; w_dot], NaN rows)"},
+    {"centroidal", RK_FAST(centroidal), "(Q) -> A_g, or (A_g, NaN rows)"},
+    {"wrench", RK_FAST(wrench), "(Q, frame, W, OUT, sign): OUT += sign J^T w; -> NaN rows"},
+    {"coriolis", RK_FAST(coriolis), "(Q, V) -> C(q, v), or (C(q, v), NaN rows)"},
+    {"inverse", RK_FAST(inverse), "(UP, Q, V, A, F_EXT) -> tau, or (tau, NaN rows)"},
+    {"com", RK_FAST(com), "(Q) -> c, or (c, NaN rows)"},
+    {"com_jacobian", RK_FAST(com_jacobian), "(Q) -> J_c, or (J_c, NaN rows)"},
+    {NULL, NULL, 0, NULL},
+};
+
+static void rk_tree_dealloc(PyObject *self)
+{
+    rk_tree *t = (rk_tree *)self;
+    Py_XDECREF(t->index);
+    free(t->tables);
+    Py_TYPE(self)->tp_free(self);
+}
+
+static PyTypeObject rk_tree_type = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "lagrangian.reach.Tree",
+    .tp_basicsize = sizeof(rk_tree),
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "a tree's tables, read once (module.tree); its methods the reach functions",
+    .tp_dealloc = rk_tree_dealloc,
+    .tp_methods = rk_tree_methods,
+};
+
+/* md from INTS (C int) and FLOATS (float64), reach_c.py's layout, copied into one block of its
+ * own (*tables; md's arrays point into it); 0 with ValueError where they are not a tree's */
+static int rk_model_from(PyObject *ints, PyObject *floats, rk_model *md, void **tables)
+{
+    PyArrayObject *Ia = (PyArrayObject *)PyArray_FROMANY(ints, NPY_INT, 1, 1, NPY_ARRAY_IN_ARRAY);
+    PyArrayObject *Fa = Ia ? (PyArrayObject *)PyArray_FROMANY(floats, NPY_DOUBLE, 1, 1,
+                                                            NPY_ARRAY_IN_ARRAY) : NULL;
+    const char *fault = NULL;
+    *tables = NULL;
+    if (!Fa) goto done;
+    const npy_intp ni = PyArray_SIZE(Ia), nd = PyArray_SIZE(Fa);
+    const int *head = PyArray_DATA(Ia);
+    if (ni < 6) { fault = "INTS: no header"; goto done; }
+    const int nb = head[0], n = head[1], fb = head[2], nf = head[3];
+    if (nb < 1 || nb > RK_MAX_BODIES || n < 0 || n > nb || (fb != 0 && fb != 1) || nf < 0
+            || nf > RK_MAX_BODIES || (head[4] != 0 && head[4] != 1)) {
+        fault = "INTS: not a tree's header";
+        goto done;
+    }
+    const long long nv = 6 * fb + n;
+    if (head[5] < 0 || head[5] > nv * nv) { fault = "INTS: not a tree's header"; goto done; }
+    if (ni != 6 + 6LL * nb + nf + head[5] || nd != 2 + 58LL * nb + 12LL * nf) {
+        fault = "INTS, FLOATS: not of the header's sizes";
+        goto done;
+    }
+    double *d = malloc((size_t)nd * sizeof(double) + (size_t)ni * sizeof(int));
+    if (!d) { PyErr_NoMemory(); goto done; }
+    *tables = d;
+    int *a = (int *)(d + nd);
+    memcpy(d, PyArray_DATA(Fa), (size_t)nd * sizeof(double));
+    memcpy(a, head, (size_t)ni * sizeof(int));
+    *md = (rk_model){.nb = nb, .n = n, .fb = fb, .nf = nf, .cset = a[4], .nczero = a[5],
+                     .bq = 7 * fb, .bv = 6 * fb, .nq = 7 * fb + n, .nv = (int)nv};
+    a += 6;
+    const int **ia[] = {&md->parent, &md->coord, &md->turns, &md->slides, &md->axis, &md->R0id};
+    for (int k = 0; k < 6; k++, a += nb) *ia[k] = a;
+    md->fbody = a;
+    md->czero = a + nf;
+    md->qlow = d[0], md->qhigh = d[1];
+    d += 2;
+    const double **da[] = {&md->mult, &md->off, &md->axsign, &md->m, &md->t0, &md->u, &md->h,
+                           &md->R0, &md->P, &md->C, &md->S, &md->J};
+    for (int k = 0; k < 12; k++) {
+        *da[k] = d;
+        d += (k < 4 ? 1 : k < 7 ? 3 : 9) * (size_t)nb;
+    }
+    md->fR = d;
+    md->ft = d + 9 * (size_t)nf;
+    for (npy_intp k = 0; k < nd; k++)
+        if (!isfinite(((const double *)*tables)[k])) { fault = "FLOATS: not all finite"; goto done; }
+    for (int i = 0; i < nb; i++) {
+        const int free = fb && i == 0, p = md->parent[i];
+        if (p < -1 || p >= i || (free && p != -1) || md->axis[i] < -1 || md->axis[i] > 2
+                || (!free && (md->coord[i] < 0 || md->coord[i] >= n))
+                || (free && (md->turns[i] || md->slides[i]))) {
+            fault = "INTS: a body not of a tree";
+            goto done;
+        }
+    }
+    for (int f = 0; f < nf; f++)
+        if (md->fbody[f] < -1 || md->fbody[f] >= nb) { fault = "INTS: a frame's body"; goto done; }
+    for (int j = 0; j < md->nczero; j++)
+        if (md->czero[j] < 0 || md->czero[j] >= nv * nv) { fault = "INTS: an entry of C"; goto done; }
+done:
+    Py_XDECREF(Ia);
+    Py_XDECREF(Fa);
+    if (fault) PyErr_SetString(PyExc_ValueError, fault);
+    if (PyErr_Occurred()) {
+        free(*tables);
+        *tables = NULL;
+        return 0;
+    }
+    return 1;
+}
+
+/* tree(INTS, FLOATS, INDEX) -> Tree: the tables read once, INDEX {frame name: frame number} */
+static PyObject *rk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 3 || !PyDict_Check(args[2])) {
+        PyErr_SetString(PyExc_TypeError, "tree(INTS, FLOATS, INDEX): INDEX a dict");
+        return NULL;
+    }
+    rk_model md;
+    void *tables;
+    if (!rk_model_from(args[0], args[1], &md, &tables)) return NULL;
+    rk_tree *t = PyObject_New(rk_tree, &rk_tree_type);
+    if (!t) { free(tables); return NULL; }
+    t->md = md;
+    t->tables = tables;
+    t->work1 = rk_work_size(&md);
+    Py_INCREF(args[2]);
+    t->index = args[2];
+    return (PyObject *)t;
+}
+
 static PyMethodDef rk_methods[] = {
-    {"frames", (PyCFunction)rk_py_frames, METH_O, "(INDEX) -> (placement, jacobian, drift) bound to INDEX {frame name: number}"},
-    {"centroidal", (PyCFunction)(void (*)(void))rk_py_centroidal, METH_FASTCALL, "(Q) -> A_g, or (A_g, NaN rows)"},
-    {"wrench", (PyCFunction)(void (*)(void))rk_py_wrench, METH_FASTCALL, "(Q, frame, W, OUT, sign): OUT += sign J^T w; -> NaN rows"},
-    {"coriolis", (PyCFunction)(void (*)(void))rk_py_coriolis, METH_FASTCALL, "(Q, V) -> C(q, v), or (C(q, v), NaN rows)"},
-    {"inverse", (PyCFunction)(void (*)(void))rk_py_inverse, METH_FASTCALL, "(INDEX, UP, Q, V, A, F_EXT) -> tau, or (tau, NaN rows)"},
-    {"com", (PyCFunction)(void (*)(void))rk_py_com, METH_FASTCALL, "(Q) -> c, or (c, NaN rows)"},
-    {"com_jacobian", (PyCFunction)(void (*)(void))rk_py_com_jacobian, METH_FASTCALL, "(Q) -> J_c, or (J_c, NaN rows)"},
+    {"tree", RK_FAST(tree), "(INTS, FLOATS, INDEX) -> Tree, its methods the reach functions"},
     {NULL, NULL, 0, NULL},
 };
 
@@ -346,5 +464,6 @@ PyMODINIT_FUNC RK_PASTE(PyInit_, LG_MODULE)(void)
     for (int k = 0; k < 3; k++)
         if (!rk_references[k] && !(rk_references[k] = PyUnicode_InternFromString(references[k])))
             return NULL;
+    if (PyType_Ready(&rk_tree_type) < 0) return NULL;
     return PyModule_Create(&rk_module);
 }

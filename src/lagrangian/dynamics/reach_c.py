@@ -1,17 +1,35 @@
 """J_dot q_dot, the centroidal momentum matrix, wrenches' generalized forces and a floating
-base's C(q, v) in compiled C (reach_kernel.c over the tree's numbers written as static tables),
-for the C backend's speed per call; centroidal.py, wrenches.py and coriolis_tree.py are the same
-formulas in numpy, used without a compiler and to name every bad input."""
+base's C(q, v) in compiled C, for the C backend's speed per call: ONE module per installation
+(reach_kernel.c and the files after it, keyed by their text and this file's alone), every tree
+given at run time as two tables built once here (``tables``) and read once by the module's
+``tree(INTS, FLOATS, INDEX)``, whose methods are the functions. centroidal.py, wrenches.py and
+coriolis_tree.py are the same formulas in numpy, used without a compiler and to name every bad
+input.
+
+The tables of a tree of nb bodies (its joints in order, a parent before its children), n joint
+coordinates, nf frames, fb 1 for a floating base (body 0 on a free flyer), nv = 6 fb + n:
+
+- INTS (C int): nb, n, fb, nf, cset, nczero; then nb each: parent (-1: the ground),
+  coordinate, turns, slides (0 or 1: a free flyer neither), axis (k where the axis is +-e_k
+  exactly, else -1), R0-is-identity (0 or 1); then nf frame bodies (-1: the ground); then the
+  nczero entries of C (row-major, nv x nv) that no body's pass sets, where cset is 1 (no mimic
+  joint shares a coordinate: each entry set once; else all zeroed first and added to).
+- FLOATS (float64): the quaternion's bounds on |q|^2, (1 -+ QUATERNION_TOLERANCE)^2; then nb
+  each: multiplier, offset (rad or m), the axis' sign, mass (kg); then 3 a body: the joint's
+  translation t0 in its parent (m), axis u, first moment h (kg m); then 9 a body (row-major):
+  R0, the turn tables P = R0 u u^T, C = R0 (1 - u u^T), S = R0 [u]x (R0 Rot(u, th) = P +
+  cos th C + sin th S), rotational inertia J (kg m^2, about the body's origin); then the
+  frames' rotations (9 each) and translations (3 each, m) in their bodies.
+"""
 
 from __future__ import annotations
 
 import hashlib
-from functools import partial
+from functools import lru_cache, partial
 from pathlib import Path
 
 import numpy as np
 
-from ..compile.codegen import c_table
 from ..model.tree import KinematicTree
 from .free_flyer import QUATERNION_TOLERANCE
 from .joint_models import joint_model
@@ -42,20 +60,20 @@ _LANES = """#undef RK_T
 #define RK_SINCOS lg_vsincos_inline"""
 
 
-def _turn_tables(joints) -> list[str]:
+def _turn_tables(joints) -> list[np.ndarray]:
     """R0 u u^T, R0 (1 - u u^T) and R0 [u]x per joint: R0 Rot(u, th) = P + cos th C + sin th S."""
     P, C, S = [], [], []
     for j in joints:
         R0, u = np.array(j.rotation, dtype=float), np.array(j.axis, dtype=float)
         uu = np.outer(u, u)
         skew = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
-        P.append((R0 @ uu).ravel().tolist())
-        C.append((R0 @ (np.eye(3) - uu)).ravel().tolist())
-        S.append((R0 @ skew).ravel().tolist())
-    return [c_table("rk_P", "double", P), c_table("rk_C", "double", C), c_table("rk_S", "double", S)]
+        P.append(R0 @ uu)
+        C.append(R0 @ (np.eye(3) - uu))
+        S.append(R0 @ skew)
+    return [P, C, S]
 
 
-def _axis_tables(joints) -> list[str]:
+def _axes(joints) -> tuple[list[int], list[float], list[bool]]:
     """Per joint: k where its axis is +-e_k exactly (else -1), that sign, and whether its R0
     is exactly 1: there R0 Rot(e_k, th) is a turn of two columns (reach_kernel.c's body)."""
     axis, sign, plain = [], [], []
@@ -65,15 +83,14 @@ def _axis_tables(joints) -> list[str]:
         axis.append(k)
         sign.append(u[k] if k >= 0 else 1.0)
         plain.append(np.array_equal(np.array(j.rotation, dtype=float), np.eye(3)))
-    return [c_table("rk_axis", "int", axis), c_table("rk_axsign", "double", sign),
-            c_table("rk_R0id", "int", plain)]
+    return axis, sign, plain
 
 
-def _coriolis_tables(tree: KinematicTree) -> list[str]:
-    """The entries of C (row-major, nv x nv) that no body's pass sets, those of two joints on
-    different branches (reach_coriolis.c sets the others once each and zeroes only these), and
-    RK_CSET: 0 where a mimic joint shares another joint's coordinate (its entries then add
-    up: the whole of C, and of A_g, is zeroed first)."""
+def _coriolis_zeros(tree: KinematicTree) -> tuple[bool, list[int]]:
+    """Whether each entry of C (and of A_g's, J's columns) is one joint's (cset: no mimic joint
+    shares another's coordinate), and the entries of C (row-major, nv x nv) that no body's pass
+    sets, those of two joints on different branches (reach_coriolis.c sets the others once each
+    and zeroes only these)."""
     free = tree.floating_base
     base = 6 if free else 0
     nv = base + len(tree.coordinates)
@@ -81,86 +98,93 @@ def _coriolis_tables(tree: KinematicTree) -> list[str]:
                for i, j in enumerate(tree.joints)]
     coordinates = [j.coordinate for j in tree.joints[int(free):]]
     shared = len(set(coordinates)) < len(coordinates)
-    written = set()
+    written = np.zeros((nv, nv), dtype=bool)
     for i in range(len(tree.joints)):
         a = i
         while a >= 0:  # i's ancestors and i itself
-            for r in columns[a]:
-                for c in columns[i]:
-                    written.update({(r, c), (c, r)})
+            rows, cols = np.array(columns[a]), np.array(columns[i])
+            written[np.ix_(rows, cols)] = written[np.ix_(cols, rows)] = True
             a = tree.joints[a].parent
-    unset = [r * nv + c for r in range(nv) for c in range(nv) if (r, c) not in written]
-    return [f"#define RK_CSET {int(not shared)}", f"#define RK_NCZERO {len(unset)}",
-            c_table("rk_czero", "int", unset)]
+    return not shared, np.flatnonzero(~written).tolist()
 
 
-def kernel_source(tree: KinematicTree):
-    """The module's C: the tables, then the kernels of _KERNELS in order."""
+def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
+    """The tree's INTS and FLOATS (this module's docstring), for the module's ``tree``."""
+    joints, frames = tree.joints, tree.frames
+    free = tree.floating_base
+    models = [joint_model(j.kind) for j in joints]
+    axis, sign, plain = _axes(joints)
+    cset, zeros = _coriolis_zeros(tree)
+    # a free flyer has no coordinate of the tree's (its column 0 unused)
+    coordinate = [0 if free and i == 0 else j.coordinate for i, j in enumerate(joints)]
+    ints = [len(joints), len(tree.coordinates), int(free), len(frames), int(cset), len(zeros),
+            *(j.parent for j in joints), *coordinate,
+            *(int(getattr(m, "turns", False)) for m in models),
+            *(int(getattr(m, "slides", False)) for m in models),
+            *axis, *map(int, plain), *(f.body for f in frames), *zeros]
+    # |quaternion|^2 within (1 -+ QUATERNION_TOLERANCE)^2, else numpy names the fault
+    floats = [np.array([(1 - QUATERNION_TOLERANCE) ** 2, (1 + QUATERNION_TOLERANCE) ** 2]),
+              *(np.array([getattr(j, name) for j in joints], dtype=float)
+                for name in ("multiplier", "offset")),
+              np.array(sign), np.array([j.mass for j in joints], dtype=float)]
+    floats += [np.array([getattr(j, name) for j in joints], dtype=float).reshape(-1)
+               for name in ("translation", "axis", "first_moment")]
+    floats += [np.array(x, dtype=float).reshape(-1)
+               for x in ([j.rotation for j in joints], *_turn_tables(joints),
+                         [j.inertia for j in joints])]
+    floats += [np.array([f.rotation for f in frames], dtype=float).reshape(-1),
+               np.array([f.translation for f in frames], dtype=float).reshape(-1)]
+    return np.array(ints, dtype=np.intc), np.concatenate(floats)
+
+
+def kernel_source():
+    """The module's C: the kernels of _KERNELS in order, the core twice."""
     from ..compile.codegen import GeneratedSource
 
-    joints, frames = tree.joints, tree.frames
-    flat = [[x for row in j.rotation for x in row] for j in joints]
-    models = [joint_model(j.kind) for j in joints]
     source = "\n".join([
-        "/* lagrangian: frame accelerations, centroidal momentum and wrenches of a tree */",
+        "/* lagrangian: frame accelerations, centroidal momentum and wrenches of any tree */",
         "#define PY_SSIZE_T_CLEAN",
         "#include <Python.h>",
         "#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION",
         "#include <numpy/arrayobject.h>",
         "#include <math.h>",
-        f"#define RK_NB {len(joints)}",
-        f"#define RK_N {len(tree.coordinates)}",
-        f"#define RK_FB {int(tree.floating_base)}",
-        # |quaternion|^2 within (1 -+ QUATERNION_TOLERANCE)^2, else numpy names the fault
-        f"#define RK_QLOW {(1 - QUATERNION_TOLERANCE) ** 2!r}",
-        f"#define RK_QHIGH {(1 + QUATERNION_TOLERANCE) ** 2!r}",
-        f"#define RK_NF {len(frames)}",
-        c_table("rk_parent", "int", [j.parent for j in joints]),
-        c_table("rk_coord", "int", [j.coordinate for j in joints]),
-        # a free flyer neither turns nor slides about an axis (body 0, read by RK_FREE)
-        c_table("rk_turns", "int", [getattr(m, "turns", False) for m in models]),
-        c_table("rk_slides", "int", [getattr(m, "slides", False) for m in models]),
-        c_table("rk_mult", "double", [j.multiplier for j in joints]),
-        c_table("rk_off", "double", [j.offset for j in joints]),
-        c_table("rk_R0", "double", flat),
-        *_turn_tables(joints),
-        *_axis_tables(joints),
-        c_table("rk_t0", "double", [list(j.translation) for j in joints]),
-        c_table("rk_u", "double", [list(j.axis) for j in joints]),
-        c_table("rk_m", "double", [j.mass for j in joints]),
-        c_table("rk_h", "double", [list(j.first_moment) for j in joints]),
-        c_table("rk_J", "double", [[x for row in j.inertia for x in row] for j in joints]),
-        c_table("rk_fbody", "int", [f.body for f in frames]),
-        c_table("rk_fR", "double", [[x for row in f.rotation for x in row] for f in frames]),
-        c_table("rk_ft", "double", [list(f.translation) for f in frames]),
-        *_coriolis_tables(tree),
+        "#include <string.h>",
         _SINCOS, _VECTOR,
     ])
     texts = [path.read_text(encoding="utf-8") for path in _KERNELS]
     head, first = texts[0].split("/* RK_CORE_BEGIN */")
     core = "\n".join([first, *texts[1:_CORE]])
     source = "\n".join([source, head, _SCALAR, core, _LANES, core, *texts[_CORE:]])
-    return GeneratedSource(source=source, parameters=(), n=len(tree.coordinates), m=0)
+    return GeneratedSource(source=source, parameters=(), n=0, m=0)
+
+
+@lru_cache(maxsize=1)
+def _key() -> str:
+    """The module's cache key: its C's text and this generator's, no tree's."""
+    text = kernel_source().source.encode() + Path(__file__).read_bytes()
+    return "reach engine\n" + hashlib.sha256(text).hexdigest()
+
+
+def engine():
+    """The one compiled module of every tree (cached on disk by its sources), or None where
+    no compiler works."""
+    from ..compile import compiled
+
+    try:
+        return compiled.load_keyed(_key(), kernel_source, native=True)
+    except compiled.BackendUnavailable:
+        return None
 
 
 def reach_module(tree: KinematicTree):
-    """The compiled module of this tree (cached on disk by its numbers and this generator),
-    or None where no compiler works."""
-    from ..compile import compiled
+    """The compiled module for this tree (the same for every tree: ``engine``), or None where
+    no compiler works or a joint is one the kernel does not know."""
     from .centroidal import ONE_DOF
 
     free = tree.floating_base  # a free flyer: body 0 only (RK_FREE)
     if any(j.kind not in ONE_DOF for j in tree.joints[int(free):]):
         return None  # a joint the kernel does not know: numpy's walks refuse it in one line
-    here = Path(__file__)
-    generator = hashlib.sha256(b"".join(path.read_bytes() for path in _KERNELS)
-                               + here.read_bytes()
-                               + here.with_name("tree_c.py").read_bytes()).hexdigest()
-    key = "\n".join(["reach", generator, repr(tree), repr(tree.frames)])
-    try:
-        return compiled.load_keyed(key, lambda: kernel_source(tree), native=True)
-    except compiled.BackendUnavailable:
-        return None
+    return engine()
 
 
 class ReachKernel:
@@ -171,18 +195,22 @@ class ReachKernel:
     def __init__(self, module, tree: KinematicTree, massive: bool):
         self.module = module
         self.frame_index = {f.name: k for k, f in enumerate(tree.frames)}
+        # the tree's tables read once into the module's Tree (reach_bindings.c); its methods
+        # bound here once: each call then goes straight to C
+        self.compiled = compiled = module.tree(*tables(tree), self.frame_index)
         # placement(Q, frame), jacobian(Q, frame, reference) and drift(Q, V, frame, reference)
-        # with the frame and reference looked up by name in C (reach_bindings.c): in Python the
-        # lookups cost a single Jacobian's call a sixth of its time
-        self.placement, self.jacobian, self.drift = module.frames(self.frame_index)
+        # with the frame and reference looked up by name in C: in Python the lookups cost a
+        # single Jacobian's call a sixth of its time
+        self.placement, self.jacobian = compiled.placement, compiled.jacobian
+        self.drift = compiled.drift
         # A_g and the centre of mass need moving mass (else numpy refuses them in one line)
-        self.centroidal = module.centroidal if massive else None
-        self.center_of_mass = module.com if massive else None
-        self.center_of_mass_jacobian = module.com_jacobian if massive else None
+        self.centroidal = compiled.centroidal if massive else None
+        self.center_of_mass = compiled.com if massive else None
+        self.center_of_mass_jacobian = compiled.com_jacobian if massive else None
         # a floating base's C by Pinocchio's factorization; a fixed base's is M's Christoffel
         # symbols (joint_space.py), which the same factorization gives: None until
         # checked_coriolis has compared the two, then the compiled function or False
-        self.coriolis = module.coriolis if tree.floating_base else None
+        self.coriolis = compiled.coriolis if tree.floating_base else None
         self.fixed_coriolis = None if not tree.floating_base else False
         self.tree = tree
         # inverse dynamics less wrenches in one pass (q, v, a, f_ext) -> tau: None until
@@ -200,14 +228,14 @@ class ReachKernel:
         rng = np.random.default_rng(0)
         q, v = rng.uniform(-1.0, 1.0, (2, 3, dynamics.n))
         try:
-            compiled = np.asarray(self.module.coriolis(q, v), dtype=float)
+            ours = np.asarray(self.compiled.coriolis(q, v), dtype=float)
             with np.errstate(all="ignore"):
                 christoffel = np.asarray(dynamics._christoffel_coriolis(q, v), dtype=float)
         except (ValueError, TypeError):
             return False
         scale = 1.0 + np.abs(christoffel).max()
-        if np.abs(compiled - christoffel).max() <= 1e-9 * scale:
-            self.fixed_coriolis = self.module.coriolis
+        if np.abs(ours - christoffel).max() <= 1e-9 * scale:
+            self.fixed_coriolis = self.compiled.coriolis
         return self.fixed_coriolis
 
     def fused_inverse(self, dynamics):
@@ -220,7 +248,7 @@ class ReachKernel:
         tree = self.tree
         g = dynamics.parameters.get(tree.gravity_parameter, 0.0) if tree.gravity_parameter else 0.0
         up = -g * np.array(tree.gravity_direction, dtype=float)  # the ground's acceleration
-        one_pass = partial(self.module.inverse, self.frame_index, up)
+        one_pass = partial(self.compiled.inverse, up)
         rng = np.random.default_rng(0)
         q = rng.uniform(-1.0, 1.0, (3, len(dynamics.coordinates)))
         if tree.floating_base:
@@ -244,7 +272,7 @@ class ReachKernel:
         states not finite (q, a wrench, or out's row already) made NaN whole; their count.
         ValueError or KeyError where the inputs are not plain or a base quaternion is off (the
         numpy path then names the fault)."""
-        wrench, bad = self.module.wrench, None
+        wrench, bad = self.compiled.wrench, None
         for name, w in wrenches.items():
             bad = wrench(q, self.frame_index[name], w, out, sign)  # the last counts them all
         if bad is None:  # no wrench: the rows NaN already (the caller's dynamics')
@@ -252,4 +280,4 @@ class ReachKernel:
         return bad
 
 
-__all__ = ["ReachKernel", "kernel_source", "reach_module"]
+__all__ = ["ReachKernel", "engine", "kernel_source", "reach_module", "tables"]

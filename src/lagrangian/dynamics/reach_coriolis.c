@@ -27,9 +27,14 @@ typedef struct {
 } RK_FN(cbody);
 
 typedef struct {
-    RK_FN(cbody) b[RK_NB];
     RK_T S0[6][6], dS0[6][6];
+    RK_FN(cbody) b[];  /* nb of them */
 } RK_FN(cwork);
+
+static size_t RK_FN(cwork_size)(const rk_model *md)
+{
+    return sizeof(RK_FN(cwork)) + (size_t)md->nb * sizeof(RK_FN(cbody));
+}
 
 /* body i's columns and their rates, (RK_T (*)[6]): the free flyer's six or the joint's one */
 #define RK_COLUMNS(w, i) (RK_FREE(i) ? (w)->S0 : (RK_T (*)[6])(w)->b[i].S)
@@ -47,28 +52,28 @@ static inline void RK_FN(inertia_times)(const RK_FN(cbody) *b, const RK_T *x, RK
     }
 }
 
-static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_T *restrict C,
-                            RK_FN(cwork) *restrict work)
+static void RK_FN(coriolis)(const rk_model *md, RK_FN(work) *space, const RK_T *restrict q,
+                            const RK_T *restrict qd, RK_T *restrict C)
 {
+    RK_FN(cwork) *restrict work = (RK_FN(cwork) *)space->x;
     RK_FN(cbody) *restrict body = work->b;
-    RK_T R[RK_NB][9], o[RK_NB][3];
-    RK_FN(bodies)(q, R, o);
-#if RK_CSET  /* each entry set once below: zero only those between branches (reach_c.py) */
-    for (int j = 0; j < RK_NCZERO; j++) C[rk_czero[j]] = RK_C(0.0);
-#else  /* a mimic joint's coordinate is another joint's too: its entries add up */
-    for (int j = 0; j < RK_NV * RK_NV; j++) C[j] = RK_C(0.0);
-#endif
-    for (int i = 0; i < RK_NB; i++) {
+    RK_T (*R)[9] = space->R, (*o)[3] = space->o;
+    RK_FN(bodies)(md, q, R, o);
+    if (md->cset)  /* each entry set once below: zero only those between branches (reach_c.py) */
+        for (int j = 0; j < md->nczero; j++) C[md->czero[j]] = RK_C(0.0);
+    else  /* a mimic joint's coordinate is another joint's too: its entries add up */
+        for (int j = 0; j < md->nv * md->nv; j++) C[j] = RK_C(0.0);
+    for (int i = 0; i < md->nb; i++) {
         RK_FN(cbody) *bi = body + i;
         RK_T (*S)[6] = RK_COLUMNS(work, i), (*dS)[6] = RK_RATES(work, i);
-        int p = rk_parent[i];
+        int p = md->parent[i];
         if (RK_FREE(i)) {
             RK_FN(free_columns)(R[0], o[0], S);
             bi->columns = 6, bi->first = 0;
         } else {
-            RK_FN(subspace)(i, R, o, S[0]);
-            for (int j = 0; j < 6; j++) S[0][j] *= rk_mult[i];
-            bi->columns = 1, bi->first = RK_BV + rk_coord[i];
+            RK_FN(subspace)(md, i, R, o, S[0]);
+            for (int j = 0; j < 6; j++) S[0][j] *= md->mult[i];
+            bi->columns = 1, bi->first = md->bv + md->coord[i];
         }
         for (int j = 0; j < 6; j++) bi->V[j] = p < 0 ? RK_C(0.0) : body[p].V[j];
         for (int c = 0; c < bi->columns; c++)
@@ -76,10 +81,10 @@ static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_
         for (int c = 0; c < bi->columns; c++) RK_FN(motion_cross)(bi->V, S[c], dS[c]);
         /* the inertia at the world's origin (as centroidal's): h = R h_i + m x, J_O */
         RK_T hr[3], RJ[9];
-        const double m = rk_m[i];
+        const double m = md->m[i];
         const RK_T *x = o[i];
-        RK_FN(apply_v)(R[i], rk_h[i], hr);
-        RK_FN(matmul_v)(R[i], rk_J[i], RJ);
+        RK_FN(apply_v)(R[i], (md->h + 3 * i), hr);
+        RK_FN(matmul_v)(R[i], (md->J + 9 * i), RJ);
         RK_T pp = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
         RK_T ph = x[0] * hr[0] + x[1] * hr[1] + x[2] * hr[2];
         bi->m = m;
@@ -109,7 +114,7 @@ static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_
         bi->A[1] += 0.5 * f[5]; bi->A[2] -= 0.5 * f[4]; bi->A[5] += 0.5 * f[3];
         bi->A[3] -= 0.5 * f[5]; bi->A[6] += 0.5 * f[4]; bi->A[7] -= 0.5 * f[3];
     }
-    for (int i = RK_NB - 1; i >= 0; i--) {
+    for (int i = md->nb - 1; i >= 0; i--) {
         RK_FN(cbody) *bi = body + i;
         RK_T (*Si)[6] = RK_COLUMNS(work, i), (*dSi)[6] = RK_RATES(work, i);
         /* per column: own = I S_dot + B S, rowI = (I S)^T, rowB = (B^T S)^T's angular half
@@ -129,7 +134,7 @@ static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_
                 rowB[c][j] = u[j] + bi->A[j] * s[3] + bi->A[3 + j] * s[4] + bi->A[6 + j] * s[5];
             }
         }
-        for (int a = i; a >= 0; a = rk_parent[a]) {
+        for (int a = i; a >= 0; a = md->parent[a]) {
             const RK_FN(cbody) *ba = body + a;
             RK_T (*Sa)[6] = RK_COLUMNS(work, a), (*dSa)[6] = RK_RATES(work, a);
             /* (a, i) with a an ancestor of i or i itself, (i, a) with a strict ancestor:
@@ -138,15 +143,15 @@ static void RK_FN(coriolis)(const RK_T *restrict q, const RK_T *restrict qd, RK_
                 for (int ci = 0; ci < bi->columns; ci++) {
                     RK_T t = RK_C(0.0);  /* C[a, i] = S_a^T (I^c_i S_dot_i + B^c_i S_i) */
                     for (int k = 0; k < 6; k++) t += Sa[ca][k] * own[ci][k];
-                    RK_CPUT(C[(ba->first + ca) * RK_NV + bi->first + ci], t);
+                    RK_CPUT(C[(ba->first + ca) * md->nv + bi->first + ci], t);
                     if (a == i) continue;
                     t = RK_C(0.0);  /* C[i, a] = S_i^T (I^c_i S_dot_a + B^c_i S_a) */
                     for (int k = 0; k < 6; k++) t += rowI[ci][k] * dSa[ca][k];
                     for (int k = 0; k < 3; k++) t += rowB[ci][k] * Sa[ca][3 + k];
-                    RK_CPUT(C[(bi->first + ci) * RK_NV + ba->first + ca], t);
+                    RK_CPUT(C[(bi->first + ci) * md->nv + ba->first + ca], t);
                 }
         }
-        int p = rk_parent[i];
+        int p = md->parent[i];
         if (p >= 0) {
             RK_FN(cbody) *bp = body + p;
             bp->m += bi->m;

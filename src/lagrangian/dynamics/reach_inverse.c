@@ -5,34 +5,36 @@
 
 /* I X for body i's spatial inertia about its own origin, world axes (X = [a; alpha] there):
  * [m a - h x alpha; h x a + R J R^T alpha], h = R h_i its first moment (kg m) */
-static inline void RK_FN(inertia_at)(int i, const RK_T *R, const RK_T *h, const RK_T *X,
-                                     RK_T *out)
+static inline void RK_FN(inertia_at)(const rk_model *md, int i, const RK_T *R, const RK_T *h,
+                                     const RK_T *X, RK_T *out)
 {
     RK_T t[3], u[3], hxa[3], ahx[3];
     RK_FN(apply_t)(R, X + 3, t);
-    RK_FN(apply_k)(rk_J[i], t, u);
+    RK_FN(apply_k)((md->J + 9 * i), t, u);
     RK_FN(apply)(R, u, t);
     RK_FN(cross)(X + 3, h, ahx);  /* -h x alpha */
     RK_FN(cross)(h, X, hxa);
     for (int j = 0; j < 3; j++) {
-        out[j] = rk_m[i] * X[j] + ahx[j];
+        out[j] = md->m[i] * X[j] + ahx[j];
         out[3 + j] = hxa[j] + t[j];
     }
 }
 
-/* tau (RK_NV) = M(q) qdd + C(q, qd) qd + g(q) - sum J_f^T w_f over the nw wrenches w_f =
+/* tau (md->nv) = M(q) qdd + C(q, qd) qd + g(q) - sum J_f^T w_f over the nw wrenches w_f =
  * [force; moment] at frames[f]'s origin, world axes (a floating base's six first: the force
  * and moment on the base about its origin, base axes) */
-static void RK_FN(inverse)(const RK_T *restrict q, const RK_T *restrict qd,
-                           const RK_T *restrict qdd, const double *up, int nw, const int *frames,
-                           const RK_T (*w)[6], RK_T *restrict tau)
+static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *restrict q,
+                           const RK_T *restrict qd, const RK_T *restrict qdd, const double *up,
+                           int nw, const int *frames, const RK_T (*w)[6], RK_T *restrict tau)
 {
-    RK_T R[RK_NB][9], o[RK_NB][3], V[RK_NB][6], A[RK_NB][6], F[RK_NB][6], S[RK_NB][6];
+    const int nb = md->nb;
+    RK_T (*R)[9] = work->R, (*o)[3] = work->o, (*V)[6] = (RK_T (*)[6])work->x, (*A)[6] = V + nb,
+         (*F)[6] = V + 2 * nb, (*S)[6] = V + 3 * nb;
     RK_T base[6][6];
-    RK_FN(bodies)(q, R, o);
-    for (int j = 0; j < RK_NV; j++) tau[j] = RK_C(0.0);
-    for (int i = 0; i < RK_NB; i++) {
-        const int p = rk_parent[i];
+    RK_FN(bodies)(md, q, R, o);
+    for (int j = 0; j < md->nv; j++) tau[j] = RK_C(0.0);
+    for (int i = 0; i < md->nb; i++) {
+        const int p = md->parent[i];
         if (RK_FREE(i)) {  /* V = S v_base, A = up + S a_base (V x S v_base = V x V = 0) */
             RK_FN(free_columns)(R[0], o[0], base);
             for (int j = 0; j < 6; j++) {
@@ -44,10 +46,10 @@ static void RK_FN(inverse)(const RK_T *restrict q, const RK_T *restrict qd,
                 }
             }
         } else {
-            const RK_T rate = rk_mult[i] * qd[RK_BV + rk_coord[i]];
-            const RK_T accel = rk_mult[i] * qdd[RK_BV + rk_coord[i]];
+            const RK_T rate = md->mult[i] * qd[md->bv + md->coord[i]];
+            const RK_T accel = md->mult[i] * qdd[md->bv + md->coord[i]];
             RK_T c[6];
-            RK_FN(subspace)(i, R, o, S[i]);
+            RK_FN(subspace)(md, i, R, o, S[i]);
             for (int j = 0; j < 6; j++) {
                 V[i][j] = (p < 0 ? RK_C(0.0) : V[p][j]) + S[i][j] * rate;
                 A[i][j] = (p < 0 ? RK_C(j < 3 ? up[j] : 0.0) : A[p][j]) + S[i][j] * accel;
@@ -59,15 +61,15 @@ static void RK_FN(inverse)(const RK_T *restrict q, const RK_T *restrict qd,
          * arms: motions there [v + w x o; w]), V x* [f; n] = [w x f; w x n + v x f], then
          * carried to the world's origin: [f; n + o x f] */
         RK_T h[3], Vo[6], Ao[6], IV[6], f[6], t1[3], t2[3];
-        RK_FN(apply_v)(R[i], rk_h[i], h);
+        RK_FN(apply_v)(R[i], (md->h + 3 * i), h);
         RK_FN(cross)(V[i] + 3, o[i], t1);
         RK_FN(cross)(A[i] + 3, o[i], t2);
         for (int j = 0; j < 3; j++) {
             Vo[j] = V[i][j] + t1[j], Vo[3 + j] = V[i][3 + j];
             Ao[j] = A[i][j] + t2[j], Ao[3 + j] = A[i][3 + j];
         }
-        RK_FN(inertia_at)(i, R[i], h, Ao, f);
-        RK_FN(inertia_at)(i, R[i], h, Vo, IV);
+        RK_FN(inertia_at)(md, i, R[i], h, Ao, f);
+        RK_FN(inertia_at)(md, i, R[i], h, Vo, IV);
         RK_FN(cross)(Vo + 3, IV, t1);
         for (int j = 0; j < 3; j++) f[j] += t1[j];
         RK_FN(cross)(Vo + 3, IV + 3, t1);
@@ -77,17 +79,17 @@ static void RK_FN(inverse)(const RK_T *restrict q, const RK_T *restrict qd,
         for (int j = 0; j < 3; j++) F[i][j] = f[j], F[i][3 + j] = f[3 + j] + t1[j];
     }
     for (int k = 0; k < nw; k++) {  /* the wrench carried to the world's origin: [f; m + p x f] */
-        const int b = rk_fbody[frames[k]];
+        const int b = md->fbody[frames[k]];
         if (b < 0) continue;  /* on the ground: no joint feels it */
         RK_T x[3], m[3];
-        RK_FN(frame_origin)(frames[k], R, o, x);
+        RK_FN(frame_origin)(md, frames[k], R, o, x);
         RK_FN(cross)(x, w[k], m);
         for (int j = 0; j < 3; j++) {
             F[b][j] -= w[k][j];
             F[b][3 + j] -= w[k][3 + j] + m[j];
         }
     }
-    for (int i = RK_NB - 1; i >= 0; i--) {
+    for (int i = md->nb - 1; i >= 0; i--) {
         if (RK_FREE(i)) {
             for (int c = 0; c < 6; c++) {
                 RK_T t = RK_C(0.0);
@@ -97,9 +99,9 @@ static void RK_FN(inverse)(const RK_T *restrict q, const RK_T *restrict qd,
         } else {
             RK_T t = RK_C(0.0);
             for (int j = 0; j < 6; j++) t += S[i][j] * F[i][j];
-            tau[RK_BV + rk_coord[i]] += rk_mult[i] * t;
+            tau[md->bv + md->coord[i]] += md->mult[i] * t;
         }
-        const int p = rk_parent[i];
+        const int p = md->parent[i];
         if (p >= 0)
             for (int j = 0; j < 6; j++) F[p][j] += F[i][j];
     }

@@ -1,31 +1,45 @@
 /* J_dot q_dot of a frame, the centroidal momentum matrix, a wrench's generalized forces and
- * C(q, v), over the tree tables that reach_c.py writes above this text (rk_* arrays, RK_NB
- * bodies, RK_N joint coordinates, RK_NF frames; RK_FB 1 for a floating base: body 0 on a free
- * flyer, q of RK_NQ = 7 + RK_N numbers and v of RK_NV = 6 + RK_N). The same formulas as
+ * C(q, v), over a tree given at run time: an rk_model, its tables read once from the two arrays
+ * reach_c.py builds (their layout: reach_c.py's docstring; checked by reach_bindings.c's
+ * rk_model_from). nb bodies, n joint coordinates, nf frames; fb 1 for a floating base: body 0
+ * on a free flyer, q of nq = 7 + n numbers and v of nv = 6 + n. The same formulas as
  * centroidal.py, wrenches.py and coriolis_tree.py: spatial velocities at the world's origin in
  * world axes, [v; w]. */
 
-#define RK_BQ (RK_FB ? 7 : 0)
-#define RK_BV (RK_FB ? 6 : 0)
-#define RK_NQ (RK_BQ + RK_N)
-#define RK_NV (RK_BV + RK_N)
-#define RK_FREE(i) (RK_FB && (i) == 0)
-#define RK_UNROLL 40  /* bodies up to which the walks over them are unrolled (compile time) */
 #define RK_MAX_WRENCHES 16  /* more: the bindings refuse, the caller adds J^T w one by one */
+#define RK_MAX_BODIES (1 << 20)  /* a bound only so that no size below overflows an int */
+
+typedef struct {
+    int nb, n, fb, nf, cset, nczero;  /* cset 0 where a mimic joint shares a coordinate */
+    int bq, bv, nq, nv;               /* the base's 7 and 6 numbers of q and v (else 0) */
+    /* per body: parent (-1: the ground, always before it), coordinate, whether its joint turns
+       and slides, k where its axis is +-e_k exactly (else -1), whether its R0 is exactly 1 */
+    const int *parent, *coord, *turns, *slides, *axis, *R0id;
+    const int *fbody;                 /* per frame: its body (-1: the ground) */
+    const int *czero;                 /* the entries of C that no body's pass sets (cset) */
+    /* per body: multiplier, offset, the axis' sign (axis >= 0), mass (kg); 3 a body: the
+       joint's translation t0 (m), axis u, first moment h (kg m); 9 a body (row-major): R0, the
+       turn tables P, C, S (R0 Rot(u, th) = P + cos th C + sin th S), inertia J (kg m^2) */
+    const double *mult, *off, *axsign, *m, *t0, *u, *h, *R0, *P, *C, *S, *J;
+    const double *fR, *ft;            /* per frame: rotation (9) and translation (3) in its body */
+    double qlow, qhigh;               /* |quaternion|^2 within these, else numpy names it */
+} rk_model;
+
+#define RK_FREE(i) (md->fb && (i) == 0)
 
 /* An output entry that one joint's column fills: set where no two joints share a coordinate
- * (RK_CSET, from reach_c.py), added to where a mimic joint's coordinate is another's (the
- * output zeroed first) */
-#if RK_CSET
-#define RK_CPUT(entry, value) ((entry) = (value))
-#else
-#define RK_CPUT(entry, value) ((entry) += (value))
-#endif
+ * (cset), added to where a mimic joint's coordinate is another's (the output zeroed first) */
+#define RK_CPUT(entry, value)                  \
+    do {                                       \
+        if (md->cset) (entry) = (value);       \
+        else (entry) += (value);               \
+    } while (0)
 
 #define RK_STR_(x) #x
 #define RK_STR(x) RK_STR_(x)
 #define RK_PASTE_(a, b) a##b
 #define RK_PASTE(a, b) RK_PASTE_(a, b)
+#define RK_ROUND(bytes) (((bytes) + 63) / 64 * 64)  /* a workspace's parts 64-byte aligned */
 
 /* R x of two tables' doubles (a sliding joint's axis in its parent's axes) */
 static inline void rk_apply_tab(const double *R, const double *x, double *out)
@@ -40,8 +54,55 @@ static inline void rk_apply_tab(const double *R, const double *x, double *out)
  * extensions). RK_FN(name) names a function, RK_C(x) a number as an RK_T, RK_SINCOS the sine
  * and cosine of an RK_T. Every branch depends on the tree alone, never on a state: the lanes
  * take the same path. Helpers with a suffix take a table's doubles: _k a constant matrix,
- * _v a constant vector. */
+ * _v a constant vector. Each function works in an RK_FN(work), sized from the model
+ * (RK_FN(work_size)): on the heap or, for a small tree's single state, the caller's stack. */
 /* RK_CORE_BEGIN */
+/* a function's workspace: every body's rotation and origin, the path to a body, and x, the
+ * function's own arrays (one function at a time on a workspace, so they share it: a drift's
+ * V and A, A_g's h and I_c, the centre of mass's H, C's rk_cwork, inverse dynamics' V, A, F, S
+ * and a wrench's tau); mass nb doubles, set nv flags (the lanes' Jacobian) */
+typedef struct {
+    RK_T (*R)[9], (*o)[3], *x;
+    double *mass;
+    int *path;
+    unsigned char *set;
+} RK_FN(work);
+
+static size_t RK_FN(cwork_size)(const rk_model *md);
+
+/* the RK_Ts of x: the largest of the functions' own arrays */
+static size_t RK_FN(work_x)(const rk_model *md)
+{
+    size_t x = 24 * (size_t)md->nb, c = (RK_FN(cwork_size)(md) + sizeof(RK_T) - 1) / sizeof(RK_T);
+    if (x < c) x = c;
+    return x < (size_t)md->nv ? (size_t)md->nv : x;
+}
+
+/* the bytes of a workspace, each part 64-byte aligned */
+static size_t RK_FN(work_size)(const rk_model *md)
+{
+    const size_t nb = (size_t)md->nb;
+    return RK_ROUND(12 * nb * sizeof(RK_T)) + RK_ROUND(RK_FN(work_x)(md) * sizeof(RK_T))
+           + RK_ROUND(nb * sizeof(double)) + RK_ROUND(nb * sizeof(int)) + RK_ROUND((size_t)md->nv);
+}
+
+/* the workspace's parts in ``block`` (64-byte aligned, RK_FN(work_size) bytes) */
+static inline void RK_FN(work_at)(const rk_model *md, void *block, RK_FN(work) *w)
+{
+    const size_t nb = (size_t)md->nb;
+    char *at = (char *)block;
+    w->R = (RK_T (*)[9])at;
+    w->o = (RK_T (*)[3])(at + 9 * nb * sizeof(RK_T));
+    at += RK_ROUND(12 * nb * sizeof(RK_T));
+    w->x = (RK_T *)at;
+    at += RK_ROUND(RK_FN(work_x)(md) * sizeof(RK_T));
+    w->mass = (double *)at;
+    at += RK_ROUND(nb * sizeof(double));
+    w->path = (int *)at;
+    at += RK_ROUND(nb * sizeof(int));
+    w->set = (unsigned char *)at;
+}
+
 static inline void RK_FN(cross)(const RK_T *a, const RK_T *b, RK_T *out)
 {
     RK_T x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2],
@@ -99,11 +160,11 @@ static inline void RK_FN(matmul_v)(const RK_T *A, const double *B, RK_T *out)
 }
 
 /* body i's rotation (body -> world) and origin (m, world), its parent's already known */
-static inline __attribute__((always_inline)) void RK_FN(body)(const RK_T *q, int i, RK_T (*R)[9],
-                                                           RK_T (*o)[3])
+static inline __attribute__((always_inline)) void RK_FN(body)(const rk_model *md, const RK_T *q,
+                                                              int i, RK_T (*R)[9], RK_T (*o)[3])
 {
     RK_T Rl[9], pl[3];
-    for (int j = 0; j < 3; j++) pl[j] = RK_C(rk_t0[i][j]);
+    for (int j = 0; j < 3; j++) pl[j] = RK_C(md->t0[3 * i + j]);
     if (RK_FREE(i)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
         RK_T x = q[3], y = q[4], z = q[5], w = q[6], Rq[9], d[3];
         RK_T k = 1.0 / (x * x + y * y + z * z + w * w);
@@ -112,29 +173,29 @@ static inline __attribute__((always_inline)) void RK_FN(body)(const RK_T *q, int
         Rq[4] = 1 - 2 * k * (x * x + z * z); Rq[5] = 2 * k * (y * z - x * w);
         Rq[6] = 2 * k * (x * z - y * w); Rq[7] = 2 * k * (y * z + x * w);
         Rq[8] = 1 - 2 * k * (x * x + y * y);
-        if (rk_R0id[i]) {  /* the usual free flyer, at the URDF root's own axes */
+        if (md->R0id[i]) {  /* the usual free flyer, at the URDF root's own axes */
             for (int j = 0; j < 9; j++) Rl[j] = Rq[j];
             for (int j = 0; j < 3; j++) pl[j] += q[j];
         } else {
-            RK_FN(matmul_k)(rk_R0[i], Rq, Rl);
-            RK_FN(apply_k)(rk_R0[i], q, d);
+            RK_FN(matmul_k)((md->R0 + 9 * i), Rq, Rl);
+            RK_FN(apply_k)((md->R0 + 9 * i), q, d);
             for (int j = 0; j < 3; j++) pl[j] += d[j];
         }
     } else {
-        const RK_T th = rk_mult[i] * q[RK_BQ + rk_coord[i]] + rk_off[i];
-        if (rk_turns[i] && !rk_slides[i] && rk_axis[i] >= 0) {
+        const RK_T th = md->mult[i] * q[md->bq + md->coord[i]] + md->off[i];
+        if (md->turns[i] && !md->slides[i] && md->axis[i] >= 0) {
             /* about +-e_k: (R_p R0) Rot(e_k, th) turns two columns of R_p R0 (a, b, k cyclic:
                Rot e_a = c e_a + s e_b, Rot e_b = -s e_a + c e_b), 12 products, not 45 */
             RK_T c, s, M[9];
             RK_SINCOS(th, &s, &c);
-            s = rk_axsign[i] * s;
-            const int k = rk_axis[i], a = (k + 1) % 3, b = (k + 2) % 3, p = rk_parent[i];
+            s = md->axsign[i] * s;
+            const int k = md->axis[i], a = (k + 1) % 3, b = (k + 2) % 3, p = md->parent[i];
             if (p < 0)
-                for (int j = 0; j < 9; j++) M[j] = RK_C(rk_R0[i][j]);
-            else if (rk_R0id[i])
+                for (int j = 0; j < 9; j++) M[j] = RK_C(md->R0[9 * i + j]);
+            else if (md->R0id[i])
                 for (int j = 0; j < 9; j++) M[j] = R[p][j];
             else
-                RK_FN(matmul_v)(R[p], rk_R0[i], M);
+                RK_FN(matmul_v)(R[p], (md->R0 + 9 * i), M);
             for (int r = 0; r < 3; r++) {
                 R[i][3 * r + a] = c * M[3 * r + a] + s * M[3 * r + b];
                 R[i][3 * r + b] = c * M[3 * r + b] - s * M[3 * r + a];
@@ -149,21 +210,21 @@ static inline __attribute__((always_inline)) void RK_FN(body)(const RK_T *q, int
             }
             return;
         }
-        if (rk_turns[i]) {
+        if (md->turns[i]) {
             /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
             RK_T c, s;
             RK_SINCOS(th, &s, &c);  /* inline (tree_c.py): a libm call costs a body's work */
-            for (int j = 0; j < 9; j++) Rl[j] = rk_P[i][j] + c * rk_C[i][j] + s * rk_S[i][j];
+            for (int j = 0; j < 9; j++) Rl[j] = md->P[9 * i + j] + c * md->C[9 * i + j] + s * md->S[9 * i + j];
         } else {
-            for (int j = 0; j < 9; j++) Rl[j] = RK_C(rk_R0[i][j]);
+            for (int j = 0; j < 9; j++) Rl[j] = RK_C(md->R0[9 * i + j]);
         }
-        if (rk_slides[i]) {
+        if (md->slides[i]) {
             double d[3];
-            rk_apply_tab(rk_R0[i], rk_u[i], d);
+            rk_apply_tab((md->R0 + 9 * i), (md->u + 3 * i), d);
             for (int j = 0; j < 3; j++) pl[j] += th * d[j];
         }
     }
-    int p = rk_parent[i];
+    int p = md->parent[i];
     if (p < 0) {
         for (int j = 0; j < 9; j++) R[i][j] = Rl[j];
         for (int j = 0; j < 3; j++) o[i][j] = pl[j];
@@ -176,40 +237,38 @@ static inline __attribute__((always_inline)) void RK_FN(body)(const RK_T *q, int
 }
 
 /* every body's rotation and origin */
-static void RK_FN(bodies)(const RK_T *q, RK_T (*R)[9], RK_T (*o)[3])
+static void RK_FN(bodies)(const rk_model *md, const RK_T *q, RK_T (*R)[9], RK_T (*o)[3])
 {
-    /* unrolled on a small tree: each body's table entries (axis, parent, rotation) known to
-       the compiler, its branches gone (10-15% of A_g's time) */
-#if RK_NB <= RK_UNROLL
-#pragma GCC unroll 40
-#endif
-    for (int i = 0; i < RK_NB; i++) RK_FN(body)(q, i, R, o);
+    for (int i = 0; i < md->nb; i++) RK_FN(body)(md, q, i, R, o);
 }
 
 /* the bodies from the root out to body b (b itself last) into path, their number returned;
  * only theirs are placed: a frame's J_dot v and J^T w need no other body */
-static int RK_FN(path)(const RK_T *q, int b, int *path, RK_T (*R)[9], RK_T (*o)[3])
+static int RK_FN(path)(const rk_model *md, const RK_T *q, int b, int *path, RK_T (*R)[9],
+                       RK_T (*o)[3])
 {
     int depth = 0;
-    for (int i = b; i >= 0; i = rk_parent[i]) depth++;
+    for (int i = b; i >= 0; i = md->parent[i]) depth++;
     int k = depth;
-    for (int i = b; i >= 0; i = rk_parent[i]) path[--k] = i;
-    for (k = 0; k < depth; k++) RK_FN(body)(q, path[k], R, o);
+    for (int i = b; i >= 0; i = md->parent[i]) path[--k] = i;
+    for (k = 0; k < depth; k++) RK_FN(body)(md, q, path[k], R, o);
     return depth;
 }
 
 /* S of body i's joint at the world's origin, world axes: [s_v; s_w] */
-static inline __attribute__((always_inline)) void RK_FN(subspace)(int i, RK_T (*R)[9], RK_T (*o)[3], RK_T *S)
+static inline __attribute__((always_inline)) void RK_FN(subspace)(const rk_model *md, int i,
+                                                                  RK_T (*R)[9], RK_T (*o)[3],
+                                                                  RK_T *S)
 {
     RK_T d[3];
-    RK_FN(apply_v)(R[i], rk_u[i], d);
-    if (rk_turns[i]) {
+    RK_FN(apply_v)(R[i], (md->u + 3 * i), d);
+    if (md->turns[i]) {
         RK_FN(cross)(o[i], d, S);
         for (int j = 0; j < 3; j++) S[3 + j] = d[j];
-        if (rk_slides[i])
+        if (md->slides[i])
             for (int j = 0; j < 3; j++) S[j] += d[j];
     } else {
-        for (int j = 0; j < 3; j++) { S[j] = rk_slides[i] ? d[j] : RK_C(0.0); S[3 + j] = RK_C(0.0); }
+        for (int j = 0; j < 3; j++) { S[j] = md->slides[i] ? d[j] : RK_C(0.0); S[3 + j] = RK_C(0.0); }
     }
 }
 
@@ -229,51 +288,57 @@ static inline __attribute__((always_inline)) void RK_FN(free_columns)(const RK_T
 
 /* a joint's columns at the world's origin, world axes, and the first coordinate they fill:
  * a free flyer's six, else one (times the joint's multiplier) */
-static inline __attribute__((always_inline)) int RK_FN(columns)(int i, RK_T (*R)[9], RK_T (*o)[3], RK_T (*F)[6], int *first,
-                                 double *mult)
+static inline __attribute__((always_inline)) int RK_FN(columns)(const rk_model *md, int i,
+                                                                RK_T (*R)[9], RK_T (*o)[3],
+                                                                RK_T (*F)[6], int *first,
+                                                                double *mult)
 {
     if (RK_FREE(i)) {
         RK_FN(free_columns)(R[0], o[0], F);
         *first = 0, *mult = 1.0;
         return 6;
     }
-    RK_FN(subspace)(i, R, o, F[0]);
-    *first = RK_BV + rk_coord[i], *mult = rk_mult[i];
+    RK_FN(subspace)(md, i, R, o, F[0]);
+    *first = md->bv + md->coord[i], *mult = md->mult[i];
     return 1;
 }
 
 /* the frame's rotation (frame -> world) and origin */
-static inline void RK_FN(frame)(int f, RK_T (*R)[9], RK_T (*o)[3], RK_T *Rf, RK_T *p)
+static inline void RK_FN(frame)(const rk_model *md, int f, RK_T (*R)[9], RK_T (*o)[3], RK_T *Rf,
+                                RK_T *p)
 {
-    int b = rk_fbody[f];
+    int b = md->fbody[f];
     if (b < 0) {
-        for (int j = 0; j < 9; j++) Rf[j] = RK_C(rk_fR[f][j]);
-        for (int j = 0; j < 3; j++) p[j] = RK_C(rk_ft[f][j]);
+        for (int j = 0; j < 9; j++) Rf[j] = RK_C(md->fR[9 * f + j]);
+        for (int j = 0; j < 3; j++) p[j] = RK_C(md->ft[3 * f + j]);
         return;
     }
     RK_T d[3];
-    RK_FN(matmul_v)(R[b], rk_fR[f], Rf);
-    RK_FN(apply_v)(R[b], rk_ft[f], d);
+    RK_FN(matmul_v)(R[b], (md->fR + 9 * f), Rf);
+    RK_FN(apply_v)(R[b], (md->ft + 3 * f), d);
     for (int j = 0; j < 3; j++) p[j] = o[b][j] + d[j];
 }
 
 /* the frame's origin alone (J^T w and inverse dynamics need no frame rotation) */
-static inline void RK_FN(frame_origin)(int f, RK_T (*R)[9], RK_T (*o)[3], RK_T *p)
+static inline void RK_FN(frame_origin)(const rk_model *md, int f, RK_T (*R)[9], RK_T (*o)[3],
+                                       RK_T *p)
 {
-    int b = rk_fbody[f];
+    int b = md->fbody[f];
     RK_T d[3];
-    RK_FN(apply_v)(R[b], rk_ft[f], d);
+    RK_FN(apply_v)(R[b], (md->ft + 3 * f), d);
     for (int j = 0; j < 3; j++) p[j] = o[b][j] + d[j];
 }
 
 /* [a; w_dot] of frame f at q_ddot = 0; ref 0 world, 1 local, 2 local_world_aligned */
-static void RK_FN(drift)(const RK_T *q, const RK_T *qd, int f, int ref, RK_T *out)
+static void RK_FN(drift)(const rk_model *md, RK_FN(work) *work, const RK_T *q, const RK_T *qd,
+                         int f, int ref, RK_T *out)
 {
-    RK_T R[RK_NB][9], o[RK_NB][3], V[RK_NB][6], A[RK_NB][6];
-    int b = rk_fbody[f];
+    RK_T (*R)[9] = work->R, (*o)[3] = work->o, (*V)[6] = (RK_T (*)[6])work->x,
+         (*A)[6] = V + md->nb;
+    int b = md->fbody[f], *path = work->path;
     for (int j = 0; j < 6; j++) out[j] = RK_C(0.0);
     if (b < 0) return;
-    int path[RK_NB], depth = RK_FN(path)(q, b, path, R, o);
+    const int depth = RK_FN(path)(md, q, b, path, R, o);
     for (int k = 0; k < depth; k++) {
         const int i = path[k];
         if (RK_FREE(i)) {  /* V = S v_base; no drift of its own (V x V = 0) */
@@ -286,9 +351,9 @@ static void RK_FN(drift)(const RK_T *q, const RK_T *qd, int f, int ref, RK_T *ou
             }
             continue;
         }
-        RK_T S[6], c[6], rate = rk_mult[i] * qd[RK_BV + rk_coord[i]];
-        int p = rk_parent[i];
-        RK_FN(subspace)(i, R, o, S);
+        RK_T S[6], c[6], rate = md->mult[i] * qd[md->bv + md->coord[i]];
+        int p = md->parent[i];
+        RK_FN(subspace)(md, i, R, o, S);
         for (int j = 0; j < 6; j++) {
             V[i][j] = (p < 0 ? RK_C(0.0) : V[p][j]) + S[j] * rate;
             A[i][j] = p < 0 ? RK_C(0.0) : A[p][j];
@@ -302,7 +367,7 @@ static void RK_FN(drift)(const RK_T *q, const RK_T *qd, int f, int ref, RK_T *ou
         for (int j = 0; j < 6; j++) A[i][j] += c[j] * rate;
     }
     RK_T Rf[9], p[3], pd[3], pdd[3], t[3];
-    RK_FN(frame)(f, R, o, Rf, p);
+    RK_FN(frame)(md, f, R, o, Rf, p);
     const RK_T *w = V[b] + 3, *wd = A[b] + 3;
     RK_FN(cross)(w, p, t);
     for (int j = 0; j < 3; j++) pd[j] = V[b][j] + t[j];
@@ -324,20 +389,20 @@ static void RK_FN(drift)(const RK_T *q, const RK_T *qd, int f, int ref, RK_T *ou
     }
 }
 
-/* tau (RK_NV) of the wrench w = [f; m] at frame f's origin, world axes: sum k S^T [f; m + p x f]
+/* tau (md->nv) of the wrench w = [f; m] at frame f's origin, world axes: sum k S^T [f; m + p x f]
  * (a free flyer's six: the force and the moment about the base's origin, base axes) */
-static void RK_FN(wrench)(const RK_T *q, int f, const RK_T *w, RK_T *out)
+static void RK_FN(wrench)(const rk_model *md, RK_FN(work) *work, const RK_T *q, int f,
+                          const RK_T *w, RK_T *out)
 {
-    RK_T R[RK_NB][9], o[RK_NB][3], p[3], m[3];
-    for (int j = 0; j < RK_NV; j++) out[j] = RK_C(0.0);
-    int b = rk_fbody[f];
+    RK_T (*R)[9] = work->R, (*o)[3] = work->o, p[3], m[3];
+    for (int j = 0; j < md->nv; j++) out[j] = RK_C(0.0);
+    int b = md->fbody[f];
     if (b < 0) return;
-    int path[RK_NB];
-    RK_FN(path)(q, b, path, R, o);
-    RK_FN(frame_origin)(f, R, o, p);
+    RK_FN(path)(md, q, b, work->path, R, o);
+    RK_FN(frame_origin)(md, f, R, o, p);
     RK_FN(cross)(p, w, m);
     for (int j = 0; j < 3; j++) m[j] += w[3 + j];
-    for (int i = b; i >= 0; i = rk_parent[i]) {
+    for (int i = b; i >= 0; i = md->parent[i]) {
         RK_T S[6];
         if (RK_FREE(i)) {  /* R^T f and R^T (m_O - o x f) */
             RK_T t[3], n[3];
@@ -347,29 +412,29 @@ static void RK_FN(wrench)(const RK_T *q, int f, const RK_T *w, RK_T *out)
             RK_FN(apply_t)(R[0], n, out + 3);
             continue;
         }
-        RK_FN(subspace)(i, R, o, S);
-        out[RK_BV + rk_coord[i]] += rk_mult[i] * (S[0] * w[0] + S[1] * w[1] + S[2] * w[2]
+        RK_FN(subspace)(md, i, R, o, S);
+        out[md->bv + md->coord[i]] += md->mult[i] * (S[0] * w[0] + S[1] * w[1] + S[2] * w[2]
                                                   + S[3] * m[0] + S[4] * m[1] + S[5] * m[2]);
     }
 }
 
-/* A_g (6 x RK_NV, row-major): composite bodies about the world's origin (mass M, first
+/* A_g (6 x md->nv, row-major): composite bodies about the world's origin (mass M, first
  * moment h, rotational inertia J_O as its six numbers xx yy zz xy xz yz), each column's
  * momentum [l; k_O] then moved to the centre of mass G: k_G = k_O - G x l */
-static void RK_FN(centroidal)(const RK_T *q, RK_T *out)
+static void RK_FN(centroidal)(const rk_model *md, RK_FN(work) *work, const RK_T *q, RK_T *out)
 {
-    RK_T R[RK_NB][9], o[RK_NB][3], h[RK_NB][3], Ic[RK_NB][6];
-    double M[RK_NB];
-    RK_FN(bodies)(q, R, o);
-#if !RK_CSET  /* else every column is one joint's, set once below */
-    for (int j = 0; j < 6 * RK_NV; j++) out[j] = RK_C(0.0);
-#endif
-    for (int i = 0; i < RK_NB; i++) {
+    RK_T (*R)[9] = work->R, (*o)[3] = work->o, (*h)[3] = (RK_T (*)[3])work->x,
+         (*Ic)[6] = (RK_T (*)[6])(work->x + 3 * md->nb);
+    double *M = work->mass;
+    RK_FN(bodies)(md, q, R, o);
+    if (!md->cset)  /* else every column is one joint's, set once below */
+        for (int j = 0; j < 6 * md->nv; j++) out[j] = RK_C(0.0);
+    for (int i = 0; i < md->nb; i++) {
         RK_T hr[3], RJ[9], T[6];
         const RK_T *p = o[i];
-        const double m = rk_m[i];
-        RK_FN(apply_v)(R[i], rk_h[i], hr);
-        RK_FN(matmul_v)(R[i], rk_J[i], RJ);
+        const double m = md->m[i];
+        RK_FN(apply_v)(R[i], (md->h + 3 * i), hr);
+        RK_FN(matmul_v)(R[i], (md->J + 9 * i), RJ);
         static const int ra[6] = {0, 1, 2, 0, 0, 1}, rc[6] = {0, 1, 2, 1, 2, 2};
         for (int e = 0; e < 6; e++) {  /* R J R^T, symmetric */
             const int a = ra[e], c = rc[e];
@@ -385,8 +450,8 @@ static void RK_FN(centroidal)(const RK_T *q, RK_T *out)
         }
         M[i] = m;
     }
-    for (int i = RK_NB - 1; i >= 0; i--) {
-        int p = rk_parent[i];
+    for (int i = md->nb - 1; i >= 0; i--) {
+        int p = md->parent[i];
         if (p < 0) continue;
         M[p] += M[i];
         for (int j = 0; j < 3; j++) h[p][j] += h[i][j];
@@ -394,17 +459,17 @@ static void RK_FN(centroidal)(const RK_T *q, RK_T *out)
     }
     double total = 0.0;
     RK_T G[3] = {RK_C(0.0), RK_C(0.0), RK_C(0.0)};
-    for (int i = 0; i < RK_NB; i++) {
-        if (rk_parent[i] >= 0) continue;
+    for (int i = 0; i < md->nb; i++) {
+        if (md->parent[i] >= 0) continue;
         total += M[i];
         for (int j = 0; j < 3; j++) G[j] += h[i][j];
     }
     for (int j = 0; j < 3; j++) G[j] /= total;
-    for (int i = 0; i < RK_NB; i++) {
+    for (int i = 0; i < md->nb; i++) {
         RK_T F[6][6];
         int first;
         double mult;
-        const int columns = RK_FN(columns)(i, R, o, F, &first, &mult);
+        const int columns = RK_FN(columns)(md, i, R, o, F, &first, &mult);
         const RK_T *J = Ic[i];
         for (int col = 0; col < columns; col++) {
             const RK_T *S = F[col];
@@ -418,8 +483,8 @@ static void RK_FN(centroidal)(const RK_T *q, RK_T *out)
             RK_FN(cross)(G, l, g);
             const int c = first + col;
             for (int j = 0; j < 3; j++) {
-                RK_CPUT(out[j * RK_NV + c], mult * l[j]);
-                RK_CPUT(out[(3 + j) * RK_NV + c], mult * (k[j] - g[j]));
+                RK_CPUT(out[j * md->nv + c], mult * l[j]);
+                RK_CPUT(out[(3 + j) * md->nv + c], mult * (k[j] - g[j]));
             }
         }
     }

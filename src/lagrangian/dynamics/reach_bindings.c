@@ -375,7 +375,7 @@ static int rk_model_from(PyObject *ints, PyObject *floats, rk_model *md, void **
     }
     const long long nv = 6 * fb + n;
     if (head[5] < 0 || head[5] > nv * nv) { fault = "INTS: not a tree's header"; goto done; }
-    if (ni != 6 + 6LL * nb + nf + head[5] || nd != 2 + 58LL * nb + 12LL * nf) {
+    if (ni != 6 + 7LL * nb + nf + head[5] || nd != 2 + 58LL * nb + 12LL * nf) {
         fault = "INTS, FLOATS: not of the header's sizes";
         goto done;
     }
@@ -388,8 +388,9 @@ static int rk_model_from(PyObject *ints, PyObject *floats, rk_model *md, void **
     *md = (rk_model){.nb = nb, .n = n, .fb = fb, .nf = nf, .cset = a[4], .nczero = a[5],
                      .bq = 7 * fb, .bv = 6 * fb, .nq = 7 * fb + n, .nv = (int)nv};
     a += 6;
-    const int **ia[] = {&md->parent, &md->coord, &md->turns, &md->slides, &md->axis, &md->R0id};
-    for (int k = 0; k < 6; k++, a += nb) *ia[k] = a;
+    const int **ia[] = {&md->parent, &md->coord, &md->turns, &md->slides, &md->axis, &md->R0id,
+                        &md->R0axis};
+    for (int k = 0; k < 7; k++, a += nb) *ia[k] = a;
     md->fbody = a;
     md->czero = a + nf;
     md->qlow = d[0], md->qhigh = d[1];
@@ -407,6 +408,7 @@ static int rk_model_from(PyObject *ints, PyObject *floats, rk_model *md, void **
     for (int i = 0; i < nb; i++) {
         const int free = fb && i == 0, p = md->parent[i];
         if (p < -1 || p >= i || (free && p != -1) || md->axis[i] < -1 || md->axis[i] > 2
+                || md->R0axis[i] < -1 || md->R0axis[i] > 2
                 || (!free && (md->coord[i] < 0 || md->coord[i] >= n))
                 || (free && (md->turns[i] || md->slides[i]))) {
             fault = "INTS: a body not of a tree";

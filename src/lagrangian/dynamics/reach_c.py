@@ -11,7 +11,8 @@ coordinates, nf frames, fb 1 for a floating base (body 0 on a free flyer), nv = 
 
 - INTS (C int): nb, n, fb, nf, cset, nczero; then nb each: parent (-1: the ground),
   coordinate, turns, slides (0 or 1: a free flyer neither), axis (k where the axis is +-e_k
-  exactly, else -1), R0-is-identity (0 or 1); then nf frame bodies (-1: the ground); then the
+  exactly, else -1), R0-is-identity (0 or 1), R0's axis (j where R0 is exactly a turn about
+  e_j, else -1); then nf frame bodies (-1: the ground); then the
   nczero entries of C (row-major, nv x nv) that no body's pass sets, where cset is 1 (no mimic
   joint shares a coordinate: each entry set once; else all zeroed first and added to).
 - FLOATS (float64): the quaternion's bounds on |q|^2, (1 -+ QUATERNION_TOLERANCE)^2; then nb
@@ -73,17 +74,31 @@ def _turn_tables(joints) -> list[np.ndarray]:
     return [P, C, S]
 
 
-def _axes(joints) -> tuple[list[int], list[float], list[bool]]:
-    """Per joint: k where its axis is +-e_k exactly (else -1), that sign, and whether its R0
-    is exactly 1: there R0 Rot(e_k, th) is a turn of two columns (reach_kernel.c's body)."""
-    axis, sign, plain = [], [], []
+def _turned_about(R: np.ndarray) -> int:
+    """j where R is exactly a turn about e_j, [[1, 0, 0], [0, c, -s], [0, s, c]] cyclically
+    (a URDF rpy of one angle), else -1."""
+    for j in range(3):
+        a, b = (j + 1) % 3, (j + 2) % 3
+        if (R[j, j] == 1.0 and not R[j, a] and not R[j, b] and not R[a, j] and not R[b, j]
+                and R[a, a] == R[b, b] and R[a, b] == -R[b, a]):
+            return j
+    return -1
+
+
+def _axes(joints) -> tuple[list[int], list[float], list[bool], list[int]]:
+    """Per joint: k where its axis is +-e_k exactly (else -1), that sign, whether its R0 is
+    exactly 1, and j where it is a turn about e_j: there R0 Rot(e_k, th) is two turns of two
+    columns each (reach_kernel.c's body)."""
+    axis, sign, plain, about = [], [], [], []
     for j in joints:
         u = [float(x) for x in j.axis]
         k = next((k for k in range(3) if abs(u[k]) == 1.0 and u[k - 1] == u[k - 2] == 0.0), -1)
         axis.append(k)
         sign.append(u[k] if k >= 0 else 1.0)
-        plain.append(np.array_equal(np.array(j.rotation, dtype=float), np.eye(3)))
-    return axis, sign, plain
+        R0 = np.array(j.rotation, dtype=float)
+        plain.append(np.array_equal(R0, np.eye(3)))
+        about.append(_turned_about(R0))
+    return axis, sign, plain, about
 
 
 def _coriolis_zeros(tree: KinematicTree) -> tuple[bool, list[int]]:
@@ -113,7 +128,7 @@ def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
     joints, frames = tree.joints, tree.frames
     free = tree.floating_base
     models = [joint_model(j.kind) for j in joints]
-    axis, sign, plain = _axes(joints)
+    axis, sign, plain, about = _axes(joints)
     cset, zeros = _coriolis_zeros(tree)
     # a free flyer has no coordinate of the tree's (its column 0 unused)
     coordinate = [0 if free and i == 0 else j.coordinate for i, j in enumerate(joints)]
@@ -121,7 +136,7 @@ def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
             *(j.parent for j in joints), *coordinate,
             *(int(getattr(m, "turns", False)) for m in models),
             *(int(getattr(m, "slides", False)) for m in models),
-            *axis, *map(int, plain), *(f.body for f in frames), *zeros]
+            *axis, *map(int, plain), *about, *(f.body for f in frames), *zeros]
     # |quaternion|^2 within (1 -+ QUATERNION_TOLERANCE)^2, else numpy names the fault
     floats = [np.array([(1 - QUATERNION_TOLERANCE) ** 2, (1 + QUATERNION_TOLERANCE) ** 2]),
               *(np.array([getattr(j, name) for j in joints], dtype=float)

@@ -13,8 +13,9 @@ typedef struct {
     int nb, n, fb, nf, cset, nczero;  /* cset 0 where a mimic joint shares a coordinate */
     int bq, bv, nq, nv;               /* the base's 7 and 6 numbers of q and v (else 0) */
     /* per body: parent (-1: the ground, always before it), coordinate, whether its joint turns
-       and slides, k where its axis is +-e_k exactly (else -1), whether its R0 is exactly 1 */
-    const int *parent, *coord, *turns, *slides, *axis, *R0id;
+       and slides, k where its axis is +-e_k exactly (else -1), whether its R0 is exactly 1, j
+       where R0 is exactly a turn about e_j (else -1) */
+    const int *parent, *coord, *turns, *slides, *axis, *R0id, *R0axis;
     const int *fbody;                 /* per frame: its body (-1: the ground) */
     const int *czero;                 /* the entries of C that no body's pass sets (cset) */
     /* per body: multiplier, offset, the axis' sign (axis >= 0), mass (kg); 3 a body: the
@@ -159,6 +160,20 @@ static inline void RK_FN(matmul_v)(const RK_T *A, const double *B, RK_T *out)
             out[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
 }
 
+/* out = M Rot(e_k, th) (c, s its cosine and sine): two columns of M turned (a, b, k cyclic:
+ * Rot e_a = c e_a + s e_b, Rot e_b = -s e_a + c e_b), 12 products, not 45 */
+static inline __attribute__((always_inline)) void RK_FN(turn)(const RK_T *M, RK_T c, RK_T s,
+                                                              RK_T *out, const int k)
+{
+    const int a = (k + 1) % 3, b = (k + 2) % 3;
+    for (int r = 0; r < 3; r++) {
+        const RK_T ma = M[3 * r + a], mb = M[3 * r + b], mk = M[3 * r + k];
+        out[3 * r + a] = c * ma + s * mb;
+        out[3 * r + b] = c * mb - s * ma;
+        out[3 * r + k] = mk;
+    }
+}
+
 /* body i's rotation (body -> world) and origin (m, world), its parent's already known */
 static inline __attribute__((always_inline)) void RK_FN(body)(const rk_model *md, const RK_T *q,
                                                               int i, RK_T (*R)[9], RK_T (*o)[3])
@@ -184,22 +199,33 @@ static inline __attribute__((always_inline)) void RK_FN(body)(const rk_model *md
     } else {
         const RK_T th = md->mult[i] * q[md->bq + md->coord[i]] + md->off[i];
         if (md->turns[i] && !md->slides[i] && md->axis[i] >= 0) {
-            /* about +-e_k: (R_p R0) Rot(e_k, th) turns two columns of R_p R0 (a, b, k cyclic:
-               Rot e_a = c e_a + s e_b, Rot e_b = -s e_a + c e_b), 12 products, not 45 */
+            /* about +-e_k: (R_p R0) Rot(e_k, th) turns two columns of R_p R0 (RK_FN(turn)) */
             RK_T c, s, M[9];
             RK_SINCOS(th, &s, &c);
             s = md->axsign[i] * s;
-            const int k = md->axis[i], a = (k + 1) % 3, b = (k + 2) % 3, p = md->parent[i];
+            const int p = md->parent[i];
+            const RK_T *from = M;
             if (p < 0)
                 for (int j = 0; j < 9; j++) M[j] = RK_C(md->R0[9 * i + j]);
             else if (md->R0id[i])
-                for (int j = 0; j < 9; j++) M[j] = R[p][j];
-            else
+                from = R[p];
+            else if (md->R0axis[i] >= 0) {  /* R0 a turn about e_j (URDF rpy of one angle): R_p R0
+                                              turns two columns of R_p, 12 products, not 27 */
+                const int j = md->R0axis[i], a = (j + 1) % 3, b = (j + 2) % 3;
+                const RK_T c0 = RK_C(md->R0[9 * i + 4 * a]), s0 = RK_C(md->R0[9 * i + 3 * b + a]);
+                switch (j) {
+                case 0: RK_FN(turn)(R[p], c0, s0, M, 0); break;
+                case 1: RK_FN(turn)(R[p], c0, s0, M, 1); break;
+                default: RK_FN(turn)(R[p], c0, s0, M, 2); break;
+                }
+            } else
                 RK_FN(matmul_v)(R[p], (md->R0 + 9 * i), M);
-            for (int r = 0; r < 3; r++) {
-                R[i][3 * r + a] = c * M[3 * r + a] + s * M[3 * r + b];
-                R[i][3 * r + b] = c * M[3 * r + b] - s * M[3 * r + a];
-                R[i][3 * r + k] = M[3 * r + k];
+            /* k a constant in each case: the columns' indices known, the turn in registers
+               (with k read at run time, a third of the centre of mass's batch) */
+            switch (md->axis[i]) {
+            case 0: RK_FN(turn)(from, c, s, R[i], 0); break;
+            case 1: RK_FN(turn)(from, c, s, R[i], 1); break;
+            default: RK_FN(turn)(from, c, s, R[i], 2); break;
             }
             if (p < 0) {
                 for (int j = 0; j < 3; j++) o[i][j] = pl[j];

@@ -23,11 +23,12 @@ from .regressor import (
 
 
 def _refuse_floating(tree, what: str) -> None:
-    # the complex-step Newton-Euler and the per-body regressor walk joints of one coordinate
-    # each; a free flyer's seven numbers and six rates are not theirs
+    # the complex-step Newton-Euler walks joints of one coordinate each; a free flyer's seven
+    # numbers and six rates are the compiled kernel's alone (derivatives_c.py, any size)
     if tree is not None and getattr(tree, "floating_base", False):
-        raise InputError(f"the {what} of a floating base are not given yet (fixed-base robots "
-                         "only); load it without floating_base=True", field="q")
+        raise InputError(f"the {what} of a floating base are computed in compiled C only, and "
+                         "this dynamics has none (backend='numpy', or no C compiler); use the "
+                         "C backend, or load it without floating_base=True", field="q")
 
 
 class DerivativesKernel(NamedTuple):

@@ -384,10 +384,11 @@ static void DK_FN(backward)(const dk_tree *tree, DK_FN(work) *w, DK_T *tau, int 
  * (c < 3) is [R e_c; 0], its psi 0 and its dv = [w x R e_c; 0]: their angular halves are not
  * summed, nor d tau/dq's entries by it (0; the caller's zeros stay). Body k's entries are
  * summed into its coordinate's like every pair's: a mimic coordinate drives two bodies. */
-static void DK_FN(base_pairs)(const dk_tree *tree, const DK_FN(work) *w, int k, DK_T *M,
-                              DK_T *dq, DK_T *dv, int fresh)
+static inline __attribute__((always_inline)) void DK_FN(base_pairs)(
+    const dk_tree *tree, const DK_FN(work) *w, int k, DK_T *M, DK_T *dq, DK_T *dv, int fresh)
 {
     const int n = tree->nv;
+    _Pragma("GCC unroll 6")
     for (int c = 0; c < 6; c++) {
         const DK_T *S = w->ffS[c];
         const int moves = c >= 3;  /* a turn of the base, not a translation */
@@ -432,9 +433,11 @@ static void DK_FN(base_pairs)(const dk_tree *tree, const DK_FN(work) *w, int k, 
  * ``fresh`` (tree->once: each coordinate one body's, so each entry comes from one pair), set
  * once and the entries no pair writes left as they are, for a caller that reads none of them
  * (the lanes' products over the pattern, the factor along the tree): a state's zeroing and its
- * additions' loads spared. */
-static void DK_FN(pairs)(const dk_tree *tree, const DK_FN(work) *w, DK_T *M, DK_T *dq, DK_T *dv,
-                         int fresh)
+ * additions' loads spared. Inlined where called: M or dq, and fresh, then constants (no
+ * test of them per pair). */
+static inline __attribute__((always_inline)) void DK_FN(pairs)(const dk_tree *tree,
+                                                              const DK_FN(work) *w, DK_T *M,
+                                                              DK_T *dq, DK_T *dv, int fresh)
 {
     const int n = tree->nv;
     if (M && !fresh)
@@ -500,7 +503,8 @@ static int DK_FN(forward_derivatives)(const dk_tree *tree, DK_T *space, const DK
     memcpy(w.F0, w.F, (size_t)nb * sizeof w.F[0]);
     memcpy(w.Y0, w.Y, (size_t)nb * sizeof w.Y[0]);
     DK_FN(backward)(tree, &w, taub, 0, 0);
-    DK_FN(pairs)(tree, &w, M, NULL, NULL, tree->ltdl);
+    if (tree->ltdl) DK_FN(pairs)(tree, &w, M, NULL, NULL, 1);
+    else DK_FN(pairs)(tree, &w, M, NULL, NULL, 0);
     for (int j = 0; j < nv; j++) b[j] = tau[j];
     for (int j = 0; j < tree->nj; j++) b[vo + j] += P[3 + j];
     for (int i = ff; i < nb; i++) b[vo + tree->coord[i]] -= tree->mult[i] * taub[i];
@@ -535,7 +539,8 @@ static int DK_FN(forward_derivatives)(const dk_tree *tree, DK_T *space, const DK
     /* the second pass: the subtrees' inertias and r1 as they are (the same q) */
     DK_FN(backward)(tree, &w, NULL, 1, 1);
     const int sparse = tree->sparse && DK_ON_LANES;
-    DK_FN(pairs)(tree, &w, NULL, dq, dv, sparse && tree->once);
+    if (sparse && tree->once) DK_FN(pairs)(tree, &w, NULL, dq, dv, 1);
+    else DK_FN(pairs)(tree, &w, NULL, dq, dv, 0);
     if (tree->ltdl)
         DK_FN(ltdl_inverse)(tree, M, diagonal, w.X, Minv);
     else

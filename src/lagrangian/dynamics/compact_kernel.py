@@ -15,7 +15,9 @@ The description ``D`` (float64, contiguous), built by ``describe``:
       3 multiplier k  4 offset (theta = k q[c] + offset)  5:14 R0 (joint -> parent axes,
       row-major)  14:17 t0 (m)  17:20 unit axis u (joint axes)  20 mass (kg)
       21:24 first moment h = m c about the body origin (kg m)  24:33 J_O (kg m^2, body axes)
-      33:40 spare. A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone.
+      33:60 a revolute joint's turn tables P = R0 u u^T, C = R0 (1 - u u^T), S = R0 [u]x
+      (row-major each: R0 Rot(u, theta) = P + cos theta C + sin theta S)  60:64 spare.
+      A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone.
 
 A new joint kind is a new code in JOINT_CODES and its cases in tree_kernel.c (tk_place for the
 placement, tk_subspace for S); the recursions themselves ask only for those. The module
@@ -37,7 +39,7 @@ from ..model.model import Model
 from ..model.tree import KinematicTree, TreeJoint
 from .recursive import RecursiveDynamics
 
-HEADER, STRIDE = 8, 40
+HEADER, STRIDE = 8, 64
 JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FREE_FLYER: 2}
 
 # the recursions (forward dynamics in a file of its own), the thread count shared with the other
@@ -48,7 +50,11 @@ _SOURCES = tuple(Path(__file__).with_name(name)
 
 
 def _source() -> str:
-    return "\n".join(path.read_text(encoding="utf-8") for path in _SOURCES)
+    from .tree_c import _SINCOS
+
+    head, rest = _SOURCES[0].read_text(encoding="utf-8").split("/* TK_SINCOS */")
+    return "\n".join([head, _SINCOS, rest,
+                      *(path.read_text(encoding="utf-8") for path in _SOURCES[1:])])
 
 # Trees of more moving bodies than this get the compact kernel; smaller ones the unrolled
 # module of tree_c.py: about 2x faster per call and, up to tree_emitter.VECTOR_LIMIT, several
@@ -77,6 +83,11 @@ def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray
         r[5:14] = np.ravel(j.rotation)
         r[14:17], r[17:20] = j.translation, j.axis
         r[20], r[21:24], r[24:33] = j.mass, j.first_moment, np.ravel(j.inertia)
+        R0, u = np.array(j.rotation, dtype=float), np.array(j.axis, dtype=float)
+        uu = np.outer(u, u)
+        skew = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
+        r[33:42], r[42:51], r[51:60] = np.ravel(R0 @ uu), np.ravel(R0 @ (np.eye(3) - uu)), \
+            np.ravel(R0 @ skew)
     D.flags.writeable = False
     return D
 
@@ -108,7 +119,8 @@ def kernel_key() -> str:
     """The module's key: its C source (and this file), never a tree."""
     here = Path(__file__)
     return "compact-tree-kernel\n" + hashlib.sha256(
-        b"".join(path.read_bytes() for path in (*_SOURCES, here))).hexdigest()
+        b"".join(path.read_bytes() for path in (*_SOURCES, here, here.with_name("tree_c.py"))
+                 )).hexdigest()
 
 
 def kernel_module():

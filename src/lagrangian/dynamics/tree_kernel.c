@@ -13,10 +13,11 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+/* TK_SINCOS */
 
 #define TK_HEADER 8     /* nb, n, gravity vector g*dir (3, world axes), mimic flag, floating
                            flag, quaternion tolerance */
-#define TK_STRIDE 40    /* numbers per body record */
+#define TK_STRIDE 64    /* numbers per body record */
 /* a body record's fields */
 #define TK_PARENT 0
 #define TK_KIND 1       /* 0 revolute, 1 prismatic, 2 free flyer (body 0 only) */
@@ -29,6 +30,8 @@
 #define TK_MASS 20
 #define TK_H 21         /* 3: first moment m c about the body origin */
 #define TK_J 24         /* 9: inertia about the body origin */
+#define TK_TURN 33      /* 27: R0 u u^T, R0 (1 - u u^T), R0 [u]x (row-major): a revolute joint's
+                           R = R0 Rot(u, theta) = P + cos(theta) C + sin(theta) S */
 /* a body's scratch */
 #define TW_STRIDE 96
 #define TW_R 0
@@ -132,17 +135,12 @@ static void tk_place(const tk_tree *t, const double *q, double *W)
         }
         const double theta = b[TK_MULT] * q[t->bq + (int)b[TK_COORD]] + b[TK_OFFSET];
         if (b[TK_KIND] == 0) {
-            /* Rot(u, theta) = c 1 + s [u]x + (1 - c) u u^T */
-            const double s = sin(theta), c = cos(theta), k = 1.0 - c;
-            const double E[9] = {c + k * u[0] * u[0], k * u[0] * u[1] - s * u[2],
-                                 k * u[0] * u[2] + s * u[1], k * u[1] * u[0] + s * u[2],
-                                 c + k * u[1] * u[1], k * u[1] * u[2] - s * u[0],
-                                 k * u[2] * u[0] - s * u[1], k * u[2] * u[1] + s * u[0],
-                                 c + k * u[2] * u[2]};
-            for (int r = 0; r < 3; r++)
-                for (int col = 0; col < 3; col++)
-                    R[3 * r + col] = R0[3 * r] * E[col] + R0[3 * r + 1] * E[3 + col]
-                                     + R0[3 * r + 2] * E[6 + col];
+            /* sine and cosine written out here: a libm call cost as much as the rest of an
+               arm's mass matrix */
+            double sn, cs;
+            lg_sincos_inline(theta, &sn, &cs);
+            const double *P = b + TK_TURN, *C = P + 9, *S = P + 18;
+            for (int r = 0; r < 9; r++) R[r] = P[r] + cs * C[r] + sn * S[r];
             memcpy(p, b + TK_T0, 3 * sizeof(double));
         } else {
             double Ru[3];

@@ -120,7 +120,22 @@ static int rk_state(const rk_job *job, npy_intp k, rk_work *work)
 /* lanes' inputs: rows k .. k + LG_LANES - 1 of x (``width`` numbers a row) as vectors */
 static inline void rk_gather(const double *x, npy_intp k, int width, lg_v4 *out)
 {
-    lg_lanes(x + k * width, width, out);
+    const double *y = x + k * width;
+    int i = 0;
+#ifdef LG_SHUFFLE
+    for (; i + LG_LANES <= width; i += LG_LANES) {
+        lg_v4 rows[LG_LANES];
+        for (int l = 0; l < LG_LANES; l++) __builtin_memcpy(&rows[l], y + l * width + i, sizeof rows[l]);
+        lg_transpose(rows, out + i);
+    }
+#endif
+    /* the rest a vector at a time, built in a register: lane by lane into memory, each vector's
+       load then waited on its lanes' stores (lg_lanes': a fifth of the Panda's CoM batch) */
+    for (; i < width; i++) {
+        lg_v4 lanes;
+        for (int l = 0; l < LG_LANES; l++) lanes[l] = y[l * width + i];
+        out[i] = lanes;
+    }
 }
 
 /* lanes' outputs into rows k .. k + LG_LANES - 1 of y (``width`` numbers a row): y = x

@@ -130,7 +130,8 @@ static inline void rk_gather(const double *x, npy_intp k, int width, lg_v4 *out)
     }
 #endif
     /* the rest a vector at a time, built in a register: lane by lane into memory, each vector's
-       load then waited on its lanes' stores (lg_lanes': a fifth of the Panda's CoM batch) */
+       load then waits on its lanes' stores (lg_lanes': 5-7% of the Panda's CoM and J_dot v
+       batches) */
     for (; i < width; i++) {
         lg_v4 lanes;
         for (int l = 0; l < LG_LANES; l++) lanes[l] = y[l * width + i];

@@ -7,7 +7,8 @@
  * world axes, [v; w]. */
 
 #define RK_MAX_WRENCHES 16  /* more: the bindings refuse, the caller adds J^T w one by one */
-#define RK_MAX_BODIES (1 << 20)  /* a bound only so that no size below overflows an int */
+#define RK_MAX_BODIES 40000  /* a bound only so that no size below overflows an int (C's
+                                 nv x nv numbers a state) */
 
 typedef struct {
     int nb, n, fb, nf, cset, nczero;  /* cset 0 where a mimic joint shares a coordinate */

@@ -1,11 +1,17 @@
 """Derivatives of the dynamics and the torque regressor against Pinocchio, on a URDF arm:
 agreement, and speed per call and in batches of 10^4 states.
 
-    python benchmarks/bench_control.py [panda|ur5|xarm7|solo12] [--states 10000]
+    python benchmarks/bench_control.py [panda|ur5|xarm7|solo12|chain200|tree100] [--states N]
+    python benchmarks/bench_control.py --build
 
 Needs the bench extra (pin, example-robot-data). The Panda's finger joints are locked at 0.
 solo12 is a floating base (a free flyer at the root, nq 19, nv 18; Pinocchio's
 JointModelFreeFlyer): its derivatives only (the regressor of a floating base is not given yet).
+chain200 is a 200-joint serial chain (fixed base), tree100 a free flyer with four limbs of two
+fingers each (96 joints, nv 102), both written here as URDF: their derivatives only, 64 states
+by default (a state's three outputs are 0.9 MB on the chain), the per-call rounds over as many.
+One compiled module serves every robot: --build times its build in an empty cache (a fresh
+process), paid once per installation; each robot then pays for its tables only (tables_s).
 
 - Per call: one state through ``dynamics().inverse_dynamics_derivatives`` (and
   ``forward_dynamics_derivatives``, ``regressor``) against ``computeRNEADerivatives``
@@ -45,6 +51,68 @@ from bench_urdf import ROBOTS, robots_folder
 import lagrangian
 
 SOLO, SOLO_PATH = "solo12", "solo_description/robots/solo12.urdf"
+CHAIN, TREE = "chain200", "tree100"
+_INERTIA = ('<inertia ixx="0.002" ixy="0.0001" ixz="0" iyy="0.0021" iyz="0.00005" '
+            'izz="0.0005"/>')
+
+
+def _link(name: str, mass: float) -> str:
+    return (f'<link name="{name}"><inertial><origin xyz="0.01 -0.005 0.03"/>'
+            f'<mass value="{mass}"/>{_INERTIA}</inertial></link>')
+
+
+def _joint(name: str, parent: str, child: str, index: int, origin: str) -> str:
+    """Revolute about x, y, z in turn; in a tree (rpy in ``origin``) every fifth a slide."""
+    slides = index % 5 == 2 and "rpy" in origin
+    axis = "0.6 0 0.8" if slides else ("1 0 0", "0 1 0", "0 0 1")[index % 3]
+    return (f'<joint name="{name}" type="{"prismatic" if slides else "revolute"}">'
+            f'<parent link="{parent}"/><child link="{child}"/><origin {origin}/>'
+            f'<axis xyz="{axis}"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>')
+
+
+def chain_urdf(n: int = 200) -> str:
+    """n revolute joints 0.1 m apart, 0.5 kg links."""
+    parts = ['<?xml version="1.0"?><robot name="chain"><link name="l0"/>']
+    for i in range(1, n + 1):
+        parts += [_link(f"l{i}", 0.5), _joint(f"j{i}", f"l{i - 1}", f"l{i}", i,
+                                              f'xyz="0 0 {0 if i == 1 else -0.1}"')]
+    return "".join(parts) + "</robot>"
+
+
+def tree_urdf(limbs: int = 4, arm: int = 12, finger: int = 6) -> str:
+    """A trunk with ``limbs`` limbs, each ``arm`` joints then two fingers of ``finger``, depth
+    first (Pinocchio's order)."""
+    parts, count = ['<?xml version="1.0"?><robot name="tree">', _link("trunk", 5.0)], 0
+    origin = 'xyz="0.02 0.01 0.06" rpy="0.1 0 -0.2"'
+    for limb in range(limbs):
+        parent = "trunk"
+        for k in range(arm):
+            parts += [_link(f"l{limb}_{k}", 0.3),
+                      _joint(f"j{limb}_{k}", parent, f"l{limb}_{k}", count, origin)]
+            parent, count = f"l{limb}_{k}", count + 1
+        for side in range(2):
+            tip = parent
+            for k in range(finger):
+                child = f"l{limb}_{side}_{k}"
+                parts += [_link(child, 0.1),
+                          _joint(f"j{limb}_{side}_{k}", tip, child, count, origin)]
+                tip, count = child, count + 1
+    return "".join(parts) + "</robot>"
+
+
+def build_time() -> float:
+    """Seconds to build the one derivatives module in an empty cache, in a fresh process."""
+    import subprocess
+    import sys
+    import tempfile
+
+    code = ("import time; from lagrangian.dynamics.derivatives_c import engine; "
+            "t = time.perf_counter(); assert engine() is not None; "
+            "print(time.perf_counter() - t)")
+    with tempfile.TemporaryDirectory() as cache:
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                             check=True, env={**os.environ, "LAGRANGIAN_CACHE": cache})
+    return float(out.stdout.split()[-1])
 
 
 def interleaved(first, second, repeat: int, clock=time.perf_counter) -> tuple[float, float]:
@@ -95,22 +163,42 @@ def main() -> None:
     import pinocchio as pin
 
     parser = argparse.ArgumentParser()
-    parser.add_argument("robot", nargs="?", default="panda", choices=sorted(ROBOTS) + [SOLO])
-    parser.add_argument("--states", type=int, default=10_000)
+    parser.add_argument("robot", nargs="?", default="panda",
+                        choices=sorted(ROBOTS) + [SOLO, CHAIN, TREE])
+    parser.add_argument("--states", type=int, default=None)
+    parser.add_argument("--build", action="store_true",
+                        help="time the derivatives module's build in an empty cache, alone")
     args = parser.parse_args()
-    floating = args.robot == SOLO
-    relative, lock = (SOLO_PATH, {}) if floating else ROBOTS[args.robot]
-    path = robots_folder() / relative
+    if args.build:
+        print(json.dumps({"derivatives_module_build_s": build_time()}))
+        return
+    large = args.robot in (CHAIN, TREE)
+    args.states = args.states or (64 if large else 10_000)
+    floating = args.robot in (SOLO, TREE)
+    lock = {}
+    if large:
+        import tempfile
+
+        xml = chain_urdf() if args.robot == CHAIN else tree_urdf()
+        path = os.path.join(tempfile.mkdtemp(), f"{args.robot}.urdf")
+        with open(path, "w") as f:
+            f.write(xml)
+        model = (pin.buildModelFromXML(xml, pin.JointModelFreeFlyer()) if floating
+                 else pin.buildModelFromXML(xml))
+    else:
+        relative, lock = (SOLO_PATH, {}) if floating else ROBOTS[args.robot]
+        path = robots_folder() / relative
+        model = (pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer()) if floating
+                 else pin.buildModelFromUrdf(str(path)))
     ours = lagrangian.load(path, lock=lock, floating_base=floating).dynamics()
-    model = (pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer()) if floating
-             else pin.buildModelFromUrdf(str(path)))
     if lock:
         model = pin.buildReducedModel(model, [model.getJointId(j) for j in lock],
                                       pin.neutral(model))
     data = model.createData()
     rng = np.random.default_rng(0)
-    q = rng.uniform(-2, 2, (args.states, model.nq))
-    v, a = rng.uniform(-2, 2, (2, args.states, model.nv))
+    spread = 0.5 if large else 2.0  # a long chain's M is ill-conditioned far from straight
+    q = rng.uniform(-spread, spread, (args.states, model.nq))
+    v, a = rng.uniform(-spread, spread, (2, args.states, model.nv))
     if floating:  # a unit quaternion, the joints in Pinocchio's order (ours: the URDF's)
         q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
         assert ours.coordinates[7:] == tuple(model.names[i] for i in range(2, model.njoints))
@@ -122,16 +210,23 @@ def main() -> None:
         "regressor": (lambda Q, V, A: ours.regressor(Q, V, A),
                       lambda Q, V, A: pin.computeJointTorqueRegressor(model, data, Q, V, A)),
     }
-    if floating:
+    if floating or large:
         del pairs["regressor"]
-    report = {"robot": args.robot, "states": args.states, "cpus": os.cpu_count(),
+    from lagrangian.dynamics.derivatives_c import derivatives_module
+
+    ours.forward_dynamics_derivatives(q[0], v[0], a[0])  # the module loaded, not timed below
+    began = time.perf_counter()
+    derivatives_module(ours.tree)
+    report = {"robot": args.robot, "nv": model.nv, "states": args.states,
+              "cpus": os.cpu_count(), "tables_s": time.perf_counter() - began,
               "threads": os.environ.get("LAGRANGIAN_THREADS", "processors"),
               "load_average_before": os.getloadavg()}
+    calls = min(200, args.states)
     for name, (mine, theirs) in pairs.items():
         mine(q[:8], v[:8], a[:8])  # compiled (and cached) before the clock starts
-        ours_call, pin_call = (t / 200 for t in interleaved(
-            lambda m=mine: [m(q[k], v[k], a[k]) for k in range(200)],
-            lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(200)], 7))
+        ours_call, pin_call = (t / calls for t in interleaved(
+            lambda m=mine: [m(q[k], v[k], a[k]) for k in range(calls)],
+            lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(calls)], 7))
         ours_batch, pin_batch = interleaved(
             lambda m=mine: m(q, v, a),
             lambda t=theirs: [t(q[k], v[k], a[k]) for k in range(args.states)], 7)
@@ -142,7 +237,8 @@ def main() -> None:
         floor = fresh_output_floor(mine(q, v, a))
         keeping = keeping_loop(theirs, q, v, a, mine(q[:1], v[:1], a[:1]))
         ours_again, pin_keeping = interleaved(lambda m=mine: m(q, v, a), keeping, 5)
-        report[name] = {"ours_per_call_us": ours_call * 1e6, "pinocchio_per_call_us": pin_call * 1e6,
+        report[name] = {"ours_per_call_us": ours_call * 1e6,
+                        "pinocchio_per_call_us": pin_call * 1e6,
                         "ours_batch_s": ours_batch, "pinocchio_loop_s": pin_batch,
                         "ours_batch_cpu_s": ours_cpu, "pinocchio_loop_cpu_s": pin_cpu,
                         "per_call_speedup": pin_call / ours_call,
@@ -155,7 +251,7 @@ def main() -> None:
     report["load_average_after"] = os.getloadavg()
     dq, dv = ours.inverse_dynamics_derivatives(q[:20], v[:20], a[:20])
     fq, fv, ftau = ours.forward_dynamics_derivatives(q[:20], v[:20], a[:20])
-    Y = None if floating else ours.regressor(q[:20], v[:20], a[:20])
+    Y = None if floating or large else ours.regressor(q[:20], v[:20], a[:20])
     worst = {"rnea_derivatives": 0.0, "aba_derivatives": 0.0, "regressor": 0.0}
     relative = 0.0  # the forward derivatives' worst difference over their largest entry
     for k in range(20):

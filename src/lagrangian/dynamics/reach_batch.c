@@ -96,7 +96,9 @@ static int rk_state(const rk_job *job, npy_intp k, rk_work *work)
         rk_coriolis(md, work, q, job->v + k * md->nv, job->y + md->nv * md->nv * k);
         break;
     case RK_PLACEMENT: rk_placement(md, work, q, job->frame, job->y + 16 * k); break;
-    case RK_JACOBIAN: rk_jacobian(md, work, q, job->frame, job->ref, job->y + 6 * md->nv * k); break;
+    case RK_JACOBIAN:
+        rk_jacobian(md, work, q, job->frame, job->ref, job->y + 6 * md->nv * k);
+        break;
     case RK_COM: rk_com(md, work, q, job->y + 3 * k); break;
     case RK_COM_JACOBIAN: rk_com_jacobian(md, work, q, job->y + 3 * md->nv * k); break;
     case RK_INVERSE: {
@@ -125,7 +127,8 @@ static inline void rk_gather(const double *x, npy_intp k, int width, lg_v4 *out)
 #ifdef LG_SHUFFLE
     for (; i + LG_LANES <= width; i += LG_LANES) {
         lg_v4 rows[LG_LANES];
-        for (int l = 0; l < LG_LANES; l++) __builtin_memcpy(&rows[l], y + l * width + i, sizeof rows[l]);
+        for (int l = 0; l < LG_LANES; l++)
+            __builtin_memcpy(&rows[l], y + l * width + i, sizeof rows[l]);
         lg_transpose(rows, out + i);
     }
 #endif

@@ -404,7 +404,10 @@ static int rk_model_from(PyObject *ints, PyObject *floats, rk_model *md, void **
     md->fR = d;
     md->ft = d + 9 * (size_t)nf;
     for (npy_intp k = 0; k < nd; k++)
-        if (!isfinite(((const double *)*tables)[k])) { fault = "FLOATS: not all finite"; goto done; }
+        if (!isfinite(((const double *)*tables)[k])) {
+            fault = "FLOATS: not all finite";
+            goto done;
+        }
     for (int i = 0; i < nb; i++) {
         const int free = fb && i == 0, p = md->parent[i];
         if (p < -1 || p >= i || (free && p != -1) || md->axis[i] < -1 || md->axis[i] > 2
@@ -418,7 +421,10 @@ static int rk_model_from(PyObject *ints, PyObject *floats, rk_model *md, void **
     for (int f = 0; f < nf; f++)
         if (md->fbody[f] < -1 || md->fbody[f] >= nb) { fault = "INTS: a frame's body"; goto done; }
     for (int j = 0; j < md->nczero; j++)
-        if (md->czero[j] < 0 || md->czero[j] >= nv * nv) { fault = "INTS: an entry of C"; goto done; }
+        if (md->czero[j] < 0 || md->czero[j] >= nv * nv) {
+            fault = "INTS: an entry of C";
+            goto done;
+        }
 done:
     Py_XDECREF(Ia);
     Py_XDECREF(Fa);

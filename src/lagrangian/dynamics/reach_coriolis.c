@@ -83,8 +83,8 @@ static void RK_FN(coriolis)(const rk_model *md, RK_FN(work) *space, const RK_T *
         RK_T hr[3], RJ[9];
         const double m = md->m[i];
         const RK_T *x = o[i];
-        RK_FN(apply_v)(R[i], (md->h + 3 * i), hr);
-        RK_FN(matmul_v)(R[i], (md->J + 9 * i), RJ);
+        RK_FN(apply_v)(R[i], md->h + 3 * i, hr);
+        RK_FN(matmul_v)(R[i], md->J + 9 * i, RJ);
         RK_T pp = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
         RK_T ph = x[0] * hr[0] + x[1] * hr[1] + x[2] * hr[2];
         bi->m = m;

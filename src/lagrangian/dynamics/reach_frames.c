@@ -18,7 +18,7 @@ static void RK_FN(placement)(const rk_model *md, RK_FN(work) *work, const RK_T *
     out[15] = RK_C(1.0);
 }
 
-/* frame f's Jacobian (6 x md->nv, row-major, linear rows first): a joint's column [s_v; s_w]
+/* frame f's Jacobian (6 x nv, row-major, linear rows first): a joint's column [s_v; s_w]
  * at the world's origin is the velocity of the point there (ref 0, world); the frame origin's
  * is s_v + s_w x p (ref 2, local_world_aligned), in the frame's axes for ref 1 (local). The
  * columns of the joints on the frame's path are set (RK_CPUT) and only the others zeroed:
@@ -81,7 +81,7 @@ static double RK_FN(moments)(const rk_model *md, const RK_T *q, RK_T (*R)[9], RK
     double total = 0.0;
     for (int i = 0; i < md->nb; i++) {
         RK_T hr[3];
-        RK_FN(apply_v)(R[i], (md->h + 3 * i), hr);
+        RK_FN(apply_v)(R[i], md->h + 3 * i, hr);
         for (int j = 0; j < 3; j++) H[i][j] = md->m[i] * o[i][j] + hr[j];
         mass[i] = md->m[i];
         total += md->m[i];
@@ -109,7 +109,7 @@ static void RK_FN(com)(const rk_model *md, RK_FN(work) *work, const RK_T *q, RK_
     }
 }
 
-/* J_c (3 x md->nv, row-major): a joint's column moves its subtree, mass M_k and first moment
+/* J_c (3 x nv, row-major): a joint's column moves its subtree, mass M_k and first moment
  * H_k, rigidly: M J_c's column is M_k s_v + s_w x H_k (O(n), not a point Jacobian per body) */
 static void RK_FN(com_jacobian)(const rk_model *md, RK_FN(work) *work, const RK_T *q, RK_T *out)
 {

@@ -10,7 +10,7 @@ static inline void RK_FN(inertia_at)(const rk_model *md, int i, const RK_T *R, c
 {
     RK_T t[3], u[3], hxa[3], ahx[3];
     RK_FN(apply_t)(R, X + 3, t);
-    RK_FN(apply_k)((md->J + 9 * i), t, u);
+    RK_FN(apply_k)(md->J + 9 * i, t, u);
     RK_FN(apply)(R, u, t);
     RK_FN(cross)(X + 3, h, ahx);  /* -h x alpha */
     RK_FN(cross)(h, X, hxa);
@@ -20,7 +20,7 @@ static inline void RK_FN(inertia_at)(const rk_model *md, int i, const RK_T *R, c
     }
 }
 
-/* tau (md->nv) = M(q) qdd + C(q, qd) qd + g(q) - sum J_f^T w_f over the nw wrenches w_f =
+/* tau (nv) = M(q) qdd + C(q, qd) qd + g(q) - sum J_f^T w_f over the nw wrenches w_f =
  * [force; moment] at frames[f]'s origin, world axes (a floating base's six first: the force
  * and moment on the base about its origin, base axes) */
 static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *restrict q,
@@ -61,7 +61,7 @@ static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *re
          * arms: motions there [v + w x o; w]), V x* [f; n] = [w x f; w x n + v x f], then
          * carried to the world's origin: [f; n + o x f] */
         RK_T h[3], Vo[6], Ao[6], IV[6], f[6], t1[3], t2[3];
-        RK_FN(apply_v)(R[i], (md->h + 3 * i), h);
+        RK_FN(apply_v)(R[i], md->h + 3 * i, h);
         RK_FN(cross)(V[i] + 3, o[i], t1);
         RK_FN(cross)(A[i] + 3, o[i], t2);
         for (int j = 0; j < 3; j++) {

@@ -193,8 +193,8 @@ static inline __attribute__((always_inline)) void RK_FN(body)(const rk_model *md
             for (int j = 0; j < 9; j++) Rl[j] = Rq[j];
             for (int j = 0; j < 3; j++) pl[j] += q[j];
         } else {
-            RK_FN(matmul_k)((md->R0 + 9 * i), Rq, Rl);
-            RK_FN(apply_k)((md->R0 + 9 * i), q, d);
+            RK_FN(matmul_k)(md->R0 + 9 * i, Rq, Rl);
+            RK_FN(apply_k)(md->R0 + 9 * i, q, d);
             for (int j = 0; j < 3; j++) pl[j] += d[j];
         }
     } else {
@@ -220,7 +220,7 @@ static inline __attribute__((always_inline)) void RK_FN(body)(const rk_model *md
                 default: RK_FN(turn)(R[p], c0, s0, M, 2); break;
                 }
             } else
-                RK_FN(matmul_v)(R[p], (md->R0 + 9 * i), M);
+                RK_FN(matmul_v)(R[p], md->R0 + 9 * i, M);
             /* k a constant in each case: the columns' indices known, the turn in registers
                (with k read at run time, a third of the centre of mass's batch) */
             switch (md->axis[i]) {
@@ -241,13 +241,14 @@ static inline __attribute__((always_inline)) void RK_FN(body)(const rk_model *md
             /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
             RK_T c, s;
             RK_SINCOS(th, &s, &c);  /* inline (tree_c.py): a libm call costs a body's work */
-            for (int j = 0; j < 9; j++) Rl[j] = md->P[9 * i + j] + c * md->C[9 * i + j] + s * md->S[9 * i + j];
+            const double *P = md->P + 9 * i, *C = md->C + 9 * i, *S = md->S + 9 * i;
+            for (int j = 0; j < 9; j++) Rl[j] = P[j] + c * C[j] + s * S[j];
         } else {
             for (int j = 0; j < 9; j++) Rl[j] = RK_C(md->R0[9 * i + j]);
         }
         if (md->slides[i]) {
             double d[3];
-            rk_apply_tab((md->R0 + 9 * i), (md->u + 3 * i), d);
+            rk_apply_tab(md->R0 + 9 * i, md->u + 3 * i, d);
             for (int j = 0; j < 3; j++) pl[j] += th * d[j];
         }
     }
@@ -288,7 +289,7 @@ static inline __attribute__((always_inline)) void RK_FN(subspace)(const rk_model
                                                                   RK_T *S)
 {
     RK_T d[3];
-    RK_FN(apply_v)(R[i], (md->u + 3 * i), d);
+    RK_FN(apply_v)(R[i], md->u + 3 * i, d);
     if (md->turns[i]) {
         RK_FN(cross)(o[i], d, S);
         for (int j = 0; j < 3; j++) S[3 + j] = d[j];
@@ -341,8 +342,8 @@ static inline void RK_FN(frame)(const rk_model *md, int f, RK_T (*R)[9], RK_T (*
         return;
     }
     RK_T d[3];
-    RK_FN(matmul_v)(R[b], (md->fR + 9 * f), Rf);
-    RK_FN(apply_v)(R[b], (md->ft + 3 * f), d);
+    RK_FN(matmul_v)(R[b], md->fR + 9 * f, Rf);
+    RK_FN(apply_v)(R[b], md->ft + 3 * f, d);
     for (int j = 0; j < 3; j++) p[j] = o[b][j] + d[j];
 }
 
@@ -352,7 +353,7 @@ static inline void RK_FN(frame_origin)(const rk_model *md, int f, RK_T (*R)[9], 
 {
     int b = md->fbody[f];
     RK_T d[3];
-    RK_FN(apply_v)(R[b], (md->ft + 3 * f), d);
+    RK_FN(apply_v)(R[b], md->ft + 3 * f, d);
     for (int j = 0; j < 3; j++) p[j] = o[b][j] + d[j];
 }
 
@@ -416,7 +417,7 @@ static void RK_FN(drift)(const rk_model *md, RK_FN(work) *work, const RK_T *q, c
     }
 }
 
-/* tau (md->nv) of the wrench w = [f; m] at frame f's origin, world axes: sum k S^T [f; m + p x f]
+/* tau (nv) of the wrench w = [f; m] at frame f's origin, world axes: sum k S^T [f; m + p x f]
  * (a free flyer's six: the force and the moment about the base's origin, base axes) */
 static void RK_FN(wrench)(const rk_model *md, RK_FN(work) *work, const RK_T *q, int f,
                           const RK_T *w, RK_T *out)
@@ -445,7 +446,7 @@ static void RK_FN(wrench)(const rk_model *md, RK_FN(work) *work, const RK_T *q, 
     }
 }
 
-/* A_g (6 x md->nv, row-major): composite bodies about the world's origin (mass M, first
+/* A_g (6 x nv, row-major): composite bodies about the world's origin (mass M, first
  * moment h, rotational inertia J_O as its six numbers xx yy zz xy xz yz), each column's
  * momentum [l; k_O] then moved to the centre of mass G: k_G = k_O - G x l */
 static void RK_FN(centroidal)(const rk_model *md, RK_FN(work) *work, const RK_T *q, RK_T *out)
@@ -460,8 +461,8 @@ static void RK_FN(centroidal)(const rk_model *md, RK_FN(work) *work, const RK_T 
         RK_T hr[3], RJ[9], T[6];
         const RK_T *p = o[i];
         const double m = md->m[i];
-        RK_FN(apply_v)(R[i], (md->h + 3 * i), hr);
-        RK_FN(matmul_v)(R[i], (md->J + 9 * i), RJ);
+        RK_FN(apply_v)(R[i], md->h + 3 * i, hr);
+        RK_FN(matmul_v)(R[i], md->J + 9 * i, RJ);
         static const int ra[6] = {0, 1, 2, 0, 0, 1}, rc[6] = {0, 1, 2, 1, 2, 2};
         for (int e = 0; e < 6; e++) {  /* R J R^T, symmetric */
             const int a = ra[e], c = rc[e];

@@ -225,3 +225,18 @@ def test_panda_on_a_free_flyer_with_mimic_fingers_has_its_forward_derivatives():
     by_q, by_v = _central(robot, q[0], v[0], tau[0], list(range(robot.nv)), floating=True)
     close(fq[0], by_q, 1e-6)
     close(fv[0], by_v, 1e-6)
+
+
+def test_a_floating_base_without_compiled_c_is_refused_in_one_line(tmp_path):
+    """The numpy backend's complex step does not take a free flyer: the derivatives say where
+    they are computed, in one line, for inverse and forward dynamics alike."""
+    from test_floating_base import FLOATING_URDF
+
+    path = tmp_path / "hopper.urdf"
+    path.write_text(FLOATING_URDF)
+    robot = lagrangian.load(path).dynamics(backend="numpy")
+    q, v = np.r_[np.zeros(6), 1.0, np.zeros(robot.nq - 7)], np.zeros(robot.nv)
+    for function in (robot.inverse_dynamics_derivatives, robot.forward_dynamics_derivatives):
+        with pytest.raises(lagrangian.InputError, match="compiled C only") as caught:
+            function(q, v, v)
+        assert caught.value.field == "q" and "\n" not in str(caught.value)

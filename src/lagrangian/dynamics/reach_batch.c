@@ -13,6 +13,9 @@
 #define RK_THREAD_STATES 1024  /* fewer per thread: starting it costs more than it saves (A_g
                                   on the Panda, 1000 states: 43 us on one thread, 70 on two) */
 #define RK_BLOCK 64  /* a multiple of LG_LANES: only the batch's last states run one by one */
+#define RK_STACK_BYTES 32768  /* a thread's workspaces up to this on its stack: no allocation
+                                 per call (one state of up to about 60 bodies; a malloc was a
+                                 fifth of a single J_dot v's call) */
 
 enum { RK_DRIFT, RK_CENTROIDAL, RK_WRENCH, RK_CORIOLIS, RK_INVERSE, RK_PLACEMENT, RK_JACOBIAN,
        RK_COM, RK_COM_JACOBIAN };
@@ -310,10 +313,13 @@ static int rk_lanes(const rk_job *job, npy_intp k, rk_space *space)
 static void *rk_run(void *argument)
 {
     rk_job *job = (rk_job *)argument;
-    /* on the heap, sized from the model: a large tree's lanes' work is more than a stack */
+    /* sized from the model: on the stack where small, else on the heap (a large tree's lanes'
+       work is more than a stack) */
     const int lanes = job->count >= LG_LANES;
+    const size_t size = rk_space_size(job->md, lanes);
+    _Alignas(64) char stack[RK_STACK_BYTES];
     rk_space space;
-    char *block = aligned_alloc(64, rk_space_size(job->md, lanes));
+    char *block = size <= sizeof stack ? stack : aligned_alloc(64, size);
     job->bad = 0;
     if (!block) return NULL;
     rk_space_at(job->md, lanes, block, &space);
@@ -330,7 +336,7 @@ static void *rk_run(void *argument)
         for (; lanes && k + LG_LANES <= k1; k += LG_LANES) job->bad += rk_lanes(job, k, &space);
         for (; k < k1; k++) job->bad += rk_state(job, k, &space.one);
     }
-    free(block);
+    if (block != stack) free(block);
     if (job->stream) lg_stream_fence();
     return NULL;
 }
@@ -362,4 +368,28 @@ static int rk_batch(rk_job *job)
     /* a thread without its workspace took no block: the others took them, unless none ran */
     if (next < job->count) { PyErr_NoMemory(); return 0; }
     return 1;
+}
+
+/* one state (job->count 1) here, on a workspace of the stack where it fits, else of the heap,
+ * without the batch's threads; its NaN rows, or -1 with MemoryError */
+static npy_intp rk_one(rk_job *job)
+{
+    _Alignas(64) char stack[RK_STACK_BYTES];
+    const size_t size = job->md->work1;
+    char *block = size <= sizeof stack ? stack : aligned_alloc(64, RK_ROUND(size));
+    if (!block) { PyErr_NoMemory(); return -1; }
+    rk_work work;
+    rk_work_at(job->md, block, &work);
+    const int bad = rk_state(job, 0, &work);
+    if (block != stack) free(block);
+    return bad;
+}
+
+/* the job: one state by rk_one, more by rk_batch; job->bad its NaN rows, 0 with MemoryError */
+static int rk_go(rk_job *job)
+{
+    if (job->count != 1) return rk_batch(job);
+    const npy_intp bad = rk_one(job);
+    job->bad = bad < 0 ? 0 : bad;
+    return bad >= 0;
 }

@@ -10,11 +10,9 @@ typedef struct {
     rk_model md;
     PyObject *index;
     void *tables;
-    size_t work1;  /* one state's workspace, bytes (rk_work_size) */
 } rk_tree;
 
 #define RK_MD(self) (&((rk_tree *)(self))->md)
-#define RK_STACK_BYTES 32768  /* one state's workspace up to this on the stack (about 60 bodies) */
 
 static PyArrayObject *rk_input(PyObject *x, int last, const char *name)
 {
@@ -85,20 +83,6 @@ bad:
     return 0;
 }
 
-/* one state (job->count 1) on a workspace of the stack where it fits (a small tree's: no
- * allocation per call), else of the heap; its NaN rows, or -1 with MemoryError */
-static npy_intp rk_one(rk_job *job, size_t work1)
-{
-    _Alignas(64) char stack[RK_STACK_BYTES];
-    char *block = work1 <= sizeof stack ? stack : aligned_alloc(64, RK_ROUND(work1));
-    if (!block) { PyErr_NoMemory(); return -1; }
-    rk_work work;
-    rk_work_at(job->md, block, &work);
-    const int bad = rk_state(job, 0, &work);
-    if (block != stack) free(block);
-    return bad;
-}
-
 /* a frame named by the tree's dict {name: frame number}; -1 with KeyError (TypeError for a
  * name not hashable) where there is none */
 static int rk_frame_named(const rk_model *md, PyObject *index, PyObject *name)
@@ -150,7 +134,7 @@ static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t n
         rk_job job = {.md = md, .kind = RK_DRIFT, .frame = f, .ref = ref, .q = PyArray_DATA(Q),
                       .v = PyArray_DATA(V), .y = PyArray_DATA((PyArrayObject *)out),
                       .count = PyArray_SIZE(Q) / md->nq};
-        if (!rk_batch(&job)) Py_CLEAR(out);
+        if (!rk_go(&job)) Py_CLEAR(out);
         bad = job.bad;
     }
     Py_DECREF(Q); Py_DECREF(V);
@@ -172,11 +156,8 @@ static PyObject *rk_of_q(PyObject *self, PyObject *Q_in, int kind, int f, int re
     if (out) {
         rk_job job = {.md = md, .kind = kind, .frame = f, .ref = ref, .q = PyArray_DATA(Q),
                       .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / md->nq};
-        if (job.count == 1) {
-            if ((bad = rk_one(&job, ((rk_tree *)self)->work1)) < 0) { Py_CLEAR(out); bad = 0; }
-        }
-        else if (!rk_batch(&job)) Py_CLEAR(out);
-        else bad = job.bad;
+        if (!rk_go(&job)) Py_CLEAR(out);
+        bad = job.bad;
     }
     Py_DECREF(Q);
     return rk_result(out, bad);
@@ -242,7 +223,7 @@ static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t 
     rk_job job = {.md = md, .kind = RK_WRENCH, .frame = f, .q = PyArray_DATA(Q), .w = &w,
                   .wshared = &shared, .sign = sign, .y = PyArray_DATA(out),
                   .count = PyArray_SIZE(Q) / md->nq};
-    int fine = rk_batch(&job);
+    int fine = rk_go(&job);
     Py_DECREF(Q); Py_DECREF(W);
     if (!fine) return NULL;
     return PyLong_FromSsize_t((Py_ssize_t)job.bad);
@@ -262,7 +243,7 @@ static PyObject *rk_py_coriolis(PyObject *self, PyObject *const *args, Py_ssize_
     if (out) {
         rk_job job = {.md = md, .kind = RK_CORIOLIS, .q = PyArray_DATA(Q), .v = PyArray_DATA(V),
                       .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(Q) / md->nq};
-        if (!rk_batch(&job)) Py_CLEAR(out);
+        if (!rk_go(&job)) Py_CLEAR(out);
         bad = job.bad;
     }
     Py_DECREF(Q); Py_DECREF(V);
@@ -312,7 +293,7 @@ static PyObject *rk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t
                       .v = PyArray_DATA(in[1]), .a = PyArray_DATA(in[2]), .up = PyArray_DATA(U),
                       .frames = frames, .w = w, .wshared = shared,
                       .y = PyArray_DATA((PyArrayObject *)out), .count = PyArray_SIZE(in[0]) / md->nq};
-        if (!rk_batch(&job)) Py_CLEAR(out);
+        if (!rk_go(&job)) Py_CLEAR(out);
         bad = job.bad;
     }
 done:
@@ -448,11 +429,11 @@ static PyObject *rk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t na
     rk_model md;
     void *tables;
     if (!rk_model_from(args[0], args[1], &md, &tables)) return NULL;
+    md.work1 = rk_work_size(&md);
     rk_tree *t = PyObject_New(rk_tree, &rk_tree_type);
     if (!t) { free(tables); return NULL; }
     t->md = md;
     t->tables = tables;
-    t->work1 = rk_work_size(&md);
     Py_INCREF(args[2]);
     t->index = args[2];
     return (PyObject *)t;

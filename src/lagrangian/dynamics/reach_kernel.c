@@ -25,6 +25,7 @@ typedef struct {
     const double *mult, *off, *axsign, *m, *t0, *u, *h, *R0, *P, *C, *S, *J;
     const double *fR, *ft;            /* per frame: rotation (9) and translation (3) in its body */
     double qlow, qhigh;               /* |quaternion|^2 within these, else numpy names it */
+    size_t work1;                     /* one state's workspace, bytes (rk_work_size) */
 } rk_model;
 
 #define RK_FREE(i) (md->fb && (i) == 0)

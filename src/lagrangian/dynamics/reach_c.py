@@ -10,17 +10,20 @@ The tables of a tree of nb bodies (its joints in order, a parent before its chil
 coordinates, nf frames, fb 1 for a floating base (body 0 on a free flyer), nv = 6 fb + n:
 
 - INTS (C int): nb, n, fb, nf, cset, nczero; then nb each: parent (-1: the ground),
-  coordinate, turns, slides (0 or 1: a free flyer neither), axis (k where the axis is +-e_k
-  exactly, else -1), R0-is-identity (0 or 1), R0's axis (j where R0 is exactly a turn about
-  e_j, else -1); then nf frame bodies (-1: the ground); then the
-  nczero entries of C (row-major, nv x nv) that no body's pass sets, where cset is 1 (no mimic
-  joint shares a coordinate: each entry set once; else all zeroed first and added to).
+  coordinate (a free flyer's 0, unused), turns, slides (0 or 1: a free flyer neither), axis
+  (k where the axis is +-e_k exactly, else -1), R0-is-identity (0 or 1), R0's axis (j where R0
+  is exactly a turn about e_j, else -1); then nf frame bodies (-1: the ground); then the
+  nczero entries of C (row-major, nv x nv) that no body's pass sets. cset is 1 where no mimic
+  joint shares a coordinate (each entry of C, A_g, J set once), else 0 (all zeroed, added to).
 - FLOATS (float64): the quaternion's bounds on |q|^2, (1 -+ QUATERNION_TOLERANCE)^2; then nb
   each: multiplier, offset (rad or m), the axis' sign, mass (kg); then 3 a body: the joint's
   translation t0 in its parent (m), axis u, first moment h (kg m); then 9 a body (row-major):
   R0, the turn tables P = R0 u u^T, C = R0 (1 - u u^T), S = R0 [u]x (R0 Rot(u, th) = P +
   cos th C + sin th S), rotational inertia J (kg m^2, about the body's origin); then the
   frames' rotations (9 each) and translations (3 each, m) in their bodies.
+
+INDEX, {frame name: frame number}, names the frames for the Tree's methods. reach_bindings.c
+checks the tables once (sizes, a parent before its child, indices in range, numbers finite).
 """
 
 from __future__ import annotations
@@ -61,7 +64,7 @@ _LANES = """#undef RK_T
 #define RK_SINCOS lg_vsincos_inline"""
 
 
-def _turn_tables(joints) -> list[np.ndarray]:
+def _turn_tables(joints) -> tuple[list, list, list]:
     """R0 u u^T, R0 (1 - u u^T) and R0 [u]x per joint: R0 Rot(u, th) = P + cos th C + sin th S."""
     P, C, S = [], [], []
     for j in joints:
@@ -71,7 +74,7 @@ def _turn_tables(joints) -> list[np.ndarray]:
         P.append(R0 @ uu)
         C.append(R0 @ (np.eye(3) - uu))
         S.append(R0 @ skew)
-    return [P, C, S]
+    return P, C, S
 
 
 def _turned_about(R: np.ndarray) -> int:
@@ -113,13 +116,15 @@ def _coriolis_zeros(tree: KinematicTree) -> tuple[bool, list[int]]:
                for i, j in enumerate(tree.joints)]
     coordinates = [j.coordinate for j in tree.joints[int(free):]]
     shared = len(set(coordinates)) < len(coordinates)
-    written = np.zeros((nv, nv), dtype=bool)
-    for i in range(len(tree.joints)):
-        a = i
-        while a >= 0:  # i's ancestors and i itself
-            rows, cols = np.array(columns[a]), np.array(columns[i])
-            written[np.ix_(rows, cols)] = written[np.ix_(cols, rows)] = True
-            a = tree.joints[a].parent
+    nb = len(tree.joints)
+    lineage = np.eye(nb, dtype=bool)  # [i, a]: a is i or an ancestor of i
+    owns = np.zeros((nb, nv))  # [i, c]: column c is body i's joint's
+    for i, j in enumerate(tree.joints):
+        if j.parent >= 0:
+            lineage[i] |= lineage[j.parent]
+        owns[i, columns[i]] = 1.0
+    related = (lineage | lineage.T).astype(float)
+    written = owns.T @ related @ owns > 0.0  # two columns of a body and its ancestor's
     return not shared, np.flatnonzero(~written).tolist()
 
 

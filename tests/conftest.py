@@ -33,11 +33,18 @@ def cli(capsys):
 
 @pytest.fixture(scope="session", autouse=True)
 def _compiled_module_cache(tmp_path_factory):
-    """Compiled C modules of the test run go to a fresh cache, never the user's."""
+    """Compiled C modules of the test run go to a fresh cache, never the user's: one for the
+    whole run, shared by pytest-xdist's workers (compiled.py locks each build, so a module is
+    compiled once and the other worker loads it)."""
     import os
 
     previous = os.environ.get("LAGRANGIAN_CACHE")
-    os.environ["LAGRANGIAN_CACHE"] = str(tmp_path_factory.mktemp("lagrangian-cache"))
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        cache = tmp_path_factory.mktemp("lagrangian-cache")
+    else:  # the workers' base folders share the run's parent
+        cache = tmp_path_factory.getbasetemp().parent / "lagrangian-cache"
+        cache.mkdir(mode=0o700, exist_ok=True)
+    os.environ["LAGRANGIAN_CACHE"] = str(cache)
     yield
     if previous is None:
         os.environ.pop("LAGRANGIAN_CACHE", None)

@@ -11,6 +11,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
+pytestmark = pytest.mark.smoke  # pytest -m smoke: the quick subset
+
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "src" / "lagrangian"
 FLAG = re.compile(r"(?:^|[\s(`'\"])--[a-z]")

@@ -80,8 +80,10 @@ def test_the_readme_is_a_front_page():
     text = README.read_text(encoding="utf-8")
     assert len(text.encode()) < 15_000
     # .ci/run and the Quick start are the same two commands.
-    assert "pip install . && lagrangian derive pendulum\npip install \".[test]\" && python -m pytest -q\n" \
-        in text
+    command = 'pip install ".[test]" && python -m pytest -q -n auto'
+    assert f"pip install . && lagrangian derive pendulum\n{command}\n" in text
+    ci = (ROOT / ".ci/run").read_text(encoding="utf-8")
+    assert 'python3 -m pip install -q ".[test]" && python3 -m pytest -q -n auto' in ci
     assert len(re.findall(r"!\[", text)) == 1 and "docs/images/report.png" in text
     assert "## Contents" in text
     # The students' entry point is above the Quick start.

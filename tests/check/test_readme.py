@@ -11,6 +11,8 @@ import pytest
 import docs_blocks
 from lagrangian.cli import main
 
+pytestmark = pytest.mark.smoke  # pytest -m smoke: the quick subset
+
 
 def section() -> str:
     return docs_blocks.block("check")

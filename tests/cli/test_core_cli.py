@@ -8,6 +8,8 @@ import pytest
 
 import lagrangian
 
+pytestmark = pytest.mark.smoke  # pytest -m smoke: the quick subset
+
 
 def test_examples_lists_every_builtin(cli):
     result = cli("examples", "--json")

@@ -7,6 +7,8 @@ import sympy as sp
 
 import lagrangian
 
+pytestmark = pytest.mark.smoke  # pytest -m smoke: the quick subset
+
 
 def small_angle_frequency(name: str, coordinate: str) -> float:
     """omega_n from the linear term of the equation: omega^2 = -(df/dq)/M at q = 0."""

@@ -7,6 +7,8 @@ import lagrangian
 from lagrangian.errors import ModelError
 from lagrangian.model.reader import parse_model, read_model
 
+pytestmark = pytest.mark.smoke  # pytest -m smoke: the quick subset
+
 PENDULUM = """
 name = "Pendulum"
 [coordinates]

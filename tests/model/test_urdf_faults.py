@@ -13,6 +13,8 @@ import pytest
 import lagrangian
 from lagrangian.errors import ModelError
 
+pytestmark = pytest.mark.smoke  # pytest -m smoke: the quick subset
+
 ARM = (Path(lagrangian.__file__).parent / "model/examples/two_link_arm.urdf").read_text()
 
 

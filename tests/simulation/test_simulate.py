@@ -13,6 +13,8 @@ from lagrangian.errors import ModelError
 from lagrangian.output.simulation import simulation_summary
 from lagrangian.simulation.simulate import SaveAt, StepControl, parse_stop_condition, simulate
 
+pytestmark = pytest.mark.smoke  # pytest -m smoke: the quick subset
+
 G = 9.81
 
 

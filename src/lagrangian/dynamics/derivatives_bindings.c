@@ -94,9 +94,9 @@ static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t na
         fine &= tree->row0[c] <= tree->row0[c + 1] && tree->lambda[c] >= -1
                 && tree->lambda[c] < c;
     for (long e = 0; e < nnz; e++) fine &= tree->rows[e] >= 0 && tree->rows[e] < nv;
-    /* a thread's work: 120 numbers a body, 4 a coordinate and four nv x nv matrices (dk4_carve,
+    /* a thread's work: 120 numbers a body, 3 a coordinate and four nv x nv matrices (dk4_carve,
        checked on a block of that size) */
-    tree->space = 120 * (size_t)nb + 4 * (size_t)nv + 4 * (size_t)nv * nv;
+    tree->space = 120 * (size_t)nb + 3 * (size_t)nv + 4 * (size_t)nv * nv;
     lg_v4 *probe = malloc(tree->space * sizeof(lg_v4));
     dk4_work w;
     fine &= probe && (size_t)(dk4_carve(tree, probe, &w) - probe) <= tree->space;

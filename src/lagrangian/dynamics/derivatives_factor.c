@@ -189,26 +189,48 @@ static inline __attribute__((always_inline)) void DK_FN(row_block)(int n, const 
     for (int jj = 0; jj < w; jj++) y[jj] = x[jj];
 }
 
+/* rows i0 .. i0 + w of column j of -A B over B's entries e0 .. e1 of the column (rows[e]),
+   A symmetric, into out: their sums held in registers (w a constant where inlined) */
+static inline __attribute__((always_inline)) void DK_FN(column_block)(
+    const dk_tree *tree, const DK_T *A, const DK_T *B, int i0, int j, int e0, int e1, DK_T *out,
+    const int w)
+{
+    const int n = tree->nv;
+    DK_T x[8];
+    for (int ii = 0; ii < w; ii++) x[ii] = DK_C(0.0);
+    for (int e = e0; e < e1; e++) {
+        const int k = tree->rows[e];
+        const DK_T b = B[k * n + j], *a = A + k * n + i0;
+        for (int ii = 0; ii < w; ii++) x[ii] -= a[ii] * b;
+    }
+    for (int ii = 0; ii < w; ii++) out[(i0 + ii) * n + j] = x[ii];
+}
+
 /* out = -A B (n x n), B's columns before ``first`` 0 (a floating base's translation: out's
    too). Row by row, eight columns at a time (one block's sums in registers: on eight lanes
    two blocks would spill past the 32). ``sparse`` (the lanes of a tree whose pattern is a
    quarter or more zeros): column by column over the entries of B that can be nonzero
    (rows[row0[j] ..]: the coordinates on a path through j's joint), A symmetric (M^-1: its
-   row k is its column k), the column's sums in x (n). */
+   row k is its column k), eight rows at a time likewise. */
 static void DK_FN(minus_product)(const dk_tree *tree, int sparse, const DK_T *A, const DK_T *B,
-                                 DK_T *out, int first, DK_T *x)
+                                 DK_T *out, int first)
 {
     const int n = tree->nv;
     if (sparse) {
         for (int j = 0; j < n; j++) {
-            for (int i = 0; i < n; i++) x[i] = DK_C(0.0);
-            for (int e = j < first ? tree->row0[j + 1] : tree->row0[j]; e < tree->row0[j + 1];
-                 e++) {
-                const int k = tree->rows[e];
-                const DK_T b = B[k * n + j], *a = A + k * n;
-                for (int i = 0; i < n; i++) x[i] -= a[i] * b;
+            const int e0 = j < first ? tree->row0[j + 1] : tree->row0[j], e1 = tree->row0[j + 1];
+            for (int i = 0; i < n; i += 8) {
+                switch (n - i < 8 ? n - i : 8) {
+                case 1: DK_FN(column_block)(tree, A, B, i, j, e0, e1, out, 1); break;
+                case 2: DK_FN(column_block)(tree, A, B, i, j, e0, e1, out, 2); break;
+                case 3: DK_FN(column_block)(tree, A, B, i, j, e0, e1, out, 3); break;
+                case 4: DK_FN(column_block)(tree, A, B, i, j, e0, e1, out, 4); break;
+                case 5: DK_FN(column_block)(tree, A, B, i, j, e0, e1, out, 5); break;
+                case 6: DK_FN(column_block)(tree, A, B, i, j, e0, e1, out, 6); break;
+                case 7: DK_FN(column_block)(tree, A, B, i, j, e0, e1, out, 7); break;
+                default: DK_FN(column_block)(tree, A, B, i, j, e0, e1, out, 8); break;
+                }
             }
-            for (int i = 0; i < n; i++) out[i * n + j] = x[i];
         }
         return;
     }

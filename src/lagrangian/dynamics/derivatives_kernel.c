@@ -129,8 +129,8 @@ typedef struct {
        world's origin (a of the ground: -g) */
     DK_T (*R)[9], (*o)[3], (*V)[6], (*Acc)[6];
     /* forward dynamics' own: the bodies' f and inertia before the sums, da, tau by body;
-       per coordinate b, zeros, the factor's diagonal, a row; and four nv x nv matrices */
-    DK_T (*F0)[6], (*da)[6], *taub, *b, *zero, *diagonal, *row, *M, *dq, *dv_, *X;
+       per coordinate b, zeros and the factor's diagonal; and four nv x nv matrices */
+    DK_T (*F0)[6], (*da)[6], *taub, *b, *zero, *diagonal, *M, *dq, *dv_, *X;
     DK_FN(inertia) *Y0;
     /* a floating base's six columns (body 0): S, psi = -g x S, dv = v x S (its parent the
        ground), Ic S, Bc^T S's angular part, and S . F */
@@ -148,7 +148,7 @@ static DK_T *DK_FN(carve)(const dk_tree *tree, DK_T *at, DK_FN(work) *w)
     DK_TAKE(r2, 3 * nb); DK_TAKE(Phi, 6 * nb); DK_TAKE(Psi, 6 * nb); DK_TAKE(R, 9 * nb);
     DK_TAKE(o, 3 * nb); DK_TAKE(V, 6 * nb); DK_TAKE(Acc, 6 * nb); DK_TAKE(F0, 6 * nb);
     DK_TAKE(da, 6 * nb); DK_TAKE(taub, nb); DK_TAKE(Y0, 13 * nb);
-    DK_TAKE(b, nv); DK_TAKE(zero, nv); DK_TAKE(diagonal, nv); DK_TAKE(row, nv);
+    DK_TAKE(b, nv); DK_TAKE(zero, nv); DK_TAKE(diagonal, nv);
     DK_TAKE(M, nv * nv); DK_TAKE(dq, nv * nv); DK_TAKE(dv_, nv * nv); DK_TAKE(X, nv * nv);
 #undef DK_TAKE
     return at;
@@ -546,8 +546,8 @@ static int DK_FN(forward_derivatives)(const dk_tree *tree, DK_T *space, const DK
     else
         DK_FN(inverse_from_factor)(nv, M, diagonal, w.X, Minv);
     /* a floating base's translation leaves tau as it is: d tau/dq's first three columns 0 */
-    DK_FN(minus_product)(tree, sparse, Minv, dq, aq, 3 * ff, w.row);
-    DK_FN(minus_product)(tree, sparse, Minv, dv, av, 0, w.row);
+    DK_FN(minus_product)(tree, sparse, Minv, dq, aq, 3 * ff);
+    DK_FN(minus_product)(tree, sparse, Minv, dv, av, 0);
     return failed;
 }
 /* DK_CORE_END */

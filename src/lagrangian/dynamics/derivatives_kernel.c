@@ -1,6 +1,7 @@
 /* d tau/dq, d tau/dq_dot of recursive Newton-Euler and d q_ddot/dq, d q_ddot/dq_dot, M^-1 of
- * forward dynamics, over a tree given at run time (dk_tree below: any number of bodies, each
- * state's work in a thread's heap block). Analytic, O(n^2) per state.
+ * forward dynamics, over a tree given at run time (dk_tree below: any number of bodies, a
+ * state's work in one block per thread, off its stack past a small tree's). Analytic, O(n^2)
+ * per state but for forward dynamics' dense M^-1 products, O(n^3).
  *
  * Spatial vectors at the world's origin in world axes, linear part first: a motion [v; w], a
  * force [f; n]. A body's joint column S (theta_dot = k q_dot[c]); v_i = v_p + S theta_dot,
@@ -30,7 +31,7 @@
  * coordinate (lambda, for the factor along the tree). Per body its parent body, coordinate,
  * whether it turns or slides, its multiplier and offset, R0, t0, its axis u (its joint's
  * frame), R0 u and P, C, S with R0 Rot(u, th) = P + cos th C + sin th S. ``space``: the
- * doubles of one thread's work on LG_LANES states (dk4_carve). */
+ * DK_T numbers of one state's work (a lane group's on the lanes: carve). */
 typedef struct {
     int nb, nj, ff, np, nv, nq, qo, vo, ltdl, once, sparse;
     const int *parent, *coord, *turns, *slides, (*pair)[2], *row0, *rows, *lambda;

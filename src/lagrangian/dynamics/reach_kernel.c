@@ -58,7 +58,8 @@ static inline void rk_apply_tab(const double *R, const double *x, double *out)
  * and cosine of an RK_T. Every branch depends on the tree alone, never on a state: the lanes
  * take the same path. Helpers with a suffix take a table's doubles: _k a constant matrix,
  * _v a constant vector. Each function works in an RK_FN(work), sized from the model
- * (RK_FN(work_size)): on the heap or, for a small tree's single state, the caller's stack. */
+ * (RK_FN(work_size)): on its thread's stack where it fits (reach_batch.c's RK_STACK_BYTES),
+ * else on the heap. */
 /* RK_CORE_BEGIN */
 /* a function's workspace: every body's rotation and origin, the path to a body, and x, the
  * function's own arrays (one function at a time on a workspace, so they share it: a drift's

@@ -10,7 +10,7 @@ import pytest
 import sympy as sp
 
 import lagrangian
-from lagrangian.derivation.steps import derivation_steps
+from lagrangian.derivation.equations import derivation_steps
 from lagrangian.model.expressions import parse_expression
 from lagrangian.output.steps import steps_document
 

@@ -96,7 +96,7 @@ def test_printed_forms_equal_the_derived_ones_for_the_bicycle():
     """Its entries are past what the model-file parser reads back (50 000 characters): the
     forms that are printed are compared directly (T, V and M; its forcing takes ~6 s to
     evaluate, and goes through the same code as every other example's above)."""
-    from lagrangian.output.derivation import _Display
+    from lagrangian.output.derivation_display import _Display
 
     eom = lagrangian.load("whipple_bicycle").equations_of_motion()
     display = _Display(eom)

@@ -20,10 +20,11 @@ from ..compile.lambdified import numpy_function
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
 from ..kinds import ConstraintKind
+from ..model.checked import unknown_name
 from ..model.expressions import as_expression
 from ..model.model import Model
 from ..model.units import generalized_force_unit
-from ..model.values import ParameterValues, State, resolve_parameters, resolve_state, unknown_name
+from ..model.values import ParameterValues, State, resolve_parameters, resolve_state
 
 _RANK_TOLERANCE = 1e-9
 _RESIDUAL_TOLERANCE = 1e-8

@@ -12,14 +12,15 @@ from ..analysis.speed_form import SpeedForm, SpeedSweep
 from ..analysis.statics import StaticsReport
 from ..check.classroom import AnswerResult, ClassReport
 from ..check.course import Lesson, course_lessons
+from ..check.crosscheck_report import CoordinateAgreement, CrosscheckReport, Reaction
 from ..check.diagnose import CheckReport, Finding
 from ..check.free_body_steps import CrosscheckSteps
-from ..check.newton_euler import CoordinateAgreement, CrosscheckReport, Reaction
 from ..check.units import UnitIssue, UnitsReport
 from ..compile.compiled import BackendUnavailable, CacheRefused, CompilerMissing
 from ..compile.functions import NumericSystem
-from ..derivation.equations import EquationsOfMotion, LoadContribution
+from ..derivation.equations import EquationsOfMotion
 from ..derivation.steps import DerivationSteps
+from ..derivation.virtual_work import LoadContribution
 from ..dynamics.frames import TreeKinematics
 from ..dynamics.joint_space import Dynamics
 from ..dynamics.model_frames import ModelKinematics

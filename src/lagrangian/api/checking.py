@@ -8,11 +8,12 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..check.classroom import ClassReport, check_class
+from ..check.crosscheck_report import CrosscheckReport
 from ..check.diagnose import CheckReport, check_answer
 from ..check.final_answers import check_final_answers
 from ..check.free_body_steps import CrosscheckSteps, crosscheck_steps
 from ..check.hints import hinted
-from ..check.newton_euler import CrosscheckReport, crosscheck
+from ..check.newton_euler import crosscheck
 from ..check.units import UnitsReport, check_model_units
 from ..model.answer import Answer, answer_from_mapping, read_answer
 

@@ -26,6 +26,7 @@ from ..errors import LagrangianError
 from ..model.model import Model
 from ..model.values import resolve_parameters, resolve_state
 from . import equivalence as eq
+from .crosscheck_report import CoordinateAgreement, CrosscheckReport, Reaction
 from .free_bodies import (
     _AppliedForces,
     _Clock,
@@ -35,7 +36,6 @@ from .free_bodies import (
     free_body,
 )
 from .jets import JetEvaluator, UnsupportedExpression
-from .newton_euler import CoordinateAgreement, CrosscheckReport, Reaction
 
 # A body more than this many elementary rotations from the ground is checked numerically: the
 # symbolic route's cost grows with the product of the chain's rotations (a chain of 4: 15 s,

@@ -1,4 +1,6 @@
-"""The equations of motion, in the convention M(q, t) q_ddot + Phi_q^T lambda = f(q, q_dot, t)."""
+"""The equations of motion, in the convention M(q, t) q_ddot + Phi_q^T lambda = f(q, q_dot, t),
+and their working step by step (derivation_steps: the method steps() computes it here, the
+steps' types in derivation/steps.py)."""
 
 from __future__ import annotations
 
@@ -7,19 +9,20 @@ from functools import cached_property
 
 import sympy as sp
 
-from ..kinds import InvariantKind
+from ..kinds import InvariantKind, LoadStepKind
 from ..model.model import Model
 from ..model.notation import join_terms, model_latex_printer
 from .display import ModelMatrix, model_scalar
-
-
-@dataclass(frozen=True)
-class LoadContribution:
-    """What one load gives to one coordinate's generalized force (N or N m)."""
-
-    load: str
-    coordinate: str
-    expression: sp.Expr
+from .kinematics import Differentiator
+from .steps import (
+    ConstraintStep,
+    CoordinateStep,
+    DerivationSteps,
+    LoadStep,
+    load_working,
+    variation_symbols,
+)
+from .virtual_work import DISSIPATION_LOAD, LoadContribution
 
 
 @dataclass(frozen=True)
@@ -227,8 +230,6 @@ class EquationsOfMotion:
     def steps(self):
         """The working of Lagrange's method from L = T - V, coordinate by coordinate and load
         by load (a DerivationSteps; derivation/steps.py)."""
-        from .steps import derivation_steps
-
         return derivation_steps(self)
 
     def _repr_latex_(self) -> str:
@@ -243,3 +244,62 @@ class EquationsOfMotion:
             rows.append(rf"{join_terms(printer.product_terms(pairs))} &= {printer.doprint(f[i])}"
                         rf" &&({printer.doprint(coordinate.symbol)})")
         return r"$\begin{aligned}" + r" \\ ".join(rows) + r"\end{aligned}$"
+
+
+# -- the working (derive --steps) ------------------------------------------------------------
+
+
+def derivation_steps(eom: EquationsOfMotion) -> DerivationSteps:
+    """Differentiate L = T - V of ``eom`` step by step and project each load (derivation/steps.py)."""
+    model = eom.model
+    q, q_dot, q_ddot, t = model.q, model.q_dot, model.q_ddot, model.time
+    d = Differentiator()
+    T, V = eom.kinetic_energy, eom.potential_energy
+    L = T - V
+    A, multipliers = eom.constraint_jacobian, eom.multipliers
+    coordinates = []
+    for i, c in enumerate(model.coordinates):
+        momentum = d(L, q_dot[i])
+        rate = sp.Add(*(d(momentum, qj) * vj for qj, vj in zip(q, q_dot, strict=True)),
+                      *(d(momentum, vj) * aj for vj, aj in zip(q_dot, q_ddot, strict=True)),
+                      d(momentum, t))
+        gradient = d(L, q[i])
+        Q = eom.generalized_forces[i]
+        lam = sp.Add(*(A[k, i] * multipliers[k] for k in range(A.rows) if A[k, i] != 0))
+        coordinates.append(CoordinateStep(c.name, momentum, rate, gradient, Q, lam,
+                                          rate - gradient - Q + lam))
+    variations = variation_symbols(model)
+    constraints = tuple(
+        ConstraintStep(constraint.name, str(constraint.kind), constraint.expression,
+                       tuple(A.row(k)), multipliers[k])
+        for k, constraint in enumerate(model.constraints))
+    return DerivationSteps(model, T, V, L, variations, tuple(coordinates),
+                           tuple(_load_steps(eom, variations, d)), constraints)
+
+
+def _load_steps(eom: EquationsOfMotion, variations, d: Differentiator) -> list[LoadStep]:
+    """Each load's virtual displacement and virtual work, in the order of derive's breakdown."""
+    model = eom.model
+    q, q_dot = model.q, model.q_dot
+    names = [c.name for c in model.coordinates]
+    by_load: dict[str, list[tuple[str, sp.Expr]]] = {}
+    for part in eom.load_contributions:
+        by_load.setdefault(part.load, []).append((part.coordinate, part.expression))
+    loads = {load.name: load for load in model.loads}
+    dampers = {damper.name: damper for damper in model.dampers}
+
+    def moved(expr, variables) -> sp.Expr:
+        return sp.Add(*(d(expr, x) * dq for x, dq in zip(variables, variations, strict=True)))
+
+    steps = []
+    for name, shares in by_load.items():
+        work = sp.Add(*(value * variations[names.index(c)] for c, value in shares))
+        component = loads.get(name, dampers.get(name))
+        if component is not None:
+            kind, acts_at, displacement, form = load_working(component, q, q_dot, moved)
+        else:
+            kind, acts_at, displacement, form = (
+                LoadStepKind.DISSIPATION if name == DISSIPATION_LOAD else LoadStepKind.GIVEN,
+                (), (), None)
+        steps.append(LoadStep(name, kind, acts_at, displacement, form, work, tuple(shares)))
+    return steps

@@ -1,13 +1,14 @@
 """The working of Lagrange's method, step by step, for a reader to follow (``derive --steps``).
 
-Each step is derived here from L = T - V by differentiation, not restated from M and f:
-per coordinate q_i, the momentum p_i = dL/dq_dot_i (kg m^2/s for an angle, kg m/s for a length),
-its rate d/dt(p_i) = sum_j (dp_i/dq_j q_dot_j + dp_i/dq_dot_j q_ddot_j) + dp_i/dt, the force
-term dL/dq_i, the generalized force Q_i of the non-potential loads and, with constraints, the
+Each step is derived from L = T - V by differentiation (derivation_steps, in
+derivation/equations.py), not restated from M and f: per coordinate q_i, the momentum
+p_i = dL/dq_dot_i (kg m^2/s for an angle, kg m/s for a length), its rate
+d/dt(p_i) = sum_j (dp_i/dq_j q_dot_j + dp_i/dq_dot_j q_ddot_j) + dp_i/dt, the force term
+dL/dq_i, the generalized force Q_i of the non-potential loads and, with constraints, the
 multiplier terms (Phi_q^T lambda)_i; the equation is d/dt(p_i) - dL/dq_i - Q_i + (Phi_q^T
 lambda)_i = 0. Per load, the virtual displacement of what it acts on (delta r = sum_i dr/dq_i
 delta q_i for a point, delta(angle) for a torque, delta(length) for a damper) and its virtual
-work delta W = sum_i Q_i delta q_i.
+work delta W = sum_i Q_i delta q_i. Here: the steps' types and each load kind's working.
 """
 
 from __future__ import annotations
@@ -22,9 +23,6 @@ from ..model.model import Damper, Model, PointForce, Torque
 from ..model.notation import latex_printer
 from ..model.rotations import Moment
 from .display import model_scalar
-from .equations import EquationsOfMotion
-from .kinematics import Differentiator
-from .virtual_work import DISSIPATION_LOAD
 
 
 def _dotted(step) -> None:
@@ -151,63 +149,7 @@ def variation_symbols(model: Model) -> tuple[sp.Symbol, ...]:
     return tuple(out)
 
 
-def derivation_steps(eom: EquationsOfMotion) -> DerivationSteps:
-    """Differentiate L = T - V of ``eom`` step by step and project each load (see module doc)."""
-    model = eom.model
-    q, q_dot, q_ddot, t = model.q, model.q_dot, model.q_ddot, model.time
-    d = Differentiator()
-    T, V = eom.kinetic_energy, eom.potential_energy
-    L = T - V
-    A, multipliers = eom.constraint_jacobian, eom.multipliers
-    coordinates = []
-    for i, c in enumerate(model.coordinates):
-        momentum = d(L, q_dot[i])
-        rate = sp.Add(*(d(momentum, qj) * vj for qj, vj in zip(q, q_dot, strict=True)),
-                      *(d(momentum, vj) * aj for vj, aj in zip(q_dot, q_ddot, strict=True)),
-                      d(momentum, t))
-        gradient = d(L, q[i])
-        Q = eom.generalized_forces[i]
-        lam = sp.Add(*(A[k, i] * multipliers[k] for k in range(A.rows) if A[k, i] != 0))
-        coordinates.append(CoordinateStep(c.name, momentum, rate, gradient, Q, lam,
-                                          rate - gradient - Q + lam))
-    variations = variation_symbols(model)
-    constraints = tuple(
-        ConstraintStep(constraint.name, str(constraint.kind), constraint.expression,
-                       tuple(A.row(k)), multipliers[k])
-        for k, constraint in enumerate(model.constraints))
-    return DerivationSteps(model, T, V, L, variations, tuple(coordinates),
-                           tuple(_load_steps(eom, variations, d)), constraints)
-
-
-def _load_steps(eom: EquationsOfMotion, variations, d: Differentiator) -> list[LoadStep]:
-    """Each load's virtual displacement and virtual work, in the order of derive's breakdown."""
-    model = eom.model
-    q, q_dot = model.q, model.q_dot
-    names = [c.name for c in model.coordinates]
-    by_load: dict[str, list[tuple[str, sp.Expr]]] = {}
-    for part in eom.load_contributions:
-        by_load.setdefault(part.load, []).append((part.coordinate, part.expression))
-    loads = {load.name: load for load in model.loads}
-    dampers = {damper.name: damper for damper in model.dampers}
-
-    def moved(expr, variables) -> sp.Expr:
-        return sp.Add(*(d(expr, x) * dq for x, dq in zip(variables, variations, strict=True)))
-
-    steps = []
-    for name, shares in by_load.items():
-        work = sp.Add(*(value * variations[names.index(c)] for c, value in shares))
-        component = loads.get(name, dampers.get(name))
-        if component is not None:
-            kind, acts_at, displacement, form = load_working(component, q, q_dot, moved)
-        else:
-            kind, acts_at, displacement, form = (
-                LoadStepKind.DISSIPATION if name == DISSIPATION_LOAD else LoadStepKind.GIVEN,
-                (), (), None)
-        steps.append(LoadStep(name, kind, acts_at, displacement, form, work, tuple(shares)))
-    return steps
-
-
-__all__ = ["ConstraintStep", "CoordinateStep", "DerivationSteps", "LoadStep", "derivation_steps",
+__all__ = ["ConstraintStep", "CoordinateStep", "DerivationSteps", "LoadStep", "load_working",
            "variation_symbols"]
 
 

@@ -2,18 +2,27 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import singledispatch
 
 import sympy as sp
 
 from ..model.model import Damper, Model, PointForce, Torque
 from ..model.rotations import Moment
-from .equations import LoadContribution
 from .kinematics import jacobian_row
 from .rigid_bodies import moment_projection
 
 DISSIPATION_LOAD = "dissipation"
 GIVEN_LOAD = "generalized_forces"
+
+
+@dataclass(frozen=True)
+class LoadContribution:
+    """What one load gives to one coordinate's generalized force (N or N m)."""
+
+    load: str
+    coordinate: str
+    expression: sp.Expr
 
 
 def load_contributions(model: Model) -> list[LoadContribution]:

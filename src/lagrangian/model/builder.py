@@ -37,12 +37,12 @@ from .model import (
     Spring,
     SteadyMotion,
     Torque,
-    Vector,
     acceleration_name,
     multiplier_name,
     velocity_name,
 )
 from .rotations import RigidBody, floated, unit_vector
+from .vector import Vector
 
 
 class ModelBuilder(RigidBodiesMixin, ConstraintsMixin, SteadyMotionMixin, ControlLawsMixin):

@@ -10,9 +10,6 @@ import sympy as sp
 
 from ..errors import did_you_mean
 from ..kinds import JointKind
-from .model import (
-    Vector,
-)
 from .rotations import (
     GROUND,
     BodyJoint,
@@ -21,6 +18,7 @@ from .rotations import (
     RigidBody,
     RotationReader,
 )
+from .vector import Vector
 
 
 def _elementary_rotations(joint: object) -> int:

@@ -21,9 +21,9 @@ from .contacts import (
 from .expressions import IDENTIFIER
 from .model import (
     Constraint,
-    Vector,
 )
 from .rotations import apply, unit_vector
+from .vector import Vector
 
 # A rolling contact's velocity coefficients are trigsimp'd only below this op count (cheap).
 TIDY_LIMIT = 40

@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from .model import Vector
 from .rotations import apply
+from .vector import Vector
 
 # Simplification of the wheel-plane direction is tried only on expressions this small (op
 # count): trigsimp of a short sin^2 + cos^2 is cheap, of a long expression it is not.

@@ -7,12 +7,14 @@ Vectors are 3-tuples; planar models have a zero third component.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import sympy as sp
 
 from ..kinds import ConstraintKind
+from .checked import si_number, unknown_name
+from .vector import Vector
 
 if TYPE_CHECKING:
     from .contacts import RollingContact
@@ -20,8 +22,6 @@ if TYPE_CHECKING:
     from .tree import KinematicTree
 
 TIME = sp.Symbol("t")
-
-Vector = tuple[sp.Expr, sp.Expr, sp.Expr]
 
 
 def velocity_name(coordinate: str) -> str:
@@ -247,11 +247,10 @@ class Model:
 
     def with_parameter_values(self, values: dict[str, float]) -> Model:
         """A copy with some parameter values replaced (SI units); unknown names are refused."""
-        from dataclasses import replace
-
-        from .values import resolve_parameters
-
-        resolved = resolve_parameters(self, values, require=False)
-        parameters = tuple(replace(p, value=v) if p.name in values else p
-                           for p, v in zip(self.parameters, resolved.values, strict=True))
+        names = [p.name for p in self.parameters]
+        for name in values:
+            if name not in names:
+                raise unknown_name(name, names, "parameter", "parameters")
+        parameters = tuple(replace(p, value=si_number(p.name, values[p.name], "parameters"))
+                           if p.name in values else p for p in self.parameters)
         return replace(self, parameters=parameters)

@@ -21,7 +21,7 @@ import sympy as sp
 
 from ..errors import ModelError, did_you_mean
 from ..kinds import JointKind
-from .model import Vector
+from .vector import Vector
 
 Matrix3 = tuple[Vector, Vector, Vector]
 

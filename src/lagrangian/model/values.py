@@ -8,14 +8,14 @@ coordinates take their ``initial`` value, velocities their ``rate``, t 0, and pa
 
 from __future__ import annotations
 
-import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
 
-from ..errors import ModelError, did_you_mean_or_list
+from ..errors import ModelError
+from .checked import si_number, unknown_name
 from .model import Model, velocity_name
 
 
@@ -121,7 +121,7 @@ def resolve_state(
     for name in values:
         if name not in known:
             raise unknown_name(name, known, what, field)
-    numbers = {name: _number(name, value, field) for name, value in values.items()}
+    numbers = {name: si_number(name, value, field) for name, value in values.items()}
     q = tuple(numbers.get(c.name, _default(c.initial)) for c in model.coordinates)
     q_dot = tuple(numbers.get(c.velocity.name, _default(c.rate)) for c in model.coordinates)
     return State(coordinates, q, q_dot, numbers.get("t", 0.0), frozenset(numbers))
@@ -151,20 +151,13 @@ def resolve_parameters(
     values: list[float | None] = []
     for p in model.parameters:
         if p.name in overrides:
-            values.append(_number(p.name, overrides[p.name], field))
+            values.append(si_number(p.name, overrides[p.name], field))
         elif p.value is None and require:
             raise ModelError(f"parameter '{p.name}' has no value; give one",
                              field=f"{field}.{p.name}")
         else:
             values.append(None if p.value is None else float(p.value))
     return ParameterValues(names, tuple(values))
-
-
-def unknown_name(name: str, known: Iterable[str], what: str, field: str | None) -> ModelError:
-    """"'x' is not a <what> of this model; did you mean 'y'?" (the hint when one is close, else
-    the valid names)."""
-    return ModelError(f"'{name}' is not a {what} of this model"
-                      f"{did_you_mean_or_list(name, known)}", field=field)
 
 
 def state_units(model: Model) -> dict[str, str | None]:
@@ -178,19 +171,3 @@ def state_units(model: Model) -> dict[str, str | None]:
 
 def _default(value: float | None) -> float:
     return 0.0 if value is None else float(value)
-
-
-def _number(name: str, value: object, field: str) -> float:
-    number = None
-    if not isinstance(value, str | bytes):  # text is read with its unit by the caller, not here
-        try:
-            number = float(value)  # numbers, numpy or sympy numbers (sympy.pi)
-        except (TypeError, ValueError):
-            pass
-    if number is None:
-        raise ModelError(f"the value of '{name}' must be a number in SI units (radians for "
-                         f"angles, e.g. math.pi), got {value!r}", field=field)
-    if not math.isfinite(number):
-        raise ModelError(f"the value of '{name}' must be a finite number, got {value!r}",
-                         field=field)
-    return number

@@ -6,8 +6,8 @@ from pathlib import Path
 from typing import Any
 
 from ..check.classroom import RECORD_KEYS, ClassReport, summary
+from ..check.crosscheck_report import CrosscheckReport
 from ..check.diagnose import CheckReport
-from ..check.newton_euler import CrosscheckReport
 from ..check.units import UnitsReport
 from ..errors import ModelError
 from ..kinds import FindingStatus

@@ -13,93 +13,12 @@ from typing import Any
 import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
-from ..derivation.intermediates import Intermediates, intermediates, is_large, with_entries
-from ..derivation.readable import readable, readable_matrix
 from ..model.expressions import format_expression
 from ..model.units import generalized_force_unit
+from .derivation_display import _Display
+from .latex import handout_latex
 
 CONVENTION = "M q_ddot + Phi_q^T lambda = forcing"
-
-
-class _Display:
-    """The readable form of the derivation's expressions (derivation/readable.py: equal to the
-    derived ones, grouped by products of the rates), as text in the model-file grammar."""
-
-    def __init__(self, eom: EquationsOfMotion, expand: bool = False):
-        model = eom.model
-        self.rates = frozenset([*model.q_dot, *model.q_ddot, *eom.multipliers])
-        self.ranges = {c.symbol: tuple(c.range) for c in model.coordinates if c.range}
-        self.intermediates = None if expand else _named(eom)
-
-    def form(self, expr) -> sp.Expr:
-        if self.intermediates is not None:
-            found = self.intermediates.reduced.get(expr)
-            if found is not None:
-                return found
-        return readable(expr, self.rates, self.ranges)
-
-    def plain(self, expr) -> sp.Expr:
-        """The readable form in the model's own names (constraints: read by the modes)."""
-        return readable(expr, self.rates, self.ranges)
-
-    def lagrangian(self, eom: EquationsOfMotion) -> sp.Expr:
-        """L = T - V from the readable T and V (grouping L again would repeat T's work)."""
-        return self.form(eom.kinetic_energy) - self.form(eom.potential_energy)
-
-    def equations(self, eom: EquationsOfMotion) -> list[sp.Expr]:
-        """M q_ddot + Phi_q^T lambda - f per coordinate, from the readable M, Phi_q and f
-        (regrouping the whole equation would repeat their work: 1-2 s at 30 links)."""
-        M, A, f = eom.mass_matrix, eom.constraint_jacobian, eom.forcing
-        rows = []
-        for i in range(M.rows):
-            terms = [self.form(M[i, j]) * a for j, a in enumerate(eom.model.q_ddot)
-                     if M[i, j] != 0]
-            terms += [self.plain(A[k, i]) * eom.multipliers[k] for k in range(A.rows)
-                      if A[k, i] != 0]
-            rows.append(sp.Add(*terms) - self.form(f[i]))
-        return rows
-
-    def matrix(self, matrix, plain: bool = False) -> sp.ImmutableMatrix:
-        if self.intermediates is not None and not plain:
-            return sp.ImmutableMatrix(matrix.rows, matrix.cols, [self.form(v) for v in matrix])
-        return readable_matrix(matrix, self.rates, self.ranges)
-
-    def definitions(self) -> list[tuple[str, str]]:
-        """(name, text) of each intermediate quantity, in order (none for small equations)."""
-        if self.intermediates is None:
-            return []
-        return [(str(symbol), format_expression(expr))
-                for symbol, expr in self.intermediates.definitions]
-
-    def __call__(self, expr, plain: bool = False) -> str:
-        return format_expression(self.plain(expr) if plain else self.form(expr))
-
-
-def printed_expressions(eom: EquationsOfMotion) -> list[sp.Expr]:
-    """Every expression derive prints but the constraints' (the Lagrangian is T - V of the
-    printed T and V; Phi, Phi_q and gamma stay in the model's names)."""
-    exprs = [eom.kinetic_energy, eom.potential_energy, eom.dissipation, *eom.mass_matrix,
-             *eom.forcing, *eom.generalized_forces,
-             *(c.expression for c in eom.load_contributions)]
-    return exprs if eom.accelerations is None else [*exprs, *eom.accelerations]
-
-
-def _named(eom: EquationsOfMotion) -> Intermediates | None:
-    """The intermediate quantities where the equations written out would be large, else None."""
-    exprs = printed_expressions(eom)
-    if not is_large(exprs):
-        return None
-    model = eom.model
-    taken = {p.name for p in model.parameters} | {str(s) for s in eom.multipliers}
-    for c in model.coordinates:
-        taken |= {c.name, c.velocity.name, c.acceleration.name}
-    named = intermediates(model, exprs, taken)
-    names = [c.name for c in model.coordinates]
-    M = eom.mass_matrix
-    entries = [(f"M_{names[i]}_{names[j]}", M[i, j]) for i in range(M.rows)
-               for j in range(i, M.cols) if M[i, j] != 0]
-    entries += [(f"f_{name}", value) for name, value in zip(names, eom.forcing, strict=True)]
-    return with_entries(named, entries, taken)
 
 
 # -- text ---------------------------------------------------------------------------------------
@@ -132,20 +51,6 @@ def _labels(model) -> dict[str, str]:
     labels["equations"] = (f"Equations of motion, d/dt(d{lagrangian}/dq_dot) - d{lagrangian}/dq"
                            f" = {force}")
     return labels
-
-
-# LaTeX: the letters of the labels, set in another alphabet when the model has a symbol of
-# that name (a length L is not the Lagrangian \mathcal{L}).
-_LATEX_LETTERS = {"T": r"\mathcal{T}", "V": r"\mathcal{V}", "D": r"\mathcal{D}",
-                  "L": r"\mathcal{L}", "Q": r"\mathcal{Q}", "M": r"\mathbf{M}",
-                  "f": r"\mathbf{f}"}
-
-
-def _latex_letters(model) -> dict[str, str]:
-    names = {p.name for p in model.parameters} | {c.name for c in model.coordinates}
-    return {letter: (other if letter in names else letter)
-            for letter, other in _LATEX_LETTERS.items()}
-
 
 
 def derivation_text(eom: EquationsOfMotion, expand: bool = False) -> str:
@@ -315,6 +220,4 @@ def derivation_latex(eom: EquationsOfMotion, standalone: bool = False,
                      expand: bool = False) -> str:
     """LaTeX (amsmath) ready to paste into a paper, or with ``standalone`` a complete document
     for pdflatex (output/latex.py: M q_ddot = f per coordinate, long rows broken)."""
-    from .latex import handout_latex  # it builds on _Display above
-
     return handout_latex(eom, standalone=standalone, expand=expand)

@@ -18,7 +18,7 @@ import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
 from ..model.notation import ModelLatexPrinter, join_terms, model_latex_printer
-from .derivation import _Display, _latex_letters
+from .derivation_display import _Display, _latex_letters
 
 # Estimated printed width (pt, 10 pt Computer Modern, display style) a row may take. The
 # standalone page is 453 pt wide (A4, 25 mm margins) and article's default column 345 pt:

@@ -26,27 +26,11 @@ from ..model.urdf import example_urdf
 from ..output.files import atomic_write, check_generated_target, check_output_path
 from .html import Markup, element, h, image, join, math, note, page, paragraph, table
 from .mathml import MathWriter, math_block, mi, mo, mrow, mtext
+from .outline import SHOWN, Section
 
 DEFAULT_T_END = 10.0  # s: the simulation's length when none is given
 _LONG_SOURCE = 20_000  # characters of model file shown before it is folded away
 TYPESET_LIMIT = 2500  # nodes of the expressions in one formula (the largest example but one: 133)
-
-SHOWN = "shown"  # the status of a section on the page; any other is why it is left out
-
-
-@dataclass(frozen=True)
-class Section:
-    """One section of the page: its anchor, title, and what it shows ("shown", or the reason it
-    does not apply)."""
-
-    key: str
-    title: str
-    status: str
-
-    @property
-    def shown(self) -> bool:
-        """The section is on the page (its status is "shown", not a reason it is left out)."""
-        return self.status == SHOWN
 
 
 @dataclass(frozen=True)

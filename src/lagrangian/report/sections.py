@@ -18,7 +18,7 @@ from .media import (
     mode_gif,
     simulation_gif,
 )
-from .page import SHOWN
+from .outline import SHOWN
 
 
 def _where(values: dict[str, float], units: dict[str, str]) -> str:

@@ -39,6 +39,48 @@ def test_import_contracts_hold():
     assert process.returncode == 0, process.stdout + process.stderr
 
 
+# The import circles still allowed, each a strongly connected component of the module graph
+# (imports inside functions and under TYPE_CHECKING included, as import-linter sees them).
+# The dynamics ones go with the engine issue; a circle elsewhere is a name in the wrong place.
+ALLOWED_CIRCLES = (
+    frozenset({"lagrangian.cli", *(f"lagrangian.cli.{name}" for name in (
+        "check", "codegen", "derive", "dynamics", "equilibria", "examples", "forces",
+        "kinematics", "modes", "regressor", "report", "simulate", "speeds", "statics",
+        "sweep"))}),
+    frozenset(f"lagrangian.dynamics.{name}" for name in (
+        "centroidal", "compact_kernel", "control_terms", "coriolis_tree", "frames",
+        "joint_space", "model_frames", "reach_c", "recursive", "recursive_numpy", "wrenches")),
+    frozenset({"lagrangian.dynamics.standalone", "lagrangian.dynamics.standalone_control"}),
+    frozenset({"lagrangian.dynamics.tree_algorithms", "lagrangian.dynamics.tree_floating"}),
+)
+
+
+def _import_circles() -> list[frozenset[str]]:
+    """The strongly connected components of more than one module: a module's component is
+    what it imports, even indirectly, that also imports it."""
+    import grimp
+
+    graph = grimp.build_graph("lagrangian", cache_dir=None)
+    seen: set[str] = set()
+    circles = []
+    for module in sorted(graph.modules):
+        if module not in seen:
+            component = {module} | (graph.find_upstream_modules(module)
+                                    & graph.find_downstream_modules(module))
+            seen |= component
+            if len(component) > 1:
+                circles.append(frozenset(component))
+    return circles
+
+
+def test_no_import_circle_but_the_allowed_ones():
+    """Every import circle left lies within one of ALLOWED_CIRCLES (one that shrinks as its
+    issue removes it still passes); a new one fails by its modules' names."""
+    new = [sorted(circle) for circle in _import_circles()
+           if not any(circle <= allowed for allowed in ALLOWED_CIRCLES)]
+    assert not new, "import circles: " + "; ".join(" <-> ".join(c) for c in new)
+
+
 def test_no_private_name_is_imported_from_another_package():
     """A helper shared between packages is public (no leading underscore) in its own layer."""
     offences = []

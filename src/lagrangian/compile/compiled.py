@@ -22,7 +22,6 @@ import json
 import os
 import shlex
 import shutil
-import signal
 import stat
 import subprocess
 import sys
@@ -37,6 +36,7 @@ import numpy as np
 
 from ..errors import LagrangianError
 from .codegen import GeneratedSource
+from .compiler_stop import BUILD_DIRS, RUNNING, in_main_thread, kill_compiler, stop_with_caller
 
 CFLAGS = ("-O2", "-fPIC", "-shared", "-fno-math-errno", "-w")
 # Opt-in for kernels that vectorize over a batch (dynamics/recursive.py): the processor's own
@@ -164,27 +164,32 @@ COMPILE_TIMEOUT_S = 600
 
 
 def _run_compiler(command: list[str]) -> subprocess.CompletedProcess:
-    """Run the compiler in its own process group: on a timeout the whole group (the driver and
-    its cc1, as, ld) is killed, not only the driver."""
+    """Run the compiler; on a timeout, an exception (Ctrl-C's included) or a terminating signal
+    (compiler_stop.stop_with_caller) the driver dies with everything it started (cc1, as, ld).
+
+    From the main thread it runs in its own session, hence its own process group: one killpg
+    then stops the whole tree, atomically, without touching ours (the compiler need not and
+    does not get a terminal's Ctrl-C itself: this process kills it). That session is also why a
+    SIGTERM, SIGHUP or group kill aimed at us would not reach it, so stop_with_caller turns
+    those into that killpg. Signal handlers only run in the main thread: from any other the
+    compiler stays in our own process group, so whatever stops our group (timeout(1), a job
+    manager, a terminal) stops it too, and a timeout kills the driver's tree found in /proc."""
+    own_group = in_main_thread()
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               stdin=subprocess.DEVNULL, text=True, start_new_session=True)
+                               stdin=subprocess.DEVNULL, text=True, start_new_session=own_group)
+    RUNNING[process] = own_group
     try:
         out, err = process.communicate(timeout=COMPILE_TIMEOUT_S)
     except subprocess.TimeoutExpired:
-        _kill_group(process)
+        kill_compiler(process, own_group)
         process.communicate()
         raise subprocess.TimeoutExpired(command, COMPILE_TIMEOUT_S) from None
-    except BaseException:  # Ctrl-C included: no compiler left running
-        _kill_group(process)
+    except BaseException:  # Ctrl-C and Stopped included: no compiler left running
+        kill_compiler(process, own_group)
         raise
+    finally:
+        RUNNING.pop(process, None)
     return subprocess.CompletedProcess(command, process.returncode, out, err)
-
-
-def _kill_group(process: subprocess.Popen) -> None:
-    try:
-        os.killpg(process.pid, signal.SIGKILL)
-    except (ProcessLookupError, PermissionError):
-        process.kill()
 
 
 def check_compiler() -> list[str]:
@@ -225,26 +230,56 @@ def _compile_with(source: str, name: str, target: Path, flags: tuple[str, ...]) 
     compiler = check_compiler()
     includes = [f"-I{d}" for d in _include_dirs()]
     extra = ["-undefined", "dynamic_lookup"] if sys.platform == "darwin" else []
-    with tempfile.TemporaryDirectory(dir=target.parent, prefix=".build-") as tmp:
-        c_file = Path(tmp) / f"{name}.c"
-        c_file.write_text(f"#define LG_MODULE {name}\n{source}")
-        built = Path(tmp) / target.name
-        command = [*compiler, *flags, *includes, str(c_file), "-o", str(built), "-lm", *extra]
+    with tempfile.TemporaryDirectory(dir=target.parent, prefix=_build_prefix(target)) as tmp:
+        BUILD_DIRS.add(tmp)  # for stop_with_caller, should a signal cut the cleanup short
         try:
-            done = _run_compiler(command)
-        except (OSError, subprocess.SubprocessError) as exc:
-            raise BackendUnavailable(f"the C compiler could not run: {exc}") from None
-        if done.returncode != 0:
-            cc = os.environ.get("CC", "").strip()
-            who = f"the C compiler CC={cc!r}" if cc else f"the C compiler {compiler[0]}"
-            raise BackendUnavailable(f"compiling the generated C failed ({who}):\n"
-                                     + (done.stderr or done.stdout or "no output")[-2000:])
-        # the digest first, then the module, then the source kept for inspection; each by
-        # rename, which replaces a planted link rather than writing through it
-        _write_atomic(_digest_path(target), json.dumps(
-            {"module": target.name, "sha256": _file_digest(built)}).encode())
-        os.replace(built, target)
-        _write_atomic(target.with_suffix(".c"), c_file.read_bytes())
+            c_file = Path(tmp) / f"{name}.c"
+            c_file.write_text(f"#define LG_MODULE {name}\n{source}")
+            built = Path(tmp) / target.name
+            command = [*compiler, *flags, *includes, str(c_file), "-o", str(built), "-lm",
+                       *extra]
+            try:
+                done = _run_compiler(command)
+            except (OSError, subprocess.SubprocessError) as exc:
+                raise BackendUnavailable(f"the C compiler could not run: {exc}") from None
+            if done.returncode != 0:
+                cc = os.environ.get("CC", "").strip()
+                who = f"the C compiler CC={cc!r}" if cc else f"the C compiler {compiler[0]}"
+                raise BackendUnavailable(f"compiling the generated C failed ({who}):\n"
+                                         + (done.stderr or done.stdout or "no output")[-2000:])
+            # the digest first, then the module, then the source kept for inspection; each by
+            # rename, which replaces a planted link rather than writing through it
+            _write_atomic(_digest_path(target), json.dumps(
+                {"module": target.name, "sha256": _file_digest(built)}).encode())
+            os.replace(built, target)
+            _write_atomic(target.with_suffix(".c"), c_file.read_bytes())
+        finally:
+            BUILD_DIRS.discard(tmp)
+
+
+def _build_prefix(module: Path) -> str:
+    return f".build-{module.name.split('.', 1)[0]}-"
+
+
+def _remove_stale_builds(module: Path) -> None:
+    """Remove the build folders of ``module`` that a killed process left (SIGKILL, a power cut).
+    Called under the module's lock, so none is a live build's; only folders of this project's
+    naming, of this user's, in the trusted (0700) cache are touched, and never through a link."""
+    prefix = _build_prefix(module)
+    try:
+        entries = list(os.scandir(module.parent))
+    except OSError:
+        return
+    for entry in entries:
+        if not entry.name.startswith(prefix):
+            continue
+        try:
+            info = entry.stat(follow_symlinks=False)
+        except OSError:
+            continue
+        if stat.S_ISDIR(info.st_mode) and (not hasattr(os, "getuid")
+                                           or info.st_uid == os.getuid()):
+            shutil.rmtree(entry.path, ignore_errors=True)
 
 
 def _write_atomic(path: Path, data: bytes) -> None:
@@ -347,11 +382,12 @@ def _load_or_build(name: str, make_source: Callable[[], GeneratedSource],
     check_compiler()
     _include_dirs()
     try:
-        with _build_lock(path):
+        with stop_with_caller(), _build_lock(path):
             # another process may have built it while this one waited for the lock
             module = _load_verified(name, path, quiet=False)
             if module is not None:
                 return module
+            _remove_stale_builds(path)
             generated = make_source()
             _compile(generated.source, name, path, native, exact)
     except OSError as exc:
@@ -390,8 +426,15 @@ def _load_verified(name: str, path: Path, quiet: bool) -> ModuleType | None:
 
 
 class _build_lock:
-    """An exclusive lock on <module>.lock in the cache (fcntl.flock: released by the kernel if
-    the process dies), so concurrent builds of one module happen once."""
+    """An exclusive lock on <module>.lock in the cache, so concurrent builds of one module happen
+    once. A stale lock is a non-issue: an flock belongs to the open file, which the kernel closes
+    when its holder dies however it dies (SIGKILL included), so the next builder takes it at
+    once (it is opened O_CLOEXEC, so no compiler inherits it and outlives us holding it). The
+    .lock file left behind is only a name to lock: never read, never trusted (its content means
+    nothing), opened without following a link, and never removed (unlinking it while another
+    process waits on it would let a third lock a new file: two builders at once). The build
+    folder a killed process leaves is removed by the next build of that module
+    (_remove_stale_builds)."""
 
     def __init__(self, module: Path):
         self.path = module.with_name(module.name.split(".", 1)[0] + ".lock")

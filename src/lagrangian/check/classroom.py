@@ -1,7 +1,9 @@
 """Grading a class: many answer files checked against one model, derived once.
 
 Answer files are named by path, glob or folder (its ``*.toml``); a file that cannot be read or
-checked becomes a result with its error, never a failure of the whole run.
+checked becomes a result with its error, never a failure of the whole run. A folder or a glob
+gives only regular files of its own: a symbolic link (a student's link to the answer key) or a
+FIFO there is a refused row and is never opened, so no other file's content reaches a message.
 """
 
 from __future__ import annotations
@@ -10,15 +12,18 @@ import csv
 import glob
 import html
 import io
+import os
+import stat
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 from ..derivation.equations import EquationsOfMotion
-from ..errors import LagrangianError
+from ..errors import LagrangianError, one_line
 from ..kinds import FindingStatus
-from ..model.answer import read_answer
+from ..model.answer import parse_answer
+from ..model.reader import file_kind, read_text_file
 from .diagnose import CheckReport, check_answer
 from .hints import hinted
 
@@ -141,43 +146,85 @@ def summary(result: AnswerResult) -> str:
     return "; ".join(named)
 
 
+def shown_name(path: str | Path) -> str:
+    """A file name as every output shows it (the text table, the JSON, the CSV): its control
+    characters escaped as Python writes them (a newline as ``\\n``, ESC as ``\\x1b``; the line
+    separators and bidirectional overrides as ``\\u2028``...), so a name is one line and cannot
+    forge rows; other characters, backslashes included, are kept (errors.one_line's rule)."""
+    return one_line(str(path))
+
+
 def answer_files(named: Iterable[str | Path], *, exclude: Iterable[str | Path] = ()
                  ) -> list[tuple[str, str | None]]:
     """(path, error) of every answer file named by a path, a glob or a folder (its *.toml,
     hidden files and ``exclude``, the model itself, left out), each once, in the order named.
-    A name that gives no file is an entry with its error."""
+    A name that gives no file is an entry with its error, and so is a file of a folder or a glob
+    that is not a regular file inside it (a symbolic link, a FIFO): refused, never read."""
+    return [(path, error) for path, error, _ in _entries(named, exclude)]
+
+
+def _entries(named: Iterable[str | Path], exclude: Iterable[str | Path]
+             ) -> list[tuple[str, str | None, bool]]:
+    """answer_files' entries, each with whether it was found (in a folder, by a glob) rather
+    than named: a found file is read without following a link, so none can be swapped in."""
     excluded = {Path(p).resolve() for p in exclude if Path(p).exists()}
-    entries: list[tuple[str, str | None]] = []
+    entries: list[tuple[str, str | None, bool]] = []
     seen: set[Path] = set()
 
-    def add(path: Path) -> None:
+    def add(path: Path, found: bool) -> None:
+        refusal = _refusal(path) if found else None
+        if refusal:
+            entries.append((str(path), f"{shown_name(path)}: {refusal}", found))
+            return
         key = path.resolve()
         if key not in seen and key not in excluded:
             seen.add(key)
-            entries.append((str(path), None))
+            entries.append((str(path), None, found))
 
     for name in named:
         text = str(name)
         path = Path(text)
         if path.is_dir():
-            found = sorted(p for p in path.glob("*.toml")
-                           if p.is_file() and not p.name.startswith("."))
-            kept = [p for p in found if p.resolve() not in excluded]
+            found = sorted(p for p in path.glob("*.toml") if not p.name.startswith("."))
+            kept = [p for p in found if p.resolve() not in excluded and not _directory(p)]
             if not kept:
-                entries.append((text, f"{text}: no answer files (*.toml) in this folder"))
+                entries.append((text, f"{shown_name(text)}: no answer files (*.toml) in this "
+                                      "folder", False))
             for p in kept:
-                add(p)
+                add(p, True)
         elif path.exists() or path.is_symlink():
-            add(path)
+            add(path, False)
         elif glob.has_magic(text):
-            found = sorted(Path(p) for p in glob.glob(text) if Path(p).is_file())
+            found = sorted(Path(p) for p in glob.glob(text) if not _directory(Path(p)))
             if not found:
-                entries.append((text, f"{text}: no file matches this pattern"))
+                entries.append((text, f"{shown_name(text)}: no file matches this pattern", False))
             for p in found:
-                add(p)
+                add(p, True)
         else:
-            entries.append((text, f"{text}: no such file"))
+            entries.append((text, f"{shown_name(text)}: no such file", False))
     return entries
+
+
+def _directory(path: Path) -> bool:
+    """A real directory (not a link to one): never an answer file, left out without a word."""
+    return not path.is_symlink() and path.is_dir()
+
+
+def _refusal(path: Path) -> str | None:
+    """Why a file found in a folder is not graded, judged without opening it (os.lstat), or
+    None for a regular file whose real place is the folder itself."""
+    try:
+        mode = os.lstat(path).st_mode
+    except OSError as exc:
+        return f"cannot read the file ({exc.strerror or exc})"
+    if stat.S_ISLNK(mode):
+        return ("not a regular file (a symbolic link): not read; only the folder's own files "
+                "are graded")
+    if not stat.S_ISREG(mode):
+        return f"not a regular file ({file_kind(mode)}): not read"
+    if path.resolve().parent != path.parent.resolve():
+        return "not inside its folder: not read"
+    return None
 
 
 def check_class(eom: EquationsOfMotion, named: Iterable[str | Path], *,
@@ -186,30 +233,34 @@ def check_class(eom: EquationsOfMotion, named: Iterable[str | Path], *,
     """Check every answer file named (paths, globs, folders) against ``eom``, derived once.
     ``final(answer)``: the findings on its final answers (M, K, omega, ...; System.check's)."""
     results = []
-    for path, error in answer_files(named, exclude=exclude):
-        results.append(AnswerResult(path, error=error) if error else
-                       check_file(eom, path, hints_only=hints_only, final=final))
+    for path, error, found in _entries(named, exclude):
+        results.append(AnswerResult(shown_name(path), error=error) if error else
+                       check_file(eom, path, hints_only=hints_only, final=final,
+                                  follow_symlinks=not found))
     return ClassReport(eom.model.name, tuple(results), hints_only)
 
 
 def check_file(eom: EquationsOfMotion, path: str | Path, *, hints_only: bool = False,
-               final: Callable | None = None) -> AnswerResult:
-    """One answer file's result; an error reading or checking it is kept, never raised."""
+               final: Callable | None = None, follow_symlinks: bool = True) -> AnswerResult:
+    """One answer file's result; an error reading or checking it is kept, never raised.
+    ``follow_symlinks=False``: a symbolic link is refused, not read."""
+    name = shown_name(path)
     try:
-        answer = read_answer(path, eom.model)
+        text = read_text_file(path, follow_symlinks=follow_symlinks)
+        answer = parse_answer(text, eom.model, source=str(path))
         report = check_answer(eom, answer)
         if final is not None and answer.final_tables:
             report = replace(report, findings=report.findings + tuple(final(answer)))
     except LagrangianError as exc:
-        return AnswerResult(str(path), error=str(exc))
+        return AnswerResult(name, error=one_line(str(exc)))
     except (RecursionError, MemoryError):
-        return AnswerResult(str(path), error=f"{path}: the answer is too large or too deeply "
-                                             "nested to check")
+        return AnswerResult(name, error=f"{name}: the answer is too large or too deeply "
+                                        "nested to check")
     except Exception as exc:  # noqa: BLE001 - one student's file never stops a class's grading
-        return AnswerResult(str(path), error=f"{path}: could not be checked "
-                                             f"({type(exc).__name__}: {exc})")
-    return AnswerResult(str(path), hinted(report) if hints_only else report)
+        return AnswerResult(name, error=one_line(f"{name}: could not be checked "
+                                                 f"({type(exc).__name__}: {exc})"))
+    return AnswerResult(name, hinted(report) if hints_only else report)
 
 
 __all__ = ["RECORD_KEYS", "AnswerResult", "ClassReport", "answer_files", "check_class",
-           "check_file", "summary"]
+           "check_file", "shown_name", "summary"]

@@ -44,7 +44,14 @@ def check(
 ) -> None:
     """Check a hand derivation (T, V, Q, equations, multipliers) and diagnose each mistake;
     with several answer files, grade a class (derived once, one row per file)."""
+    from ..model.reader import check_text_file
+
+    single = len(answers) == 1 and _one_file(answers[0])
+    if single and Path(answers[0]).exists():
+        # a FIFO, a device or a 3 GB file is refused at once, before the model is even read
+        _refused_as_unreadable(lambda: check_text_file(answers[0]), json_)
     from .. import AnswerResult, ClassReport, answer_files
+    from ..check.classroom import shown_name
     from ..output.check import (
         check_class_csv_path,
         check_document,
@@ -54,7 +61,6 @@ def check(
         write_class_csv,
     )
 
-    single = len(answers) == 1 and _one_file(answers[0])
     inputs: tuple[Path, ...] = ()
     if csv is not None:
         named = answers if single else [p for p, error in answer_files(answers) if not error]
@@ -63,14 +69,10 @@ def check(
     system = load_system(model, set_, lock)
     if single:
         system.equations_of_motion()  # the model's own faults stay errors without a document
-        try:
-            report = system.check(answers[0], hints_only=hints_only)
-        except LagrangianError as exc:
-            if json_:  # a script reading the JSON gets a document, not an empty stdout
-                print_json({"verdict": "unreadable", "findings": [], "error": str(exc)})
-            raise
+        report = _refused_as_unreadable(
+            lambda: system.check(answers[0], hints_only=hints_only), json_)
         if csv is not None:
-            write_class_csv(ClassReport(system.name, (AnswerResult(answers[0], report),),
+            write_class_csv(ClassReport(system.name, (AnswerResult(shown_name(answers[0]), report),),
                                         hints_only), csv, inputs=inputs)
         if json_:
             print_json(check_document(report))
@@ -88,6 +90,17 @@ def check(
         typer.echo(class_text(grades), nl=False)
     if grades.exit_status:
         raise SystemExit(grades.exit_status)
+
+
+def _refused_as_unreadable(work, json_: bool):
+    """``work()``; its LagrangianError raised again, after an "unreadable" document with --json
+    (a script reading the JSON gets a document, not an empty stdout)."""
+    try:
+        return work()
+    except LagrangianError as exc:
+        if json_:
+            print_json({"verdict": "unreadable", "findings": [], "error": str(exc)})
+        raise
 
 
 def _one_file(name: str) -> bool:

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import errno
+import os
 import re
+import stat
 import tomllib
 from collections.abc import Callable, Mapping
 from pathlib import Path
+from typing import BinaryIO
 
 from ..errors import ModelError, did_you_mean, did_you_mean_or_list
 from .builder import ModelBuilder
@@ -49,14 +53,87 @@ def model_file_schema() -> dict[str, tuple[frozenset[str], frozenset[str]]]:
     return schema
 
 
-def read_text_file(path: str | Path) -> str:
-    """The text of a user's input file; a missing or unreadable file is a ModelError naming it."""
+# An input file (a model, an answer, a URDF) is text a person writes or a tool exports: the
+# examples are under 10 kB and a robot's URDF (its meshes are other files) hundreds of kB at
+# most, so 16 MiB leaves room for any generated file and still refuses a runaway one before it
+# is read (a 3 GB answer file cost 3.2 GB of memory and 22 s before its first refusal).
+MAX_TEXT_FILE_BYTES = 16 * 2**20
+
+_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO"),
+          (stat.S_ISCHR, "a device"), (stat.S_ISBLK, "a device"),
+          (stat.S_ISSOCK, "a socket"), (stat.S_ISLNK, "a symbolic link"))
+
+
+def file_kind(mode: int) -> str:
+    """What a file that is not a regular one is ("a FIFO"), from its st_mode."""
+    return next((name for test, name in _KINDS if test(mode)), "not a file")
+
+
+def _size(n: int) -> str:
+    """'3 GiB (3221225472 bytes)'."""
+    for unit, scale in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if n >= scale:
+            return f"{n / scale:.3g} {unit} ({n} bytes)"
+    return f"{n} bytes"
+
+
+def read_text_file(path: str | Path, *, follow_symlinks: bool = True) -> str:
+    """The text of a user's input file; a missing, unreadable, non-regular (a FIFO, a device, a
+    directory) or too large (MAX_TEXT_FILE_BYTES) file is a ModelError naming it, raised before
+    anything is read. ``follow_symlinks=False`` refuses a symbolic link as well."""
+    source = str(path)
+    with _opened(path, follow_symlinks) as stream:
+        try:
+            data = stream.read(MAX_TEXT_FILE_BYTES + 1)  # a file still growing stops here
+        except OSError as exc:
+            raise ModelError(f"cannot read the file ({exc.strerror or exc})", source=source) \
+                from None
+    if len(data) > MAX_TEXT_FILE_BYTES:
+        raise ModelError(f"the file grew past the limit of {_size(MAX_TEXT_FILE_BYTES)} for an "
+                         "input file while it was read", source=source)
     try:
-        return Path(path).read_text(encoding="utf-8")
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ModelError(f"cannot read the file ({exc})", source=source) from None
+    return text.replace("\r\n", "\n").replace("\r", "\n")  # universal newlines, as read_text
+
+
+def check_text_file(path: str | Path, *, follow_symlinks: bool = True) -> None:
+    """Refuse ``path`` as read_text_file would before reading (missing, not a regular file, too
+    large), reading nothing: lets a command refuse a bad input before its slow work."""
+    _opened(path, follow_symlinks).close()
+
+
+def _opened(path: str | Path, follow_symlinks: bool) -> BinaryIO:
+    """``path`` open for reading, once it is known to be a regular file within the limit."""
+    source = str(path)
+    # O_NONBLOCK: opening a FIFO must not wait for a writer; O_BINARY: bytes as written (Windows)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+    if not follow_symlinks:
+        flags |= getattr(os, "O_NOFOLLOW", 0)
+    link = ModelError("not a regular file (a symbolic link): not read", source=source)
+    try:
+        if not follow_symlinks and Path(path).is_symlink():  # where O_NOFOLLOW is unknown
+            raise link
+        handle = os.open(path, flags)
     except FileNotFoundError:
-        raise ModelError("no such file", source=str(path)) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ModelError(f"cannot read the file ({exc})", source=str(path)) from None
+        raise ModelError("no such file", source=source) from None
+    except OSError as exc:
+        if not follow_symlinks and exc.errno == errno.ELOOP:
+            raise link from None
+        raise ModelError(f"cannot read the file ({exc.strerror or exc})", source=source) \
+            from None
+    info = os.fstat(handle)  # the open file's, so nothing can be swapped in after the check
+    fault = None
+    if not stat.S_ISREG(info.st_mode):
+        fault = f"not a regular file ({file_kind(info.st_mode)}): not read"
+    elif info.st_size > MAX_TEXT_FILE_BYTES:
+        fault = (f"the file is {_size(info.st_size)}, over the limit of "
+                 f"{_size(MAX_TEXT_FILE_BYTES)} for an input file: not read")
+    if fault:
+        os.close(handle)
+        raise ModelError(fault, source=source)
+    return os.fdopen(handle, "rb")
 
 
 def read_model(path: str | Path) -> Model:

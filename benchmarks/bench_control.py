@@ -106,7 +106,7 @@ def build_time() -> float:
     import sys
     import tempfile
 
-    code = ("import time; from lagrangian.dynamics.derivatives_c import engine; "
+    code = ("import time; from lagrangian.dynamics.engine.derivatives_c import engine; "
             "t = time.perf_counter(); assert engine() is not None; "
             "print(time.perf_counter() - t)")
     with tempfile.TemporaryDirectory() as cache:
@@ -212,7 +212,7 @@ def main() -> None:
     }
     if floating or large:
         del pairs["regressor"]
-    from lagrangian.dynamics.derivatives_c import derivatives_module
+    from lagrangian.dynamics.engine.derivatives_c import derivatives_module
 
     ours.forward_dynamics_derivatives(q[0], v[0], a[0])  # the module loaded, not timed below
     began = time.perf_counter()

@@ -1,4 +1,4 @@
-"""A floating base on the compact kernel (dynamics/tree_kernel.c, the free flyer as body 0)
+"""A floating base on the compact kernel (dynamics/engine/tree_kernel.c, the free flyer as body 0)
 against the unrolled module of the same tree (tree_c.py) and Pinocchio's aba, for Talos.
 
     python benchmarks/bench_floating_compact.py            # talos_reduced and talos_full_v2

@@ -1,4 +1,4 @@
-"""The compact tree kernel (dynamics/tree_kernel.c: one compiled module for every tree, the tree
+"""The compact tree kernel (dynamics/engine/tree_kernel.c: one compiled module for every tree, the tree
 an array at run time) against Pinocchio's aba, and against the unrolled module of each tree.
 
     python benchmarks/bench_tree_kernel.py                 # Panda (n = 7), chains of 50 and 200

@@ -72,7 +72,7 @@ ENGINE = """
 import json, sys, time
 from lagrangian import load
 arm = load(sys.argv[1], lock=json.loads(sys.argv[2])).dynamics(backend="numpy")
-from lagrangian.dynamics.reach_c import ReachKernel, engine
+from lagrangian.dynamics.engine.reach_c import ReachKernel, engine
 t0 = time.perf_counter()
 module = engine()
 t1 = time.perf_counter()

@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 import lagrangian
 from lagrangian.compile import codegen, compiled
-from lagrangian.dynamics.standalone import c_prefix, standalone_c
+from lagrangian.dynamics.standalone.standalone import c_prefix, standalone_c
 
 needs_c = pytest.mark.skipif(not compiled.available(), reason="no C compiler / Python headers")
 

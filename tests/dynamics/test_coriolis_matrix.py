@@ -87,7 +87,7 @@ def test_cli_prints_c_on_request_and_refuses_it_for_a_damper(cli):
 @pytest.mark.parametrize("mimic", [False, True], ids=["two legs", "a mimic knee"])
 def test_a_floating_base_with_branches_and_a_mimic_joint(tmp_path, mimic):
     """Two legs: the compiled C(q, v) sets each entry once and zeroes those between the legs
-    (reach_c.py's RK_CSET; the lanes' workspace is reused from state to state), A_g each
+    (the reach tables' cset flag; the lanes' workspace is reused from state to state), A_g each
     column. A mimic joint's coordinate is another joint's: there both add both joints' terms
     into their entries. Either way as numpy's, with C v = bias - g, over enough states for the
     vector lanes and the one-by-one rest."""

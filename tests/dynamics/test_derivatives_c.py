@@ -1,4 +1,4 @@
-"""The derivatives of a tree's dynamics in compiled C (dynamics/derivatives_c.py): against
+"""The derivatives of a tree's dynamics in compiled C (dynamics/engine/derivatives_c.py): against
 Pinocchio's computeRNEADerivatives / computeABADerivatives, the complex step through our
 numpy Newton-Euler (derivatives.py), and central differences of our own inverse and forward
 dynamics, on a branched tree with a mimic joint, a tilted prismatic axis and a massless link;
@@ -217,7 +217,7 @@ def test_floating_base_derivatives_agree_with_central_differences_on_the_manifol
     along v; a bad quaternion is refused in one line."""
     from test_floating_base import FLOATING_URDF
 
-    from lagrangian.dynamics.free_flyer import integrate
+    from lagrangian.dynamics.tree.free_flyer import integrate
 
     path = tmp_path / "hopper.urdf"
     path.write_text(FLOATING_URDF)
@@ -280,8 +280,8 @@ def test_a_branching_trees_factor_along_the_tree_gives_the_forward_derivatives(t
     pytest.importorskip("yourdfpy")
     from test_reach_reports import TWO_LEGS
 
-    from lagrangian.dynamics.derivatives_c import factored_along_the_tree
-    from lagrangian.dynamics.free_flyer import integrate
+    from lagrangian.dynamics.engine.derivatives_c import factored_along_the_tree
+    from lagrangian.dynamics.tree.free_flyer import integrate
 
     path = tmp_path / "biped.urdf"
     path.write_text(TWO_LEGS)

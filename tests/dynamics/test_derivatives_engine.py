@@ -1,4 +1,4 @@
-"""One compiled derivatives engine for every robot (dynamics/derivatives_c.py): a 200-joint chain
+"""One compiled derivatives engine for every robot (dynamics/engine/derivatives_c.py): a 200-joint chain
 and a 102-coordinate floating tree get the compiled derivatives, which are forward dynamics'
 own (M^-1, central differences of FD on the manifold, Pinocchio's computeABADerivatives); two
 robots share the one module and the second compiles nothing; the Panda on a free flyer with
@@ -95,7 +95,7 @@ def _identity(robot, q, ftau):
 def _central(robot, q, v, tau, columns, floating: bool, h: float = 1e-6):
     """d q_ddot/dq and d q_ddot/dq_dot at one state, the given columns, by central differences
     of forward dynamics (along q (+) h e_k on a floating base), in one batch."""
-    from lagrangian.dynamics.free_flyer import integrate
+    from lagrangian.dynamics.tree.free_flyer import integrate
 
     E = h * np.eye(robot.nv)[columns]
     if floating:
@@ -130,7 +130,7 @@ def test_a_200_joint_chain_gets_the_compiled_forward_derivatives(chain):
 def test_a_floating_tree_of_102_coordinates_gets_the_compiled_forward_derivatives(hydra):
     """Four limbs of two fingers each on a free flyer (factored along the tree): M^-1, and every
     column of d q_ddot/dq (on the manifold) and d q_ddot/dq_dot by central differences."""
-    from lagrangian.dynamics.derivatives_c import factored_along_the_tree
+    from lagrangian.dynamics.engine.derivatives_c import factored_along_the_tree
 
     assert hydra.nv == 102 and hydra._derivatives_kernel() is not None
     assert factored_along_the_tree(hydra.tree) is not None

@@ -26,7 +26,7 @@ from tests.dynamics.test_floating_base import (  # noqa: E402
 
 
 def _module_text(ours) -> str:
-    from lagrangian.dynamics.tree_module import module_source
+    from lagrangian.dynamics.engine.tree_module import module_source
 
     return module_source(ours.tree, tuple(ours.parameters)).source
 
@@ -127,9 +127,9 @@ def test_the_articulated_body_algorithm_of_the_hopper(tmp_path):
     import subprocess
 
     pin = pytest.importorskip("pinocchio")
-    from lagrangian.dynamics.tree_algorithms import _forward_dynamics
-    from lagrangian.dynamics.tree_c import _SINCOS, _inputs
-    from lagrangian.dynamics.tree_emitter import _Emitter, _Layout
+    from lagrangian.dynamics.emit.tree_algorithms import _forward_dynamics
+    from lagrangian.dynamics.emit.tree_c import _SINCOS, _inputs
+    from lagrangian.dynamics.emit.tree_emitter import _Emitter, _Layout
 
     path = tmp_path / "hopper.urdf"
     path.write_text(FLOATING_URDF)

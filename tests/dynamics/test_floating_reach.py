@@ -81,7 +81,7 @@ def test_coriolis_matrix_of_a_floating_base(robot):
 def test_the_tree_coriolis_matrix_is_the_christoffel_one_on_a_fixed_base():
     """Two derivations agree: on a fixed base the spatial factorization (coriolis_tree.py) is
     the matrix of M's Christoffel symbols (joint_space.py, from the bias forces)."""
-    from lagrangian.dynamics.coriolis_tree import coriolis_matrix
+    from lagrangian.dynamics.algorithms.coriolis_tree import coriolis_matrix
 
     path = _robots() / "solo_description/robots/solo12.urdf"
     fixed = lagrangian.load(path).dynamics(backend="numpy")
@@ -320,7 +320,7 @@ def test_the_hopper_in_both_backends(tmp_path, backend):
             _close(ours_k[k], pin.getFrameClassicalAcceleration(
                 model, data, _pinocchio_frame(model, name), reference).vector)
     if getattr(ours, "backend", None) == "recursive":  # compiled: so is the reach kernel
-        from lagrangian.dynamics.reach_c import ReachKernel
+        from lagrangian.dynamics.engine.reach_c import ReachKernel
 
         assert isinstance(ours._reach, ReachKernel) and ours._reach.coriolis is not None
     near = q[0, iq].copy()

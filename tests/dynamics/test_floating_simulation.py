@@ -36,7 +36,7 @@ START = {"base_qx": 0.3, "base_qy": -0.2, "base_qz": 0.1, "base_qw": float(np.sq
 def _momentum(dynamics, q, v):
     """Linear momentum and angular momentum about the CoM, world axes: the base rows of M v
     are the base's spatial momentum in its own axes, about its origin."""
-    from lagrangian.dynamics.free_flyer import quaternion_matrix
+    from lagrangian.dynamics.tree.free_flyer import quaternion_matrix
 
     base = np.einsum("kij,kj->ki", dynamics.mass_matrix(q)[:, :6], v)
     R = quaternion_matrix(q[:, 3:7])
@@ -149,7 +149,7 @@ def test_joint_torques_of_a_controller_are_internal_and_do_their_work(robot):
 def test_a_wrench_on_the_base_accelerates_the_centre_of_mass_by_f_over_m(robot):
     """All nv entries: a world-fixed force F at the base origin (given in base axes each
     call), gravity off: m c'' = F whatever the tumbling."""
-    from lagrangian.dynamics.free_flyer import quaternion_matrix
+    from lagrangian.dynamics.tree.free_flyer import quaternion_matrix
 
     weightless = robot.with_parameters(g=0.0)
     force = np.array([1.2, -0.6, 2.1])

@@ -1,4 +1,4 @@
-"""A link's inertial as a runtime parameter of a robot's dynamics (dynamics/inertials.py):
+"""A link's inertial as a runtime parameter of a robot's dynamics (dynamics/tree/inertials.py):
 ``dynamics(parameters={"b.mass": ...})`` and ``--set b.mass=...`` equal the URDF edited so, and
 Pinocchio with the link's inertia replaced; the compact kernel takes them without a rebuild."""
 

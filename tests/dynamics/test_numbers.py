@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import lagrangian
-from lagrangian.dynamics.numbers import batch_shape, float_array
+from lagrangian.dynamics.tree.numbers import batch_shape, float_array
 from lagrangian.errors import InputError
 
 

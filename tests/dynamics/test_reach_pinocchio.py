@@ -256,7 +256,7 @@ def test_a_robot_without_moving_mass_has_no_centroidal_momentum(tmp_path):
                     'type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
                     '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
     kinematics = lagrangian.load(path).model.kinematic_tree
-    from lagrangian.dynamics.frames import TreeKinematics
+    from lagrangian.dynamics.algorithms.frames import TreeKinematics
 
     with pytest.raises(lagrangian.InputError, match="no mass"):
         TreeKinematics(kinematics).centroidal_momentum_matrix(np.zeros(1))
@@ -267,8 +267,8 @@ def test_a_joint_of_more_than_one_coordinate_is_refused_not_miscounted(system):
     joint they do not know (a spherical one here) is refused in one line, never summed wrong."""
     from dataclasses import replace
 
-    from lagrangian.dynamics.coriolis_tree import coriolis_matrix
-    from lagrangian.dynamics.frames import TreeKinematics
+    from lagrangian.dynamics.algorithms.coriolis_tree import coriolis_matrix
+    from lagrangian.dynamics.algorithms.frames import TreeKinematics
 
     tree = system.model.kinematic_tree
     odd = replace(tree, joints=(replace(tree.joints[0], kind="spherical"), *tree.joints[1:]))
@@ -279,11 +279,11 @@ def test_a_joint_of_more_than_one_coordinate_is_refused_not_miscounted(system):
                  lambda: coriolis_matrix(kinematics, np.zeros(3), np.zeros(3))):
         with pytest.raises(lagrangian.InputError, match="spherical joint: not yet"):
             call()
-    from lagrangian.dynamics.wrenches import wrench_forces
+    from lagrangian.dynamics.algorithms.wrenches import wrench_forces
 
     with pytest.raises(lagrangian.InputError, match="spherical joint: not yet"):
         wrench_forces(kinematics, np.zeros(3), {"tool": np.zeros(6)})
-    from lagrangian.dynamics.reach_c import reach_module
+    from lagrangian.dynamics.engine.reach_c import reach_module
 
     assert reach_module(odd) is None
 

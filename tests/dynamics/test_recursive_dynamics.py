@@ -70,8 +70,8 @@ TREE = ('<?xml version="1.0"?><robot name="turret">' + "".join([
 @pytest.fixture(scope="module", params=["unrolled", "compact"])
 def tree(tmp_path_factory, request):
     """The turret, its dynamics on each kernel: the tree's own unrolled module, or the compact
-    kernel (dynamics/compact_kernel.py) for every tree (the size threshold set below 0)."""
-    from lagrangian.dynamics import compact_kernel
+    kernel (dynamics/engine/compact_kernel.py) for every tree (the size threshold set below 0)."""
+    from lagrangian.dynamics.engine import compact_kernel
 
     path = tmp_path_factory.mktemp("tree") / "turret.urdf"
     path.write_text(TREE)
@@ -304,7 +304,7 @@ def test_standalone_recursive_c_gives_the_python_numbers(tree, tmp_path):
     # (the Python numbers are the derived equations' in the first test)
     import ctypes
 
-    from lagrangian.dynamics.standalone import standalone_tree_c
+    from lagrangian.dynamics.standalone.standalone import standalone_tree_c
 
     compiler = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
     code = standalone_tree_c(tree.model, applicable_tree(tree.model), tree.parameters, "tur")

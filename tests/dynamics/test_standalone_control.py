@@ -13,7 +13,7 @@ import pytest
 
 import lagrangian
 from control_models import PENDULUM
-from lagrangian.dynamics.standalone import standalone_c, standalone_tree_c
+from lagrangian.dynamics.standalone.standalone import standalone_c, standalone_tree_c
 from lagrangian.model.examples import example_path
 from lagrangian.output.files import write_c
 

@@ -1,5 +1,5 @@
 """Issue 23: a 200-joint serial chain (a snake robot) loads and gives its first forward
-dynamics in under 10 s from a cold cache, on the compact kernel (dynamics/tree_kernel.c), and
+dynamics in under 10 s from a cold cache, on the compact kernel (dynamics/engine/tree_kernel.c), and
 agrees with Pinocchio's aba."""
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ from lagrangian.derivation.energies import dissipation_terms, potential_terms
 from lagrangian.derivation.inertia import add_rotation, add_translation
 from lagrangian.derivation.steps import load_working
 from lagrangian.derivation.virtual_work import load_projection
-from lagrangian.dynamics.joint_models import JOINT_MODELS, joint_model
+from lagrangian.dynamics.tree.joint_models import JOINT_MODELS, joint_model
 from lagrangian.kinds import LoadStepKind
 from lagrangian.model.components import (
     COMPONENT_KINDS,

@@ -44,14 +44,14 @@ def check(
 ) -> None:
     """Check a hand derivation (T, V, Q, equations, multipliers) and diagnose each mistake;
     with several answer files, grade a class (derived once, one row per file)."""
-    from ..model.reader import check_text_file
+    from .. import check_input_file
 
     single = len(answers) == 1 and _one_file(answers[0])
     if single and Path(answers[0]).exists():
         # a FIFO, a device or a 3 GB file is refused at once, before the model is even read
-        _refused_as_unreadable(lambda: check_text_file(answers[0]), json_)
+        _refused_as_unreadable(lambda: check_input_file(answers[0]), json_)
     from .. import AnswerResult, ClassReport, answer_files
-    from ..check.classroom import shown_name
+    from ..errors import one_line as shown_name  # a file name as every output shows it
     from ..output.check import (
         check_class_csv_path,
         check_document,

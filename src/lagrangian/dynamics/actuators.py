@@ -19,8 +19,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import InputError, ModelError, did_you_mean_or_list
-from .free_flyer import BASE_VELOCITY
 from .joint_space import Dynamics, solve_positive
+from .tree.free_flyer import BASE_VELOCITY
 
 
 def actuator_values(model, armature: Mapping[str, float] | None,

@@ -21,7 +21,7 @@ from ..compile.functions import NumericSystem
 from ..compile.lambdified import StateFunction
 from ..errors import DynamicsWarning, InputError, ModelError
 from ..model.expressions import as_expression
-from .numbers import float_array
+from .tree.numbers import float_array
 
 
 class ConstrainedDynamics:

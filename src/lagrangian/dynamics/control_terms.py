@@ -131,14 +131,14 @@ class ControlTerms:
             found = None
             tree = getattr(self, "tree", None)
             if tree is not None and getattr(self, "module", None) is not None:
-                from .derivatives_c import applies, derivatives_module, runtime_values
+                from .engine.derivatives_c import applies, derivatives_module, runtime_values
 
                 module = derivatives_module(tree) if applies(tree) else None
                 if module is not None:
                     inverse, regressor = module.inverse_derivatives, module.regressor
                     checked = (inverse, regressor)
                     if tree.floating_base:
-                        from .free_flyer import checking_quaternions
+                        from .tree.free_flyer import checking_quaternions
 
                         checked = tuple(checking_quaternions(f) for f in checked)
                     found = DerivativesKernel(inverse, module.forward_derivatives, regressor,
@@ -250,7 +250,7 @@ def _inverses(mass: np.ndarray) -> np.ndarray:
 def _reported(out: tuple) -> tuple:
     """The C's (outputs..., count of NaN rows): one DynamicsWarning at the user's call, and the
     outputs."""
-    from .joint_space import warn_undefined
+    from .tree.numbers import warn_undefined
 
     first = out[0]
     warn_undefined(out[-1], int(np.prod(first.shape[:-2], dtype=np.int64)), stacklevel=4)

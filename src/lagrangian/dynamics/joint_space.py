@@ -34,20 +34,12 @@ from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, DynamicsWarning, InputError, ModelError
 from ..model.model import Model
 from ..model.values import resolve_parameters
+from .algorithms.frames import TreeKinematics, tree_kinematics
 from .control_terms import ControlTerms
-from .frames import TreeKinematics, tree_kinematics
-from .numbers import batch_shape, float_array
+from .tree.numbers import batch_shape, float_array, solve_positive, warn_undefined
 
 if TYPE_CHECKING:
     from .model_frames import ModelKinematics
-
-
-def warn_undefined(count: int, total: int, stacklevel: int = 4) -> None:
-    """One DynamicsWarning for ``count`` of ``total`` states with NaN rows (at the user's call)."""
-    warnings.warn(DynamicsWarning(
-        f"{count} of {total} states have no dynamics (an input not finite, or a mass matrix "
-        "that is not positive definite): their rows are NaN", count, total),
-        stacklevel=stacklevel)
 
 
 def reported_rows(out, tail: int, stacklevel: int = 4):
@@ -93,25 +85,6 @@ def _without_warnings(compute, *arrays):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynamicsWarning)
         return compute(*arrays)
-
-
-def solve_positive(mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """M^-1 rhs for a flat batch (N, n, n), (N, n) by Cholesky, NaN in the rows whose M is not
-    positive definite (each row as if alone)."""
-    try:
-        L = np.linalg.cholesky(mass)
-    except np.linalg.LinAlgError:
-        out = np.full(rhs.shape, np.nan)
-        for k in range(len(mass)):  # only on this path: find the rows without a factor
-            try:
-                L = np.linalg.cholesky(mass[k:k + 1])
-            except np.linalg.LinAlgError:
-                continue
-            y = np.linalg.solve(L, rhs[k:k + 1, :, None])
-            out[k] = np.linalg.solve(np.swapaxes(L, -1, -2), y)[0, :, 0]
-        return out
-    y = np.linalg.solve(L, rhs[..., None])
-    return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
 
 
 class Dynamics(ControlTerms):
@@ -180,7 +153,7 @@ class Dynamics(ControlTerms):
         for x in flat:
             good &= np.isfinite(x).all(axis=-1)
         if self.velocity_names is not None and fields[0] == "q":  # a floating base's quaternion
-            from .free_flyer import check_quaternions
+            from .tree.free_flyer import check_quaternions
 
             check_quaternions(flat[0])
         if good.all():
@@ -317,7 +290,7 @@ class Dynamics(ControlTerms):
     def _reach_kernel(self):
         self._reach = False
         if getattr(self, "backend", None) in ("recursive", "compact"):  # compiled C backends
-            from .reach_c import ReachKernel, reach_module
+            from .engine.reach_c import ReachKernel, reach_module
 
             module = reach_module(self.tree)
             if module is not None:
@@ -354,7 +327,7 @@ class Dynamics(ControlTerms):
         return undefined_rows(self._wrenches_numpy, (q, v, x, f_ext, forward), inputs, 1, 5)
 
     def _wrenches_numpy(self, q, v, x, f_ext, forward: bool) -> np.ndarray:
-        from .wrenches import wrench_forces
+        from .algorithms.wrenches import wrench_forces
 
         tau_ext = wrench_forces(self.kinematics, self._vector(q, "q"), f_ext)
         if forward:
@@ -375,7 +348,7 @@ class Dynamics(ControlTerms):
         V = np.broadcast_to(v, batch + v.shape[-1:]).reshape(-1, v.shape[-1])
         if self.velocity_names is None:
             return (Q + V).reshape(batch + q.shape[-1:])
-        from .free_flyer import check_quaternions, integrate
+        from .tree.free_flyer import check_quaternions, integrate
 
         check_quaternions(Q)
         return integrate(Q, V).reshape(batch + q.shape[-1:])
@@ -388,7 +361,7 @@ class Dynamics(ControlTerms):
                   for x in (q0, q1))
         if self.velocity_names is None:
             return (Q1 - Q0).reshape(batch + (self.n,))
-        from .free_flyer import check_quaternions, difference
+        from .tree.free_flyer import check_quaternions, difference
 
         check_quaternions(Q0)
         check_quaternions(Q1)
@@ -413,7 +386,7 @@ class Dynamics(ControlTerms):
                     return out if out.__class__ is not tuple else reported_rows(out, 2)
                 except (ValueError, TypeError):
                     pass  # numpy below broadcasts, or names the fault in one line
-            from .coriolis_tree import coriolis_matrix
+            from .algorithms.coriolis_tree import coriolis_matrix
 
             # partial, not a lambda: a closure over self would slow the compiled path above
             return self._guarded(partial(coriolis_matrix, self.kinematics), (q, v),
@@ -513,7 +486,7 @@ class TreeDynamics(Dynamics):
         self.coordinates = tree.coordinates
         self.n = len(tree.coordinates)
         if tree.floating_base:  # Pinocchio's layout: the base's numbers first (free_flyer.py)
-            from .free_flyer import BASE_CONFIGURATION, BASE_VELOCITY
+            from .tree.free_flyer import BASE_CONFIGURATION, BASE_VELOCITY
 
             self.coordinates = BASE_CONFIGURATION + tree.coordinates
             self.velocity_names = BASE_VELOCITY + tree.coordinates

@@ -22,8 +22,8 @@ from ..derivation.kinematics import Differentiator
 from ..errors import InputError, did_you_mean_or_list
 from ..model.model import Body, Model, Particle
 from ..model.rotations import apply
-from .frames import check_reference, expressed
-from .numbers import batch_shape, float_array
+from .algorithms.frames import check_reference, expressed
+from .tree.numbers import batch_shape, float_array
 
 _ZERO = sp.S.Zero
 

@@ -33,62 +33,13 @@ import numpy as np
 
 from ..errors import InputError
 from ..model.model import Model
-from ..model.tree import KinematicTree, body_tree
+from ..model.tree import KinematicTree
+from .engine.compact_kernel import kernel_module
+from .engine.tree_module import module_source, tree_key
 from .joint_space import TreeDynamics, reported_rows
-from .numbers import batch_shape, float_array
-from .tree_module import module_source, tree_key
-
-# A model file's tree of at least this many bodies runs the recursions (numbers, simulation,
-# modes): below it the derived equations compile quickly and print as the user wrote them.
-TREE_PATH_BODIES = 6
-
-
-def applicable_tree(model: Model, parameters: Mapping[str, float] | None = None
-                    ) -> KinematicTree | None:
-    """The model's kinematic tree when it describes the model's whole dynamics (a robot read
-    from URDF and not edited since: only its rigid bodies, gravity and the actuator forces; or
-    a model file's rigid bodies on revolute and prismatic joints, in numbers at ``parameters``
-    over the model's values), else None, so that nothing else a model holds is ever left out."""
-    tree = model.kinematic_tree
-    if tree is None:
-        if not model.rigid_bodies or any(b.joint is None for b in model.rigid_bodies):
-            return None
-        from ..model.values import resolve_parameters
-
-        values = resolve_parameters(model, parameters, require=False)
-        if any(v is None for v in values.values):
-            return None
-        # built from the model itself: its bodies, gravity and forces are checked there
-        return body_tree(model, dict(zip((p.symbol for p in model.parameters), values.values,
-                                         strict=True)))
-    if (model.particles or model.bodies or model.springs or model.dampers or model.loads
-            or model.constraints or model.definitions
-            or model.kinetic_energy != 0 or model.potential_energy != 0
-            or model.dissipation != 0):
-        return None
-    if model.rigid_bodies != tree.rigid_bodies:
-        return None
-    if tuple(c.name for c in model.coordinates) != tree.coordinates:
-        return None
-    names = {p.name: p.symbol for p in model.parameters}
-    if any(a is not None and a not in names
-           for a in (tree.gravity_parameter, *tree.actuators)):
-        return None
-    gravity = model.gravity
-    if (gravity is None) != (tree.gravity_parameter is None):
-        return None
-    if gravity is not None and (gravity.magnitude != names[tree.gravity_parameter] or
-                                tuple(float(d) for d in gravity.direction)
-                                != tree.gravity_direction):
-        return None
-    expected = {c: ((names[a]),) for c, a in zip(tree.coordinates, tree.actuators, strict=True)
-                if a is not None}
-    given: dict[str, tuple] = {}
-    for coordinate, force in model.generalized_forces:
-        given[coordinate] = given.get(coordinate, ()) + (force,)
-    if given != expected:
-        return None
-    return tree
+from .tree.applicable import TREE_PATH_BODIES, applicable_tree
+from .tree.description import describe
+from .tree.numbers import batch_shape, float_array
 
 
 class RecursiveDynamics(TreeDynamics):
@@ -232,11 +183,81 @@ class RecursiveDynamics(TreeDynamics):
         return out if out.__class__ is not tuple else reported_rows(out, 0)
 
 
+class CompactDynamics(RecursiveDynamics):
+    """A tree's recursive dynamics on the compact kernel, batched over leading axes (SI units);
+    the functions of recursive.RecursiveDynamics, the tree ``description`` their last argument."""
+
+    kernel = "compact"
+
+    def __init__(self, model: Model, tree: KinematicTree,
+                 parameters: Mapping[str, float] | None = None):
+        self._take_tree(model, tree, parameters)
+        self.module = kernel_module()
+        self.description = describe(tree, self.parameters)
+        m, D = self.module, self.description
+        self._mass, self._bias, self._gravity = m.mass_matrix, m.bias_forces, m.gravity
+        self._inverse, self._forward = m.inverse_dynamics, m.forward_dynamics
+        self._kinetic, self._potential = m.kinetic_energy, m.potential_energy
+        self._P = D
+
+    def __repr__(self) -> str:
+        return f"CompactDynamics(coordinates={list(self.coordinates)})"
+
+    def numeric_system(self):
+        """The NumericSystem over this kernel (M, f = -b, energy, accelerations, rhs)."""
+        from ..compile.functions import NumericSystem
+
+        if self.tree.floating_base:  # q and v differ in length: simulate_floating steps it
+            from .recursive_numpy import floating_refusal
+
+            raise floating_refusal()
+        return NumericSystem(coordinates=self.coordinates, constraint_names=(),
+                             constraint_kinds=(), parameters=dict(self.parameters),
+                             _kernel=_CompactKernel(self))
+
+
+class _CompactKernel:
+    """NumericSystem's kernel over the compact module (no constraints: m = 0)."""
+
+    backend = "compact"  # not "c": the module has no DOP853 loop of its own (scipy steps)
+
+    def __init__(self, dynamics: CompactDynamics):
+        self.m, self.D, self.n = dynamics.module, dynamics.description, dynamics.n
+
+    def _plain(self, out):
+        return out[0] if out.__class__ is tuple else out
+
+    def parts(self, Q, V, T):
+        count = len(Q)
+        return (self._plain(self.m.mass_matrix(Q, self.D)),
+                -self._plain(self.m.bias_forces(Q, V, self.D)),
+                np.zeros((count, 0, self.n)), np.zeros((count, 0)))
+
+    def residual(self, Q, V, T):
+        return np.zeros((len(Q), 0))
+
+    def energy(self, Q, V, T):
+        return (self._plain(self.m.kinetic_energy(Q, V, self.D))
+                + self._plain(self.m.potential_energy(Q, self.D)))
+
+    def accelerations(self, Q, V, T):
+        qdd = self._plain(self.m.forward_dynamics(Q, V, np.zeros_like(Q), self.D))
+        return qdd, np.zeros((len(Q), 0))
+
+    def rhs(self, t, y):
+        y = np.asarray(y, dtype=float)
+        n = self.n
+        if y.shape != (2 * n,):
+            raise ValueError(f"y must hold {2 * n} numbers [q, q_dot]")
+        qdd = self._plain(self.m.forward_dynamics(y[:n], y[n:], np.zeros(n), self.D))
+        return np.concatenate([y[n:], qdd])
+
+
 def _unit_quaternions(q) -> np.ndarray:
     """q with its base quaternions refused in one line (free_flyer.check_quaternions: which
     state, what norm) where the module refused them, else (a norm within rounding of the
     tolerance) made unit."""
-    from .free_flyer import check_quaternions
+    from .tree.free_flyer import check_quaternions
 
     Q = np.array(q, dtype=float)
     flat = Q.reshape(-1, Q.shape[-1])
@@ -245,4 +266,4 @@ def _unit_quaternions(q) -> np.ndarray:
     return flat.reshape(Q.shape)
 
 
-__all__ = ["RecursiveDynamics", "applicable_tree"]
+__all__ = ["applicable_tree", "CompactDynamics", "RecursiveDynamics", "TREE_PATH_BODIES"]

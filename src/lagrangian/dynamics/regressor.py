@@ -24,7 +24,7 @@ from ..compile.lambdified import StateFunction
 from ..errors import InputError
 from ..kinds import JointKind
 from ..model.expressions import as_expression
-from .joint_models import joint_model
+from .tree.joint_models import joint_model
 
 PARAMETERS_PER_BODY = ("m", "mc_x", "mc_y", "mc_z", "I_xx", "I_xy", "I_yy", "I_xz", "I_yz", "I_zz")
 # (row, column) of I for I_xx, I_xy, I_yy, I_xz, I_yz, I_zz: Pinocchio's order

@@ -31,10 +31,15 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
     from ..compile.compiled import BackendUnavailable
     from ..compile.functions import tell_numpy_fallback
     from ..model.urdf_payload import PREFIX as PAYLOAD_PREFIX
-    from .compact_kernel import COMPACT_ABOVE, CompactDynamics
-    from .inertials import split_inertials
-    from .recursive import TREE_PATH_BODIES, RecursiveDynamics, applicable_tree
+    from .engine.compact_kernel import COMPACT_ABOVE
+    from .recursive import (
+        TREE_PATH_BODIES,
+        CompactDynamics,
+        RecursiveDynamics,
+        applicable_tree,
+    )
     from .recursive_numpy import RecursiveNumpyDynamics
+    from .tree.inertials import split_inertials
 
     if kernel not in ("auto", "unrolled", "compact"):
         raise InputError(f"unknown kernel {kernel!r} (auto, unrolled or compact)", field="kernel")

@@ -15,7 +15,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import InputError, did_you_mean_or_list
+from ...errors import InputError, did_you_mean_or_list
 
 
 def wrench_arrays(kinematics, f_ext) -> dict[str, np.ndarray]:
@@ -50,7 +50,7 @@ def wrench_forces(kinematics, q, f_ext) -> np.ndarray:
     there: tau_j = k (s_v . f + s_w . m_O) for the joints above the frame's body (a free
     flyer's six columns S: its force and moment about the base's origin, base axes)."""
     from .centroidal import require_known_joints, world_columns
-    from .recursive_numpy import _cross
+    from .recursions import _cross
 
     tree = getattr(kinematics, "tree", None)
     if tree is not None:

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
-from ..model.tree import KinematicTree
+from ...errors import ModelError
+from ...model.tree import KinematicTree
 
 Term = float | str  # a number, or the C name of a value computed before
 # coordinates up to which batches run several states per vector operation: every tree the
@@ -221,3 +221,26 @@ class _Layout:
                           for name in tree.actuators]
         self.n = len(tree.coordinates) + tree.base_nv  # v's numbers (q has base_nq before)
         self.nq = len(tree.coordinates) + tree.base_nq
+
+
+def _cholesky_solve(E: _Emitter, mass: dict, rhs: list) -> list:
+    """x with M x = rhs by M = L L^T, straight-line (zeros of M, e.g. between two branches of
+    the tree, fold away); M given by its lower triangle."""
+    n = len(rhs)
+    L: dict = {}
+    inverse = []
+    for j in range(n):
+        d = E.sub(mass.get((j, j), 0.0), E.sum(E.mul(L[j, k], L[j, k]) for k in range(j)))
+        inverse.append(E.div(1.0, E.call("sqrt", d)))
+        for i in range(j + 1, n):
+            e = E.sub(mass.get((i, j), 0.0), E.sum(E.mul(L[i, k], L[j, k]) for k in range(j)))
+            L[i, j] = E.mul(e, inverse[j])
+        L[j, j] = E.div(1.0, inverse[j])
+    y = []
+    for i in range(n):
+        y.append(E.mul(E.sub(rhs[i], E.sum(E.mul(L[i, k], y[k]) for k in range(i))), inverse[i]))
+    x = [0.0] * n
+    for i in reversed(range(n)):
+        x[i] = E.mul(E.sub(y[i], E.sum(E.mul(L[k, i], x[k]) for k in range(i + 1, n))),
+                     inverse[i])
+    return x

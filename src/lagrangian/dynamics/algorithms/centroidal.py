@@ -17,13 +17,22 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
-from ..kinds import JointKind
-from .numbers import batch_shape, float_array
-from .recursive_numpy import _cross, _dot
+from ...errors import InputError
+from ...kinds import JointKind
+from ..tree.joint_models import ONE_DOF
+from ..tree.numbers import batch_shape, float_array
+from .recursions import _cross, _dot
 
-# the joints of one coordinate each (the compiled kernel of reach_c.py takes only these)
-ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
+REFERENCES = ("world", "local", "local_world_aligned")
+
+
+def check_reference(reference: str) -> None:
+    """A frame Jacobian's reference is one of REFERENCES, else one line naming it."""
+    if reference not in REFERENCES:
+        raise InputError(f"unknown reference '{reference}'; use one of "
+                         f"{', '.join(REFERENCES)}", field="reference")
+
+
 # the joints these walks take: those, and a floating base's free flyer (six columns)
 WALKED = (*ONE_DOF, JointKind.FREE_FLYER)
 
@@ -58,7 +67,7 @@ def world_columns(kinematics, k: int, joint, body) -> tuple[np.ndarray, list[int
 
 def velocity_array(kinematics, v, field: str = "v") -> np.ndarray:
     """v as an array of nv numbers along the last axis, else one line naming ``field``."""
-    from .free_flyer import BASE_VELOCITY
+    from ..tree.free_flyer import BASE_VELOCITY
 
     v = float_array(v, field)
     if v.ndim == 0 or v.shape[-1] != kinematics.n:
@@ -99,8 +108,6 @@ def jacobian_dot_times_v(kinematics, q, v, frame: str, reference: str) -> np.nda
     "local_world_aligned" the origin's acceleration and w_dot in world axes, "local" the same in
     the frame's axes, "world" those of the body point passing the world's origin (Pinocchio's
     getFrameClassicalAcceleration with a = 0)."""
-    from .frames import check_reference
-
     require_known_joints(kinematics.tree, "J_dot q_dot")
     check_reference(reference)
     n, nq = kinematics.n, len(kinematics.coordinates)
@@ -183,5 +190,6 @@ def _world_subspace(kinematics, k: int, joint, body):
     return linear, w
 
 
-__all__ = ["ONE_DOF", "WALKED", "centroidal_momentum_matrix", "jacobian_dot_times_v",
-           "require_known_joints", "spatial_motion", "velocity_array", "world_columns"]
+__all__ = ["centroidal_momentum_matrix", "check_reference", "jacobian_dot_times_v", "ONE_DOF",
+           "REFERENCES", "require_known_joints", "spatial_motion", "velocity_array", "WALKED",
+           "world_columns"]

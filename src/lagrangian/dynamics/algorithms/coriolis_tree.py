@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..tree.numbers import batch_shape
 from .centroidal import require_known_joints, velocity_array, world_columns
-from .numbers import batch_shape
 
 
 def _skew(x: np.ndarray) -> np.ndarray:

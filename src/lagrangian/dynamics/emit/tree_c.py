@@ -3,18 +3,17 @@ for batches (the standalone C and the compiled module share it)."""
 
 from __future__ import annotations
 
-from ..compile.codegen import sincos_kernel
-from ..model.tree import KinematicTree
+from ...compile.codegen import sincos_kernel
+from ...model.tree import KinematicTree
 from .tree_algorithms import (
     _articulated,
-    _cholesky_solve,
     _forward_dynamics,
     _inverse_dynamics,
     _kinetic_energy,
     _mass_matrix,
     _potential_energy,
 )
-from .tree_emitter import _Emitter, _Layout
+from .tree_emitter import _cholesky_solve, _Emitter, _Layout
 
 
 def _inputs(name: str, n: int) -> list[str]:

@@ -34,10 +34,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model.tree import KinematicTree
-from .free_flyer import QUATERNION_TOLERANCE
-from .joint_models import joint_model
-from .tree_c import _SINCOS, _VECTOR
+from ...model.tree import KinematicTree
+from ..emit.tree_c import _SINCOS, _VECTOR
+from ..tree.free_flyer import QUATERNION_TOLERANCE
+from ..tree.joint_models import joint_model
 
 # the walks, frames and the centre of mass, C(q, v), inverse dynamics with wrenches, then the
 # batches and the Python bindings: one module's C, in this order; the first four's core (from
@@ -159,7 +159,7 @@ def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
 
 def kernel_source():
     """The module's C: the kernels of _KERNELS in order, the core twice."""
-    from ..compile.codegen import GeneratedSource
+    from ...compile.codegen import GeneratedSource
 
     source = "\n".join([
         "/* lagrangian: frame accelerations, centroidal momentum and wrenches of any tree */",
@@ -188,7 +188,7 @@ def _key() -> str:
 def engine():
     """The one compiled module of every tree (cached on disk by its sources), or None where
     no compiler works."""
-    from ..compile import compiled
+    from ...compile import compiled
 
     try:
         return compiled.load_keyed(_key(), kernel_source, native=True)
@@ -199,7 +199,7 @@ def engine():
 def reach_module(tree: KinematicTree):
     """The compiled module for this tree (the same for every tree: ``engine``), or None where
     no compiler works or a joint is one the kernel does not know."""
-    from .centroidal import ONE_DOF
+    from ..tree.joint_models import ONE_DOF
 
     free = tree.floating_base  # a free flyer: body 0 only (RK_FREE)
     if any(j.kind not in ONE_DOF for j in tree.joints[int(free):]):

@@ -11,9 +11,9 @@ tree's numbers written as static tables, a floating base's free flyer as body 0.
 
 from __future__ import annotations
 
-from ..compile.codegen import c_comment_text, c_table
-from ..model.tree import KinematicTree
-from .joint_models import joint_model
+from ...compile.codegen import c_comment_text, c_table
+from ...model.tree import KinematicTree
+from ..tree.joint_models import joint_model
 
 
 def c_string(text: str) -> str:

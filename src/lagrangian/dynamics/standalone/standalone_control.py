@@ -9,15 +9,28 @@ from collections.abc import Callable, Mapping, Sequence
 
 import sympy as sp
 
-from ..compile.codegen import CodegenError, CPrinter, c_block, c_comment_text
-from ..derivation.equations import EquationsOfMotion
-from ..model.model import Model
-from .standalone import renamed_for_c
+from ...compile.codegen import CodegenError, CPrinter, c_block, c_comment_text
+from ...derivation.equations import EquationsOfMotion
+from ...model.model import Model
 
 # B's columns of the inputs named, from the derived equations: simulation.control's
 # input_columns(eom, names, field=, source=), given by the caller (dynamics does not import
 # simulation)
 Columns = Callable[..., list[list[sp.Expr]]]
+
+
+def renamed_for_c(exprs, rename: dict, fault: str) -> list[sp.Expr]:
+    """The expressions (sympy's, never a user's text) in the C's own names (``rename``: q, v,
+    t and the parameters as q[i], v[i], p[k] or numbers); a symbol outside it refused,
+    ``fault`` naming what is wrong."""
+    out = []
+    for e in exprs:
+        e = sp.sympify(e)  # safe: sympy objects
+        unknown = e.free_symbols - set(rename)
+        if unknown:
+            raise CodegenError(f"{fault} {sorted(map(str, unknown))}")
+        out.append(e.xreplace(rename))
+    return out
 
 
 def _columns(model: Model, names: Sequence[str],
@@ -105,4 +118,4 @@ def with_control(header: str, source: str, declarations: str, definitions: str
     return header[:end] + declarations + header[end:], source.rstrip("\n") + "\n" + definitions
 
 
-__all__ = ["Columns", "control_c", "with_control"]
+__all__ = ["Columns", "control_c", "renamed_for_c", "with_control"]

@@ -4,9 +4,11 @@ escaping from deep inside a dynamics function (None reads as NaN: that state's r
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
-from ..errors import InputError
+from ...errors import DynamicsWarning, InputError
 
 
 def float_array(value, field: str) -> np.ndarray:
@@ -33,4 +35,31 @@ def batch_shape(arrays, fields) -> tuple[int, ...]:
                          field=fields[0] if len(set(fields)) == 1 else "/".join(fields)) from None
 
 
-__all__ = ["batch_shape", "float_array"]
+def warn_undefined(count: int, total: int, stacklevel: int = 4) -> None:
+    """One DynamicsWarning for ``count`` of ``total`` states with NaN rows (at the user's call)."""
+    warnings.warn(DynamicsWarning(
+        f"{count} of {total} states have no dynamics (an input not finite, or a mass matrix "
+        "that is not positive definite): their rows are NaN", count, total),
+        stacklevel=stacklevel)
+
+
+def solve_positive(mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """M^-1 rhs for a flat batch (N, n, n), (N, n) by Cholesky, NaN in the rows whose M is not
+    positive definite (each row as if alone)."""
+    try:
+        L = np.linalg.cholesky(mass)
+    except np.linalg.LinAlgError:
+        out = np.full(rhs.shape, np.nan)
+        for k in range(len(mass)):  # only on this path: find the rows without a factor
+            try:
+                L = np.linalg.cholesky(mass[k:k + 1])
+            except np.linalg.LinAlgError:
+                continue
+            y = np.linalg.solve(L, rhs[k:k + 1, :, None])
+            out[k] = np.linalg.solve(np.swapaxes(L, -1, -2), y)[0, :, 0]
+        return out
+    y = np.linalg.solve(L, rhs[..., None])
+    return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
+
+
+__all__ = ["batch_shape", "float_array", "solve_positive", "warn_undefined"]

@@ -8,7 +8,7 @@ IA a = tau - pA, gravity entering as the ground's upward acceleration g."""
 
 from __future__ import annotations
 
-from .tree_emitter import Term, _Emitter
+from .tree_emitter import Term, _cholesky_solve, _Emitter
 
 
 def free_root_motion(v) -> tuple[list[Term], list[Term]]:
@@ -22,8 +22,6 @@ def free_root_acceleration(E: _Emitter, R, A, B, C, pn, pf, tau, up):
     moment). Gives (aw, av), the base's spatial acceleration with the ground's upward g in it
     (what its children read), and q_ddot[:6] = (av - R^T up, aw), the base's own (m/s^2,
     rad/s^2)."""
-    from .tree_algorithms import _cholesky_solve
-
     # unknowns (av, aw) so that the rows read (f, n), tau's order: [[C, B^T], [B, A]]
     block = {}
     for r in range(6):

@@ -33,10 +33,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..model.tree import KinematicTree
-from .free_flyer import QUATERNION_TOLERANCE
-from .joint_models import JOINT_MODELS
-from .tree_c import _SINCOS, _VECTOR
+from ...model.tree import KinematicTree
+from ..emit.tree_c import _SINCOS, _VECTOR
+from ..tree.free_flyer import QUATERNION_TOLERANCE
+from ..tree.joint_models import JOINT_MODELS
 
 _KERNEL = Path(__file__).with_name("derivatives_kernel.c")
 _REGRESSOR = Path(__file__).with_name("derivatives_regressor.c")  # the core's last part
@@ -196,7 +196,7 @@ def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
 def kernel_source():
     """The module's C: derivatives_kernel.c's core on one state and on the lanes, the thread
     count and the bindings; the same for every tree."""
-    from ..compile.codegen import GeneratedSource
+    from ...compile.codegen import GeneratedSource
 
     text = _KERNEL.read_text(encoding="utf-8")
     head, rest = text.split("/* DK_CORE_BEGIN */")
@@ -224,7 +224,7 @@ def kernel_source():
 def applies(tree: KinematicTree | None) -> bool:
     """Whether the kernel takes this tree: revolute and prismatic joints on a fixed base or a
     floating one (a free flyer at the root), of any size."""
-    from ..kinds import JointKind
+    from ...kinds import JointKind
 
     if tree is None or not tree.joints:
         return False
@@ -239,7 +239,7 @@ def applies(tree: KinematicTree | None) -> bool:
 def engine():
     """The one compiled module for every tree (built once per installation, then from the
     verified cache), or None where no compiler works."""
-    from ..compile import compiled
+    from ...compile import compiled
 
     generated = kernel_source()
     key = "\n".join(["derivatives", hashlib.sha256(

@@ -12,8 +12,8 @@ from typing import Protocol
 
 import numpy as np
 
-from ..errors import ModelError
-from ..kinds import JointKind
+from ...errors import ModelError
+from ...kinds import JointKind
 from .free_flyer import FreeFlyerModel
 
 
@@ -66,6 +66,10 @@ class JointModel:
         if self.slides:
             p = t0 + theta[:, None] * (R0 @ u)
         return R, p
+
+
+# the joints of one coordinate each (the compiled kernel of reach_c.py takes only these)
+ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
 
 
 JOINT_MODELS: dict[JointKind, JointModel | FreeFlyerModel] = {

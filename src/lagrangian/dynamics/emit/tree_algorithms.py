@@ -7,9 +7,9 @@ first: the joints read q[7:] and v[6:] by their coordinate, the base its own (_f
 
 from __future__ import annotations
 
-from ..kinds import JointKind
-from ..model.tree import KinematicTree
-from .joint_models import joint_model
+from ...kinds import JointKind
+from ...model.tree import KinematicTree
+from ..tree.joint_models import joint_model
 from .tree_emitter import Term, _Emitter, _Layout
 from .tree_floating import free_root_acceleration, free_root_motion
 
@@ -415,24 +415,3 @@ def _potential_energy(E: _Emitter, tree: KinematicTree, layout: _Layout, q) -> T
 
 
 
-def _cholesky_solve(E: _Emitter, mass: dict, rhs: list) -> list:
-    """x with M x = rhs by M = L L^T, straight-line (zeros of M, e.g. between two branches of
-    the tree, fold away); M given by its lower triangle."""
-    n = len(rhs)
-    L: dict = {}
-    inverse = []
-    for j in range(n):
-        d = E.sub(mass.get((j, j), 0.0), E.sum(E.mul(L[j, k], L[j, k]) for k in range(j)))
-        inverse.append(E.div(1.0, E.call("sqrt", d)))
-        for i in range(j + 1, n):
-            e = E.sub(mass.get((i, j), 0.0), E.sum(E.mul(L[i, k], L[j, k]) for k in range(j)))
-            L[i, j] = E.mul(e, inverse[j])
-        L[j, j] = E.div(1.0, inverse[j])
-    y = []
-    for i in range(n):
-        y.append(E.mul(E.sub(rhs[i], E.sum(E.mul(L[i, k], y[k]) for k in range(i))), inverse[i]))
-    x = [0.0] * n
-    for i in reversed(range(n)):
-        x[i] = E.mul(E.sub(y[i], E.sum(E.mul(L[k, i], x[k]) for k in range(i + 1, n))),
-                     inverse[i])
-    return x

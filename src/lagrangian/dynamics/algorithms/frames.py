@@ -14,14 +14,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError, did_you_mean_or_list
-from ..kinds import JointKind
-from ..model.tree import KinematicTree
-from .free_flyer import BASE_CONFIGURATION, check_quaternions
-from .joint_models import joint_model
-from .numbers import float_array
-
-REFERENCES = ("world", "local", "local_world_aligned")
+from ...errors import InputError, did_you_mean_or_list
+from ...kinds import JointKind
+from ...model.tree import KinematicTree
+from ..tree.free_flyer import BASE_CONFIGURATION, check_quaternions
+from ..tree.joint_models import joint_model
+from ..tree.numbers import float_array
+from .centroidal import REFERENCES, check_reference
 
 
 class TreeKinematics:
@@ -204,13 +203,6 @@ class TreeKinematics:
         from .centroidal import centroidal_momentum_matrix
 
         return centroidal_momentum_matrix(self, q)
-
-
-def check_reference(reference: str) -> None:
-    """A frame Jacobian's reference is one of REFERENCES, else one line naming it."""
-    if reference not in REFERENCES:
-        raise InputError(f"unknown reference '{reference}'; use one of "
-                         f"{', '.join(REFERENCES)}", field="reference")
 
 
 def expressed(J: np.ndarray, R: np.ndarray, p: np.ndarray, reference: str) -> np.ndarray:

@@ -8,10 +8,10 @@ import hashlib
 from functools import lru_cache
 from pathlib import Path
 
-from ..model.tree import KinematicTree
-from .free_flyer import QUATERNION_TOLERANCE
-from .tree_c import dynamics_functions
-from .tree_emitter import VECTOR_LIMIT
+from ...model.tree import KinematicTree
+from ..emit.tree_c import dynamics_functions
+from ..emit.tree_emitter import VECTOR_LIMIT
+from ..tree.free_flyer import QUATERNION_TOLERANCE
 
 # The Python bindings of the batched functions (threads over states, vector lanes): real C.
 # batch_threads.c first: the thread count the three compiled modules' batches share
@@ -34,7 +34,7 @@ _METHODS = " ".join(
 def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
     """The compiled module's C: the recursive functions, lg_parts/lg_energy/lg_residual for
     template.c (simulation, accelerations), and batched bindings for each function."""
-    from ..compile.codegen import TEMPLATE, GeneratedSource
+    from ...compile.codegen import TEMPLATE, GeneratedSource
 
     n = len(tree.coordinates) + tree.base_nv  # v's numbers; q's are RT_NQ (a floating base)
     # vector variants (LG_LANES states at once) for batches up to VECTOR_LIMIT coordinates; a
@@ -97,9 +97,10 @@ static void lg_residual(const double *restrict q, const double *restrict v, doub
 @lru_cache(maxsize=1)
 def _generator_key() -> str:
     """The tree generator itself: a change to any of its files is a new module."""
-    here = Path(__file__).parent
-    files = ("tree_emitter.py", "tree_algorithms.py", "tree_floating.py", "joint_models.py",
-             "tree_c.py", "tree_module.py", "batch_threads.c", "tree_bindings.c")
+    here = Path(__file__).parents[1]  # dynamics/: the generator spans emit/, tree/, engine/
+    files = ("emit/tree_emitter.py", "emit/tree_algorithms.py", "emit/tree_floating.py",
+             "tree/joint_models.py", "emit/tree_c.py", "engine/tree_module.py",
+             "engine/batch_threads.c", "engine/tree_bindings.c")
     return hashlib.sha256(b"".join((here / f).read_bytes() for f in files)).hexdigest()
 
 

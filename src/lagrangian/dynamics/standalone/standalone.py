@@ -16,10 +16,11 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..compile.codegen import CodegenError, CPrinter, c_block, c_comment_text
-from ..derivation.equations import EquationsOfMotion
-from ..model.model import Model
-from ..model.tree import KinematicTree
+from ...compile.codegen import CodegenError, CPrinter, c_block, c_comment_text
+from ...derivation.equations import EquationsOfMotion
+from ...model.model import Model
+from ...model.tree import KinematicTree
+from .standalone_control import renamed_for_c
 
 
 @dataclass(frozen=True)
@@ -36,20 +37,6 @@ def c_prefix(name: str) -> str:
     most 40 characters (a model's name never reaches C as anything else)."""
     text = re.sub(r"[^a-z0-9_]", "_", name.strip().lower()).strip("_")[:40].strip("_") or "model"
     return text if text[0].isalpha() else "m_" + text
-
-
-def renamed_for_c(exprs, rename: dict, fault: str) -> list[sp.Expr]:
-    """The expressions (sympy's, never a user's text) in the C's own names (``rename``: q, v,
-    t and the parameters as q[i], v[i], p[k] or numbers); a symbol outside it refused,
-    ``fault`` naming what is wrong."""
-    out = []
-    for e in exprs:
-        e = sp.sympify(e)  # safe: sympy objects
-        unknown = e.free_symbols - set(rename)
-        if unknown:
-            raise CodegenError(f"{fault} {sorted(map(str, unknown))}")
-        out.append(e.xreplace(rename))
-    return out
 
 
 def standalone_c(eom: EquationsOfMotion, values: dict[str, float], prefix: str | None = None
@@ -240,14 +227,14 @@ def standalone_tree_c(model: Model, tree: KinematicTree, values: dict[str, float
     number of bodies (M quadratic) instead of the expanded equations; with the tree's frames,
     their placements and Jacobians (standalone_frames.py). ``parameters``: the names in the
     C's parameter array (default: the model's)."""
-    from .tree_c import dynamics_functions
+    from ..emit.tree_c import dynamics_functions
 
     if parameters is None:
         parameters = [p.name for p in model.parameters]
     P = prefix or c_prefix(model.name)
     coordinates, velocities = list(tree.coordinates), None
     if tree.floating_base:  # Pinocchio's layout: the base's numbers first (free_flyer.py)
-        from .free_flyer import BASE_CONFIGURATION, BASE_VELOCITY
+        from ..tree.free_flyer import BASE_CONFIGURATION, BASE_VELOCITY
 
         coordinates, velocities = [*BASE_CONFIGURATION, *coordinates], [*BASE_VELOCITY,
                                                                         *coordinates]
@@ -278,8 +265,8 @@ def standalone_for(model: Model, equations: Callable[[], EquationsOfMotion],
     else from the equations ``equations()`` derives; with a [control] table, its laws as
     <prefix>_control and <prefix>_control_forces (standalone_control.py; ``columns``: B's
     columns of inputs on a parameter or a load, simulation.control.input_columns)."""
-    from ..compile.functions import refuse_large_chain
-    from .recursive import TREE_PATH_BODIES, applicable_tree
+    from ...compile.functions import refuse_large_chain
+    from ..tree.applicable import TREE_PATH_BODIES, applicable_tree
 
     tree = applicable_tree(model, values)
     derived = None

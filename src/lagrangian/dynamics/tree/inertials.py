@@ -11,8 +11,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import InputError, did_you_mean
-from ..model.tree import INERTIAL_FIELDS, KinematicTree, with_link_inertials
+from ...errors import InputError, did_you_mean
+from ...model.tree import INERTIAL_FIELDS, KinematicTree, with_link_inertials
 
 
 def split_inertials(tree: KinematicTree | None, parameters: Mapping[str, object] | None,

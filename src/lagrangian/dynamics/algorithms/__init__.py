@@ -1,0 +1,1 @@
+"""The numpy reference recursions over a tree, one family per file."""

@@ -11,13 +11,13 @@ class JointKind(StrEnum):
     """How a joint moves its body, in model files and URDF alike: about its axis (revolute),
     along it (prismatic), by a rotation sequence (spherical), not at all (fixed) or freely in
     space (free_flyer: a URDF robot's floating base). A kinematic tree moves its bodies by the
-    one-degree-of-freedom kinds and the free flyer at its root (dynamics/joint_models.py)."""
+    one-degree-of-freedom kinds and the free flyer at its root (dynamics/tree/joint_models.py)."""
 
     REVOLUTE = "revolute"
     PRISMATIC = "prismatic"
     SPHERICAL = "spherical"
     FIXED = "fixed"
-    # a URDF robot's floating base (dynamics/free_flyer.py): six degrees of freedom, in a tree
+    # a URDF robot's floating base (dynamics/tree/free_flyer.py): six degrees of freedom, in a tree
     # only (a model file's body moves by its coordinates)
     FREE_FLYER = "free_flyer"
 

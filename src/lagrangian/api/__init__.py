@@ -21,10 +21,10 @@ from ..compile.functions import NumericSystem
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.steps import DerivationSteps
 from ..derivation.virtual_work import LoadContribution
-from ..dynamics.frames import TreeKinematics
+from ..dynamics.algorithms.frames import TreeKinematics
 from ..dynamics.joint_space import Dynamics
 from ..dynamics.model_frames import ModelKinematics
-from ..dynamics.standalone import StandaloneSource
+from ..dynamics.standalone.standalone import StandaloneSource
 from ..errors import DerivationError, InputError, LagrangianError, MissingExtraError, ModelError
 from ..kinds import Backend, ConstraintKind, InvariantKind, JointKind, RunStatus
 from ..model.answer import Answer

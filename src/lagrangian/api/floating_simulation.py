@@ -28,7 +28,7 @@ from ..simulation.simulate import at_limit, beyond_limits, exceeded_limits, urdf
 def configuration_rate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """q_dot (nq) of a floating-base state: base position rate R v_lin (m/s, world axes),
     quaternion rate 1/2 q (x) (0, omega) (x y z w; omega in base axes, rad/s), joint rates v."""
-    from ..dynamics.free_flyer import quaternion_matrix
+    from ..dynamics.tree.free_flyer import quaternion_matrix
 
     x, y, z, w = q[3:7]
     wx, wy, wz = v[3:6]
@@ -46,7 +46,7 @@ def floating_start(dynamics, model, initial: Mapping[str, float] | None
                    ) -> tuple[float, np.ndarray, np.ndarray]:
     """(t0, q0, v0) from ``initial``: the base's names (base_x .. base_qw, base_vx .. base_wz),
     the joints' as for a fixed base; the base at rest at the origin unless given (SI)."""
-    from ..dynamics.free_flyer import check_quaternions
+    from ..dynamics.tree.free_flyer import check_quaternions
 
     given = dict(initial or {})
     base_q, base_v = dynamics.coordinates[:7], dynamics.velocity_names[:6]

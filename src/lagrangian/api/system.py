@@ -34,7 +34,7 @@ from ..derivation.regularity import require_inertia
 from ..derivation.steps import DerivationSteps
 from ..dynamics.actuators import actuated
 from ..dynamics.selection import model_dynamics, recursive_dynamics
-from ..dynamics.standalone import StandaloneSource
+from ..dynamics.standalone.standalone import StandaloneSource
 from ..dynamics.tree_at_rest import TreeAtRest
 from ..errors import InputError, LagrangianError, did_you_mean
 from ..model.builder import ModelBuilder
@@ -249,7 +249,7 @@ class System(CheckMethods, ControlMethods, StudyMethods):
         ``prefix`` names the functions (default: from the model's name), ``parameters`` override
         the model's values compiled in as defaults; a [control] table's laws as <prefix>_control
         and <prefix>_control_forces. Write it with ``lagrangian.output.files.write_c(code, dir)``."""
-        from ..dynamics.standalone import c_prefix, standalone_for
+        from ..dynamics.standalone.standalone import c_prefix, standalone_for
         from ..simulation.control import input_columns  # B of a [control] table's inputs
 
         if prefix is not None and c_prefix(prefix) != prefix:
@@ -312,9 +312,9 @@ class System(CheckMethods, ControlMethods, StudyMethods):
         the model's own loads (dynamics/joint_space.py). A URDF robot runs recursive algorithms in
         generated C (dynamics/recursive.py; in numpy without a compiler or with backend
         "numpy"), the other models their derived equations. A URDF robot's ``parameters`` may
-        set a link's inertial (``{"tool0.mass": 2.5}``, dynamics/inertials.py) without a
+        set a link's inertial (``{"tool0.mass": 2.5}``, dynamics/tree/inertials.py) without a
         rebuild; ``kernel`` "unrolled" (the tree's own code), "compact" (one module for every
-        tree) or "auto" (by the tree's size, dynamics/compact_kernel.py). ``actuators=True``
+        tree) or "auto" (by the tree's size, dynamics/engine/compact_kernel.py). ``actuators=True``
         adds the URDF's joint damping and friction, ``armature`` {joint: kg m^2 or kg} to M
         (dynamics/actuators.py)."""
         if parameters is None and backend == "auto" and kernel == "auto" \

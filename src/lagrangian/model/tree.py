@@ -8,7 +8,7 @@ Each moving body hangs from its parent body (or the ground) by one revolute or p
 with theta = k q[c] + offset (k = 1, offset = 0 except for a mimic joint). A floating base is a
 free-flyer joint at the root (joints[0], parent -1, kind free_flyer): the base link's body, moved
 by the configuration's first 7 numbers (position, quaternion x y z w) and the velocity's first 6
-(dynamics/free_flyer.py); the other joints' numbers follow, q[7 + c] and v[6 + c]. Fixed and locked
+(dynamics/tree/free_flyer.py); the other joints' numbers follow, q[7 + c] and v[6 + c]. Fixed and locked
 joints are folded into R_0, t_0 of the next joint down, and the links they carry into the
 inertia of the moving body above them. A body's inertia is (m, h = m c, J_O): mass (kg), first
 moment about its frame's origin (kg m) and inertia tensor about that origin (kg m^2), in its
@@ -150,7 +150,7 @@ class KinematicTree:
     # The model's rigid bodies built from the same joints: a model whose bodies are not these
     # (edited after reading) is not described by this tree.
     rigid_bodies: tuple = field(default=(), compare=False, repr=False)
-    # Every link and joint frame, for placements and Jacobians (dynamics/frames.py); not part of
+    # Every link and joint frame, for placements and Jacobians (dynamics/algorithms/frames.py); not part of
     # the tree's identity (the dynamics, and the compiled module's key, do not depend on them).
     frames: tuple[TreeFrame, ...] = field(default=(), compare=False, repr=False)
     # Every link with an inertial (TreeLink): its mass, centre of mass and inertia are the

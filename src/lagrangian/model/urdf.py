@@ -16,7 +16,7 @@ equations, as Pinocchio does: M, C q_dot and g are the rigid-body terms a contro
 dynamics(actuators=True) adds them (dynamics/actuators.py).
 
 The root link is bolted to the world unless ``floating_base``: then a free-flyer joint carries it
-(its kinematic tree's first joint, dynamics/free_flyer.py), as Pinocchio's
+(its kinematic tree's first joint, dynamics/tree/free_flyer.py), as Pinocchio's
 ``buildModelFromUrdf(path, JointModelFreeFlyer())``. A URDF ``floating`` joint from the root link
 is read the same way (its origin the free flyer's placement). A floating base lives in the tree
 only: the model's coordinates and rigid bodies are the joints', and deriving its equations is

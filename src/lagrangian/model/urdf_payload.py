@@ -4,7 +4,7 @@ of the link's frame (m), as if the file had one more link on a fixed joint carry
 
 ``{"tool0": 2.5}`` puts 2.5 kg at the link's origin; ``{"tool0": (2.5, (0, 0, 0.1))}`` 10 cm
 along its z axis. The robot's tree changes; its dynamics run on the compact kernel
-(dynamics/compact_kernel.py), which takes the tree's numbers at run time: no rebuild.
+(dynamics/engine/compact_kernel.py), which takes the tree's numbers at run time: no rebuild.
 """
 
 from __future__ import annotations

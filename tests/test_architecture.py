@@ -153,3 +153,13 @@ def test_rooms_stay_small():
             folders[name.split("/")[0]] = folders.get(name.split("/")[0], 0) + n
     crowded = {folder: f"{n / total:.1%}" for folder, n in folders.items() if n > 0.2 * total}
     assert not crowded, crowded
+
+
+def test_one_integrator_stage():
+    """Every integration of the equations of motion (a floating base's on SE(3) too) is in
+    simulation/: no other module steps an ODE with scipy."""
+    outside = [path.relative_to(PACKAGE) for path in PACKAGE.rglob("*.py")
+               if "simulation" not in path.relative_to(PACKAGE).parts
+               and re.search(r"scipy\.integrate|from scipy import integrate",
+                             path.read_text(encoding="utf-8"))]
+    assert outside == []

@@ -211,8 +211,8 @@ class System(CheckMethods, ControlMethods, StudyMethods):
         is the n joint torques or all n + 6 entries, the base's wrench first, and
         ``stop_when`` may name the base's numbers (base_z, base_vz, ...)."""
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
-        if tree and self._floating:  # q (+) v dt on SE(3): api/floating_simulation.py
-            from .floating_simulation import simulate_floating
+        if tree and self._floating:  # q (+) v dt on SE(3): simulation/floating.py
+            from ..simulation.floating import simulate_floating
 
             step_control, save_at = run_options(step_control, save_at, method, rtol, atol,
                                                 samples, 1001)

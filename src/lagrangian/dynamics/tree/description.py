@@ -10,7 +10,7 @@ The description ``D`` (float64, contiguous), built by ``describe``:
     floating base (body 0 on a free flyer: q of n + 7 numbers, v of n + 6, free_flyer.py's
     layout), D[7] the quaternion-norm tolerance (free_flyer.QUATERNION_TOLERANCE);
     D[8:8+n] the actuator parameters tau_<joint> (N m or N), acting as loads;
-    then nb records of STRIDE = 40 numbers, parent first (parent < own index):
+    then nb records of STRIDE = 64 numbers, parent first (parent < own index):
       0 parent (-1 the ground)  1 kind code (JOINT_CODES)  2 coordinate index c
       3 multiplier k  4 offset (theta = k q[c] + offset)  5:14 R0 (joint -> parent axes,
       row-major)  14:17 t0 (m)  17:20 unit axis u (joint axes)  20 mass (kg)

@@ -17,13 +17,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InputError
 from ...kinds import JointKind
+
+# the quaternions' numbers are the model's (simulation integrates them too): re-exported here
+from ...model.quaternions import QUATERNION_TOLERANCE, check_quaternions, quaternion_matrix
 
 BASE_CONFIGURATION = ("base_x", "base_y", "base_z", "base_qx", "base_qy", "base_qz", "base_qw")
 BASE_VELOCITY = ("base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz")
-# |quaternion| may differ from 1 by this much (float32 data are ~6e-8 off); beyond, refused.
-QUATERNION_TOLERANCE = 1e-6
 # The six columns of S: linear velocity e_k per unit (k = 0..2), then angular e_k.
 _UNIT = np.eye(3)
 
@@ -44,17 +44,6 @@ class FreeFlyerModel:
         """R (N, 3, 3) and p (N, 3) of the base in its parent for configurations q7 (N, 7)."""
         R = quaternion_matrix(q7[:, 3:7])
         return R0 @ R, t0 + q7[:, :3] @ np.asarray(R0).T
-
-
-def quaternion_matrix(quaternion) -> np.ndarray:
-    """The rotation (..., 3, 3) of quaternions (..., 4) in the order x, y, z, w, normalized."""
-    quaternion = np.asarray(quaternion, dtype=float)
-    x, y, z, w = np.moveaxis(quaternion / np.linalg.norm(quaternion, axis=-1, keepdims=True),
-                             -1, 0)
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1)], -2)
 
 
 def matrix_quaternion(R) -> np.ndarray:
@@ -142,22 +131,6 @@ def checking_quaternions(function):
             check_quaternions(flat)
         return function(q, *rest)
     return checked
-
-
-def check_quaternions(Q: np.ndarray, field: str = "q") -> None:
-    """Refuse, in one line, a configuration (N, nq) whose base quaternion (entries 3..6) has a
-    norm off 1 by more than QUATERNION_TOLERANCE; a state whose q is not all finite is not
-    refused (its row of every function is NaN, as the compiled modules give)."""
-    with np.errstate(invalid="ignore", over="ignore"):
-        norms = np.linalg.norm(Q[:, 3:7], axis=-1)
-    finite = np.isfinite(Q).all(axis=-1)
-    bad = np.flatnonzero(finite & (np.abs(norms - 1.0) > QUATERNION_TOLERANCE))
-    if bad.size:
-        raise InputError(
-            f"the base quaternion (base_qx, base_qy, base_qz, base_qw) has norm "
-            f"{norms[bad[0]]:.9g}" + (f" in state {bad[0]}" if len(Q) > 1 else "")
-            + f"; a unit quaternion is needed (|q| within {QUATERNION_TOLERANCE:g} of 1)",
-            field=field)
 
 
 def integrate(Q: np.ndarray, V: np.ndarray) -> np.ndarray:

@@ -16,20 +16,19 @@ import numpy as np
 
 from ..errors import InputError, did_you_mean
 from ..kinds import InvariantKind, RunStatus
+from ..model.quaternions import check_quaternions, quaternion_matrix
 from ..model.values import resolve_state
-from ..simulation.events import StopCondition, parse_stop_condition
-from ..simulation.integration_loops import LoopRun, crossing_time
-from ..simulation.invariants import cumulative_work
-from ..simulation.options import SaveAt, StepControl
-from ..simulation.result import STATUS_MESSAGES, SimulationResult
-from ..simulation.simulate import at_limit, beyond_limits, exceeded_limits, urdf_limits
+from .events import StopCondition, parse_stop_condition
+from .integration_loops import LoopRun, crossing_time
+from .invariants import cumulative_work
+from .options import SaveAt, StepControl
+from .result import STATUS_MESSAGES, SimulationResult
+from .simulate import at_limit, beyond_limits, exceeded_limits, urdf_limits
 
 
 def configuration_rate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """q_dot (nq) of a floating-base state: base position rate R v_lin (m/s, world axes),
     quaternion rate 1/2 q (x) (0, omega) (x y z w; omega in base axes, rad/s), joint rates v."""
-    from ..dynamics.tree.free_flyer import quaternion_matrix
-
     x, y, z, w = q[3:7]
     wx, wy, wz = v[3:6]
     rate = np.empty(len(q))
@@ -46,8 +45,6 @@ def floating_start(dynamics, model, initial: Mapping[str, float] | None
                    ) -> tuple[float, np.ndarray, np.ndarray]:
     """(t0, q0, v0) from ``initial``: the base's names (base_x .. base_qw, base_vx .. base_wz),
     the joints' as for a fixed base; the base at rest at the origin unless given (SI)."""
-    from ..dynamics.tree.free_flyer import check_quaternions
-
     given = dict(initial or {})
     base_q, base_v = dynamics.coordinates[:7], dynamics.velocity_names[:6]
     q_base = dict(zip(base_q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0), strict=True))

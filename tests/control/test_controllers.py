@@ -177,3 +177,17 @@ def test_lqr_from_the_modes_linearization_is_the_same_and_balances(cart_pole, up
     assert np.abs(from_modes.state(run.q[-1], run.q_dot[-1])).max() < 1e-2
     with pytest.raises(InputError, match="modes"):
         lqr(cart_pole.modes(UPRIGHT), [1, 10, 1, 1], 0.1)
+
+
+def test_computed_torque_on_a_floating_base_is_refused_in_one_line(cli):
+    """tau = M q_ddot_d + b would command the base's wrench, which nothing applies: refused,
+    in Python and on the command line (was a numpy shapes error, q of 9 against v of 8)."""
+    pytest.importorskip("yourdfpy")
+    robot = lagrangian.load("two_link_arm", floating_base=True)
+    with pytest.raises(ModelError, match="computed torque needs every coordinate actuated"):
+        lagrangian.computed_torque(robot, np.zeros(9), 100.0, 20.0)
+    code, out, err = cli("simulate", "two_link_arm", "--floating-base", "--control",
+                         "computed-torque", "--t-end", "0.1")
+    assert code == 2 and out == ""
+    (line,) = err.strip().splitlines()
+    assert line.startswith("error: --floating-base: computed torque needs every coordinate")

@@ -64,6 +64,13 @@ def computed_torque(system, q_des, Kp, Kd) -> ComputedTorque:
     if constraints:  # M q_ddot = tau - bias would ignore the constraint forces
         raise ModelError(f"computed torque needs a model without constraints (this one has "
                          f"{len(constraints)}: {', '.join(constraints)})", field="constraints")
+    if getattr(dynamics, "velocity_names", None) is not None:
+        # tau = M(q) q_ddot_d + b commands all nv forces, the base's wrench among them: a
+        # floating base's simulation takes the joints' forces only (nothing pushes the base)
+        raise ModelError("computed torque needs every coordinate actuated, and a floating "
+                         "base's six are not (its wrench is the contacts'); load the robot "
+                         "with a fixed base, or close the loop with a controller of the "
+                         "joints (t, q, v) -> u", field="floating_base")
     names = tuple(dynamics.coordinates)
     n = len(names)
     Kp = square_matrix(Kp, n, "Kp", definite=True)

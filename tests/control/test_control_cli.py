@@ -37,6 +37,13 @@ def test_lqr_from_the_command_line_balances_the_cart_pole(cli):
      "error: --Q: expected a number, 4 diagonal entries or a 4 x 4 matrix"),
     (["--control", "lqr", "--about", "theta=pi", "--inputs", "F", "--R", "a"],
      "error: --R: expected a number or comma-separated numbers"),
+    # weights whose squares overflow: refused by size, not a LinAlgError traceback
+    (["--control", "lqr", "--about", "theta=pi", "--inputs", "F", "--Q", "1e308"],
+     "error: --Q: an entry of 1e+308 is too large (at most 1e+100"),
+    (["--control", "lqr", "--about", "theta=pi", "--inputs", "F", "--Q", "1e99"],
+     "error: --Q: no stabilizing Riccati solution"),
+    (["--control", "computed-torque", "--kp", "1e200"],
+     "error: --kp: an entry of 1e+200 is too large"),
 ])
 def test_bad_control_flags_are_one_line_errors(cli, flags, message):
     result = cli("simulate", "cart_pendulum", "--t-end", "1", *flags)

@@ -6,6 +6,8 @@ import numpy as np
 
 from ..errors import InputError
 
+LARGEST_ENTRY = 1e100  # a weight's or gain's entry; its square stays far inside double range
+
 
 def square_matrix(value, size: int, field: str, *, definite: bool = False) -> np.ndarray:
     """A size x size symmetric matrix from a number, a diagonal of ``size`` numbers or a
@@ -20,6 +22,12 @@ def square_matrix(value, size: int, field: str, *, definite: bool = False) -> np
                          f"matrix, got shape {np.shape(value)}", field=field)
     if not np.all(np.isfinite(array)):
         raise InputError("entries must be finite numbers", field=field)
+    if np.abs(array).max(initial=0.0) > LARGEST_ENTRY:
+        # the Riccati and eigenvalue solvers square and multiply the weights: 1e308 overflowed
+        # into eigenvalues that did not converge; only the ratio of Q to R matters
+        raise InputError(f"an entry of {float(np.abs(array).max()):.3g} is too large (at most "
+                         f"{LARGEST_ENTRY:g}; scale the weights together, only their ratio "
+                         "matters)", field=field)
     scale = max(float(np.abs(array).max()), 1e-300)
     if not np.allclose(array, array.T, rtol=0, atol=1e-12 * scale):
         raise InputError("the matrix must be symmetric", field=field)

@@ -7,6 +7,8 @@ x = [z - z0; z_dot] in the linear model's coordinates z about its equilibrium z0
 
 from __future__ import annotations
 
+import warnings
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -99,12 +101,17 @@ def lqr(linear_model: LinearModel, Q, R) -> LQR:
     R = square_matrix(R, width, "R", definite=True)
     _require_stabilizable(A, B, model.inputs)
     try:
-        S = scipy.linalg.solve_continuous_are(A, B, Q, R)
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")  # a failing solve warns first: the refusal says it
+            S = scipy.linalg.solve_continuous_are(A, B, Q, R)
     except (np.linalg.LinAlgError, ValueError) as exc:
         raise InputError(f"no stabilizing Riccati solution ({exc}); Q must weigh every "
                          "unstable mode", field="Q") from None
-    K = np.linalg.solve(R, B.T @ S)
-    closed = np.linalg.eigvals(A - B @ K)
+    try:
+        K = np.linalg.solve(R, B.T @ S)
+        closed = np.linalg.eigvals(A - B @ K)
+    except np.linalg.LinAlgError:  # a solution too ill-conditioned to trust: refused as one
+        closed = np.array([np.nan])
     if not np.all(closed.real < 0):
         raise InputError("the Riccati solution does not stabilize (A, B): Q must weigh every "
                          "unstable mode", field="Q")

@@ -8,7 +8,6 @@ x = [z - z0; z_dot] in the linear model's coordinates z about its equilibrium z0
 from __future__ import annotations
 
 import warnings
-
 from dataclasses import dataclass
 
 import numpy as np

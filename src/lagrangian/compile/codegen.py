@@ -18,6 +18,7 @@ from sympy.codegen.rewriting import create_expand_pow_optimization, optimize
 from sympy.printing.c import C99CodePrinter
 
 from ..derivation.equations import EquationsOfMotion
+from .exact import machine_numbers
 
 TEMPLATE = Path(__file__).with_name("template.c")
 
@@ -172,7 +173,8 @@ def _statements(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: CPrin
                 ) -> list[tuple[str | None, str, str, bool]]:
     """(name of a shared subexpression or None, target, C expression, constant?) computing
     ``targets[i] = exprs[i]`` with shared subexpressions hoisted."""
-    exprs = _fewer_trig_calls([sp.sympify(e) for e in exprs])  # safe: already sympy objects
+    # exact numbers as doubles before cse, which would split p/q into p and 1/q
+    exprs = _fewer_trig_calls([machine_numbers(sp.sympify(e)) for e in exprs])
     optimizations = "basic" if _basic_cse_pays(exprs) else None
     replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"),
                                    optimizations=optimizations)

@@ -14,6 +14,7 @@ import sympy as sp
 
 from ..model.expressions import as_expression
 from ..model.model import Model
+from .exact import machine_numbers
 
 # Common-subexpression elimination pays for big expressions only: on a large sparse model
 # (mostly short, independent entries) it costs more than it saves.
@@ -24,7 +25,8 @@ def numpy_function(args: Sequence[sp.Symbol], exprs: sp.Expr | Sequence[sp.Expr]
     """One numpy function of ``args`` returning ``exprs`` (a list, or one value for one
     expression); cse when the expressions are big enough to share work."""
     many = not isinstance(exprs, sp.Basic)
-    items = [as_expression(e) for e in exprs] if many else [as_expression(exprs)]
+    items = [machine_numbers(as_expression(e)) for e in exprs] if many \
+        else [machine_numbers(as_expression(exprs))]
     cse = operations_exceed(items, CSE_MIN_OPERATIONS)
     return sp.lambdify(list(args), items if many else items[0], modules="numpy", cse=cse)
 

@@ -17,7 +17,7 @@ import sympy as sp
 from ..model.expressions import format_expression
 from ..model.model import Body, Damper, Model, Particle, PointForce, Spring, Torque, multiplier_name
 from ..model.rotations import Moment, RigidBody
-from ..model.units import generalized_force_unit, is_angle_unit, registry
+from ..model.units import UnitOutsideTable, generalized_force_unit, is_angle_unit, registry, si_dimension
 
 ENERGY = "J"
 POWER = "W"
@@ -69,16 +69,19 @@ def quantity(unit: str | None):
         return None
 
 
-def symbol_units(model: Model) -> dict[sp.Symbol, object]:
-    """Symbol -> unit quantity (None: unknown) for parameters, coordinates and their rates."""
-    ureg = registry()
-    second = ureg.Quantity(1, "s")
+def symbol_units(model: Model, quantity_of=None) -> dict[sp.Symbol, object]:
+    """Symbol -> unit quantity (None: unknown) for parameters, coordinates and their rates;
+    pint's quantities, or ``quantity_of``'s (si_dimension: UnitOutsideTable past its table)."""
+    if quantity_of is None:
+        quantity_of, second = quantity, registry().Quantity(1, "s")
+    else:
+        second = quantity_of("s")
     units: dict[sp.Symbol, object] = {model.time: second}
     for p in model.parameters:
-        units[p.symbol] = quantity(p.unit)
+        units[p.symbol] = quantity_of(p.unit)
     for c in model.coordinates:
         # Radians are dimensionless: sin(theta) is fine and theta_dot is 1/s.
-        q = quantity("" if is_angle_unit(c.unit) or not c.unit else c.unit)
+        q = quantity_of("" if is_angle_unit(c.unit) or not c.unit else c.unit)
         units[c.symbol] = q
         units[c.velocity] = None if q is None else q / second
         units[c.acceleration] = None if q is None else q / second**2
@@ -92,6 +95,8 @@ def describe(q) -> str:
         return "unknown units"
     if q.dimensionless:
         return "no units (dimensionless)"
+    if not hasattr(q, "units"):  # a table Dimension: its report is never shown (pint redoes it)
+        return str(q.dimensionality)
     text = f"{q.units:~C}"
     return text.replace("**", "^")
 
@@ -104,17 +109,18 @@ MAX_REPEATED_ISSUES = 10_000
 class DimensionChecker:
     """Walks a sympy expression, returning its dimension and collecting inconsistencies."""
 
-    def __init__(self, units: Mapping[sp.Symbol, object]):
+    def __init__(self, units: Mapping[sp.Symbol, object], quantity_of=None):
         self.units = units
         self.issues: list[UnitIssue] = []
-        self._one = registry().Quantity(1)
+        self._quantity = quantity_of or quantity
+        self._one = registry().Quantity(1) if quantity_of is None else quantity_of("")
         self._memo: dict = {}
 
     def check(self, item: str, expression: sp.Expr, expected: str | None = None,
               what: str = "") -> None:
         """Record every inconsistent term of ``expression``; with ``expected``, every term whose
         dimension differs from it (``what`` names the expected quantity, e.g. 'an energy')."""
-        target = quantity(expected) if expected is not None else None
+        target = self._quantity(expected) if expected is not None else None
         terms = sp.Add.make_args(expression) if target is not None else (expression,)
         for term in terms:
             if term.is_Number:
@@ -250,8 +256,25 @@ def _same(a, b) -> bool:
 
 
 def check_model_units(model: Model) -> UnitsReport:
-    """Every dimensionally inconsistent term of the model: T, V, D, components, loads, Q."""
-    checker = DimensionChecker(symbol_units(model))
+    """Every dimensionally inconsistent term of the model: T, V, D, components, loads, Q.
+
+    Every `derive` of a model file runs this (its warnings), and pint's import and registry
+    were a third of a small command's time: a model whose units all lie in the exact SI table
+    (si_dimension) is judged without pint. pint judges it again whenever the table meets a unit
+    outside it or finds an issue (the messages name units as pint writes them), so every
+    report is pint's own.
+    """
+    try:
+        report = _check_model_units(model, si_dimension)
+    except UnitOutsideTable:
+        report = None
+    if report is None or report.issues:
+        report = _check_model_units(model, None)
+    return report
+
+
+def _check_model_units(model: Model, quantity_of) -> UnitsReport:
+    checker = DimensionChecker(symbol_units(model, quantity_of), quantity_of)
     c = checker.check
     if model.kinetic_energy != 0:
         c("T", model.kinetic_energy, ENERGY, "an energy")

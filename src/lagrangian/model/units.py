@@ -22,12 +22,120 @@ _SI_UNITS = frozenset({"m", "kg", "s", "rad", "N", "J", "W", "N*m", "m/s", "m/s^
                        "rad/s^2", "kg*m^2", "N/m", "N*s/m", "N*m/rad", "N*m*s/rad"})
 
 
+# The dimensions (pint's names) of the units model files use most, exactly as pint gives them
+# for a quantity in base units: the units check of every `derive` runs on these without pint.
+_L, _M, _T = "[length]", "[mass]", "[time]"
+_SI_DIMENSIONS = {
+    "": {}, "1": {}, "rad": {}, "deg": {}, "m": {_L: 1}, "kg": {_M: 1}, "s": {_T: 1},
+    "N": {_L: 1, _M: 1, _T: -2}, "J": {_L: 2, _M: 1, _T: -2}, "W": {_L: 2, _M: 1, _T: -3},
+    "N*m": {_L: 2, _M: 1, _T: -2}, "m/s": {_L: 1, _T: -1}, "m/s^2": {_L: 1, _T: -2},
+    "rad/s": {_T: -1}, "rad/s^2": {_T: -2}, "kg*m^2": {_L: 2, _M: 1}, "N/m": {_M: 1, _T: -2},
+    "N*s/m": {_M: 1, _T: -1}, "N*m/rad": {_L: 2, _M: 1, _T: -2},
+    "N*m*s/rad": {_L: 2, _M: 1, _T: -1},
+}
+
+
+class UnitOutsideTable(LookupError):
+    """A unit the exact SI table does not hold: pint must judge it."""
+
+
+class Dimension:
+    """The dimension of a quantity in base units, as pint's ``dimensionality`` (exponents by
+    pint's base names, zeros dropped), with the arithmetic the units check does on it: the same
+    float operations in the same order as pint's, so every comparison comes out the same."""
+
+    __slots__ = ("dimensionality",)
+
+    def __init__(self, dimensionality: dict):
+        self.dimensionality = dimensionality
+
+    @property
+    def dimensionless(self) -> bool:
+        return not self.dimensionality
+
+    def _combined(self, other: Dimension, sign: int) -> Dimension:
+        result = dict(self.dimensionality)
+        for name, exponent in other.dimensionality.items():
+            total = result.get(name, 0) + exponent if sign > 0 else result.get(name, 0) - exponent
+            if total == 0:
+                result.pop(name, None)
+            else:
+                result[name] = total
+        return Dimension(result)
+
+    def __mul__(self, other: Dimension) -> Dimension:
+        return self._combined(other, 1)
+
+    def __truediv__(self, other: Dimension) -> Dimension:
+        return self._combined(other, -1)
+
+    def __pow__(self, power: float) -> Dimension:
+        if power == 0:
+            return Dimension({})
+        return Dimension({name: exponent * power for name, exponent in self.dimensionality.items()})
+
+
+def si_dimension(unit: str | None) -> Dimension | None:
+    """The dimension of ``unit`` from the exact table (None: no unit, an unknown dimension);
+    UnitOutsideTable for any other unit."""
+    if unit is None:
+        return None
+    found = _SI_DIMENSIONS.get(unit)
+    if found is None:
+        raise UnitOutsideTable(unit)
+    return Dimension(dict(found))
+
+
 @functools.cache
 def registry():
-    """The shared pint unit registry (imported lazily: pint is slow to import)."""
-    import pint
+    """The shared pint unit registry (imported lazily: pint is slow to import).
 
+    Every `derive` of a model file reaches it (the units warnings), so its start-up cost is
+    every small command's: the parsed definitions are kept in the cache directory (parsing
+    them is 0.35 s, loading them 0.02 s), and pint is imported without dask (below).
+    """
+    pint = _import_pint()
+    folder = _pint_cache_folder()
+    if folder is not None:
+        try:
+            return pint.UnitRegistry(autoconvert_offset_to_baseunit=True, cache_folder=folder)
+        except Exception:  # noqa: BLE001 - a cache file half-written by a process beside us, or
+            pass  # an unreadable one: the registry is parsed afresh, as without a cache
     return pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
+
+
+def _import_pint():
+    """pint, imported with dask hidden when dask is not loaded yet: pint.compat imports
+    dask.base (0.13 s, with psutil and jinja2) only to let quantities wrap dask arrays, which
+    nothing here makes. A process that has imported dask already (xarray's sweeps) keeps it."""
+    import sys
+
+    if "pint" in sys.modules or "dask" in sys.modules:
+        import pint
+
+        return pint
+    sys.modules["dask"] = None  # find_spec and import both read None as "not installed"
+    try:
+        import pint
+    finally:
+        if sys.modules.get("dask", "") is None:
+            del sys.modules["dask"]
+    return pint
+
+
+def _pint_cache_folder():
+    """A folder for pint's parsed definitions inside the trusted cache directory (pint keeps
+    them as pickles, which are code: only a directory no one else can write is used), or None
+    (no cache: the registry is parsed each time)."""
+    from ..compile.compiled import trusted_cache_dir
+    from ..errors import LagrangianError
+
+    try:
+        folder = trusted_cache_dir() / "pint"
+        folder.mkdir(mode=0o700, exist_ok=True)
+    except (LagrangianError, OSError):
+        return None
+    return folder
 
 
 def unit_syntax_problem(text: str) -> str | None:

@@ -68,7 +68,8 @@ ONLY_WITH_ANIMATE = {"size": "a frame size is", "fps": "frames a second are",
                      "mode": "a mode number is", "view": "a viewpoint is"}
 SIZE_HELP = "Frame size of the animation in pixels, WIDTHxHEIGHT (default 400x400 a drawing)."
 FPS_HELP = "Frames a second of the animation (1 to 120)."
-LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
+LOCK_HELP = ("URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeat, or join with "
+             "commas (a=0,b=0).")
 PAYLOAD_HELP = ("URDF: a point mass fixed to a link, LINK=MASS[@X,Y,Z] (kg; m in the link's "
                 "frame, default its origin); repeatable.")
 FLOATING_HELP = ("URDF: a free-flyer joint under the root link (a robot that walks or flies): q is "
@@ -97,8 +98,9 @@ def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = 
     later --set g=... rescales that vector's magnitude)."""
     from .. import load, parse_quantity
 
+    # --lock a=0,b=0 as --lock a=0 --lock b=0, as --set reads a comma list
     locked = {name: parse_quantity(text, None, f"--lock {name}")
-              for name, text in assignments(lock, "--lock")}
+              for name, text in assignments(comma_separated(lock), "--lock")}
     carried = payloads(payload)
     freed = {"floating_base": True} if floating_base else {}
     with warnings.catch_warnings(record=True) as seen:  # what the reader left out, one line each

@@ -90,17 +90,12 @@ def si_dimension(unit: str | None) -> Dimension | None:
 def registry():
     """The shared pint unit registry (imported lazily: pint is slow to import).
 
-    Every `derive` of a model file reaches it (the units warnings), so its start-up cost is
-    every small command's: the parsed definitions are kept in the cache directory (parsing
-    them is 0.35 s, loading them 0.02 s), and pint is imported without dask (below).
+    A model whose units are all in the exact SI table never reaches it (check/units.py); for
+    the others pint is imported without dask (below). pint's on-disk cache of its parsed
+    definitions is not used: it is pickles (code), and the model stage knows no trusted cache
+    directory (that is the compile stage's).
     """
     pint = _import_pint()
-    folder = _pint_cache_folder()
-    if folder is not None:
-        try:
-            return pint.UnitRegistry(autoconvert_offset_to_baseunit=True, cache_folder=folder)
-        except Exception:  # noqa: BLE001 - a cache file half-written by a process beside us, or
-            pass  # an unreadable one: the registry is parsed afresh, as without a cache
     return pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
 
 
@@ -121,21 +116,6 @@ def _import_pint():
         if sys.modules.get("dask", "") is None:
             del sys.modules["dask"]
     return pint
-
-
-def _pint_cache_folder():
-    """A folder for pint's parsed definitions inside the trusted cache directory (pint keeps
-    them as pickles, which are code: only a directory no one else can write is used), or None
-    (no cache: the registry is parsed each time)."""
-    from ..compile.compiled import trusted_cache_dir
-    from ..errors import LagrangianError
-
-    try:
-        folder = trusted_cache_dir() / "pint"
-        folder.mkdir(mode=0o700, exist_ok=True)
-    except (LagrangianError, OSError):
-        return None
-    return folder
 
 
 def unit_syntax_problem(text: str) -> str | None:

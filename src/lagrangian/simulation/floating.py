@@ -23,7 +23,7 @@ from .integration_loops import LoopRun, crossing_time
 from .invariants import cumulative_work
 from .options import SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
-from .simulate import at_limit, beyond_limits, exceeded_limits, urdf_limits
+from .simulate import at_limit, beyond_limits, check_start_within, exceeded_limits, urdf_limits
 
 
 def configuration_rate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -156,6 +156,7 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
         stop = floating_stop_condition(stop, dynamics, model)
     joint_limits = urdf_limits(model, positions=limits)
     t0, q0, v0 = floating_start(dynamics, model, initial)
+    check_start_within(joint_limits, q0[7:])  # the joints' numbers follow the base's seven
     if not (np.isfinite(t_end) and t_end > t0):
         raise InputError(f"the end time ({t_end} s) must be after the start time ({t0} s)",
                          field="t_end")

@@ -35,7 +35,7 @@ from .options import METHODS, SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["METHODS", "STATUS_MESSAGES", "JointLimit", "SaveAt", "SimulationResult", "StepControl",
-           "StopCondition", "at_limit", "beyond_limits", "exceeded_limits", "model_law",
+           "StopCondition", "at_limit", "beyond_limits", "check_start_within", "exceeded_limits", "model_law",
            "parse_stop_condition", "simulate", "urdf_limits"]
 
 DEFAULT_STEP_CONTROL = StepControl()  # DOP853, rtol = atol = 1e-9
@@ -104,6 +104,7 @@ def simulate(
     power_terms = StateFunction(model, forces, substitution)
 
     q0, v0, projected = start.q_array(), start.q_dot_array(), {}
+    check_start_within(positioned, q0)
     if drift is not None:
         q0, v0, projected = _project_start(drift, start)
 
@@ -292,6 +293,22 @@ def exceeded_limits(limits: Sequence[JointLimit], parameters: Mapping[str, float
                         "limit": limit.effort, "value": float(abs(value)), "t": None,
                         "unit": "N" if limit.unit == "m" else "N m"})
     return tuple(out)
+
+
+def check_start_within(limits: Sequence[JointLimit], q: np.ndarray) -> None:
+    """Refuse, in one line, a start beyond a joint's position limit (the event fires only on a
+    crossing, so such a run went on without a word): the joint, its value and its limit."""
+    for limit in limits:
+        if limit.lower is None or limit.upper is None:
+            continue
+        x = float(q[limit.coordinate])
+        if not limit.lower <= x <= limit.upper:
+            side, bound = ("below", limit.lower) if x < limit.lower else ("above", limit.upper)
+            raise InputError(
+                f"joint '{limit.joint}' ({limit.name}) starts at {x:.6g}, {side} its position "
+                f"limit {bound:.6g} (range {limit.lower:.6g} to {limit.upper:.6g}); start it "
+                "inside, or run with the position limits ignored",
+                field="initial")
 
 
 def beyond_limits(limits: Sequence[JointLimit]):

@@ -18,7 +18,7 @@ from sympy.codegen.rewriting import create_expand_pow_optimization, optimize
 from sympy.printing.c import C99CodePrinter
 
 from ..derivation.equations import EquationsOfMotion
-from .exact import machine_numbers
+from .exact import distinct_nodes, machine_numbers
 
 TEMPLATE = Path(__file__).with_name("template.c")
 
@@ -97,17 +97,7 @@ def _split_angle_pair(e):
     return sp.cos(a) * sp.cos(b) - sp.sin(a) * sp.sin(b)
 
 
-def _nodes(exprs) -> set:
-    """Every distinct sub-expression, each visited once (sympy's own walks visit a shared
-    sub-expression once per occurrence: exponential in the depth of nested rotations)."""
-    seen: set = set()
-    stack = list(exprs)
-    while stack:
-        e = stack.pop()
-        if e not in seen:
-            seen.add(e)
-            stack.extend(e.args)
-    return seen
+_nodes = distinct_nodes  # every distinct sub-expression, each once
 
 
 def _trig_calls(exprs) -> int:

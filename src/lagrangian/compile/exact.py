@@ -28,7 +28,7 @@ def machine_numbers(expr: sp.Expr) -> sp.Expr:
     if not isinstance(expr, sp.Basic):
         return expr
     swaps = {}
-    for node in _distinct(expr):
+    for node in distinct_nodes([expr]):
         if node.is_Rational and (abs(node.p) > LARGEST_EXACT or node.q > LARGEST_EXACT):
             swaps[node] = _double(node)
         elif node.is_Pow and node.args[0].is_Rational and node.args[1].is_Integer:
@@ -43,9 +43,11 @@ def machine_numbers(expr: sp.Expr) -> sp.Expr:
     return expr.xreplace(rest) if rest else expr
 
 
-def _distinct(expr: sp.Basic) -> set:
+def distinct_nodes(exprs) -> set:
+    """Every distinct sub-expression of ``exprs``, each visited once (sympy's own walks visit a
+    shared sub-expression once per occurrence: exponential in the depth of nested rotations)."""
     seen: set = set()
-    stack = [expr]
+    stack = list(exprs)
     while stack:
         node = stack.pop()
         if node not in seen:
@@ -62,4 +64,4 @@ def _double(number: sp.Rational) -> sp.Float:
     return sp.Float(value)
 
 
-__all__ = ["LARGEST_EXACT", "machine_numbers"]
+__all__ = ["LARGEST_EXACT", "distinct_nodes", "machine_numbers"]

@@ -164,7 +164,8 @@ def _statements(exprs: Sequence[sp.Expr], targets: Sequence[str], printer: CPrin
     """(name of a shared subexpression or None, target, C expression, constant?) computing
     ``targets[i] = exprs[i]`` with shared subexpressions hoisted."""
     # exact numbers as doubles before cse, which would split p/q into p and 1/q
-    exprs = _fewer_trig_calls([machine_numbers(sp.sympify(e)) for e in exprs])
+    exprs = [machine_numbers(sp.sympify(e)) for e in exprs]  # safe: already sympy objects
+    exprs = _fewer_trig_calls(exprs)
     optimizations = "basic" if _basic_cse_pays(exprs) else None
     replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"),
                                    optimizations=optimizations)

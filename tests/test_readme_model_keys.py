@@ -53,6 +53,11 @@ MEANINGS = {
                    "b\"` (= 0)",
     "contacts": "a wheel rolling without slipping on the ground: `body`, `radius`, `axle` (body "
                 "axes); the ground `normal` (default against gravity)",
+    "impacts": "an impact when `guard` g(q, t) falls through 0: the striking `point` (a vector, "
+               "a particle or body, or {body, offset}), the surface `normal`, `restitution` e in "
+               "[0, 1] (default 0), `tangential` \"slip\" (default) or \"stick\"; `release = "
+               "\"pivot\"` lets the pin at the origin go, `relabel = { q = \"expr\" }` the "
+               "coordinates after (see Impacts)",
     "steady": "the steady motion `speeds` linearizes about by default: `speed` a parameter "
               "(m/s), `rates = { x_dot = \"v\" }` in the parameters, `keep` the coordinates "
               "whose equations stay, `about` coordinate values",

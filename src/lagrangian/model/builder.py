@@ -22,6 +22,7 @@ from .contacts import (
     RollingContact,
 )
 from .expressions import IDENTIFIER, MAX_TREE_NODES, RESERVED, parse_expression, tree_size
+from .impacts import ImpactsMixin
 from .model import (
     TIME,
     Attachment,
@@ -45,7 +46,8 @@ from .rotations import RigidBody, floated, unit_vector
 from .vector import Vector
 
 
-class ModelBuilder(RigidBodiesMixin, ConstraintsMixin, SteadyMotionMixin, ControlLawsMixin):
+class ModelBuilder(RigidBodiesMixin, ConstraintsMixin, SteadyMotionMixin, ControlLawsMixin,
+                   ImpactsMixin):
     """Mutable shell that validates each piece as it is added and builds an immutable Model."""
 
     def __init__(self, name: str = "", description: str = "", *, source: str | None = None):
@@ -435,6 +437,7 @@ class ModelBuilder(RigidBodiesMixin, ConstraintsMixin, SteadyMotionMixin, Contro
             source=self.source,
             contacts=tuple(self._contacts),
             steady_motion=self._steady_motion,
+            impacts=self._impact_list(),
         )
         return replace(model, control=self._control_laws(model)) if self._control else model
 

@@ -18,6 +18,7 @@ from .vector import Vector
 
 if TYPE_CHECKING:
     from .contacts import RollingContact
+    from .impacts import Impact
     from .rotations import RigidBody
     from .tree import KinematicTree
 
@@ -206,6 +207,8 @@ class Model:
     # coordinate (its generalized force), a parameter or a load; used only when a run asks
     # for them (simulate's controller="model"), never by derive.
     control: tuple[tuple[str, sp.Expr], ...] = ()
+    # Impacts ([[impacts]] in the file, model/impacts.py): a guard, a striking point, its law.
+    impacts: tuple[Impact, ...] = ()
     # A robot read from URDF keeps its tree in numbers (model/tree.py) for recursive dynamics;
     # not part of the model's identity (equal models with and without it are equal).
     kinematic_tree: KinematicTree | None = field(default=None, compare=False, repr=False)

@@ -19,7 +19,7 @@ from .units import check_unit, to_si
 TOP_LEVEL = {
     "name", "description", "coordinates", "parameters", "definitions", "energy", "gravity",
     "particles", "bodies", "springs", "dampers", "loads", "generalized_forces", "constraints",
-    "contacts", "steady", "control",
+    "contacts", "steady", "control", "impacts",
 }
 COMPONENT_KEYS = {
     "particles": ({"name", "mass", "position"}, set()),
@@ -30,6 +30,8 @@ COMPONENT_KEYS = {
     "loads": ({"name"}, {"point", "force", "torque", "angle", "body", "moment", "axes"}),
     "constraints": ({"name"}, {"holonomic", "velocity"}),
     "contacts": ({"name", "body", "radius", "axle"}, {"normal"}),
+    "impacts": ({"name", "guard", "point", "normal"},
+                {"restitution", "tangential", "release", "relabel"}),
 }
 COORDINATE_KEYS = {"unit", "initial", "rate", "range"}  # a coordinate given as a table
 PARAMETER_KEYS = {"value", "unit"}  # a parameter given as a table
@@ -310,6 +312,13 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
             item["name"], holonomic=item.get("holonomic"), velocity=item.get("velocity"),
             field=f"constraints[{index}]",
         )
+    for index, item in _components(data, "impacts", source):
+        field = f"impacts[{index}]"
+        builder.add_impact(
+            item["name"], item["guard"], item["point"], item["normal"],
+            restitution=item.get("restitution", 0),
+            tangential=_string(item.get("tangential", "slip"), f"{field}.tangential", source),
+            release=item.get("release"), relabel=item.get("relabel"), field=field)
     for key, law in _table(data, "control", source).items():
         field = f"control.{key}"
         builder.add_control_law(key, _string(law, field, source), field=field)

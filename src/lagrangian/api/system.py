@@ -272,6 +272,18 @@ class System(CheckMethods, ControlMethods, StudyMethods):
         except CodegenError as exc:
             raise InputError(f"cannot write C: {exc}", field="lang") from None
 
+    # -- bridges to other tools ------------------------------------------------------------------
+
+    def to_casadi(self, inputs: Sequence[str] = (), parameters: Mapping[str, float] | None = None):
+        """CasADi Functions built node by node from the derived equations (SI units, x = [q;
+        q_dot]): ``rhs(x, u)``, ``mass_matrix(q)``, ``forcing(q, q_dot, u)`` and, with
+        constraints, ``constraints(q, q_dot)``; ``inputs`` name the entries of u as in
+        ``linearize(inputs=...)``. Needs the extra [casadi] (docs/bridges.md)."""
+        from ..compile.casadi_functions import casadi_functions
+
+        refuse_large_chain(self.model)
+        return casadi_functions(self.equations_of_motion(), inputs, parameters)
+
     # -- compiled numeric functions -------------------------------------------------------------
 
     def numeric(self, parameters: Mapping[str, float] | None = None, backend: str = "auto"

@@ -56,6 +56,7 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
         SpeedSweep,
         StandaloneSource,
         State,
+        StateLayout,
         StaticsReport,
         StepControl,
         StopCondition,
@@ -70,6 +71,7 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
         load,
         parse_model,
         read_model,
+        state_layout,
     )
     from .control import computed_torque, lqr
     from .errors import DynamicsWarning, ModelWarning
@@ -123,6 +125,7 @@ __all__ = [
     "SpeedSweep",
     "StandaloneSource",
     "State",
+    "StateLayout",
     "StaticsReport",
     "StepControl",
     "StopCondition",
@@ -158,6 +161,7 @@ __all__ = [
     "resolve_state",
     "speed_sweep",
     "state_units",
+    "state_layout",
     "lqr",
     "computed_torque",
     "cos",

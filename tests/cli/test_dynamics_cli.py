@@ -76,7 +76,7 @@ def test_dynamics_of_a_model_file(cli):
 
 
 @pytest.mark.parametrize(("args", "words"), [
-    (("--q", "0.1"), "--q: expected 2 comma-separated values, got 1"),
+    (("--q", "0.1"), "--q: expected 2 comma-separated values (hinge, slide), got 1"),
     (("--lock", "slid=0.1"), "--lock slid: no joint 'slid'"),
     (("--a", "1,1", "--tau", "1,1"), "give one"),
 ])

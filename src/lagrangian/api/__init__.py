@@ -34,6 +34,7 @@ from ..model.reader import parse_model, read_model
 from ..model.values import ParameterValues, State
 from ..simulation.events import StopCondition
 from ..simulation.options import SaveAt, StepControl
+from .layout import StateLayout, state_layout
 from .modes import ModalAnalysis
 from .simulation import Simulation
 from .system import System, SystemBuilder, load
@@ -52,11 +53,13 @@ __all__ = [
     "load",
     "parse_model",
     "read_model",
+    "state_layout",
     # what a System is made of and takes
     "Answer",
     "Model",
     "ParameterValues",
     "State",
+    "StateLayout",
     "SaveAt",
     # the kinds and states it names (string enums)
     "Backend",

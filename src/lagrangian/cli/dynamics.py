@@ -23,6 +23,7 @@ from .common import (
 LOCK_HELP = "URDF: freeze a joint at a value, NAME=VALUE (30deg, 0.02m); repeatable."
 WRENCH_HELP = ("URDF: a wrench on a frame, FRAME=fx,fy,fz,mx,my,mz (N, N m; world axes, at the "
                "frame's origin), acting in --a and --tau; repeatable.")
+WRENCH = ("fx", "fy", "fz", "mx", "my", "mz")
 ARMATURE_HELP = "URDF: a joint's rotor inertia, JOINT=VALUE (kg m^2, or kg); repeatable."
 
 
@@ -30,19 +31,21 @@ def _wrenches(texts: list[str]) -> dict[str, list[float]]:
     """--wrench FRAME=fx,fy,fz,mx,my,mz as {frame: six numbers}."""
     from .common import assignments
 
-    return {name: _vector(value, 6, f"--wrench {name}", [])
+    return {name: _vector(value, WRENCH, f"--wrench {name}", [])
             for name, value in assignments(texts, "--wrench")}
 
 
-def _vector(text: str | None, n: int, flag: str, default: list[float]) -> list[float]:
-    """A comma-separated vector in the model's coordinate order (each entry may carry a unit)."""
+def _vector(text: str | None, names, flag: str, default: list[float]) -> list[float]:
+    """A comma-separated vector in the model's coordinate order (each entry may carry a unit);
+    ``names`` the library's names of its entries, listed when the count is wrong."""
     from .. import parse_quantity
 
     if text is None:
         return default
     parts = [p.strip() for p in text.split(",")]
-    if len(parts) != n:
-        raise InputError(f"expected {n} comma-separated values, got {len(parts)}", field=flag)
+    if len(parts) != len(names):
+        raise InputError(f"expected {len(names)} comma-separated values "
+                         f"({', '.join(names)}), got {len(parts)}", field=flag)
     return [parse_quantity(p, None, flag) for p in parts]
 
 
@@ -90,7 +93,7 @@ def dynamics(
     """Mass matrix, bias forces C q_dot + g, gravity, inverse or forward dynamics, energies."""
     import numpy as np  # here, not at the top: --help loads no numpy (tests/cli/test_startup.py)
 
-    from .. import resolve_state
+    from .. import resolve_state, state_layout
     from ..output.dynamics import dynamics_document, dynamics_text
 
     if a is not None and tau is not None:
@@ -115,8 +118,10 @@ def dynamics(
     system = load_system(model, own, lock, gravity, payload, floating_base)
     coordinates = system.model.coordinates
     start = resolve_state(system.model)  # the model's own initial state (the library's defaults)
-    names_q, names_v, base_q, base_v = base_layout(system)
-    qs = _vector(q, len(names_q), "--q", base_q + list(start.q))
+    layout = state_layout(system)  # the names of q's and v's entries (a floating base's differ)
+    names_q, names_v = list(layout.q), list(layout.v)
+    base_q, base_v = list(layout.base_q), list(layout.base_v)
+    qs = _vector(q, names_q, "--q", base_q + list(start.q))
     if q is not None:  # --q 30,0 means 30 rad for an angle
         from .. import state_units
 
@@ -129,8 +134,7 @@ def dynamics(
 
         for line in limit_warnings(system.model, dict(zip(names, joints, strict=True)), "--q"):
             warn(line)
-    n = len(names_v)
-    vs = _vector(v, n, "--v", base_v + list(start.q_dot))
+    vs = _vector(v, names_v, "--v", base_v + list(start.q_dot))
     # a link's inertial (--set fore.mass=3) is a runtime parameter of the robot's dynamics
     f = system.dynamics(parameters=inertials or None, actuators=actuators,
                         armature=rotors or None)
@@ -142,14 +146,14 @@ def dynamics(
         values = {"q": qs, "v": vs, "mass_matrix": f.mass_matrix(qs),
                   "bias_forces": f.bias_forces(qs, vs), "gravity": f.gravity(qs)}
         if a is not None:
-            values["a"] = _vector(a, n, "--a", [])
+            values["a"] = _vector(a, names_v, "--a", [])
             values["inverse_dynamics"] = f.inverse_dynamics(qs, vs, values["a"],
                                                             f_ext=wrenches or None)
             if derivatives:
                 values["dtau_dq"], values["dtau_dv"] = (  # + 0.0: no -0 printed
                     x + 0.0 for x in f.inverse_dynamics_derivatives(qs, vs, values["a"]))
         if tau is not None:
-            values["tau"] = _vector(tau, n, "--tau", [])
+            values["tau"] = _vector(tau, names_v, "--tau", [])
             values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"],
                                                             f_ext=wrenches or None)
             if constraints:
@@ -188,11 +192,11 @@ def dynamics(
         typer.echo(dynamics_text(names_q, values, velocities, extra, constraints), nl=False)
 
 
+
 def base_layout(system):
-    """The names of q and v, and a floating base's default numbers before the joints' (at the
-    world's origin, unturned, at rest): none for a fixed base."""
-    joints = [c.name for c in system.model.coordinates]
-    if not getattr(system.model.kinematic_tree, "floating_base", False):
-        return joints, joints, [], []
-    f = system.dynamics()
-    return list(f.coordinates), list(f.velocity_names), [0.0] * 6 + [1.0], [0.0] * 6
+    """The names of q and v, and a floating base's default numbers before the joints' (none for
+    a fixed base), as the library's state_layout gives them."""
+    from .. import state_layout
+
+    layout = state_layout(system)
+    return list(layout.q), list(layout.v), list(layout.base_q), list(layout.base_v)

@@ -34,14 +34,14 @@ def kinematics(
 
     system = load_system(model, set_, lock, floating_base=floating_base)
     names, velocities, base_q, _ = base_layout(system)
-    qs = _vector(q, len(names), "--q", base_q + list(resolve_state(system.model).q))
+    qs = _vector(q, names, "--q", base_q + list(resolve_state(system.model).q))
     robot = system.dynamics().kinematics
     name = frame if frame is not None else robot.frames[-1]
     values = {"q": qs, "placement": robot.placement(qs, name),
               "jacobian": robot.jacobian(qs, name, reference),
               "center_of_mass": robot.center_of_mass(qs),
               "center_of_mass_jacobian": robot.center_of_mass_jacobian(qs)}
-    vs = None if v is None else _vector(v, len(velocities), "--v", [])
+    vs = None if v is None else _vector(v, velocities, "--v", [])
     if vs is not None:
         values["v"] = vs
         values["jacobian_dot_times_v"] = robot.jacobian_dot_times_v(qs, vs, name, reference)

@@ -40,9 +40,9 @@ def regressor(
     start = resolve_state(system.model)
     names_q, names_v, base_q, base_v = base_layout(system)
     n = len(names_v)
-    qs = _vector(q, len(names_q), "--q", base_q + list(start.q))
-    vs = _vector(v, n, "--v", base_v + list(start.q_dot))
-    accelerations = _vector(a, n, "--a", [0.0] * n)
+    qs = _vector(q, names_q, "--q", base_q + list(start.q))
+    vs = _vector(v, names_v, "--v", base_v + list(start.q_dot))
+    accelerations = _vector(a, names_v, "--a", [0.0] * n)
     names = None if parameters is None else [p.strip() for p in parameters.split(",")]
     f = system.dynamics()
     try:

@@ -53,6 +53,7 @@ from ..simulation.simulate import (
     urdf_limits,
 )
 from .checking import CheckMethods
+from .conservation import ConservationMethods
 from .control import ControlMethods
 from .modes import ModalAnalysis
 from .options import run_options
@@ -60,7 +61,7 @@ from .simulation import Simulation
 from .studies import StudyMethods
 
 
-class System(CheckMethods, ControlMethods, StudyMethods):
+class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods):
     """A mechanical system described in generalized coordinates.
 
     >>> import lagrangian

@@ -218,7 +218,8 @@ def _jacobi(eom: EquationsOfMotion, common: dict) -> ConservedQuantity | NotCons
         return NotConserved("h", ConservedKind.JACOBI,
                             "; ".join(causes) or "the loads do work")
     equals = kind == InvariantKind.ENERGY
-    expression = eom.kinetic_energy + eom.potential_energy if equals else eom.jacobi_integral
+    expression = eom.kinetic_energy + eom.potential_energy if equals \
+        else sp.expand(eom.jacobi_integral)
     return ConservedQuantity("h", ConservedKind.JACOBI, expression, (),
                              equals_energy=equals, **common)
 
@@ -276,6 +277,12 @@ def _affine_generators(L: sp.Expr, eom: EquationsOfMotion, cyclic: Sequence[int]
             continue
         a = row[:n]
         B = [row[n + i * n:n + (i + 1) * n] for i in range(n)]
+        # the sense: a rotation counter-clockwise (B below the diagonal positive, x y_dot -
+        # y x_dot), a translation along +a
+        lead = [B[i][j] for i in range(n) for j in range(i) if B[i][j] != 0] or \
+            [x for x in a if x != 0]
+        if lead and lead[0] < 0:
+            a, B = [-x for x in a], [[-x for x in line] for line in B]
         generator = tuple(sp.nsimplify(a[i]) + sum((B[i][j] * q[j] for j in range(n)),
                                                    sp.S.Zero) for i in range(n))
         B_dot = [sum((B[i][j] * q_dot[j] for j in range(n)), sp.S.Zero) for i in range(n)]

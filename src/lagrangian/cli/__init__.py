@@ -42,6 +42,7 @@ def _main(version: Annotated[bool, typer.Option(
 # `examples` start in a fraction of a second (tests/cli/test_startup.py).
 from . import check as _check  # noqa: E402,F401
 from . import codegen as _codegen  # noqa: E402,F401
+from . import conserved as _conserved  # noqa: E402,F401
 from . import derive as _derive  # noqa: E402,F401
 from . import dynamics as _dynamics  # noqa: E402,F401
 from . import equilibria as _equilibria  # noqa: E402,F401

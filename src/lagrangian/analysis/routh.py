@@ -43,8 +43,6 @@ def routhian_model(eom: EquationsOfMotion, cyclic: Sequence[str]) -> Model:
                              field="routh")
     if len(set(cyclic)) != len(cyclic):
         raise ModelError("a coordinate is named twice", field="routh")
-    if len(cyclic) == len(names):
-        raise ModelError("Routh's reduction keeps at least one coordinate", field="routh")
     found = conserved_quantities(eom) if model.kinematic_tree is None else None
     if found is None:
         raise ModelError("Routh's reduction needs a derived L; a robot's tree has none",
@@ -60,6 +58,8 @@ def routhian_model(eom: EquationsOfMotion, cyclic: Sequence[str]) -> Model:
                              field="routh")
         raise ModelError(f"the momentum of '{name}' is not conserved: {broken[0].reason}",
                          field="routh")
+    if len(cyclic) == len(names):
+        raise ModelError("Routh's reduction keeps at least one coordinate", field="routh")
     existing = {p.name for p in model.parameters} | set(names)
     L = eom.lagrangian
     index = [names.index(n) for n in cyclic]

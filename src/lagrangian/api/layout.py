@@ -19,6 +19,7 @@ class StateLayout:
 
     @property
     def floating(self) -> bool:
+        """Whether q and v hold a floating base's numbers first."""
         return bool(self.base_q)
 
     def names(self, vector: str) -> tuple[str, ...]:

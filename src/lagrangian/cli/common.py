@@ -90,6 +90,15 @@ def in_flags(error: LagrangianError) -> LagrangianError:
     return ModelError(error.message, field=f"{FLAG_OF_FIELD[head]} {rest}".strip())
 
 
+def in_flags_text(warning: Warning) -> str:
+    """A library warning's line with the Python field it starts with (``lock elbow=...``, its
+    ``field``) named by the flag (``--lock elbow=...``)."""
+    text, field = str(warning), getattr(warning, "field", None)
+    if field in FLAG_OF_FIELD and text.startswith(f"{field} "):
+        return FLAG_OF_FIELD[field] + text[len(field):]
+    return text
+
+
 def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = (),
                 gravity: str | None = None, payload: Iterable[str] = (),
                 floating_base: bool = False) -> System:
@@ -98,9 +107,9 @@ def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = 
     later --set g=... rescales that vector's magnitude)."""
     from .. import load, parse_quantity
 
-    # --lock a=0,b=0 as --lock a=0 --lock b=0, as --set reads a comma list
-    locked = {name: parse_quantity(text, None, f"--lock {name}")
-              for name, text in assignments(comma_separated(lock), "--lock")}
+    # --lock a=0,b=0 as --lock a=0 --lock b=0, as --set reads a comma list; each text read by
+    # the library in its joint's unit (an angle, a length) and checked against its limit
+    locked = dict(assignments(comma_separated(lock), "--lock"))
     carried = payloads(payload)
     freed = {"floating_base": True} if floating_base else {}
     with warnings.catch_warnings(record=True) as seen:  # what the reader left out, one line each
@@ -109,7 +118,7 @@ def load_system(model: str, settings: Iterable[str] = (), lock: Iterable[str] = 
             if locked or carried or freed else load(model)
     for warning in seen:
         if issubclass(warning.category, ModelWarning):
-            warn(str(warning.message))
+            warn(in_flags_text(warning.message))
         else:
             warnings.warn_explicit(warning.message, warning.category, warning.filename,
                                    warning.lineno)

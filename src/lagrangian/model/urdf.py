@@ -45,6 +45,7 @@ from .model import Model
 from .reader import read_text_file
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
 from .tree import KinematicTree
+from .urdf_lock import lock_value
 from .urdf_tree import MOVABLE, SNAP, carries_nothing, numeric_tree
 
 SUPPORTED = (*MOVABLE, "fixed")
@@ -53,7 +54,8 @@ GRAVITY = 9.81  # m/s^2, along -z
 
 def read_urdf(path, lock: Mapping[str, float] | None = None,
               payload: Mapping[str, object] | None = None, floating_base: bool = False) -> Model:
-    """Load a URDF file as a model; ``lock`` freezes joints at values (rad or m) by name,
+    """Load a URDF file as a model; ``lock`` freezes joints at values (rad or m, or a text
+    with its unit, "30deg") by name,
     ``payload`` adds point masses to links (urdf_payload.py), ``floating_base`` frees the root."""
     return parse_urdf(read_text_file(path), source=str(path), lock=lock, payload=payload,
                       floating_base=floating_base)
@@ -378,13 +380,7 @@ class _Tree:
                                  "continuous and prismatic joints can be locked",
                                  field=f"lock.{name}")
             # a locked mimic joint (the Panda's second finger) is frozen at its own value
-            try:
-                lock[name] = float(value)
-            except (TypeError, ValueError):
-                raise ModelError(f"the value {value!r} is not a number",
-                                 field=f"lock.{name}") from None
-            if not math.isfinite(lock[name]):
-                raise ModelError(f"the value {value!r} is not finite", field=f"lock.{name}")
+            lock[name] = lock_value(self.by_name[name], value)  # its unit and limit checked
 
         builder = ModelBuilder(self.name, f"Robot '{self.name}' read from URDF "
                                f"({len(order)} joints, {len(self.links)} links).",

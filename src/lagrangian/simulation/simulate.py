@@ -79,6 +79,13 @@ def simulate(
     if eom is None and (model is None or functions is None or functions.m):
         raise ValueError("a run without equations needs the model and a tree's functions")
     model = eom.model if eom is not None else model
+    if eom is not None and model.impacts:  # through its impacts: simulation/hybrid.py
+        from .hybrid import simulate_through_impacts
+
+        return simulate_through_impacts(
+            eom, t_end, initial=initial, parameters=parameters, step_control=step_control,
+            save_at=save_at, progress=progress, functions=functions, stop=stop, limits=limits,
+            controller=controller, inputs=inputs)
     start = resolve_state(model, initial, field="initial", what="coordinate or velocity (or t)")
     if not (math.isfinite(t_end) and t_end > start.t):
         raise InputError(f"the end time ({t_end} s) must be after the start time ({start.t} s)",

@@ -1,0 +1,355 @@
+"""Simulation through impacts: each guard crossing located (to about 1e-12 s), the derived impact
+map applied (derivation/impact_map.py), and the run goes on; an accumulation of impacts (a ball
+coming to rest) is detected and ends the run, or settles it where the user asks.
+
+The flow between impacts is simulate's scipy step loop; a guard g(q, t) of the model's
+[[impacts]] fires when it falls through 0 (the event max_i(-g_i) turning >= 0), the crossing is
+found by the dense output (brentq) and polished by Newton steps of the guard along the flow.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy as sp
+
+from ..compile.functions import NumericSystem, numeric
+from ..compile.lambdified import StateFunction
+from ..derivation.equations import EquationsOfMotion
+from ..derivation.impact_map import ImpactMap, derive_impact_maps
+from ..errors import InputError
+from ..kinds import InvariantKind
+from ..model.values import resolve_parameters, resolve_state
+from .integration_loops import integrate_steps
+from .invariants import cumulative_work, energy_is_conserved, invariant_kind
+from .options import SaveAt, StepControl
+from .result import STATUS_MESSAGES, SimulationResult
+
+ACCUMULATED = "accumulated"  # impacts accumulate (Zeno): the run stops at their limit time
+IMPACT_LIMIT = "impact_limit"  # the cap on the number of impacts was reached
+SETTLED = "settled"  # impacts accumulated and the model was put to rest on the surface
+HYBRID_STATUS = {ACCUMULATED: "impacts accumulate (the motion comes to rest on a surface)",
+                 IMPACT_LIMIT: "stopped at the cap on the number of impacts",
+                 SETTLED: "impacts accumulated and the model rests on the surface"}
+STATUS_MESSAGES.update(HYBRID_STATUS)
+MAX_IMPACTS = 1000
+DEFAULT_STEPS, DEFAULT_SAMPLES = StepControl(), SaveAt()  # as simulate's
+# Impacts accumulate when the last intervals between them shrink geometrically (two ratios
+# agreeing to this) and what is left of the series, dt r / (1 - r), is below ACCUMULATION_TIME.
+RATIO_AGREEMENT = 1e-3
+ACCUMULATION_TIME = 1e-9  # s
+# ... or when an interval is below this (times max(1, t)): no longer resolved in time.
+SHORTEST_INTERVAL = 1e-13
+
+
+@dataclass(frozen=True)
+class ImpactRecord:
+    """One impact: its time (s), name, state before and after (by name, SI), the impulse on
+    the model at the striking point (N s, world axes), the kinetic energy lost (J) and the
+    residual of the law on the striking point's velocity after it (m/s)."""
+
+    time: float
+    name: str
+    before: dict[str, float]
+    after: dict[str, float]
+    impulse: tuple[float, ...]
+    energy_lost: float
+    residual: float
+
+    def to_dict(self) -> dict:
+        return {"t": self.time, "name": self.name, "before": self.before, "after": self.after,
+                "impulse": list(self.impulse), "energy_lost": self.energy_lost,
+                "residual": self.residual}
+
+
+@dataclass(frozen=True, repr=False)
+class HybridResult(SimulationResult):
+    """A SimulationResult through impacts: ``impacts`` lists each (ImpactRecord) in order;
+    ``accumulation_time`` the limit time of accumulating impacts (s) where they did."""
+
+    impacts: tuple[ImpactRecord, ...] = field(default=())
+    accumulation_time: float | None = None
+
+
+class CompiledImpact:
+    """An ImpactMap in numbers (parameter values put in): apply(q, v, t) -> (q+, v+, record
+    parts); functions of (q, q_dot, t)."""
+
+    def __init__(self, model, impact_map: ImpactMap, substitution: Mapping):
+        self.map = impact_map
+        self.name = impact_map.name
+        self.k = impact_map.extension
+        self.size = impact_map.mass_matrix.shape[0]
+        self.rows = impact_map.jacobian.shape[0]
+        m = impact_map
+        parts = [*m.mass_matrix, *m.jacobian, *m.restitution_matrix, *m.point_velocity,
+                 *m.normal, *m.relabelled, *m.relabel_jacobian]
+        self._shapes = [m.mass_matrix.shape, m.jacobian.shape, m.restitution_matrix.shape,
+                        m.point_velocity.shape, m.normal.shape, m.relabelled.shape,
+                        m.relabel_jacobian.shape]
+        self._parts = StateFunction(model, parts, substitution)
+        e = float(sp.sympify(m.impact.restitution).xreplace(substitution))
+        if not 0 <= e <= 1:
+            raise InputError(f"impact '{self.name}': the restitution is {e:g}, outside [0, 1]",
+                             field="parameters")
+        if m.extension and e != 0:
+            raise InputError(f"impact '{self.name}': a released pivot needs restitution 0, "
+                             f"got {e:g}", field="parameters")
+        self.restitution = e
+
+    def matrices(self, q, v, t):
+        """M, J, E, the point's velocity rows P, n, R(q), dR/dq at one state."""
+        flat = self._parts.at(q, v, t)
+        out, start = [], 0
+        for rows, cols in self._shapes:
+            out.append(flat[start:start + rows * cols].reshape(rows, cols))
+            start += rows * cols
+        return out
+
+    def apply(self, q, v, t):
+        """(q+, v+, impulse, energy lost, residual, extended velocities before and after)."""
+        M, J, E, P, n, R, DR = self.matrices(q, v, t)
+        ve = np.concatenate([np.zeros(self.k), v])
+        kkt, rhs = kkt_system(M, J, E, ve)
+        try:
+            solution = np.linalg.solve(kkt, rhs)
+        except np.linalg.LinAlgError:
+            raise InputError(f"impact '{self.name}' at t = {t:.12g} s: the impact equations "
+                             "are singular (the mass matrix is singular where the law leaves "
+                             "the point free)", field="impacts") from None
+        after = solution[:self.size]
+        impulse_rows = solution[self.size:]
+        impulse = impulse_rows if J.shape[0] == P.shape[0] else impulse_rows[0] * n[:, 0]
+        lost = 0.5 * float(ve @ M @ ve - after @ M @ after)
+        residual = float(np.max(np.abs(J @ after + E @ (J @ ve)))) if len(J) else 0.0
+        return R[:, 0], DR @ after[self.k:], impulse, lost, residual, ve, after
+
+
+def kkt_system(M, J, E, v_before):
+    """[[M, -J^T], [J, 0]] and [M v-; -E J v-]: the impact equations (docstring above)."""
+    k = J.shape[0]
+    kkt = np.block([[M, -J.T], [J, np.zeros((k, k))]])
+    rhs = np.concatenate([M @ v_before, -E @ (J @ v_before)])
+    return kkt, rhs
+
+
+class Guards:
+    """The guards g_i(q, t) and their rates dg_i/dt = grad g . q_dot + dg/dt, as numbers."""
+
+    def __init__(self, model, maps, substitution):
+        t = model.time
+        gs = [m.guard for m in maps]
+        rates = [sp.Add(*(g.diff(s) * c.velocity for s, c in zip(model.q, model.coordinates,
+                                                                   strict=True)), g.diff(t))
+                 for g in gs]
+        self.values = StateFunction(model, gs, substitution)
+        self.rates = StateFunction(model, rates, substitution)
+
+    def event(self, q, v, t) -> float:
+        """max_i(-g_i): turns >= 0 when a guard falls through 0."""
+        return float(np.max(-self.values.at(q, v, t)))
+
+
+def polish(guards: Guards, index: int, functions: NumericSystem, t: float, y: np.ndarray,
+           n: int) -> tuple[float, np.ndarray]:
+    """Newton steps on g_index along the flow (an RK4 step of the correction each time):
+    the crossing to about 1e-12 s."""
+    for _ in range(4):
+        g = guards.values.at(y[:n], y[n:], t)[index]
+        rate = guards.rates.at(y[:n], y[n:], t)[index]
+        if rate == 0 or not math.isfinite(g / rate):
+            break
+        dt = -g / rate
+        if abs(dt) > 1e-6 * max(1.0, abs(t)):
+            break  # brentq was already close; a large step means a graze: keep its time
+        y = _rk4(functions, t, y, dt)
+        t += dt
+        if abs(dt) < 1e-15 * max(1.0, abs(t)):
+            break
+    return t, y
+
+
+def _rk4(functions, t, y, h):
+    f = functions.rhs
+    k1 = f(t, y)
+    k2 = f(t + h / 2, y + h / 2 * k1)
+    k3 = f(t + h / 2, y + h / 2 * k2)
+    k4 = f(t + h, y + h * k3)
+    return y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+
+def compiled_impacts(eom: EquationsOfMotion, substitution, maps=None):
+    """(CompiledImpact for each impact, Guards) at the parameter values."""
+    maps = maps if maps is not None else derive_impact_maps(eom)
+    return [CompiledImpact(eom.model, m, substitution) for m in maps], \
+        Guards(eom.model, maps, substitution)
+
+
+def simulate_through_impacts(
+    eom: EquationsOfMotion, t_end: float, *, initial=None, parameters=None,
+    step_control: StepControl = DEFAULT_STEPS, save_at: SaveAt = DEFAULT_SAMPLES,
+    progress: Callable[[float], None] | None = None, functions: NumericSystem | None = None,
+    max_impacts: int = MAX_IMPACTS, settle: bool = False, **unused,
+) -> HybridResult:
+    """Integrate ``eom`` from its start to ``t_end`` (s) through its model's impacts: each
+    located, mapped and listed; accumulating impacts end the run (status 'accumulated') or,
+    with ``settle``, leave the model at rest on the surface to ``t_end`` (status 'settled');
+    ``max_impacts`` caps their number (status 'impact_limit')."""
+    for name, value in unused.items():
+        if value not in (None, (), False, True):
+            raise InputError(f"'{name}' is not available for a model with impacts",
+                             field=name)
+    if isinstance(max_impacts, bool) or not isinstance(max_impacts, int) or max_impacts < 0:
+        raise InputError(f"max_impacts must be a whole number >= 0, got {max_impacts!r}",
+                         field="max_impacts")
+    model = eom.model
+    start = resolve_state(model, initial, field="initial", what="coordinate or velocity (or t)")
+    if not (math.isfinite(t_end) and t_end > start.t):
+        raise InputError(f"the end time ({t_end} s) must be after the start time ({start.t} s)",
+                         field="t_end")
+    values = resolve_parameters(model, parameters)
+    substitution = values.symbol_values(model)
+    functions = functions if functions is not None else numeric(eom, values)
+    impacts, guards = compiled_impacts(eom, substitution)
+    n = functions.n
+    grid = np.linspace(start.t, t_end, save_at.samples)
+    t0, y = float(start.t), np.concatenate([start.q_array(), start.q_dot_array()])
+    ts, ys, records = [], [], []
+    times: dict[str, list[float]] = {}
+    steps = nfev = 0
+    status, message, limit_time = "finished", STATUS_MESSAGES["finished"], None
+    names = [*model.q, *model.q_dot]
+    began = time.perf_counter()
+    while True:
+        segment = np.concatenate([[t0], grid[grid > t0]])
+        if len(segment) < 2:
+            segment = np.array([t0, t_end])
+        run = integrate_steps(functions.rhs, t0, y, float(t_end), segment, step_control,
+                              guards.event, None, progress)
+        steps += run.steps or 0
+        nfev += run.nfev
+        ts.append(run.t)
+        ys.append(run.y)
+        if run.status != "stopped":
+            status, message = run.status, run.message
+            break
+        t_hit, y_hit = float(run.t[-1]), np.array(run.y[-1])
+        which = int(np.argmin(guards.values.at(y_hit[:n], y_hit[n:], t_hit)))
+        t_hit, y_hit = polish(guards, which, functions, t_hit, y_hit, n)
+        kept = int(np.searchsorted(run.t[:-1], t_hit))  # samples before the polished time
+        ts[-1] = np.concatenate([run.t[:kept], [t_hit]])
+        ys[-1] = np.concatenate([run.y[:kept], [y_hit]])
+        impact = impacts[which]
+        q_new, v_new, impulse, lost, residual, _, _ = impact.apply(y_hit[:n], y_hit[n:], t_hit)
+        y = np.concatenate([q_new, v_new])
+        records.append(ImpactRecord(
+            float(t_hit), impact.name, _named(names, y_hit), _named(names, y),
+            tuple(float(x) for x in impulse), float(lost), float(residual)))
+        t0 = t_hit
+        history = times.setdefault(impact.name, [])
+        history.append(t_hit)
+        limit_time = accumulation(history)
+        if limit_time is not None:
+            status = ACCUMULATED
+            message = (f"impacts at '{impact.name}' accumulate at t = {limit_time:.12g} s "
+                       f"({len(history)} impacts): the motion comes to rest there")
+            if settle:
+                y, settled = _settled(impact, y, limit_time, n)
+                if settled:
+                    status = SETTLED
+                    message += f"; settled at rest to t = {t_end:g} s"
+                    later = grid[grid > limit_time]
+                    ts.append(np.concatenate([[limit_time], later]))
+                    ys.append(np.tile(y, (len(later) + 1, 1)))
+                else:
+                    message += "; not settled: it still moves along the surface"
+            break
+        if len(records) >= max_impacts:
+            status = IMPACT_LIMIT
+            message = (f"stopped at the cap of {max_impacts} impacts at t = {t_hit:.12g} s "
+                       "(raise max_impacts / --max-impacts)")
+            ts.append(np.array([t_hit]))
+            ys.append(y[None, :])
+            break
+        if t_hit >= t_end:
+            ts.append(np.array([t_hit]))
+            ys.append(y[None, :])
+            break
+    wall = time.perf_counter() - began
+    return _result(eom, functions, substitution, np.concatenate(ts), np.concatenate(ys),
+                   step_control, status, message, steps, nfev, wall, t_end, records, limit_time)
+
+
+def accumulation(history: list[float]) -> float | None:
+    """The limit time of impacts whose intervals shrink geometrically (s), once what is left of
+    the series is below ACCUMULATION_TIME (or an interval no longer resolves); else None."""
+    if len(history) >= 2:
+        last = history[-1] - history[-2]
+        if last < SHORTEST_INTERVAL * max(1.0, abs(history[-1])):
+            return history[-1]
+    if len(history) < 4:
+        return None
+    d1, d2, d3 = (history[-1] - history[-2], history[-2] - history[-3],
+                  history[-3] - history[-4])
+    if d2 <= 0 or d3 <= 0:
+        return None
+    r1, r2 = d1 / d2, d2 / d3
+    if not (0 < r1 < 1 and abs(r1 - r2) <= RATIO_AGREEMENT * r1):
+        return None
+    left = d1 * r1 / (1 - r1)
+    return history[-1] + left if left < ACCUMULATION_TIME else None
+
+
+def _settled(impact: CompiledImpact, y: np.ndarray, t: float, n: int):
+    """The state after a plastic impact (e = 0) at the last one, and whether it is at rest."""
+    q, v = y[:n], y[n:]
+    M, J, E, *_ = impact.matrices(q, v, t)
+    ve = np.concatenate([np.zeros(impact.k), v])
+    kkt, rhs = kkt_system(M, J, np.zeros_like(E), ve)
+    after = np.linalg.solve(kkt, rhs)[impact.k:impact.size]
+    scale = max(1.0, float(np.max(np.abs(v))))
+    at_rest = float(np.max(np.abs(after), initial=0.0)) < 1e-6 * scale
+    return np.concatenate([q, np.zeros(n) if at_rest else after]), at_rest
+
+
+def _named(names, y) -> dict[str, float]:
+    return {str(s): float(x) for s, x in zip(names, y, strict=True)}
+
+
+def _result(eom, functions, substitution, t, y, step_control, status, message, steps, nfev,
+            wall, t_end, records, limit_time) -> HybridResult:
+    model = eom.model
+    n = functions.n
+    q, q_dot = y[:, :n], y[:, n:]
+    energy = functions.energy(q, q_dot, t)
+    kinetic = energy - functions.energy(q, np.zeros_like(q_dot), t)
+    power_terms = StateFunction(model, eom.generalized_forces, substitution)
+    power = np.einsum("ki,ki->k", power_terms(q, q_dot, t), q_dot)
+    empty = np.zeros((len(t), 0))
+    kind, invariant, work = invariant_kind(eom), energy, None
+    if kind != InvariantKind.ENERGY:  # h, and the work of explicit time (no constraints here)
+        invariant = StateFunction(model, [eom.jacobi_integral], substitution)(q, q_dot, t)[:, 0]
+        if kind == InvariantKind.WORK_BALANCE:
+            supplied = power + StateFunction(model, [eom.explicit_time_power],
+                                             substitution)(q, q_dot, t)[:, 0]
+            work = cumulative_work(t, supplied)
+    lossless = all(abs(r.energy_lost) <= 1e-9 * max(1.0, abs(float(energy[0])))
+                   for r in records)
+    return HybridResult(
+        model=model, coordinates=functions.coordinates, constraint_names=(),
+        parameters=dict(functions.parameters), t=t, q=q, q_dot=q_dot, energy=energy,
+        power=power, multipliers=empty, residuals=empty, step_control=step_control,
+        status=status, message=message, steps=steps, nfev=nfev, wall_time=wall,
+        backend="scipy", energy_conserved=energy_is_conserved(eom) and lossless,
+        t_end=float(t_end), kinetic_energy=kinetic, invariant=kind, invariant_values=invariant,
+        work=work, impacts=tuple(records), accumulation_time=limit_time)
+
+
+__all__ = ["ACCUMULATED", "HYBRID_STATUS", "IMPACT_LIMIT", "MAX_IMPACTS", "SETTLED",
+           "CompiledImpact", "Guards", "HybridResult", "ImpactRecord", "accumulation",
+           "compiled_impacts", "kkt_system", "polish",
+           "simulate_through_impacts"]

@@ -57,12 +57,13 @@ class Hamiltonian:
                              "coordinates (M^-1 by hand grows fast); rhs() works for any",
                              field="hamiltonian")
         M = sp.Matrix(self.inertia)
-        inverse = sp.simplify(M.inv()) if n > 1 else sp.Matrix([[1 / M[0, 0]]])
         d = sp.Matrix(self.momenta) - sp.Matrix(self.shift)
-        kinetic = (d.T * inverse * d)[0, 0] / 2
-        kinetic = sp.factor_terms(sp.simplify(kinetic)) if sp.count_ops(kinetic) < 300 \
-            else kinetic
-        return kinetic - self.rest
+        if n == 1:
+            return sp.factor_terms(d[0] ** 2 / (2 * M[0, 0])) - self.rest
+        # M^-1 = adj(M) / det(M): the determinant tidied once (cos^2 + sin^2 folded)
+        determinant = sp.factor_terms(sp.trigsimp(sp.expand(M.det())))
+        quadratic = sp.expand((d.T * M.adjugate() * d)[0, 0])
+        return sp.factor_terms(quadratic / (2 * determinant)) - self.rest
 
     @property
     def text(self) -> str:

@@ -1,0 +1,63 @@
+"""`lagrangian conserved`, `derive --routh` and `derive --hamilton` on model files (issue 40)."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "analysis"))
+from conserved_models import CENTRAL_WELL, SPHERICAL_PENDULUM  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("conserved_cli")
+    paths = {}
+    for name, text in (("spherical", SPHERICAL_PENDULUM), ("central", CENTRAL_WELL)):
+        paths[name] = folder / f"{name}.toml"
+        paths[name].write_text(text)
+    return paths
+
+
+def test_conserved_lists_the_cyclic_momentum_in_the_modules_notation(cli, files):
+    result = cli("conserved", str(files["spherical"]))
+    assert result.code == 0, result.err
+    assert "p_phi = m φ̇ l² sin²θ" in result.out
+    assert "equal to T + V" in result.out
+    document = json.loads(cli("conserved", str(files["central"]), "--json").out)
+    kinds = {q["kind"]: q for q in document["conserved"]}
+    assert set(kinds) == {"jacobi", "noether"}
+    assert kinds["noether"]["expression"] == "m*(x*y_dot - x_dot*y)"
+
+
+def test_conserved_on_the_hoop_says_t_plus_v_is_not_conserved(cli):
+    document = json.loads(cli("conserved", "bead_on_hoop", "--set", "Omega=5", "--json").out)
+    assert [(q["kind"], q["equals_energy"]) for q in document["conserved"]] == [("jacobi", False)]
+
+
+def test_derive_routh_gives_the_effective_potential(cli, files):
+    result = cli("derive", str(files["spherical"]), "--routh", "phi", "--json")
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    assert document["coordinates"] == ["theta"]
+    routh = document["routhian"]
+    assert "p_phi" in routh["parameters"] and "R = sum p_k q_dot_k - L" in routh["convention"]
+    assert routh["effective_potential"] == \
+        "-g*l*m*cos(theta) + p_phi**2/(2*l**2*m*sin(theta)**2)"
+    bad = cli("derive", str(files["spherical"]), "--routh", "theta")
+    assert bad.code == 2 and bad.err.count("\n") == 1 and "not cyclic" in bad.err
+
+
+def test_derive_hamilton_prints_h_and_the_momenta(cli):
+    result = cli("derive", "pendulum", "--hamilton", "--json")
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    assert document["momenta"] == {"p_theta": "L**2*m*theta_dot"}
+    assert document["q_dot"] == {"theta": "p_theta/(L**2*m)"}
+    text = cli("derive", "pendulum", "--hamilton").out
+    assert "H = " in text
+    bad = cli("derive", "cartesian_pendulum", "--hamilton")
+    assert bad.code == 2 and "unconstrained" in bad.err

@@ -1,0 +1,124 @@
+"""Periodic orbits through impacts (a walker's gait, a rimless wheel rolling down a slope):
+the fixed point of the Poincare map on the section just after an impact, found by Newton's
+method on P(x) - x with the map's exact Jacobian (simulation/poincare.py), and its multipliers.
+
+The multipliers are the eigenvalues of DP at the fixed point less the one of the flow's own
+direction (0: a start moved along the orbit returns to the same point); the cycle is stable
+when every one is inside the unit circle. Units SI.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+from ..model.values import resolve_state
+from ..simulation.options import StepControl
+from ..simulation.poincare import PoincareMap
+
+TOLERANCE = 1e-10  # |P(x) - x| at convergence, relative to max(1, |x|)
+MAX_ITERATIONS = 40
+WARM_UP = 3  # plain returns of the map before Newton (a start off the section lands on it)
+CYCLE_STEPS = StepControl(rtol=1e-11, atol=1e-11)
+
+
+@dataclass(frozen=True)
+class LimitCycle:
+    """A periodic orbit through impacts: ``state`` just after its impact (by coordinate and
+    velocity name, SI), ``period`` (s), ``multipliers`` (eigenvalues of the linearized
+    Poincare map, the flow direction's 0 left out, largest first), ``stable``."""
+
+    state: dict[str, float]
+    period: float
+    multipliers: tuple[complex, ...]
+    stable: bool
+    impact: str
+    iterations: int
+    residual: float
+    monodromy: np.ndarray = field(repr=False, compare=False)
+
+    def to_dict(self) -> dict:
+        """JSON-ready: state, period, multipliers as [re, im], stable, impact, residual."""
+        return {"state": dict(self.state), "period": self.period,
+                "multipliers": [[float(m.real), float(m.imag)] for m in self.multipliers],
+                "stable": self.stable, "impact": self.impact, "iterations": self.iterations,
+                "residual": self.residual}
+
+    def __repr__(self) -> str:
+        values = ", ".join(f"{k} = {v:.9g}" for k, v in self.state.items())
+        shown = ", ".join(_complex(m) for m in self.multipliers)
+        kind = "stable" if self.stable else "unstable"
+        return (f"LimitCycle(period = {self.period:.9g} s, {kind}; after '{self.impact}': "
+                f"{values}; multipliers {shown})")
+
+    def _repr_html_(self) -> str:
+        rows = "".join(f"<tr><td>{k}</td><td>{v:.9g}</td></tr>" for k, v in self.state.items())
+        shown = ", ".join(_complex(m) for m in self.multipliers)
+        return (f"<p>Limit cycle through '{self.impact}': period {self.period:.9g} s, "
+                f"{'stable' if self.stable else 'unstable'}; multipliers {shown}</p>"
+                f"<table><tr><th>just after the impact</th><th>value (SI)</th></tr>{rows}"
+                "</table>")
+
+
+def _complex(m: complex) -> str:
+    if abs(m.imag) < 1e-12 * max(1.0, abs(m)):
+        return f"{m.real:.9g}"
+    return f"{m.real:.9g}{m.imag:+.9g}j"
+
+
+def limit_cycle(eom, substitution, functions, guess=None, *, step_control=CYCLE_STEPS,
+                tolerance=TOLERANCE, max_iterations=MAX_ITERATIONS) -> LimitCycle:
+    """The periodic orbit through the model's impacts nearest ``guess`` (a state by name just
+    after an impact; None: the model's initial state, first carried to an impact)."""
+    model = eom.model
+    if not model.impacts:
+        raise InputError("the model has no impacts ([[impacts]]): no cycle through one",
+                         field="impacts")
+    n = len(model.coordinates)
+    poincare = PoincareMap(eom, substitution, functions, step_control)
+    start = resolve_state(model, guess, field="guess", time=False,
+                          what="coordinate or velocity")
+    x = np.concatenate([start.q_array(), start.q_dot_array()])
+    if guess is None:
+        for _ in range(WARM_UP):
+            x, *_ = poincare(x)
+    for iteration in range(1, max_iterations + 1):
+        x_next, period, name, DP = poincare(x, jacobian=True)
+        residual = x_next - x
+        scale = max(1.0, float(np.max(np.abs(x))))
+        if float(np.max(np.abs(residual))) < tolerance * scale:
+            flow = functions.rhs(0.0, x)
+            return _cycle(model, x, period, name, DP, iteration, residual, flow)
+        step = np.linalg.lstsq(DP - np.eye(2 * n), -residual, rcond=None)[0]
+        x = x + _bounded(step, scale)
+        if not np.all(np.isfinite(x)):
+            break
+    raise InputError(f"no limit cycle found from the guess ({max_iterations} Newton steps "
+                     "did not converge): give a guess nearer the cycle (--guess NAME=VALUE) or "
+                     "check the slope and parameters", field="guess")
+
+
+def _bounded(step, scale, largest=0.5):
+    size = float(np.max(np.abs(step)))
+    return step if size <= largest * scale else step * (largest * scale / size)
+
+
+def _cycle(model, x, period, name, DP, iterations, residual, flow) -> LimitCycle:
+    eigenvalues, vectors = np.linalg.eig(DP)
+    # the flow direction's: DP f(x*) = 0 (the zero eigenvalue whose vector is along the flow)
+    along = np.abs(vectors.conj().T @ flow) / max(float(np.linalg.norm(flow)), 1e-300)
+    small = np.abs(eigenvalues) < 1e-6 * max(1.0, float(np.max(np.abs(eigenvalues))))
+    trivial = int(np.argmax(np.where(small, along, -1.0))) if small.any() \
+        else int(np.argmin(np.abs(eigenvalues)))
+    kept = sorted(np.delete(eigenvalues, trivial), key=lambda m: -abs(m))
+    names = [c.name for c in model.coordinates] + [c.velocity.name for c in model.coordinates]
+    state = {k: float(v) for k, v in zip(names, x, strict=True)}
+    multipliers = tuple(complex(m) for m in kept)
+    return LimitCycle(state, float(period), multipliers,
+                      bool(all(abs(m) < 1 for m in multipliers)), name, iterations,
+                      float(np.max(np.abs(residual))), DP)
+
+
+__all__ = ["LimitCycle", "limit_cycle"]

@@ -7,10 +7,6 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
-
-import lagrangian
-from lagrangian.errors import ModelError
-
 from conserved_models import (
     CENTRAL_WELL,
     DAMPED_PAIR,
@@ -19,6 +15,9 @@ from conserved_models import (
     PUSHED_PAIR,
     SPHERICAL_PENDULUM,
 )
+
+import lagrangian
+from lagrangian.errors import ModelError
 
 
 @pytest.fixture(scope="module")

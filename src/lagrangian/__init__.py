@@ -73,6 +73,7 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
         read_model,
         state_layout,
     )
+    from .api.optimize import Trajectory, optimize
     from .control import computed_torque, lqr
     from .errors import DynamicsWarning, ModelWarning
 
@@ -152,6 +153,7 @@ __all__ = [
     "course_folder",
     "example_names",
     "example_path",
+    "example_robots",
     "example_summary",
     "example_text",
     "parse_quantity",
@@ -164,6 +166,8 @@ __all__ = [
     "state_layout",
     "lqr",
     "computed_torque",
+    "optimize",
+    "Trajectory",
     "cos",
     "exp",
     "sin",
@@ -183,6 +187,7 @@ _HOMES = {
     "resolve_state": ("model.values", "resolve_state"),
     "example_names": ("model.examples", "example_names"),
     "example_path": ("model.examples", "example_path"),
+    "example_robots": ("model.robots", "example_robots"),
     "example_summary": ("model.examples", "example_summary"),
     "example_text": ("model.examples", "example_text"),
     "physical_warnings": ("derivation.regularity", "physical_warnings"),
@@ -201,6 +206,8 @@ _HOMES = {
     "check_report_path": ("report.page", "check_report_path"),
     "lqr": ("control.lqr", "lqr"),
     "computed_torque": ("control.computed_torque", "computed_torque"),
+    "optimize": ("api.optimize", "optimize"),
+    "Trajectory": ("control.optimize", "Trajectory"),
 }
 
 

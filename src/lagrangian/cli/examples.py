@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from .. import example_names, example_path, example_summary, example_text
+from .. import example_names, example_path, example_robots, example_summary, example_text
 from . import app
 from .common import print_json
 
@@ -32,6 +32,25 @@ def _show(name: str, json_: bool) -> None:
                    f"{pairs.replace('--', '- -')} -->")
 
 
+def _robots(json_: bool) -> None:
+    """example-robot-data's robots by short name and path; a name a built-in example also has
+    is marked: the built-in example comes first, the robot loads by its path."""
+    listing = example_robots()
+    if json_:
+        print_json({"robots": listing})
+        return
+    if not listing:
+        typer.echo("example-robot-data is not installed (pip install example-robot-data, or "
+                   "set EXAMPLE_ROBOT_DATA_DIR to its robots/ folder)")
+        return
+    width = max(len(robot["name"]) for robot in listing)
+    for robot in listing:
+        mark = "  (a built-in example has this name: load the robot by its path)" \
+            if robot["shadowed"] else ""
+        typer.echo(f"{robot['name']:<{width}}  {robot['path']}{mark}")
+    typer.echo("\nLoad one by its name, e.g.: lagrangian dynamics panda --q 0,0,0,-1.5,0,1.5,0,0")
+
+
 @app.command()
 def examples(
     show: Annotated[str | None, typer.Option("--show", help="Print one example's model file.")] = None,
@@ -42,8 +61,14 @@ def examples(
     copy: Annotated[str | None, typer.Option(
         "--copy", help="With --course: write the teaching set into this new folder (each "
                        "lesson's model.toml and answer files).")] = None,
+    robots: Annotated[bool, typer.Option(
+        "--robots", help="List example-robot-data's URDFs installed here, with their paths "
+                         "(a short name loads one: lagrangian dynamics panda).")] = False,
 ) -> None:
     """List the built-in examples (use a name wherever a MODEL file is expected)."""
+    if robots:
+        _robots(json_)
+        return
     if course or copy is not None:
         from .course import course_command
 

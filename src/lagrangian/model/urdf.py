@@ -62,11 +62,20 @@ def read_urdf(path, lock: Mapping[str, float] | None = None,
 
 
 def example_urdf(name: str):
-    """The path of a built-in URDF example (``two_link_arm``), or None."""
+    """The path of a built-in URDF example (``two_link_arm``), else of an installed
+    example-robot-data robot by its short name (``panda``, model/robots.py) that no built-in
+    example shadows, or None."""
     from importlib import resources
 
+    from .examples import example_names
+    from .robots import example_robot
+
     entry = resources.files("lagrangian.model.examples") / f"{name}.urdf"
-    return Path(str(entry)) if re.fullmatch(r"\w+", name) and entry.is_file() else None
+    if not re.fullmatch(r"\w+", name):
+        return None
+    if entry.is_file():
+        return Path(str(entry))
+    return None if name in example_names() else example_robot(name)
 
 
 def parse_urdf(text: str, *, source: str = "<urdf>",

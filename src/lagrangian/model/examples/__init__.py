@@ -29,8 +29,13 @@ def example_path(name: str) -> Path:
     """Path of a built-in example's model file (or URDF)."""
     files = _files()
     if name not in files:
-        raise ModelError(f"no such file or built-in example '{name}'{did_you_mean(name, files)} "
-                         "(`lagrangian examples` lists them)")
+        from ..robots import installed_robots  # example-robot-data's names, where installed
+
+        robots = [robot for robot in installed_robots() if robot not in files]
+        where = "; `lagrangian examples --robots` the robots" if robots else ""
+        raise ModelError(f"no such file or built-in example '{name}'"
+                         f"{did_you_mean(name, [*files, *robots])} "
+                         f"(`lagrangian examples` lists them{where})")
     return files[name]
 
 

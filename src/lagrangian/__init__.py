@@ -73,7 +73,6 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
         read_model,
         state_layout,
     )
-    from .api.optimize import Trajectory, optimize
     from .control import computed_torque, lqr
     from .errors import DynamicsWarning, ModelWarning
 
@@ -166,8 +165,6 @@ __all__ = [
     "state_layout",
     "lqr",
     "computed_torque",
-    "optimize",
-    "Trajectory",
     "cos",
     "exp",
     "sin",
@@ -206,8 +203,6 @@ _HOMES = {
     "check_report_path": ("report.page", "check_report_path"),
     "lqr": ("control.lqr", "lqr"),
     "computed_torque": ("control.computed_torque", "computed_torque"),
-    "optimize": ("api.optimize", "optimize"),
-    "Trajectory": ("control.optimize", "Trajectory"),
 }
 
 

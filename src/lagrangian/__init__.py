@@ -73,6 +73,7 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
         read_model,
         state_layout,
     )
+    from .api.optimize import Trajectory, optimize
     from .control import computed_torque, lqr
     from .errors import DynamicsWarning, ModelWarning
 
@@ -165,6 +166,8 @@ __all__ = [
     "state_layout",
     "lqr",
     "computed_torque",
+    "optimize",
+    "Trajectory",
     "cos",
     "exp",
     "sin",
@@ -203,6 +206,8 @@ _HOMES = {
     "check_report_path": ("report.page", "check_report_path"),
     "lqr": ("control.lqr", "lqr"),
     "computed_torque": ("control.computed_torque", "computed_torque"),
+    "optimize": ("api.optimize", "optimize"),
+    "Trajectory": ("control.optimize", "Trajectory"),
 }
 
 

@@ -50,6 +50,7 @@ from . import examples as _examples  # noqa: E402,F401
 from . import forces as _forces  # noqa: E402,F401
 from . import kinematics as _kinematics  # noqa: E402,F401
 from . import modes as _modes  # noqa: E402,F401
+from . import optimize as _optimize  # noqa: E402,F401
 from . import regressor as _regressor  # noqa: E402,F401
 from . import report as _report  # noqa: E402,F401
 from . import simulate as _simulate  # noqa: E402,F401

@@ -121,7 +121,8 @@ class CasadiFunctions:
     ``rhs(x, u)`` -> x_dot (with constraints, the KKT solve simulate uses), ``mass_matrix(q)``
     -> M, ``forcing(q, q_dot, u)`` -> f of M q_ddot (+ Phi_q^T lambda) = f, ``constraints(q,
     q_dot)`` -> the residuals Phi (holonomic) and A q_dot + b (velocity), None without
-    constraints. ``inputs`` name the entries of u (as ``linearize(inputs=...)``)."""
+    constraints. ``inputs`` name the entries of u (as ``linearize(inputs=...)``): a generalized
+    force on a coordinate, or added to a load's parameter (as simulate's controller does)."""
 
     coordinates: tuple[str, ...]
     inputs: tuple[str, ...]
@@ -170,10 +171,8 @@ def casadi_functions(eom: EquationsOfMotion, inputs: Sequence[str] = (),
     if _uses(eom, set(input_symbols), forcing=False):
         raise ModelError("an input enters the mass matrix or the constraints: inputs are loads "
                          "(forces, torques), not masses or lengths", field="inputs")
-    values = resolve_parameters(model, {k: v for k, v in dict(parameters or {}).items()
-                                        if k not in inputs}, require=False)
-    env: dict = {s: float(x) for s, x in values.symbol_values(model).items()
-                 if s not in input_symbols}
+    values = resolve_parameters(model, parameters, require=False)
+    env: dict = {s: float(x) for s, x in values.symbol_values(model).items()}
     missing = sorted(p.name for p in model.parameters
                      if p.symbol not in env and p.symbol not in input_symbols)
     needed = {str(s) for s in _free(eom)} & set(missing)
@@ -182,7 +181,8 @@ def casadi_functions(eom: EquationsOfMotion, inputs: Sequence[str] = (),
                          field="parameters")
     env.update({s: q[i] for i, s in enumerate(model.q)})
     env.update({s: v[i] for i, s in enumerate(model.q_dot)})
-    env.update({s: u[k] for s, k in input_symbols.items()})
+    # an input on a parameter is added to the parameter's own value, as simulate's controller
+    env.update({s: env.get(s, 0.0) + u[k] for s, k in input_symbols.items()})
     env.update({s: 0.0 for s in symbols if s not in env})  # unused parameters
     mass = ca.reshape(ca.vertcat(*sympy_to_sx(list(eom.mass_matrix), env)), n, n).T
     forcing = ca.vertcat(*sympy_to_sx(list(eom.forcing), env))

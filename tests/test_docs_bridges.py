@@ -1,0 +1,56 @@
+"""docs/bridges.md: its Python and its commands run, and what they show is the physics."""
+
+from __future__ import annotations
+
+import json
+import re
+import shlex
+
+import numpy as np
+import pytest
+
+from docs_blocks import block
+
+
+def python_of(name: str) -> str:
+    (code,) = re.findall(r"```python\n(.*?)```", block(name, "bridges.md"), re.S)
+    return code
+
+
+def commands(name: str) -> list[list[str]]:
+    lines = [shlex.split(line[2:]) for code in re.findall(r"```console\n(.*?)```",
+                                                            block(name, "bridges.md"), re.S)
+             for line in code.splitlines() if line.startswith("$ ")]
+    assert all(args[0] == "lagrangian" for args in lines)
+    return [args[1:] for args in lines]
+
+
+def test_casadi_block_gives_the_linearized_A(capsys):
+    import lagrangian
+
+    namespace: dict = {}
+    exec(python_of("bridges-casadi"), namespace)  # noqa: S102 - our own documentation
+    A = np.asarray(namespace["A"]([0, 0, 0, 0], [0]))
+    expected = lagrangian.load("double_pendulum").linearize(
+        {"theta1": 0, "theta2": 0}).A
+    assert np.allclose(A, expected, rtol=1e-10, atol=1e-10)
+    assert "inputs=['theta1']" in capsys.readouterr().out
+
+
+def test_optimize_block_swings_the_pole_up():
+    namespace: dict = {}
+    exec(python_of("bridges-optimize"), namespace)  # noqa: S102 - our own documentation
+    swing, run = namespace["swing"], namespace["run"]
+    assert swing.converged
+    assert np.abs(swing.states["x"]).max() <= 1 + 1e-6  # the track's bound held
+    assert np.abs(swing.inputs["push"]).max() <= 20 + 1e-6
+    assert np.abs(run.q[-1] - [0, np.pi]).max() <= swing.defects["replay"] + 1e-6
+
+
+def test_optimize_commands(cli):
+    text, as_json = commands("bridges-optimize-cli")
+    result = cli(*text)
+    assert result.code == 0, result.err
+    assert "converged" in result.out and "NOT" not in result.out
+    document = json.loads(cli(*as_json).out)
+    assert document["converged"] and document["states"]["theta"][-1] == pytest.approx(np.pi)

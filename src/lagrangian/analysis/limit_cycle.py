@@ -69,15 +69,16 @@ def _complex(m: complex) -> str:
 
 
 def limit_cycle(eom, substitution, functions, guess=None, *, step_control=CYCLE_STEPS,
-                tolerance=TOLERANCE, max_iterations=MAX_ITERATIONS) -> LimitCycle:
+                tolerance=TOLERANCE, max_iterations=MAX_ITERATIONS, maps=None) -> LimitCycle:
     """The periodic orbit through the model's impacts nearest ``guess`` (a state by name just
-    after an impact; None: the model's initial state, first carried to an impact)."""
+    after an impact; None: the model's initial state, first carried to an impact); ``maps``
+    the derived impact maps where they are at hand."""
     model = eom.model
     if not model.impacts:
         raise InputError("the model has no impacts ([[impacts]]): no cycle through one",
                          field="impacts")
     n = len(model.coordinates)
-    poincare = PoincareMap(eom, substitution, functions, step_control)
+    poincare = PoincareMap(eom, substitution, functions, step_control, maps)
     start = resolve_state(model, guess, field="guess", time=False,
                           what="coordinate or velocity")
     x = np.concatenate([start.q_array(), start.q_dot_array()])

@@ -15,10 +15,19 @@ class Simulation(SimulationResult):
     of a SimulationResult; ``to_pandas()``, ``save()``, ``plot()`` and ``animate()`` show them.
     """
 
+    # a run through impacts (simulation/hybrid.py): each ImpactRecord, and where they
+    # accumulate (s); () and None for other runs
+    impacts: tuple = ()
+    accumulation_time: float | None = None
+
     @classmethod
     def of(cls, result: SimulationResult) -> Simulation:
         """The same run (the same arrays, not copied) with the methods that show it."""
-        return cls(**{f.name: getattr(result, f.name) for f in fields(SimulationResult)})
+        run = cls(**{f.name: getattr(result, f.name) for f in fields(SimulationResult)})
+        for name in ("impacts", "accumulation_time"):  # a HybridResult's
+            if hasattr(result, name):
+                object.__setattr__(run, name, getattr(result, name))
+        return run
 
     def __getitem__(self, column: str):
         """One column by name: 't', 'theta', 'theta_dot', 'energy', 'lambda_rod', ..."""

@@ -55,13 +55,14 @@ from ..simulation.simulate import (
 from .checking import CheckMethods
 from .conservation import ConservationMethods
 from .control import ControlMethods
+from .impacts import ImpactMethods
 from .modes import ModalAnalysis
 from .options import run_options
 from .simulation import Simulation
 from .studies import StudyMethods
 
 
-class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods):
+class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, ImpactMethods):
     """A mechanical system described in generalized coordinates.
 
     >>> import lagrangian
@@ -194,6 +195,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods):
         limits: bool = True,
         controller=None,
         inputs: Sequence[str] | None = None,
+        max_impacts: int | None = None,
+        settle: bool = False,
     ) -> Simulation:
         """Integrate the equations of motion to ``t_end`` (s); returns a Simulation.
 
@@ -210,7 +213,10 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods):
         as lagrangian.control's controllers do), to the model's own; "model" runs the file's
         [control] laws, compiled with its equations: docs/control.md. On a floating base u
         is the n joint torques or all n + 6 entries, the base's wrench first, and
-        ``stop_when`` may name the base's numbers (base_z, base_vz, ...)."""
+        ``stop_when`` may name the base's numbers (base_z, base_vz, ...). A model with
+        [[impacts]] runs through them (``.impacts`` lists each; status 'accumulated' where they
+        accumulate, 'settled' with ``settle=True``, 'impact_limit' at ``max_impacts``, default
+        1000): docs/simulation.md."""
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
         if tree and self._floating:  # q (+) v dt on SE(3): simulation/floating.py
             from ..simulation.floating import simulate_floating
@@ -226,6 +232,10 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods):
         step_control, save_at = run_options(step_control, save_at, method, rtol, atol, samples,
                                          1001)
         stop = parse_stop_condition(stop_when, self._model) if isinstance(stop_when, str) else stop_when
+        if self._model.impacts and not tree:  # through them: each listed (.impacts)
+            return Simulation.of(self._run_through_impacts(
+                t_end, start, step_control, save_at, progress, stop, controller, max_impacts,
+                settle))
         law = isinstance(controller, str) and not tree and inputs is None
         controller = self._model_law(controller) if law else controller  # once per System
         result = simulate(None if tree else self.equations_of_motion(), t_end, initial=start,

@@ -114,19 +114,37 @@ class CompiledImpact:
         """(q+, v+, impulse, energy lost, residual, extended velocities before and after)."""
         M, J, E, P, n, R, DR = self.matrices(q, v, t)
         ve = np.concatenate([np.zeros(self.k), v])
-        kkt, rhs = kkt_system(M, J, E, ve)
-        try:
-            solution = np.linalg.solve(kkt, rhs)
-        except np.linalg.LinAlgError:
-            raise InputError(f"impact '{self.name}' at t = {t:.12g} s: the impact equations "
-                             "are singular (the mass matrix is singular where the law leaves "
-                             "the point free)", field="impacts") from None
+        solution = solve_impact(M, J, E, ve, f"impact '{self.name}' at t = {t:.12g} s")
         after = solution[:self.size]
         impulse_rows = solution[self.size:]
         impulse = impulse_rows if J.shape[0] == P.shape[0] else impulse_rows[0] * n[:, 0]
         lost = 0.5 * float(ve @ M @ ve - after @ M @ after)
         residual = float(np.max(np.abs(J @ after + E @ (J @ ve)))) if len(J) else 0.0
         return R[:, 0], DR @ after[self.k:], impulse, lost, residual, ve, after
+
+
+def solve_impact(M, J, E, v_before, where: str) -> np.ndarray:
+    """[q_dot+; Lambda] from the impact equations; rows of J that repeat others (a stick
+    law's tangential row along a velocity the point cannot have) are allowed, a velocity the
+    equations leave free (M singular where J does not hold it) is refused."""
+    kkt, rhs = kkt_system(M, J, E, v_before)
+    try:
+        with np.errstate(all="ignore"):
+            values = np.linalg.svd(kkt, compute_uv=False)
+            rows = np.linalg.svd(J, compute_uv=False) if J.size else np.zeros(0)
+            solution = np.linalg.lstsq(kkt, rhs, rcond=None)[0]
+    except np.linalg.LinAlgError:
+        values, rows, solution = np.zeros(1), np.zeros(0), None
+    top = float(values.max(initial=0.0))
+    rank = int(np.sum(values > 1e-11 * top)) if top > 0 else 0
+    independent = int(np.sum(rows > 1e-11 * max(float(rows.max(initial=0.0)), 1e-300)))
+    if solution is None or not np.all(np.isfinite(solution)) or rank < len(M) + independent:
+        raise InputError(f"{where}: the impact equations are singular (the mass matrix is "
+                         "singular where the law leaves the point free)", field="impacts")
+    if np.max(np.abs(kkt @ solution - rhs), initial=0.0) > \
+            1e-8 * max(1.0, float(np.max(np.abs(rhs)))):
+        raise InputError(f"{where}: the impact equations have no solution", field="impacts")
+    return solution
 
 
 def kkt_system(M, J, E, v_before):
@@ -193,12 +211,13 @@ def simulate_through_impacts(
     eom: EquationsOfMotion, t_end: float, *, initial=None, parameters=None,
     step_control: StepControl = DEFAULT_STEPS, save_at: SaveAt = DEFAULT_SAMPLES,
     progress: Callable[[float], None] | None = None, functions: NumericSystem | None = None,
-    max_impacts: int = MAX_IMPACTS, settle: bool = False, **unused,
+    max_impacts: int = MAX_IMPACTS, settle: bool = False, maps=None, **unused,
 ) -> HybridResult:
     """Integrate ``eom`` from its start to ``t_end`` (s) through its model's impacts: each
     located, mapped and listed; accumulating impacts end the run (status 'accumulated') or,
     with ``settle``, leave the model at rest on the surface to ``t_end`` (status 'settled');
-    ``max_impacts`` caps their number (status 'impact_limit')."""
+    ``max_impacts`` caps their number (status 'impact_limit'); ``maps`` the derived impact
+    maps where they are at hand."""
     for name, value in unused.items():
         if value not in (None, (), False, True):
             raise InputError(f"'{name}' is not available for a model with impacts",
@@ -214,7 +233,7 @@ def simulate_through_impacts(
     values = resolve_parameters(model, parameters)
     substitution = values.symbol_values(model)
     functions = functions if functions is not None else numeric(eom, values)
-    impacts, guards = compiled_impacts(eom, substitution)
+    impacts, guards = compiled_impacts(eom, substitution, maps)
     n = functions.n
     grid = np.linspace(start.t, t_end, save_at.samples)
     t0, y = float(start.t), np.concatenate([start.q_array(), start.q_dot_array()])
@@ -309,8 +328,7 @@ def _settled(impact: CompiledImpact, y: np.ndarray, t: float, n: int):
     q, v = y[:n], y[n:]
     M, J, E, *_ = impact.matrices(q, v, t)
     ve = np.concatenate([np.zeros(impact.k), v])
-    kkt, rhs = kkt_system(M, J, np.zeros_like(E), ve)
-    after = np.linalg.solve(kkt, rhs)[impact.k:impact.size]
+    after = solve_impact(M, J, np.zeros_like(E), ve, "settling")[impact.k:impact.size]
     scale = max(1.0, float(np.max(np.abs(v))))
     at_rest = float(np.max(np.abs(after), initial=0.0)) < 1e-6 * scale
     return np.concatenate([q, np.zeros(n) if at_rest else after]), at_rest
@@ -351,5 +369,5 @@ def _result(eom, functions, substitution, t, y, step_control, status, message, s
 
 __all__ = ["ACCUMULATED", "HYBRID_STATUS", "IMPACT_LIMIT", "MAX_IMPACTS", "SETTLED",
            "CompiledImpact", "Guards", "HybridResult", "ImpactRecord", "accumulation",
-           "compiled_impacts", "kkt_system", "polish",
+           "compiled_impacts", "kkt_system", "polish", "solve_impact",
            "simulate_through_impacts"]

@@ -100,7 +100,7 @@ class PoincareMap:
     """x (the state just after an impact) -> the state just after the next impact, the time
     between them (s), which impact, and (with ``jacobian``) the map's Jacobian."""
 
-    def __init__(self, eom, substitution, functions, step_control, maps=None, t_max=100.0):
+    def __init__(self, eom, substitution, functions, step_control, maps=None, t_max=20.0):
         from .hybrid import compiled_impacts
 
         model = eom.model

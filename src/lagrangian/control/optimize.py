@@ -139,7 +139,10 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
     if functions.constraints is not None:
         m = len(functions.constraint_names)
         Phi = functions.constraints.map(nodes)(X[: n2 // 2, :], X[n2 // 2:, :])
-        opti.subject_to(Phi[:, 0] == 0)  # the start on the constraints; the dynamics keep it
+        # the start on the constraints, at position and velocity level; the dynamics keep it
+        q0, v0 = X[: n2 // 2, 0], X[n2 // 2:, 0]
+        opti.subject_to(Phi[:, 0] == 0)
+        opti.subject_to(_holonomic_rates(ca, functions, n2 // 2)(q0, v0) == 0)
         constraint_rows = Phi
     else:
         m, constraint_rows = 0, None
@@ -184,6 +187,16 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
         iterations=int(stats.get("iter_count", 0)), midpoint_inputs=um)
     trajectory.defects["replay"] = _replay_error(functions, trajectory, x)
     return trajectory
+
+
+def _holonomic_rates(ca, functions: CasadiFunctions, n: int):
+    """d/dt Phi = Phi_q q_dot of the holonomic constraints (the rows without q_dot), a
+    Function (q, q_dot); velocity constraints already hold at the velocity level."""
+    q, v = ca.SX.sym("q", n), ca.SX.sym("v", n)
+    residual = functions.constraints(q, v)
+    rows = [i for i in range(residual.shape[0]) if not ca.depends_on(residual[i], v)]
+    rates = ca.jtimes(residual[rows], q, v) if rows else ca.SX(0, 1)
+    return ca.Function("rates", [q, v], [rates])
 
 
 def _rows(k: int, n2: int, nodes, middle) -> list:
@@ -252,13 +265,14 @@ def _number(value, field: str) -> float:
 
 
 def _start(model: Model, functions: CasadiFunctions, start) -> tuple[dict[int, float], dict]:
-    """The fixed start (index -> value) and, for a constrained model, the free entries (the
-    states start does not name, placed on the constraints by the solver) with their guess."""
+    """The fixed start (index -> value) and, for a constrained model given a partial start, the
+    free entries (the states start does not name, placed on the constraints by the solver)
+    with their guess (the model's initial values)."""
     names = functions.states
     given = _named(start, names, "start")
     state = resolve_state(model, {names[i]: v for i, v in given.items()}, field="start")
     values = [*map(float, state.q), *map(float, state.q_dot)]
-    if functions.constraints is None:
+    if functions.constraints is None or not given:  # the model's own start is consistent
         return {i: values[i] for i in range(len(names))}, {}
     return given, {i: values[i] for i in range(len(names)) if i not in given}
 

@@ -43,6 +43,7 @@ def _main(version: Annotated[bool, typer.Option(
 from . import check as _check  # noqa: E402,F401
 from . import codegen as _codegen  # noqa: E402,F401
 from . import conserved as _conserved  # noqa: E402,F401
+from . import cycle as _cycle  # noqa: E402,F401
 from . import derive as _derive  # noqa: E402,F401
 from . import dynamics as _dynamics  # noqa: E402,F401
 from . import equilibria as _equilibria  # noqa: E402,F401

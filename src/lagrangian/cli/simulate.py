@@ -58,6 +58,8 @@ def simulate(
     kd: Annotated[str, typer.Option("--kd", help="--control computed-torque: rate gain (1/s), a number or the diagonal.")] = "20",  # noqa: E501
     along: Annotated[bool, typer.Option("--linearize-along", help="Also A(t), B(t) of x = [q; q_dot] at the saved samples (u: each coordinate's generalized force); with --json under the key linearize_along; a constrained model's through its multipliers.")] = False,  # noqa: E501
     independent: Annotated[list[str], typer.Option("--independent", help="--linearize-along on a constrained model: A(t), B(t) on the constraint manifold in these n - m coordinates (repeat, or separate by commas; auto: the best conditioned along the run).")] = [],  # noqa: B006,E501
+    max_impacts: Annotated[int | None, typer.Option("--max-impacts", help="A model with [[impacts]]: stop after this many (default 1000; status 'impact_limit').")] = None,  # noqa: E501
+    settle: Annotated[bool, typer.Option("--settle", help="A model with [[impacts]]: where impacts accumulate (a ball coming to rest), rest on the surface to the end time (status 'settled') instead of stopping there.")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
@@ -125,7 +127,7 @@ def simulate(
             end, initial=start, method=step_control.method,
             rtol=step_control.rtol, atol=step_control.atol, samples=save_at.samples,
             stop_when=stop, progress=progress.update, limits=not ignore_limits,
-            controller=controller,
+            controller=controller, **_impact_options(system, max_impacts, settle),
         )
     warning = projection_warning(simulation)
     if warning:
@@ -160,9 +162,17 @@ def simulate(
             document["control"] = {"kind": control, **controller.summary()}
         if linearized is not None:
             document["linearize_along"] = linearized.summary()
+        if system.model.impacts:
+            from ..output.impacts import impacts_document
+
+            document["impacts"] = impacts_document(simulation)
         print_json(document)
     else:
         typer.echo(simulation_text(simulation, written), nl=False)
+        if system.model.impacts:
+            from ..output.impacts import impacts_text
+
+            typer.echo(impacts_text(simulation), nl=False)
         if controller is not None:
             typer.echo(law_text(system.model) if controller == "model"
                        else controller_text(controller))
@@ -181,6 +191,18 @@ def simulate(
         saved = f"; partial result saved to {', '.join(written.values())}" if written else ""
         typer.echo(f"{simulation.message}{saved}", err=True)
         raise SystemExit(130)
+
+
+def _impact_options(system, max_impacts, settle) -> dict:
+    """--max-impacts and --settle for a model with impacts; refused for one without."""
+    from ..errors import InputError
+
+    if system.model.impacts:
+        return {"max_impacts": max_impacts, "settle": settle}
+    for flag, given in (("--max-impacts", max_impacts is not None), ("--settle", settle)):
+        if given:
+            raise InputError("the model has no [[impacts]]", field=flag)
+    return {}
 
 
 def _controller(system, control, about, inputs, q_weight, r_weight, kp, kd):

@@ -69,18 +69,32 @@ TREE = ('<?xml version="1.0"?><robot name="turret">' + "".join([
 
 @pytest.fixture(scope="module", params=["unrolled", "compact"])
 def tree(tmp_path_factory, request):
-    """The turret, its dynamics on each kernel: the tree's own unrolled module, or the compact
-    kernel (dynamics/engine/compact_kernel.py) for every tree (the size threshold set below 0)."""
-    from lagrangian.dynamics.engine import compact_kernel
-
+    """The turret, and the kernel its dynamics run on: the engine's one module for every tree
+    (the default) or the tree's own unrolled module (kernel="unrolled")."""
     path = tmp_path_factory.mktemp("tree") / "turret.urdf"
     path.write_text(TREE)
-    with pytest.MonkeyPatch.context() as patch:
-        if request.param == "compact":
-            patch.setattr(compact_kernel, "COMPACT_ABOVE", -1)
-        system = lagrangian.load(path, lock={"grip": 0.01})
-        assert system.dynamics().kernel == request.param or not compiled.available()
-        yield system
+    system = lagrangian.load(path, lock={"grip": 0.01})
+    assert system.dynamics().kernel == "compact" or not compiled.available()
+    return OnKernel(system, request.param)
+
+
+class OnKernel:
+    """A System whose dynamics and numeric functions run on one kernel (the rest its own)."""
+
+    def __init__(self, system, kernel):
+        self.system, self.kernel = system, kernel
+
+    def __getattr__(self, name):
+        return getattr(self.system, name)
+
+    def dynamics(self, **options):
+        return self.system.dynamics(**{"kernel": self.kernel, **options})
+
+    def numeric(self):
+        return self.dynamics().numeric_system()
+
+    def with_parameters(self, **values):
+        return OnKernel(self.system.with_parameters(**values), self.kernel)
 
 
 def states(n, count=6, seed=3):
@@ -183,10 +197,10 @@ def test_a_large_batch_split_over_threads_equals_one_call_per_state(tree):
 def test_a_compiler_that_refuses_the_native_flags_still_builds(tree, monkeypatch, tmp_path):
     """The batches are built for this processor (its own vector width); a compiler that
     refuses those flags gets the portable ones, with the same numbers."""
+    native = tree.dynamics()
     monkeypatch.setenv("LAGRANGIAN_CACHE", str(tmp_path))
     monkeypatch.setattr(compiled, "NATIVE_CFLAGS", ("-mno-such-instruction-set",))
     portable = RecursiveDynamics(tree.model, applicable_tree(tree.model))
-    native = tree.dynamics()
     assert portable.module.__name__ != native.module.__name__
     q, v, a, _ = states(native.n, count=9, seed=8)
     np.testing.assert_allclose(portable.mass_matrix(q), native.mass_matrix(q),
@@ -200,12 +214,13 @@ def test_a_compiler_that_refuses_an_exactness_flag_still_builds(tree, monkeypatc
     """The robot's module asks for no fused multiply-adds and no packing of scalar code
     (compiled.EXACT_CFLAGS); a compiler that knows only the first still builds it, with the
     same numbers."""
+    native = tree.dynamics()
     monkeypatch.setenv("LAGRANGIAN_CACHE", str(tmp_path))
     monkeypatch.setattr(compiled, "EXACT_CFLAGS", ("-ffp-contract=off", "-fno-such-flag"))
     fallback = RecursiveDynamics(tree.model, applicable_tree(tree.model))
     q, v, a, _ = states(fallback.n, count=9, seed=8)
     np.testing.assert_allclose(fallback.inverse_dynamics(q, v, a),
-                               tree.dynamics().inverse_dynamics(q, v, a), rtol=1e-12, atol=1e-12)
+                               native.inverse_dynamics(q, v, a), rtol=1e-12, atol=1e-12)
 
 
 @needs_c

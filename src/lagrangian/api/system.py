@@ -336,8 +336,9 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         generated C (dynamics/recursive.py; in numpy without a compiler or with backend
         "numpy"), the other models their derived equations. A URDF robot's ``parameters`` may
         set a link's inertial (``{"tool0.mass": 2.5}``, dynamics/tree/inertials.py) without a
-        rebuild; ``kernel`` "unrolled" (the tree's own code), "compact" (one module for every
-        tree) or "auto" (by the tree's size, dynamics/engine/compact_kernel.py). ``actuators=True``
+        rebuild; ``kernel`` "auto" or "compact" (the engine: one compiled module for every
+        tree and variant) or "unrolled" (the tree's own code, compiled per tree on first use,
+        about 2x faster per call). ``actuators=True``
         adds the URDF's joint damping and friction, ``armature`` {joint: kg m^2 or kg} to M
         (dynamics/actuators.py)."""
         if parameters is None and backend == "auto" and kernel == "auto" \

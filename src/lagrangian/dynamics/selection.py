@@ -20,9 +20,9 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
                        backend: str = "auto", kernel: str = "auto"):
     """The recursive dynamics of a URDF tree, or of a model file's tree of rigid bodies on
     joints (at least TREE_PATH_BODIES of them): compiled C (recursive.RecursiveDynamics, the
-    tree's own unrolled module, or compact_kernel.CompactDynamics, one module for every tree:
-    ``kernel`` "unrolled", "compact" or "auto" by the tree's size and whether a link's inertial
-    is set), or numpy (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with
+    engine's one compiled module for every tree by default (``kernel`` "auto" or "compact"), or
+    the tree's own unrolled module, compiled per tree, with ``kernel="unrolled"``), or numpy
+    (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with
     backend "auto", where no compiler works; None where they do not apply: not a bare tree, or
     a mass matrix that is not positive definite (the symbolic path names the joints).
 
@@ -30,8 +30,6 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
     INERTIAL_FIELDS: mass, com_x, ..., ixx, ...), as if the URDF had been edited."""
     from ..compile.compiled import BackendUnavailable
     from ..compile.functions import tell_numpy_fallback
-    from ..model.urdf_payload import PREFIX as PAYLOAD_PREFIX
-    from .engine.compact_kernel import COMPACT_ABOVE
     from .recursive import (
         TREE_PATH_BODIES,
         CompactDynamics,
@@ -54,11 +52,10 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
         tree = inertials
     dynamics = None
     if backend != "numpy":
-        # a link's inertial set here, or a payload: the compact kernel takes them at run time;
-        # a floating base too (its free flyer is body 0 there)
-        compact = kernel == "compact" or (kernel == "auto" and (
-            inertials or len(tree.joints) > COMPACT_ABOVE
-            or any(link.name.startswith(PAYLOAD_PREFIX) for link in tree.links)))
+        # one engine for every tree and variant (a link's inertial, a payload, a floating
+        # base: run-time numbers, no build); the per-tree unrolled module only when asked for,
+        # about 2x faster per call after a compile of seconds per tree (docs/benchmarks.md)
+        compact = kernel != "unrolled"
         try:
             dynamics = (CompactDynamics if compact else RecursiveDynamics)(model, tree, parameters)
         except BackendUnavailable as exc:

@@ -9,9 +9,9 @@ from ...errors import ModelError
 from ...model.tree import KinematicTree
 
 Term = float | str  # a number, or the C name of a value computed before
-# coordinates up to which batches run several states per vector operation: every tree the
-# unrolled module takes by default (16 bodies, compact_kernel.COMPACT_ABOVE), a floating
-# base's six included (Solo12's cold build 4.1 -> 4.5 s; its M, bias and ID batches 1.5-2.7x)
+# coordinates up to which batches run several states per vector operation: a 16-body tree
+# asked for with kernel="unrolled", a floating base's six included (Solo12's cold build
+# 4.1 -> 4.5 s; its M, bias and ID batches 1.5-2.7x)
 VECTOR_LIMIT = 24
 
 

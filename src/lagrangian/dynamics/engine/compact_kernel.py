@@ -30,13 +30,6 @@ def _source() -> str:
     return "\n".join([head, _SINCOS, rest,
                       *(path.read_text(encoding="utf-8") for path in _SOURCES[1:])])
 
-# Trees of more moving bodies than this get the compact kernel; smaller ones the unrolled
-# module of tree_c.py: about 2x faster per call and, up to tree_emitter.VECTOR_LIMIT, several
-# states per vector operation in a batch, while its cold compile stays under ~20 s (measured:
-# docs/benchmarks.md, benchmarks/bench_tree_kernel.py --threshold).
-COMPACT_ABOVE = 16
-
-
 @lru_cache(maxsize=1)
 def kernel_key() -> str:
     """The module's key: its C source (and this file), never a tree."""
@@ -57,4 +50,4 @@ def kernel_module():
         source=_source(), parameters=(), n=0, m=0), native=True)
 
 
-__all__ = ["COMPACT_ABOVE", "kernel_key", "kernel_module"]
+__all__ = ["kernel_key", "kernel_module"]

@@ -59,7 +59,8 @@ SWEEP_VARY = {
     "rolling_disk": "R", "sleeping_top": "l", "slider_crank": "k", "support_pendulum": "L",
     "torque_free_body": "I1", "two_mass": "k", "virtual_work_link": "L", "whipple_bicycle": "v",
     "two_link_arm": "g", "massless_crank": "l", "coin_steady": "r", "slider_arm": "g",
-    "symbol_free": None,
+    "symbol_free": None, "bouncing_ball": "e", "rimless_wheel": "gamma",
+    "compass_gait": "gamma",
 }
 
 # statics where there are loads: the configuration and the load magnitudes found

@@ -114,6 +114,12 @@ class LinearModel(SecondOrderForm):
     # H dq + G dq_dot = 0 as rows over the state (dq, dq_dot). A keeps H dq + G dq_dot constant,
     # so the motions of the system are the invariant subspace where it is zero.
     state_constraints: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    # With inputs: the value of each that holds the equilibrium (its trim, analysis/trim.py:
+    # the parameter's value, or the generalized force on a coordinate; SI), and the model's own
+    # (a parameter's value in the model, 0 for a coordinate). u in B u is measured from the
+    # model's own: trim - nominal holds the state.
+    trim: dict[str, float] = field(default_factory=dict)
+    nominal_inputs: dict[str, float] = field(default_factory=dict)
 
     @property
     def constrained(self) -> bool:
@@ -136,8 +142,10 @@ class LinearModel(SecondOrderForm):
 
     def __repr__(self) -> str:
         about = ", ".join(f"{k}={v:.6g}" for k, v in self.equilibrium.items())
+        trim = "".join(f", {k}={v:.6g}" for k, v in self.trim.items())
         return (f"LinearModel(about {about}; coordinates={list(self.coordinates)}, "
-                f"inputs={list(self.inputs)})\nM =\n{self.mass_matrix}\nC =\n"
+                f"inputs={list(self.inputs)}{'; trim' if trim else ''}{trim[1:]})\n"
+                f"M =\n{self.mass_matrix}\nC =\n"
                 f"{self.damping_matrix}\nK =\n{self.stiffness_matrix}")
 
 

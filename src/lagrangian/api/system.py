@@ -17,7 +17,6 @@ from ..analysis.forces import ForceReport, evaluate_generalized_forces
 from ..analysis.linearization import (
     LinearModel,
     SymbolicLinearModel,
-    input_columns,
     is_statically_stable,
     linear_model_at,
     symbolic_linear_model,
@@ -382,9 +381,12 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
 
         ``about`` maps coordinate names to SI values (the others are solved for); without it the
         equilibrium nearest the initial values is used. ``inputs`` name parameters, loads or
-        coordinates (a generalized force). ``symbolic=True`` gives exact M, C, K of a small
-        unconstrained model with the parameters kept as symbols. ``steady`` linearizes about a
-        steady motion instead: cyclic coordinates turning at constant rates, e.g.
+        coordinates (a generalized force); their values that make ``about`` an equilibrium are
+        solved for (least squares, the residual checked: the result's ``trim``), so a load's
+        value in the file does not matter; refused only when no input can hold it.
+        ``symbolic=True`` gives exact M, C, K of a small unconstrained model with the
+        parameters kept as symbols. ``steady`` linearizes about a steady motion instead: cyclic
+        coordinates turning at constant rates, e.g.
         ``steady={"psi_dot": 10}`` (rad/s), the rest at ``about`` (the others solved for).
         """
         if steady:
@@ -400,9 +402,13 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         # inputs are columns of the derived equations' generalized forces
         functions = self._static_functions if not inputs or self._recursive is None \
             else AtRestFunctions(self.equations_of_motion())
+        if inputs:  # the inputs' values that hold ``about`` solved for (its trim)
+            from ..analysis.trim import trimmed_linear_model
+
+            return trimmed_linear_model(functions, about, inputs, lambda values: AtRestFunctions(
+                self.equations_of_motion(), values))
         q, multipliers = resolve_equilibrium(functions, about)
-        columns = input_columns(functions.eom, q, inputs, functions.parameters) if inputs else None
-        return linear_model_at(functions, q, multipliers, inputs=inputs, input_columns=columns)
+        return linear_model_at(functions, q, multipliers)
 
     def modes(self, about: Mapping[str, float] | None = None, *,
               steady: Mapping[str, float] | None = None,
@@ -505,7 +511,9 @@ def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None
     """Load a model file (TOML), a robot (URDF: ``lock`` freezes joints by name, rad or m;
     ``payload`` {link: mass, or (mass, (x, y, z))} fixes point masses (kg, m in the link's
     frame) to links, as an edited URDF would; ``floating_base`` frees its root link, nq = n + 7,
-    nv = n + 6: dynamics and kinematics only), or a built-in example by name (see
+    nv = n + 6: dynamics and kinematics only), a MuJoCo robot (MJCF, .xml: hinge and slide
+    joints in MuJoCo's qpos order, docs/bridges.md; ``lock`` and ``payload`` as for URDF), or
+    a built-in example by name (see
     ``examples()``); ``gravity`` (g_x, g_y, g_z) in m/s^2 turns the model's gravity
     (System.with_gravity)."""
     system = _load(path_or_example, lock, payload, floating_base)
@@ -514,6 +522,10 @@ def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None
 
 def _load(path_or_example: str | Path, lock, payload, floating_base) -> System:
     path = Path(path_or_example)
+    if path.suffix.lower() in (".xml", ".mjcf"):  # MuJoCo's MJCF, read as the URDF it is
+        from ..model.mjcf import read_mjcf
+
+        return System(read_mjcf(path, lock, payload, floating_base))
     urdf = path if path.suffix.lower() == ".urdf" else (
         None if path.exists() else example_urdf(str(path_or_example)))
     if urdf is not None:

@@ -27,6 +27,9 @@ ANIMATE_HELP = ("Animate the mechanism oscillating in each mode (the lowest six 
                 ".gif, .html (a player) or .mp4 (needs lagrangian[mp4]).")
 MODE_HELP = "With --animate: only this mode, numbered from 1 as printed."
 VIEW_HELP = "With --animate, bodies in space: AZIMUTH,ELEVATION in degrees (default isometric)."
+INPUTS_HELP = ("Loads, parameters or coordinates (a generalized force) that drive the system: "
+               "their values that make --about an equilibrium are solved for and printed (the "
+               "trim), the linear model's B is theirs; repeat, or separate by commas.")
 STEADY_HELP = ("Steady motion: a cyclic coordinate's constant rate, NAME_dot=VALUE (psi_dot=10, "
                "rad/s, or an expression in the parameters: thetaR_dot=-v/rR); linearize about "
                "it instead of an equilibrium.")
@@ -53,6 +56,7 @@ def modes(
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
     payload: Annotated[list[str], typer.Option("--payload", help=PAYLOAD_HELP)] = [],  # noqa: B006
+    drives: Annotated[list[str], typer.Option("--inputs", help=INPUTS_HELP)] = [],  # noqa: B006
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option("--plot", help="Draw the mode shapes to a PNG file.")] = None,
     animate: Annotated[Path | None, typer.Option("--animate", help=ANIMATE_HELP)] = None,
@@ -81,18 +85,27 @@ def modes(
         check_animation_target(animate)
         size, fps, view = check_size(size), check_fps(20 if fps is None else fps), check_view(view)
     rates = steady_assignments(system, steady)
-    analysis = system.modes(about=point or None, steady=rates or None)
+    names = [name.strip() for text in drives for name in text.split(",") if name.strip()]
+    analysis = system.modes(about=point or None, steady=rates or None, inputs=names)
+    trim = analysis.linear_model.trim
     if plot is not None:
         write_mode_plot(analysis, plot, protect=inputs)
     if animate is not None:
         analysis.animate(animate, mode=mode, fps=fps, size=size, view=view)
     if json_:
         document = modes_document(analysis)
+        if names:  # the inputs, their trim and B (x = [z; z_dot])
+            document.update(inputs=names, trim=trim,
+                            input_matrix=analysis.linear_model.B.tolist())
         if animate is not None:
             document["animation"] = str(animate)
         print_json(document)
     else:
         typer.echo(modes_text(analysis), nl=False)
+        if trim:
+            from .simulate import trim_text
+
+            typer.echo(trim_text(trim))
         if plot is not None:
             typer.echo(f"Mode shapes drawn to {plot}")
         if animate is not None:

@@ -176,6 +176,8 @@ def simulate(
         if controller is not None:
             typer.echo(law_text(system.model) if controller == "model"
                        else controller_text(controller))
+            if getattr(controller, "trim", None):  # the library's trim (System.linearize)
+                typer.echo(trim_text(controller.trim))
         if linearized is not None:
             size, width = linearized.B.shape[1:]
             where = "" if not linearized.dependent else (
@@ -234,6 +236,12 @@ def _controller(system, control, about, inputs, q_weight, r_weight, kp, kd):
         model = system.linearize(point, inputs=names)
         return lqr(model, _numbers(q_weight, "Q"), _numbers(r_weight, "R"))
     return computed_torque(system, point or {}, _numbers(kp, "Kp"), _numbers(kd, "Kd"))
+
+
+def trim_text(trim: dict[str, float]) -> str:
+    """One line: the inputs' values that hold the equilibrium (the linear model's trim)."""
+    values = ", ".join(f"{name} = {value:.6g}" for name, value in trim.items())
+    return f"trim (the inputs' values that hold the equilibrium, SI): {values}"
 
 
 def _numbers(text: str, field: str):

@@ -8,7 +8,7 @@ x = [z - z0; z_dot] in the linear model's coordinates z about its equilibrium z0
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -37,6 +37,10 @@ class LQR:
     equilibrium: dict[str, float]
     _positions: np.ndarray  # index of each z in the model's coordinates
     _origin: np.ndarray  # z0
+    # the inputs' values that hold the equilibrium (the linear model's trim), and what u adds
+    # to the model's own values to reach them (trim - nominal; 0 where the model's hold it)
+    trim: dict[str, float] = field(default_factory=dict)
+    _offset: np.ndarray | None = None
 
     @property
     def gain(self) -> np.ndarray:
@@ -60,19 +64,24 @@ class LQR:
                                v[..., self._positions]], axis=-1)
 
     def __call__(self, t, q, q_dot) -> np.ndarray:
-        """u = -K x (the inputs' units: N, N m, or the parameter's)."""
-        return -(self.K @ self.state(q, q_dot))
+        """u = u* - K x on top of the model's own input values, u* what holds the equilibrium
+        (trim - nominal; the inputs' units: N, N m, or the parameter's)."""
+        u = -(self.K @ self.state(q, q_dot))
+        return u if self._offset is None else self._offset + u
 
     def summary(self) -> dict:
         """JSON-ready: inputs, states, K, closed-loop eigenvalues (re, im)."""
         return {"inputs": list(self.inputs), "states": list(self.state_names),
-                "equilibrium": dict(self.equilibrium), "K": self.K.tolist(),
+                "equilibrium": dict(self.equilibrium), "trim": dict(self.trim),
+                "K": self.K.tolist(),
                 "closed_loop_eigenvalues": [[float(v.real), float(v.imag)]
                                             for v in self.closed_loop_eigenvalues]}
 
     def __repr__(self) -> str:
         slowest = self.closed_loop_eigenvalues[0]
+        trim = ", ".join(f"{k}={v:.6g}" for k, v in self.trim.items())
         return (f"LQR(inputs={list(self.inputs)}, states={list(self.state_names)}, "
+                f"{'trim ' + trim + ', ' if trim else ''}"
                 f"slowest closed-loop eigenvalue {slowest:.4g} 1/s)\nK =\n{self.K}")
 
 
@@ -117,9 +126,13 @@ def lqr(linear_model: LinearModel, Q, R) -> LQR:
     names = list(model.user_coordinates)
     positions = np.array([names.index(c) for c in model.coordinates], dtype=int)
     origin = np.array([model.equilibrium[c] for c in model.coordinates], dtype=float)
+    trim = dict(model.trim)
+    offset = np.array([trim[name] - model.nominal_inputs.get(name, 0.0) for name in model.inputs],
+                      dtype=float) if trim else None
     return LQR(K=K, S=S, Q=Q, R=R, A=A, B=B, inputs=tuple(model.inputs),
                state_names=tuple(model.state_names), equilibrium=dict(model.equilibrium),
-               _positions=positions, _origin=origin)
+               _positions=positions, _origin=origin, trim=trim,
+               _offset=offset if offset is not None and np.any(offset) else None)
 
 
 def _require_stabilizable(A: np.ndarray, B: np.ndarray, inputs) -> None:

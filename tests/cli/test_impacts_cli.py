@@ -25,12 +25,6 @@ def test_cycle_json_of_the_rimless_wheel_at_a_slope_given_by_set(cli):
     assert document["stable"] is True
 
 
-def test_cycle_text_of_the_compass_gait(cli):
-    code, out, err = cli("cycle", "compass_gait")
-    assert code == 0, err
-    assert "stable limit cycle through 'heel_strike'" in out and "period 0.73446" in out
-
-
 def test_cycle_refuses_a_model_without_impacts(cli):
     code, out, err = cli("cycle", "pendulum")
     assert code == 2 and out == ""

@@ -54,3 +54,12 @@ def test_optimize_commands(cli):
     assert "converged" in result.out and "NOT" not in result.out
     document = json.loads(cli(*as_json).out)
     assert document["converged"] and document["states"]["theta"][-1] == pytest.approx(np.pi)
+
+
+def test_mjcf_block_reads_the_arm(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(python_of("bridges-mjcf"), namespace)  # noqa: S102 - our own documentation
+    dynamics = namespace["dynamics"]
+    assert dynamics.mass_matrix([0.3])[0, 0] == pytest.approx(0.51, rel=1e-12)
+    assert dynamics.gravity([0.3])[0] == pytest.approx(2 * 9.81 * 0.5 * np.sin(0.3), rel=1e-12)

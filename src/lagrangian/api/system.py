@@ -511,7 +511,9 @@ def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None
     """Load a model file (TOML), a robot (URDF: ``lock`` freezes joints by name, rad or m;
     ``payload`` {link: mass, or (mass, (x, y, z))} fixes point masses (kg, m in the link's
     frame) to links, as an edited URDF would; ``floating_base`` frees its root link, nq = n + 7,
-    nv = n + 6: dynamics and kinematics only), or a built-in example by name (see
+    nv = n + 6: dynamics and kinematics only), a MuJoCo robot (MJCF, .xml: hinge and slide
+    joints in MuJoCo's qpos order, docs/bridges.md; ``lock`` and ``payload`` as for URDF), or
+    a built-in example by name (see
     ``examples()``); ``gravity`` (g_x, g_y, g_z) in m/s^2 turns the model's gravity
     (System.with_gravity)."""
     system = _load(path_or_example, lock, payload, floating_base)
@@ -520,6 +522,10 @@ def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None
 
 def _load(path_or_example: str | Path, lock, payload, floating_base) -> System:
     path = Path(path_or_example)
+    if path.suffix.lower() in (".xml", ".mjcf"):  # MuJoCo's MJCF, read as the URDF it is
+        from ..model.mjcf import read_mjcf
+
+        return System(read_mjcf(path, lock, payload, floating_base))
     urdf = path if path.suffix.lower() == ".urdf" else (
         None if path.exists() else example_urdf(str(path_or_example)))
     if urdf is not None:

@@ -355,3 +355,38 @@ def test_small_angle_equation_is_named_a_linearization():
     assert (eq.status, eq.code) == ("wrong", "equation_linearized")
     assert "small-angle" in eq.message and "theta = 0" in eq.message
     assert "dividing" not in eq.message
+
+
+def test_each_item_has_its_own_code_where_no_misconception_names_the_slip():
+    """The codes of T, V, D, Q and L rows fit the item (a class's CSV reads them)."""
+    report = check_text("damped_oscillator", '''
+[energy]
+V = "k*x^2"
+D = "c*x_dot^2"
+''')
+    assert report.codes("V") == ["potential_term"]
+    assert report.codes("D") == ["dissipation_term"]
+    Q = check_text("pendulum", '[generalized_forces]\ntheta = "m*g*L"\n')
+    assert Q.codes("Q[theta]") == ["generalized_force_wrong"]
+    assert check_text("pendulum", '[energy]\nT = "1/2*m*l^2*theta_dot^2"\n').codes("T") == \
+        ["unknown_name"]
+    assert check_text("pendulum", '[energy]\nL = "m*L^2*theta_dot^2 + m*g*L"\n').codes("L") == \
+        ["lagrangian_wrong"]
+
+
+@pytest.mark.parametrize("coupling", ["- 1/2*k_c*(x2 - x1)^2", "- 1/2*k_c*(x1 - x2)^2"])
+def test_a_flipped_coupling_spring_is_a_potential_sign_naming_the_spring(coupling):
+    report = check_text("two_mass", f'''
+[energy]
+V = "1/2*k*x1^2 {coupling} + 1/2*k*x2^2"
+''')
+    V = finding(report, "V")
+    assert V.code == "potential_sign"
+    assert "spring k_c coupling x1 and x2" in V.message
+    assert "spring store" in V.message and "rises" not in V.message
+
+
+def test_a_spring_sign_slip_gets_the_springs_question():
+    V = finding(check_text("ladder_spring_mass", '[energy]\nV = "-1/2*k*x^2"\n'), "V")
+    assert V.code == "potential_sign" and "spring store" in V.message
+    assert "rises" not in V.message

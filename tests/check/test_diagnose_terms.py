@@ -210,7 +210,7 @@ def test_a_spring_of_the_wrong_sign_is_named():
 def test_a_missing_term_of_V_is_not_a_sign_error():
     v = finding(check_text("double_pendulum", '[energy]\nV = "-(m1 + m2)*g*l1*cos(theta1)"\n'),
                 "V")
-    assert v.code == "equation_wrong" and "missing" in v.message
+    assert v.code == "potential_term" and "missing" in v.message
 
 
 def test_a_potential_force_left_out_of_an_equation_names_its_body():

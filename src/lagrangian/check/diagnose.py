@@ -21,6 +21,7 @@ from ..model.expressions import format_expression as fmt
 from ..model.model import Model
 from ..model.units import generalized_force_unit
 from . import equivalence as eq
+from .diagnose_lagrangian import lagrangian_findings
 from .diagnose_terms import (
     about_zero,
     difference_message,
@@ -41,6 +42,9 @@ CODES = (
     "generalized_force_missing", "generalized_force_projection",
     "reaction_in_minimal_coordinates", "multiplier_count", "equation_wrong",
     "equation_equivalent", "units_mismatch", "equation_linearized",
+    # the item's own code where no more specific diagnosis names the slip (issue 40)
+    "potential_term", "dissipation_term", "generalized_force_wrong", "unknown_name",
+    "lagrangian_wrong",
 )
 
 
@@ -53,6 +57,9 @@ class Finding:
     code: str | None
     message: str
     expected: str | None = None
+    # what --hints-only says instead of the message: specific, and never the answer (None:
+    # the module's question for the code, check/hints.py)
+    hint: str | None = None
 
     def __post_init__(self):  # "correct" as written, checked: a misspelled status is an error
         object.__setattr__(self, "status", FindingStatus(self.status))
@@ -110,6 +117,9 @@ def check_answer(eom: EquationsOfMotion, answer: Answer) -> CheckReport:
     if answer.dissipation is not None:
         findings += numeric.run(checker.dissipation, [answer.dissipation], [eom.dissipation],
                                 answer.dissipation)
+    if answer.lagrangian is not None:  # checked as T - V
+        findings += numeric.run(lambda value: lagrangian_findings(checker, value),
+                                [answer.lagrangian], [eom.lagrangian], answer.lagrangian)
     for name, value in answer.generalized_forces:
         i = [c.name for c in model.coordinates].index(name)
         findings += numeric.run(checker.generalized_force, [value],
@@ -221,17 +231,19 @@ class _Checker:
                             "datum, which is fine (only dV/dq enters the equations).", expected)]
         rises = ("Does V increase as the body rises? Take V positive upward (V = m g h) "
                  "and be consistent with the datum.")
-        if eq.constant_in_state(V_user + V, self.points):
-            return [Finding("V", "wrong", "potential_sign", f"V has the wrong sign. {rises}",
-                            expected)]
         parts = potential_parts(self.model)
+        if eq.constant_in_state(V_user + V, self.points):
+            question = sign_question([label for label, _ in parts], rises)
+            return [Finding("V", "wrong", "potential_sign", f"V has the wrong sign. {question}",
+                            expected, hint=question)]
         if len(parts) > 1:
             for label, part in parts:
                 if eq.constant_in_state(V_user - (V - 2 * part), self.points):
                     return [Finding("V", "wrong", "potential_sign",
                                     f"the {label} has the wrong sign (it should be "
                                     f"{fmt(eq.display(part))}). {sign_question([label], rises)}",
-                                    expected)]
+                                    expected, hint=f"The {label} has the wrong sign. "
+                                    + sign_question([label], rises))]
         flipped = flipped_potential_term(V_user, V, self.model, self.points)
         if flipped is not None:
             labels, term = flipped
@@ -239,19 +251,20 @@ class _Checker:
                             f"the term {fmt(eq.display(term))} of the "
                             f"{' and the '.join(labels)} has the wrong sign (yours has "
                             f"{fmt(eq.display(-term))}). {sign_question(labels, rises)}",
-                            expected)]
+                            expected, hint=f"One term of the {' and the '.join(labels)} has "
+                            f"the wrong sign. {sign_question(labels, rises)}")]
         for label, part in parts:
             if eq.constant_in_state(V_user - (V - part), self.points):
-                return [Finding("V", "wrong", "equation_wrong",
+                return [Finding("V", "wrong", "potential_term",
                                 f"V is missing the {label}: {fmt(eq.display(part))}.", expected)]
         missing = flipped_potential_term(V_user, V, self.model, self.points, factor=1)
         if missing is not None:
             labels, term = missing
-            return [Finding("V", "wrong", "equation_wrong",
+            return [Finding("V", "wrong", "potential_term",
                             f"V is missing the term {fmt(eq.display(term))} of the "
                             f"{' and the '.join(labels)}.", expected)]
         difference = eq.display(V_user - V)
-        return [Finding("V", "wrong", "equation_wrong",
+        return [Finding("V", "wrong", "potential_term",
                         f"V differs from ours by {fmt(difference)} (not a constant).", expected)]
 
     # D ---------------------------------------------------------------------------------
@@ -264,7 +277,7 @@ class _Checker:
         if eq.identical(D_user, D, self.points):
             return [Finding("D", "correct", None, "D matches.", None)]
         difference = eq.display(D_user - D)
-        return [Finding("D", "wrong", "equation_wrong",
+        return [Finding("D", "wrong", "dissipation_term",
                         f"the dissipation function differs from ours by {fmt(difference)}; "
                         "D = sum 1/2 c (rate)^2.", fmt(D))]
 
@@ -278,8 +291,8 @@ class _Checker:
         expected = fmt(eq.display(Q))
         foreign = self.answer.foreign_symbols(item)
         if self._misspelled(foreign):
-            return [Finding(item, "wrong", "equation_wrong", self._misspelled(foreign, item),
-                            expected)]
+            return [Finding(item, "wrong", "unknown_name", self._misspelled(foreign, item),
+                            expected, hint=self._misspelled(foreign, item))]
         if foreign:
             listed = ", ".join(sorted(map(str, foreign)))
             stripped = Q_user.xreplace({s: 0 for s in foreign})
@@ -290,7 +303,7 @@ class _Checker:
                                 f"{item} contains {listed}, which the model does not have: ideal "
                                 "reactions do no virtual work, so in minimal coordinates they "
                                 f"vanish; leave them out.{rest}", expected)]
-            return [Finding(item, "wrong", "equation_wrong",
+            return [Finding(item, "wrong", "generalized_force_wrong",
                             f"{item} contains {listed}, which the model does not have: constraint "
                             "reactions enter as multipliers (Phi_q^T lambda), not as generalized "
                             f"forces.{rest}", expected)]
@@ -329,7 +342,7 @@ class _Checker:
                        f"belong in V); yours minus ours is {fmt(difference)}.")
         else:
             message = f"{item} differs from ours by {fmt(difference)}."
-        return [Finding(item, "wrong", "equation_wrong", message, expected)]
+        return [Finding(item, "wrong", "generalized_force_wrong", message, expected)]
 
     def _mis_projected(self, Q_user, Q, contributions):
         """The load whose contribution the user replaced by something else (same magnitudes)."""
@@ -546,6 +559,8 @@ class _Checker:
             items.append(("V", answer.potential_energy, "J", "an energy"))
         if answer.dissipation is not None:
             items.append(("D", answer.dissipation, "W", "a power"))
+        if answer.lagrangian is not None:
+            items.append(("L", answer.lagrangian, "J", "an energy"))
         for name, value in answer.generalized_forces:
             unit = generalized_force_unit(self.model.coordinate(name).unit)
             items.append((f"Q[{name}]", value, unit, f"energy per unit of {name}"))
@@ -566,11 +581,11 @@ class _Checker:
         if not foreign:
             return []
         listed = ", ".join(sorted(map(str, foreign)))
-        return [Finding(item, "wrong", "equation_wrong",
-                        self._misspelled(foreign, label)
-                        or f"{label} uses {listed}, which the model does not declare.",
-                        fmt(self.eom.kinetic_energy if item == "T" else
-                            self.eom.potential_energy if item == "V" else self.eom.dissipation))]
+        said = self._misspelled(foreign, label) or \
+            f"{label} uses {listed}, which the model does not declare."
+        ours = self.eom.kinetic_energy if item == "T" else \
+            self.eom.potential_energy if item == "V" else self.eom.dissipation
+        return [Finding(item, "wrong", "unknown_name", said, fmt(ours), hint=said)]
 
     def _misspelled(self, foreign, label: str | None = None) -> str:
         """'V uses L1, ...; did you mean l1?' when an undeclared name is close to a declared one."""

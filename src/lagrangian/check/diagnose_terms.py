@@ -79,8 +79,14 @@ def flipped_potential_term(V_user: sp.Expr, V: sp.Expr, model: Model, points: eq
     for label, part in potential_parts(model):
         if not eq.is_small(part):
             continue
+        written = sp.Add.make_args(part)  # as written: 1/2 k_c (x2 - x1)^2 is one term
+        if len(written) > 1:
+            terms += [(term_label(term, label, model), term) for term in written
+                      if term.free_symbols & state]
+        else:
+            written = ()
         terms += [(label, term) for term in sp.Add.make_args(sp.expand(part))
-                  if term.free_symbols & state]
+                  if term.free_symbols & state and term not in written]
     for label, term in terms:
         if eq.constant_in_state(V_user - (V - factor * term), points):
             return [label], term
@@ -94,6 +100,22 @@ def flipped_potential_term(V_user: sp.Expr, V: sp.Expr, model: Model, points: eq
         if eq.constant_in_state(V_user - (V - factor * together), points):
             return list(dict.fromkeys(label for label, _ in members)), together
     return None
+
+
+def term_label(term: sp.Expr, label: str, model: Model) -> str:
+    """A term of a written V named by what it is: 1/2 k_c (x2 - x1)^2 is the spring k_c
+    between x1 and x2 (a stiffness parameter times a square of the coordinates)."""
+    coefficient, square = term.as_independent(*model.q, model.time, as_Add=False)
+    base, exponent = square.as_base_exp()
+    stiffness = [p for p in model.parameters if p.symbol in coefficient.free_symbols and (
+        (p.unit or "").replace(" ", "") in ("N/m", "N*m/rad", "N*m", "kg/s^2", "N/rad")
+        or p.name.lower().startswith("k"))]
+    if exponent != 2 or not stiffness or not base.free_symbols & set(model.q):
+        return label
+    names = [c.name for c in model.coordinates if c.symbol in base.free_symbols]
+    between = f" coupling {' and '.join(names)}" if len(names) == 2 else f" on {names[0]}" \
+        if len(names) == 1 else ""
+    return f"potential of spring {stiffness[0].name}{between}"
 
 
 def sign_question(labels: list[str], rises: str) -> str:

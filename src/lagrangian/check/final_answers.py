@@ -18,9 +18,8 @@ import numpy as np
 import sympy as sp
 
 from ..errors import DerivationError, ModelError
-from ..model.answer import Answer, answer_names
+from ..model.answer import Answer, answer_expression, answer_names
 from ..model.expressions import format_expression as fmt
-from ..model.expressions import parse_expression
 from . import equivalence as eq
 from .diagnose import Finding
 from .final_at_rest import AtRest
@@ -63,7 +62,7 @@ def check_final_answers(system: Analysis, answer: Answer) -> list[Finding]:
     model = system.equations_of_motion().model
     names = answer_names(model)
     final = read_final_answers(dict(answer.final_tables), model, lambda value, field:
-                               parse_expression(value, names, field=field, source=answer.source),
+                               answer_expression(value, names, field, answer.source),
                                answer.source)
     return _FinalChecker(system, final, answer.source).run()
 
@@ -239,12 +238,13 @@ class _FinalChecker:
                                         f"{item} = {written.text} matches ours, {true:.6g} "
                                         f"{unit}, compared {written.precision}.", None))
                 continue
+            slip = self.damped_hint(written, mode, convert) + \
+                _frequency_hint(written.value, true, kind)
             findings.append(Finding(
                 item, "wrong", "frequency_wrong",
                 f"{item} = {written.text}: ours is {true:.6g} {unit}, which does not round to "
-                f"yours (compared {written.precision}).{self.damped_hint(written, mode, convert)}"
-                f"{_frequency_hint(written.value, true, kind)}",
-                f"{true:.6g} {unit}"))
+                f"yours (compared {written.precision}).{slip}",
+                f"{true:.6g} {unit}", hint=_slip_hint(written.value, true, kind, slip)))
         return findings
 
     @staticmethod
@@ -291,6 +291,21 @@ class _FinalChecker:
 def _shown(entry: Entry) -> str:
     """An entry as written when a number, else as we read it (never raw text: one line)."""
     return entry.written.text if entry.written is not None else fmt(entry.value)
+
+
+def _slip_hint(yours: float, ours: float, kind: str, slip: str) -> str | None:
+    """--hints-only's words for a frequency slip: which one, never the value."""
+    if "2 pi" in slip:
+        return ("Is it in the units asked (omega in rad/s, f in Hz)? omega = 2 pi f: rad/s and "
+                "Hz differ by 2 pi.")
+    if "squared" in slip:
+        return "Is it omega or omega^2? The eigenvalues of det(K - omega^2 M) = 0 are omega^2."
+    if "damped" in slip:
+        return "Is it the natural (undamped) frequency omega_n, or the damped one omega_d?"
+    if yours > ours:
+        return ("Yours is too high: does ω² solve det(K − ω² M) = 0 with every mass and "
+                "inertia in M?")
+    return "Yours is too low: does ω² solve det(K − ω² M) = 0 with every stiffness in K?"
 
 
 def _frequency_hint(yours: float, ours: float, kind: str) -> str:

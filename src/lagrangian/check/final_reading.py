@@ -40,10 +40,13 @@ class Written:
     value: float
     step: float | None
     figures: int | None = None
+    in_parameters: bool = False  # written in the model's parameters (sqrt(k/m))
 
     @property
     def precision(self) -> str:
         """How it is compared, in words ("to the 3 significant figures you wrote")."""
+        if self.in_parameters:
+            return "at the model's parameter values, as written in its parameters"
         if self.step is None:
             return "exactly: a whole number or a constant is exact"
         if self.figures is not None:
@@ -257,11 +260,44 @@ class _Reader:
         if kind == "f" and re.search(r"rad|deg|rpm|rev", text, re.I):
             raise self.fail(f"f is in Hz (cycles per second); write rad/s as omega = [...], "
                             f"got {value!r}", field)
-        written = read_written(value, FREQUENCY_KINDS[kind][0], field, self.source)
+        written = self._symbolic(value, field)
+        if written is None:
+            written = read_written(value, FREQUENCY_KINDS[kind][0], field, self.source)
         if written.value <= 0:
             raise self.fail(f"expected a positive {FREQUENCY_KINDS[kind][1]}, got {value!r}",
                             field)
         return written
+
+    def _symbolic(self, value: object, field: str) -> Written | None:
+        """A value written in the model's parameters ("sqrt(k/m)", "√(g/L)", "2*pi*sqrt(m/k)"),
+        taken at the model's values and compared exactly (to 1e-9); None when ``value`` is a
+        number with a unit (read_written reads it) or names no parameter."""
+        quantity = _NUMBER.match(value) if isinstance(value, str) else None
+        if not isinstance(value, str) or quantity and (
+                not quantity[4] or quantity[4][0] not in "*/^(+-"):
+            return None  # a number, with its unit where it has one (4.43 rad/s)
+        parameters = {p.symbol: p for p in self.model.parameters}
+        try:
+            expression = self.expression(value, field)
+        except ModelError:
+            return None  # a unit (4.43 rad/s) or a fault that read_written names
+        symbols = expression.free_symbols
+        if not symbols or not symbols <= set(parameters):
+            if symbols - set(parameters):
+                names = ", ".join(sorted(str(s) for s in symbols - set(parameters)))
+                raise self.fail(f"{value!r} may use the model's parameters only, not {names}",
+                                field)
+            return None
+        missing = sorted(p.name for s, p in parameters.items() if s in symbols and p.value is None)
+        if missing:
+            raise self.fail(f"{value!r} uses parameters without a value: {', '.join(missing)}",
+                            field)
+        number = expression.xreplace({s: parameters[s].value for s in symbols})
+        try:
+            return Written(value, float(number), None, in_parameters=True)
+        except TypeError:
+            raise self.fail(f"{value!r} is not a real number at the model's values", field) \
+                from None
 
     def mode_shapes(self, table: Mapping) -> tuple:
         _known(table, ("shapes",), "mode_shapes", self.source)
@@ -274,7 +310,8 @@ class _Reader:
         for i, shape in enumerate(shapes, start=1):
             field = f"mode_shapes.shapes[{i}]"
             shape = self._list(shape, field, n, "components", per)
-            written = tuple(read_written(v, "1", f"{field}[{j}]", self.source)
+            written = tuple(self._symbolic(v, f"{field}[{j}]")
+                            or read_written(v, "1", f"{field}[{j}]", self.source)
                             for j, v in enumerate(shape, start=1))
             if all(w.value == 0 for w in written):
                 raise self.fail("a mode shape cannot be all zeros", field)

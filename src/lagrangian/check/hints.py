@@ -1,6 +1,8 @@
 """Hints instead of answers (`check --hints-only`): each finding keeps its item, status and code,
-loses its expected expression and any value, and gives the seed module's diagnostic question
-(module 7, section 07: misconceptions and diagnostics) so a student can use the checker alone.
+loses its expected expression and any value, and gives its own hint where the diagnosis left one
+(a Finding's ``hint``: which slip, never the answer), else the seed module's diagnostic question
+for its code (module 7, section 07: misconceptions and diagnostics), so a student can use the
+checker alone.
 """
 
 from __future__ import annotations
@@ -58,6 +60,55 @@ HINTS: dict[str, Hint] = {
                           "Ideal reactions do no virtual work; sum the rest and solve."),
     "units_mismatch": Hint("Units", "Does every term have the same units (T and V in J, Q in J "
                            "per unit of its coordinate)?", "Check each term's units."),
+    # each item's own question where no misconception names the slip (issue 40)
+    "potential_term": Hint("A term of V", "Did I write the potential of every weight (m g h) "
+                           "and every spring (1/2 k s², s its stretch), once each?",
+                           "Write V term by term from the heights and the stretches."),
+    "dissipation_term": Hint("A term of D", "Does D = sum 1/2 c (rate)² take each damper's "
+                             "own rate of stretch?", "Write each damper's rate in the "
+                             "coordinates."),
+    "generalized_force_wrong": Hint("A generalized force", "Is Q the virtual work per unit of "
+                                    "the coordinate, of the non-potential loads only?",
+                                    "Project each load with δW = Q · δq; weights and springs "
+                                    "belong in V."),
+    "unknown_name": Hint("A name the model does not have", "Does every name match the model's "
+                         "coordinates and parameters (case matters)?",
+                         "Use the model's own names."),
+    "lagrangian_wrong": Hint("The Lagrangian", "Is L kinetic minus potential energy, L = T − V?",
+                             "Write T and V first, then take their difference."),
+    "equation_wrong": Hint("A wrong equation", "Did I apply d/dt(∂L/∂q̇) − ∂L/∂q = Q to this "
+                           "coordinate, with every term of T and V differentiated?",
+                           "Re-derive the equation from T, V and Q, term by term."),
+    "equation_linearized": Hint("A linearized equation", "Is this the full equation of motion, "
+                                "or its small-angle form?", "Keep sin and cos in the equation "
+                                "of motion; a small-angle form goes under [linearized]."),
+    "matrix_entry": Hint("A matrix entry", "Is M from the terms of T in q̇ and K from the "
+                         "second derivatives of V at the equilibrium?",
+                         "Read M from T and K from V, entry by entry."),
+    "frequency_wrong": Hint("A natural frequency", "Does ω² solve det(K − ω² M) = 0, in rad/s?",
+                            "Solve the eigenproblem with the model's M and K."),
+    "frequency_count": Hint("How many frequencies", "Is there one natural frequency per degree "
+                            "of freedom?", "List one per mode."),
+    "damping_ratio_wrong": Hint("A damping ratio", "Is ζ = c / (2 √(k m)) for one coordinate, "
+                                "c over its critical value?", "Compare c with 2 √(k m)."),
+    "mode_shape_wrong": Hint("A mode shape", "Does the shape solve (K − ω² M) φ = 0 for its "
+                             "frequency?", "Substitute ω² and solve for the ratio of the "
+                             "components."),
+    "linear_coefficient": Hint("A linearized coefficient", "Did I expand each term to first "
+                               "order about the equilibrium (sin θ ≈ θ − θ₀ there)?",
+                               "Take the derivative of each term at the equilibrium."),
+    "linear_offset": Hint("A linearized offset", "Is the expansion about the equilibrium, "
+                          "where the constant terms balance?", "Measure the coordinates from "
+                          "the equilibrium."),
+    "not_linearized": Hint("Not linearized", "Is every term first order in the coordinates "
+                           "and rates about the equilibrium?", "Drop the products and powers "
+                           "of small quantities."),
+    "generalized_force_value": _FORCE,
+    "equilibrium_wrong": Hint("An equilibrium", "Do the forces balance there at rest, "
+                              "dV/dq = Q with q̇ = 0?", "Solve dV/dq = Q for each coordinate."),
+    "equilibrium_missing": Hint("An equilibrium left out", "Did I find every configuration "
+                                "where dV/dq = Q at rest (each root, within the coordinate's "
+                                "range)?", "Solve dV/dq = Q for all its roots."),
 }
 GENERAL = Hint("A wrong item", "Did I apply d/dt(∂L/∂q̇) − ∂L/∂q = Q to each coordinate, with "
                "L = T − V and every generalized force included?",
@@ -78,6 +129,8 @@ def hinted(report: CheckReport) -> CheckReport:
 def _hinted(finding: Finding) -> Finding:
     if finding.status == FindingStatus.CORRECT:
         return replace(finding, expected=None)
+    if finding.hint:  # the item's own, specific and non-revealing
+        return replace(finding, message=finding.hint, expected=None)
     hint = hint_for(finding.code)
     return replace(finding, message=f"{hint.question} {hint.correction}", expected=None)
 

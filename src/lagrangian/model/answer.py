@@ -1,6 +1,7 @@
 """A user's hand derivation (ANSWER.toml) read in the model-file grammar, to be checked.
 
-Tables: ``[energy]`` T, V, D; ``[generalized_forces]`` one entry per coordinate;
+Tables: ``[energy]`` T, V, D and L (the Lagrangian, checked as T - V);
+``[generalized_forces]`` one entry per coordinate;
 ``[equations]`` one entry per coordinate, ``"lhs = rhs"`` or an expression equal to zero;
 ``[multipliers]`` ``count`` or ``names``; the final answers (``[matrices]``, ``[frequencies]``,
 ``[mode_shapes]``, ``[linearized]``, ``[generalized_forces]`` with ``at``, ``[equilibria]``,
@@ -20,6 +21,7 @@ from pathlib import Path
 import sympy as sp
 
 from ..errors import ModelError
+from .answer_notation import module_notation_text, prime_hint, primes_as_rates
 from .expressions import CONSTANTS, FUNCTIONS, parse_expression
 from .model import Model, multiplier_name
 from .reader import check_known_keys, load_toml, read_text_file
@@ -32,7 +34,7 @@ FREQUENCY_KEYS = ("omega", "f", "period", "zeta")
 TABLES = ("energy", "generalized_forces", "equations", "multipliers", *FINAL_TABLES,
           "coordinates")
 _FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
-ENERGY_KEYS = ("T", "V", "D")
+ENERGY_KEYS = ("T", "V", "D", "L")  # L: the Lagrangian, checked as T - V
 MULTIPLIER_KEYS = ("count", "names")
 
 
@@ -61,6 +63,7 @@ class Answer:
     kinetic_energy: sp.Expr | None = None
     potential_energy: sp.Expr | None = None
     dissipation: sp.Expr | None = None
+    lagrangian: sp.Expr | None = None  # [energy] L, checked as T - V
     generalized_forces: tuple[tuple[str, sp.Expr], ...] = ()
     equations: tuple[tuple[str, sp.Expr], ...] = ()
     multiplier_count: int | None = None
@@ -77,7 +80,8 @@ class Answer:
     @property
     def is_empty(self) -> bool:
         return (self.kinetic_energy is None and self.potential_energy is None
-                and self.dissipation is None and not self.generalized_forces
+                and self.dissipation is None and self.lagrangian is None
+                and not self.generalized_forces
                 and not self.equations and self.multiplier_count is None
                 and self.multiplier_names is None
                 and all(key == "coordinates" for key, _ in self.final_tables))
@@ -117,14 +121,21 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
     foreign: dict[str, frozenset[sp.Symbol]] = {}
 
     def expression(value: object, field: str, item: str) -> sp.Expr:
-        if isinstance(value, str):
-            extra = _foreign_names(value, names, field, source)
+        if not isinstance(value, str):
+            return parse_expression(value, names, field=field, source=source)
+        rewritten = module_notation_text(value)
+        for k, text in enumerate([rewritten, value] if rewritten is not None else [value]):
+            try:
+                extra = _foreign_names(text, names, field, source)
+                parsed = parse_expression(text, {**names, **extra}, field=field, source=source)
+            except ModelError as error:
+                if k == 0 and rewritten is not None:
+                    continue  # the grammar's own message, of the text as written
+                raise _prime_or(error, value, names, field, source) from None
             if extra:
                 foreign[item] = foreign.get(item, frozenset()) | set(extra.values())
-            scope = {**names, **extra}
-        else:
-            scope = names
-        return parse_expression(value, scope, field=field, source=source)
+            return parsed
+        raise AssertionError("unreachable")  # the last text parses or raises
 
     energy = _table(data, "energy", source)
     check_known_keys(energy, ENERGY_KEYS, "energy", source)
@@ -182,6 +193,7 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
         kinetic_energy=values.get("T"),
         potential_energy=values.get("V"),
         dissipation=values.get("D"),
+        lagrangian=values.get("L"),
         generalized_forces=generalized,
         equations=tuple(equations),
         multiplier_count=count,
@@ -190,11 +202,47 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
         final_tables=final,
     )
     if answer.is_empty:
-        raise ModelError("the answer has nothing to check: give [energy] T/V/D, "
+        raise ModelError("the answer has nothing to check: give [energy] T/V/D/L, "
                          "[generalized_forces], [equations], [multipliers], [matrices], "
                          "[frequencies], [mode_shapes], [linearized] or [equilibria]",
                          source=source)
     return answer
+
+
+def answer_expression(value: object, names: Mapping[str, sp.Expr], field: str,
+                      source: str) -> sp.Expr:
+    """One answer expression, in the grammar or as the module prints it (½ m L² θ̇², cosθ,
+    implicit products, √): model/answer_notation.py; a prime gets the spelling to use."""
+    if not isinstance(value, str):
+        return parse_expression(value, names, field=field, source=source)
+    rewritten = module_notation_text(value)
+    if rewritten is not None:
+        try:
+            return parse_expression(rewritten, names, field=field, source=source)
+        except ModelError:
+            pass  # the grammar's own message, of the text as written
+    try:
+        return parse_expression(value, names, field=field, source=source)
+    except ModelError as error:
+        raise _prime_or(error, value, names, field, source) from None
+
+
+def _prime_or(error: ModelError, text: str, names: Mapping[str, sp.Expr], field: str,
+              source: str) -> ModelError:
+    """The prime's spelling hint where ``text`` reads with its primes as rates, else ``error``."""
+    spelled = primes_as_rates(text)
+    if spelled is None:
+        return error
+    for candidate in (module_notation_text(spelled), spelled):
+        if candidate is None:
+            continue
+        try:
+            extra = {n: sp.Symbol(n) for n in plain_names(candidate) if _FOREIGN.match(n)}
+            parse_expression(candidate, {**extra, **names}, field=field, source=source)
+        except ModelError:
+            continue
+        return ModelError(prime_hint(text), field=field, source=source)
+    return error
 
 
 def _foreign_names(text: str, names: Mapping[str, sp.Expr], field: str,

@@ -138,8 +138,9 @@ class PoincareMap:
                 t_hit = _crossing(self.guards, dense, solver.t_old, solver.t, n)
                 return self._after(dense(t_hit), t_hit, jacobian)
             armed = armed or g < 0
-        raise InputError(f"no impact within {self.t_max:g} s of the start: not a cycle "
-                         "through an impact (try another guess)", field="guess")
+        raise InputError(f"no impact within {self.t_max:g} s of the start (the motion comes to "
+                         "rest or falls before its guard: no cycle through an impact from "
+                         "there; try another guess, --guess NAME=VALUE)", field="guess")
 
     def _after(self, z, t, jacobian):
         from .hybrid import polish

@@ -97,7 +97,7 @@ def limit_cycle(eom, substitution, functions, guess=None, *, step_control=CYCLE_
         if not np.all(np.isfinite(x)):
             break
     raise InputError(f"no limit cycle found from the guess ({max_iterations} Newton steps "
-                     "did not converge): give a guess nearer the cycle (--guess NAME=VALUE) or "
+                     "did not converge): give a guess nearer the cycle or "
                      "check the slope and parameters", field="guess")
 
 

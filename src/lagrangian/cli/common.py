@@ -30,6 +30,8 @@ FLAG_OF_FIELD = {
     "initial": "--initial",
     "t_end": "--t-end",
     "stop_when": "--stop-when",
+    "guess": "--guess",
+    "max_impacts": "--max-impacts",
     "method": "--method",
     "rtol": "--rtol",
     "atol": "--atol",

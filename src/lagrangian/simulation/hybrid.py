@@ -297,7 +297,7 @@ def simulate_through_impacts(
         if len(records) >= max_impacts:
             status = IMPACT_LIMIT
             message = (f"stopped at the cap of {max_impacts} impacts at t = {t_hit:.12g} s "
-                       "(raise max_impacts / --max-impacts)")
+                       "(raise max_impacts)")
             ts.append(np.array([t_hit]))
             ys.append(y[None, :])
             spent.append(lost_so_far)

@@ -140,7 +140,7 @@ class PoincareMap:
             armed = armed or g < 0
         raise InputError(f"no impact within {self.t_max:g} s of the start (the motion comes to "
                          "rest or falls before its guard: no cycle through an impact from "
-                         "there; try another guess, --guess NAME=VALUE)", field="guess")
+                         "there; try another guess)", field="guess")
 
     def _after(self, z, t, jacobian):
         from .hybrid import polish

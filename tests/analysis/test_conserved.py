@@ -151,3 +151,12 @@ def test_hamiltonian_refuses_constraints_and_bad_shapes():
         lagrangian.load("cartesian_pendulum").hamiltonian()
     with pytest.raises(ModelError, match="p takes 1 values"):
         lagrangian.load("pendulum").hamiltonian().rhs([0.1], [0.1, 0.2])
+
+
+def test_a_real_eigenvalue_has_no_damping_ratio_in_the_modes_table():
+    """The inverted pendulum grows without oscillating: zeta is shown as '–', not a number."""
+    from lagrangian.output.modes import modes_text
+
+    analysis = lagrangian.load("pendulum").modes(about={"theta": math.pi})
+    row = [line for line in modes_text(analysis).splitlines() if "grows" in line][0]
+    assert row.split()[4] == "–"

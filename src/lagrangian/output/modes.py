@@ -147,7 +147,8 @@ def modes_text(analysis: ModalAnalysis) -> str:
               header]
     for i, m in enumerate(analysis.modes, 1):
         period = "-" if m.period is None else _number(m.period)
-        zeta = "-" if m.damping_ratio is None else _number(m.damping_ratio)
+        # a damping ratio belongs to an oscillation: a real eigenvalue (frequency 0) has none
+        zeta = "–" if m.damping_ratio is None or m.frequency == 0 else _number(m.damping_ratio)
         shape = "  ".join(f"{_number(m.shape[n]):>9}" for n in names)
         lines.append(f"{i:>4}  {_number(m.frequency):>13}  {_number(m.frequency_hz):>10}  "
                      f"{period:>10}  {zeta:>8}  {_number(m.growth_rate):>12}  {shape}  "

@@ -60,3 +60,9 @@ def test_simulate_text_shows_the_impacts(cli):
 def test_impact_options_refused_without_impacts(cli):
     code, _, err = cli("simulate", "pendulum", "--t-end", "0.1", "--settle")
     assert code == 2 and "--settle" in err and "no [[impacts]]" in err
+
+
+def test_setting_an_impacts_parameter_is_no_stray_setting(cli):
+    code, _, err = cli("simulate", "bouncing_ball", "--set", "e=0.5", "--t-end", "0.1",
+                       "--samples", "3")
+    assert code == 0 and "appears in no equation" not in err

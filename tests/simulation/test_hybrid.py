@@ -96,3 +96,16 @@ def test_a_plain_simulate_call_goes_through_the_impacts(ball):
 
     result = simulate(ball.equations_of_motion(), 1.5)
     assert [r.time for r in result.impacts] == pytest.approx(closed_form_times(2), abs=1e-9)
+
+
+def test_a_plastic_impact_that_presses_into_the_floor_rests_there(ball):
+    """e = 0: no velocity left along the normal and gravity pressing in: a contact from then
+    on, not a ball sinking through the floor unseen."""
+    plastic = ball.with_parameters(e=0.0)
+    run = plastic.simulate(2.0, samples=21)
+    assert run.status == "accumulated" and "pressed into it" in run.message
+    assert run.accumulation_time == pytest.approx(math.sqrt(2 * H / G), abs=1e-12)
+    assert run.q_dot[-1, 0] == pytest.approx(0.0, abs=1e-12)
+    assert np.all(run.q[:, 0] > -1e-12)
+    rested = plastic.simulate(2.0, samples=21, settle=True)
+    assert rested.status == "settled" and rested.t[-1] == pytest.approx(2.0)

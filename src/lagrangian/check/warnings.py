@@ -68,6 +68,11 @@ def setting_warnings(eom: EquationsOfMotion, names: Iterable[str]) -> list[str]:
     speed = steady.speed if steady is not None else None
     # a gain of the [control] laws counts: it changes every run with controller="model"
     controlled = {str(s) for _, law in eom.model.control for s in law.free_symbols}
+    # ... and a parameter of an impact (its restitution, guard, point, normal or relabelling)
+    for impact in eom.model.impacts:
+        parts = (impact.guard, impact.restitution, *impact.point, *impact.normal,
+                 *(e for _, e in impact.relabel))
+        controlled |= {str(s) for part in parts for s in part.free_symbols}
     return [f"'{name}' is set but appears in no equation of motion: its value changes nothing"
             + (f" here ('{name}' is the speed of the [steady] motion: `speeds`, `modes`)"
                if name == speed else "")

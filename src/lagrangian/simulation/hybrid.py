@@ -44,6 +44,7 @@ RATIO_AGREEMENT = 1e-3
 ACCUMULATION_TIME = 1e-9  # s
 # ... or when an interval is below this (times max(1, t)): no longer resolved in time.
 SHORTEST_INTERVAL = 1e-13
+ON_GUARD = 1e-9  # |g| below which a piece starts on a guard (just after its impact)
 
 
 @dataclass(frozen=True)
@@ -171,6 +172,19 @@ class Guards:
         """max_i(-g_i): turns >= 0 when a guard falls through 0."""
         return float(np.max(-self.values.at(q, v, t)))
 
+    def leaving(self, q, v, t):
+        """(event, offsets) for a piece of the flow starting at (q, v, t): a guard on its zero
+        there (|g| < ON_GUARD; the one just crossed) counts from its value there, so its
+        rounding (+-1e-17) neither fires it at once nor hides the next crossing; it must rise
+        above that value before it can fall through it."""
+        values = self.values.at(q, v, t)
+        offsets = np.where(np.abs(values) < ON_GUARD, values, 0.0)
+
+        def event(q, v, t) -> float:
+            return float(np.max(offsets - self.values.at(q, v, t)))
+
+        return event, offsets
+
 
 def polish(guards: Guards, index: int, functions: NumericSystem, t: float, y: np.ndarray,
            n: int) -> tuple[float, np.ndarray]:
@@ -248,8 +262,9 @@ def simulate_through_impacts(
         segment = np.concatenate([[t0], grid[grid > t0]])
         if len(segment) < 2:
             segment = np.array([t0, t_end])
+        event, offsets = guards.leaving(y[:n], y[n:], t0)
         run = integrate_steps(functions.rhs, t0, y, float(t_end), segment, step_control,
-                              guards.event, None, progress)
+                              event, None, progress)
         steps += run.steps or 0
         nfev += run.nfev
         ts.append(run.t)
@@ -259,7 +274,7 @@ def simulate_through_impacts(
             status, message = run.status, run.message
             break
         t_hit, y_hit = float(run.t[-1]), np.array(run.y[-1])
-        which = int(np.argmin(guards.values.at(y_hit[:n], y_hit[n:], t_hit)))
+        which = int(np.argmin(guards.values.at(y_hit[:n], y_hit[n:], t_hit) - offsets))
         t_hit, y_hit = polish(guards, which, functions, t_hit, y_hit, n)
         kept = int(np.searchsorted(run.t[:-1], t_hit))  # samples before the polished time
         ts[-1] = np.concatenate([run.t[:kept], [t_hit]])
@@ -278,10 +293,17 @@ def simulate_through_impacts(
         history = times.setdefault(impact.name, [])
         history.append(t_hit)
         limit_time = accumulation(history)
+        resting = limit_time is None and pressing(impact, functions, y, t_hit, n)
+        if resting:
+            limit_time = t_hit
         if limit_time is not None:
             status = ACCUMULATED
             message = (f"impacts at '{impact.name}' accumulate at t = {limit_time:.12g} s "
                        f"({len(history)} impacts): the motion comes to rest there")
+            if resting:
+                message = (f"after the impact at '{impact.name}' at t = {t_hit:.12g} s the "
+                           "point stays on the surface, pressed into it: the motion comes to "
+                           "rest there (a contact, not an impact, from then on)")
             if settle:
                 y, settled = _settled(impact, y, limit_time, n)
                 if settled:
@@ -293,6 +315,10 @@ def simulate_through_impacts(
                     spent.append(lost_so_far)
                 else:
                     message += "; not settled: it still moves along the surface"
+            if status == ACCUMULATED:  # the run ends on the state just after the last impact
+                ts.append(np.array([t_hit]))
+                ys.append(y[None, :])
+                spent.append(lost_so_far)
             break
         if len(records) >= max_impacts:
             status = IMPACT_LIMIT
@@ -333,6 +359,25 @@ def accumulation(history: list[float]) -> float | None:
         return None
     left = d1 * r1 / (1 - r1)
     return history[-1] + left if left < ACCUMULATION_TIME else None
+
+
+def pressing(impact: CompiledImpact, functions: NumericSystem, y: np.ndarray, t: float,
+             n: int) -> bool:
+    """After a plastic impact (no release, no relabel) whose point is left with no normal
+    velocity: True when the flow then accelerates it into the surface (a ball with e = 0 on
+    the floor), where a guard would let it sink through unseen."""
+    if impact.k or impact.map.impact.relabel:
+        return False
+    q, v = y[:n], y[n:]
+    _, _, _, P, normal, _, _ = impact.matrices(q, v, t)
+    speed = float(normal[:, 0] @ P @ v)
+    scale = max(1e-300, float(np.max(np.abs(P @ v), initial=0.0)), 1e-9)
+    if abs(speed) > 1e-9 * max(1.0, scale):
+        return False
+    step = 1e-6 * max(1.0, abs(t))
+    later = _rk4(functions, t, y, step)
+    _, _, _, P, normal, _, _ = impact.matrices(later[:n], later[n:], t + step)
+    return float(normal[:, 0] @ P @ later[n:]) < speed
 
 
 def _settled(impact: CompiledImpact, y: np.ndarray, t: float, n: int):
@@ -388,5 +433,5 @@ def _result(eom, functions, substitution, t, y, step_control, status, message, s
 
 __all__ = ["ACCUMULATED", "HYBRID_STATUS", "IMPACT_LIMIT", "MAX_IMPACTS", "SETTLED",
            "CompiledImpact", "Guards", "HybridResult", "ImpactRecord", "accumulation",
-           "compiled_impacts", "kkt_system", "polish", "solve_impact",
+           "compiled_impacts", "kkt_system", "polish", "pressing", "solve_impact",
            "simulate_through_impacts"]

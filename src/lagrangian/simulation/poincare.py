@@ -20,7 +20,7 @@ import sympy as sp
 
 from ..compile.lambdified import StateFunction
 from ..errors import InputError
-from .hybrid import CompiledImpact, Guards, kkt_system
+from .hybrid import CompiledImpact, kkt_system
 
 
 class FlowSensitivity:
@@ -125,29 +125,30 @@ class PoincareMap:
         fun = self.flow.rhs if jacobian else self.functions.rhs
         solver = integrate.DOP853(fun, 0.0, z0, self.t_max, rtol=self.steps.rtol,
                                   atol=self.steps.atol)
-        armed = self.guards.event(x[:n], x[n:], 0.0) < 0
+        event, offsets = self.guards.leaving(x[:n], x[n:], 0.0)
+        armed = event(x[:n], x[n:], 0.0) < 0
         while solver.status == "running":
             solver.step()
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
                 raise InputError(f"the flow failed at t = {solver.t:.6g} s before the next "
                                  "impact", field="guess")
             y = solver.y
-            g = self.guards.event(y[:n], y[n:2 * n], solver.t)
+            g = event(y[:n], y[n:2 * n], solver.t)
             if armed and g >= 0:
                 dense = solver.dense_output()
-                t_hit = _crossing(self.guards, dense, solver.t_old, solver.t, n)
-                return self._after(dense(t_hit), t_hit, jacobian)
+                t_hit = _crossing(event, dense, solver.t_old, solver.t, n)
+                return self._after(dense(t_hit), t_hit, jacobian, offsets)
             armed = armed or g < 0
         raise InputError(f"no impact within {self.t_max:g} s of the start (the motion comes to "
                          "rest or falls before its guard: no cycle through an impact from "
                          "there; try another guess)", field="guess")
 
-    def _after(self, z, t, jacobian):
+    def _after(self, z, t, jacobian, offsets):
         from .hybrid import polish
 
         n = self.flow.n
         y = z[:2 * n]
-        which = int(np.argmin(self.guards.values.at(y[:n], y[n:], t)))
+        which = int(np.argmin(self.guards.values.at(y[:n], y[n:], t) - offsets))
         t, y = polish(self.guards, which, self.functions, t, y, n)
         impact = self.impacts[which]
         q_new, v_new, *_ = impact.apply(y[:n], y[n:], t)
@@ -169,12 +170,12 @@ class PoincareMap:
         return x_new, t, impact.name, D @ saltation @ Phi
 
 
-def _crossing(guards: Guards, dense, t_old, t_new, n):
+def _crossing(event, dense, t_old, t_new, n):
     from scipy import optimize
 
     def g(t):
         y = dense(t)
-        return guards.event(y[:n], y[n:2 * n], t)
+        return event(y[:n], y[n:2 * n], t)
 
     if g(t_old) >= 0:
         return t_old

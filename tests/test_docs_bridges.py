@@ -63,3 +63,15 @@ def test_mjcf_block_reads_the_arm(tmp_path, monkeypatch):
     dynamics = namespace["dynamics"]
     assert dynamics.mass_matrix([0.3])[0, 0] == pytest.approx(0.51, rel=1e-12)
     assert dynamics.gravity([0.3])[0] == pytest.approx(2 * 9.81 * 0.5 * np.sin(0.3), rel=1e-12)
+
+
+def test_fmu_blocks_export_and_simulate_the_pendulum(cli, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (export,) = commands("bridges-fmu-cli")
+    result = cli(*export)
+    assert result.code == 0, result.err
+    namespace: dict = {}
+    exec(python_of("bridges-fmu"), namespace)  # noqa: S102 - our own documentation
+    assert "[]" in capsys.readouterr().out
+    period = float(np.diff(namespace["up"]).mean())
+    assert period == pytest.approx(2 * np.pi * np.sqrt(0.5 / 9.81), rel=1e-5)

@@ -48,6 +48,7 @@ from . import derive as _derive  # noqa: E402,F401
 from . import dynamics as _dynamics  # noqa: E402,F401
 from . import equilibria as _equilibria  # noqa: E402,F401
 from . import examples as _examples  # noqa: E402,F401
+from . import export as _export  # noqa: E402,F401
 from . import forces as _forces  # noqa: E402,F401
 from . import kinematics as _kinematics  # noqa: E402,F401
 from . import modes as _modes  # noqa: E402,F401

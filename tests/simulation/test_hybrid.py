@@ -109,3 +109,15 @@ def test_a_plastic_impact_that_presses_into_the_floor_rests_there(ball):
     assert np.all(run.q[:, 0] > -1e-12)
     rested = plastic.simulate(2.0, samples=21, settle=True)
     assert rested.status == "settled" and rested.t[-1] == pytest.approx(2.0)
+
+
+def test_a_relabelling_that_moves_the_model_is_refused():
+    """The rimless wheel relabelled by one spoke angle instead of two: the hub is not where
+    the impact left it about the new foot."""
+    from lagrangian.model.examples import example_text
+    from lagrangian.model.reader import parse_model
+
+    text = example_text("rimless_wheel").replace('"theta - 2*alpha"', '"theta - alpha"')
+    wrong = lagrangian.System(parse_model(text, source="wheel.toml"))
+    with pytest.raises(InputError, match="after its relabelling the particle 'hub'"):
+        wrong.simulate(2.0, samples=11)

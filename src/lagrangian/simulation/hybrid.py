@@ -27,6 +27,7 @@ from ..model.values import resolve_parameters, resolve_state
 from .integration_loops import integrate_steps
 from .invariants import cumulative_work, energy_is_conserved, invariant_kind
 from .options import SaveAt, StepControl
+from .relabel_check import RelabelCheck
 from .result import STATUS_MESSAGES, SimulationResult
 
 ACCUMULATED = "accumulated"  # impacts accumulate (Zeno): the run stops at their limit time
@@ -101,6 +102,8 @@ class CompiledImpact:
             raise InputError(f"impact '{self.name}': a released pivot needs restitution 0, "
                              f"got {e:g}", field="parameters")
         self.restitution = e
+        relabels = bool(m.impact.relabel) or bool(m.extension)
+        self._geometry = RelabelCheck(model, m, substitution) if relabels else None
 
     def matrices(self, q, v, t):
         """M, J, E, the point's velocity rows P, n, R(q), dR/dq at one state."""
@@ -113,6 +116,8 @@ class CompiledImpact:
 
     def apply(self, q, v, t):
         """(q+, v+, impulse, energy lost, residual, extended velocities before and after)."""
+        if self._geometry is not None:
+            self._geometry(q, t)
         M, J, E, P, n, R, DR = self.matrices(q, v, t)
         ve = np.concatenate([np.zeros(self.k), v])
         solution = solve_impact(M, J, E, ve, f"impact '{self.name}' at t = {t:.12g} s")

@@ -68,7 +68,7 @@ MEANINGS = {
 ANSWER_MEANINGS = {
     "": "`coordinates = [\"x2\", \"x1\"]` (or a `[coordinates]` table): your order of rows, "
         "columns and shape components (default the model's); the other keys are the tables below",
-    "energy": "your T, V, D as expressions",
+    "energy": "your T, V, D as expressions; `L` the Lagrangian, checked as T - V",
     "generalized_forces": "`coordinate = \"Q\"` expressions; with `at = { theta = \"30deg\" }`, "
                           "values at that configuration (at rest): `theta = \"43.3 N*m\"`, item "
                           "`Q_theta`",
@@ -88,6 +88,10 @@ ANSWER_MEANINGS = {
                "--solve-for`, item `statics.F`",
     "equilibria": "`theta = [\"0\", \"pi\"]` positions, any order (several coordinates: the i-th "
                   "entries make the i-th equilibrium)",
+    "momenta": "`coordinate = \"p\"`, p = dL/dq_dot, item `p[x]`",
+    "conserved": "`cyclic = [\"phi\"]` and `quantities = [\"...\"]` constant along every motion",
+    "routhian": "`cyclic = [\"phi\"]` and `R` (= sum p q_dot - L) or `L_R` (= -R), in p_<name>",
+    "hamiltonian": "`H` in the coordinates and momenta p_<coordinate>",
 }
 
 

@@ -6,6 +6,7 @@ import re
 
 from check_helpers import check_text, finding
 
+from lagrangian.check.conserved_answers import MECHANICS_CODES
 from lagrangian.check.diagnose import CODES
 from lagrangian.check.final_answers import FINAL_CODES
 from lagrangian.check.hints import GENERAL, HINTS, hinted
@@ -40,5 +41,5 @@ def test_the_springs_sign_question_survives_hints_only():
 
 
 def test_every_code_has_its_own_question():
-    missing = [code for code in (*CODES, *FINAL_CODES) if code not in HINTS]
+    missing = [code for code in (*CODES, *FINAL_CODES, *MECHANICS_CODES) if code not in HINTS]
     assert missing == []

@@ -189,7 +189,7 @@ def _work_along(eom: EquationsOfMotion, generator: Sequence[sp.Expr]) -> str | N
     the loads' virtual work Q . xi, or a constraint's Phi_q xi, must vanish."""
     model = eom.model
     work = sp.Add(*(Q * x for Q, x in zip(eom.generalized_forces, generator, strict=True)))
-    if not _is_zero(work, model):
+    if not _is_zero(work, model) and not _is_zero(work.xreplace(_values(model)), model):
         loads = sorted({c.load for c in eom.load_contributions
                         if generator[[c_.name for c_ in model.coordinates]
                                      .index(c.coordinate)] != 0})
@@ -202,9 +202,22 @@ def _work_along(eom: EquationsOfMotion, generator: Sequence[sp.Expr]) -> str | N
     return None
 
 
+def _values(model) -> dict:
+    """The parameters that have a value: a load switched off (F = 0) does no work."""
+    return {p.symbol: sp.Float(p.value) if p.value != 0 else sp.S.Zero
+            for p in model.parameters if p.value is not None}
+
+
 def _jacobi(eom: EquationsOfMotion, common: dict) -> ConservedQuantity | NotConserved | None:
-    """h = q_dot . dL/dq_dot - L when conserved (with whether it is T + V), else why not."""
+    """h = q_dot . dL/dq_dot - L when conserved (with whether it is T + V), else why not; a
+    load that the model's values switch off (F = 0) does no work."""
     kind = eom.invariant_kind
+    if kind == InvariantKind.WORK_BALANCE and _is_zero(
+            eom.power.xreplace(_values(eom.model)), eom.model):
+        T, V, h = eom.kinetic_energy, eom.potential_energy, eom.jacobi_integral
+        equals = _is_zero(h - T - V, eom.model)
+        return ConservedQuantity("h", ConservedKind.JACOBI, T + V if equals else sp.expand(h),
+                                 (), equals_energy=equals, **common)
     if kind == InvariantKind.WORK_BALANCE:
         model = eom.model
         causes = []

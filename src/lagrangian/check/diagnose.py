@@ -235,7 +235,7 @@ class _Checker:
         if eq.constant_in_state(V_user + V, self.points):
             question = sign_question([label for label, _ in parts], rises)
             return [Finding("V", "wrong", "potential_sign", f"V has the wrong sign. {question}",
-                            expected, hint=question)]
+                            expected, hint=None if question == rises else question)]
         if len(parts) > 1:
             for label, part in parts:
                 if eq.constant_in_state(V_user - (V - 2 * part), self.points):

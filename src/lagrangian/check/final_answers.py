@@ -21,6 +21,7 @@ from ..errors import DerivationError, ModelError
 from ..model.answer import Answer, answer_expression, answer_names
 from ..model.expressions import format_expression as fmt
 from . import equivalence as eq
+from .conserved_answers import check_mechanics
 from .diagnose import Finding
 from .final_at_rest import AtRest
 from .final_linear import check_linearized, exact_linear
@@ -61,10 +62,12 @@ def check_final_answers(system: Analysis, answer: Answer) -> list[Finding]:
         return []
     model = system.equations_of_motion().model
     names = answer_names(model)
-    final = read_final_answers(dict(answer.final_tables), model, lambda value, field:
+    tables = dict(answer.final_tables)
+    final = read_final_answers(tables, model, lambda value, field:
                                answer_expression(value, names, field, answer.source),
                                answer.source)
-    return _FinalChecker(system, final, answer.source).run()
+    return _FinalChecker(system, final, answer.source).run() + \
+        check_mechanics(system, tables, answer.source)
 
 
 class _FinalChecker:

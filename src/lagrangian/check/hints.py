@@ -106,6 +106,35 @@ HINTS: dict[str, Hint] = {
     "generalized_force_value": _FORCE,
     "equilibrium_wrong": Hint("An equilibrium", "Do the forces balance there at rest, "
                               "dV/dq = Q with q̇ = 0?", "Solve dV/dq = Q for each coordinate."),
+    # what L conserves, Routh and Hamilton (check/conserved_answers.py)
+    "momentum_wrong": Hint("A momentum", "Is p = ∂L/∂q̇, with every term of T that has q̇?",
+                           "Differentiate L with respect to the rate, cross terms included."),
+    "not_cyclic": Hint("A coordinate taken for cyclic", "Does L contain the coordinate itself, "
+                       "not only its rate?", "Only a coordinate absent from L is cyclic."),
+    "cyclic_missing": Hint("A cyclic coordinate left out", "Which coordinates does L not "
+                           "contain?", "Each such coordinate's momentum is conserved."),
+    "momentum_not_conserved": Hint("A broken momentum", "Does a load do virtual work along "
+                                   "the cyclic coordinate?", "A cyclic momentum is conserved "
+                                   "only where Q along it vanishes."),
+    "energy_not_conserved": Hint("T + V taken for conserved", "Does a drive, a load or explicit "
+                                 "time do work on the system?", "Where a drive does work, the "
+                                 "Jacobi integral h = q̇ · ∂L/∂q̇ − L may be conserved "
+                                 "instead."),
+    "not_conserved": Hint("A quantity that changes", "Does dF/dt vanish by the equations of "
+                          "motion?", "Look for cyclic coordinates and for h."),
+    "routhian_sign": Hint("The Routhian's sign", "Which convention: R = p q̇ − L, or the "
+                          "reduced Lagrangian L_R = −R?", "Here R = Σ p q̇ − L (Goldstein)."),
+    "effective_potential": Hint("The effective potential", "Did you write the cyclic rate "
+                                "through its momentum before forming R?",
+                                "Eliminate q̇ of the cyclic coordinate with p = ∂L/∂q̇."),
+    "routhian_wrong": Hint("The Routhian", "Is R = Σ p q̇ − L over the cyclic coordinates, "
+                           "their rates written through p?", "Form R term by term."),
+    "hamiltonian_in_velocities": Hint("H in the rates", "Is H written in the momenta p?",
+                                      "Write each q̇ through p = ∂L/∂q̇."),
+    "hamiltonian_inverse": Hint("M for M⁻¹", "Did you invert p = M q̇ for q̇?",
+                                "The kinetic part of H is ½ pᵀ M⁻¹ p."),
+    "hamiltonian_wrong": Hint("The Hamiltonian", "Is H = p · q̇ − L with q̇ written through p?",
+                              "Form H from the momenta, term by term."),
     "equilibrium_missing": Hint("An equilibrium left out", "Did I find every configuration "
                                 "where dV/dq = Q at rest (each root, within the coordinate's "
                                 "range)?", "Solve dV/dq = Q for all its roots."),

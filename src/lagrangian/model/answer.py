@@ -31,8 +31,10 @@ from .tokens import plain_names
 FINAL_TABLES = ("matrices", "frequencies", "mode_shapes", "linearized", "equilibria", "statics")
 MATRICES = ("M", "K", "C")
 FREQUENCY_KEYS = ("omega", "f", "period", "zeta")
+# What L conserves, Routh and Hamilton (check/conserved_answers.py), kept as written too.
+MECHANICS_TABLES = ("momenta", "conserved", "routhian", "hamiltonian")
 TABLES = ("energy", "generalized_forces", "equations", "multipliers", *FINAL_TABLES,
-          "coordinates")
+          *MECHANICS_TABLES, "coordinates")
 _FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 ENERGY_KEYS = ("T", "V", "D", "L")  # L: the Lagrangian, checked as T - V
 MULTIPLIER_KEYS = ("count", "names")
@@ -52,7 +54,11 @@ def answer_file_schema() -> dict[str, tuple[frozenset[str], frozenset[str]]]:
             "mode_shapes": (frozenset({"shapes"}), none),
             "linearized": (frozenset({"about"}), coordinate),
             "equilibria": (none, coordinate),
-            "statics": (frozenset({"at"}), frozenset({"<parameter>", "lambda_<constraint>"}))}
+            "statics": (frozenset({"at"}), frozenset({"<parameter>", "lambda_<constraint>"})),
+            "momenta": (none, coordinate),
+            "conserved": (none, frozenset({"cyclic", "quantities"})),
+            "routhian": (frozenset({"cyclic"}), frozenset({"R", "L_R"})),
+            "hamiltonian": (frozenset({"H"}), none)}
 
 
 @dataclass(frozen=True)
@@ -149,7 +155,8 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
             (name, expression(forces[name], f"generalized_forces.{name}", f"Q[{name}]"))
             for name in coordinates if name in forces
         )
-    final = tuple((key, data[key]) for key in (*FINAL_TABLES, "coordinates") if key in data)
+    final = tuple((key, data[key]) for key in (*FINAL_TABLES, *MECHANICS_TABLES, "coordinates")
+                  if key in data)
     if "at" in forces:
         final += (("generalized_forces", forces),)
 
@@ -204,7 +211,8 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
     if answer.is_empty:
         raise ModelError("the answer has nothing to check: give [energy] T/V/D/L, "
                          "[generalized_forces], [equations], [multipliers], [matrices], "
-                         "[frequencies], [mode_shapes], [linearized] or [equilibria]",
+                         "[frequencies], [mode_shapes], [linearized], [equilibria], [momenta], "
+                         "[conserved], [routhian] or [hamiltonian]",
                          source=source)
     return answer
 

@@ -46,40 +46,6 @@ typedef struct {
 
 #define TK_FREE(b) ((b)[TK_KIND] == 2.0)
 
-static inline void tk_cross(const double *a, const double *b, double *c)
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static inline void tk_apply(const double *R, const double *x, double *y)  /* y = R x */
-{
-    for (int i = 0; i < 3; i++) y[i] = R[3 * i] * x[0] + R[3 * i + 1] * x[1] + R[3 * i + 2] * x[2];
-}
-
-static inline void tk_apply_t(const double *R, const double *x, double *y)  /* y = R^T x */
-{
-    for (int i = 0; i < 3; i++) y[i] = R[i] * x[0] + R[3 + i] * x[1] + R[6 + i] * x[2];
-}
-
-static inline double tk_dot(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void tk_sandwich(const double *R, const double *A, double *out)  /* R A R^T */
-{
-    double T[9];
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            T[3 * i + j] = R[3 * i] * A[j] + R[3 * i + 1] * A[3 + j] + R[3 * i + 2] * A[6 + j];
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            out[3 * i + j] = T[3 * i] * R[3 * j] + T[3 * i + 1] * R[3 * j + 1]
-                             + T[3 * i + 2] * R[3 * j + 2];
-}
-
 static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
 {
     if (size < TK_HEADER) return -1;
@@ -112,46 +78,25 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
     return 0;
 }
 
-/* Each body's R and p for the configuration q (into the scratch W). */
-static void tk_place(const tk_tree *t, const double *q, double *W)
-{
-    for (int i = 0; i < t->nb; i++) {
-        const double *b = t->body + i * TK_STRIDE;
-        double *R = W + i * TW_STRIDE + TW_R, *p = W + i * TW_STRIDE + TW_P;
-        const double *R0 = b + TK_R0, *u = b + TK_AXIS;
-        if (TK_FREE(b)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
-            const double x = q[3], y = q[4], z = q[5], s = q[6];
-            const double k = 2.0 / (x * x + y * y + z * z + s * s);
-            const double E[9] = {1 - k * (y * y + z * z), k * (x * y - z * s), k * (x * z + y * s),
-                                 k * (x * y + z * s), 1 - k * (x * x + z * z), k * (y * z - x * s),
-                                 k * (x * z - y * s), k * (y * z + x * s), 1 - k * (x * x + y * y)};
-            for (int r = 0; r < 3; r++)
-                for (int col = 0; col < 3; col++)
-                    R[3 * r + col] = R0[3 * r] * E[col] + R0[3 * r + 1] * E[3 + col]
-                                     + R0[3 * r + 2] * E[6 + col];
-            tk_apply(R0, q, p);
-            for (int r = 0; r < 3; r++) p[r] += b[TK_T0 + r];
-            continue;
-        }
-        const double theta = b[TK_MULT] * q[t->bq + (int)b[TK_COORD]] + b[TK_OFFSET];
-        if (b[TK_KIND] == 0) {
-            /* sine and cosine written out here: a libm call cost as much as the rest of an
-               arm's mass matrix */
-            double sn, cs;
-            lg_sincos_inline(theta, &sn, &cs);
-            const double *P = b + TK_TURN, *C = P + 9, *S = P + 18;
-            for (int r = 0; r < 9; r++) R[r] = P[r] + cs * C[r] + sn * S[r];
-            memcpy(p, b + TK_T0, 3 * sizeof(double));
-        } else {
-            double Ru[3];
-            memcpy(R, R0, 9 * sizeof(double));
-            tk_apply(R0, u, Ru);
-            for (int r = 0; r < 3; r++) p[r] = b[TK_T0 + r] + Ru[r] * theta;
-        }
-    }
-}
+/* Small 3-vector helpers as macros, so that each takes a tree's doubles or a state's numbers
+   (a TK_T: one double, or LG_LANES of them) in any place; the core below is compiled twice. */
+#define TK_CROSS(a, b, c) do {                                       \
+        TK_T c0_ = (a)[1] * (b)[2] - (a)[2] * (b)[1];                \
+        TK_T c1_ = (a)[2] * (b)[0] - (a)[0] * (b)[2];                \
+        TK_T c2_ = (a)[0] * (b)[1] - (a)[1] * (b)[0];                \
+        (c)[0] = c0_; (c)[1] = c1_; (c)[2] = c2_;                    \
+    } while (0)
+#define TK_APPLY(R, x, y) do {  /* y = R x */                                        \
+        for (int r_ = 0; r_ < 3; r_++)                                               \
+            (y)[r_] = (R)[3 * r_] * (x)[0] + (R)[3 * r_ + 1] * (x)[1] + (R)[3 * r_ + 2] * (x)[2]; \
+    } while (0)
+#define TK_APPLY_T(R, x, y) do {  /* y = R^T x */                                    \
+        for (int r_ = 0; r_ < 3; r_++)                                               \
+            (y)[r_] = (R)[r_] * (x)[0] + (R)[3 + r_] * (x)[1] + (R)[6 + r_] * (x)[2]; \
+    } while (0)
+#define TK_DOT(a, b) ((a)[0] * (b)[0] + (a)[1] * (b)[1] + (a)[2] * (b)[2])
 
-/* S = (s_w, s_v) per unit rate of q (the multiplier k included). */
+/* S = (s_w, s_v) per unit rate of q (the multiplier k included): the tree's numbers alone. */
 static inline void tk_subspace(const double *b, double *sw, double *sv)
 {
     const double k = b[TK_MULT];
@@ -161,109 +106,173 @@ static inline void tk_subspace(const double *b, double *sw, double *sv)
     }
 }
 
-/* Recursive Newton-Euler: tau = M a + C v + g - tau0 (v, a NULL: zero). */
-static void tk_inverse(const tk_tree *t, const double *q, const double *v, const double *a,
-                       double *W, double *tau)
+/* TK_CORE_BEGIN */
+/* The recursions, emitted twice by compact_kernel.py: on one state (tk_*, TK_T double) and
+   on LG_LANES states at once (tk4_*, TK_T lg_v4). TK_FN(name) names a function, TK_C(x) a
+   number as a TK_T. Every branch depends on the tree alone, never on a state, so the lanes
+   take one path and each lane's numbers are its state's single call's, bit for bit (the module
+   is built without fused multiply-adds); a failed state (a matrix not positive definite) is
+   marked in the functions' returned TK_BAD, its numbers left for the caller to blank. */
+
+static inline void TK_FN(sandwich)(const TK_T *R, const TK_T *A, TK_T *out)  /* R A R^T */
 {
-    tk_place(t, q, W);
-    for (int i = 0; i < t->bv; i++) tau[i] = 0.0;
-    for (int i = 0; i < t->n; i++) tau[t->bv + i] = -t->tau0[i];
+    TK_T T[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            T[3 * i + j] = R[3 * i] * A[j] + R[3 * i + 1] * A[3 + j] + R[3 * i + 2] * A[6 + j];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            out[3 * i + j] = T[3 * i] * R[3 * j] + T[3 * i + 1] * R[3 * j + 1]
+                             + T[3 * i + 2] * R[3 * j + 2];
+}
+
+/* Each body's R and p for the configuration q (into the scratch W). */
+static void TK_FN(place)(const tk_tree *t, const TK_T *q, TK_T *W)
+{
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
-        double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
-        double *om = w + TW_A, *dom = om + 3, *acc = om + 6, *f = om + 9, *nn = om + 12;
+        TK_T *R = W + i * TW_STRIDE + TW_R, *p = W + i * TW_STRIDE + TW_P;
+        const double *R0 = b + TK_R0, *u = b + TK_AXIS;
+        if (TK_FREE(b)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
+            const TK_T x = q[3], y = q[4], z = q[5], s = q[6];
+            const TK_T k = 2.0 / (x * x + y * y + z * z + s * s);
+            const TK_T E[9] = {1.0 - k * (y * y + z * z), k * (x * y - z * s), k * (x * z + y * s),
+                               k * (x * y + z * s), 1.0 - k * (x * x + z * z), k * (y * z - x * s),
+                               k * (x * z - y * s), k * (y * z + x * s), 1.0 - k * (x * x + y * y)};
+            for (int r = 0; r < 3; r++)
+                for (int col = 0; col < 3; col++)
+                    R[3 * r + col] = R0[3 * r] * E[col] + R0[3 * r + 1] * E[3 + col]
+                                     + R0[3 * r + 2] * E[6 + col];
+            TK_APPLY(R0, q, p);
+            for (int r = 0; r < 3; r++) p[r] += b[TK_T0 + r];
+            continue;
+        }
+        const TK_T theta = b[TK_MULT] * q[t->bq + (int)b[TK_COORD]] + b[TK_OFFSET];
+        if (b[TK_KIND] == 0) {
+            /* sine and cosine written out here: a libm call cost as much as the rest of an
+               arm's mass matrix */
+            TK_T sn, cs;
+            TK_SINCOS(theta, &sn, &cs);
+            const double *P = b + TK_TURN, *C = P + 9, *S = P + 18;
+            for (int r = 0; r < 9; r++) R[r] = P[r] + cs * C[r] + sn * S[r];
+            for (int r = 0; r < 3; r++) p[r] = TK_C(b[TK_T0 + r]);
+        } else {
+            double Ru[3];
+            for (int r = 0; r < 9; r++) R[r] = TK_C(R0[r]);
+            TK_APPLY(R0, u, Ru);
+            for (int r = 0; r < 3; r++) p[r] = b[TK_T0 + r] + Ru[r] * theta;
+        }
+    }
+}
+
+/* Recursive Newton-Euler: tau = M a + C v + g - tau0 (v, a NULL: zero). */
+static void TK_FN(inverse)(const tk_tree *t, const TK_T *q, const TK_T *v, const TK_T *a,
+                           TK_T *W, TK_T *tau)
+{
+    TK_FN(place)(t, q, W);
+    for (int i = 0; i < t->bv; i++) tau[i] = TK_C(0.0);
+    for (int i = 0; i < t->n; i++) tau[t->bv + i] = TK_C(-t->tau0[i]);
+    for (int i = 0; i < t->nb; i++) {
+        const double *b = t->body + i * TK_STRIDE;
+        TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
+        TK_T *om = w + TW_A, *dom = om + 3, *acc = om + 6, *f = om + 9, *nn = om + 12;
         const int parent = (int)b[TK_PARENT], c = (int)b[TK_COORD];
-        double sw[3], sv[3], x[3], y[3];
+        double sw[3], sv[3];
+        TK_T x[3], y[3];
         tk_subspace(b, sw, sv);
         if (parent < 0) {
             const double up[3] = {-t->g[0], -t->g[1], -t->g[2]};  /* the ground accelerates up */
-            for (int r = 0; r < 3; r++) om[r] = dom[r] = 0.0;
-            tk_apply_t(R, up, acc);
+            for (int r = 0; r < 3; r++) om[r] = dom[r] = TK_C(0.0);
+            TK_APPLY_T(R, up, acc);
             if (TK_FREE(b)) {  /* the origin's acceleration a_v + w x v_v, body axes */
                 if (v) {
-                    tk_cross(v + 3, v, x);
+                    TK_CROSS(v + 3, v, x);
                     for (int r = 0; r < 3; r++) { om[r] = v[3 + r]; acc[r] += x[r]; }
                 }
                 if (a)
                     for (int r = 0; r < 3; r++) { dom[r] = a[3 + r]; acc[r] += a[r]; }
             }
         } else {
-            const double *pw = W + parent * TW_STRIDE + TW_A, *pdw = pw + 3, *pa = pw + 6;
-            double z[3];
-            tk_apply_t(R, pw, om);
-            tk_apply_t(R, pdw, dom);
+            const TK_T *pw = W + parent * TW_STRIDE + TW_A, *pdw = pw + 3, *pa = pw + 6;
+            TK_T z[3];
+            TK_APPLY_T(R, pw, om);
+            TK_APPLY_T(R, pdw, dom);
             /* a_parent + dw x p + w x (w x p) */
-            tk_cross(pdw, p, x);
-            tk_cross(pw, p, y);
-            tk_cross(pw, y, z);
+            TK_CROSS(pdw, p, x);
+            TK_CROSS(pw, p, y);
+            TK_CROSS(pw, y, z);
             for (int r = 0; r < 3; r++) x[r] += pa[r] + z[r];
-            tk_apply_t(R, x, acc);
+            TK_APPLY_T(R, x, acc);
         }
-        const double rate = v && !TK_FREE(b) ? v[t->bv + c] : 0.0;
-        const double accel = a && !TK_FREE(b) ? a[t->bv + c] : 0.0;
-        if (rate != 0.0) {
-            double ws[3] = {rate * sw[0], rate * sw[1], rate * sw[2]};
-            tk_cross(om, ws, x);
+        if (v && !TK_FREE(b)) {  /* the joint's rate: w += S w, the Coriolis terms */
+            const TK_T rate = v[t->bv + c];
+            TK_T ws[3] = {rate * sw[0], rate * sw[1], rate * sw[2]};
+            TK_CROSS(om, ws, x);
             for (int r = 0; r < 3; r++) { om[r] += ws[r]; dom[r] += x[r]; }
-            double vs[3] = {rate * sv[0], rate * sv[1], rate * sv[2]};
-            tk_cross(om, vs, x);
+            TK_T vs[3] = {rate * sv[0], rate * sv[1], rate * sv[2]};
+            TK_CROSS(om, vs, x);
             for (int r = 0; r < 3; r++) acc[r] += 2.0 * x[r];
         }
-        for (int r = 0; r < 3; r++) { dom[r] += accel * sw[r]; acc[r] += accel * sv[r]; }
+        if (a && !TK_FREE(b)) {
+            const TK_T accel = a[t->bv + c];
+            for (int r = 0; r < 3; r++) { dom[r] += accel * sw[r]; acc[r] += accel * sv[r]; }
+        }
         /* f = m a + dw x h + w x (w x h), n = J dw + w x J w + h x a (about the origin) */
         const double m = b[TK_MASS], *h = b + TK_H, *J = b + TK_J;
-        double wh[3], z[3];
-        tk_cross(dom, h, x);
-        tk_cross(om, h, wh);
-        tk_cross(om, wh, z);
+        TK_T wh[3], z[3];
+        TK_CROSS(dom, h, x);
+        TK_CROSS(om, h, wh);
+        TK_CROSS(om, wh, z);
         for (int r = 0; r < 3; r++) f[r] = m * acc[r] + x[r] + z[r];
-        tk_apply(J, dom, nn);
-        tk_apply(J, om, y);
-        tk_cross(om, y, x);
-        tk_cross(h, acc, z);
+        TK_APPLY(J, dom, nn);
+        TK_APPLY(J, om, y);
+        TK_CROSS(om, y, x);
+        TK_CROSS(h, acc, z);
         for (int r = 0; r < 3; r++) nn[r] += x[r] + z[r];
     }
     for (int i = t->nb - 1; i >= 0; i--) {
         const double *b = t->body + i * TK_STRIDE;
-        double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
-        double *f = w + TW_A + 9, *nn = w + TW_A + 12, sw[3], sv[3];
+        TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
+        TK_T *f = w + TW_A + 9, *nn = w + TW_A + 12;
+        double sw[3], sv[3];
         if (TK_FREE(b)) {  /* the base's wrench in its axes, force then moment */
             for (int r = 0; r < 3; r++) { tau[r] += f[r]; tau[3 + r] += nn[r]; }
             continue;
         }
         tk_subspace(b, sw, sv);
-        tau[t->bv + (int)b[TK_COORD]] += tk_dot(sw, nn) + tk_dot(sv, f);
+        tau[t->bv + (int)b[TK_COORD]] += TK_DOT(sw, nn) + TK_DOT(sv, f);
         const int parent = (int)b[TK_PARENT];
         if (parent >= 0) {
-            double *pf = W + parent * TW_STRIDE + TW_A + 9, *pn = pf + 3, F[3], N[3], x[3];
-            tk_apply(R, f, F);
-            tk_apply(R, nn, N);
-            tk_cross(p, F, x);
+            TK_T *pf = W + parent * TW_STRIDE + TW_A + 9, *pn = pf + 3, F[3], N[3], x[3];
+            TK_APPLY(R, f, F);
+            TK_APPLY(R, nn, N);
+            TK_CROSS(p, F, x);
             for (int r = 0; r < 3; r++) { pf[r] += F[r]; pn[r] += N[r] + x[r]; }
         }
     }
 }
 
 /* M by the composite-rigid-body algorithm (row-major n x n). */
-static void tk_mass(const tk_tree *t, const double *q, double *W, double *M)
+static void TK_FN(mass)(const tk_tree *t, const TK_T *q, TK_T *W, TK_T *M)
 {
     const int n = t->nv;
-    tk_place(t, q, W);
-    memset(M, 0, (size_t)n * n * sizeof(double));
+    TK_FN(place)(t, q, W);
+    for (int k = 0; k < n * n; k++) M[k] = TK_C(0.0);
     for (int i = 0; i < t->nb; i++) {  /* composite inertias start as the bodies' own */
-        double *c = W + i * TW_STRIDE + TW_A;
+        TK_T *c = W + i * TW_STRIDE + TW_A;
         const double *b = t->body + i * TK_STRIDE;
-        memcpy(c, b + TK_MASS, 13 * sizeof(double));
+        for (int k = 0; k < 13; k++) c[k] = TK_C(b[TK_MASS + k]);
     }
     for (int i = t->nb - 1; i >= 0; i--) {
         const double *b = t->body + i * TK_STRIDE;
-        double *w = W + i * TW_STRIDE, *c = w + TW_A;
-        const double m = c[0], *h = c + 1, *J = c + 4;
+        TK_T *w = W + i * TW_STRIDE, *c = w + TW_A;
+        const TK_T m = c[0], *h = c + 1, *J = c + 4;
         if (TK_FREE(b)) {  /* the whole robot's inertia: [[m 1, -[h]x], [[h]x, J]] */
-            const double H[9] = {0.0, -h[2], h[1], h[2], 0.0, -h[0], -h[1], h[0], 0.0};
+            const TK_T zero = TK_C(0.0);
+            const TK_T H[9] = {zero, -h[2], h[1], h[2], zero, -h[0], -h[1], h[0], zero};
             for (int r = 0; r < 3; r++)
                 for (int col = 0; col < 3; col++) {
-                    M[r * n + col] = r == col ? m : 0.0;
+                    M[r * n + col] = r == col ? m : zero;
                     M[r * n + 3 + col] = -H[3 * r + col];
                     M[(3 + r) * n + col] = H[3 * r + col];
                     M[(3 + r) * n + 3 + col] = J[3 * r + col];
@@ -271,21 +280,22 @@ static void tk_mass(const tk_tree *t, const double *q, double *W, double *M)
             continue;
         }
         const int ci = t->bv + (int)b[TK_COORD];
-        double sw[3], sv[3], force[3], moment[3], x[3];
+        double sw[3], sv[3];
+        TK_T force[3], moment[3], x[3];
         tk_subspace(b, sw, sv);
         /* the composite's wrench for a unit rate: f = m s_v + s_w x h, n = J s_w + h x s_v */
-        tk_cross(sw, h, x);
+        TK_CROSS(sw, h, x);
         for (int r = 0; r < 3; r++) force[r] = m * sv[r] + x[r];
-        tk_apply(J, sw, moment);
-        tk_cross(h, sv, x);
+        TK_APPLY(J, sw, moment);
+        TK_CROSS(h, sv, x);
         for (int r = 0; r < 3; r++) moment[r] += x[r];
-        M[ci * n + ci] += tk_dot(sw, moment) + tk_dot(sv, force);
+        M[ci * n + ci] += TK_DOT(sw, moment) + TK_DOT(sv, force);
         for (int k = i; (int)t->body[k * TK_STRIDE + TK_PARENT] >= 0;) {
-            const double *wk = W + k * TW_STRIDE;
-            double F[3], N[3];
-            tk_apply(wk + TW_R, force, F);
-            tk_apply(wk + TW_R, moment, N);
-            tk_cross(wk + TW_P, F, x);
+            const TK_T *wk = W + k * TW_STRIDE;
+            TK_T F[3], N[3];
+            TK_APPLY(wk + TW_R, force, F);
+            TK_APPLY(wk + TW_R, moment, N);
+            TK_CROSS(wk + TW_P, F, x);
             for (int r = 0; r < 3; r++) { force[r] = F[r]; moment[r] = N[r] + x[r]; }
             k = (int)t->body[k * TK_STRIDE + TK_PARENT];
             const double *bk = t->body + k * TK_STRIDE;
@@ -300,24 +310,26 @@ static void tk_mass(const tk_tree *t, const double *q, double *W, double *M)
             }
             double kw[3], kv[3];
             tk_subspace(bk, kw, kv);
-            const double e = tk_dot(kw, moment) + tk_dot(kv, force);
+            const TK_T e = TK_DOT(kw, moment) + TK_DOT(kv, force);
             const int ck = t->bv + (int)bk[TK_COORD];
             M[ci * n + ck] += e;
             M[ck * n + ci] += e;
         }
         const int parent = (int)b[TK_PARENT];
         if (parent >= 0) {  /* the composite moved into the parent's axes */
-            const double *R = w + TW_R, *p = w + TW_P;
-            double *pc = W + parent * TW_STRIDE + TW_A, hr[3], S[9];
-            tk_apply(R, h, hr);
-            tk_sandwich(R, J, S);
-            const double ph = tk_dot(p, hr), pp = tk_dot(p, p);
+            const TK_T *R = w + TW_R, *p = w + TW_P;
+            TK_T *pc = W + parent * TW_STRIDE + TW_A, hr[3], S[9];
+            TK_APPLY(R, h, hr);
+            TK_FN(sandwich)(R, J, S);
+            const TK_T ph = TK_DOT(p, hr), pp = TK_DOT(p, p);
             /* J' = R J R^T + m (|p|^2 1 - p p^T) + 2 (p.h) 1 - p h^T - h p^T */
             for (int r = 0; r < 3; r++)
-                for (int col = 0; col < 3; col++)
-                    pc[4 + 3 * r + col] += S[3 * r + col]
-                        + (r == col ? m * pp + 2.0 * ph : 0.0)
-                        - m * p[r] * p[col] - p[r] * hr[col] - hr[r] * p[col];
+                for (int col = 0; col < 3; col++) {
+                    TK_T e = S[3 * r + col];
+                    if (r == col) e += m * pp + 2.0 * ph;
+                    pc[4 + 3 * r + col] += e - m * p[r] * p[col] - p[r] * hr[col]
+                                           - hr[r] * p[col];
+                }
             for (int r = 0; r < 3; r++) pc[1 + r] += hr[r] + m * p[r];
             pc[0] += m;
         }
@@ -325,52 +337,58 @@ static void tk_mass(const tk_tree *t, const double *q, double *W, double *M)
 }
 
 /* T = 1/2 sum (m v.v + 2 v.(w x h) + w.J w) */
-static double tk_kinetic(const tk_tree *t, const double *q, const double *v, double *W)
+static TK_T TK_FN(kinetic)(const tk_tree *t, const TK_T *q, const TK_T *v, TK_T *W)
 {
-    tk_place(t, q, W);
-    double total = 0.0;
+    TK_FN(place)(t, q, W);
+    TK_T total = TK_C(0.0);
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
-        double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
-        double *om = w + TW_A, *vel = om + 3, sw[3], sv[3], x[3];
+        TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
+        TK_T *om = w + TW_A, *vel = om + 3, x[3];
+        double sw[3], sv[3];
         const int parent = (int)b[TK_PARENT];
         tk_subspace(b, sw, sv);
         if (TK_FREE(b)) {
             for (int r = 0; r < 3; r++) { om[r] = v[3 + r]; vel[r] = v[r]; }
         } else if (parent < 0) {
-            for (int r = 0; r < 3; r++) om[r] = vel[r] = 0.0;
+            for (int r = 0; r < 3; r++) om[r] = vel[r] = TK_C(0.0);
         } else {
-            const double *pw = W + parent * TW_STRIDE + TW_A;
-            tk_cross(pw, p, x);
+            const TK_T *pw = W + parent * TW_STRIDE + TW_A;
+            TK_CROSS(pw, p, x);
             for (int r = 0; r < 3; r++) x[r] += pw[3 + r];
-            tk_apply_t(R, pw, om);
-            tk_apply_t(R, x, vel);
+            TK_APPLY_T(R, pw, om);
+            TK_APPLY_T(R, x, vel);
         }
-        const double rate = TK_FREE(b) ? 0.0 : v[t->bv + (int)b[TK_COORD]];
-        for (int r = 0; r < 3; r++) { om[r] += rate * sw[r]; vel[r] += rate * sv[r]; }
-        double Jw[3], wh[3];
-        tk_apply(b + TK_J, om, Jw);
-        tk_cross(om, b + TK_H, wh);
-        total += b[TK_MASS] * tk_dot(vel, vel) + 2.0 * tk_dot(vel, wh) + tk_dot(om, Jw);
+        if (!TK_FREE(b)) {
+            const TK_T rate = v[t->bv + (int)b[TK_COORD]];
+            for (int r = 0; r < 3; r++) { om[r] += rate * sw[r]; vel[r] += rate * sv[r]; }
+        }
+        TK_T Jw[3], wh[3];
+        TK_APPLY(b + TK_J, om, Jw);
+        TK_CROSS(om, b + TK_H, wh);
+        total += b[TK_MASS] * TK_DOT(vel, vel) + 2.0 * TK_DOT(vel, wh) + TK_DOT(om, Jw);
     }
     return 0.5 * total;
 }
 
 /* V = -sum (m g.r + g.h), g the gravity vector in each body's axes, r its origin */
-static double tk_potential(const tk_tree *t, const double *q, double *W)
+static TK_T TK_FN(potential)(const tk_tree *t, const TK_T *q, TK_T *W)
 {
-    tk_place(t, q, W);
-    double total = 0.0;
+    TK_FN(place)(t, q, W);
+    TK_T total = TK_C(0.0);
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
-        double *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P, *gb = w + TW_A;
+        TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P, *gb = w + TW_A;
         const int parent = (int)b[TK_PARENT];
-        const double *gl = parent < 0 ? t->g : W + parent * TW_STRIDE + TW_A;
-        const double height = parent < 0 ? 0.0 : W[parent * TW_STRIDE + TW_A + 3];
-        gb[3] = height + tk_dot(gl, p);  /* g . r of this origin */
-        tk_apply_t(R, gl, gb);
-        total -= b[TK_MASS] * gb[3] + tk_dot(gb, b + TK_H);
+        if (parent < 0) {
+            gb[3] = TK_DOT(t->g, p);  /* g . r of this origin */
+            TK_APPLY_T(R, t->g, gb);
+        } else {
+            const TK_T *gl = W + parent * TW_STRIDE + TW_A;
+            gb[3] = gl[3] + TK_DOT(gl, p);
+            TK_APPLY_T(R, gl, gb);
+        }
+        total -= b[TK_MASS] * gb[3] + TK_DOT(gb, b + TK_H);
     }
     return total;
 }
-

@@ -18,42 +18,116 @@ typedef struct {
     int failed;
 } tk_job;
 
+/* One state on the scalar functions into y (size numbers); 0 where it is defined. */
+static int tk_one(const tk_tree *t, int kind, const double **a, double *W, double *L,
+                  double *y)
+{
+    switch (kind) {
+    case TK_MASSM: tk_mass(t, a[0], W, y); return 0;
+    case TK_BIAS: tk_inverse(t, a[0], a[1], NULL, W, y); return 0;
+    case TK_GRAVITY: tk_inverse(t, a[0], NULL, NULL, W, y); return 0;
+    case TK_INVERSE: tk_inverse(t, a[0], a[1], a[2], W, y); return 0;
+    case TK_FORWARD:
+        return t->mimic ? tk_forward_cholesky(t, a[0], a[1], a[2], W, L, y)
+                        : tk_forward_aba(t, a[0], a[1], a[2], W, y);
+    case TK_KINETIC: y[0] = tk_kinetic(t, a[0], a[1], W); return 0;
+    default: y[0] = tk_potential(t, a[0], W); return 0;
+    }
+}
+
+/* LG_LANES states at once on the lanes' functions into Y (size lanes); the failed lanes' mask */
+static lg_i4 tk_lanes(const tk_tree *t, int kind, const lg_v4 **a, lg_v4 *W, lg_v4 *L,
+                      lg_v4 *Y)
+{
+    const lg_i4 fine = {0};
+    switch (kind) {
+    case TK_MASSM: tk4_mass(t, a[0], W, Y); return fine;
+    case TK_BIAS: tk4_inverse(t, a[0], a[1], NULL, W, Y); return fine;
+    case TK_GRAVITY: tk4_inverse(t, a[0], NULL, NULL, W, Y); return fine;
+    case TK_INVERSE: tk4_inverse(t, a[0], a[1], a[2], W, Y); return fine;
+    case TK_FORWARD:
+        return t->mimic ? tk4_forward_cholesky(t, a[0], a[1], a[2], W, L, Y)
+                        : tk4_forward_aba(t, a[0], a[1], a[2], W, Y);
+    case TK_KINETIC: Y[0] = tk4_kinetic(t, a[0], a[1], W); return fine;
+    default: Y[0] = tk4_potential(t, a[0], W); return fine;
+    }
+}
+
+static int tk_finite(const double *x, int width)
+{
+    for (int i = 0; i < width; i++)
+        if (!isfinite(x[i])) return 0;
+    return 1;
+}
+
+/* A thread's share of a batch: LG_LANES states at a time on the lanes (each lane's numbers its
+   state's own single call's, bit for bit), the rest one by one. A state whose inputs are not
+   all finite rides its lanes as zeros, its row NaN after. */
 static void *tk_run(void *argument)
 {
     tk_job *job = (tk_job *)argument;
     const tk_tree *t = job->tree;
-    const int size = job->size;
+    const int size = job->size, nin = job->nin;
+    const size_t need = (size_t)t->nb * TW_STRIDE + (size_t)t->nv * t->nv;
     /* scratch: on the stack for a small tree (a call on one state costs no malloc) */
     double small[4096];
-    const size_t need = (size_t)t->nb * TW_STRIDE + (size_t)t->nv * t->nv;
     double *W = need <= 4096 ? small : malloc(need * sizeof(double));
     if (!W) { job->failed = 1; return NULL; }
     double *L = W + (size_t)t->nb * TW_STRIDE;
-    npy_intp bad = 0;
-    for (npy_intp k = job->k0; k < job->k1; k++) {
-        const double *a[3] = {NULL, NULL, NULL};
-        int fine = 1;
-        for (int j = 0; j < job->nin; j++) {
-            a[j] = job->x[j] + k * job->step[j];
-            const int width = j == 0 ? t->nq : t->nv;
-            for (int i = 0; i < width; i++)
-                if (!isfinite(a[j][i])) fine = 0;
+    npy_intp bad = 0, k = job->k0;
+    const int width[3] = {t->nq, t->nv, t->nv};
+    if (job->k1 - k >= LG_LANES) {
+        /* the lanes' scratch, inputs and output: W, L, then X[j] (width[j]), then Y (size) */
+        const size_t lanes = need + (size_t)t->nq + 2 * (size_t)t->nv + (size_t)size;
+        lg_v4 *V = NULL;
+        if (posix_memalign((void **)&V, 64, lanes * sizeof(lg_v4)) != 0) {
+            if (W != small) free(W);
+            job->failed = 1;
+            return NULL;
         }
-        double *y = job->y + k * size;
-        if (fine) {
-            switch (job->kind) {
-            case TK_MASSM: tk_mass(t, a[0], W, y); break;
-            case TK_BIAS: tk_inverse(t, a[0], a[1], NULL, W, y); break;
-            case TK_GRAVITY: tk_inverse(t, a[0], NULL, NULL, W, y); break;
-            case TK_INVERSE: tk_inverse(t, a[0], a[1], a[2], W, y); break;
-            case TK_FORWARD:
-                fine = (t->mimic ? tk_forward_cholesky(t, a[0], a[1], a[2], W, L, y)
-                        : tk_forward_aba(t, a[0], a[1], a[2], W, y)) == 0;
-                break;
-            case TK_KINETIC: y[0] = tk_kinetic(t, a[0], a[1], W); break;
-            case TK_POTENTIAL: y[0] = tk_potential(t, a[0], W); break;
+        lg_v4 *VL = V + (size_t)t->nb * TW_STRIDE, *X[3], *Y;
+        X[0] = V + need;
+        X[1] = X[0] + t->nq;
+        X[2] = X[1] + t->nv;
+        Y = X[2] + t->nv;
+        const lg_v4 *args[3] = {X[0], X[1], X[2]};
+        for (; k + LG_LANES <= job->k1; k += LG_LANES) {
+            int lost[LG_LANES];
+            for (int l = 0; l < LG_LANES; l++) {
+                lost[l] = 0;
+                for (int j = 0; j < nin; j++)
+                    if (!tk_finite(job->x[j] + (k + l) * job->step[j], width[j])) lost[l] = 1;
+            }
+            for (int j = 0; j < nin; j++) {
+                const double *x = job->x[j];
+                for (int l = 0; l < LG_LANES; l++) {
+                    const double *row = x + (k + l) * job->step[j];
+                    for (int i = 0; i < width[j]; i++) X[j][i][l] = lost[l] ? 0.0 : row[i];
+                }
+            }
+            const lg_i4 failed = tk_lanes(t, job->kind, args, V, VL, Y);
+            double *y = job->y + k * size;
+            for (int l = 0; l < LG_LANES; l++) {
+                double *row = y + (npy_intp)l * size;
+                if (lost[l] || failed[l]) {
+                    for (int i = 0; i < size; i++) row[i] = NAN;
+                    bad++;
+                } else {
+                    for (int i = 0; i < size; i++) row[i] = Y[i][l];
+                }
             }
         }
+        free(V);
+    }
+    for (; k < job->k1; k++) {
+        const double *a[3] = {NULL, NULL, NULL};
+        int fine = 1;
+        for (int j = 0; j < nin; j++) {
+            a[j] = job->x[j] + k * job->step[j];
+            if (!tk_finite(a[j], width[j])) fine = 0;
+        }
+        double *y = job->y + k * size;
+        if (fine) fine = tk_one(t, job->kind, a, W, L, y) == 0;
         if (!fine) {
             for (int i = 0; i < size; i++) y[i] = NAN;
             bad++;

@@ -121,3 +121,14 @@ def test_a_relabelling_that_moves_the_model_is_refused():
     wrong = lagrangian.System(parse_model(text, source="wheel.toml"))
     with pytest.raises(InputError, match="after its relabelling the particle 'hub'"):
         wrong.simulate(2.0, samples=11)
+
+
+def test_a_normal_that_disagrees_with_the_guard_is_refused():
+    """The floor's normal given pointing down: the ball 'leaves' it as y falls through 0."""
+    from lagrangian.model.examples import example_text
+    from lagrangian.model.reader import parse_model
+
+    text = example_text("bouncing_ball").replace("normal = [0, 1]", "normal = [0, -1]")
+    with pytest.raises(InputError, match="leaves the surface") as caught:
+        lagrangian.System(parse_model(text)).simulate(1.0, samples=11)
+    assert "\n" not in str(caught.value)

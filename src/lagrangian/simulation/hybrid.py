@@ -45,6 +45,7 @@ RATIO_AGREEMENT = 1e-3
 ACCUMULATION_TIME = 1e-9  # s
 # ... or when an interval is below this (times max(1, t)): no longer resolved in time.
 SHORTEST_INTERVAL = 1e-13
+APPROACH_TOLERANCE = 1e-9  # a normal velocity before the impact above this (relative) leaves
 ON_GUARD = 1e-9  # |g| below which a piece starts on a guard (just after its impact)
 
 
@@ -120,6 +121,12 @@ class CompiledImpact:
             self._geometry(q, t)
         M, J, E, P, n, R, DR = self.matrices(q, v, t)
         ve = np.concatenate([np.zeros(self.k), v])
+        approach = float(n[:, 0] @ P @ ve)  # the point's normal velocity before (m/s)
+        if approach > APPROACH_TOLERANCE * max(1.0, float(np.max(np.abs(P @ ve)))):
+            raise InputError(f"impact '{self.name}' at t = {t:.12g} s: its guard falls through 0 "
+                             f"while the striking point leaves the surface (normal velocity "
+                             f"{approach:.6g} m/s): the guard, the point or the normal disagree",
+                             field="impacts")
         solution = solve_impact(M, J, E, ve, f"impact '{self.name}' at t = {t:.12g} s")
         after = solution[:self.size]
         impulse_rows = solution[self.size:]

@@ -60,6 +60,9 @@ def figure_png(figure, dpi: float = 100) -> bytes:
     return buffer.getvalue()
 
 
+MARKED_IMPACTS = 200  # impacts marked on the time histories (an accumulation has many more)
+
+
 def time_history_figure(result: SimulationResult, units: dict[str, str] | None = None):
     """A matplotlib Figure: coordinates (one panel per unit), energy T + V, multipliers.
 
@@ -109,6 +112,9 @@ def time_history_figure(result: SimulationResult, units: dict[str, str] | None =
             ax.plot(result.t, result.multipliers[:, i], label=plain_text(f"lambda_{name}"))
         ax.set_ylabel("multiplier")
         _legend_outside(ax)
+    for record in getattr(result, "impacts", ())[:MARKED_IMPACTS]:  # a run through impacts
+        for ax in axes:
+            ax.axvline(record.time, color="0.75", linewidth=0.6, linestyle=":", zorder=0)
     axes[-1].set_xlabel("t (s)")
     status = "" if result.completed else f" ({result.status})"
     figure.suptitle(plain_text(f"{result.model_name}{status}"))

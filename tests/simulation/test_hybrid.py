@@ -132,3 +132,15 @@ def test_a_normal_that_disagrees_with_the_guard_is_refused():
     with pytest.raises(InputError, match="leaves the surface") as caught:
         lagrangian.System(parse_model(text)).simulate(1.0, samples=11)
     assert "\n" not in str(caught.value)
+
+
+def test_a_walkers_pivot_moves_on_by_each_step():
+    """The compass gait's released stance foot: the pivot advances by the step, 2 l sin(alpha)
+    along the slope, at each heel strike (the animation draws the walker there)."""
+    run = lagrangian.load("compass_gait").simulate(1.6, samples=9)
+    steps = [record for record in run.impacts]
+    assert len(steps) == 2
+    alpha = abs(steps[0].before["theta_st"])
+    after = run.pivot_offsets[run.t > steps[1].time]
+    assert after[:, 0] == pytest.approx(2 * 2 * 1.0 * math.sin(alpha), rel=1e-6)
+    assert np.all(run.pivot_offsets[run.t < steps[0].time] == 0)

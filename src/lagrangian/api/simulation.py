@@ -19,12 +19,13 @@ class Simulation(SimulationResult):
     # accumulate (s); () and None for other runs
     impacts: tuple = ()
     accumulation_time: float | None = None
+    pivot_offsets = None  # (N, d) m: where a walker's pivot is at each sample
 
     @classmethod
     def of(cls, result: SimulationResult) -> Simulation:
         """The same run (the same arrays, not copied) with the methods that show it."""
         run = cls(**{f.name: getattr(result, f.name) for f in fields(SimulationResult)})
-        for name in ("impacts", "accumulation_time"):  # a HybridResult's
+        for name in ("impacts", "accumulation_time", "pivot_offsets"):  # a HybridResult's
             if hasattr(result, name):
                 object.__setattr__(run, name, getattr(result, name))
         return run

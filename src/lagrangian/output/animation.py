@@ -121,8 +121,11 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
                          for i in range(result.q.shape[1])])
     figure = animation_figure(size)
     ax = figure.add_subplot()
+    offsets = getattr(result, "pivot_offsets", None)  # a walker: where its pivot is by now
+    shift = None if offsets is None else offsets[np.clip(
+        np.searchsorted(result.t, times, side="right") - 1, 0, len(result.t) - 1)]
     panel = mechanism_panel(ax, geometry, q, v, times, view=view, trail=max(1, int(fps)),
-                            title=plain_text(result.model_name))
+                            title=plain_text(result.model_name), shift=shift)
     clock = _clock(ax)
 
     def draw(k):
@@ -178,12 +181,15 @@ class Panel(NamedTuple):
 
 def mechanism_panel(ax, geometry: Mechanism, q: np.ndarray, v: np.ndarray, times: np.ndarray, *,
                     view: tuple[float, float] = ISOMETRIC_VIEW, trail: int = 25, title: str = "",
-                    show_axes: bool = True) -> Panel:
+                    show_axes: bool = True, shift: np.ndarray | None = None) -> Panel:
     """Draw the mechanism at states q, v (k, n) on ``ax`` (equal scales; a non-square panel
-    gets a square drawing in its middle); each particle leaves a trail of ``trail`` frames."""
+    gets a square drawing in its middle); each particle leaves a trail of ``trail`` frames.
+    ``shift`` (k, 2) moves each frame's drawing (a walker's pivot, m)."""
     if geometry.rigid_body_names:
         return _space_panel(ax, geometry, times, q, v, view, title)
     frame = geometry.frame(q, v, times)
+    if shift is not None:
+        frame = _shifted(frame, np.asarray(shift, dtype=float)[:, :2])
     particles, bars, springs, dampers = frame.particles, frame.bars, frame.springs, frame.dampers
     rolling = {j: (radius, np.array(normal)) for j, radius, normal in geometry.rolling}
     # A rolling body's reach is its wheel, not its bar of the same inertia.
@@ -295,6 +301,18 @@ def mechanism_panel(ax, geometry: Mechanism, q: np.ndarray, v: np.ndarray, times
                 *wheel_lines.values(), *blocks, *trails, dots, pivot_marks, hinges]
 
     return Panel(draw, frame)
+
+
+def _shifted(frame, shift: np.ndarray):
+    """Every position of a Frame moved by shift (k, 2) m."""
+    def moved(points, depth):
+        if points is None:
+            return None
+        return points + shift.reshape((len(shift),) + (1,) * depth + (2,))
+
+    return frame._replace(particles=moved(frame.particles, 1), bars=moved(frame.bars, 2),
+                          springs=moved(frame.springs, 2), dampers=moved(frame.dampers, 2),
+                          rods=moved(frame.rods, 2), pivots=moved(frame.pivots, 1))
 
 
 def _clock(ax):

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import sympy as sp
@@ -76,6 +76,9 @@ class HybridResult(SimulationResult):
 
     impacts: tuple[ImpactRecord, ...] = field(default=())
     accumulation_time: float | None = None
+    # where the model's pivot is at each sample (N, 2 or 3; m, the model's axes): the released
+    # pivots' striking points added up (a walker's way down its slope); None without release
+    pivot_offsets: np.ndarray | None = None
 
 
 class CompiledImpact:
@@ -95,6 +98,8 @@ class CompiledImpact:
                         m.point_velocity.shape, m.normal.shape, m.relabelled.shape,
                         m.relabel_jacobian.shape]
         self._parts = StateFunction(model, parts, substitution)
+        d = m.normal.shape[0]
+        self._point = StateFunction(model, list(m.impact.point[:d]), substitution)
         e = float(sp.sympify(m.impact.restitution).xreplace(substitution))
         if not 0 <= e <= 1:
             raise InputError(f"impact '{self.name}': the restitution is {e:g}, outside [0, 1]",
@@ -105,6 +110,10 @@ class CompiledImpact:
         self.restitution = e
         relabels = bool(m.impact.relabel) or bool(m.extension)
         self._geometry = RelabelCheck(model, m, substitution) if relabels else None
+
+    def striking_point(self, q, t) -> np.ndarray:
+        """r(q) of the striking point (m, the model's axes)."""
+        return self._point.at(q, np.zeros(len(q)), t)
 
     def matrices(self, q, v, t):
         """M, J, E, the point's velocity rows P, n, R(q), dR/dq at one state."""
@@ -265,6 +274,7 @@ def simulate_through_impacts(
     t0, y = float(start.t), np.concatenate([start.q_array(), start.q_dot_array()])
     ts, ys, records = [], [], []
     spent, lost_so_far = [], 0.0  # T + V's drops at the impacts before each piece (J)
+    pivots, pivot = [], None  # where the pivot is in each piece (m), None while none released
     times: dict[str, list[float]] = {}
     steps = nfev = 0
     status, message, limit_time = "finished", STATUS_MESSAGES["finished"], None
@@ -282,6 +292,7 @@ def simulate_through_impacts(
         ts.append(run.t)
         ys.append(run.y)
         spent.append(lost_so_far)
+        pivots.append(pivot)
         if run.status != "stopped":
             status, message = run.status, run.message
             break
@@ -293,6 +304,9 @@ def simulate_through_impacts(
         ys[-1] = np.concatenate([run.y[:kept], [y_hit]])
         impact = impacts[which]
         q_new, v_new, impulse, lost, residual, _, _ = impact.apply(y_hit[:n], y_hit[n:], t_hit)
+        if impact.k:  # the striking point is the new pivot
+            here = impact.striking_point(y_hit[:n], t_hit)
+            pivot = here if pivot is None else pivot + here
         y = np.concatenate([q_new, v_new])
         # T + V's drop across the impact: the kinetic energy lost, and where the pivot moved
         # (a walker's new stance foot) the potential's new reference
@@ -325,12 +339,14 @@ def simulate_through_impacts(
                     ts.append(np.concatenate([[limit_time], later]))
                     ys.append(np.tile(y, (len(later) + 1, 1)))
                     spent.append(lost_so_far)
+                    pivots.append(pivot)
                 else:
                     message += "; not settled: it still moves along the surface"
             if status == ACCUMULATED:  # the run ends on the state just after the last impact
                 ts.append(np.array([t_hit]))
                 ys.append(y[None, :])
                 spent.append(lost_so_far)
+                pivots.append(pivot)
             break
         if len(records) >= max_impacts:
             status = IMPACT_LIMIT
@@ -339,18 +355,26 @@ def simulate_through_impacts(
             ts.append(np.array([t_hit]))
             ys.append(y[None, :])
             spent.append(lost_so_far)
+            pivots.append(pivot)
             break
         if t_hit >= t_end:
             ts.append(np.array([t_hit]))
             ys.append(y[None, :])
             spent.append(lost_so_far)
+            pivots.append(pivot)
             break
     wall = time.perf_counter() - began
     losses = np.concatenate([np.full(len(piece), lost) for piece, lost in zip(ts, spent,
                                                                              strict=True)])
-    return _result(eom, functions, substitution, np.concatenate(ts), np.concatenate(ys),
-                   step_control, status, message, steps, nfev, wall, t_end, records, limit_time,
-                   losses)
+    offsets = None
+    if any(p is not None for p in pivots):
+        d = len(next(p for p in pivots if p is not None))
+        offsets = np.concatenate([np.tile(np.zeros(d) if p is None else p, (len(piece), 1))
+                                  for piece, p in zip(ts, pivots, strict=True)])
+    result = _result(eom, functions, substitution, np.concatenate(ts), np.concatenate(ys),
+                     step_control, status, message, steps, nfev, wall, t_end, records,
+                     limit_time, losses)
+    return replace(result, pivot_offsets=offsets)
 
 
 def accumulation(history: list[float]) -> float | None:

@@ -118,6 +118,9 @@ def _mode_animations(c, analysis) -> Markup:
                       "mode is shown as its coordinates moving, each on its own track."), gallery])
 
 
+REPORTED_IMPACTS = 10  # impacts listed on the page
+
+
 def simulation_section(c, t_end: float) -> tuple[Markup, str]:
     from ..output.plots import time_history_figure
 
@@ -128,6 +131,14 @@ def simulation_section(c, t_end: float) -> tuple[Markup, str]:
     figure = time_history_figure(simulation, _units(c))
     parts.append(element("figure", image(data_uri(figure_png(figure), "image/png"),
                                          "the coordinates and the energy over time")))
+    if simulation.impacts:  # a run through the model's impacts: the first ones, by number
+        shown = simulation.impacts[:REPORTED_IMPACTS]
+        parts.append(table(["t (s)", "impact", "impulse (N s)", "kinetic energy lost (J)"],
+                           [(number(r.time), r.name, ", ".join(number(x) for x in r.impulse),
+                             number(r.energy_lost)) for r in shown]))
+        more = len(simulation.impacts) - len(shown)
+        if more:
+            parts.append(note(f"... and {more} more impacts (simulate --json lists them)."))
     if c.model.particles or c.model.bodies or c.model.rigid_bodies:
         gif = simulation_gif(simulation, size=c.size, fps=c.fps)
         parts.append(element("figure", image(data_uri(gif, "image/gif"), "the simulated motion",

@@ -17,7 +17,8 @@ def optimize(system: System, inputs: Sequence[str], t_final: float, nodes: int =
     """The trajectory from ``start`` (the model's initial state where not given) to ``goal``
     (the named states at ``t_final`` s) that minimises the effort, the integral of |u|^2 dt,
     with u the named ``inputs`` (loads, parameters or coordinates, as in ``linearize``) within
-    ``bounds`` {name: (lower, upper)} (SI); direct collocation on ``nodes`` points,
+    ``bounds`` {name: (lower, upper)} (SI; a robot's joint position limits are bounds too
+    unless ``bounds`` names the joint); direct collocation on ``nodes`` points,
     ``method`` "trapezoidal" or "hermite-simpson", solved by IPOPT through CasADi (extra
     [casadi]). Replay it with ``system.simulate(t_final, initial=trajectory.initial_state(),
     controller=trajectory.controller())``: docs/bridges.md."""
@@ -27,9 +28,10 @@ def optimize(system: System, inputs: Sequence[str], t_final: float, nodes: int =
     if isinstance(inputs, str):
         inputs = [inputs]
     functions = system.to_casadi(inputs=inputs, parameters=parameters)
+    limits = {name: span for name, span in system.joint_limits.items() if name not in inputs}
     return collocate(functions, system.model, t_final, nodes, start=start, goal=goal,
-                     bounds=bounds, objective=objective, method=method, tolerance=tolerance,
-                     max_iterations=max_iterations)
+                     bounds={**limits, **dict(bounds or {})}, objective=objective,
+                     method=method, tolerance=tolerance, max_iterations=max_iterations)
 
 
 __all__ = ["Trajectory", "optimize"]

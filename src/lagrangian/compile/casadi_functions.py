@@ -131,6 +131,8 @@ class CasadiFunctions:
     mass_matrix: object
     forcing: object
     constraints: object | None
+    # per input, the coordinate whose generalized force it is (its index), None for a load
+    input_coordinates: tuple[int | None, ...] = ()
 
     @property
     def states(self) -> tuple[str, ...]:
@@ -206,7 +208,8 @@ def casadi_functions(eom: EquationsOfMotion, inputs: Sequence[str] = (),
         rhs=ca.Function("rhs", [x, u], [ca.vertcat(v, q_ddot)], ["x", "u"], ["x_dot"]),
         mass_matrix=ca.Function("mass_matrix", [q], [mass], ["q"], ["M"]),
         forcing=ca.Function("forcing", [q, v, u], [forcing], ["q", "q_dot", "u"], ["f"]),
-        constraints=constraints)
+        constraints=constraints,
+        input_coordinates=tuple(names.index(k) if k in names else None for k in inputs))
 
 
 def _free(eom: EquationsOfMotion) -> set:

@@ -44,6 +44,8 @@ class Trajectory:
     defects: dict[str, float]
     iterations: int
     midpoint_inputs: np.ndarray = field(repr=False, default_factory=lambda: np.zeros((0, 0)))
+    # per input, the coordinate whose generalized force it is (index), None for a load
+    input_coordinates: tuple[int | None, ...] = field(repr=False, default=())
 
     def input_at(self, t: float) -> np.ndarray:
         """u(t) as the collocation scheme represents it: piecewise linear (trapezoidal) or
@@ -63,8 +65,19 @@ class Trajectory:
 
     def controller(self):
         """u(t) as an open-loop controller (t, q, q_dot) -> u with its ``inputs``, for
-        ``System.simulate(t_final, initial=..., controller=trajectory.controller())``."""
+        ``System.simulate(t_final, initial=..., controller=trajectory.controller())``; inputs
+        that are all coordinates give the n generalized forces (0 on the others)."""
         trajectory = self
+        n = len(self.states) // 2
+        rows = list(self.input_coordinates)
+        if rows and all(row is not None for row in rows):  # generalized forces: B = I
+
+            def forces(t, q, q_dot):
+                tau = np.zeros(n)
+                tau[rows] = trajectory.input_at(t)
+                return tau
+
+            return forces
 
         def open_loop(t, q, q_dot):
             return trajectory.input_at(t)
@@ -184,7 +197,8 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
         inputs={name: u[k].copy() for k, name in enumerate(functions.inputs)},
         defects={"collocation": residual, "final_state": final, "constraints": violation,
                  "replay": 0.0},
-        iterations=int(stats.get("iter_count", 0)), midpoint_inputs=um)
+        iterations=int(stats.get("iter_count", 0)), midpoint_inputs=um,
+        input_coordinates=functions.input_coordinates)
     trajectory.defects["replay"] = _replay_error(functions, trajectory, x)
     return trajectory
 

@@ -148,7 +148,7 @@ def test_mjcf_written_by_mujoco_from_a_urdf(name, tmp_path):
 REFUSALS = [
     ('<body><joint type="ball"/><geom size="0.1"/></body>', "a ball joint is not supported"),
     ('<body><freejoint/><geom size="0.1"/></body>', "a free joint is not supported"),
-    ('<body><joint armature="0.1"/><geom size="0.1"/></body>', "armature other than 0"),
+    ('<body><joint armature="0.1"/><geom size="0.1"/></body>', "armature is not kept"),
     ('<body><joint ref="10"/><geom size="0.1"/></body>', "ref other than 0"),
     ('<body><joint stiffness="3"/><geom size="0.1"/></body>', "stiffness other than 0"),
     ('<body><joint type="spin"/><geom size="0.1"/></body>', "unknown joint type 'spin'"),
@@ -189,3 +189,23 @@ def test_unsupported_or_bad_documents_refused_in_one_line(document, message, tmp
     with pytest.raises(ModelError, match=message) as caught:
         lagrangian.load(path)
     assert str(caught.value).startswith(str(path)) and "\n" not in str(caught.value)
+
+
+def test_armature_refused_then_given_to_dynamics_agrees_with_mujoco(arm, tmp_path):
+    """MuJoCo's armature adds to M's diagonal: refused in the file (the model keeps none),
+    and the same numbers given to System.dynamics(armature=...) match MuJoCo's M and qacc."""
+    system, _ = arm
+    armed = ARM.replace('name="j1" type="hinge"', 'name="j1" armature="0.2" type="hinge"') \
+        .replace('name="s" type="slide"', 'name="s" armature="0.05" type="slide"')
+    path = tmp_path / "armed.xml"
+    path.write_text(armed)
+    with pytest.raises(ModelError, match=r"armature=\{'j1': 0.2\}") as caught:
+        lagrangian.load(path)
+    assert "body 'base'.joint 'j1'.armature" in str(caught.value)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    dynamics = system.dynamics(backend="numpy", actuators=True,
+                               armature={"j1": 0.2, "s": 0.05})
+    for q, v, tau in states(model.nq, 2):
+        M, _, qacc, inverse, _ = mujoco_terms(model, q, v, tau)
+        assert np.allclose(dynamics.mass_matrix(q), M, rtol=0, atol=1e-9)
+        assert np.allclose(dynamics.forward_dynamics(q, v, tau), qacc, rtol=0, atol=1e-9)

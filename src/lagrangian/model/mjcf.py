@@ -348,7 +348,12 @@ class _Reader:
         if kind not in JOINT_KINDS:
             raise self.error(f"unknown joint type {kind!r} (hinge, slide, ball or free)"
                              f"{did_you_mean(kind, JOINT_KINDS)}", f"{field}.type")
-        for key in ("ref", "stiffness", "armature", "springref"):
+        armature = self.numbers(attrs.get("armature", "0"), 1, f"{field}.armature")[0]
+        if armature != 0:  # the model keeps no armature: a load would drop it from M
+            raise self.error(f"armature is not kept in the model (yet): remove it and give "
+                             f"System.dynamics(armature={{'{name}': {armature:g}}})",
+                             f"{field}.armature")
+        for key in ("ref", "stiffness", "springref"):
             if float(self.numbers(attrs.get(key, "0"), 1, f"{field}.{key}")[0]) != 0:
                 raise self.error(f"{key} other than 0 is not supported (yet)", f"{field}.{key}")
         if attrs.get("springdamper"):

@@ -156,3 +156,13 @@ def test_the_compass_gaits_multipliers_agree_with_goswamis_map(gait):
     for ours, theirs in zip(gait.multipliers, nontrivial, strict=True):
         assert abs(ours - theirs) < 1e-5 or abs(ours - np.conj(theirs)) < 1e-5
     assert gait.stable and len(gait.multipliers) == 3
+
+
+def test_a_driven_model_has_no_autonomous_cycle():
+    from lagrangian.model.examples import example_text
+    from lagrangian.model.reader import parse_model
+
+    text = example_text("rimless_wheel").replace(
+        '[[impacts]]', '[generalized_forces]\ntheta = "0.1*sin(t)"\n\n[[impacts]]')
+    with pytest.raises(InputError, match="explicit time"):
+        lagrangian.System(parse_model(text)).limit_cycle()

@@ -108,6 +108,11 @@ class PoincareMap:
                 any(model.time in i.guard.free_symbols for i in model.impacts):
             raise InputError("a limit cycle needs guards without explicit time t",
                              field="impacts")
+        if any(model.time in sp.sympify(part).free_symbols  # safe: sympy objects, no text
+               for part in (eom.mass_matrix, eom.forcing)):
+            raise InputError("a limit cycle needs equations without explicit time t (a driven "
+                             "model's period is its drive's, not a return to an impact)",
+                             field="impacts")
         self.model, self.functions, self.steps = model, functions, step_control
         self.impacts, self.guards = compiled_impacts(eom, substitution, maps)
         self.flow = FlowSensitivity(eom, substitution)

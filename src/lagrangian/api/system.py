@@ -191,7 +191,7 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         rtol: float = 1e-9,
         atol: float = 1e-9,
         samples: int = 1001,
-        limits: bool = True,
+        limits: bool | str = True,
         controller=None,
         inputs: Sequence[str] | None = None,
         max_impacts: int | None = None,
@@ -206,7 +206,9 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         condition such as "theta < 0" (or a StopCondition) that ends the run. Constrained models
         are kept on Phi = 0 by projection (see docs/simulation.md). A robot read from URDF
         stops with status 'limit' when a joint reaches its position limit, naming it
-        (``limits=False`` ignores them); velocity and effort limits exceeded are reported
+        (``limits=False`` ignores them; a start beyond one is refused, or with
+        ``limits="clamp"`` started at the limit, with ``limits=False`` where it is, a warning
+        in the result's message either way); velocity and effort limits exceeded are reported
         either way (``summary()["limits_exceeded"]``). ``controller`` (t, q, q_dot) -> u adds
         generalized forces, or B u for named ``inputs`` (its own ``inputs`` where it has them,
         as lagrangian.control's controllers do), to the model's own; "model" runs the file's
@@ -216,6 +218,15 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         [[impacts]] runs through them (``.impacts`` lists each; status 'accumulated' where they
         accumulate, 'settled' with ``settle=True``, 'impact_limit' at ``max_impacts``, default
         1000): docs/simulation.md."""
+        # a start beyond a position limit: refused, clamped to it, or run from where it is
+        start_beyond = {True: "refuse", "clamp": "clamp", False: "ignore"}.get(limits) \
+            if isinstance(limits, bool | str) else None
+        if start_beyond is None:
+            raise InputError(f"limits is True, False or 'clamp', not {limits!r}", field="limits")
+        if start_beyond == "clamp" and self._floating:
+            raise InputError("a floating base's start is not clamped (yet): start it inside, "
+                             "or run with limits=False", field="limits")
+        limits = limits is not False
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
         if tree and self._floating:  # q (+) v dt on SE(3): simulation/floating.py
             from ..simulation.floating import simulate_floating
@@ -242,7 +253,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
                           progress=progress, functions=None if law else self._numeric,
                           limits=urdf_limits(self._model, positions=limits), controller=controller,
                           inputs=getattr(controller, "inputs", ()) if inputs is None else inputs,
-                          model=self._model)
+                          model=self._model, start_beyond=start_beyond,
+                          start_limits=urdf_limits(self._model))
         return Simulation.of(result)
 
     @property

@@ -48,7 +48,8 @@ def simulate(
     size: Annotated[str | None, typer.Option("--size", help=SIZE_HELP)] = None,
     fps: Annotated[int | None, typer.Option("--fps", help=FPS_HELP + " Default 20.")] = None,
     stop_when: Annotated[str | None, typer.Option("--stop-when", help="Stop when a condition turns true, e.g. \"theta < 0\".")] = None,  # noqa: E501
-    ignore_limits: Annotated[bool, typer.Option("--ignore-limits", help="URDF: run through the joints' position limits (by default a joint reaching one ends the run, status 'limit').")] = False,  # noqa: E501
+    ignore_limits: Annotated[bool, typer.Option("--ignore-limits", help="URDF: run through the joints' position limits (by default a joint reaching one ends the run, status 'limit', and a start beyond one is refused); a start beyond one is warned.")] = False,  # noqa: E501
+    clamp_start: Annotated[bool, typer.Option("--clamp-start", help="URDF: a start beyond a joint's position limit starts at the limit (with a warning) instead of being refused.")] = False,  # noqa: E501
     control: Annotated[str | None, typer.Option("--control", help="Close the loop: lqr (about --about, inputs --inputs, weights --Q, --R), computed-torque (to the configuration --about, gains --kp, --kd), or model (the model file's own [control] laws, compiled with its equations).")] = None,  # noqa: E501
     about: Annotated[list[str], typer.Option("--about", help="--control: the equilibrium (lqr) or target (computed-torque), NAME=VALUE; others solved for or at their initial values.")] = [],  # noqa: B006,E501
     control_inputs: Annotated[list[str], typer.Option("--inputs", help="--control lqr: the loads, parameters or coordinates it drives (F); repeat, or separate by commas.")] = [],  # noqa: B006,E501
@@ -121,12 +122,16 @@ def simulate(
     if animate is not None:  # free, or an animation this project wrote: never another file
         check_animation_target(animate)
     controller = _controller(system, control, about, control_inputs, q_weight, r_weight, kp, kd)
+    if clamp_start and ignore_limits:
+        raise InputError("clamps a start to the limits that --ignore-limits ignores; give one",
+                         field="--clamp-start")
+    limits = "clamp" if clamp_start else not ignore_limits
 
     with _Progress(end) as progress:
         simulation = system.simulate(
             end, initial=start, method=step_control.method,
             rtol=step_control.rtol, atol=step_control.atol, samples=save_at.samples,
-            stop_when=stop, progress=progress.update, limits=not ignore_limits,
+            stop_when=stop, progress=progress.update, limits=limits,
             controller=controller, **_impact_options(system, max_impacts, settle),
         )
     warning = projection_warning(simulation)

@@ -35,8 +35,8 @@ from .options import METHODS, SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["METHODS", "STATUS_MESSAGES", "JointLimit", "SaveAt", "SimulationResult", "StepControl",
-           "StopCondition", "at_limit", "beyond_limits", "check_start_within", "exceeded_limits", "model_law",
-           "parse_stop_condition", "simulate", "urdf_limits"]
+           "START_LIMITS", "StopCondition", "at_limit", "beyond_limits", "check_start_within",
+           "exceeded_limits", "model_law", "parse_stop_condition", "simulate", "urdf_limits"]
 
 DEFAULT_STEP_CONTROL = StepControl()  # DOP853, rtol = atol = 1e-9
 DEFAULT_SAVE_AT = SaveAt()  # 1001 evenly spaced samples
@@ -58,6 +58,8 @@ def simulate(
     controller: Controller | str | None = None,
     inputs: Sequence[str] = (),
     model: Model | None = None,
+    start_beyond: str = "refuse",
+    start_limits: Sequence[JointLimit] | None = None,
 ) -> SimulationResult:
     """Integrate from the initial state to ``t_end`` (s), saving where ``save_at`` says.
 
@@ -71,6 +73,9 @@ def simulate(
     (t, q, q_dot) -> u adds generalized forces (or, with ``inputs``, B u: simulation/control.py)
     to the model's own, in the scipy loop; ``controller="model"`` closes the loop with the
     model's own [control] laws instead, compiled with the equations (simulation/control_law.py).
+    A start beyond a position limit (``start_limits``, default the position ``limits``) is
+    refused, or with ``start_beyond`` "clamp" started at the limit, "ignore" where it is, each
+    noted in the result's message (check_start_within).
 
     ``eom`` None: the run of a kinematic tree's recursive algorithms (``functions``, of
     ``model``), with nothing derived: no constraints, no explicit t, T quadratic in q_dot, and
@@ -105,13 +110,16 @@ def simulate(
     drift = DriftControl(functions, StateFunction(model, eom.velocity_bias, substitution)) \
         if functions.m else None
     event = _event(StateFunction(model, [stop.function], substitution)) if stop else None
-    beyond = beyond_limits(limits) if limits else None
     positioned = [m for m in limits if m.lower is not None and m.upper is not None]
     forces = eom.generalized_forces if eom is not None else _tree_forces(model)
     power_terms = StateFunction(model, forces, substitution)
 
     q0, v0, projected = start.q_array(), start.q_dot_array(), {}
-    check_start_within(positioned, q0)
+    q0, beyond_at_start = check_start_within(positioned if start_limits is None else start_limits,
+                                             q0, start_beyond)
+    if beyond_at_start:  # clamped (or ignored): the start as it was used
+        start = replace(start, q=tuple(float(x) for x in q0))
+    beyond = beyond_limits(limits, q0) if limits else None
     if drift is not None:
         q0, v0, projected = _project_start(drift, start)
 
@@ -130,6 +138,8 @@ def simulate(
     wall = time.perf_counter() - began
     if run.status == RunStatus.FAILED:
         run = replace(run, message=_explain_failure(functions, run))
+    if beyond_at_start:
+        run = replace(run, message=f"{run.message}; warning: {beyond_at_start}")
     if run.status == RunStatus.FAILED and model.rigid_bodies:  # an Euler-angle singularity, named
         where = {**substitution, **dict(zip(model.q, run.y[-1][:functions.n], strict=True))}
         lock = gimbal_lock(model.rigid_bodies, where)
@@ -302,35 +312,61 @@ def exceeded_limits(limits: Sequence[JointLimit], parameters: Mapping[str, float
     return tuple(out)
 
 
-def check_start_within(limits: Sequence[JointLimit], q: np.ndarray) -> None:
-    """Refuse, in one line, a start beyond a joint's position limit (the event fires only on a
-    crossing, so such a run went on without a word): the joint, its value and its limit."""
+START_LIMITS = ("refuse", "clamp", "ignore")
+# A joint that starts on its limit (a clamped start, the Panda's finger at 0) counts as beyond
+# it once past by this much, relative to 1 + |limit|: at 0 it would mask every other joint.
+_ON_LIMIT = 1e-9
+
+
+def check_start_within(limits: Sequence[JointLimit], q: np.ndarray, start: str = "refuse"
+                       ) -> tuple[np.ndarray, str]:
+    """A start beyond a joint's position limit (the event fires only on a crossing, so such a
+    run went on without a word): refused in one line naming the joint, its value and its limit
+    (``start`` "refuse"), or started at the limit ("clamp") or where it is ("ignore"), with a
+    note for the result's message (empty where every joint starts inside). Returns (q, note)."""
+    if start not in START_LIMITS:
+        raise InputError(f"unknown start {start!r}: refuse, clamp or ignore", field="limits")
+    q, notes = np.array(q, dtype=float), []
     for limit in limits:
         if limit.lower is None or limit.upper is None:
             continue
         x = float(q[limit.coordinate])
-        if not limit.lower <= x <= limit.upper:
-            side, bound = ("below", limit.lower) if x < limit.lower else ("above", limit.upper)
-            raise InputError(
-                f"joint '{limit.joint}' ({limit.name}) starts at {x:.6g}, {side} its position "
-                f"limit {bound:.6g} (range {limit.lower:.6g} to {limit.upper:.6g}); start it "
-                "inside, or run with the position limits ignored",
-                field="initial")
+        if limit.lower <= x <= limit.upper:
+            continue
+        side, bound = ("below", limit.lower) if x < limit.lower else ("above", limit.upper)
+        where = (f"joint '{limit.joint}' ({limit.name}) starts at {x:.6g}, {side} its position "
+                 f"limit {bound:.6g} (range {limit.lower:.6g} to {limit.upper:.6g})")
+        if start == "refuse":
+            raise InputError(f"{where}; start it inside, clamp it to the limit or run with the "
+                             "position limits ignored", field="initial")
+        if start == "clamp":  # on the limit: the event sees it leave (beyond_limits)
+            q[limit.coordinate] = bound
+            notes.append(f"{where} {limit.unit}: clamped to the limit")
+        else:
+            notes.append(f"{where} {limit.unit}: started there, the limits ignored")
+    return q, "; ".join(notes)
 
 
-def beyond_limits(limits: Sequence[JointLimit]):
+def beyond_limits(limits: Sequence[JointLimit], q0: np.ndarray | None = None):
     """h(q) = the largest distance beyond a position limit (< 0 while every joint is inside):
-    the event turns true when a joint reaches its limit; None without position limits."""
+    the event turns true when a joint reaches its limit; None without position limits. A joint
+    that starts on a limit (in ``q0``) turns it true once past it by _ON_LIMIT (relative): at 0
+    from the start, h would hide every other joint's crossing."""
     limits = [limit for limit in limits if limit.lower is not None and limit.upper is not None]
     if not limits:
         return None
     index = np.array([limit.coordinate for limit in limits])
     lower = np.array([limit.lower for limit in limits])
     upper = np.array([limit.upper for limit in limits])
+    low_margin, high_margin = np.zeros(len(limits)), np.zeros(len(limits))
+    if q0 is not None:
+        x0 = np.asarray(q0, dtype=float)[index]
+        low_margin = np.where(x0 <= lower, _ON_LIMIT * (1 + np.abs(lower)), 0.0)
+        high_margin = np.where(x0 >= upper, _ON_LIMIT * (1 + np.abs(upper)), 0.0)
 
     def beyond(q, v, t) -> float:
         x = np.asarray(q, dtype=float)[index]
-        return float(np.max(np.maximum(lower - x, x - upper)))
+        return float(np.max(np.maximum(lower - x - low_margin, x - upper - high_margin)))
 
     return beyond
 

@@ -17,6 +17,7 @@ from ..errors import InputError, ModelError
 from ..model.checked import unknown_name
 from ..model.model import Model
 from ..model.values import resolve_state
+from ..simulation.replay import replay
 
 METHODS = ("trapezoidal", "hermite-simpson")
 OBJECTIVES = ("effort",)
@@ -222,19 +223,8 @@ def _rows(k: int, n2: int, nodes, middle) -> list:
 def _replay_error(functions: CasadiFunctions, trajectory: Trajectory, x: np.ndarray) -> float:
     """The largest state difference at the nodes between the collocated trajectory and u(t)
     integrated accurately (DOP853, rtol 1e-10) from the same start: the discretisation error."""
-    from scipy.integrate import solve_ivp
-
-    rhs = functions.rhs
-
-    def f(t, y):
-        return np.asarray(rhs(y, trajectory.input_at(t))).ravel()
-
-    t = trajectory.t
-    run = solve_ivp(f, (t[0], t[-1]), x[:, 0], method="DOP853", t_eval=t, rtol=1e-10,
-                    atol=1e-10, max_step=(t[1] - t[0]) / 2)  # u(t) has kinks at the nodes
-    if not run.success or run.y.shape[1] != len(t):
-        return float("inf")
-    return float(np.max(np.abs(run.y - x)))
+    states = replay(functions.rhs, trajectory.input_at, trajectory.t, x[:, 0])
+    return float("inf") if states is None else float(np.max(np.abs(states - x)))
 
 
 def _choice(value: str, allowed: Sequence[str], name: str) -> str:

@@ -1,5 +1,6 @@
-"""System.to_fmu / `lagrangian export --fmu`: an FMI 2.0 Model Exchange FMU that passes fmpy's
-validation, and whose simulation by fmpy matches closed forms and our own simulate."""
+"""System.to_fmu / `lagrangian export --fmu`: an FMI 2.0 FMU (Model Exchange and Co-Simulation)
+that passes fmpy's validation, and whose simulation by fmpy matches closed forms and our own
+simulate."""
 
 from __future__ import annotations
 
@@ -32,6 +33,7 @@ def test_the_fmu_passes_fmpys_validation(pendulum_fmu):
     assert validate_fmu(str(path)) == []
     description = read_model_description(str(path))
     assert description.fmiVersion == "2.0" and description.modelExchange is not None
+    assert description.coSimulation is not None
     kinds = {v.name: (v.causality, v.variability) for v in description.modelVariables}
     assert kinds["theta"] == ("output", "continuous")
     assert kinds["theta_dot"] == ("output", "continuous")
@@ -39,10 +41,12 @@ def test_the_fmu_passes_fmpys_validation(pendulum_fmu):
     assert kinds["Q_theta"] == ("input", "continuous")
 
 
-def test_fmpy_matches_our_simulate(pendulum_fmu):
+@pytest.mark.parametrize("kind", ["ModelExchange", "CoSimulation"])
+def test_fmpy_matches_our_simulate(pendulum_fmu, kind):
+    """fmpy's CVode on the Model Exchange FMU, and the Co-Simulation FMU's own Runge-Kutta."""
     system, path = pendulum_fmu
     result = simulate_fmu(str(path), stop_time=3.0, output_interval=0.01,
-                          relative_tolerance=1e-11)
+                          relative_tolerance=1e-11, fmi_type=kind)
     run = system.simulate(3.0, samples=301, rtol=1e-11, atol=1e-11)
     assert np.allclose(result["time"], run.t, atol=1e-12)
     assert np.abs(result["theta"] - run.q[:, 0]).max() < 1e-6

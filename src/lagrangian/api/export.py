@@ -1,4 +1,4 @@
-"""System.to_fmu: an FMI 2.0 Model Exchange FMU of a model (output/fmu.py)."""
+"""System.to_fmu: an FMI 2.0 FMU (Model Exchange and Co-Simulation) of a model (output/fmu.py)."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ from ..output.fmu import PREFIX, fmu_bytes, model_identifier, write_fmu
 
 
 def to_fmu(system, path: str | Path, parameters: Mapping[str, float] | None = None) -> Path:
-    """Write ``path`` (.fmu): FMI 2.0 Model Exchange, the generated C compiled for this
-    platform; the states q, q_dot as outputs, the parameters tunable (their values, SI, with
-    ``parameters`` overriding the model's), a generalized force Q_<coordinate> per coordinate
-    as an input. Unconstrained models whose equations do not depend on time (as System.to_c)."""
+    """Write ``path`` (.fmu): FMI 2.0 Model Exchange and Co-Simulation, the generated C compiled
+    for this platform; the states q, q_dot as outputs, the parameters tunable (their values,
+    SI, with ``parameters`` overriding the model's), a generalized force Q_<coordinate> per
+    coordinate as an input. Unconstrained models whose equations do not depend on time (as System.to_c)."""
     path = Path(path)
     if path.suffix.lower() != ".fmu":
         raise InputError(f"{path} does not end in .fmu", field="fmu")

@@ -1,5 +1,6 @@
-"""`lagrangian export MODEL --fmu out.fmu [--set k=2]`: the model as an FMI 2.0 Model Exchange
-FMU (the generated C compiled for this platform) for Modelica tools, Simulink or fmpy."""
+"""`lagrangian export MODEL --fmu out.fmu [--set k=2]`: the model as an FMI 2.0 FMU, Model
+Exchange and Co-Simulation (the generated C compiled for this platform) for Modelica tools,
+Simulink or fmpy."""
 
 from __future__ import annotations
 
@@ -11,8 +12,9 @@ import typer
 from . import app
 from .common import SET_HELP, load_system
 
-FMU_HELP = ("Write an FMI 2.0 Model Exchange FMU: states q, q_dot as outputs, the parameters "
-            "tunable, a generalized force Q_<coordinate> per coordinate as an input.")
+FMU_HELP = ("Write an FMI 2.0 FMU (Model Exchange and Co-Simulation): states q, q_dot as "
+            "outputs, the parameters tunable, a generalized force Q_<coordinate> per "
+            "coordinate as an input.")
 
 
 @app.command()
@@ -28,6 +30,7 @@ def export(
         raise lagrangian.InputError("say what to export: --fmu out.fmu", field="fmu")
     system = load_system(model, set_)
     written = system.to_fmu(fmu)
-    typer.echo(f"FMU (FMI 2.0 Model Exchange) of '{system.name}' written to {written}: states "
-               f"{', '.join(c.name for c in system.model.coordinates)} and their rates, "
+    typer.echo(f"FMU (FMI 2.0, Model Exchange and Co-Simulation) of '{system.name}' written "
+               f"to {written}: states {', '.join(c.name for c in system.model.coordinates)} "
+               "and their rates, "
                f"{len(system.parameters)} tunable parameters")

@@ -1,5 +1,6 @@
-"""An FMI 2.0 Model Exchange FMU of a model: the standalone C of its dynamics (System.to_c) under
-an FMI wrapper of our own, compiled for this platform, zipped with its modelDescription.xml.
+"""An FMI 2.0 FMU of a model, Model Exchange and Co-Simulation (classical Runge-Kutta, internal
+steps of at most 1 ms): the standalone C of its dynamics (System.to_c) under an FMI wrapper of
+our own, compiled for this platform, zipped with its modelDescription.xml.
 
 Variables (SI): the states q and q_dot (outputs, continuous, exact start values), their
 derivatives der(q) = q_dot and der(q_dot) = M^-1 (tau - b), the model's parameters (tunable)
@@ -96,10 +97,15 @@ def _model_description(identifier, name, description, coordinates, units, parame
     me = ElementTree.SubElement(root, "ModelExchange", {
         "modelIdentifier": identifier, "canNotUseMemoryManagementFunctions": "true",
         "canGetAndSetFMUstate": "false", "canSerializeFMUstate": "false"})
-    files = ElementTree.SubElement(me, "SourceFiles")
-    for file_name in sources:
-        if file_name.endswith(".c"):
-            ElementTree.SubElement(files, "File", {"name": file_name})
+    cs = ElementTree.SubElement(root, "CoSimulation", {
+        "modelIdentifier": identifier, "canHandleVariableCommunicationStepSize": "true",
+        "canNotUseMemoryManagementFunctions": "true", "canGetAndSetFMUstate": "false",
+        "canSerializeFMUstate": "false"})
+    for interface in (me, cs):
+        files = ElementTree.SubElement(interface, "SourceFiles")
+        for file_name in sources:
+            if file_name.endswith(".c"):
+                ElementTree.SubElement(files, "File", {"name": file_name})
     ElementTree.SubElement(root, "DefaultExperiment", {"startTime": "0.0", "stopTime": "10.0",
                                                         "tolerance": "1e-09"})
     variables = ElementTree.SubElement(root, "ModelVariables")
@@ -219,7 +225,7 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
                                      fmi2String location, const fmi2CallbackFunctions *f,
                                      fmi2Boolean visible, fmi2Boolean logging) {
     (void)name; (void)guid; (void)location; (void)f; (void)visible; (void)logging;
-    if (type != fmi2ModelExchange) return NULL;
+    if (type != fmi2ModelExchange && type != fmi2CoSimulation) return NULL;
     Model *m = (Model *)calloc(1, sizeof(Model));
     if (m) reset(m);
     return m;
@@ -357,6 +363,69 @@ EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t 
     memcpy(x, m->x, sizeof(double) * NX);
     return fmi2OK;
 }
+/* Co-Simulation: classical Runge-Kutta, internal steps of at most CS_STEP s. */
+#define CS_STEP 1e-3
+
+static int derivative(Model *m, const double *x, double *dx) {
+    double a[N + 1];
+    if (@P@_forward_dynamics(x, x + N, m->tau, m->p, a) != 0) return -1;
+    memcpy(dx, x + N, sizeof(double) * N);
+    memcpy(dx + N, a, sizeof(double) * N);
+    return 0;
+}
+
+EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet) {
+    Model *m = (Model *)c;
+    (void)noSet;
+    if (!(h >= 0)) return fmi2Error;
+    int steps = (int)(h / CS_STEP) + 1;
+    double dt = h / steps, k1[NX], k2[NX], k3[NX], k4[NX], y[NX];
+    for (int s = 0; s < steps; s++) {
+        double *x = m->x;
+        if (derivative(m, x, k1)) return fmi2Error;
+        for (int i = 0; i < NX; i++) y[i] = x[i] + 0.5 * dt * k1[i];
+        if (derivative(m, y, k2)) return fmi2Error;
+        for (int i = 0; i < NX; i++) y[i] = x[i] + 0.5 * dt * k2[i];
+        if (derivative(m, y, k3)) return fmi2Error;
+        for (int i = 0; i < NX; i++) y[i] = x[i] + dt * k3[i];
+        if (derivative(m, y, k4)) return fmi2Error;
+        for (int i = 0; i < NX; i++) x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    }
+    m->t = t + h;
+    m->fresh = 0;
+    return fmi2OK;
+}
+EXPORT fmi2Status fmi2CancelStep(fmi2Component c) { (void)c; return fmi2Error; }
+EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                              size_t n, const fmi2Integer order[],
+                                              const fmi2Real v[]) {
+    (void)c; (void)vr; (void)order; (void)v; return n ? fmi2Error : fmi2OK;
+}
+EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                               size_t n, const fmi2Integer order[],
+                                               fmi2Real v[]) {
+    (void)c; (void)vr; (void)order; (void)v; return n ? fmi2Error : fmi2OK;
+}
+EXPORT fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *v) {
+    (void)c; (void)s; (void)v; return fmi2Discard;
+}
+EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *v) {
+    Model *m = (Model *)c;
+    if (s != fmi2LastSuccessfulTime) return fmi2Discard;
+    *v = m->t; return fmi2OK;
+}
+EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s,
+                                       fmi2Integer *v) {
+    (void)c; (void)s; (void)v; return fmi2Discard;
+}
+EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s,
+                                       fmi2Boolean *v) {
+    (void)c; (void)s; (void)v; return fmi2Discard;
+}
+EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *v) {
+    (void)c; (void)s; (void)v; return fmi2Discard;
+}
+
 EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
     (void)c;
     for (size_t i = 0; i < nx; i++) x[i] = 1.0;

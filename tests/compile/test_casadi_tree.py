@@ -31,19 +31,24 @@ MJCF = """
 """
 
 
+@pytest.fixture(scope="module")
+def arm():
+    return lagrangian.load("two_link_arm")
+
+
 def random_states(n, count=3, seed=2):
     rng = np.random.default_rng(seed)
     return [(rng.uniform(-1, 1, n), rng.uniform(-2, 2, n)) for _ in range(count)]
 
 
 @pytest.mark.parametrize("name", ["two_link_arm", "ur5"])
-def test_tree_functions_equal_our_recursive_dynamics(name):
+def test_tree_functions_equal_our_recursive_dynamics(name, arm):
     path = lagrangian.model.urdf.example_urdf(name) if name != "two_link_arm" else name
     if path is None:
         pytest.skip(f"{name}: example-robot-data is not installed")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        system = lagrangian.load(path)
+        system = arm if name == "two_link_arm" else lagrangian.load(path)
     first = system.model.coordinates[0].name
     functions = system.to_casadi(inputs=[first])
     dynamics = system.dynamics(backend="numpy")
@@ -78,8 +83,7 @@ def test_an_mjcf_robot_in_casadi_agrees_with_mujoco(tmp_path):
                            data.qacc, rtol=0, atol=1e-9)
 
 
-def test_a_urdf_arm_optimised_and_replayed():
-    arm = lagrangian.load("two_link_arm")
+def test_a_urdf_arm_optimised_and_replayed(arm):
     """Rest to rest in 1 s from the horizontal, the actuators' torques (tau_<joint>) within
     60 N m, the joints within their position limits (bounds of their own: the least effort
     folds the elbow to its limit, -3.1 rad, which eases the shoulder's load)."""

@@ -120,6 +120,15 @@ def test_a_constrained_crank_turned_rest_to_rest():
     assert np.abs(run.q[:, 0] - result.states["theta"]).max() <= result.defects["replay"]
 
 
+def test_a_solve_cut_short_says_so(motor_pendulum):
+    import json
+
+    result = lagrangian.optimize(motor_pendulum, ["u"], 3.0, 10, max_iterations=2, **SWING_UP)
+    assert not result.converged and result.status == "Maximum_Iterations_Exceeded"
+    json.dumps(result.to_dict(), allow_nan=False)  # a JSON document whatever the solve left
+    assert "not converged" in repr(result) and "not converged" in result._repr_html_()
+
+
 def test_bad_requests_are_refused_in_one_line(motor_pendulum, monkeypatch):
     cases = [
         (dict(goal={"phi": 1.0}), ModelError, "'phi' is not a state"),

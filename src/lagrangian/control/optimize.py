@@ -91,13 +91,25 @@ class Trajectory:
         return {name: float(values[0]) for name, values in self.states.items()}
 
     def to_dict(self) -> dict:
-        """A JSON-ready document: cost, converged, t, states, inputs, defects."""
-        return {"method": self.method, "objective": self.objective, "cost": self.cost,
-                "converged": self.converged, "status": self.status,
-                "iterations": self.iterations, "defects": dict(self.defects),
+        """A JSON-ready document: cost, converged, t, states, inputs, defects (a number that
+        is not finite, as a failed solve may leave, is null)."""
+        return {"method": self.method, "objective": self.objective,
+                "cost": _finite(self.cost), "converged": self.converged,
+                "status": self.status, "iterations": self.iterations,
+                "defects": {k: _finite(v) for k, v in self.defects.items()},
                 "t": self.t.tolist(),
-                "states": {k: v.tolist() for k, v in self.states.items()},
-                "inputs": {k: v.tolist() for k, v in self.inputs.items()}}
+                "states": {k: [_finite(x) for x in v] for k, v in self.states.items()},
+                "inputs": {k: [_finite(x) for x in v] for k, v in self.inputs.items()}}
+
+    def _repr_html_(self) -> str:
+        import html
+
+        verdict = "converged" if self.converged else f"not converged ({self.status})"
+        rows = "".join(f"<tr><td>{html.escape(k)}</td><td>{v:.3g}</td></tr>"
+                       for k, v in self.defects.items())
+        return (f"<p>Optimal trajectory, {html.escape(self.method)} collocation on "
+                f"{len(self.t)} nodes: {html.escape(verdict)}; effort {self.cost:.6g}</p>"
+                f"<table><tr><th>defect</th><th>largest</th></tr>{rows}</table>")
 
     def __repr__(self) -> str:
         verdict = "converged" if self.converged else f"not converged ({self.status})"
@@ -212,6 +224,11 @@ def _holonomic_rates(ca, functions: CasadiFunctions, n: int):
     rows = [i for i in range(residual.shape[0]) if not ca.depends_on(residual[i], v)]
     rates = ca.jtimes(residual[rows], q, v) if rows else ca.SX(0, 1)
     return ca.Function("rates", [q, v], [rates])
+
+
+def _finite(x) -> float | None:
+    x = float(x)
+    return x if np.isfinite(x) else None
 
 
 def _rows(k: int, n2: int, nodes, middle) -> list:

@@ -179,7 +179,7 @@ def test_unsupported_or_bad_bodies_refused_in_one_line(body, message, tmp_path):
     ("<mujoco><actuator><muscle joint='j'/></actuator><worldbody/></mujoco>",
      "actuator with dynamics"),
     ('<!DOCTYPE m [<!ENTITY x "y">]><mujoco><worldbody/></mujoco>', "DOCTYPE"),
-    ("<robot name='r'/>", "not <mujoco>: not an MJCF model"),
+    ("<world/>", "not <mujoco> \\(MJCF\\) or <robot> \\(URDF\\)"),
     ("<mujoco><worldbody>", "not well-formed XML"),
     ("<mujoco><compiler angle='grad'/><worldbody/></mujoco>", "neither degree nor radian"),
 ])
@@ -209,3 +209,9 @@ def test_armature_refused_then_given_to_dynamics_agrees_with_mujoco(arm, tmp_pat
         M, _, qacc, inverse, _ = mujoco_terms(model, q, v, tau)
         assert np.allclose(dynamics.mass_matrix(q), M, rtol=0, atol=1e-9)
         assert np.allclose(dynamics.forward_dynamics(q, v, tau), qacc, rtol=0, atol=1e-9)
+
+
+def test_a_urdf_saved_as_xml_is_read_as_a_urdf(tmp_path):
+    path = tmp_path / "arm.xml"
+    path.write_text(example_urdf("two_link_arm").read_text())
+    assert lagrangian.load(path).coordinates == lagrangian.load("two_link_arm").coordinates

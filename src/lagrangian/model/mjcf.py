@@ -59,11 +59,6 @@ def read_mjcf(path, lock: Mapping[str, float] | None = None,
                       floating_base=floating_base)
 
 
-def is_mjcf(path: Path) -> bool:
-    """An .xml (or .mjcf) file: MJCF is read by its suffix, as a URDF by .urdf."""
-    return path.suffix.lower() in (".xml", ".mjcf")
-
-
 def parse_mjcf(text: str, *, source: str = "<mjcf>", lock: Mapping[str, float] | None = None,
                payload: Mapping[str, object] | None = None,
                floating_base: bool = False) -> Model:
@@ -72,7 +67,11 @@ def parse_mjcf(text: str, *, source: str = "<mjcf>", lock: Mapping[str, float] |
     from .gravity import with_gravity
     from .urdf import parse_urdf
 
-    reader = _Reader(_root(text, source), source)
+    root = _root(text, source)
+    if root.tag == "robot":  # a URDF saved as .xml: read as one
+        return parse_urdf(text, source=source, lock=lock, payload=payload,
+                          floating_base=floating_base)
+    reader = _Reader(root, source)
     urdf = reader.urdf()
     model = parse_urdf(urdf, source=source, lock=lock, payload=payload,
                        floating_base=floating_base)
@@ -99,9 +98,9 @@ def _root(text: str, source: str):
     if root.getroottree().docinfo.doctype:
         raise ModelError("a <!DOCTYPE> (an MJCF file needs none; entities are not read)",
                          source=source)
-    if root.tag != "mujoco":
-        raise ModelError(f"the root element is <{root.tag}>, not <mujoco>: not an MJCF model",
-                         source=source)
+    if root.tag not in ("mujoco", "robot"):
+        raise ModelError(f"the root element is <{root.tag}>, not <mujoco> (MJCF) or <robot> "
+                         "(URDF): not a robot description", source=source)
     return root
 
 
@@ -510,4 +509,4 @@ def _text(values) -> str:
     return " ".join(repr(float(v)) for v in values)
 
 
-__all__ = ["is_mjcf", "parse_mjcf", "read_mjcf"]
+__all__ = ["parse_mjcf", "read_mjcf"]

@@ -313,8 +313,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         return casadi_functions(self.equations_of_motion(), inputs, parameters)
 
     def to_fmu(self, path: str | Path, parameters: Mapping[str, float] | None = None) -> Path:
-        """Write an FMI 2.0 Model Exchange FMU (.fmu) of the model: its standalone C compiled
-        for this platform, q and q_dot as outputs, the parameters tunable (SI; ``parameters``
+        """Write an FMI 2.0 FMU (.fmu: Model Exchange and Co-Simulation) of the model: its
+        standalone C compiled for this platform, q and q_dot as outputs, the parameters tunable (SI; ``parameters``
         override the model's values), Q_<coordinate> inputs (docs/bridges.md)."""
         from .export import to_fmu
 

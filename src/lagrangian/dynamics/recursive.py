@@ -31,7 +31,6 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import InputError
 from ..model.model import Model
 from ..model.tree import KinematicTree
 from .engine.compact_kernel import kernel_module
@@ -39,7 +38,7 @@ from .engine.tree_module import module_source, tree_key
 from .joint_space import TreeDynamics, reported_rows
 from .tree.applicable import TREE_PATH_BODIES, applicable_tree
 from .tree.description import describe
-from .tree.numbers import batch_shape, float_array
+from .tree.numbers import batch_shape
 
 
 class RecursiveDynamics(TreeDynamics):
@@ -104,23 +103,17 @@ class RecursiveDynamics(TreeDynamics):
         return f"RecursiveDynamics(coordinates={list(self.coordinates)})"
 
     def _call(self, function, *arrays):
-        # numbers first: text or a mapping named here, not by a field read off numpy's text
+        """The slow path, after the module refused the fast one: every input checked here, in
+        front (numbers, widths named by coordinate, a floating base's quaternions, broadcast
+        batch shapes), then one C call; nothing read off the module's error text."""
         third = "tau" if function is self._forward else "a"
-        arrays = [float_array(x, field) for x, field in zip(arrays, ("q", "v", third), strict=False)]
-        try:
-            return function(*arrays, self._P)
-        except ValueError as exc:
-            if str(exc).startswith("q: the base quaternion"):  # the module's check: say more
-                return function(_unit_quaternions(arrays[0]), *arrays[1:], self._P)
-            if "batch shapes" in str(exc):  # broadcast in numpy, then one C call
-                batch = batch_shape(arrays, ("q", "v", third)[:len(arrays)])
-                return self._call(function, *(
-                    np.ascontiguousarray(np.broadcast_to(x, batch + x.shape[-1:]))
-                    for x in arrays))
-            field = str(exc).split(":")[0]
-            width, names = self._width(field)
-            raise InputError(f"expected {width} values ({', '.join(names)}) "
-                             "along the last axis", field=field) from None
+        fields = ("q", "v", third)[:len(arrays)]
+        arrays = [self._vector(x, field) for x, field in zip(arrays, fields, strict=True)]
+        if self.tree.floating_base:
+            arrays[0] = _unit_quaternions(arrays[0])
+        batch = batch_shape(arrays, fields)
+        arrays = [np.ascontiguousarray(np.broadcast_to(x, batch + x.shape[-1:])) for x in arrays]
+        return function(*arrays, self._P)
 
     def mass_matrix(self, q):
         """M(q), shape (..., n, n)."""
@@ -255,14 +248,19 @@ class _CompactKernel:
 
 def _unit_quaternions(q) -> np.ndarray:
     """q with its base quaternions refused in one line (free_flyer.check_quaternions: which
-    state, what norm) where the module refused them, else (a norm within rounding of the
-    tolerance) made unit."""
-    from .tree.free_flyer import check_quaternions
+    state, what norm), else q itself, with only the quaternions the module's own test would
+    refuse (a norm within rounding of the tolerance) made unit: a unit one keeps its bits."""
+    from .tree.free_flyer import QUATERNION_TOLERANCE, check_quaternions
 
-    Q = np.array(q, dtype=float)
+    Q = np.asarray(q, dtype=float)
     flat = Q.reshape(-1, Q.shape[-1])
     check_quaternions(flat)
-    flat[:, 3:7] /= np.linalg.norm(flat[:, 3:7], axis=-1, keepdims=True)
+    norms = np.sqrt((flat[:, 3:7] ** 2).sum(axis=-1))
+    edge = np.isfinite(flat).all(axis=-1) & ~(np.abs(norms - 1.0) <= QUATERNION_TOLERANCE)
+    if not edge.any():
+        return Q
+    flat = flat.copy()
+    flat[edge, 3:7] /= norms[edge, None]
     return flat.reshape(Q.shape)
 
 

@@ -147,7 +147,8 @@ def test_mjcf_written_by_mujoco_from_a_urdf(name, tmp_path):
 
 REFUSALS = [
     ('<body><joint type="ball"/><geom size="0.1"/></body>', "a ball joint is not supported"),
-    ('<body><freejoint/><geom size="0.1"/></body>', "a free joint is not supported"),
+    ('<body><freejoint/><geom size="0.1"/></body>', "a free joint is read only with "
+                                                      "floating_base=True"),
     ('<body><joint armature="0.1"/><geom size="0.1"/></body>', "armature is not kept"),
     ('<body><joint ref="10"/><geom size="0.1"/></body>', "ref other than 0"),
     ('<body><joint stiffness="3"/><geom size="0.1"/></body>', "stiffness other than 0"),
@@ -215,3 +216,62 @@ def test_a_urdf_saved_as_xml_is_read_as_a_urdf(tmp_path):
     path = tmp_path / "arm.xml"
     path.write_text(example_urdf("two_link_arm").read_text())
     assert lagrangian.load(path).coordinates == lagrangian.load("two_link_arm").coordinates
+
+
+QUADRUPED_LEG = """
+<mujoco model="leg">
+  <worldbody>
+    <body name="trunk" pos="0 0 0.4">
+      <freejoint name="root"/>
+      <inertial pos="0.01 0.02 -0.01" mass="5" fullinertia="0.1 0.2 0.25 0.01 -0.02 0.03"/>
+      <body name="thigh" pos="0.2 0.1 0" euler="10 0 20">
+        <joint name="hip" axis="0 1 0" pos="0 0 0.02"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03"/>
+        <body name="shin" pos="0 0 -0.3">
+          <joint name="knee" axis="1 1 0"/>
+          <geom type="box" size="0.02 0.03 0.15" pos="0 0 -0.15"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_a_free_joint_with_floating_base_is_mujocos_body_in_pinocchios_layout(tmp_path):
+    """q = [p, qx, qy, qz, qw, joints] for MuJoCo's [p, qw, qx, qy, qz, joints]; v = T v_mj
+    with T = diag(R^T, 1, ...) (MuJoCo's linear velocity is in world axes): so M_mj = T^T M T
+    and, the accelerations differing by T' v, bias_mj = T^T (M T' v_mj + b)."""
+    path = tmp_path / "leg.xml"
+    path.write_text(QUADRUPED_LEG)
+    system = lagrangian.load(path, floating_base=True)
+    dynamics = system.dynamics(backend="numpy")
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    assert (dynamics.nq, dynamics.nv) == (model.nq, model.nv) == (9, 8)
+    rng = np.random.default_rng(4)
+    for _ in range(3):
+        quaternion = rng.normal(size=4)
+        quaternion /= np.linalg.norm(quaternion)
+        data.qpos[:] = np.r_[rng.normal(size=3), quaternion, rng.uniform(-1, 1, 2)]
+        data.qvel[:] = rng.normal(size=8)
+        mujoco.mj_forward(model, data)
+        M = np.zeros((8, 8))
+        mujoco.mj_fullM(model, data, M)
+        R = np.zeros(9)
+        mujoco.mju_quat2Mat(R, quaternion)
+        R = R.reshape(3, 3)
+        q = np.r_[data.qpos[:3], quaternion[1:], quaternion[0], data.qpos[7:]]
+        T = np.eye(8)
+        T[:3, :3] = R.T
+        w = data.qvel[3:6]
+        T_dot = np.zeros((8, 8))
+        T_dot[:3, :3] = -np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]]) @ R.T
+        ours = dynamics.mass_matrix(q)
+        assert np.allclose(T.T @ ours @ T, M, rtol=0, atol=1e-9)
+        bias = T.T @ (ours @ T_dot @ data.qvel + dynamics.bias_forces(q, T @ data.qvel))
+        assert np.allclose(bias, data.qfrc_bias, rtol=0, atol=1e-9)
+    with pytest.raises(ModelError, match="only joint of the one body at the top"):
+        bad = tmp_path / "bad.xml"
+        bad.write_text(QUADRUPED_LEG.replace('<joint name="hip"', '<freejoint/><joint name="hip"'))
+        lagrangian.load(bad, floating_base=True)

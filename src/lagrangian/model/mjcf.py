@@ -6,9 +6,10 @@ The body tree is written as the URDF it is, with our own numbers and names (a bo
 frame sits at its joint's anchor, several joints in one body chain through massless links), and
 read by the URDF reader, so an MJCF robot enters the same engine. Each joint is a coordinate in
 MuJoCo's qpos order (depth first in document order) with MuJoCo's sign and zero, so a state
-moves between MuJoCo and us unchanged. What would change the dynamics and is not modelled
-(ball and free joints, tendons, equality constraints, actuators with dynamics, a joint's ref,
-stiffness or armature, ...) is refused in one line naming the file, the element and the fault.
+moves between MuJoCo and us unchanged. A free joint is read only with ``floating_base`` (the
+tree's free flyer, in Pinocchio's layout, not MuJoCo's). What would change the dynamics and is
+not modelled (ball joints, tendons, equality constraints, actuators with dynamics, a joint's
+ref, stiffness or armature, ...) is refused in one line naming the file, element and fault.
 Units SI (MJCF's lengths in m, masses in kg; angles by the compiler, degrees by default).
 """
 
@@ -72,9 +73,10 @@ def parse_mjcf(text: str, *, source: str = "<mjcf>", lock: Mapping[str, float] |
         return parse_urdf(text, source=source, lock=lock, payload=payload,
                           floating_base=floating_base)
     reader = _Reader(root, source)
+    reader.floating = bool(floating_base)
     urdf = reader.urdf()
     model = parse_urdf(urdf, source=source, lock=lock, payload=payload,
-                       floating_base=floating_base)
+                       floating_base=bool(floating_base) and reader.free is None)
     joints = len(reader.joint_names)
     model = replace(model, description=f"Robot '{model.name}' read from MJCF ({joints} joints, "
                                        f"{reader.bodies} bodies).")
@@ -130,6 +132,8 @@ class _Reader:
         self.defaults = self._defaults()
         self._check_actuators()
         self.joint_names: list[str] = []
+        self.floating = False  # floating_base asked for: a free joint is read (_free)
+        self.free: str | None = None  # the free joint's name, once read
         self.link_names: set[str] = {"world"}
         self.bodies = 0
 
@@ -276,7 +280,7 @@ class _Reader:
         for child in _children(worlds[0]):
             if child.tag == "joint" or child.tag == "freejoint":
                 raise self.error("the world body cannot have joints", f"worldbody.{child.tag}")
-        if not self.joint_names:
+        if not self.joint_names and self.free is None:
             raise self.error("no hinge or slide joint: nothing moves", "worldbody")
         return ElementTree.tostring(robot, encoding="unicode")
 
@@ -341,9 +345,13 @@ class _Reader:
         field = f"{where}.joint '{name}'"
         attrs = self.attrs(joint, childclass, field) if joint.tag == "joint" else {}
         kind = kind or attrs.get("type", "hinge")
-        if kind in ("ball", "free"):
-            raise self.error(f"a {kind} joint is not supported yet (hinge and slide joints "
-                             "are)", field)
+        if kind == "free":
+            return self._free(name, body, parent, current, field, only=len(
+                [c for c in _children(joint.getparent()) if c.tag in ("joint", "freejoint")]
+            ) == 1)
+        if kind == "ball":
+            raise self.error("a ball joint is not supported yet (hinge and slide joints are)",
+                             field)
         if kind not in JOINT_KINDS:
             raise self.error(f"unknown joint type {kind!r} (hinge, slide, ball or free)"
                              f"{did_you_mean(kind, JOINT_KINDS)}", f"{field}.type")
@@ -376,6 +384,26 @@ class _Reader:
                          friction=float(self.numbers(attrs.get("frictionloss", "0"), 1,
                                                      f"{field}.frictionloss")[0]))
         return link, (_transform(np.eye(3), -anchor) if kind == "hinge" else np.eye(4))
+
+    def _free(self, name: str, body: str, parent: str, current, field: str, only: bool):
+        """A free joint, with floating_base: the tree's free flyer, in its own layout."""
+        if not self.floating:
+            raise self.error("a free joint is read only with floating_base=True (load(..., "
+                             "floating_base=True), --floating-base): the base's state then "
+                             "has Pinocchio's layout, q = [x, y, z, qx, qy, qz, qw] and v = "
+                             "[linear, angular velocity in body axes]; MuJoCo's (w first, "
+                             "linear velocity in world axes) is not a joint kind yet", field)
+        if parent != "world" or not only or self.free is not None:
+            raise self.error("a free joint must be the only joint of the one body at the top "
+                             "of the worldbody (the floating base)", field)
+        if self.joint_names:
+            raise self.error("the floating base must come first in the worldbody", field)
+        self.free = name
+        link = self._fresh_link(body)
+        # the free flyer's state is the body's placement: the file's pos and quat are only
+        # MuJoCo's default qpos0
+        self._urdf_joint(name, "floating", "world", link, np.eye(4))
+        return link, np.eye(4)
 
     def _limit(self, attrs, field: str, scale: float):
         limited = attrs.get("limited", "auto")

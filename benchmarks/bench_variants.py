@@ -6,10 +6,9 @@ variant writes into the cache (issue "One engine for every robot").
 
 One fresh process with an empty cache (LAGRANGIAN_CACHE in a temporary folder): the Panda
 runs first (the engine's one-time builds, reported apart), then each variant in turn, timed
-from its load (its tables included) to its last answer. ``--kernel auto`` is what a user gets:
-a small tree's M, ID and FD on its own unrolled module (compiled per tree), the reach and
-derivatives functions on the one engine; ``--kernel compact`` puts M, ID and FD on the engine
-too. Needs the bench extra (pin, example-robot-data) for the URDFs.
+from its load (its tables included) to its last answer. ``--kernel auto`` (the same as
+``compact``) is what a user gets: every function on the one engine; ``--kernel unrolled`` puts
+M, ID and FD on each tree's own unrolled module (compiled per tree). Needs the bench extra (pin, example-robot-data) for the URDFs.
 """
 
 from __future__ import annotations

@@ -75,3 +75,11 @@ def test_fmu_blocks_export_and_simulate_the_pendulum(cli, tmp_path, monkeypatch,
     assert "[]" in capsys.readouterr().out
     period = float(np.diff(namespace["up"]).mean())
     assert period == pytest.approx(2 * np.pi * np.sqrt(0.5 / 9.81), rel=1e-5)
+
+
+def test_opty_block_prints_the_cart_poles_equations(capsys):
+    namespace: dict = {}
+    exec(python_of("bridges-opty"), namespace)  # noqa: S102 - our own documentation
+    equations = namespace["equations"]
+    assert [str(x) for x in equations.states] == ["x(t)", "theta(t)", "x_dot(t)", "theta_dot(t)"]
+    assert "r_push(t)" in capsys.readouterr().out

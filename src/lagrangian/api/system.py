@@ -312,6 +312,16 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         refuse_large_chain(self.model)
         return casadi_functions(self.equations_of_motion(), inputs, parameters)
 
+    def to_opty(self, inputs: Sequence[str] = (), parameters: Mapping[str, float] | None = None):
+        """opty's equations of an unconstrained model (sympy, opty itself not needed):
+        ``eom`` = 0 in x = [q(t); u(t)] and x', ``states``, ``specified`` r_<input>(t) (named
+        as for ``linearize(inputs=...)``), ``parameters`` for known_parameter_map and
+        ``time``, for ``opty.Problem(obj, grad, eom, states, nodes, interval, ...)``."""
+        from ..compile.opty_equations import opty_equations
+
+        refuse_large_chain(self.model)
+        return opty_equations(self.equations_of_motion(), inputs, parameters)
+
     def to_fmu(self, path: str | Path, parameters: Mapping[str, float] | None = None) -> Path:
         """Write an FMI 2.0 FMU (.fmu: Model Exchange and Co-Simulation) of the model: its
         standalone C compiled for this platform, q and q_dot as outputs, the parameters tunable (SI; ``parameters``

@@ -324,8 +324,9 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
 
     def to_fmu(self, path: str | Path, parameters: Mapping[str, float] | None = None) -> Path:
         """Write an FMI 2.0 FMU (.fmu: Model Exchange and Co-Simulation) of the model: its
-        standalone C compiled for this platform, q and q_dot as outputs, the parameters tunable (SI; ``parameters``
-        override the model's values), Q_<coordinate> inputs (docs/bridges.md)."""
+        standalone C compiled for this platform, q and q_dot as outputs, the parameters
+        tunable (SI; ``parameters`` override the model's values), Q_<coordinate> inputs
+        (docs/bridges.md)."""
         from .export import to_fmu
 
         return to_fmu(self, path, parameters)

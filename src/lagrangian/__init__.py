@@ -74,6 +74,7 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
         state_layout,
     )
     from .api.optimize import Trajectory, optimize
+    from .api.robot_builder import RobotBuilder
     from .control import computed_torque, lqr
     from .errors import DynamicsWarning, ModelWarning
 
@@ -118,6 +119,7 @@ __all__ = [
     "NumericSystem",
     "ParameterValues",
     "Reaction",
+    "RobotBuilder",
     "RunStatus",
     "SaveAt",
     "Simulation",
@@ -207,6 +209,7 @@ _HOMES = {
     "lqr": ("control.lqr", "lqr"),
     "computed_torque": ("control.computed_torque", "computed_torque"),
     "optimize": ("api.optimize", "optimize"),
+    "RobotBuilder": ("api.robot_builder", "RobotBuilder"),
     "Trajectory": ("control.optimize", "Trajectory"),
 }
 

@@ -10,8 +10,10 @@ from enum import StrEnum
 class JointKind(StrEnum):
     """How a joint moves its body, in model files and URDF alike: about its axis (revolute),
     along it (prismatic), by a rotation sequence (spherical), not at all (fixed) or freely in
-    space (free_flyer: a URDF robot's floating base). A kinematic tree moves its bodies by the
-    one-degree-of-freedom kinds and the free flyer at its root (dynamics/tree/joint_models.py)."""
+    space (free_flyer: a URDF robot's floating base), or about and along its axis at once
+    (helical: a screw, turning theta and sliding pitch * theta; the Python tree builder's,
+    model/robot_builder.py). A kinematic tree moves its bodies by the one-degree-of-freedom
+    kinds and the free flyer at its root (dynamics/tree/joint_models.py)."""
 
     REVOLUTE = "revolute"
     PRISMATIC = "prismatic"
@@ -20,6 +22,9 @@ class JointKind(StrEnum):
     # a URDF robot's floating base (dynamics/tree/free_flyer.py): six degrees of freedom, in a tree
     # only (a model file's body moves by its coordinates)
     FREE_FLYER = "free_flyer"
+    # a screw (Pinocchio's JointModelHelicalUnaligned): in a tree only, made by
+    # lagrangian.RobotBuilder (URDF and model files have none)
+    HELICAL = "helical"
 
 
 class ConstraintKind(StrEnum):

@@ -87,10 +87,11 @@ def tree_motion(tree, gravity: float, Q, V, A):
         u = np.array(joint.axis, dtype=float)
         theta = joint.multiplier * Q[:, iq + joint.coordinate] + joint.offset
         R, p = model.placement_arrays(np.array(joint.rotation, dtype=float),
-                                      np.array(joint.translation, dtype=float), u, theta)
+                                      np.array(joint.translation, dtype=float), u, theta,
+                                      joint.pitch)
         R = np.broadcast_to(R, (count, 3, 3))
         p = np.broadcast_to(p, (count, 3))
-        s_w, s_v = (None if s is None else np.array(s, dtype=float) for s in model.subspace(u))
+        s_w, s_v = (None if s is None else np.array(s, dtype=float) for s in model.subspace(u, joint.pitch))
         placements.append((R, p))
         spaces.append((s_w, s_v))
         RT = np.swapaxes(R, -1, -2)

@@ -4,6 +4,7 @@ Each moving body hangs from its parent body (or the ground) by one revolute or p
 
     R = R_0 Rot(u, theta),  p = t_0           (revolute: child axes -> parent axes, origin in parent)
     R = R_0,                p = t_0 + R_0 u theta   (prismatic)
+    R = R_0 Rot(u, theta),  p = t_0 + R_0 u pitch theta   (helical: a screw, pitch in m/rad)
 
 with theta = k q[c] + offset (k = 1, offset = 0 except for a mimic joint). A floating base is a
 free-flyer joint at the root (joints[0], parent -1, kind free_flyer): the base link's body, moved
@@ -48,6 +49,7 @@ class TreeJoint:
     mass: float  # kg
     first_moment: Vector3  # h = m c about the joint's origin, body axes (kg m)
     inertia: Matrix3x3  # J_O about the joint's origin, body axes (kg m^2)
+    pitch: float = 0.0  # a helical joint's slide per turn of theta (m/rad); 0 for the others
 
     def __post_init__(self):
         object.__setattr__(self, "kind", JointKind(self.kind))

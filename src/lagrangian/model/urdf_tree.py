@@ -14,6 +14,9 @@ from ..kinds import JointKind
 from .tree import KinematicTree, TreeFrame, TreeJoint, TreeLink, link_inertias
 
 MOVABLE = ("revolute", "continuous", "prismatic")
+# a screw: no URDF type, the tree builder's only (model/robot_builder.py: the joint's ``pitch``,
+# m/rad)
+HELICAL = "helical"
 # Entries of a rotation within this of 0 or +-1 are taken as exact: cos(pi/2) = 6e-17 in a
 # URDF's rpy would otherwise keep every product it enters.
 SNAP = 1e-14
@@ -29,7 +32,7 @@ def numeric_tree(links_by_name, root: str, order, position, names: dict[str, str
     anchor = {root: (-1, np.eye(3), np.zeros(3))}  # link -> (moving body, R, t in it)
     joints: list[dict] = []
     free = dict(parent=-1, kind=JointKind.FREE_FLYER, axis=np.zeros(3), coordinate=-1,
-                multiplier=1.0, offset=0.0)  # the free flyer: its numbers come first
+                multiplier=1.0, offset=0.0, pitch=0.0)  # the free flyer: its numbers come first
     if floating_base:  # Pinocchio's name for the root joint it adds
         joints.append(dict(free, name="root_joint", rotation=np.eye(3),
                            translation=np.zeros(3)))
@@ -44,7 +47,7 @@ def numeric_tree(links_by_name, root: str, order, position, names: dict[str, str
                                translation=translation))
             anchor[joint.child] = (len(joints) - 1, np.eye(3), np.zeros(3))
             continue
-        if joint.type not in MOVABLE:
+        if joint.type not in MOVABLE and joint.type != HELICAL:
             anchor[joint.child] = (body, rotation, translation)
             continue
         axis = np.asarray(joint.axis if joint.axis is not None else (1, 0, 0), float)
@@ -57,12 +60,15 @@ def numeric_tree(links_by_name, root: str, order, position, names: dict[str, str
             joints.append(dict(name=joint.name, parent=body, kind=JOINT_KIND[joint.type],
                                rotation=rotation, translation=translation, axis=axis,
                                coordinate=coordinate[str(symbol)], multiplier=k,
-                               offset=offset))
+                               offset=offset, pitch=float(getattr(joint, "pitch", 0.0))))
             anchor[joint.child] = (len(joints) - 1, np.eye(3), np.zeros(3))
         else:  # locked, or a mimic of a locked joint: a fixed joint at that value
             theta = float(angle)
             if joint.type == "prismatic":
                 anchor[joint.child] = (body, rotation, translation + rotation @ axis * theta)
+            elif joint.type == HELICAL:
+                anchor[joint.child] = (body, rotation @ axis_rotation(axis, theta),
+                                       translation + rotation @ axis * (joint.pitch * theta))
             else:
                 anchor[joint.child] = (body, rotation @ axis_rotation(axis, theta),
                                        translation)
@@ -104,7 +110,7 @@ def numeric_tree(links_by_name, root: str, order, position, names: dict[str, str
             name=j["name"], parent=j["parent"], kind=j["kind"], rotation=matrix(j["rotation"]),
             translation=vector(j["translation"]), axis=vector(j["axis"]),
             coordinate=j["coordinate"], multiplier=j["multiplier"], offset=j["offset"],
-            mass=m, first_moment=vector(h), inertia=matrix(0.5 * (J + J.T)))
+            mass=m, first_moment=vector(h), inertia=matrix(0.5 * (J + J.T)), pitch=j["pitch"])
             for j, (m, h, J) in zip(joints, inertias, strict=True)),
         coordinates=tuple(names.values()), gravity_parameter="g",
         gravity_direction=(0.0, 0.0, -1.0),
@@ -122,7 +128,7 @@ def carries_nothing(inertial) -> bool:
 
 
 JOINT_KIND = {"revolute": JointKind.REVOLUTE, "continuous": JointKind.REVOLUTE,
-         "prismatic": JointKind.PRISMATIC}
+              "prismatic": JointKind.PRISMATIC, HELICAL: JointKind.HELICAL}
 
 
 def snapped(a) -> np.ndarray:
@@ -141,5 +147,5 @@ def axis_rotation(axis, angle: float) -> np.ndarray:
         + (1 - math.cos(angle)) * np.outer(x, x)
 
 
-__all__ = ["JOINT_KIND", "MOVABLE", "SNAP", "axis_rotation", "carries_nothing", "numeric_tree",
+__all__ = ["HELICAL", "JOINT_KIND", "MOVABLE", "SNAP", "axis_rotation", "carries_nothing", "numeric_tree",
            "snapped"]

@@ -39,11 +39,12 @@ WALKED = (*ONE_DOF, JointKind.FREE_FLYER)
 
 def require_known_joints(tree, what: str, field: str = "q") -> None:
     """Refused in one line for a tree with a joint these walks do not know (their columns
-    would be miscounted): revolute, prismatic and a floating base's free flyer are known."""
+    would be miscounted): revolute, prismatic, helical and a floating base's free flyer are
+    known."""
     odd = sorted({str(j.kind) for j in tree.joints if j.kind not in WALKED})
     if odd:
         raise InputError(f"{what} of a tree with a {', '.join(odd)} joint: not yet (revolute, "
-                         "prismatic and a floating base's free flyer only)", field=field)
+                         "prismatic, helical and a floating base's free flyer only)", field=field)
 
 
 def world_columns(kinematics, k: int, joint, body) -> tuple[np.ndarray, list[int]]:
@@ -182,7 +183,7 @@ def centroidal_momentum_matrix(kinematics, q) -> np.ndarray:
 def _world_subspace(kinematics, k: int, joint, body):
     """S of joint k at the world's origin in world axes: (s_v (N, 3), s_w (N, 3) or None)."""
     R, o = body
-    s_w, s_v = kinematics._models[k].subspace(joint.axis)
+    s_w, s_v = kinematics._models[k].subspace(joint.axis, joint.pitch)
     w = None if s_w is None else R @ np.array(s_w)
     linear = np.zeros(o.shape) if w is None else _cross(o, w)  # the origin's: w x (0 - o)
     if s_v is not None:

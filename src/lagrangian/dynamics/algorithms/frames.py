@@ -66,7 +66,7 @@ class TreeKinematics:
                 theta = joint.multiplier * Q[:, self.tree.base_nq + joint.coordinate] + joint.offset
                 R, p = model.placement_arrays(np.array(joint.rotation),
                                               np.array(joint.translation), np.array(joint.axis),
-                                              theta)
+                                              theta, joint.pitch)
             R = np.broadcast_to(R, (count, 3, 3))
             p = np.broadcast_to(p, (count, 3))
             if joint.parent < 0:
@@ -124,7 +124,7 @@ class TreeKinematics:
             if joint.kind == JointKind.FREE_FLYER:  # six columns, the base's own
                 columns, first = self._models[k].columns(), 0
             else:
-                columns = [self._models[k].subspace(joint.axis)]
+                columns = [self._models[k].subspace(joint.axis, joint.pitch)]
                 first = self.tree.base_nv + joint.coordinate
             for c, (s_w, s_v) in enumerate(columns):
                 column = np.zeros((len(Q), 6))

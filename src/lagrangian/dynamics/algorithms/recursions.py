@@ -76,7 +76,8 @@ class _Joint:
         self.R0 = np.array(joint.rotation, dtype=float)
         self.t0 = np.array(joint.translation, dtype=float)
         self.u = np.array(joint.axis, dtype=float)
-        s_w, s_v = (None, None) if self.free else self.model.subspace(self.u)  # per unit rate
+        self.pitch = joint.pitch  # a helical joint's (m/rad)
+        s_w, s_v = (None, None) if self.free else self.model.subspace(self.u, self.pitch)
         self.s_w = None if s_w is None else np.array(s_w)
         self.s_v = None if s_v is None else np.array(s_v)
         self.m = float(joint.mass)
@@ -121,7 +122,7 @@ class TreeRecursions:
                 placements.append((R, p, _skew_batch(p)))
                 continue
             theta = j.multiplier * Q[:, j.iq] + j.offset
-            R, p = j.model.placement_arrays(j.R0, j.t0, j.u, theta)
+            R, p = j.model.placement_arrays(j.R0, j.t0, j.u, theta, j.pitch)
             placements.append((R, p, j.P0 if p is j.t0 else _skew_batch(p)))
         return placements
 

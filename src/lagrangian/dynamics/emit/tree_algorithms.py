@@ -98,7 +98,7 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
         else:
             wl, dwl, al = w[joint.parent], dw[joint.parent], acc[joint.parent]
         if not _free(joint):
-            s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
+            s_w, s_v = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
             rate = E.mul(v[joint.coordinate], joint.multiplier)
             accel = E.mul(a[joint.coordinate], joint.multiplier)
             w_in = E.apply_transpose(R, wl)
@@ -128,7 +128,8 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
         if _free(joint):  # the wrench on the base, force then moment, in its axes
             base = f[i] + n[i]
             continue
-        tau_full[i] = _project(E, joint_model(joint.kind).subspace(joint.axis), n[i], f[i])
+        tau_full[i] = _project(E, joint_model(joint.kind).subspace(joint.axis, joint.pitch),
+                               n[i], f[i])
         if joint.parent >= 0:
             R, p = placements[i]
             force = E.apply(R, f[i])
@@ -160,7 +161,7 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
                      [E.neg(hy), hx, 0.0, J[i][2][0], J[i][2][1], J[i][2][2]]]
             base = {(r, c): x for r, row in enumerate(block) for c, x in enumerate(row)}
             continue
-        subspace = joint_model(joint.kind).subspace(joint.axis)
+        subspace = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
         force, moment = _unit_rate_wrench(E, subspace, mass[i], h[i], J[i])
         full[i, i] = _project(E, subspace, moment, force)
         k = i
@@ -173,8 +174,8 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
             if _free(ancestor):  # S = 1: the wrench itself, force then moment
                 coupling[i] = force + moment
                 continue
-            full[i, k] = _project(E, joint_model(ancestor.kind).subspace(ancestor.axis), moment,
-                                  force)
+            space = joint_model(ancestor.kind).subspace(ancestor.axis, ancestor.pitch)
+            full[i, k] = _project(E, space, moment, force)
         parent = joint.parent
         if parent >= 0:  # the composite inertia of body i, moved into its parent's axes
             R, p = placements[i]
@@ -239,7 +240,7 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
             w_i, v_i = free_root_motion(base_v)
             c.append((zero, zero))
         else:
-            s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
+            s_w, s_v = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
             rate = v[joint.coordinate]
             wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
                                                                      vel[joint.parent])
@@ -272,7 +273,7 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
         joint = tree.joints[i]
         if _free(joint):  # the root: solved in the forward pass below
             continue
-        s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
+        s_w, s_v = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
         zero = [0.0] * 3
         # U = IA S: Un = A s_w + B s_v, Uf = B^T s_w + C s_v
         Un = E.vadd(zero if s_w is None else E.apply(A[i], s_w),
@@ -339,7 +340,7 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
         Un, Uf = U[i]
         x = E.div(E.sub(uu[i], E.add(E.dot(Un, aw), E.dot(Uf, av))), D[i])
         qdd[first + joint.coordinate] = x
-        s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
+        s_w, s_v = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
         if s_w is not None:
             aw = E.vadd(aw, E.scale(x, s_w))
         if s_v is not None:
@@ -377,7 +378,7 @@ def _velocities(E: _Emitter, tree: KinematicTree, q, v):
         rate = E.mul(v[joint.coordinate], joint.multiplier)
         w_i = E.apply_transpose(R, wl)
         v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
-        s_w, s_v = joint_model(joint.kind).subspace(joint.axis)
+        s_w, s_v = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
         if s_w is not None:
             w_i = E.vadd(w_i, E.scale(rate, s_w))
         if s_v is not None:

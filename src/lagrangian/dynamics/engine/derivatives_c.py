@@ -5,7 +5,7 @@ and the joint-torque regressor Y; a batch in one call on vector lanes and thread
 (derivatives_bindings.c). One compiled module for every tree (keyed by its C and this file,
 never a tree's numbers): the tree is given at run time as two tables, made once per dynamics
 object, and gravity, the actuator parameters tau_<joint> and the bodies' inertials as P
-(runtime_values). Revolute and prismatic joints, a free flyer at the root; the complex step of
+(runtime_values). Revolute, prismatic and helical joints, a free flyer at the root; the complex step of
 derivatives.py is the fallback (and the check). Units SI.
 
 The tables (``tables``), nb bodies numbered parents first, nj joint coordinates, a floating
@@ -20,7 +20,9 @@ base's six velocity coordinates first (nv = nj + 6 ff, nq = nj + 7 ff):
     row0[j + 1]], ascending), lambda[nv] (each coordinate's parent coordinate, -1 at a root).
     D (float64), field by field, each nb records: multiplier k and offset (theta = k q + offset;
     1 each), R0 (joint -> parent axes, row-major, 9), P, C, S (9 each: R0 Rot(u, theta) =
-    P + cos theta C + sin theta S), t0 (m, 3), the unit axis u (joint axes, 3), R0 u (3).
+    P + cos theta C + sin theta S), t0 (m, 3), the unit axis u (joint axes, 3), R0 u times the
+    lead (3: the slide per unit theta, 1 prismatic, the pitch in m/rad helical, which turns and
+    slides; 0 revolute).
 """
 
 from __future__ import annotations
@@ -166,6 +168,9 @@ def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
     # R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x
     P, C, S = R0 @ uu, R0 @ (np.eye(3) - uu), R0 @ skew
     models = [JOINT_MODELS[j.kind] for j in joints]
+    # the slide per unit theta (a revolute joint's 0 unused; a prismatic one's 1 exactly)
+    lead = np.array([m.lead(j.pitch) if getattr(m, "slides", False) else 1.0
+                     for m, j in zip(models, joints, strict=True)])
     pairs = _pairs(tree)
     rows = _column_rows(tree, pairs)
     starts = np.cumsum([0] + [len(r) for r in rows])
@@ -187,7 +192,7 @@ def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
     D = np.concatenate([[j.multiplier for j in joints], [j.offset for j in joints],
                         R0.ravel(), P.ravel(), C.ravel(), S.ravel(),
                         np.array([j.translation for j in joints], dtype=float).ravel(),
-                        u.ravel(), np.einsum("bij,bj->bi", R0, u).ravel()])
+                        u.ravel(), (lead[:, None] * np.einsum("bij,bj->bi", R0, u)).ravel()])
     for table in (I, D):
         table.flags.writeable = False
     return I, D
@@ -222,8 +227,8 @@ def kernel_source():
 
 
 def applies(tree: KinematicTree | None) -> bool:
-    """Whether the kernel takes this tree: revolute and prismatic joints on a fixed base or a
-    floating one (a free flyer at the root), of any size."""
+    """Whether the kernel takes this tree: revolute, prismatic and helical joints on a fixed
+    base or a floating one (a free flyer at the root), of any size."""
     from ...kinds import JointKind
 
     if tree is None or not tree.joints:
@@ -233,7 +238,7 @@ def applies(tree: KinematicTree | None) -> bool:
         if kinds[0] != JointKind.FREE_FLYER:
             return False
         kinds = kinds[1:]
-    return all(k in (JointKind.REVOLUTE, JointKind.PRISMATIC) for k in kinds)
+    return all(k in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.HELICAL) for k in kinds)
 
 
 def engine():

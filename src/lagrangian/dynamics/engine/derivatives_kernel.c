@@ -29,8 +29,9 @@
  * np ancestor pairs (k, j), j on k's path to the ground, k first; per coordinate j the rows
  * that d tau/d(q, q_dot)_j can have nonzero (rows[row0[j] .. row0[j + 1]]), and its parent
  * coordinate (lambda, for the factor along the tree). Per body its parent body, coordinate,
- * whether it turns or slides, its multiplier and offset, R0, t0, its axis u (its joint's
- * frame), R0 u and P, C, S with R0 Rot(u, th) = P + cos th C + sin th S. ``space``: the
+ * whether it turns or slides (a helical joint both), its multiplier and offset, R0, t0, its
+ * axis u (its joint's frame), R0 u times the lead (the slide per unit th: 1 prismatic, the
+ * pitch helical) and P, C, S with R0 Rot(u, th) = P + cos th C + sin th S. ``space``: the
  * DK_T numbers of one state's work (a lane group's on the lanes: carve). */
 typedef struct {
     int nb, nj, ff, np, nv, nq, qo, vo, ltdl, once, sparse;
@@ -231,11 +232,22 @@ static void DK_FN(kinematics)(const dk_tree *tree, const DK_T *q, const DK_T *qd
         for (int j = 0; j < 3; j++)
             axis[j] = R[i][3 * j] * tree->u[i][0] + R[i][3 * j + 1] * tree->u[i][1]
                       + R[i][3 * j + 2] * tree->u[i][2];
-        /* S: [o x a; a] turning about the world axis a, [a; 0] sliding along it */
+        /* S: [o x a; a] turning about the world axis a, [a; 0] sliding along it; a helical
+           joint turns and slides: [o x a + lead a; a], lead a = R_p (lead R0 u) */
         DK_T *S = w->S[i];
         if (tree->turns[i]) {
             DK_FN(cross)(o[i], axis, S);
             for (int j = 0; j < 3; j++) S[3 + j] = axis[j];
+            if (tree->slides[i]) {
+                DK_T d[3];
+                if (p < 0)
+                    for (int j = 0; j < 3; j++) d[j] = DK_C(tree->R0u[i][j]);
+                else
+                    for (int j = 0; j < 3; j++)
+                        d[j] = R[p][3 * j] * tree->R0u[i][0] + R[p][3 * j + 1] * tree->R0u[i][1]
+                               + R[p][3 * j + 2] * tree->R0u[i][2];
+                for (int j = 0; j < 3; j++) S[j] += d[j];
+            }
         } else {
             for (int j = 0; j < 3; j++) { S[j] = axis[j]; S[3 + j] = DK_C(0.0); }
         }

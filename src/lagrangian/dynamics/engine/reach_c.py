@@ -16,7 +16,9 @@ coordinates, nf frames, fb 1 for a floating base (body 0 on a free flyer), nv = 
   nczero entries of C (row-major, nv x nv) that no body's pass sets. cset is 1 where no mimic
   joint shares a coordinate (each entry of C, A_g, J set once), else 0 (all zeroed, added to).
 - FLOATS (float64): the quaternion's bounds on |q|^2, (1 -+ QUATERNION_TOLERANCE)^2; then nb
-  each: multiplier, offset (rad or m), the axis' sign, mass (kg); then 3 a body: the joint's
+  each: multiplier, offset (rad or m), the axis' sign (a joint that only turns) or the lead
+  of one that slides (its slide along u per unit of its variable: 1 prismatic, the pitch in
+  m/rad helical, which turns and slides), mass (kg); then 3 a body: the joint's
   translation t0 in its parent (m), axis u, first moment h (kg m); then 9 a body (row-major):
   R0, the turn tables P = R0 u u^T, C = R0 (1 - u u^T), S = R0 [u]x (R0 Rot(u, th) = P +
   cos th C + sin th S), rotational inertia J (kg m^2, about the body's origin); then the
@@ -134,6 +136,9 @@ def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
     free = tree.floating_base
     models = [joint_model(j.kind) for j in joints]
     axis, sign, plain, about = _axes(joints)
+    # a sliding joint's slot of the sign holds its lead (reach_kernel.c's RK_LEAD)
+    sign = [m.lead(j.pitch) if getattr(m, "slides", False) else s
+            for m, j, s in zip(models, joints, sign, strict=True)]
     cset, zeros = _coriolis_zeros(tree)
     # a free flyer has no coordinate of the tree's (its column 0 unused)
     coordinate = [0 if free and i == 0 else j.coordinate for i, j in enumerate(joints)]

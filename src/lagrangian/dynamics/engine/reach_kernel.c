@@ -19,7 +19,9 @@ typedef struct {
     const int *parent, *coord, *turns, *slides, *axis, *R0id, *R0axis;
     const int *fbody;                 /* per frame: its body (-1: the ground) */
     const int *czero;                 /* the entries of C that no body's pass sets (cset) */
-    /* per body: multiplier, offset, the axis' sign (axis >= 0), mass (kg); 3 a body: the
+    /* per body: multiplier, offset, the axis' sign (axis >= 0) of a joint that only turns, or
+       the lead of one that slides (its slide along u per unit th: 1 prismatic, the pitch in
+       m/rad helical, which turns and slides: RK_LEAD), mass (kg); 3 a body: the
        joint's translation t0 (m), axis u, first moment h (kg m); 9 a body (row-major): R0, the
        turn tables P, C, S (R0 Rot(u, th) = P + cos th C + sin th S), inertia J (kg m^2) */
     const double *mult, *off, *axsign, *m, *t0, *u, *h, *R0, *P, *C, *S, *J;
@@ -29,6 +31,7 @@ typedef struct {
 } rk_model;
 
 #define RK_FREE(i) (md->fb && (i) == 0)
+#define RK_LEAD(i) (md->axsign[i])  /* a sliding joint's (the table's slot of the sign) */
 
 /* An output entry that one joint's column fills: set where no two joints share a coordinate
  * (cset), added to where a mimic joint's coordinate is another's (the output zeroed first) */
@@ -248,10 +251,13 @@ static inline __attribute__((always_inline)) void RK_FN(body)(const rk_model *md
         } else {
             for (int j = 0; j < 9; j++) Rl[j] = RK_C(md->R0[9 * i + j]);
         }
-        if (md->slides[i]) {
+        if (md->slides[i]) {  /* by lead th along R0 u (a prismatic joint's lead 1) */
             double d[3];
             rk_apply_tab(md->R0 + 9 * i, md->u + 3 * i, d);
-            for (int j = 0; j < 3; j++) pl[j] += th * d[j];
+            if (md->turns[i])
+                for (int j = 0; j < 3; j++) pl[j] += (RK_LEAD(i) * th) * d[j];
+            else
+                for (int j = 0; j < 3; j++) pl[j] += th * d[j];
         }
     }
     int p = md->parent[i];
@@ -295,8 +301,8 @@ static inline __attribute__((always_inline)) void RK_FN(subspace)(const rk_model
     if (md->turns[i]) {
         RK_FN(cross)(o[i], d, S);
         for (int j = 0; j < 3; j++) S[3 + j] = d[j];
-        if (md->slides[i])
-            for (int j = 0; j < 3; j++) S[j] += d[j];
+        if (md->slides[i])  /* a helical joint: and along the axis by its pitch */
+            for (int j = 0; j < 3; j++) S[j] += RK_LEAD(i) * d[j];
     } else {
         for (int j = 0; j < 3; j++) { S[j] = md->slides[i] ? d[j] : RK_C(0.0); S[3 + j] = RK_C(0.0); }
     }

@@ -1,8 +1,8 @@
 /* The compact tree kernel: the recursions of tree_algorithms.py as loops over a tree given at
    run time as one array of doubles (its layout in compact_kernel.py), compiled once for every
    tree. Units SI. Each body i hangs from parent(i) < i (or the ground, -1) by one joint:
-   R = R0 Rot(u, theta) (revolute) or R0 (prismatic), p = t0 (+ R0 u theta), with
-   theta = k q[c] + offset; R turns body axes into parent axes, p is the origin in the parent.
+   R = R0 Rot(u, theta) (revolute, helical) or R0 (prismatic), p = t0 (+ R0 u lead theta: lead
+   1 prismatic, the pitch helical), with theta = k q[c] + offset; R turns body axes into parent axes, p is the origin in the parent.
    A floating base (header flag) is body 0 on a free flyer (kind 2, free_flyer.py): q holds
    nq = 7 + n numbers (its position, quaternion x y z w, then the joints: q[7 + c]), v, a and
    tau nv = 6 + n (its twist in its own axes, linear then angular, then v[6 + c]). */
@@ -20,7 +20,7 @@
 #define TK_STRIDE 64    /* numbers per body record */
 /* a body record's fields */
 #define TK_PARENT 0
-#define TK_KIND 1       /* 0 revolute, 1 prismatic, 2 free flyer (body 0 only) */
+#define TK_KIND 1       /* 0 revolute, 1 prismatic, 2 free flyer (body 0 only), 3 helical */
 #define TK_COORD 2
 #define TK_MULT 3
 #define TK_OFFSET 4
@@ -32,6 +32,9 @@
 #define TK_J 24         /* 9: inertia about the body origin */
 #define TK_TURN 33      /* 27: R0 u u^T, R0 (1 - u u^T), R0 [u]x (row-major): a revolute joint's
                            R = R0 Rot(u, theta) = P + cos(theta) C + sin(theta) S */
+#define TK_LEAD 61      /* the slide along u per unit theta: 1 prismatic, pitch (m/rad) helical */
+#define TK_TURNS(b) ((b)[TK_KIND] == 0.0 || (b)[TK_KIND] == 3.0)
+#define TK_SLIDES(b) ((b)[TK_KIND] == 1.0 || (b)[TK_KIND] == 3.0)
 /* a body's scratch */
 #define TW_STRIDE 96
 #define TW_R 0
@@ -71,7 +74,7 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
         if (t->fb && i == 0) {  /* the free flyer, and only it, on the ground */
             if (!TK_FREE(b) || b[TK_PARENT] != -1) return -1;
         } else if (!(b[TK_COORD] >= 0 && b[TK_COORD] < t->n)
-                   || !(b[TK_KIND] == 0 || b[TK_KIND] == 1)) {
+                   || !(TK_TURNS(b) || TK_SLIDES(b))) {
             return -1;
         }
     }
@@ -99,10 +102,10 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
 /* S = (s_w, s_v) per unit rate of q (the multiplier k included): the tree's numbers alone. */
 static inline void tk_subspace(const double *b, double *sw, double *sv)
 {
-    const double k = b[TK_MULT];
+    const double k = b[TK_MULT], lead = TK_SLIDES(b) ? k * b[TK_LEAD] : 0.0;
     for (int r = 0; r < 3; r++) {
-        sw[r] = b[TK_KIND] == 0 ? k * b[TK_AXIS + r] : 0.0;
-        sv[r] = b[TK_KIND] == 1 ? k * b[TK_AXIS + r] : 0.0;
+        sw[r] = TK_TURNS(b) ? k * b[TK_AXIS + r] : 0.0;
+        sv[r] = lead * b[TK_AXIS + r];
     }
 }
 
@@ -148,7 +151,7 @@ static void TK_FN(place)(const tk_tree *t, const TK_T *q, TK_T *W)
             continue;
         }
         const TK_T theta = b[TK_MULT] * q[t->bq + (int)b[TK_COORD]] + b[TK_OFFSET];
-        if (b[TK_KIND] == 0) {
+        if (TK_TURNS(b)) {
             /* sine and cosine written out here: a libm call cost as much as the rest of an
                arm's mass matrix */
             TK_T sn, cs;
@@ -157,10 +160,15 @@ static void TK_FN(place)(const tk_tree *t, const TK_T *q, TK_T *W)
             for (int r = 0; r < 9; r++) R[r] = P[r] + cs * C[r] + sn * S[r];
             for (int r = 0; r < 3; r++) p[r] = TK_C(b[TK_T0 + r]);
         } else {
-            double Ru[3];
             for (int r = 0; r < 9; r++) R[r] = TK_C(R0[r]);
+        }
+        if (TK_SLIDES(b)) {  /* along R0 u by lead theta (a prismatic joint's lead 1) */
+            double Ru[3];
             TK_APPLY(R0, u, Ru);
-            for (int r = 0; r < 3; r++) p[r] = b[TK_T0 + r] + Ru[r] * theta;
+            if (b[TK_KIND] == 1.0)
+                for (int r = 0; r < 3; r++) p[r] = b[TK_T0 + r] + Ru[r] * theta;
+            else
+                for (int r = 0; r < 3; r++) p[r] = b[TK_T0 + r] + Ru[r] * (b[TK_LEAD] * theta);
         }
     }
 }

@@ -67,6 +67,9 @@ def frame_functions(P: str, tree: KinematicTree) -> str:
         c_table("fr_coord", "int", [j.coordinate for j in joints]),
         c_table("fr_turns", "int", [getattr(m, "turns", False) for m in models]),
         c_table("fr_slides", "int", [getattr(m, "slides", False) for m in models]),
+        # the slide per unit th: 1 prismatic, the pitch (m/rad) helical (turns and slides)
+        c_table("fr_lead", "double", [m.lead(j.pitch) if getattr(m, "slides", False) else 0.0
+                                      for m, j in zip(models, joints, strict=True)]),
         c_table("fr_mult", "double", [j.multiplier for j in joints]),
         c_table("fr_off", "double", [j.offset for j in joints]),
         c_table("fr_R0", "double", [[x for row in j.rotation for x in row] for j in joints]),
@@ -139,7 +142,7 @@ static void fr_bodies(const double *q, double (*R)[9], double (*o)[3])
             }}
             if (fr_slides[i]) {{
                 fr_apply(fr_R0[i], u, d);
-                for (int j = 0; j < 3; j++) pl[j] += th * d[j];
+                for (int j = 0; j < 3; j++) pl[j] += (fr_lead[i] * th) * d[j];
             }}
         }}
         fr_matmul(fr_R0[i], Rj, Rl);
@@ -218,7 +221,7 @@ void {P}_frame_jacobian(const double *q, int frame, int reference, double *J)
         if (fr_slides[i]) {{
             double d[3];
             fr_apply(R[i], fr_u[i], d);
-            for (int j = 0; j < 3; j++) v[j] += d[j];
+            for (int j = 0; j < 3; j++) v[j] += fr_lead[i] * d[j];
         }}
         fr_column(J, FR_BV + fr_coord[i], v, w, fr_mult[i]);
     }}
@@ -261,7 +264,7 @@ static int fr_columns(int i, double (*R)[9], double (*o)[3], double (*S)[6], int
     if (fr_slides[i]) {{
         double d[3];
         fr_apply(R[i], fr_u[i], d);
-        for (int j = 0; j < 3; j++) v[j] += d[j];
+        for (int j = 0; j < 3; j++) v[j] += fr_lead[i] * d[j];
     }}
     for (int j = 0; j < 3; j++) {{ S[0][j] = fr_mult[i] * v[j]; S[0][3 + j] = fr_mult[i] * w[j]; }}
     *first = FR_BV + fr_coord[i];

@@ -16,10 +16,14 @@ The description ``D`` (float64, contiguous), built by ``describe``:
       row-major)  14:17 t0 (m)  17:20 unit axis u (joint axes)  20 mass (kg)
       21:24 first moment h = m c about the body origin (kg m)  24:33 J_O (kg m^2, body axes)
       33:60 a revolute joint's turn tables P = R0 u u^T, C = R0 (1 - u u^T), S = R0 [u]x
-      (row-major each: R0 Rot(u, theta) = P + cos theta C + sin theta S)  60:64 spare.
-      A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone.
+      (row-major each: R0 Rot(u, theta) = P + cos theta C + sin theta S; every kind's)
+      60 spare  61 the lead: the slide along u per unit theta (1 prismatic, the pitch in m/rad
+      helical, 0 revolute)  62:64 spare.
+      A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone; a helical joint
+      (code 3) turns as a revolute one and slides by its lead.
 
-A new joint kind is a new code in JOINT_CODES and its cases in tree_kernel.c (tk_place for the
+A new joint kind is a new code in JOINT_CODES (tests/dynamics/test_joint_kinds.py walks each)
+and its cases in tree_kernel.c (tk_place for the
 placement, tk_subspace for S); the recursions themselves ask only for those. The module
 (tree_kernel.c, tree_kernel_forward.c, then its Python bindings tree_kernel_bindings.c) is keyed
 by its source alone, never the tree's numbers.
@@ -34,11 +38,14 @@ import numpy as np
 from ...kinds import JointKind
 from ...model.tree import KinematicTree, TreeJoint
 from .free_flyer import QUATERNION_TOLERANCE
+from .joint_models import JOINT_MODELS
 
 HEADER, STRIDE = 8, 64
+LEAD = 61  # a record's slide per unit theta (tree_kernel.c's TK_LEAD)
 
 
-JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FREE_FLYER: 2}
+JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FREE_FLYER: 2,
+               JointKind.HELICAL: 3}
 
 
 def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
@@ -59,6 +66,8 @@ def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray
         r[5:14] = np.ravel(j.rotation)
         r[14:17], r[17:20] = j.translation, j.axis
         r[20], r[21:24], r[24:33] = j.mass, j.first_moment, np.ravel(j.inertia)
+        model = JOINT_MODELS[JointKind(j.kind)]
+        r[LEAD] = model.lead(j.pitch) if hasattr(model, "lead") else 0.0
         R0, u = np.array(j.rotation, dtype=float), np.array(j.axis, dtype=float)
         uu = np.outer(u, u)
         skew = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
@@ -81,13 +90,15 @@ def joints_of(D: np.ndarray) -> tuple[TreeJoint, ...]:
             return tuple(tuple(float(x) for x in row) for row in np.reshape(a, (3, 3)))
 
         free = kinds[int(r[1])] == JointKind.FREE_FLYER
+        helical = kinds[int(r[1])] == JointKind.HELICAL
         out.append(TreeJoint(name="", parent=int(r[0]), kind=kinds[int(r[1])],
                              rotation=matrix(r[5:14]), translation=tuple(map(float, r[14:17])),
                              axis=tuple(map(float, r[17:20])),
                              coordinate=-1 if free else int(r[2]),
                              multiplier=float(r[3]), offset=float(r[4]), mass=float(r[20]),
-                             first_moment=tuple(map(float, r[21:24])), inertia=matrix(r[24:33])))
+                             first_moment=tuple(map(float, r[21:24])), inertia=matrix(r[24:33]),
+                             pitch=float(r[LEAD]) if helical else 0.0))
     return tuple(out)
 
 
-__all__ = ["HEADER", "JOINT_CODES", "STRIDE", "describe", "joints_of"]
+__all__ = ["HEADER", "JOINT_CODES", "LEAD", "STRIDE", "describe", "joints_of"]

@@ -2,8 +2,11 @@
 joint places its body and the motion subspace S = (s_w, s_v) that one unit of joint rate gives it.
 
 The recursions (tree_algorithms for generated code, recursive_numpy for numpy) never ask which
-kind a joint is: they use S and the placement. A new one-degree-of-freedom joint (a helical
-joint: S = (u, pitch u)) is one entry of JOINT_MODELS, not a branch in every algorithm."""
+kind a joint is: they use S and the placement. A one-degree-of-freedom joint is one entry of
+JOINT_MODELS (and its branch in each C kernel: tree_kernel.c's tk_place and tk_subspace,
+reach_kernel.c's body and subspace, derivatives_kernel.c's kinematics), not a branch in every
+algorithm. The helical joint (a screw, Pinocchio's JointModelHelicalUnaligned) turns and
+slides: S = (u, pitch u), pitch (m/rad) the joint's own number (TreeJoint.pitch)."""
 
 from __future__ import annotations
 
@@ -30,18 +33,37 @@ class JointModel:
     """One kind of one-degree-of-freedom joint: its motion subspace per unit rate, in joint axes.
 
     ``turns``: the body turns about the axis u by the joint variable (rad);
-    ``slides``: the body slides along u by the joint variable (m)."""
+    ``slides``: the body slides along u by the joint variable (m), or by pitch times it where
+    ``pitched`` (a helical joint: it turns and slides by one variable)."""
 
     kind: JointKind
     turns: bool
     slides: bool
     nq: int = 1  # configuration numbers (a free flyer's: 7, free_flyer.py)
     nv: int = 1  # velocity numbers
+    pitched: bool = False  # the slide is pitch * theta (m/rad): the joint's pitch is needed
 
-    def subspace(self, axis) -> tuple[list | None, list | None]:
-        """S = (s_w, s_v): angular and linear velocity of the body per unit rate (None: zero)."""
+    def lead(self, pitch: float | None = None) -> float:
+        """The slide per unit of the joint variable: 1 for a prismatic joint (m/m), the pitch
+        for a helical one (m/rad), 0 for one that does not slide. A pitched kind without its
+        pitch is refused by name (a caller that knows only the unpitched kinds)."""
+        if not self.slides:
+            return 0.0
+        if not self.pitched:
+            return 1.0
+        if pitch is None:
+            raise ModelError(f"a {self.kind} joint slides by its pitch times its angle: this "
+                             "algorithm was not given the joint's pitch", field="joint")
+        return float(pitch)
+
+    def subspace(self, axis, pitch: float | None = None) -> tuple[list | None, list | None]:
+        """S = (s_w, s_v): angular and linear velocity of the body per unit rate (None: zero);
+        ``pitch`` the joint's (TreeJoint.pitch), needed by a helical joint."""
         u = list(axis)
-        return (u if self.turns else None), (u if self.slides else None)
+        if not self.slides:
+            return (u if self.turns else None), None
+        lead = self.lead(pitch)
+        return (u if self.turns else None), (u if lead == 1.0 else [lead * x for x in u])
 
     def placement_terms(self, E: _Terms, joint, theta, rotation):
         """The body's rotation R (body -> parent) and origin p (m) in its parent, as terms;
@@ -52,11 +74,14 @@ class JointModel:
             sin, cos = E.sincos(theta)
             R = E.matmul(R0, rotation(E, joint, cos, sin))
         if self.slides:
-            p = E.vadd(p, E.scale(theta, E.apply(R0, joint.axis)))
+            lead = self.lead(getattr(joint, "pitch", None))
+            axis = joint.axis if lead == 1.0 else [lead * x for x in joint.axis]
+            p = E.vadd(p, E.scale(theta, E.apply(R0, axis)))
         return R, p
 
-    def placement_arrays(self, R0, t0, u, theta):
-        """R (N, 3, 3) or (3, 3) and p (N, 3) or (3,) for joint values theta (N,), in numpy."""
+    def placement_arrays(self, R0, t0, u, theta, pitch: float | None = None):
+        """R (N, 3, 3) or (3, 3) and p (N, 3) or (3,) for joint values theta (N,), in numpy;
+        ``pitch`` the joint's, needed by a helical joint."""
         R, p = R0, t0
         if self.turns:
             c, s = np.cos(theta)[:, None, None], np.sin(theta)[:, None, None]
@@ -64,17 +89,19 @@ class JointModel:
             skew = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
             R = R0 @ (uu + c * (np.eye(3) - uu) + s * skew)  # Rot(u, theta)
         if self.slides:
-            p = t0 + theta[:, None] * (R0 @ u)
+            p = t0 + (self.lead(pitch) * theta)[:, None] * (R0 @ u)
         return R, p
 
 
 # the joints of one coordinate each (the compiled kernel of reach_c.py takes only these)
-ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
+ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.HELICAL)
 
 
 JOINT_MODELS: dict[JointKind, JointModel | FreeFlyerModel] = {
     JointKind.REVOLUTE: JointModel(JointKind.REVOLUTE, turns=True, slides=False),
     JointKind.PRISMATIC: JointModel(JointKind.PRISMATIC, turns=False, slides=True),
+    # a screw: Rot(u, theta) and pitch * theta along u (S = (u, pitch u), pitch in m/rad)
+    JointKind.HELICAL: JointModel(JointKind.HELICAL, turns=True, slides=True, pitched=True),
     # a floating base: only at a tree's root, and only in numpy and frames.py (recursive.py)
     JointKind.FREE_FLYER: FreeFlyerModel(),
 }

@@ -1,0 +1,258 @@
+"""Every joint kind a kinematic tree moves (dynamics/tree/joint_models.py's JOINT_MODELS) and
+every kind expanded into them (a universal joint, lagrangian.RobotBuilder; a URDF planar joint)
+walked through every backend method (M, bias, g, ID, FD, T, V, a frame's placement and
+Jacobian, the ID and FD derivatives) on the compiled engine (dynamics(), the default) and the
+numpy reference (backend="numpy"), against Pinocchio's own model of the same robot built from
+its JointModel classes (JointModelHelicalUnaligned, JointModelUniversal, ...) to 1e-10. A kind
+with no tree here, or with no branch in a kernel, fails under its own name.
+
+Pinocchio 4.1's computeRNEADerivatives and computeABADerivatives are wrong for
+JointModelUniversal (its d tau/dq disagrees with its own rnea's finite differences by O(1)), so
+a universal joint's derivatives are checked against the same robot in Pinocchio with the joint
+as two RevoluteUnaligned joints (its rnea and aba shown equal to JointModelUniversal's first)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import lagrangian
+from lagrangian.dynamics.tree.description import JOINT_CODES
+from lagrangian.dynamics.tree.joint_models import JOINT_MODELS
+from lagrangian.kinds import JointKind
+from lagrangian.model.urdf import parse_urdf
+
+pin = pytest.importorskip("pinocchio")
+pytest.importorskip("yourdfpy")
+
+TOLERANCE = 1e-10
+BACKENDS = ("compiled", "numpy")
+
+
+def _unit(x):
+    x = np.array(x, dtype=float)
+    return x / np.linalg.norm(x)
+
+
+# (name, mass kg, centre of mass m, principal moments about it kg m^2), link axes
+LINKS = [("base", 2.0, (0.05, -0.02, 0.04), (0.05, 0.04, 0.06)),
+         ("a", 1.2, (0.1, 0.02, -0.05), (0.02, 0.03, 0.015)),
+         ("b", 0.8, (0.0, 0.1, 0.03), (0.01, 0.012, 0.02)),
+         ("c", 0.5, (0.03, -0.02, 0.1), (0.004, 0.005, 0.006)),
+         ("tool", 0.3, (0.0, 0.0, 0.02), (0.001, 0.002, 0.0015))]
+ORIGINS = [((0.1, 0.2, 0.3), (0.1, -0.2, 0.3)), ((0.2, 0.0, 0.1), (0.4, 0.1, -0.3)),
+           ((0.0, 0.15, 0.05), (-0.2, 0.3, 0.1))]
+AXES = [_unit((0.3, -0.5, 0.8)), _unit((1.0, 0.2, -0.1)), _unit((0.0, 1.0, 1.0))]
+# a second axis for each universal joint, perpendicular to the first
+SECOND = [_unit(np.cross(AXES[0], (1.0, 0.0, 0.0))), None, _unit(np.cross(AXES[2], (0.0, 0.0, 1.0)))]
+PITCHES = [0.07, 0.0, -0.12]
+TOOL = ((0.05, 0.0, 0.1), (0.2, 0.0, 0.5))  # a fixed joint from c: folded into c's body
+
+# each tree: the kinds of its joints base -> a -> b -> c (a revolute joint between, so that the
+# kind sits at the root and below a turning body), floating: a free flyer carries the base
+TREES = {
+    JointKind.REVOLUTE: (("revolute", "revolute", "revolute"), False),
+    JointKind.PRISMATIC: (("prismatic", "revolute", "prismatic"), False),
+    JointKind.HELICAL: (("helical", "revolute", "helical"), False),
+    JointKind.FREE_FLYER: (("helical", "revolute", "prismatic"), True),
+    "universal": (("universal", "revolute", "universal"), False),
+}
+EXPANDED = ("universal", "planar")
+
+
+def _builder(kinds):
+    b = lagrangian.RobotBuilder("kinds")
+    for name, mass, com, moments in LINKS:
+        b.link(name, mass=mass, com=com, inertia=moments)
+    chain = ("base", "a", "b", "c")
+    for k, kind in enumerate(kinds):
+        (xyz, rpy), axis = ORIGINS[k], AXES[k]
+        b.joint(f"j{k + 1}", kind, chain[k], chain[k + 1], xyz=xyz, rpy=rpy, axis=axis,
+                pitch=PITCHES[k] if kind == "helical" else 0.0,
+                axis2=SECOND[k] if kind == "universal" else None)
+    b.joint("tool_joint", "fixed", "c", "tool", xyz=TOOL[0], rpy=TOOL[1])
+    return b
+
+
+def _inertia(name):
+    _, mass, com, moments = next(link for link in LINKS if link[0] == name)
+    return pin.Inertia(mass, np.array(com), np.diag(moments))
+
+
+def _placement(xyz, rpy):
+    return pin.SE3(pin.rpy.rpyToMatrix(*rpy), np.array(xyz, dtype=float))
+
+
+def _joint_model(kind, k):
+    """Pinocchio's model of joint k + 1 of a tree of TREES."""
+    if kind == "revolute":
+        return pin.JointModelRevoluteUnaligned(AXES[k])
+    if kind == "prismatic":
+        return pin.JointModelPrismaticUnaligned(AXES[k])
+    if kind == "helical":
+        return pin.JointModelHelicalUnaligned(AXES[k], PITCHES[k])
+    return pin.JointModelUniversal(AXES[k], SECOND[k])
+
+
+def _pinocchio(kinds, floating, chain=False):
+    """The same robot in Pinocchio from its own joint models, and the joint of link c's body;
+    ``chain``: a universal joint as two revolute ones (for the derivatives)."""
+    model = pin.Model()
+    parent = 0
+    if floating:
+        parent = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "root_joint")
+        model.appendBodyToJoint(parent, _inertia("base"), pin.SE3.Identity())
+    for k, kind in enumerate(kinds):
+        (xyz, rpy), axis = ORIGINS[k], AXES[k]
+        joint = _joint_model(kind, k)
+        if kind == "universal" and chain:
+            parent = model.addJoint(parent, pin.JointModelRevoluteUnaligned(axis),
+                                    _placement(xyz, rpy), f"j{k + 1}_1")
+            joint = pin.JointModelRevoluteUnaligned(SECOND[k])
+            parent = model.addJoint(parent, joint, pin.SE3.Identity(), f"j{k + 1}_2")
+        else:
+            parent = model.addJoint(parent, joint, _placement(xyz, rpy), f"j{k + 1}")
+        model.appendBodyToJoint(parent, _inertia("abc"[k]), pin.SE3.Identity())
+    model.appendBodyToJoint(parent, _inertia("tool"), _placement(*TOOL))
+    return model, parent
+
+
+PLANAR_URDF = """<robot name="planar_arm">
+  <link name="world"/>
+  <link name="base"><inertial><origin xyz="0.05 -0.02 0.04"/><mass value="2"/>
+    <inertia ixx="0.05" ixy="0" ixz="0" iyy="0.04" iyz="0" izz="0.06"/></inertial></link>
+  <link name="c"><inertial><origin xyz="0.03 -0.02 0.1"/><mass value="0.5"/>
+    <inertia ixx="0.004" ixy="0" ixz="0" iyy="0.005" iyz="0" izz="0.006"/></inertial></link>
+  <joint name="mobile" type="planar"><parent link="world"/><child link="base"/>
+    <origin xyz="0.1 0.2 0.3" rpy="0.1 -0.2 0.3"/><axis xyz="0 0 1"/></joint>
+  <joint name="arm" type="revolute"><parent link="base"/><child link="c"/>
+    <origin xyz="0.2 0 0.1" rpy="0.4 0.1 -0.3"/><axis xyz="1 0 0"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+</robot>"""
+
+
+def _planar():
+    """A mobile arm on a URDF planar joint, and in Pinocchio x, y sliding and theta turning in
+    the joint's frame (the planar joint's own coordinates: rates their time derivatives)."""
+    system = lagrangian.System(parse_urdf(PLANAR_URDF))
+    model = pin.Model()
+    x = model.addJoint(0, pin.JointModelPX(), _placement(*ORIGINS[0]), "mobile_x")
+    y = model.addJoint(x, pin.JointModelPY(), pin.SE3.Identity(), "mobile_y")
+    theta = model.addJoint(y, pin.JointModelRZ(), pin.SE3.Identity(), "mobile_theta")
+    model.appendBodyToJoint(theta, _inertia("base"), pin.SE3.Identity())
+    arm = model.addJoint(theta, pin.JointModelRX(), _placement(*ORIGINS[1]), "arm")
+    model.appendBodyToJoint(arm, _inertia("c"), pin.SE3.Identity())
+    return system, model, arm
+
+
+@pytest.fixture(scope="module", params=[*sorted(JOINT_MODELS), *EXPANDED], ids=str)
+def case(request):
+    """(kind, the System, Pinocchio's model and data, the joint whose body frame "c" is,
+    states q, v, a, tau, and the Pinocchio model and data of the derivatives); every kind of
+    JOINT_MODELS is a param: one without a tree here fails by its name."""
+    kind = request.param
+    if kind == "planar":
+        system, model, body = _planar()
+        derivatives = model
+    else:
+        if kind not in TREES:
+            pytest.fail(f"no tree walks the {kind} joint: add one to TREES")
+        kinds, floating = TREES[kind]
+        system = _builder(kinds).build(floating_base=floating)
+        model, body = _pinocchio(kinds, floating)
+        derivatives = _pinocchio(kinds, floating, chain=True)[0]
+    data = model.createData()
+    rng = np.random.default_rng(7)
+    q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq)) \
+        if kind == JointKind.FREE_FLYER else rng.uniform(-1.0, 1.0, model.nq)
+    v, a = rng.uniform(-1.0, 1.0, (2, model.nv))
+    assert len(system.dynamics().coordinates) == model.nq, kind
+    tau = pin.rnea(model, data, q, v, a)
+    chain = derivatives.createData()  # the same robot: the same ID and FD
+    _agree(pin.rnea(derivatives, chain, q, v, a), tau, f"{kind}: Pinocchio's two models")
+    _agree(pin.aba(derivatives, chain, q, v, tau), a, f"{kind}: Pinocchio's two models")
+    return kind, system, model, data, body, (q, v, a, tau), (derivatives, chain)
+
+
+@pytest.fixture(scope="module")
+def backends(case):
+    system = case[1]
+    return {"compiled": system.dynamics(), "numpy": system.dynamics(backend="numpy")}
+
+
+def _agree(ours, theirs, what):
+    ours, theirs = np.asarray(ours, dtype=float), np.asarray(theirs, dtype=float)
+    assert ours.shape == theirs.shape, what
+    error = float(np.abs(ours - theirs).max())
+    assert error <= TOLERANCE * (1.0 + float(np.abs(theirs).max())), f"{what}: off by {error:.2e}"
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_dynamics_agree_with_pinocchio(case, backends, backend):
+    kind, _, model, data, _, (q, v, a, tau), _ = case
+    d = backends[backend]
+    where = f"{kind} joint, {backend}"
+    assert (getattr(d, "kernel", None) == "compact" if backend == "compiled"
+            else d.backend == "recursive-numpy"), where
+    M = pin.crba(model, data, q)
+    _agree(d.mass_matrix(q), np.triu(M) + np.triu(M, 1).T, f"{where}: M")
+    _agree(d.bias_forces(q, v), pin.nle(model, data, q, v), f"{where}: bias")
+    _agree(d.gravity(q), pin.computeGeneralizedGravity(model, data, q), f"{where}: g")
+    _agree(d.inverse_dynamics(q, v, a), tau, f"{where}: ID")
+    _agree(d.forward_dynamics(q, v, tau), pin.aba(model, data, q, v, tau), f"{where}: FD")
+    _agree(d.kinetic_energy(q, v), pin.computeKineticEnergy(model, data, q, v), f"{where}: T")
+    _agree(d.potential_energy(q), pin.computePotentialEnergy(model, data, q), f"{where}: V")
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_frames_agree_with_pinocchio(case, backends, backend):
+    kind, _, model, data, body, (q, *_), _ = case
+    d = backends[backend]
+    where = f"{kind} joint, {backend}"
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    _agree(d.placement(q, "c"), data.oMi[body].homogeneous, f"{where}: placement")
+    for reference, pinocchio in (("local_world_aligned", pin.LOCAL_WORLD_ALIGNED),
+                                 ("local", pin.LOCAL), ("world", pin.WORLD)):
+        _agree(d.jacobian(q, "c", reference),
+               pin.getJointJacobian(model, data, body, pinocchio), f"{where}: J {reference}")
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_derivatives_agree_with_pinocchio(case, backends, backend):
+    kind, system, _, _, _, (q, v, a, tau), (model, data) = case
+    d = backends[backend]
+    where = f"{kind} joint, {backend}"
+    if backend == "numpy" and system.model.kinematic_tree.floating_base:
+        with pytest.raises(lagrangian.LagrangianError, match="floating"):
+            d.inverse_dynamics_derivatives(q, v, a)
+        return
+    dq, dv, _ = pin.computeRNEADerivatives(model, data, q, v, a)
+    ours = d.inverse_dynamics_derivatives(q, v, a)
+    _agree(ours[0], dq, f"{where}: d tau/dq")
+    _agree(ours[1], dv, f"{where}: d tau/dv")
+    fq, fv, inverse = pin.computeABADerivatives(model, data, q, v, tau)
+    ours = d.forward_dynamics_derivatives(q, v, tau)
+    _agree(ours[0], fq, f"{where}: d a/dq")
+    _agree(ours[1], fv, f"{where}: d a/dv")
+    _agree(ours[2], inverse, f"{where}: d a/d tau")
+
+
+def test_every_kind_has_a_code_and_a_tree():
+    """A kind in JOINT_MODELS has its record code (description.py) and a tree here."""
+    assert set(JOINT_CODES) == set(JOINT_MODELS), set(JOINT_MODELS) ^ set(JOINT_CODES)
+    missing = sorted(set(JOINT_MODELS) - set(TREES))
+    assert not missing, f"no tree walks the {', '.join(missing)} joint"
+
+
+def test_a_kind_without_its_branch_is_refused_by_the_engine():
+    """A record code the kernel has no branch for is refused by tk_open: no silent motion."""
+    from lagrangian.dynamics.engine.compact_kernel import kernel_module
+    from lagrangian.dynamics.tree.description import HEADER, describe
+
+    system = _builder(TREES[JointKind.HELICAL][0]).build()
+    tree = system.model.kinematic_tree
+    D = np.array(describe(tree, {"g": 9.81}))
+    D[HEADER + len(tree.coordinates) + 1] = 9.0  # body 0's kind: a code no branch takes
+    with pytest.raises((TypeError, ValueError), match="not a tree description"):
+        kernel_module().mass_matrix(np.zeros(len(tree.coordinates)), D)

@@ -238,6 +238,52 @@ def test_derivatives_agree_with_pinocchio(case, backends, backend):
     _agree(ours[2], inverse, f"{where}: d a/d tau")
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_momentum_coriolis_and_regressor_agree_with_pinocchio(case, backends, backend):
+    """The centre of mass, A_g, J_dot v, C(q, v) and the regressor Y (Pinocchio's C and Y
+    of a universal joint from its two revolute joints, as its derivatives)."""
+    kind, _, model, data, body, (q, v, a, tau), (chain, chain_data) = case
+    d = backends[backend]
+    where = f"{kind} joint, {backend}"
+    _agree(d.center_of_mass(q), pin.centerOfMass(model, data, q), f"{where}: com")
+    _agree(d.centroidal_momentum_matrix(q), pin.ccrba(model, data, q, v), f"{where}: A_g")
+    pin.forwardKinematics(model, data, q, v, np.zeros(model.nv))
+    _agree(d.jacobian_dot_times_v(q, v, "c", "local_world_aligned"),
+           pin.getClassicalAcceleration(model, data, body, pin.LOCAL_WORLD_ALIGNED).vector,
+           f"{where}: J_dot v")
+    _agree(d.coriolis_matrix(q, v), pin.computeCoriolisMatrix(chain, chain_data, q, v),
+           f"{where}: C")
+    Y = d.regressor(q, v, a)
+    _agree(Y, pin.computeJointTorqueRegressor(chain, chain_data, q, v, a), f"{where}: Y")
+    _agree(Y @ d.inertial_parameters(), tau, f"{where}: Y pi")
+
+
+def test_a_batch_is_its_single_calls(case, backends):
+    """The compiled engine's batches (vector lanes) on each kind: rows equal the single calls
+    (M, ID, FD bit for bit; a frame's Jacobian and the derivatives to 1e-13), a NaN state's
+    row NaN."""
+    kind, _, model, _, _, (q, v, a, tau), _ = case
+    d = backends["compiled"]
+    rng = np.random.default_rng(11)
+    Q = np.array([pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+                  for _ in range(9)])
+    V, A = rng.uniform(-1.0, 1.0, (2, 9, model.nv))
+    Q[4, -1] = np.nan
+    with pytest.warns(lagrangian.DynamicsWarning):
+        batches = [d.mass_matrix(Q), d.inverse_dynamics(Q, V, A), d.forward_dynamics(Q, V, A),
+                   d.jacobian(Q, "c"), d.forward_dynamics_derivatives(Q, V, A)[0]]
+    for k, batch in enumerate(batches):
+        assert np.isnan(batch[4]).all(), (kind, k)
+        for i in (0, 3, 8):
+            single = [d.mass_matrix(Q[i]), d.inverse_dynamics(Q[i], V[i], A[i]),
+                      d.forward_dynamics(Q[i], V[i], A[i]), d.jacobian(Q[i], "c"),
+                      d.forward_dynamics_derivatives(Q[i], V[i], A[i])[0]][k]
+            if k < 3:
+                assert np.array_equal(batch[i], single), (kind, k, i)
+            else:
+                _agree(batch[i], single, f"{kind}: batch {k}, row {i}")
+
+
 def test_every_kind_has_a_code_and_a_tree():
     """A kind in JOINT_MODELS has its record code (description.py) and a tree here."""
     assert set(JOINT_CODES) == set(JOINT_MODELS), set(JOINT_MODELS) ^ set(JOINT_CODES)

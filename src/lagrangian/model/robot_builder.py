@@ -52,7 +52,7 @@ _MOVING = ("revolute", "prismatic", HELICAL)
 @dataclass(frozen=True)
 class _Inertial:  # what urdf_tree.numeric_tree reads of a link's inertial
     mass: float
-    origin: np.ndarray  # 4 x 4: the centre of mass in link axes (the inertial frame's axes = the link's)
+    origin: np.ndarray  # 4 x 4: the centre of mass in link axes (the inertial's axes the link's)
     inertia: np.ndarray  # about the centre of mass, link axes (kg m^2)
 
 
@@ -75,7 +75,7 @@ class _Joint:  # a URDF joint's fields, and a helical joint's pitch (m/rad)
     mimic: None = None
 
 
-@dataclass
+@dataclass(eq=False)
 class RobotTree:
     """A robot's links and joints as given (``link``, ``joint``), read into a Model by
     ``build_model`` (the URDF reader's model, with its kinematic tree)."""
@@ -122,7 +122,8 @@ class RobotTree:
         """Add a joint of ``kind`` (KINDS) from link ``parent`` to link ``child``, its frame at
         ``xyz`` (m), ``rpy`` (rad) in the parent's; ``axis`` (joint axes, made unit), a helical
         joint's ``pitch`` (m/rad), a universal joint's second axis ``axis2`` (perpendicular to
-        ``axis``); ``limits`` (lower, upper) of its coordinate (rad or m)."""
+        ``axis``); ``limits`` (lower, upper) of its coordinate (rad or m; a universal joint's
+        two coordinates each)."""
         where = f"joint '{name}'"
         self._name(name, where)
         if name in {j.name for j in self.joints} | {j.name for j in self._universal}:

@@ -8,6 +8,7 @@ answer reader reads this notation back (model/answer_notation.py).
 from __future__ import annotations
 
 import re
+import unicodedata
 
 import sympy as sp
 
@@ -22,6 +23,7 @@ SUPERSCRIPTS = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
 SUBSCRIPTS = str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉")
 DOT, DDOT = "\u0307", "\u0308"
 MINUS = "−"
+_LOWERED = set("₀₁₂₃₄₅₆₇₈₉")
 _NAME = re.compile(r"^([A-Za-z]+?)(\d*)(_dot|_ddot)?$")
 
 
@@ -124,7 +126,10 @@ def _factor(expr: sp.Expr) -> str:
 def _function(expr: sp.Function, power: str) -> str:
     name = {"Abs": "abs"}.get(type(expr).__name__, type(expr).__name__)
     if len(expr.args) == 1 and expr.args[0].is_Symbol and name in ("sin", "cos", "tan"):
-        return f"{name}{power}{_factor(expr.args[0])}"
+        letter = _factor(expr.args[0])
+        bare = "".join(c for c in letter if not unicodedata.combining(c) and c not in _LOWERED)
+        if len(bare) == 1:  # cosθ, sinφ₁; a longer name keeps its parentheses: cos(lam)
+            return f"{name}{power}{letter}"
     inner = ", ".join(_add(a) for a in expr.args)
     return f"{name}{power}({inner})"
 

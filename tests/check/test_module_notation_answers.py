@@ -76,3 +76,17 @@ def test_implicit_products_read_as_the_module_means_them():
     assert finding(report, "V").status == "equivalent"  # another datum
     with pytest.raises(ModelError, match="energy.T"):  # still refused: nothing to read
         check_text("pendulum", '[energy]\nT = "½ m L² θ̇² +"\n')
+
+
+@pytest.mark.parametrize("model", ["pendulum", "two_mass", "double_pendulum", "bead_on_hoop"])
+def test_what_conserved_prints_in_the_modules_notation_reads_back(model):
+    """The printer (output/module_notation.py) and the answer reader agree: T and V printed as
+    the module writes them are checked correct."""
+    from check_helpers import system
+
+    from lagrangian.output.module_notation import module_notation
+
+    eom = system(model).equations_of_motion()
+    T, V = module_notation(eom.kinetic_energy), module_notation(eom.potential_energy)
+    report = check_text(model, f'[energy]\nT = "{T}"\nV = "{V}"\n')
+    assert report.correct, (T, V, report)

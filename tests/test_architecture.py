@@ -47,7 +47,7 @@ ALLOWED_CIRCLES = (
     frozenset({"lagrangian.cli", *(f"lagrangian.cli.{name}" for name in (
         "check", "codegen", "cycle", "derive", "dynamics", "equilibria", "examples", "forces",
         "kinematics", "modes", "regressor", "report", "simulate", "speeds", "statics",
-        "sweep", "export", "optimize"))}),
+        "sweep", "export", "optimize", "conserved"))}),
 )
 
 

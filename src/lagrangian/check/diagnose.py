@@ -118,7 +118,7 @@ def check_answer(eom: EquationsOfMotion, answer: Answer) -> CheckReport:
         findings += numeric.run(checker.dissipation, [answer.dissipation], [eom.dissipation],
                                 answer.dissipation)
     if answer.lagrangian is not None:  # checked as T - V
-        findings += numeric.run(lambda value: lagrangian_findings(checker, value),
+        findings += numeric.run(lambda value: lagrangian_findings(checker, value, Finding),
                                 [answer.lagrangian], [eom.lagrangian], answer.lagrangian)
     for name, value in answer.generalized_forces:
         i = [c.name for c in model.coordinates].index(name)

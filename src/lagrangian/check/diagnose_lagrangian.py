@@ -16,10 +16,9 @@ from ..model.expressions import format_expression as fmt
 from . import equivalence as eq
 
 
-def lagrangian_findings(checker, L_user: sp.Expr) -> list:
-    """The findings on L (item "L"); ``checker`` is diagnose's _Checker."""
-    from .diagnose import Finding
-
+def lagrangian_findings(checker, L_user: sp.Expr, Finding) -> list:
+    """The findings on L (item "L"); ``checker`` is diagnose's _Checker, ``Finding`` its
+    finding type (passed in: this room sits below diagnose)."""
     eom, points, model = checker.eom, checker.points, checker.model
     T, V = eom.kinetic_energy, eom.potential_energy
     L = T - V

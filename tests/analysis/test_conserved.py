@@ -160,3 +160,20 @@ def test_a_real_eigenvalue_has_no_damping_ratio_in_the_modes_table():
     analysis = lagrangian.load("pendulum").modes(about={"theta": math.pi})
     row = [line for line in modes_text(analysis).splitlines() if "grows" in line][0]
     assert row.split()[4] == "–"
+
+
+def test_a_cyclic_coordinate_that_l_still_shows_leaves_the_reduced_model(models, tmp_path):
+    """sin^2 phi + cos^2 phi in T: phi is cyclic (by value), and the Routhian of Kepler's
+    problem has the effective potential p^2/(2 m r^2) - k/r in r alone."""
+    from conserved_models import KEPLER
+
+    path = tmp_path / "kepler_dressed.toml"
+    path.write_text(KEPLER.replace('T = "1/2*m*(r_dot^2 + r^2*phi_dot^2)"',
+                                   'T = "1/2*m*(r_dot^2 + r^2*phi_dot^2)*(sin(phi)^2 + cos(phi)^2)"'))
+    reduced = lagrangian.load(path).routhian("phi")
+    m, k, r = _symbols(models["kepler"], "m", "k", "r")
+    p = sp.Symbol("p_phi")
+    assert reduced.model.potential_energy.free_symbols <= {m, k, r, p}
+    assert sp.simplify(reduced.model.potential_energy - (p**2 / (2 * m * r**2) - k / r)) == 0
+    circular = reduced.with_parameters(p_phi=math.sqrt(2.0 * 3.0 * 1.5))  # r0 = p^2/(m k)
+    assert circular.equilibria()[0].coordinates["r"] == pytest.approx(1.5, rel=1e-9)

@@ -73,11 +73,11 @@ class Hamiltonian:
     def _functions(self):
         model = self.eom.model
         q, q_dot, t = model.q, model.q_dot, model.time
-        values = {p.symbol: float(p.value) for p in model.parameters if p.value is not None}
+        values = {p.symbol: sp.Float(p.value) for p in model.parameters if p.value is not None}
         L = self.eom.lagrangian
         parts = [*self.inertia, *self.shift, *(L.diff(x) for x in q),
                  *self.eom.generalized_forces]
-        parts = [sp.sympify(e).xreplace(values) for e in parts]  # safe: sympy objects
+        parts = [sp.sympify(sp.sympify(e).xreplace(values)) for e in parts]  # sympy objects
         missing = set().union(*(e.free_symbols for e in parts)) - {*q, *q_dot, t}
         if missing:
             raise ModelError("parameters without a value: "

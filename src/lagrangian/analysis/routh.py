@@ -81,14 +81,22 @@ def routhian_model(eom: EquationsOfMotion, cyclic: Sequence[str]) -> Model:
                          field="routh")
     solved = (A.inv() if len(v_c) > 1 else sp.Matrix([[1 / A[0, 0]]])) \
         * (sp.Matrix(p_symbols) - b)
-    rates = {v: sp.simplify(s) for v, s in zip(v_c, solved, strict=True)}
+    # L does not depend on a cyclic coordinate, though it may still show it (sin^2 psi +
+    # cos^2 psi): it is set to 0, so the reduced model has the kept coordinates only
+    absent = {model.q[i]: sp.S.Zero for i in index}
+    rates = {v: sp.factor_terms(sp.together(s.xreplace(absent)))
+             for v, s in zip(v_c, solved, strict=True)}
+    L = L.xreplace(absent)
     reduced = sp.expand(L.xreplace(rates) - sum((p * rates[v] for p, v in
                                                  zip(p_symbols, v_c, strict=True)), sp.S.Zero))
-    reduced = sp.expand(sp.simplify(reduced)) if sp.count_ops(reduced) < 400 else reduced
     kept = [c for c in model.coordinates if c.name not in cyclic]
     kept_velocities = dict.fromkeys((c.velocity for c in kept), sp.S.Zero)
     potential = -reduced.xreplace(kept_velocities)
     kinetic = sp.expand(reduced + potential)
+    if sp.count_ops(kinetic) < 400:
+        kinetic = sp.expand(sp.simplify(kinetic))
+    if sp.count_ops(potential) < 2000:  # the effective potential, tidied (the top's: 3 s)
+        potential = sp.simplify(potential)
     start = resolve_state(model)
     state = {**dict(zip(model.q, start.q_array(), strict=True)),
              **dict(zip(model.q_dot, start.q_dot_array(), strict=True)), model.time: 0.0}
@@ -99,7 +107,7 @@ def routhian_model(eom: EquationsOfMotion, cyclic: Sequence[str]) -> Model:
         number = float(value) if value.is_number else None
         parameters.append(Parameter(symbol.name, symbol, number,
                                     momentum_unit(model.coordinates[i].unit)))
-    forces = tuple((c.name, Q.xreplace(rates)) for c, Q in
+    forces = tuple((c.name, Q.xreplace(absent).xreplace(rates)) for c, Q in
                    zip(model.coordinates, eom.generalized_forces, strict=True)
                    if c.name not in cyclic and Q != 0)
     return Model(name=f"{model.name}, reduced by Routh ({', '.join(cyclic)} cyclic)",

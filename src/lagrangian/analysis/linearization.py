@@ -196,10 +196,17 @@ def linear_model_at(
 ) -> LinearModel:
     """The linear model at a known equilibrium (q0, lambda0), from the compiled functions."""
     model = functions.model
-    values = functions.evaluate(np.asarray(q0, dtype=float), t)
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused just below
+        values = functions.evaluate(np.asarray(q0, dtype=float), t)
+        stiffness = total_stiffness(values, multipliers)
     n = functions.n
     mass, damping = values["mass"], values["damping"]
-    stiffness = total_stiffness(values, multipliers)
+    for matrix, what in ((mass, "mass matrix M"), (damping, "damping matrix C"),
+                         (stiffness, "stiffness matrix K")):
+        if not np.all(np.isfinite(matrix)):
+            raise DerivationError(f"the {what} is not finite at this equilibrium (a number "
+                                  "beyond floating point: m L^2 of L = 1e300 overflows)")
+    _require_balance(functions, values, multipliers)
     kinds = [c.kind for c in model.constraints]
     holonomic = [i for i, k in enumerate(kinds) if k == ConstraintKind.HOLONOMIC]
     velocity = [i for i, k in enumerate(kinds) if k != ConstraintKind.HOLONOMIC]
@@ -241,6 +248,27 @@ def linear_model_at(
         full_damping_matrix=damping,
         full_stiffness_matrix=stiffness,
     )
+
+
+# The forces at an equilibrium balance to this fraction of the largest force at play.
+BALANCE_TOLERANCE = 1e-6
+
+
+def _require_balance(functions, values, multipliers) -> None:
+    """The equilibrium checked once more, in numbers that cannot overflow a scale: a force of
+    1e308 N left unbalanced was judged against an infinite scale and passed."""
+    force = values["forcing"]
+    reaction = values["jacobian"].T @ np.asarray(multipliers, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        residual = force - reaction
+    scale = max(float(np.abs(force).max(initial=0.0)),
+                float(np.abs(reaction).max(initial=0.0)), 1.0)
+    worst = int(np.argmax(np.abs(residual))) if residual.size else 0
+    if residual.size and not (np.all(np.isfinite(residual)) and
+                              abs(residual[worst]) <= BALANCE_TOLERANCE * scale):
+        name = functions.model.coordinates[worst].name
+        raise ModelError(f"not an equilibrium: the forces at rest do not balance (residual "
+                         f"{residual[worst]:.3g} on {name})", field="about")
 
 
 def is_statically_stable(functions: AtRestFunctions, q0: np.ndarray, multipliers: np.ndarray,

@@ -43,6 +43,13 @@ class _Held:
 def trimmed_linear_model(functions: AtRestFunctions, about: Mapping[str, float] | None,
                          inputs: Sequence[str],
                          rebuild: Callable[[dict[str, float]], AtRestFunctions]) -> LinearModel:
+    """trimmed_linear_model without numpy's warnings: an overflow (F = 1e308) is judged by the
+    residual and the linear model's own finiteness check, in one line."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        return _trimmed(functions, about, inputs, rebuild)
+
+
+def _trimmed(functions, about, inputs, rebuild) -> LinearModel:
     """The linear model about ``about`` with the ``inputs`` at their trim (``trim`` and
     ``nominal_inputs`` of the result: the values that hold the state, the model's own). Where
     the model's own values hold it, those are the trim; else least squares over the inputs.
@@ -52,7 +59,7 @@ def trimmed_linear_model(functions: AtRestFunctions, about: Mapping[str, float] 
     parameters = dict(functions.parameters)
     symbols = [input_parameter(model, name) for name in inputs]
     nominal = np.array([0.0 if s is None else float(parameters[str(s)]) for s in symbols])
-    try:
+    try:  # the model's own values hold it (the balance checked again by linear_model_at)
         q, multipliers = resolve_equilibrium(functions, about)
         return _model(functions, q, multipliers, inputs, nominal, nominal, parameters)
     except ModelError as refusal:
@@ -74,8 +81,9 @@ def trimmed_linear_model(functions: AtRestFunctions, about: Mapping[str, float] 
         jacobian = values["jacobian"]
         columns = input_columns(current.eom, q0, inputs, current.parameters)
         system = np.hstack([columns, -jacobian.T])
-        with np.errstate(all="ignore"):
-            solution = np.linalg.lstsq(system, -force, rcond=None)[0]
+        solution = np.linalg.lstsq(system, -force, rcond=None)[0] \
+            if np.all(np.isfinite(system)) and np.all(np.isfinite(force)) \
+            else np.full(system.shape[1], np.nan)
         step = solution[:len(inputs)]
         residual = force + system @ solution
         scale = max(float(np.abs(force).max(initial=0.0)),

@@ -444,7 +444,10 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
 
             return trimmed_linear_model(functions, about, inputs, lambda values: AtRestFunctions(
                 self.equations_of_motion(), values))
-        q, multipliers = resolve_equilibrium(functions, about)
+        import numpy as np
+
+        with np.errstate(over="ignore", invalid="ignore"):  # judged by linear_model_at's check
+            q, multipliers = resolve_equilibrium(functions, about)
         return linear_model_at(functions, q, multipliers)
 
     def modes(self, about: Mapping[str, float] | None = None, *,

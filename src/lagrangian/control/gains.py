@@ -13,6 +13,8 @@ def square_matrix(value, size: int, field: str, *, definite: bool = False) -> np
     """A size x size symmetric matrix from a number, a diagonal of ``size`` numbers or a
     matrix; positive semidefinite (``definite``: positive definite), finite."""
     array = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(array)):  # before inf * I makes NaN (and numpy's warning)
+        raise InputError("entries must be finite numbers", field=field)
     if array.ndim == 0:
         array = array * np.eye(size)
     elif array.ndim == 1 and array.shape == (size,):

@@ -147,8 +147,9 @@ def simulate(
             run = replace(run, message=f"{run.message}: {lock}")
 
     t, q, q_dot = run.t, run.y[:, :functions.n], run.y[:, functions.n:]
-    energy = functions.energy(q, q_dot, t)
-    kinetic = energy - functions.energy(q, np.zeros_like(q_dot), t)  # T: E less its q_dot = 0 part
+    with np.errstate(over="ignore", invalid="ignore"):  # a failed run's overflow: NaN, quietly
+        energy = functions.energy(q, q_dot, t)
+        kinetic = energy - functions.energy(q, np.zeros_like(q_dot), t)  # T: E less its V
     power = np.einsum("ki,ki->k", power_terms(q, q_dot, t), q_dot)
     controls = control_forces = None
     if loop is not None or law is not None:  # the controller's work enters the balance

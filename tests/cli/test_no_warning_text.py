@@ -1,0 +1,58 @@
+"""Odd numbers on the command line (1e308, inf, nan, 1e-320, 1e300 in --set, --Q, --kp, ...):
+each answer or refusal comes without numpy's RuntimeWarning text around it, a refusal in one
+line (issue 39: 13 refusals were several lines long). Found by fuzzing the CLI with these
+numbers in --set, --initial, --q, --v, --Q, --R, --kp, --t-end, --about and --at."""
+
+from __future__ import annotations
+
+import warnings
+
+import pytest
+
+CART = ["cart_pendulum", "--t-end", "0.2", "--samples", "3", "--about", "theta=pi"]
+
+
+def _quiet(cli, *args):
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")  # each warning shown, not once per place
+        result = cli(*args)
+    leaked = [str(w.message) for w in seen if issubclass(w.category, RuntimeWarning)]
+    assert not leaked, leaked
+    assert "Warning" not in result.err and "Traceback" not in result.err
+    return result
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    # m L^2 of L = 1e300 overflows: M is inf (was scipy's "array must not contain infs")
+    (("modes", "pendulum", "--set", "L=1e300"), "error: the mass matrix M is not finite"),
+    (("simulate", *CART, "--control", "lqr", "--inputs", "F", "--Q", "inf"),
+     "error: --Q: entries must be finite numbers"),
+    (("simulate", *CART, "--control", "lqr", "--inputs", "F", "--R", "nan"),
+     "error: --R: entries must be finite numbers"),
+    (("simulate", *CART, "--control", "computed-torque", "--kp", "inf"),
+     "error: --kp: entries must be finite numbers"),
+])
+def test_a_refusal_is_one_line_without_warnings(cli, args, message):
+    result = _quiet(cli, *args)
+    assert result.code == 2
+    assert len(result.err.strip().splitlines()) == 1 and result.err.startswith(message)
+
+
+def test_a_failed_run_of_a_huge_mass_says_why_without_warnings(cli):
+    # m = 1e308: T overflows at the first step; simulate's verdict (exit 1) with the reason
+    result = _quiet(cli, "simulate", "pendulum", "--t-end", "1", "--set", "m=1e308")
+    assert result.code == 1
+    assert "too large to integrate" in result.err
+
+
+def test_a_huge_file_value_of_the_input_is_trimmed_quietly(cli):
+    # the push F = 1e308 N in the file: the trim takes it off (F = 0 holds the upright); it
+    # was taken as the trim, the 1e308 N residual judged against a scale that overflowed
+    result = _quiet(cli, "modes", "cart_pendulum", "--about", "x=0,theta=pi", "--inputs", "F",
+                    "--set", "F=1e308")
+    assert result.code == 0, result.err
+    assert "trim (the inputs' values that hold the equilibrium, SI): F = 0" in result.out
+    result = _quiet(cli, "modes", "cart_pendulum", "--about", "x=0,theta=pi", "--set", "F=1e308")
+    assert result.code == 2
+    assert result.err.strip() == ("error: --about: not an equilibrium: the forces at rest do not "
+                                  "balance (residual 1e+308 on x)")

@@ -45,7 +45,8 @@ def runnable_examples():
 def test_c_backend_agrees_with_numpy_on_every_example(name):
     system = lagrangian.load(name)
     fast, slow = system.numeric(backend="c"), system.numeric(backend="numpy")
-    assert (fast.backend, slow.backend) == ("c", "numpy")
+    # compiled: generated C, or a tree's recursions on the engine (one module for every tree)
+    assert (fast.backend in ("c", "compact"), slow.backend) == (True, "numpy")
     rng = np.random.default_rng(7)
     q, q_dot, t = rng.uniform(-1, 1, (4, 3, fast.n)), rng.uniform(-1, 1, (4, 3, fast.n)), 0.7
     for function in ("mass_matrix", "forcing", "constraint_jacobian", "acceleration_rhs",

@@ -62,7 +62,8 @@ def derive(
             if found is not None:
                 from ..output.conserved import conserved_document
 
-                document["conserved"] = conserved_document(found, eom.model)["conserved"]
+                # part of the working: derive's own keys stay as without --steps
+                document["steps"]["conserved"] = conserved_document(found, eom.model)["conserved"]
         print_json(document)
     elif format is Format.latex:
         latex = derivation_latex(eom, standalone=standalone, expand=expand)

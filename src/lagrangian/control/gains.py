@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from ..errors import InputError
@@ -12,7 +14,14 @@ LARGEST_ENTRY = 1e100  # a weight's or gain's entry; its square stays far inside
 def square_matrix(value, size: int, field: str, *, definite: bool = False) -> np.ndarray:
     """A size x size symmetric matrix from a number, a diagonal of ``size`` numbers or a
     matrix; positive semidefinite (``definite``: positive definite), finite."""
-    array = np.asarray(value, dtype=float)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # a complex entry: numpy's ComplexWarning refused
+            array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, Warning):  # text, a ragged list, a mapping, 1j
+        raise InputError(f"expected a number, {size} diagonal entries or a {size} x {size} "
+                         f"matrix of real numbers, got {type(value).__name__}",
+                         field=field) from None
     if not np.all(np.isfinite(array)):  # before inf * I makes NaN (and numpy's warning)
         raise InputError("entries must be finite numbers", field=field)
     if array.ndim == 0:

@@ -115,9 +115,11 @@ def lqr(linear_model: LinearModel, Q, R) -> LQR:
     except (np.linalg.LinAlgError, ValueError) as exc:
         raise InputError(f"no stabilizing Riccati solution ({exc}); Q must weigh every "
                          "unstable mode", field="Q") from None
-    try:
-        K = np.linalg.solve(R, B.T @ S)
-        closed = np.linalg.eigvals(A - B @ K)
+    try:  # a subnormal R (2e-309) overflows K: refused below as not stabilizing, quietly
+        with np.errstate(all="ignore"):
+            K = np.linalg.solve(R, B.T @ S)
+            closed = np.linalg.eigvals(A - B @ K) if np.all(np.isfinite(K)) \
+                else np.array([np.nan])
     except np.linalg.LinAlgError:  # a solution too ill-conditioned to trust: refused as one
         closed = np.array([np.nan])
     if not np.all(closed.real < 0):

@@ -83,8 +83,21 @@ def example_robot(name: str) -> Path | None:
 def example_robots() -> list[dict[str, object]]:
     """Each robot as {"name", "path", "package", "shadowed"}: ``shadowed`` when a built-in
     example has the same name (that example is what the name loads; the robot loads by path)."""
-    from .examples import example_names
-
-    builtin = set(example_names())
+    builtin = _built_in_names()
     return [{"name": name, "path": str(path), "package": path.parts[-3],
              "shadowed": name in builtin} for name, path in installed_robots().items()]
+
+
+def shadowed(name: str) -> bool:
+    """Whether a built-in example has the name ``name`` (it comes first)."""
+    return name in _built_in_names()
+
+
+def _built_in_names() -> set[str]:
+    """The built-in examples' names (model/examples' files, read here without importing that
+    module, which names these robots in its own refusal)."""
+    from importlib import resources
+
+    folder = resources.files("lagrangian.model.examples")
+    return {Path(entry.name).stem for entry in folder.iterdir()
+            if entry.name.endswith((".toml", ".urdf"))}

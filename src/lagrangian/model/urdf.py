@@ -67,15 +67,14 @@ def example_urdf(name: str):
     example shadows, or None."""
     from importlib import resources
 
-    from .examples import example_names
-    from .robots import example_robot
+    from .robots import example_robot, shadowed
 
     entry = resources.files("lagrangian.model.examples") / f"{name}.urdf"
     if not re.fullmatch(r"\w+", name):
         return None
     if entry.is_file():
         return Path(str(entry))
-    return None if name in example_names() else example_robot(name)
+    return None if shadowed(name) else example_robot(name)
 
 
 def parse_urdf(text: str, *, source: str = "<urdf>",

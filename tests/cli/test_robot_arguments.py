@@ -119,3 +119,16 @@ def test_python_lock_texts_and_limits(slider):
                      "'hinge'"]
     with pytest.raises(lagrangian.ModelError, match="not an angle"):
         lagrangian.load(slider, lock={"hinge": "1kg"})
+
+
+def test_a_lock_warns_exactly_as_q_does(cli):
+    # 100 rad on the two-link arm's shoulder: a bare angle beyond a turn, and beyond its limit
+    code, _, err_q = cli("dynamics", "two_link_arm", "--q", "100,0")
+    assert code == 0
+    code, _, err_lock = cli("dynamics", "two_link_arm", "--lock", "shoulder=100")
+    assert code == 0
+    from_q = [line.replace("--q ", "", 1) for line in err_q.splitlines() if "--q " in line]
+    from_lock = [line.replace("--lock ", "", 1) for line in err_lock.splitlines()
+                 if "--lock " in line]
+    assert from_q == from_lock and len(from_q) == 2
+    assert "is read as 100 rad (5729.58 deg); write 100deg for degrees" in from_q[0]

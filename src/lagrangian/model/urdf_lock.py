@@ -5,6 +5,7 @@ and its position limit as a coordinate's value is (beyond the limit: a ModelWarn
 from __future__ import annotations
 
 import math
+import re
 import warnings
 
 from ..errors import ModelError, ModelWarning
@@ -32,13 +33,23 @@ def lock_value(joint, value: object) -> float:
             raise ModelError(f"the value {value!r} is not a number", field=field) from None
     if not math.isfinite(number):
         raise ModelError(f"the value {value!r} is not finite", field=field)
+    text = value.strip() if isinstance(value, str) else ""
+    if unit == "rad" and _BARE_NUMBER.fullmatch(text) and abs(number) > 2 * math.pi:
+        _warn(f"lock {joint.name}={text} is read as {text} rad ({math.degrees(number):.6g} deg); "
+              f"write {text}deg for degrees")  # as --q's bare angle beyond a turn
     limit = joint.limit if joint.type != "continuous" else None
     lower, upper = (None, None) if limit is None else (limit.lower, limit.upper)
     if lower is not None and upper is not None and lower < upper \
             and not lower <= number <= upper:
-        warning = ModelWarning(f"lock {joint.name}={number:.6g} {unit} is beyond the position "
-                               f"limit [{lower:.6g}, {upper:.6g}] {unit} of URDF joint "
-                               f"'{joint.name}'")
-        warning.field = "lock"  # the CLI names its flag (--lock)
-        warnings.warn(warning, stacklevel=2)
+        _warn(f"lock {joint.name}={number:.6g} {unit} is beyond the position limit "
+              f"[{lower:.6g}, {upper:.6g}] {unit} of URDF joint '{joint.name}'")
     return number
+
+
+_BARE_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+
+
+def _warn(line: str) -> None:
+    warning = ModelWarning(line)
+    warning.field = "lock"  # the CLI names its flag (--lock)
+    warnings.warn(warning, stacklevel=3)

@@ -109,6 +109,11 @@ static inline void tk_subspace(const double *b, double *sw, double *sv)
     }
 }
 
+/* the mass matrix's scratch per body: its rotation and origin in the world, its composite
+   inertia about the world's origin (m, h, J_O's six), its joint's s_w and s_v there */
+enum { TW_RW = TW_A, TW_OW = TW_RW + 9, TW_IC = TW_OW + 3, TW_SW = TW_IC + 10,
+       TW_SV = TW_SW + 3 };
+
 /* TK_CORE_BEGIN */
 /* The recursions, emitted twice by compact_kernel.py: on one state (tk_*, TK_T double) and
    on LG_LANES states at once (tk4_*, TK_T lg_v4). TK_FN(name) names a function, TK_C(x) a
@@ -130,7 +135,7 @@ static inline void TK_FN(sandwich)(const TK_T *R, const TK_T *A, TK_T *out)  /* 
 }
 
 /* Each body's R and p for the configuration q (into the scratch W). */
-static void TK_FN(place)(const tk_tree *t, const TK_T *q, TK_T *W)
+static void TK_FN(place)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict W)
 {
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
@@ -174,8 +179,8 @@ static void TK_FN(place)(const tk_tree *t, const TK_T *q, TK_T *W)
 }
 
 /* Recursive Newton-Euler: tau = M a + C v + g - tau0 (v, a NULL: zero). */
-static void TK_FN(inverse)(const tk_tree *t, const TK_T *q, const TK_T *v, const TK_T *a,
-                           TK_T *W, TK_T *tau)
+static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T *restrict v,
+                           const TK_T *restrict a, TK_T *restrict W, TK_T *restrict tau)
 {
     TK_FN(place)(t, q, W);
     for (int i = 0; i < t->bv; i++) tau[i] = TK_C(0.0);
@@ -260,92 +265,142 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *q, const TK_T *v, const
     }
 }
 
-/* M by the composite-rigid-body algorithm (row-major n x n). */
-static void TK_FN(mass)(const tk_tree *t, const TK_T *q, TK_T *W, TK_T *M)
+/* M by the composite-rigid-body algorithm in world axes about the world's origin (row-major
+   n x n): each body's inertia (mass m, first moment h, rotational inertia J_O) moved there once,
+   composites summed child into parent with no turning, then M[i][j] = S_j . (I_c(i) S_i) for
+   each joint j from body i to the root: one 6-vector dot a pair, where the bodies' own axes
+   turned the composite's wrench at every step of that walk. */
+static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict W,
+                        TK_T *restrict M)
 {
     const int n = t->nv;
     TK_FN(place)(t, q, W);
     for (int k = 0; k < n * n; k++) M[k] = TK_C(0.0);
-    for (int i = 0; i < t->nb; i++) {  /* composite inertias start as the bodies' own */
-        TK_T *c = W + i * TW_STRIDE + TW_A;
+    for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
-        for (int k = 0; k < 13; k++) c[k] = TK_C(b[TK_MASS + k]);
+        TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
+        TK_T *Rw = w + TW_RW, *o = w + TW_OW, *Ic = w + TW_IC;
+        const int parent = (int)b[TK_PARENT];
+        if (parent < 0) {  /* the ground's axes are the world's (a free flyer's pose too) */
+            for (int r = 0; r < 9; r++) Rw[r] = R[r];
+            for (int r = 0; r < 3; r++) o[r] = p[r];
+        } else {
+            const TK_T *Rp = W + parent * TW_STRIDE + TW_RW, *op = W + parent * TW_STRIDE + TW_OW;
+            TK_T d[3];
+            for (int r = 0; r < 3; r++)
+                for (int col = 0; col < 3; col++)
+                    Rw[3 * r + col] = Rp[3 * r] * R[col] + Rp[3 * r + 1] * R[3 + col]
+                                      + Rp[3 * r + 2] * R[6 + col];
+            TK_APPLY(Rp, p, d);
+            for (int r = 0; r < 3; r++) o[r] = op[r] + d[r];
+        }
+        /* Ic = (m, h_O = R h + m o, J_O = R J R^T + m (|o|^2 1 - o o^T) + 2 (o.Rh) 1 - o (Rh)^T
+           - (Rh) o^T), J_O as xx yy zz xy xz yz */
+        const double m = b[TK_MASS];
+        TK_T hr[3], RJ[9];
+        TK_APPLY(Rw, b + TK_H, hr);
+        for (int r = 0; r < 3; r++)
+            for (int col = 0; col < 3; col++)
+                RJ[3 * r + col] = Rw[3 * r] * b[TK_J + col] + Rw[3 * r + 1] * b[TK_J + 3 + col]
+                                  + Rw[3 * r + 2] * b[TK_J + 6 + col];
+        const TK_T oo = TK_DOT(o, o), oh = TK_DOT(o, hr);
+        static const int ra[6] = {0, 1, 2, 0, 0, 1}, rc[6] = {0, 1, 2, 1, 2, 2};
+        Ic[0] = TK_C(m);
+        for (int r = 0; r < 3; r++) Ic[1 + r] = hr[r] + m * o[r];
+        for (int e = 0; e < 6; e++) {
+            const int x = ra[e], y = rc[e];
+            TK_T v = RJ[3 * x] * Rw[3 * y] + RJ[3 * x + 1] * Rw[3 * y + 1]
+                     + RJ[3 * x + 2] * Rw[3 * y + 2];
+            if (e < 3) v += m * oo + 2.0 * oh;
+            Ic[4 + e] = v - m * o[x] * o[y] - o[x] * hr[y] - hr[x] * o[y];
+        }
+        /* the joint's motion per unit rate at the world's origin: s_w = R s, s_v = R v + o x s_w */
+        if (!TK_FREE(b)) {
+            double sw[3], sv[3];
+            TK_T *Sw = w + TW_SW, *Sv = w + TW_SV, x[3];
+            tk_subspace(b, sw, sv);
+            TK_APPLY(Rw, sw, Sw);
+            TK_APPLY(Rw, sv, Sv);
+            TK_CROSS(o, Sw, x);
+            for (int r = 0; r < 3; r++) Sv[r] += x[r];
+        }
+    }
+    for (int i = t->nb - 1; i > 0; i--) {  /* composites: children before their parents */
+        const int parent = (int)t->body[i * TK_STRIDE + TK_PARENT];
+        if (parent < 0) continue;
+        const TK_T *Ic = W + i * TW_STRIDE + TW_IC;
+        TK_T *Icp = W + parent * TW_STRIDE + TW_IC;
+        for (int k = 0; k < 10; k++) Icp[k] += Ic[k];
     }
     for (int i = t->nb - 1; i >= 0; i--) {
         const double *b = t->body + i * TK_STRIDE;
-        TK_T *w = W + i * TW_STRIDE, *c = w + TW_A;
-        const TK_T m = c[0], *h = c + 1, *J = c + 4;
-        if (TK_FREE(b)) {  /* the whole robot's inertia: [[m 1, -[h]x], [[h]x, J]] */
-            const TK_T zero = TK_C(0.0);
-            const TK_T H[9] = {zero, -h[2], h[1], h[2], zero, -h[0], -h[1], h[0], zero};
-            for (int r = 0; r < 3; r++)
-                for (int col = 0; col < 3; col++) {
-                    M[r * n + col] = r == col ? m : zero;
-                    M[r * n + 3 + col] = -H[3 * r + col];
-                    M[(3 + r) * n + col] = H[3 * r + col];
-                    M[(3 + r) * n + 3 + col] = J[3 * r + col];
+        const TK_T *w = W + i * TW_STRIDE, *Ic = w + TW_IC, *h = Ic + 1, *J = Ic + 4;
+        if (TK_FREE(b)) {  /* the base's six columns [R e_c; 0] and [o x R e_c; R e_c] */
+            const TK_T *Rw = w + TW_RW, *o = w + TW_OW;
+            TK_T S[6][6], F[6][6];
+            for (int c = 0; c < 3; c++) {
+                TK_T e[3] = {Rw[c], Rw[3 + c], Rw[6 + c]}, x[3];
+                TK_CROSS(o, e, x);
+                for (int r = 0; r < 3; r++) {
+                    S[c][r] = e[r]; S[c][3 + r] = TK_C(0.0);
+                    S[3 + c][r] = x[r]; S[3 + c][3 + r] = e[r];
+                }
+            }
+            for (int c = 0; c < 6; c++) {  /* F = Ic S: [m s_v + s_w x h; h x s_v + J_O s_w] */
+                const TK_T *sv = S[c], *sw = S[c] + 3;
+                TK_T x[3];
+                TK_CROSS(sw, h, x);
+                for (int r = 0; r < 3; r++) F[c][r] = Ic[0] * sv[r] + x[r];
+                TK_CROSS(h, sv, x);
+                F[c][3] = x[0] + J[0] * sw[0] + J[3] * sw[1] + J[4] * sw[2];
+                F[c][4] = x[1] + J[3] * sw[0] + J[1] * sw[1] + J[5] * sw[2];
+                F[c][5] = x[2] + J[4] * sw[0] + J[5] * sw[1] + J[2] * sw[2];
+            }
+            for (int c = 0; c < 6; c++)
+                for (int r = 0; r < 6; r++) {
+                    TK_T e = TK_C(0.0);
+                    for (int k = 0; k < 6; k++) e += S[r][k] * F[c][k];
+                    M[r * n + c] += e;
                 }
             continue;
         }
+        const TK_T *Sw = w + TW_SW, *Sv = w + TW_SV;
+        TK_T f[6], x[3];
+        TK_CROSS(Sw, h, x);  /* I_c(i) S_i */
+        for (int r = 0; r < 3; r++) f[r] = Ic[0] * Sv[r] + x[r];
+        TK_CROSS(h, Sv, x);
+        f[3] = x[0] + J[0] * Sw[0] + J[3] * Sw[1] + J[4] * Sw[2];
+        f[4] = x[1] + J[3] * Sw[0] + J[1] * Sw[1] + J[5] * Sw[2];
+        f[5] = x[2] + J[4] * Sw[0] + J[5] * Sw[1] + J[2] * Sw[2];
         const int ci = t->bv + (int)b[TK_COORD];
-        double sw[3], sv[3];
-        TK_T force[3], moment[3], x[3];
-        tk_subspace(b, sw, sv);
-        /* the composite's wrench for a unit rate: f = m s_v + s_w x h, n = J s_w + h x s_v */
-        TK_CROSS(sw, h, x);
-        for (int r = 0; r < 3; r++) force[r] = m * sv[r] + x[r];
-        TK_APPLY(J, sw, moment);
-        TK_CROSS(h, sv, x);
-        for (int r = 0; r < 3; r++) moment[r] += x[r];
-        M[ci * n + ci] += TK_DOT(sw, moment) + TK_DOT(sv, force);
-        for (int k = i; (int)t->body[k * TK_STRIDE + TK_PARENT] >= 0;) {
-            const TK_T *wk = W + k * TW_STRIDE;
-            TK_T F[3], N[3];
-            TK_APPLY(wk + TW_R, force, F);
-            TK_APPLY(wk + TW_R, moment, N);
-            TK_CROSS(wk + TW_P, F, x);
-            for (int r = 0; r < 3; r++) { force[r] = F[r]; moment[r] = N[r] + x[r]; }
-            k = (int)t->body[k * TK_STRIDE + TK_PARENT];
+        M[ci * n + ci] += TK_DOT(Sv, f) + TK_DOT(Sw, f + 3);
+        for (int k = (int)b[TK_PARENT]; k >= 0; k = (int)t->body[k * TK_STRIDE + TK_PARENT]) {
             const double *bk = t->body + k * TK_STRIDE;
-            if (TK_FREE(bk)) {  /* the base's six columns: the wrench itself */
-                for (int r = 0; r < 3; r++) {
-                    M[ci * n + r] += force[r];  /* += : mimic joints share a column */
-                    M[r * n + ci] += force[r];
-                    M[ci * n + 3 + r] += moment[r];
-                    M[(3 + r) * n + ci] += moment[r];
+            const TK_T *wk = W + k * TW_STRIDE;
+            if (TK_FREE(bk)) {  /* the base's six columns: S_base^T f */
+                const TK_T *Rw = wk + TW_RW, *o = wk + TW_OW;
+                for (int c = 0; c < 3; c++) {
+                    TK_T e[3] = {Rw[c], Rw[3 + c], Rw[6 + c]}, y[3];
+                    TK_CROSS(o, e, y);
+                    const TK_T lin = TK_DOT(e, f), ang = TK_DOT(y, f) + TK_DOT(e, f + 3);
+                    M[ci * n + c] += lin;  /* += : mimic joints share a column */
+                    M[c * n + ci] += lin;
+                    M[ci * n + 3 + c] += ang;
+                    M[(3 + c) * n + ci] += ang;
                 }
                 break;
             }
-            double kw[3], kv[3];
-            tk_subspace(bk, kw, kv);
-            const TK_T e = TK_DOT(kw, moment) + TK_DOT(kv, force);
+            const TK_T e = TK_DOT(wk + TW_SV, f) + TK_DOT(wk + TW_SW, f + 3);
             const int ck = t->bv + (int)bk[TK_COORD];
             M[ci * n + ck] += e;
             M[ck * n + ci] += e;
-        }
-        const int parent = (int)b[TK_PARENT];
-        if (parent >= 0) {  /* the composite moved into the parent's axes */
-            const TK_T *R = w + TW_R, *p = w + TW_P;
-            TK_T *pc = W + parent * TW_STRIDE + TW_A, hr[3], S[9];
-            TK_APPLY(R, h, hr);
-            TK_FN(sandwich)(R, J, S);
-            const TK_T ph = TK_DOT(p, hr), pp = TK_DOT(p, p);
-            /* J' = R J R^T + m (|p|^2 1 - p p^T) + 2 (p.h) 1 - p h^T - h p^T */
-            for (int r = 0; r < 3; r++)
-                for (int col = 0; col < 3; col++) {
-                    TK_T e = S[3 * r + col];
-                    if (r == col) e += m * pp + 2.0 * ph;
-                    pc[4 + 3 * r + col] += e - m * p[r] * p[col] - p[r] * hr[col]
-                                           - hr[r] * p[col];
-                }
-            for (int r = 0; r < 3; r++) pc[1 + r] += hr[r] + m * p[r];
-            pc[0] += m;
         }
     }
 }
 
 /* T = 1/2 sum (m v.v + 2 v.(w x h) + w.J w) */
-static TK_T TK_FN(kinetic)(const tk_tree *t, const TK_T *q, const TK_T *v, TK_T *W)
+static TK_T TK_FN(kinetic)(const tk_tree *t, const TK_T *restrict q, const TK_T *restrict v,
+                           TK_T *restrict W)
 {
     TK_FN(place)(t, q, W);
     TK_T total = TK_C(0.0);
@@ -380,7 +435,7 @@ static TK_T TK_FN(kinetic)(const tk_tree *t, const TK_T *q, const TK_T *v, TK_T 
 }
 
 /* V = -sum (m g.r + g.h), g the gravity vector in each body's axes, r its origin */
-static TK_T TK_FN(potential)(const tk_tree *t, const TK_T *q, TK_T *W)
+static TK_T TK_FN(potential)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict W)
 {
     TK_FN(place)(t, q, W);
     TK_T total = TK_C(0.0);

@@ -44,8 +44,9 @@ static TK_MASK TK_FN(free_acceleration)(const tk_tree *t, const TK_T *IA, const 
 /* The articulated-body algorithm (no mimic joints: each coordinate drives one body); -1 where
    a joint's articulated inertia is not positive (a massless branch). Spatial vectors are
    (angular, linear) at the body's origin in its axes. */
-static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *q, const TK_T *v,
-                                  const TK_T *tau, TK_T *W, TK_T *qdd)
+static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *restrict q,
+                                  const TK_T *restrict v, const TK_T *restrict tau,
+                                  TK_T *restrict W, TK_T *restrict qdd)
 {
     TK_MASK bad = TK_FINE;
     TK_FN(place)(t, q, W);
@@ -226,8 +227,10 @@ static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *q, const TK_T *v
 
 /* q_ddot = M^-1 (tau - b) by Cholesky (a tree with mimic joints); -1 where M is not positive
    definite. L needs n * n numbers (TK_Ts). */
-static TK_MASK TK_FN(forward_cholesky)(const tk_tree *t, const TK_T *q, const TK_T *v,
-                                       const TK_T *tau, TK_T *W, TK_T *L, TK_T *qdd)
+static TK_MASK TK_FN(forward_cholesky)(const tk_tree *t, const TK_T *restrict q,
+                                       const TK_T *restrict v, const TK_T *restrict tau,
+                                       TK_T *restrict W, TK_T *restrict L,
+                                       TK_T *restrict qdd)
 {
     TK_MASK bad = TK_FINE;
     const int n = t->nv;

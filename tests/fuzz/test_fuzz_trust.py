@@ -17,11 +17,11 @@ from hypothesis import HealthCheck, given, settings
 # inputs per surface in CI (deterministic); docs/robustness.md counts them
 CI_INPUTS = {
     "control laws (model file reader)": 200,
-    "LQR options (Python Q, R)": 300,
-    "LQR options (--Q, --R text)": 300,
+    "LQR options (Python Q, R)": 200,
+    "LQR options (--Q, --R text)": 200,
     "class folders (answer_files)": 200,
     "report options (--size, --fps, --t-end, --out)": 300,
-    "codegen names (--name)": 300,
+    "codegen names (--name)": 200,
 }
 TALLY: dict[str, dict[str, int]] = {}
 # Defects found here in code another session owns (check/classroom.py), tolerated until their

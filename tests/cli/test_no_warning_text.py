@@ -5,6 +5,7 @@ numbers in --set, --initial, --q, --v, --Q, --R, --kp, --t-end, --about and --at
 
 from __future__ import annotations
 
+import re
 import warnings
 
 import pytest
@@ -56,3 +57,23 @@ def test_a_huge_file_value_of_the_input_is_trimmed_quietly(cli):
     assert result.code == 2
     assert result.err.strip() == ("error: --about: not an equilibrium: the forces at rest do not "
                                   "balance (residual 1e+308 on x)")
+
+
+def test_weights_of_text_or_below_double_range_are_one_line():
+    # found by tests/fuzz/fuzz_trust.py: R = "abc" was numpy's ValueError; a subnormal R
+    # overflowed K = R^-1 B^T S with a RuntimeWarning
+    import math
+
+    import lagrangian
+
+    upright = lagrangian.load("cart_pendulum").linearize({"x": 0, "theta": math.pi},
+                                                         inputs=["F"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        for R, message in (("abc", "expected a number, 1 diagonal entries or a 1 x 1 matrix of "
+                                   "real numbers, got str"),
+                           ([[1, 2], [3]], "matrix of real numbers, got list"),
+                           (1j, "matrix of real numbers, got complex"),
+                           (2.2e-309, "its smallest eigenvalue 2.2e-309 is too small")):
+            with pytest.raises(lagrangian.InputError, match=re.escape(message)):
+                lagrangian.lqr(upright, 1, R)

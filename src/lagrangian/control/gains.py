@@ -47,4 +47,8 @@ def square_matrix(value, size: int, field: str, *, definite: bool = False) -> np
         kind = "positive definite" if definite else "positive semidefinite"
         raise InputError(f"the matrix must be {kind} (its smallest eigenvalue is "
                          f"{smallest:.3g})", field=field)
+    if definite and smallest < 1 / LARGEST_ENTRY:  # R^-1 of a subnormal R overflows K
+        raise InputError(f"its smallest eigenvalue {smallest:.3g} is too small (at least "
+                         f"{1 / LARGEST_ENTRY:g}; scale the weights together, only their ratio "
+                         "matters)", field=field)
     return (array + array.T) / 2

@@ -176,7 +176,11 @@ def _entries(named: Iterable[str | Path], exclude: Iterable[str | Path]
         if refusal:
             entries.append((str(path), f"{shown_name(path)}: {refusal}", found))
             return
-        key = path.resolve()
+        key = _resolved(path)
+        if key is None:
+            entries.append((str(path), f"{shown_name(path)}: a symbolic link that leads nowhere "
+                                       "(a loop): not read", found))
+            return
         if key not in seen and key not in excluded:
             seen.add(key)
             entries.append((str(path), None, found))
@@ -186,7 +190,7 @@ def _entries(named: Iterable[str | Path], exclude: Iterable[str | Path]
         path = Path(text)
         if path.is_dir():
             found = sorted(p for p in path.glob("*.toml") if not p.name.startswith("."))
-            kept = [p for p in found if p.resolve() not in excluded and not _directory(p)]
+            kept = [p for p in found if _resolved(p) not in excluded and not _directory(p)]
             if not kept:
                 entries.append((text, f"{shown_name(text)}: no answer files (*.toml) in this "
                                       "folder", False))
@@ -203,6 +207,14 @@ def _entries(named: Iterable[str | Path], exclude: Iterable[str | Path]
         else:
             entries.append((text, f"{shown_name(text)}: no such file", False))
     return entries
+
+
+def _resolved(path: Path) -> Path | None:
+    """The file's real place, or None where its links loop (resolving raises)."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError):
+        return None
 
 
 def _directory(path: Path) -> bool:
@@ -222,7 +234,7 @@ def _refusal(path: Path) -> str | None:
                 "are graded")
     if not stat.S_ISREG(mode):
         return f"not a regular file ({file_kind(mode)}): not read"
-    if path.resolve().parent != path.parent.resolve():
+    if _resolved(path) is None or path.resolve().parent != path.parent.resolve():
         return "not inside its folder: not read"
     return None
 

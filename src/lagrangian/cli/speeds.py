@@ -70,6 +70,10 @@ def speeds(
         raise InputError("the sweep needs --to above --from and --points of at least 2",
                          field="--points")
     point = state_assignments(system, about, "--about")
+    # --at read before the speed form is derived: a bad speed costs no derivation
+    default = system.model.steady_motion
+    named = speed or (default.speed if default is not None else None)
+    chosen = _chosen_speeds(system, named, at) if named else None
     kept = [name.strip() for setting in keep for name in setting.split(",") if name.strip()]
     form = system.speed_form(steady_settings(steady) or None, speed, kept or None,
                              about=point or None)
@@ -78,7 +82,8 @@ def speeds(
     from .. import speed_sweep
 
     sweep = speed_sweep(form, np.linspace(lowest, highest, points))
-    chosen = _chosen_speeds(system, form, at)
+    if chosen is None:
+        chosen = _chosen_speeds(system, form.speed, at)
     if plot is not None:
         write_speed_plot(form, sweep, plot, protect=inputs)
     if json_:
@@ -94,21 +99,21 @@ def speeds(
             typer.echo(f"Eigenvalues against speed drawn to {plot}")
 
 
-def _chosen_speeds(system, form, settings: list[str]) -> list[float]:
+def _chosen_speeds(system, speed: str, settings: list[str]) -> list[float]:
     """--at SPEED=V1,V2,...: the speeds (m/s) to evaluate, named by the speed parameter."""
     from .. import parse_quantity
 
-    unit = next((p.unit for p in system.model.parameters if p.name == form.speed), None)
+    unit = next((p.unit for p in system.model.parameters if p.name == speed), None)
     speeds: list[float] = []
     for setting in settings:
         name, sep, text = setting.partition("=")
         if not sep or not text.strip():
-            raise InputError(f"expected {form.speed}=V1,V2,..., got {setting!r}", field="--at")
-        if name.strip() != form.speed:
+            raise InputError(f"expected {speed}=V1,V2,..., got {setting!r}", field="--at")
+        if name.strip() != speed:
             raise InputError(f"'{name.strip()}' is not the speed parameter; write "
-                             f"{form.speed}=V1,V2,...", field="--at")
+                             f"{speed}=V1,V2,...", field="--at")
         for item in text.split(","):
             if not item.strip():
                 raise InputError(f"an empty value in {text!r}", field="--at")
-            speeds.append(parse_quantity(item.strip(), unit, f"--at {form.speed}"))
+            speeds.append(parse_quantity(item.strip(), unit, f"--at {speed}"))
     return speeds

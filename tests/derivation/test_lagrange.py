@@ -31,8 +31,10 @@ def brute_force_residuals(eom):
         back[f.diff(t, 2)] = c.acceleration
         back[f.diff(t)] = c.velocity
         back[f] = c.symbol
-    L = eom.lagrangian.subs(to_time)
-    D = eom.dissipation.subs(to_time)
+    # xreplace, not subs: the same literal rewriting without subs' pattern matching (the
+    # bicycle's brute force 51 s -> 6 s)
+    L = eom.lagrangian.xreplace(to_time)
+    D = eom.dissipation.xreplace(to_time)
     residuals = []
     for i, (c, f) in enumerate(zip(model.coordinates, functions, strict=True)):
         qd = f.diff(t)
@@ -41,10 +43,10 @@ def brute_force_residuals(eom):
         given = sum((part.expression for part in eom.load_contributions
                      if part.coordinate == c.name and part.load not in
                      {d.name for d in model.dampers} | {"dissipation"}), sp.S.Zero)
-        expression -= given.subs(to_time)
+        expression -= given.xreplace(to_time)
         for k in range(eom.multipliers.rows):
-            expression += eom.constraint_jacobian[k, i].subs(to_time) * eom.multipliers[k]
-        residuals.append(expression.subs(back))
+            expression += eom.constraint_jacobian[k, i].xreplace(to_time) * eom.multipliers[k]
+        residuals.append(expression.xreplace(back))
     return residuals
 
 

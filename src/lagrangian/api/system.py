@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
-from functools import cached_property
+from functools import cached_property, lru_cache
 from pathlib import Path
 
 import sympy as sp
@@ -60,6 +60,12 @@ from .options import run_options
 from .simulation import Simulation
 from .studies import StudyMethods
 
+
+@lru_cache(maxsize=16)
+def _derived(model: Model) -> EquationsOfMotion:
+    """Lagrange's equations of a model, cached by its content (a Model is frozen and compares
+    by value): a model file loaded twice, or two Systems of one model, share one derivation."""
+    return derive(model)
 
 class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, ImpactMethods):
     """A mechanical system described in generalized coordinates.
@@ -158,7 +164,7 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
 
     @cached_property
     def _equations(self) -> EquationsOfMotion:
-        return derive(self._model)
+        return _derived(self._model)
 
     def generalized_forces_at(
         self, configuration: Mapping[str, float], parameters: Mapping[str, float] | None = None

@@ -36,6 +36,7 @@ class RelabelCheck:
                 rows += list(item.position[:d])
                 turned = kind == "body" and hasattr(item, "angle")
                 rows += [sp.cos(item.angle), sp.sin(item.angle)] if turned else [0, 0]
+                # safe: a particle's or body's mass is the reader's parsed expression
                 self.masses.append(float(sp.sympify(item.mass).xreplace(substitution)))
                 self.labels.append(f"{kind} '{item.name}'")
         self.d = d

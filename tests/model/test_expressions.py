@@ -88,3 +88,30 @@ def test_deep_nesting_is_refused_not_crashing():
         parse("(" * 300 + "m" + ")" * 300)
     with pytest.raises(ModelError, match="longer than"):
         parse("m+" * 60000 + "m")
+
+
+@pytest.mark.parametrize(
+    ("text", "fault"),
+    [("0od", "'d' is not an octal digit"), ("2*0o8 + m", "'8' is not an octal digit"),
+     ("0b2", "'2' is not a binary digit"), ("0B1e", "'e' is not a binary digit"),
+     ("0x_", "needs digits after '0x'"), ("0x1_", "single underscores"),
+     ("0b1__0", "single underscores")],
+)
+def test_a_malformed_based_number_is_the_models_error_naming_the_field(text, fault):
+    """Python's int(text, 0) refuses these with a bare ValueError: ours names field and digit."""
+    with pytest.raises(ModelError) as info:
+        parse(text)
+    assert info.value.field == "energy.T" and fault in str(info.value)
+
+
+def test_based_numbers_keep_their_value():
+    assert parse("0o17 + 0x_ff + 0b1_01") == 15 + 255 + 5
+
+
+def test_the_cli_refuses_a_malformed_number_in_one_line(cli, tmp_path):
+    model = tmp_path / "bad.toml"
+    model.write_text('[coordinates]\nx = "m"\n[parameters]\nm = 1\n[energy]\n'
+                     'T = "m*x_dot^2/2"\nV = "0od*x^2"\n', encoding="utf-8")
+    code, out, err = cli("derive", str(model))
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and "energy.V" in err and "octal digit" in err, err

@@ -141,6 +141,7 @@ def _literal(text: str, fail) -> sp.Rational:
     if clean[:2] in ("0x", "0o", "0b"):
         if len(clean) > MAX_NUMBER_DIGITS:
             raise fail(f"the number has more than {MAX_NUMBER_DIGITS} digits")
+        _check_based(text, fail)
         value = int(clean, 0)
         if value >= 10**MAX_NUMBER_DIGITS:
             raise fail(f"the number has more than {MAX_NUMBER_DIGITS} digits")
@@ -169,6 +170,23 @@ def _literal(text: str, fail) -> sp.Rational:
                    f"read as 0): write 0 or a larger number")
     value = sign * int(digits)
     return sp.Integer(value * 10**power) if power >= 0 else sp.Rational(value, 10**-power)
+
+
+_BASES = {"x": ("a hexadecimal", "0123456789abcdef"), "o": ("an octal", "01234567"),
+          "b": ("a binary", "01")}
+
+
+def _check_based(text: str, fail) -> None:
+    """A 0x/0o/0b literal's digits, checked as Python's int(text, 0) would, so that a malformed
+    one ('0od', '0b2', '0x_') is the model's error, naming the digit, never int's ValueError."""
+    kind, allowed = _BASES[text[1].lower()]
+    body = text[2:]
+    for char in body:
+        if char != "_" and char.lower() not in allowed:
+            raise fail(f"cannot parse the number {_quote(text)}: '{char}' is not {kind} digit")
+    if not body.replace("_", "") or body.endswith("_") or "__" in body:
+        raise fail(f"cannot parse the number {_quote(text)}: {kind} number needs digits after "
+                   f"'{text[:2]}', with single underscores only between them")
 
 
 # -- parsing ------------------------------------------------------------------------------

@@ -122,8 +122,8 @@ def mjcf_written_by_mujoco(urdf_path, tmp_path, strip_mimic: bool = False):
 def test_mjcf_written_by_mujoco_from_a_urdf(name, tmp_path):
     """MuJoCo reads the URDF and writes MJCF; that MJCF read by us and by MuJoCo agree to 1e-9,
     and with our reading of the URDF to MuJoCo's printed precision (6 digits). The Panda's
-    mimic finger is made a joint of its own (MuJoCo writes a mimic as an equality constraint,
-    refused here)."""
+    mimic finger is made a joint of its own here (MuJoCo writes a mimic as a joint equality, read
+    back as the mimic: tests/model/test_mjcf_state.py)."""
     urdf = example_urdf(name)
     if urdf is None:
         pytest.skip(f"{name}: example-robot-data is not installed")
@@ -149,7 +149,6 @@ REFUSALS = [
     ('<body><joint type="ball"/><geom size="0.1"/></body>', "a ball joint is not supported"),
     ('<body><freejoint/><geom size="0.1"/></body>', "a free joint is read only with "
                                                       "floating_base=True"),
-    ('<body><joint armature="0.1"/><geom size="0.1"/></body>', "armature is not kept"),
     ('<body><joint ref="10"/><geom size="0.1"/></body>', "ref other than 0"),
     ('<body><joint stiffness="3"/><geom size="0.1"/></body>', "stiffness other than 0"),
     ('<body><joint type="spin"/><geom size="0.1"/></body>', "unknown joint type 'spin'"),
@@ -192,24 +191,27 @@ def test_unsupported_or_bad_documents_refused_in_one_line(document, message, tmp
     assert str(caught.value).startswith(str(path)) and "\n" not in str(caught.value)
 
 
-def test_armature_refused_then_given_to_dynamics_agrees_with_mujoco(arm, tmp_path):
-    """MuJoCo's armature adds to M's diagonal: refused in the file (the model keeps none),
-    and the same numbers given to System.dynamics(armature=...) match MuJoCo's M and qacc."""
-    system, _ = arm
+def test_armature_kept_for_the_actuators_agrees_with_mujoco(arm, tmp_path):
+    """MuJoCo's armature adds to M's diagonal: kept in the model (source_armature) and added
+    by System.dynamics(actuators=True) with the damping, matching MuJoCo's M, mj_forward's qacc
+    and mj_inverse; the rigid body's M leaves it out, and armature= overrides the file's."""
     armed = ARM.replace('name="j1" type="hinge"', 'name="j1" armature="0.2" type="hinge"') \
         .replace('name="s" type="slide"', 'name="s" armature="0.05" type="slide"')
     path = tmp_path / "armed.xml"
     path.write_text(armed)
-    with pytest.raises(ModelError, match=r"armature=\{'j1': 0.2\}") as caught:
-        lagrangian.load(path)
-    assert "body 'base'.joint 'j1'.armature" in str(caught.value)
+    system = lagrangian.load(path)
+    assert dict(system.model.source_armature) == {"j1": 0.2, "s": 0.05}
     model = mujoco.MjModel.from_xml_path(str(path))
-    dynamics = system.dynamics(backend="numpy", actuators=True,
-                               armature={"j1": 0.2, "s": 0.05})
+    dynamics = system.dynamics(backend="numpy", actuators=True)
+    rigid = system.dynamics(backend="numpy")
     for q, v, tau in states(model.nq, 2):
         M, _, qacc, inverse, _ = mujoco_terms(model, q, v, tau)
         assert np.allclose(dynamics.mass_matrix(q), M, rtol=0, atol=1e-9)
+        assert np.allclose(rigid.mass_matrix(q), M - np.diag(model.dof_armature), atol=1e-9)
         assert np.allclose(dynamics.forward_dynamics(q, v, tau), qacc, rtol=0, atol=1e-9)
+        assert np.allclose(dynamics.inverse_dynamics(q, v, qacc), tau, rtol=0, atol=1e-9)
+    given = system.dynamics(backend="numpy", actuators=True, armature={"j1": 0.5})
+    assert given.actuators["j1"]["armature"] == 0.5 and given.actuators["s"]["armature"] == 0.05
 
 
 def test_a_urdf_saved_as_xml_is_read_as_a_urdf(tmp_path):

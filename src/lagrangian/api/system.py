@@ -9,56 +9,38 @@ from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from functools import cached_property, lru_cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import sympy as sp
 
-from ..analysis.equilibria import Equilibria, find_equilibria, resolve_equilibrium
-from ..analysis.forces import ForceReport, evaluate_generalized_forces
-from ..analysis.linearization import (
-    LinearModel,
-    SymbolicLinearModel,
-    is_statically_stable,
-    linear_model_at,
-    symbolic_linear_model,
-)
-from ..analysis.modes import is_stable, modal_analysis
-from ..analysis.statics import StaticsReport, solve_statics
-from ..analysis.steady import steady_linear_model
-from ..compile.at_rest import AtRestFunctions
-from ..compile.codegen import CodegenError
-from ..compile.functions import NumericSystem, numeric, refuse_large_chain
-from ..derivation.equations import EquationsOfMotion
 from ..derivation.lagrange import derive
-from ..derivation.regularity import require_inertia
-from ..derivation.steps import DerivationSteps
-from ..dynamics.actuators import actuated
-from ..dynamics.selection import model_dynamics, recursive_dynamics
-from ..dynamics.standalone.standalone import StandaloneSource
-from ..dynamics.tree_at_rest import TreeAtRest
 from ..errors import InputError, LagrangianError, did_you_mean
 from ..model.builder import ModelBuilder
-from ..model.examples import example_path
 from ..model.model import Model
-from ..model.notation import latex_symbol_names
-from ..model.reader import read_model
-from ..model.urdf import example_urdf, read_urdf
-from ..model.values import State, resolve_state
-from ..simulation.events import StopCondition
-from ..simulation.simulate import (
-    SaveAt,
-    StepControl,
-    parse_stop_condition,
-    simulate,
-    urdf_limits,
-)
 from .checking import CheckMethods
 from .conservation import ConservationMethods
 from .control import ControlMethods
 from .impacts import ImpactMethods
-from .modes import ModalAnalysis
-from .options import run_options
-from .simulation import Simulation
 from .studies import StudyMethods
+
+# The rest of the library is imported inside the methods that use it: a command pays only for
+# the stages it runs (`derive` loads no checker, compiler, engine or integrator; issue 38).
+if TYPE_CHECKING:
+    from ..analysis.equilibria import Equilibria
+    from ..analysis.forces import ForceReport
+    from ..analysis.linearization import LinearModel, SymbolicLinearModel
+    from ..analysis.statics import StaticsReport
+    from ..compile.at_rest import AtRestFunctions
+    from ..compile.functions import NumericSystem
+    from ..derivation.equations import EquationsOfMotion
+    from ..derivation.steps import DerivationSteps
+    from ..dynamics.standalone.standalone import StandaloneSource
+    from ..dynamics.tree_at_rest import TreeAtRest
+    from ..model.values import State
+    from ..simulation.events import StopCondition
+    from ..simulation.options import SaveAt, StepControl
+    from .modes import ModalAnalysis
+    from .simulation import Simulation
 
 
 @lru_cache(maxsize=16)
@@ -170,6 +152,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         self, configuration: Mapping[str, float], parameters: Mapping[str, float] | None = None
     ) -> ForceReport:
         """Each generalized force, and each load's part of it, at a configuration (SI)."""
+        from ..analysis.forces import evaluate_generalized_forces
+
         return evaluate_generalized_forces(self.equations_of_motion(), configuration, parameters)
 
     def statics(
@@ -179,6 +163,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         """The load magnitudes (parameters ``solve_for``, entering Q linearly) that hold the
         mechanism at rest at ``configuration`` (SI; coordinates not given follow the
         constraints), by virtual work delta W = 0, with each load's share and the reactions."""
+        from ..analysis.statics import solve_statics
+
         unknowns = [solve_for] if isinstance(solve_for, str) else list(solve_for)
         return solve_statics(self.equations_of_motion(), configuration, unknowns, parameters)
 
@@ -224,6 +210,13 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         [[impacts]] runs through them (``.impacts`` lists each; status 'accumulated' where they
         accumulate, 'settled' with ``settle=True``, 'impact_limit' at ``max_impacts``, default
         1000): docs/simulation.md."""
+        from ..compile.functions import refuse_large_chain
+        from ..derivation.regularity import require_inertia
+        from ..model.values import resolve_state
+        from ..simulation.simulate import parse_stop_condition, simulate, urdf_limits
+        from .options import run_options
+        from .simulation import Simulation
+
         # a start beyond a position limit: refused, clamped to it, or run from where it is
         start_beyond = {True: "refuse", "clamp": "clamp", False: "ignore"}.get(limits) \
             if isinstance(limits, bool | str) else None
@@ -277,6 +270,7 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         ``prefix`` names the functions (default: from the model's name), ``parameters`` override
         the model's values compiled in as defaults; a [control] table's laws as <prefix>_control
         and <prefix>_control_forces. Write it with ``lagrangian.output.files.write_c(code, dir)``."""
+        from ..compile.codegen import CodegenError
         from ..dynamics.standalone.standalone import c_prefix, standalone_for
         from ..simulation.control import input_columns  # B of a [control] table's inputs
 
@@ -310,6 +304,7 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         recursive Newton-Euler over casadi SX (nothing derived; inputs: coordinates or their
         tau_<joint>). Needs the extra [casadi] (docs/bridges.md)."""
         from ..compile.casadi_functions import casadi_functions
+        from ..compile.functions import refuse_large_chain
 
         if self._model.source_names and self._model.kinematic_tree is not None:
             from ..compile.casadi_tree import tree_casadi_functions
@@ -323,6 +318,7 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         ``eom`` = 0 in x = [q(t); u(t)] and x', ``states``, ``specified`` r_<input>(t) (named
         as for ``linearize(inputs=...)``), ``parameters`` for known_parameter_map and
         ``time``, for ``opty.Problem(obj, grad, eom, states, nodes, interval, ...)``."""
+        from ..compile.functions import refuse_large_chain
         from ..compile.opty_equations import opty_equations
 
         refuse_large_chain(self.model)
@@ -346,6 +342,9 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         backend "c" (generated C, compiled once and cached), "numpy", or "auto" (C if a compiler
         works). Parameters (SI) override the model's values.
         """
+        from ..compile.functions import numeric, refuse_large_chain
+        from ..dynamics.selection import recursive_dynamics
+
         if parameters is None and backend == "auto":
             return self._numeric
         fast = recursive_dynamics(self.model, parameters, backend)  # a tree: no derivation
@@ -357,6 +356,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
     @cached_property
     def _numeric(self) -> NumericSystem:
         """The default numeric system, compiled once per System (its parameters are fixed)."""
+        from ..compile.functions import numeric, refuse_large_chain
+
         fast = self._recursive
         if fast is not None:
             return fast.numeric_system()
@@ -367,6 +368,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
     def _recursive(self):
         """Recursive dynamics of a URDF tree in generated C (numpy without a compiler), or
         None (dynamics/joint_space.py)."""
+        from ..dynamics.selection import recursive_dynamics
+
         return recursive_dynamics(self.model)
 
     def dynamics(self, parameters: Mapping[str, float] | None = None, backend: str = "auto",
@@ -381,8 +384,11 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         rebuild; ``kernel`` "auto" or "compact" (the engine: one compiled module for every
         tree and variant) or "unrolled" (the tree's own code, compiled per tree on first use,
         about 2x faster per call). ``actuators=True``
-        adds the URDF's joint damping and friction, ``armature`` {joint: kg m^2 or kg} to M
-        (dynamics/actuators.py)."""
+        adds the URDF's joint damping and friction (and an MJCF's armature), ``armature``
+        {joint: kg m^2 or kg} to M (dynamics/actuators.py)."""
+        from ..dynamics.actuators import actuated
+        from ..dynamics.selection import model_dynamics
+
         if parameters is None and backend == "auto" and kernel == "auto" \
                 and self._recursive is not None:
             rigid = self._recursive
@@ -390,6 +396,9 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
             rigid = model_dynamics(self.model, lambda: self.numeric(parameters, backend),
                                    parameters, backend, equations=self.equations_of_motion,
                                    kernel=kernel)
+        if actuators and self.model.source_armature and (armature is None
+                                                         or isinstance(armature, Mapping)):
+            armature = {**dict(self.model.source_armature), **dict(armature or {})}  # the file's
         return rigid if not actuators and armature is None else \
             actuated(rigid, self.model, armature, friction=actuators)
 
@@ -399,13 +408,22 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
     def _static_functions(self) -> AtRestFunctions | TreeAtRest:
         """Compiled functions at rest, built once per System (parameters are fixed per System):
         a tree's from its recursions (nothing derived), else from the derived equations."""
+        from ..compile.at_rest import AtRestFunctions
+        from ..compile.functions import refuse_large_chain
+
         if self._recursive is not None:
+            from ..dynamics.tree_at_rest import TreeAtRest
+
             return TreeAtRest(self._recursive)
         refuse_large_chain(self.model)
         return AtRestFunctions(self.equations_of_motion())
 
     def equilibria(self) -> Equilibria:
         """Configurations of rest, f(q, 0) = Phi_q^T lambda with Phi(q) = 0, each with its stability."""
+        from ..analysis.equilibria import find_equilibria
+        from ..analysis.linearization import is_statically_stable, linear_model_at
+        from ..analysis.modes import is_stable
+
         functions = self._static_functions
         # a tree's M is positive definite (checked when its recursions were taken)
         statics = self._recursive is None and not self.equations_of_motion().has_inertia
@@ -432,7 +450,11 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         coordinates turning at constant rates, e.g.
         ``steady={"psi_dot": 10}`` (rad/s), the rest at ``about`` (the others solved for).
         """
+        from ..analysis.linearization import linear_model_at, symbolic_linear_model
+        from ..compile.at_rest import AtRestFunctions
+
         if steady:
+            from ..analysis.steady import steady_linear_model
             from ..errors import ModelError
 
             if symbolic or inputs:
@@ -452,6 +474,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
                 self.equations_of_motion(), values))
         import numpy as np
 
+        from ..analysis.equilibria import resolve_equilibrium
+
         with np.errstate(over="ignore", invalid="ignore"):  # judged by linear_model_at's check
             q, multipliers = resolve_equilibrium(functions, about)
         return linear_model_at(functions, q, multipliers)
@@ -464,6 +488,11 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         [steady] table (a bicycle: it has no upright equilibrium at rest) is taken about that
         steady motion when neither ``about`` nor ``steady`` is given. ``inputs`` (as in
         linearize) give its ``linear_model`` a B, so lqr(modes, Q, R) can use it."""
+        from ..analysis.modes import modal_analysis
+        from ..compile.functions import refuse_large_chain
+        from ..derivation.regularity import require_inertia
+        from .modes import ModalAnalysis
+
         if self._recursive is None:  # a tree's M is positive definite (checked)
             refuse_large_chain(self.model)
             require_inertia(self.equations_of_motion(), "modes")
@@ -529,6 +558,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         return f"System({self._model.name!r}, coordinates=[{names}])"
 
     def _repr_latex_(self) -> str:
+        from ..model.notation import latex_symbol_names
+
         eom = self.equations_of_motion()
         names = latex_symbol_names(self._model)
         return rf"$L = {sp.latex(eom.lagrangian, symbol_names=names)}$"
@@ -569,6 +600,10 @@ def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None
 
 
 def _load(path_or_example: str | Path, lock, payload, floating_base) -> System:
+    from ..model.examples import example_path
+    from ..model.reader import read_model
+    from ..model.urdf import example_urdf, read_urdf
+
     path = Path(path_or_example)
     if path.suffix.lower() in (".xml", ".mjcf"):  # MuJoCo's MJCF, read as the URDF it is
         from ..model.mjcf import read_mjcf

@@ -7,9 +7,12 @@ frame sits at its joint's anchor, several joints in one body chain through massl
 read by the URDF reader, so an MJCF robot enters the same engine. Each joint is a coordinate in
 MuJoCo's qpos order (depth first in document order) with MuJoCo's sign and zero, so a state
 moves between MuJoCo and us unchanged. A free joint is read only with ``floating_base`` (the
-tree's free flyer, in Pinocchio's layout, not MuJoCo's). What would change the dynamics and is
-not modelled (ball joints, tendons, equality constraints, actuators with dynamics, a joint's
-ref, stiffness or armature, ...) is refused in one line naming the file, element and fault.
+tree's free flyer, in Pinocchio's layout: model/mjcf_state.py converts MuJoCo's). A joint
+equality with a linear polycoef is a mimic joint (model/mjcf_equality.py). A joint's damping,
+frictionloss and armature are kept (Model.source_dynamics, source_armature) for
+dynamics(actuators=True). What would change the dynamics and is not modelled (ball joints,
+tendons, other equalities, actuators with dynamics, a joint's ref or stiffness, ...) is refused
+in one line naming the file, element and fault.
 Units SI (MJCF's lengths in m, masses in kg; angles by the compiler, degrees by default).
 """
 
@@ -24,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, did_you_mean, require_extra
+from .mjcf_equality import check_mimics, folded_losses, read_equalities
 from .mjcf_geometry import (
     DENSITY,
     axis_angle_matrix,
@@ -41,7 +45,7 @@ from .reader import read_text_file
 
 MAX_MJCF_NUMBER = 1e30  # as a URDF's numbers (model/urdf.py)
 # Elements that change the dynamics and are not modelled here: refused by name.
-REFUSED = {"tendon": "tendons", "equality": "equality constraints", "include": "<include> of "
+REFUSED = {"tendon": "tendons", "include": "<include> of "
            "other files", "flexcomp": "flexes", "deformable": "deformables",
            "composite": "composites", "replicate": "<replicate>", "attach": "<attach>",
            "plugin": "plugins"}
@@ -78,8 +82,11 @@ def parse_mjcf(text: str, *, source: str = "<mjcf>", lock: Mapping[str, float] |
     model = parse_urdf(urdf, source=source, lock=lock, payload=payload,
                        floating_base=bool(floating_base) and reader.free is None)
     joints = len(reader.joint_names)
+    coordinate = {joint: name for name, joint in model.source_names}  # locked: none
     model = replace(model, description=f"Robot '{model.name}' read from MJCF ({joints} joints, "
-                                       f"{reader.bodies} bodies).")
+                                       f"{reader.bodies} bodies).",
+                    source_armature=tuple((coordinate[joint], value) for joint, value
+                                          in reader.armature.items() if joint in coordinate))
     gravity = reader.gravity
     if not np.allclose(gravity, (0.0, 0.0, -9.81), rtol=0, atol=0):
         model = with_gravity(model, tuple(gravity), field="option.gravity")
@@ -119,7 +126,7 @@ class _Reader:
         self.name = root.get("model") or Path(source).stem or "MJCF robot"
         for element in root.iter():
             if isinstance(element.tag, str) and element.tag in REFUSED and (
-                    element.tag not in ("tendon", "equality") or _children(element)):
+                    element.tag != "tendon" or _children(element)):
                 raise self.error(f"{REFUSED[element.tag]} are not supported (yet)",
                                  f"<{element.tag}>")
         for frame in root.iter("frame"):
@@ -131,6 +138,10 @@ class _Reader:
         self.gravity = self._gravity()
         self.defaults = self._defaults()
         self._check_actuators()
+        self.mimics = read_equalities(self)  # joint1 -> (joint2, c0, c1)
+        # per hinge or slide joint: (damping, frictionloss, armature), and its URDF element
+        self.losses: dict[str, tuple[float, float, float]] = {}
+        self.elements: dict[str, object] = {}
         self.joint_names: list[str] = []
         self.floating = False  # floating_base asked for: a free joint is read (_free)
         self.free: str | None = None  # the free joint's name, once read
@@ -282,6 +293,18 @@ class _Reader:
                 raise self.error("the world body cannot have joints", f"worldbody.{child.tag}")
         if not self.joint_names and self.free is None:
             raise self.error("no hinge or slide joint: nothing moves", "worldbody")
+        check_mimics(self, self.mimics, self.joint_names, self.free)
+        for name, (joint2, c0, c1) in self.mimics.items():
+            ElementTree.SubElement(self.elements[name], "mimic", joint=joint2,
+                                   multiplier=repr(float(c1)), offset=repr(float(c0)))
+        self.armature = {}
+        for name, (damping, friction, armature) in folded_losses(self, self.mimics,
+                                                                 self.losses).items():
+            if damping or friction:
+                ElementTree.SubElement(self.elements[name], "dynamics", damping=repr(damping),
+                                       friction=repr(friction))
+            if armature:
+                self.armature[name] = armature
         return ElementTree.tostring(robot, encoding="unicode")
 
     def _fresh_link(self, name: str) -> str:
@@ -346,20 +369,21 @@ class _Reader:
         attrs = self.attrs(joint, childclass, field) if joint.tag == "joint" else {}
         kind = kind or attrs.get("type", "hinge")
         if kind == "free":
-            return self._free(name, body, parent, current, field, only=len(
+            return self._free(name, body, parent, current, field, attrs, only=len(
                 [c for c in _children(joint.getparent()) if c.tag in ("joint", "freejoint")]
             ) == 1)
         if kind == "ball":
-            raise self.error("a ball joint is not supported yet (hinge and slide joints are)",
-                             field)
+            raise self.error("a ball joint is not supported: the kinematic tree has no "
+                             "spherical joint (three hinges would be Euler angles, singular "
+                             "where MuJoCo's quaternion is not, and another state)", field)
         if kind not in JOINT_KINDS:
             raise self.error(f"unknown joint type {kind!r} (hinge, slide, ball or free)"
                              f"{did_you_mean(kind, JOINT_KINDS)}", f"{field}.type")
-        armature = self.numbers(attrs.get("armature", "0"), 1, f"{field}.armature")[0]
-        if armature != 0:  # the model keeps no armature: a load would drop it from M
-            raise self.error(f"armature is not kept in the model (yet): remove it and give "
-                             f"System.dynamics(armature={{'{name}': {armature:g}}})",
-                             f"{field}.armature")
+        losses = [self.numbers(attrs.get(key, "0"), 1, f"{field}.{key}")[0]
+                  for key in ("damping", "frictionloss", "armature")]
+        for key, value in zip(("damping", "frictionloss", "armature"), losses, strict=True):
+            if value < 0:
+                raise self.error(f"{key} {value:g} is negative", f"{field}.{key}")
         for key in ("ref", "stiffness", "springref"):
             if float(self.numbers(attrs.get(key, "0"), 1, f"{field}.{key}")[0]) != 0:
                 raise self.error(f"{key} other than 0 is not supported (yet)", f"{field}.{key}")
@@ -378,14 +402,13 @@ class _Reader:
         urdf_kind = "prismatic" if kind == "slide" else (
             "revolute" if limit is not None else "continuous")
         origin = current @ _transform(np.eye(3), anchor) if kind == "hinge" else current
-        self._urdf_joint(name, urdf_kind, parent, link, origin, axis, limit,
-                         damping=float(self.numbers(attrs.get("damping", "0"), 1,
-                                                    f"{field}.damping")[0]),
-                         friction=float(self.numbers(attrs.get("frictionloss", "0"), 1,
-                                                     f"{field}.frictionloss")[0]))
+        self.elements[name] = self._urdf_joint(name, urdf_kind, parent, link, origin, axis,
+                                               limit)
+        self.losses[name] = (float(losses[0]), float(losses[1]), float(losses[2]))
         return link, (_transform(np.eye(3), -anchor) if kind == "hinge" else np.eye(4))
 
-    def _free(self, name: str, body: str, parent: str, current, field: str, only: bool):
+    def _free(self, name: str, body: str, parent: str, current, field: str, attrs,
+              only: bool):
         """A free joint, with floating_base: the tree's free flyer, in its own layout."""
         if not self.floating:
             raise self.error("a free joint is read only with floating_base=True (load(..., "
@@ -398,6 +421,10 @@ class _Reader:
                              "of the worldbody (the floating base)", field)
         if self.joint_names:
             raise self.error("the floating base must come first in the worldbody", field)
+        for key in ("damping", "frictionloss", "armature", "stiffness"):  # <joint type=free>
+            if self.numbers(attrs.get(key, "0"), 1, f"{field}.{key}")[0] != 0:
+                raise self.error(f"{key} on a free joint is not supported: the floating "
+                                 "base's six numbers have no actuator", f"{field}.{key}")
         self.free = name
         link = self._fresh_link(body)
         # the free flyer's state is the body's placement: the file's pos and quat are only
@@ -421,7 +448,7 @@ class _Reader:
         return span[0] * scale, span[1] * scale
 
     def _urdf_joint(self, name: str, kind: str, parent: str, child: str, origin: np.ndarray,
-                    axis=None, limit=None, damping: float = 0.0, friction: float = 0.0) -> None:
+                    axis=None, limit=None):
         joint = ElementTree.SubElement(self.robot, "joint", name=name, type=kind)
         ElementTree.SubElement(joint, "parent", link=parent)
         ElementTree.SubElement(joint, "child", link=child)
@@ -432,10 +459,8 @@ class _Reader:
         if limit is not None:
             ElementTree.SubElement(joint, "limit", lower=repr(float(limit[0])),
                                    upper=repr(float(limit[1])), effort="0", velocity="0")
-        if damping or friction:
-            ElementTree.SubElement(joint, "dynamics", damping=repr(damping),
-                                   friction=repr(friction))
         ElementTree.SubElement(self.robot, "link", name=child)
+        return joint
 
     def _inertial(self, body, link: str, current: np.ndarray, childclass: str,
                   where: str) -> None:

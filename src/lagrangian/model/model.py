@@ -223,6 +223,11 @@ class Model:
     # friction in N m or N), 0 where the file gives none; used only by dynamics(actuators=True).
     source_dynamics: tuple[tuple[str, float, float], ...] = field(
         default=(), compare=False, repr=False)
+    # ... and its joints' armature, the rotor inertia on M's diagonal (kg m^2 or kg; an MJCF
+    # joint's, model/mjcf.py): (coordinate name, armature), the coordinates with one; used only
+    # by dynamics(actuators=True), as <dynamics>.
+    source_armature: tuple[tuple[str, float], ...] = field(
+        default=(), compare=False, repr=False)
 
     @property
     def q(self) -> tuple[sp.Symbol, ...]:

@@ -27,7 +27,7 @@ def test_python_example_runs(tmp_path, monkeypatch, capsys):
     code = re.findall(r"```python\n(.*?)```", section(), re.S)[0]
     exec(compile(code.replace("t_end=5", "t_end=1"), "report", "exec"), {})
     assert capsys.readouterr().out.strip() == \
-        "Report('Two masses on three springs', 7 of 9 sections shown)"
+        "Report('Two masses on three springs', 8 of 11 sections shown)"
     assert os.path.getsize(tmp_path / "two_mass.html") > 10_000
 
 

@@ -151,7 +151,7 @@ def test_sections_that_do_not_apply_say_so_in_one_line():
         if name == "two_mass":  # given by its energies: each mode's coordinates on tracks
             assert "given by its energies only" in page.section("modes")
             gifs = [a for a in page.tags("img") if a.get("class") == "animation"]
-            assert len(gifs) == 2 and "No drawing" in page.section("model")
+            assert len(gifs) == 2 and "Nothing to draw" in page.section("model")
     assert statuses["pendulum"]["forces"] == "not applicable: no loads"
     assert statuses["pendulum"]["check"] == "not applicable: no answer"
     assert statuses["atwood"]["equilibria"] == "not applicable: none found"

@@ -34,6 +34,15 @@ SIMULATION_FPS = 20
 SIMULATION_FRAMES = 120
 
 
+NOTHING_TO_DRAW = ("Nothing to draw: the model is given by its energies only, with no particle "
+                   "or body to place in space.")
+
+
+def drawable(model: Model) -> bool:
+    """Whether the model has something to draw: a particle or a body."""
+    return bool(model.particles or model.bodies or model.rigid_bodies)
+
+
 def data_uri(data: bytes, mime: str) -> str:
     return f"data:{mime};base64,{base64.b64encode(data).decode('ascii')}"
 

@@ -126,6 +126,7 @@ def build_report(system, *, answer=None, t_end: float | None = None,
     ``size`` ("WxH" or (width, height) pixels) and ``fps`` set every animation's frames, as
     for ``modes --animate``. An unreadable answer or a bad size is refused before any work."""
     from ..output.media import check_fps, check_size
+    from . import invariants
     from . import sections as numeric
 
     size, fps = check_size(size), None if fps is None else check_fps(fps)
@@ -141,8 +142,10 @@ def build_report(system, *, answer=None, t_end: float | None = None,
         ("equations", "Equations of motion", _equations_section),
         ("equilibria", "Equilibria and their stability", numeric.equilibria_section),
         ("modes", "Modes", numeric.modes_section),
+        ("conserved", "Conserved quantities", invariants.conserved_section),
         ("simulation", "Simulation", lambda c: numeric.simulation_section(
             c, DEFAULT_T_END if t_end is None else float(t_end))),
+        ("cycle", "Limit cycle through the impacts", invariants.limit_cycle_section),
         ("units", "Units check", numeric.units_section),
         ("check", "Check of a hand derivation", lambda c: numeric.check_section(c, checked)),
     ]
@@ -188,7 +191,7 @@ def model_file_text(model) -> tuple[str, str] | None:
 
 
 def _model_section(c: _Page) -> tuple[Markup, str]:
-    from .media import data_uri, drawing_png
+    from .media import NOTHING_TO_DRAW, data_uri, drawable, drawing_png
 
     model = c.model
     parts = []
@@ -201,13 +204,17 @@ def _model_section(c: _Page) -> tuple[Markup, str]:
             ["name", "value (SI)", "unit"],
             [(p.name, _value(p.value), p.unit or "") for p in model.parameters])]
     drawing = [element("h3", "Drawing")]
-    try:
-        q = np.array([co.initial or 0.0 for co in model.coordinates], dtype=float)
-        drawing.append(element("figure", image(data_uri(drawing_png(model, q), "image/png"),
-                                               f"the mechanism {model.name} at its initial state"),
-                               element("figcaption", "At the initial values of the coordinates.")))
-    except LagrangianError as exc:
-        drawing.append(note(f"No drawing: {exc}"))
+    if not drawable(model):
+        drawing.append(note(NOTHING_TO_DRAW))
+    else:
+        try:
+            q = np.array([co.initial or 0.0 for co in model.coordinates], dtype=float)
+            drawing.append(element(
+                "figure", image(data_uri(drawing_png(model, q), "image/png"),
+                                f"the mechanism {model.name} at its initial state"),
+                element("figcaption", "At the initial values of the coordinates.")))
+        except LagrangianError as exc:
+            drawing.append(note(f"No drawing: {exc}"))
     parts.append(element("div", element("div", *tables), element("div", *drawing),
                          class_="columns"))
     found = model_file_text(model)

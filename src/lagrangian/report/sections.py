@@ -8,12 +8,15 @@ from __future__ import annotations
 
 from ..errors import LagrangianError
 from ..kinds import FindingStatus
+from .expected import expected_markup
 from .html import Markup, element, image, join, note, number, paragraph, table
 from .media import (
     MODE_CYCLE,
     MODES_ANIMATED,
+    NOTHING_TO_DRAW,
     coordinate_mode_gif,
     data_uri,
+    drawable,
     figure_png,
     mode_gif,
     simulation_gif,
@@ -74,7 +77,9 @@ def modes_section(c) -> tuple[Markup, str]:
     header = ["mode", "ω (rad/s)", "f (Hz)", "ζ", "growth (1/s)", "kind",
               *(f"shape: {n}" for n in names)]
     rows = [[str(i), number(m.frequency), number(m.frequency_hz),
-             number(m.damping_ratio, 4), number(m.growth_rate, 4), m.kind,
+             # a real eigenvalue has no damping ratio (as `modes` prints it): "–"
+             "–" if m.damping_ratio is None or m.frequency == 0 else number(m.damping_ratio, 4),
+             number(m.growth_rate, 4), m.kind,
              *(number(m.shape.get(n), 4) for n in names)]
             for i, m in enumerate(analysis, 1)]
     parts.append(table(header, rows))
@@ -88,7 +93,7 @@ def modes_section(c) -> tuple[Markup, str]:
 
 def _mode_animations(c, analysis) -> Markup:
     """A looping GIF of the mechanism in each of the lowest oscillating modes."""
-    drawable = bool(c.model.particles or c.model.bodies or c.model.rigid_bodies)
+    drawn = drawable(c.model)
     figures = []
     for i, mode in enumerate(analysis.modes[:MODES_ANIMATED], 1):
         if mode.frequency <= 0:
@@ -96,14 +101,14 @@ def _mode_animations(c, analysis) -> Markup:
                                                   "oscillate, so there is no motion to show.")))
             continue
         try:
-            gif = mode_gif(c.model, analysis, mode, i, size=c.size, fps=c.fps) if drawable \
+            gif = mode_gif(c.model, analysis, mode, i, size=c.size, fps=c.fps) if drawn \
                 else coordinate_mode_gif(analysis, mode, i, _units(c), size=c.size, fps=c.fps)
         except LagrangianError as exc:
             figures.append(note(f"Mode {i}: no animation ({exc})."))
             continue
         caption = (f"Mode {i}: {number(mode.frequency, 4)} rad/s, period "
                    f"{number(mode.period, 4)} s, played in {MODE_CYCLE:g} s; "
-                   + ("amplitude exaggerated, " if drawable else "")
+                   + ("amplitude exaggerated, " if drawn else "")
                    + "growth or decay left out.")
         figures.append(element("figure", image(data_uri(gif, "image/gif"),
                                                f"the mechanism moving in mode {i}",
@@ -112,10 +117,10 @@ def _mode_animations(c, analysis) -> Markup:
     if len(analysis) > MODES_ANIMATED:
         figures.append(note(f"The {len(analysis) - MODES_ANIMATED} higher modes are not drawn."))
     gallery = element("div", *figures, class_="gallery")
-    if drawable:
+    if drawn:
         return gallery
-    return join([note("The model is given by its energies only (no particles or bodies): each "
-                      "mode is shown as its coordinates moving, each on its own track."), gallery])
+    return join([note(f"{NOTHING_TO_DRAW} Each mode is shown as its coordinates moving, each "
+                      "on its own track."), gallery])
 
 
 REPORTED_IMPACTS = 10  # impacts listed on the page
@@ -139,13 +144,13 @@ def simulation_section(c, t_end: float) -> tuple[Markup, str]:
         more = len(simulation.impacts) - len(shown)
         if more:
             parts.append(note(f"... and {more} more impacts (simulate --json lists them)."))
-    if c.model.particles or c.model.bodies or c.model.rigid_bodies:
+    if drawable(c.model):
         gif = simulation_gif(simulation, size=c.size, fps=c.fps)
         parts.append(element("figure", image(data_uri(gif, "image/gif"), "the simulated motion",
                                              class_="animation"),
                              element("figcaption", "The simulated motion, looping.")))
     else:
-        parts.append(note("No animation: the model is given by its energies only."))
+        parts.append(note(f"{NOTHING_TO_DRAW} The plot above shows its coordinates over time."))
     return join(parts), SHOWN
 
 
@@ -176,7 +181,7 @@ def check_section(c, report) -> tuple[Markup, str]:
     rows = [(f.item, element("span", f.status, class_="good" if f.status in good
                              else "bad" if f.status == bad else None),
              f.code or "", f.message, "" if f.expected is None or f.status == FindingStatus.CORRECT
-             else f.expected) for f in report.findings]
+             else expected_markup(c.write, c.model, f.expected)) for f in report.findings]
     verdict = element("span", report.verdict, class_="good" if report.passed else "bad")
     parts = [paragraph(f"{report.answer} against {report.model}: ", verdict)]
     if rows:

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
-from ..analysis.conserved import ConservedQuantities, conserved_quantities
-from ..analysis.hamilton import Hamiltonian, hamiltonian_of
-from ..analysis.routh import routhian_model
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # imported by the methods that use them (issue 38)
+    from ..analysis.conserved import ConservedQuantities
+    from ..analysis.hamilton import Hamiltonian
 
 
 class ConservationMethods:
@@ -17,6 +19,8 @@ class ConservationMethods:
         whether it equals T + V), and Noether quantities of affine generators xi = a + B q
         (translations, rotations in Cartesian coordinates); a load or constraint doing virtual
         work along xi breaks one (listed in ``.broken`` with why)."""
+        from ..analysis.conserved import conserved_quantities
+
         found = self.__dict__.get("_conserved")
         if found is None:
             found = self.__dict__["_conserved"] = conserved_quantities(
@@ -28,11 +32,15 @@ class ConservationMethods:
         (the Routhian R = -L_R), each conserved momentum a parameter ``p_<name>`` (its value
         at the model's initial state by default; set it with ``with_parameters``). Steady
         motions become equilibria: ``.equilibria()``, ``.modes()``, ``.simulate()`` work."""
+        from ..analysis.routh import routhian_model
+
         return type(self)(routhian_model(self.equations_of_motion(), list(cyclic)))
 
     def hamiltonian(self) -> Hamiltonian:
         """H(q, p) = p . q_dot - L with momenta ``p_<q>``; ``.rhs(q, p)`` -> (q_dot, p_dot),
         ``.momenta_of(q, q_dot)``, ``.H`` (written out up to 4 coordinates)."""
+        from ..analysis.hamilton import hamiltonian_of
+
         found = self.__dict__.get("_hamiltonian")
         if found is None:
             found = self.__dict__["_hamiltonian"] = hamiltonian_of(self.equations_of_motion())

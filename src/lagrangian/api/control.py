@@ -5,12 +5,10 @@ laws closed into its equations once per System."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
-from ..control.along import TrajectoryLinearization, linearize_along
-from ..dynamics.constrained import ConstrainedDynamics
-from ..model.expressions import as_expression
-from ..model.values import resolve_parameters
-from ..simulation.simulate import model_law
+if TYPE_CHECKING:  # imported by the methods that use them (issue 38)
+    from ..control.along import TrajectoryLinearization
 
 
 class ControlMethods:
@@ -29,12 +27,17 @@ class ControlMethods:
         n - m independent coordinates, or "auto" for the best conditioned along the run) gives
         A(t), B(t) on the constraint manifold instead, in x = [q_i; q_i_dot] (holonomic
         constraints; the others follow from Phi = 0 and Phi_dot = 0)."""
+        from ..control.along import linearize_along
+
         return linearize_along(self._dynamics_in_time(), simulation, inputs, independent)
 
     def _dynamics_in_time(self):
         """dynamics(), or where a model file's equations hold t explicitly (a moving support)
         and dynamics() would read them at t = 0, the same through dynamics/constrained.py,
         which takes each sample's t."""
+        from ..dynamics.constrained import ConstrainedDynamics
+        from ..model.expressions import as_expression
+
         if self._recursive is None and not self.model.constraints:
             eom = self.equations_of_motion()
             parts = [*eom.mass_matrix, *eom.forcing]
@@ -44,6 +47,9 @@ class ControlMethods:
 
     def _model_law(self, controller: str):
         """The model's [control] laws closed into its equations (controller="model"), kept."""
+        from ..model.values import resolve_parameters
+        from ..simulation.simulate import model_law
+
         found = self.__dict__.get("_closed_loop")
         if found is None or controller != "model":
             eom = self.equations_of_motion()

@@ -5,12 +5,13 @@ analysis/limit_cycle.py)."""
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
-from ..analysis.limit_cycle import LimitCycle, limit_cycle
-from ..derivation.impact_map import ImpactMap, derive_impact_maps
 from ..errors import InputError
-from ..model.values import resolve_parameters
-from ..simulation.hybrid import MAX_IMPACTS, simulate_through_impacts
+
+if TYPE_CHECKING:  # imported by the methods that use them (issue 38)
+    from ..analysis.limit_cycle import LimitCycle
+    from ..derivation.impact_map import ImpactMap
 
 
 class ImpactMethods:
@@ -19,6 +20,8 @@ class ImpactMethods:
     def impact_maps(self) -> tuple[ImpactMap, ...]:
         """Each impact's map in symbols: M, the rows J of the striking point's velocity the law
         sets, E, the guard and the relabelling (derived once per System)."""
+        from ..derivation.impact_map import derive_impact_maps
+
         found = self.__dict__.get("_impact_maps")
         if found is None:
             found = self.__dict__["_impact_maps"] = derive_impact_maps(
@@ -30,6 +33,9 @@ class ImpactMethods:
         after the impact (by name, SI), ``.period`` (s), ``.multipliers`` (the linearized
         Poincare map's eigenvalues, exact to integration tolerance) and ``.stable``. ``guess``:
         a state just after an impact (default: the model's initial state, carried to one)."""
+        from ..analysis.limit_cycle import limit_cycle
+        from ..model.values import resolve_parameters
+
         if not self.model.impacts:
             raise InputError("the model has no impacts ([[impacts]]): no cycle through one",
                              field="impacts")
@@ -41,6 +47,8 @@ class ImpactMethods:
     def _run_through_impacts(self, t_end, start, step_control, save_at, progress, stop,
                              controller, max_impacts, settle):
         """simulate()'s run for a model with impacts (simulation/hybrid.py)."""
+        from ..simulation.hybrid import MAX_IMPACTS, simulate_through_impacts
+
         if stop is not None:
             raise InputError("a stop condition is not available for a model with impacts "
                              "(the run ends at t_end, an accumulation or max_impacts)",

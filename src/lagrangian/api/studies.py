@@ -6,13 +6,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from ..analysis.speed_form import SpeedForm, SpeedSweep, speed_form, speed_sweep
-from ..derivation.regularity import require_inertia
 from ..errors import InputError
-from ..simulation.events import StopCondition
-from ..simulation.simulate import SaveAt, StepControl, parse_stop_condition
-from .options import run_options
+
+if TYPE_CHECKING:  # imported by the methods that use them (issue 38)
+    from ..analysis.speed_form import SpeedForm, SpeedSweep
+    from ..simulation.options import SaveAt, StepControl
 
 
 class StudyMethods:
@@ -26,6 +26,8 @@ class StudyMethods:
         (analysis/speed_form.py); ``steady`` gives each steady rate as an expression in the
         parameters, e.g. {"x_dot": "v", "thetaR_dot": "-v/rR", "thetaF_dot": "-v/rF"}. What is
         not given comes from the model's [steady] table."""
+        from ..analysis.speed_form import speed_form
+
         steady, speed, keep, about = self._steady_motion(steady, speed, keep, about)
         return speed_form(self.equations_of_motion(), about, steady, speed, keep)
 
@@ -36,6 +38,8 @@ class StudyMethods:
         """Eigenvalues (1/s) of the reduced equations at each speed (m/s; default 0 to 10 in
         steps of 0.1), and the speeds where their real parts cross zero (a bicycle's weave and
         capsize speeds) with the stable range."""
+        from ..analysis.speed_form import speed_sweep
+
         if speeds is None:
             speeds = [i / 10 for i in range(101)]
         return speed_sweep(self.speed_form(steady, speed, keep, about=about), speeds)
@@ -85,8 +89,12 @@ class StudyMethods:
         condition or a StopCondition) set each member's simulation, as in System.simulate.
         """
         from ..analysis.study import SimulationOptions, make_study
+        from ..derivation.regularity import require_inertia
         from ..output.sweep import require_study_packages
+        from ..simulation.events import StopCondition
+        from ..simulation.simulate import parse_stop_condition
         from ..study.engine import run_study
+        from .options import run_options
 
         require_study_packages(out)  # the extra [sweep], asked before the derivation
         eom = self.equations_of_motion()

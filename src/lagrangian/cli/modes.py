@@ -67,20 +67,22 @@ def modes(
 ) -> None:
     """Linearize about an equilibrium: M, C, K, natural frequencies, damping and mode shapes."""
     from ..errors import InputError
-    from ..output.animation import check_animation_target, check_fps, check_size, check_view
     from ..output.files import check_output_path
-    from ..output.modes import modes_document, modes_text, write_mode_plot
-    from ..output.plots import check_plot_path
+    from ..output.modes import modes_document, modes_text
 
     system = load_system(model, set_, lock, gravity, payload)
     point = state_assignments(system, about, "--about")
     inputs = (Path(model),) if Path(model).exists() else ()
     if plot is not None:  # before the analysis: a path that cannot be written costs nothing
+        from ..output.plots import check_plot_path
+
         check_output_path(check_plot_path(plot), "plot", inputs=inputs)
     for given, field in ((mode, "mode"), (size, "size"), (fps, "fps"), (view, "view")):
         if given is not None and animate is None:
             raise InputError(f"{ONLY_WITH_ANIMATE[field]} only used with --animate", field=field)
     if animate is not None:  # the same: everything checked before the analysis
+        from ..output.animation import check_animation_target, check_fps, check_size, check_view
+
         check_output_path(animate, "animation", inputs=inputs)
         check_animation_target(animate)
         size, fps, view = check_size(size), check_fps(20 if fps is None else fps), check_view(view)
@@ -89,6 +91,8 @@ def modes(
     analysis = system.modes(about=point or None, steady=rates or None, inputs=names)
     trim = analysis.linear_model.trim
     if plot is not None:
+        from ..output.modes import write_mode_plot
+
         write_mode_plot(analysis, plot, protect=inputs)
     if animate is not None:
         analysis.animate(animate, mode=mode, fps=fps, size=size, view=view)

@@ -66,19 +66,20 @@ def simulate(
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
     from .. import SaveAt, StepControl, parse_quantity, parse_stop_condition, resolve_state
     from ..errors import InputError
-    from ..output.animation import (
-        check_animatable,
-        check_animation_path,
-        check_animation_target,
-        check_fps,
-        check_size,
-        check_view,
-    )
     from ..output.control import controller_text, law_summary, law_text
     from ..output.files import check_output_path, partial_path
-    from ..output.plots import check_plot_path
     from ..output.simulation import projection_warning, simulation_document, simulation_text
-    from ..output.tables import check_table_path
+
+    # the writers' checks only for what was asked: a plain run loads no animation or plotting
+    if animate is not None or view is not None or size is not None or fps is not None:
+        from ..output.animation import (
+            check_animatable,
+            check_animation_path,
+            check_animation_target,
+            check_fps,
+            check_size,
+            check_view,
+        )
 
     system = load_system(model, set_, lock, gravity, payload, floating_base)
     floating = getattr(system.model.kinematic_tree, "floating_base", False)
@@ -98,8 +99,12 @@ def simulate(
         raise InputError("it names the coordinates of --linearize-along: give both",
                          field="--independent")
     if out is not None:
+        from ..output.tables import check_table_path
+
         check_table_path(out)
     if plot is not None:
+        from ..output.plots import check_plot_path
+
         check_plot_path(plot)
     if animate is not None:
         check_animation_path(animate)
@@ -214,8 +219,8 @@ def _impact_options(system, max_impacts, settle) -> dict:
 
 def _controller(system, control, about, inputs, q_weight, r_weight, kp, kd):
     """The controller --control names, built by lagrangian.control; None without --control."""
-    from .. import computed_torque, lqr
     from ..errors import InputError
+
     given = {"--about": about, "--inputs": inputs, "--Q": q_weight != "1", "--R": r_weight != "1",
              "--kp": kp != "100", "--kd": kd != "20"}
     used = {None: (), "lqr": ("--about", "--inputs", "--Q", "--R"),
@@ -232,6 +237,7 @@ def _controller(system, control, about, inputs, q_weight, r_weight, kp, kd):
         return None
     if control == "model":  # the file's [control] laws: simulate checks there are some
         return control
+    from .. import computed_torque, lqr
     point = state_assignments(system, about, "--about") or None
     if control == "lqr":
         names = [name.strip() for text in inputs for name in text.split(",") if name.strip()]

@@ -5,13 +5,15 @@ from __future__ import annotations
 import functools
 import io
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import InputError
-from ..simulation.result import SimulationResult
 from .files import atomic_write
-from .simulation import INVARIANT_WORDS
+
+if TYPE_CHECKING:
+    from ..simulation.result import SimulationResult
 
 PLOT_FORMATS = (".png", ".svg", ".pdf")
 
@@ -68,6 +70,8 @@ def time_history_figure(result: SimulationResult, units: dict[str, str] | None =
 
     Built without pyplot, so it works headless; in Jupyter the Figure shows itself.
     """
+    from .simulation import INVARIANT_WORDS  # the run's words: loaded with a run to plot
+
     units = units or {}
     groups: dict[str, list[int]] = {}
     for i, name in enumerate(result.coordinates):

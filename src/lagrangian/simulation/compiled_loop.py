@@ -26,7 +26,12 @@ class FastResult:
     success: bool
     message: str
     steps: int = 0  # accepted steps
+    status: int = 0  # the C loop's code: _MESSAGES (1: max_steps reached)
+    t_reached: float = 0.0  # s: the time the loop got to
 
+
+MAX_STEPS = 10_000_000  # accepted steps of one call at most
+STEP_LIMIT = 1  # the C loop's status when it reached max_steps
 
 _MESSAGES = {
     0: "The solver successfully reached the end of the integration interval.",
@@ -46,7 +51,7 @@ def integrate_fast(
     rtol: float,
     atol: float,
     t_eval: np.ndarray | None = None,
-    max_steps: int = 10_000_000,
+    max_steps: int = MAX_STEPS,
 ) -> FastResult | None:
     """Integrate y' = rhs(t, y), y = [q, q_dot], over t_span (s) by DOP853 in compiled C.
 
@@ -78,4 +83,4 @@ def integrate_fast(
         kernel.parameter_values, t0, t1, y0, float(rtol), float(atol), t_eval, int(max_steps))
     message = _MESSAGES[status].format(max_steps=max_steps, t=t_reached)
     return FastResult(t=t, y=y, nfev=int(nfev), success=status == 0, message=message,
-                      steps=int(steps))
+                      steps=int(steps), status=int(status), t_reached=float(t_reached))

@@ -19,6 +19,7 @@ from ..kinds import InvariantKind, RunStatus
 from ..model.quaternions import check_quaternions, quaternion_matrix
 from ..model.values import resolve_state
 from .events import StopCondition, parse_stop_condition
+from .guards import GuardedRhs, StepCollapse, check_start
 from .integration_loops import LoopRun, crossing_time
 from .invariants import cumulative_work
 from .options import SaveAt, StepControl
@@ -181,7 +182,11 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     solver_class = solvers[step_control.method]
     options = {} if step_control.max_step is None else {"max_step": step_control.max_step}
     grid = np.linspace(t0, t_end, save_at.samples)
-    solver = solver_class(rhs, t0, np.concatenate([q0, v0]), t_end, rtol=step_control.rtol,
+    y0 = np.concatenate([q0, v0])
+    # a rate that overflows the accelerations at once: refused (simulation/guards.py)
+    check_start(rhs, t0, y0, dynamics.velocity_names, tuple(initial or ()))
+    guarded = GuardedRhs(rhs, step_control.method, len(y0), t0, t_end)
+    solver = solver_class(guarded, t0, y0, t_end, rtol=step_control.rtol,
                           atol=step_control.atol, **options)
     user = None if stop is None else _stop_event(stop, dynamics, model, system.parameters)
     limit, beyond = _limit_event(joint_limits)
@@ -204,6 +209,7 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
                 status = RunStatus.FAILED
                 message = f"the step failed at t = {solver.t:.6g} s: {message_of_step}"
                 break
+            guarded.accepted(solver.t)
             dense = solver.dense_output()
             # the accepted state back on the unit sphere: |q| drifts by the step's error only
             solver.y[3:7] /= np.linalg.norm(solver.y[3:7])
@@ -234,6 +240,8 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
                 progress(solver.t)
     except KeyboardInterrupt:
         status, message = RunStatus.INTERRUPTED, f"interrupted at t = {solver.t:.6g} s"
+    except StepCollapse as collapse:
+        status, message = RunStatus.FAILED, collapse.message
     wall = time.perf_counter() - began
     Y = np.array(samples)
     t = np.array(times)

@@ -16,6 +16,7 @@ import numpy as np
 from ..compile.functions import NumericSystem
 from ..kinds import RunStatus
 from .drift import DriftControl
+from .guards import COLLAPSE_STEPS, GuardedRhs, StepCollapse, collapse_message, end_spacing
 from .options import StepControl
 from .result import STATUS_MESSAGES
 
@@ -46,6 +47,7 @@ def integrate_compiled(functions: NumericSystem, t_span: tuple[float, float], y0
         from .compiled_loop import integrate_fast
     except ImportError:
         return None
+    spacing = end_spacing(float(grid[0]), float(grid[-1]))
     pieces = [(0, len(grid) - 1)]
     if progress is not None and len(grid) > 2:
         first = max(1, (len(grid) - 1) // 100)
@@ -56,10 +58,10 @@ def integrate_compiled(functions: NumericSystem, t_span: tuple[float, float], y0
     while pieces:
         a, b = pieces.pop(0)
         began = time.perf_counter()
-        result = integrate_fast(functions, (float(grid[a]), float(grid[b])), y_start,
-                                rtol=step.rtol, atol=step.atol, t_eval=grid[a:b + 1])
+        result, tries = _piece(integrate_fast, functions, grid, a, b, y_start, step, spacing)
         if result is None:
             return None
+        nfev += tries
         t = np.asarray(result.t, dtype=float)
         y = np.asarray(result.y, dtype=float).reshape(len(t), len(y_start))
         skip = 1 if ts and len(t) and t[0] == ts[-1][-1] else 0
@@ -99,6 +101,28 @@ def integrate_compiled(functions: NumericSystem, t_span: tuple[float, float], y0
                    "compiled")
 
 
+def _piece(integrate_fast, functions, grid, a, b, y_start, step, spacing):
+    """One piece of the compiled loop, grid[a] to grid[b], with the collapse test: first at
+    most COLLAPSE_STEPS steps, then as many as their mean step says the piece needs (x10 at
+    least); a capped try whose mean step is below the end time's float spacing is a collapse.
+    Returns (the result, the calls of the tries before it)."""
+    from .compiled_loop import MAX_STEPS, STEP_LIMIT, FastResult
+
+    t_a, t_b, cap, tries = float(grid[a]), float(grid[b]), COLLAPSE_STEPS, 0
+    while True:
+        result = integrate_fast(functions, (t_a, t_b), y_start, rtol=step.rtol, atol=step.atol,
+                                t_eval=grid[a:b + 1], max_steps=cap)
+        if result is None or result.status != STEP_LIMIT or cap >= MAX_STEPS:
+            return result, tries
+        why = collapse_message(cap, t_a, result.t_reached, spacing)
+        if why:
+            return FastResult(result.t, result.y, result.nfev, False, why, result.steps,
+                              result.status, result.t_reached), tries
+        tries += result.nfev
+        mean = (result.t_reached - t_a) / cap
+        cap = int(min(MAX_STEPS, max(10 * cap, 2 * (t_b - t_a) / mean)))
+
+
 def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y0: np.ndarray,
                     t_end: float, grid: np.ndarray, step: StepControl,
                     event: Callable | None = None, drift: DriftControl | None = None,
@@ -109,9 +133,10 @@ def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y
     from scipy import integrate
 
     solver_class = getattr(integrate, step.method)
+    guarded = GuardedRhs(fun, step.method, len(y0), t0, t_end)  # rejections, NaN h, collapse
 
     def start(t, y, first_step=None):
-        return solver_class(fun, t, y, t_end, rtol=step.rtol, atol=step.atol,
+        return solver_class(guarded, t, y, t_end, rtol=step.rtol, atol=step.atol,
                             max_step=step.max_step, first_step=first_step)
 
     ts, ys = [t0], [y0.copy()]
@@ -137,6 +162,7 @@ def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y
                                f"(stopped at t = {solver.t_old:.9g} s)")
                     break
                 steps += 1
+                guarded.accepted(solver.t)
                 dense = solver.dense_output()
                 t_stop, hit = solver.t, False
                 if event is not None:
@@ -162,6 +188,8 @@ def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y
     except KeyboardInterrupt:
         status = RunStatus.INTERRUPTED
         message = f"interrupted by the user (Ctrl-C) at t = {_reached(solver, t0):.9g} s"
+    except StepCollapse as collapse:
+        status, message = RunStatus.FAILED, collapse.message
     except np.linalg.LinAlgError:
         status = RunStatus.FAILED
         message = ("singular mass matrix (or constraint Jacobian without full rank) "

@@ -29,6 +29,7 @@ from .control import Controller, ControlLoop
 from .control_law import MODEL_LAW, ModelLaw
 from .drift import DriftControl
 from .events import StopCondition, parse_stop_condition
+from .guards import check_start
 from .integration_loops import LoopRun, integrate_compiled, integrate_steps
 from .invariants import cumulative_work, energy_is_conserved, invariant_kind
 from .options import METHODS, SaveAt, StepControl
@@ -129,6 +130,9 @@ def simulate(
         loop.output(start.t, q0, v0)  # a wrong shape refused before the run
     grid = np.linspace(start.t, t_end, save_at.samples)
     y0 = np.concatenate([q0, v0])
+    # a rate that overflows the accelerations at once: refused, not left to the step control
+    check_start(functions.rhs if loop is None else loop.rhs, start.t, y0, start.velocities,
+                start.given)
     began = time.perf_counter()
     run = _integrate(functions, y0, grid, step_control, event, drift, progress,
                      compiled_loop and not functions.m and event is None and loop is None, beyond,

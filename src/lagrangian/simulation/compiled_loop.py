@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..compile.functions import NumericSystem
+from .guards import MAX_STEPS
 
 
 @dataclass(frozen=True)
@@ -30,7 +31,6 @@ class FastResult:
     t_reached: float = 0.0  # s: the time the loop got to
 
 
-MAX_STEPS = 10_000_000  # accepted steps of one call at most
 STEP_LIMIT = 1  # the C loop's status when it reached max_steps
 
 _MESSAGES = {

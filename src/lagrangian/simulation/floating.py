@@ -242,6 +242,11 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
         status, message = RunStatus.INTERRUPTED, f"interrupted at t = {solver.t:.6g} s"
     except StepCollapse as collapse:
         status, message = RunStatus.FAILED, collapse.message
+    except ValueError:  # Radau's or BDF's LU of a Jacobian that is not finite
+        collapse = guarded.jacobian_failure()
+        if collapse is None:
+            raise
+        status, message = RunStatus.FAILED, collapse.message
     wall = time.perf_counter() - began
     Y = np.array(samples)
     t = np.array(times)

@@ -200,10 +200,20 @@ class Guards:
         rounding (+-1e-17) neither fires it at once nor hides the next crossing; it must rise
         above that value before it can fall through it."""
         values = self.values.at(q, v, t)
-        offsets = np.where(np.abs(values) < ON_GUARD, values, 0.0)
+        on = np.abs(values) < ON_GUARD
+        offsets = np.where(on, values, 0.0)
+        # The event is 0 at the start (the guards just struck, on their offsets), so the loop
+        # arms it only after a step: another guard falling through 0 within that first step
+        # went unseen (a tumbling rod's other end through the floor). Where the guards just
+        # struck rise at once, the start reads as the other guards' value alone (below 0:
+        # armed). One that falls first (a walker's scuffing swing foot) still has to rise
+        # above its value before it can strike.
+        others = ~on
+        start = t if others.any() and np.all(self.rates.at(q, v, t)[on] > 0) else None
 
         def event(q, v, t) -> float:
-            return float(np.max(offsets - self.values.at(q, v, t)))
+            terms = offsets - self.values.at(q, v, t)
+            return float(np.max(terms[others] if t == start else terms))
 
         return event, offsets
 

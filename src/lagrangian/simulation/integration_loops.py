@@ -16,7 +16,14 @@ import numpy as np
 from ..compile.functions import NumericSystem
 from ..kinds import RunStatus
 from .drift import DriftControl
-from .guards import COLLAPSE_STEPS, GuardedRhs, StepCollapse, collapse_message, end_spacing
+from .guards import (
+    COLLAPSE_STEPS,
+    MAX_STEPS,
+    GuardedRhs,
+    StepCollapse,
+    collapse_message,
+    end_spacing,
+)
 from .options import StepControl
 from .result import STATUS_MESSAGES
 
@@ -58,7 +65,8 @@ def integrate_compiled(functions: NumericSystem, t_span: tuple[float, float], y0
     while pieces:
         a, b = pieces.pop(0)
         began = time.perf_counter()
-        result, tries = _piece(integrate_fast, functions, grid, a, b, y_start, step, spacing)
+        result, tries = _piece(integrate_fast, functions, grid, a, b, y_start, step, spacing,
+                               steps or 0)
         if result is None:
             return None
         nfev += tries
@@ -101,12 +109,13 @@ def integrate_compiled(functions: NumericSystem, t_span: tuple[float, float], y0
                    "compiled")
 
 
-def _piece(integrate_fast, functions, grid, a, b, y_start, step, spacing):
+def _piece(integrate_fast, functions, grid, a, b, y_start, step, spacing, taken):
     """One piece of the compiled loop, grid[a] to grid[b], with the collapse test: first at
     most COLLAPSE_STEPS steps, then as many as their mean step says the piece needs (x10 at
-    least); a capped try whose mean step is below the end time's float spacing is a collapse.
-    Returns (the result, the calls of the tries before it)."""
-    from .compiled_loop import MAX_STEPS, STEP_LIMIT, FastResult
+    least); a capped try whose mean step is below the end time's float spacing, or would pass
+    MAX_STEPS in all (``taken`` before the piece), is a collapse. Returns (the result, the
+    calls of the tries before it)."""
+    from .compiled_loop import STEP_LIMIT, FastResult
 
     t_a, t_b, cap, tries = float(grid[a]), float(grid[b]), COLLAPSE_STEPS, 0
     while True:
@@ -114,7 +123,7 @@ def _piece(integrate_fast, functions, grid, a, b, y_start, step, spacing):
                                 t_eval=grid[a:b + 1], max_steps=cap)
         if result is None or result.status != STEP_LIMIT or cap >= MAX_STEPS:
             return result, tries
-        why = collapse_message(cap, t_a, result.t_reached, spacing)
+        why = collapse_message(cap, t_a, result.t_reached, spacing, float(grid[-1]), taken)
         if why:
             return FastResult(result.t, result.y, result.nfev, False, why, result.steps,
                               result.status, result.t_reached), tries
@@ -189,6 +198,11 @@ def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y
         status = RunStatus.INTERRUPTED
         message = f"interrupted by the user (Ctrl-C) at t = {_reached(solver, t0):.9g} s"
     except StepCollapse as collapse:
+        status, message = RunStatus.FAILED, collapse.message
+    except ValueError:  # Radau's or BDF's LU of a Jacobian that is not finite
+        collapse = guarded.jacobian_failure()
+        if collapse is None:
+            raise
         status, message = RunStatus.FAILED, collapse.message
     except np.linalg.LinAlgError:
         status = RunStatus.FAILED

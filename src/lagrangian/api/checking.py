@@ -33,7 +33,6 @@ class CheckMethods:
         ``hints_only``: no expected expression or value, the module's diagnostic question instead.
         """
         from ..check.diagnose import check_answer
-        from ..check.final_answers import check_final_answers
         from ..check.hints import hinted
         from ..model.answer import Answer, answer_from_mapping, read_answer
 
@@ -45,7 +44,7 @@ class CheckMethods:
         if answer.final_tables:
             # final answers (M, K, omega, shapes, ...) come from this system's own analysis
             report = replace(report, findings=report.findings
-                             + tuple(check_final_answers(self, answer)))
+                             + tuple(_final_answers(self, answer)))
         return hinted(report) if hints_only else report
 
     def check_many(self, answers, *, hints_only: bool = False) -> ClassReport:
@@ -54,12 +53,11 @@ class CheckMethods:
         be read is a result with its error. Returns a ClassReport (``results``, ``counts``,
         ``records()`` one per file per item, ``csv_text()``; a table in a notebook)."""
         from ..check.classroom import check_class
-        from ..check.final_answers import check_final_answers
 
         named = [answers] if isinstance(answers, str | Path) else list(answers)
         return check_class(self.equations_of_motion(), named, hints_only=hints_only,
                            exclude=[self._model.source] if self._model.source else [],
-                           final=lambda answer: check_final_answers(self, answer))
+                           final=lambda answer: _final_answers(self, answer))
 
     def crosscheck(self) -> CrosscheckReport:
         """Newton-Euler (free bodies, reactions eliminated) vs Lagrange, coordinate by
@@ -80,3 +78,11 @@ class CheckMethods:
         from ..check.units import check_model_units
 
         return check_model_units(self._model)
+
+
+def _final_answers(system, answer) -> list:
+    """The findings on an answer's final tables (check/final_answers.py, loaded by an answer
+    that has them)."""
+    from ..check.final_answers import check_final_answers
+
+    return check_final_answers(system, answer)

@@ -5,6 +5,7 @@ Like MuJoCo's model/data split, the Model is fixed; what is derived from it is c
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from functools import cached_property, lru_cache
@@ -368,6 +369,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
     def _recursive(self):
         """Recursive dynamics of a URDF tree in generated C (numpy without a compiler), or
         None (dynamics/joint_space.py)."""
+        if self._model.kinematic_tree is None and not self._model.rigid_bodies:
+            return None  # particles and energies: no tree to recurse on, no engine to load
         from ..dynamics.selection import recursive_dynamics
 
         return recursive_dynamics(self.model)
@@ -602,18 +605,21 @@ def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None
 def _load(path_or_example: str | Path, lock, payload, floating_base) -> System:
     from ..model.examples import example_path
     from ..model.reader import read_model
-    from ..model.urdf import example_urdf, read_urdf
 
     path = Path(path_or_example)
     if path.suffix.lower() in (".xml", ".mjcf"):  # MuJoCo's MJCF, read as the URDF it is
         from ..model.mjcf import read_mjcf
 
         return System(read_mjcf(path, lock, payload, floating_base))
-    urdf = path if path.suffix.lower() == ".urdf" else (
-        None if path.exists() else example_urdf(str(path_or_example)))
-    if urdf is not None:
-        model = read_urdf(urdf, lock, payload, floating_base)
-        return System(model if urdf is path else replace(model, source=f"example:{path}"))
+    # a built-in model file by name is no URDF (example_urdf gives None): no URDF reader loaded
+    if path.exists() or not _built_in_model_file(str(path_or_example)):
+        from ..model.urdf import example_urdf, read_urdf
+
+        urdf = path if path.suffix.lower() == ".urdf" else (
+            None if path.exists() else example_urdf(str(path_or_example)))
+        if urdf is not None:
+            model = read_urdf(urdf, lock, payload, floating_base)
+            return System(model if urdf is path else replace(model, source=f"example:{path}"))
     for name, given, what in (("payload", payload, "links to carry a payload"),
                               ("lock", lock, "joints to lock"),
                               ("floating_base", floating_base, "a base to float")):
@@ -623,3 +629,14 @@ def _load(path_or_example: str | Path, lock, payload, floating_base) -> System:
         return System(read_model(path))
     model = read_model(example_path(str(path_or_example)))
     return System(replace(model, source=f"example:{path_or_example}"))
+
+
+def _built_in_model_file(name: str) -> bool:
+    """Whether ``name`` is a built-in example's model file (TOML) with no built-in URDF of the
+    same name (that one would come first)."""
+    from importlib import resources
+
+    if not re.fullmatch(r"\w+", name):
+        return False
+    folder = resources.files("lagrangian.model.examples")
+    return (folder / f"{name}.toml").is_file() and not (folder / f"{name}.urdf").is_file()

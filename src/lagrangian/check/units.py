@@ -407,10 +407,21 @@ def _(load: Torque) -> list[tuple]:
 
 def answer_unit_issues(model: Model, items: list[tuple[str, sp.Expr, str | None, str]],
                        extra: Mapping[sp.Symbol, object] | None = None) -> list[UnitIssue]:
-    """Unit issues of a user's items: (item, expression, expected unit or None, what)."""
-    units = symbol_units(model)
+    """Unit issues of a user's items: (item, expression, expected unit or None, what). As
+    for the model (check_model_units): the exact SI table first, without pint; pint again
+    wherever the table meets another unit or finds an issue, so every issue is pint's own."""
+    try:
+        issues = _answer_unit_issues(model, items, extra, si_dimension)
+    except UnitOutsideTable:
+        issues = None
+    return _answer_unit_issues(model, items, extra, None) if issues is None or issues \
+        else issues
+
+
+def _answer_unit_issues(model: Model, items, extra, quantity_of) -> list[UnitIssue]:
+    units = symbol_units(model, quantity_of)
     units.update(extra or {})
-    checker = DimensionChecker(units)
+    checker = DimensionChecker(units, quantity_of)
     for item, expression, expected, what in items:
         checker.check(item, expression, expected, what)
     return list(_unique(checker.issues))

@@ -20,6 +20,11 @@ from .exact import machine_numbers
 # (mostly short, independent entries) it costs more than it saves.
 CSE_MIN_OPERATIONS = 2000
 
+# numpy's namespace as modules="numpy" builds it (numpy's names, numpy.linalg's over them, the
+# same printer and the same generated code), from the modules themselves: "numpy" runs
+# `from numpy import *`, which imports numpy.f2py and numpy.testing, 0.3 s of a small command.
+_NUMPY = [np.linalg, np]
+
 
 def numpy_function(args: Sequence[sp.Symbol], exprs: sp.Expr | Sequence[sp.Expr]) -> Callable:
     """One numpy function of ``args`` returning ``exprs`` (a list, or one value for one
@@ -28,7 +33,7 @@ def numpy_function(args: Sequence[sp.Symbol], exprs: sp.Expr | Sequence[sp.Expr]
     items = [machine_numbers(as_expression(e)) for e in exprs] if many \
         else [machine_numbers(as_expression(exprs))]
     cse = operations_exceed(items, CSE_MIN_OPERATIONS)
-    return sp.lambdify(list(args), items if many else items[0], modules="numpy", cse=cse)
+    return sp.lambdify(list(args), items if many else items[0], modules=_NUMPY, cse=cse)
 
 
 def operations_exceed(items: Sequence[sp.Expr], limit: int) -> bool:

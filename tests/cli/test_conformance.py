@@ -60,7 +60,7 @@ SWEEP_VARY = {
     "torque_free_body": "I1", "two_mass": "k", "virtual_work_link": "L", "whipple_bicycle": "v",
     "two_link_arm": "g", "massless_crank": "l", "coin_steady": "r", "slider_arm": "g",
     "symbol_free": None, "bouncing_ball": "e", "rimless_wheel": "gamma",
-    "compass_gait": "gamma",
+    "compass_gait": "gamma", "falling_rod": "e",
 }
 
 # statics where there are loads: the configuration and the load magnitudes found

@@ -194,13 +194,15 @@ class Guards:
         """max_i(-g_i): turns >= 0 when a guard falls through 0."""
         return float(np.max(-self.values.at(q, v, t)))
 
-    def leaving(self, q, v, t):
+    def leaving(self, q, v, t, struck: int | None = None):
         """(event, offsets) for a piece of the flow starting at (q, v, t): a guard on its zero
         there (|g| < ON_GUARD; the one just crossed) counts from its value there, so its
         rounding (+-1e-17) neither fires it at once nor hides the next crossing; it must rise
         above that value before it can fall through it."""
         values = self.values.at(q, v, t)
         on = np.abs(values) < ON_GUARD
+        if struck is not None:  # only the guard just struck: another near 0 strikes as it falls
+            on &= np.arange(len(values)) == struck
         offsets = np.where(on, values, 0.0)
         # The event is 0 at the start (the guards just struck, on their offsets), so the loop
         # arms it only after a step: another guard falling through 0 within that first step
@@ -291,11 +293,12 @@ def simulate_through_impacts(
     status, message, limit_time = "finished", STATUS_MESSAGES["finished"], None
     names = [*model.q, *model.q_dot]
     began = time.perf_counter()
+    struck = None  # the guard of the last impact
     while True:
         segment = np.concatenate([[t0], grid[grid > t0]])
         if len(segment) < 2:
             segment = np.array([t0, t_end])
-        event, offsets = guards.leaving(y[:n], y[n:], t0)
+        event, offsets = guards.leaving(y[:n], y[n:], t0, struck)
         run = integrate_steps(functions.rhs, t0, y, float(t_end), segment, step_control,
                               event, None, progress)
         steps += run.steps or 0
@@ -326,7 +329,7 @@ def simulate_through_impacts(
         records.append(ImpactRecord(
             float(t_hit), impact.name, _named(names, y_hit), _named(names, y),
             tuple(float(x) for x in impulse), float(lost), float(residual)))
-        t0 = t_hit
+        t0, struck = t_hit, which
         history = times.setdefault(impact.name, [])
         history.append(t_hit)
         limit_time = accumulation(history)

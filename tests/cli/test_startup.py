@@ -59,3 +59,50 @@ def test_a_command_still_does_its_work():
                               "json"], capture_output=True, text=True)
     assert process.returncode == 0, process.stderr
     assert "g*sin(theta)" in json.dumps(json.loads(process.stdout))  # m L² θ̈ + m g L sin θ = 0
+
+
+_ANSWER = "src/lagrangian/model/examples/course/worked_example_1/right.toml"
+
+# What each small command must not load (issue 38: each answers in about a second): the
+# libraries and stages it does not use. scipy is modes' (its generalized eigenproblem).
+_NOT_LOADED = {
+    ("derive", "pendulum"): ("scipy", "pint", "matplotlib", "pandas", "xarray",
+                             "lagrangian.simulation", "lagrangian.dynamics",
+                             "lagrangian.check.diagnose", "lagrangian.compile.compiled"),
+    ("simulate", "pendulum", "--t-end", "2"): ("scipy", "pint", "matplotlib", "pandas", "xarray",
+                                               "lagrangian.dynamics", "lagrangian.check.diagnose",
+                                               "lagrangian.output.animation"),
+    ("modes", "double_pendulum"): ("pint", "matplotlib", "pandas", "xarray",
+                                   "lagrangian.dynamics", "lagrangian.simulation",
+                                   "lagrangian.output.animation", "lagrangian.check.diagnose"),
+    ("check", "pendulum", _ANSWER): ("scipy", "pint", "matplotlib", "pandas", "xarray",
+                                     "lagrangian.dynamics", "lagrangian.simulation",
+                                     "lagrangian.check.final_answers"),
+}
+
+
+@pytest.mark.parametrize("args", list(_NOT_LOADED), ids=lambda args: args[0])
+def test_a_small_command_loads_only_what_it_uses(args):
+    process = subprocess.run([sys.executable, "-c", _PROBE, json.dumps(list(args)),
+                              json.dumps(["scipy", "pint", "matplotlib", "pandas", "xarray",
+                                          "lagrangian"])],
+                             capture_output=True, text=True, check=True)
+    loaded = json.loads(process.stdout.splitlines()[-1])
+    unwanted = [name for name in loaded
+                if any(name == stem or name.startswith(stem + ".") for stem in _NOT_LOADED[args])]
+    assert unwanted == []
+
+
+def test_every_command_is_found_by_its_name():
+    """The command line loads a named command's module alone (cli/__init__.py COMMAND_MODULES):
+    every module's commands are listed there under their own module, and nothing else."""
+    import pkgutil
+    from importlib import import_module
+
+    import lagrangian.cli as cli
+
+    for found in pkgutil.iter_modules(cli.__path__):
+        import_module(f"lagrangian.cli.{found.name}")
+    registered = {cli.command_name(info): info.callback.__module__.rpartition(".")[2]
+                  for info in cli.app.registered_commands}
+    assert registered == cli.COMMAND_MODULES

@@ -39,26 +39,47 @@ def _main(version: Annotated[bool, typer.Option(
 
 # Each command lives in its own module and registers itself on `app` when imported. The modules
 # import sympy, scipy, matplotlib and pandas inside the commands, never at the top: `--help` and
-# `examples` start in a fraction of a second (tests/cli/test_startup.py).
-from . import check as _check  # noqa: E402,F401
-from . import codegen as _codegen  # noqa: E402,F401
-from . import conserved as _conserved  # noqa: E402,F401
-from . import cycle as _cycle  # noqa: E402,F401
-from . import derive as _derive  # noqa: E402,F401
-from . import dynamics as _dynamics  # noqa: E402,F401
-from . import equilibria as _equilibria  # noqa: E402,F401
-from . import examples as _examples  # noqa: E402,F401
-from . import export as _export  # noqa: E402,F401
-from . import forces as _forces  # noqa: E402,F401
-from . import kinematics as _kinematics  # noqa: E402,F401
-from . import modes as _modes  # noqa: E402,F401
-from . import optimize as _optimize  # noqa: E402,F401
-from . import regressor as _regressor  # noqa: E402,F401
-from . import report as _report  # noqa: E402,F401
-from . import simulate as _simulate  # noqa: E402,F401
-from . import speeds as _speeds  # noqa: E402,F401
-from . import statics as _statics  # noqa: E402,F401
-from . import sweep as _sweep  # noqa: E402,F401
+# `examples` start in a fraction of a second (tests/cli/test_startup.py). A command named on the
+# command line loads its own module only, and typer builds that command alone (building all of
+# them from their signatures, and compiling their modules, was 0.1-0.2 s of every small command,
+# issue 38); the group's help, --version and an unknown name load them all. The modules in the
+# order the help lists them; tests/cli/test_startup.py checks the names against the commands.
+COMMAND_MODULES = {
+    "check": "check", "crosscheck": "check", "units": "check", "codegen": "codegen",
+    "conserved": "conserved", "cycle": "cycle", "derive": "derive", "dynamics": "dynamics",
+    "equilibria": "equilibria", "examples": "examples", "export": "export", "forces": "forces",
+    "kinematics": "kinematics", "modes": "modes", "optimize": "optimize",
+    "regressor": "regressor", "report": "report", "simulate": "simulate", "speeds": "speeds",
+    "statics": "statics", "sweep": "sweep",
+}
+_ORDER = {module: i for i, module in enumerate(dict.fromkeys(COMMAND_MODULES.values()))}
+
+
+def command_name(info) -> str:
+    """A registered command's name on the command line, as typer names it."""
+    from typer.main import get_command_name
+
+    return info.name or get_command_name(info.callback.__name__)
+
+
+def _app_for(words: list[str]) -> typer.Typer:
+    """The app that runs ``words``: the command they name, alone, or every command."""
+    import copy
+    from importlib import import_module
+
+    name = words[0] if words else None
+    for module in [COMMAND_MODULES[name]] if name in COMMAND_MODULES else _ORDER:
+        import_module(f"{__name__}.{module}")
+    # the help's order whatever order the modules came in (a test process runs many commands)
+    app.registered_commands.sort(key=lambda info: _ORDER.get(
+        info.callback.__module__.rpartition(".")[2], len(_ORDER)))
+    if name not in COMMAND_MODULES:
+        return app
+    alone = copy.copy(app)  # the same group (callback, settings), with the one command
+    alone.registered_commands = [i for i in app.registered_commands if command_name(i) == name]
+    return alone
+
+
 from .common import TerminalText, flush_warnings, in_flags, reset_warnings  # noqa: E402
 
 
@@ -81,7 +102,8 @@ def _run(argv: list[str] | None) -> None:
     """The command, its errors as one line `error: ...` and its exit status."""
     try:
         try:
-            code = app(args=argv, prog_name="lagrangian", standalone_mode=False)
+            words = sys.argv[1:] if argv is None else list(argv)
+            code = _app_for(words)(args=words, prog_name="lagrangian", standalone_mode=False)
         except SystemExit as exc:  # a command's own status: warnings only with a success
             if exc.code in (0, None):
                 flush_warnings()

@@ -122,7 +122,9 @@ class CasadiFunctions:
     -> M, ``forcing(q, q_dot, u)`` -> f of M q_ddot (+ Phi_q^T lambda) = f, ``constraints(q,
     q_dot)`` -> the residuals Phi (holonomic) and A q_dot + b (velocity), None without
     constraints. ``inputs`` name the entries of u (as ``linearize(inputs=...)``): a generalized
-    force on a coordinate, or added to a load's parameter (as simulate's controller does)."""
+    force on a coordinate, or added to a load's parameter (as simulate's controller does).
+    A floating base's state is x = [q (nq = n + 7); v (nv = n + 6)] in our dynamics' layout
+    (``configuration``, ``velocities``: compile/casadi_tree.py), M nv x nv, f and tau nv."""
 
     coordinates: tuple[str, ...]
     inputs: tuple[str, ...]
@@ -133,10 +135,21 @@ class CasadiFunctions:
     constraints: object | None
     # per input, the coordinate whose generalized force it is (its index), None for a load
     input_coordinates: tuple[int | None, ...] = ()
+    # a floating base's names of q and v (the base's numbers first); () on a fixed base
+    configuration: tuple[str, ...] = ()
+    velocities: tuple[str, ...] = ()
+
+    @property
+    def floating_base(self) -> bool:
+        """Whether x holds a floating base's seven and six numbers first."""
+        return bool(self.configuration)
 
     @property
     def states(self) -> tuple[str, ...]:
-        """The names of x: the coordinates, then their velocities (``theta_dot``)."""
+        """The names of x: the coordinates, then their velocities (``theta_dot``); a floating
+        base's numbers first in each (base_x .. base_qw, base_vx .. base_wz)."""
+        if self.configuration:
+            return self.configuration + self.velocities
         return self.coordinates + tuple(f"{c}_dot" for c in self.coordinates)
 
     def __repr__(self) -> str:

@@ -3,6 +3,11 @@
 minimise the effort J = integral of |u|^2 dt (u in the inputs' SI units) over x(t) = [q; q_dot],
 u(t) on [0, t_final], subject to x_dot = rhs(x, u) at the collocation points (trapezoidal or
 Hermite-Simpson), x(0) = start, x(t_final) = goal where given, and bounds on u and x.
+
+A floating base's x = [q; v] holds its position, quaternion (x y z w) and body twist first, as
+our dynamics (compile/casadi_tree.py): its quaternion is collocated as the other numbers (its
+rate keeps |q| = 1 up to the scheme's error, and the base's R is that of q / |q|); it starts at
+the origin at rest, level, unless ``start`` names its numbers.
 """
 
 from __future__ import annotations
@@ -16,6 +21,7 @@ from ..compile.casadi_functions import CasadiFunctions
 from ..errors import InputError, ModelError
 from ..model.checked import unknown_name
 from ..model.model import Model
+from ..model.quaternions import QUATERNION_TOLERANCE
 from ..model.values import resolve_state
 from ..simulation.replay import replay
 
@@ -47,6 +53,9 @@ class Trajectory:
     midpoint_inputs: np.ndarray = field(repr=False, default_factory=lambda: np.zeros((0, 0)))
     # per input, the coordinate whose generalized force it is (index), None for a load
     input_coordinates: tuple[int | None, ...] = field(repr=False, default=())
+    # how many generalized forces the controller gives when every input is a coordinate's:
+    # the coordinates (a floating base's joints: simulate puts no force on the base)
+    force_width: int = field(repr=False, default=0)
 
     def input_at(self, t: float) -> np.ndarray:
         """u(t) as the collocation scheme represents it: piecewise linear (trapezoidal) or
@@ -69,7 +78,7 @@ class Trajectory:
         ``System.simulate(t_final, initial=..., controller=trajectory.controller())``; inputs
         that are all coordinates give the n generalized forces (0 on the others)."""
         trajectory = self
-        n = len(self.states) // 2
+        n = self.force_width or len(self.states) // 2
         rows = list(self.input_coordinates)
         if rows and all(row is not None for row in rows):  # generalized forces: B = I
 
@@ -137,6 +146,8 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
                          "coordinate: inputs=[...])", field="inputs")
     first = _start(model, functions, start)
     target = _named(goal, names, "goal")
+    if functions.floating_base:
+        _check_quaternion(target, "goal", required=False)
     lower, upper = _bounds(bounds, names, functions.inputs)
 
     opti = ca.Opti()
@@ -160,13 +171,14 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
     for d in defects:
         opti.subject_to(ca.vec(d) == 0)
     fixed, free = first
+    nq = len(functions.configuration) or n2 // 2  # q's entries of x, then v's
     for i, value in fixed.items():
         opti.subject_to(X[i, 0] == value)
     if functions.constraints is not None:
         m = len(functions.constraint_names)
-        Phi = functions.constraints.map(nodes)(X[: n2 // 2, :], X[n2 // 2:, :])
+        Phi = functions.constraints.map(nodes)(X[:nq, :], X[nq:, :])
         # the start on the constraints, at position and velocity level; the dynamics keep it
-        q0, v0 = X[: n2 // 2, 0], X[n2 // 2:, 0]
+        q0, v0 = X[:nq, 0], X[nq:, 0]
         opti.subject_to(Phi[:, 0] == 0)
         opti.subject_to(_holonomic_rates(ca, functions, n2 // 2)(q0, v0) == 0)
         constraint_rows = Phi
@@ -211,7 +223,8 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
         defects={"collocation": residual, "final_state": final, "constraints": violation,
                  "replay": 0.0},
         iterations=int(stats.get("iter_count", 0)), midpoint_inputs=um,
-        input_coordinates=functions.input_coordinates)
+        input_coordinates=functions.input_coordinates,
+        force_width=len(functions.coordinates))
     trajectory.defects["replay"] = _replay_error(functions, trajectory, x)
     return trajectory
 
@@ -291,6 +304,17 @@ def _start(model: Model, functions: CasadiFunctions, start) -> tuple[dict[int, f
     with their guess (the model's initial values)."""
     names = functions.states
     given = _named(start, names, "start")
+    if functions.floating_base:  # the base at the origin, level and at rest unless given
+        base = {**dict(zip(functions.configuration[:7], (0.0,) * 6 + (1.0,), strict=True)),
+                **dict.fromkeys(functions.velocities[:6], 0.0)}
+        joints = {names[i]: v for i, v in given.items() if names[i] not in base}
+        state = resolve_state(model, joints, field="start")
+        base.update({names[i]: v for i, v in given.items() if names[i] in base})
+        values = [*(base[k] for k in functions.configuration[:7]), *map(float, state.q),
+                  *(base[k] for k in functions.velocities[:6]), *map(float, state.q_dot)]
+        every = dict(enumerate(values))
+        _check_quaternion(every, "start", required=True)
+        return every, {}
     state = resolve_state(model, {names[i]: v for i, v in given.items()}, field="start")
     values = [*map(float, state.q), *map(float, state.q_dot)]
     if functions.constraints is None or not given:  # the model's own start is consistent
@@ -331,12 +355,20 @@ def _guess(fixed, free, target, n2: int, nodes: int) -> np.ndarray:
     return begin[:, None] + (end - begin)[:, None] * s[None, :]
 
 
+def _check_quaternion(values: dict[int, float], what: str, required: bool) -> None:
+    """A floating base's quaternion (x entries 3..6) of unit norm where all four are given."""
+    if not required and not all(i in values for i in range(3, 7)):
+        return
+    norm = float(np.sqrt(sum(values[i] ** 2 for i in range(3, 7))))
+    if abs(norm - 1.0) > QUATERNION_TOLERANCE:
+        raise InputError(f"the base quaternion (base_qx, base_qy, base_qz, base_qw) has norm "
+                         f"{norm:.9g}: a unit quaternion is needed", field=what)
+
+
 def check_model(model: Model) -> None:
-    """Refuse what collocation on the derived equations cannot take (a floating base)."""
-    tree = getattr(model, "kinematic_tree", None)
-    if tree is not None and tree.floating_base:
-        raise ModelError("a floating base cannot be optimised yet (its state lives on SE(3))",
-                         field="optimize")
+    """Refuse what collocation cannot take (nothing yet: kept for the API's call)."""
+    if not isinstance(model, Model):
+        raise ModelError("optimize needs a model", field="optimize")
 
 
 __all__ = ["METHODS", "OBJECTIVES", "Trajectory", "check_model", "collocate"]

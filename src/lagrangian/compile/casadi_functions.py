@@ -123,6 +123,7 @@ class CasadiFunctions:
     q_dot)`` -> the residuals Phi (holonomic) and A q_dot + b (velocity), None without
     constraints. ``inputs`` name the entries of u (as ``linearize(inputs=...)``): a generalized
     force on a coordinate, or added to a load's parameter (as simulate's controller does).
+    Equations with t explicit (``time_dependent``): each Function takes t (s) last.
     A floating base's state is x = [q (nq = n + 7); v (nv = n + 6)] in our dynamics' layout
     (``configuration``, ``velocities``: compile/casadi_tree.py), M nv x nv, f and tau nv."""
 
@@ -138,6 +139,9 @@ class CasadiFunctions:
     # a floating base's names of q and v (the base's numbers first); () on a fixed base
     configuration: tuple[str, ...] = ()
     velocities: tuple[str, ...] = ()
+    # the equations hold t explicitly (a driven support, a force of time): each Function then
+    # takes t (s) as its last argument, rhs(x, u, t), mass_matrix(q, t), ...
+    time_dependent: bool = False
 
     @property
     def floating_base(self) -> bool:
@@ -154,6 +158,7 @@ class CasadiFunctions:
 
     def __repr__(self) -> str:
         extra = f", constraints={list(self.constraint_names)}" if self.constraint_names else ""
+        extra += ", time_dependent=True" if self.time_dependent else ""
         return (f"CasadiFunctions(states={list(self.states)}, inputs={list(self.inputs)}"
                 f"{extra})")
 
@@ -169,10 +174,10 @@ def casadi_functions(eom: EquationsOfMotion, inputs: Sequence[str] = (),
     if len(set(inputs)) != len(inputs):
         raise ModelError(f"an input is named twice: {list(inputs)}", field="inputs")
     n, m, r = len(model.q), len(model.constraints), len(inputs)
-    if _uses(eom, {model.time}):
-        raise ModelError("the equations depend on time t explicitly: the CasADi functions "
-                         "take no t yet", field="to_casadi")
+    timed = _uses(eom, {model.time})  # t explicit: every function takes it last
     q, v, u = ca.SX.sym("q", n), ca.SX.sym("q_dot", n), ca.SX.sym("u", r)
+    t = ca.SX.sym("t")
+    extra, extra_name = ([t], ["t"]) if timed else ([], [])
     symbols = {p.symbol for p in model.parameters}
     input_symbols: dict[sp.Symbol, int] = {}
     generalized: list[tuple[int, int]] = []  # (coordinate row, input index)
@@ -199,6 +204,7 @@ def casadi_functions(eom: EquationsOfMotion, inputs: Sequence[str] = (),
     # an input on a parameter is added to the parameter's own value, as simulate's controller
     env.update({s: env.get(s, 0.0) + u[k] for s, k in input_symbols.items()})
     env.update({s: 0.0 for s in symbols if s not in env})  # unused parameters
+    env[model.time] = t
     mass = ca.reshape(ca.vertcat(*sympy_to_sx(list(eom.mass_matrix), env)), n, n).T
     forcing = ca.vertcat(*sympy_to_sx(list(eom.forcing), env))
     for row, k in generalized:
@@ -210,7 +216,8 @@ def casadi_functions(eom: EquationsOfMotion, inputs: Sequence[str] = (),
         kkt = ca.blockcat([[mass, jacobian.T], [jacobian, ca.SX.zeros(m, m)]])
         q_ddot = ca.solve(kkt, ca.vertcat(forcing, gamma))[:n]
         residual = ca.vertcat(*sympy_to_sx([c.expression for c in model.constraints], env))
-        constraints = ca.Function("constraints", [q, v], [residual], ["q", "q_dot"], ["residual"])
+        constraints = ca.Function("constraints", [q, v, *extra], [residual],
+                                  ["q", "q_dot", *extra_name], ["residual"])
     else:
         q_ddot = ca.solve(mass, forcing)
         constraints = None
@@ -218,11 +225,14 @@ def casadi_functions(eom: EquationsOfMotion, inputs: Sequence[str] = (),
     return CasadiFunctions(
         coordinates=tuple(names), inputs=inputs,
         constraint_names=tuple(c.name for c in model.constraints),
-        rhs=ca.Function("rhs", [x, u], [ca.vertcat(v, q_ddot)], ["x", "u"], ["x_dot"]),
-        mass_matrix=ca.Function("mass_matrix", [q], [mass], ["q"], ["M"]),
-        forcing=ca.Function("forcing", [q, v, u], [forcing], ["q", "q_dot", "u"], ["f"]),
+        rhs=ca.Function("rhs", [x, u, *extra], [ca.vertcat(v, q_ddot)],
+                        ["x", "u", *extra_name], ["x_dot"]),
+        mass_matrix=ca.Function("mass_matrix", [q, *extra], [mass], ["q", *extra_name], ["M"]),
+        forcing=ca.Function("forcing", [q, v, u, *extra], [forcing],
+                            ["q", "q_dot", "u", *extra_name], ["f"]),
         constraints=constraints,
-        input_coordinates=tuple(names.index(k) if k in names else None for k in inputs))
+        input_coordinates=tuple(names.index(k) if k in names else None for k in inputs),
+        time_dependent=timed)
 
 
 def _free(eom: EquationsOfMotion) -> set:

@@ -154,7 +154,9 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
     X, U = opti.variable(n2, nodes), opti.variable(r, nodes)
     h = t_final / (nodes - 1)
     f = functions.rhs
-    F = f.map(nodes)(X, U)  # x_dot at every node
+    times = np.linspace(0.0, t_final, nodes)[None, :]  # the model's t at the nodes (s)
+    timed = (ca.DM(times),) if functions.time_dependent else ()
+    F = f.map(nodes)(X, U, *timed)  # x_dot at every node
     defects = []
     if method == "trapezoidal":
         defects.append(X[:, 1:] - X[:, :-1] - h / 2 * (F[:, :-1] + F[:, 1:]))
@@ -162,7 +164,7 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
         Um = None
     else:  # Hermite-Simpson, separated: midpoint states and inputs are variables
         Xm, Um = opti.variable(n2, nodes - 1), opti.variable(r, nodes - 1)
-        Fm = f.map(nodes - 1)(Xm, Um)
+        Fm = f.map(nodes - 1)(Xm, Um, *((ca.DM(times[:, :-1] + h / 2),) if timed else ()))
         defects.append(Xm - (X[:, :-1] + X[:, 1:]) / 2 - h / 8 * (F[:, :-1] - F[:, 1:]))
         defects.append(X[:, 1:] - X[:, :-1] - h / 6 * (F[:, :-1] + 4 * Fm + F[:, 1:]))
         cost = h / 6 * ca.sum2(ca.sum1(U[:, :-1] ** 2) + 4 * ca.sum1(Um ** 2)
@@ -176,11 +178,11 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
         opti.subject_to(X[i, 0] == value)
     if functions.constraints is not None:
         m = len(functions.constraint_names)
-        Phi = functions.constraints.map(nodes)(X[:nq, :], X[nq:, :])
+        Phi = functions.constraints.map(nodes)(X[:nq, :], X[nq:, :], *timed)
         # the start on the constraints, at position and velocity level; the dynamics keep it
         q0, v0 = X[:nq, 0], X[nq:, 0]
         opti.subject_to(Phi[:, 0] == 0)
-        opti.subject_to(_holonomic_rates(ca, functions, n2 // 2)(q0, v0) == 0)
+        opti.subject_to(_holonomic_rates(ca, functions, n2 // 2)(q0, v0, 0.0) == 0)
         constraint_rows = Phi
     else:
         m, constraint_rows = 0, None
@@ -230,13 +232,15 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
 
 
 def _holonomic_rates(ca, functions: CasadiFunctions, n: int):
-    """d/dt Phi = Phi_q q_dot of the holonomic constraints (the rows without q_dot), a
-    Function (q, q_dot); velocity constraints already hold at the velocity level."""
-    q, v = ca.SX.sym("q", n), ca.SX.sym("v", n)
-    residual = functions.constraints(q, v)
+    """d/dt Phi = Phi_q q_dot + Phi_t of the holonomic constraints (the rows without q_dot), a
+    Function (q, q_dot, t); velocity constraints already hold at the velocity level."""
+    q, v, t = ca.SX.sym("q", n), ca.SX.sym("v", n), ca.SX.sym("t")
+    residual = functions.constraints(q, v, *((t,) if functions.time_dependent else ()))
     rows = [i for i in range(residual.shape[0]) if not ca.depends_on(residual[i], v)]
     rates = ca.jtimes(residual[rows], q, v) if rows else ca.SX(0, 1)
-    return ca.Function("rates", [q, v], [rates])
+    if rows and functions.time_dependent:
+        rates = rates + ca.jacobian(residual[rows], t)
+    return ca.Function("rates", [q, v, t], [rates])
 
 
 def _finite(x) -> float | None:
@@ -253,7 +257,11 @@ def _rows(k: int, n2: int, nodes, middle) -> list:
 def _replay_error(functions: CasadiFunctions, trajectory: Trajectory, x: np.ndarray) -> float:
     """The largest state difference at the nodes between the collocated trajectory and u(t)
     integrated accurately (DOP853, rtol 1e-10) from the same start: the discretisation error."""
-    states = replay(functions.rhs, trajectory.input_at, trajectory.t, x[:, 0])
+    if functions.time_dependent:  # t rides along with u: rhs(x, u, t)
+        states = replay(lambda y, ut: functions.rhs(y, ut[:-1], ut[-1]),
+                        lambda t: np.r_[trajectory.input_at(t), t], trajectory.t, x[:, 0])
+    else:
+        states = replay(functions.rhs, trajectory.input_at, trajectory.t, x[:, 0])
     return float("inf") if states is None else float(np.max(np.abs(states - x)))
 
 

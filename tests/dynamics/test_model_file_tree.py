@@ -16,8 +16,7 @@ import lagrangian
 from lagrangian.compile import compiled
 from lagrangian.compile.functions import numeric
 from lagrangian.derivation.lagrange import derive
-from lagrangian.dynamics.recursive import TREE_PATH_BODIES, RecursiveDynamics, applicable_tree
-from lagrangian.dynamics.recursive_numpy import RecursiveNumpyDynamics
+from lagrangian.dynamics.recursive import TREE_PATH_BODIES, TreeDynamics, applicable_tree
 from lagrangian.errors import ModelError
 from lagrangian.model.builder import ModelBuilder
 from lagrangian.model.rotations import MAX_CHAIN_ROTATIONS
@@ -77,14 +76,14 @@ def test_a_random_tree_of_bodies_on_joints_agrees_with_lagrange(seed, n):
     model = random_tree(seed, n).build_model()
     tree = applicable_tree(model)
     assert tree is not None and len(tree.joints) == n
-    assert_agree(model, RecursiveNumpyDynamics(model, tree), seed=seed)
+    assert_agree(model, TreeDynamics(model, tree, kernel="numpy"), seed=seed)
 
 
 def test_the_spatial_chain_with_an_actuator_and_without_gravity_agrees():
     for builder in (random_tree(7, 3, branching=False, actuator=True),
                     random_tree(8, 3, gravity=False)):
         model = builder.build_model()
-        assert_agree(model, RecursiveNumpyDynamics(model, applicable_tree(model)))
+        assert_agree(model, TreeDynamics(model, applicable_tree(model), kernel="numpy"))
 
 
 def test_a_planar_chain_on_z_axes_agrees_and_has_the_textbook_mass_matrix():
@@ -102,7 +101,7 @@ def test_a_planar_chain_on_z_axes_agrees_and_has_the_textbook_mass_matrix():
                          parent=f"rod{i - 1}" if i else None, joint=joint,
                          center=[0, -length / 2, 0])
     model = b.build_model()
-    dynamics = RecursiveNumpyDynamics(model, applicable_tree(model))
+    dynamics = TreeDynamics(model, applicable_tree(model), kernel="numpy")
     assert_agree(model, dynamics)
     # two rods hanging straight: M = m l^2 [[1/3 + 1/12 + 9/4, 1/12 + 1/4 + 1/2], [., 1/3]]
     expected = m * length**2 * np.array([[8 / 3, 5 / 6], [5 / 6, 1 / 3]])
@@ -113,7 +112,7 @@ def test_a_planar_chain_on_z_axes_agrees_and_has_the_textbook_mass_matrix():
 @needs_c
 def test_the_compiled_tree_agrees_with_lagrange():
     model = random_tree(11, 4, actuator=True).build_model()
-    assert_agree(model, RecursiveDynamics(model, applicable_tree(model)))
+    assert_agree(model, TreeDynamics(model, applicable_tree(model), kernel="unrolled"))
 
 
 def test_a_model_holding_anything_else_has_no_tree():
@@ -153,7 +152,7 @@ def test_the_tree_follows_the_parameter_values():
     assert heavier.joints[0].mass == 5.0
     assert applicable_tree(model).joints[0].mass != 5.0
     assert_agree(model.with_parameter_values({"m0": 5.0}),
-                 RecursiveNumpyDynamics(model, heavier, {"m0": 5.0}))
+                 TreeDynamics(model, heavier, {"m0": 5.0}, kernel="numpy"))
 
 
 def chain(n: int) -> ModelBuilder:
@@ -181,7 +180,7 @@ def test_a_chain_too_deep_to_derive_is_refused_before_the_work_and_its_dynamics_
     assert time.perf_counter() - started < 10
     # the numbers go down the tree: the chain hanging straight down is at rest
     dynamics = system.dynamics(backend="numpy")
-    assert isinstance(dynamics, RecursiveNumpyDynamics)
+    assert dynamics.kernel == "numpy"
     assert np.allclose(dynamics.gravity(np.zeros(n)), 0.0, atol=1e-12)
     # a body's weight m g at the top joint, turned a quarter about x: n m g (n/2 - ... ) by value
     q = np.zeros(n)
@@ -257,7 +256,7 @@ def test_the_documented_chain_runs_and_shows_the_physics():
     scope: dict = {}
     exec(compile(code, str(Path(docs_blocks.block_file("tree-model-file"))), "exec"), scope)
     n = scope["n"]
-    assert isinstance(scope["snake"].dynamics(), RecursiveDynamics)
+    assert scope["snake"].dynamics().backend == "recursive"
     expected = sum(k + 0.5 for k in range(n)) * 9.81
     assert scope["held"] == pytest.approx(expected, rel=1e-12)
     assert f"{expected:.1f} N m" in code

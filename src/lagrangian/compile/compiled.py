@@ -195,18 +195,38 @@ def _run_compiler(command: list[str]) -> subprocess.CompletedProcess:
 def check_compiler() -> list[str]:
     """The compiler command, or CompilerMissing saying why there is none."""
     compiler = find_compiler()
-    if compiler is not None:
-        return compiler
+    if compiler is None:
+        raise missing_compiler()
+    return compiler
+
+
+def missing_compiler() -> CompilerMissing | None:
+    """Why no C compiler can be had (a CompilerMissing to show or raise), None where one can."""
+    if find_compiler() is not None:
+        return None
     cc = os.environ.get("CC", "").strip()
     if cc:
         try:
             shlex.split(cc)
         except ValueError:
-            raise CompilerMissing(f"CC={cc!r} is not a command (unbalanced quote; unset CC, or "
-                                  "point it at gcc or clang)") from None
-        raise CompilerMissing(f"CC={cc!r} names no program on PATH (unset CC, or point it at gcc "
-                              "or clang)")
-    raise CompilerMissing("no C compiler found (set CC, or install gcc or clang)")
+            return CompilerMissing(f"CC={cc!r} is not a command (unbalanced quote; unset CC, or "
+                                   "point it at gcc or clang)")
+        return CompilerMissing(f"CC={cc!r} names no program on PATH (unset CC, or point it at "
+                               "gcc or clang)")
+    return CompilerMissing("no C compiler found (set CC, or install gcc or clang)")
+
+
+def ready(key: str, native: bool = False, exact: bool = False) -> bool:
+    """Whether the module of this key can be had without a build (loaded, or in the verified
+    cache) or built here (a compiler and Python's headers): a backend chosen up front."""
+    name = keyed_module_name(key, native, exact)
+    if name in _LOADED:
+        return True
+    suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
+    if sys.platform != "win32" and _load_verified(name, trusted_cache_dir() / f"{name}{suffix}",
+                                                  quiet=True) is not None:
+        return True
+    return available()
 
 
 def _compile(source: str, name: str, target: Path, native: bool = False,

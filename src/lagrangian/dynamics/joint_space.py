@@ -32,8 +32,6 @@ import numpy as np
 from ..compile.functions import NumericSystem
 from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, DynamicsWarning, InputError, ModelError
-from ..model.model import Model
-from ..model.values import resolve_parameters
 from .algorithms.frames import TreeKinematics, tree_kinematics
 from .control_terms import ControlTerms
 from .tree.numbers import batch_shape, float_array, solve_positive, warn_undefined
@@ -91,8 +89,8 @@ class Dynamics(ControlTerms):
     """Joint-space dynamics, batched over leading axes (SI units): M(q), the bias
     C(q, q_dot) q_dot + g(q), g(q), inverse and forward dynamics and the energies. The one type
     every path returns: this class evaluates the derived equations (a NumericSystem), and the
-    recursive algorithms of a URDF tree (recursive.RecursiveDynamics in C,
-    recursive_numpy.RecursiveNumpyDynamics in numpy) are its subclasses."""
+    recursive algorithms of a URDF tree (recursive.TreeDynamics, over a backend) are its
+    subclass."""
 
     coordinates: tuple[str, ...]  # the configuration's names (nq of them)
     n: int  # the velocity's numbers: M is n x n (nv; nq = n but for a floating base)
@@ -472,27 +470,4 @@ class Dynamics(ControlTerms):
                              - self.functions.energy(Q, np.zeros_like(V)), (q, v), ("q", "v"), ())
 
 
-class TreeDynamics(Dynamics):
-    """The recursive algorithms of a URDF robot's kinematic tree (recursive.RecursiveDynamics in
-    generated C, recursive_numpy.RecursiveNumpyDynamics in numpy): what both keep of the model."""
-
-    _christoffel = True  # a tree's only velocity terms are M's (no dampers in the tree)
-
-    def _take_tree(self, model: Model, tree, parameters: Mapping[str, float] | None) -> None:
-        """The model, its tree, and every parameter's value (SI) by name, in the model's order."""
-        values = resolve_parameters(model, parameters)
-        self.model = model
-        self.tree = tree
-        self.coordinates = tree.coordinates
-        self.n = len(tree.coordinates)
-        if tree.floating_base:  # Pinocchio's layout: the base's numbers first (free_flyer.py)
-            from .tree.free_flyer import BASE_CONFIGURATION, BASE_VELOCITY
-
-            self.coordinates = BASE_CONFIGURATION + tree.coordinates
-            self.velocity_names = BASE_VELOCITY + tree.coordinates
-            self.n += 6
-        self.parameters = {p.name: float(v)
-                           for p, v in zip(model.parameters, values.values, strict=True)}
-
-
-__all__ = ["Dynamics", "TreeDynamics", "solve_positive", "warn_undefined"]
+__all__ = ["Dynamics", "solve_positive", "warn_undefined"]

@@ -1,5 +1,6 @@
 """Recursive rigid-body dynamics of a robot's kinematic tree (model/tree.py) in numpy: the
-fallback of recursive.py's generated C where no C compiler works, or backend "numpy".
+reference recursions as a backend (backends.py) of recursive.TreeDynamics, where no C compiler
+works, or backend "numpy".
 
 The same algorithms over the same tree, each body's quantities an array over a flat batch of
 states (N, 3) or (N, 3, 3), the bodies visited in Python:
@@ -24,100 +25,109 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import ModelError
-from ..model.model import Model
+from ..model.quaternions import QUATERNION_TOLERANCE
 from ..model.tree import KinematicTree
-from .algorithms.recursions import TreeRecursions, _Joint, _positive_definite, _TreeKernel
-from .joint_space import TreeDynamics, solve_positive
+from .algorithms.recursions import TreeRecursions, _Joint, _TreeKernel
 from .tree.description import describe, joints_of
+from .tree.numbers import solve_positive
 
 
-class RecursiveNumpyDynamics(TreeRecursions, TreeDynamics):
-    """Recursive dynamics of a tree in numpy, batched over leading axes (SI units).
+class NumpyBackend(TreeRecursions):
+    """The tree's recursions in numpy over flat batches (backends.py's contract, SI units)."""
 
-    Every input is (..., n) (or (n,), broadcast against the others); outputs keep the batch
-    shape. Same interface as recursive.RecursiveDynamics.
-    """
+    kernel = "numpy"
+    tables = None
 
-    backend = "recursive-numpy"
-
-    def __init__(self, model: Model, tree: KinematicTree,
-                 parameters: Mapping[str, float] | None = None):
-        self._take_tree(model, tree, parameters)
+    def __init__(self, tree: KinematicTree, parameters: Mapping[str, float], nv: int):
+        self.tree, self.n = tree, nv
         missing = [name for name in (tree.gravity_parameter, *tree.actuators)
-                   if name is not None and name not in self.parameters]
+                   if name is not None and name not in parameters]
         if missing:
             raise ModelError(f"the tree's parameters {missing} are not the model's")
-        self._g = self.parameters.get(tree.gravity_parameter, 0.0)  # None: no gravity
+        self._g = parameters.get(tree.gravity_parameter, 0.0)  # None: no gravity
         self._actuators = np.array([0.0] * tree.base_nv  # no actuator drives a floating base
-                                   + [self.parameters.get(a, 0.0) for a in tree.actuators],
+                                   + [parameters.get(a, 0.0) for a in tree.actuators],
                                    dtype=float)
         # the ground accelerates up by g: every body feels gravity (Newton-Euler's trick)
         self._up = -self._g * np.array(tree.gravity_direction, dtype=float)
-        # the bodies as the compact C kernel reads them (compact_kernel.describe): one
-        # description; a floating base (a joint that kernel does not take) from the tree itself
-        joints = tree.joints if tree.floating_base else joints_of(describe(tree, self.parameters))
+        # the bodies as the engine reads them (tree/description.py): one description; a
+        # floating base (a joint that description does not turn) from the tree itself
+        joints = tree.joints if tree.floating_base else joints_of(describe(tree, parameters))
         self._joints = [_Joint(j, tree) for j in joints]
+        self._widths = (nv + 1 if tree.floating_base else nv, nv, nv)
 
-    def __repr__(self) -> str:
-        return f"RecursiveNumpyDynamics(coordinates={list(self.coordinates)})"
+    def _rows(self, compute, arrays, tail: tuple[int, ...], forward: bool = False):
+        """compute(*flat (N, width)) over the finite states, NaN rows for the rest (and for
+        forward dynamics, for rows without a finite answer): the outputs, or (outputs, count);
+        NotImplemented for inputs the front has not handed on."""
+        flat = self._handed_on(arrays)
+        if flat is None:
+            return NotImplemented
+        batch, flat = flat
+        total = len(flat[0])
+        good = np.ones(total, dtype=bool)
+        for x in flat:
+            good &= np.isfinite(x).all(axis=-1)
+        out = np.full((total,) + tail, np.nan)
+        if good.any():
+            out[good] = np.asarray(compute(*(x[good] for x in flat)),
+                                   dtype=float).reshape((-1,) + tail)
+        if forward:
+            good &= np.isfinite(out.reshape(total, -1)).all(axis=-1)
+            out[~good] = np.nan
+        bad = total - int(good.sum())
+        out = out.reshape(batch + tail)
+        return (out, bad) if bad else out
 
-    # -- the public functions --------------------------------------------------------------------
-
-    def regular(self) -> bool:
-        """Whether M is positive definite at a few random states (a massless branch is not)."""
-        rng = np.random.default_rng(0)
-        q = rng.uniform(-np.pi, np.pi, (3, self.nq))
+    def _handed_on(self, arrays):
+        """(batch shape, flat inputs) for float64 C-ordered inputs of the tree's widths, one
+        batch shape (a single state broadcast) and unit base quaternions; else None."""
+        shape = None
+        for x, width in zip(arrays, self._widths, strict=False):
+            if x.__class__ is not np.ndarray or x.dtype != np.float64 or x.ndim == 0 \
+                    or not x.flags.c_contiguous or x.shape[-1] != width:
+                return None
+            if x.ndim > 1 or len(arrays) == 1:
+                if shape is not None and x.shape[:-1] != shape:
+                    return None
+                shape = x.shape[:-1]
+        shape = () if shape is None else shape
+        total = int(np.prod(shape, dtype=np.int64))
+        flat = [np.broadcast_to(x, shape + x.shape[-1:]).reshape(total, x.shape[-1])
+                for x in arrays]
         if self.tree.floating_base:
-            q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
-        return all(_positive_definite(m) for m in self.mass_matrix(q))
+            Q = flat[0]
+            norms = np.sqrt((Q[:, 3:7] ** 2).sum(axis=-1))
+            if (np.isfinite(Q).all(axis=-1) & ~(np.abs(norms - 1.0) <= QUATERNION_TOLERANCE)).any():
+                return None
+        return shape, flat
 
-    def mass_matrix(self, q):
-        """M(q), shape (..., n, n)."""
-        return self._guarded(self._composite_rigid_body, (q,), ("q",), (self.n, self.n))
+    def mass_matrix(self, q, tables=None):
+        return self._rows(self._composite_rigid_body, (q,), (self.n, self.n))
 
-    def bias_forces(self, q, v):
-        """C(q, q_dot) q_dot + g(q), shape (..., n)."""
-        return self._guarded(lambda Q, V: self._newton_euler(Q, V, None), (q, v), ("q", "v"),
-                             (self.n,))
+    def bias_forces(self, q, v, tables=None):
+        return self._rows(lambda Q, V: self._newton_euler(Q, V, None), (q, v), (self.n,))
 
-    def gravity(self, q):
-        """g(q), shape (..., n)."""
-        return self._guarded(lambda Q: self._newton_euler(Q, None, None), (q,), ("q",),
-                             (self.n,))
+    def gravity(self, q, tables=None):
+        return self._rows(lambda Q: self._newton_euler(Q, None, None), (q,), (self.n,))
 
-    def inverse_dynamics(self, q, v, a, f_ext=None):
-        """tau = M a + C q_dot + g - sum J^T w, shape (..., n) (f_ext: wrenches.py)."""
-        if f_ext is not None:  # wrenches at frames (wrenches.py)
-            return self._with_wrenches(q, v, a, f_ext, forward=False)
-        return self._guarded(self._newton_euler, (q, v, a), ("q", "v", "a"), (self.n,))
+    def inverse_dynamics(self, q, v, a, tables=None):
+        return self._rows(self._newton_euler, (q, v, a), (self.n,))
 
-    def forward_dynamics(self, q, v, tau, f_ext=None):
-        """q_ddot = M^-1 (tau + sum J^T w - C q_dot - g), shape (..., n); NaN where M is not
-        positive definite (f_ext: wrenches.py)."""
-        if f_ext is not None:  # wrenches at frames (wrenches.py)
-            return self._with_wrenches(q, v, tau, f_ext, forward=True)
-        return self._guarded(lambda Q, V, TAU: solve_positive(
+    def forward_dynamics(self, q, v, tau, tables=None):
+        return self._rows(lambda Q, V, TAU: solve_positive(
             self._composite_rigid_body(Q), TAU - self._newton_euler(Q, V, None)),
-            (q, v, tau), ("q", "v", "tau"), (self.n,), forward=True)
+            (q, v, tau), (self.n,), forward=True)
 
-    def kinetic_energy(self, q, v):
-        """T in J, shape (...)."""
-        return self._guarded(self._kinetic, (q, v), ("q", "v"), ())
+    def kinetic_energy(self, q, v, tables=None):
+        return self._rows(self._kinetic, (q, v), ())
 
-    def potential_energy(self, q):
-        """V in J, shape (...)."""
-        return self._guarded(self._potential, (q,), ("q",), ())
+    def potential_energy(self, q, tables=None):
+        return self._rows(self._potential, (q,), ())
 
-    def numeric_system(self):
-        """The NumericSystem over these functions (M, f = -b, energy, accelerations, rhs), as
-        the symbolic path gives it; simulation uses it."""
-        from ..compile.functions import NumericSystem
-
-        if self.tree.floating_base:
-            raise floating_refusal()
-        return NumericSystem(coordinates=self.coordinates, constraint_names=(),
-                             constraint_kinds=(), parameters=dict(self.parameters),
-                             _kernel=_TreeKernel(self))
+    def numeric_kernel(self, n: int):
+        """NumericSystem's kernel over these recursions (simulation)."""
+        return _TreeKernel(self)
 
 
 def floating_refusal() -> ModelError:
@@ -127,4 +137,4 @@ def floating_refusal() -> ModelError:
                       "use dynamics() and its integrate(q, v, dt)")
 
 
-__all__ = ["RecursiveNumpyDynamics"]
+__all__ = ["NumpyBackend", "floating_refusal"]

@@ -1,7 +1,8 @@
-"""Which dynamics a model gets: a tree's recursive algorithms (compiled C, the unrolled module
-or the compact kernel by the tree's size; numpy without a compiler), else the functions of its
-derived equations (constrained.py's DAE where it has constraints). The choice, not the physics:
-joint_space.py, recursive.py and compact_kernel.py hold that."""
+"""Which dynamics a model gets: a tree's recursive algorithms (recursive.TreeDynamics over the
+engine, a tree's unrolled module, or numpy without a compiler: the backend chosen here, once, up
+front), else the functions of its derived equations (constrained.py's DAE where it has
+constraints). The choice, not the physics: joint_space.py, recursive.py and backends.py hold
+that."""
 
 from __future__ import annotations
 
@@ -19,24 +20,16 @@ from .joint_space import Dynamics
 def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = None,
                        backend: str = "auto", kernel: str = "auto"):
     """The recursive dynamics of a URDF tree, or of a model file's tree of rigid bodies on
-    joints (at least TREE_PATH_BODIES of them): compiled C (recursive.RecursiveDynamics, the
-    engine's one compiled module for every tree by default (``kernel`` "auto" or "compact"), or
-    the tree's own unrolled module, compiled per tree, with ``kernel="unrolled"``), or numpy
-    (recursive_numpy.RecursiveNumpyDynamics) for backend "numpy" or, with
-    backend "auto", where no compiler works; None where they do not apply: not a bare tree, or
-    a mass matrix that is not positive definite (the symbolic path names the joints).
+    joints (at least TREE_PATH_BODIES of them): recursive.TreeDynamics over the engine's one
+    compiled module for every tree (``kernel`` "auto" or "compact"), the tree's own unrolled
+    module, compiled per tree (``kernel="unrolled"``), or the numpy reference (backend "numpy",
+    or backend "auto" where no compiler works: chosen here, up front, with one line saying so);
+    None where they do not apply: not a bare tree, or a mass matrix that is not positive
+    definite (the symbolic path names the joints).
 
     ``parameters`` may set a URDF link's inertial by ``<link>.<field>`` (model/tree.py
     INERTIAL_FIELDS: mass, com_x, ..., ixx, ...), as if the URDF had been edited."""
-    from ..compile.compiled import BackendUnavailable
-    from ..compile.functions import tell_numpy_fallback
-    from .recursive import (
-        TREE_PATH_BODIES,
-        CompactDynamics,
-        RecursiveDynamics,
-        applicable_tree,
-    )
-    from .recursive_numpy import RecursiveNumpyDynamics
+    from .recursive import TREE_PATH_BODIES, TreeDynamics, applicable_tree
     from .tree.inertials import split_inertials
 
     if kernel not in ("auto", "unrolled", "compact"):
@@ -50,23 +43,13 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
         return None
     if inertials:
         tree = inertials
-    dynamics = None
-    if backend != "numpy":
-        # one engine for every tree and variant (a link's inertial, a payload, a floating
-        # base: run-time numbers, no build); the per-tree unrolled module only when asked for,
-        # about 2x faster per call after a compile of seconds per tree (docs/benchmarks.md)
-        compact = kernel != "unrolled"
-        try:
-            dynamics = (CompactDynamics if compact else RecursiveDynamics)(model, tree, parameters)
-        except BackendUnavailable as exc:
-            if backend == "c":
-                raise
-            # the same algorithms in numpy: the expanded equations of a 7-joint arm are too
-            # deep for lambdify, the recursions are not
-            tell_numpy_fallback(exc, "the robot's recursive dynamics run in numpy, about 1000x "
-                                "slower per call than compiled C")
-    if dynamics is None:
-        dynamics = RecursiveNumpyDynamics(model, tree, parameters)
+    # one engine for every tree and variant (a link's inertial, a payload, a floating base:
+    # run-time numbers, no build); the per-tree unrolled module only when asked for, about 2x
+    # faster per call after a compile of seconds per tree (docs/benchmarks.md)
+    chosen = "unrolled" if kernel == "unrolled" else "compact"
+    if backend == "numpy" or (backend == "auto" and not _compiled_ready(chosen)):
+        chosen = "numpy"
+    dynamics = TreeDynamics(model, tree, parameters, kernel=chosen)
     if tree.floating_base or dynamics.regular():
         # a floating base has no symbolic path to fall to: NaN rows where M is singular
         return dynamics
@@ -75,6 +58,25 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
                          "(a joint that moves no mass)", field="parameters")
     _refuse_massless_joints(model, dynamics)
     return None
+
+
+def _compiled_ready(kernel: str) -> bool:
+    """Whether the compiled backend can be had (the engine: in the cache or buildable; a tree's
+    unrolled module: buildable); else one line saying numpy runs instead, and why."""
+    from ..compile import compiled
+    from ..compile.functions import tell_numpy_fallback
+    from .engine.compact_kernel import kernel_key
+
+    if compiled.ready(kernel_key(), native=True, exact=True) if kernel == "compact" \
+            else compiled.available():
+        return True
+    # the same algorithms in numpy: the expanded equations of a 7-joint arm are too deep for
+    # lambdify, the recursions are not
+    reason = compiled.missing_compiler() or compiled.BackendUnavailable(
+        "Python's C headers are missing")
+    tell_numpy_fallback(reason, "the robot's recursive dynamics run in numpy, about 1000x slower "
+                        "per call than compiled C")
+    return False
 
 
 def _refuse_massless_joints(model: Model, dynamics) -> None:

@@ -1,6 +1,6 @@
 """The recursions of recursive_numpy.py over a tree in numpy, on flat batches of states (N, ...),
 the bodies visited in Python: Newton-Euler, the composite-rigid-body M, forward dynamics by
-Cholesky, the energies; a mixin (TreeRecursions) of recursive_numpy.RecursiveNumpyDynamics, which
+Cholesky, the energies; a mixin (TreeRecursions) of recursive_numpy.NumpyBackend, which
 sets _joints, _g, _up and _actuators, and the NumericSystem kernel over it."""
 
 from __future__ import annotations
@@ -110,7 +110,7 @@ def _positive_definite(matrix) -> bool:
 
 class TreeRecursions:
     """Newton-Euler, CRBA, forward dynamics and the energies over flat batches (SI); the
-    host sets tree, n, _joints, _g, _up and _actuators (recursive_numpy.RecursiveNumpyDynamics)."""
+    host sets tree, n, _joints, _g, _up and _actuators (recursive_numpy.NumpyBackend)."""
 
     def _kinematics(self, Q):
         """Each body's rotation R (body -> parent axes, (N, 3, 3) or constant), origin p in

@@ -3,7 +3,6 @@
    definite, gives NaN in its own output row and is counted; the other states are computed as
    alone. With none such the output array is returned, else (output, count). */
 enum { RT_MASS, RT_BIAS, RT_GRAVITY, RT_INVERSE, RT_FORWARD, RT_KINETIC, RT_POTENTIAL };
-static const char *rt_names[] = {"q", "v", "third"};
 #define RT_PTHREADS LG_PTHREADS  /* batch_threads.c, above this text */
 #define RT_MAX_THREADS LG_MAX_THREADS
 #define RT_THREAD_STATES 1024
@@ -154,8 +153,9 @@ static void *rt_run(void *argument)
 /* How many threads a batch of ``count`` states runs on (batch_threads.c). */
 static int rt_threads(npy_intp count) { return lg_threads(count, RT_THREAD_STATES); }
 
-/* An argument as C-ordered doubles: an array that already is one taken as it is (the common
-   call, a fraction of a microsecond less than the general conversion), else converted. */
+/* An argument that already is C-ordered doubles (a new reference), else NULL with no error
+   set: the caller answers NotImplemented and the Python front checks and shapes the inputs
+   (recursive.py), so no error text here is ever read. */
 static PyArrayObject *rt_doubles(PyObject *x)
 {
     if (PyArray_CheckExact(x)) {
@@ -165,7 +165,7 @@ static PyArrayObject *rt_doubles(PyObject *x)
             return a;
         }
     }
-    return (PyArrayObject *)PyArray_FROMANY(x, NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
+    return NULL;
 }
 
 static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int kind)
@@ -180,14 +180,9 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     int base = 0;
     for (int i = 0; i < nin; i++) {
         in[i] = rt_doubles(args[i]);
-        if (!in[i]) goto done;
+        if (!in[i]) goto slow;
         int nd = PyArray_NDIM(in[i]);
-        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != RT_WIDTH(i)) {
-            PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
-                         i == 2 ? (kind == RT_FORWARD ? "tau" : "a") : rt_names[i],
-                         RT_WIDTH(i));
-            goto done;
-        }
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != RT_WIDTH(i)) goto slow;
         if (PyArray_SIZE(in[i]) / RT_WIDTH(i) > PyArray_SIZE(in[base]) / RT_WIDTH(base))
             base = i;
     }
@@ -199,16 +194,16 @@ static PyObject *rt_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
             continue;
         }
         if (PyArray_NDIM(in[i]) != nd  /* the batch axes, all but the last */
-            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp))) {
-            PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
-            goto done;
-        }
+            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp)))
+            goto slow;
         step[i] = RT_WIDTH(i);
     }
 #if RT_FLOATING
     if (!lg_unit_quaternions((const double *)PyArray_DATA(in[0]), step[0] ? count : 1, step[0],
-                             RT_NQ, RT_QUATERNION_TOLERANCE))
-        goto done;
+                             RT_NQ, RT_QUATERNION_TOLERANCE)) {
+        PyErr_Clear();  /* the front names the state and its norm */
+        goto slow;
+    }
 #endif
     P = lg_doubles(args[nin], LG_NP, "parameters");
     if (!P) goto done;
@@ -254,6 +249,9 @@ done:
     for (int i = 0; i < 3; i++) Py_XDECREF(in[i]);
     Py_XDECREF(P);
     return out;
+slow:  /* not the fast path's inputs: the Python front checks and shapes them */
+    for (int i = 0; i < 3; i++) Py_XDECREF(in[i]);
+    Py_RETURN_NOTIMPLEMENTED;
 }
 
 #define RT_WRAP(name, nin, kind) \

@@ -30,8 +30,9 @@
 #define TK_MASS 20
 #define TK_H 21         /* 3: first moment m c about the body origin */
 #define TK_J 24         /* 9: inertia about the body origin */
-#define TK_TURN 33      /* 27: R0 u u^T, R0 (1 - u u^T), R0 [u]x (row-major): a revolute joint's
-                           R = R0 Rot(u, theta) = P + cos(theta) C + sin(theta) S */
+#define TK_PERM 33      /* 3: where R0 is a signed permutation, each row's nonzero column */
+#define TK_SIGN 36      /* 3: that entry, +-1 */
+#define TK_PERMUTED 39  /* 1 where R0 is a signed permutation (description.py) */
 #define TK_LEAD 61      /* the slide along u per unit theta: 1 prismatic, pitch (m/rad) helical */
 #define TK_TURNS(b) ((b)[TK_KIND] == 0.0 || (b)[TK_KIND] == 3.0)
 #define TK_SLIDES(b) ((b)[TK_KIND] == 1.0 || (b)[TK_KIND] == 3.0)
@@ -40,6 +41,8 @@
 #define TW_R 0
 #define TW_P 9
 #define TW_A 12         /* 6-vectors and 6x6 matrices of the algorithms from here */
+#define TW_CS 92        /* cos and sin of theta (1, 0 for a joint that does not turn) */
+#define TW_SN 93
 
 typedef struct {
     int nb, n, mimic, fb, bq, bv, nq, nv;  /* bq, bv: the base's numbers before the joints' */
@@ -99,14 +102,12 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
     } while (0)
 #define TK_DOT(a, b) ((a)[0] * (b)[0] + (a)[1] * (b)[1] + (a)[2] * (b)[2])
 
-/* S = (s_w, s_v) per unit rate of q (the multiplier k included): the tree's numbers alone. */
+/* S = ((0, 0, s_w), (0, 0, s_v)) per unit rate of q (the multiplier k included), about the
+   joint's z: the tree's numbers alone. */
 static inline void tk_subspace(const double *b, double *sw, double *sv)
 {
-    const double k = b[TK_MULT], lead = TK_SLIDES(b) ? k * b[TK_LEAD] : 0.0;
-    for (int r = 0; r < 3; r++) {
-        sw[r] = TK_TURNS(b) ? k * b[TK_AXIS + r] : 0.0;
-        sv[r] = lead * b[TK_AXIS + r];
-    }
+    *sw = TK_TURNS(b) ? b[TK_MULT] : 0.0;
+    *sv = TK_SLIDES(b) ? b[TK_MULT] * b[TK_LEAD] : 0.0;
 }
 
 /* the mass matrix's scratch per body: its rotation and origin in the world, its composite
@@ -134,13 +135,13 @@ static inline void TK_FN(sandwich)(const TK_T *R, const TK_T *A, TK_T *out)  /* 
                              + T[3 * i + 2] * R[3 * j + 2];
 }
 
-/* Each body's R and p for the configuration q (into the scratch W). */
+/* Each body's R and p for the configuration q (into the scratch W), and theta's cos, sin. */
 static void TK_FN(place)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict W)
 {
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
-        TK_T *R = W + i * TW_STRIDE + TW_R, *p = W + i * TW_STRIDE + TW_P;
-        const double *R0 = b + TK_R0, *u = b + TK_AXIS;
+        TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
+        const double *R0 = b + TK_R0;
         if (TK_FREE(b)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
             const TK_T x = q[3], y = q[4], z = q[5], s = q[6];
             const TK_T k = 2.0 / (x * x + y * y + z * z + s * s);
@@ -153,6 +154,8 @@ static void TK_FN(place)(const tk_tree *t, const TK_T *restrict q, TK_T *restric
                                      + R0[3 * r + 2] * E[6 + col];
             TK_APPLY(R0, q, p);
             for (int r = 0; r < 3; r++) p[r] += b[TK_T0 + r];
+            w[TW_CS] = TK_C(1.0);
+            w[TW_SN] = TK_C(0.0);
             continue;
         }
         const TK_T theta = b[TK_MULT] * q[t->bq + (int)b[TK_COORD]] + b[TK_OFFSET];
@@ -161,19 +164,33 @@ static void TK_FN(place)(const tk_tree *t, const TK_T *restrict q, TK_T *restric
                arm's mass matrix */
             TK_T sn, cs;
             TK_SINCOS(theta, &sn, &cs);
-            const double *P = b + TK_TURN, *C = P + 9, *S = P + 18;
-            for (int r = 0; r < 9; r++) R[r] = P[r] + cs * C[r] + sn * S[r];
-            for (int r = 0; r < 3; r++) p[r] = TK_C(b[TK_T0 + r]);
+            w[TW_CS] = cs;
+            w[TW_SN] = sn;
+            if (b[TK_PERMUTED] != 0.0) {  /* row r of R0 Rot(z) is +-row PERM[r] of Rot(z) */
+                for (int r = 0; r < 3; r++) {
+                    const int k = (int)b[TK_PERM + r];
+                    const double e = b[TK_SIGN + r];
+                    TK_T *row = R + 3 * r;
+                    if (k == 0) { row[0] = e * cs; row[1] = -e * sn; row[2] = TK_C(0.0); }
+                    else if (k == 1) { row[0] = e * sn; row[1] = e * cs; row[2] = TK_C(0.0); }
+                    else { row[0] = TK_C(0.0); row[1] = TK_C(0.0); row[2] = TK_C(e); }
+                }
+            } else {  /* columns: cos R0 e_x + sin R0 e_y, cos R0 e_y - sin R0 e_x, R0 e_z */
+                for (int r = 0; r < 3; r++) {
+                    R[3 * r] = cs * R0[3 * r] + sn * R0[3 * r + 1];
+                    R[3 * r + 1] = cs * R0[3 * r + 1] - sn * R0[3 * r];
+                    R[3 * r + 2] = TK_C(R0[3 * r + 2]);
+                }
+            }
         } else {
+            w[TW_CS] = TK_C(1.0);
+            w[TW_SN] = TK_C(0.0);
             for (int r = 0; r < 9; r++) R[r] = TK_C(R0[r]);
         }
-        if (TK_SLIDES(b)) {  /* along R0 u by lead theta (a prismatic joint's lead 1) */
-            double Ru[3];
-            TK_APPLY(R0, u, Ru);
-            if (b[TK_KIND] == 1.0)
-                for (int r = 0; r < 3; r++) p[r] = b[TK_T0 + r] + Ru[r] * theta;
-            else
-                for (int r = 0; r < 3; r++) p[r] = b[TK_T0 + r] + Ru[r] * (b[TK_LEAD] * theta);
+        for (int r = 0; r < 3; r++) p[r] = TK_C(b[TK_T0 + r]);
+        if (TK_SLIDES(b)) {  /* along R0 e_z by lead theta (a prismatic joint's lead 1) */
+            const TK_T slide = b[TK_KIND] == 1.0 ? theta : b[TK_LEAD] * theta;
+            for (int r = 0; r < 3; r++) p[r] += R0[3 * r + 2] * slide;
         }
     }
 }
@@ -190,9 +207,9 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
         TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
         TK_T *om = w + TW_A, *dom = om + 3, *acc = om + 6, *f = om + 9, *nn = om + 12;
         const int parent = (int)b[TK_PARENT], c = (int)b[TK_COORD];
-        double sw[3], sv[3];
+        double sw, sv;
         TK_T x[3], y[3];
-        tk_subspace(b, sw, sv);
+        tk_subspace(b, &sw, &sv);
         if (parent < 0) {
             const double up[3] = {-t->g[0], -t->g[1], -t->g[2]};  /* the ground accelerates up */
             for (int r = 0; r < 3; r++) om[r] = dom[r] = TK_C(0.0);
@@ -217,18 +234,18 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
             for (int r = 0; r < 3; r++) x[r] += pa[r] + z[r];
             TK_APPLY_T(R, x, acc);
         }
-        if (v && !TK_FREE(b)) {  /* the joint's rate: w += S w, the Coriolis terms */
-            const TK_T rate = v[t->bv + c];
-            TK_T ws[3] = {rate * sw[0], rate * sw[1], rate * sw[2]};
-            TK_CROSS(om, ws, x);
-            for (int r = 0; r < 3; r++) { om[r] += ws[r]; dom[r] += x[r]; }
-            TK_T vs[3] = {rate * sv[0], rate * sv[1], rate * sv[2]};
-            TK_CROSS(om, vs, x);
-            for (int r = 0; r < 3; r++) acc[r] += 2.0 * x[r];
+        if (v && !TK_FREE(b)) {  /* the joint's rate about z: w += S w, the Coriolis terms */
+            const TK_T rate = v[t->bv + c], wz = rate * sw, vz = rate * sv;
+            dom[0] += om[1] * wz;  /* w x (0, 0, wz) */
+            dom[1] -= om[0] * wz;
+            om[2] += wz;
+            acc[0] += 2.0 * (om[1] * vz);
+            acc[1] -= 2.0 * (om[0] * vz);
         }
         if (a && !TK_FREE(b)) {
             const TK_T accel = a[t->bv + c];
-            for (int r = 0; r < 3; r++) { dom[r] += accel * sw[r]; acc[r] += accel * sv[r]; }
+            dom[2] += accel * sw;
+            acc[2] += accel * sv;
         }
         /* f = m a + dw x h + w x (w x h), n = J dw + w x J w + h x a (about the origin) */
         const double m = b[TK_MASS], *h = b + TK_H, *J = b + TK_J;
@@ -247,13 +264,13 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
         const double *b = t->body + i * TK_STRIDE;
         TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
         TK_T *f = w + TW_A + 9, *nn = w + TW_A + 12;
-        double sw[3], sv[3];
+        double sw, sv;
         if (TK_FREE(b)) {  /* the base's wrench in its axes, force then moment */
             for (int r = 0; r < 3; r++) { tau[r] += f[r]; tau[3 + r] += nn[r]; }
             continue;
         }
-        tk_subspace(b, sw, sv);
-        tau[t->bv + (int)b[TK_COORD]] += TK_DOT(sw, nn) + TK_DOT(sv, f);
+        tk_subspace(b, &sw, &sv);
+        tau[t->bv + (int)b[TK_COORD]] += sw * nn[2] + sv * f[2];
         const int parent = (int)b[TK_PARENT];
         if (parent >= 0) {
             TK_T *pf = W + parent * TW_STRIDE + TW_A + 9, *pn = pf + 3, F[3], N[3], x[3];
@@ -284,6 +301,27 @@ static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict
         if (parent < 0) {  /* the ground's axes are the world's (a free flyer's pose too) */
             for (int r = 0; r < 9; r++) Rw[r] = R[r];
             for (int r = 0; r < 3; r++) o[r] = p[r];
+        } else if (b[TK_PERMUTED] != 0.0) {  /* Rw = (Rp R0) Rot(z): columns moved, then turned */
+            const TK_T *Rp = W + parent * TW_STRIDE + TW_RW, *op = W + parent * TW_STRIDE + TW_OW;
+            TK_T Q[9], d[3];
+            for (int r = 0; r < 3; r++) {  /* column PERM[r] of Rp R0 is SIGN[r] Rp e_r */
+                const int k = (int)b[TK_PERM + r];
+                const double e = b[TK_SIGN + r];
+                for (int x = 0; x < 3; x++) Q[3 * x + k] = e * Rp[3 * x + r];
+            }
+            const TK_T cs = w[TW_CS], sn = w[TW_SN];
+            for (int x = 0; x < 3; x++) {
+                if (TK_TURNS(b)) {
+                    Rw[3 * x] = cs * Q[3 * x] + sn * Q[3 * x + 1];
+                    Rw[3 * x + 1] = cs * Q[3 * x + 1] - sn * Q[3 * x];
+                } else {
+                    Rw[3 * x] = Q[3 * x];
+                    Rw[3 * x + 1] = Q[3 * x + 1];
+                }
+                Rw[3 * x + 2] = Q[3 * x + 2];
+            }
+            TK_APPLY(Rp, p, d);
+            for (int r = 0; r < 3; r++) o[r] = op[r] + d[r];
         } else {
             const TK_T *Rp = W + parent * TW_STRIDE + TW_RW, *op = W + parent * TW_STRIDE + TW_OW;
             TK_T d[3];
@@ -314,13 +352,13 @@ static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict
             if (e < 3) v += m * oo + 2.0 * oh;
             Ic[4 + e] = v - m * o[x] * o[y] - o[x] * hr[y] - hr[x] * o[y];
         }
-        /* the joint's motion per unit rate at the world's origin: s_w = R s, s_v = R v + o x s_w */
+        /* the joint's motion per unit rate at the world's origin: s_w = Rw e_z sw,
+           s_v = Rw e_z sv + o x s_w */
         if (!TK_FREE(b)) {
-            double sw[3], sv[3];
+            double sw, sv;
             TK_T *Sw = w + TW_SW, *Sv = w + TW_SV, x[3];
-            tk_subspace(b, sw, sv);
-            TK_APPLY(Rw, sw, Sw);
-            TK_APPLY(Rw, sv, Sv);
+            tk_subspace(b, &sw, &sv);
+            for (int r = 0; r < 3; r++) { Sw[r] = sw * Rw[3 * r + 2]; Sv[r] = sv * Rw[3 * r + 2]; }
             TK_CROSS(o, Sw, x);
             for (int r = 0; r < 3; r++) Sv[r] += x[r];
         }
@@ -408,9 +446,9 @@ static TK_T TK_FN(kinetic)(const tk_tree *t, const TK_T *restrict q, const TK_T 
         const double *b = t->body + i * TK_STRIDE;
         TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
         TK_T *om = w + TW_A, *vel = om + 3, x[3];
-        double sw[3], sv[3];
+        double sw, sv;
         const int parent = (int)b[TK_PARENT];
-        tk_subspace(b, sw, sv);
+        tk_subspace(b, &sw, &sv);
         if (TK_FREE(b)) {
             for (int r = 0; r < 3; r++) { om[r] = v[3 + r]; vel[r] = v[r]; }
         } else if (parent < 0) {
@@ -424,7 +462,8 @@ static TK_T TK_FN(kinetic)(const tk_tree *t, const TK_T *restrict q, const TK_T 
         }
         if (!TK_FREE(b)) {
             const TK_T rate = v[t->bv + (int)b[TK_COORD]];
-            for (int r = 0; r < 3; r++) { om[r] += rate * sw[r]; vel[r] += rate * sv[r]; }
+            om[2] += rate * sw;
+            vel[2] += rate * sv;
         }
         TK_T Jw[3], wh[3];
         TK_APPLY(b + TK_J, om, Jw);

@@ -1,4 +1,6 @@
 /* ---- batched bindings: f(Q[, V[, X]], D), each input (..., n) or (n,), D the tree ----
+   Inputs that are not already float64 C-ordered arrays of the tree's widths, with one batch
+   shape and unit base quaternions, give NotImplemented: the Python front checks them. 
    (a floating base: Q (..., nq), the others and the outputs nv wide: tree_kernel.c)
    As tree_bindings.c: a state whose inputs are not all finite, or (forward dynamics) without
    a finite result, gives NaN in its own row and is counted; with none such the output array
@@ -145,10 +147,9 @@ static int tk_threads(npy_intp count, int nb)
     return parts > count ? (int)(count < 1 ? 1 : count) : parts;
 }
 
-static const char *tk_names[] = {"q", "v", "third"};
-
-/* x as a float64 C-contiguous array: the usual ndarray taken as it is (the general conversion
-   cost a single call a sixth of its time), anything else converted */
+/* x as a float64 C-contiguous array (a new reference) when it already is one, else NULL with
+   no error set: an input off the fast path makes the call answer NotImplemented, and the
+   Python front (recursive.py) checks and shapes it; no error text is ever read. */
 static PyArrayObject *tk_array(PyObject *x, int min_depth, int max_depth)
 {
     if (PyArray_CheckExact(x) && PyArray_TYPE((PyArrayObject *)x) == NPY_DOUBLE
@@ -158,8 +159,7 @@ static PyArrayObject *tk_array(PyObject *x, int min_depth, int max_depth)
         Py_INCREF(x);
         return (PyArrayObject *)x;
     }
-    return (PyArrayObject *)PyArray_FROMANY(x, NPY_DOUBLE, min_depth, max_depth,
-                                            NPY_ARRAY_CARRAY_RO);
+    return NULL;
 }
 
 static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int kind)
@@ -173,7 +173,10 @@ static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
         return NULL;
     }
     D = tk_array(args[nin], 1, 1);
-    if (!D) return NULL;
+    if (!D) {
+        PyErr_SetString(PyExc_TypeError, "tree: not a tree description (compact_kernel.py)");
+        return NULL;
+    }
     if (tk_open((const double *)PyArray_DATA(D), PyArray_SIZE(D), &tree)) {
         PyErr_SetString(PyExc_TypeError, "tree: not a tree description (compact_kernel.py)");
         goto done;
@@ -183,13 +186,9 @@ static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     int base = 0;
     for (int i = 0; i < nin; i++) {
         in[i] = tk_array(args[i], 0, 0);
-        if (!in[i]) goto done;
+        if (!in[i]) goto slow;
         int nd = PyArray_NDIM(in[i]);
-        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != TK_WIDTH(i)) {
-            PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
-                         i == 2 ? (kind == TK_FORWARD ? "tau" : "a") : tk_names[i], TK_WIDTH(i));
-            goto done;
-        }
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != TK_WIDTH(i)) goto slow;
         if (PyArray_SIZE(in[i]) / TK_WIDTH(i) > PyArray_SIZE(in[base]) / TK_WIDTH(base)) base = i;
     }
     npy_intp count = PyArray_SIZE(in[base]) / TK_WIDTH(base);
@@ -200,15 +199,15 @@ static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
             continue;
         }
         if (PyArray_NDIM(in[i]) != nd  /* the batch axes, all but the last */
-            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp))) {
-            PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
-            goto done;
-        }
+            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp)))
+            goto slow;
         step[i] = TK_WIDTH(i);
     }
     if (tree.fb && !lg_unit_quaternions((const double *)PyArray_DATA(in[0]),
-                                        step[0] ? count : 1, step[0], tree.nq, tree.qtol))
-        goto done;
+                                        step[0] ? count : 1, step[0], tree.nq, tree.qtol)) {
+        PyErr_Clear();  /* the front names the state and its norm */
+        goto slow;
+    }
 #undef TK_WIDTH
     npy_intp dims[NPY_MAXDIMS];
     memcpy(dims, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
@@ -255,6 +254,10 @@ done:
     for (int i = 0; i < 3; i++) Py_XDECREF(in[i]);
     Py_XDECREF(D);
     return out;
+slow:  /* not the fast path's inputs: the Python front checks and shapes them */
+    for (int i = 0; i < 3; i++) Py_XDECREF(in[i]);
+    Py_XDECREF(D);
+    Py_RETURN_NOTIMPLEMENTED;
 }
 
 #define TK_WRAP(name, nin, kind) \

@@ -56,10 +56,10 @@ static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *restrict q,
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
         TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
-        double sw[3], sv[3];
+        double sw, sv;
         TK_T x[3];
         const int parent = (int)b[TK_PARENT];
-        tk_subspace(b, sw, sv);  /* zero for the free flyer: its motion is v[:6] itself */
+        tk_subspace(b, &sw, &sv);  /* zero for the free flyer: its motion is v[:6] itself */
         const TK_T rate = TK_FREE(b) ? TK_C(0.0) : v[t->bv + (int)b[TK_COORD]];
         TK_T *vw = w + V, *vv = w + V + 3;
         if (TK_FREE(b)) {
@@ -73,17 +73,17 @@ static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *restrict q,
             TK_APPLY_T(R, pv, vw);
             TK_APPLY_T(R, x, vv);
         }
-        /* c = v x (S rate), with the parent's part: (w x s_w, w x s_v + v_l x s_w) rate */
+        /* c = v x (S rate), with the parent's part: (w x s_w, w x s_v + v_l x s_w) rate, S
+           about z */
         TK_T *cw = w + C, *cv = w + C + 3, y[3];
-        TK_CROSS(vw, sw, cw);
-        TK_CROSS(vw, sv, x);
-        TK_CROSS(vv, sw, y);
-        for (int r = 0; r < 3; r++) {
-            cw[r] *= rate;
-            cv[r] = (x[r] + y[r]) * rate;
-            vw[r] += rate * sw[r];
-            vv[r] += rate * sv[r];
-        }
+        cw[0] = vw[1] * sw * rate;
+        cw[1] = -(vw[0] * sw) * rate;
+        cw[2] = TK_C(0.0);
+        cv[0] = (vw[1] * sv + vv[1] * sw) * rate;
+        cv[1] = -(vw[0] * sv + vv[0] * sw) * rate;
+        cv[2] = TK_C(0.0);
+        vw[2] += rate * sw;
+        vv[2] += rate * sv;
         /* IA = I, pA = v x* I v: I v = (J w + h x v, m v + w x h) */
         const double m = b[TK_MASS], *h = b + TK_H, *J = b + TK_J;
         TK_T *In = w + IA, *pa = w + PA, Iw[3], Iv[3], z[3];
@@ -113,16 +113,11 @@ static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *restrict q,
     for (int i = t->nb - 1; i >= 0; i--) {
         const double *b = t->body + i * TK_STRIDE;
         TK_T *w = W + i * TW_STRIDE, *In = w + IA, *pa = w + PA, *U_ = w + U;
-        double S[6];
+        double sw, sv;
         if (TK_FREE(b)) continue;  /* the root: solved outright below */
-        tk_subspace(b, S, S + 3);
-        for (int r = 0; r < 6; r++) {
-            TK_T s = TK_C(0.0);
-            for (int k = 0; k < 6; k++) s += In[6 * r + k] * S[k];
-            U_[r] = s;
-        }
-        TK_T d = TK_C(0.0), su = TK_C(0.0);
-        for (int r = 0; r < 6; r++) { d += S[r] * U_[r]; su += S[r] * pa[r]; }
+        tk_subspace(b, &sw, &sv);  /* S = (0, 0, sw, 0, 0, sv) */
+        for (int r = 0; r < 6; r++) U_[r] = In[6 * r + 2] * sw + In[6 * r + 5] * sv;
+        const TK_T d = sw * U_[2] + sv * U_[5], su = sw * pa[2] + sv * pa[5];
         const int c = (int)b[TK_COORD];
         const TK_T u = tau[t->bv + c] + t->tau0[c] - su;
         bad |= TK_NOT_POSITIVE(d);
@@ -195,7 +190,7 @@ static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *restrict q,
         TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P, *ac = w + A;
         const int parent = (int)b[TK_PARENT];
         TK_T x[3];
-        double S[6];
+        double sw, sv;
         if (TK_FREE(b)) {
             bad |= TK_FN(free_acceleration)(t, w + IA, w + PA, R, tau, ac, qdd);
             TK_GIVE_UP(bad);
@@ -213,12 +208,13 @@ static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *restrict q,
             TK_APPLY_T(R, x, ac + 3);
         }
         for (int r = 0; r < 6; r++) ac[r] += w[C + r];
-        tk_subspace(b, S, S + 3);
+        tk_subspace(b, &sw, &sv);
         TK_T s = TK_C(0.0);
         for (int r = 0; r < 6; r++) s += w[U + r] * ac[r];
         const TK_T x_dd = (w[UU] - s) / w[D];
         qdd[t->bv + (int)b[TK_COORD]] = x_dd;
-        for (int r = 0; r < 6; r++) ac[r] += S[r] * x_dd;
+        ac[2] += sw * x_dd;
+        ac[5] += sv * x_dd;
     }
     for (int i = 0; i < t->nv; i++)
         bad |= TK_NOT_FINITE(qdd[i]);

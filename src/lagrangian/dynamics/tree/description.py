@@ -10,17 +10,25 @@ The description ``D`` (float64, contiguous), built by ``describe``:
     floating base (body 0 on a free flyer: q of n + 7 numbers, v of n + 6, free_flyer.py's
     layout), D[7] the quaternion-norm tolerance (free_flyer.QUATERNION_TOLERANCE);
     D[8:8+n] the actuator parameters tau_<joint> (N m or N), acting as loads;
-    then nb records of STRIDE = 64 numbers, parent first (parent < own index):
+    then nb records of STRIDE = 64 numbers, parent first (parent < own index), each in its
+    joint's canonical axes (below):
       0 parent (-1 the ground)  1 kind code (JOINT_CODES)  2 coordinate index c
       3 multiplier k  4 offset (theta = k q[c] + offset)  5:14 R0 (joint -> parent axes,
-      row-major)  14:17 t0 (m)  17:20 unit axis u (joint axes)  20 mass (kg)
+      row-major)  14:17 t0 (m)  17:20 unit axis u, always (0, 0, 1)  20 mass (kg)
       21:24 first moment h = m c about the body origin (kg m)  24:33 J_O (kg m^2, body axes)
-      33:60 a revolute joint's turn tables P = R0 u u^T, C = R0 (1 - u u^T), S = R0 [u]x
-      (row-major each: R0 Rot(u, theta) = P + cos theta C + sin theta S; every kind's)
-      60 spare  61 the lead: the slide along u per unit theta (1 prismatic, the pitch in m/rad
+      33:36 where R0 is a signed permutation, the column of each row's one nonzero, 36:39 its
+      sign, 39 1 then (else 0: R0 is read as its nine numbers)  40:61 spare
+      61 the lead: the slide along u per unit theta (1 prismatic, the pitch in m/rad
       helical, 0 revolute)  62:64 spare.
       A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone; a helical joint
       (code 3) turns as a revolute one and slides by its lead.
+
+Canonical axes: each body's axes are turned by a fixed A (A e_z = u, a signed permutation
+for an axis along a joint axis' own x, y or z) so that every joint turns and slides about z:
+R = R0 Rot(z, theta) is 12 products, or none where R0 is a signed permutation (a URDF's
+quarter turns), and S has one nonzero. M, the energies and every generalized force are the
+same in any body axes; R0 becomes A_parent^T R0 A, t0 A_parent^T t0, h A^T h, J A^T J A. A
+rotation within 1e-14 of a signed permutation is taken as that permutation.
 
 A new joint kind is a new code in JOINT_CODES (tests/dynamics/test_joint_kinds.py walks each)
 and its cases in tree_kernel.c (tk_place for the
@@ -48,9 +56,33 @@ JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FREE_FLY
                JointKind.HELICAL: 3}
 
 
+def canonical_frame(joint: TreeJoint) -> np.ndarray:
+    """A (3x3, joint axes -> canonical axes) with A e_z = u: exact where u is a signed basis
+    vector; the identity for a free flyer."""
+    if JointKind(joint.kind) == JointKind.FREE_FLYER:
+        return np.eye(3)
+    u = np.array(joint.axis, dtype=float)
+    u = u / np.linalg.norm(u)
+    a = np.zeros(3)
+    a[int(np.argmin(np.abs(u)))] = 1.0  # the basis vector least along u
+    x = a - (a @ u) * u
+    x = x / np.linalg.norm(x)
+    return np.column_stack([x, np.cross(u, x), u])
+
+
+def _signed_permutation(R: np.ndarray) -> np.ndarray | None:
+    """R snapped to a signed permutation where it is one within 1e-14, else None."""
+    snapped = np.where(np.abs(R) < 1e-14, 0.0, np.where(np.abs(np.abs(R) - 1.0) < 1e-14,
+                                                        np.sign(R), np.nan))
+    if np.isnan(snapped).any() or not (np.count_nonzero(snapped, axis=1) == 1).all() \
+            or not (np.count_nonzero(snapped, axis=0) == 1).all():
+        return None
+    return snapped
+
+
 def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
-    """The tree as the kernel's array D (layout above), with the parameters' values (g and the
-    actuators) in SI units."""
+    """The tree as the kernel's array D (layout above, canonical axes), with the parameters'
+    values (g and the actuators) in SI units."""
     n, nb = len(tree.coordinates), len(tree.joints)
     D = np.zeros(HEADER + n + nb * STRIDE)
     D[0], D[1] = nb, n
@@ -59,27 +91,32 @@ def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray
     D[5] = float(not np.all(drives == 1))
     D[6], D[7] = float(tree.floating_base), QUATERNION_TOLERANCE
     D[HEADER:HEADER + n] = [float(parameters.get(a, 0.0)) for a in tree.actuators]  # None: 0
+    frames = [canonical_frame(j) for j in tree.joints]
     for i, j in enumerate(tree.joints):
         r = D[HEADER + n + i * STRIDE:HEADER + n + (i + 1) * STRIDE]
+        A, Ap = frames[i], (frames[j.parent] if j.parent >= 0 else np.eye(3))
         r[0], r[1], r[2] = j.parent, JOINT_CODES[JointKind(j.kind)], max(j.coordinate, 0)
         r[3], r[4] = j.multiplier, j.offset
-        r[5:14] = np.ravel(j.rotation)
-        r[14:17], r[17:20] = j.translation, j.axis
-        r[20], r[21:24], r[24:33] = j.mass, j.first_moment, np.ravel(j.inertia)
+        R0 = Ap.T @ np.array(j.rotation, dtype=float) @ A
+        permutation = _signed_permutation(R0)
+        if permutation is not None:
+            R0 = permutation
+            columns = np.argmax(np.abs(permutation), axis=1)
+            r[33:36], r[36:39], r[39] = columns, permutation[np.arange(3), columns], 1.0
+        r[5:14] = np.ravel(R0)
+        r[14:17] = Ap.T @ np.array(j.translation, dtype=float)
+        r[17:20] = (0.0, 0.0, 1.0) if JointKind(j.kind) != JointKind.FREE_FLYER else j.axis
+        r[20], r[21:24] = j.mass, A.T @ np.array(j.first_moment, dtype=float)
+        r[24:33] = np.ravel(A.T @ np.array(j.inertia, dtype=float) @ A)
         model = JOINT_MODELS[JointKind(j.kind)]
         r[LEAD] = model.lead(j.pitch) if hasattr(model, "lead") else 0.0
-        R0, u = np.array(j.rotation, dtype=float), np.array(j.axis, dtype=float)
-        uu = np.outer(u, u)
-        skew = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
-        r[33:42], r[42:51], r[51:60] = np.ravel(R0 @ uu), np.ravel(R0 @ (np.eye(3) - uu)), \
-            np.ravel(R0 @ skew)
     D.flags.writeable = False
     return D
 
 
 def joints_of(D: np.ndarray) -> tuple[TreeJoint, ...]:
-    """The bodies of a description as TreeJoints (names left empty): what the numpy twin
-    (recursive_numpy.py) reads, so that both compute from the same array."""
+    """The bodies of a description as TreeJoints (names left empty, canonical axes): what the
+    numpy twin (recursive_numpy.py) reads, so that both compute from the same array."""
     kinds = {code: kind for kind, code in JOINT_CODES.items()}
     nb, n = int(D[0]), int(D[1])
     out = []
@@ -101,4 +138,4 @@ def joints_of(D: np.ndarray) -> tuple[TreeJoint, ...]:
     return tuple(out)
 
 
-__all__ = ["HEADER", "JOINT_CODES", "LEAD", "STRIDE", "describe", "joints_of"]
+__all__ = ["HEADER", "JOINT_CODES", "LEAD", "STRIDE", "canonical_frame", "describe", "joints_of"]

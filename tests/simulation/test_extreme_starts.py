@@ -137,3 +137,53 @@ def test_a_loop_on_derivatives_that_are_never_finite_ends_in_bounded_calls(metho
                           np.linspace(0.0, 1.0, 11), StepControl(method=method))
     assert run.status == RunStatus.FAILED and run.t[-1] == 0.0
     assert len(calls) <= MAX_REJECTED * 12 + 2 * 12
+
+
+HOPPER = """<?xml version="1.0"?>
+<robot name="hopper">
+  <link name="trunk"><inertial><mass value="3.0"/>
+    <inertia ixx="0.05" ixy="0" ixz="0" iyy="0.07" iyz="0" izz="0.06"/></inertial></link>
+  <link name="leg"><inertial><origin xyz="0 0 -0.15"/><mass value="0.8"/>
+    <inertia ixx="0.006" ixy="0" ixz="0" iyy="0.006" iyz="0" izz="0.001"/></inertial></link>
+  <joint name="hip" type="revolute"><parent link="trunk"/><child link="leg"/>
+    <origin xyz="0.1 0 -0.05"/><axis xyz="0 1 0"/>
+    <limit lower="-3" upper="3" effort="1" velocity="100"/></joint>
+</robot>
+"""
+
+
+@pytest.fixture(scope="module")
+def hopper(tmp_path_factory):
+    pytest.importorskip("yourdfpy")
+    path = tmp_path_factory.mktemp("hopper") / "hopper.urdf"
+    path.write_text(HOPPER)
+    return lagrangian.load(path, floating_base=True)
+
+
+@pytest.fixture
+def dynamics_calls(hopper, monkeypatch):
+    """The floating base's forward dynamics, counted (one per right-hand side)."""
+    dynamics, calls = hopper.dynamics(), []
+    original = dynamics.forward_dynamics
+
+    def counted(q, v, tau):
+        calls.append(1)
+        return original(q, v, tau)
+
+    monkeypatch.setattr(dynamics, "forward_dynamics", counted)
+    return calls
+
+
+@pytest.mark.parametrize("name", ["base_wx", "hip_dot"])
+def test_a_floating_base_refuses_an_overflowing_rate(hopper, dynamics_calls, name):
+    with pytest.raises(InputError) as refused:
+        hopper.simulate(1.0, initial={name: 1e308}, limits=False)
+    assert str(refused.value) == (f"initial.{name}: 1e+308 makes the motion overflow (the "
+                                  "accelerations are not finite at t = 0 s)")
+    assert len(dynamics_calls) <= 1 + 1
+
+
+def test_a_floating_base_spinning_too_fast_fails_within_one_window(hopper, dynamics_calls):
+    run = hopper.simulate(1.0, initial={"hip_dot": 1e50}, limits=False)
+    assert run.status == RunStatus.FAILED and "the step size collapsed" in run.message
+    assert len(dynamics_calls) == run.nfev + 1 <= WINDOW_CALLS  # + 1: the start's check

@@ -10,11 +10,12 @@ run as on a fixed base (simulation/simulate.py): the event located on the step's
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import InputError, did_you_mean
+from ..errors import DynamicsWarning, InputError, did_you_mean
 from ..kinds import InvariantKind, RunStatus
 from ..model.quaternions import check_quaternions
 from ..model.values import resolve_state
@@ -171,12 +172,12 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     control = None if controller is None else FloatingControl(controller, nv)
     evaluations = [0]
 
-    def rhs(t, y):
-        evaluations[0] += 1
+    def rhs(t, y, controlled=True):
+        evaluations[0] += controlled  # the run's calls: the start's check is not one
         q, v = y[:nq].copy(), y[nq:]
         # a step's stages leave the unit sphere by the step's error: the dynamics read R(q/|q|)
         q[3:7] /= np.linalg.norm(q[3:7])
-        tau = zero if control is None else control(t, q, v)
+        tau = zero if control is None or not controlled else control(t, q, v)
         return np.concatenate([configuration_rate(q, v), dynamics.forward_dynamics(q, v, tau)])
 
     solvers = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF,
@@ -190,7 +191,8 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     y0 = np.concatenate([q0, v0])
     # a rate that overflows the accelerations at once: refused (simulation/guards.py)
     rates = (*dynamics.velocity_names[:6], *(f"{c.name}_dot" for c in model.coordinates))
-    check_start(rhs, t0, y0, rates, tuple(initial or ()))
+    # the robot's own motion: the controller is not called for it (its calls are the run's)
+    check_start(lambda t, y: rhs(t, y, controlled=False), t0, y0, rates, tuple(initial or ()))
     guarded = GuardedRhs(rhs, step_control.method, len(y0), t0, t_end)
     solver = None  # built in the loop's try: its first step size calls the guarded rhs
     user = None if stop is None else _stop_event(stop, dynamics, model, system.parameters)
@@ -207,44 +209,47 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
         return y
 
     try:
-        solver = solver_class(guarded, t0, y0, t_end, rtol=step_control.rtol,
-                              atol=step_control.atol, **options)
-        while k < len(grid):
-            message_of_step = solver.step()
-            steps += 1
-            if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
-                status = RunStatus.FAILED
-                message = f"the step failed at t = {solver.t:.6g} s: {message_of_step}"
-                break
-            guarded.accepted(solver.t)
-            dense = solver.dense_output()
-            # the accepted state back on the unit sphere: |q| drifts by the step's error only
-            solver.y[3:7] /= np.linalg.norm(solver.y[3:7])
-            t_stop, hit = solver.t, False
-            if event is not None:
-                g_new = event(solver.y[:nq], solver.y[nq:], solver.t)
-                if armed and g_new >= 0:  # where it turns true, as the fixed base's loop
-                    t_stop = crossing_time(lambda q, v, t: event(unit(q), v, t), dense,
-                                           solver.t_old, solver.t, nq)
-                    hit = True
-                elif g_new < 0:
-                    armed = True
-            while k < len(grid) and grid[k] <= t_stop:
-                samples.append(unit(dense(grid[k])))
-                times.append(float(grid[k]))
-                k += 1
-            if hit:
-                if t_stop > times[-1]:
-                    samples.append(unit(dense(t_stop)))
-                    times.append(float(t_stop))
-                status, message = RunStatus.STOPPED, f"stop condition met at t = {t_stop:.12g} s"
-                break
-            if solver.status == "finished" and k < len(grid):
-                samples.append(solver.y.copy())
-                times.append(float(grid[k]))
-                k += 1
-            if progress is not None:
-                progress(solver.t)
+        # overflow in a failing step is the run's verdict, not numpy's or the tree's text
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", DynamicsWarning)
+            solver = solver_class(guarded, t0, y0, t_end, rtol=step_control.rtol,
+                                  atol=step_control.atol, **options)
+            while k < len(grid):
+                message_of_step = solver.step()
+                steps += 1
+                if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
+                    status = RunStatus.FAILED
+                    message = f"the step failed at t = {solver.t:.6g} s: {message_of_step}"
+                    break
+                guarded.accepted(solver.t)
+                dense = solver.dense_output()
+                # the accepted state back on the unit sphere: |q| drifts by the step's error only
+                solver.y[3:7] /= np.linalg.norm(solver.y[3:7])
+                t_stop, hit = solver.t, False
+                if event is not None:
+                    g_new = event(solver.y[:nq], solver.y[nq:], solver.t)
+                    if armed and g_new >= 0:  # where it turns true, as the fixed base's loop
+                        t_stop = crossing_time(lambda q, v, t: event(unit(q), v, t), dense,
+                                               solver.t_old, solver.t, nq)
+                        hit = True
+                    elif g_new < 0:
+                        armed = True
+                while k < len(grid) and grid[k] <= t_stop:
+                    samples.append(unit(dense(grid[k])))
+                    times.append(float(grid[k]))
+                    k += 1
+                if hit:
+                    if t_stop > times[-1]:
+                        samples.append(unit(dense(t_stop)))
+                        times.append(float(t_stop))
+                    status, message = RunStatus.STOPPED, f"stop condition met at t = {t_stop:.12g} s"
+                    break
+                if solver.status == "finished" and k < len(grid):
+                    samples.append(solver.y.copy())
+                    times.append(float(grid[k]))
+                    k += 1
+                if progress is not None:
+                    progress(solver.t)
     except KeyboardInterrupt:
         reached = t0 if solver is None else solver.t
         status, message = RunStatus.INTERRUPTED, f"interrupted at t = {reached:.6g} s"

@@ -131,8 +131,8 @@ def simulate(
     grid = np.linspace(start.t, t_end, save_at.samples)
     y0 = np.concatenate([q0, v0])
     # a rate that overflows the accelerations at once: refused, not left to the step control
-    check_start(functions.rhs if loop is None else loop.rhs, start.t, y0, start.velocities,
-                start.given)
+    # (the model's own motion: a controller is not called for it, its calls are the run's)
+    check_start(functions.rhs, start.t, y0, start.velocities, start.given)
     began = time.perf_counter()
     run = _integrate(functions, y0, grid, step_control, event, drift, progress,
                      compiled_loop and not functions.m and event is None and loop is None, beyond,

@@ -76,7 +76,9 @@ def simulate(
     model's own [control] laws instead, compiled with the equations (simulation/control_law.py).
     A start beyond a position limit (``start_limits``, default the position ``limits``) is
     refused, or with ``start_beyond`` "clamp" started at the limit, "ignore" where it is, each
-    noted in the result's message (check_start_within).
+    noted in the result's message (check_start_within). A rate that makes the accelerations
+    overflow at the start is refused naming it; a step size that collapses ends the run as
+    'failed', each within a bounded number of calls (simulation/guards.py).
 
     ``eom`` None: the run of a kinematic tree's recursive algorithms (``functions``, of
     ``model``), with nothing derived: no constraints, no explicit t, T quadratic in q_dot, and

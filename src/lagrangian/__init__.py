@@ -144,27 +144,15 @@ __all__ = [
     "load",
     "parse_model",
     "read_model",
-    "MAX_STUDY_POINTS",
     "SIMULATION_METHODS",
     "answer_files",
-    "check_input_file",
     "bare_angle_warnings",
     "check_report_path",
-    "limit_warnings",
-    "course_document",
-    "course_folder",
     "example_names",
     "example_path",
     "example_robots",
-    "example_summary",
-    "example_text",
     "parse_quantity",
     "parse_steady_rates",
-    "parse_stop_condition",
-    "physical_warnings",
-    "resolve_state",
-    "speed_sweep",
-    "state_units",
     "state_layout",
     "lqr",
     "computed_torque",
@@ -185,25 +173,13 @@ _HOMES = {
     "DynamicsWarning": ("errors", "DynamicsWarning"),
     "ModelWarning": ("errors", "ModelWarning"),
     "parse_quantity": ("model.units", "parse_quantity"),
-    "state_units": ("model.values", "state_units"),
-    "resolve_state": ("model.values", "resolve_state"),
     "example_names": ("model.examples", "example_names"),
     "example_path": ("model.examples", "example_path"),
     "example_robots": ("model.robots", "example_robots"),
-    "example_summary": ("model.examples", "example_summary"),
-    "example_text": ("model.examples", "example_text"),
-    "physical_warnings": ("derivation.regularity", "physical_warnings"),
     "SIMULATION_METHODS": ("simulation.options", "METHODS"),
-    "parse_stop_condition": ("simulation.events", "parse_stop_condition"),
-    "speed_sweep": ("analysis.speed_form", "speed_sweep"),
     "parse_steady_rates": ("analysis.steady", "parse_steady_rates"),
-    "MAX_STUDY_POINTS": ("analysis.study", "MAX_STUDY_POINTS"),
     "bare_angle_warnings": ("check.warnings", "bare_angle_warnings"),
-    "limit_warnings": ("check.warnings", "limit_warnings"),
     "answer_files": ("check.classroom", "answer_files"),
-    "check_input_file": ("model.reader", "check_text_file"),
-    "course_document": ("check.course", "course_document"),
-    "course_folder": ("check.course", "course_folder"),
     "course_lessons": ("check.course", "course_lessons"),
     "check_report_path": ("report.page", "check_report_path"),
     "lqr": ("control.lqr", "lqr"),
@@ -213,20 +189,38 @@ _HOMES = {
     "Trajectory": ("control.optimize", "Trajectory"),
 }
 
+# The command line's own helpers (issue 38): not the public face (``__all__``, ``dir()``), yet
+# found here, since the CLI is a client of this package only (pyproject.toml's import contract:
+# it imports no stage directly). Each is public in its own module.
+_CLI_HOMES = {
+    "state_units": ("model.values", "state_units"),
+    "resolve_state": ("model.values", "resolve_state"),
+    "example_summary": ("model.examples", "example_summary"),
+    "example_text": ("model.examples", "example_text"),
+    "physical_warnings": ("derivation.regularity", "physical_warnings"),
+    "parse_stop_condition": ("simulation.events", "parse_stop_condition"),
+    "speed_sweep": ("analysis.speed_form", "speed_sweep"),
+    "MAX_STUDY_POINTS": ("analysis.study", "MAX_STUDY_POINTS"),
+    "limit_warnings": ("check.warnings", "limit_warnings"),
+    "check_input_file": ("model.reader", "check_text_file"),
+    "course_document": ("check.course", "course_document"),
+    "course_folder": ("check.course", "course_folder"),
+}
+
 
 def __getattr__(name: str):
     """Each public name loaded on first use: `import lagrangian` (and the command line's start,
     `lagrangian --help`) pays for sympy, scipy and the API only when a name is asked for."""
-    if name not in __all__:
+    if name not in __all__ and name not in _CLI_HOMES:
         raise AttributeError(f"module 'lagrangian' has no attribute {name!r}")
     if name in _SYMPY_NAMES:
         import sympy
 
         value = getattr(sympy, name)
-    elif name in _HOMES:
+    elif name in _HOMES or name in _CLI_HOMES:
         from importlib import import_module
 
-        home, attribute = _HOMES[name]
+        home, attribute = _HOMES.get(name) or _CLI_HOMES[name]
         value = getattr(import_module(f"{__name__}.{home}"), attribute)
     else:
         from . import api
@@ -237,4 +231,4 @@ def __getattr__(name: str):
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+    return sorted({*globals(), *__all__} - set(_CLI_HOMES))

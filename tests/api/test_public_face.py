@@ -127,3 +127,20 @@ def test_one_simulation_type():
     assert lagrangian.SimulationResult is lagrangian.Simulation
     run = lagrangian.load("pendulum").simulate(0.1)
     assert type(run) is lagrangian.Simulation
+
+
+def test_the_command_lines_own_helpers_are_not_the_public_face():
+    """Names that only the CLI uses (issue 38) are out of ``__all__`` and ``dir()``, yet found
+    on the package (the CLI imports nothing else) and public in their own modules."""
+    from lagrangian.model.values import resolve_state
+
+    helpers = lagrangian._CLI_HOMES
+    assert "resolve_state" in helpers and "state_units" in helpers
+    for name in helpers:
+        assert name not in lagrangian.__all__
+        assert getattr(lagrangian, name) is not None
+        assert name not in dir(lagrangian)
+    assert lagrangian.resolve_state is resolve_state
+    # still every one of the API's names, and the functions the documentation uses
+    for name in ("load", "System", "example_path", "parse_steady_rates", "lqr", "sin"):
+        assert name in lagrangian.__all__

@@ -16,7 +16,7 @@ from lagrangian.model.urdf import example_urdf
 def test_the_floating_and_time_block(capsys):
     if example_urdf("solo12") is None:
         pytest.skip("example-robot-data is not installed")
-    (code,) = re.findall(r"```python\n(.*?)```", block("bridges-casadi-floating", "bridges.md"),
+    (code,) = re.findall(r"```python\n(.*?)```", block("bridges-floating-casadi", "bridges.md"),
                          re.S)
     namespace: dict = {}
     exec(code, namespace)  # noqa: S102 - our own documentation

@@ -13,7 +13,7 @@ from docs_blocks import block
 
 def test_the_layout_block_converts_a_drones_state(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    (code,) = re.findall(r"```python\n(.*?)```", block("bridges-mjcf-state", "bridges.md"), re.S)
+    (code,) = re.findall(r"```python\n(.*?)```", block("bridges-mujoco-layout", "bridges.md"), re.S)
     namespace: dict = {}
     exec(code, namespace)  # noqa: S102 - our own documentation
     v, a, q = namespace["v"], namespace["a"], namespace["q"]

@@ -20,7 +20,10 @@ def optimize(system: System, inputs: Sequence[str], t_final: float, nodes: int =
     ``bounds`` {name: (lower, upper)} (SI; a robot's joint position limits are bounds too
     unless ``bounds`` names the joint); direct collocation on ``nodes`` points,
     ``method`` "trapezoidal" or "hermite-simpson", solved by IPOPT through CasADi (extra
-    [casadi]). Replay it with ``system.simulate(t_final, initial=trajectory.initial_state(),
+    [casadi]). A floating base's states are its position, quaternion and twist (base_x ..
+    base_wz) before the joints', the base at the origin, level and at rest unless ``start``
+    names them; a model with t in its equations is collocated at the nodes' times from t = 0.
+    Replay it with ``system.simulate(t_final, initial=trajectory.initial_state(),
     controller=trajectory.controller())``: docs/bridges.md."""
     if not isinstance(system, System):
         raise TypeError("optimize(system, ...) takes a lagrangian System (lagrangian.load)")

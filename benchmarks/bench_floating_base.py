@@ -68,10 +68,10 @@ def forward_side_by_side(robot, model, ours_states, pinocchio_states) -> None:
     import pinocchio as pin
 
     data = model.createData()
-    # the module's function and its last argument: the parameters' values (unrolled module),
-    # or the tree's description (the compact kernel, Talos's: tree_kernel.c)
+    # the module's function and its last argument, the backend's tables: the parameters'
+    # values (unrolled module), or the tree's prepared description (the engine, Talos's)
     module = robot.module
-    P = robot.description if robot.kernel == "compact" else robot.parameter_values
+    P = robot.recursions.tables
     q, v, tau = ours_states
     q0, v0, t0 = q[0], v[0], tau[0]
     qp, vp, tp = pinocchio_states

@@ -300,4 +300,6 @@ def test_a_kind_without_its_branch_is_refused_by_the_engine():
     D = np.array(describe(tree, {"g": 9.81}))
     D[HEADER + len(tree.coordinates) + 1] = 9.0  # body 0's kind: a code no branch takes
     with pytest.raises((TypeError, ValueError), match="not a tree description"):
+        kernel_module().prepare(D)
+    with pytest.raises(TypeError, match="not a prepared tree"):  # the tables, never the array
         kernel_module().mass_matrix(np.zeros(len(tree.coordinates)), D)

@@ -45,12 +45,13 @@ class TreeBackend(Protocol):
 
 
 class CompiledBackend:
-    """The recursions in compiled C: the engine's module with the tree's description D as its
-    tables (kernel "compact"), or a tree's unrolled module with its parameter values
-    ("unrolled")."""
+    """The recursions in compiled C: the engine's module with the tree's description D,
+    prepared once (checked and copied: ``module.prepare(D)``), as its tables (kernel
+    "compact"), or a tree's unrolled module with its parameter values ("unrolled")."""
 
-    def __init__(self, kernel: str, module, tables: np.ndarray):
+    def __init__(self, kernel: str, module, tables, description: np.ndarray | None = None):
         self.kernel, self.module, self.tables = kernel, module, tables
+        self.description = description
         for name in RECURSIONS:  # the module's own functions: no Python between
             setattr(self, name, getattr(module, name))
 
@@ -71,7 +72,8 @@ def compiled_backend(tree: KinematicTree, parameters: Mapping[str, float], names
         from .engine.compact_kernel import kernel_module
         from .tree.description import describe
 
-        return CompiledBackend("compact", kernel_module(), describe(tree, parameters))
+        module, D = kernel_module(), describe(tree, parameters)
+        return CompiledBackend("compact", module, module.prepare(D), D)
     from ..compile import compiled
     from .engine.tree_module import module_source, tree_key
 
@@ -90,8 +92,8 @@ class _CompactKernel:
 
     backend = "compact"  # not "c": the module has no DOP853 loop of its own (scipy steps)
 
-    def __init__(self, module, D: np.ndarray, n: int):
-        self.m, self.D, self.n = module, D, n
+    def __init__(self, module, tree, n: int):
+        self.m, self.D, self.n = module, tree, n  # the prepared tree
 
     def _plain(self, out):
         return out[0] if out.__class__ is tuple else out

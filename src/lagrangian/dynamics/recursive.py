@@ -89,8 +89,8 @@ class TreeDynamics(Dynamics):
 
     @property
     def description(self):
-        """The engine's tables D of this tree (tree/description.py; kernel "compact")."""
-        return self._P if self.kernel == "compact" else None
+        """The engine's description D of this tree (tree/description.py; kernel "compact")."""
+        return getattr(self.recursions, "description", None)
 
     def regular(self) -> bool:
         """Whether M is positive definite at a few random states (a massless branch is not)."""

@@ -205,6 +205,7 @@ _CLI_HOMES = {
     "check_input_file": ("model.reader", "check_text_file"),
     "course_document": ("check.course", "course_document"),
     "course_folder": ("check.course", "course_folder"),
+    "state_dynamics": ("api.state_dynamics", "state_dynamics"),
 }
 
 

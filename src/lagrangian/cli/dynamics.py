@@ -3,12 +3,11 @@ inverse or forward dynamics and the energies at one state."""
 
 from __future__ import annotations
 
-import warnings
 from typing import Annotated
 
 import typer
 
-from ..errors import DerivationError, DynamicsWarning, InputError
+from ..errors import InputError
 from . import app
 from .common import (
     FLOATING_HELP,
@@ -35,7 +34,7 @@ def _wrenches(texts: list[str]) -> dict[str, list[float]]:
             for name, value in assignments(texts, "--wrench")}
 
 
-def _vector(text: str | None, names, flag: str, default: list[float]) -> list[float]:
+def _vector(text: str | None, names, flag: str, default: list[float] | None) -> list[float] | None:
     """A comma-separated vector in the model's coordinate order (each entry may carry a unit);
     ``names`` the library's names of its entries, listed when the count is wrong."""
     from .. import parse_quantity
@@ -91,9 +90,7 @@ def dynamics(
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Mass matrix, bias forces C q_dot + g, gravity, inverse or forward dynamics, energies."""
-    import numpy as np  # here, not at the top: --help loads no numpy (tests/cli/test_startup.py)
-
-    from .. import resolve_state, state_layout
+    from .. import resolve_state, state_dynamics, state_layout
     from ..output.dynamics import dynamics_document, dynamics_text
 
     if a is not None and tau is not None:
@@ -138,47 +135,14 @@ def dynamics(
     # a link's inertial (--set fore.mass=3) is a runtime parameter of the robot's dynamics
     f = system.dynamics(parameters=inertials or None, actuators=actuators,
                         armature=rotors or None)
-    constraints = tuple(getattr(f, "constraint_names", ()) or ())
-    with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings(record=True) as seen:
-        # an overflow is refused below; a state without dynamics (M not positive definite)
-        # is a DynamicsWarning and NaN, reported in one line
-        warnings.simplefilter("always", DynamicsWarning)
-        values = {"q": qs, "v": vs, "mass_matrix": f.mass_matrix(qs),
-                  "bias_forces": f.bias_forces(qs, vs), "gravity": f.gravity(qs)}
-        if a is not None:
-            values["a"] = _vector(a, names_v, "--a", [])
-            values["inverse_dynamics"] = f.inverse_dynamics(qs, vs, values["a"],
-                                                            f_ext=wrenches or None)
-            if derivatives:
-                values["dtau_dq"], values["dtau_dv"] = (  # + 0.0: no -0 printed
-                    x + 0.0 for x in f.inverse_dynamics_derivatives(qs, vs, values["a"]))
-        if tau is not None:
-            values["tau"] = _vector(tau, names_v, "--tau", [])
-            values["forward_dynamics"] = f.forward_dynamics(qs, vs, values["tau"],
-                                                            f_ext=wrenches or None)
-            if constraints:
-                values["multipliers"] = f.multipliers(qs, vs, values["tau"])
-            if derivatives:
-                values["dqdd_dq"], values["dqdd_dv"], values["dqdd_dtau"] = (
-                    x + 0.0 for x in f.forward_dynamics_derivatives(qs, vs, values["tau"]))
-        if coriolis:
-            values["coriolis_matrix"] = f.coriolis_matrix(qs, vs)
-        values["kinetic_energy"] = f.kinetic_energy(qs, vs)
-        values["potential_energy"] = f.potential_energy(qs)
-    undefined = [w for w in seen if issubclass(w.category, DynamicsWarning)]
-    if undefined:
-        nan = [key.replace("_", " ") for key, value in values.items()
-               if np.isnan(np.asarray(value, dtype=float)).all()]
-        warn(f"no {', '.join(nan) or 'dynamics'} at this state: the mass matrix is not "
-             "positive definite there (or an input is not finite); shown as NaN (null in JSON)")
-    for key, value in values.items():  # an overflow is no result (m L^2 of 1e299 each)
-        array = np.asarray(value, dtype=float)
-        if undefined and np.isnan(array).all():
-            continue
-        if not np.all(np.isfinite(array)):
-            raise DerivationError(f"the {key.replace('_', ' ')} is not finite at this state "
-                                  "(a number beyond floating point, or a state outside the "
-                                  "model's domain)")
+    # the library evaluates and judges the numbers (a state without dynamics: NaN, said in one
+    # line; an overflow: refused); the command prints them
+    found = state_dynamics(f, qs, vs, a=_vector(a, names_v, "--a", None),
+                           tau=_vector(tau, names_v, "--tau", None), f_ext=wrenches or None,
+                           derivatives=derivatives, coriolis=coriolis)
+    for line in found.warnings:
+        warn(line)
+    values, constraints = found.values, found.constraints
     velocities = names_v if base_q else None
     extra = {}
     if wrenches:

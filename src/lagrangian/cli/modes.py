@@ -86,7 +86,7 @@ def modes(
         check_output_path(animate, "animation", inputs=inputs)
         check_animation_target(animate)
         size, fps, view = check_size(size), check_fps(20 if fps is None else fps), check_view(view)
-    rates = steady_assignments(system, steady)
+    rates = steady_assignments(system, steady) if steady else {}
     names = [name.strip() for text in drives for name in text.split(",") if name.strip()]
     analysis = system.modes(about=point or None, steady=rates or None, inputs=names)
     trim = analysis.linear_model.trim

@@ -16,7 +16,6 @@ from ..derivation.equations import EquationsOfMotion
 from ..model.expressions import format_expression
 from ..model.units import generalized_force_unit
 from .derivation_display import _Display
-from .latex import handout_latex
 
 CONVENTION = "M q_ddot + Phi_q^T lambda = forcing"
 
@@ -220,4 +219,6 @@ def derivation_latex(eom: EquationsOfMotion, standalone: bool = False,
                      expand: bool = False) -> str:
     """LaTeX (amsmath) ready to paste into a paper, or with ``standalone`` a complete document
     for pdflatex (output/latex.py: M q_ddot = f per coordinate, long rows broken)."""
+    from .latex import handout_latex  # LaTeX's printer: loaded by --format latex
+
     return handout_latex(eom, standalone=standalone, expand=expand)

@@ -78,7 +78,7 @@ def limit_cycle(eom, substitution, functions, guess=None, *, step_control=CYCLE_
         raise InputError("the model has no impacts ([[impacts]]): no cycle through one",
                          field="impacts")
     n = len(model.coordinates)
-    poincare = PoincareMap(eom, substitution, functions, step_control, maps)
+    poincare = _poincare_map(eom, substitution, functions, step_control, maps)
     start = resolve_state(model, guess, field="guess", time=False,
                           what="coordinate or velocity")
     x = np.concatenate([start.q_array(), start.q_dot_array()])
@@ -99,6 +99,28 @@ def limit_cycle(eom, substitution, functions, guess=None, *, step_control=CYCLE_
     raise InputError(f"no limit cycle found from the guess ({max_iterations} Newton steps "
                      "did not converge): give a guess nearer the cycle or "
                      "check the slope and parameters", field="guess")
+
+
+_MAPS: dict = {}  # the last few Poincare maps: their compiled sensitivities cost 0.4-0.7 s
+_MAPS_KEPT = 8
+
+
+def _poincare_map(eom, substitution, functions, step_control, maps) -> PoincareMap:
+    """The Poincare map of these equations at these parameter values, built once: a second
+    limit_cycle() of a System (or of a model loaded again: the derivation is shared by content)
+    reuses its compiled flow sensitivities and impact derivatives."""
+    key = (id(eom), id(functions), step_control,
+           tuple(sorted((str(k), str(v)) for k, v in substitution.items())),
+           None if maps is None else tuple(id(m) for m in maps))
+    found = _MAPS.get(key)
+    if found is not None and found[0] is eom and found[1] is functions:
+        return found[2]
+    if len(_MAPS) >= _MAPS_KEPT:
+        _MAPS.pop(next(iter(_MAPS)))
+    poincare = PoincareMap(eom, substitution, functions, step_control, maps)
+    # eom and functions kept with it, so their ids stay theirs while the entry lives
+    _MAPS[key] = (eom, functions, poincare, maps)
+    return poincare
 
 
 def _bounded(step, scale, largest=0.5):

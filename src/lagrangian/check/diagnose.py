@@ -176,12 +176,12 @@ class _Checker:
 
     def kinetic(self, T_user: sp.Expr) -> list[Finding]:
         T = self.eom.kinetic_energy
-        expected = fmt(eq.display(T))
         unknown = self._unknown_names("T", "T")
         if unknown:
             return unknown
         if eq.identical(T_user, T, self.points):
             return [Finding("T", "correct", None, "T matches.", None)]
+        expected = fmt(eq.display(T))  # a wrong T's finding shows ours (simplify: not before)
         parts = kinetic_parts(self.model)
         for label, part in parts:
             if len(parts) > 1 and eq.identical(T_user, T - part, self.points):
@@ -218,12 +218,12 @@ class _Checker:
 
     def potential(self, V_user: sp.Expr) -> list[Finding]:
         V = self.eom.potential_energy
-        expected = fmt(eq.display(V))
         unknown = self._unknown_names("V", "V")
         if unknown:
             return unknown
         if eq.identical(V_user, V, self.points):
             return [Finding("V", "correct", None, "V matches.", None)]
+        expected = fmt(eq.display(V))  # a wrong V's finding shows ours (simplify: not before)
         if eq.constant_in_state(V_user - V, self.points):
             offset = eq.display(V_user - V)
             return [Finding("V", "equivalent", "potential_datum",

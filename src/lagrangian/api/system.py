@@ -189,6 +189,7 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         inputs: Sequence[str] | None = None,
         max_impacts: int | None = None,
         settle: bool = False,
+        canonical: bool = False,
     ) -> Simulation:
         """Integrate the equations of motion to ``t_end`` (s); returns a Simulation.
 
@@ -210,7 +211,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         ``stop_when`` may name the base's numbers (base_z, base_vz, ...). A model with
         [[impacts]] runs through them (``.impacts`` lists each; status 'accumulated' where they
         accumulate, 'settled' with ``settle=True``, 'impact_limit' at ``max_impacts``, default
-        1000): docs/simulation.md."""
+        1000): docs/simulation.md. ``canonical=True`` integrates Hamilton's equations in
+        (q, p) instead (``hamiltonian()``; the momenta in ``.momenta`` and the p_<q> columns)."""
         from ..compile.functions import refuse_large_chain
         from ..derivation.regularity import require_inertia
         from ..model.values import resolve_state
@@ -228,6 +230,13 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
                              "or run with limits=False", field="limits")
         limits = limits is not False
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
+        if canonical is not True and canonical is not False:
+            raise InputError(f"canonical is True or False, not {canonical!r}", field="canonical")
+        if canonical and (tree or self._model.impacts):
+            raise InputError("a run in (q, p) is for a model file without impacts: "
+                             + ("a robot's tree has no derived L" if tree else
+                                "its impacts map velocities, not momenta (yet)"),
+                             field="canonical")
         if tree and self._floating:  # q (+) v dt on SE(3): simulation/floating.py
             from ..simulation.floating import simulate_floating
 
@@ -254,7 +263,8 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
                           limits=urdf_limits(self._model, positions=limits), controller=controller,
                           inputs=getattr(controller, "inputs", ()) if inputs is None else inputs,
                           model=self._model, start_beyond=start_beyond,
-                          start_limits=urdf_limits(self._model))
+                          start_limits=urdf_limits(self._model),
+                          canonical=self.hamiltonian() if canonical else None)
         return Simulation.of(result)
 
     @property

@@ -70,6 +70,8 @@ class SimulationResult:
     control_forces: np.ndarray | None = None  # B u: the generalized forces it added (N, n)
     # a floating base's velocity names (nv = n + 6: its twist, then the joints), q of nq = n + 7
     velocity_names: tuple[str, ...] | None = None
+    # a run in (q, p) (canonical=...): the momenta p = dL/dq_dot at each sample (N, n)
+    momenta: np.ndarray | None = None
 
     @property
     def rate_names(self) -> tuple[str, ...]:
@@ -102,12 +104,16 @@ class SimulationResult:
         return self.status in (RunStatus.FINISHED, RunStatus.STOPPED, RunStatus.LIMIT)
 
     def columns(self) -> dict[str, np.ndarray]:
-        """Named columns: t, <q>, <q>_dot, energy, lambda_<c>, residual_<c>, power."""
+        """Named columns: t, <q>, <q>_dot (p_<q> for a run in (q, p)), energy, lambda_<c>,
+        residual_<c>, power."""
         out: dict[str, np.ndarray] = {"t": self.t}
         for i, name in enumerate(self.coordinates):
             out[name] = self.q[:, i]
         for i, name in enumerate(self.rate_names):
             out[name] = self.q_dot[:, i]
+        if self.momenta is not None:  # a run in (q, p): p_<q>, the module's notation
+            for i, name in enumerate(self.coordinates):
+                out[f"p_{name}"] = self.momenta[:, i]
         out["energy"] = self.energy
         for i, name in enumerate(self.constraint_names):
             out[f"lambda_{name}"] = self.multipliers[:, i]

@@ -14,6 +14,7 @@ import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 import numpy as np
 
@@ -61,6 +62,7 @@ def simulate(
     model: Model | None = None,
     start_beyond: str = "refuse",
     start_limits: Sequence[JointLimit] | None = None,
+    canonical: CanonicalEquations | None = None,
 ) -> SimulationResult:
     """Integrate from the initial state to ``t_end`` (s), saving where ``save_at`` says.
 
@@ -78,7 +80,9 @@ def simulate(
     refused, or with ``start_beyond`` "clamp" started at the limit, "ignore" where it is, each
     noted in the result's message (check_start_within). A rate that makes the accelerations
     overflow at the start is refused naming it; a step size that collapses ends the run as
-    'failed', each within a bounded number of calls (simulation/guards.py).
+    'failed', each within a bounded number of calls (simulation/guards.py). ``canonical``
+    (the model's Hamiltonian, analysis/hamilton.py) integrates Hamilton's equations in (q, p)
+    instead, in the step loop: the samples' q_dot from p, the momenta in ``momenta``.
 
     ``eom`` None: the run of a kinematic tree's recursive algorithms (``functions``, of
     ``model``), with nothing derived: no constraints, no explicit t, T quadratic in q_dot, and
@@ -113,6 +117,9 @@ def simulate(
     drift = DriftControl(functions, StateFunction(model, eom.velocity_bias, substitution)) \
         if functions.m else None
     event = _event(StateFunction(model, [stop.function], substitution)) if stop else None
+    if canonical is not None:
+        _refuse_canonical(functions, parameters, loop_wanted=controller is not None or law
+                          is not None)
     positioned = [m for m in limits if m.lower is not None and m.upper is not None]
     forces = eom.generalized_forces if eom is not None else _tree_forces(model)
     power_terms = StateFunction(model, forces, substitution)
@@ -136,9 +143,14 @@ def simulate(
     # (the model's own motion: a controller is not called for it, its calls are the run's)
     check_start(functions.rhs, start.t, y0, start.velocities, start.given)
     began = time.perf_counter()
-    run = _integrate(functions, y0, grid, step_control, event, drift, progress,
-                     compiled_loop and not functions.m and event is None and loop is None, beyond,
-                     rhs=None if loop is None else loop.rhs)
+    momenta = None
+    if canonical is not None:  # in (q, p): the events and limits read q_dot from p
+        run, momenta = _integrate_canonical(canonical, y0, grid, step_control, event, progress,
+                                            beyond)
+    else:
+        run = _integrate(functions, y0, grid, step_control, event, drift, progress,
+                         compiled_loop and not functions.m and event is None and loop is None,
+                         beyond, rhs=None if loop is None else loop.rhs)
     if beyond is not None and run.status == RunStatus.STOPPED:
         run = at_limit(run, positioned, beyond, event, functions.n)
     wall = time.perf_counter() - began
@@ -189,8 +201,64 @@ def simulate(
         kinetic_energy=kinetic, invariant=kind, invariant_values=invariant, work=work,
         limits_exceeded=exceeded_limits(limits, functions.parameters, t, q_dot),
         controls=controls, control_names=(loop or law).names if controls is not None else (),
-        control_forces=control_forces,
+        control_forces=control_forces, momenta=momenta,
     )
+
+
+class CanonicalEquations(Protocol):
+    """Hamilton's equations of a model (analysis/hamilton.Hamiltonian), SI units."""
+
+    def rhs(self, q, p, t: float = 0.0) -> tuple[np.ndarray, np.ndarray]: ...
+    def velocities_of(self, q, p, t: float = 0.0) -> np.ndarray: ...
+    def momenta_of(self, q, q_dot, t: float = 0.0) -> np.ndarray: ...
+
+
+def _refuse_canonical(functions: NumericSystem, parameters, loop_wanted: bool) -> None:
+    """What a run in (q, p) does not take yet, in one line each."""
+    if functions.m:
+        raise InputError("Hamilton's equations here are for a model without constraints",
+                         field="canonical")
+    if loop_wanted:
+        raise InputError("a run in (q, p) takes no controller (yet): run it in (q, q_dot)",
+                         field="canonical")
+    if parameters:
+        raise InputError("a run in (q, p) uses the model's own parameter values: give them to "
+                         "the model (with_parameters)", field="canonical")
+
+
+def _integrate_canonical(canonical: CanonicalEquations, y0, grid, step_control, event,
+                         progress, beyond) -> tuple[LoopRun, np.ndarray]:
+    """Hamilton's equations q_dot = M^-1 (p - b), p_dot = dL/dq + Q in the step loop, from the
+    start's p = M q_dot + b; the events and limits see q_dot. The run's states as [q, q_dot]
+    (q_dot from each sample's p), and the momenta p (N, n)."""
+    n = len(y0) // 2
+    start = np.concatenate([y0[:n], canonical.momenta_of(y0[:n], y0[n:], float(grid[0]))])
+
+    def rhs(t, y):
+        q_dot, p_dot = canonical.rhs(y[:n], y[n:], t)
+        return np.concatenate([q_dot, p_dot])
+
+    def seen(function):
+        return None if function is None else (
+            lambda q, p, t: function(q, canonical.velocities_of(q, p, t), t))
+
+    if beyond is not None:
+        user = event
+        event = beyond if user is None else (lambda q, v, t: max(user(q, v, t), beyond(q, v, t)))
+    run = integrate_steps(rhs, float(grid[0]), start, float(grid[-1]), grid, step_control,
+                          seen(event), None, progress)
+    q, p = run.y[:, :n], run.y[:, n:]
+    y = np.concatenate([q, _velocities(canonical, run.t, q, p)], axis=1)
+    return replace(run, y=y, backend=f"{run.backend}, Hamilton's equations in (q, p)"), p
+
+
+def _velocities(canonical: CanonicalEquations, t, q, p) -> np.ndarray:
+    """q_dot at each sample from its (q, p); NaN past a failed run's last finite sample."""
+    out = np.full(q.shape, np.nan)
+    for k in range(len(t)):
+        if np.isfinite(q[k]).all() and np.isfinite(p[k]).all():
+            out[k] = canonical.velocities_of(q[k], p[k], float(t[k]))
+    return out
 
 
 def model_law(eom, controller: str, inputs, substitution) -> ModelLaw:

@@ -27,12 +27,15 @@ import sympy as sp
 from sympy.core.mul import _keep_coeff
 from sympy.simplify.fu import TR10i
 
+from .trig_normal import trig_normal_form
+
 COEFFICIENT_BUDGET = 160  # nodes of a coefficient above which only cheap steps run
 SMALL_EXPRESSION = 1500  # nodes of a whole expression whose coefficients get a budget of 400
 SMALL_ANGLES = 3  # ... and at most this many distinct trig arguments
 _SMALL_BUDGET = 400
 MAX_MONOMIALS = 400  # rate products per expression above which no grouping is attempted
 MAX_PULLED_TERMS = 40  # terms of a sum above which no common factor is pulled out of it
+NORMAL_FORM_FROM = 40  # nodes of a compacted coefficient from which sin^2 + cos^2 is normalized
 _CACHE_LIMIT = 50_000
 
 _TRIG = (sp.sin, sp.cos)
@@ -318,6 +321,14 @@ def compact(coefficient: sp.Expr, budget: int = COEFFICIENT_BUDGET) -> sp.Expr:
         except Exception:  # noqa: BLE001 - a failed rewrite only costs readability
             pass
     best = options[0] if len(options) == 1 else _shortest(options)
+    if _size(best, NORMAL_FORM_FROM) >= NORMAL_FORM_FROM and _trig_candidates(best):
+        # sin^2 + cos^2 = 1 applied exactly (a particle-built top's T: products of its rotation
+        # matrix's entries); the normal form and its common factors out. Only where the forms
+        # above left a long one: the expansion costs a few ms a coefficient
+        normal = trig_normal_form(coefficient)
+        if normal is not None:
+            collected = _collected(normal)
+            best = _shortest([best, normal, collected, sp.factor_terms(collected)])
     return _remember(key, best)
 
 

@@ -1,0 +1,110 @@
+"""A symmetric top built of four particles (no rigid body: its T holds products of its rotation
+matrix's entries) prints within 1.3x the operation count of the textbook heavy top's M and f
+(Goldstein, Sec. 5.7, with I1 = 4 m h^2 + 2 m r^2 about the pivot and I3 = 4 m r^2), and
+equal to them; the exact sin^2 + cos^2 = 1 normal form behind it (derivation/trig_normal.py)."""
+
+from __future__ import annotations
+
+import pytest
+import sympy as sp
+
+import lagrangian
+from lagrangian.derivation.trig_normal import trig_normal_form
+from lagrangian.model.expressions import parse_expression
+from lagrangian.output.derivation import derivation_document
+
+AXES = {  # the body axes in world: the columns of Rz(phi) Rx(theta) Rz(psi)
+    "e1": ["cos(phi)*cos(psi) - sin(phi)*cos(theta)*sin(psi)",
+           "sin(phi)*cos(psi) + cos(phi)*cos(theta)*sin(psi)", "sin(theta)*sin(psi)"],
+    "e2": ["-cos(phi)*sin(psi) - sin(phi)*cos(theta)*cos(psi)",
+           "-sin(phi)*sin(psi) + cos(phi)*cos(theta)*cos(psi)", "sin(theta)*cos(psi)"],
+    "e3": ["sin(phi)*sin(theta)", "-cos(phi)*sin(theta)", "cos(theta)"],
+}
+
+
+def particle_top() -> str:
+    """Four particles m on a ring of radius r at height h on the symmetry axis (z-x-z)."""
+    definitions = "\n".join(f'{axis}{"xyz"[i]} = "{text}"' for axis, column in AXES.items()
+                            for i, text in enumerate(column))
+    particles = "".join(
+        f'[[particles]]\nname = "p{k}"\nmass = "m"\nposition = ['
+        + ", ".join(f'"{sign}r*{axis}{x} + h*e3{x}"' for x in "xyz") + "]\n"
+        for k, (sign, axis) in enumerate([("", "e1"), ("", "e2"), ("-", "e1"), ("-", "e2")]))
+    return f'''name = "Particle top"
+[coordinates]
+phi = {{ unit = "rad", initial = 0.0, rate = 0.0 }}
+theta = {{ unit = "rad", initial = 0.3, rate = 0.0 }}
+psi = {{ unit = "rad", initial = 0.0, rate = 60.0 }}
+[parameters]
+m = {{ value = 0.1, unit = "kg" }}
+r = {{ value = 0.03, unit = "m" }}
+h = {{ value = 0.04, unit = "m" }}
+g = {{ value = 9.81, unit = "m/s^2" }}
+[definitions]
+{definitions}
+[gravity]
+g = "g"
+direction = [0, 0, -1]
+{particles}'''
+
+
+@pytest.fixture(scope="module")
+def printed():
+    system = lagrangian.System(lagrangian.parse_model(particle_top()))
+    eom = system.equations_of_motion()
+    document = derivation_document(eom)
+    model = eom.model
+    names = {p.name: p.symbol for p in model.parameters}
+    for c in model.coordinates:
+        names.update({c.name: c.symbol, c.velocity.name: c.velocity,
+                      c.acceleration.name: c.acceleration})
+    return document, names, eom
+
+
+def textbook(n):
+    m, r, h, g = n["m"], n["r"], n["h"], n["g"]
+    th, wp, wt, ws = n["theta"], n["phi_dot"], n["theta_dot"], n["psi_dot"]
+    I1, I3, mgl = 4 * m * h**2 + 2 * m * r**2, 4 * m * r**2, 4 * m * g * h
+    s, c = sp.sin(th), sp.cos(th)
+    mass = [I1 * s**2 + I3 * c**2, 0, I3 * c, 0, I1, 0, I3 * c, 0, I3]
+    forcing = [2 * (I3 - I1) * wp * wt * s * c + I3 * ws * wt * s,
+               I1 * wp**2 * s * c - I3 * wp * s * (ws + wp * c) + mgl * s, I3 * wp * wt * s]
+    energy = (I1 * (wt**2 + wp**2 * s**2) + I3 * (ws + wp * c) ** 2) / 2
+    return mass, forcing, energy
+
+
+def _zero(expr) -> bool:
+    """Exactly 0 (sympy's simplify, an independent route: the tests' expressions are small)."""
+    return sp.simplify(sp.expand_trig(expr)) == 0
+
+
+def test_the_printed_m_and_f_are_the_textbooks_within_1_3(printed):
+    document, names, _ = printed
+    forcing = [parse_expression(x, names) for x in document["forcing"]]
+    mass = [parse_expression(x, names) for row in document["mass_matrix"] for x in row]
+    book_mass, book_forcing, _ = textbook(names)
+    assert all(_zero(a - b) for a, b in zip(mass, book_mass, strict=True))
+    assert all(_zero(a - b) for a, b in zip(forcing, book_forcing, strict=True))
+    ops = lambda xs: sum(map(sp.count_ops, xs))  # noqa: E731
+    assert ops(mass) <= 1.3 * ops(book_mass), document["mass_matrix"]
+    assert ops(forcing) <= 1.3 * ops(book_forcing), document["forcing"]
+
+
+def test_the_printed_t_is_the_textbooks(printed):
+    document, names, eom = printed
+    T = parse_expression(document["kinetic_energy"], names)
+    _, _, book = textbook(names)
+    assert _zero(T - book) and _zero(T - eom.kinetic_energy)
+    assert sp.count_ops(T) <= 2 * sp.count_ops(book)  # it printed 13x before
+    assert "phi" not in str(T).replace("phi_dot", "")  # the precession angle is cyclic
+
+
+def test_the_normal_form_applies_the_identity_exactly():
+    a, b, k = sp.symbols("a b k")
+    s, c = sp.sin, sp.cos
+    assert trig_normal_form(s(a) ** 2 + c(a) ** 2) == 1
+    assert trig_normal_form((s(a) * s(b) - c(a) * c(b)) ** 2
+                            + (s(a) * c(b) + c(a) * s(b)) ** 2) == 1
+    assert trig_normal_form(k * (s(a) ** 4 - c(a) ** 4) + k * (c(a) ** 2 - s(a) ** 2)) == 0
+    assert trig_normal_form(1 / c(a)) is None  # not a polynomial in the sine and cosine
+    assert trig_normal_form(k**2) is None  # no angle

@@ -61,6 +61,7 @@ def simulate(
     independent: Annotated[list[str], typer.Option("--independent", help="--linearize-along on a constrained model: A(t), B(t) on the constraint manifold in these n - m coordinates (repeat, or separate by commas; auto: the best conditioned along the run).")] = [],  # noqa: B006,E501
     max_impacts: Annotated[int | None, typer.Option("--max-impacts", help="A model with [[impacts]]: stop after this many (default 1000; status 'impact_limit').")] = None,  # noqa: E501
     settle: Annotated[bool, typer.Option("--settle", help="A model with [[impacts]]: where impacts accumulate (a ball coming to rest), rest on the surface to the end time (status 'settled') instead of stopping there.")] = False,  # noqa: E501
+    canonical: Annotated[bool, typer.Option("--canonical", help="Integrate Hamilton's equations in (q, p) instead of (q, q_dot); --out gains the momenta p_<q>.")] = False,  # noqa: E501
     json_: Annotated[bool, typer.Option("--json", help="Print a JSON summary.")] = False,
 ) -> None:
     """Integrate the equations of motion from the initial state and report, save, plot, animate."""
@@ -138,6 +139,7 @@ def simulate(
             rtol=step_control.rtol, atol=step_control.atol, samples=save_at.samples,
             stop_when=stop, progress=progress.update, limits=limits,
             controller=controller, **_impact_options(system, max_impacts, settle),
+            **({"canonical": True} if canonical else {}),
         )
     warning = projection_warning(simulation)
     if warning:

@@ -44,7 +44,13 @@ def simulation_summary(result: SimulationResult) -> dict:
             for name, (given, used) in result.projected_initial_state.items()
         },
         "limits_exceeded": [dict(record) for record in result.limits_exceeded],
+        **({} if result.momenta is None else {"final_momenta": _final_momenta(result)}),
     }
+
+
+def _final_momenta(result: SimulationResult) -> dict[str, float]:
+    """A run in (q, p): p_<q> at the last sample (kg m/s or kg m^2/s)."""
+    return {f"p_{name}": float(result.momenta[-1, i]) for i, name in enumerate(result.coordinates)}
 
 
 def simulation_document(result: SimulationResult, outputs: dict[str, str]) -> dict:
@@ -62,6 +68,9 @@ def simulation_text(result: SimulationResult, written: dict[str, str]) -> str:
     lines.append(f"  {steps}{result.nfev} right-hand-side calls, wall time {result.wall_time:.3g} s")
     state = ", ".join(f"{k} = {v:.9g}" for k, v in result.final_state.items())
     lines.append(f"  final state: {state}")
+    if result.momenta is not None:
+        momenta = ", ".join(f"{k} = {v:.9g}" for k, v in _final_momenta(result).items())
+        lines.append(f"  final momenta: {momenta}")
     if result.energy_drift is not None:
         lines.append(f"  relative energy drift: {result.energy_drift:.2e}")
     elif result.invariant_drift is not None:

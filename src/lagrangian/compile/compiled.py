@@ -31,12 +31,15 @@ from collections.abc import Callable
 from functools import lru_cache
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import LagrangianError
-from .codegen import GeneratedSource
 from .compiler_stop import BUILD_DIRS, RUNNING, in_main_thread, kill_compiler, stop_with_caller
+
+if TYPE_CHECKING:  # the generator (and sympy's C printer) is loaded by a module to build only
+    from .codegen import GeneratedSource
 
 CFLAGS = ("-O2", "-fPIC", "-shared", "-fno-math-errno", "-w")
 # Opt-in for kernels that vectorize over a batch (dynamics/recursive.py): the processor's own

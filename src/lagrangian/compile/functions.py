@@ -263,9 +263,10 @@ def _tree_text(expression, memo: dict) -> str:
 
 def _c_kernel(eom: EquationsOfMotion, values: dict) -> CKernel:
     from . import compiled
-    from .codegen import CodegenError
 
-    def source():
+    def source():  # only for a module not yet built: a cached one needs no C printer
+        from .codegen import CodegenError
+
         try:
             return _generated(eom)
         except CodegenError as exc:

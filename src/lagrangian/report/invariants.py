@@ -77,8 +77,9 @@ def limit_cycle_section(c) -> tuple[Markup, str]:
                     "is one)."), "not applicable: no impacts"
     try:
         cycle = c.system.limit_cycle()
-    except LagrangianError as exc:
-        return note(f"No limit cycle found from the initial state: {exc}."), \
+    except LagrangianError as exc:  # the reason without its field: no guess was given here
+        reason = getattr(exc, "message", str(exc)).rstrip(".")
+        return note(f"No limit cycle found from the initial state: {reason}."), \
             "not applicable: no cycle found"
     units = {co.name: co.unit or "" for co in model.coordinates}
     units |= {co.velocity.name: f"{co.unit or '1'}/s" for co in model.coordinates}

@@ -14,7 +14,6 @@ from ..analysis.modes import ModalAnalysis, Mode
 from ..errors import ModelError
 from ..kinds import ModeKind
 from .files import atomic_write
-from .plots import notebook_figure, plain_text
 
 # The plot shows at most this many modes (the lowest), in a grid of at most PLOT_COLUMNS columns.
 PLOT_MAX_MODES = 12
@@ -192,6 +191,8 @@ def mode_plot_size(mode_count: int) -> tuple[int, int]:
 
 def mode_shape_figure(analysis: ModalAnalysis):
     """A matplotlib Figure with one panel per mode (the lowest twelve): the shape per coordinate."""
+    from .plots import notebook_figure, plain_text  # the figure's helpers: loaded by a plot
+
     modes = analysis.modes[:PLOT_MAX_MODES]
     if not modes:
         raise ModelError("there are no modes to plot (no degree of freedom)", field="plot")

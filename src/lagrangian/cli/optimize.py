@@ -8,7 +8,14 @@ from typing import Annotated
 import typer
 
 from . import app
-from .common import GRAVITY_HELP, SET_HELP, load_system, print_json, state_assignments
+from .common import (
+    FLOATING_HELP,
+    GRAVITY_HELP,
+    SET_HELP,
+    load_system,
+    print_json,
+    state_assignments,
+)
 
 TO_HELP = "The goal at t_final: STATE=VALUE (theta=pi, theta_dot=0); the other states are free."
 FROM_HELP = "The start: STATE=VALUE (default: the model's initial values)."
@@ -31,6 +38,7 @@ def optimize(
     method: Annotated[str, typer.Option("--method", help=METHOD_HELP)] = "trapezoidal",
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,
+    floating_base: Annotated[bool, typer.Option("--floating-base", help=FLOATING_HELP)] = False,
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Minimise the effort (integral of u^2 dt) from the start to the goal by collocation."""
@@ -39,10 +47,13 @@ def optimize(
     from ..output.trajectory import trajectory_document, trajectory_text
     from .common import assignments, comma_separated
 
-    system = load_system(model, set_, (), gravity, ())
+    system = load_system(model, set_, (), gravity, (), floating_base)
     goal = state_assignments(system, to, "--to")
     start = state_assignments(system, from_, "--from")
     states = {name for c in system.model.coordinates for name in (c.name, c.velocity.name)}
+    if floating_base:  # the base's numbers (base_x .. base_wz) are states too, judged by optimize
+        dynamics = system.dynamics()
+        states |= {*dynamics.coordinates, *dynamics.velocity_names}
     bounds = {}
     for name, text in assignments(comma_separated(bound), "--bound"):
         lower, sep, upper = text.partition(":")

@@ -9,11 +9,13 @@ from enum import StrEnum
 
 class JointKind(StrEnum):
     """How a joint moves its body, in model files and URDF alike: about its axis (revolute),
-    along it (prismatic), by a rotation sequence (spherical), not at all (fixed) or freely in
-    space (free_flyer: a URDF robot's floating base), or about and along its axis at once
-    (helical: a screw, turning theta and sliding pitch * theta; the Python tree builder's,
-    model/robot_builder.py). A kinematic tree moves its bodies by the one-degree-of-freedom
-    kinds and the free flyer at its root (dynamics/tree/joint_models.py)."""
+    along it (prismatic), by a rotation sequence (spherical: in a kinematic tree a ball joint,
+    MuJoCo's, by a unit quaternion w x y z and the angular velocity in the child's axes), not
+    at all (fixed) or freely in space (free_flyer: a URDF robot's floating base), or about and
+    along its axis at once (helical: a screw, turning theta and sliding pitch * theta; the
+    Python tree builder's, model/robot_builder.py). A kinematic tree moves its bodies by the
+    one-degree-of-freedom kinds, ball joints and the free flyer at its root
+    (dynamics/tree/joint_models.py)."""
 
     REVOLUTE = "revolute"
     PRISMATIC = "prismatic"

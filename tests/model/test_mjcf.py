@@ -146,7 +146,8 @@ def test_mjcf_written_by_mujoco_from_a_urdf(name, tmp_path):
 
 
 REFUSALS = [
-    ('<body><joint type="ball"/><geom size="0.1"/></body>', "a ball joint is not supported"),
+    ('<body><joint type="ball" damping="1"/><geom size="0.1"/></body>',
+     "damping on a ball joint is not supported"),
     ('<body><freejoint/><geom size="0.1"/></body>', "a free joint is read only with "
                                                       "floating_base=True"),
     ('<body><joint ref="10"/><geom size="0.1"/></body>', "ref other than 0"),
@@ -159,7 +160,7 @@ REFUSALS = [
     ('<body pos="0 0 nan"><joint/><geom size="0.1"/></body>', "not finite"),
     ('<body quat="1 0 0"><joint/><geom size="0.1"/></body>', "expected 4 numbers, got 3"),
     ('<body><joint range="1 -1"/><geom size="0.1"/></body>', "the range 1 -1 is empty"),
-    ('<body><geom size="0.1"/></body>', "no hinge or slide joint"),
+    ('<body><geom size="0.1"/></body>', "no hinge, slide or ball joint"),
 ]
 
 

@@ -23,3 +23,19 @@ def test_the_layout_block_converts_a_drones_state(tmp_path, monkeypatch):
     # the tilt joint's armature (1e-3 kg m^2) is in MuJoCo's M and in ours
     assert namespace["model"].dof_armature[6] == pytest.approx(1e-3)
     assert dict(namespace["drone"].model.source_armature) == {"tilt": 1e-3}
+
+
+def test_the_ball_joint_block_prints_the_pendulums_physics(tmp_path, monkeypatch):
+    """The bob (2 kg, 0.5 m below the pivot, 0.01 kg m^2 about its centre) tilted 0.5 rad:
+    g = m g l sin 0.5 about x, M_xx = 0.01 + m l^2; a turn about the bob's z by 0.1 rad."""
+    monkeypatch.chdir(tmp_path)
+    (code,) = re.findall(r"```python\n(.*?)```", block("bridges-ball-joint", "bridges.md"), re.S)
+    namespace: dict = {}
+    exec(code, namespace)  # noqa: S102 - our own documentation
+    f, tilt = namespace["f"], np.array(namespace["tilt"])
+    assert f.gravity(tilt) == pytest.approx([2 * 9.81 * 0.5 * np.sin(0.5), 0, 0], abs=1e-12)
+    assert f.mass_matrix(tilt)[0, 0] == pytest.approx(0.51, abs=1e-12)
+    turned = f.integrate(tilt, [0.0, 0.0, 1.0], 0.1)
+    expected = [np.cos(0.25) * np.cos(0.05), np.sin(0.25) * np.cos(0.05),
+                -np.sin(0.25) * np.sin(0.05), np.cos(0.25) * np.sin(0.05)]
+    assert turned == pytest.approx(expected, abs=1e-12)

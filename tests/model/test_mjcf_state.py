@@ -268,7 +268,8 @@ def test_an_inactive_equality_changes_nothing(tmp_path):
 
 
 @pytest.mark.parametrize("joint, message", [
-    ('<joint type="ball" name="shoulder"/>', "joint 'shoulder'.*no spherical joint"),
+    ('<joint type="ball" name="shoulder" armature="0.1"/>',
+     "joint 'shoulder'.*armature on a ball joint"),
     ('<joint type="free" damping="0.1"/>', "damping on a free joint"),
     ('<joint armature="-1"/>', "armature -1 is negative"),
 ])

@@ -75,7 +75,10 @@ def compiled_backend(tree: KinematicTree, parameters: Mapping[str, float], names
         module, D = kernel_module(), describe(tree, parameters)
         return CompiledBackend("compact", module, module.prepare(D), D)
     from ..compile import compiled
+    from ..model.tree import refuse_ball_joints
     from .engine.tree_module import module_source, tree_key
+
+    refuse_ball_joints(tree, "the unrolled per-tree module (kernel='unrolled')")
 
     values = np.array([parameters[name] for name in names], dtype=float)
     values.flags.writeable = False

@@ -20,6 +20,7 @@ from .regressor import (
     tree_parameters,
     tree_regressor,
 )
+from .tree.spherical import refuse_spherical
 
 
 def _refuse_floating(tree, what: str) -> None:
@@ -50,6 +51,7 @@ class ControlTerms:
     def _regressor_of(self, parameters: Sequence[str] | None):
         tree = getattr(self, "tree", None)
         if tree is not None:
+            refuse_spherical(tree, "the regressor")
             if parameters is not None:
                 raise InputError("a robot's regressor is over its bodies' 10 inertial "
                                  "parameters each; parameters=[...] is for model files",
@@ -152,6 +154,7 @@ class ControlTerms:
             tree = getattr(self, "tree", None)
             fast = self._derivatives_kernel()
             if fast is None:
+                refuse_spherical(tree, "the derivatives of the dynamics")
                 _refuse_floating(tree, "derivatives of the dynamics")
             if fast is not None:
                 inverse, P = fast.checked_inverse, fast.P

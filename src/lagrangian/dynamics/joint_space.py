@@ -151,9 +151,15 @@ class Dynamics(ControlTerms):
         for x in flat:
             good &= np.isfinite(x).all(axis=-1)
         if self.velocity_names is not None and fields[0] == "q":  # a floating base's quaternion
-            from .tree.free_flyer import check_quaternions
+            tree = getattr(self, "tree", None)
+            if tree is not None and tree.spherical:  # and the ball joints' (tree/spherical.py)
+                from .tree.spherical import check_tree_quaternions
 
-            check_quaternions(flat[0])
+                check_tree_quaternions(tree, flat[0])
+            else:
+                from .tree.free_flyer import check_quaternions
+
+                check_quaternions(flat[0])
         if good.all():
             out = np.asarray(compute(*flat), dtype=float).reshape((total,) + tail)
         else:
@@ -336,7 +342,7 @@ class Dynamics(ControlTerms):
     def integrate(self, q, v, dt: float = 1.0) -> np.ndarray:
         """q (+) v dt: the configuration reached moving at velocity v for dt s, (..., nq); a
         floating base moves along its twist (SE(3)'s exponential) and its quaternion comes
-        back normalized, the joints by q + v dt."""
+        back normalized, a ball joint's quaternion by q exp(w dt), the joints by q + v dt."""
         step = float_array(dt, "dt")
         if step.ndim:
             raise InputError(f"expected one number of seconds, got shape {step.shape}", field="dt")
@@ -346,6 +352,12 @@ class Dynamics(ControlTerms):
         V = np.broadcast_to(v, batch + v.shape[-1:]).reshape(-1, v.shape[-1])
         if self.velocity_names is None:
             return (Q + V).reshape(batch + q.shape[-1:])
+        tree = getattr(self, "tree", None)
+        if tree is not None and tree.spherical:  # each ball turned by exp(w dt) (spherical.py)
+            from .tree.spherical import check_tree_quaternions, integrate_tree
+
+            check_tree_quaternions(tree, Q)
+            return integrate_tree(tree, Q, V).reshape(batch + q.shape[-1:])
         from .tree.free_flyer import check_quaternions, integrate
 
         check_quaternions(Q)
@@ -359,6 +371,13 @@ class Dynamics(ControlTerms):
                   for x in (q0, q1))
         if self.velocity_names is None:
             return (Q1 - Q0).reshape(batch + (self.n,))
+        tree = getattr(self, "tree", None)
+        if tree is not None and tree.spherical:
+            from .tree.spherical import check_tree_quaternions, difference_tree
+
+            check_tree_quaternions(tree, Q0, "q0")
+            check_tree_quaternions(tree, Q1, "q1")
+            return difference_tree(tree, Q0, Q1).reshape(batch + (self.n,))
         from .tree.free_flyer import check_quaternions, difference
 
         check_quaternions(Q0)

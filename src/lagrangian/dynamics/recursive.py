@@ -42,6 +42,7 @@ from .joint_space import Dynamics, reported_rows
 from .recursive_numpy import NumpyBackend, floating_refusal
 from .tree.applicable import TREE_PATH_BODIES, applicable_tree
 from .tree.numbers import batch_shape
+from .tree.spherical import ball_slices, check_tree_quaternions, refuse_spherical, unit_ball_quaternions
 
 BACKENDS = {"compact": "recursive", "unrolled": "recursive", "numpy": "recursive-numpy"}
 
@@ -62,11 +63,14 @@ class TreeDynamics(Dynamics):
         self.model, self.tree = model, tree
         self.coordinates = tree.coordinates
         self.n = len(tree.coordinates)
+        if tree.spherical:  # a ball joint: 4 numbers in q (w x y z), 3 in v (tree/spherical.py)
+            self.velocity_names = tree.velocity_coordinates
+            self.n = len(tree.velocity_coordinates)
         if tree.floating_base:  # Pinocchio's layout: the base's numbers first (free_flyer.py)
             from .tree.free_flyer import BASE_CONFIGURATION, BASE_VELOCITY
 
             self.coordinates = BASE_CONFIGURATION + tree.coordinates
-            self.velocity_names = BASE_VELOCITY + tree.coordinates
+            self.velocity_names = BASE_VELOCITY + tree.velocity_coordinates
             self.n += 6
         self.parameters = {p.name: float(v)
                            for p, v in zip(model.parameters, values.values, strict=True)}
@@ -98,6 +102,8 @@ class TreeDynamics(Dynamics):
         q = rng.uniform(-np.pi, np.pi, (3, self.nq))
         if self.tree.floating_base:
             q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
+        for _, iq, _ in ball_slices(self.tree):
+            q[:, iq:iq + 4] /= np.linalg.norm(q[:, iq:iq + 4], axis=-1, keepdims=True)
         return all(_positive_definite(m) for m in self.mass_matrix(q))
 
     def numeric_system(self):
@@ -107,6 +113,7 @@ class TreeDynamics(Dynamics):
 
         if self.tree.floating_base:  # q and v differ in length: simulate_floating steps it
             raise floating_refusal()
+        refuse_spherical(self.tree, "simulate and the equations' numeric functions (q_dot = v)")
         return NumericSystem(coordinates=self.coordinates, constraint_names=(),
                              constraint_kinds=(), parameters=dict(self.parameters),
                              _kernel=self.recursions.numeric_kernel(self.n))
@@ -123,6 +130,11 @@ class TreeDynamics(Dynamics):
         arrays = [self._vector(x, field) for x, field in zip(arrays, fields, strict=True)]
         if self.tree.floating_base:
             arrays[0] = _unit_quaternions(arrays[0])
+        if self.tree.spherical:  # each ball's: refused in one line naming the joint, or unit
+            Q = np.asarray(arrays[0], dtype=float)
+            flat = Q.reshape(-1, Q.shape[-1])
+            check_tree_quaternions(self.tree, flat)
+            arrays[0] = unit_ball_quaternions(self.tree, flat).reshape(Q.shape)
         batch = batch_shape(arrays, fields)
         arrays = [np.ascontiguousarray(np.broadcast_to(x, batch + x.shape[-1:]), dtype=float)
                   for x in arrays]

@@ -11,7 +11,9 @@ states (N, 3) or (N, 3, 3), the bodies visited in Python:
 - kinetic energy 1/2 sum (m v.v + 2 v.(w x h) + w.J_O w), potential energy m g height.
 
 A floating base (a free flyer at the root, free_flyer.py) takes q of nq = n + 7 numbers and v, a,
-tau of nv = n + 6: its body moves by its own twist, and its share of tau is the wrench on it.
+tau of nv = n + 6: its body moves by its own twist, and its share of tau is the wrench on it. A
+ball joint (tree/spherical.py) has 4 numbers in q (w x y z) and 3 in v (its body's angular
+velocity in its own axes): its share of tau is the moment on its body.
 
 Unlike the fully expanded equations (whose lambdified expression trees grow too deep for a
 7-joint arm), the cost grows with the number of bodies (CRBA: with bodies x depth). Units SI;
@@ -30,6 +32,7 @@ from ..model.tree import KinematicTree
 from .algorithms.recursions import TreeRecursions, _Joint, _TreeKernel
 from .tree.description import describe, joints_of
 from .tree.numbers import solve_positive
+from .tree.spherical import ball_quaternions_unit
 
 
 class NumpyBackend(TreeRecursions):
@@ -54,7 +57,7 @@ class NumpyBackend(TreeRecursions):
         # floating base (a joint that description does not turn) from the tree itself
         joints = tree.joints if tree.floating_base else joints_of(describe(tree, parameters))
         self._joints = [_Joint(j, tree) for j in joints]
-        self._widths = (nv + 1 if tree.floating_base else nv, nv, nv)
+        self._widths = (tree.nq, nv, nv)
 
     def _rows(self, compute, arrays, tail: tuple[int, ...], forward: bool = False):
         """compute(*flat (N, width)) over the finite states, NaN rows for the rest (and for
@@ -100,6 +103,8 @@ class NumpyBackend(TreeRecursions):
             norms = np.sqrt((Q[:, 3:7] ** 2).sum(axis=-1))
             if (np.isfinite(Q).all(axis=-1) & ~(np.abs(norms - 1.0) <= QUATERNION_TOLERANCE)).any():
                 return None
+        if self.tree.spherical and not ball_quaternions_unit(self.tree, flat[0]):
+            return None
         return shape, flat
 
     def mass_matrix(self, q, tables=None):

@@ -1,18 +1,18 @@
 """Robots from MuJoCo's MJCF: bodies, hinge and slide joints, inertials (diaginertia or
-fullinertia, or inferred from geoms by MuJoCo's rules), default classes and the compiler's
-angle and eulerseq, read into the same robot description as a URDF (model/urdf.py).
-
-The body tree is written as the URDF it is, with our own numbers and names (a body's link
-frame sits at its joint's anchor, several joints in one body chain through massless links), and
-read by the URDF reader, so an MJCF robot enters the same engine. Each joint is a coordinate in
-MuJoCo's qpos order (depth first in document order) with MuJoCo's sign and zero, so a state
-moves between MuJoCo and us unchanged. A free joint is read only with ``floating_base`` (the
-tree's free flyer, in Pinocchio's layout: model/mjcf_state.py converts MuJoCo's). A joint
-equality with a linear polycoef is a mimic joint (model/mjcf_equality.py). A joint's damping,
-frictionloss and armature are kept (Model.source_dynamics, source_armature) for
-dynamics(actuators=True). What would change the dynamics and is not modelled (ball joints,
-tendons, other equalities, actuators with dynamics, a joint's ref or stiffness, ...) is refused
-in one line naming the file, element and fault.
+fullinertia, or inferred from geoms by MuJoCo's rules), default classes and the compiler's angle
+and eulerseq, read into the same robot description as a URDF (model/urdf.py). The body tree is
+written as the URDF it is, with our own numbers and names (a body's link frame sits at its
+joint's anchor, several joints in one body chain through massless links), and read by the URDF
+reader, so an MJCF robot enters the same engine. Each joint is a coordinate in MuJoCo's qpos
+order (depth first in document order) with MuJoCo's sign and zero, so a state moves between
+MuJoCo and us unchanged; a ball joint is the tree's spherical joint, its quaternion w x y z and
+angular velocity in the child's axes as MuJoCo's (model/mjcf_ball.py). A free joint is read only
+with ``floating_base`` (the tree's free flyer, in Pinocchio's layout: model/mjcf_state.py
+converts MuJoCo's). A joint equality with a linear polycoef is a mimic joint
+(model/mjcf_equality.py). A joint's damping, frictionloss and armature are kept
+(Model.source_dynamics, source_armature) for dynamics(actuators=True). What would change the
+dynamics and is not modelled (tendons, other equalities, actuators with dynamics, a joint's ref
+or stiffness, ...) is refused in one line naming the file, element and fault.
 Units SI (MJCF's lengths in m, masses in kg; angles by the compiler, degrees by default).
 """
 
@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, did_you_mean, require_extra
+from .mjcf_ball import ball_joint, with_ball_joints
 from .mjcf_equality import check_mimics, folded_losses, read_equalities
 from .mjcf_geometry import (
     DENSITY,
@@ -81,7 +82,9 @@ def parse_mjcf(text: str, *, source: str = "<mjcf>", lock: Mapping[str, float] |
     urdf = reader.urdf()
     model = parse_urdf(urdf, source=source, lock=lock, payload=payload,
                        floating_base=bool(floating_base) and reader.free is None)
-    joints = len(reader.joint_names)
+    joints = len(reader.joint_names) + len(reader.balls)
+    if reader.balls:  # the tree's ball joints in MuJoCo's layout (mjcf_ball.py)
+        model = with_ball_joints(model, reader.balls, source)
     coordinate = {joint: name for name, joint in model.source_names}  # locked: none
     model = replace(model, description=f"Robot '{model.name}' read from MJCF ({joints} joints, "
                                        f"{reader.bodies} bodies).",
@@ -143,6 +146,7 @@ class _Reader:
         self.losses: dict[str, tuple[float, float, float]] = {}
         self.elements: dict[str, object] = {}
         self.joint_names: list[str] = []
+        self.balls: dict[str, tuple[str, str, str]] = {}  # a ball joint's three URDF hinges
         self.floating = False  # floating_base asked for: a free joint is read (_free)
         self.free: str | None = None  # the free joint's name, once read
         self.link_names: set[str] = {"world"}
@@ -291,8 +295,8 @@ class _Reader:
         for child in _children(worlds[0]):
             if child.tag == "joint" or child.tag == "freejoint":
                 raise self.error("the world body cannot have joints", f"worldbody.{child.tag}")
-        if not self.joint_names and self.free is None:
-            raise self.error("no hinge or slide joint: nothing moves", "worldbody")
+        if not self.joint_names and self.free is None and not self.balls:
+            raise self.error("no hinge, slide or ball joint: nothing moves", "worldbody")
         check_mimics(self, self.mimics, self.joint_names, self.free)
         for name, (joint2, c0, c1) in self.mimics.items():
             ElementTree.SubElement(self.elements[name], "mimic", joint=joint2,
@@ -373,9 +377,7 @@ class _Reader:
                 [c for c in _children(joint.getparent()) if c.tag in ("joint", "freejoint")]
             ) == 1)
         if kind == "ball":
-            raise self.error("a ball joint is not supported: the kinematic tree has no "
-                             "spherical joint (three hinges would be Euler angles, singular "
-                             "where MuJoCo's quaternion is not, and another state)", field)
+            return ball_joint(self, name, body, parent, current, field, attrs, last)
         if kind not in JOINT_KINDS:
             raise self.error(f"unknown joint type {kind!r} (hinge, slide, ball or free)"
                              f"{did_you_mean(kind, JOINT_KINDS)}", f"{field}.type")
@@ -389,7 +391,7 @@ class _Reader:
                 raise self.error(f"{key} other than 0 is not supported (yet)", f"{field}.{key}")
         if attrs.get("springdamper"):
             raise self.error("springdamper is not supported (yet)", f"{field}.springdamper")
-        if name in self.joint_names:
+        if name in self.joint_names or name in self.balls:
             raise self.error(f"two joints are named '{name}'", field)
         self.joint_names.append(name)
         axis = self.vector(attrs, "axis", (0, 0, 1), field)

@@ -2,7 +2,9 @@
 
 MuJoCo's qpos holds every joint in document order, a free joint as x y z (m) and its quaternion
 w x y z; qvel a free joint's linear velocity in world axes (m/s) and its angular velocity in
-body axes (rad/s). Ours holds a free flyer as x y z and the quaternion x y z w, its velocity v
+body axes (rad/s). A ball joint is the same in both: its quaternion w x y z in q, its body's
+angular velocity in its own axes in v (and its moment in tau), so its numbers are copied.
+Ours holds a free flyer as x y z and the quaternion x y z w, its velocity v
 = (R^T p_dot, w) all in body axes, and no entry for a mimic joint (an MJCF joint equality:
 q_mimic = k q_master + offset). With G = d qvel / d v (R on the base's linear rows, k on a
 mimic's), the maps are
@@ -39,13 +41,28 @@ class MujocoLayout:
         masters = {joint for _, joint in model.source_names}
         # per MuJoCo hinge or slide joint, in order: (our coordinate, multiplier, offset,
         # whether it is the coordinate's own joint)
-        self.joints = [(j.coordinate, j.multiplier, j.offset, j.name in masters)
-                       for j in tree.joints if j.kind != JointKind.FREE_FLYER]
+        moving = [j for j in tree.joints
+                  if j.kind not in (JointKind.FREE_FLYER, JointKind.SPHERICAL)]
+        self.joints = [(j.coordinate, j.multiplier, j.offset, j.name in masters) for j in moving]
         self.names = [j.name for j in tree.joints if j.kind != JointKind.FREE_FLYER]
         self.n = len(tree.coordinates)
+        # per hinge or slide joint: (MuJoCo's q and v index, ours), after the base's numbers;
+        # per ball joint: the same for its 4 and 3 numbers
+        self._slots, self._balls = [], []
+        mq = mv = 0
+        for j in tree.joints:
+            if j.kind == JointKind.FREE_FLYER:
+                continue
+            ours = (j.coordinate, tree.velocity_index(j.coordinate))
+            if j.kind == JointKind.SPHERICAL:
+                self._balls.append((mq, mv, *ours))
+                mq, mv = mq + 4, mv + 3
+            else:
+                self._slots.append((mq, mv, *ours))
+                mq, mv = mq + 1, mv + 1
         base = 7 if self.floating else 0
-        self.nq, self.nv = base + len(self.joints), base - bool(base) + len(self.joints)
-        self.our_nq, self.our_nv = base + self.n, base - bool(base) + self.n
+        self.nq, self.nv = base + mq, base - bool(base) + mv
+        self.our_nq, self.our_nv = tree.nq, tree.nv
 
     def __repr__(self) -> str:
         return (f"MujocoLayout(nq={self.nq}, nv={self.nv} <-> nq={self.our_nq}, "
@@ -81,9 +98,11 @@ class MujocoLayout:
         if self.floating:
             q[..., :3] = qpos[..., :3]
             q[..., 3:6], q[..., 6] = qpos[..., 4:7], qpos[..., 3]
-        for k, (c, _, _, own) in enumerate(self.joints):
+        for (c, _, _, own), (k, _, _, _) in zip(self.joints, self._slots, strict=True):
             if own:
                 q[..., base + c] = qpos[..., base + k]
+        for k, _, c, _ in self._balls:
+            q[..., base + c:base + c + 4] = qpos[..., base + k:base + k + 4]
         if qvel is None:
             return q
         R = self._rotation(q[..., 3:7], "qpos") if self.floating else None
@@ -101,9 +120,11 @@ class MujocoLayout:
         if self.floating:
             v[..., :3] = np.einsum("...ji,...j->...i", R, qvel[..., :3])
             v[..., 3:6] = qvel[..., 3:6]
-        for k, (c, _, _, own) in enumerate(self.joints):
+        for (_, _, _, own), (_, k, _, c) in zip(self.joints, self._slots, strict=True):
             if own:
                 v[..., base + c] = qvel[..., base + k]
+        for _, k, _, c in self._balls:
+            v[..., base + c:base + c + 3] = qvel[..., base + k:base + k + 3]
         return v
 
     def force_from_mujoco(self, qpos, qfrc) -> np.ndarray:
@@ -117,8 +138,10 @@ class MujocoLayout:
             R = self._rotation(q[..., 3:7], "qpos")
             tau[..., :3] = np.einsum("...ji,...j->...i", R, qfrc[..., :3])
             tau[..., 3:6] = qfrc[..., 3:6]
-        for k, (c, multiplier, _, _) in enumerate(self.joints):
+        for (_, multiplier, _, _), (_, k, _, c) in zip(self.joints, self._slots, strict=True):
             tau[..., base + c] += multiplier * qfrc[..., base + k]
+        for _, k, _, c in self._balls:
+            tau[..., base + c:base + c + 3] = qfrc[..., base + k:base + k + 3]
         return tau
 
     # -- ours -> MuJoCo ---------------------------------------------------------------------
@@ -134,8 +157,10 @@ class MujocoLayout:
             R = self._rotation(q[..., 3:7], "q")
             qpos[..., :3] = q[..., :3]
             qpos[..., 3], qpos[..., 4:7] = q[..., 6], q[..., 3:6]
-        for k, (c, multiplier, offset, _) in enumerate(self.joints):
+        for (c, multiplier, offset, _), (k, _, _, _) in zip(self.joints, self._slots, strict=True):
             qpos[..., base + k] = multiplier * q[..., base + c] + offset
+        for k, _, c, _ in self._balls:
+            qpos[..., base + k:base + k + 4] = q[..., base + c:base + c + 4]
         if v is None:
             return qpos
         v = self._array(v, self.our_nv, "v")
@@ -155,8 +180,10 @@ class MujocoLayout:
         if self.floating:
             qvel[..., :3] = np.einsum("...ij,...j->...i", R, v[..., :3])
             qvel[..., 3:6] = v[..., 3:6]
-        for k, (c, multiplier, _, _) in enumerate(self.joints):
+        for (_, multiplier, _, _), (_, k, _, c) in zip(self.joints, self._slots, strict=True):
             qvel[..., base + k] = multiplier * v[..., base + c]
+        for _, k, _, c in self._balls:
+            qvel[..., base + k:base + k + 3] = v[..., base + c:base + c + 3]
         return qvel
 
     def force_to_mujoco(self, q, tau) -> np.ndarray:
@@ -170,9 +197,11 @@ class MujocoLayout:
             R = self._rotation(q[..., 3:7], "q")
             qfrc[..., :3] = np.einsum("...ij,...j->...i", R, tau[..., :3])
             qfrc[..., 3:6] = tau[..., 3:6]
-        for k, (c, _, _, own) in enumerate(self.joints):
+        for (_, _, _, own), (_, k, _, c) in zip(self.joints, self._slots, strict=True):
             if own:
                 qfrc[..., base + k] = tau[..., base + c]
+        for _, k, _, c in self._balls:
+            qfrc[..., base + k:base + k + 3] = tau[..., base + c:base + c + 3]
         return qfrc
 
 

@@ -6,7 +6,11 @@ Each moving body hangs from its parent body (or the ground) by one revolute or p
     R = R_0,                p = t_0 + R_0 u theta   (prismatic)
     R = R_0 Rot(u, theta),  p = t_0 + R_0 u pitch theta   (helical: a screw, pitch in m/rad)
 
-with theta = k q[c] + offset (k = 1, offset = 0 except for a mimic joint). A floating base is a
+with theta = k q[c] + offset (k = 1, offset = 0 except for a mimic joint). A spherical (ball)
+joint turns its body by a unit quaternion, MuJoCo's ball joint: R = R_0 R(qw, qx, qy, qz), p = t_0,
+four configuration numbers q[c:c+4] (w first, MuJoCo's order) and three velocity numbers, the
+body's angular velocity relative to its parent in the body's own axes (rad/s); so after a ball
+joint a coordinate's place in q and in v differ (KinematicTree.velocity_index). A floating base is a
 free-flyer joint at the root (joints[0], parent -1, kind free_flyer): the base link's body, moved
 by the configuration's first 7 numbers (position, quaternion x y z w) and the velocity's first 6
 (dynamics/tree/free_flyer.py); the other joints' numbers follow, q[7 + c] and v[6 + c]. Fixed and locked
@@ -43,7 +47,7 @@ class TreeJoint:
     rotation: Matrix3x3  # R_0: joint axes -> parent body axes
     translation: Vector3  # t_0: the joint's origin in the parent body (m)
     axis: Vector3  # unit axis u in joint axes
-    coordinate: int  # index of the generalized coordinate that drives it
+    coordinate: int  # index in ``coordinates`` of the (first) configuration number that drives it
     multiplier: float  # theta = multiplier * q[coordinate] + offset
     offset: float
     mass: float  # kg
@@ -148,7 +152,11 @@ class KinematicTree:
     coordinates: tuple[str, ...]
     gravity_parameter: str
     gravity_direction: Vector3
-    actuators: tuple[str, ...]  # one parameter name per coordinate
+    actuators: tuple[str, ...]  # one parameter name (or None) per velocity number
+    # the velocity's names where they differ from the coordinates (a ball joint: 4 numbers in q,
+    # 3 in v); () where they are the same. Out of repr: the compiled modules' keys (repr) of
+    # the trees without a ball joint stay as they were.
+    velocities: tuple[str, ...] = field(default=(), repr=False)
     # The model's rigid bodies built from the same joints: a model whose bodies are not these
     # (edited after reading) is not described by this tree.
     rigid_bodies: tuple = field(default=(), compare=False, repr=False)
@@ -162,6 +170,35 @@ class KinematicTree:
     # robot's trunk), for the note that names floating_base; not part of the dynamics.
     root_link: str = field(default="", compare=False, repr=False)
     root_mass: float = field(default=0.0, compare=False, repr=False)
+    # The model's own coordinates where they are not the tree's (an MJCF ball joint: three hinge
+    # angles in the symbolic model, its quaternion here); () where they are the same.
+    model_coordinates: tuple[str, ...] = field(default=(), compare=False, repr=False)
+
+    @property
+    def velocity_coordinates(self) -> tuple[str, ...]:
+        """The names of the joints' velocity numbers (the coordinates but for ball joints)."""
+        return self.velocities or self.coordinates
+
+    @property
+    def spherical(self) -> tuple[TreeJoint, ...]:
+        """The tree's ball joints (a quaternion each)."""
+        return tuple(j for j in self.joints if j.kind == JointKind.SPHERICAL)
+
+    @property
+    def nq(self) -> int:
+        """The configuration's numbers: the base's, then the joints' (4 per ball joint)."""
+        return self.base_nq + len(self.coordinates)
+
+    @property
+    def nv(self) -> int:
+        """The velocity's numbers: the base's, then the joints' (3 per ball joint)."""
+        return self.base_nv + len(self.velocity_coordinates)
+
+    def velocity_index(self, coordinate: int) -> int:
+        """Where the configuration number ``coordinate`` (an index in ``coordinates``) has its
+        rate among the joints' velocity numbers: one less per ball joint before it."""
+        return coordinate - sum(1 for j in self.joints
+                                if j.kind == JointKind.SPHERICAL and j.coordinate < coordinate)
 
     @property
     def floating_base(self) -> bool:
@@ -177,6 +214,19 @@ class KinematicTree:
     def base_nv(self) -> int:
         """Velocity numbers before the joints' own: 6 for a floating base, else 0."""
         return 6 if self.floating_base else 0
+
+
+def refuse_ball_joints(tree: KinematicTree | None, what: str) -> None:
+    """Refuse, in one line naming the joint, a tree with a ball joint where ``what`` (an
+    algorithm or an export) walks one-number joints only (its numbers would be miscounted)."""
+    balls = () if tree is None else tree.spherical
+    if balls:
+        from ..errors import ModelError
+
+        raise ModelError(f"joint '{balls[0].name}' is a ball (spherical) joint, which {what} "
+                         "does not take yet (M, inverse and forward dynamics, the energies, "
+                         "frames and Jacobians do, on the compact and numpy backends)",
+                         field="joint")
 
 
 _IDENTITY: Matrix3x3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
@@ -266,4 +316,4 @@ def _numbers(vector, values) -> tuple | None:
 
 
 __all__ = ["INERTIAL_FIELDS", "KinematicTree", "TreeFrame", "TreeJoint", "TreeLink", "body_tree",
-           "link_inertias", "with_link_inertials"]
+           "link_inertias", "refuse_ball_joints", "with_link_inertials"]

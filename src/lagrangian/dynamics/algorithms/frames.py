@@ -7,7 +7,8 @@ S = (s_w, s_v) per unit of joint variable, so the Jacobian's column of a coordin
 over the joints it drives (theta = k q + offset), k times S carried to the frame:
 angular s_w and linear s_v + s_w x (p - o), in world axes (p the frame's origin, o the joint's).
 A floating base (free_flyer.py) takes q of nq = n + 7 and gives Jacobians of nv = n + 6 columns:
-its six first, S = 1 in the base's axes.
+its six first, S = 1 in the base's axes. A ball joint (tree/spherical.py) has four numbers in q
+(its quaternion w x y z) and three columns: S = 1 on the angular rows, in its body's axes.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from ...model.tree import KinematicTree
 from ..tree.free_flyer import BASE_CONFIGURATION, check_quaternions
 from ..tree.joint_models import joint_model
 from ..tree.numbers import float_array
+from ..tree.spherical import check_tree_quaternions
 from .centroidal import REFERENCES, check_reference
 
 
@@ -30,7 +32,7 @@ class TreeKinematics:
 
     def __init__(self, tree: KinematicTree):
         self.tree = tree
-        self.n = len(tree.coordinates) + tree.base_nv  # the velocity's numbers (Jacobian columns)
+        self.n = tree.nv  # the velocity's numbers (Jacobian columns)
         self.coordinates = (BASE_CONFIGURATION if tree.floating_base else ()) + tree.coordinates
         self._frames = {f.name: f for f in tree.frames}
         self._models = [joint_model(j.kind) for j in tree.joints]
@@ -50,7 +52,9 @@ class TreeKinematics:
             raise InputError(f"expected {nq} values ({', '.join(self.coordinates)}) along the "
                              f"last axis, got shape {shape}", field=field)
         batch = q.shape[:-1]
-        if self.tree.floating_base:
+        if self.tree.spherical:  # the base's and each ball's, named in one line
+            check_tree_quaternions(self.tree, q.reshape(-1, nq), field)
+        elif self.tree.floating_base:
             check_quaternions(q.reshape(-1, nq))
         return q.reshape(-1, nq), batch
 
@@ -62,6 +66,10 @@ class TreeKinematics:
             if joint.kind == JointKind.FREE_FLYER:
                 R, p = model.placement_arrays(np.array(joint.rotation),
                                               np.array(joint.translation), Q[:, :7])
+            elif joint.kind == JointKind.SPHERICAL:
+                start = self.tree.base_nq + joint.coordinate
+                R, p = model.placement_arrays(np.array(joint.rotation),
+                                              np.array(joint.translation), Q[:, start:start + 4])
             else:
                 theta = joint.multiplier * Q[:, self.tree.base_nq + joint.coordinate] + joint.offset
                 R, p = model.placement_arrays(np.array(joint.rotation),
@@ -123,9 +131,13 @@ class TreeKinematics:
             R, o = bodies[k]
             if joint.kind == JointKind.FREE_FLYER:  # six columns, the base's own
                 columns, first = self._models[k].columns(), 0
+            elif joint.kind == JointKind.SPHERICAL:  # three angular columns, its own axes
+                columns = self._models[k].columns()
+                first = self.tree.base_nv + self.tree.velocity_index(joint.coordinate)
             else:
                 columns = [self._models[k].subspace(joint.axis, joint.pitch)]
-                first = self.tree.base_nv + joint.coordinate
+                first = self.tree.base_nv + (self.tree.velocity_index(joint.coordinate)
+                                             if self.tree.spherical else joint.coordinate)
             for c, (s_w, s_v) in enumerate(columns):
                 column = np.zeros((len(Q), 6))
                 if s_w is not None:

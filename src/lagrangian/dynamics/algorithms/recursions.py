@@ -68,16 +68,19 @@ class _Joint:
         self.parent = joint.parent
         self.model = joint_model(joint.kind)
         self.free = joint.kind == JointKind.FREE_FLYER  # a floating base: numbers 0..6 of q
+        self.ball = joint.kind == JointKind.SPHERICAL  # q[iq:iq+4] w x y z, v[iv:iv+3]
         self.coordinate = joint.coordinate
-        self.iq = tree.base_nq + joint.coordinate  # its number in q, and in v, a and tau
-        self.iv = tree.base_nv + joint.coordinate
+        self.iq = tree.base_nq + joint.coordinate  # its (first) number in q, and in v, a, tau
+        self.iv = tree.base_nv + (tree.velocity_index(joint.coordinate) if tree.spherical
+                                  else joint.coordinate)
         self.multiplier = joint.multiplier
         self.offset = joint.offset
         self.R0 = np.array(joint.rotation, dtype=float)
         self.t0 = np.array(joint.translation, dtype=float)
         self.u = np.array(joint.axis, dtype=float)
         self.pitch = joint.pitch  # a helical joint's (m/rad)
-        s_w, s_v = (None, None) if self.free else self.model.subspace(self.u, self.pitch)
+        s_w, s_v = (None, None) if self.free or self.ball else self.model.subspace(self.u,
+                                                                                  self.pitch)
         self.s_w = None if s_w is None else np.array(s_w)
         self.s_v = None if s_v is None else np.array(s_v)
         self.m = float(joint.mass)
@@ -121,6 +124,10 @@ class TreeRecursions:
                 R, p = j.model.placement_arrays(j.R0, j.t0, Q[:, :7])
                 placements.append((R, p, _skew_batch(p)))
                 continue
+            if j.ball:  # R0 R(quaternion), the origin fixed
+                R, p = j.model.placement_arrays(j.R0, j.t0, Q[:, j.iq:j.iq + 4])
+                placements.append((R, p, j.P0))
+                continue
             theta = j.multiplier * Q[:, j.iq] + j.offset
             R, p = j.model.placement_arrays(j.R0, j.t0, j.u, theta, j.pitch)
             placements.append((R, p, j.P0 if p is j.t0 else _skew_batch(p)))
@@ -155,6 +162,19 @@ class TreeRecursions:
                 # a + dw x p + w x (w x p), with y x p = [p]x^T y
                 a_i = _apply_transpose(R, al + _apply_transpose(P, dwl)
                                        + _cross(wl, _apply_transpose(P, wl)))
+            if j.ball:  # w += w_rel, dw += w x w_rel + dw_rel (S = 1 on the angular rows)
+                w_i, dw_i = w_in, dw_in
+                if V is not None:
+                    w_i = w_in + V[:, j.iv:j.iv + 3]
+                    dw_i = dw_in + _cross(w_in, V[:, j.iv:j.iv + 3])
+                if A is not None:
+                    dw_i = dw_i + A[:, j.iv:j.iv + 3]
+                w.append(w_i)
+                dw.append(dw_i)
+                acc.append(a_i)
+                f.append(j.m * a_i - _apply(j.H, dw_i) - _cross(w_i, _apply(j.H, w_i)))
+                n.append(_apply(j.J, dw_i) + _cross(w_i, _apply(j.J, w_i)) + _apply(j.H, a_i))
+                continue
             rate = None if V is None else j.multiplier * V[:, j.iv, None]
             w_i, dw_i = w_in, dw_in
             if rate is not None and j.s_w is not None:
@@ -182,7 +202,10 @@ class TreeRecursions:
                 tau[:, :3] += f[i]
                 tau[:, 3:6] += n[i]
                 continue
-            tau[:, j.iv] += j.multiplier * _project(j, n[i], f[i])
+            if j.ball:  # the moment on the body about its joint, in its axes
+                tau[:, j.iv:j.iv + 3] += n[i]
+            else:
+                tau[:, j.iv] += j.multiplier * _project(j, n[i], f[i])
             if j.parent >= 0:
                 R, p, P = placements[i]
                 force = _apply(R, f[i])
@@ -199,22 +222,65 @@ class TreeRecursions:
         h = [j.h for j in joints]
         J = [j.J for j in joints]
         M = np.zeros((count, self.n, self.n))
-        eye = np.eye(3)
         for i in reversed(range(len(joints))):
             j = joints[i]
             if j.free:  # the floating base: the composite inertia itself, [[m, -[h]x], [[h]x, J]]
                 M[:, :6, :6] += _spatial_inertia(mass[i], h[i], J[i], count)
                 continue
-            # unit rate along S: f = m s_v + s_w x h, n = J s_w + h x s_v
-            force, moment = np.zeros(3), np.zeros(3)
-            if j.s_w is not None:
-                force, moment = force + np.cross(j.s_w, h[i]), moment + J[i] @ j.s_w
-            if j.s_v is not None:
-                force, moment = force + mass[i] * j.s_v, moment + np.cross(h[i], j.s_v)
-            force = np.broadcast_to(force, (count, 3))
-            moment = np.broadcast_to(moment, (count, 3))
-            ci, ki = j.iv, j.multiplier
-            M[:, ci, ci] += ki * ki * _project(j, moment, force)
+            if j.ball:
+                self._ball_columns(M, placements, i, mass, h, J, count)
+            else:
+                self._joint_column(M, placements, i, h, J, mass, count)
+            self._composite_into_parent(placements, i, mass, h, J, count)
+        return M
+
+    def _joint_column(self, M, placements, i, h, J, mass, count):
+        """M's column (and row) of the one-number joint i: its composite's wrench per unit
+        rate, projected on each joint from i up to the root."""
+        joints = self._joints
+        j = joints[i]
+        # unit rate along S: f = m s_v + s_w x h, n = J s_w + h x s_v
+        force, moment = np.zeros(3), np.zeros(3)
+        if j.s_w is not None:
+            force, moment = force + np.cross(j.s_w, h[i]), moment + J[i] @ j.s_w
+        if j.s_v is not None:
+            force, moment = force + mass[i] * j.s_v, moment + np.cross(h[i], j.s_v)
+        force = np.broadcast_to(force, (count, 3))
+        moment = np.broadcast_to(moment, (count, 3))
+        ci, ki = j.iv, j.multiplier
+        M[:, ci, ci] += ki * ki * _project(j, moment, force)
+        k = i
+        while joints[k].parent >= 0:
+            R, p, P = placements[k]
+            force = _apply(R, force)
+            moment = _apply(R, moment) + _apply(P, force)
+            k = joints[k].parent
+            ancestor = joints[k]
+            if ancestor.free:  # the base's six numbers: S = 1, (force, moment)
+                entry = ki * np.concatenate([force, moment], axis=-1)
+                M[:, ci, :6] += entry
+                M[:, :6, ci] += entry
+                continue
+            if ancestor.ball:  # its three angular columns: the moment itself
+                entry = ki * moment
+                M[:, ci, ancestor.iv:ancestor.iv + 3] += entry
+                M[:, ancestor.iv:ancestor.iv + 3, ci] += entry
+                continue
+            entry = ki * ancestor.multiplier * _project(ancestor, moment, force)
+            M[:, ci, ancestor.iv] += entry
+            M[:, ancestor.iv, ci] += entry
+
+    def _ball_columns(self, M, placements, i, mass, h, J, count):
+        """M's three columns (and rows) of the ball joint i: for each unit angular rate e_k
+        of its body, the composite's wrench (f = e_k x h, n = J e_k), projected up the tree."""
+        joints = self._joints
+        j = joints[i]
+        for col in range(3):
+            e = np.eye(3)[col]
+            force = np.broadcast_to(np.cross(e, h[i]), (count, 3))
+            moment = np.broadcast_to(J[i] @ e, (count, 3))
+            c = j.iv + col
+            M[:, j.iv:j.iv + 3, c] += moment
             k = i
             while joints[k].parent >= 0:
                 R, p, P = placements[k]
@@ -222,28 +288,35 @@ class TreeRecursions:
                 moment = _apply(R, moment) + _apply(P, force)
                 k = joints[k].parent
                 ancestor = joints[k]
-                if ancestor.free:  # the base's six numbers: S = 1, (force, moment)
-                    entry = ki * np.concatenate([force, moment], axis=-1)
-                    M[:, ci, :6] += entry
-                    M[:, :6, ci] += entry
-                    continue
-                entry = ki * ancestor.multiplier * _project(ancestor, moment, force)
-                M[:, ci, ancestor.iv] += entry
-                M[:, ancestor.iv, ci] += entry
-            if j.parent >= 0:  # the composite inertia of body i, moved into its parent's axes
-                R, p, _ = placements[i]
-                hr = _apply(R, h[i])
-                p = np.broadcast_to(p, (count, 3))
-                ph, pp = _dot(p, hr)[:, None, None], _dot(p, p)[:, None, None]
-                outer = p[:, :, None] * hr[..., None, :]
-                # J' = R J R^T + m (|p|^2 1 - p p^T) + 2 (p.h) 1 - p h^T - h p^T
-                shifted = (R @ J[i] @ np.swapaxes(R, -1, -2)
-                           + mass[i] * (pp * eye - p[:, :, None] * p[:, None, :])
-                           + 2.0 * ph * eye - outer - np.swapaxes(outer, -1, -2))
-                J[j.parent] = J[j.parent] + shifted
-                h[j.parent] = h[j.parent] + hr + mass[i] * p
-                mass[j.parent] = mass[j.parent] + mass[i]
-        return M
+                if ancestor.free:
+                    entry = np.concatenate([force, moment], axis=-1)
+                    M[:, c, :6] += entry
+                    M[:, :6, c] += entry
+                elif ancestor.ball:
+                    M[:, c, ancestor.iv:ancestor.iv + 3] += moment
+                    M[:, ancestor.iv:ancestor.iv + 3, c] += moment
+                else:
+                    entry = ancestor.multiplier * _project(ancestor, moment, force)
+                    M[:, c, ancestor.iv] += entry
+                    M[:, ancestor.iv, c] += entry
+
+    def _composite_into_parent(self, placements, i, mass, h, J, count):
+        """Body i's composite inertia (m, h, J_O) added to its parent's, in the parent's axes."""
+        j = self._joints[i]
+        eye = np.eye(3)
+        if j.parent >= 0:  # the composite inertia of body i, moved into its parent's axes
+            R, p, _ = placements[i]
+            hr = _apply(R, h[i])
+            p = np.broadcast_to(p, (count, 3))
+            ph, pp = _dot(p, hr)[:, None, None], _dot(p, p)[:, None, None]
+            outer = p[:, :, None] * hr[..., None, :]
+            # J' = R J R^T + m (|p|^2 1 - p p^T) + 2 (p.h) 1 - p h^T - h p^T
+            shifted = (R @ J[i] @ np.swapaxes(R, -1, -2)
+                       + mass[i] * (pp * eye - p[:, :, None] * p[:, None, :])
+                       + 2.0 * ph * eye - outer - np.swapaxes(outer, -1, -2))
+            J[j.parent] = J[j.parent] + shifted
+            h[j.parent] = h[j.parent] + hr + mass[i] * p
+            mass[j.parent] = mass[j.parent] + mass[i]
 
     def _velocities(self, Q, V):
         placements = self._kinematics(Q)
@@ -256,6 +329,10 @@ class TreeRecursions:
                 vel.append(V[:, :3])
                 continue
             wl, vl = (zero, zero) if j.parent < 0 else (w[j.parent], vel[j.parent])
+            if j.ball:  # its own angular velocity added in its axes; its origin is fixed
+                w.append(_apply_transpose(R, wl) + V[:, j.iv:j.iv + 3])
+                vel.append(_apply_transpose(R, vl + _apply_transpose(P, wl)))
+                continue
             rate = (j.multiplier * V[:, j.iv])[:, None]
             w_i = _apply_transpose(R, wl)
             v_i = _apply_transpose(R, vl + _apply_transpose(P, wl))

@@ -5,7 +5,10 @@
    1 prismatic, the pitch helical), with theta = k q[c] + offset; R turns body axes into parent axes, p is the origin in the parent.
    A floating base (header flag) is body 0 on a free flyer (kind 2, free_flyer.py): q holds
    nq = 7 + n numbers (its position, quaternion x y z w, then the joints: q[7 + c]), v, a and
-   tau nv = 6 + n (its twist in its own axes, linear then angular, then v[6 + c]). */
+   tau nv = 6 + n (its twist in its own axes, linear then angular, then v[6 + c]). A ball joint
+   (kind 4, spherical.py) turns its body by the unit quaternion q[QCOORD:QCOORD + 4] (w x y z,
+   MuJoCo's), R = R0 R(q), p = t0, at the angular velocity v[COORD:COORD + 3] in the body's axes:
+   a coordinate's place in q (QCOORD) and in v (COORD) then differ, and n counts v's. */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
@@ -20,8 +23,9 @@
 #define TK_STRIDE 64    /* numbers per body record */
 /* a body record's fields */
 #define TK_PARENT 0
-#define TK_KIND 1       /* 0 revolute, 1 prismatic, 2 free flyer (body 0 only), 3 helical */
-#define TK_COORD 2
+#define TK_KIND 1       /* 0 revolute, 1 prismatic, 2 free flyer (body 0 only), 3 helical,
+                           4 ball */
+#define TK_COORD 2      /* its (first) number in v, after the base's */
 #define TK_MULT 3
 #define TK_OFFSET 4
 #define TK_R0 5         /* 9, row-major */
@@ -33,6 +37,7 @@
 #define TK_PERM 33      /* 3: where R0 is a signed permutation, each row's nonzero column */
 #define TK_SIGN 36      /* 3: that entry, +-1 */
 #define TK_PERMUTED 39  /* 1 where R0 is a signed permutation (description.py) */
+#define TK_QCOORD 40    /* its (first) number in q, after the base's */
 #define TK_LEAD 61      /* the slide along u per unit theta: 1 prismatic, pitch (m/rad) helical */
 #define TK_TURNS(b) ((b)[TK_KIND] == 0.0 || (b)[TK_KIND] == 3.0)
 #define TK_SLIDES(b) ((b)[TK_KIND] == 1.0 || (b)[TK_KIND] == 3.0)
@@ -46,11 +51,13 @@
 
 typedef struct {
     int nb, n, mimic, fb, bq, bv, nq, nv;  /* bq, bv: the base's numbers before the joints' */
+    int balls;  /* ball joints: each one more number in q than in v */
     double qtol;
     const double *g, *tau0, *body;
 } tk_tree;
 
 #define TK_FREE(b) ((b)[TK_KIND] == 2.0)
+#define TK_BALL(b) ((b)[TK_KIND] == 4.0)
 
 static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
 {
@@ -62,21 +69,30 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
     t->qtol = d[7];
     t->bq = t->fb ? 7 : 0;
     t->bv = t->fb ? 6 : 0;
-    t->nq = t->bq + t->n;
-    t->nv = t->bv + t->n;
     t->g = d + 2;
     t->tau0 = d + TK_HEADER;
     t->body = d + TK_HEADER + t->n;
     if (t->nb < 1 || t->n < (t->fb ? 0 : 1)
         || size != TK_HEADER + t->n + (Py_ssize_t)t->nb * TK_STRIDE)
         return -1;
+    t->balls = 0;
+    for (int i = 0; i < t->nb; i++)
+        if (TK_BALL(t->body + i * TK_STRIDE)) t->balls++;
+    t->nq = t->bq + t->n + t->balls;
+    t->nv = t->bv + t->n;
+    if (t->balls) t->mimic = 1;  /* forward dynamics by Cholesky of M */
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
         if (!(b[TK_PARENT] >= -1 && b[TK_PARENT] < i))
             return -1;
         if (t->fb && i == 0) {  /* the free flyer, and only it, on the ground */
             if (!TK_FREE(b) || b[TK_PARENT] != -1) return -1;
+        } else if (TK_BALL(b)) {
+            if (!(b[TK_COORD] >= 0 && b[TK_COORD] + 3 <= t->n && b[TK_QCOORD] >= 0
+                  && b[TK_QCOORD] + 4 <= t->n + t->balls))
+                return -1;
         } else if (!(b[TK_COORD] >= 0 && b[TK_COORD] < t->n)
+                   || !(b[TK_QCOORD] >= 0 && b[TK_QCOORD] < t->n + t->balls)
                    || !(TK_TURNS(b) || TK_SLIDES(b))) {
             return -1;
         }
@@ -158,7 +174,23 @@ static void TK_FN(place)(const tk_tree *t, const TK_T *restrict q, TK_T *restric
             w[TW_SN] = TK_C(0.0);
             continue;
         }
-        const TK_T theta = b[TK_MULT] * q[t->bq + (int)b[TK_COORD]] + b[TK_OFFSET];
+        if (TK_BALL(b)) {  /* R0 R(quaternion w x y z, normalized), p = t0 */
+            const TK_T *e = q + t->bq + (int)b[TK_QCOORD];
+            const TK_T s = e[0], x = e[1], y = e[2], z = e[3];
+            const TK_T k = 2.0 / (x * x + y * y + z * z + s * s);
+            const TK_T E[9] = {1.0 - k * (y * y + z * z), k * (x * y - z * s), k * (x * z + y * s),
+                               k * (x * y + z * s), 1.0 - k * (x * x + z * z), k * (y * z - x * s),
+                               k * (x * z - y * s), k * (y * z + x * s), 1.0 - k * (x * x + y * y)};
+            for (int r = 0; r < 3; r++)
+                for (int col = 0; col < 3; col++)
+                    R[3 * r + col] = R0[3 * r] * E[col] + R0[3 * r + 1] * E[3 + col]
+                                     + R0[3 * r + 2] * E[6 + col];
+            for (int r = 0; r < 3; r++) p[r] = TK_C(b[TK_T0 + r]);
+            w[TW_CS] = TK_C(1.0);
+            w[TW_SN] = TK_C(0.0);
+            continue;
+        }
+        const TK_T theta = b[TK_MULT] * q[t->bq + (int)b[TK_QCOORD]] + b[TK_OFFSET];
         if (TK_TURNS(b)) {
             /* sine and cosine written out here: a libm call cost as much as the rest of an
                arm's mass matrix */
@@ -234,7 +266,15 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
             for (int r = 0; r < 3; r++) x[r] += pa[r] + z[r];
             TK_APPLY_T(R, x, acc);
         }
-        if (v && !TK_FREE(b)) {  /* the joint's rate about z: w += S w, the Coriolis terms */
+        if (TK_BALL(b)) {  /* w += w_rel, dw += w x w_rel + dw_rel (body axes) */
+            if (v) {
+                const TK_T *wr = v + t->bv + c;
+                TK_CROSS(om, wr, x);
+                for (int r = 0; r < 3; r++) { dom[r] += x[r]; om[r] += wr[r]; }
+            }
+            if (a)
+                for (int r = 0; r < 3; r++) dom[r] += a[t->bv + c + r];
+        } else if (v && !TK_FREE(b)) {  /* the joint's rate about z: w += S w, the Coriolis terms */
             const TK_T rate = v[t->bv + c], wz = rate * sw, vz = rate * sv;
             dom[0] += om[1] * wz;  /* w x (0, 0, wz) */
             dom[1] -= om[0] * wz;
@@ -242,7 +282,7 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
             acc[0] += 2.0 * (om[1] * vz);
             acc[1] -= 2.0 * (om[0] * vz);
         }
-        if (a && !TK_FREE(b)) {
+        if (a && !TK_FREE(b) && !TK_BALL(b)) {
             const TK_T accel = a[t->bv + c];
             dom[2] += accel * sw;
             acc[2] += accel * sv;
@@ -269,8 +309,12 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
             for (int r = 0; r < 3; r++) { tau[r] += f[r]; tau[3 + r] += nn[r]; }
             continue;
         }
-        tk_subspace(b, &sw, &sv);
-        tau[t->bv + (int)b[TK_COORD]] += sw * nn[2] + sv * f[2];
+        if (TK_BALL(b)) {  /* the moment on the body about its joint, its axes */
+            for (int r = 0; r < 3; r++) tau[t->bv + (int)b[TK_COORD] + r] += nn[r];
+        } else {
+            tk_subspace(b, &sw, &sv);
+            tau[t->bv + (int)b[TK_COORD]] += sw * nn[2] + sv * f[2];
+        }
         const int parent = (int)b[TK_PARENT];
         if (parent >= 0) {
             TK_T *pf = W + parent * TW_STRIDE + TW_A + 9, *pn = pf + 3, F[3], N[3], x[3];
@@ -281,6 +325,10 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
         }
     }
 }
+
+/* a ball joint's columns of M and S_c . f (tree_kernel_forward.c) */
+static inline TK_T TK_FN(ball_dot)(const TK_T *w, int c, const TK_T *f);
+static void TK_FN(ball_columns)(const tk_tree *t, const TK_T *W, int i, TK_T *M);
 
 /* M by the composite-rigid-body algorithm in world axes about the world's origin (row-major
    n x n): each body's inertia (mass m, first moment h, rotational inertia J_O) moved there once,
@@ -354,7 +402,7 @@ static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict
         }
         /* the joint's motion per unit rate at the world's origin: s_w = Rw e_z sw,
            s_v = Rw e_z sv + o x s_w */
-        if (!TK_FREE(b)) {
+        if (!TK_FREE(b) && !TK_BALL(b)) {
             double sw, sv;
             TK_T *Sw = w + TW_SW, *Sv = w + TW_SV, x[3];
             tk_subspace(b, &sw, &sv);
@@ -402,6 +450,10 @@ static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict
                 }
             continue;
         }
+        if (TK_BALL(b)) {
+            TK_FN(ball_columns)(t, W, i, M);
+            continue;
+        }
         const TK_T *Sw = w + TW_SW, *Sv = w + TW_SV;
         TK_T f[6], x[3];
         TK_CROSS(Sw, h, x);  /* I_c(i) S_i */
@@ -427,6 +479,15 @@ static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict
                     M[(3 + c) * n + ci] += ang;
                 }
                 break;
+            }
+            if (TK_BALL(bk)) {  /* the ball's three columns: S_ball^T f */
+                const int ck = t->bv + (int)bk[TK_COORD];
+                for (int c = 0; c < 3; c++) {
+                    const TK_T e = TK_FN(ball_dot)(wk, c, f);
+                    M[ci * n + ck + c] += e;
+                    M[(ck + c) * n + ci] += e;
+                }
+                continue;
             }
             const TK_T e = TK_DOT(wk + TW_SV, f) + TK_DOT(wk + TW_SW, f + 3);
             const int ck = t->bv + (int)bk[TK_COORD];
@@ -460,7 +521,9 @@ static TK_T TK_FN(kinetic)(const tk_tree *t, const TK_T *restrict q, const TK_T 
             TK_APPLY_T(R, pw, om);
             TK_APPLY_T(R, x, vel);
         }
-        if (!TK_FREE(b)) {
+        if (TK_BALL(b)) {
+            for (int r = 0; r < 3; r++) om[r] += v[t->bv + (int)b[TK_COORD] + r];
+        } else if (!TK_FREE(b)) {
             const TK_T rate = v[t->bv + (int)b[TK_COORD]];
             om[2] += rate * sw;
             vel[2] += rate * sv;

@@ -1,6 +1,7 @@
 /* The compact tree kernel's forward dynamics, after tree_kernel.c (its records, scratch and
    helpers): the articulated-body algorithm, a floating base's acceleration, and M^-1 (tau - b)
-   by Cholesky where mimic joints drive several bodies from one coordinate. Units SI. */
+   by Cholesky where mimic joints drive several bodies from one coordinate or a ball joint
+   turns a body, and a ball joint's three columns of M. Units SI. */
 
 /* The floating base's spatial acceleration a = IA^-1 (tau - pA) (angular, linear; S = 1, its
    articulated inertia IA after every child's share, the ground's upward g in a: what its
@@ -260,4 +261,65 @@ static TK_MASK TK_FN(forward_cholesky)(const tk_tree *t, const TK_T *restrict q,
     for (int i = 0; i < n; i++)
         bad |= TK_NOT_FINITE(qdd[i]);
     return bad;
+}
+
+/* S_c . f for column c of a ball joint's S at the world's origin (s_w = Rw e_c, s_v = o x s_w)
+   and a wrench f (force, moment) there. */
+static inline TK_T TK_FN(ball_dot)(const TK_T *w, int c, const TK_T *f)
+{
+    const TK_T *Rw = w + TW_RW, *o = w + TW_OW;
+    TK_T e[3] = {Rw[c], Rw[3 + c], Rw[6 + c]}, y[3];
+    TK_CROSS(o, e, y);
+    return TK_DOT(y, f) + TK_DOT(e, f + 3);
+}
+
+/* A ball joint's three columns of M (body i, its composite inertia Ic in W): F_c = Ic S_c, then
+   S_k . F_c for the ball itself and each joint k from its parent to the root. */
+static void TK_FN(ball_columns)(const tk_tree *t, const TK_T *W, int i, TK_T *M)
+{
+    const int n = t->nv;
+    const double *b = t->body + i * TK_STRIDE;
+    const TK_T *w = W + i * TW_STRIDE, *Ic = w + TW_IC, *h = Ic + 1, *J = Ic + 4;
+    const TK_T *Rw = w + TW_RW, *o = w + TW_OW;
+    const int ci = t->bv + (int)b[TK_COORD];
+    for (int c = 0; c < 3; c++) {
+        TK_T sw[3] = {Rw[c], Rw[3 + c], Rw[6 + c]}, sv[3], f[6], x[3];
+        TK_CROSS(o, sw, sv);
+        TK_CROSS(sw, h, x);  /* Ic S: [m s_v + s_w x h; h x s_v + J_O s_w] */
+        for (int r = 0; r < 3; r++) f[r] = Ic[0] * sv[r] + x[r];
+        TK_CROSS(h, sv, x);
+        f[3] = x[0] + J[0] * sw[0] + J[3] * sw[1] + J[4] * sw[2];
+        f[4] = x[1] + J[3] * sw[0] + J[1] * sw[1] + J[5] * sw[2];
+        f[5] = x[2] + J[4] * sw[0] + J[5] * sw[1] + J[2] * sw[2];
+        for (int r = 0; r < 3; r++) M[(ci + r) * n + ci + c] += TK_FN(ball_dot)(w, r, f);
+        for (int k = (int)b[TK_PARENT]; k >= 0; k = (int)t->body[k * TK_STRIDE + TK_PARENT]) {
+            const double *bk = t->body + k * TK_STRIDE;
+            const TK_T *wk = W + k * TW_STRIDE;
+            if (TK_FREE(bk)) {  /* the base's six columns [R e_r; 0] and [o x R e_r; R e_r] */
+                const TK_T *Rk = wk + TW_RW, *ok = wk + TW_OW;
+                for (int r = 0; r < 3; r++) {
+                    TK_T e[3] = {Rk[r], Rk[3 + r], Rk[6 + r]}, y[3];
+                    TK_CROSS(ok, e, y);
+                    const TK_T lin = TK_DOT(e, f), ang = TK_DOT(y, f) + TK_DOT(e, f + 3);
+                    M[(ci + c) * n + r] += lin;
+                    M[r * n + ci + c] += lin;
+                    M[(ci + c) * n + 3 + r] += ang;
+                    M[(3 + r) * n + ci + c] += ang;
+                }
+                break;
+            }
+            const int ck = t->bv + (int)bk[TK_COORD];
+            if (TK_BALL(bk)) {
+                for (int r = 0; r < 3; r++) {
+                    const TK_T e = TK_FN(ball_dot)(wk, r, f);
+                    M[(ci + c) * n + ck + r] += e;
+                    M[(ck + r) * n + ci + c] += e;
+                }
+                continue;
+            }
+            const TK_T e = TK_DOT(wk + TW_SV, f) + TK_DOT(wk + TW_SW, f + 3);
+            M[(ci + c) * n + ck] += e;
+            M[ck * n + ci + c] += e;
+        }
+    }
 }

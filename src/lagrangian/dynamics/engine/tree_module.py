@@ -35,6 +35,9 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
     """The compiled module's C: the recursive functions, lg_parts/lg_energy/lg_residual for
     template.c (simulation, accelerations), and batched bindings for each function."""
     from ...compile.codegen import TEMPLATE, GeneratedSource
+    from ...model.tree import refuse_ball_joints
+
+    refuse_ball_joints(tree, "the unrolled per-tree module (kernel='unrolled')")
 
     n = len(tree.coordinates) + tree.base_nv  # v's numbers; q's are RT_NQ (a floating base)
     # vector variants (LG_LANES states at once) for batches up to VECTOR_LIMIT coordinates; a

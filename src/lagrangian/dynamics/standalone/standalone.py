@@ -227,8 +227,10 @@ def standalone_tree_c(model: Model, tree: KinematicTree, values: dict[str, float
     number of bodies (M quadratic) instead of the expanded equations; with the tree's frames,
     their placements and Jacobians (standalone_frames.py). ``parameters``: the names in the
     C's parameter array (default: the model's)."""
+    from ...model.tree import refuse_ball_joints
     from ..emit.tree_c import dynamics_functions
 
+    refuse_ball_joints(tree, "the standalone C export")
     if parameters is None:
         parameters = [p.name for p in model.parameters]
     P = prefix or c_prefix(model.name)

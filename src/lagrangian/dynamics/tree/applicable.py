@@ -39,7 +39,8 @@ def applicable_tree(model: Model, parameters: Mapping[str, float] | None = None
         return None
     if model.rigid_bodies != tree.rigid_bodies:
         return None
-    if tuple(c.name for c in model.coordinates) != tree.coordinates:
+    # an MJCF ball joint: three hinge angles in the model's symbolic bodies, a quaternion here
+    if tuple(c.name for c in model.coordinates) != (tree.model_coordinates or tree.coordinates):
         return None
     names = {p.name: p.symbol for p in model.parameters}
     if any(a is not None and a not in names
@@ -52,8 +53,8 @@ def applicable_tree(model: Model, parameters: Mapping[str, float] | None = None
                                 tuple(float(d) for d in gravity.direction)
                                 != tree.gravity_direction):
         return None
-    expected = {c: ((names[a]),) for c, a in zip(tree.coordinates, tree.actuators, strict=True)
-                if a is not None}
+    expected = {c: ((names[a]),) for c, a in zip(tree.velocity_coordinates, tree.actuators,
+                                                 strict=True) if a is not None}
     given: dict[str, tuple] = {}
     for coordinate, force in model.generalized_forces:
         given[coordinate] = given.get(coordinate, ()) + (force,)

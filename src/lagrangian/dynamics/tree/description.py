@@ -4,24 +4,30 @@ mass, centre of mass or inertia changes without a rebuild.
 
 The description ``D`` (float64, contiguous), built by ``describe``:
 
-    D[0] nb bodies, D[1] n joint coordinates, D[2:5] the gravity vector g * direction (world
-    axes, m/s^2), D[5] 1 where a coordinate drives more or fewer than one body (mimic joints:
-    forward dynamics by Cholesky of M instead of the articulated-body algorithm), D[6] 1 for a
+    D[0] nb bodies, D[1] n the joints' velocity numbers (their coordinates, but 3 for a ball
+    joint's 4 configuration numbers), D[2:5] the gravity vector g * direction (world
+    axes, m/s^2), D[5] 1 where a coordinate drives more or fewer than one body (mimic joints)
+    or the tree has a ball joint: forward dynamics by Cholesky of M instead of the
+    articulated-body algorithm, D[6] 1 for a
     floating base (body 0 on a free flyer: q of n + 7 numbers, v of n + 6, free_flyer.py's
     layout), D[7] the quaternion-norm tolerance (free_flyer.QUATERNION_TOLERANCE);
-    D[8:8+n] the actuator parameters tau_<joint> (N m or N), acting as loads;
+    D[8:8+n] the actuator parameters tau_<joint> (N m or N), acting as loads, one per velocity
+    number;
     then nb records of STRIDE = 64 numbers, parent first (parent < own index), each in its
     joint's canonical axes (below):
-      0 parent (-1 the ground)  1 kind code (JOINT_CODES)  2 coordinate index c
+      0 parent (-1 the ground)  1 kind code (JOINT_CODES)  2 the index c of its (first)
+      velocity number among the joints'; 40 that of its (first) configuration number
       3 multiplier k  4 offset (theta = k q[c] + offset)  5:14 R0 (joint -> parent axes,
       row-major)  14:17 t0 (m)  17:20 unit axis u, always (0, 0, 1)  20 mass (kg)
       21:24 first moment h = m c about the body origin (kg m)  24:33 J_O (kg m^2, body axes)
       33:36 where R0 is a signed permutation, the column of each row's one nonzero, 36:39 its
-      sign, 39 1 then (else 0: R0 is read as its nine numbers)  40:61 spare
+      sign, 39 1 then (else 0: R0 is read as its nine numbers)  41:61 spare
       61 the lead: the slide along u per unit theta (1 prismatic, the pitch in m/rad
       helical, 0 revolute)  62:64 spare.
       A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone; a helical joint
-      (code 3) turns as a revolute one and slides by its lead.
+      (code 3) turns as a revolute one and slides by its lead; a ball joint (code 4,
+      spherical.py) reads R0, t0, the inertia and its q (w x y z) and v offsets, in its own
+      axes (no canonical turn: its velocity is in the child's axes).
 
 Canonical axes: each body's axes are turned by a fixed A (A e_z = u, a signed permutation
 for an axis along a joint axis' own x, y or z) so that every joint turns and slides about z:
@@ -50,16 +56,19 @@ from .joint_models import JOINT_MODELS
 
 HEADER, STRIDE = 8, 64
 LEAD = 61  # a record's slide per unit theta (tree_kernel.c's TK_LEAD)
+QCOORD = 40  # a record's configuration index (tree_kernel.c's TK_QCOORD)
 
 
 JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FREE_FLYER: 2,
-               JointKind.HELICAL: 3}
+               JointKind.HELICAL: 3, JointKind.SPHERICAL: 4}
+# the kinds whose body keeps its own axes (no canonical turn about a joint axis)
+_OWN_AXES = (JointKind.FREE_FLYER, JointKind.SPHERICAL)
 
 
 def canonical_frame(joint: TreeJoint) -> np.ndarray:
     """A (3x3, joint axes -> canonical axes) with A e_z = u: exact where u is a signed basis
-    vector; the identity for a free flyer."""
-    if JointKind(joint.kind) == JointKind.FREE_FLYER:
+    vector; the identity for a free flyer and a ball joint."""
+    if JointKind(joint.kind) in _OWN_AXES:
         return np.eye(3)
     u = np.array(joint.axis, dtype=float)
     u = u / np.linalg.norm(u)
@@ -83,29 +92,31 @@ def _signed_permutation(R: np.ndarray) -> np.ndarray | None:
 def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
     """The tree as the kernel's array D (layout above, canonical axes), with the parameters'
     values (g and the actuators) in SI units."""
-    n, nb = len(tree.coordinates), len(tree.joints)
+    n, nb = len(tree.velocity_coordinates), len(tree.joints)
     D = np.zeros(HEADER + n + nb * STRIDE)
     D[0], D[1] = nb, n
     D[2:5] = float(parameters.get(tree.gravity_parameter, 0.0)) * np.array(tree.gravity_direction)
     drives = np.bincount([j.coordinate for j in tree.joints if j.coordinate >= 0], minlength=n)
-    D[5] = float(not np.all(drives == 1))
+    D[5] = float(not np.all(drives == 1) or bool(tree.spherical))
     D[6], D[7] = float(tree.floating_base), QUATERNION_TOLERANCE
     D[HEADER:HEADER + n] = [float(parameters.get(a, 0.0)) for a in tree.actuators]  # None: 0
     frames = [canonical_frame(j) for j in tree.joints]
     for i, j in enumerate(tree.joints):
         r = D[HEADER + n + i * STRIDE:HEADER + n + (i + 1) * STRIDE]
         A, Ap = frames[i], (frames[j.parent] if j.parent >= 0 else np.eye(3))
-        r[0], r[1], r[2] = j.parent, JOINT_CODES[JointKind(j.kind)], max(j.coordinate, 0)
+        r[0], r[1] = j.parent, JOINT_CODES[JointKind(j.kind)]
+        r[2] = tree.velocity_index(j.coordinate) if j.coordinate >= 0 else 0
+        r[QCOORD] = max(j.coordinate, 0)
         r[3], r[4] = j.multiplier, j.offset
         R0 = Ap.T @ np.array(j.rotation, dtype=float) @ A
         permutation = _signed_permutation(R0)
-        if permutation is not None:
+        if permutation is not None and JointKind(j.kind) != JointKind.SPHERICAL:
             R0 = permutation
             columns = np.argmax(np.abs(permutation), axis=1)
             r[33:36], r[36:39], r[39] = columns, permutation[np.arange(3), columns], 1.0
         r[5:14] = np.ravel(R0)
         r[14:17] = Ap.T @ np.array(j.translation, dtype=float)
-        r[17:20] = (0.0, 0.0, 1.0) if JointKind(j.kind) != JointKind.FREE_FLYER else j.axis
+        r[17:20] = (0.0, 0.0, 1.0) if JointKind(j.kind) not in _OWN_AXES else j.axis
         r[20], r[21:24] = j.mass, A.T @ np.array(j.first_moment, dtype=float)
         r[24:33] = np.ravel(A.T @ np.array(j.inertia, dtype=float) @ A)
         model = JOINT_MODELS[JointKind(j.kind)]
@@ -131,11 +142,11 @@ def joints_of(D: np.ndarray) -> tuple[TreeJoint, ...]:
         out.append(TreeJoint(name="", parent=int(r[0]), kind=kinds[int(r[1])],
                              rotation=matrix(r[5:14]), translation=tuple(map(float, r[14:17])),
                              axis=tuple(map(float, r[17:20])),
-                             coordinate=-1 if free else int(r[2]),
+                             coordinate=-1 if free else int(r[QCOORD]),
                              multiplier=float(r[3]), offset=float(r[4]), mass=float(r[20]),
                              first_moment=tuple(map(float, r[21:24])), inertia=matrix(r[24:33]),
                              pitch=float(r[LEAD]) if helical else 0.0))
     return tuple(out)
 
 
-__all__ = ["HEADER", "JOINT_CODES", "LEAD", "STRIDE", "canonical_frame", "describe", "joints_of"]
+__all__ = ["HEADER", "JOINT_CODES", "LEAD", "QCOORD", "STRIDE", "canonical_frame", "describe", "joints_of"]

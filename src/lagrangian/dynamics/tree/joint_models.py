@@ -18,6 +18,7 @@ import numpy as np
 from ...errors import ModelError
 from ...kinds import JointKind
 from .free_flyer import FreeFlyerModel
+from .spherical import SphericalModel
 
 
 class _Terms(Protocol):  # the emitter's arithmetic (tree_emitter._Emitter)
@@ -97,17 +98,20 @@ class JointModel:
 ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.HELICAL)
 
 
-JOINT_MODELS: dict[JointKind, JointModel | FreeFlyerModel] = {
+JOINT_MODELS: dict[JointKind, JointModel | FreeFlyerModel | SphericalModel] = {
     JointKind.REVOLUTE: JointModel(JointKind.REVOLUTE, turns=True, slides=False),
     JointKind.PRISMATIC: JointModel(JointKind.PRISMATIC, turns=False, slides=True),
     # a screw: Rot(u, theta) and pitch * theta along u (S = (u, pitch u), pitch in m/rad)
     JointKind.HELICAL: JointModel(JointKind.HELICAL, turns=True, slides=True, pitched=True),
     # a floating base: only at a tree's root, and only in numpy and frames.py (recursive.py)
     JointKind.FREE_FLYER: FreeFlyerModel(),
+    # a ball joint (MuJoCo's): a quaternion w x y z, the angular velocity in the body's axes
+    # (spherical.py); M, ID, FD and the energies in numpy and the compact engine only
+    JointKind.SPHERICAL: SphericalModel(),
 }
 
 
-def joint_model(kind: JointKind) -> JointModel | FreeFlyerModel:
+def joint_model(kind: JointKind) -> JointModel | FreeFlyerModel | SphericalModel:
     """The model of a joint kind that a kinematic tree can move."""
     try:
         return JOINT_MODELS[JointKind(kind)]

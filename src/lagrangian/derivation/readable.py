@@ -381,7 +381,57 @@ def _readable(expr: sp.Expr, generators: frozenset, ranges: dict) -> sp.Expr:
         result = _shortest([result, tidied])
     else:
         result = _grouped(tidied, generators, budget)
+        if _size(result, 400) < 400:
+            square = _completed_square(tidied, generators, budget)
+            if square is not None and _ops(square) < _ops(result) - 2:
+                result = square
     return result
+
+
+def _completed_square(expr: sp.Expr, generators: frozenset, budget: int) -> sp.Expr | None:
+    """A quadratic form in the rates (plus a rate-free part: T) with one rate's terms gathered
+    into a square, a (u + sum_w b_w/(2 a) w)^2 from a u^2 + sum_w b_w u w (a top's
+    C (psi_dot + phi_dot cos(theta))^2), the rest compacted; None where it is no such form."""
+    try:
+        groups = _monomials(expr, generators)
+    except _TooMany:
+        return None
+    free = compact(sp.Add(*groups.pop((), [])), budget)
+    if not groups or any(sum(p for _, p in m) != 2 for m in groups):
+        return None
+    coefficients = {m: compact(sp.Add(*c), budget) for m, c in groups.items()}
+    rates = sorted({g for m in coefficients for g, _ in m}, key=str)
+    if len(rates) > 6:
+        return None
+    best, best_ops = None, None
+    for u in rates:
+        a = coefficients.get(((u, 2),))
+        if a is None or a == 0:
+            continue
+        shifts = {}
+        for m, c in coefficients.items():
+            if len(m) == 2 and u in (m[0][0], m[1][0]):
+                shift = sp.cancel(c / (2 * a))
+                if _size(shift, 40) >= 40:
+                    break
+                shifts[m[1][0] if m[0][0] == u else m[0][0]] = shift
+        else:
+            if not shifts:
+                continue
+            rest = {m: c for m, c in coefficients.items() if u not in (g for g, _ in m)}
+            ws = sorted(shifts, key=str)
+            for i, w in enumerate(ws):
+                for w2 in ws[i:]:
+                    key = _key({w: 2} if w == w2 else {w: 1, w2: 1})
+                    twice = 1 if w == w2 else 2
+                    rest[key] = rest.get(key, sp.S.Zero) - twice * a * shifts[w] * shifts[w2]
+            square = a * (u + sp.Add(*(shifts[w] * w for w in ws))) ** 2
+            terms = [compact(c, budget) * _product(m) for m, c in rest.items()]
+            candidate = free + _pull_common([square, *terms], generators)
+            ops = _ops(candidate)
+            if best is None or ops < best_ops:
+                best, best_ops = candidate, ops
+    return best
 
 
 def _pull_common(terms: list[sp.Expr], keep: frozenset = frozenset()) -> sp.Expr:

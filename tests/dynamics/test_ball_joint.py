@@ -52,6 +52,26 @@ CHAIN = """<mujoco model="ball_hinge_chain">
 </mujoco>"""
 
 
+# several joints in one body (a hinge then a ball; a ball then a slide), a ball from a
+# childclass default, a welded child, inertias from geoms
+BODIES = """<mujoco model="joints_in_one_body">
+  <default><default class="balls"><joint type="ball"/></default></default>
+  <worldbody>
+    <body name="a" pos="0 0.1 1" euler="10 20 30">
+      <joint name="h0" axis="1 0 0" pos="0 0 0.05"/>
+      <joint name="b0" type="ball" pos="0.02 0 0"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.4" size="0.04"/>
+      <body name="weld" pos="0.1 0 -0.2"><geom type="sphere" size="0.05"/></body>
+      <body name="b" pos="0 0 -0.4" childclass="balls">
+        <joint name="b1" pos="0 0.01 0"/>
+        <joint name="s1" type="slide" axis="0 1 1"/>
+        <geom type="box" size="0.03 0.04 0.1" pos="0 0 -0.1"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
 def _load(tmp_path_factory, text, name):
     path = tmp_path_factory.mktemp("ball") / f"{name}.xml"
     path.write_text(text)
@@ -100,7 +120,12 @@ def _agree(ours, theirs, what):
     assert error <= TOLERANCE * (1.0 + float(np.abs(theirs).max())), f"{what}: off by {error:.2e}"
 
 
-@pytest.mark.parametrize("robot", ["pendulum", "chain"])
+@pytest.fixture(scope="module")
+def bodies(tmp_path_factory):
+    return _load(tmp_path_factory, BODIES, "bodies")
+
+
+@pytest.mark.parametrize("robot", ["pendulum", "chain", "bodies"])
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_M_ID_and_FD_agree_with_mujoco(request, robot, backend):
     system, dynamics, model = request.getfixturevalue(robot)

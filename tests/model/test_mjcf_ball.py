@@ -15,7 +15,8 @@ from lagrangian.model.mjcf_state import mujoco_layout
 mujoco = pytest.importorskip("mujoco")
 pytest.importorskip("yourdfpy")
 
-# a floating trunk, a shoulder ball joint at an anchor off the limb's origin, then an elbow
+# a floating trunk (its full inertia), a shoulder ball joint at an anchor off the limb's origin
+# (inertia from its geom), then an elbow with armature
 LIMB = """<mujoco model="limb">
   <worldbody>
     <body name="trunk" pos="0 0 0.5">
@@ -25,7 +26,7 @@ LIMB = """<mujoco model="limb">
         <joint name="shoulder" type="ball" pos="0 0 0.03"/>
         <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03"/>
         <body name="forearm" pos="0 0 -0.3">
-          <joint name="elbow" axis="1 1 0"/>
+          <joint name="elbow" axis="1 1 0" armature="0.02"/>
           <geom type="box" size="0.02 0.03 0.15" pos="0 0 -0.15"/>
         </body>
       </body>
@@ -69,7 +70,8 @@ def test_the_layout_of_a_floating_limb_with_a_ball_joint(limb):
 @pytest.mark.parametrize("backend", ["compiled", "numpy"])
 def test_inverse_and_forward_dynamics_agree_with_mujoco(limb, backend):
     system, model, layout = limb
-    d = system.dynamics() if backend == "compiled" else system.dynamics(backend="numpy")
+    d = system.dynamics(actuators=True, **({} if backend == "compiled" else {"backend": "numpy"}))
+    assert d.actuators["elbow"]["armature"] == 0.02
     data = mujoco.MjData(model)
     rng = np.random.default_rng(8)
     for _ in range(4):
@@ -101,10 +103,11 @@ def test_what_a_ball_joint_does_not_take_is_refused_in_one_line(joint, message, 
     assert "\n" not in str(caught.value)
 
 
-def test_a_locked_ball_hinge_is_refused(tmp_path):
+def test_a_locked_ball_joint_is_refused(tmp_path):
     path = tmp_path / "robot.xml"
     path.write_text("<mujoco><worldbody><body><joint type='ball' name='b'/><geom size='0.1'/>"
                     "<body pos='0 0 -1'><joint name='h'/><geom size='0.1'/></body></body>"
                     "</worldbody></mujoco>")
-    with pytest.raises(ModelError, match="ball joint 'b' cannot be locked"):
-        lagrangian.load(path, lock={"b__x": 0.0})
+    for lock in ({"b": 0.0}, {"b__x": 0.0}):
+        with pytest.raises(ModelError, match="ball joint 'b' cannot be locked"):
+            lagrangian.load(path, lock=lock)

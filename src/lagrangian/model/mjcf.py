@@ -80,6 +80,10 @@ def parse_mjcf(text: str, *, source: str = "<mjcf>", lock: Mapping[str, float] |
     reader = _Reader(root, source)
     reader.floating = bool(floating_base)
     urdf = reader.urdf()
+    locked = [name for name in (lock or {}) if name in reader.balls]
+    if locked:
+        raise ModelError(f"the ball joint '{locked[0]}' cannot be locked (yet)",
+                         field=f"lock.{locked[0]}", source=source)
     model = parse_urdf(urdf, source=source, lock=lock, payload=payload,
                        floating_base=bool(floating_base) and reader.free is None)
     joints = len(reader.joint_names) + len(reader.balls)

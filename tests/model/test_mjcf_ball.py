@@ -88,6 +88,24 @@ def test_inverse_and_forward_dynamics_agree_with_mujoco(limb, backend):
         np.testing.assert_allclose(ours, expected, rtol=0, atol=1e-9)
 
 
+def test_integrate_and_difference_on_a_floating_base_with_a_ball(limb):
+    """q (+) v dt moves the base by its twist and the shoulder by exp(w dt), both quaternions
+    kept unit; difference is its inverse; the ball's part as MuJoCo's mj_integratePos."""
+    system, model, layout = limb
+    d = system.dynamics()
+    rng = np.random.default_rng(2)
+    qpos, qvel, _ = _state(model, rng)
+    q, v = layout.from_mujoco(qpos, qvel)
+    moved = d.integrate(q, v, 0.2)
+    assert np.linalg.norm(moved[3:7]) == pytest.approx(1.0, abs=1e-15)
+    np.testing.assert_allclose(d.difference(q, moved), 0.2 * v, rtol=0, atol=1e-12)
+    expected = qpos.copy()
+    mujoco.mj_integratePos(model, expected, qvel, 0.2)
+    ball = moved[7:11] * np.sign(moved[7:11] @ expected[7:11])
+    np.testing.assert_allclose(ball, expected[7:11], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(moved[11], expected[11], rtol=0, atol=1e-12)
+
+
 @pytest.mark.parametrize("joint, message", [
     ('<joint type="ball" damping="0.1"/>', "damping on a ball joint"),
     ('<joint type="ball" frictionloss="0.1"/>', "frictionloss on a ball joint"),

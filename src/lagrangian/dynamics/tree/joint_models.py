@@ -6,7 +6,9 @@ kind a joint is: they use S and the placement. A one-degree-of-freedom joint is 
 JOINT_MODELS (and its branch in each C kernel: tree_kernel.c's tk_place and tk_subspace,
 reach_kernel.c's body and subspace, derivatives_kernel.c's kinematics), not a branch in every
 algorithm. The helical joint (a screw, Pinocchio's JointModelHelicalUnaligned) turns and
-slides: S = (u, pitch u), pitch (m/rad) the joint's own number (TreeJoint.pitch)."""
+slides: S = (u, pitch u), pitch (m/rad) the joint's own number (TreeJoint.pitch). The free
+flyer (free_flyer.py) and the ball joint (spherical.py, MuJoCo's: a quaternion w x y z, three
+angular rates in its body's axes) are entries of several numbers, walked by their own branches."""
 
 from __future__ import annotations
 

@@ -157,6 +157,10 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     (``limits`` False: the joints run through them), as simulate does on a fixed base."""
     from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
+    from ..model.tree import refuse_ball_joints
+
+    # a ball joint's quaternion is not stepped here yet: refused before any state is built
+    refuse_ball_joints(system.model.kinematic_tree, "simulate on a floating base")
     dynamics = system.dynamics()
     model = system.model
     if isinstance(stop, str):

@@ -4,18 +4,13 @@ Jacobi integral, each wrong form with its own diagnosis."""
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import pytest
 from check_helpers import check_text, finding
 
 import lagrangian
+from conserved_models import SPHERICAL_PENDULUM
 from lagrangian.errors import ModelError
 from lagrangian.model.answer import parse_answer
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "analysis"))
-from conserved_models import SPHERICAL_PENDULUM  # noqa: E402
 
 
 @pytest.fixture(scope="module")

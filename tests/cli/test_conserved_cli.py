@@ -3,13 +3,10 @@
 from __future__ import annotations
 
 import json
-import sys
-from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "analysis"))
-from conserved_models import CENTRAL_WELL, SPHERICAL_PENDULUM  # noqa: E402
+from conserved_models import CENTRAL_WELL, SPHERICAL_PENDULUM
 
 
 @pytest.fixture(scope="module")

@@ -11,25 +11,9 @@ import pytest
 
 import lagrangian
 from lagrangian.errors import InputError
+from mjcf_models import leg
 
-LEG = """
-<mujoco model="leg">
-  <worldbody>
-    <body name="trunk">
-      <freejoint name="root"/>
-      <inertial pos="0.01 0.02 -0.01" mass="5" fullinertia="0.1 0.2 0.25 0.01 -0.02 0.03"/>
-      <body name="thigh" pos="0.2 0.1 0" euler="10 0 20">
-        <joint name="hip" axis="0 1 0" pos="0 0 0.02"/>
-        <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03"/>
-        <body name="shin" pos="0 0 -0.3">
-          <joint name="knee" axis="1 1 0"/>
-          <geom type="box" size="0.02 0.03 0.15" pos="0 0 -0.15"/>
-        </body>
-      </body>
-    </body>
-  </worldbody>
-</mujoco>
-"""
+LEG = leg()
 GOAL = {"hip": 1.0, "knee": -0.8, "hip_dot": 0.0, "knee_dot": 0.0}
 
 

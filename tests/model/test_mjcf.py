@@ -13,6 +13,7 @@ import pytest
 import lagrangian
 from lagrangian.errors import ModelError
 from lagrangian.model.urdf import example_urdf
+from mjcf_models import leg
 
 # Every supported feature: fullinertia, inertia from geoms (capsule by fromto, box with a mass,
 # sphere, cylinder with a density, ellipsoid turned by xyaxes), default classes and childclass,
@@ -221,24 +222,7 @@ def test_a_urdf_saved_as_xml_is_read_as_a_urdf(tmp_path):
     assert lagrangian.load(path).coordinates == lagrangian.load("two_link_arm").coordinates
 
 
-QUADRUPED_LEG = """
-<mujoco model="leg">
-  <worldbody>
-    <body name="trunk" pos="0 0 0.4">
-      <freejoint name="root"/>
-      <inertial pos="0.01 0.02 -0.01" mass="5" fullinertia="0.1 0.2 0.25 0.01 -0.02 0.03"/>
-      <body name="thigh" pos="0.2 0.1 0" euler="10 0 20">
-        <joint name="hip" axis="0 1 0" pos="0 0 0.02"/>
-        <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03"/>
-        <body name="shin" pos="0 0 -0.3">
-          <joint name="knee" axis="1 1 0"/>
-          <geom type="box" size="0.02 0.03 0.15" pos="0 0 -0.15"/>
-        </body>
-      </body>
-    </body>
-  </worldbody>
-</mujoco>
-"""
+QUADRUPED_LEG = leg(trunk_height=0.4)
 
 
 def test_a_free_joint_with_floating_base_is_mujocos_body_in_pinocchios_layout(tmp_path):

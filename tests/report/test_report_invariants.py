@@ -15,6 +15,7 @@ import pytest
 from test_report import Page
 
 import lagrangian
+from conserved_models import spherical_pendulum
 from lagrangian.analysis.limit_cycle import CYCLE_STEPS
 from lagrangian.model.reader import parse_model
 from lagrangian.model.values import resolve_parameters
@@ -27,23 +28,7 @@ from lagrangian.simulation.poincare import PoincareMap
 
 G = 9.81
 ANSWERS = Path(__file__).resolve().parents[1] / "check" / "answers"
-SPHERICAL = '''
-name = "Spherical pendulum"
-[coordinates]
-theta = { unit = "rad", initial = 0.6, rate = 0.4 }
-phi = { unit = "rad", initial = 0.0, rate = 1.5 }
-[parameters]
-m = { value = 1.3, unit = "kg" }
-l = { value = 0.8, unit = "m" }
-g = { value = 9.81, unit = "m/s^2" }
-[gravity]
-g = "g"
-direction = [0, 0, -1]
-[[particles]]
-name = "bob"
-mass = "m"
-position = ["l*sin(theta)*cos(phi)", "l*sin(theta)*sin(phi)", "-l*cos(theta)"]
-'''
+SPHERICAL = spherical_pendulum(theta_dot=0.4, phi_dot=1.5)
 
 
 def _text(markup: str) -> str:

@@ -7,25 +7,10 @@ import numpy as np
 import pytest
 
 import lagrangian
+from conserved_models import spherical_pendulum
 from lagrangian.errors import InputError
 
-SPHERICAL = '''
-name = "Spherical pendulum"
-[coordinates]
-theta = { unit = "rad", initial = 0.6, rate = 0.3 }
-phi = { unit = "rad", initial = 0.0, rate = 1.0 }
-[parameters]
-m = { value = 1.3, unit = "kg" }
-l = { value = 0.8, unit = "m" }
-g = { value = 9.81, unit = "m/s^2" }
-[gravity]
-g = "g"
-direction = [0, 0, -1]
-[[particles]]
-name = "bob"
-mass = "m"
-position = ["l*sin(theta)*cos(phi)", "l*sin(theta)*sin(phi)", "-l*cos(theta)"]
-'''
+SPHERICAL = spherical_pendulum(theta_dot=0.3)
 
 
 @pytest.fixture(scope="module")

@@ -34,7 +34,13 @@ from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, DynamicsWarning, InputError, ModelError
 from .algorithms.frames import TreeKinematics, tree_kinematics
 from .control_terms import ControlTerms
-from .tree.numbers import batch_shape, float_array, solve_positive, warn_undefined
+from .tree.numbers import (
+    batch_shape,
+    float_array,
+    over_finite_rows,
+    solve_positive,
+    warn_undefined,
+)
 
 if TYPE_CHECKING:
     from .model_frames import ModelKinematics
@@ -147,9 +153,6 @@ class Dynamics(ControlTerms):
         total = int(np.prod(batch, dtype=np.int64))
         flat = [np.broadcast_to(x, batch + x.shape[-1:]).reshape(total, x.shape[-1])
                 for x in arrays]
-        good = np.ones(total, dtype=bool)
-        for x in flat:
-            good &= np.isfinite(x).all(axis=-1)
         if self.velocity_names is not None and fields[0] == "q":  # a floating base's quaternion
             tree = getattr(self, "tree", None)
             if tree is not None and tree.spherical:  # and the ball joints' (tree/spherical.py)
@@ -160,16 +163,7 @@ class Dynamics(ControlTerms):
                 from .tree.free_flyer import check_quaternions
 
                 check_quaternions(flat[0])
-        if good.all():
-            out = np.asarray(compute(*flat), dtype=float).reshape((total,) + tail)
-        else:
-            out = np.full((total,) + tail, np.nan)
-            if good.any():
-                out[good] = np.asarray(compute(*(x[good] for x in flat)),
-                                       dtype=float).reshape((-1,) + tail)
-        if forward:
-            good &= np.isfinite(out.reshape(total, -1)).all(axis=-1)
-            out[~good] = np.nan
+        out, good = over_finite_rows(compute, flat, tail, forward)
         bad = total - int(good.sum())
         if bad:
             warn_undefined(bad, total)

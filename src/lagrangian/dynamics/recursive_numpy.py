@@ -31,7 +31,7 @@ from ..model.quaternions import QUATERNION_TOLERANCE
 from ..model.tree import KinematicTree
 from .algorithms.recursions import TreeRecursions, _Joint, _TreeKernel
 from .tree.description import describe, joints_of
-from .tree.numbers import solve_positive
+from .tree.numbers import over_finite_rows, solve_positive
 from .tree.spherical import ball_quaternions_unit
 
 
@@ -67,18 +67,8 @@ class NumpyBackend(TreeRecursions):
         if flat is None:
             return NotImplemented
         batch, flat = flat
-        total = len(flat[0])
-        good = np.ones(total, dtype=bool)
-        for x in flat:
-            good &= np.isfinite(x).all(axis=-1)
-        out = np.full((total,) + tail, np.nan)
-        if good.any():
-            out[good] = np.asarray(compute(*(x[good] for x in flat)),
-                                   dtype=float).reshape((-1,) + tail)
-        if forward:
-            good &= np.isfinite(out.reshape(total, -1)).all(axis=-1)
-            out[~good] = np.nan
-        bad = total - int(good.sum())
+        out, good = over_finite_rows(compute, flat, tail, forward)
+        bad = len(good) - int(good.sum())
         out = out.reshape(batch + tail)
         return (out, bad) if bad else out
 

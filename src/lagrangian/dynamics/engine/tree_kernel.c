@@ -151,6 +151,20 @@ static inline void TK_FN(sandwich)(const TK_T *R, const TK_T *A, TK_T *out)  /* 
                              + T[3 * i + 2] * R[3 * j + 2];
 }
 
+/* R = R0 E(x, y, z, s): E the rotation of the quaternion (x, y, z, s = its scalar part), made
+   unit here (a free flyer's, a ball joint's) */
+static inline void TK_FN(turned)(const double *R0, TK_T x, TK_T y, TK_T z, TK_T s, TK_T *R)
+{
+    const TK_T k = 2.0 / (x * x + y * y + z * z + s * s);
+    const TK_T E[9] = {1.0 - k * (y * y + z * z), k * (x * y - z * s), k * (x * z + y * s),
+                       k * (x * y + z * s), 1.0 - k * (x * x + z * z), k * (y * z - x * s),
+                       k * (x * z - y * s), k * (y * z + x * s), 1.0 - k * (x * x + y * y)};
+    for (int r = 0; r < 3; r++)
+        for (int col = 0; col < 3; col++)
+            R[3 * r + col] = R0[3 * r] * E[col] + R0[3 * r + 1] * E[3 + col]
+                             + R0[3 * r + 2] * E[6 + col];
+}
+
 /* Each body's R and p for the configuration q (into the scratch W), and theta's cos, sin. */
 static void TK_FN(place)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict W)
 {
@@ -159,15 +173,7 @@ static void TK_FN(place)(const tk_tree *t, const TK_T *restrict q, TK_T *restric
         TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
         const double *R0 = b + TK_R0;
         if (TK_FREE(b)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
-            const TK_T x = q[3], y = q[4], z = q[5], s = q[6];
-            const TK_T k = 2.0 / (x * x + y * y + z * z + s * s);
-            const TK_T E[9] = {1.0 - k * (y * y + z * z), k * (x * y - z * s), k * (x * z + y * s),
-                               k * (x * y + z * s), 1.0 - k * (x * x + z * z), k * (y * z - x * s),
-                               k * (x * z - y * s), k * (y * z + x * s), 1.0 - k * (x * x + y * y)};
-            for (int r = 0; r < 3; r++)
-                for (int col = 0; col < 3; col++)
-                    R[3 * r + col] = R0[3 * r] * E[col] + R0[3 * r + 1] * E[3 + col]
-                                     + R0[3 * r + 2] * E[6 + col];
+            TK_FN(turned)(R0, q[3], q[4], q[5], q[6], R);
             TK_APPLY(R0, q, p);
             for (int r = 0; r < 3; r++) p[r] += b[TK_T0 + r];
             w[TW_CS] = TK_C(1.0);
@@ -176,15 +182,7 @@ static void TK_FN(place)(const tk_tree *t, const TK_T *restrict q, TK_T *restric
         }
         if (TK_BALL(b)) {  /* R0 R(quaternion w x y z, normalized), p = t0 */
             const TK_T *e = q + t->bq + (int)b[TK_QCOORD];
-            const TK_T s = e[0], x = e[1], y = e[2], z = e[3];
-            const TK_T k = 2.0 / (x * x + y * y + z * z + s * s);
-            const TK_T E[9] = {1.0 - k * (y * y + z * z), k * (x * y - z * s), k * (x * z + y * s),
-                               k * (x * y + z * s), 1.0 - k * (x * x + z * z), k * (y * z - x * s),
-                               k * (x * z - y * s), k * (y * z + x * s), 1.0 - k * (x * x + y * y)};
-            for (int r = 0; r < 3; r++)
-                for (int col = 0; col < 3; col++)
-                    R[3 * r + col] = R0[3 * r] * E[col] + R0[3 * r + 1] * E[3 + col]
-                                     + R0[3 * r + 2] * E[6 + col];
+            TK_FN(turned)(R0, e[1], e[2], e[3], e[0], R);
             for (int r = 0; r < 3; r++) p[r] = TK_C(b[TK_T0 + r]);
             w[TW_CS] = TK_C(1.0);
             w[TW_SN] = TK_C(0.0);

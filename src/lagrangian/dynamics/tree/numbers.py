@@ -43,6 +43,27 @@ def warn_undefined(count: int, total: int, stacklevel: int = 4) -> None:
         stacklevel=stacklevel)
 
 
+def over_finite_rows(compute, flat, tail: tuple[int, ...], forward: bool = False):
+    """compute(*flat inputs (N, width)) -> (N, *tail) over the states whose inputs are all
+    finite, NaN rows for the others (and, ``forward``, for rows without a finite answer):
+    (outputs, the rows' mask of defined answers)."""
+    total = len(flat[0])
+    good = np.ones(total, dtype=bool)
+    for x in flat:
+        good &= np.isfinite(x).all(axis=-1)
+    if good.all():
+        out = np.asarray(compute(*flat), dtype=float).reshape((total,) + tail)
+    else:
+        out = np.full((total,) + tail, np.nan)
+        if good.any():
+            out[good] = np.asarray(compute(*(x[good] for x in flat)),
+                                   dtype=float).reshape((-1,) + tail)
+    if forward:
+        good &= np.isfinite(out.reshape(total, -1)).all(axis=-1)
+        out[~good] = np.nan
+    return out, good
+
+
 def solve_positive(mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """M^-1 rhs for a flat batch (N, n, n), (N, n) by Cholesky, NaN in the rows whose M is not
     positive definite (each row as if alone)."""
@@ -62,4 +83,5 @@ def solve_positive(mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
 
 
-__all__ = ["batch_shape", "float_array", "solve_positive", "warn_undefined"]
+__all__ = ["batch_shape", "float_array", "over_finite_rows", "solve_positive",
+           "warn_undefined"]

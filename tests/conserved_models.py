@@ -1,10 +1,10 @@
 """Model files for the conserved-quantity, Routh and Hamilton tests (closed forms known)."""
 
-SPHERICAL_PENDULUM = '''
+_SPHERICAL = '''
 name = "Spherical pendulum"
 [coordinates]
-theta = { unit = "rad", initial = 0.6, rate = 0.0 }
-phi = { unit = "rad", initial = 0.0, rate = 1.0 }
+theta = { unit = "rad", initial = 0.6, rate = @THETA_DOT@ }
+phi = { unit = "rad", initial = 0.0, rate = @PHI_DOT@ }
 [parameters]
 m = { value = 1.3, unit = "kg" }
 l = { value = 0.8, unit = "m" }
@@ -17,6 +17,15 @@ name = "bob"
 mass = "m"
 position = ["l*sin(theta)*cos(phi)", "l*sin(theta)*sin(phi)", "-l*cos(theta)"]
 '''
+
+
+def spherical_pendulum(theta_dot: float = 0.0, phi_dot: float = 1.0) -> str:
+    """A bob of 1.3 kg on a 0.8 m rod, from theta = 0.6 rad with these rates (rad/s)."""
+    return _SPHERICAL.replace("@THETA_DOT@", repr(float(theta_dot))).replace(
+        "@PHI_DOT@", repr(float(phi_dot)))
+
+
+SPHERICAL_PENDULUM = spherical_pendulum()
 
 KEPLER = '''
 name = "Kepler problem"

@@ -176,8 +176,11 @@ def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y
                 t_stop, hit = solver.t, False
                 if event is not None:
                     g_new = event(solver.y[:n], solver.y[n:], solver.t)
-                    if armed and g_new >= 0:
-                        t_stop, hit = crossing_time(event, dense, solver.t_old, solver.t, n), True
+                    touch = None if not armed or g_new >= 0 else touch_inside(
+                        event, dense, solver.t_old, solver.t, n)
+                    if armed and (g_new >= 0 or touch is not None):
+                        end = solver.t if touch is None else touch
+                        t_stop, hit = crossing_time(event, dense, solver.t_old, end, n), True
                     elif g_new < 0:
                         armed = True
                 while index < len(grid) and grid[index] <= t_stop:
@@ -220,6 +223,23 @@ def integrate_steps(fun: Callable[[float, np.ndarray], np.ndarray], t0: float, y
 
 def _reached(solver, t0: float) -> float:
     return float(solver.t) if solver is not None else float(t0)
+
+
+# where a step's dense output is looked at between its ends: a condition (a guard, a stop
+# condition, a joint limit) that turns true and back within one step shows there, unless it
+# stays true for less than about an eighth of the step
+INSIDE = tuple(k / 8 for k in range(1, 8))
+
+
+def touch_inside(event, dense, t_old: float, t_new: float, n: int) -> float | None:
+    """The first of the step's inner points (INSIDE) where the event function is >= 0 though
+    both ends are < 0 (a touch that leaves again within the step), else None."""
+    for fraction in INSIDE:
+        t = t_old + fraction * (t_new - t_old)
+        y = dense(t)
+        if event(y[:n], y[n:], t) >= 0:
+            return t
+    return None
 
 
 def crossing_time(event, dense, t_old: float, t_new: float, n: int) -> float:

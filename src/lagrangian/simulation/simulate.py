@@ -315,7 +315,8 @@ def _integrate(functions, y0, grid, step_control, event, drift, progress, compil
     """The compiled DOP853 loop where it applies (and is there), else the scipy step loop.
     With position limits (``beyond``) the compiled loop's samples are checked, and a run with a
     sample at or beyond a limit is run again in the step loop, whose event finds the time the
-    joint reaches it (a touch between two samples that leaves again goes unseen there)."""
+    joint reaches it (integration_loops.touch_inside: also a touch that leaves again within one
+    step, unless shorter than about an eighth of it)."""
     n = len(y0) // 2
     if compiled and step_control.method == "DOP853" and math.isinf(step_control.max_step):
         run = integrate_compiled(functions, (float(grid[0]), float(grid[-1])), y0, step_control,

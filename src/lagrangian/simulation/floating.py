@@ -21,7 +21,7 @@ from ..model.quaternions import check_quaternions
 from ..model.values import resolve_state
 from .events import StopCondition, parse_stop_condition
 from .guards import GuardedRhs, StepCollapse, check_start
-from .integration_loops import LoopRun, crossing_time
+from .integration_loops import LoopRun, crossing_time, touch_inside
 from .invariants import cumulative_work
 from .options import SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
@@ -232,9 +232,12 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
                 t_stop, hit = solver.t, False
                 if event is not None:
                     g_new = event(solver.y[:nq], solver.y[nq:], solver.t)
-                    if armed and g_new >= 0:  # where it turns true, as the fixed base's loop
-                        t_stop = crossing_time(lambda q, v, t: event(unit(q), v, t), dense,
-                                               solver.t_old, solver.t, nq)
+                    on_sphere = lambda q, v, t: event(unit(q), v, t)  # noqa: E731
+                    touch = None if not armed or g_new >= 0 else touch_inside(
+                        on_sphere, dense, solver.t_old, solver.t, nq)
+                    if armed and (g_new >= 0 or touch is not None):  # as the fixed base's loop
+                        end = solver.t if touch is None else touch
+                        t_stop = crossing_time(on_sphere, dense, solver.t_old, end, nq)
                         hit = True
                     elif g_new < 0:
                         armed = True

@@ -166,3 +166,15 @@ def test_a_driven_model_has_no_autonomous_cycle():
         '[[impacts]]', '[generalized_forces]\ntheta = "0.1*sin(t)"\n\n[[impacts]]')
     with pytest.raises(InputError, match="explicit time"):
         lagrangian.System(parse_model(text)).limit_cycle()
+
+
+def test_a_cycle_search_from_the_models_own_start_names_it_not_a_guess():
+    """The falling rod comes to rest: no cycle. Without --guess the refusal names the model's
+    initial state (its coordinates), with one the guess."""
+    rod = lagrangian.load("falling_rod")
+    with pytest.raises(InputError) as caught:
+        rod.limit_cycle()
+    assert caught.value.field == "coordinates"
+    with pytest.raises(InputError) as caught:
+        rod.limit_cycle({"theta": 0.3})
+    assert caught.value.field == "guess"

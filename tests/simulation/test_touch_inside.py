@@ -32,3 +32,4 @@ def test_an_elastic_rods_ends_never_pass_through_the_floor():
     for end in (y - L / 2 * np.sin(theta), y + L / 2 * np.sin(theta)):
         assert end.min() > -1e-9
     assert {r.name for r in run.impacts} == {"end_a", "end_b"}
+

@@ -82,11 +82,14 @@ def limit_cycle(eom, substitution, functions, guess=None, *, step_control=CYCLE_
     start = resolve_state(model, guess, field="guess", time=False,
                           what="coordinate or velocity")
     x = np.concatenate([start.q_array(), start.q_dot_array()])
+    # what a failure names: the guess given, else the model's initial state (its coordinates)
+    field, origin = ("guess", "the guess") if guess is not None else (
+        "coordinates", "the model's initial state")
     if guess is None:
         for _ in range(WARM_UP):
-            x, *_ = poincare(x)
+            x, *_ = poincare(x, field=field)
     for iteration in range(1, max_iterations + 1):
-        x_next, period, name, DP = poincare(x, jacobian=True)
+        x_next, period, name, DP = poincare(x, jacobian=True, field=field)
         residual = x_next - x
         scale = max(1.0, float(np.max(np.abs(x))))
         if float(np.max(np.abs(residual))) < tolerance * scale:
@@ -96,9 +99,9 @@ def limit_cycle(eom, substitution, functions, guess=None, *, step_control=CYCLE_
         x = x + _bounded(step, scale)
         if not np.all(np.isfinite(x)):
             break
-    raise InputError(f"no limit cycle found from the guess ({max_iterations} Newton steps "
+    raise InputError(f"no limit cycle found from {origin} ({max_iterations} Newton steps "
                      "did not converge): give a guess nearer the cycle or "
-                     "check the slope and parameters", field="guess")
+                     "check the slope and parameters", field=field)
 
 
 _MAPS: dict = {}  # the last few Poincare maps: their compiled sensitivities cost 0.4-0.7 s

@@ -129,7 +129,7 @@ class PoincareMap:
         self._gradients = StateFunction(model, [x for row in grads for x in row], substitution)
         self.t_max = t_max
 
-    def __call__(self, x, jacobian: bool = False):
+    def __call__(self, x, jacobian: bool = False, field: str = "guess"):
         from scipy import integrate
 
         n = self.flow.n
@@ -143,19 +143,19 @@ class PoincareMap:
             solver.step()
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
                 raise InputError(f"the flow failed at t = {solver.t:.6g} s before the next "
-                                 "impact", field="guess")
+                                 "impact", field=field)
             y = solver.y
             g = event(y[:n], y[n:2 * n], solver.t)
             if armed and g >= 0:
                 dense = solver.dense_output()
                 t_hit = _crossing(event, dense, solver.t_old, solver.t, n)
-                return self._after(dense(t_hit), t_hit, jacobian, offsets)
+                return self._after(dense(t_hit), t_hit, jacobian, offsets, field)
             armed = armed or g < 0
         raise InputError(f"no impact within {self.t_max:g} s of the start (the motion comes to "
                          "rest or falls before its guard: no cycle through an impact from "
-                         "there; try another guess)", field="guess")
+                         "there; try a guess nearer a cycle)", field=field)
 
-    def _after(self, z, t, jacobian, offsets):
+    def _after(self, z, t, jacobian, offsets, field: str = "guess"):
         from .hybrid import polish
 
         n = self.flow.n
@@ -174,7 +174,7 @@ class PoincareMap:
         rate = float(grad @ f)
         if rate == 0 or not math.isfinite(rate):
             raise InputError("the guard is crossed tangentially (a graze): no Poincare map "
-                             "there", field="guess")
+                             "there", field=field)
         saltation = np.eye(2 * n) - np.outer(f, grad) / rate
         if which not in self._derivatives:
             self._derivatives[which] = ImpactDerivatives(self.model, impact, self._substitution)

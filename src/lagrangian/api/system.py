@@ -15,12 +15,13 @@ from typing import TYPE_CHECKING
 import sympy as sp
 
 from ..derivation.lagrange import derive
-from ..errors import InputError, LagrangianError, did_you_mean
+from ..errors import InputError, LagrangianError
 from ..model.builder import ModelBuilder
 from ..model.model import Model
 from .checking import CheckMethods
 from .conservation import ConservationMethods
 from .control import ControlMethods
+from .export import ExportMethods
 from .impacts import ImpactMethods
 from .studies import StudyMethods
 
@@ -35,7 +36,6 @@ if TYPE_CHECKING:
     from ..compile.functions import NumericSystem
     from ..derivation.equations import EquationsOfMotion
     from ..derivation.steps import DerivationSteps
-    from ..dynamics.standalone.standalone import StandaloneSource
     from ..dynamics.tree_at_rest import TreeAtRest
     from ..model.values import State
     from ..simulation.events import StopCondition
@@ -50,7 +50,8 @@ def _derived(model: Model) -> EquationsOfMotion:
     by value): a model file loaded twice, or two Systems of one model, share one derivation."""
     return derive(model)
 
-class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, ImpactMethods):
+class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, ImpactMethods,
+             ExportMethods):
     """A mechanical system described in generalized coordinates.
 
     >>> import lagrangian
@@ -271,78 +272,6 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
     def _floating(self) -> bool:
         tree = getattr(self._model, "kinematic_tree", None)
         return bool(tree is not None and tree.floating_base)
-
-    # -- standalone C for a controller -----------------------------------------------------------
-
-    def to_c(self, prefix: str | None = None, parameters: Mapping[str, float] | None = None
-             ) -> StandaloneSource:
-        """Standalone C99 (header and source, libm only, no allocation) of M(q), the bias
-        C q_dot + g, g(q), inverse and forward dynamics and the energies (SI units);
-        ``prefix`` names the functions (default: from the model's name), ``parameters`` override
-        the model's values compiled in as defaults; a [control] table's laws as <prefix>_control
-        and <prefix>_control_forces. Write it with ``lagrangian.output.files.write_c(code, dir)``."""
-        from ..compile.codegen import CodegenError
-        from ..dynamics.standalone.standalone import c_prefix, standalone_for
-        from ..simulation.control import input_columns  # B of a [control] table's inputs
-
-        if prefix is not None and c_prefix(prefix) != prefix:
-            raise InputError(f"{prefix!r} is not a C identifier (lower-case ASCII letters, digits "
-                             "and _, a letter first, at most 40)", field="prefix")
-        values = dict(self.parameters)
-        for name, value in dict(parameters or {}).items():
-            if name not in values:
-                raise InputError(f"'{name}' is not a parameter of this model"
-                                 f"{did_you_mean(name, values)}", field="parameters")
-            values[name] = float(value)
-        missing = [k for k, v in values.items() if v is None]
-        if missing:
-            raise InputError(f"parameters without a value: {', '.join(missing)} (give them with "
-                             "parameters=...)", field="parameters")
-        system = self if not parameters else self.with_parameters(**dict(parameters))
-        try:
-            return standalone_for(system.model, system.equations_of_motion, values, prefix,
-                                  columns=input_columns)
-        except CodegenError as exc:
-            raise InputError(f"cannot write C: {exc}", field="lang") from None
-
-    # -- bridges to other tools ------------------------------------------------------------------
-
-    def to_casadi(self, inputs: Sequence[str] = (), parameters: Mapping[str, float] | None = None):
-        """CasADi Functions built node by node from the derived equations (SI units, x = [q;
-        q_dot]): ``rhs(x, u)``, ``mass_matrix(q)``, ``forcing(q, q_dot, u)`` and, with
-        constraints, ``constraints(q, q_dot)``; ``inputs`` name the entries of u as in
-        ``linearize(inputs=...)``. A robot read from URDF or MJCF gets them from its tree by
-        recursive Newton-Euler over casadi SX (nothing derived; inputs: coordinates or their
-        tau_<joint>). Needs the extra [casadi] (docs/bridges.md)."""
-        from ..compile.casadi_functions import casadi_functions
-        from ..compile.functions import refuse_large_chain
-
-        if self._model.source_names and self._model.kinematic_tree is not None:
-            from ..compile.casadi_tree import tree_casadi_functions
-
-            return tree_casadi_functions(self._model, inputs, parameters)
-        refuse_large_chain(self.model)
-        return casadi_functions(self.equations_of_motion(), inputs, parameters)
-
-    def to_opty(self, inputs: Sequence[str] = (), parameters: Mapping[str, float] | None = None):
-        """opty's equations of an unconstrained model (sympy, opty itself not needed):
-        ``eom`` = 0 in x = [q(t); u(t)] and x', ``states``, ``specified`` r_<input>(t) (named
-        as for ``linearize(inputs=...)``), ``parameters`` for known_parameter_map and
-        ``time``, for ``opty.Problem(obj, grad, eom, states, nodes, interval, ...)``."""
-        from ..compile.functions import refuse_large_chain
-        from ..compile.opty_equations import opty_equations
-
-        refuse_large_chain(self.model)
-        return opty_equations(self.equations_of_motion(), inputs, parameters)
-
-    def to_fmu(self, path: str | Path, parameters: Mapping[str, float] | None = None) -> Path:
-        """Write an FMI 2.0 FMU (.fmu: Model Exchange and Co-Simulation) of the model: its
-        standalone C compiled for this platform, q and q_dot as outputs, the parameters
-        tunable (SI; ``parameters`` override the model's values), Q_<coordinate> inputs
-        (docs/bridges.md)."""
-        from .export import to_fmu
-
-        return to_fmu(self, path, parameters)
 
     # -- compiled numeric functions -------------------------------------------------------------
 

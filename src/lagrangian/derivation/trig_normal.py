@@ -23,6 +23,56 @@ MAX_TERMS = 4000  # terms of the expanded polynomial past which it is not tried
 MAX_NODES = 3000  # nodes of the coefficient (before expansion) past which it is not tried
 
 
+def _polynomial_in(expr: sp.Expr, gens: set) -> bool:
+    """Whether ``expr`` is a polynomial in ``gens`` by its tree alone (no expansion): each power
+    of something holding them a nonnegative integer power, no other function of them."""
+    seen: set = set()
+    stack = [expr]
+    while stack:
+        node = stack.pop()
+        if node in seen or node.is_Atom:
+            continue
+        seen.add(node)
+        if node.is_Pow:
+            if not (node.exp.is_Integer and node.exp >= 0) and node.base.free_symbols & gens:
+                return False
+            stack.append(node.base)
+        elif node.is_Add or node.is_Mul:
+            stack.extend(node.args)
+        elif node.free_symbols & gens:  # sqrt is a Pow; this is any other function of them
+            return False
+    return True
+
+
+def _terms_bound(expr: sp.Expr, limit: int) -> int:
+    """An upper bound on the terms of ``expr`` expanded (sums add, products multiply, an integer
+    power k of n terms at most C(n + k - 1, k)), from the tree without expanding it; any value
+    past ``limit`` stands for "too many"."""
+    memo: dict[sp.Basic, int] = {}
+
+    def bound(node: sp.Basic) -> int:
+        found = memo.get(node)
+        if found is not None:
+            return found
+        if node.is_Add:
+            value = sum(bound(a) for a in node.args)
+        elif node.is_Mul:
+            value = 1
+            for a in node.args:
+                value *= bound(a)
+                if value > limit:
+                    break
+        elif node.is_Pow and node.exp.is_Integer and node.exp > 1:
+            n = bound(node.base)
+            value = comb(n + int(node.exp) - 1, int(node.exp)) if n <= limit else limit + 1
+        else:
+            value = 1
+        memo[node] = value = min(value, limit + 1)
+        return value
+
+    return bound(expr)
+
+
 def trig_normal_form(expr: sp.Expr) -> sp.Expr | None:
     """An equal form of ``expr`` with sin^2 + cos^2 = 1 applied exactly (see the module), or
     None where it is not a polynomial in the sines and cosines, or too large."""
@@ -39,6 +89,10 @@ def trig_normal_form(expr: sp.Expr) -> sp.Expr | None:
     if replaced.atoms(sp.sin, sp.cos):  # a trig function of something else inside (sin(sin x))
         return None
     gens = [*sines, *cosines]
+    # before expanding (the cost): a sine under a root or in a denominator is no polynomial,
+    # and an expansion past MAX_TERMS is not tried
+    if not _polynomial_in(replaced, set(gens)) or _terms_bound(replaced, MAX_TERMS) > MAX_TERMS:
+        return None
     try:
         poly = sp.Poly(replaced, *gens)
     except sp.PolynomialError:  # a sine in a denominator, under a root: not a polynomial

@@ -77,8 +77,7 @@ class Hamiltonian:
         L = self.eom.lagrangian
         parts = [*self.inertia, *self.shift, *(L.diff(x) for x in q),
                  *self.eom.generalized_forces]
-        # safe: every part is a derived sympy expression or number, never text
-        parts = [sp.sympify(sp.sympify(e).xreplace(values)) for e in parts]
+        parts = [sp.sympify(sp.sympify(e).xreplace(values)) for e in parts]  # safe: derived
         missing = set().union(*(e.free_symbols for e in parts)) - {*q, *q_dot, t}
         if missing:
             raise ModelError("parameters without a value: "

@@ -103,8 +103,7 @@ def routhian_model(eom: EquationsOfMotion, cyclic: Sequence[str]) -> Model:
     values = {p.symbol: p.value for p in model.parameters if p.value is not None}
     parameters = list(model.parameters)
     for name, symbol, i in zip(cyclic, p_symbols, index, strict=True):
-        # safe: rows are sympy expressions of the derived momenta (no text reaches here)
-        value = sp.sympify(rows[cyclic.index(name)]).xreplace({**values, **state})
+        value = sp.sympify(rows[cyclic.index(name)]).xreplace({**values, **state})  # safe: derived
         number = float(value) if value.is_number else None
         parameters.append(Parameter(symbol.name, symbol, number,
                                     momentum_unit(model.coordinates[i].unit)))

@@ -100,8 +100,7 @@ class CompiledImpact:
         self._parts = StateFunction(model, parts, substitution)
         d = m.normal.shape[0]
         self._point = StateFunction(model, list(m.impact.point[:d]), substitution)
-        # safe: the restitution is the model reader's parsed expression or a number
-        e = float(sp.sympify(m.impact.restitution).xreplace(substitution))
+        e = float(sp.sympify(m.impact.restitution).xreplace(substitution))  # safe: parsed
         if not 0 <= e <= 1:
             raise InputError(f"impact '{self.name}': the restitution is {e:g}, outside [0, 1]",
                              field="parameters")

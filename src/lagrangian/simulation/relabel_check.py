@@ -36,8 +36,8 @@ class RelabelCheck:
                 rows += list(item.position[:d])
                 turned = kind == "body" and hasattr(item, "angle")
                 rows += [sp.cos(item.angle), sp.sin(item.angle)] if turned else [0, 0]
-                # safe: a particle's or body's mass is the reader's parsed expression
-                self.masses.append(float(sp.sympify(item.mass).xreplace(substitution)))
+                # a particle's or body's mass: the reader's parsed expression, never text
+                self.masses.append(float(sp.sympify(item.mass).xreplace(substitution)))  # safe
                 self.labels.append(f"{kind} '{item.name}'")
         self.d = d
         rows += list(impact.point[:d])

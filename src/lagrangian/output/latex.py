@@ -31,9 +31,11 @@ Terms = list[tuple[bool, str]]  # (negative, LaTeX of the magnitude), joined wit
 # -- escaping user text -------------------------------------------------------------------------
 
 _TEXT_ESCAPES = {
-    "\\": r"\textbackslash{}", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&", "%": r"\%",
-    "#": r"\#", "_": r"\_", "^": r"\textasciicircum{}", "~": r"\textasciitilde{}",
-    "<": r"\textless{}", ">": r"\textgreater{}", "|": r"\textbar{}", '"': "''",
+    # ASCII's specials as math or accents, not \textless and its kin: those live in the TS1
+    # encoding, whose only fonts in a plain TeX Live are bitmaps drawn by METAFONT on first use
+    "\\": r"\ensuremath{\backslash}", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&", "%": r"\%",
+    "#": r"\#", "_": r"\_", "^": r"\^{}", "~": r"\~{}",
+    "<": r"\ensuremath{<}", ">": r"\ensuremath{>}", "|": r"\ensuremath{|}", '"': "''",
     # typography beyond Latin-1 that names often carry
     "\u2013": "--", "\u2014": "---", "\u2018": "`", "\u2019": "'", "\u201c": "``",
     "\u201d": "''", "\u2026": "...",
@@ -428,7 +430,6 @@ def _environment(name: str, rows: Sequence[str], notag: bool = False) -> list[st
 
 
 _PREAMBLE = r"""\documentclass[10pt,a4paper]{article}
-\usepackage[T1]{fontenc}
 \usepackage[margin=25mm]{geometry}
 \usepackage{amsmath,amssymb}
 \allowdisplaybreaks
@@ -473,4 +474,6 @@ def _handout_latex(eom: EquationsOfMotion, standalone: bool, expand: bool) -> st
     for heading, block in blocks:
         body += [rf"\section*{{{heading}}}", *block]
     body.append(r"\end{document}")
+    if not "".join(body).isascii():  # Latin-1 text needs T1 (EC fonts); ASCII keeps Type 1 CM
+        body.insert(1, r"\usepackage[T1]{fontenc}")
     return "\n".join(body) + "\n"

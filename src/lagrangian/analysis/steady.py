@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from ..compile.lambdified import StateFunction
+from ..compile.lambdified import numpy_function
 from ..derivation.equations import EquationsOfMotion
 from ..derivation.kinematics import Differentiator
 from ..errors import DerivationError, InputError, ModelError, did_you_mean
@@ -108,21 +108,20 @@ def _parameter_value(model, text: str, field: str, parameters) -> float:
                          field=field) from None
 
 
-class SteadyFunctions:
-    """M, f, their slopes -df/dq and -df/dq_dot, the constraints A, gamma, A q_dot + b, its
-    slope H, dA/dq and the holonomic residuals, compiled once at given parameter values."""
+class _SteadyTerms:
+    """M, f, their slopes, the constraint terms and the holonomic residuals of one set of
+    equations as one numpy function of (q, q_dot, t, parameters): compiled once, evaluated at
+    any parameter values (a study of the rider's mass fits a form per mass)."""
 
-    def __init__(self, eom: EquationsOfMotion, values: Mapping[sp.Symbol, float]):
+    def __init__(self, eom: EquationsOfMotion):
         model = eom.model
-        self.model = model
         q, q_dot, t = model.q, model.q_dot, model.time
-        n = self.n = len(q)
-        k = self.k = len(model.constraints)
-        forcing = [as_expression(e).xreplace(values) for e in eom.forcing]
-        mass = [as_expression(e).xreplace(values) for e in eom.mass_matrix]
-        jacobian = [as_expression(e).xreplace(values) for e in eom.constraint_jacobian]
-        bias = [as_expression(e).xreplace(values) for e in eom.velocity_bias]
-        gamma = [as_expression(e).xreplace(values) for e in eom.acceleration_rhs]
+        n, k = len(q), len(model.constraints)
+        forcing = [as_expression(e) for e in eom.forcing]
+        mass = [as_expression(e) for e in eom.mass_matrix]
+        jacobian = [as_expression(e) for e in eom.constraint_jacobian]
+        bias = [as_expression(e) for e in eom.velocity_bias]
+        gamma = [as_expression(e) for e in eom.acceleration_rhs]
         if any(t in e.free_symbols for e in (*forcing, *mass, *jacobian, *bias)):
             raise ModelError("the equations depend on time t explicitly, so there is no "
                              "steady motion to linearize about", field=FIELD)
@@ -134,16 +133,34 @@ class SteadyFunctions:
         level_slope = [d(e, x) for e in level for x in q]
         jacobian_slope = [d(e, x) for e in jacobian for x in q]
         # Holonomic constraints hold at position level too: Phi(q0) = 0 on the steady motion.
-        self.holonomic = [i for i, c in enumerate(model.constraints) if c.kind == ConstraintKind.HOLONOMIC]
-        positions = [model.constraints[i].expression.xreplace(values) for i in self.holonomic]
+        self.holonomic = [i for i, c in enumerate(model.constraints)
+                          if c.kind == ConstraintKind.HOLONOMIC]
+        positions = [as_expression(model.constraints[i].expression) for i in self.holonomic]
         self.sizes = [n * n, n, n * n, n * n, k * n, k, k, k * n, k * n * n]
-        self.function = StateFunction(model, [*mass, *forcing, *stiffness, *damping, *jacobian,
-                                              *gamma, *level, *level_slope, *jacobian_slope,
-                                              *positions])
+        self.parameters = tuple(p.symbol for p in model.parameters)
+        self.function = numpy_function(
+            [*q, *q_dot, t, *self.parameters],
+            [*mass, *forcing, *stiffness, *damping, *jacobian, *gamma, *level, *level_slope,
+             *jacobian_slope, *positions])
+
+
+class SteadyFunctions:
+    """M, f, their slopes -df/dq and -df/dq_dot, the constraints A, gamma, A q_dot + b, its
+    slope H, dA/dq and the holonomic residuals, at given parameter values (SI)."""
+
+    def __init__(self, eom: EquationsOfMotion, values: Mapping[sp.Symbol, float]):
+        self.model = eom.model
+        self.n, self.k = len(self.model.q), len(self.model.constraints)
+        terms = _steady_terms(eom)
+        self.holonomic, self.sizes, self._function = terms.holonomic, terms.sizes, terms.function
+        # a parameter without a value is NaN: every term it enters is then NaN, and refused
+        self._values = tuple(float(values.get(s, np.nan)) for s in terms.parameters)
 
     def evaluate(self, qv, vv) -> dict[str, np.ndarray]:
         n, k = self.n, self.k
-        parts = np.split(self.function.at(qv, vv, 0.0), np.cumsum(self.sizes))
+        flat = np.array([float(x) for x in self._function(*qv, *vv, 0.0, *self._values)],
+                        dtype=float)
+        parts = np.split(flat, np.cumsum(self.sizes))
         return {"M": parts[0].reshape(n, n), "f": parts[1], "K": parts[2].reshape(n, n),
                 "C": parts[3].reshape(n, n), "A": parts[4].reshape(k, n), "gamma": parts[5],
                 "level": parts[6], "H": parts[7].reshape(k, n),
@@ -159,25 +176,28 @@ class SteadyFunctions:
         return solution[:n], solution[n:]
 
 
-# The compiled functions of the last few (equations, parameter values): a speed sweep or a
-# benchmark-form fit linearizes the same equations many times.
-_FUNCTIONS: dict[tuple, tuple[EquationsOfMotion, SteadyFunctions]] = {}
+# The compiled terms of the last few equations: a speed sweep, a benchmark-form fit or a study
+# of several parameter values linearizes the same equations many times.
+_TERMS: dict[int, tuple[EquationsOfMotion, _SteadyTerms]] = {}
+
+
+def _steady_terms(eom: EquationsOfMotion) -> _SteadyTerms:
+    found = _TERMS.get(id(eom))
+    if found is not None and found[0] is eom:
+        return found[1]
+    terms = _SteadyTerms(eom)
+    if len(_TERMS) >= 4:
+        _TERMS.pop(next(iter(_TERMS)))
+    _TERMS[id(eom)] = (eom, terms)
+    return terms
 
 
 def steady_functions(eom: EquationsOfMotion,
                      parameters: Mapping[str, float] | ParameterValues | None = None,
                      ) -> SteadyFunctions:
-    """The compiled steady-motion functions of ``eom`` at these parameter values (cached)."""
+    """The steady-motion functions of ``eom`` at these parameter values (compiled once)."""
     values = resolve_parameters(eom.model, parameters).symbol_values(eom.model)
-    key = (id(eom), tuple(sorted((str(s), float(v)) for s, v in values.items())))
-    found = _FUNCTIONS.get(key)
-    if found is not None and found[0] is eom:
-        return found[1]
-    functions = SteadyFunctions(eom, values)
-    if len(_FUNCTIONS) >= 4:
-        _FUNCTIONS.pop(next(iter(_FUNCTIONS)))
-    _FUNCTIONS[key] = (eom, functions)
-    return functions
+    return SteadyFunctions(eom, values)
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
 from ..errors import ModelError
@@ -134,6 +135,32 @@ class Study:
         return values
 
 
+def _digest(*expressions) -> str:
+    """The expressions' content as a digest, the same in every process: a hash of each node from
+    its class and its arguments' hashes, each shared node hashed once (printing the bicycle's M
+    and f took 1-3 s; this takes milliseconds). sympy keeps arguments in a canonical order."""
+    memo: dict[int, tuple[str, object]] = {}
+
+    def node(x) -> str:
+        seen = memo.get(id(x))
+        if seen is not None:
+            return seen[0]
+        if x.args:
+            text = type(x).__name__ + "(" + ",".join(node(a) for a in x.args) + ")"
+        elif isinstance(x, sp.Float):
+            text = "Float" + repr(x._mpf_)  # every bit, not the printed digits
+        elif isinstance(x, sp.Symbol):
+            text = type(x).__name__ + ":" + x.name + repr(sorted(x.assumptions0.items()))
+        else:
+            text = type(x).__name__ + ":" + str(x)
+        digest = hashlib.blake2b(text.encode(), digest_size=16).hexdigest()
+        memo[id(x)] = (digest, x)  # x held, so that its id is not reused meanwhile
+        return digest
+
+    trees = [sp.sympify(e) for e in expressions]  # safe: derived sympy objects, never text
+    return hashlib.sha256(",".join(node(t) for t in trees).encode()).hexdigest()
+
+
 def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence[float]],
                sample: Mapping[str, str | Distribution] | None = None, members: int = 0,
                seed: int = 0, simulation: SimulationOptions | None = None,
@@ -208,13 +235,13 @@ def make_study(eom: EquationsOfMotion, compute: str, vary: Mapping[str, Sequence
             # to 1000 members, at least 8 chunks so that every worker of a small cluster gets some
             size = int(np.prod([len(v) for _, v in axes], dtype=np.int64)) * max(int(members), 1)
             chunk_size = min(1000, max(100, -(-size // 8)))
-    key = hashlib.sha256(pickle.dumps((model.name, str(eom.lagrangian), compute,
+    equations = _digest(eom.lagrangian, eom.forcing, eom.mass_matrix)
+    key = hashlib.sha256(pickle.dumps((model.name, equations, compute,
                                        [(n, v.tobytes()) for n, v in axes],
                                        [(n, v.tobytes()) for n, v in draws],
                                        simulation, chunk_size, about_values))).hexdigest()[:20]
     simulation_kind = None if simulation is None else (simulation.method, simulation.stop_when)
-    functions_key = hashlib.sha256(pickle.dumps((model.name, str(eom.lagrangian),
-                                                 str(eom.forcing), str(eom.mass_matrix),
+    functions_key = hashlib.sha256(pickle.dumps((model.name, equations,
                                                  compute == "simulate", simulation_kind))
                                    ).hexdigest()[:20]
     return Study(eom, compute, tuple(axes), tuple(draws), simulation, None, int(chunk_size), key,

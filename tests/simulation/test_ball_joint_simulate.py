@@ -1,26 +1,173 @@
-"""simulate on a robot with a ball joint: refused in one line naming the joint (its quaternion is
-not stepped by the integrators yet), on a floating base and on a fixed one."""
+"""simulate through ball joints (MuJoCo's, w x y z, the angular velocity in the body's axes), on
+a fixed and a floating base (simulation/floating.py, tree_state.py): a free spherical pendulum
+keeps T + V and the vertical angular momentum (both in closed form from the file's numbers); a
+ball pendulum started in a plane stays in it and swings as the same body on a hinge; MuJoCo's
+own RK4 trajectories (fixed and floating) reproduced to their integration error."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import lagrangian
 from lagrangian.errors import LagrangianError
 
-ARM = """<mujoco model="arm"><worldbody><body name="upper" pos="0 0 1">{free}
-<joint name="shoulder" type="ball"/>
-<geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03" mass="1"/>
-<body name="fore" pos="0 0 -0.3"><joint name="elbow" axis="0 1 0"/>
-<geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03" mass="0.5"/>
+# the bob hangs 0.6 m below its pivot (0.1 m above the body's origin), off axis, with a full
+# inertia tensor about its centre of mass (kg m^2)
+PENDULUM = """<mujoco model="spherical_pendulum"><worldbody><body name="bob" pos="0 0 1">
+<joint name="ball" type="{kind}" pos="0 0 0.1" axis="0 1 0"/>
+<inertial pos="{centre} -0.5" mass="1.3" fullinertia="{inertia}"/></body></worldbody></mujoco>"""
+MASS, PIVOT, CENTRE = 1.3, np.array([0.0, 0.0, 1.1]), np.array([0.05, 0.02, -0.6])
+I_CENTRE = np.array([[0.04, 0.001, -0.002], [0.001, 0.03, 0.003], [-0.002, 0.003, 0.02]])
+# about the pivot: parallel axes, r the centre from the pivot in the body's axes
+J_PIVOT = I_CENTRE + MASS * (CENTRE @ CENTRE * np.eye(3) - np.outer(CENTRE, CENTRE))
+
+# a ball (its anchor off the body's origin), then a hinge about (0, 1, 1) in a turned body
+ARM = """<mujoco model="arm"><option integrator="RK4" timestep="{dt}"/><worldbody>
+<body name="upper" pos="0 0 1">{free}<joint name="shoulder" type="ball" pos="0 0 0.05"/>
+<geom type="capsule" fromto="0 0 0 0.05 0 -0.3" size="0.03" mass="1"/>
+<body name="fore" pos="0 0 -0.3" euler="0 20 10"><joint name="elbow" axis="0 1 1"/>
+<geom type="box" size="0.02 0.03 0.15" pos="0 0 -0.15" mass="0.5"/>
 </body></body></worldbody></mujoco>"""
+# the floating one: a 4 kg trunk on a free joint (full inertia) carries the arm
+LIMB = """<mujoco model="limb"><option integrator="RK4" timestep="{dt}"/><worldbody>
+<body name="trunk" pos="0 0 0.5"><freejoint name="root"/>
+<inertial pos="0.01 0.02 -0.01" mass="4" fullinertia="0.1 0.2 0.25 0.01 -0.02 0.03"/>
+<body name="arm" pos="0.2 0.1 0" euler="10 0 20"><joint name="shoulder" type="ball" pos="0 0 0.03"/>
+<geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03"/>
+<body name="forearm" pos="0 0 -0.3"><joint name="elbow" axis="1 1 0"/>
+<geom type="box" size="0.02 0.03 0.15" pos="0 0 -0.15"/></body></body></body>
+</worldbody></mujoco>"""
 
 
-@pytest.mark.parametrize("floating", [False, True])
-def test_simulate_refuses_a_ball_joint_by_name(tmp_path, floating):
-    path = tmp_path / "arm.xml"
-    path.write_text(ARM.format(free=""))
-    system = lagrangian.load(path, **({"floating_base": True} if floating else {}))
-    with pytest.raises(LagrangianError, match="'shoulder' is a ball") as caught:
-        system.simulate(0.1)
-    assert "\n" not in str(caught.value)
+def _load(tmp_path_factory, text: str, name: str, **options):
+    path = tmp_path_factory.mktemp("ball_simulate") / f"{name}.xml"
+    path.write_text(text)
+    return lagrangian.load(path, **options), path
+
+
+def _rotation(q):
+    w, x, y, z = q / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+@pytest.fixture(scope="module")
+def pendulum(tmp_path_factory):
+    inertia = "0.04 0.03 0.02 0.001 -0.002 0.003"
+    return _load(tmp_path_factory, PENDULUM.format(kind="ball", centre="0.05 0.02", inertia=inertia),
+                 "spherical")[0]
+
+
+def test_a_free_spherical_pendulum_keeps_its_energy_and_vertical_angular_momentum(pendulum):
+    """T + V = 1/2 w.J_O w + m g z_c and L_z = (R J_O w)_z, from the file's numbers."""
+    q0 = np.array([0.9, 0.3, -0.2, 0.1]) / np.linalg.norm([0.9, 0.3, -0.2, 0.1])
+    w0 = np.array([1.5, -0.7, 2.0])
+    names = ("ball_qw", "ball_qx", "ball_qy", "ball_qz", "ball_wx", "ball_wy", "ball_wz")
+    run = pendulum.simulate(2.0, initial=dict(zip(names, [*q0, *w0], strict=True)),
+                            rtol=1e-11, atol=1e-11, samples=41)
+    assert run.status == "finished"
+    assert run.coordinates == ("ball_qw", "ball_qx", "ball_qy", "ball_qz")
+    assert tuple(run.columns())[5:8] == ("ball_wx", "ball_wy", "ball_wz")
+    q, w = run.q, run.q_dot
+    np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0, rtol=0, atol=1e-14)
+    assert np.linalg.norm(q[-1] - q0) > 0.1  # it swung
+    energy = [0.5 * wi @ J_PIVOT @ wi + MASS * 9.81 * (PIVOT + _rotation(qi) @ CENTRE)[2]
+              for qi, wi in zip(q, w, strict=True)]
+    momentum = [(_rotation(qi) @ J_PIVOT @ wi)[2] for qi, wi in zip(q, w, strict=True)]
+    np.testing.assert_allclose(energy, energy[0], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(momentum, momentum[0], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(run.energy, energy, rtol=0, atol=1e-9)  # the run's own T + V
+
+
+@pytest.fixture(scope="module")
+def planar(tmp_path_factory):
+    # the centre in the x-z plane and y a principal axis: a swing about y stays in that plane
+    inertia = "0.04 0.03 0.02 0 0.001 0"  # ixx iyy izz ixy ixz iyz
+    return tuple(_load(tmp_path_factory, PENDULUM.format(kind=kind, centre="0.05 0",
+                                                         inertia=inertia),
+                       kind)[0] for kind in ("ball", "hinge"))
+
+
+def test_a_ball_pendulum_started_in_a_plane_stays_in_it_and_swings_as_the_hinge_one(planar):
+    ball, hinge = planar
+    theta0, rate0 = 1.2, -0.5  # rad, rad/s about y
+    swung = ball.simulate(3.0, initial={"ball_qw": np.cos(theta0 / 2),
+                                        "ball_qy": np.sin(theta0 / 2), "ball_wy": rate0},
+                          rtol=1e-11, atol=1e-11, samples=61)
+    hinged = hinge.simulate(3.0, initial={"ball": theta0, "ball_dot": rate0}, rtol=1e-11,
+                            atol=1e-11, samples=61)
+    assert swung.status == hinged.status == "finished"
+    q, w = swung.q, swung.q_dot
+    np.testing.assert_allclose(q[:, [1, 3]], 0.0, rtol=0, atol=1e-12)  # no turn out of it
+    np.testing.assert_allclose(w[:, [0, 2]], 0.0, rtol=0, atol=1e-12)
+    angle = np.unwrap(2 * np.arctan2(q[:, 2], q[:, 0]))
+    assert np.ptp(angle) > 2.0  # a large swing, far from the linear one
+    np.testing.assert_allclose(angle, hinged.q[:, 0], rtol=0, atol=1e-8)
+    np.testing.assert_allclose(w[:, 1], hinged.q_dot[:, 0], rtol=0, atol=1e-8)
+
+
+def _mujoco_run(mujoco, text: str, qpos, qvel, t_end: float, dt: float):
+    model = mujoco.MjModel.from_xml_string(text.format(dt=repr(dt), free=""))
+    data = mujoco.MjData(model)
+    data.qpos[:], data.qvel[:] = qpos, qvel
+    for _ in range(round(t_end / dt)):
+        mujoco.mj_step(model, data)
+    return data.qpos.copy(), data.qvel.copy()
+
+
+@pytest.mark.parametrize("floating", [False, True], ids=["fixed", "floating"])
+def test_the_trajectory_is_mujocos_to_its_rk4_error(tmp_path_factory, floating):
+    """MuJoCo's RK4 (mj_integratePos on the ball's quaternion) at dt and dt/2: its error at
+    dt/2 is about their difference / 15 (fourth order); ours (DOP853, rtol 1e-11) is within."""
+    mujoco = pytest.importorskip("mujoco")
+    from lagrangian.model.mjcf_state import mujoco_layout
+
+    text = LIMB if floating else ARM
+    system, _ = _load(tmp_path_factory, text.format(dt=0.01, free=""), "robot",
+                      **({"floating_base": True} if floating else {}))
+    layout = mujoco_layout(system)
+    rng = np.random.default_rng(3)
+    qpos = rng.uniform(-1, 1, layout.nq)
+    qvel = rng.uniform(-1.5, 1.5, layout.nv)
+    base = 7 if floating else 0
+    if floating:
+        qpos[3:7] /= np.linalg.norm(qpos[3:7])
+    qpos[base:base + 4] /= np.linalg.norm(qpos[base:base + 4])
+    t_end = 0.5
+    coarse = _mujoco_run(mujoco, text, qpos, qvel, t_end, 5e-4)
+    fine = _mujoco_run(mujoco, text, qpos, qvel, t_end, 2.5e-4)
+    q, v = layout.from_mujoco(qpos, qvel)
+    d = system.dynamics()
+    start = {**dict(zip(d.coordinates, q, strict=True)),
+             **{(n if n not in d.coordinates else f"{n}_dot"): x
+                for n, x in zip(d.velocity_names, v, strict=True)}}
+    run = system.simulate(t_end, initial=start, rtol=1e-11, atol=1e-11, samples=2)
+    assert run.status == "finished"
+    ours = layout.to_mujoco(run.q[-1], run.q_dot[-1])
+    for k in range(2):  # qpos, then qvel
+        error = np.abs(fine[k] - coarse[k]).max() / 15
+        assert np.abs(ours[k] - fine[k]).max() <= 3 * error + 1e-10, k
+    assert np.abs(ours[0] - qpos).max() > 0.05  # it moved
+
+
+def test_what_a_ball_joint_does_not_take_is_refused_in_one_line(tmp_path_factory):
+    system, _ = _load(tmp_path_factory, ARM.format(dt=0.01, free=""), "arm")
+    cases = [({"initial": {"shoulder__x": 0.1}}, "'shoulder__x' is an Euler angle of the "
+              "ball joint 'shoulder'"),
+             ({"initial": {"shoulder_qw": 0.5}}, "ball joint 'shoulder' quaternion"),
+             ({"initial": {"shoulder_qq": 0.5}}, "'shoulder_qq' is not a coordinate"),
+             ({"stop_when": "shoulder__y > 1"}, "'shoulder__y' is an Euler angle"),
+             ({"limits": "clamp"}, "is not clamped")]
+    for options, message in cases:
+        with pytest.raises(LagrangianError, match=message) as caught:
+            system.simulate(0.1, **options)
+        assert "\n" not in str(caught.value)
+
+
+def test_a_stop_condition_on_a_ball_quaternion_ends_the_run_there(tmp_path_factory):
+    system, _ = _load(tmp_path_factory, ARM.format(dt=0.01, free=""), "arm")
+    run = system.simulate(2.0, initial={"shoulder_wx": 3.0}, stop_when="shoulder_qw < 0.9")
+    assert run.status == "stopped"
+    assert run.q[-1, 0] == pytest.approx(0.9, abs=1e-7)

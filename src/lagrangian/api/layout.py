@@ -40,10 +40,12 @@ class StateLayout:
 def state_layout(system) -> StateLayout:
     """The StateLayout of ``system`` (a floating base's names from its dynamics: the base's
     x, y, z, qx, qy, qz, qw then the joints in q; vx, vy, vz, wx, wy, wz then the joint rates
-    in v)."""
+    in v; a ball joint's <ball>_qw, _qx, _qy, _qz in q and <ball>_wx, _wy, _wz in v)."""
     joints = tuple(c.name for c in system.model.coordinates)
-    if not getattr(system.model.kinematic_tree, "floating_base", False):
+    tree = system.model.kinematic_tree
+    floating = getattr(tree, "floating_base", False)
+    if not floating and not getattr(tree, "spherical", ()):
         return StateLayout(joints, joints)
-    f = system.dynamics()
+    f = system.dynamics()  # a ball joint's quaternion and angular velocity (not Euler hinges)
     return StateLayout(tuple(f.coordinates), tuple(f.velocity_names),
-                       (0.0,) * 6 + (1.0,), (0.0,) * 6)
+                       *(((0.0,) * 6 + (1.0,), (0.0,) * 6) if floating else ()))

@@ -226,8 +226,11 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
             if isinstance(limits, bool | str) else None
         if start_beyond is None:
             raise InputError(f"limits is True, False or 'clamp', not {limits!r}", field="limits")
-        if start_beyond == "clamp" and self._floating:
-            raise InputError("a floating base's start is not clamped (yet): start it inside, "
+        # q and v differ in length (a floating base, a ball joint): simulation/floating.py
+        manifold = self._floating or bool(getattr(self._model.kinematic_tree, "spherical", ()))
+        if start_beyond == "clamp" and manifold:
+            raise InputError(("a floating base's" if self._floating else "a robot with a ball "
+                              "joint:") + " start is not clamped (yet): start it inside, "
                              "or run with limits=False", field="limits")
         limits = limits is not False
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
@@ -238,7 +241,7 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
                              + ("a robot's tree has no derived L" if tree else
                                 "its impacts map velocities, not momenta (yet)"),
                              field="canonical")
-        if tree and self._floating:  # q (+) v dt on SE(3): simulation/floating.py
+        if tree and manifold:  # q (+) v dt on SE(3) and S^3: simulation/floating.py
             from ..simulation.floating import simulate_floating
 
             step_control, save_at = run_options(step_control, save_at, method, rtol, atol,

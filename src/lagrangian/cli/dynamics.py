@@ -115,23 +115,24 @@ def dynamics(
     system = load_system(model, own, lock, gravity, payload, floating_base)
     coordinates = system.model.coordinates
     start = resolve_state(system.model)  # the model's own initial state (the library's defaults)
-    layout = state_layout(system)  # the names of q's and v's entries (a floating base's differ)
+    # the names of q's and v's entries (a floating base's and a ball joint's differ)
+    layout = state_layout(system)
     names_q, names_v = list(layout.q), list(layout.v)
     base_q, base_v = list(layout.base_q), list(layout.base_v)
-    qs = _vector(q, names_q, "--q", base_q + list(start.q))
-    if q is not None:  # --q 30,0 means 30 rad for an angle
+    own = [c.name for c in coordinates]
+    qs = _vector(q, names_q, "--q", _start(names_q, base_q, dict(zip(own, start.q, strict=True))))
+    if q is not None:  # --q 30,0 means 30 rad for an angle (a ball's quaternion: no angle)
         from .. import state_units
 
-        names = [c.name for c in coordinates]
-        texts = [part.strip() for part in q.split(",")][len(base_q):]
-        joints = qs[len(base_q):]
-        warn_bare_angles("--q", zip(names, texts, strict=True), state_units(system.model),
-                         dict(zip(names, joints, strict=True)))
+        given = [(name, part.strip()) for name, part in zip(names_q, q.split(","), strict=True)
+                 if name in own]
+        joints = {name: value for name, value in zip(names_q, qs, strict=True) if name in own}
+        warn_bare_angles("--q", given, state_units(system.model), joints)
         from .. import limit_warnings
 
-        for line in limit_warnings(system.model, dict(zip(names, joints, strict=True)), "--q"):
+        for line in limit_warnings(system.model, joints, "--q"):
             warn(line)
-    vs = _vector(v, names_v, "--v", base_v + list(start.q_dot))
+    vs = _vector(v, names_v, "--v", _start(names_v, base_v, dict(zip(own, start.q_dot, strict=True))))
     # a link's inertial (--set fore.mass=3) is a runtime parameter of the robot's dynamics
     f = system.dynamics(parameters=inertials or None, actuators=actuators,
                         armature=rotors or None)
@@ -143,7 +144,7 @@ def dynamics(
     for line in found.warnings:
         warn(line)
     values, constraints = found.values, found.constraints
-    velocities = names_v if base_q else None
+    velocities = names_v if names_v != names_q else None  # a floating base, a ball joint
     extra = {}
     if wrenches:
         extra["wrenches"] = wrenches
@@ -155,6 +156,12 @@ def dynamics(
     else:
         typer.echo(dynamics_text(names_q, values, velocities, extra, constraints), nl=False)
 
+
+def _start(names, base, joints) -> list[float]:
+    """The default vector: a floating base's numbers, then each joint's initial value (rate),
+    a ball joint's quaternion unturned (w = 1) and its angular velocity 0."""
+    return list(base) + [joints.get(name, 1.0 if name.endswith("_qw") else 0.0)
+                         for name in names[len(base):]]
 
 
 def base_layout(system):

@@ -83,19 +83,22 @@ def simulate(
         )
 
     system = load_system(model, set_, lock, gravity, payload, floating_base)
-    floating = getattr(system.model.kinematic_tree, "floating_base", False)
+    tree = system.model.kinematic_tree
+    # q and v differ (a floating base's numbers, a ball joint's quaternion): simulate judges
+    manifold = getattr(tree, "floating_base", False) or bool(getattr(tree, "spherical", ()))
     if not system.runs_on_tree:  # a tree's masses are checked as it is read; nothing derived
         warn_if_unphysical(system.equations_of_motion())
     end = parse_quantity(t_end, "s", "--t-end")
     # Everything the user typed is checked (by the library) before the integration starts.
     start = state_assignments(system, initial, "--initial")
-    if not floating:  # a floating base's names (base_x .. base_wz) are judged by simulate
+    if not manifold:  # the base's (base_x .. base_wz) and a ball's names: judged by simulate
         start = resolve_state(system.model, start, field="initial")
     step_control = StepControl(method, rtol, atol)
     save_at = SaveAt(samples)
-    # a floating base's condition may name base_x .. base_wz: simulate reads it (one line)
+    # a floating base's condition may name base_x .. base_wz, a ball's shoulder_qw ..
+    # shoulder_wz: simulate reads it (one line)
     stop = parse_stop_condition(stop_when, system.model) \
-        if stop_when is not None and not floating else stop_when
+        if stop_when is not None and not manifold else stop_when
     if independent and not along:
         raise InputError("it names the coordinates of --linearize-along: give both",
                          field="--independent")

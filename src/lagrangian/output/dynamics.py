@@ -102,9 +102,13 @@ def dynamics_text(coordinates, values: Mapping[str, Any], velocities=None,
     rates = names if velocities is None else list(velocities)
     width = max(len(n) for n in names + rates + list(constraints or ()))
     lines = [f"Coordinates: {', '.join(names)} (SI: rad or m; tau in N m or N)"]
-    if velocities is not None:
-        lines.append(f"Velocities: {', '.join(rates)} (the base's twist in its own axes: m/s, "
-                     "rad/s; its tau is the wrench on it: N, N m)")
+    if velocities is not None:  # a floating base's twist, a ball's angular velocity
+        what = (["the base's twist in its own axes: m/s, rad/s; its tau is the wrench on it: "
+                 "N, N m"] if "base_vx" in rates else []) + (
+            ["a ball joint's w x y z quaternion and its angular velocity in its body's axes: "
+             "rad/s; its tau the moment, N m"] if any(n.endswith("_qw") and n != "base_qw"
+                                                     for n in names) else [])
+        lines.append(f"Velocities: {', '.join(rates)} ({'; '.join(what)})")
     for key, value in values.items():
         array = np.asarray(value, dtype=float)
         title = titles.get(key, key)

@@ -1,10 +1,14 @@
-"""simulate for a floating base: y = [q (nq = n + 7), v (nv = n + 6)] integrated on the manifold.
+"""simulate for a tree whose q and v differ in length, a floating base or ball joints (fixed or
+floating base): y = [q (nq), v (nv)] integrated on the manifold (simulation/tree_state.py).
 
 q_dot from v by the free flyer's kinematics (position rate R v_lin, quaternion rate
-1/2 q (x) (0, omega)), v_dot by the tree's forward dynamics; the quaternion is renormalized
-after each accepted step (scipy's stepped loop; the compiled DOP853 loop takes q_dot = v only).
-A stop condition (which may name the base's numbers) and the joints' position limits end the
-run as on a fixed base (simulation/simulate.py): the event located on the step's dense output.
+1/2 q (x) (0, omega)) and each ball's 1/2 q (x) (0, omega) (w first, omega in the body's
+axes), v_dot by the tree's forward dynamics; every quaternion is renormalized after each
+accepted step and at each sample (scipy's stepped loop; the compiled DOP853 loop takes
+q_dot = v only). A stop condition (which may name the base's and the balls' numbers) and the
+joints' position limits end the run as on a fixed base (simulation/simulate.py): the event
+located on the step's dense output. A ball joint has no position limit (MJCF's cone range is
+refused as the file is read).
 """
 
 from __future__ import annotations
@@ -15,10 +19,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import DynamicsWarning, InputError, did_you_mean
+from ..errors import DynamicsWarning, InputError
 from ..kinds import InvariantKind, RunStatus
-from ..model.quaternions import check_quaternions
-from ..model.values import resolve_state
 from .events import StopCondition, parse_stop_condition
 from .guards import GuardedRhs, StepCollapse, check_start
 from .integration_loops import LoopRun, crossing_time, touch_inside
@@ -26,14 +28,22 @@ from .invariants import cumulative_work
 from .options import SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
 from .simulate import at_limit, beyond_limits, check_start_within, exceeded_limits, urdf_limits
+from .tree_state import TreeState
 
 
 def configuration_rate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """q_dot (nq) of a floating-base state: base position rate R v_lin (m/s, world axes),
     quaternion rate 1/2 q (x) (0, omega) (x y z w; omega in base axes, rad/s), joint rates v."""
+    rate = np.empty(len(q))
+    base_rate(q, v, rate)
+    rate[7:] = v[6:]
+    return rate
+
+
+def base_rate(q: np.ndarray, v: np.ndarray, rate: np.ndarray) -> None:
+    """The base's seven entries of q_dot into ``rate`` (configuration_rate)."""
     x, y, z, w = (float(c) for c in q[3:7])
     vx, vy, vz, wx, wy, wz = (float(c) for c in v[:6])
-    rate = np.empty(len(q))
     # R(q/|q|) v_lin written out (model/quaternions.py's matrix): a (1, 3, 3) stack of numpy
     # calls per right-hand side cost 30 times the tree's forward dynamics
     s = 2.0 / (x * x + y * y + z * z + w * w)
@@ -44,69 +54,30 @@ def configuration_rate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
                                 w * wy + z * wx - x * wz,
                                 w * wz + x * wy - y * wx,
                                 -x * wx - y * wy - z * wz])
-    rate[7:] = v[6:]
-    return rate
-
-
-def floating_start(dynamics, model, initial: Mapping[str, float] | None
-                   ) -> tuple[float, np.ndarray, np.ndarray]:
-    """(t0, q0, v0) from ``initial``: the base's names (base_x .. base_qw, base_vx .. base_wz),
-    the joints' as for a fixed base; the base at rest at the origin unless given (SI)."""
-    given = dict(initial or {})
-    base_q, base_v = dynamics.coordinates[:7], dynamics.velocity_names[:6]
-    q_base = dict(zip(base_q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0), strict=True))
-    v_base = dict.fromkeys(base_v, 0.0)
-    joints = {}
-    for name, value in given.items():
-        target = q_base if name in q_base else v_base if name in v_base else joints
-        if target is not joints:
-            try:
-                value = float(value)
-            except (TypeError, ValueError):
-                raise InputError(f"{name}: {value!r} is not a number (SI units)",
-                                 field="initial") from None
-        target[name] = value
-    try:
-        start = resolve_state(model, joints, field="initial",
-                              what="coordinate or velocity (or t)")
-    except InputError:
-        raise
-    except Exception as exc:  # a base name misspelled: name the base's too
-        unknown = next((k for k in joints if k != "t" and k not in
-                        {c.name for c in model.coordinates}
-                        | {f"{c.name}_dot" for c in model.coordinates}), None)
-        if unknown is None:
-            raise
-        known = [*base_q, *base_v, *(c.name for c in model.coordinates), "t"]
-        raise InputError(f"'{unknown}' is not a coordinate or velocity of this floating-base "
-                         f"robot{did_you_mean(unknown, known)}", field="initial") from exc
-    q0 = np.array([float(q_base[k]) for k in base_q] + list(start.q_array()))
-    v0 = np.array([float(v_base[k]) for k in base_v] + list(start.q_dot_array()))
-    check_quaternions(q0[None], field="initial")
-    q0[3:7] /= np.linalg.norm(q0[3:7])
-    return start.t, q0, v0
 
 
 class FloatingControl:
     """A controller's generalized forces on a floating base: (t, q, v) -> u with u the n joint
     torques (N m or N; the base unactuated, as a legged robot's), or all nv = n + 6 entries
-    with the base's wrench first (force, then moment, base axes: a thruster, a drone)."""
+    with the base's wrench first (force, then moment, base axes: a thruster, a drone). On a
+    fixed base, all nv entries (a ball's three: the moment in its body's axes, N m)."""
 
-    def __init__(self, controller, nv: int):
+    def __init__(self, controller, nv: int, floating: bool = True):
         if not callable(controller):
             raise InputError("the controller must be a callable (t, q, v) -> u",
                              field="controller")
-        self.controller, self.nv = controller, nv
+        self.controller, self.nv, self.floating = controller, nv, floating
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         u = np.asarray(self.controller(t, q, v), dtype=float)
         joints = self.nv - 6
-        if u.shape == (joints,):
+        if self.floating and u.shape == (joints,):
             u = np.concatenate([np.zeros(6), u])
         elif u.shape != (self.nv,):
-            raise InputError(f"the controller returned shape {u.shape}; expected ({joints},) "
-                             f"joint torques or ({self.nv},) with the base's wrench first",
-                             field="controller")
+            raise InputError(f"the controller returned shape {u.shape}; expected "
+                             + (f"({joints},) joint torques or ({self.nv},) with the base's "
+                                "wrench first" if self.floating else f"({self.nv},), one per "
+                                "velocity number"), field="controller")
         if not np.all(np.isfinite(u)):
             raise InputError(f"the controller returned a value that is not finite at "
                              f"t = {t:.9g} s", field="controller")
@@ -114,26 +85,32 @@ class FloatingControl:
 
 
 def floating_stop_condition(text: str, dynamics, model) -> StopCondition:
-    """``text`` ('base_z < 0.2', 'knee > 1') parsed with the base's names (base_x .. base_qw,
-    base_vx .. base_wz) beside the model's; one line for an unknown name."""
+    """``text`` ('base_z < 0.2', 'knee > 1', 'shoulder_qw < 0.9') parsed with the base's names
+    (base_x .. base_qw, base_vx .. base_wz) and the balls' (<ball>_qw .. _qz, <ball>_wx ..
+    _wz) beside the model's; one line for an unknown name or a ball's Euler hinge."""
     import sympy as sp
 
-    base = (*dynamics.coordinates[:7], *dynamics.velocity_names[:6])
-    return parse_stop_condition(text, model, names={name: sp.Symbol(name) for name in base})
+    state = TreeState(dynamics, model)
+    own = (*state.base_q, *state.base_v, *sorted(state.ball_q), *sorted(state.ball_v))
+    stop = parse_stop_condition(text, model, names={name: sp.Symbol(name) for name in own})
+    for symbol in sorted(stop.function.free_symbols, key=str):
+        name = str(symbol)
+        state.refuse_hinge(name.removesuffix("_dot"), "stop_when")
+    return stop
 
 
-def _stop_event(stop: StopCondition, dynamics, model, parameters):
-    """g(q, v, t) of a stop condition (> 0 where it holds), q and v in the floating layout."""
+def _stop_event(stop: StopCondition, state: TreeState, model, parameters):
+    """g(q, v, t) of a stop condition (> 0 where it holds), q and v in the tree's layout."""
     import sympy as sp
 
     from ..compile.lambdified import numpy_function
 
     values = {p.symbol: parameters[p.name] for p in model.parameters
               if parameters.get(p.name) is not None}
-    base_q = [sp.Symbol(name) for name in dynamics.coordinates[:7]]
-    base_v = [sp.Symbol(name) for name in dynamics.velocity_names[:6]]
-    g = numpy_function([*base_q, *model.q, *base_v, *model.q_dot, model.time],
-                       stop.function.xreplace(values))
+    by_name = {c.name: c for c in model.coordinates}
+    q_args = [by_name[n].symbol if n in by_name else sp.Symbol(n) for n in state.q_names]
+    v_args = [by_name[n].velocity if n in by_name else sp.Symbol(n) for n in state.v_names]
+    g = numpy_function([*q_args, *v_args, model.time], stop.function.xreplace(values))
 
     def event(q, v, t) -> float:
         return float(np.real(g(*q, *v, t)))
@@ -141,48 +118,52 @@ def _stop_event(stop: StopCondition, dynamics, model, parameters):
     return event
 
 
-def _limit_event(limits):
-    """The joints' position-limit event (simulate.beyond_limits) on the floating layout."""
+def _limit_event(limits, state: TreeState):
+    """The joints' position-limit event (simulate.beyond_limits) on the tree's layout."""
     beyond = beyond_limits(limits)
-    return None if beyond is None else (lambda q, v, t: beyond(q[7:], v[6:], t)), beyond
+    return None if beyond is None else (
+        lambda q, v, t: beyond(state.joints_q(q), state.joints_v(v), t)), beyond
 
 
 def simulate_floating(system, t_end: float, initial, step_control: StepControl,
                       save_at: SaveAt, controller=None, stop: str | StopCondition | None = None,
                       limits: bool = True, progress=None) -> SimulationResult:
-    """Integrate a floating-base robot to ``t_end`` (s) with the model's own loads (its
-    tau_<joint> parameters), gravity and a ``controller``'s forces (FloatingControl); the
-    quaternion kept of norm 1 after every step. ``stop`` ends the run where it turns true
-    (status 'stopped'), a joint reaching its URDF position limit ends it with status 'limit'
-    (``limits`` False: the joints run through them), as simulate does on a fixed base."""
+    """Integrate a floating-base robot, or one with ball joints, to ``t_end`` (s) with the
+    model's own loads (its tau_<joint> parameters), gravity and a ``controller``'s forces
+    (FloatingControl); every quaternion kept of norm 1 after every step. ``stop`` ends the
+    run where it turns true (status 'stopped'), a joint reaching its URDF position limit ends
+    it with status 'limit' (``limits`` False: the joints run through them), as simulate does
+    on a fixed base."""
     from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
-    from ..model.tree import refuse_ball_joints
-
-    # a ball joint's quaternion is not stepped here yet: refused before any state is built
-    refuse_ball_joints(system.model.kinematic_tree, "simulate on a floating base")
     dynamics = system.dynamics()
     model = system.model
+    state = TreeState(dynamics, model)
     if isinstance(stop, str):
         stop = floating_stop_condition(stop, dynamics, model)
     joint_limits = urdf_limits(model, positions=limits)
-    t0, q0, v0 = floating_start(dynamics, model, initial)
-    check_start_within(joint_limits, q0[7:])  # the joints' numbers follow the base's seven
+    t0, q0, v0 = state.start(model, initial)
+    check_start_within(joint_limits, state.joints_q(q0))  # the limits are the model's
     if not (np.isfinite(t_end) and t_end > t0):
         raise InputError(f"the end time ({t_end} s) must be after the start time ({t0} s)",
                          field="t_end")
     nq, nv = dynamics.nq, dynamics.nv
     zero = np.zeros(nv)
-    control = None if controller is None else FloatingControl(controller, nv)
+    control = None if controller is None else FloatingControl(controller, nv, state.floating)
     evaluations = [0]
+    q_of, v_of = state.q_index, state.v_index
 
     def rhs(t, y, controlled=True):
         evaluations[0] += controlled  # the run's calls: the start's check is not one
-        q, v = y[:nq].copy(), y[nq:]
-        # a step's stages leave the unit sphere by the step's error: the dynamics read R(q/|q|)
-        q[3:7] /= np.linalg.norm(q[3:7])
+        q, v = state.unit(y[:nq].copy()), y[nq:]
+        # a step's stages leave the unit sphere by the step's error: the dynamics read q/|q|
         tau = zero if control is None or not controlled else control(t, q, v)
-        return np.concatenate([configuration_rate(q, v), dynamics.forward_dynamics(q, v, tau)])
+        rate = np.empty(nq)
+        if state.floating:
+            base_rate(q, v, rate)
+        rate[q_of] = v[v_of]
+        state.ball_rate(q, v, rate)
+        return np.concatenate([rate, dynamics.forward_dynamics(q, v, tau)])
 
     solvers = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF,
                "LSODA": LSODA}
@@ -194,13 +175,13 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     grid = np.linspace(t0, t_end, save_at.samples)
     y0 = np.concatenate([q0, v0])
     # a rate that overflows the accelerations at once: refused (simulation/guards.py)
-    rates = (*dynamics.velocity_names[:6], *(f"{c.name}_dot" for c in model.coordinates))
+    rates = tuple(n if n not in state.q_names else f"{n}_dot" for n in state.v_names)
     # the robot's own motion: the controller is not called for it (its calls are the run's)
     check_start(lambda t, y: rhs(t, y, controlled=False), t0, y0, rates, tuple(initial or ()))
     guarded = GuardedRhs(rhs, step_control.method, len(y0), t0, t_end)
     solver = None  # built in the loop's try: its first step size calls the guarded rhs
-    user = None if stop is None else _stop_event(stop, dynamics, model, system.parameters)
-    limit, beyond = _limit_event(joint_limits)
+    user = None if stop is None else _stop_event(stop, state, model, system.parameters)
+    limit, beyond = _limit_event(joint_limits, state)
     event = user if limit is None else limit if user is None else (
         lambda q, v, t: max(user(q, v, t), limit(q, v, t)))
     samples, times = [np.concatenate([q0, v0])], [t0]
@@ -209,7 +190,7 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     began = time.perf_counter()
 
     def unit(y):  # a sample (or q) on the unit sphere too; y is dense output's own copy
-        y[3:7] /= np.linalg.norm(y[3:7])
+        state.unit(y[:nq])
         return y
 
     try:
@@ -228,7 +209,7 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
                 guarded.accepted(solver.t)
                 dense = solver.dense_output()
                 # the accepted state back on the unit sphere: |q| drifts by the step's error only
-                solver.y[3:7] /= np.linalg.norm(solver.y[3:7])
+                state.unit(solver.y[:nq])
                 t_stop, hit = solver.t, False
                 if event is not None:
                     g_new = event(solver.y[:nq], solver.y[nq:], solver.t)
@@ -273,16 +254,17 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     if status == RunStatus.STOPPED and beyond is not None:  # a joint's limit, or the condition
         y = Y[-1]
         there = None if user is None else user(y[:nq], y[nq:], t[-1])
-        joints = LoopRun(t[-1:], np.r_[y[7:nq], y[nq + 6:]][None], status, message, steps, 0)
+        joints = LoopRun(t[-1:], np.r_[state.joints_q(y[:nq]), state.joints_v(y[nq:])][None],
+                         status, message, steps, 0)
         decided = at_limit(joints, [m for m in joint_limits if m.lower is not None
                                     and m.upper is not None], beyond,
-                           None if there is None else (lambda *_: there), nq - 7)
+                           None if there is None else (lambda *_: there), state.n)
         status, message = decided.status, decided.message
     q, v = Y[:, :nq], Y[:, nq:]
     kinetic = dynamics.kinetic_energy(q, v)
     energy = kinetic + dynamics.potential_energy(q)
-    own = _joint_forces(model, system.parameters)  # the model's tau_<joint>: on the joints
-    power = v[:, 6:] @ own
+    own = state.on_joints(_joint_forces(model, system.parameters))  # the model's tau_<joint>
+    power = v @ own
     if control is not None:  # the controller's power at the samples: the work balance
         power = power + np.einsum("ij,ij->i", v, np.array([control(ti, qi, vi) for ti, qi, vi
                                                              in zip(t, q, v, strict=True)]))
@@ -299,7 +281,7 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
         work=cumulative_work(t, power) if working else None,
         velocity_names=tuple(dynamics.velocity_names),
         stop_when=stop.text if stop is not None else None,
-        limits_exceeded=exceeded_limits(joint_limits, system.parameters, t, v[:, 6:]))
+        limits_exceeded=exceeded_limits(joint_limits, system.parameters, t, state.joints_v(v)))
 
 
 def _joint_forces(model, parameters: Mapping[str, float]) -> np.ndarray:

@@ -1,0 +1,169 @@
+"""The state of a robot's tree where q and v differ in length (simulation/floating.py steps it):
+a floating base's 7 numbers (x y z, then a unit quaternion x y z w) and twist (6), and each ball
+joint's unit quaternion (w x y z, MuJoCo's order, 4 numbers) and angular velocity in the body's
+own axes (3, rad/s); every other joint one angle (rad) or length (m) and its rate.
+
+q_dot from v: the base's by its kinematics (floating.configuration_rate), a ball's
+1/2 q (x) (0, omega) (the rate of q exp(omega dt)), a joint's its own rate. The joints' numbers
+are also read in the model's coordinates (``joints_q``, ``joints_v``: a ball's three Euler
+hinges there read 0), where the position limits, the loads and the stop condition live.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..errors import InputError, ModelError, did_you_mean
+from ..model.values import resolve_state
+
+BASE_START = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)  # at the origin, unturned
+BALL_START = (1.0, 0.0, 0.0, 0.0)  # w x y z: the joint's reference orientation
+
+
+class TreeState:
+    """Where each joint's numbers sit in q (nq) and v (nv), from the dynamics' names."""
+
+    def __init__(self, dynamics, model):
+        tree = model.kinematic_tree
+        self.q_names, self.v_names = tuple(dynamics.coordinates), tuple(dynamics.velocity_names)
+        self.nq, self.nv = len(self.q_names), len(self.v_names)
+        self.floating = tree.floating_base
+        # each ball: (name, q index of its w, v index of its omega_x)
+        self.balls = tuple((j.name, tree.base_nq + j.coordinate,
+                            tree.base_nv + tree.velocity_index(j.coordinate))
+                           for j in tree.spherical)
+        self.base_q = self.q_names[:tree.base_nq]
+        self.base_v = self.v_names[:tree.base_nv]
+        self.ball_q = {n for name, iq, _ in self.balls for n in self.q_names[iq:iq + 4]}
+        self.ball_v = {n for name, _, iv in self.balls for n in self.v_names[iv:iv + 3]}
+        # the model's coordinates, and where each of the tree's own is in q and in v
+        coordinates = [c.name for c in model.coordinates]
+        self.n = len(coordinates)
+        pairs = [(i, self.q_names.index(name), self.v_names.index(name))
+                 for i, name in enumerate(coordinates) if name in self.q_names]
+        self.model_index = np.array([p[0] for p in pairs], dtype=int)
+        self.q_index = np.array([p[1] for p in pairs], dtype=int)
+        self.v_index = np.array([p[2] for p in pairs], dtype=int)
+        # a ball's Euler hinges (MJCF: <ball>__x, __y, __z): the model's, not the state's
+        self.hinges = {name: ball for ball, *_ in self.balls
+                       for name in coordinates if name.startswith(f"{ball}__")}
+        self.joint_q = self.base_q == () and not self.balls  # q is the model's coordinates
+
+    def joints_q(self, q: np.ndarray) -> np.ndarray:
+        """The model's coordinates (..., n) from q (..., nq): a ball's hinges 0."""
+        out = np.zeros(q.shape[:-1] + (self.n,))
+        out[..., self.model_index] = q[..., self.q_index]
+        return out
+
+    def joints_v(self, v: np.ndarray) -> np.ndarray:
+        """The model's coordinate rates (..., n) from v (..., nv): a ball's hinges 0."""
+        out = np.zeros(v.shape[:-1] + (self.n,))
+        out[..., self.model_index] = v[..., self.v_index]
+        return out
+
+    def on_joints(self, forces: np.ndarray) -> np.ndarray:
+        """Generalized forces on the model's coordinates (n) as v's entries (nv)."""
+        out = np.zeros(self.nv)
+        out[self.v_index] = forces[self.model_index]
+        return out
+
+    def ball_rate(self, q: np.ndarray, v: np.ndarray, rate: np.ndarray) -> None:
+        """Each ball's quaternion rate 1/2 q (x) (0, omega) into ``rate`` (w first)."""
+        for _, iq, iv in self.balls:
+            w, x, y, z = (float(c) for c in q[iq:iq + 4])
+            wx, wy, wz = (float(c) for c in v[iv:iv + 3])
+            rate[iq] = -0.5 * (x * wx + y * wy + z * wz)
+            rate[iq + 1] = 0.5 * (w * wx + y * wz - z * wy)
+            rate[iq + 2] = 0.5 * (w * wy + z * wx - x * wz)
+            rate[iq + 3] = 0.5 * (w * wz + x * wy - y * wx)
+
+    def unit(self, q: np.ndarray) -> np.ndarray:
+        """q with the base's and each ball's quaternion scaled to norm 1, in place."""
+        if self.floating:
+            q[3:7] /= np.linalg.norm(q[3:7])
+        for _, iq, _ in self.balls:
+            q[iq:iq + 4] /= np.linalg.norm(q[iq:iq + 4])
+        return q
+
+    def refuse_hinge(self, name: str, field: str) -> None:
+        """One line for a ball's Euler hinge named where the state's numbers are wanted."""
+        ball = self.hinges.get(name)
+        if ball is not None:
+            raise InputError(
+                f"'{name}' is an Euler angle of the ball joint '{ball}', which the run does not "
+                f"step: give its quaternion {ball}_qw, {ball}_qx, {ball}_qy, {ball}_qz (w x y z, "
+                f"unit) and its angular velocity {ball}_wx, {ball}_wy, {ball}_wz (rad/s, body "
+                "axes)", field=field)
+
+    def start(self, model, initial: Mapping[str, object] | None
+              ) -> tuple[float, np.ndarray, np.ndarray]:
+        """(t0, q0, v0) from ``initial``: the base's and the balls' numbers by their names
+        (default at the origin, unturned, at rest), the other joints' as for a fixed base
+        (<joint>, <joint>_dot; default the model's initial values), SI; a quaternion off unit
+        norm refused in one line naming it."""
+        from ..model.units import parse_quantity
+
+        given = dict(initial or {})
+        own = dict(zip(self.base_q, BASE_START if self.floating else (), strict=True))
+        for _, iq, _ in self.balls:
+            own.update(zip(self.q_names[iq:iq + 4], BALL_START, strict=True))
+        own.update(dict.fromkeys((*self.base_v, *self.ball_v), 0.0))
+        units = self.units()
+        joints = {}
+        for name, value in given.items():
+            if name not in own:
+                self.refuse_hinge(name, f"initial.{name}")
+                joints[name] = value
+                continue
+            try:
+                own[name] = parse_quantity(value, units[name], f"initial.{name}") \
+                    if isinstance(value, str) else float(value)
+            except (TypeError, ValueError):
+                raise InputError(f"{name}: {value!r} is not a number (SI units)",
+                                 field="initial") from None
+        try:
+            start = resolve_state(model, joints, field="initial",
+                                  what="coordinate or velocity (or t)")
+        except (InputError, ModelError):
+            known = [*self.q_names, *self.v_names, "t"]
+            unknown = next((k for k in joints if k != "t" and k not in known
+                            and k.removesuffix("_dot") not in known), None)
+            if unknown is None:
+                raise
+            raise InputError(f"'{unknown}' is not a coordinate or velocity of this robot"
+                             f"{did_you_mean(unknown, known)}", field="initial") from None
+        q_model, v_model = start.q_array(), start.q_dot_array()
+        q0 = np.array([own.get(name, 0.0) for name in self.q_names], dtype=float)
+        v0 = np.array([own.get(name, 0.0) for name in self.v_names], dtype=float)
+        q0[self.q_index] = q_model[self.model_index]
+        v0[self.v_index] = v_model[self.model_index]
+        self.check_unit(q0, "initial")
+        return start.t, self.unit(q0), v0
+
+    def units(self) -> dict[str, str]:
+        """The unit of each base and ball number (a quaternion's: 1)."""
+        out = {}
+        if self.floating:
+            out.update(zip(self.base_q, ("m",) * 3 + ("1",) * 4, strict=True))
+            out.update(zip(self.base_v, ("m/s",) * 3 + ("rad/s",) * 3, strict=True))
+        out.update({**dict.fromkeys(self.ball_q, "1"), **dict.fromkeys(self.ball_v, "rad/s")})
+        return out
+
+    def check_unit(self, q: np.ndarray, field: str) -> None:
+        """Refuse a base or ball quaternion whose norm is off 1 by more than the tolerance."""
+        from ..model.quaternions import QUATERNION_TOLERANCE, check_quaternions
+
+        if self.floating:
+            check_quaternions(q[None], field=field)
+        for name, iq, _ in self.balls:
+            norm = float(np.linalg.norm(q[iq:iq + 4]))
+            if not abs(norm - 1.0) <= QUATERNION_TOLERANCE:
+                raise InputError(
+                    f"the ball joint '{name}' quaternion ({', '.join(self.q_names[iq:iq + 4])})"
+                    f" has norm {norm:.9g}; a unit quaternion is needed (|q| within "
+                    f"{QUATERNION_TOLERANCE:g} of 1)", field=field)
+
+
+__all__ = ["BALL_START", "BASE_START", "TreeState"]

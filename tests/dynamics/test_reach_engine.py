@@ -2,7 +2,8 @@
 a floating base run on the same module object, the second and third writing nothing into the
 compiled cache, their frame Jacobians against Pinocchio's computeFrameJacobian; a tree of 120
 joints (branches, tilted axes, sliders) on one state and on threads' batches against the numpy
-twins (frames.py, centroidal.py); tables that describe no tree refused in one line."""
+twins (frames.py, centroidal.py); a description or tables that describe no tree refused in one
+line."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import pytest
 import lagrangian
 from lagrangian.compile import compiled
 from lagrangian.dynamics.engine.reach_c import ReachKernel, engine, reach_module, tables
+from lagrangian.dynamics.tree.description import HEADER, STRIDE, describe
 from robot_data import robots
 
 pytest.importorskip("yourdfpy")
@@ -141,17 +143,21 @@ def test_a_large_trees_jacobian_and_centroidal_matrix_agree_with_numpy(big):
 
 def test_tables_that_describe_no_tree_are_refused(big):
     ours, kernel = big
-    ints, floats = tables(ours.tree)
+    D, (ints, floats) = describe(ours.tree, {}), tables(ours.tree)
     module, index = kernel.module, kernel.frame_index
-    bad_parent = ints.copy()
-    bad_parent[6 + 5] = 9  # body 5's parent after it
-    for args, match in [((ints[:-1], floats), "sizes"), ((ints, floats[:-1]), "sizes"),
-                        ((bad_parent, floats), "tree"), ((ints[:4], floats), "header")]:
+    bad_parent = D.copy()
+    bad_parent[HEADER + int(D[1]) + 5 * STRIDE] = 9  # body 5's parent after it
+    bad_frame = ints.copy()
+    bad_frame[3] = 10 ** 6  # frame 0 on no body
+    for args, match in [((D, ints[:-1], floats), "sizes"), ((D, ints, floats[:-1]), "sizes"),
+                        ((bad_parent, ints, floats), "description"), ((D[:-1], ints, floats),
+                                                                      "description"),
+                        ((D, bad_frame, floats), "frame"), ((D, ints[:2], floats), "header")]:
         with pytest.raises(ValueError, match=match):
             module.tree(*args, index)
     spoilt = floats.copy()
     spoilt[10] = np.nan
     with pytest.raises(ValueError, match="finite"):
-        module.tree(ints, spoilt, index)
+        module.tree(D, ints, spoilt, index)
     with pytest.raises(TypeError):
-        module.tree(ints, floats, list(index))
+        module.tree(D, ints, floats, list(index))

@@ -4,8 +4,9 @@ mass, centre of mass or inertia changes without a rebuild.
 
 The tree reaches it as one array D (its layout and ``describe``: tree/description.py).
 
-A new joint kind is a new code in JOINT_CODES and its cases in tree_kernel.c (tk_place for the
-placement, tk_subspace for S); the recursions themselves ask only for those. The module
+A new joint kind is a new code in JOINT_CODES and its branch in joint.h (jt_place for the
+placement, tk_subspace for S), which the reach and derivatives modules read too; the recursions
+themselves ask only for those. The module
 (tree_kernel.c, tree_kernel_forward.c, then its Python bindings tree_kernel_bindings.c) is keyed
 by its source alone, never the tree's numbers. The recursions are compiled twice, on one state
 and on LG_LANES states at once (a batch's several states per vector instruction), from one text.
@@ -16,6 +17,8 @@ from __future__ import annotations
 import hashlib
 from functools import lru_cache
 from pathlib import Path
+
+from .headers import HEADERS, spliced
 
 # the recursions (forward dynamics in a file of its own), the thread count shared with the other
 # modules, then the batched Python bindings (one translation unit)
@@ -66,8 +69,8 @@ def _source() -> str:
     head, core = first.split("/* TK_CORE_BEGIN */")
     before, after = head.split("/* TK_SINCOS */")
     core = "\n".join([core, forward])
-    return "\n".join([before, _SINCOS, _VECTOR, after, _SCALAR, core, _LANES, core, threads,
-                      bindings])
+    return spliced("\n".join([before, _SINCOS, _VECTOR, after, _SCALAR, core, _LANES, core,
+                               threads, bindings]))
 
 
 @lru_cache(maxsize=1)
@@ -75,10 +78,9 @@ def kernel_key() -> str:
     """The module's key: its C source (and this file), never a tree."""
     here = Path(__file__)
     return "compact-tree-kernel\n" + hashlib.sha256(
-        b"".join(path.read_bytes() for path in (*_SOURCES, here, here.parents[1] / "emit" /
-                                                "tree_c.py", here.parents[1] / "tree" /
-                                                "description.py")
-                 )).hexdigest()
+        b"".join(path.read_bytes() for path in (*_SOURCES, *HEADERS, here, here.parents[1] /
+                                                "emit" / "tree_c.py", here.parents[1] / "tree"
+                                                / "description.py"))).hexdigest()
 
 
 def kernel_module():

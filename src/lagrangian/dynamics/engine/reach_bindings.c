@@ -1,6 +1,6 @@
 /* Python bindings of reach_kernel.c's functions (frames, C(q, v), A_g, wrenches, inverse
- * dynamics): tree(INTS, FLOATS, INDEX) reads a tree's tables once (reach_c.py's layout) into a
- * Tree, whose methods take arrays (..., n) of float64, checked and handed to reach_batch.c's
+ * dynamics): tree(D, INTS, FLOATS, INDEX) reads a tree's description and tables once (their
+ * layouts: tree/description.py, reach_c.py) into a Tree, whose methods take arrays (..., n) of float64, checked and handed to reach_batch.c's
  * batches; a method returns its output, or (output, count of NaN rows) where some state's
  * inputs are not all finite. */
 
@@ -335,70 +335,73 @@ static PyTypeObject rk_tree_type = {
     .tp_methods = rk_tree_methods,
 };
 
-/* md from INTS (C int) and FLOATS (float64), reach_c.py's layout, copied into one block of its
+/* md from the description D (float64, tree/description.py's layout: joint.h's tk_open checks
+ * it), INTS (C int) and FLOATS (float64) of reach_c.py's layout, copied into one block of its
  * own (*tables; md's arrays point into it); 0 with ValueError where they are not a tree's */
-static int rk_model_from(PyObject *ints, PyObject *floats, rk_model *md, void **tables)
+static int rk_model_from(PyObject *description, PyObject *ints, PyObject *floats, rk_model *md,
+                         void **tables)
 {
-    PyArrayObject *Ia = (PyArrayObject *)PyArray_FROMANY(ints, NPY_INT, 1, 1, NPY_ARRAY_IN_ARRAY);
+    PyArrayObject *Da = (PyArrayObject *)PyArray_FROMANY(description, NPY_DOUBLE, 1, 1,
+                                                         NPY_ARRAY_IN_ARRAY);
+    PyArrayObject *Ia = Da ? (PyArrayObject *)PyArray_FROMANY(ints, NPY_INT, 1, 1,
+                                                              NPY_ARRAY_IN_ARRAY) : NULL;
     PyArrayObject *Fa = Ia ? (PyArrayObject *)PyArray_FROMANY(floats, NPY_DOUBLE, 1, 1,
                                                             NPY_ARRAY_IN_ARRAY) : NULL;
     const char *fault = NULL;
     *tables = NULL;
     if (!Fa) goto done;
-    const npy_intp ni = PyArray_SIZE(Ia), nd = PyArray_SIZE(Fa);
+    const npy_intp nD = PyArray_SIZE(Da), ni = PyArray_SIZE(Ia), nd = PyArray_SIZE(Fa);
+    tk_tree t;
+    if (tk_open(PyArray_DATA(Da), nD, &t)) { fault = "D: not a tree description"; goto done; }
+    if (t.balls) { fault = "D: a ball joint (not in the reach module yet)"; goto done; }
     const int *head = PyArray_DATA(Ia);
-    if (ni < 6) { fault = "INTS: no header"; goto done; }
-    const int nb = head[0], n = head[1], fb = head[2], nf = head[3];
-    if (nb < 1 || nb > RK_MAX_BODIES || n < 0 || n > nb || (fb != 0 && fb != 1) || nf < 0
-            || nf > RK_MAX_BODIES || (head[4] != 0 && head[4] != 1)) {
+    if (ni < 3) { fault = "INTS: no header"; goto done; }
+    const int nb = t.nb, n = t.n, fb = t.fb, nf = head[0];
+    if (nb > RK_MAX_BODIES || nf < 0 || nf > RK_MAX_BODIES || (head[1] != 0 && head[1] != 1)) {
         fault = "INTS: not a tree's header";
         goto done;
     }
-    const long long nv = 6 * fb + n;
-    if (head[5] < 0 || head[5] > nv * nv) { fault = "INTS: not a tree's header"; goto done; }
-    if (ni != 6 + 7LL * nb + nf + head[5] || nd != 2 + 58LL * nb + 12LL * nf) {
+    const long long nv = t.nv;
+    if (head[2] < 0 || head[2] > nv * nv) { fault = "INTS: not a tree's header"; goto done; }
+    if (ni != 3LL + nf + head[2] || nd != 2 + 12LL * nf) {
         fault = "INTS, FLOATS: not of the header's sizes";
         goto done;
     }
-    double *d = malloc((size_t)nd * sizeof(double) + (size_t)ni * sizeof(int));
+    /* the description's copy, the frames' numbers, then per body mult, m, h (3), J (9) */
+    const size_t doubles = (size_t)nD + (size_t)nd + 14 * (size_t)nb;
+    double *d = malloc(doubles * sizeof(double) + ((size_t)ni + 2 * (size_t)nb) * sizeof(int));
     if (!d) { PyErr_NoMemory(); goto done; }
     *tables = d;
-    int *a = (int *)(d + nd);
-    memcpy(d, PyArray_DATA(Fa), (size_t)nd * sizeof(double));
+    memcpy(d, PyArray_DATA(Da), (size_t)nD * sizeof(double));
+    tk_open(d, nD, &t);  /* the same numbers: checked above */
+    double *fr = d + nD, *per = fr + nd;
+    int *a = (int *)(d + doubles);
+    memcpy(fr, PyArray_DATA(Fa), (size_t)nd * sizeof(double));
     memcpy(a, head, (size_t)ni * sizeof(int));
-    *md = (rk_model){.nb = nb, .n = n, .fb = fb, .nf = nf, .cset = a[4], .nczero = a[5],
-                     .bq = 7 * fb, .bv = 6 * fb, .nq = 7 * fb + n, .nv = (int)nv};
-    a += 6;
-    const int **ia[] = {&md->parent, &md->coord, &md->turns, &md->slides, &md->axis, &md->R0id,
-                        &md->R0axis};
-    for (int k = 0; k < 7; k++, a += nb) *ia[k] = a;
-    md->fbody = a;
-    md->czero = a + nf;
-    md->qlow = d[0], md->qhigh = d[1];
-    d += 2;
-    const double **da[] = {&md->mult, &md->off, &md->axsign, &md->m, &md->t0, &md->u, &md->h,
-                           &md->R0, &md->P, &md->C, &md->S, &md->J};
-    for (int k = 0; k < 12; k++) {
-        *da[k] = d;
-        d += (k < 4 ? 1 : k < 7 ? 3 : 9) * (size_t)nb;
-    }
-    md->fR = d;
-    md->ft = d + 9 * (size_t)nf;
-    for (npy_intp k = 0; k < nd; k++)
-        if (!isfinite(((const double *)*tables)[k])) {
-            fault = "FLOATS: not all finite";
-            goto done;
-        }
+    *md = (rk_model){.nb = nb, .n = n, .fb = fb, .nf = nf, .cset = a[1], .nczero = a[2],
+                     .bq = t.bq, .bv = t.bv, .nq = t.nq, .nv = t.nv, .t = t};
+    md->fbody = a + 3;
+    md->czero = a + 3 + nf;
+    int *parent = a + ni, *coord = parent + nb;
+    double *mult = per, *m = per + nb, *h = per + 2 * (size_t)nb, *J = per + 5 * (size_t)nb;
     for (int i = 0; i < nb; i++) {
-        const int free = fb && i == 0, p = md->parent[i];
-        if (p < -1 || p >= i || (free && p != -1) || md->axis[i] < -1 || md->axis[i] > 2
-                || md->R0axis[i] < -1 || md->R0axis[i] > 2
-                || (!free && (md->coord[i] < 0 || md->coord[i] >= n))
-                || (free && (md->turns[i] || md->slides[i]))) {
-            fault = "INTS: a body not of a tree";
+        const double *b = t.body + (size_t)i * TK_STRIDE;
+        parent[i] = (int)b[TK_PARENT];
+        coord[i] = TK_FREE(b) ? 0 : (int)b[TK_COORD];
+        mult[i] = b[TK_MULT];
+        m[i] = b[TK_MASS];
+        for (int j = 0; j < 3; j++) h[3 * i + j] = b[TK_H + j];
+        for (int j = 0; j < 9; j++) J[9 * i + j] = b[TK_J + j];
+    }
+    md->parent = parent, md->coord = coord, md->mult = mult, md->m = m, md->h = h, md->J = J;
+    md->qlow = fr[0], md->qhigh = fr[1];
+    md->fR = fr + 2;
+    md->ft = fr + 2 + 9 * (size_t)nf;
+    for (size_t k = 0; k < (size_t)nD + (size_t)nd; k++)
+        if (!isfinite(d[k])) {
+            fault = "D, FLOATS: not all finite";
             goto done;
         }
-    }
     for (int f = 0; f < nf; f++)
         if (md->fbody[f] < -1 || md->fbody[f] >= nb) { fault = "INTS: a frame's body"; goto done; }
     for (int j = 0; j < md->nczero; j++)
@@ -407,6 +410,7 @@ static int rk_model_from(PyObject *ints, PyObject *floats, rk_model *md, void **
             goto done;
         }
 done:
+    Py_XDECREF(Da);
     Py_XDECREF(Ia);
     Py_XDECREF(Fa);
     if (fault) PyErr_SetString(PyExc_ValueError, fault);
@@ -418,29 +422,30 @@ done:
     return 1;
 }
 
-/* tree(INTS, FLOATS, INDEX) -> Tree: the tables read once, INDEX {frame name: frame number} */
+/* tree(D, INTS, FLOATS, INDEX) -> Tree: the description and tables read once, INDEX {frame
+ * name: frame number} */
 static PyObject *rk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
-    if (nargs != 3 || !PyDict_Check(args[2])) {
-        PyErr_SetString(PyExc_TypeError, "tree(INTS, FLOATS, INDEX): INDEX a dict");
+    if (nargs != 4 || !PyDict_Check(args[3])) {
+        PyErr_SetString(PyExc_TypeError, "tree(D, INTS, FLOATS, INDEX): INDEX a dict");
         return NULL;
     }
     rk_model md;
     void *tables;
-    if (!rk_model_from(args[0], args[1], &md, &tables)) return NULL;
+    if (!rk_model_from(args[0], args[1], args[2], &md, &tables)) return NULL;
     md.work1 = rk_work_size(&md);
     rk_tree *t = PyObject_New(rk_tree, &rk_tree_type);
     if (!t) { free(tables); return NULL; }
     t->md = md;
     t->tables = tables;
-    Py_INCREF(args[2]);
-    t->index = args[2];
+    Py_INCREF(args[3]);
+    t->index = args[3];
     return (PyObject *)t;
 }
 
 static PyMethodDef rk_methods[] = {
-    {"tree", RK_FAST(tree), "(INTS, FLOATS, INDEX) -> Tree, its methods the reach functions"},
+    {"tree", RK_FAST(tree), "(D, INTS, FLOATS, INDEX) -> Tree, its methods the reach functions"},
     {NULL, NULL, 0, NULL},
 };
 

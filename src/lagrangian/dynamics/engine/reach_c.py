@@ -1,31 +1,24 @@
 """J_dot q_dot, the centroidal momentum matrix, wrenches' generalized forces and a floating
 base's C(q, v) in compiled C, for the C backend's speed per call: ONE module per installation
-(reach_kernel.c and the files after it, keyed by their text and this file's alone), every tree
-given at run time as two tables built once here (``tables``) and read once by the module's
-``tree(INTS, FLOATS, INDEX)``, whose methods are the functions. centroidal.py, wrenches.py and
-coriolis_tree.py are the same formulas in numpy, used without a compiler and to name every bad
-input.
+(reach_kernel.c and the files after it, with joint.h and spatial.h, keyed by their text and
+this file's alone), every tree given at run time as its description D (tree/description.py,
+the tree kernel's: each joint in canonical axes, placed by joint.h) and two small tables built
+once here (``tables``), read once by the module's ``tree(D, INTS, FLOATS, INDEX)``, whose
+methods are the functions. centroidal.py, wrenches.py and coriolis_tree.py are the same
+formulas in numpy, used without a compiler and to name every bad input.
 
-The tables of a tree of nb bodies (its joints in order, a parent before its children), n joint
-coordinates, nf frames, fb 1 for a floating base (body 0 on a free flyer), nv = 6 fb + n:
+The tables of a tree of nv velocity numbers with nf frames:
 
-- INTS (C int): nb, n, fb, nf, cset, nczero; then nb each: parent (-1: the ground),
-  coordinate (a free flyer's 0, unused), turns, slides (0 or 1: a free flyer neither), axis
-  (k where the axis is +-e_k exactly, else -1), R0-is-identity (0 or 1), R0's axis (j where R0
-  is exactly a turn about e_j, else -1); then nf frame bodies (-1: the ground); then the
-  nczero entries of C (row-major, nv x nv) that no body's pass sets. cset is 1 where no mimic
-  joint shares a coordinate (each entry of C, A_g, J set once), else 0 (all zeroed, added to).
-- FLOATS (float64): the quaternion's bounds on |q|^2, (1 -+ QUATERNION_TOLERANCE)^2; then nb
-  each: multiplier, offset (rad or m), the axis' sign (a joint that only turns) or the lead
-  of one that slides (its slide along u per unit of its variable: 1 prismatic, the pitch in
-  m/rad helical, which turns and slides), mass (kg); then 3 a body: the joint's
-  translation t0 in its parent (m), axis u, first moment h (kg m); then 9 a body (row-major):
-  R0, the turn tables P = R0 u u^T, C = R0 (1 - u u^T), S = R0 [u]x (R0 Rot(u, th) = P +
-  cos th C + sin th S), rotational inertia J (kg m^2, about the body's origin); then the
-  frames' rotations (9 each) and translations (3 each, m) in their bodies.
+- INTS (C int): nf, cset, nczero; then nf frame bodies (-1: the ground); then the nczero
+  entries of C (row-major, nv x nv) that no body's pass sets. cset is 1 where no mimic joint
+  shares a coordinate (each entry of C, A_g, J set once), else 0 (all zeroed, added to).
+- FLOATS (float64): the quaternion's bounds on |q|^2, (1 -+ QUATERNION_TOLERANCE)^2; then the
+  frames' rotations (9 each, row-major) and translations (3 each, m) in their bodies' canonical
+  axes (description.canonical_frame).
 
 INDEX, {frame name: frame number}, names the frames for the Tree's methods. reach_bindings.c
-checks the tables once (sizes, a parent before its child, indices in range, numbers finite).
+checks D and the tables once (sizes, a parent before its child, indices in range, numbers
+finite).
 """
 
 from __future__ import annotations
@@ -38,8 +31,9 @@ import numpy as np
 
 from ...model.tree import KinematicTree
 from ..emit.tree_c import _SINCOS, _VECTOR
+from ..tree.description import canonical_frame, describe
 from ..tree.free_flyer import QUATERNION_TOLERANCE
-from ..tree.joint_models import joint_model
+from .headers import header_bytes, spliced
 
 # the walks, frames and the centre of mass, C(q, v), inverse dynamics with wrenches, then the
 # batches and the Python bindings: one module's C, in this order; the first four's core (from
@@ -64,46 +58,6 @@ _LANES = """#undef RK_T
 #define RK_FN(name) rk4_##name
 #define RK_C(x) LG_V4(x)
 #define RK_SINCOS lg_vsincos_inline"""
-
-
-def _turn_tables(joints) -> tuple[list, list, list]:
-    """R0 u u^T, R0 (1 - u u^T) and R0 [u]x per joint: R0 Rot(u, th) = P + cos th C + sin th S."""
-    P, C, S = [], [], []
-    for j in joints:
-        R0, u = np.array(j.rotation, dtype=float), np.array(j.axis, dtype=float)
-        uu = np.outer(u, u)
-        skew = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
-        P.append(R0 @ uu)
-        C.append(R0 @ (np.eye(3) - uu))
-        S.append(R0 @ skew)
-    return P, C, S
-
-
-def _turned_about(R: np.ndarray) -> int:
-    """j where R is exactly a turn about e_j, [[1, 0, 0], [0, c, -s], [0, s, c]] cyclically
-    (a URDF rpy of one angle), else -1."""
-    for j in range(3):
-        a, b = (j + 1) % 3, (j + 2) % 3
-        if (R[j, j] == 1.0 and not R[j, a] and not R[j, b] and not R[a, j] and not R[b, j]
-                and R[a, a] == R[b, b] and R[a, b] == -R[b, a]):
-            return j
-    return -1
-
-
-def _axes(joints) -> tuple[list[int], list[float], list[bool], list[int]]:
-    """Per joint: k where its axis is +-e_k exactly (else -1), that sign, whether its R0 is
-    exactly 1, and j where it is a turn about e_j: there R0 Rot(e_k, th) is two turns of two
-    columns each (reach_kernel.c's body)."""
-    axis, sign, plain, about = [], [], [], []
-    for j in joints:
-        u = [float(x) for x in j.axis]
-        k = next((k for k in range(3) if abs(u[k]) == 1.0 and u[k - 1] == u[k - 2] == 0.0), -1)
-        axis.append(k)
-        sign.append(u[k] if k >= 0 else 1.0)
-        R0 = np.array(j.rotation, dtype=float)
-        plain.append(np.array_equal(R0, np.eye(3)))
-        about.append(_turned_about(R0))
-    return axis, sign, plain, about
 
 
 def _coriolis_zeros(tree: KinematicTree) -> tuple[bool, list[int]]:
@@ -132,33 +86,18 @@ def _coriolis_zeros(tree: KinematicTree) -> tuple[bool, list[int]]:
 
 def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
     """The tree's INTS and FLOATS (this module's docstring), for the module's ``tree``."""
-    joints, frames = tree.joints, tree.frames
-    free = tree.floating_base
-    models = [joint_model(j.kind) for j in joints]
-    axis, sign, plain, about = _axes(joints)
-    # a sliding joint's slot of the sign holds its lead (reach_kernel.c's RK_LEAD)
-    sign = [m.lead(j.pitch) if getattr(m, "slides", False) else s
-            for m, j, s in zip(models, joints, sign, strict=True)]
+    frames = tree.frames
     cset, zeros = _coriolis_zeros(tree)
-    # a free flyer has no coordinate of the tree's (its column 0 unused)
-    coordinate = [0 if free and i == 0 else j.coordinate for i, j in enumerate(joints)]
-    ints = [len(joints), len(tree.coordinates), int(free), len(frames), int(cset), len(zeros),
-            *(j.parent for j in joints), *coordinate,
-            *(int(getattr(m, "turns", False)) for m in models),
-            *(int(getattr(m, "slides", False)) for m in models),
-            *axis, *map(int, plain), *about, *(f.body for f in frames), *zeros]
+    ints = [len(frames), int(cset), len(zeros), *(f.body for f in frames), *zeros]
+    # a frame in its body's canonical axes, as D holds the body (A^T R_f, A^T t_f)
+    axes = [canonical_frame(tree.joints[f.body]) if f.body >= 0 else np.eye(3) for f in frames]
+    rotations = [A.T @ np.array(f.rotation, dtype=float) for A, f in zip(axes, frames, strict=True)]
+    translations = [A.T @ np.array(f.translation, dtype=float)
+                    for A, f in zip(axes, frames, strict=True)]
     # |quaternion|^2 within (1 -+ QUATERNION_TOLERANCE)^2, else numpy names the fault
     floats = [np.array([(1 - QUATERNION_TOLERANCE) ** 2, (1 + QUATERNION_TOLERANCE) ** 2]),
-              *(np.array([getattr(j, name) for j in joints], dtype=float)
-                for name in ("multiplier", "offset")),
-              np.array(sign), np.array([j.mass for j in joints], dtype=float)]
-    floats += [np.array([getattr(j, name) for j in joints], dtype=float).reshape(-1)
-               for name in ("translation", "axis", "first_moment")]
-    floats += [np.array(x, dtype=float).reshape(-1)
-               for x in ([j.rotation for j in joints], *_turn_tables(joints),
-                         [j.inertia for j in joints])]
-    floats += [np.array([f.rotation for f in frames], dtype=float).reshape(-1),
-               np.array([f.translation for f in frames], dtype=float).reshape(-1)]
+              np.array(rotations, dtype=float).reshape(-1),
+              np.array(translations, dtype=float).reshape(-1)]
     return np.array(ints, dtype=np.intc), np.concatenate(floats)
 
 
@@ -179,14 +118,14 @@ def kernel_source():
     texts = [path.read_text(encoding="utf-8") for path in _KERNELS]
     head, first = texts[0].split("/* RK_CORE_BEGIN */")
     core = "\n".join([first, *texts[1:_CORE]])
-    source = "\n".join([source, head, _SCALAR, core, _LANES, core, *texts[_CORE:]])
+    source = spliced("\n".join([source, head, _SCALAR, core, _LANES, core, *texts[_CORE:]]))
     return GeneratedSource(source=source, parameters=(), n=0, m=0)
 
 
 @lru_cache(maxsize=1)
 def _key() -> str:
     """The module's cache key: its C's text and this generator's, no tree's."""
-    text = kernel_source().source.encode() + Path(__file__).read_bytes()
+    text = kernel_source().source.encode() + Path(__file__).read_bytes() + header_bytes()
     return "reach engine\n" + hashlib.sha256(text).hexdigest()
 
 
@@ -220,9 +159,11 @@ class ReachKernel:
     def __init__(self, module, tree: KinematicTree, massive: bool):
         self.module = module
         self.frame_index = {f.name: k for k, f in enumerate(tree.frames)}
-        # the tree's tables read once into the module's Tree (reach_bindings.c); its methods
+        # the tree's description (gravity and actuators unused: 0) and tables read once into
+        # the module's Tree (reach_bindings.c); its methods
         # bound here once: each call then goes straight to C
-        self.compiled = compiled = module.tree(*tables(tree), self.frame_index)
+        self.compiled = compiled = module.tree(describe(tree, {}), *tables(tree),
+                                               self.frame_index)
         # placement(Q, frame), jacobian(Q, frame, reference) and drift(Q, V, frame, reference)
         # with the frame and reference looked up by name in C: in Python the lookups cost a
         # single Jacobian's call a sixth of its time

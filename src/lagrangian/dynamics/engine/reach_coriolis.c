@@ -10,9 +10,9 @@
 static inline void RK_FN(motion_cross)(const RK_T *V, const RK_T *s, RK_T *out)
 {
     RK_T a[3], b[3], c[3];
-    RK_FN(cross)(V + 3, s, a);
-    RK_FN(cross)(V, s + 3, b);
-    RK_FN(cross)(V + 3, s + 3, c);
+    SP_CROSS(V + 3, s, a);
+    SP_CROSS(V, s + 3, b);
+    SP_CROSS(V + 3, s + 3, c);
     for (int j = 0; j < 3; j++) { out[j] = a[j] + b[j]; out[3 + j] = c[j]; }
 }
 
@@ -44,8 +44,8 @@ static size_t RK_FN(cwork_size)(const rk_model *md)
 static inline void RK_FN(inertia_times)(const RK_FN(cbody) *b, const RK_T *x, RK_T *out)
 {
     RK_T s[3], t[3];
-    RK_FN(cross)(b->h, x + 3, s);
-    RK_FN(cross)(b->h, x, t);
+    SP_CROSS(b->h, x + 3, s);
+    SP_CROSS(b->h, x, t);
     for (int j = 0; j < 3; j++) {
         out[j] = b->m * x[j] - s[j];
         out[3 + j] = t[j] + b->J[3 * j] * x[3] + b->J[3 * j + 1] * x[4] + b->J[3 * j + 2] * x[5];
@@ -83,8 +83,8 @@ static void RK_FN(coriolis)(const rk_model *md, RK_FN(work) *space, const RK_T *
         RK_T hr[3], RJ[9];
         const double m = md->m[i];
         const RK_T *x = o[i];
-        RK_FN(apply_v)(R[i], md->h + 3 * i, hr);
-        RK_FN(matmul_v)(R[i], md->J + 9 * i, RJ);
+        SP_APPLY(R[i], md->h + 3 * i, hr);
+        SP_MATMUL(R[i], md->J + 9 * i, RJ);
         RK_T pp = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
         RK_T ph = x[0] * hr[0] + x[1] * hr[1] + x[2] * hr[2];
         bi->m = m;
@@ -102,7 +102,7 @@ static void RK_FN(coriolis)(const rk_model *md, RK_FN(work) *space, const RK_T *
         for (int j = 0; j < 3; j++) bi->l[j] = f[j];
         for (int c = 0; c < 3; c++) {  /* [w]x J, column by column */
             RK_T col[3] = {J[c], J[3 + c], J[6 + c]}, t[3];
-            RK_FN(cross)(w, col, t);
+            SP_CROSS(w, col, t);
             for (int j = 0; j < 3; j++) WJ[3 * j + c] = t[j];
         }
         RK_T vh = v[0] * h[0] + v[1] * h[1] + v[2] * h[2];
@@ -125,8 +125,8 @@ static void RK_FN(coriolis)(const rk_model *md, RK_FN(work) *space, const RK_T *
             RK_T t[3], u[3];
             RK_FN(inertia_times)(bi, dSi[c], own[c]);
             RK_FN(inertia_times)(bi, s, rowI[c]);
-            RK_FN(cross)(bi->l, s + 3, t);  /* B s = [-l x s_w; A s_w] */
-            RK_FN(cross)(bi->l, s, u);
+            SP_CROSS(bi->l, s + 3, t);  /* B s = [-l x s_w; A s_w] */
+            SP_CROSS(bi->l, s, u);
             for (int j = 0; j < 3; j++) {
                 own[c][j] -= t[j];
                 own[c][3 + j] += bi->A[3 * j] * s[3] + bi->A[3 * j + 1] * s[4]

@@ -48,13 +48,13 @@ static void RK_FN(jacobian)(const rk_model *md, RK_FN(work) *work, const RK_T *q
             RK_T v[3], w[3], t[3];
             for (int j = 0; j < 3; j++) { v[j] = S[j]; w[j] = S[3 + j]; }
             if (ref != 0) {
-                RK_FN(cross)(w, p, t);
+                SP_CROSS(w, p, t);
                 for (int j = 0; j < 3; j++) v[j] += t[j];
             }
             if (ref == 1) {
-                RK_FN(apply_t)(Rf, v, t);
+                SP_APPLY_T(Rf, v, t);
                 for (int j = 0; j < 3; j++) v[j] = t[j];
-                RK_FN(apply_t)(Rf, w, t);
+                SP_APPLY_T(Rf, w, t);
                 for (int j = 0; j < 3; j++) w[j] = t[j];
             }
             const int c = first + col;
@@ -81,7 +81,7 @@ static double RK_FN(moments)(const rk_model *md, const RK_T *q, RK_T (*R)[9], RK
     double total = 0.0;
     for (int i = 0; i < md->nb; i++) {
         RK_T hr[3];
-        RK_FN(apply_v)(R[i], md->h + 3 * i, hr);
+        SP_APPLY(R[i], md->h + 3 * i, hr);
         for (int j = 0; j < 3; j++) H[i][j] = md->m[i] * o[i][j] + hr[j];
         mass[i] = md->m[i];
         total += md->m[i];
@@ -125,7 +125,7 @@ static void RK_FN(com_jacobian)(const rk_model *md, RK_FN(work) *work, const RK_
         const int columns = RK_FN(columns)(md, i, R, o, F, &first, &mult);
         for (int col = 0; col < columns; col++) {
             RK_T l[3];
-            RK_FN(cross)(F[col] + 3, H[i], l);
+            SP_CROSS(F[col] + 3, H[i], l);
             for (int j = 0; j < 3; j++)
                 RK_CPUT(out[j * md->nv + first + col], mult * (mass[i] * F[col][j] + l[j]) / total);
         }

@@ -9,11 +9,11 @@ static inline void RK_FN(inertia_at)(const rk_model *md, int i, const RK_T *R, c
                                      const RK_T *X, RK_T *out)
 {
     RK_T t[3], u[3], hxa[3], ahx[3];
-    RK_FN(apply_t)(R, X + 3, t);
-    RK_FN(apply_k)(md->J + 9 * i, t, u);
-    RK_FN(apply)(R, u, t);
-    RK_FN(cross)(X + 3, h, ahx);  /* -h x alpha */
-    RK_FN(cross)(h, X, hxa);
+    SP_APPLY_T(R, X + 3, t);
+    SP_APPLY(md->J + 9 * i, t, u);
+    SP_APPLY(R, u, t);
+    SP_CROSS(X + 3, h, ahx);  /* -h x alpha */
+    SP_CROSS(h, X, hxa);
     for (int j = 0; j < 3; j++) {
         out[j] = md->m[i] * X[j] + ahx[j];
         out[3 + j] = hxa[j] + t[j];
@@ -61,21 +61,21 @@ static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *re
          * arms: motions there [v + w x o; w]), V x* [f; n] = [w x f; w x n + v x f], then
          * carried to the world's origin: [f; n + o x f] */
         RK_T h[3], Vo[6], Ao[6], IV[6], f[6], t1[3], t2[3];
-        RK_FN(apply_v)(R[i], md->h + 3 * i, h);
-        RK_FN(cross)(V[i] + 3, o[i], t1);
-        RK_FN(cross)(A[i] + 3, o[i], t2);
+        SP_APPLY(R[i], md->h + 3 * i, h);
+        SP_CROSS(V[i] + 3, o[i], t1);
+        SP_CROSS(A[i] + 3, o[i], t2);
         for (int j = 0; j < 3; j++) {
             Vo[j] = V[i][j] + t1[j], Vo[3 + j] = V[i][3 + j];
             Ao[j] = A[i][j] + t2[j], Ao[3 + j] = A[i][3 + j];
         }
         RK_FN(inertia_at)(md, i, R[i], h, Ao, f);
         RK_FN(inertia_at)(md, i, R[i], h, Vo, IV);
-        RK_FN(cross)(Vo + 3, IV, t1);
+        SP_CROSS(Vo + 3, IV, t1);
         for (int j = 0; j < 3; j++) f[j] += t1[j];
-        RK_FN(cross)(Vo + 3, IV + 3, t1);
-        RK_FN(cross)(Vo, IV, t2);
+        SP_CROSS(Vo + 3, IV + 3, t1);
+        SP_CROSS(Vo, IV, t2);
         for (int j = 0; j < 3; j++) f[3 + j] += t1[j] + t2[j];
-        RK_FN(cross)(o[i], f, t1);
+        SP_CROSS(o[i], f, t1);
         for (int j = 0; j < 3; j++) F[i][j] = f[j], F[i][3 + j] = f[3 + j] + t1[j];
     }
     for (int k = 0; k < nw; k++) {  /* the wrench carried to the world's origin: [f; m + p x f] */
@@ -83,7 +83,7 @@ static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *re
         if (b < 0) continue;  /* on the ground: no joint feels it */
         RK_T x[3], m[3];
         RK_FN(frame_origin)(md, frames[k], R, o, x);
-        RK_FN(cross)(x, w[k], m);
+        SP_CROSS(x, w[k], m);
         for (int j = 0; j < 3; j++) {
             F[b][j] -= w[k][j];
             F[b][3 + j] -= w[k][3 + j] + m[j];

@@ -1,10 +1,15 @@
 /* J_dot q_dot of a frame, the centroidal momentum matrix, a wrench's generalized forces and
- * C(q, v), over a tree given at run time: an rk_model, its tables read once from the two arrays
- * reach_c.py builds (their layout: reach_c.py's docstring; checked by reach_bindings.c's
- * rk_model_from). nb bodies, n joint coordinates, nf frames; fb 1 for a floating base: body 0
- * on a free flyer, q of nq = 7 + n numbers and v of nv = 6 + n. The same formulas as
- * centroidal.py, wrenches.py and coriolis_tree.py: spatial velocities at the world's origin in
- * world axes, [v; w]. */
+ * C(q, v), over a tree given at run time: an rk_model, read once from the tree's description D
+ * (tree/description.py's layout, the same array as the tree kernel's: joint.h reads it and
+ * places each joint) and two small tables of frames and of C's pattern that reach_c.py builds
+ * (checked by reach_bindings.c's rk_model_from). nb bodies, n joint coordinates, nf frames; fb 1
+ * for a floating base: body 0 on a free flyer, q of nq = 7 + n numbers and v of nv = 6 + n. The
+ * same formulas as centroidal.py, wrenches.py and coriolis_tree.py: spatial velocities at the
+ * world's origin in world axes, [v; w]. Each body's axes are its canonical ones (its joint about
+ * z), in which D holds its inertia and the tables its frames. */
+
+#include "spatial.h"
+#include "joint.h"
 
 #define RK_MAX_WRENCHES 16  /* more: the bindings refuse, the caller adds J^T w one by one */
 #define RK_MAX_BODIES 40000  /* a bound only so that no size below overflows an int (C's
@@ -13,25 +18,21 @@
 typedef struct {
     int nb, n, fb, nf, cset, nczero;  /* cset 0 where a mimic joint shares a coordinate */
     int bq, bv, nq, nv;               /* the base's 7 and 6 numbers of q and v (else 0) */
-    /* per body: parent (-1: the ground, always before it), coordinate, whether its joint turns
-       and slides, k where its axis is +-e_k exactly (else -1), whether its R0 is exactly 1, j
-       where R0 is exactly a turn about e_j (else -1) */
-    const int *parent, *coord, *turns, *slides, *axis, *R0id, *R0axis;
+    tk_tree t;                        /* the description (joint.h), body records at t.body */
+    /* per body, read out of D once: parent (-1: the ground, always before it), coordinate
+       (its number in v after the base's), multiplier, mass (kg), first moment h (kg m, 3)
+       and inertia J (kg m^2, 9, about its origin), in its canonical axes */
+    const int *parent, *coord;
+    const double *mult, *m, *h, *J;
     const int *fbody;                 /* per frame: its body (-1: the ground) */
     const int *czero;                 /* the entries of C that no body's pass sets (cset) */
-    /* per body: multiplier, offset, the axis' sign (axis >= 0) of a joint that only turns, or
-       the lead of one that slides (its slide along u per unit th: 1 prismatic, the pitch in
-       m/rad helical, which turns and slides: RK_LEAD), mass (kg); 3 a body: the
-       joint's translation t0 (m), axis u, first moment h (kg m); 9 a body (row-major): R0, the
-       turn tables P, C, S (R0 Rot(u, th) = P + cos th C + sin th S), inertia J (kg m^2) */
-    const double *mult, *off, *axsign, *m, *t0, *u, *h, *R0, *P, *C, *S, *J;
     const double *fR, *ft;            /* per frame: rotation (9) and translation (3) in its body */
     double qlow, qhigh;               /* |quaternion|^2 within these, else numpy names it */
     size_t work1;                     /* one state's workspace, bytes (rk_work_size) */
 } rk_model;
 
 #define RK_FREE(i) (md->fb && (i) == 0)
-#define RK_LEAD(i) (md->axsign[i])  /* a sliding joint's (the table's slot of the sign) */
+#define RK_BODY(i) (md->t.body + (size_t)(i) * TK_STRIDE)  /* body i's record in D */
 
 /* An output entry that one joint's column fills: set where no two joints share a coordinate
  * (cset), added to where a mimic joint's coordinate is another's (the output zeroed first) */
@@ -47,13 +48,12 @@ typedef struct {
 #define RK_PASTE(a, b) RK_PASTE_(a, b)
 #define RK_ROUND(bytes) (((bytes) + 63) / 64 * 64)  /* a workspace's parts 64-byte aligned */
 
-/* R x of two tables' doubles (a sliding joint's axis in its parent's axes) */
-static inline void rk_apply_tab(const double *R, const double *x, double *out)
-{
-    out[0] = R[0] * x[0] + R[1] * x[1] + R[2] * x[2];
-    out[1] = R[3] * x[0] + R[4] * x[1] + R[5] * x[2];
-    out[2] = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
-}
+/* joint.h's and spatial.h's number type and names: the core's (RK_T, RK_FN) */
+#define SP_T RK_T
+#define JT_T RK_T
+#define JT_FN(name) RK_FN(jt_##name)
+#define JT_C(x) RK_C(x)
+#define JT_SINCOS RK_SINCOS
 
 /* The core below (to the end of reach_inverse.c) is emitted twice by reach_c.py: on one state
  * (rk_*, RK_T double) and on LG_LANES states at once (rk4_*, RK_T lg_v4, GCC/Clang vector
@@ -64,6 +64,8 @@ static inline void rk_apply_tab(const double *R, const double *x, double *out)
  * (RK_FN(work_size)): on its thread's stack where it fits (reach_batch.c's RK_STACK_BYTES),
  * else on the heap. */
 /* RK_CORE_BEGIN */
+/* JT_CORE: joint.h's core, here */
+
 /* a function's workspace: every body's rotation and origin, the path to a body, and x, the
  * function's own arrays (one function at a time on a workspace, so they share it: a drift's
  * V and A, A_g's h and I_c, the centre of mass's H, C's rk_cwork, inverse dynamics' V, A, F, S
@@ -110,166 +112,13 @@ static inline void RK_FN(work_at)(const rk_model *md, void *block, RK_FN(work) *
     w->set = (unsigned char *)at;
 }
 
-static inline void RK_FN(cross)(const RK_T *a, const RK_T *b, RK_T *out)
-{
-    RK_T x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2],
-         z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x; out[1] = y; out[2] = z;
-}
-
-static inline void RK_FN(apply)(const RK_T *R, const RK_T *x, RK_T *out)
-{
-    RK_T a = R[0] * x[0] + R[1] * x[1] + R[2] * x[2], b = R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
-         c = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
-    out[0] = a; out[1] = b; out[2] = c;
-}
-
-static inline void RK_FN(apply_k)(const double *R, const RK_T *x, RK_T *out)
-{
-    RK_T a = R[0] * x[0] + R[1] * x[1] + R[2] * x[2], b = R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
-         c = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
-    out[0] = a; out[1] = b; out[2] = c;
-}
-
-static inline void RK_FN(apply_v)(const RK_T *R, const double *x, RK_T *out)
-{
-    RK_T a = R[0] * x[0] + R[1] * x[1] + R[2] * x[2], b = R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
-         c = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
-    out[0] = a; out[1] = b; out[2] = c;
-}
-
-static inline void RK_FN(apply_t)(const RK_T *R, const RK_T *x, RK_T *out)
-{
-    RK_T a = R[0] * x[0] + R[3] * x[1] + R[6] * x[2], b = R[1] * x[0] + R[4] * x[1] + R[7] * x[2],
-         c = R[2] * x[0] + R[5] * x[1] + R[8] * x[2];
-    out[0] = a; out[1] = b; out[2] = c;
-}
-
-static inline void RK_FN(matmul)(const RK_T *A, const RK_T *B, RK_T *out)
-{
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            out[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
-}
-
-static inline void RK_FN(matmul_k)(const double *A, const RK_T *B, RK_T *out)
-{
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            out[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
-}
-
-static inline void RK_FN(matmul_v)(const RK_T *A, const double *B, RK_T *out)
-{
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            out[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
-}
-
-/* out = M Rot(e_k, th) (c, s its cosine and sine): two columns of M turned (a, b, k cyclic:
- * Rot e_a = c e_a + s e_b, Rot e_b = -s e_a + c e_b), 12 products, not 45 */
-static inline __attribute__((always_inline)) void RK_FN(turn)(const RK_T *M, RK_T c, RK_T s,
-                                                              RK_T *out, const int k)
-{
-    const int a = (k + 1) % 3, b = (k + 2) % 3;
-    for (int r = 0; r < 3; r++) {
-        const RK_T ma = M[3 * r + a], mb = M[3 * r + b], mk = M[3 * r + k];
-        out[3 * r + a] = c * ma + s * mb;
-        out[3 * r + b] = c * mb - s * ma;
-        out[3 * r + k] = mk;
-    }
-}
-
 /* body i's rotation (body -> world) and origin (m, world), its parent's already known */
 static inline __attribute__((always_inline)) void RK_FN(body)(const rk_model *md, const RK_T *q,
                                                               int i, RK_T (*R)[9], RK_T (*o)[3])
 {
-    RK_T Rl[9], pl[3];
-    for (int j = 0; j < 3; j++) pl[j] = RK_C(md->t0[3 * i + j]);
-    if (RK_FREE(i)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
-        RK_T x = q[3], y = q[4], z = q[5], w = q[6], Rq[9], d[3];
-        RK_T k = 1.0 / (x * x + y * y + z * z + w * w);
-        Rq[0] = 1 - 2 * k * (y * y + z * z); Rq[1] = 2 * k * (x * y - z * w);
-        Rq[2] = 2 * k * (x * z + y * w); Rq[3] = 2 * k * (x * y + z * w);
-        Rq[4] = 1 - 2 * k * (x * x + z * z); Rq[5] = 2 * k * (y * z - x * w);
-        Rq[6] = 2 * k * (x * z - y * w); Rq[7] = 2 * k * (y * z + x * w);
-        Rq[8] = 1 - 2 * k * (x * x + y * y);
-        if (md->R0id[i]) {  /* the usual free flyer, at the URDF root's own axes */
-            for (int j = 0; j < 9; j++) Rl[j] = Rq[j];
-            for (int j = 0; j < 3; j++) pl[j] += q[j];
-        } else {
-            RK_FN(matmul_k)(md->R0 + 9 * i, Rq, Rl);
-            RK_FN(apply_k)(md->R0 + 9 * i, q, d);
-            for (int j = 0; j < 3; j++) pl[j] += d[j];
-        }
-    } else {
-        const RK_T th = md->mult[i] * q[md->bq + md->coord[i]] + md->off[i];
-        if (md->turns[i] && !md->slides[i] && md->axis[i] >= 0) {
-            /* about +-e_k: (R_p R0) Rot(e_k, th) turns two columns of R_p R0 (RK_FN(turn)) */
-            RK_T c, s, M[9];
-            RK_SINCOS(th, &s, &c);
-            s = md->axsign[i] * s;
-            const int p = md->parent[i];
-            const RK_T *from = M;
-            if (p < 0)
-                for (int j = 0; j < 9; j++) M[j] = RK_C(md->R0[9 * i + j]);
-            else if (md->R0id[i])
-                from = R[p];
-            else if (md->R0axis[i] >= 0) {  /* R0 a turn about e_j (URDF rpy of one angle): R_p R0
-                                              turns two columns of R_p, 12 products, not 27 */
-                const int j = md->R0axis[i], a = (j + 1) % 3, b = (j + 2) % 3;
-                const RK_T c0 = RK_C(md->R0[9 * i + 4 * a]), s0 = RK_C(md->R0[9 * i + 3 * b + a]);
-                switch (j) {
-                case 0: RK_FN(turn)(R[p], c0, s0, M, 0); break;
-                case 1: RK_FN(turn)(R[p], c0, s0, M, 1); break;
-                default: RK_FN(turn)(R[p], c0, s0, M, 2); break;
-                }
-            } else
-                RK_FN(matmul_v)(R[p], md->R0 + 9 * i, M);
-            /* k a constant in each case: the columns' indices known, the turn in registers
-               (with k read at run time, a third of the centre of mass's batch) */
-            switch (md->axis[i]) {
-            case 0: RK_FN(turn)(from, c, s, R[i], 0); break;
-            case 1: RK_FN(turn)(from, c, s, R[i], 1); break;
-            default: RK_FN(turn)(from, c, s, R[i], 2); break;
-            }
-            if (p < 0) {
-                for (int j = 0; j < 3; j++) o[i][j] = pl[j];
-            } else {
-                RK_T d[3];
-                RK_FN(apply)(R[p], pl, d);
-                for (int j = 0; j < 3; j++) o[i][j] = o[p][j] + d[j];
-            }
-            return;
-        }
-        if (md->turns[i]) {
-            /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
-            RK_T c, s;
-            RK_SINCOS(th, &s, &c);  /* inline (tree_c.py): a libm call costs a body's work */
-            const double *P = md->P + 9 * i, *C = md->C + 9 * i, *S = md->S + 9 * i;
-            for (int j = 0; j < 9; j++) Rl[j] = P[j] + c * C[j] + s * S[j];
-        } else {
-            for (int j = 0; j < 9; j++) Rl[j] = RK_C(md->R0[9 * i + j]);
-        }
-        if (md->slides[i]) {  /* by lead th along R0 u (a prismatic joint's lead 1) */
-            double d[3];
-            rk_apply_tab(md->R0 + 9 * i, md->u + 3 * i, d);
-            if (md->turns[i])
-                for (int j = 0; j < 3; j++) pl[j] += (RK_LEAD(i) * th) * d[j];
-            else
-                for (int j = 0; j < 3; j++) pl[j] += th * d[j];
-        }
-    }
-    int p = md->parent[i];
-    if (p < 0) {
-        for (int j = 0; j < 9; j++) R[i][j] = Rl[j];
-        for (int j = 0; j < 3; j++) o[i][j] = pl[j];
-    } else {
-        RK_T d[3];
-        RK_FN(matmul)(R[p], Rl, R[i]);
-        RK_FN(apply)(R[p], pl, d);
-        for (int j = 0; j < 3; j++) o[i][j] = o[p][j] + d[j];
-    }
+    const int p = md->parent[i];
+    RK_FN(jt_placed)(&md->t, RK_BODY(i), q, p < 0 ? NULL : R[p], p < 0 ? NULL : o[p], R[i],
+                     o[i]);
 }
 
 /* every body's rotation and origin */
@@ -291,20 +140,21 @@ static int RK_FN(path)(const rk_model *md, const RK_T *q, int b, int *path, RK_T
     return depth;
 }
 
-/* S of body i's joint at the world's origin, world axes: [s_v; s_w] */
+/* S of body i's joint per unit theta at the world's origin, world axes: [s_v; s_w], its axis
+ * d = R e_z (canonical axes): s_w = d where it turns, s_v = o x s_w + lead d where it slides */
 static inline __attribute__((always_inline)) void RK_FN(subspace)(const rk_model *md, int i,
                                                                   RK_T (*R)[9], RK_T (*o)[3],
                                                                   RK_T *S)
 {
-    RK_T d[3];
-    RK_FN(apply_v)(R[i], md->u + 3 * i, d);
-    if (md->turns[i]) {
-        RK_FN(cross)(o[i], d, S);
+    const double *b = RK_BODY(i);
+    const RK_T d[3] = {R[i][2], R[i][5], R[i][8]};
+    if (TK_TURNS(b)) {
+        SP_CROSS(o[i], d, S);
         for (int j = 0; j < 3; j++) S[3 + j] = d[j];
-        if (md->slides[i])  /* a helical joint: and along the axis by its pitch */
-            for (int j = 0; j < 3; j++) S[j] += RK_LEAD(i) * d[j];
+        if (TK_SLIDES(b))  /* a helical joint: and along the axis by its pitch */
+            for (int j = 0; j < 3; j++) S[j] += b[TK_LEAD] * d[j];
     } else {
-        for (int j = 0; j < 3; j++) { S[j] = md->slides[i] ? d[j] : RK_C(0.0); S[3 + j] = RK_C(0.0); }
+        for (int j = 0; j < 3; j++) { S[j] = d[j]; S[3 + j] = RK_C(0.0); }
     }
 }
 
@@ -314,7 +164,7 @@ static inline __attribute__((always_inline)) void RK_FN(free_columns)(const RK_T
 {
     for (int c = 0; c < 3; c++) {
         RK_T w[3] = {R[c], R[3 + c], R[6 + c]}, v[3];
-        RK_FN(cross)(o, w, v);
+        SP_CROSS(o, w, v);
         for (int j = 0; j < 3; j++) {
             S[c][j] = w[j]; S[c][3 + j] = RK_C(0.0);
             S[3 + c][j] = v[j]; S[3 + c][3 + j] = w[j];
@@ -350,8 +200,8 @@ static inline void RK_FN(frame)(const rk_model *md, int f, RK_T (*R)[9], RK_T (*
         return;
     }
     RK_T d[3];
-    RK_FN(matmul_v)(R[b], md->fR + 9 * f, Rf);
-    RK_FN(apply_v)(R[b], md->ft + 3 * f, d);
+    SP_MATMUL(R[b], md->fR + 9 * f, Rf);
+    SP_APPLY(R[b], md->ft + 3 * f, d);
     for (int j = 0; j < 3; j++) p[j] = o[b][j] + d[j];
 }
 
@@ -361,7 +211,7 @@ static inline void RK_FN(frame_origin)(const rk_model *md, int f, RK_T (*R)[9], 
 {
     int b = md->fbody[f];
     RK_T d[3];
-    RK_FN(apply_v)(R[b], md->ft + 3 * f, d);
+    SP_APPLY(R[b], md->ft + 3 * f, d);
     for (int j = 0; j < 3; j++) p[j] = o[b][j] + d[j];
 }
 
@@ -396,30 +246,30 @@ static void RK_FN(drift)(const rk_model *md, RK_FN(work) *work, const RK_T *q, c
         }
         /* [v; w] x [s_v; s_w] = [w x s_v + v x s_w; w x s_w] */
         RK_T t1[3], t2[3];
-        RK_FN(cross)(V[i] + 3, S, t1);
-        RK_FN(cross)(V[i], S + 3, t2);
-        RK_FN(cross)(V[i] + 3, S + 3, c + 3);
+        SP_CROSS(V[i] + 3, S, t1);
+        SP_CROSS(V[i], S + 3, t2);
+        SP_CROSS(V[i] + 3, S + 3, c + 3);
         for (int j = 0; j < 3; j++) c[j] = t1[j] + t2[j];
         for (int j = 0; j < 6; j++) A[i][j] += c[j] * rate;
     }
     RK_T Rf[9], p[3], pd[3], pdd[3], t[3];
     RK_FN(frame)(md, f, R, o, Rf, p);
     const RK_T *w = V[b] + 3, *wd = A[b] + 3;
-    RK_FN(cross)(w, p, t);
+    SP_CROSS(w, p, t);
     for (int j = 0; j < 3; j++) pd[j] = V[b][j] + t[j];
-    RK_FN(cross)(wd, p, t);
+    SP_CROSS(wd, p, t);
     for (int j = 0; j < 3; j++) pdd[j] = A[b][j] + t[j];
-    RK_FN(cross)(w, pd, t);
+    SP_CROSS(w, pd, t);
     for (int j = 0; j < 3; j++) pdd[j] += t[j];
     if (ref == 0) {  /* the point at the world's origin: p_ddot - w_dot x p - w x (w x p) */
         RK_T wp[3], wwp[3];
-        RK_FN(cross)(wd, p, t);
-        RK_FN(cross)(w, p, wp);
-        RK_FN(cross)(w, wp, wwp);
+        SP_CROSS(wd, p, t);
+        SP_CROSS(w, p, wp);
+        SP_CROSS(w, wp, wwp);
         for (int j = 0; j < 3; j++) { out[j] = pdd[j] - t[j] - wwp[j]; out[3 + j] = wd[j]; }
     } else if (ref == 1) {
-        RK_FN(apply_t)(Rf, pdd, out);
-        RK_FN(apply_t)(Rf, wd, out + 3);
+        SP_APPLY_T(Rf, pdd, out);
+        SP_APPLY_T(Rf, wd, out + 3);
     } else {
         for (int j = 0; j < 3; j++) { out[j] = pdd[j]; out[3 + j] = wd[j]; }
     }
@@ -436,16 +286,16 @@ static void RK_FN(wrench)(const rk_model *md, RK_FN(work) *work, const RK_T *q, 
     if (b < 0) return;
     RK_FN(path)(md, q, b, work->path, R, o);
     RK_FN(frame_origin)(md, f, R, o, p);
-    RK_FN(cross)(p, w, m);
+    SP_CROSS(p, w, m);
     for (int j = 0; j < 3; j++) m[j] += w[3 + j];
     for (int i = b; i >= 0; i = md->parent[i]) {
         RK_T S[6];
         if (RK_FREE(i)) {  /* R^T f and R^T (m_O - o x f) */
             RK_T t[3], n[3];
-            RK_FN(cross)(o[0], w, t);
+            SP_CROSS(o[0], w, t);
             for (int j = 0; j < 3; j++) n[j] = m[j] - t[j];
-            RK_FN(apply_t)(R[0], w, out);
-            RK_FN(apply_t)(R[0], n, out + 3);
+            SP_APPLY_T(R[0], w, out);
+            SP_APPLY_T(R[0], n, out + 3);
             continue;
         }
         RK_FN(subspace)(md, i, R, o, S);
@@ -469,8 +319,8 @@ static void RK_FN(centroidal)(const rk_model *md, RK_FN(work) *work, const RK_T 
         RK_T hr[3], RJ[9], T[6];
         const RK_T *p = o[i];
         const double m = md->m[i];
-        RK_FN(apply_v)(R[i], md->h + 3 * i, hr);
-        RK_FN(matmul_v)(R[i], md->J + 9 * i, RJ);
+        SP_APPLY(R[i], md->h + 3 * i, hr);
+        SP_MATMUL(R[i], md->J + 9 * i, RJ);
         static const int ra[6] = {0, 1, 2, 0, 0, 1}, rc[6] = {0, 1, 2, 1, 2, 2};
         for (int e = 0; e < 6; e++) {  /* R J R^T, symmetric */
             const int a = ra[e], c = rc[e];
@@ -510,13 +360,13 @@ static void RK_FN(centroidal)(const rk_model *md, RK_FN(work) *work, const RK_T 
         for (int col = 0; col < columns; col++) {
             const RK_T *S = F[col];
             RK_T l[3], k[3], t[3], g[3];
-            RK_FN(cross)(S + 3, h[i], l);  /* l = M s_v + s_w x h, k = h x s_v + J_O s_w */
-            RK_FN(cross)(h[i], S, k);
+            SP_CROSS(S + 3, h[i], l);  /* l = M s_v + s_w x h, k = h x s_v + J_O s_w */
+            SP_CROSS(h[i], S, k);
             t[0] = J[0] * S[3] + J[3] * S[4] + J[4] * S[5];
             t[1] = J[3] * S[3] + J[1] * S[4] + J[5] * S[5];
             t[2] = J[4] * S[3] + J[5] * S[4] + J[2] * S[5];
             for (int j = 0; j < 3; j++) { l[j] += M[i] * S[j]; k[j] += t[j]; }
-            RK_FN(cross)(G, l, g);
+            SP_CROSS(G, l, g);
             const int c = first + col;
             for (int j = 0; j < 3; j++) {
                 RK_CPUT(out[j * md->nv + c], mult * l[j]);

@@ -37,7 +37,7 @@ static TK_MASK TK_FN(free_acceleration)(const tk_tree *t, const TK_T *IA, const 
         for (int k = i + 1; k < 6; k++) a[i] -= L[6 * k + i] * a[k];
         a[i] /= L[6 * i + i];
     }
-    TK_APPLY_T(R, up, gb);
+    SP_APPLY_T(R, up, gb);
     for (int r = 0; r < 3; r++) { qdd[r] = a[3 + r] - gb[r]; qdd[3 + r] = a[r]; }
     return bad;
 }
@@ -69,10 +69,10 @@ static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *restrict q,
             for (int r = 0; r < 3; r++) vw[r] = vv[r] = TK_C(0.0);
         } else {
             const TK_T *pv = W + parent * TW_STRIDE + V;
-            TK_CROSS(pv, p, x);
+            SP_CROSS(pv, p, x);
             for (int r = 0; r < 3; r++) x[r] += pv[3 + r];
-            TK_APPLY_T(R, pv, vw);
-            TK_APPLY_T(R, x, vv);
+            SP_APPLY_T(R, pv, vw);
+            SP_APPLY_T(R, x, vv);
         }
         /* c = v x (S rate), with the parent's part: (w x s_w, w x s_v + v_l x s_w) rate, S
            about z */
@@ -100,15 +100,15 @@ static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *restrict q,
                 In[6 * r + col + 3] = TK_C(H[3 * r + col]);
                 In[6 * (r + 3) + col] = TK_C(H[3 * col + r]);
             }
-        TK_APPLY(J, vw, Iw);
-        TK_CROSS(h, vv, x);
+        SP_APPLY(J, vw, Iw);
+        SP_CROSS(h, vv, x);
         for (int r = 0; r < 3; r++) Iw[r] += x[r];
-        TK_CROSS(vw, h, x);
+        SP_CROSS(vw, h, x);
         for (int r = 0; r < 3; r++) Iv[r] = m * vv[r] + x[r];
         /* v x* (n, f) = (w x n + v x f, w x f) */
-        TK_CROSS(vw, Iw, x);
-        TK_CROSS(vv, Iv, z);
-        TK_CROSS(vw, Iv, y);
+        SP_CROSS(vw, Iw, x);
+        SP_CROSS(vv, Iv, z);
+        SP_CROSS(vw, Iv, y);
         for (int r = 0; r < 3; r++) { pa[r] = x[r] + z[r]; pa[3 + r] = y[r]; }
     }
     for (int i = t->nb - 1; i >= 0; i--) {
@@ -156,19 +156,19 @@ static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *restrict q,
         for (int k = 0; k < 3; k++) {  /* column k of P X is p x (column k of X) */
             TK_T col[3], out[3];
             for (int r = 0; r < 3; r++) col[r] = Cr[3 * r + k];
-            TK_CROSS(p, col, out);
+            SP_CROSS(p, col, out);
             for (int r = 0; r < 3; r++) PC[3 * r + k] = out[r];
             for (int r = 0; r < 3; r++) col[r] = Br[3 * k + r];  /* column k of B^T */
-            TK_CROSS(p, col, out);
+            SP_CROSS(p, col, out);
             for (int r = 0; r < 3; r++) PBt[3 * r + k] = out[r];
         }
         for (int r = 0; r < 3; r++) {  /* row r of X P is -(p x row r of X) ... = row x p */
             TK_T row[3], out[3];
             for (int k = 0; k < 3; k++) row[k] = Br[3 * r + k];
-            TK_CROSS(row, p, out);
+            SP_CROSS(row, p, out);
             for (int k = 0; k < 3; k++) BP[3 * r + k] = out[k];
             for (int k = 0; k < 3; k++) row[k] = PC[3 * r + k];
-            TK_CROSS(row, p, out);
+            SP_CROSS(row, p, out);
             for (int k = 0; k < 3; k++) PCP[3 * r + k] = out[k];
         }
         for (int r = 0; r < 3; r++)
@@ -181,9 +181,9 @@ static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *restrict q,
                 PI[6 * (r + 3) + k + 3] += Cr[3 * r + k];
             }
         TK_T F[3], N[3], x[3];
-        TK_APPLY(R, pv + 3, F);
-        TK_APPLY(R, pv, N);
-        TK_CROSS(p, F, x);
+        SP_APPLY(R, pv + 3, F);
+        SP_APPLY(R, pv, N);
+        SP_CROSS(p, F, x);
         for (int r = 0; r < 3; r++) { Pp[r] += N[r] + x[r]; Pp[3 + r] += F[r]; }
     }
     for (int i = 0; i < t->nb; i++) {
@@ -200,13 +200,13 @@ static TK_MASK TK_FN(forward_aba)(const tk_tree *t, const TK_T *restrict q,
         if (parent < 0) {  /* the ground accelerates up by g: (0, -g) */
             const double up[3] = {-t->g[0], -t->g[1], -t->g[2]};
             for (int r = 0; r < 3; r++) ac[r] = TK_C(0.0);
-            TK_APPLY_T(R, up, ac + 3);
+            SP_APPLY_T(R, up, ac + 3);
         } else {
             const TK_T *pa = W + parent * TW_STRIDE + A;
-            TK_CROSS(pa, p, x);
+            SP_CROSS(pa, p, x);
             for (int r = 0; r < 3; r++) x[r] += pa[3 + r];
-            TK_APPLY_T(R, pa, ac);
-            TK_APPLY_T(R, x, ac + 3);
+            SP_APPLY_T(R, pa, ac);
+            SP_APPLY_T(R, x, ac + 3);
         }
         for (int r = 0; r < 6; r++) ac[r] += w[C + r];
         tk_subspace(b, &sw, &sv);
@@ -269,8 +269,8 @@ static inline TK_T TK_FN(ball_dot)(const TK_T *w, int c, const TK_T *f)
 {
     const TK_T *Rw = w + TW_RW, *o = w + TW_OW;
     TK_T e[3] = {Rw[c], Rw[3 + c], Rw[6 + c]}, y[3];
-    TK_CROSS(o, e, y);
-    return TK_DOT(y, f) + TK_DOT(e, f + 3);
+    SP_CROSS(o, e, y);
+    return SP_DOT(y, f) + SP_DOT(e, f + 3);
 }
 
 /* A ball joint's three columns of M (body i, its composite inertia Ic in W): F_c = Ic S_c, then
@@ -284,10 +284,10 @@ static void TK_FN(ball_columns)(const tk_tree *t, const TK_T *W, int i, TK_T *M)
     const int ci = t->bv + (int)b[TK_COORD];
     for (int c = 0; c < 3; c++) {
         TK_T sw[3] = {Rw[c], Rw[3 + c], Rw[6 + c]}, sv[3], f[6], x[3];
-        TK_CROSS(o, sw, sv);
-        TK_CROSS(sw, h, x);  /* Ic S: [m s_v + s_w x h; h x s_v + J_O s_w] */
+        SP_CROSS(o, sw, sv);
+        SP_CROSS(sw, h, x);  /* Ic S: [m s_v + s_w x h; h x s_v + J_O s_w] */
         for (int r = 0; r < 3; r++) f[r] = Ic[0] * sv[r] + x[r];
-        TK_CROSS(h, sv, x);
+        SP_CROSS(h, sv, x);
         f[3] = x[0] + J[0] * sw[0] + J[3] * sw[1] + J[4] * sw[2];
         f[4] = x[1] + J[3] * sw[0] + J[1] * sw[1] + J[5] * sw[2];
         f[5] = x[2] + J[4] * sw[0] + J[5] * sw[1] + J[2] * sw[2];
@@ -299,8 +299,8 @@ static void TK_FN(ball_columns)(const tk_tree *t, const TK_T *W, int i, TK_T *M)
                 const TK_T *Rk = wk + TW_RW, *ok = wk + TW_OW;
                 for (int r = 0; r < 3; r++) {
                     TK_T e[3] = {Rk[r], Rk[3 + r], Rk[6 + r]}, y[3];
-                    TK_CROSS(ok, e, y);
-                    const TK_T lin = TK_DOT(e, f), ang = TK_DOT(y, f) + TK_DOT(e, f + 3);
+                    SP_CROSS(ok, e, y);
+                    const TK_T lin = SP_DOT(e, f), ang = SP_DOT(y, f) + SP_DOT(e, f + 3);
                     M[(ci + c) * n + r] += lin;
                     M[r * n + ci + c] += lin;
                     M[(ci + c) * n + 3 + r] += ang;
@@ -317,7 +317,7 @@ static void TK_FN(ball_columns)(const tk_tree *t, const TK_T *W, int i, TK_T *M)
                 }
                 continue;
             }
-            const TK_T e = TK_DOT(wk + TW_SV, f) + TK_DOT(wk + TW_SW, f + 3);
+            const TK_T e = SP_DOT(wk + TW_SV, f) + SP_DOT(wk + TW_SW, f + 3);
             M[(ci + c) * n + ck] += e;
             M[ck * n + ci + c] += e;
         }

@@ -21,7 +21,8 @@ The description ``D`` (float64, contiguous), built by ``describe``:
       row-major)  14:17 t0 (m)  17:20 unit axis u, always (0, 0, 1)  20 mass (kg)
       21:24 first moment h = m c about the body origin (kg m)  24:33 J_O (kg m^2, body axes)
       33:36 where R0 is a signed permutation, the column of each row's one nonzero, 36:39 its
-      sign, 39 1 then (else 0: R0 is read as its nine numbers)  41:61 spare
+      sign, 39 1 then (else 0: R0 is read as its nine numbers), 41:44 then for each column
+      k the row whose nonzero is there, 44:47 its sign  47:61 spare
       61 the lead: the slide along u per unit theta (1 prismatic, the pitch in m/rad
       helical, 0 revolute)  62:64 spare.
       A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone; a helical joint
@@ -37,10 +38,10 @@ same in any body axes; R0 becomes A_parent^T R0 A, t0 A_parent^T t0, h A^T h, J 
 rotation within 1e-14 of a signed permutation is taken as that permutation.
 
 A new joint kind is a new code in JOINT_CODES (tests/dynamics/test_joint_kinds.py walks each)
-and its cases in tree_kernel.c (tk_place for the
-placement, tk_subspace for S); the recursions themselves ask only for those. The module
-(tree_kernel.c, tree_kernel_forward.c, then its Python bindings tree_kernel_bindings.c) is keyed
-by its source alone, never the tree's numbers.
+and its branch in engine/joint.h (jt_place for the placement, tk_subspace for S), which every
+compiled module reads D with (the tree kernel, the reach module); the recursions themselves ask
+only for those. Each module is keyed by its source and the headers alone, never the tree's
+numbers.
 """
 
 from __future__ import annotations
@@ -114,6 +115,8 @@ def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray
             R0 = permutation
             columns = np.argmax(np.abs(permutation), axis=1)
             r[33:36], r[36:39], r[39] = columns, permutation[np.arange(3), columns], 1.0
+            rows = np.argmax(np.abs(permutation), axis=0)  # column k's nonzero row
+            r[41:44], r[44:47] = rows, permutation[rows, np.arange(3)]
         r[5:14] = np.ravel(R0)
         r[14:17] = Ap.T @ np.array(j.translation, dtype=float)
         r[17:20] = (0.0, 0.0, 1.0) if JointKind(j.kind) not in _OWN_AXES else j.axis

@@ -171,3 +171,15 @@ def test_a_stop_condition_on_a_ball_quaternion_ends_the_run_there(tmp_path_facto
     run = system.simulate(2.0, initial={"shoulder_wx": 3.0}, stop_when="shoulder_qw < 0.9")
     assert run.status == "stopped"
     assert run.q[-1, 0] == pytest.approx(0.9, abs=1e-7)
+
+
+def test_a_controllers_moment_on_a_ball_does_the_work_the_energy_gains(pendulum):
+    """u = a moment in the body's axes (N m): T + V - h0 = int u.w dt (the work balance, its
+    integral by Simpson's rule on the samples: 401 of them close it to about 1e-9 J)."""
+    run = pendulum.simulate(1.0, initial={"ball_wx": 1.0},
+                            controller=lambda t, q, v: np.array([0.3, -0.2, 0.5 * np.cos(t)]),
+                            rtol=1e-11, atol=1e-11, samples=401)
+    assert run.status == "finished" and run.invariant == "work_balance"
+    assert np.ptp(run.energy) > 0.1  # the moment did work
+    assert abs(run.balance).max() < 1e-8
+    np.testing.assert_allclose(np.linalg.norm(run.q, axis=1), 1.0, rtol=0, atol=1e-14)

@@ -110,6 +110,7 @@ def simulate(
         from ..output.plots import check_plot_path
 
         check_plot_path(plot)
+    _refuse_on_manifold(tree, animate, control, along)
     if animate is not None:
         check_animation_path(animate)
         check_animatable(system.model)
@@ -208,6 +209,26 @@ def simulate(
         saved = f"; partial result saved to {', '.join(written.values())}" if written else ""
         typer.echo(f"{simulation.message}{saved}", err=True)
         raise SystemExit(130)
+
+
+def _refuse_on_manifold(tree, animate, control, along) -> None:
+    """What a run whose q and v differ does not take yet, refused in one line before it: the
+    drawing (it turns the model's bodies by q), and on a ball joint the controllers and the
+    linearization along the run (both built on q_dot = v)."""
+    from ..errors import InputError
+
+    balls = getattr(tree, "spherical", ())
+    if animate is not None and (balls or getattr(tree, "floating_base", False)):
+        what = f"the ball joint '{balls[0].name}'" if balls else "a floating base"
+        raise InputError(f"a robot with {what} is not animated yet (its quaternion is not "
+                         "the drawing's coordinates); --out and --plot are", field="--animate")
+    for flag, given, then in (
+            ("--control", control not in (None, "model"), "; in Python, give simulate a "
+             "controller (t, q, v) -> u of nv torques (a ball's: its moment, body axes)"),
+            ("--linearize-along", along, "")):
+        if given and balls:
+            raise InputError(f"the ball joint '{balls[0].name}' is not linearized yet (q_dot is "
+                             f"not v for its quaternion){then}", field=flag)
 
 
 def _impact_options(system, max_impacts, settle) -> dict:

@@ -24,6 +24,8 @@ CSE_MIN_OPERATIONS = 2000
 # same printer and the same generated code), from the modules themselves: "numpy" runs
 # `from numpy import *`, which imports numpy.f2py and numpy.testing, 0.3 s of a small command.
 _NUMPY = [np.linalg, np]
+# use_imps=False: no expression here carries an implemented_function, and looking for one walks
+# the expression tree written out, node by node (20 of 34 s of a ten-body chain's lambdify)
 
 
 def numpy_function(args: Sequence[sp.Symbol], exprs: sp.Expr | Sequence[sp.Expr]) -> Callable:
@@ -33,7 +35,8 @@ def numpy_function(args: Sequence[sp.Symbol], exprs: sp.Expr | Sequence[sp.Expr]
     items = [machine_numbers(as_expression(e)) for e in exprs] if many \
         else [machine_numbers(as_expression(exprs))]
     cse = operations_exceed(items, CSE_MIN_OPERATIONS)
-    return sp.lambdify(list(args), items if many else items[0], modules=_NUMPY, cse=cse)
+    return sp.lambdify(list(args), items if many else items[0], modules=_NUMPY, cse=cse,
+                       use_imps=False)
 
 
 def operations_exceed(items: Sequence[sp.Expr], limit: int) -> bool:
@@ -58,7 +61,7 @@ def mpmath_function(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr]) -> Call
     # bicycle's Newton-Euler rows took ~1.4 million mpmath sin/cos at 12 points and a minute
     # of printing; cse is exact (it only names repeated subexpressions).
     cse = operations_exceed(items, CSE_MIN_OPERATIONS)
-    return sp.lambdify(list(args), items, modules="mpmath", cse=cse)
+    return sp.lambdify(list(args), items, modules="mpmath", cse=cse, use_imps=False)
 
 
 class StateFunction:

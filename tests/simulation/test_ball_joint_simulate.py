@@ -183,3 +183,15 @@ def test_a_controllers_moment_on_a_ball_does_the_work_the_energy_gains(pendulum)
     assert np.ptp(run.energy) > 0.1  # the moment did work
     assert abs(run.balance).max() < 1e-8
     np.testing.assert_allclose(np.linalg.norm(run.q, axis=1), 1.0, rtol=0, atol=1e-14)
+
+
+def test_a_hinges_position_limit_beside_a_ball_still_ends_the_run(tmp_path_factory):
+    """The elbow's range (30 degrees, MJCF's default unit) stops a run that swings it there."""
+    text = ARM.format(dt=0.01, free="").replace(
+        'axis="0 1 1"/>', 'axis="0 1 1" limited="true" range="-30 30"/>')
+    system, _ = _load(tmp_path_factory, text, "limited")
+    run = system.simulate(2.0, initial={"elbow_dot": 4.0, "shoulder_wz": 1.0})
+    assert run.status == "limit" and "joint 'elbow'" in run.message
+    assert abs(run.q[-1, 4]) == pytest.approx(np.radians(30), abs=1e-7)
+    with pytest.raises(LagrangianError, match="joint 'elbow' .* starts at 0.7"):
+        system.simulate(0.1, initial={"elbow": 0.7})

@@ -12,7 +12,7 @@ import typer
 
 from . import app
 from .common import FLOATING_HELP, load_system, print_json
-from .dynamics import LOCK_HELP, _vector, base_layout
+from .dynamics import LOCK_HELP, _start, _vector, base_layout
 
 
 @app.command()
@@ -34,7 +34,9 @@ def kinematics(
 
     system = load_system(model, set_, lock, floating_base=floating_base)
     names, velocities, base_q, _ = base_layout(system)
-    qs = _vector(q, names, "--q", base_q + list(resolve_state(system.model).q))
+    start = resolve_state(system.model)  # a ball joint's default: unturned (dynamics._start)
+    qs = _vector(q, names, "--q", _start(names, base_q, dict(zip(start.coordinates, start.q,
+                                                                  strict=True))))
     robot = system.dynamics().kinematics
     name = frame if frame is not None else robot.frames[-1]
     values = {"q": qs, "placement": robot.placement(qs, name),
@@ -49,7 +51,7 @@ def kinematics(
         values["centroidal_momentum_matrix"] = robot.centroidal_momentum_matrix(qs)
         if vs is not None:
             values["centroidal_momentum"] = values["centroidal_momentum_matrix"] @ vs
-    velocities = velocities if base_q else None
+    velocities = velocities if velocities != names else None  # a floating base, a ball
     if json_:
         print_json(kinematics_document(names, name, reference, values, velocities))
     else:

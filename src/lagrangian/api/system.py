@@ -209,7 +209,9 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         as lagrangian.control's controllers do), to the model's own; "model" runs the file's
         [control] laws, compiled with its equations: docs/control.md. On a floating base u
         is the n joint torques or all n + 6 entries, the base's wrench first, and
-        ``stop_when`` may name the base's numbers (base_z, base_vz, ...). A model with
+        ``stop_when`` may name the base's numbers (base_z, base_vz, ...); a ball joint's
+        quaternion and angular velocity are named <joint>_qw .. _qz and <joint>_wx .. _wz
+        (docs/bridges.md). A model with
         [[impacts]] runs through them (``.impacts`` lists each; status 'accumulated' where they
         accumulate, 'settled' with ``settle=True``, 'impact_limit' at ``max_impacts``, default
         1000): docs/simulation.md. ``canonical=True`` integrates Hamilton's equations in

@@ -6,8 +6,10 @@ The reader writes the ball as three hinges about the anchor's x, y and z axes (t
 between them) for the URDF reader, so that the model's symbolic bodies are the same robot in
 Euler angles (``<joint>__x``, ``__y``, ``__z``: what derive and the symbolic paths see); then
 ``with_ball_joints`` merges the three tree bodies into one spherical joint, whose configuration
-names are ``<joint>_qw, _qx, _qy, _qz`` and velocity names ``<joint>_wx, _wy, _wz``. The three
-hinges' actuator parameters are dropped: a ball joint has no actuator here.
+names are ``<joint>_qw, _qx, _qy, _qz`` and velocity names ``<joint>_wx, _wy, _wz``: the names
+that dynamics, kinematics and simulate (its start, stop condition and columns) take, where the
+Euler hinges are refused by name. The three hinges' actuator parameters are dropped: a ball
+joint has no actuator here.
 """
 
 from __future__ import annotations

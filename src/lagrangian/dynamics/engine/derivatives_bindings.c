@@ -1,7 +1,8 @@
 /* The Python bindings of derivatives_kernel.c's functions (derivatives_c.py appends this text
  * after the kernel's core, emitted on one state and on vector lanes). */
 
-/* -- Python bindings: tree(I, D) makes a tree's capsule once (derivatives_c.py's tables);
+/* -- Python bindings: tree(D, I) makes a tree's capsule once (its description and
+ * derivatives_c.py's table);
  * the functions take (tree, Q, V, X, P) with Q, V, X (..., nq / nv) float64 (or (nq,), shared
  * by the batch), P = [g (3), tau_<joint> (nj), 13 per body]; outputs (..., nv, nv) each, as a
  * tuple, with the count of NaN rows appended where a state's inputs are not all finite (or,
@@ -12,7 +13,6 @@
 #define DK_MAX_THREADS LG_MAX_THREADS
 #define DK_THREAD_STATES 512
 #define DK_HEADER 8  /* I's first numbers: nb, nj, ff, np, nnz, ltdl, once, sparse */
-#define DK_BODY 47   /* D's doubles per body: mult, off, R0, P, C, S (9 each), t0, u, R0 u */
 
 /* The states a thread takes at a time from the batch's shared counter (a multiple of
    LG_LANES): the threads share the batch as they go, so one slowed by the machine's other work
@@ -28,60 +28,61 @@ static void dk_tree_free(PyObject *capsule)
     free(PyCapsule_GetPointer(capsule, "lagrangian.derivatives_tree"));
 }
 
-/* The tree of tables I (int32) and D (float64), laid out as derivatives_c.py's docstring says,
- * copied into one block with the tree; every index checked here once (the kernel trusts them). */
+/* The tree of its description D (float64, tree/description.py's: joint.h's tk_open checks it)
+ * and the table I (int32, derivatives_c.py's layout), copied into one block with the tree;
+ * every index checked here once (the kernel trusts them). */
 static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
     PyArrayObject *table_i = NULL, *table_d = NULL;
     PyObject *result = NULL;
     if (nargs != 2) {
-        PyErr_SetString(PyExc_TypeError, "expected (I, D)");
+        PyErr_SetString(PyExc_TypeError, "expected (D, I)");
         return NULL;
     }
-    table_i = (PyArrayObject *)PyArray_FROMANY(args[0], NPY_INT32, 1, 1, NPY_ARRAY_CARRAY_RO);
-    table_d = (PyArrayObject *)PyArray_FROMANY(args[1], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
+    table_d = (PyArrayObject *)PyArray_FROMANY(args[0], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
+    table_i = (PyArrayObject *)PyArray_FROMANY(args[1], NPY_INT32, 1, 1, NPY_ARRAY_CARRAY_RO);
     if (!table_i || !table_d) goto done;
     const npy_intp ni = PyArray_SIZE(table_i), nd = PyArray_SIZE(table_d);
     const int *h = (const int *)PyArray_DATA(table_i);
-    if (ni < DK_HEADER) goto bad;
+    tk_tree t;
+    if (ni < DK_HEADER || tk_open(PyArray_DATA(table_d), nd, &t) || t.balls) goto bad;
     const long nb = h[0], nj = h[1], ff = h[2], np = h[3], nnz = h[4];
-    if (nb < 1 || nj < 0 || (ff != 0 && ff != 1) || np < nb || nnz < 0) goto bad;
+    if (nb != t.nb || nj != t.n || ff != t.fb || np < nb || nnz < 0) goto bad;
     const long nv = nj + 6 * ff;
-    const long nint = DK_HEADER + 4 * nb + 2 * np + (nv + 1) + nnz + nv;
-    if (ni != nint || nd != DK_BODY * nb) goto bad;
-    dk_tree *tree = malloc(sizeof(dk_tree) + (size_t)nint * sizeof(int)
-                           + (size_t)nd * sizeof(double));
+    const long nint = DK_HEADER + 2 * np + (nv + 1) + nnz + nv;
+    if (ni != nint) goto bad;
+    /* the block: the tree, D's copy, each body's multiplier, then I and each body's parent
+       and coordinate */
+    dk_tree *tree = malloc(sizeof(dk_tree) + ((size_t)nd + nb) * sizeof(double)
+                           + ((size_t)nint + 2 * nb) * sizeof(int));
     if (!tree) {
         PyErr_NoMemory();
         goto done;
     }
     double *reals = (double *)(tree + 1);  /* the doubles first: aligned after the struct */
-    int *ints = (int *)(reals + nd);
+    double *mult = reals + nd;
+    int *ints = (int *)(mult + nb), *parent = ints + nint, *coord = parent + nb;
     memcpy(reals, PyArray_DATA(table_d), (size_t)nd * sizeof(double));
     memcpy(ints, h, (size_t)nint * sizeof(int));
     *tree = (dk_tree){.nb = nb, .nj = nj, .ff = ff, .np = np, .nv = nv, .nq = nj + 7 * ff,
                       .qo = 7 * ff, .vo = 6 * ff, .ltdl = h[5] != 0, .once = h[6] != 0,
                       .sparse = h[7] != 0};
+    tk_open(reals, nd, &tree->t);  /* the same numbers: checked above */
+    for (long i = 0; i < nb; i++) {
+        const double *b = DK_BODY_OF(tree, i);
+        parent[i] = (int)b[TK_PARENT];
+        coord[i] = TK_FREE(b) ? 0 : (int)b[TK_COORD];
+        mult[i] = b[TK_MULT];
+    }
+    tree->parent = parent;
+    tree->coord = coord;
+    tree->mult = mult;
     const int *at = ints + DK_HEADER;
-    tree->parent = at; at += nb;
-    tree->coord = at; at += nb;
-    tree->turns = at; at += nb;
-    tree->slides = at; at += nb;
     tree->pair = (const int (*)[2])at; at += 2 * np;
     tree->row0 = at; at += nv + 1;
     tree->rows = at; at += nnz;
     tree->lambda = at;
-    const double *x = reals;
-    tree->mult = x; x += nb;
-    tree->off = x; x += nb;
-    tree->R0 = (const double (*)[9])x; x += 9 * nb;
-    tree->P = (const double (*)[9])x; x += 9 * nb;
-    tree->C = (const double (*)[9])x; x += 9 * nb;
-    tree->Sk = (const double (*)[9])x; x += 9 * nb;
-    tree->t0 = (const double (*)[3])x; x += 3 * nb;
-    tree->u = (const double (*)[3])x; x += 3 * nb;
-    tree->R0u = (const double (*)[3])x;
     int fine = tree->parent[0] == -1 && tree->row0[0] == 0 && tree->row0[nv] == nnz;
     for (long i = 0; i < nb; i++)
         fine &= tree->parent[i] >= -1 && tree->parent[i] < i
@@ -109,7 +110,8 @@ static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t na
     if (!result) free(tree);
     goto done;
 bad:
-    PyErr_SetString(PyExc_ValueError, "tree: tables not laid out as derivatives_c.py's");
+    PyErr_SetString(PyExc_ValueError,
+                    "tree: not a description (description.py) and table (derivatives_c.py)");
 done:
     Py_XDECREF(table_i);
     Py_XDECREF(table_d);

@@ -8,21 +8,17 @@ object, and gravity, the actuator parameters tau_<joint> and the bodies' inertia
 (runtime_values). Revolute, prismatic and helical joints, a free flyer at the root; the complex step of
 derivatives.py is the fallback (and the check). Units SI.
 
-The tables (``tables``), nb bodies numbered parents first, nj joint coordinates, a floating
-base's six velocity coordinates first (nv = nj + 6 ff, nq = nj + 7 ff):
+The tree reaches it as its description D (tree/description.py, the tree kernel's: each joint
+in canonical axes, placed by joint.h) and one table of its pattern (``tables``), nb bodies
+numbered parents first, nj joint coordinates, a floating base's six velocity coordinates first
+(nv = nj + 6 ff, nq = nj + 7 ff):
 
     I (int32): nb, nj, ff (1: body 0 a free flyer), np pairs, nnz pattern entries, ltdl (1:
     M factored along the tree), once (1: each coordinate one body's), sparse (1: the lanes'
-    products over the pattern); then parent[nb] (-1 the ground), coordinate[nb] (the joint's
-    index among the nj; body 0's unused on a floating base), turns[nb], slides[nb] (0 or 1),
-    pairs[np][2] (k, j: j on k's path to the ground, k itself first), row0[nv + 1] and
-    rows[nnz] (column j's rows that d tau/d(q, q_dot) can have nonzero: rows[row0[j] ..
-    row0[j + 1]], ascending), lambda[nv] (each coordinate's parent coordinate, -1 at a root).
-    D (float64), field by field, each nb records: multiplier k and offset (theta = k q + offset;
-    1 each), R0 (joint -> parent axes, row-major, 9), P, C, S (9 each: R0 Rot(u, theta) =
-    P + cos theta C + sin theta S), t0 (m, 3), the unit axis u (joint axes, 3), R0 u times the
-    lead (3: the slide per unit theta, 1 prismatic, the pitch in m/rad helical, which turns and
-    slides; 0 revolute).
+    products over the pattern); then pairs[np][2] (k, j: j on k's path to the ground, k itself
+    first), row0[nv + 1] and rows[nnz] (column j's rows that d tau/d(q, q_dot) can have
+    nonzero: rows[row0[j] .. row0[j + 1]], ascending), lambda[nv] (each coordinate's parent
+    coordinate, -1 at a root).
 """
 
 from __future__ import annotations
@@ -37,8 +33,9 @@ import numpy as np
 
 from ...model.tree import KinematicTree
 from ..emit.tree_c import _SINCOS, _VECTOR
+from ..tree.description import HEADER, STRIDE, describe
 from ..tree.free_flyer import QUATERNION_TOLERANCE
-from ..tree.joint_models import JOINT_MODELS
+from .headers import header_bytes, spliced
 
 _KERNEL = Path(__file__).with_name("derivatives_kernel.c")
 _REGRESSOR = Path(__file__).with_name("derivatives_regressor.c")  # the core's last part
@@ -153,24 +150,11 @@ def factored_along_the_tree(tree: KinematicTree,
     return parents if max(children) > 1 else None
 
 
-def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
-    """The tree's I (int32) and D (float64), laid out as this module's docstring says."""
-    joints = tree.joints
-    nb, nj = len(joints), len(tree.coordinates)
+def tables(tree: KinematicTree) -> np.ndarray:
+    """The tree's I (int32), laid out as this module's docstring says."""
+    nb, nj = len(tree.joints), len(tree.coordinates)
     floating = int(bool(tree.floating_base))
     nv = nj + 6 * floating
-    R0 = np.array([j.rotation for j in joints], dtype=float).reshape(nb, 3, 3)
-    u = np.array([j.axis for j in joints], dtype=float).reshape(nb, 3)
-    uu = np.einsum("bi,bj->bij", u, u)
-    skew = np.zeros((nb, 3, 3))
-    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -u[:, 2], u[:, 1], -u[:, 0]
-    skew -= np.swapaxes(skew, 1, 2)
-    # R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x
-    P, C, S = R0 @ uu, R0 @ (np.eye(3) - uu), R0 @ skew
-    models = [JOINT_MODELS[j.kind] for j in joints]
-    # the slide per unit theta (a revolute joint's 0 unused; a prismatic one's 1 exactly)
-    lead = np.array([m.lead(j.pitch) if getattr(m, "slides", False) else 1.0
-                     for m, j in zip(models, joints, strict=True)])
     pairs = _pairs(tree)
     rows = _column_rows(tree, pairs)
     starts = np.cumsum([0] + [len(r) for r in rows])
@@ -183,19 +167,10 @@ def tables(tree: KinematicTree) -> tuple[np.ndarray, np.ndarray]:
     header = [nb, nj, floating, len(pairs), int(starts[-1]), int(parents is not None),
               int(one_body is not None), int(sparse)]
     I = np.concatenate([
-        header, [j.parent for j in joints],
-        [0 if floating and b == 0 else j.coordinate for b, j in enumerate(joints)],
-        [bool(getattr(m, "turns", False)) for m in models],
-        [bool(getattr(m, "slides", False)) for m in models],
-        np.ravel(np.array(pairs, dtype=int)), starts, [k for r in rows for k in r],
+        header, np.ravel(np.array(pairs, dtype=int)), starts, [k for r in rows for k in r],
         parents if parents is not None else [-1] * nv]).astype(np.int32)
-    D = np.concatenate([[j.multiplier for j in joints], [j.offset for j in joints],
-                        R0.ravel(), P.ravel(), C.ravel(), S.ravel(),
-                        np.array([j.translation for j in joints], dtype=float).ravel(),
-                        u.ravel(), (lead[:, None] * np.einsum("bij,bj->bi", R0, u)).ravel()])
-    for table in (I, D):
-        table.flags.writeable = False
-    return I, D
+    I.flags.writeable = False
+    return I
 
 
 def kernel_source():
@@ -223,6 +198,7 @@ def kernel_source():
         _SINCOS, _VECTOR,
         head, _SCALAR, core, _LANES, core, bindings,
     ])
+    source = spliced(source)
     return GeneratedSource(source=source, parameters=(), n=0, m=0)
 
 
@@ -248,7 +224,7 @@ def engine():
 
     generated = kernel_source()
     key = "\n".join(["derivatives", hashlib.sha256(
-        generated.source.encode() + Path(__file__).read_bytes()).hexdigest()])
+        generated.source.encode() + Path(__file__).read_bytes() + header_bytes()).hexdigest()])
     try:
         return compiled.load_keyed(key, lambda: generated, native=True)
     except compiled.BackendUnavailable:
@@ -272,27 +248,21 @@ def derivatives_module(tree: KinematicTree) -> TreeDerivatives | None:
     module = engine()
     if module is None:
         return None
-    handle = module.tree(*tables(tree))
+    handle = module.tree(describe(tree, {}), tables(tree))
     return TreeDerivatives(partial(module.inverse_derivatives, handle),
                            partial(module.forward_derivatives, handle),
                            partial(module.regressor, handle), module)
 
 
-def _flat(matrix) -> list[float]:
-    return [float(x) for row in matrix for x in row]
-
-
 def runtime_values(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
     """P = [g times the tree's direction (m/s^2, 3), tau_<joint> (N m or N, one per
     coordinate; 0 where none), then per body m (kg), h = m c (kg m, 3) and J_O (kg m^2, 9,
-    about its origin in its axes)], read-only."""
-    g = float(parameters.get(tree.gravity_parameter, 0.0) or 0.0) \
-        if tree.gravity_parameter is not None else 0.0
-    actuators = [float(parameters.get(a, 0.0) or 0.0) if a is not None else 0.0
-                 for a in tree.actuators]
-    inertials = [[j.mass, *j.first_moment, *_flat(j.inertia)] for j in tree.joints]
-    P = np.concatenate([g * np.array(tree.gravity_direction, dtype=float), actuators,
-                        np.ravel(np.array(inertials, dtype=float))])
+    about its origin)], read-only: the description's numbers (describe), each body's in its
+    canonical axes, as the kernel places it."""
+    D = describe(tree, parameters)
+    n, nb = int(D[1]), int(D[0])
+    records = D[HEADER + n:].reshape(nb, STRIDE)
+    P = np.concatenate([D[2:5], D[HEADER:HEADER + n], records[:, 20:33].ravel()])
     P.flags.writeable = False
     return P
 

@@ -23,65 +23,49 @@
 #define DK_PASTE_(a, b) a##b
 #define DK_PASTE(a, b) DK_PASTE_(a, b)
 
-/* The tree, read at run time (derivatives_c.py builds its two tables, the bindings copy them
- * here once per tree): nb bodies, nj joint coordinates, ff 1 on a floating base (body 0 a free
- * flyer, its 7 q and 6 v first: qo, vo), nv = nj + 6 ff velocity coordinates, nq = nj + 7 ff;
- * np ancestor pairs (k, j), j on k's path to the ground, k first; per coordinate j the rows
- * that d tau/d(q, q_dot)_j can have nonzero (rows[row0[j] .. row0[j + 1]]), and its parent
- * coordinate (lambda, for the factor along the tree). Per body its parent body, coordinate,
- * whether it turns or slides (a helical joint both), its multiplier and offset, R0, t0, its
- * axis u (its joint's frame), R0 u times the lead (the slide per unit th: 1 prismatic, the
- * pitch helical) and P, C, S with R0 Rot(u, th) = P + cos th C + sin th S. ``space``: the
- * DK_T numbers of one state's work (a lane group's on the lanes: carve). */
+#include "spatial.h"
+#include "joint.h"
+
+/* The tree, read at run time: its description D (tree/description.py, the tree kernel's; each
+ * joint in canonical axes, placed by joint.h) and one table of its pattern (derivatives_c.py),
+ * copied here once per tree by the bindings: nb bodies, nj joint coordinates, ff 1 on a
+ * floating base (body 0 a free flyer, its 7 q and 6 v first: qo, vo), nv = nj + 6 ff velocity
+ * coordinates, nq = nj + 7 ff; np ancestor pairs (k, j), j on k's path to the ground, k first;
+ * per coordinate j the rows that d tau/d(q, q_dot)_j can have nonzero (rows[row0[j] ..
+ * row0[j + 1]]), and its parent coordinate (lambda, for the factor along the tree). Per body,
+ * read out of D once: its parent body, coordinate and multiplier. ``space``: the DK_T numbers
+ * of one state's work (a lane group's on the lanes: carve). */
 typedef struct {
     int nb, nj, ff, np, nv, nq, qo, vo, ltdl, once, sparse;
-    const int *parent, *coord, *turns, *slides, (*pair)[2], *row0, *rows, *lambda;
-    const double *mult, *off, (*R0)[9], (*P)[9], (*C)[9], (*Sk)[9], (*t0)[3], (*u)[3],
-        (*R0u)[3];
+    tk_tree t;
+    const int *parent, *coord, (*pair)[2], *row0, *rows, *lambda;
+    const double *mult;
     size_t space;
 } dk_tree;
+
+#define DK_BODY_OF(tree, i) ((tree)->t.body + (size_t)(i) * TK_STRIDE)  /* body i's record */
+
+/* joint.h's and spatial.h's number type and names: the core's (DK_T, DK_FN) */
+#define SP_T DK_T
+#define JT_T DK_T
+#define JT_FN(name) DK_FN(jt_##name)
+#define JT_C(x) DK_C(x)
+#define JT_SINCOS DK_SINCOS
 
 /* The core below is emitted twice by derivatives_c.py: on one state (dk_*, DK_T double) and on
  * LG_LANES states at once (dk4_*, DK_T lg_v4, GCC/Clang vector extensions). DK_FN(name) names a
  * function, DK_C(x) a constant as a DK_T, DK_SINCOS and DK_SQRT the functions of a DK_T, and
  * DK_FAILED(d) the lanes where !(d > 0) as a DK_MASK, DK_BITS(mask) those lanes as bits. */
 /* DK_CORE_BEGIN */
-static inline void DK_FN(cross)(const DK_T *a, const DK_T *b, DK_T *out)
-{
-    DK_T x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2],
-         z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x; out[1] = y; out[2] = z;
-}
-
-static inline void DK_FN(apply)(const DK_T *R, const DK_T *x, DK_T *out)
-{
-    DK_T a = R[0] * x[0] + R[1] * x[1] + R[2] * x[2], b = R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
-         c = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
-    out[0] = a; out[1] = b; out[2] = c;
-}
-
-/* A B with B a table's (doubles) */
-static inline void DK_FN(matmul_c)(const DK_T *A, const double *B, DK_T *out)
-{
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            out[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
-}
-
-static inline void DK_FN(matmul)(const DK_T *A, const DK_T *B, DK_T *out)
-{
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            out[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
-}
+/* JT_CORE: joint.h's core, here */
 
 /* motion x motion: [w x yv + v x yw; w x yw] */
 static inline void DK_FN(mcross)(const DK_T *x, const DK_T *y, DK_T *out)
 {
     DK_T a[3], b[3], c[3];
-    DK_FN(cross)(x + 3, y, a);
-    DK_FN(cross)(x, y + 3, b);
-    DK_FN(cross)(x + 3, y + 3, c);
+    SP_CROSS(x + 3, y, a);
+    SP_CROSS(x, y + 3, b);
+    SP_CROSS(x + 3, y + 3, c);
     for (int j = 0; j < 3; j++) { out[j] = a[j] + b[j]; out[3 + j] = c[j]; }
 }
 
@@ -89,20 +73,15 @@ static inline void DK_FN(mcross)(const DK_T *x, const DK_T *y, DK_T *out)
 static inline void DK_FN(fcross)(const DK_T *x, const DK_T *f, DK_T *out)
 {
     DK_T a[3], b[3], c[3];
-    DK_FN(cross)(x + 3, f, a);
-    DK_FN(cross)(x, f, b);
-    DK_FN(cross)(x + 3, f + 3, c);
+    SP_CROSS(x + 3, f, a);
+    SP_CROSS(x, f, b);
+    SP_CROSS(x + 3, f + 3, c);
     for (int j = 0; j < 3; j++) { out[j] = a[j]; out[3 + j] = b[j] + c[j]; }
 }
 
 static inline DK_T DK_FN(dot6)(const DK_T *a, const DK_T *b)
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
-}
-
-static inline DK_T DK_FN(dot3)(const DK_T *a, const DK_T *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
 /* A spatial inertia at the world's origin: mass m, c = m x_G (3), J_O (3 x 3, symmetric). */
@@ -112,9 +91,9 @@ typedef struct { DK_T m, c[3], J[9]; } DK_FN(inertia);
 static inline void DK_FN(iapply)(const DK_FN(inertia) *Y, const DK_T *x, DK_T *out)
 {
     DK_T a[3], b[3], Jw[3];
-    DK_FN(cross)(x + 3, Y->c, a);
-    DK_FN(cross)(Y->c, x, b);
-    DK_FN(apply)(Y->J, x + 3, Jw);
+    SP_CROSS(x + 3, Y->c, a);
+    SP_CROSS(Y->c, x, b);
+    SP_APPLY(Y->J, x + 3, Jw);
     for (int j = 0; j < 3; j++) { out[j] = Y->m * x[j] + a[j]; out[3 + j] = b[j] + Jw[j]; }
 }
 
@@ -156,29 +135,18 @@ static DK_T *DK_FN(carve)(const dk_tree *tree, DK_T *at, DK_FN(work) *w)
     return at;
 }
 
-/* A floating base (body 0): q[0:3] its origin, q[3:7] its quaternion x y z w (normalized here),
- * R = R0 R(quaternion), o = t0 + R0 q[0:3]; its velocity and acceleration in its own axes, so
+/* A floating base (body 0): q[0:3] its origin, q[3:7] its quaternion x y z w (joint.h places
+ * it: R = R0 R(quaternion), o = t0 + R0 q[0:3]); its velocity and acceleration in its own axes, so
  * its columns are the world's images of the unit twists: [R e_c; 0] and [o x R e_c; R e_c]. */
 static void DK_FN(base)(const dk_tree *tree, const DK_T *q, const DK_T *qd, const DK_T *qdd,
                         const double *g, DK_FN(work) *w)
 {
-    const DK_T x = q[3], y = q[4], z = q[5], r = q[6];
-    const DK_T t = 2.0 / (x * x + y * y + z * z + r * r);
-    const DK_T Rq[9] = {1.0 - t * (y * y + z * z), t * (x * y - z * r), t * (x * z + y * r),
-                        t * (x * y + z * r), 1.0 - t * (x * x + z * z), t * (y * z - x * r),
-                        t * (x * z - y * r), t * (y * z + x * r), 1.0 - t * (x * x + y * y)};
     DK_T *R = w->R[0], *o = w->o[0], *V = w->V[0], *Acc = w->Acc[0];
-    for (int a = 0; a < 3; a++) {
-        for (int b = 0; b < 3; b++)
-            R[3 * a + b] = tree->R0[0][3 * a] * Rq[b] + tree->R0[0][3 * a + 1] * Rq[3 + b]
-                           + tree->R0[0][3 * a + 2] * Rq[6 + b];
-        o[a] = tree->t0[0][a] + tree->R0[0][3 * a] * q[0] + tree->R0[0][3 * a + 1] * q[1]
-               + tree->R0[0][3 * a + 2] * q[2];
-    }
+    DK_FN(jt_placed)(&tree->t, DK_BODY_OF(tree, 0), q, NULL, NULL, R, o);
     for (int c = 0; c < 3; c++) {
         DK_T *L = w->ffS[c], *A = w->ffS[3 + c];
         for (int j = 0; j < 3; j++) { L[j] = R[3 * j + c]; L[3 + j] = DK_C(0.0); A[3 + j] = L[j]; }
-        DK_FN(cross)(o, L, A);
+        SP_CROSS(o, L, A);
     }
     for (int j = 0; j < 6; j++) {
         V[j] = DK_C(0.0);
@@ -204,50 +172,18 @@ static void DK_FN(kinematics)(const dk_tree *tree, const DK_T *q, const DK_T *qd
             DK_FN(base)(tree, q, qd, qdd, g, w);
             continue;
         }
-        DK_T th = tree->mult[i] * q[tree->qo + tree->coord[i]] + tree->off[i];
-        DK_T Rl[9], pl[3];
-        for (int j = 0; j < 3; j++) pl[j] = DK_C(tree->t0[i][j]);
-        if (tree->turns[i]) {
-            /* R0 Rot(u, th) = R0 u u^T + cos th R0 (1 - u u^T) + sin th R0 [u]x (tables) */
-            DK_T c, s;
-            DK_SINCOS(th, &s, &c);
-            for (int j = 0; j < 9; j++) Rl[j] = tree->P[i][j] + c * tree->C[i][j] + s * tree->Sk[i][j];
-        } else {
-            for (int j = 0; j < 9; j++) Rl[j] = DK_C(tree->R0[i][j]);
-        }
-        if (tree->slides[i])
-            for (int j = 0; j < 3; j++) pl[j] += th * tree->R0u[i][j];
-        int p = tree->parent[i];
-        DK_T axis[3];
-        if (p < 0) {
-            for (int j = 0; j < 9; j++) R[i][j] = Rl[j];
-            for (int j = 0; j < 3; j++) o[i][j] = pl[j];
-        } else {
-            DK_T d[3];
-            DK_FN(matmul)(R[p], Rl, R[i]);
-            DK_FN(apply)(R[p], pl, d);
-            for (int j = 0; j < 3; j++) o[i][j] = o[p][j] + d[j];
-        }
-        /* the world axis R u: R's column when u is a table's unit vector along x, y or z */
-        for (int j = 0; j < 3; j++)
-            axis[j] = R[i][3 * j] * tree->u[i][0] + R[i][3 * j + 1] * tree->u[i][1]
-                      + R[i][3 * j + 2] * tree->u[i][2];
-        /* S: [o x a; a] turning about the world axis a, [a; 0] sliding along it; a helical
-           joint turns and slides: [o x a + lead a; a], lead a = R_p (lead R0 u) */
+        const double *b = DK_BODY_OF(tree, i);
+        const int p = tree->parent[i];
+        DK_FN(jt_placed)(&tree->t, b, q, p < 0 ? NULL : R[p], p < 0 ? NULL : o[p], R[i], o[i]);
+        /* S: [o x a; a] turning about the world axis a = R e_z (canonical axes), [a; 0] sliding
+           along it; a helical joint turns and slides: [o x a + lead a; a] */
+        const DK_T axis[3] = {R[i][2], R[i][5], R[i][8]};
         DK_T *S = w->S[i];
-        if (tree->turns[i]) {
-            DK_FN(cross)(o[i], axis, S);
+        if (TK_TURNS(b)) {
+            SP_CROSS(o[i], axis, S);
             for (int j = 0; j < 3; j++) S[3 + j] = axis[j];
-            if (tree->slides[i]) {
-                DK_T d[3];
-                if (p < 0)
-                    for (int j = 0; j < 3; j++) d[j] = DK_C(tree->R0u[i][j]);
-                else
-                    for (int j = 0; j < 3; j++)
-                        d[j] = R[p][3 * j] * tree->R0u[i][0] + R[p][3 * j + 1] * tree->R0u[i][1]
-                               + R[p][3 * j + 2] * tree->R0u[i][2];
-                for (int j = 0; j < 3; j++) S[j] += d[j];
-            }
+            if (TK_SLIDES(b))
+                for (int j = 0; j < 3; j++) S[j] += b[TK_LEAD] * axis[j];
         } else {
             for (int j = 0; j < 3; j++) { S[j] = axis[j]; S[3 + j] = DK_C(0.0); }
         }
@@ -286,8 +222,8 @@ static void DK_FN(forward)(const dk_tree *tree, const DK_T *q, const DK_T *qd, c
         for (int j = 0; j < 3; j++)
             hr[j] = R[i][3 * j] * inertial[1] + R[i][3 * j + 1] * inertial[2]
                     + R[i][3 * j + 2] * inertial[3];
-        DK_FN(matmul_c)(R[i], inertial + 4, RJ);
-        DK_T pp = DK_FN(dot3)(po, po), ph = DK_FN(dot3)(po, hr);
+        SP_MATMUL(R[i], inertial + 4, RJ);
+        DK_T pp = SP_DOT(po, po), ph = SP_DOT(po, hr);
         for (int a = 0; a < 3; a++)
             for (int b = a; b < 3; b++) {
                 DK_T T = RJ[3 * a] * R[i][3 * b] + RJ[3 * a + 1] * R[i][3 * b + 1]
@@ -306,10 +242,10 @@ static void DK_FN(forward)(const dk_tree *tree, const DK_T *q, const DK_T *qd, c
         for (int j = 0; j < 6; j++) w->F[i][j] = Ya[j] + vh[j];
         /* B: L = l, A = X + X^T - (c v^T + v c^T) + 2 (v.c) 1 - [n]x, X = [w]x J_O */
         const DK_T *vl = V[i], *vw = V[i] + 3, *c = Y->c;
-        DK_T X[9], cv = DK_FN(dot3)(vl, c);
+        DK_T X[9], cv = SP_DOT(vl, c);
         for (int b = 0; b < 3; b++) {
             DK_T col[3] = {Y->J[b], Y->J[3 + b], Y->J[6 + b]}, r[3];
-            DK_FN(cross)(vw, col, r);
+            SP_CROSS(vw, col, r);
             X[b] = r[0]; X[3 + b] = r[1]; X[6 + b] = r[2];
         }
         DK_T *A = w->A[i];
@@ -327,8 +263,8 @@ static void DK_FN(forward)(const dk_tree *tree, const DK_T *q, const DK_T *qd, c
 static inline void DK_FN(bapply)(const DK_T *L, const DK_T *A, const DK_T *x, DK_T *out)
 {
     DK_T t[3];
-    DK_FN(cross)(L, x + 3, t);
-    DK_FN(apply)(A, x + 3, out + 3);
+    SP_CROSS(L, x + 3, t);
+    SP_APPLY(A, x + 3, out + 3);
     for (int j = 0; j < 3; j++) out[j] = -2.0 * t[j];
 }
 
@@ -348,7 +284,7 @@ static void DK_FN(backward)(const dk_tree *tree, DK_FN(work) *w, DK_T *tau, int 
             DK_T t[6], u[6], x[6];
             /* Bc^T S (angular part): 2 L x s_v + A^T s_w */
             DK_T *r2 = w->r2[i];
-            DK_FN(cross)(w->L[i], S, r2);
+            SP_CROSS(w->L[i], S, r2);
             for (int j = 0; j < 3; j++)
                 r2[j] = 2.0 * r2[j] + w->A[i][j] * S[3] + w->A[i][3 + j] * S[4]
                         + w->A[i][6 + j] * S[5];
@@ -367,7 +303,7 @@ static void DK_FN(backward)(const dk_tree *tree, DK_FN(work) *w, DK_T *tau, int 
                 w->fftau[c] = DK_FN(dot6)(T, w->F[0]);
                 if (!columns) continue;
                 DK_T *r2 = w->ffr2[c];
-                DK_FN(cross)(w->L[0], T, r2);
+                SP_CROSS(w->L[0], T, r2);
                 for (int j = 0; j < 3; j++)
                     r2[j] = 2.0 * r2[j] + w->A[0][j] * T[3] + w->A[0][3 + j] * T[4]
                             + w->A[0][6 + j] * T[5];
@@ -408,13 +344,13 @@ static inline __attribute__((always_inline)) void DK_FN(base_pairs)(
         if (k == 0) {
             for (int r = 0; r < 6; r++) {
                 const DK_T *r1 = w->ffr1[r], *r2 = w->ffr2[r];
-                if (M) M[r * n + c] = moves ? DK_FN(dot6)(r1, S) : DK_FN(dot3)(r1, S);
+                if (M) M[r * n + c] = moves ? DK_FN(dot6)(r1, S) : SP_DOT(r1, S);
                 if (!dq) continue;
                 if (moves) {
                     dq[r * n + c] = DK_FN(dot6)(r1, w->ffpsi[c]);
-                    dv[r * n + c] = DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3);
+                    dv[r * n + c] = DK_FN(dot6)(r1, w->ffdv[c]) + SP_DOT(r2, S + 3);
                 } else {
-                    dv[r * n + c] = DK_FN(dot3)(r1, w->ffdv[c]);
+                    dv[r * n + c] = SP_DOT(r1, w->ffdv[c]);
                 }
             }
             continue;
@@ -423,20 +359,20 @@ static inline __attribute__((always_inline)) void DK_FN(base_pairs)(
         const double m = tree->mult[k];
         const DK_T *r1 = w->r1[k], *r2 = w->r2[k];
         if (M) {
-            const DK_T mkc = m * (moves ? DK_FN(dot6)(r1, S) : DK_FN(dot3)(r1, S));
+            const DK_T mkc = m * (moves ? DK_FN(dot6)(r1, S) : SP_DOT(r1, S));
             DK_ADD(M[ck * n + c], mkc);
             DK_ADD(M[c * n + ck], mkc);
         }
         if (!dq) continue;
         if (moves) {
             DK_ADD(dq[ck * n + c], m * DK_FN(dot6)(r1, w->ffpsi[c]));
-            DK_ADD(dv[ck * n + c], m * (DK_FN(dot6)(r1, w->ffdv[c]) + DK_FN(dot3)(r2, S + 3)));
+            DK_ADD(dv[ck * n + c], m * (DK_FN(dot6)(r1, w->ffdv[c]) + SP_DOT(r2, S + 3)));
             DK_ADD(dq[c * n + ck], m * DK_FN(dot6)(S, w->Phi[k]));
             DK_ADD(dv[c * n + ck], m * DK_FN(dot6)(S, w->Psi[k]));
         } else {
-            DK_ADD(dv[ck * n + c], m * DK_FN(dot3)(r1, w->ffdv[c]));
-            DK_ADD(dq[c * n + ck], m * DK_FN(dot3)(S, w->Phi[k]));
-            DK_ADD(dv[c * n + ck], m * DK_FN(dot3)(S, w->Psi[k]));
+            DK_ADD(dv[ck * n + c], m * SP_DOT(r1, w->ffdv[c]));
+            DK_ADD(dq[c * n + ck], m * SP_DOT(S, w->Phi[k]));
+            DK_ADD(dv[c * n + ck], m * SP_DOT(S, w->Psi[k]));
         }
     }
 }
@@ -474,9 +410,9 @@ static inline __attribute__((always_inline)) void DK_FN(pairs)(const dk_tree *tr
         if (!dq) continue;
         const DK_T *r2 = w->r2[k];
         DK_ADD(dq[ck * n + cj],
-               kk * (DK_FN(dot6)(r1, w->psi[j]) + DK_FN(dot3)(r2, w->dv[j] + 3)));
+               kk * (DK_FN(dot6)(r1, w->psi[j]) + SP_DOT(r2, w->dv[j] + 3)));
         DK_ADD(dv[ck * n + cj],
-               kk * (2.0 * DK_FN(dot6)(r1, w->dv[j]) + DK_FN(dot3)(r2, w->S[j] + 3)));
+               kk * (2.0 * DK_FN(dot6)(r1, w->dv[j]) + SP_DOT(r2, w->S[j] + 3)));
         if (k != j) {
             DK_ADD(dq[cj * n + ck], kk * DK_FN(dot6)(w->S[j], w->Phi[k]));
             DK_ADD(dv[cj * n + ck], kk * DK_FN(dot6)(w->S[j], w->Psi[k]));

@@ -10,22 +10,22 @@ static inline void DK_FN(regressor_column)(const DK_T *S, double mult, const DK_
                                            DK_T Nh[3][3], DK_T Nj[6][3], DK_T *row)
 {
     DK_T sv[3], sl[3], sw[3], t[3];
-    DK_FN(cross)(S + 3, o, t);
+    SP_CROSS(S + 3, o, t);
     for (int j = 0; j < 3; j++) sv[j] = S[j] + t[j];
     for (int j = 0; j < 3; j++) {
         sl[j] = R[j] * sv[0] + R[3 + j] * sv[1] + R[6 + j] * sv[2];
         sw[j] = R[j] * S[3] + R[3 + j] * S[4] + R[6 + j] * S[5];
     }
-    row[0] += mult * DK_FN(dot3)(sl, al);
+    row[0] += mult * SP_DOT(sl, al);
     for (int c = 0; c < 3; c++)
-        row[1 + c] += mult * (DK_FN(dot3)(sl, Fh[c]) + DK_FN(dot3)(sw, Nh[c]));
-    for (int p = 0; p < 6; p++) row[4 + p] += mult * DK_FN(dot3)(sw, Nj[p]);
+        row[1 + c] += mult * (SP_DOT(sl, Fh[c]) + SP_DOT(sw, Nh[c]));
+    for (int p = 0; p < 6; p++) row[4 + p] += mult * SP_DOT(sw, Nj[p]);
 }
 
 /* Y (nv x 10 nb, row-major) with tau = Y pi, pi = [m, m c, I_xx, I_xy, I_yy, I_xz, I_yz,
- * I_zz] per body about its origin in its axes (Pinocchio's order): body i's wrench at its origin
- * per parameter, from its angular velocity w, angular acceleration dw and its origin's
- * acceleration ac (gravity in), in its axes: m [ac; 0], h [(dw x + w x w x) h; h x ac],
+ * I_zz] per body about its origin in its link's own axes (Pinocchio's order): body i's wrench
+ * at its origin per parameter, from its angular velocity w, angular acceleration dw and its
+ * origin's acceleration ac (gravity in), in its axes: m [ac; 0], h [(dw x + w x w x) h; h x ac],
  * J [0; J dw + w x J w]; each paired with S_k of every joint k at or above it, in its axes. */
 static void DK_FN(regressor)(const dk_tree *tree, DK_T *space, const DK_T *q, const DK_T *qd,
                              const DK_T *qdd, const double *g, DK_T *Y)
@@ -36,14 +36,22 @@ static void DK_FN(regressor)(const dk_tree *tree, DK_T *space, const DK_T *q, co
     const int nb = tree->nb, width = 10 * nb;
     for (int j = 0; j < tree->nv * width; j++) Y[j] = DK_C(0.0);
     for (int i = 0; i < nb; i++) {
-        const DK_T *R = w.R[i], *o = w.o[i], *V = w.V[i], *Acc = w.Acc[i];
+        const DK_T *o = w.o[i], *V = w.V[i], *Acc = w.Acc[i];
+        /* the link's own axes, whose inertial pi is: R = R_c A^T, R_c the body's canonical
+           axes (D's) and A (D's TK_AXES) the canonical axes in the link's */
+        const double *A = DK_BODY_OF(tree, i) + TK_AXES;
+        DK_T R[9];
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                R[3 * r + c] = w.R[i][3 * r] * A[3 * c] + w.R[i][3 * r + 1] * A[3 * c + 1]
+                               + w.R[i][3 * r + 2] * A[3 * c + 2];
         DK_T vo[3], ac[3], t[3], wl[3], dwl[3], al[3], ww[3];
         /* the origin's velocity v + w x o and classical acceleration a + dw x o + w x vo */
-        DK_FN(cross)(V + 3, o, t);
+        SP_CROSS(V + 3, o, t);
         for (int j = 0; j < 3; j++) vo[j] = V[j] + t[j];
-        DK_FN(cross)(Acc + 3, o, t);
+        SP_CROSS(Acc + 3, o, t);
         for (int j = 0; j < 3; j++) ac[j] = Acc[j] + t[j];
-        DK_FN(cross)(V + 3, vo, t);
+        SP_CROSS(V + 3, vo, t);
         for (int j = 0; j < 3; j++) ac[j] += t[j];
         for (int j = 0; j < 3; j++) {  /* into the body's axes: R^T x */
             wl[j] = R[j] * V[3] + R[3 + j] * V[4] + R[6 + j] * V[5];
@@ -55,11 +63,11 @@ static void DK_FN(regressor)(const dk_tree *tree, DK_T *space, const DK_T *q, co
         for (int c = 0; c < 3; c++) {  /* h = e_c: (dw x + w x w x) e_c, e_c x ac */
             DK_T e[3] = {DK_C(0.0), DK_C(0.0), DK_C(0.0)}, x[3], y[3];
             e[c] = DK_C(1.0);
-            DK_FN(cross)(dwl, e, x);
-            DK_FN(cross)(wl, e, y);
-            DK_FN(cross)(wl, y, t);
+            SP_CROSS(dwl, e, x);
+            SP_CROSS(wl, e, y);
+            SP_CROSS(wl, y, t);
             for (int j = 0; j < 3; j++) Fh[c][j] = x[j] + t[j];
-            DK_FN(cross)(e, al, Nh[c]);
+            SP_CROSS(e, al, Nh[c]);
         }
         /* J's six entries: J dw + w x J w for J = E_rc + E_cr */
         static const int rows[6] = {0, 0, 1, 0, 1, 2}, cols[6] = {0, 1, 1, 2, 2, 2};
@@ -68,7 +76,7 @@ static void DK_FN(regressor)(const dk_tree *tree, DK_T *space, const DK_T *q, co
             const int r = rows[p], c = cols[p];
             Jd[r] += dwl[c]; Jw[r] += wl[c];
             if (r != c) { Jd[c] += dwl[r]; Jw[c] += wl[r]; }
-            DK_FN(cross)(wl, Jw, ww);
+            SP_CROSS(wl, Jw, ww);
             for (int j = 0; j < 3; j++) Nj[p][j] = Jd[j] + ww[j];
         }
         for (int kk = i; kk >= tree->ff; kk = tree->parent[kk])

@@ -37,6 +37,7 @@
 #define TK_QCOORD 40    /* its (first) number in q, after the base's */
 #define TK_ROW 41       /* 3: where R0 is a signed permutation, each column's nonzero row */
 #define TK_ROWSIGN 44   /* 3: that entry, +-1 */
+#define TK_AXES 47      /* 9: A, the canonical axes -> the body's own (its link's), row-major */
 #define TK_LEAD 61      /* the slide along u per unit theta: 1 prismatic, pitch (m/rad) helical */
 #define TK_TURNS(b) ((b)[TK_KIND] == 0.0 || (b)[TK_KIND] == 3.0)
 #define TK_SLIDES(b) ((b)[TK_KIND] == 1.0 || (b)[TK_KIND] == 3.0)

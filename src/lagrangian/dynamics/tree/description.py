@@ -22,7 +22,8 @@ The description ``D`` (float64, contiguous), built by ``describe``:
       21:24 first moment h = m c about the body origin (kg m)  24:33 J_O (kg m^2, body axes)
       33:36 where R0 is a signed permutation, the column of each row's one nonzero, 36:39 its
       sign, 39 1 then (else 0: R0 is read as its nine numbers), 41:44 then for each column
-      k the row whose nonzero is there, 44:47 its sign  47:61 spare
+      k the row whose nonzero is there, 44:47 its sign  47:56 A (canonical -> the joint's
+      own body axes, row-major: what a result per the link's own inertial turns by)  56:61 spare
       61 the lead: the slide along u per unit theta (1 prismatic, the pitch in m/rad
       helical, 0 revolute)  62:64 spare.
       A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone; a helical joint
@@ -58,6 +59,7 @@ from .joint_models import JOINT_MODELS
 HEADER, STRIDE = 8, 64
 LEAD = 61  # a record's slide per unit theta (tree_kernel.c's TK_LEAD)
 QCOORD = 40  # a record's configuration index (tree_kernel.c's TK_QCOORD)
+AXES = 47  # a record's A, canonical -> own body axes (joint.h's TK_AXES)
 
 
 JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FREE_FLYER: 2,
@@ -121,6 +123,7 @@ def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray
         r[14:17] = Ap.T @ np.array(j.translation, dtype=float)
         r[17:20] = (0.0, 0.0, 1.0) if JointKind(j.kind) not in _OWN_AXES else j.axis
         r[20], r[21:24] = j.mass, A.T @ np.array(j.first_moment, dtype=float)
+        r[AXES:AXES + 9] = np.ravel(A)
         r[24:33] = np.ravel(A.T @ np.array(j.inertia, dtype=float) @ A)
         model = JOINT_MODELS[JointKind(j.kind)]
         r[LEAD] = model.lead(j.pitch) if hasattr(model, "lead") else 0.0
@@ -152,4 +155,5 @@ def joints_of(D: np.ndarray) -> tuple[TreeJoint, ...]:
     return tuple(out)
 
 
-__all__ = ["HEADER", "JOINT_CODES", "LEAD", "QCOORD", "STRIDE", "canonical_frame", "describe", "joints_of"]
+__all__ = ["AXES", "HEADER", "JOINT_CODES", "LEAD", "QCOORD", "STRIDE", "canonical_frame", "describe",
+           "joints_of"]

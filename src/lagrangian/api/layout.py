@@ -40,11 +40,12 @@ class StateLayout:
 def state_layout(system) -> StateLayout:
     """The StateLayout of ``system`` (a floating base's names from its dynamics: the base's
     x, y, z, qx, qy, qz, qw then the joints in q; vx, vy, vz, wx, wy, wz then the joint rates
-    in v; a ball joint's <ball>_qw, _qx, _qy, _qz in q and <ball>_wx, _wy, _wz in v)."""
+    in v; a ball joint's <ball>_qw, _qx, _qy, _qz in q and <ball>_wx, _wy, _wz in v; a free
+    flyer below the root <joint>_x .. _qw in q and <joint>_vx .. _wz in v)."""
     joints = tuple(c.name for c in system.model.coordinates)
     tree = system.model.kinematic_tree
     floating = getattr(tree, "floating_base", False)
-    if not floating and not getattr(tree, "spherical", ()):
+    if not floating and not getattr(tree, "quaternion_joints", ()):  # ball, free flyer
         return StateLayout(joints, joints)
     f = system.dynamics()  # a ball joint's quaternion and angular velocity (not Euler hinges)
     return StateLayout(tuple(f.coordinates), tuple(f.velocity_names),

@@ -19,7 +19,7 @@ from collections.abc import Mapping, Sequence
 from ..errors import ModelError
 from ..kinds import JointKind
 from ..model.model import Model
-from ..model.tree import KinematicTree
+from ..model.tree import KinematicTree, refuse_free_joints
 from .casadi_functions import CasadiFunctions, _casadi
 
 
@@ -152,6 +152,7 @@ def tree_casadi_functions(model: Model, inputs: Sequence[str] = (),
     tree = model.kinematic_tree
     if tree is None:
         raise ModelError("the model has no kinematic tree", field="to_casadi")
+    refuse_free_joints(tree, "the CasADi functions of a tree")
     values = {p.name: p.value for p in model.parameters}
     for name, value in dict(parameters or {}).items():
         if name not in values:

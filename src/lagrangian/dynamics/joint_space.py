@@ -155,7 +155,7 @@ class Dynamics(ControlTerms):
                 for x in arrays]
         if self.velocity_names is not None and fields[0] == "q":  # a floating base's quaternion
             tree = getattr(self, "tree", None)
-            if tree is not None and tree.spherical:  # and the ball joints' (tree/spherical.py)
+            if tree is not None and tree.quaternion_joints:  # and the ball joints' (tree/spherical.py)
                 from .tree.spherical import check_tree_quaternions
 
                 check_tree_quaternions(tree, flat[0])
@@ -347,7 +347,7 @@ class Dynamics(ControlTerms):
         if self.velocity_names is None:
             return (Q + V).reshape(batch + q.shape[-1:])
         tree = getattr(self, "tree", None)
-        if tree is not None and tree.spherical:  # each ball turned by exp(w dt) (spherical.py)
+        if tree is not None and tree.quaternion_joints:  # each ball turned by exp(w dt) (spherical.py)
             from .tree.spherical import check_tree_quaternions, integrate_tree
 
             check_tree_quaternions(tree, Q)
@@ -366,7 +366,7 @@ class Dynamics(ControlTerms):
         if self.velocity_names is None:
             return (Q1 - Q0).reshape(batch + (self.n,))
         tree = getattr(self, "tree", None)
-        if tree is not None and tree.spherical:
+        if tree is not None and tree.quaternion_joints:
             from .tree.spherical import check_tree_quaternions, difference_tree
 
             check_tree_quaternions(tree, Q0, "q0")

@@ -42,7 +42,7 @@ from .joint_space import Dynamics, reported_rows
 from .recursive_numpy import NumpyBackend, floating_refusal
 from .tree.applicable import TREE_PATH_BODIES, applicable_tree
 from .tree.numbers import batch_shape
-from .tree.spherical import ball_slices, check_tree_quaternions, refuse_spherical, unit_ball_quaternions
+from .tree.spherical import check_tree_quaternions, quaternion_slices, refuse_spherical, unit_ball_quaternions
 
 BACKENDS = {"compact": "recursive", "unrolled": "recursive", "numpy": "recursive-numpy"}
 
@@ -63,7 +63,7 @@ class TreeDynamics(Dynamics):
         self.model, self.tree = model, tree
         self.coordinates = tree.coordinates
         self.n = len(tree.coordinates)
-        if tree.spherical:  # a ball joint: 4 numbers in q (w x y z), 3 in v (tree/spherical.py)
+        if tree.quaternion_joints:  # a ball joint: 4 numbers in q, 3 in v; a free flyer 7 and 6
             self.velocity_names = tree.velocity_coordinates
             self.n = len(tree.velocity_coordinates)
         if tree.floating_base:  # Pinocchio's layout: the base's numbers first (free_flyer.py)
@@ -102,7 +102,7 @@ class TreeDynamics(Dynamics):
         q = rng.uniform(-np.pi, np.pi, (3, self.nq))
         if self.tree.floating_base:
             q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
-        for _, iq, _ in ball_slices(self.tree):
+        for _, _, iq, _ in quaternion_slices(self.tree):
             q[:, iq:iq + 4] /= np.linalg.norm(q[:, iq:iq + 4], axis=-1, keepdims=True)
         return all(_positive_definite(m) for m in self.mass_matrix(q))
 
@@ -130,7 +130,7 @@ class TreeDynamics(Dynamics):
         arrays = [self._vector(x, field) for x, field in zip(arrays, fields, strict=True)]
         if self.tree.floating_base:
             arrays[0] = _unit_quaternions(arrays[0])
-        if self.tree.spherical:  # each ball's: refused in one line naming the joint, or unit
+        if self.tree.quaternion_joints:  # each one's: refused in one line naming it, or unit
             Q = np.asarray(arrays[0], dtype=float)
             flat = Q.reshape(-1, Q.shape[-1])
             check_tree_quaternions(self.tree, flat)

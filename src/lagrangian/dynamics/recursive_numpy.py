@@ -13,7 +13,10 @@ states (N, 3) or (N, 3, 3), the bodies visited in Python:
 A floating base (a free flyer at the root, free_flyer.py) takes q of nq = n + 7 numbers and v, a,
 tau of nv = n + 6: its body moves by its own twist, and its share of tau is the wrench on it. A
 ball joint (tree/spherical.py) has 4 numbers in q (w x y z) and 3 in v (its body's angular
-velocity in its own axes): its share of tau is the moment on its body.
+velocity in its own axes): its share of tau is the moment on its body. A free flyer below the
+root (a URDF floating joint between two links) has 7 numbers in q (x y z in its parent's joint
+frame, qx qy qz qw) and 6 in v (its body's twist relative to its parent, linear then angular, in
+its own axes), as Pinocchio's JointModelFreeFlyer: its share of tau is the wrench on its body.
 
 Unlike the fully expanded equations (whose lambdified expression trees grow too deep for a
 7-joint arm), the cost grows with the number of bodies (CRBA: with bodies x depth). Units SI;
@@ -54,8 +57,10 @@ class NumpyBackend(TreeRecursions):
         # the ground accelerates up by g: every body feels gravity (Newton-Euler's trick)
         self._up = -self._g * np.array(tree.gravity_direction, dtype=float)
         # the bodies as the engine reads them (tree/description.py): one description; a
-        # floating base (a joint that description does not turn) from the tree itself
-        joints = tree.joints if tree.floating_base else joints_of(describe(tree, parameters))
+        # floating base (a joint that description does not turn) and a free flyer below the
+        # root (one the engine does not take: selection.py) from the tree itself
+        joints = (tree.joints if tree.floating_base or tree.free_joints
+                  else joints_of(describe(tree, parameters)))
         self._joints = [_Joint(j, tree) for j in joints]
         self._widths = (tree.nq, nv, nv)
 
@@ -93,7 +98,7 @@ class NumpyBackend(TreeRecursions):
             norms = np.sqrt((Q[:, 3:7] ** 2).sum(axis=-1))
             if (np.isfinite(Q).all(axis=-1) & ~(np.abs(norms - 1.0) <= QUATERNION_TOLERANCE)).any():
                 return None
-        if self.tree.spherical and not ball_quaternions_unit(self.tree, flat[0]):
+        if self.tree.quaternion_joints and not ball_quaternions_unit(self.tree, flat[0]):
             return None
         return shape, flat
 

@@ -13,7 +13,11 @@ body's angular velocity relative to its parent in the body's own axes (rad/s); s
 joint a coordinate's place in q and in v differ (KinematicTree.velocity_index). A floating base is a
 free-flyer joint at the root (joints[0], parent -1, kind free_flyer): the base link's body, moved
 by the configuration's first 7 numbers (position, quaternion x y z w) and the velocity's first 6
-(dynamics/tree/free_flyer.py); the other joints' numbers follow, q[7 + c] and v[6 + c]. Fixed and locked
+(dynamics/tree/free_flyer.py); the other joints' numbers follow, q[7 + c] and v[6 + c]. A free
+flyer below the root (a URDF floating joint between two links, coordinate c >= 0) moves its body
+in its parent by q[c:c+7] (x y z in the joint's frame, then qx qy qz qw: R = R_0 R(q),
+p = t_0 + R_0 (x, y, z)) and v's six numbers (linear then angular, the body's own axes), as
+Pinocchio's JointModelFreeFlyer anywhere in a tree. Fixed and locked
 joints are folded into R_0, t_0 of the next joint down, and the links they carry into the
 inertia of the moving body above them. A body's inertia is (m, h = m c, J_O): mass (kg), first
 moment about its frame's origin (kg m) and inertia tensor about that origin (kg m^2), in its
@@ -194,16 +198,32 @@ class KinematicTree:
         """The velocity's numbers: the base's, then the joints' (3 per ball joint)."""
         return self.base_nv + len(self.velocity_coordinates)
 
+    @property
+    def free_joints(self) -> tuple[TreeJoint, ...]:
+        """The free flyers below the root (a URDF floating joint between two links): 7 of the
+        joints' own configuration numbers each (x y z, qx qy qz qw), 6 velocity numbers."""
+        return tuple(j for j in self.joints
+                     if j.kind == JointKind.FREE_FLYER and j.coordinate >= 0)
+
+    @property
+    def quaternion_joints(self) -> tuple[TreeJoint, ...]:
+        """The joints with a quaternion among the joints' own numbers (ball joints and free
+        flyers below the root): where q and v differ in length after the base."""
+        return tuple(j for j in self.joints if j.coordinate >= 0 and j.kind in _QUATERNION)
+
     def velocity_index(self, coordinate: int) -> int:
         """Where the configuration number ``coordinate`` (an index in ``coordinates``) has its
-        rate among the joints' velocity numbers: one less per ball joint before it."""
+        rate among the joints' velocity numbers: one less per ball joint or free flyer before
+        it (4 numbers in q and 3 in v, or 7 and 6)."""
         return coordinate - sum(1 for j in self.joints
-                                if j.kind == JointKind.SPHERICAL and j.coordinate < coordinate)
+                                if j.kind in _QUATERNION and 0 <= j.coordinate < coordinate)
 
     @property
     def floating_base(self) -> bool:
-        """Whether the root body moves freely (a free-flyer joint first)."""
-        return bool(self.joints) and self.joints[0].kind == JointKind.FREE_FLYER
+        """Whether the root body moves freely (a free-flyer joint first, its numbers the
+        base's: coordinate -1)."""
+        return bool(self.joints) and self.joints[0].kind == JointKind.FREE_FLYER \
+            and self.joints[0].coordinate < 0
 
     @property
     def base_nq(self) -> int:
@@ -217,8 +237,9 @@ class KinematicTree:
 
 
 def refuse_ball_joints(tree: KinematicTree | None, what: str) -> None:
-    """Refuse, in one line naming the joint, a tree with a ball joint where ``what`` (an
-    algorithm or an export) walks one-number joints only (its numbers would be miscounted)."""
+    """Refuse, in one line naming the joint, a tree with a ball joint or a free flyer below
+    the root where ``what`` (an algorithm or an export) walks one-number joints and a base
+    only (its numbers would be miscounted)."""
     balls = () if tree is None else tree.spherical
     if balls:
         from ..errors import ModelError
@@ -227,8 +248,28 @@ def refuse_ball_joints(tree: KinematicTree | None, what: str) -> None:
                          "does not take yet (M, inverse and forward dynamics, the energies, "
                          "frames and Jacobians do, on the compact and numpy backends)",
                          field="joint")
+    refuse_free_joints(tree, what)
 
 
+def refuse_free_joints(tree: KinematicTree | None, what: str) -> None:
+    """Refuse, in one line naming the joint, a tree with a free flyer below the root (a URDF
+    floating joint between two links) where ``what`` does not take one."""
+    free = () if tree is None else tree.free_joints
+    if free:
+        from ..errors import ModelError
+
+        raise ModelError(f"joint '{free[0].name}' is a floating joint below the root (a free "
+                         f"flyer between two links), which {what} does not take yet (M, "
+                         "inverse and forward dynamics, the energies, frames and Jacobians do, "
+                         "on the numpy backend)", field="joint")
+
+
+_QUATERNION = (JointKind.SPHERICAL, JointKind.FREE_FLYER)
+# a free flyer's numbers by suffix, in Pinocchio's order (a floating base's: base_x, ...; one
+# below the root: <joint>_x, ...): position in the parent's joint frame (m) and quaternion, then
+# the body's linear (m/s) and angular (rad/s) velocity in its own axes
+FREE_CONFIGURATION = ("x", "y", "z", "qx", "qy", "qz", "qw")
+FREE_VELOCITY = ("vx", "vy", "vz", "wx", "wy", "wz")
 _IDENTITY: Matrix3x3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
@@ -315,5 +356,6 @@ def _numbers(vector, values) -> tuple | None:
     return None if None in found else found
 
 
-__all__ = ["INERTIAL_FIELDS", "KinematicTree", "TreeFrame", "TreeJoint", "TreeLink", "body_tree",
-           "link_inertias", "refuse_ball_joints", "with_link_inertials"]
+__all__ = ["FREE_CONFIGURATION", "FREE_VELOCITY", "INERTIAL_FIELDS", "KinematicTree",
+           "TreeFrame", "TreeJoint", "TreeLink", "body_tree", "link_inertias",
+           "refuse_ball_joints", "refuse_free_joints", "with_link_inertials"]

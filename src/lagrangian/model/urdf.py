@@ -20,7 +20,10 @@ The root link is bolted to the world unless ``floating_base``: then a free-flyer
 ``buildModelFromUrdf(path, JointModelFreeFlyer())``. A URDF ``floating`` joint from the root link
 is read the same way (its origin the free flyer's placement). A floating base lives in the tree
 only: the model's coordinates and rigid bodies are the joints', and deriving its equations is
-refused (derivation/lagrange.py).
+refused (derivation/lagrange.py). Any other floating joint (between two links) frees its child
+from its parent: a free flyer inside the tree (<joint>_x .. _qw in q, <joint>_vx .. _wz in v,
+model/tree.py), and in the model six coordinates <joint>_x, _y, _z (m) and _roll, _pitch, _yaw
+(rad), the symbolic bodies' (urdf_bodies.py); no actuator, no limit.
 """
 
 from __future__ import annotations
@@ -42,9 +45,10 @@ from .expressions import RESERVED
 from .lazy_bodies import LAZY_ABOVE
 from .model import Model
 from .reader import read_text_file
+from .tree import FREE_CONFIGURATION, FREE_VELOCITY
 from .urdf_bodies import SymbolicBodies, _number
 from .urdf_lock import lock_value
-from .urdf_tree import MOVABLE, numeric_tree
+from .urdf_tree import FREE_SLIDES, FREE_TURNS, MOVABLE, numeric_tree
 
 SUPPORTED = (*MOVABLE, "fixed")
 GRAVITY = 9.81  # m/s^2, along -z
@@ -269,20 +273,24 @@ class _Tree(SymbolicBodies):
         return roots[0], children
 
     def _check_floating(self, root: str, children: dict[str, list]) -> None:
-        """A floating joint frees the whole robot: the one movable joint of the root link, as
-        the free flyer at the tree's root (Pinocchio's layout puts it first)."""
+        """A floating joint that is the root link's one moving joint frees the whole robot: the
+        free flyer at the tree's root (Pinocchio's layout puts it first). Any other one frees
+        its child from its parent (self.free: a free flyer below the root, its own seven
+        configuration numbers); it has no limit and no mimic."""
+        self.free = {}
         for joint in self.joints:
             if joint.type != "floating":
                 continue
             where = f"joint '{joint.name}'"
-            if joint.parent != root:
-                raise self.error(f"a floating joint frees the robot's base: its parent must be "
-                                 f"the root link '{root}', not '{joint.parent}'", where)
+            if joint.mimic is not None:
+                raise self.error("a floating joint cannot mimic another joint", f"{where}.mimic")
             others = [j.name for j in children[root] if j is not joint and j.type != "fixed"]
-            if others:
-                raise self.error(f"the root link '{root}' also moves joint '{others[0]}': a "
-                                 "floating joint must be the root link's only moving joint",
-                                 where)
+            if joint.parent == root and not others:
+                continue  # the floating base
+            if joint.limit is not None:
+                raise self.error("a floating joint has no limits (its child moves freely, as "
+                                 "Pinocchio's free flyer): remove its <limit>", f"{where}.limit")
+            self.free[joint.name] = ""  # its coordinates' stem, named in model()
 
     def _expand_planar(self) -> None:
         """Each planar joint as the three one-coordinate joints it is: <name>_x and <name>_y
@@ -342,8 +350,9 @@ class _Tree(SymbolicBodies):
                                  field=f"lock.{name}")
         self._expand_planar()
         root, children = self._check_tree()
-        if floating_base and any(j.type == "floating" for j in self.joints):
-            floating = next(j.name for j in self.joints if j.type == "floating")
+        floats = [j.name for j in self.joints if j.type == "floating" and j.name not in self.free]
+        if floating_base and floats:
+            floating = floats[0]
             raise ModelError(f"the URDF's joint '{floating}' already floats the base; "
                              "floating_base would add a second free flyer above it",
                              field="floating_base")
@@ -373,6 +382,9 @@ class _Tree(SymbolicBodies):
         names: dict[str, str] = {}
         taken = {"g"}
         for joint in order:
+            if joint.name in self.free:  # its six coordinates (urdf_bodies.py), no actuator
+                self.free[joint.name] = self._free_coordinates(builder, joint, taken)
+                continue
             if joint.type not in MOVABLE or joint.name in lock or joint.mimic is not None:
                 continue
             name = identifier(joint.name)
@@ -394,7 +406,7 @@ class _Tree(SymbolicBodies):
             tau = builder.parameter(f"tau_{name}", 0.0, "N" if unit == "m" else "N*m",
                                     field=field)
             builder.add_generalized_force(name, tau, field=field)
-        if not names:
+        if not names and not self.free:
             raise self.error("no joint left to move: a model needs at least one revolute, "
                              "continuous or prismatic joint that is not locked"
                              + (" (a lone floating body: not yet)" if floating_base or any(
@@ -402,12 +414,14 @@ class _Tree(SymbolicBodies):
         position = self._positions(lock, names)
         model = builder.build_model()
         if len(names) > LAZY_ABOVE:  # a long chain: its symbolic bodies when first asked for
-            tree = numeric_tree(self.links, root, order, position, names, (), floating_base)
+            tree = numeric_tree(self.links, root, order, position, names, (), floating_base,
+                                self.free)
             bodies = self._lazy_bodies(root, order, position, tree)
             tree = replace(tree, rigid_bodies=bodies)
         else:
             bodies = tuple(self._bodies(root, order, position))
-            tree = numeric_tree(self.links, root, order, position, names, bodies, floating_base)
+            tree = numeric_tree(self.links, root, order, position, names, bodies, floating_base,
+                                self.free)
         if self.planar:  # a planar joint's own name: its frame, its child link's
             by_link = {f.name: f for f in tree.frames}
             tree = replace(tree, frames=tree.frames + tuple(
@@ -419,6 +433,21 @@ class _Tree(SymbolicBodies):
                                             for joint, name in names.items()),
                        source_dynamics=tuple((name, *self._friction(joint))
                                              for joint, name in names.items()))
+
+    def _free_coordinates(self, builder: ModelBuilder, joint, taken: set[str]) -> str:
+        """A floating joint's six coordinates, <stem>_x, _y, _z (m) and _roll, _pitch, _yaw
+        (rad), each at 0, unbounded and without an actuator; the stem (the joint's name) is
+        kept clear of the tree's own names for it (free_flyer.free_names)."""
+        stem = identifier(joint.name)
+        suffixes = (*FREE_SLIDES, *FREE_TURNS, *FREE_CONFIGURATION, *FREE_VELOCITY)
+        while any(f"{stem}_{k}" in taken or f"tau_{stem}_{k}" in taken for k in suffixes):
+            stem += "_"
+        taken |= {f"{stem}_{k}" for k in suffixes}
+        field = f"joint '{joint.name}'"
+        for k in (*FREE_SLIDES, *FREE_TURNS):
+            builder.coordinate(f"{stem}_{k}", "m" if k in FREE_SLIDES else "rad", initial=0.0,
+                               rate=0.0, field=field)
+        return stem
 
     def _friction(self, name: str) -> tuple[float, float]:
         """A joint's <dynamics> damping and Coulomb friction (0 where absent); a negative or

@@ -18,11 +18,7 @@ from ..errors import ModelWarning
 from .lazy_bodies import LazyBodies
 from .rotations import GROUND, Frame, RigidBody, apply, apply_transpose, compose, rotate, translate
 from .tree import KinematicTree
-from .urdf_tree import MOVABLE, SNAP, carries_nothing
-
-# a floating joint's six symbolic coordinates, by suffix: three slides, then the rpy angles
-FREE_SLIDES = ("x", "y", "z")
-FREE_TURNS = ("roll", "pitch", "yaw")
+from .urdf_tree import FREE_SLIDES, FREE_TURNS, MOVABLE, SNAP, carries_nothing
 
 
 def _number(x: float) -> sp.Expr:
@@ -51,6 +47,8 @@ def _vector(a) -> tuple:
 class SymbolicBodies:
     """The rigid bodies of a URDF tree (urdf._Tree's: its links, error and free joints)."""
 
+    free: dict[str, str]  # a floating joint between two links -> its coordinates' stem
+
     def _bodies(self, root: str, order, position) -> list[RigidBody]:
         frames: dict[str, Frame] = {root: GROUND}
         parents: dict[str, str | None] = {root: None}
@@ -64,7 +62,14 @@ class SymbolicBodies:
                 origin = np.asarray(joint.origin, dtype=float)
                 frame = translate(frame, _vector(origin[:3, 3]))
                 frame = _turned(frame, _matrix(origin[:3, :3]))
-            if joint.type in MOVABLE:
+            if joint.name in self.free:  # x, y, z along the joint frame, then rpy
+                base = self.free[joint.name]
+                frame = translate(frame, tuple(sp.Symbol(f"{base}_{k}") for k in FREE_SLIDES))
+                for k, axis in zip(reversed(FREE_TURNS), ((0, 0, 1), (0, 1, 0), (1, 0, 0)),
+                                   strict=True):
+                    frame = rotate(frame, axis, sp.Symbol(f"{base}_{k}"),
+                                   sp.Symbol(f"{base}_{k}_dot"))
+            elif joint.type in MOVABLE:
                 axis = np.asarray(joint.axis if joint.axis is not None else (1, 0, 0), float)
                 norm = float(np.linalg.norm(axis))
                 if not math.isfinite(norm) or norm == 0:
@@ -77,7 +82,7 @@ class SymbolicBodies:
                     frame = rotate(frame, axis, angle, rate)
             frames[joint.child] = frame
             parents[joint.child] = joint.parent
-            moves[joint.child] = moves[joint.parent] or (
+            moves[joint.child] = moves[joint.parent] or joint.name in self.free or (
                 joint.type in MOVABLE and bool(position(joint)[0].free_symbols))
         bodies = []
         for name, frame in frames.items():
@@ -147,4 +152,4 @@ def _turned(frame: Frame, rotation) -> Frame:
 
 
 
-__all__ = ["FREE_SLIDES", "FREE_TURNS", "SymbolicBodies"]
+__all__ = ["SymbolicBodies"]

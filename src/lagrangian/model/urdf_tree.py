@@ -11,9 +11,21 @@ import math
 import numpy as np
 
 from ..kinds import JointKind
-from .tree import KinematicTree, TreeFrame, TreeJoint, TreeLink, link_inertias
+from .tree import (
+    FREE_CONFIGURATION,
+    FREE_VELOCITY,
+    KinematicTree,
+    TreeFrame,
+    TreeJoint,
+    TreeLink,
+    link_inertias,
+)
 
 MOVABLE = ("revolute", "continuous", "prismatic")
+# a floating joint's six symbolic coordinates, by suffix (urdf_bodies.py): three slides along
+# its frame's axes, then the rpy angles
+FREE_SLIDES = ("x", "y", "z")
+FREE_TURNS = ("roll", "pitch", "yaw")
 # a screw: no URDF type, the tree builder's only (model/robot_builder.py: the joint's ``pitch``,
 # m/rad)
 HELICAL = "helical"
@@ -23,12 +35,32 @@ SNAP = 1e-14
 
 
 def numeric_tree(links_by_name, root: str, order, position, names: dict[str, str], bodies,
-                 floating_base: bool = False) -> KinematicTree:
+                 floating_base: bool = False, free_joints=None) -> KinematicTree:
     """The same robot as numbers for the recursive algorithms (model/tree.py): ``links_by_name``
     the URDF's links, ``order`` its joints parent-first, ``position(joint)`` a joint's angle or
-    distance as k q + offset, ``names`` joint -> coordinate."""
-    index = {joint: i for i, joint in enumerate(names)}
-    coordinate = {symbol: index[joint] for joint, symbol in names.items()}
+    distance as k q + offset, ``names`` joint -> coordinate, ``free_joints`` a floating joint
+    between two links -> its coordinates' stem (a free flyer with seven numbers in q, six in
+    v, no actuator; the model's six symbolic coordinates are its x, y, z and rpy)."""
+    free_joints = free_joints or {}
+    # each joint's first number in q, and the tree's q and v names, in the joints' order
+    sequence = (list(names) if not free_joints
+                else [j.name for j in order if j.name in names or j.name in free_joints])
+    place: dict[str, int] = {}
+    configuration, velocity, actuators, symbolic = [], [], [], []
+    for name in sequence:
+        place[name] = len(configuration)
+        if name in free_joints:
+            stem = free_joints[name]
+            configuration += [f"{stem}_{k}" for k in FREE_CONFIGURATION]
+            velocity += [f"{stem}_{k}" for k in FREE_VELOCITY]
+            symbolic += [f"{stem}_{k}" for k in (*FREE_SLIDES, *FREE_TURNS)]
+            actuators += [None] * len(FREE_VELOCITY)
+        else:
+            configuration.append(names[name])
+            velocity.append(names[name])
+            symbolic.append(names[name])
+            actuators.append(f"tau_{names[name]}")
+    coordinate = {symbol: place[joint] for joint, symbol in names.items()}
     anchor = {root: (-1, np.eye(3), np.zeros(3))}  # link -> (moving body, R, t in it)
     joints: list[dict] = []
     free = dict(parent=-1, kind=JointKind.FREE_FLYER, axis=np.zeros(3), coordinate=-1,
@@ -42,6 +74,11 @@ def numeric_tree(links_by_name, root: str, order, position, names: dict[str, str
         origin = np.eye(4) if joint.origin is None else np.asarray(joint.origin, float)
         rotation = snapped(turn @ snapped(origin[:3, :3]))
         translation = shift + turn @ snapped(origin[:3, 3])
+        if joint.name in free_joints:  # a free flyer below the root: its own numbers
+            joints.append(dict(free, name=joint.name, parent=body, rotation=rotation,
+                               translation=translation, coordinate=place[joint.name]))
+            anchor[joint.child] = (len(joints) - 1, np.eye(3), np.zeros(3))
+            continue
         if joint.type == "floating":  # the root link's only moving joint (_check_floating)
             joints.append(dict(free, name=joint.name, rotation=rotation,
                                translation=translation))
@@ -112,9 +149,10 @@ def numeric_tree(links_by_name, root: str, order, position, names: dict[str, str
             coordinate=j["coordinate"], multiplier=j["multiplier"], offset=j["offset"],
             mass=m, first_moment=vector(h), inertia=matrix(0.5 * (J + J.T)), pitch=j["pitch"])
             for j, (m, h, J) in zip(joints, inertias, strict=True)),
-        coordinates=tuple(names.values()), gravity_parameter="g",
-        gravity_direction=(0.0, 0.0, -1.0),
-        actuators=tuple(f"tau_{name}" for name in names.values()),
+        coordinates=tuple(configuration), gravity_parameter="g",
+        gravity_direction=(0.0, 0.0, -1.0), actuators=tuple(actuators),
+        velocities=tuple(velocity) if free_joints else (),
+        model_coordinates=tuple(symbolic) if free_joints else (),
         rigid_bodies=tuple(bodies), root_link=root, root_mass=held)
 
 
@@ -147,5 +185,5 @@ def axis_rotation(axis, angle: float) -> np.ndarray:
         + (1 - math.cos(angle)) * np.outer(x, x)
 
 
-__all__ = ["HELICAL", "JOINT_KIND", "MOVABLE", "SNAP", "axis_rotation", "carries_nothing", "numeric_tree",
-           "snapped"]
+__all__ = ["FREE_SLIDES", "FREE_TURNS", "HELICAL", "JOINT_KIND", "MOVABLE", "SNAP",
+           "axis_rotation", "carries_nothing", "numeric_tree", "snapped"]

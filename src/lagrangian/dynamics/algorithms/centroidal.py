@@ -50,20 +50,25 @@ def require_known_joints(tree, what: str, field: str = "q") -> None:
 def world_columns(kinematics, k: int, joint, body) -> tuple[np.ndarray, list[int]]:
     """Joint k's motion subspace at the world's origin in world axes, (N, 6, c) with linear
     rows first and the multiplier in, and the c velocity numbers it drives: a free flyer's six
-    (S = 1 in the base's axes: [R e; 0] and [p x R e; R e]), else the joint's one column."""
+    (S = 1 in its body's axes: [R e; 0] and [p x R e; R e]; the base's, or one below the
+    root), else the joint's one column."""
     R, o = body
     if joint.kind == JointKind.FREE_FLYER:
         S = np.zeros((len(o), 6, 6))
         S[:, :3, :3] = R
         S[:, 3:, 3:] = R
         S[:, :3, 3:] = np.cross(o[:, :, None], R, axisa=1, axisb=1, axisc=1)
-        return S, list(range(6))
+        if joint.coordinate < 0:  # the floating base's six
+            return S, list(range(6))
+        first = kinematics.tree.base_nv + kinematics.tree.velocity_index(joint.coordinate)
+        return S, list(range(first, first + 6))  # a free flyer's below the root
     s_v, s_w = _world_subspace(kinematics, k, joint, body)
     S = np.zeros((len(o), 6, 1))
     S[:, :3, 0] = s_v
     if s_w is not None:
         S[:, 3:, 0] = s_w
-    return joint.multiplier * S, [kinematics.tree.base_nv + joint.coordinate]
+    return joint.multiplier * S, [kinematics.tree.base_nv
+                                  + kinematics.tree.velocity_index(joint.coordinate)]
 
 
 def velocity_array(kinematics, v, field: str = "v") -> np.ndarray:

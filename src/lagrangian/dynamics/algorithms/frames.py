@@ -7,7 +7,8 @@ S = (s_w, s_v) per unit of joint variable, so the Jacobian's column of a coordin
 over the joints it drives (theta = k q + offset), k times S carried to the frame:
 angular s_w and linear s_v + s_w x (p - o), in world axes (p the frame's origin, o the joint's).
 A floating base (free_flyer.py) takes q of nq = n + 7 and gives Jacobians of nv = n + 6 columns:
-its six first, S = 1 in the base's axes. A ball joint (tree/spherical.py) has four numbers in q
+its six first, S = 1 in the base's axes; a free flyer below the root has seven numbers in q
+(x y z qx qy qz qw) and six columns of its own. A ball joint (tree/spherical.py) has four numbers in q
 (its quaternion w x y z) and three columns: S = 1 on the angular rows, in its body's axes.
 """
 
@@ -52,7 +53,7 @@ class TreeKinematics:
             raise InputError(f"expected {nq} values ({', '.join(self.coordinates)}) along the "
                              f"last axis, got shape {shape}", field=field)
         batch = q.shape[:-1]
-        if self.tree.spherical:  # the base's and each ball's, named in one line
+        if self.tree.quaternion_joints:  # the base's and each ball's or free flyer's, in one line
             check_tree_quaternions(self.tree, q.reshape(-1, nq), field)
         elif self.tree.floating_base:
             check_quaternions(q.reshape(-1, nq))
@@ -63,9 +64,11 @@ class TreeKinematics:
         count = len(Q)
         world = []
         for joint, model in zip(self.tree.joints, self._models, strict=True):
-            if joint.kind == JointKind.FREE_FLYER:
+            if joint.kind == JointKind.FREE_FLYER:  # the base's numbers, or its own below the root
+                start = 0 if joint.coordinate < 0 else self.tree.base_nq + joint.coordinate
                 R, p = model.placement_arrays(np.array(joint.rotation),
-                                              np.array(joint.translation), Q[:, :7])
+                                              np.array(joint.translation),
+                                              Q[:, start:start + 7])
             elif joint.kind == JointKind.SPHERICAL:
                 start = self.tree.base_nq + joint.coordinate
                 R, p = model.placement_arrays(np.array(joint.rotation),
@@ -129,15 +132,17 @@ class TreeKinematics:
         for k in self._ancestors(body):
             joint = self.tree.joints[k]
             R, o = bodies[k]
-            if joint.kind == JointKind.FREE_FLYER:  # six columns, the base's own
+            if joint.kind == JointKind.FREE_FLYER:  # six columns, the base's or its own
                 columns, first = self._models[k].columns(), 0
+                if joint.coordinate >= 0:
+                    first = self.tree.base_nv + self.tree.velocity_index(joint.coordinate)
             elif joint.kind == JointKind.SPHERICAL:  # three angular columns, its own axes
                 columns = self._models[k].columns()
                 first = self.tree.base_nv + self.tree.velocity_index(joint.coordinate)
             else:
                 columns = [self._models[k].subspace(joint.axis, joint.pitch)]
                 first = self.tree.base_nv + (self.tree.velocity_index(joint.coordinate)
-                                             if self.tree.spherical else joint.coordinate)
+                                             if self.tree.velocities else joint.coordinate)
             for c, (s_w, s_v) in enumerate(columns):
                 column = np.zeros((len(Q), 6))
                 if s_w is not None:

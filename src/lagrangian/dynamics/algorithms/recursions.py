@@ -67,20 +67,26 @@ class _Joint:
     def __init__(self, joint, tree: KinematicTree):
         self.parent = joint.parent
         self.model = joint_model(joint.kind)
-        self.free = joint.kind == JointKind.FREE_FLYER  # a floating base: numbers 0..6 of q
+        flyer = joint.kind == JointKind.FREE_FLYER
+        self.free = flyer and joint.coordinate < 0  # a floating base: numbers 0..6 of q
+        # a free flyer below the root: q[iq:iq+7] x y z qx qy qz qw, v[iv:iv+6] linear, angular
+        self.inner = flyer and joint.coordinate >= 0
         self.ball = joint.kind == JointKind.SPHERICAL  # q[iq:iq+4] w x y z, v[iv:iv+3]
         self.coordinate = joint.coordinate
         self.iq = tree.base_nq + joint.coordinate  # its (first) number in q, and in v, a, tau
-        self.iv = tree.base_nv + (tree.velocity_index(joint.coordinate) if tree.spherical
+        self.iv = tree.base_nv + (tree.velocity_index(joint.coordinate) if tree.velocities
                                   else joint.coordinate)
+        # S as (s_w, s_v) columns, one per velocity number, for the joints of several
+        self.columns = (j_model.columns() if (j_model := self.model_of(joint)) is not None
+                        else None)
         self.multiplier = joint.multiplier
         self.offset = joint.offset
         self.R0 = np.array(joint.rotation, dtype=float)
         self.t0 = np.array(joint.translation, dtype=float)
         self.u = np.array(joint.axis, dtype=float)
         self.pitch = joint.pitch  # a helical joint's (m/rad)
-        s_w, s_v = (None, None) if self.free or self.ball else self.model.subspace(self.u,
-                                                                                  self.pitch)
+        s_w, s_v = ((None, None) if flyer or self.ball
+                    else self.model.subspace(self.u, self.pitch))
         self.s_w = None if s_w is None else np.array(s_w)
         self.s_v = None if s_v is None else np.array(s_v)
         self.m = float(joint.mass)
@@ -88,6 +94,12 @@ class _Joint:
         self.H = _skew(self.h)
         self.P0 = _skew(self.t0)  # [p]x of a revolute joint's fixed origin
         self.J = np.array(joint.inertia, dtype=float)
+
+    def model_of(self, joint):
+        """The joint model of a joint of several velocity numbers below the root, else None."""
+        if joint.coordinate >= 0 and joint.kind in (JointKind.FREE_FLYER, JointKind.SPHERICAL):
+            return joint_model(joint.kind)
+        return None
 
 
 def _spatial_inertia(m, h, J, count: int) -> np.ndarray:
@@ -128,6 +140,10 @@ class TreeRecursions:
                 R, p = j.model.placement_arrays(j.R0, j.t0, Q[:, j.iq:j.iq + 4])
                 placements.append((R, p, j.P0))
                 continue
+            if j.inner:  # R0 R(quaternion), the origin t0 + R0 (x, y, z)
+                R, p = j.model.placement_arrays(j.R0, j.t0, Q[:, j.iq:j.iq + 7])
+                placements.append((R, p, _skew_batch(p)))
+                continue
             theta = j.multiplier * Q[:, j.iq] + j.offset
             R, p = j.model.placement_arrays(j.R0, j.t0, j.u, theta, j.pitch)
             placements.append((R, p, j.P0 if p is j.t0 else _skew_batch(p)))
@@ -162,6 +178,22 @@ class TreeRecursions:
                 # a + dw x p + w x (w x p), with y x p = [p]x^T y
                 a_i = _apply_transpose(R, al + _apply_transpose(P, dwl)
                                        + _cross(wl, _apply_transpose(P, wl)))
+            if j.inner:  # the relative twist (v_r, w_r) and its rate (a_r, dw_r), body axes
+                w_i, dw_i = w_in, dw_in
+                if V is not None:  # the origin slides at R v_r in the parent: Coriolis and turn
+                    v_r, w_r = V[:, j.iv:j.iv + 3], V[:, j.iv + 3:j.iv + 6]
+                    w_i = w_in + w_r
+                    dw_i = dw_in + _cross(w_in, w_r)
+                    a_i = a_i + 2.0 * _cross(w_in, v_r) + _cross(w_r, v_r)
+                if A is not None:
+                    a_i = a_i + A[:, j.iv:j.iv + 3]
+                    dw_i = dw_i + A[:, j.iv + 3:j.iv + 6]
+                w.append(w_i)
+                dw.append(dw_i)
+                acc.append(a_i)
+                f.append(j.m * a_i - _apply(j.H, dw_i) - _cross(w_i, _apply(j.H, w_i)))
+                n.append(_apply(j.J, dw_i) + _cross(w_i, _apply(j.J, w_i)) + _apply(j.H, a_i))
+                continue
             if j.ball:  # w += w_rel, dw += w x w_rel + dw_rel (S = 1 on the angular rows)
                 w_i, dw_i = w_in, dw_in
                 if V is not None:
@@ -204,6 +236,9 @@ class TreeRecursions:
                 continue
             if j.ball:  # the moment on the body about its joint, in its axes
                 tau[:, j.iv:j.iv + 3] += n[i]
+            elif j.inner:  # the wrench on the body, force then moment, in its axes
+                tau[:, j.iv:j.iv + 3] += f[i]
+                tau[:, j.iv + 3:j.iv + 6] += n[i]
             else:
                 tau[:, j.iv] += j.multiplier * _project(j, n[i], f[i])
             if j.parent >= 0:
@@ -227,8 +262,8 @@ class TreeRecursions:
             if j.free:  # the floating base: the composite inertia itself, [[m, -[h]x], [[h]x, J]]
                 M[:, :6, :6] += _spatial_inertia(mass[i], h[i], J[i], count)
                 continue
-            if j.ball:
-                self._ball_columns(M, placements, i, mass, h, J, count)
+            if j.columns is not None:  # a ball joint's three, a free flyer's six
+                self._several_columns(M, placements, i, mass, h, J, count)
             else:
                 self._joint_column(M, placements, i, h, J, mass, count)
             self._composite_into_parent(placements, i, mass, h, J, count)
@@ -266,21 +301,34 @@ class TreeRecursions:
                 M[:, ci, ancestor.iv:ancestor.iv + 3] += entry
                 M[:, ancestor.iv:ancestor.iv + 3, ci] += entry
                 continue
+            if ancestor.inner:  # its six columns (S = 1): the wrench itself
+                entry = ki * np.concatenate([force, moment], axis=-1)
+                M[:, ci, ancestor.iv:ancestor.iv + 6] += entry
+                M[:, ancestor.iv:ancestor.iv + 6, ci] += entry
+                continue
             entry = ki * ancestor.multiplier * _project(ancestor, moment, force)
             M[:, ci, ancestor.iv] += entry
             M[:, ancestor.iv, ci] += entry
 
-    def _ball_columns(self, M, placements, i, mass, h, J, count):
-        """M's three columns (and rows) of the ball joint i: for each unit angular rate e_k
-        of its body, the composite's wrench (f = e_k x h, n = J e_k), projected up the tree."""
+    def _several_columns(self, M, placements, i, mass, h, J, count):
+        """M's columns (and rows) of joint i of several velocity numbers (a ball joint's three
+        angular, a free flyer's three linear and three angular, in its body's axes): for each
+        unit rate (s_w, s_v), the composite's wrench (f = m s_v + s_w x h, n = J s_w + h x s_v),
+        projected on its own columns and on each joint up the tree."""
         joints = self._joints
         j = joints[i]
-        for col in range(3):
-            e = np.eye(3)[col]
-            force = np.broadcast_to(np.cross(e, h[i]), (count, 3))
-            moment = np.broadcast_to(J[i] @ e, (count, 3))
+        for col, (s_w, s_v) in enumerate(j.columns):
+            force, moment = np.zeros(3), np.zeros(3)
+            if s_w is not None:
+                force, moment = force + np.cross(s_w, h[i]), moment + J[i] @ s_w
+            if s_v is not None:
+                force, moment = force + mass[i] * s_v, moment + np.cross(h[i], s_v)
+            force = np.broadcast_to(force, (count, 3))
+            moment = np.broadcast_to(moment, (count, 3))
             c = j.iv + col
-            M[:, j.iv:j.iv + 3, c] += moment
+            for row, (r_w, r_v) in enumerate(j.columns):
+                M[:, j.iv + row, c] += ((0.0 if r_w is None else moment @ r_w)
+                                        + (0.0 if r_v is None else force @ r_v))
             k = i
             while joints[k].parent >= 0:
                 R, p, P = placements[k]
@@ -288,10 +336,11 @@ class TreeRecursions:
                 moment = _apply(R, moment) + _apply(P, force)
                 k = joints[k].parent
                 ancestor = joints[k]
-                if ancestor.free:
+                if ancestor.free or ancestor.inner:  # its six numbers: the wrench itself
                     entry = np.concatenate([force, moment], axis=-1)
-                    M[:, c, :6] += entry
-                    M[:, :6, c] += entry
+                    first = 0 if ancestor.free else ancestor.iv
+                    M[:, c, first:first + 6] += entry
+                    M[:, first:first + 6, c] += entry
                 elif ancestor.ball:
                     M[:, c, ancestor.iv:ancestor.iv + 3] += moment
                     M[:, ancestor.iv:ancestor.iv + 3, c] += moment
@@ -332,6 +381,10 @@ class TreeRecursions:
             if j.ball:  # its own angular velocity added in its axes; its origin is fixed
                 w.append(_apply_transpose(R, wl) + V[:, j.iv:j.iv + 3])
                 vel.append(_apply_transpose(R, vl + _apply_transpose(P, wl)))
+                continue
+            if j.inner:  # its own twist added, linear then angular, in its axes
+                w.append(_apply_transpose(R, wl) + V[:, j.iv + 3:j.iv + 6])
+                vel.append(_apply_transpose(R, vl + _apply_transpose(P, wl)) + V[:, j.iv:j.iv + 3])
                 continue
             rate = (j.multiplier * V[:, j.iv])[:, None]
             w_i = _apply_transpose(R, wl)

@@ -55,22 +55,30 @@ def ball_slices(tree) -> list[tuple[str, int, int]]:
              tree.base_nv + tree.velocity_index(j.coordinate)) for j in tree.spherical]
 
 
+def quaternion_slices(tree) -> list[tuple[str, str, int, str]]:
+    """(name, what, index, order) of each quaternion among the joints' numbers, in the full q:
+    a ball joint's (w x y z) and a free flyer's below the root (x y z w, after x, y, z)."""
+    free = [(j.name, "floating joint", tree.base_nq + j.coordinate + 3, "x y z w")
+            for j in tree.free_joints]
+    return [(name, "ball joint", iq, "w x y z") for name, iq, _ in ball_slices(tree)] + free
+
+
 def check_tree_quaternions(tree, Q: np.ndarray, field: str = "q") -> None:
     """Refuse, in one line, a flat batch of configurations (N, nq) whose base quaternion or any
     ball joint's quaternion has a norm off 1 by more than QUATERNION_TOLERANCE, naming the
     joint and the state; a state not all finite is not refused (its rows are NaN)."""
     if tree.floating_base:
         check_quaternions(Q, field=field)
-    if not tree.spherical:
+    if not tree.quaternion_joints:
         return
     with np.errstate(invalid="ignore", over="ignore"):
         finite = np.isfinite(Q).all(axis=-1)
-        for name, iq, _ in ball_slices(tree):
+        for name, what, iq, order in quaternion_slices(tree):
             norms = np.linalg.norm(Q[:, iq:iq + 4], axis=-1)
             bad = np.flatnonzero(finite & (np.abs(norms - 1.0) > QUATERNION_TOLERANCE))
             if bad.size:
                 raise InputError(
-                    f"the ball joint '{name}' quaternion (q[{iq}:{iq + 4}], w x y z) has norm "
+                    f"the {what} '{name}' quaternion (q[{iq}:{iq + 4}], {order}) has norm "
                     f"{norms[bad[0]]:.9g}" + (f" in state {bad[0]}" if len(Q) > 1 else "")
                     + f"; a unit quaternion is needed (|q| within {QUATERNION_TOLERANCE:g} of 1)",
                     field=field)
@@ -80,7 +88,7 @@ def unit_ball_quaternions(tree, Q: np.ndarray) -> np.ndarray:
     """Q (N, nq) with each ball quaternion within the tolerance but not within rounding of 1
     made unit (as the base's, recursive._unit_quaternions): a unit one keeps its bits."""
     out = Q
-    for _, iq, _ in ball_slices(tree):
+    for _, _, iq, _ in quaternion_slices(tree):
         norms = np.sqrt((out[:, iq:iq + 4] ** 2).sum(axis=-1))
         edge = np.isfinite(out).all(axis=-1) & ~(np.abs(norms - 1.0) <= QUATERNION_TOLERANCE)
         if edge.any():
@@ -92,7 +100,7 @@ def unit_ball_quaternions(tree, Q: np.ndarray) -> np.ndarray:
 def ball_quaternions_unit(tree, Q: np.ndarray) -> bool:
     """Whether every finite state's ball quaternions are within the tolerance of unit norm."""
     finite = np.isfinite(Q).all(axis=-1)
-    for _, iq, _ in ball_slices(tree):
+    for _, _, iq, _ in quaternion_slices(tree):
         norms = np.sqrt((Q[:, iq:iq + 4] ** 2).sum(axis=-1))
         if (finite & ~(np.abs(norms - 1.0) <= QUATERNION_TOLERANCE)).any():
             return False
@@ -146,30 +154,37 @@ def difference_balls(tree, Q0: np.ndarray, Q1: np.ndarray, out: np.ndarray) -> N
 
 
 def integrate_tree(tree, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
-    """q (+) v for a flat batch of a tree with ball joints: a floating base by its twist
-    (free_flyer.py), each ball by q exp(w), the other joints by q + v."""
+    """q (+) v for a flat batch of a tree with ball joints or free flyers below the root: a
+    floating base and each free flyer by its twist (free_flyer.py), each ball by q exp(w), the
+    other joints by q + v."""
+    from .free_flyer import integrate
+
     out = np.empty_like(Q)
     if tree.floating_base:
-        from .free_flyer import integrate
-
         out[:, :7] = integrate(Q[:, :7], V[:, :6])[:, :7]
     qs, vs = joint_layout(tree)
     out[:, tree.base_nq + qs] = Q[:, tree.base_nq + qs] + V[:, tree.base_nv + vs]
     integrate_balls(tree, Q, V, out)
+    for j in tree.free_joints:  # a free flyer below the root: by its twist, as the base's
+        iq, iv = tree.base_nq + j.coordinate, tree.base_nv + tree.velocity_index(j.coordinate)
+        out[:, iq:iq + 7] = integrate(Q[:, iq:iq + 7], V[:, iv:iv + 6])
     return out
 
 
 def difference_tree(tree, Q0: np.ndarray, Q1: np.ndarray) -> np.ndarray:
     """v with q0 (+) v = q1 for a flat batch of a tree with ball joints (integrate_tree's
     inverse), shape (N, nv)."""
+    from .free_flyer import difference
+
     out = np.empty((len(Q0), tree.nv))
     if tree.floating_base:
-        from .free_flyer import difference
-
         out[:, :6] = difference(Q0[:, :7], Q1[:, :7])
     qs, vs = joint_layout(tree)
     out[:, tree.base_nv + vs] = Q1[:, tree.base_nq + qs] - Q0[:, tree.base_nq + qs]
     difference_balls(tree, Q0, Q1, out)
+    for j in tree.free_joints:
+        iq, iv = tree.base_nq + j.coordinate, tree.base_nv + tree.velocity_index(j.coordinate)
+        out[:, iv:iv + 6] = difference(Q0[:, iq:iq + 7], Q1[:, iq:iq + 7])
     return out
 
 
@@ -178,11 +193,12 @@ def joint_layout(tree) -> tuple[np.ndarray, np.ndarray]:
     plain coordinates and of the v entries that are their rates, in the same order."""
     qs, vs = [], []
     balls = {j.coordinate for j in tree.spherical}
+    free = {j.coordinate for j in tree.free_joints}
     c = 0
     k = 0
     while c < len(tree.coordinates):
-        if c in balls:
-            c, k = c + 4, k + 3
+        if c in balls or c in free:  # a quaternion: 4 numbers and 3 rates, or 7 and 6
+            c, k = (c + 4, k + 3) if c in balls else (c + 7, k + 6)
             continue
         qs.append(c)
         vs.append(k)
@@ -197,6 +213,7 @@ def refuse_spherical(tree, what: str) -> None:
 
 
 __all__ = ["SphericalModel", "ball_quaternions_unit", "ball_slices", "check_tree_quaternions",
+           "quaternion_slices",
            "difference_balls", "difference_tree", "exp_quaternion", "integrate_balls",
            "integrate_tree", "joint_layout",
            "log_quaternion", "refuse_spherical", "unit_ball_quaternions", "wxyz_matrix"]

@@ -7,6 +7,7 @@ line naming the joint)."""
 
 from __future__ import annotations
 
+import json
 import re
 
 import numpy as np
@@ -136,7 +137,8 @@ def test_dynamics_and_frames_match_pinocchio(robots, key):
 
 
 def test_velocity_terms_and_the_manifold_match_pinocchio(robots):
-    """C(q, v), J_dot v, A_g and the centre of mass; q (+) v dt and its inverse on the manifold."""
+    """C(q, v), J_dot v, A_g, the centre of mass and a wrench at a frame; q (+) v dt and its
+    inverse on the manifold."""
     ours, model, _ = robots["arm"]
     data = model.createData()
     iq, iv = _orders(ours, model)
@@ -154,6 +156,13 @@ def test_velocity_terms_and_the_manifold_match_pinocchio(robots):
     drift = pin.getFrameClassicalAcceleration(model, data, model.getFrameId("tip"),
                                               pin.LOCAL_WORLD_ALIGNED)
     np.testing.assert_allclose(ours.jacobian_dot_times_v(q, v, "tip"), drift.vector, atol=1e-9)
+    # a wrench on the box (world axes, at its frame's origin: the joint's), Pinocchio's per joint
+    wrench = np.array([0.3, -0.2, 0.5, 0.1, 0.4, -0.3])
+    R = data.oMi[model.getJointId("grip")].rotation
+    f_ext = [pin.Force.Zero() for _ in range(model.njoints)]
+    f_ext[model.getJointId("grip")] = pin.Force(R.T @ wrench[:3], R.T @ wrench[3:])
+    np.testing.assert_allclose(ours.inverse_dynamics(q, v, v, f_ext={"box": wrench})[iv],
+                               pin.rnea(model, data, Q[0], V[0], V[0], f_ext), atol=1e-9)
     moved = pin.integrate(model, Q[0], 0.3 * V[0])
     np.testing.assert_allclose(ours.integrate(q, v, 0.3)[iq], moved, atol=1e-12)
     np.testing.assert_allclose(ours.difference(q, ours.integrate(q, v, 0.3)), 0.3 * v,
@@ -216,6 +225,12 @@ def test_engine_only_paths_refuse_in_one_line(robots):
              "regressor": lambda: ours.regressor(q, v, v),
              "standalone C export": lambda: system.to_c("carrier"),
              "simulate": lambda: system.simulate(0.1)}
+    try:
+        import casadi  # noqa: F401 (an extra: its functions refuse the tree once it is there)
+    except ImportError:
+        pass
+    else:
+        calls["to_casadi"] = system.to_casadi
     for what, call in calls.items():
         with pytest.raises(lagrangian.ModelError) as info:
             call()
@@ -259,3 +274,23 @@ def test_the_docs_example_runs(capsys, tmp_path, monkeypatch):
     assert lines[0] == "10 9"
     assert lines[1] == "('hook_x', 'hook_y', 'hook_z', 'hook_qx', 'hook_qy', 'hook_qz', 'hook_qw')"
     assert lines[2] == "True"  # the free hook falls at g, whatever the crane's motors do
+
+
+def test_the_command_prints_the_layout(robots, cli):
+    """lagrangian dynamics: the free flyer's numbers named, its quaternion unturned by default,
+    the bias there Pinocchio's; a quaternion off unit norm refused in one line."""
+    ours, model, path = robots["arm"]
+    result = cli("dynamics", str(path), "--json")
+    assert result.code == 0, result.err
+    document = json.loads(result.out)
+    assert (document["nq"], document["nv"]) == (10, 9)
+    assert document["coordinates"] == list(ours.coordinates)
+    assert document["velocities"] == list(ours.velocity_names)
+    assert document["q"] == [0, 0, 0, 0, 0, 0, 0, 0, 1, 0]
+    iq, iv = _orders(ours, model)
+    theirs = pin.nonLinearEffects(model, model.createData(), np.array(document["q"])[iq],
+                                  np.zeros(9))
+    np.testing.assert_allclose(np.array(document["bias_forces"])[iv], theirs, atol=1e-9)
+    bad = cli("dynamics", str(path), "--q", "0,0,0,0,0,0,0,0.5,0,0")
+    assert bad.code == 2 and bad.err.splitlines()[-1].startswith(
+        "error: --q: the floating joint 'grip' quaternion (q[5:9], x y z w) has norm 0.5")

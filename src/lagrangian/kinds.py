@@ -14,8 +14,8 @@ class JointKind(StrEnum):
     at all (fixed) or freely in space (free_flyer: a URDF robot's floating base), or about and
     along its axis at once (helical: a screw, turning theta and sliding pitch * theta; the
     Python tree builder's, model/robot_builder.py). A kinematic tree moves its bodies by the
-    one-degree-of-freedom kinds, ball joints and the free flyer at its root
-    (dynamics/tree/joint_models.py)."""
+    one-degree-of-freedom kinds, ball joints and free flyers (at its root, a floating base; or
+    below it, a URDF floating joint between two links) (dynamics/tree/joint_models.py)."""
 
     REVOLUTE = "revolute"
     PRISMATIC = "prismatic"

@@ -21,6 +21,7 @@ import sympy as sp
 
 from ..errors import ModelError, did_you_mean
 from ..kinds import JointKind
+from .structure import same_structure
 from .vector import Vector
 
 Matrix3 = tuple[Vector, Vector, Vector]
@@ -83,6 +84,13 @@ class RigidBody:
     # spherical joint, a URDF link), and its elementary rotations from the ground.
     joint: BodyJoint | None = None
     depth: int = 0
+
+    def __eq__(self, other) -> bool:
+        # field by field with shared nodes compared once (structure.py): sympy's == on a deep
+        # chain's positions compares them written out
+        if not isinstance(other, RigidBody):
+            return NotImplemented
+        return same_structure(self, other)
 
     def world_angular_velocity(self) -> Vector:
         """omega in world axes, R omega_body (rad/s)."""

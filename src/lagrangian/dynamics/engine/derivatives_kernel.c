@@ -143,11 +143,7 @@ static void DK_FN(base)(const dk_tree *tree, const DK_T *q, const DK_T *qd, cons
 {
     DK_T *R = w->R[0], *o = w->o[0], *V = w->V[0], *Acc = w->Acc[0];
     DK_FN(jt_placed)(&tree->t, DK_BODY_OF(tree, 0), q, NULL, NULL, R, o);
-    for (int c = 0; c < 3; c++) {
-        DK_T *L = w->ffS[c], *A = w->ffS[3 + c];
-        for (int j = 0; j < 3; j++) { L[j] = R[3 * j + c]; L[3 + j] = DK_C(0.0); A[3 + j] = L[j]; }
-        SP_CROSS(o, L, A);
-    }
+    DK_FN(jt_columns)(DK_BODY_OF(tree, 0), R, o, w->ffS);  /* its six columns (joint.h) */
     for (int j = 0; j < 6; j++) {
         V[j] = DK_C(0.0);
         Acc[j] = DK_C(j < 3 ? -g[j] : 0.0);
@@ -175,18 +171,8 @@ static void DK_FN(kinematics)(const dk_tree *tree, const DK_T *q, const DK_T *qd
         const double *b = DK_BODY_OF(tree, i);
         const int p = tree->parent[i];
         DK_FN(jt_placed)(&tree->t, b, q, p < 0 ? NULL : R[p], p < 0 ? NULL : o[p], R[i], o[i]);
-        /* S: [o x a; a] turning about the world axis a = R e_z (canonical axes), [a; 0] sliding
-           along it; a helical joint turns and slides: [o x a + lead a; a] */
-        const DK_T axis[3] = {R[i][2], R[i][5], R[i][8]};
-        DK_T *S = w->S[i];
-        if (TK_TURNS(b)) {
-            SP_CROSS(o[i], axis, S);
-            for (int j = 0; j < 3; j++) S[3 + j] = axis[j];
-            if (TK_SLIDES(b))
-                for (int j = 0; j < 3; j++) S[j] += b[TK_LEAD] * axis[j];
-        } else {
-            for (int j = 0; j < 3; j++) { S[j] = axis[j]; S[3 + j] = DK_C(0.0); }
-        }
+        DK_FN(jt_columns)(b, R[i], o[i], (DK_T (*)[6])w->S[i]);  /* S (joint.h) */
+        const DK_T *S = w->S[i];
         DK_T vp[6], ap[6];
         for (int j = 0; j < 6; j++) {
             vp[j] = p >= 0 ? V[p][j] : DK_C(0.0);

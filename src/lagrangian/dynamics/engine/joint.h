@@ -253,3 +253,37 @@ static inline __attribute__((always_inline)) void JT_FN(placed)(const tk_tree *t
     JT_FN(place)(t, b, q, R, p, &cs, &sn);
     JT_FN(world)(b, Rp, op, R, p, cs, sn, Rw, ow);
 }
+
+/* Body b's joint's motion per unit rate at the world's origin in world axes, [s_v; s_w] a
+   column, from its rotation R (body -> world) and origin o: a free flyer's six (its twist in
+   its own axes: [R e_c; 0], then [o x R e_c; R e_c]), a ball's three (its angular velocity in
+   its own axes: [o x R e_c; R e_c]), else one about the world axis a = R e_z: [o x a (+ lead
+   a, helical); a] where it turns, [a; 0] where it only slides; their count. */
+static inline __attribute__((always_inline)) int JT_FN(columns)(const double *b, const JT_T *R,
+                                                                const JT_T *o, JT_T (*S)[6])
+{
+    if (TK_FREE(b) || TK_BALL(b)) {
+        const int free = TK_FREE(b), at = free ? 3 : 0;
+        for (int c = 0; c < 3; c++) {
+            JT_T w[3] = {R[c], R[3 + c], R[6 + c]}, v[3];
+            SP_CROSS(o, w, v);
+            for (int j = 0; j < 3; j++) {
+                if (free) { S[c][j] = w[j]; S[c][3 + j] = JT_C(0.0); }
+                S[at + c][j] = v[j];
+                S[at + c][3 + j] = w[j];
+            }
+        }
+        return free ? 6 : 3;
+    }
+    const JT_T d[3] = {R[2], R[5], R[8]};
+    JT_T *s = S[0];
+    if (TK_TURNS(b)) {
+        SP_CROSS(o, d, s);
+        for (int j = 0; j < 3; j++) s[3 + j] = d[j];
+        if (TK_SLIDES(b))  /* a helical joint: and along the axis by its lead */
+            for (int j = 0; j < 3; j++) s[j] += b[TK_LEAD] * d[j];
+    } else {
+        for (int j = 0; j < 3; j++) { s[j] = d[j]; s[3 + j] = JT_C(0.0); }
+    }
+    return 1;
+}

@@ -35,22 +35,38 @@ static PyArrayObject *rk_input(PyObject *x, int last, const char *name)
     return a;
 }
 
-/* a floating base's quaternions (entries 3..6 of each state) of norm within the tolerance, in
- * every state whose q is all finite (the others' rows are NaN, as the tree module's rule);
- * else ValueError, and numpy names the state */
+/* a floating base's quaternions (entries 3..6 of each state) and each ball joint's (w x y z at
+ * its q number) of norm within the tolerance, in every state whose q is all finite (the
+ * others' rows are NaN, as the tree module's rule); else ValueError, and numpy names the
+ * state */
 static int rk_unit_quaternions(const rk_model *md, PyArrayObject *Q)
 {
-    if (!md->fb) return 1;
+    if (!md->fb && !md->t.balls) return 1;
     npy_intp count = PyArray_SIZE(Q) / md->nq;
     const double *q = PyArray_DATA(Q);
     for (npy_intp k = 0; k < count; k++, q += md->nq) {
-        double n2 = q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6];
-        if (rk_finite_row(q, md->nq) && (n2 < md->qlow || n2 > md->qhigh)) {
-            PyErr_SetString(PyExc_ValueError, "q: the base quaternion is not of unit norm");
-            return 0;
+        if (!rk_finite_row(q, md->nq)) continue;
+        for (int i = 0; i < md->nb; i++) {
+            const double *b = RK_BODY(i), *e = q + md->bq + (int)b[TK_QCOORD];
+            if (TK_FREE(b)) e = q + 3;
+            else if (!TK_BALL(b)) continue;
+            double n2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3];
+            if (n2 < md->qlow || n2 > md->qhigh) {
+                PyErr_SetString(PyExc_ValueError, "q: a quaternion is not of unit norm");
+                return 0;
+            }
         }
     }
     return 1;
+}
+
+/* 1 where the tree has no ball joint, else ValueError: what needs a joint of one number or
+ * a free flyer (J_dot v, A_g, C(q, v), wrenches, inverse dynamics: numpy's refuse a ball) */
+static int rk_no_balls(const rk_model *md, const char *what)
+{
+    if (!md->t.balls) return 1;
+    PyErr_Format(PyExc_ValueError, "%s: a ball joint (not in the reach module)", what);
+    return 0;
 }
 
 static PyObject *rk_output(PyArrayObject *like, int tail0, int tail1)
@@ -119,6 +135,7 @@ static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t n
 {
     const rk_model *md = RK_MD(self);
     if (nargs != 4) { PyErr_SetString(PyExc_TypeError, "drift(Q, V, frame, reference)"); return NULL; }
+    if (!rk_no_balls(md, "drift")) return NULL;
     const int f = rk_frame_named(md, ((rk_tree *)self)->index, args[2]);
     if (f < 0) return NULL;
     const int ref = rk_reference_named(args[3]);
@@ -186,6 +203,7 @@ static PyObject *rk_py_jacobian(PyObject *self, PyObject *const *args, Py_ssize_
     static PyObject *rk_py_##name(PyObject *self, PyObject *const *args, Py_ssize_t nargs)    \
     {                                                                                          \
         if (nargs != 1) { PyErr_SetString(PyExc_TypeError, #name "(Q)"); return NULL; }       \
+        if (kind == RK_CENTROIDAL && !rk_no_balls(RK_MD(self), #name)) return NULL;            \
         return rk_of_q(self, args[0], kind, 0, 0, tail0, tail1);                               \
     }
 RK_OF_Q(com, RK_COM, 3, 0)
@@ -198,6 +216,7 @@ static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t 
 {
     const rk_model *md = RK_MD(self);
     if (nargs != 5) { PyErr_SetString(PyExc_TypeError, "wrench(Q, frame, W, OUT, sign)"); return NULL; }
+    if (!rk_no_balls(md, "wrench")) return NULL;
     int f = (int)PyLong_AsLong(args[1]);
     double sign = PyFloat_AsDouble(args[4]);
     if (PyErr_Occurred()) return NULL;
@@ -233,6 +252,7 @@ static PyObject *rk_py_coriolis(PyObject *self, PyObject *const *args, Py_ssize_
 {
     const rk_model *md = RK_MD(self);
     if (nargs != 2) { PyErr_SetString(PyExc_TypeError, "coriolis(Q, V)"); return NULL; }
+    if (!rk_no_balls(md, "coriolis")) return NULL;
     PyArrayObject *Q = rk_input(args[0], md->nq, "q");
     if (!Q) return NULL;
     if (!rk_unit_quaternions(md, Q)) { Py_DECREF(Q); return NULL; }
@@ -258,6 +278,7 @@ static PyObject *rk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t
 {
     const rk_model *md = RK_MD(self);
     PyObject *index = ((rk_tree *)self)->index;
+    if (!rk_no_balls(md, "inverse")) return NULL;
     if (nargs != 5 || !PyDict_Check(args[4])) {
         PyErr_SetString(PyExc_TypeError, "inverse(UP, Q, V, A, F_EXT)");
         return NULL;
@@ -353,7 +374,6 @@ static int rk_model_from(PyObject *description, PyObject *ints, PyObject *floats
     const npy_intp nD = PyArray_SIZE(Da), ni = PyArray_SIZE(Ia), nd = PyArray_SIZE(Fa);
     tk_tree t;
     if (tk_open(PyArray_DATA(Da), nD, &t)) { fault = "D: not a tree description"; goto done; }
-    if (t.balls) { fault = "D: a ball joint (not in the reach module yet)"; goto done; }
     const int *head = PyArray_DATA(Ia);
     if (ni < 3) { fault = "INTS: no header"; goto done; }
     const int nb = t.nb, n = t.n, fb = t.fb, nf = head[0];

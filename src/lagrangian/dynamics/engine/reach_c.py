@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...kinds import JointKind
 from ...model.tree import KinematicTree
 from ..emit.tree_c import _SINCOS, _VECTOR
 from ..tree.description import canonical_frame, describe
@@ -67,8 +68,11 @@ def _coriolis_zeros(tree: KinematicTree) -> tuple[bool, list[int]]:
     and zeroes only these)."""
     free = tree.floating_base
     base = 6 if free else 0
-    nv = base + len(tree.coordinates)
-    columns = [list(range(6)) if free and i == 0 else [base + j.coordinate]
+    nv = tree.nv
+    # each body's velocity numbers: the base's six, a ball's three, else one
+    columns = [list(range(6)) if free and i == 0 else
+               [base + tree.velocity_index(j.coordinate) + c
+                for c in range(3 if j.kind == JointKind.SPHERICAL else 1)]
                for i, j in enumerate(tree.joints)]
     coordinates = [j.coordinate for j in tree.joints[int(free):]]
     shared = len(set(coordinates)) < len(coordinates)
@@ -142,11 +146,14 @@ def engine():
 
 def reach_module(tree: KinematicTree):
     """The compiled module for this tree (the same for every tree: ``engine``), or None where
-    no compiler works or a joint is one the kernel does not know."""
+    no compiler works or a joint is one the kernel does not know. A ball joint's tree has its
+    placements, Jacobians and centre of mass here; its J_dot v, A_g, C(q, v) and wrenches are
+    refused by the module (ValueError), and numpy's walks name the fault in one line."""
     from ..tree.joint_models import ONE_DOF
 
     free = tree.floating_base  # a free flyer: body 0 only (RK_FREE)
-    if any(j.kind not in ONE_DOF for j in tree.joints[int(free):]):
+    if any(j.kind not in ONE_DOF and j.kind != JointKind.SPHERICAL
+           for j in tree.joints[int(free):]):
         return None  # a joint the kernel does not know: numpy's walks refuse it in one line
     return engine()
 

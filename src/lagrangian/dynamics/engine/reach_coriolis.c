@@ -68,10 +68,10 @@ static void RK_FN(coriolis)(const rk_model *md, RK_FN(work) *space, const RK_T *
         RK_T (*S)[6] = RK_COLUMNS(work, i), (*dS)[6] = RK_RATES(work, i);
         int p = md->parent[i];
         if (RK_FREE(i)) {
-            RK_FN(free_columns)(R[0], o[0], S);
+            RK_FREE_COLUMNS(md, R[0], o[0], S);
             bi->columns = 6, bi->first = 0;
         } else {
-            RK_FN(subspace)(md, i, R, o, S[0]);
+            RK_SUBSPACE(md, i, R, o, S[0]);
             for (int j = 0; j < 6; j++) S[0][j] *= md->mult[i];
             bi->columns = 1, bi->first = md->bv + md->coord[i];
         }

@@ -36,7 +36,7 @@ static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *re
     for (int i = 0; i < md->nb; i++) {
         const int p = md->parent[i];
         if (RK_FREE(i)) {  /* V = S v_base, A = up + S a_base (V x S v_base = V x V = 0) */
-            RK_FN(free_columns)(R[0], o[0], base);
+            RK_FREE_COLUMNS(md, R[0], o[0], base);
             for (int j = 0; j < 6; j++) {
                 V[0][j] = RK_C(0.0);
                 A[0][j] = RK_C(j < 3 ? up[j] : 0.0);
@@ -49,7 +49,7 @@ static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *re
             const RK_T rate = md->mult[i] * qd[md->bv + md->coord[i]];
             const RK_T accel = md->mult[i] * qdd[md->bv + md->coord[i]];
             RK_T c[6];
-            RK_FN(subspace)(md, i, R, o, S[i]);
+            RK_SUBSPACE(md, i, R, o, S[i]);
             for (int j = 0; j < 6; j++) {
                 V[i][j] = (p < 0 ? RK_C(0.0) : V[p][j]) + S[i][j] * rate;
                 A[i][j] = (p < 0 ? RK_C(j < 3 ? up[j] : 0.0) : A[p][j]) + S[i][j] * accel;

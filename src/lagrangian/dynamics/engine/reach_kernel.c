@@ -140,53 +140,25 @@ static int RK_FN(path)(const rk_model *md, const RK_T *q, int b, int *path, RK_T
     return depth;
 }
 
-/* S of body i's joint per unit theta at the world's origin, world axes: [s_v; s_w], its axis
- * d = R e_z (canonical axes): s_w = d where it turns, s_v = o x s_w + lead d where it slides */
-static inline __attribute__((always_inline)) void RK_FN(subspace)(const rk_model *md, int i,
-                                                                  RK_T (*R)[9], RK_T (*o)[3],
-                                                                  RK_T *S)
-{
-    const double *b = RK_BODY(i);
-    const RK_T d[3] = {R[i][2], R[i][5], R[i][8]};
-    if (TK_TURNS(b)) {
-        SP_CROSS(o[i], d, S);
-        for (int j = 0; j < 3; j++) S[3 + j] = d[j];
-        if (TK_SLIDES(b))  /* a helical joint: and along the axis by its pitch */
-            for (int j = 0; j < 3; j++) S[j] += b[TK_LEAD] * d[j];
-    } else {
-        for (int j = 0; j < 3; j++) { S[j] = d[j]; S[3 + j] = RK_C(0.0); }
-    }
-}
+/* S of body i's joint of one number per unit theta at the world's origin, world axes:
+ * [s_v; s_w] (joint.h's columns) */
+#define RK_SUBSPACE(md, i, R, o, S) \
+    ((void)RK_FN(jt_columns)(RK_BODY(i), (R)[i], (o)[i], (RK_T (*)[6])(S)))
 
-/* a free flyer's six columns at the world's origin, world axes (S = 1 in the base's axes):
- * S[c] = [R e_c; 0], S[3 + c] = [o x R e_c; R e_c] */
-static inline __attribute__((always_inline)) void RK_FN(free_columns)(const RK_T *R, const RK_T *o, RK_T (*S)[6])
-{
-    for (int c = 0; c < 3; c++) {
-        RK_T w[3] = {R[c], R[3 + c], R[6 + c]}, v[3];
-        SP_CROSS(o, w, v);
-        for (int j = 0; j < 3; j++) {
-            S[c][j] = w[j]; S[c][3 + j] = RK_C(0.0);
-            S[3 + c][j] = v[j]; S[3 + c][3 + j] = w[j];
-        }
-    }
-}
+/* a free flyer's six columns at the world's origin, world axes (S = 1 in the base's axes) */
+#define RK_FREE_COLUMNS(md, R, o, S) ((void)RK_FN(jt_columns)(RK_BODY(0), (R), (o), (S)))
 
-/* a joint's columns at the world's origin, world axes, and the first coordinate they fill:
- * a free flyer's six, else one (times the joint's multiplier) */
+/* a joint's columns at the world's origin, world axes (joint.h), and the first coordinate
+ * they fill: a free flyer's six, a ball's three, else one (times the joint's multiplier) */
 static inline __attribute__((always_inline)) int RK_FN(columns)(const rk_model *md, int i,
                                                                 RK_T (*R)[9], RK_T (*o)[3],
                                                                 RK_T (*F)[6], int *first,
                                                                 double *mult)
 {
-    if (RK_FREE(i)) {
-        RK_FN(free_columns)(R[0], o[0], F);
-        *first = 0, *mult = 1.0;
-        return 6;
-    }
-    RK_FN(subspace)(md, i, R, o, F[0]);
-    *first = md->bv + md->coord[i], *mult = md->mult[i];
-    return 1;
+    const double *b = RK_BODY(i);
+    *first = RK_FREE(i) ? 0 : md->bv + md->coord[i];
+    *mult = TK_FREE(b) || TK_BALL(b) ? 1.0 : md->mult[i];
+    return RK_FN(jt_columns)(b, R[i], o[i], F);
 }
 
 /* the frame's rotation (frame -> world) and origin */
@@ -229,7 +201,7 @@ static void RK_FN(drift)(const rk_model *md, RK_FN(work) *work, const RK_T *q, c
         const int i = path[k];
         if (RK_FREE(i)) {  /* V = S v_base; no drift of its own (V x V = 0) */
             RK_T F[6][6];
-            RK_FN(free_columns)(R[0], o[0], F);
+            RK_FREE_COLUMNS(md, R[0], o[0], F);
             for (int j = 0; j < 6; j++) {
                 V[0][j] = RK_C(0.0);
                 A[0][j] = RK_C(0.0);
@@ -239,7 +211,7 @@ static void RK_FN(drift)(const rk_model *md, RK_FN(work) *work, const RK_T *q, c
         }
         RK_T S[6], c[6], rate = md->mult[i] * qd[md->bv + md->coord[i]];
         int p = md->parent[i];
-        RK_FN(subspace)(md, i, R, o, S);
+        RK_SUBSPACE(md, i, R, o, S);
         for (int j = 0; j < 6; j++) {
             V[i][j] = (p < 0 ? RK_C(0.0) : V[p][j]) + S[j] * rate;
             A[i][j] = p < 0 ? RK_C(0.0) : A[p][j];
@@ -298,7 +270,7 @@ static void RK_FN(wrench)(const rk_model *md, RK_FN(work) *work, const RK_T *q, 
             SP_APPLY_T(R[0], n, out + 3);
             continue;
         }
-        RK_FN(subspace)(md, i, R, o, S);
+        RK_SUBSPACE(md, i, R, o, S);
         out[md->bv + md->coord[i]] += md->mult[i] * (S[0] * w[0] + S[1] * w[1] + S[2] * w[2]
                                                   + S[3] * m[0] + S[4] * m[1] + S[5] * m[2]);
     }

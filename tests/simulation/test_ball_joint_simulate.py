@@ -195,3 +195,30 @@ def test_a_hinges_position_limit_beside_a_ball_still_ends_the_run(tmp_path_facto
     assert abs(run.q[-1, 4]) == pytest.approx(np.radians(30), abs=1e-7)
     with pytest.raises(LagrangianError, match="joint 'elbow' .* starts at 0.7"):
         system.simulate(0.1, initial={"elbow": 0.7})
+
+
+def test_the_drawing_turns_the_balls_hinges_to_the_quaternions_rotation(tmp_path_factory):
+    """The animation draws the model's bodies, a ball as three hinges x, y, z: their angles
+    give Rx Ry Rz = R(q) at every sample, and the rates are the angles' (by differences)."""
+    from lagrangian.simulation.tree_state import drawing_coordinates
+
+    system, _ = _load(tmp_path_factory, ARM.format(dt=0.01, free=""), "drawn")
+    run = system.simulate(1.0, initial={"shoulder_wx": 2.0, "shoulder_wy": -1.0,
+                                        "shoulder_wz": 3.0, "elbow_dot": 1.0}, samples=201)
+    q, v = drawing_coordinates(system.model, run.t, run.q, run.q_dot)
+    assert [c.name for c in system.model.coordinates] == ["shoulder__x", "shoulder__y",
+                                                           "shoulder__z", "elbow"]
+
+    def turn(axis, angle):
+        c, s = np.cos(angle), np.sin(angle)
+        i, j = [k for k in range(3) if k != axis]
+        R = np.eye(3)
+        R[i, i], R[i, j], R[j, i], R[j, j] = c, -s, s, c
+        return R if axis != 1 else R.T  # about y the sine's sign is the other way
+
+    for k in range(0, 201, 10):
+        R = turn(0, q[k, 0]) @ turn(1, q[k, 1]) @ turn(2, q[k, 2])
+        np.testing.assert_allclose(R, _rotation(run.q[k, :4]), rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(q[:, 3], run.q[:, 4])  # the elbow as it is
+    np.testing.assert_array_equal(v[:, 3], run.q_dot[:, 3])
+    assert np.abs(np.diff(q[:, :3], axis=0)).max() < 0.5  # unwrapped: no jump of 2 pi

@@ -212,16 +212,16 @@ def simulate(
 
 
 def _refuse_on_manifold(tree, animate, control, along) -> None:
-    """What a run whose q and v differ does not take yet, refused in one line before it: the
-    drawing (it turns the model's bodies by q), and on a ball joint the controllers and the
-    linearization along the run (both built on q_dot = v)."""
+    """What a run whose q and v differ does not take yet, refused in one line before it: a
+    floating base's drawing (the model's bodies hold no base; a ball is drawn by its Euler
+    hinges), and on a ball joint the controllers and the linearization along the run (both
+    built on q_dot = v)."""
     from ..errors import InputError
 
     balls = getattr(tree, "spherical", ())
-    if animate is not None and (balls or getattr(tree, "floating_base", False)):
-        what = f"the ball joint '{balls[0].name}'" if balls else "a floating base"
-        raise InputError(f"a robot with {what} is not animated yet (its quaternion is not "
-                         "the drawing's coordinates); --out and --plot are", field="--animate")
+    if animate is not None and getattr(tree, "floating_base", False):
+        raise InputError("a floating base's run is not animated yet: --out and --plot are",
+                         field="--animate")
     for flag, given, then in (
             ("--control", control not in (None, "model"), "; in Python, give simulate a "
              "controller (t, q, v) -> u of nv torques (a ball's: its moment, body axes)"),

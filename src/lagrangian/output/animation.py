@@ -110,15 +110,24 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
     bodies in space is seen from ``view`` = (azimuth, elevation) in degrees); ``size`` =
     (width, height) of its frames in pixels (default 400 x 400)."""
     check_animatable(result.model)
+    samples_q, samples_v = result.q, result.q_dot
+    if samples_q.shape[1] != samples_v.shape[1]:  # a ball's quaternion: the bodies' Euler hinges
+        from ..simulation.tree_state import drawing_coordinates
+
+        drawn = drawing_coordinates(result.model, result.t, samples_q, samples_v)
+        if drawn is None:
+            raise InputError("a floating base's run is not animated yet: its table and plot "
+                             "are", field="animation")
+        samples_q, samples_v = drawn
     view = check_view(view)
     size = check_size(size)
     fps = check_fps(fps)
     geometry = mechanism(result.model, result.parameters)
     times = animation_frames(result, fps, max_frames)
-    q = np.column_stack([np.interp(times, result.t, result.q[:, i])
-                         for i in range(result.q.shape[1])])
-    v = np.column_stack([np.interp(times, result.t, result.q_dot[:, i])
-                         for i in range(result.q.shape[1])])
+    q = np.column_stack([np.interp(times, result.t, samples_q[:, i])
+                         for i in range(samples_q.shape[1])])
+    v = np.column_stack([np.interp(times, result.t, samples_v[:, i])
+                         for i in range(samples_q.shape[1])])
     figure = animation_figure(size)
     ax = figure.add_subplot()
     offsets = getattr(result, "pivot_offsets", None)  # a walker: where its pivot is by now

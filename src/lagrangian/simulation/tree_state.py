@@ -26,7 +26,11 @@ class TreeState:
     """Where each joint's numbers sit in q (nq) and v (nv), from the dynamics' names."""
 
     def __init__(self, dynamics, model):
+        from ..model.tree import refuse_free_joints
+
         tree = model.kinematic_tree
+        # a free flyer below the root: its 7 numbers are not stepped here (yet)
+        refuse_free_joints(tree, "simulate")
         self.q_names, self.v_names = tuple(dynamics.coordinates), tuple(dynamics.velocity_names)
         self.nq, self.nv = len(self.q_names), len(self.v_names)
         self.floating = tree.floating_base
@@ -166,4 +170,32 @@ class TreeState:
                     f"{QUATERNION_TOLERANCE:g} of 1)", field=field)
 
 
-__all__ = ["BALL_START", "BASE_START", "TreeState"]
+def drawing_coordinates(model, t: np.ndarray, q: np.ndarray, v: np.ndarray):
+    """The model's coordinates and rates (N, n) of a fixed-base run with ball joints (t, q, v at
+    its samples): each ball's quaternion as its three Euler hinges <ball>__x, __y, __z
+    (R(q) = Rx Ry Rz, model/mjcf_ball.py's chain), unwrapped, their rates by differences; the
+    other joints as they are. None for a floating base (the model's bodies hold no base)."""
+    tree = model.kinematic_tree
+    if tree is None or tree.floating_base:
+        return None
+    names = [c.name for c in model.coordinates]
+    velocities = tree.velocity_coordinates
+    out_q, out_v = np.zeros((len(q), len(names))), np.zeros((len(q), len(names)))
+    for k, name in enumerate(names):
+        if name in tree.coordinates:
+            out_q[:, k] = q[:, tree.coordinates.index(name)]
+            out_v[:, k] = v[:, velocities.index(name)]
+    for joint in tree.spherical:
+        w, x, y, z = (q[:, joint.coordinate + i] for i in range(4))
+        angles = np.unwrap(np.stack([  # Rx(a) Ry(b) Rz(c): R02 = sin b, R12, R22, R01, R00
+            np.arctan2(-2 * (y * z - x * w), 1 - 2 * (x * x + y * y)),
+            np.arcsin(np.clip(2 * (x * z + y * w), -1.0, 1.0)),
+            np.arctan2(-2 * (x * y - z * w), 1 - 2 * (y * y + z * z))], -1), axis=0)
+        for i, axis in enumerate("xyz"):
+            k = names.index(f"{joint.name}__{axis}")
+            out_q[:, k] = angles[:, i]
+            out_v[:, k] = np.gradient(angles[:, i], t) if len(t) > 1 else 0.0
+    return out_q, out_v
+
+
+__all__ = ["BALL_START", "BASE_START", "TreeState", "drawing_coordinates"]

@@ -367,7 +367,10 @@ def test_every_kind_has_a_code_and_a_tree():
 
 
 def test_a_kind_without_its_branch_is_refused_by_the_engine():
-    """A record code the kernel has no branch for is refused by tk_open: no silent motion."""
+    """A record code joint.h has no branch for is refused by its tk_open in each module that
+    reads the description (the tree kernel, the reach and the derivatives modules): no silent
+    motion."""
+    from lagrangian.dynamics.engine import derivatives_c, reach_c
     from lagrangian.dynamics.engine.compact_kernel import kernel_module
     from lagrangian.dynamics.tree.description import HEADER, describe
 
@@ -379,3 +382,12 @@ def test_a_kind_without_its_branch_is_refused_by_the_engine():
         kernel_module().prepare(D)
     with pytest.raises(TypeError, match="not a prepared tree"):  # the tables, never the array
         kernel_module().mass_matrix(np.zeros(len(tree.coordinates)), D)
+    reach, derivatives = reach_c.engine(), derivatives_c.engine()
+    if reach is None or derivatives is None:
+        pytest.skip("no C compiler")
+    with pytest.raises(ValueError, match="not a tree description"):
+        reach.tree(D, *reach_c.tables(tree), {})
+    with pytest.raises(ValueError, match="not a description"):
+        derivatives.tree(D, derivatives_c.tables(tree))
+    reach.tree(describe(tree, {}), *reach_c.tables(tree), {})  # the same tree's own D: taken
+    derivatives.tree(describe(tree, {}), derivatives_c.tables(tree))

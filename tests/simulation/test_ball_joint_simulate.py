@@ -222,3 +222,15 @@ def test_the_drawing_turns_the_balls_hinges_to_the_quaternions_rotation(tmp_path
     np.testing.assert_array_equal(q[:, 3], run.q[:, 4])  # the elbow as it is
     np.testing.assert_array_equal(v[:, 3], run.q_dot[:, 3])
     assert np.abs(np.diff(q[:, :3], axis=0)).max() < 0.5  # unwrapped: no jump of 2 pi
+
+
+def test_a_run_goes_on_from_its_last_state(pendulum):
+    """Two runs of 1 s, the second from the first's last_state, end where one of 2 s does."""
+    start = {"ball_wx": 1.5, "ball_wz": 2.0}
+    options = {"rtol": 1e-11, "atol": 1e-11, "samples": 3}
+    whole = pendulum.simulate(2.0, initial=start, **options)
+    first = pendulum.simulate(1.0, initial=start, **options)
+    second = pendulum.simulate(2.0, initial=first.last_state, **options)
+    assert second.t[0] == 1.0
+    np.testing.assert_allclose(second.q[-1], whole.q[-1], rtol=0, atol=1e-8)
+    np.testing.assert_allclose(second.q_dot[-1], whole.q_dot[-1], rtol=0, atol=1e-8)

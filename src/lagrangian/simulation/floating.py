@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import DynamicsWarning, InputError
 from ..kinds import InvariantKind, RunStatus
+from ..model.values import State
 from .events import StopCondition, parse_stop_condition
 from .guards import GuardedRhs, StepCollapse, check_start
 from .integration_loops import LoopRun, crossing_time, touch_inside
@@ -177,7 +178,8 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     # a rate that overflows the accelerations at once: refused (simulation/guards.py)
     rates = tuple(n if n not in state.q_names else f"{n}_dot" for n in state.v_names)
     # the robot's own motion: the controller is not called for it (its calls are the run's)
-    check_start(lambda t, y: rhs(t, y, controlled=False), t0, y0, rates, tuple(initial or ()))
+    given = tuple(initial.given if isinstance(initial, State) else initial or ())
+    check_start(lambda t, y: rhs(t, y, controlled=False), t0, y0, rates, given)
     guarded = GuardedRhs(rhs, step_control.method, len(y0), t0, t_end)
     solver = None  # built in the loop's try: its first step size calls the guarded rhs
     user = None if stop is None else _stop_event(stop, state, model, system.parameters)

@@ -108,7 +108,15 @@ class TreeState:
         (<joint>, <joint>_dot; default the model's initial values), SI; a quaternion off unit
         norm refused in one line naming it."""
         from ..model.units import parse_quantity
+        from ..model.values import State
 
+        if isinstance(initial, State):  # a run's last_state: the tree's own layout, or refused
+            if initial.coordinates != self.q_names or len(initial.q_dot) != self.nv:
+                raise InputError(f"the state's coordinates {list(initial.coordinates)} are not "
+                                 f"this robot's {list(self.q_names)}", field="initial")
+            q0 = initial.q_array()
+            self.check_unit(q0, "initial")
+            return float(initial.t), self.unit(q0), initial.q_dot_array()
         given = dict(initial or {})
         own = dict(zip(self.base_q, BASE_START if self.floating else (), strict=True))
         for _, iq, _ in self.balls:

@@ -53,7 +53,6 @@ class TreeState:
         # a ball's Euler hinges (MJCF: <ball>__x, __y, __z): the model's, not the state's
         self.hinges = {name: ball for ball, *_ in self.balls
                        for name in coordinates if name.startswith(f"{ball}__")}
-        self.joint_q = self.base_q == () and not self.balls  # q is the model's coordinates
 
     def joints_q(self, q: np.ndarray) -> np.ndarray:
         """The model's coordinates (..., n) from q (..., nq): a ball's hinges 0."""

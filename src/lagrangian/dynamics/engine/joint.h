@@ -38,6 +38,7 @@
 #define TK_ROW 41       /* 3: where R0 is a signed permutation, each column's nonzero row */
 #define TK_ROWSIGN 44   /* 3: that entry, +-1 */
 #define TK_AXES 47      /* 9: A, the canonical axes -> the body's own (its link's), row-major */
+#define TK_IDENTITY 56  /* 1 where R0 is exactly the identity */
 #define TK_LEAD 61      /* the slide along u per unit theta: 1 prismatic, pitch (m/rad) helical */
 #define TK_TURNS(b) ((b)[TK_KIND] == 0.0 || (b)[TK_KIND] == 3.0)
 #define TK_SLIDES(b) ((b)[TK_KIND] == 1.0 || (b)[TK_KIND] == 3.0)
@@ -105,13 +106,17 @@ static inline void tk_subspace(const double *b, double *sw, double *sv)
 
 /* JT_CORE_BEGIN */
 /* R = R0 E(x, y, z, s): E the rotation of the quaternion (x, y, z, s = its scalar part), made
-   unit here (a free flyer's, a ball joint's) */
+   unit here (a free flyer's, a ball joint's); R0 NULL: the identity, R = E */
 static inline void JT_FN(turned)(const double *R0, JT_T x, JT_T y, JT_T z, JT_T s, JT_T *R)
 {
     const JT_T k = 2.0 / (x * x + y * y + z * z + s * s);
     const JT_T E[9] = {1.0 - k * (y * y + z * z), k * (x * y - z * s), k * (x * z + y * s),
                        k * (x * y + z * s), 1.0 - k * (x * x + z * z), k * (y * z - x * s),
                        k * (x * z - y * s), k * (y * z + x * s), 1.0 - k * (x * x + y * y)};
+    if (!R0) {
+        for (int r = 0; r < 9; r++) R[r] = E[r];
+        return;
+    }
     for (int r = 0; r < 3; r++)
         for (int col = 0; col < 3; col++)
             R[3 * r + col] = R0[3 * r] * E[col] + R0[3 * r + 1] * E[3 + col]
@@ -129,17 +134,22 @@ static inline __attribute__((always_inline)) void JT_FN(place)(const tk_tree *t,
 {
     const double *R0 = b + TK_R0;
     if (TK_FREE(b)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
-        JT_FN(turned)(R0, q[3], q[4], q[5], q[6], R);
-        for (int r = 0; r < 3; r++)
-            p[r] = R0[3 * r] * q[0] + R0[3 * r + 1] * q[1] + R0[3 * r + 2] * q[2];
-        for (int r = 0; r < 3; r++) p[r] += b[TK_T0 + r];
+        if (b[TK_IDENTITY] != 0.0) {  /* the usual free flyer, at the root link's own axes */
+            JT_FN(turned)(NULL, q[3], q[4], q[5], q[6], R);
+            for (int r = 0; r < 3; r++) p[r] = q[r] + b[TK_T0 + r];
+        } else {
+            JT_FN(turned)(R0, q[3], q[4], q[5], q[6], R);
+            for (int r = 0; r < 3; r++)
+                p[r] = R0[3 * r] * q[0] + R0[3 * r + 1] * q[1] + R0[3 * r + 2] * q[2];
+            for (int r = 0; r < 3; r++) p[r] += b[TK_T0 + r];
+        }
         *cos_ = JT_C(1.0);
         *sin_ = JT_C(0.0);
         return;
     }
     if (TK_BALL(b)) {  /* R0 R(quaternion w x y z, normalized), p = t0 */
         const JT_T *e = q + t->bq + (int)b[TK_QCOORD];
-        JT_FN(turned)(R0, e[1], e[2], e[3], e[0], R);
+        JT_FN(turned)(b[TK_IDENTITY] != 0.0 ? NULL : R0, e[1], e[2], e[3], e[0], R);
         for (int r = 0; r < 3; r++) p[r] = JT_C(b[TK_T0 + r]);
         *cos_ = JT_C(1.0);
         *sin_ = JT_C(0.0);
@@ -262,18 +272,24 @@ static inline __attribute__((always_inline)) void JT_FN(placed)(const tk_tree *t
 static inline __attribute__((always_inline)) int JT_FN(columns)(const double *b, const JT_T *R,
                                                                 const JT_T *o, JT_T (*S)[6])
 {
-    if (TK_FREE(b) || TK_BALL(b)) {
-        const int free = TK_FREE(b), at = free ? 3 : 0;
+    if (TK_FREE(b)) {
         for (int c = 0; c < 3; c++) {
             JT_T w[3] = {R[c], R[3 + c], R[6 + c]}, v[3];
             SP_CROSS(o, w, v);
             for (int j = 0; j < 3; j++) {
-                if (free) { S[c][j] = w[j]; S[c][3 + j] = JT_C(0.0); }
-                S[at + c][j] = v[j];
-                S[at + c][3 + j] = w[j];
+                S[c][j] = w[j]; S[c][3 + j] = JT_C(0.0);
+                S[3 + c][j] = v[j]; S[3 + c][3 + j] = w[j];
             }
         }
-        return free ? 6 : 3;
+        return 6;
+    }
+    if (TK_BALL(b)) {
+        for (int c = 0; c < 3; c++) {
+            JT_T w[3] = {R[c], R[3 + c], R[6 + c]}, v[3];
+            SP_CROSS(o, w, v);
+            for (int j = 0; j < 3; j++) { S[c][j] = v[j]; S[c][3 + j] = w[j]; }
+        }
+        return 3;
     }
     const JT_T d[3] = {R[2], R[5], R[8]};
     JT_T *s = S[0];

@@ -41,17 +41,15 @@ static PyArrayObject *rk_input(PyObject *x, int last, const char *name)
  * state */
 static int rk_unit_quaternions(const rk_model *md, PyArrayObject *Q)
 {
-    if (!md->fb && !md->t.balls) return 1;
+    if (!md->nquat) return 1;
     npy_intp count = PyArray_SIZE(Q) / md->nq;
     const double *q = PyArray_DATA(Q);
     for (npy_intp k = 0; k < count; k++, q += md->nq) {
-        if (!rk_finite_row(q, md->nq)) continue;
-        for (int i = 0; i < md->nb; i++) {
-            const double *b = RK_BODY(i), *e = q + md->bq + (int)b[TK_QCOORD];
-            if (TK_FREE(b)) e = q + 3;
-            else if (!TK_BALL(b)) continue;
+        for (int j = 0; j < md->nquat; j++) {
+            const double *e = q + md->quat[j];
             double n2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3];
-            if (n2 < md->qlow || n2 > md->qhigh) {
+            /* the row's finiteness read only for a quaternion off (a NaN's n2 is neither) */
+            if ((n2 < md->qlow || n2 > md->qhigh) && rk_finite_row(q, md->nq)) {
                 PyErr_SetString(PyExc_ValueError, "q: a quaternion is not of unit norm");
                 return 0;
             }
@@ -389,7 +387,7 @@ static int rk_model_from(PyObject *description, PyObject *ints, PyObject *floats
     }
     /* the description's copy, the frames' numbers, then per body mult, m, h (3), J (9) */
     const size_t doubles = (size_t)nD + (size_t)nd + 14 * (size_t)nb;
-    double *d = malloc(doubles * sizeof(double) + ((size_t)ni + 2 * (size_t)nb) * sizeof(int));
+    double *d = malloc(doubles * sizeof(double) + ((size_t)ni + 3 * (size_t)nb) * sizeof(int));
     if (!d) { PyErr_NoMemory(); goto done; }
     *tables = d;
     memcpy(d, PyArray_DATA(Da), (size_t)nD * sizeof(double));
@@ -402,18 +400,21 @@ static int rk_model_from(PyObject *description, PyObject *ints, PyObject *floats
                      .bq = t.bq, .bv = t.bv, .nq = t.nq, .nv = t.nv, .t = t};
     md->fbody = a + 3;
     md->czero = a + 3 + nf;
-    int *parent = a + ni, *coord = parent + nb;
+    int *parent = a + ni, *coord = parent + nb, *quat = coord + nb, nquat = 0;
     double *mult = per, *m = per + nb, *h = per + 2 * (size_t)nb, *J = per + 5 * (size_t)nb;
     for (int i = 0; i < nb; i++) {
         const double *b = t.body + (size_t)i * TK_STRIDE;
         parent[i] = (int)b[TK_PARENT];
         coord[i] = TK_FREE(b) ? 0 : (int)b[TK_COORD];
         mult[i] = b[TK_MULT];
+        if (TK_FREE(b)) quat[nquat++] = 3;  /* x y z w after the origin */
+        else if (TK_BALL(b)) quat[nquat++] = t.bq + (int)b[TK_QCOORD];  /* w x y z */
         m[i] = b[TK_MASS];
         for (int j = 0; j < 3; j++) h[3 * i + j] = b[TK_H + j];
         for (int j = 0; j < 9; j++) J[9 * i + j] = b[TK_J + j];
     }
     md->parent = parent, md->coord = coord, md->mult = mult, md->m = m, md->h = h, md->J = J;
+    md->quat = quat, md->nquat = nquat;
     md->qlow = fr[0], md->qhigh = fr[1];
     md->fR = fr + 2;
     md->ft = fr + 2 + 9 * (size_t)nf;

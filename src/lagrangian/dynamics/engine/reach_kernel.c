@@ -24,6 +24,8 @@ typedef struct {
        and inertia J (kg m^2, 9, about its origin), in its canonical axes */
     const int *parent, *coord;
     const double *mult, *m, *h, *J;
+    int nquat;                        /* the quaternions in q: the base's, each ball's */
+    const int *quat;                  /* where each begins in q */
     const int *fbody;                 /* per frame: its body (-1: the ground) */
     const int *czero;                 /* the entries of C that no body's pass sets (cset) */
     const double *fR, *ft;            /* per frame: rotation (9) and translation (3) in its body */

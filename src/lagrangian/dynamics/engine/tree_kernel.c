@@ -1,6 +1,7 @@
 /* The compact tree kernel: the recursions of tree_algorithms.py as loops over a tree given at
-   run time as one array of doubles (its layout in compact_kernel.py), compiled once for every
-   tree. Units SI. Each body i hangs from parent(i) < i (or the ground, -1) by one joint:
+   run time as one array of doubles (its layout: tree/description.py and joint.h, which places
+   each joint kind for this module, the reach and the derivatives modules), compiled once for
+   every tree. Units SI. Each body i hangs from parent(i) < i (or the ground, -1) by one joint:
    R = R0 Rot(u, theta) (revolute, helical) or R0 (prismatic), p = t0 (+ R0 u lead theta: lead
    1 prismatic, the pitch helical), with theta = k q[c] + offset; R turns body axes into parent axes, p is the origin in the parent.
    A floating base (header flag) is body 0 on a free flyer (kind 2, free_flyer.py): q holds

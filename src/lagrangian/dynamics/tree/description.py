@@ -23,7 +23,8 @@ The description ``D`` (float64, contiguous), built by ``describe``:
       33:36 where R0 is a signed permutation, the column of each row's one nonzero, 36:39 its
       sign, 39 1 then (else 0: R0 is read as its nine numbers), 41:44 then for each column
       k the row whose nonzero is there, 44:47 its sign  47:56 A (canonical -> the joint's
-      own body axes, row-major: what a result per the link's own inertial turns by)  56:61 spare
+      own body axes, row-major: what a result per the link's own inertial turns by)  56 1 where R0
+      is exactly the identity (a free flyer's or a ball's turn then needs no product)  57:61 spare
       61 the lead: the slide along u per unit theta (1 prismatic, the pitch in m/rad
       helical, 0 revolute)  62:64 spare.
       A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone; a helical joint
@@ -60,6 +61,7 @@ HEADER, STRIDE = 8, 64
 LEAD = 61  # a record's slide per unit theta (tree_kernel.c's TK_LEAD)
 QCOORD = 40  # a record's configuration index (tree_kernel.c's TK_QCOORD)
 AXES = 47  # a record's A, canonical -> own body axes (joint.h's TK_AXES)
+IDENTITY = 56  # a record's flag: R0 exactly 1 (joint.h's TK_IDENTITY)
 
 
 JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FREE_FLYER: 2,
@@ -120,6 +122,7 @@ def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray
             rows = np.argmax(np.abs(permutation), axis=0)  # column k's nonzero row
             r[41:44], r[44:47] = rows, permutation[rows, np.arange(3)]
         r[5:14] = np.ravel(R0)
+        r[IDENTITY] = float(np.array_equal(R0, np.eye(3)))
         r[14:17] = Ap.T @ np.array(j.translation, dtype=float)
         r[17:20] = (0.0, 0.0, 1.0) if JointKind(j.kind) not in _OWN_AXES else j.axis
         r[20], r[21:24] = j.mass, A.T @ np.array(j.first_moment, dtype=float)
@@ -155,5 +158,5 @@ def joints_of(D: np.ndarray) -> tuple[TreeJoint, ...]:
     return tuple(out)
 
 
-__all__ = ["AXES", "HEADER", "JOINT_CODES", "LEAD", "QCOORD", "STRIDE", "canonical_frame", "describe",
-           "joints_of"]
+__all__ = ["AXES", "HEADER", "IDENTITY", "JOINT_CODES", "LEAD", "QCOORD", "STRIDE",
+           "canonical_frame", "describe", "joints_of"]

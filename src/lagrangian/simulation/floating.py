@@ -1,13 +1,16 @@
 """simulate for a tree whose q and v differ in length, a floating base or ball joints (fixed or
-floating base): y = [q (nq), v (nv)] integrated on the manifold (simulation/tree_state.py).
+floating base): y = [q, v (nv)] integrated on the manifold (simulation/tree_state.py).
 
 q_dot from v by the free flyer's kinematics (position rate R v_lin, quaternion rate
-1/2 q (x) (0, omega)) and each ball's 1/2 q (x) (0, omega) (w first, omega in the body's
-axes), v_dot by the tree's forward dynamics; every quaternion is renormalized after each
-accepted step and at each sample (scipy's stepped loop; the compiled DOP853 loop takes
-q_dot = v only). A stop condition (which may name the base's and the balls' numbers) and the
-joints' position limits end the run as on a fixed base (simulation/simulate.py): the event
-located on the step's dense output. A ball joint has no position limit (MJCF's cone range is
+1/2 q (x) (0, omega)), the base's quaternion renormalized after each accepted step and at each
+sample; each ball joint as q = c (x) exp(d) (q (+) d, MuJoCo's mj_integratePos), the solver
+stepping the turn d (3 numbers, rad) by d_dot = J_r(d)^-1 omega (omega in the body's axes)
+and moving the centre c to the ball when |d| passes tree_state.RECENTRE (restarting there with
+the step size it had), so a ball's quaternion is of norm 1 by construction; v_dot by the
+tree's forward dynamics (scipy's stepped loop; the compiled DOP853 loop takes q_dot = v only).
+A stop condition (which may name the base's and the balls' numbers) and the joints' position
+limits end the run as on a fixed base (simulation/simulate.py): the event located on the
+step's dense output. A ball joint has no position limit (MJCF's cone range is
 refused as the file is read).
 """
 
@@ -29,7 +32,7 @@ from .invariants import cumulative_work
 from .options import SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
 from .simulate import at_limit, beyond_limits, check_start_within, exceeded_limits, urdf_limits
-from .tree_state import TreeState
+from .tree_state import BallCharts, TreeState
 
 
 def configuration_rate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -154,17 +157,23 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     evaluations = [0]
     q_of, v_of = state.q_index, state.v_index
 
+    chart = BallCharts(state, q0)  # each ball's quaternion stepped as a turn from a centre
+    nz = chart.nz
+
     def rhs(t, y, controlled=True):
         evaluations[0] += controlled  # the run's calls: the start's check is not one
-        q, v = state.unit(y[:nq].copy()), y[nq:]
         # a step's stages leave the unit sphere by the step's error: the dynamics read q/|q|
+        q, v = chart.q(y[:nz]), y[nz:]
         tau = zero if control is None or not controlled else control(t, q, v)
         rate = np.empty(nq)
         if state.floating:
             base_rate(q, v, rate)
         rate[q_of] = v[v_of]
-        state.ball_rate(q, v, rate)
-        return np.concatenate([rate, dynamics.forward_dynamics(q, v, tau)])
+        return np.concatenate([chart.rate(y[:nz], v, rate),
+                               dynamics.forward_dynamics(q, v, tau)])
+
+    def full(y):  # [q, v] of the solver's [z, v]: every quaternion of norm 1
+        return np.concatenate([chart.q(y[:nz]), y[nz:]])
 
     solvers = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF,
                "LSODA": LSODA}
@@ -174,7 +183,7 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     solver_class = solvers[step_control.method]
     options = {} if step_control.max_step is None else {"max_step": step_control.max_step}
     grid = np.linspace(t0, t_end, save_at.samples)
-    y0 = np.concatenate([q0, v0])
+    y0 = np.concatenate([chart.z0(q0), v0])
     # a rate that overflows the accelerations at once: refused (simulation/guards.py)
     rates = tuple(n if n not in state.q_names else f"{n}_dot" for n in state.v_names)
     # the robot's own motion: the controller is not called for it (its calls are the run's)
@@ -191,10 +200,6 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     armed = event is not None and event(q0, v0, t0) < 0  # true at the start: not a crossing
     began = time.perf_counter()
 
-    def unit(y):  # a sample (or q) on the unit sphere too; y is dense output's own copy
-        state.unit(y[:nq])
-        return y
-
     try:
         # overflow in a failing step is the run's verdict, not numpy's or the tree's text
         with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -209,37 +214,47 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
                     message = f"the step failed at t = {solver.t:.6g} s: {message_of_step}"
                     break
                 guarded.accepted(solver.t)
-                dense = solver.dense_output()
-                # the accepted state back on the unit sphere: |q| drifts by the step's error only
-                state.unit(solver.y[:nq])
+                step = solver.dense_output()
+                dense = lambda t, step=step: full(step(t))  # noqa: E731 - in q's layout
+                # the base's quaternion back on the unit sphere: |q| drifts by the step's error
+                if state.floating:
+                    solver.y[3:7] /= np.linalg.norm(solver.y[3:7])
+                y_new = full(solver.y)
                 t_stop, hit = solver.t, False
                 if event is not None:
-                    g_new = event(solver.y[:nq], solver.y[nq:], solver.t)
-                    on_sphere = lambda q, v, t: event(unit(q), v, t)  # noqa: E731
+                    g_new = event(y_new[:nq], y_new[nq:], solver.t)
                     touch = None if not armed or g_new >= 0 else touch_inside(
-                        on_sphere, dense, solver.t_old, solver.t, nq)
+                        event, dense, solver.t_old, solver.t, nq)
                     if armed and (g_new >= 0 or touch is not None):  # as the fixed base's loop
                         end = solver.t if touch is None else touch
-                        t_stop = crossing_time(on_sphere, dense, solver.t_old, end, nq)
+                        t_stop = crossing_time(event, dense, solver.t_old, end, nq)
                         hit = True
                     elif g_new < 0:
                         armed = True
                 while k < len(grid) and grid[k] <= t_stop:
-                    samples.append(unit(dense(grid[k])))
+                    samples.append(dense(grid[k]))
                     times.append(float(grid[k]))
                     k += 1
                 if hit:
                     if t_stop > times[-1]:
-                        samples.append(unit(dense(t_stop)))
+                        samples.append(dense(t_stop))
                         times.append(float(t_stop))
                     status, message = RunStatus.STOPPED, f"stop condition met at t = {t_stop:.12g} s"
                     break
                 if solver.status == "finished" and k < len(grid):
-                    samples.append(solver.y.copy())
+                    samples.append(y_new)
                     times.append(float(grid[k]))
                     k += 1
                 if progress is not None:
                     progress(solver.t)
+                restart = solver.y.copy()
+                if solver.status == "running" and chart.recentre(restart):
+                    # the step size carries over: a restart costs one call (the solver's f)
+                    first = min(solver.step_size or np.inf, t_end - solver.t)
+                    solver = solver_class(guarded, solver.t, restart, t_end,
+                                          rtol=step_control.rtol, atol=step_control.atol,
+                                          first_step=first if 0 < first < np.inf else None,
+                                          **options)
     except KeyboardInterrupt:
         reached = t0 if solver is None else solver.t
         status, message = RunStatus.INTERRUPTED, f"interrupted at t = {reached:.6g} s"

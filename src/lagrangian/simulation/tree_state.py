@@ -3,14 +3,16 @@ a floating base's 7 numbers (x y z, then a unit quaternion x y z w) and twist (6
 joint's unit quaternion (w x y z, MuJoCo's order, 4 numbers) and angular velocity in the body's
 own axes (3, rad/s); every other joint one angle (rad) or length (m) and its rate.
 
-q_dot from v: the base's by its kinematics (floating.configuration_rate), a ball's
-1/2 q (x) (0, omega) (the rate of q exp(omega dt)), a joint's its own rate. The joints' numbers
+q_dot from v: the base's by its kinematics (floating.configuration_rate), a joint's its own
+rate; a ball is stepped on the sphere of rotations (BallCharts: q = c (x) exp(d), the solver's
+three numbers d a turn from a centre c). The joints' numbers
 are also read in the model's coordinates (``joints_q``, ``joints_v``: a ball's three Euler
 hinges there read 0), where the position limits, the loads and the stop condition live.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
 import numpy as np
@@ -71,16 +73,6 @@ class TreeState:
         out = np.zeros(self.nv)
         out[self.v_index] = forces[self.model_index]
         return out
-
-    def ball_rate(self, q: np.ndarray, v: np.ndarray, rate: np.ndarray) -> None:
-        """Each ball's quaternion rate 1/2 q (x) (0, omega) into ``rate`` (w first)."""
-        for _, iq, iv in self.balls:
-            w, x, y, z = (float(c) for c in q[iq:iq + 4])
-            wx, wy, wz = (float(c) for c in v[iv:iv + 3])
-            rate[iq] = -0.5 * (x * wx + y * wy + z * wz)
-            rate[iq + 1] = 0.5 * (w * wx + y * wz - z * wy)
-            rate[iq + 2] = 0.5 * (w * wy + z * wx - x * wz)
-            rate[iq + 3] = 0.5 * (w * wz + x * wy - y * wx)
 
     def unit(self, q: np.ndarray) -> np.ndarray:
         """q with the base's and each ball's quaternion scaled to norm 1, in place."""
@@ -177,6 +169,106 @@ class TreeState:
                     f"{QUATERNION_TOLERANCE:g} of 1)", field=field)
 
 
+# A ball's chart moves to where the ball is once it has turned this far from the chart's
+# centre (rad): J_r^-1 stays near 1 (it is singular at 2 pi), the restart is rare.
+RECENTRE = 1.0
+
+
+class BallCharts:
+    """The integrator's configuration z: q with each ball's quaternion q_b replaced by a turn
+    d (3 numbers, rad, in the body's axes) from a centre c, q_b = c (x) exp(d) (q (+) d, as
+    MuJoCo's mj_integratePos), so q_b stays on the unit sphere; d_dot = J_r(d)^-1 omega. The
+    other numbers (the base's seven, the joints') are z's as they are in q."""
+
+    def __init__(self, state: TreeState, q0: np.ndarray):
+        self.state = state
+        starts = {iq: iv for _, iq, iv in state.balls}
+        kept_q, kept_z, self.balls = [], [], []  # balls: (q index, z index, v index)
+        i = z = 0
+        while i < state.nq:
+            if i in starts:
+                self.balls.append((i, z, starts[i]))
+                i, z = i + 4, z + 3
+            else:
+                kept_q.append(i)
+                kept_z.append(z)
+                i, z = i + 1, z + 1
+        self.nz = z
+        self.kept_q, self.kept_z = np.array(kept_q, dtype=int), np.array(kept_z, dtype=int)
+        self.centres = {iq: q0[iq:iq + 4] / np.linalg.norm(q0[iq:iq + 4])
+                        for iq, _, _ in self.balls}
+
+    def z0(self, q0: np.ndarray) -> np.ndarray:
+        """z at the centres (every turn 0)."""
+        z = np.zeros(self.nz)
+        z[self.kept_z] = q0[self.kept_q]
+        return z
+
+    def q(self, z: np.ndarray) -> np.ndarray:
+        """q (nq) of z: each ball c (x) exp(d), the base's quaternion normalized."""
+        if not self.balls:
+            return self.state.unit(np.array(z, dtype=float))
+        q = np.empty(self.state.nq)
+        q[self.kept_q] = z[self.kept_z]
+        for iq, iz, _ in self.balls:
+            q[iq:iq + 4] = _turned(self.centres[iq], z[iz:iz + 3])
+        if self.state.floating:
+            q[3:7] /= np.linalg.norm(q[3:7])
+        return q
+
+    def rate(self, z: np.ndarray, v: np.ndarray, rate: np.ndarray) -> np.ndarray:
+        """z_dot from q_dot (``rate``, its balls' entries unused): each ball's J_r(d)^-1 w."""
+        if not self.balls:
+            return rate
+        out = np.empty(self.nz)
+        out[self.kept_z] = rate[self.kept_q]
+        for _, iz, iv in self.balls:
+            out[iz:iz + 3] = _inverse_right_jacobian(z[iz:iz + 3], v[iv:iv + 3])
+        return out
+
+    def recentre(self, z: np.ndarray) -> bool:
+        """Move every chart to its ball's place (z's turns 0) where one has turned past
+        RECENTRE, in place; whether it did (the solver then starts again from z)."""
+        if not any(np.linalg.norm(z[iz:iz + 3]) > RECENTRE for _, iz, _ in self.balls):
+            return False
+        for iq, iz, _ in self.balls:
+            self.centres[iq] = _turned(self.centres[iq], z[iz:iz + 3])
+            z[iz:iz + 3] = 0.0
+        return True
+
+
+def _turned(c: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """c (x) exp(d), w first, normalized (d in rad, about the body's axes)."""
+    dx, dy, dz = (float(x) for x in d)
+    angle = math.sqrt(dx * dx + dy * dy + dz * dz)
+    half = 0.5 * angle
+    # sin(angle/2)/angle, its series where the angle is tiny (no 0/0)
+    k = 0.5 - angle * angle / 48 if angle < 1e-4 else math.sin(half) / angle
+    ew, ex, ey, ez = math.cos(half), k * dx, k * dy, k * dz
+    aw, ax, ay, az = (float(x) for x in c)
+    out = np.array([aw * ew - ax * ex - ay * ey - az * ez, aw * ex + ax * ew + ay * ez - az * ey,
+                    aw * ey - ax * ez + ay * ew + az * ex, aw * ez + ax * ey - ay * ex + az * ew])
+    return out / math.sqrt(float(out @ out))
+
+
+def _inverse_right_jacobian(d: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """J_r(d)^-1 w = w + 1/2 d x w + (1/a^2 - (1 + cos a)/(2 a sin a)) d x (d x w), a = |d|:
+    the rate of the turn d whose body angular velocity is w (rad/s)."""
+    dx, dy, dz = (float(x) for x in d)
+    wx, wy, wz = (float(x) for x in w)
+    a2 = dx * dx + dy * dy + dz * dz
+    if a2 < 1e-8:  # the factor's series: 1/12 + a^2/720
+        factor = 1.0 / 12 + a2 / 720
+    else:
+        a = math.sqrt(a2)
+        factor = 1.0 / a2 - (1.0 + math.cos(a)) / (2.0 * a * math.sin(a))
+    # written out: numpy's cross costs ten times the rest of a right-hand side here
+    cx, cy, cz = dy * wz - dz * wy, dz * wx - dx * wz, dx * wy - dy * wx
+    return np.array([wx + 0.5 * cx + factor * (dy * cz - dz * cy),
+                     wy + 0.5 * cy + factor * (dz * cx - dx * cz),
+                     wz + 0.5 * cz + factor * (dx * cy - dy * cx)])
+
+
 def drawing_coordinates(model, t: np.ndarray, q: np.ndarray, v: np.ndarray):
     """The model's coordinates and rates (N, n) of a fixed-base run with ball joints (t, q, v at
     its samples): each ball's quaternion as its three Euler hinges <ball>__x, __y, __z
@@ -205,4 +297,5 @@ def drawing_coordinates(model, t: np.ndarray, q: np.ndarray, v: np.ndarray):
     return out_q, out_v
 
 
-__all__ = ["BALL_START", "BASE_START", "TreeState", "drawing_coordinates"]
+__all__ = ["BALL_START", "BASE_START", "RECENTRE", "BallCharts", "TreeState",
+           "drawing_coordinates"]

@@ -234,3 +234,18 @@ def test_a_run_goes_on_from_its_last_state(pendulum):
     assert second.t[0] == 1.0
     np.testing.assert_allclose(second.q[-1], whole.q[-1], rtol=0, atol=1e-8)
     np.testing.assert_allclose(second.q_dot[-1], whole.q_dot[-1], rtol=0, atol=1e-8)
+
+
+@pytest.mark.parametrize("method", ["DOP853", "Radau"])
+def test_a_fast_spin_turns_at_the_closed_forms_rate_through_many_charts(tmp_path_factory,
+                                                                         method):
+    """A body symmetric about the vertical spun at w = 10 rad/s about it: q = (cos wt/2, 0, 0,
+    sin wt/2) at every sample, through about 20 moves of the ball's chart (one per radian)."""
+    text = PENDULUM.format(kind="ball", centre="0 0", inertia="0.04 0.04 0.02 0 0 0")
+    system, _ = _load(tmp_path_factory, text, "spin")
+    run = system.simulate(2.0, initial={"ball_wz": 10.0}, method=method, rtol=1e-11,
+                          atol=1e-11, samples=41)
+    assert run.status == "finished"
+    expected = np.stack([np.cos(5 * run.t), 0 * run.t, 0 * run.t, np.sin(5 * run.t)], -1)
+    np.testing.assert_allclose(run.q, expected, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(run.q_dot, [[0.0, 0.0, 10.0]] * len(run.t), rtol=0, atol=1e-8)

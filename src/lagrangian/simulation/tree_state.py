@@ -52,6 +52,11 @@ class TreeState:
         self.model_index = np.array([p[0] for p in pairs], dtype=int)
         self.q_index = np.array([p[1] for p in pairs], dtype=int)
         self.v_index = np.array([p[2] for p in pairs], dtype=int)
+        placed = {*self.base_q, *self.ball_q, *(self.q_names[i] for i in self.q_index)}
+        stray = [name for name in self.q_names if name not in placed]
+        if stray:  # every number is stepped by one rule: none may be left out
+            raise ModelError(f"simulate cannot place the tree's coordinate '{stray[0]}' among "
+                             "the model's coordinates (not yet)", field="joint")
         # a ball's Euler hinges (MJCF: <ball>__x, __y, __z): the model's, not the state's
         self.hinges = {name: ball for ball, *_ in self.balls
                        for name in coordinates if name.startswith(f"{ball}__")}

@@ -106,6 +106,25 @@ def identical(a: sp.Expr, b: sp.Expr, points: Points) -> bool:
     return all(close(row[0], row[1], points.tolerance) for row in rows)
 
 
+def identical_pairs(pairs: Sequence[tuple[sp.Expr, sp.Expr]], points: Points) -> list[bool]:
+    """a == b identically for each pair: the large ones evaluated together, so that one
+    compiled function shares their common subexpressions (the bicycle's Newton-Euler rows)."""
+    same: list[bool | None] = []
+    large = []
+    for a, b in pairs:
+        difference = sp.expand(a - b) if is_small(a) and is_small(b) else a - b
+        same.append(True if difference == 0 else None)
+        if difference != 0:
+            large += [a, b]
+    rows = points.evaluate(large) if large else []
+    k = 0
+    for i, known in enumerate(same):
+        if known is None:
+            same[i] = all(close(row[k], row[k + 1], points.tolerance) for row in rows)
+            k += 2
+    return [bool(x) for x in same]
+
+
 def constant_in_state(expression: sp.Expr, points: Points) -> bool:
     """True when ``expression`` depends on parameters only (same value across a group)."""
     rows = points.evaluate([expression])

@@ -40,6 +40,7 @@ from ..derivation.equations import EquationsOfMotion
 from ..errors import LagrangianError
 from ..model.expressions import format_expression as fmt
 from ..model.model import Model
+from ..model.structure import complex_values
 from ..model.values import resolve_parameters, resolve_state
 from . import equivalence as eq
 from .crosscheck_report import CoordinateAgreement, CrosscheckReport, Reaction
@@ -111,10 +112,15 @@ def _at_initial_state(eom: EquationsOfMotion, reactions: tuple[Reaction, ...]
     values = {**parameters, **{s: sp.Float(v)
                                for s, v in resolve_state(model).symbol_values(model).items()}}
 
+    def real(numbers: list[complex]) -> list[float]:
+        if any(abs(z.imag) > 1e-12 * max(1.0, abs(z.real)) for z in numbers):
+            raise ValueError("a complex value")
+        return [z.real for z in numbers]
+
     def number(matrix) -> np.ndarray:
-        return np.array([[float(e.xreplace(values)) for e in row]
-                         for row in sp.Matrix(matrix).tolist()], dtype=float).reshape(
-                             sp.Matrix(matrix).shape)
+        matrix = sp.Matrix(matrix)
+        return np.array(real(complex_values(list(matrix), values)),
+                        dtype=float).reshape(matrix.shape)
 
     n, m = len(model.q), eom.multipliers.shape[0]
     try:
@@ -123,7 +129,7 @@ def _at_initial_state(eom: EquationsOfMotion, reactions: tuple[Reaction, ...]
         gamma = number(eom.acceleration_rhs).ravel() if m else np.zeros(0)
         K = np.block([[M, A.T], [A, np.zeros((m, m))]])
         solved = np.linalg.solve(K, np.concatenate([f, gamma]))
-    except (TypeError, ValueError, np.linalg.LinAlgError):
+    except (TypeError, ValueError, ArithmeticError, np.linalg.LinAlgError):
         return reactions  # symbols left (no value) or singular at this state
     if not np.all(np.isfinite(solved)):
         return reactions
@@ -132,8 +138,8 @@ def _at_initial_state(eom: EquationsOfMotion, reactions: tuple[Reaction, ...]
     out = []
     for r in reactions:
         try:
-            numbers = tuple(float(c.xreplace(values)) for c in r.components)
-        except (TypeError, ValueError):
+            numbers = tuple(real(complex_values(r.components, values)))
+        except (TypeError, ValueError, ArithmeticError):
             out.append(r)
             continue
         out.append(Reaction(r.joint, r.labels, r.components, numbers))
@@ -145,8 +151,9 @@ def _compare(eom: EquationsOfMotion, newton_euler: list[sp.Expr],
     """Each E_i against Lagrange's (M q_ddot - f)_i, identically (at random points)."""
     lagrange = list(eom.mass_matrix * eom.acceleration_symbols - eom.forcing)
     agreements = []
-    for c, ne, la in zip(eom.model.coordinates, newton_euler, lagrange, strict=True):
-        same = eq.identical(ne, la, points)
+    verdicts = eq.identical_pairs(list(zip(newton_euler, lagrange, strict=True)), points)
+    for c, ne, la, same in zip(eom.model.coordinates, newton_euler, lagrange, verdicts,
+                               strict=True):
         difference = None if same else fmt(eq.display(sp.expand(ne - la)) if eq.is_small(ne - la)
                                            else ne - la)
         agreements.append(CoordinateAgreement(c.name, same, difference, ne))

@@ -50,4 +50,56 @@ class _Comparison:
         return result
 
 
-__all__ = ["same_structure"]
+
+
+
+def complex_values(expressions, values) -> list[complex]:
+    """Each expression's value (complex) with ``values`` (symbol -> number) put in, each
+    shared node evaluated once: xreplace and evalf walk a large tree as if written out (the
+    bicycle's joint reactions at its initial state). A node of a kind not listed here is
+    evaluated by sympy itself, on the numbers of its arguments."""
+    memo: dict[int, tuple[complex, object]] = {}
+    given = {k: complex(v) for k, v in values.items()}
+
+    def value(x) -> complex:
+        seen = memo.get(id(x))
+        if seen is not None:
+            return seen[0]
+        if x in given:
+            result = given[x]
+        elif x.is_Number or x.is_NumberSymbol or x is sp.I:
+            result = complex(x)
+        elif x.is_Add:
+            result = sum((value(a) for a in x.args), 0j)
+        elif x.is_Mul:
+            result = 1 + 0j
+            for a in x.args:
+                result *= value(a)
+        elif x.is_Pow:
+            base, exponent = value(x.base), value(x.exp)
+            if exponent.imag == 0 and exponent.real == int(exponent.real):
+                result = base ** int(exponent.real)
+            else:
+                result = base ** exponent
+        elif type(x) in _FUNCTIONS and len(x.args) == 1:
+            result = _FUNCTIONS[type(x)](value(x.args[0]))
+        elif not x.args:
+            raise ValueError(f"no value for {x}")
+        else:  # safe: sympy objects (numbers put in), never text
+            result = complex(x.func(*(sp.sympify(value(a)) for a in x.args)).evalf())
+        memo[id(x)] = (result, x)  # x held, so that its id is not reused meanwhile
+        return result
+
+    return [value(sp.sympify(e)) for e in expressions]  # safe: sympy objects, never text
+
+
+def _functions():
+    import cmath
+    return {sp.sin: cmath.sin, sp.cos: cmath.cos, sp.tan: cmath.tan, sp.exp: cmath.exp,
+            sp.log: cmath.log, sp.sinh: cmath.sinh, sp.cosh: cmath.cosh, sp.tanh: cmath.tanh,
+            sp.asin: cmath.asin, sp.acos: cmath.acos, sp.atan: cmath.atan,
+            sp.Abs: lambda z: complex(abs(z))}
+
+
+_FUNCTIONS = _functions()
+__all__ = ["complex_values", "same_structure"]

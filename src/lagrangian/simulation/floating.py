@@ -162,7 +162,8 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
 
     def rhs(t, y, controlled=True):
         evaluations[0] += controlled  # the run's calls: the start's check is not one
-        # a step's stages leave the unit sphere by the step's error: the dynamics read q/|q|
+        # the base's quaternion leaves the unit sphere by a step's error (the dynamics read
+        # q/|q|); a ball's is on it by construction (c exp(d))
         q, v = chart.q(y[:nz]), y[nz:]
         tau = zero if control is None or not controlled else control(t, q, v)
         rate = np.empty(nq)
@@ -178,7 +179,8 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     solvers = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF,
                "LSODA": LSODA}
     if step_control.method not in solvers:  # StepControl knows more than scipy steps here
-        raise InputError(f"a floating base integrates with {', '.join(solvers)}, not "
+        raise InputError(f"a floating base or a ball joint integrates with "
+                         f"{', '.join(solvers)}, not "
                          f"{step_control.method}", field="method")
     solver_class = solvers[step_control.method]
     options = {} if step_control.max_step is None else {"max_step": step_control.max_step}

@@ -240,16 +240,8 @@ static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict
         const double *b = t->body + i * TK_STRIDE;
         const TK_T *w = W + i * TW_STRIDE, *Ic = w + TW_IC, *h = Ic + 1, *J = Ic + 4;
         if (TK_FREE(b)) {  /* the base's six columns [R e_c; 0] and [o x R e_c; R e_c] */
-            const TK_T *Rw = w + TW_RW, *o = w + TW_OW;
             TK_T S[6][6], F[6][6];
-            for (int c = 0; c < 3; c++) {
-                TK_T e[3] = {Rw[c], Rw[3 + c], Rw[6 + c]}, x[3];
-                SP_CROSS(o, e, x);
-                for (int r = 0; r < 3; r++) {
-                    S[c][r] = e[r]; S[c][3 + r] = TK_C(0.0);
-                    S[3 + c][r] = x[r]; S[3 + c][3 + r] = e[r];
-                }
-            }
+            JT_FN(columns)(b, w + TW_RW, w + TW_OW, S);
             for (int c = 0; c < 6; c++) {  /* F = Ic S: [m s_v + s_w x h; h x s_v + J_O s_w] */
                 const TK_T *sv = S[c], *sw = S[c] + 3;
                 TK_T x[3];

@@ -280,7 +280,7 @@ def _c_kernel(eom: EquationsOfMotion, values: dict) -> CKernel:
 _TOLD: set[str] = set()
 
 
-def _tell_once(line: str) -> None:
+def tell_once(line: str) -> None:
     """One plain line on stderr, once per process (not a Python warning: this is advice)."""
     if line not in _TOLD:
         _TOLD.add(line)
@@ -368,7 +368,7 @@ def tell_numpy_fallback(exc: Exception, what_happens: str) -> None:
     from .compiled import CompilerMissing
 
     if isinstance(exc, CompilerMissing):
-        _tell_once(f"note: {str(exc).split(' (')[0]}, so {what_happens}; for the fast path "
+        tell_once(f"note: {str(exc).split(' (')[0]}, so {what_happens}; for the fast path "
                    + ("unset CC or point it at gcc or clang" if "CC=" in str(exc)
                       else "install gcc or clang (or set CC)"))
     elif compiled_was_expected():

@@ -68,12 +68,12 @@ def _engine_takes(tree, kernel: str) -> bool:
     """Whether the compiled backend takes this tree; else (a free flyer below the root, a URDF
     floating joint between two links) one line saying numpy runs instead, naming the joint.
     Asked for by name (kernel "unrolled"), the compiled path refuses it in one line itself."""
-    from ..compile.functions import _tell_once  # the no-compiler note's once-per-process line
+    from ..compile.functions import tell_once  # the no-compiler note's once-per-process line
 
     free = tree.free_joints
     if not free or kernel == "unrolled":
         return True
-    _tell_once(f"note: joint '{free[0].name}' is a floating joint below the root, which "
+    tell_once(f"note: joint '{free[0].name}' is a floating joint below the root, which "
                "the compiled engine does not take yet, so the robot's recursive dynamics run "
                "in numpy, about 1000x slower per call than compiled C")
     return False

@@ -85,7 +85,8 @@ def mode_document(mode: Mode) -> dict[str, Any]:
         "frequency": mode.frequency,
         "frequency_hz": mode.frequency_hz,
         "period": mode.period,
-        "damping_ratio": mode.damping_ratio,
+        # a damping ratio belongs to an oscillation: a real eigenvalue's is null, as the text's '–'
+        "damping_ratio": None if mode.frequency == 0 else mode.damping_ratio,
         "growth_rate": mode.growth_rate,
         "shape": dict(mode.shape),
         **mode_phases(mode),

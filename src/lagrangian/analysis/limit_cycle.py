@@ -22,6 +22,7 @@ TOLERANCE = 1e-10  # |P(x) - x| at convergence, relative to max(1, |x|)
 MAX_ITERATIONS = 40
 WARM_UP = 3  # plain returns of the map before Newton (a start off the section lands on it)
 CYCLE_STEPS = StepControl(rtol=1e-11, atol=1e-11)
+NEUTRAL = 1e-6  # |m| within this of 1 is on the unit circle (to the map's integration tolerance)
 
 
 @dataclass(frozen=True)
@@ -39,25 +40,33 @@ class LimitCycle:
     residual: float
     monodromy: np.ndarray = field(repr=False, compare=False)
 
+    @property
+    def stability(self) -> str:
+        """'stable' (every multiplier inside the unit circle), 'unstable' (one outside), or
+        'neutral' (none outside, one on it: a family of cycles, an elastic ball's bounces)."""
+        if self.stable:
+            return "stable"
+        return "unstable" if any(abs(m) > 1 + NEUTRAL for m in self.multipliers) else "neutral"
+
     def to_dict(self) -> dict:
-        """JSON-ready: state, period, multipliers as [re, im], stable, impact, residual."""
+        """JSON-ready: state, period, multipliers as [re, im], stable, stability, impact,
+        residual."""
         return {"state": dict(self.state), "period": self.period,
                 "multipliers": [[float(m.real), float(m.imag)] for m in self.multipliers],
-                "stable": self.stable, "impact": self.impact, "iterations": self.iterations,
-                "residual": self.residual}
+                "stable": self.stable, "stability": self.stability, "impact": self.impact,
+                "iterations": self.iterations, "residual": self.residual}
 
     def __repr__(self) -> str:
         values = ", ".join(f"{k} = {v:.9g}" for k, v in self.state.items())
         shown = ", ".join(_complex(m) for m in self.multipliers)
-        kind = "stable" if self.stable else "unstable"
-        return (f"LimitCycle(period = {self.period:.9g} s, {kind}; after '{self.impact}': "
+        return (f"LimitCycle(period = {self.period:.9g} s, {self.stability}; after '{self.impact}': "
                 f"{values}; multipliers {shown})")
 
     def _repr_html_(self) -> str:
         rows = "".join(f"<tr><td>{k}</td><td>{v:.9g}</td></tr>" for k, v in self.state.items())
         shown = ", ".join(_complex(m) for m in self.multipliers)
         return (f"<p>Limit cycle through '{self.impact}': period {self.period:.9g} s, "
-                f"{'stable' if self.stable else 'unstable'}; multipliers {shown}</p>"
+                f"{self.stability}; multipliers {shown}</p>"
                 f"<table><tr><th>just after the impact</th><th>value (SI)</th></tr>{rows}"
                 "</table>")
 
@@ -85,11 +94,17 @@ def limit_cycle(eom, substitution, functions, guess=None, *, step_control=CYCLE_
     # what a failure names: the guess given, else the model's initial state (its coordinates)
     field, origin = ("guess", "the guess") if guess is not None else (
         "coordinates", "the model's initial state")
+    returns: list[float] = []  # the plain returns' periods, before Newton
     if guess is None:
         for _ in range(WARM_UP):
-            x, *_ = poincare(x, field=field)
+            x, period, *_ = poincare(x, field=field)
+            returns.append(period)
     for iteration in range(1, max_iterations + 1):
-        x_next, period, name, DP = poincare(x, jacobian=True, field=field)
+        try:
+            x_next, period, name, DP = poincare(x, jacobian=True, field=field)
+        except InputError as exc:
+            _accumulating(returns, exc, field)
+            raise
         residual = x_next - x
         scale = max(1.0, float(np.max(np.abs(x))))
         if float(np.max(np.abs(residual))) < tolerance * scale:
@@ -124,6 +139,18 @@ def _poincare_map(eom, substitution, functions, step_control, maps) -> PoincareM
     # eom and functions kept with it, so their ids stay theirs while the entry lives
     _MAPS[key] = (eom, functions, poincare, maps)
     return poincare
+
+
+def _accumulating(returns: list[float], exc: InputError, field: str) -> None:
+    """Raise the accumulation's own line where each plain return was shorter than the last
+    (a ball with e < 1: the bounces shrink to rest, a point Newton then lands on)."""
+    returns = returns[1:]  # the first runs from the start to an impact: not a return
+    if len(returns) >= 2 and all(b < a for a, b in zip(returns[:-1], returns[1:], strict=True)):
+        shown = " -> ".join(f"{p:.4g}" for p in returns)
+        raise InputError(f"no limit cycle: the impacts accumulate (each return is shorter: "
+                         f"{shown} s), so the motion comes to rest with no periodic orbit "
+                         "(every impact loses energy that nothing gives back)",
+                         field=field) from exc
 
 
 def _bounded(step, scale, largest=0.5):

@@ -41,9 +41,13 @@ def cycle_document(cycle) -> dict:
 
 def cycle_text(cycle, model_name: str) -> str:
     """The cycle in words: period, stability, multipliers and the state after the impact."""
-    kind = "stable" if cycle.stable else "unstable"
-    lines = [f"{model_name}: a {kind} limit cycle through '{cycle.impact}', period "
+    kind = {"stable": "a stable", "unstable": "an unstable",
+            "neutral": "a neutrally stable"}[cycle.stability]
+    lines = [f"{model_name}: {kind} limit cycle through '{cycle.impact}', period "
              f"{cycle.period:.10g} s"]
+    if cycle.stability == "neutral":  # not asymptotically stable: a perturbed start stays off
+        lines.append("  a multiplier on the unit circle: nearby starts keep their own cycles "
+                     "(a family of them), neither drawn back nor driven away")
     lines.append("  multipliers (linearized Poincare map): " + ", ".join(
         _complex(m) + f" (|{abs(m):.6g}|)" for m in cycle.multipliers))
     lines.append("  state just after the impact: " + ", ".join(

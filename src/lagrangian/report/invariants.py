@@ -83,13 +83,14 @@ def limit_cycle_section(c) -> tuple[Markup, str]:
             "not applicable: no cycle found"
     units = {co.name: co.unit or "" for co in model.coordinates}
     units |= {co.velocity.name: f"{co.unit or '1'}/s" for co in model.coordinates}
-    verdict = element("span", "stable" if cycle.stable else "unstable",
+    verdict = element("span", {"neutral": "neutrally stable"}.get(cycle.stability,
+                                                                  cycle.stability),
                       class_="good" if cycle.stable else "bad")
     largest = max((abs(m) for m in cycle.multipliers), default=0.0)
     parts = [paragraph(f"A periodic motion through the impact '{cycle.impact}', period "
                        f"{number(cycle.period, 9)} s: ", verdict,
                        f" (the largest multiplier has |μ| = {number(largest, 6)}, "
-                       f"{'inside' if cycle.stable else 'not inside'} the unit circle). "
+                       f"{_where(cycle)} the unit circle). "
                        "The fixed point of the Poincaré map on the section just after the "
                        "impact, found by Newton's method on the map's exact Jacobian.")]
     parts.append(element("h3", "The fixed point, just after the impact"))
@@ -112,3 +113,8 @@ def _complex(m: complex) -> str:
         return number(m.real, 9)
     sign = "−" if m.imag < 0 else "+"
     return f"{number(m.real, 9)} {sign} {number(abs(m.imag), 9)}i"
+
+
+def _where(cycle) -> str:
+    """Where the largest multiplier lies: inside, on (a neutral cycle) or outside the circle."""
+    return {"stable": "inside", "neutral": "on", "unstable": "outside"}[cycle.stability]

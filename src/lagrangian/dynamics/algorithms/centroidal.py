@@ -9,8 +9,9 @@ velocity of the body point passing the origin): V_k = V_parent + S_k theta_dot_k
 q_ddot = 0 the spatial acceleration A_k = A_parent + (V_k x S_k) theta_dot_k, with
 [v; w] x [v'; w'] = [w x v' + v x w'; w x w']. A point p of the body then has p_dot =
 v_O + w x p and p_ddot = a_O + w_dot x p + w x p_dot. A floating base's free flyer gives six
-columns (S = 1 in the base's axes, world_columns) and, its S moving with its own body, no drift
-of its own (V x V = 0).
+columns (S = 1 in the base's axes, world_columns), a ball joint three (S = 1 on the angular
+rows, its body's axes); each S moves with its own body (d/dt S = V x S), so at q_ddot = 0 the
+drift it adds is V x (S v), as a one-number joint's.
 """
 
 from __future__ import annotations
@@ -33,26 +34,32 @@ def check_reference(reference: str) -> None:
                          f"{', '.join(REFERENCES)}", field="reference")
 
 
-# the joints these walks take: those, and a floating base's free flyer (six columns)
-WALKED = (*ONE_DOF, JointKind.FREE_FLYER)
+# the joints these walks take: those, a free flyer (six columns) and a ball joint (three)
+WALKED = (*ONE_DOF, JointKind.FREE_FLYER, JointKind.SPHERICAL)
 
 
 def require_known_joints(tree, what: str, field: str = "q") -> None:
     """Refused in one line for a tree with a joint these walks do not know (their columns
-    would be miscounted): revolute, prismatic, helical and a floating base's free flyer are
-    known."""
+    would be miscounted): revolute, prismatic, helical, ball and free flyer are known."""
     odd = sorted({str(j.kind) for j in tree.joints if j.kind not in WALKED})
     if odd:
         raise InputError(f"{what} of a tree with a {', '.join(odd)} joint: not yet (revolute, "
-                         "prismatic, helical and a floating base's free flyer only)", field=field)
+                         "prismatic, helical, ball and free flyer only)", field=field)
 
 
 def world_columns(kinematics, k: int, joint, body) -> tuple[np.ndarray, list[int]]:
     """Joint k's motion subspace at the world's origin in world axes, (N, 6, c) with linear
     rows first and the multiplier in, and the c velocity numbers it drives: a free flyer's six
     (S = 1 in its body's axes: [R e; 0] and [p x R e; R e]; the base's, or one below the
-    root), else the joint's one column."""
+    root), a ball joint's three (S = [0; 1] in its body's axes: [o x R e; R e]), else the
+    joint's one column."""
     R, o = body
+    if joint.kind == JointKind.SPHERICAL:
+        S = np.zeros((len(o), 6, 3))
+        S[:, 3:] = R
+        S[:, :3] = np.cross(o[:, :, None], R, axisa=1, axisb=1, axisc=1)
+        first = kinematics.tree.base_nv + kinematics.tree.velocity_index(joint.coordinate)
+        return S, list(range(first, first + 3))
     if joint.kind == JointKind.FREE_FLYER:
         S = np.zeros((len(o), 6, 6))
         S[:, :3, :3] = R

@@ -7,6 +7,8 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
+
+import lagrangian
 from conserved_models import (
     CENTRAL_WELL,
     DAMPED_PAIR,
@@ -15,8 +17,6 @@ from conserved_models import (
     PUSHED_PAIR,
     SPHERICAL_PENDULUM,
 )
-
-import lagrangian
 from lagrangian.errors import ModelError
 
 

@@ -57,7 +57,8 @@ def test_commands_print_the_new_quantities(cli):
 
 @pytest.mark.parametrize(("arguments", "message"), [
     (("--wrench", "fre=1,2,3,0,0,0"), "error: --wrench: no frame named 'fre'; did you mean 'fore'"),
-    (("--wrench", "fore=1,2"), "error: --wrench fore: expected 6 comma-separated values (fx, fy, fz, mx, my, mz), got 2"),
+    (("--wrench", "fore=1,2"),
+     "error: --wrench fore: expected 6 comma-separated values (fx, fy, fz, mx, my, mz), got 2"),
     (("--wrench", "fore"), "error: --wrench: expected NAME=VALUE"),
     (("--armature", "shoulde=0.1"), "error: --armature: no joint named 'shoulde'; did you mean"),
     (("--armature", "shoulder=-1"), "error: --armature shoulder: a rotor inertia is a finite"),

@@ -25,7 +25,7 @@ from ..kinds import InvariantKind
 from ..model.answer import MECHANICS_TABLES, answer_expression, answer_names
 from ..model.expressions import format_expression as fmt
 from . import equivalence as eq
-from .diagnose import Finding
+from .finding import Finding
 
 MECHANICS_CODES = (
     "momentum_wrong", "not_cyclic", "cyclic_missing", "momentum_not_conserved",

@@ -30,6 +30,7 @@ from .diagnose_terms import (
     projection_message,
     sign_question,
 )
+from .finding import Finding
 from .units import answer_unit_issues
 
 CODES = (
@@ -41,23 +42,6 @@ CODES = (
     "potential_term", "dissipation_term", "generalized_force_wrong", "unknown_name",
     "lagrangian_wrong",
 )
-
-
-@dataclass(frozen=True)
-class Finding:
-    """The verdict on one item; ``code`` is None when correct, ``expected`` our version."""
-
-    item: str
-    status: FindingStatus
-    code: str | None
-    message: str
-    expected: str | None = None
-    # what --hints-only says instead of the message: specific, and never the answer (None:
-    # the module's question for the code, check/hints.py)
-    hint: str | None = None
-
-    def __post_init__(self):  # "correct" as written, checked: a misspelled status is an error
-        object.__setattr__(self, "status", FindingStatus(self.status))
 
 
 @dataclass(frozen=True)

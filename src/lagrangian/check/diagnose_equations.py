@@ -25,7 +25,7 @@ from .diagnose_terms import (
 )
 
 if TYPE_CHECKING:
-    from .diagnose import Finding
+    from .finding import Finding
 
 
 class EquationDiagnoses:

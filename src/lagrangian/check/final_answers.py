@@ -22,7 +22,6 @@ from ..model.answer import Answer, answer_expression, answer_names
 from ..model.expressions import format_expression as fmt
 from . import equivalence as eq
 from .conserved_answers import check_mechanics
-from .diagnose import Finding
 from .final_at_rest import AtRest
 from .final_linear import check_linearized, exact_linear
 from .final_reading import (
@@ -35,6 +34,7 @@ from .final_reading import (
     read_final_answers,
 )
 from .final_statics import STATICS_CODES, check_statics
+from .finding import Finding
 
 FINAL_CODES = (
     "matrix_entry", "frequency_wrong", "frequency_count", "damping_ratio_wrong",

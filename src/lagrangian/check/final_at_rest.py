@@ -10,8 +10,8 @@ import math
 import sympy as sp
 
 from ..model.units import generalized_force_unit, is_angle_unit
-from .diagnose import Finding
 from .final_reading import FinalAnswers, Written, agrees
+from .finding import Finding
 
 
 class AtRest:

@@ -21,8 +21,8 @@ from ..errors import ModelError
 from ..model.expressions import as_expression
 from ..model.expressions import format_expression as fmt
 from . import equivalence as eq
-from .diagnose import Finding
 from .final_reading import SLACK, Entry
+from .finding import Finding
 
 EXACT_MAX_COORDINATES = 8  # symbolic Jacobians of f beyond this cost seconds; numbers instead
 EXACT_MAX_OPERATIONS = 4000  # the same for f's size (a URDF arm's f): numbers instead

@@ -11,8 +11,8 @@ import math
 from ..errors import ModelError
 from ..model.expressions import as_expression
 from ..model.units import is_angle_unit
-from .diagnose import Finding
 from .final_reading import FinalAnswers, Written, agrees
+from .finding import Finding
 
 STATICS_CODES = ("statics_value", "statics_load", "statics_potential")
 # The seed module's words (misconceptions table) for the slip that explains a value.

@@ -35,8 +35,13 @@ def test_equilibria_of_a_steady_motion_model_point_to_its_steady_motion(cli):
 
 
 def test_a_modes_sweep_of_the_bicycle_is_self_stable_at_its_steady_speed(cli):
-    pytest.importorskip("dask.distributed")
-    result = cli("sweep", "whipple_bicycle", "--vary", "rR=0.3", "--workers", "1", "--json")
+    distributed = pytest.importorskip("dask.distributed")
+    # a scheduler in this process: its worker uses this process's derivation of the bicycle,
+    # where a worker process of its own derives it again (3-4 s)
+    with distributed.Client(processes=False, n_workers=1, threads_per_worker=1,
+                            dashboard_address=":0") as client:
+        result = cli("sweep", "whipple_bicycle", "--vary", "rR=0.3", "--scheduler",
+                     client.scheduler.address, "--json")
     assert result.code == 0, result.err
     summary = json.loads(result.out)
     assert summary["ok"] == 1 and summary["stable_points"] == 1

@@ -264,7 +264,7 @@ def test_a_robot_without_moving_mass_has_no_centroidal_momentum(tmp_path):
 
 def test_a_joint_of_more_than_one_coordinate_is_refused_not_miscounted(system):
     """The walks give each joint its own columns (one, or a free flyer's six): a tree with a
-    joint they do not know (a spherical one here) is refused in one line, never summed wrong;
+    joint they do not know (a fixed one here, which a tree merges away) is refused in one line, never summed wrong;
     the compiled module takes no joint it has no columns for."""
     from dataclasses import replace
 
@@ -272,17 +272,17 @@ def test_a_joint_of_more_than_one_coordinate_is_refused_not_miscounted(system):
     from lagrangian.dynamics.algorithms.frames import TreeKinematics
 
     tree = system.model.kinematic_tree
-    odd = replace(tree, joints=(replace(tree.joints[0], kind="spherical"), *tree.joints[1:]))
+    odd = replace(tree, joints=(replace(tree.joints[0], kind="fixed"), *tree.joints[1:]))
     kinematics = TreeKinematics.__new__(TreeKinematics)
-    kinematics.tree, kinematics.n = odd, 3
+    kinematics.tree, kinematics.n, kinematics.coordinates = odd, 3, tree.coordinates
     for call in (lambda: kinematics.jacobian_dot_times_v(np.zeros(3), np.zeros(3), "tool"),
                  lambda: kinematics.centroidal_momentum_matrix(np.zeros(3)),
                  lambda: coriolis_matrix(kinematics, np.zeros(3), np.zeros(3))):
-        with pytest.raises(lagrangian.InputError, match="spherical joint: not yet"):
+        with pytest.raises(lagrangian.InputError, match="fixed joint: not yet"):
             call()
     from lagrangian.dynamics.algorithms.wrenches import wrench_forces
 
-    with pytest.raises(lagrangian.InputError, match="spherical joint: not yet"):
+    with pytest.raises(lagrangian.InputError, match="fixed joint: not yet"):
         wrench_forces(kinematics, np.zeros(3), {"tool": np.zeros(6)})
     from lagrangian.dynamics.engine.reach_c import reach_module
 

@@ -1,9 +1,9 @@
 """A URDF floating joint between two links: a free flyer inside the tree, as Pinocchio's
 buildModelFromUrdf reads it (JointModelFreeFlyer: q = x y z in the parent's joint frame, then
 qx qy qz qw; v = the child's linear then angular velocity relative to its parent, in its own
-axes). The oracle is Pinocchio at random states, compared by joint name; the numpy reference
-runs it (the compiled engine does not take it yet, and every engine-only path says so in one
-line naming the joint)."""
+axes). The oracle is Pinocchio at random states, compared by joint name, and the numpy
+reference; the compiled engine runs it (joint.h's kind 5), and every path that does not take it
+yet says so in one line naming the joint."""
 
 from __future__ import annotations
 
@@ -178,7 +178,7 @@ def test_the_layout_names_and_the_symbolic_bodies(robots):
                                      "grip_qz", "grip_qw")
     assert ours.velocity_names[2:8] == ("grip_vx", "grip_vy", "grip_vz", "grip_wx", "grip_wy",
                                         "grip_wz")
-    assert (ours.nq, ours.nv, ours.backend) == (10, 9, "recursive-numpy")
+    assert (ours.nq, ours.nv, ours.backend) == (10, 9, "recursive")
     model = ours.model
     assert [c.name for c in model.coordinates][2:8] == ["grip_x", "grip_y", "grip_z",
                                                         "grip_roll", "grip_pitch", "grip_yaw"]
@@ -203,16 +203,36 @@ def test_the_layout_names_and_the_symbolic_bodies(robots):
     np.testing.assert_allclose(origin, placement[:3, 3], atol=1e-12)
 
 
-def test_numpy_is_chosen_up_front_with_one_notice(robots, capsys):
-    from lagrangian.compile import functions
-
-    for line in [x for x in functions._TOLD if "floating joint below the root" in x]:
-        functions._TOLD.discard(line)  # said once per process: said again here
-    _, _, path = robots["arm"]
-    dynamics = lagrangian.load(path).dynamics()
-    lines = [x for x in capsys.readouterr().err.splitlines() if "floating joint" in x]
-    assert len(lines) == 1 and "joint 'grip'" in lines[0] and "numpy" in lines[0]
-    assert dynamics.backend == "recursive-numpy"
+@pytest.mark.parametrize("key", ["arm", "pod floating"])
+def test_the_engine_agrees_with_the_numpy_reference(robots, key, capsys):
+    """The compiled engine is chosen with no notice, and its M, ID, FD, T, V, frames,
+    Jacobians and centre of mass equal the numpy reference's to 1e-9, batched and per state."""
+    ours, model, path = robots[key]
+    reference = lagrangian.load(path, floating_base=key != "arm").dynamics(backend="numpy")
+    assert ours.backend == "recursive" and reference.backend == "recursive-numpy"
+    assert "floating joint" not in capsys.readouterr().err
+    iq, iv = _orders(ours, model)
+    Q, V, A = _states(model, 6, seed=7)
+    q, v, a = np.empty_like(Q), np.empty_like(V), np.empty_like(A)
+    q[:, iq], v[:, iv], a[:, iv] = Q, V, A
+    calls = {"M": lambda d, *x: d.mass_matrix(x[0]),
+             "ID": lambda d, *x: d.inverse_dynamics(*x),
+             "FD": lambda d, *x: d.forward_dynamics(*x),
+             "T": lambda d, *x: d.kinetic_energy(x[0], x[1]),
+             "V": lambda d, *x: d.potential_energy(x[0]),
+             "com": lambda d, *x: d.center_of_mass(x[0]),
+             "J_com": lambda d, *x: d.center_of_mass_jacobian(x[0])}
+    for frame in ours.frames:
+        calls[frame] = lambda d, *x, f=frame: d.placement(x[0], f)
+        calls["J " + frame] = lambda d, *x, f=frame: d.jacobian(x[0], f)
+        calls["J local " + frame] = lambda d, *x, f=frame: d.jacobian(x[0], f, "local")
+    for name, call in calls.items():
+        expected = call(reference, q, v, a)
+        scale = max(1.0, float(np.abs(expected).max()))
+        np.testing.assert_allclose(call(ours, q, v, a), expected, atol=1e-9 * scale,
+                                   err_msg=name)
+        np.testing.assert_allclose(call(ours, q[2], v[2], a[2]), expected[2],
+                                   atol=1e-9 * scale, err_msg=name)
 
 
 def test_engine_only_paths_refuse_in_one_line(robots):
@@ -220,7 +240,6 @@ def test_engine_only_paths_refuse_in_one_line(robots):
     system = lagrangian.load(path)
     q, v = np.r_[np.zeros(8), 1.0, 0.0], np.zeros(9)
     calls = {"kernel='unrolled'": lambda: system.dynamics(kernel="unrolled"),
-             "backend='c'": lambda: system.dynamics(backend="c"),
              "derivatives": lambda: ours.forward_dynamics_derivatives(q, v, v),
              "regressor": lambda: ours.regressor(q, v, v),
              "standalone C export": lambda: system.to_c("carrier"),

@@ -14,7 +14,6 @@ from ..compile.functions import NumericSystem
 from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, InputError
 from ..model.model import Model
-from ..model.tree import refuse_free_joints
 from .joint_space import Dynamics
 
 
@@ -44,14 +43,11 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
         return None
     if inertials:
         tree = inertials
-    if backend == "c" and kernel != "unrolled":  # the engine asked for by name
-        refuse_free_joints(tree, "the compiled engine (backend='c')")
     # one engine for every tree and variant (a link's inertial, a payload, a floating base:
     # run-time numbers, no build); the per-tree unrolled module only when asked for, about 2x
     # faster per call after a compile of seconds per tree (docs/benchmarks.md)
     chosen = "unrolled" if kernel == "unrolled" else "compact"
-    if backend == "numpy" or (backend == "auto" and not _engine_takes(tree, kernel)) \
-            or (backend == "auto" and not _compiled_ready(chosen)):
+    if backend == "numpy" or (backend == "auto" and not _compiled_ready(chosen)):
         chosen = "numpy"
     dynamics = TreeDynamics(model, tree, parameters, kernel=chosen)
     if tree.floating_base or dynamics.regular():
@@ -62,21 +58,6 @@ def recursive_dynamics(model: Model, parameters: Mapping[str, float] | None = No
                          "(a joint that moves no mass)", field="parameters")
     _refuse_massless_joints(model, dynamics)
     return None
-
-
-def _engine_takes(tree, kernel: str) -> bool:
-    """Whether the compiled backend takes this tree; else (a free flyer below the root, a URDF
-    floating joint between two links) one line saying numpy runs instead, naming the joint.
-    Asked for by name (kernel "unrolled"), the compiled path refuses it in one line itself."""
-    from ..compile.functions import tell_once  # the no-compiler note's once-per-process line
-
-    free = tree.free_joints
-    if not free or kernel == "unrolled":
-        return True
-    tell_once(f"note: joint '{free[0].name}' is a floating joint below the root, which "
-               "the compiled engine does not take yet, so the robot's recursive dynamics run "
-               "in numpy, about 1000x slower per call than compiled C")
-    return False
 
 
 def _compiled_ready(kernel: str) -> bool:

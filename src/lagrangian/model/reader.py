@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import errno
+import functools
 import os
 import re
 import stat
@@ -145,6 +146,14 @@ def read_model(path: str | Path) -> Model:
 
 def parse_model(text: str, *, source: str = "<model>") -> Model:
     """Parse the text of a TOML model file."""
+    return _parsed(text, source)
+
+
+@functools.lru_cache(maxsize=32)
+def _parsed(text: str, source: str) -> Model:
+    # by content: a Model is immutable, and one text read twice (a notebook cell run again, a
+    # second command in one process) is built once (the bicycle's rolling contacts take 1 s);
+    # a refused text raises again, never cached
     return model_from_mapping(load_toml(text, source), source=source)
 
 

@@ -8,7 +8,11 @@
    Kinds: 0 revolute, 1 prismatic, 2 free flyer (body 0 only: q[0:3] its origin, q[3:7] its
    quaternion x y z w; v[0:6] its twist in its own axes, linear then angular), 3 helical (turns
    and slides by its lead), 4 ball (q[QCOORD:QCOORD + 4] a unit quaternion w x y z, MuJoCo's;
-   v[COORD:COORD + 3] the angular velocity in the body's axes). Others: theta = k q[c] + offset,
+   v[COORD:COORD + 3] the angular velocity in the body's axes), 5 a free flyer below the root
+   (a URDF floating joint between two links, Pinocchio's JointModelFreeFlyer anywhere:
+   q[QCOORD:QCOORD + 7] x y z in the parent's joint frame, then its quaternion x y z w, R = R0
+   R(q), p = t0 + R0 (x, y, z); v[COORD:COORD + 6] its linear then angular velocity relative
+   to its parent, in its own axes). Others: theta = k q[c] + offset,
    R = R0 Rot(z, theta), p = t0 + R0 e_z lead theta (lead 1 prismatic, the pitch helical).
 
    The part before JT_CORE_BEGIN is read once; the part after it is emitted in each module's
@@ -21,7 +25,7 @@
 /* a body record's fields */
 #define TK_PARENT 0
 #define TK_KIND 1       /* 0 revolute, 1 prismatic, 2 free flyer (body 0 only), 3 helical,
-                           4 ball */
+                           4 ball, 5 free flyer below the root */
 #define TK_COORD 2      /* its (first) number in v, after the base's */
 #define TK_MULT 3
 #define TK_OFFSET 4
@@ -44,10 +48,12 @@
 #define TK_SLIDES(b) ((b)[TK_KIND] == 1.0 || (b)[TK_KIND] == 3.0)
 #define TK_FREE(b) ((b)[TK_KIND] == 2.0)
 #define TK_BALL(b) ((b)[TK_KIND] == 4.0)
+#define TK_FLYER(b) ((b)[TK_KIND] == 5.0)
 
 typedef struct {
     int nb, n, mimic, fb, bq, bv, nq, nv;  /* bq, bv: the base's numbers before the joints' */
     int balls;  /* ball joints: each one more number in q than in v */
+    int flyers;  /* free flyers below the root: each 7 numbers in q, 6 in v */
     double qtol;
     const double *g, *tau0, *body;
 } tk_tree;
@@ -70,12 +76,14 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
     if (t->nb < 1 || t->n < (t->fb ? 0 : 1)
         || size != TK_HEADER + t->n + (Py_ssize_t)t->nb * TK_STRIDE)
         return -1;
-    t->balls = 0;
-    for (int i = 0; i < t->nb; i++)
+    t->balls = t->flyers = 0;
+    for (int i = 0; i < t->nb; i++) {
         if (TK_BALL(t->body + i * TK_STRIDE)) t->balls++;
-    t->nq = t->bq + t->n + t->balls;
+        if (TK_FLYER(t->body + i * TK_STRIDE)) t->flyers++;
+    }
+    t->nq = t->bq + t->n + t->balls + t->flyers;
     t->nv = t->bv + t->n;
-    if (t->balls) t->mimic = 1;  /* forward dynamics by Cholesky of M */
+    if (t->balls || t->flyers) t->mimic = 1;  /* forward dynamics by Cholesky of M */
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
         if (!(b[TK_PARENT] >= -1 && b[TK_PARENT] < i))
@@ -84,10 +92,14 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
             if (!TK_FREE(b) || b[TK_PARENT] != -1) return -1;
         } else if (TK_BALL(b)) {
             if (!(b[TK_COORD] >= 0 && b[TK_COORD] + 3 <= t->n && b[TK_QCOORD] >= 0
-                  && b[TK_QCOORD] + 4 <= t->n + t->balls))
+                  && b[TK_QCOORD] + 4 <= t->nq - t->bq))
+                return -1;
+        } else if (TK_FLYER(b)) {
+            if (!(b[TK_COORD] >= 0 && b[TK_COORD] + 6 <= t->n && b[TK_QCOORD] >= 0
+                  && b[TK_QCOORD] + 7 <= t->nq - t->bq))
                 return -1;
         } else if (!(b[TK_COORD] >= 0 && b[TK_COORD] < t->n)
-                   || !(b[TK_QCOORD] >= 0 && b[TK_QCOORD] < t->n + t->balls)
+                   || !(b[TK_QCOORD] >= 0 && b[TK_QCOORD] < t->nq - t->bq)
                    || !(TK_TURNS(b) || TK_SLIDES(b))) {
             return -1;
         }
@@ -133,14 +145,16 @@ static inline __attribute__((always_inline)) void JT_FN(place)(const tk_tree *t,
                                                                JT_T *sin_)
 {
     const double *R0 = b + TK_R0;
-    if (TK_FREE(b)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
+    if (TK_FREE(b) || TK_FLYER(b)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
+        /* the base's numbers first in q, or one below the root's among the joints' */
+        const JT_T *x = TK_FREE(b) ? q : q + t->bq + (int)b[TK_QCOORD];
         if (b[TK_IDENTITY] != 0.0) {  /* the usual free flyer, at the root link's own axes */
-            JT_FN(turned)(NULL, q[3], q[4], q[5], q[6], R);
-            for (int r = 0; r < 3; r++) p[r] = q[r] + b[TK_T0 + r];
+            JT_FN(turned)(NULL, x[3], x[4], x[5], x[6], R);
+            for (int r = 0; r < 3; r++) p[r] = x[r] + b[TK_T0 + r];
         } else {
-            JT_FN(turned)(R0, q[3], q[4], q[5], q[6], R);
+            JT_FN(turned)(R0, x[3], x[4], x[5], x[6], R);
             for (int r = 0; r < 3; r++)
-                p[r] = R0[3 * r] * q[0] + R0[3 * r + 1] * q[1] + R0[3 * r + 2] * q[2];
+                p[r] = R0[3 * r] * x[0] + R0[3 * r + 1] * x[1] + R0[3 * r + 2] * x[2];
             for (int r = 0; r < 3; r++) p[r] += b[TK_T0 + r];
         }
         *cos_ = JT_C(1.0);
@@ -266,13 +280,13 @@ static inline __attribute__((always_inline)) void JT_FN(placed)(const tk_tree *t
 
 /* Body b's joint's motion per unit rate at the world's origin in world axes, [s_v; s_w] a
    column, from its rotation R (body -> world) and origin o: a free flyer's six (its twist in
-   its own axes: [R e_c; 0], then [o x R e_c; R e_c]), a ball's three (its angular velocity in
+   its own axes: [R e_c; 0], then [o x R e_c; R e_c]; one below the root's the same), a ball's three (its angular velocity in
    its own axes: [o x R e_c; R e_c]), else one about the world axis a = R e_z: [o x a (+ lead
    a, helical); a] where it turns, [a; 0] where it only slides; their count. */
 static inline __attribute__((always_inline)) int JT_FN(columns)(const double *b, const JT_T *R,
                                                                 const JT_T *o, JT_T (*S)[6])
 {
-    if (TK_FREE(b)) {
+    if (TK_FREE(b) || TK_FLYER(b)) {
         for (int c = 0; c < 3; c++) {
             JT_T w[3] = {R[c], R[3 + c], R[6 + c]}, v[3];
             SP_CROSS(o, w, v);

@@ -9,7 +9,9 @@
    tau nv = 6 + n (its twist in its own axes, linear then angular, then v[6 + c]). A ball joint
    (kind 4, spherical.py) turns its body by the unit quaternion q[QCOORD:QCOORD + 4] (w x y z,
    MuJoCo's), R = R0 R(q), p = t0, at the angular velocity v[COORD:COORD + 3] in the body's axes:
-   a coordinate's place in q (QCOORD) and in v (COORD) then differ, and n counts v's. */
+   a coordinate's place in q (QCOORD) and in v (COORD) then differ, and n counts v's. A free
+   flyer below the root (kind 5) moves its body by q[QCOORD:QCOORD + 7] (x y z, quaternion x y
+   z w) at the twist v[COORD:COORD + 6] (linear, angular) relative to its parent, in its axes. */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
@@ -119,6 +121,24 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
             }
             if (a)
                 for (int r = 0; r < 3; r++) dom[r] += a[t->bv + c + r];
+        } else if (TK_FLYER(b)) {  /* its twist (v_r, w_r) added, body axes */
+            if (v) {  /* a += 2 w x v_r + w_r x v_r, dw += w x w_r, w += w_r */
+                const TK_T *vr = v + t->bv + c, *wr = vr + 3;
+                TK_T z[3];
+                SP_CROSS(om, vr, x);
+                SP_CROSS(wr, vr, y);
+                SP_CROSS(om, wr, z);
+                for (int r = 0; r < 3; r++) {
+                    acc[r] += 2.0 * x[r] + y[r];
+                    dom[r] += z[r];
+                    om[r] += wr[r];
+                }
+            }
+            if (a)
+                for (int r = 0; r < 3; r++) {
+                    acc[r] += a[t->bv + c + r];
+                    dom[r] += a[t->bv + c + 3 + r];
+                }
         } else if (v && !TK_FREE(b)) {  /* the joint's rate about z: w += S w, the Coriolis terms */
             const TK_T rate = v[t->bv + c], wz = rate * sw, vz = rate * sv;
             dom[0] += om[1] * wz;  /* w x (0, 0, wz) */
@@ -127,7 +147,7 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
             acc[0] += 2.0 * (om[1] * vz);
             acc[1] -= 2.0 * (om[0] * vz);
         }
-        if (a && !TK_FREE(b) && !TK_BALL(b)) {
+        if (a && !TK_FREE(b) && !TK_BALL(b) && !TK_FLYER(b)) {
             const TK_T accel = a[t->bv + c];
             dom[2] += accel * sw;
             acc[2] += accel * sv;
@@ -156,6 +176,11 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
         }
         if (TK_BALL(b)) {  /* the moment on the body about its joint, its axes */
             for (int r = 0; r < 3; r++) tau[t->bv + (int)b[TK_COORD] + r] += nn[r];
+        } else if (TK_FLYER(b)) {  /* the wrench on the body, force then moment, its axes */
+            for (int r = 0; r < 3; r++) {
+                tau[t->bv + (int)b[TK_COORD] + r] += f[r];
+                tau[t->bv + (int)b[TK_COORD] + 3 + r] += nn[r];
+            }
         } else {
             tk_subspace(b, &sw, &sv);
             tau[t->bv + (int)b[TK_COORD]] += sw * nn[2] + sv * f[2];
@@ -174,6 +199,9 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
 /* a ball joint's columns of M and S_c . f (tree_kernel_forward.c) */
 static inline TK_T TK_FN(ball_dot)(const TK_T *w, int c, const TK_T *f);
 static void TK_FN(ball_columns)(const tk_tree *t, const TK_T *W, int i, TK_T *M);
+/* a free flyer's below the root six columns of M, and S_k^T f at an ancestor's six */
+static void TK_FN(flyer_columns)(const tk_tree *t, const TK_T *W, int i, TK_T *M);
+static inline void TK_FN(flyer_dots)(const TK_T *w, const TK_T *f, TK_T *e);
 
 /* M by the composite-rigid-body algorithm in world axes about the world's origin (row-major
    n x n): each body's inertia (mass m, first moment h, rotational inertia J_O) moved there once,
@@ -220,7 +248,7 @@ static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict
         }
         /* the joint's motion per unit rate at the world's origin: s_w = Rw e_z sw,
            s_v = Rw e_z sv + o x s_w */
-        if (!TK_FREE(b) && !TK_BALL(b)) {
+        if (!TK_FREE(b) && !TK_BALL(b) && !TK_FLYER(b)) {
             double sw, sv;
             TK_T *Sw = w + TW_SW, *Sv = w + TW_SV, x[3];
             tk_subspace(b, &sw, &sv);
@@ -264,6 +292,10 @@ static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict
             TK_FN(ball_columns)(t, W, i, M);
             continue;
         }
+        if (TK_FLYER(b)) {
+            TK_FN(flyer_columns)(t, W, i, M);
+            continue;
+        }
         const TK_T *Sw = w + TW_SW, *Sv = w + TW_SV;
         TK_T f[6], x[3];
         SP_CROSS(Sw, h, x);  /* I_c(i) S_i */
@@ -296,6 +328,16 @@ static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict
                     const TK_T e = TK_FN(ball_dot)(wk, c, f);
                     M[ci * n + ck + c] += e;
                     M[(ck + c) * n + ci] += e;
+                }
+                continue;
+            }
+            if (TK_FLYER(bk)) {  /* a free flyer's six columns: S_k^T f */
+                const int ck = t->bv + (int)bk[TK_COORD];
+                TK_T e[6];
+                TK_FN(flyer_dots)(wk, f, e);
+                for (int c = 0; c < 6; c++) {
+                    M[ci * n + ck + c] += e[c];
+                    M[(ck + c) * n + ci] += e[c];
                 }
                 continue;
             }
@@ -333,6 +375,9 @@ static TK_T TK_FN(kinetic)(const tk_tree *t, const TK_T *restrict q, const TK_T 
         }
         if (TK_BALL(b)) {
             for (int r = 0; r < 3; r++) om[r] += v[t->bv + (int)b[TK_COORD] + r];
+        } else if (TK_FLYER(b)) {  /* its twist, linear then angular, in its axes */
+            const TK_T *vr = v + t->bv + (int)b[TK_COORD];
+            for (int r = 0; r < 3; r++) { vel[r] += vr[r]; om[r] += vr[3 + r]; }
         } else if (!TK_FREE(b)) {
             const TK_T rate = v[t->bv + (int)b[TK_COORD]];
             om[2] += rate * sw;

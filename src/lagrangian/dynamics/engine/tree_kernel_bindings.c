@@ -221,8 +221,9 @@ static int tk_unit_balls(const tk_tree *t, const double *q, npy_intp states, npy
         if (!finite) continue;
         for (int i = 0; i < t->nb; i++) {
             const double *b = t->body + i * TK_STRIDE;
-            if (!TK_BALL(b)) continue;
-            const double *e = x + t->bq + (int)b[TK_QCOORD];
+            if (!TK_BALL(b) && !TK_FLYER(b)) continue;
+            /* a ball's w x y z, a flyer's x y z w after its x, y, z */
+            const double *e = x + t->bq + (int)b[TK_QCOORD] + (TK_FLYER(b) ? 3 : 0);
             const double norm = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
             if (!(fabs(norm - 1.0) <= t->qtol)) return 0;
         }
@@ -273,7 +274,7 @@ static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
         PyErr_Clear();  /* the front names the state and its norm */
         goto slow;
     }
-    if (tree.balls && !tk_unit_balls(&tree, (const double *)PyArray_DATA(in[0]),
+    if ((tree.balls || tree.flyers) && !tk_unit_balls(&tree, (const double *)PyArray_DATA(in[0]),
                                      step[0] ? count : 1, step[0]))
         goto slow;
 #undef TK_WIDTH

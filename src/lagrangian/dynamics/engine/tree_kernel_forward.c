@@ -1,7 +1,8 @@
 /* The compact tree kernel's forward dynamics, after tree_kernel.c (its records, scratch and
    helpers): the articulated-body algorithm, a floating base's acceleration, and M^-1 (tau - b)
    by Cholesky where mimic joints drive several bodies from one coordinate or a ball joint
-   turns a body, and a ball joint's three columns of M. Units SI. */
+   turns a body, and a ball joint's three columns of M, a free flyer's below the root six.
+   Units SI. */
 
 /* The floating base's spatial acceleration a = IA^-1 (tau - pA) (angular, linear; S = 1, its
    articulated inertia IA after every child's share, the ground's upward g in a: what its
@@ -317,9 +318,82 @@ static void TK_FN(ball_columns)(const tk_tree *t, const TK_T *W, int i, TK_T *M)
                 }
                 continue;
             }
+            if (TK_FLYER(bk)) {
+                TK_T e[6];
+                TK_FN(flyer_dots)(wk, f, e);
+                for (int r = 0; r < 6; r++) {
+                    M[(ci + c) * n + ck + r] += e[r];
+                    M[(ck + r) * n + ci + c] += e[r];
+                }
+                continue;
+            }
             const TK_T e = SP_DOT(wk + TW_SV, f) + SP_DOT(wk + TW_SW, f + 3);
             M[(ci + c) * n + ck] += e;
             M[ck * n + ci + c] += e;
+        }
+    }
+}
+
+/* S_k^T f for the six columns of a free flyer below the root (body axes R e_c at its origin o
+   in the world: [R e_c; 0] linear, [o x R e_c; R e_c] angular) and a wrench f (force, moment)
+   at the world's origin. */
+static inline void TK_FN(flyer_dots)(const TK_T *w, const TK_T *f, TK_T *e)
+{
+    const TK_T *Rw = w + TW_RW, *o = w + TW_OW;
+    for (int c = 0; c < 3; c++) {
+        TK_T u[3] = {Rw[c], Rw[3 + c], Rw[6 + c]}, y[3];
+        SP_CROSS(o, u, y);
+        e[c] = SP_DOT(u, f);
+        e[3 + c] = SP_DOT(y, f) + SP_DOT(u, f + 3);
+    }
+}
+
+/* A free flyer's six columns of M below the root (body i, its composite inertia Ic in W):
+   F_c = Ic S_c, then S_k^T F_c for the flyer itself and each joint k from its parent to the
+   root. */
+static void TK_FN(flyer_columns)(const tk_tree *t, const TK_T *W, int i, TK_T *M)
+{
+    const int n = t->nv;
+    const double *b = t->body + i * TK_STRIDE;
+    const TK_T *w = W + i * TW_STRIDE, *Ic = w + TW_IC, *h = Ic + 1, *J = Ic + 4;
+    const int ci = t->bv + (int)b[TK_COORD];
+    TK_T S[6][6];
+    JT_FN(columns)(b, w + TW_RW, w + TW_OW, S);
+    for (int c = 0; c < 6; c++) {
+        const TK_T *sv = S[c], *sw = S[c] + 3;
+        TK_T f[6], x[3], e[6];
+        SP_CROSS(sw, h, x);  /* Ic S: [m s_v + s_w x h; h x s_v + J_O s_w] */
+        for (int r = 0; r < 3; r++) f[r] = Ic[0] * sv[r] + x[r];
+        SP_CROSS(h, sv, x);
+        f[3] = x[0] + J[0] * sw[0] + J[3] * sw[1] + J[4] * sw[2];
+        f[4] = x[1] + J[3] * sw[0] + J[1] * sw[1] + J[5] * sw[2];
+        f[5] = x[2] + J[4] * sw[0] + J[5] * sw[1] + J[2] * sw[2];
+        TK_FN(flyer_dots)(w, f, e);
+        for (int r = 0; r < 6; r++) M[(ci + r) * n + ci + c] += e[r];
+        for (int k = (int)b[TK_PARENT]; k >= 0; k = (int)t->body[k * TK_STRIDE + TK_PARENT]) {
+            const double *bk = t->body + k * TK_STRIDE;
+            const TK_T *wk = W + k * TW_STRIDE;
+            const int ck = TK_FREE(bk) ? 0 : t->bv + (int)bk[TK_COORD];
+            if (TK_FREE(bk) || TK_FLYER(bk)) {  /* the base's six columns, or a flyer's */
+                TK_FN(flyer_dots)(wk, f, e);
+                for (int r = 0; r < 6; r++) {
+                    M[(ci + c) * n + ck + r] += e[r];
+                    M[(ck + r) * n + ci + c] += e[r];
+                }
+                if (TK_FREE(bk)) break;
+                continue;
+            }
+            if (TK_BALL(bk)) {
+                for (int r = 0; r < 3; r++) {
+                    const TK_T d = TK_FN(ball_dot)(wk, r, f);
+                    M[(ci + c) * n + ck + r] += d;
+                    M[(ck + r) * n + ci + c] += d;
+                }
+                continue;
+            }
+            const TK_T d = SP_DOT(wk + TW_SV, f) + SP_DOT(wk + TW_SW, f + 3);
+            M[(ci + c) * n + ck] += d;
+            M[ck * n + ci + c] += d;
         }
     }
 }

@@ -27,7 +27,9 @@ The description ``D`` (float64, contiguous), built by ``describe``:
       is exactly the identity (a free flyer's or a ball's turn then needs no product)  57:61 spare
       61 the lead: the slide along u per unit theta (1 prismatic, the pitch in m/rad
       helical, 0 revolute)  62:64 spare.
-      A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone; a helical joint
+      A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone; one below the
+      root (code 5, FLYER: a URDF floating joint between two links) reads R0, t0, the inertia
+      and its q (x y z qx qy qz qw) and v (linear, angular) offsets; a helical joint
       (code 3) turns as a revolute one and slides by its lead; a ball joint (code 4,
       spherical.py) reads R0, t0, the inertia and its q (w x y z) and v offsets, in its own
       axes (no canonical turn: its velocity is in the child's axes).
@@ -62,6 +64,8 @@ LEAD = 61  # a record's slide per unit theta (tree_kernel.c's TK_LEAD)
 QCOORD = 40  # a record's configuration index (tree_kernel.c's TK_QCOORD)
 AXES = 47  # a record's A, canonical -> own body axes (joint.h's TK_AXES)
 IDENTITY = 56  # a record's flag: R0 exactly 1 (joint.h's TK_IDENTITY)
+FLYER = 5  # a free flyer below the root's code (joint.h's TK_FLYER): JointKind.FREE_FLYER's own
+# code 2 is the floating base's, whose numbers are the base's, not the joints'
 
 
 JOINT_CODES = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FREE_FLYER: 2,
@@ -102,20 +106,21 @@ def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray
     D[0], D[1] = nb, n
     D[2:5] = float(parameters.get(tree.gravity_parameter, 0.0)) * np.array(tree.gravity_direction)
     drives = np.bincount([j.coordinate for j in tree.joints if j.coordinate >= 0], minlength=n)
-    D[5] = float(not np.all(drives == 1) or bool(tree.spherical))
+    D[5] = float(not np.all(drives == 1) or bool(tree.quaternion_joints))
     D[6], D[7] = float(tree.floating_base), QUATERNION_TOLERANCE
     D[HEADER:HEADER + n] = [float(parameters.get(a, 0.0)) for a in tree.actuators]  # None: 0
     frames = [canonical_frame(j) for j in tree.joints]
     for i, j in enumerate(tree.joints):
         r = D[HEADER + n + i * STRIDE:HEADER + n + (i + 1) * STRIDE]
         A, Ap = frames[i], (frames[j.parent] if j.parent >= 0 else np.eye(3))
-        r[0], r[1] = j.parent, JOINT_CODES[JointKind(j.kind)]
+        inner = JointKind(j.kind) == JointKind.FREE_FLYER and j.coordinate >= 0
+        r[0], r[1] = j.parent, FLYER if inner else JOINT_CODES[JointKind(j.kind)]
         r[2] = tree.velocity_index(j.coordinate) if j.coordinate >= 0 else 0
         r[QCOORD] = max(j.coordinate, 0)
         r[3], r[4] = j.multiplier, j.offset
         R0 = Ap.T @ np.array(j.rotation, dtype=float) @ A
         permutation = _signed_permutation(R0)
-        if permutation is not None and JointKind(j.kind) != JointKind.SPHERICAL:
+        if permutation is not None and JointKind(j.kind) != JointKind.SPHERICAL and not inner:
             R0 = permutation
             columns = np.argmax(np.abs(permutation), axis=1)
             r[33:36], r[36:39], r[39] = columns, permutation[np.arange(3), columns], 1.0
@@ -137,7 +142,7 @@ def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray
 def joints_of(D: np.ndarray) -> tuple[TreeJoint, ...]:
     """The bodies of a description as TreeJoints (names left empty, canonical axes): what the
     numpy twin (recursive_numpy.py) reads, so that both compute from the same array."""
-    kinds = {code: kind for kind, code in JOINT_CODES.items()}
+    kinds = {code: kind for kind, code in JOINT_CODES.items()} | {FLYER: JointKind.FREE_FLYER}
     nb, n = int(D[0]), int(D[1])
     out = []
     for i in range(nb):
@@ -146,7 +151,7 @@ def joints_of(D: np.ndarray) -> tuple[TreeJoint, ...]:
         def matrix(a):
             return tuple(tuple(float(x) for x in row) for row in np.reshape(a, (3, 3)))
 
-        free = kinds[int(r[1])] == JointKind.FREE_FLYER
+        free = int(r[1]) == JOINT_CODES[JointKind.FREE_FLYER]  # the base's (FLYER: its own q)
         helical = kinds[int(r[1])] == JointKind.HELICAL
         out.append(TreeJoint(name="", parent=int(r[0]), kind=kinds[int(r[1])],
                              rotation=matrix(r[5:14]), translation=tuple(map(float, r[14:17])),
@@ -158,5 +163,5 @@ def joints_of(D: np.ndarray) -> tuple[TreeJoint, ...]:
     return tuple(out)
 
 
-__all__ = ["AXES", "HEADER", "IDENTITY", "JOINT_CODES", "LEAD", "QCOORD", "STRIDE",
+__all__ = ["AXES", "FLYER", "HEADER", "IDENTITY", "JOINT_CODES", "LEAD", "QCOORD", "STRIDE",
            "canonical_frame", "describe", "joints_of"]

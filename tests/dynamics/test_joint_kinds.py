@@ -8,8 +8,9 @@ with no tree here, or with no branch in a kernel, fails under its own name.
 
 The ball (spherical) joint is read from MJCF (MuJoCo's ball joint: its quaternion w x y z, its
 angular velocity in the child's axes) and compared with Pinocchio's JointModelSpherical (the
-quaternion x y z w, the same velocity): q is reordered between the two. Its derivatives, C(q, v),
-A_g, J_dot v and the regressor are refused in one line naming the joint.
+quaternion x y z w, the same velocity): q is reordered between the two. Its derivatives (the
+numpy reference's complex step along the turn, q (x) exp(dq), as Pinocchio's), C(q, v), A_g and
+J_dot v agree with Pinocchio's; the regressor is refused in one line naming the joint.
 
 Pinocchio 4.1's computeRNEADerivatives and computeABADerivatives are wrong for
 JointModelUniversal (its d tau/dq disagrees with its own rnea's finite differences by O(1)), so
@@ -283,21 +284,14 @@ def test_derivatives_agree_with_pinocchio(case, backends, backend):
     kind, system, _, _, _, (q, v, a, tau), (model, data) = case
     d = backends[backend]
     where = f"{kind} joint, {backend}"
-    if kind == JointKind.SPHERICAL:  # not yet: refused by name
-        for derivative in (d.inverse_dynamics_derivatives, d.forward_dynamics_derivatives):
-            with pytest.raises(lagrangian.LagrangianError, match="'j1' is a ball"):
-                derivative(_ours(kind, q), v, a)
-        return
-    if backend == "numpy" and system.model.kinematic_tree.floating_base:
-        with pytest.raises(lagrangian.LagrangianError, match="floating"):
-            d.inverse_dynamics_derivatives(q, v, a)
-        return
+    # a ball joint's d/dq along its turn in its body's axes (q (x) exp(dq)), as Pinocchio's
+    mine = _ours(kind, q) if kind == JointKind.SPHERICAL else q
     dq, dv, _ = pin.computeRNEADerivatives(model, data, q, v, a)
-    ours = d.inverse_dynamics_derivatives(q, v, a)
+    ours = d.inverse_dynamics_derivatives(mine, v, a)
     _agree(ours[0], dq, f"{where}: d tau/dq")
     _agree(ours[1], dv, f"{where}: d tau/dv")
     fq, fv, inverse = pin.computeABADerivatives(model, data, q, v, tau)
-    ours = d.forward_dynamics_derivatives(q, v, tau)
+    ours = d.forward_dynamics_derivatives(mine, v, tau)
     _agree(ours[0], fq, f"{where}: d a/dq")
     _agree(ours[1], fv, f"{where}: d a/dv")
     _agree(ours[2], inverse, f"{where}: d a/d tau")
@@ -341,17 +335,15 @@ def test_a_batch_is_its_single_calls(case, backends):
                      for _ in range(9)])
     V, A = rng.uniform(-1.0, 1.0, (2, 9, model.nv))
     Q[4, -1] = np.nan
-    ball = kind == JointKind.SPHERICAL  # no derivatives yet
     with pytest.warns(lagrangian.DynamicsWarning):
         batches = [d.mass_matrix(Q), d.inverse_dynamics(Q, V, A), d.forward_dynamics(Q, V, A),
-                   d.jacobian(Q, "c")] + ([] if ball else
-                                          [d.forward_dynamics_derivatives(Q, V, A)[0]])
+                   d.jacobian(Q, "c"), d.forward_dynamics_derivatives(Q, V, A)[0]]
     for k, batch in enumerate(batches):
         assert np.isnan(batch[4]).all(), (kind, k)
         for i in (0, 3, 8):
             single = [d.mass_matrix(Q[i]), d.inverse_dynamics(Q[i], V[i], A[i]),
                       d.forward_dynamics(Q[i], V[i], A[i]), d.jacobian(Q[i], "c"),
-                      None if ball else d.forward_dynamics_derivatives(Q[i], V[i], A[i])[0]][k]
+                      d.forward_dynamics_derivatives(Q[i], V[i], A[i])[0]][k]
             if k < 3:
                 assert np.array_equal(batch[i], single), (kind, k, i)
             else:

@@ -264,8 +264,8 @@ def test_a_robot_without_moving_mass_has_no_centroidal_momentum(tmp_path):
 
 def test_a_joint_of_more_than_one_coordinate_is_refused_not_miscounted(system):
     """The walks give each joint its own columns (one, or a free flyer's six): a tree with a
-    joint they do not know (a fixed one here, which a tree merges away) is refused in one line, never summed wrong;
-    the compiled module takes no joint it has no columns for."""
+    joint they do not know (a fixed one here, which a tree merges away) is refused in one line,
+    never summed wrong; the compiled module takes no joint it has no columns for."""
     from dataclasses import replace
 
     from lagrangian.dynamics.algorithms.coriolis_tree import coriolis_matrix

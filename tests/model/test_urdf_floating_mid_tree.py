@@ -169,6 +169,28 @@ def test_velocity_terms_and_the_manifold_match_pinocchio(robots):
                                atol=1e-12)
 
 
+@pytest.mark.parametrize("key", ["arm", "pod floating"])
+def test_the_derivatives_match_pinocchio(robots, key):
+    """d tau/dq, d tau/dv (computeRNEADerivatives) and d a/dq, d a/dv, M^-1
+    (computeABADerivatives), the free flyer's d/dq along its own tangent, q (x) exp(dq): the
+    numpy reference's complex step, the compiled derivatives having no such joint."""
+    ours, model, _ = robots[key]
+    data = model.createData()
+    iq, iv = _orders(ours, model)
+    Q, V, A = _states(model, 2, seed=5)
+    q, v, a = np.empty_like(Q), np.empty_like(V), np.empty_like(A)
+    q[:, iq], v[:, iv], a[:, iv] = Q, V, A
+    inverse, forward = ours.inverse_dynamics_derivatives(q, v, a), \
+        ours.forward_dynamics_derivatives(q, v, a)
+    for k in range(len(Q)):
+        theirs = pin.computeRNEADerivatives(model, data, Q[k], V[k], A[k])
+        for ours_, theirs_ in zip(inverse, theirs[:2], strict=True):
+            np.testing.assert_allclose(ours_[k][np.ix_(iv, iv)], theirs_, atol=1e-9)
+        theirs = pin.computeABADerivatives(model, data, Q[k], V[k], A[k])
+        for ours_, theirs_ in zip(forward, theirs, strict=True):
+            np.testing.assert_allclose(ours_[k][np.ix_(iv, iv)], theirs_, atol=1e-9)
+
+
 def test_the_layout_names_and_the_symbolic_bodies(robots):
     """The free flyer's numbers are named after its joint; the model's own coordinates are its
     x, y, z and rpy (the symbolic bodies, in the URDF's R = Rz(yaw) Ry(pitch) Rx(roll)), and the
@@ -240,7 +262,6 @@ def test_engine_only_paths_refuse_in_one_line(robots):
     system = lagrangian.load(path)
     q, v = np.r_[np.zeros(8), 1.0, 0.0], np.zeros(9)
     calls = {"kernel='unrolled'": lambda: system.dynamics(kernel="unrolled"),
-             "derivatives": lambda: ours.forward_dynamics_derivatives(q, v, v),
              "regressor": lambda: ours.regressor(q, v, v),
              "standalone C export": lambda: system.to_c("carrier"),
              "simulate": lambda: system.simulate(0.1)}

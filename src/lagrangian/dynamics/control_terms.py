@@ -23,15 +23,6 @@ from .regressor import (
 from .tree.spherical import refuse_spherical
 
 
-def _refuse_floating(tree, what: str) -> None:
-    # the complex-step Newton-Euler walks joints of one coordinate each; a free flyer's seven
-    # numbers and six rates are the compiled kernel's alone (derivatives_c.py, any size)
-    if tree is not None and getattr(tree, "floating_base", False):
-        raise InputError(f"the {what} of a floating base are computed in compiled C only, and "
-                         "this dynamics has none (backend='numpy', or no C compiler); use the "
-                         "C backend, or load it without floating_base=True", field="q")
-
-
 class DerivativesKernel(NamedTuple):
     """A tree's compiled derivatives (derivatives_c.py): each function takes (Q, V, X, P); the
     C refuses a base quaternion of the wrong norm with a ValueError, the checked ones name the
@@ -153,21 +144,21 @@ class ControlTerms:
         if found is None:
             tree = getattr(self, "tree", None)
             fast = self._derivatives_kernel()
-            if fast is None:
-                refuse_spherical(tree, "the derivatives of the dynamics")
-                _refuse_floating(tree, "derivatives of the dynamics")
             if fast is not None:
                 inverse, P = fast.checked_inverse, fast.P
 
                 def found(Q, V, A):
                     return inverse(Q, V, A, P)[:2]
-            elif tree is not None:
+            elif tree is not None:  # the numpy reference's Newton-Euler, by the complex step
                 from .derivatives import tree_inverse_dynamics_derivatives
+                from .recursive_numpy import NumpyBackend
 
-                g = self.parameters[tree.gravity_parameter]
+                recursions = getattr(self, "recursions", None)
+                if not isinstance(recursions, NumpyBackend):
+                    recursions = NumpyBackend(tree, self.parameters, self.n)
 
                 def found(Q, V, A):
-                    return tree_inverse_dynamics_derivatives(tree, g, Q, V, A)
+                    return tree_inverse_dynamics_derivatives(recursions, Q, V, A)
             else:
                 from .derivatives import ModelDerivatives
 
@@ -181,9 +172,10 @@ class ControlTerms:
     def inverse_dynamics_derivatives(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
         """(d tau/dq, d tau/dq_dot) of tau = M(q) q_ddot + C q_dot + g, (..., n, n) each (row
         i: tau_i), as Pinocchio's computeRNEADerivatives: a URDF tree's analytic in compiled C
-        (derivatives_c.py; a floating base's d/dq along its own axes, q (+) dq, n = nv; the
-        complex step through Newton-Euler without a compiler, fixed base, exact to rounding), a
-        model file's from its derived M and f."""
+        (derivatives_c.py; a floating base's d/dq along its own axes, q (+) dq, n = nv); else
+        the complex step through the numpy reference's Newton-Euler, along every joint's
+        tangent (ball joints and free flyers too), exact to rounding; a model file's from its
+        derived M and f."""
         fast = self._derivatives_kernel()
         if fast is not None:  # one C call; a bad input goes the guarded way to be named
             try:

@@ -5,9 +5,11 @@ M^-1 (tau evaluated at q_ddot = FD(q, q_dot, tau)), as Pinocchio's computeABADer
 - A model file: generated from the derived equations (tau = M(q) q_ddot - f(q, q_dot)):
   d tau/dq_k = dM/dq_k q_ddot - df/dq_k, d tau/dq_dot = -df/dq_dot, differentiated by sympy
   once and compiled (numpy), exact.
-- A URDF tree: the complex step through the recursive Newton-Euler in numpy: tau(q + i h e_k)
-  with h = 1e-40 gives d tau/dq_k = Im tau / h, exact to rounding (no difference is taken, so
-  nothing cancels: this is not a finite difference). Units SI.
+- A URDF tree without its compiled module: the complex step through the numpy reference's
+  recursive Newton-Euler: tau(q (+) i h e_k) with h = 1e-40 gives d tau/dq_k = Im tau / h,
+  exact to rounding (no difference is taken, so nothing cancels: this is not a finite
+  difference), along the tangent of every joint's chart (ball joints and free flyers too).
+  Units SI.
 """
 
 from __future__ import annotations
@@ -17,52 +19,61 @@ import sympy as sp
 
 from ..compile.lambdified import StateFunction
 from ..model.expressions import as_expression
-from .regressor import cross_matrix, tree_motion
+from ..model.quaternions import quaternion_matrix
 
 # The complex step: small enough that h^2 terms vanish beside 1 in double precision, large
 # enough that h times the largest derivative is no subnormal.
 STEP = 1e-40
 
 
-def tree_inverse_dynamics(tree, gravity: float, Q, V, A) -> np.ndarray:
-    """tau (N, n) by recursive Newton-Euler, real or complex inputs (the actuator parameters
-    aside)."""
-    count, n = Q.shape
-    placements, spaces, w, dw, acc = tree_motion(tree, gravity, Q, V, A)
-    dtype = np.result_type(Q, V, A, float)
-    forces, moments = [], []
-    for joint, w_i, dw_i, a_i in zip(tree.joints, w, dw, acc, strict=True):
-        m, h, J = joint.mass, np.array(joint.first_moment), np.array(joint.inertia)
-        forces.append(m * a_i + np.cross(dw_i, h) + np.cross(w_i, np.cross(w_i, h)))
-        moments.append(dw_i @ J.T + np.cross(w_i, w_i @ J.T) + np.cross(h, a_i))
-    tau = np.zeros((count, n), dtype=dtype)
-    for i in reversed(range(len(tree.joints))):
-        joint = tree.joints[i]
-        s_w, s_v = spaces[i]
-        if s_w is not None:
-            tau[:, joint.coordinate] += joint.multiplier * (moments[i] @ s_w)
-        if s_v is not None:
-            tau[:, joint.coordinate] += joint.multiplier * (forces[i] @ s_v)
-        if joint.parent >= 0:
-            R, p = placements[i]
-            force = np.einsum("nij,nj->ni", R, forces[i])
-            forces[joint.parent] = forces[joint.parent] + force
-            moments[joint.parent] = (moments[joint.parent] + np.einsum("nij,nj->ni", R, moments[i])
-                                     + np.einsum("nij,nj->ni", cross_matrix(p), force))
-    return tau
+def tangent_steps(recursions, Q, h: float) -> np.ndarray:
+    """Q (N, nq) moved by i h along each of the nv velocity numbers, (N, nv, nq) complex: q (+)
+    i h e_k to first order in h, on the tree's own charts (a one-number joint: q_c + i h; a ball
+    joint's quaternion w x y z, q (x) (0, i h e_r / 2), its turn in its body's axes; a free
+    flyer's, the base's or one below the root's: x y z + R(q) i h e_r, its quaternion x y z w
+    (x) (i h e_r / 2, 0)), as Pinocchio's integrate (q (x) exp(dq)), so that the slopes are
+    its derivatives along the tangent."""
+    count, nq = Q.shape
+    out = np.repeat(Q[:, None, :].astype(complex), recursions.n, axis=1)
+    step = 1j * h
+    units = np.eye(3)
+    seen = set()
+    for j in recursions._joints:
+        if j.free or j.inner:  # x y z, then x y z w
+            iq, iv = (0, 0) if j.free else (j.iq, j.iv)
+            quaternion = Q[:, iq + 3:iq + 7]
+            vector, scalar = quaternion[:, :3], quaternion[:, 3:]
+            R = quaternion_matrix(quaternion)
+            for r in range(3):
+                out[:, iv + r, iq:iq + 3] += step * R[:, :, r]
+                turn = scalar * units[r] + np.cross(vector, units[r])  # q (x) (e_r, 0), vector
+                out[:, iv + 3 + r, iq + 3:iq + 6] += 0.5 * step * turn
+                out[:, iv + 3 + r, iq + 6] -= 0.5 * step * vector[:, r]
+        elif j.ball:  # w x y z
+            quaternion = Q[:, j.iq:j.iq + 4]
+            scalar, vector = quaternion[:, :1], quaternion[:, 1:]
+            for r in range(3):
+                out[:, j.iv + r, j.iq] -= 0.5 * step * vector[:, r]
+                out[:, j.iv + r, j.iq + 1:j.iq + 4] += 0.5 * step * (
+                    scalar * units[r] + np.cross(vector, units[r]))
+        elif (j.iq, j.iv) not in seen:  # mimic joints share their coordinate's one step
+            seen.add((j.iq, j.iv))
+            out[:, j.iv, j.iq] += step
+    return out
 
 
-def tree_inverse_dynamics_derivatives(tree, gravity: float, Q, V, A):
-    """(d tau/dq, d tau/dq_dot), (N, n, n) each, by the complex step (one batched pass over
-    2 n perturbed copies of each state)."""
-    count, n = Q.shape
-    step = 1j * STEP * np.eye(n)
-    zero = np.zeros((n, n))
-    Qc = (Q[:, None, :] + np.concatenate([step, zero]))  # (N, 2n, n)
-    Vc = (V[:, None, :] + np.concatenate([zero, step]))
-    Ac = np.broadcast_to(A[:, None, :], Qc.shape)
-    tau = tree_inverse_dynamics(tree, gravity, Qc.reshape(-1, n), Vc.reshape(-1, n),
-                                Ac.reshape(-1, n).astype(complex))
+def tree_inverse_dynamics_derivatives(recursions, Q, V, A):
+    """(d tau/dq, d tau/dq_dot), (N, nv, nv) each, by the complex step through the numpy
+    reference's Newton-Euler (recursive_numpy.NumpyBackend: one batched pass over 2 nv moved
+    copies of each state); d/dq along the tangent of q's charts (tangent_steps), as
+    Pinocchio's computeRNEADerivatives for every joint kind."""
+    count, n = V.shape
+    nq = Q.shape[1]
+    Qc = np.concatenate([tangent_steps(recursions, Q, STEP),
+                         np.repeat(Q[:, None, :].astype(complex), n, axis=1)], axis=1)
+    Vc = V[:, None, :] + np.concatenate([np.zeros((n, n)), 1j * STEP * np.eye(n)])
+    Ac = np.broadcast_to(A[:, None, :], Vc.shape).astype(complex)
+    tau = recursions._newton_euler(Qc.reshape(-1, nq), Vc.reshape(-1, n), Ac.reshape(-1, n))
     slopes = tau.imag.reshape(count, 2 * n, n) / STEP  # [k, i] = d tau_i / d x_k
     return np.swapaxes(slopes[:, :n], -1, -2), np.swapaxes(slopes[:, n:], -1, -2)
 

@@ -14,9 +14,12 @@ QUATERNION_TOLERANCE = 1e-6
 
 def quaternion_matrix(quaternion) -> np.ndarray:
     """The rotation (..., 3, 3) of quaternions (..., 4) in the order x, y, z, w, normalized."""
-    quaternion = np.asarray(quaternion, dtype=float)
-    x, y, z, w = np.moveaxis(quaternion / np.linalg.norm(quaternion, axis=-1, keepdims=True),
-                             -1, 0)
+    quaternion = np.asarray(quaternion, dtype=np.result_type(quaternion, float))
+    if quaternion.dtype.kind == "c":  # the complex step: |q| analytic, sqrt(q . q), not |q|
+        norm = np.sqrt((quaternion * quaternion).sum(axis=-1, keepdims=True))
+    else:
+        norm = np.linalg.norm(quaternion, axis=-1, keepdims=True)
+    x, y, z, w = np.moveaxis(quaternion / norm, -1, 0)
     return np.stack([
         np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
         np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),

@@ -245,8 +245,8 @@ def refuse_ball_joints(tree: KinematicTree | None, what: str) -> None:
         from ..errors import ModelError
 
         raise ModelError(f"joint '{balls[0].name}' is a ball (spherical) joint, which {what} "
-                         "does not take yet (M, inverse and forward dynamics, the energies, "
-                         "frames and Jacobians do, on the compact and numpy backends)",
+                         "does not take yet (M, inverse and forward dynamics and their "
+                         "derivatives, the energies, frames and Jacobians do)",
                          field="joint")
     refuse_free_joints(tree, what)
 
@@ -260,8 +260,8 @@ def refuse_free_joints(tree: KinematicTree | None, what: str) -> None:
 
         raise ModelError(f"joint '{free[0].name}' is a floating joint below the root (a free "
                          f"flyer between two links), which {what} does not take yet (M, "
-                         "inverse and forward dynamics, the energies, frames and Jacobians do, "
-                         "on the numpy backend)", field="joint")
+                         "inverse and forward dynamics and their derivatives, the energies, "
+                         "frames and Jacobians do)", field="joint")
 
 
 _QUATERNION = (JointKind.SPHERICAL, JointKind.FREE_FLYER)

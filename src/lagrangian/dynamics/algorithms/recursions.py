@@ -17,7 +17,7 @@ def _cross(a, b):
     constant, [a]x b by a matrix made once is cheaper (numpy's cost is per call here)."""
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype=np.result_type(a, b))
     out[..., 0] = a1 * b2 - a2 * b1
     out[..., 1] = a2 * b0 - a0 * b2
     out[..., 2] = a0 * b1 - a1 * b0
@@ -40,7 +40,7 @@ def _dot(a, b):
 
 def _skew_batch(p) -> np.ndarray:
     """[p]x for each row of p (N, 3)."""
-    out = np.zeros(p.shape[:-1] + (3, 3))
+    out = np.zeros(p.shape[:-1] + (3, 3), dtype=np.result_type(p, float))
     out[..., 0, 1], out[..., 0, 2], out[..., 1, 2] = -p[..., 2], p[..., 1], -p[..., 0]
     out[..., 1, 0], out[..., 2, 0], out[..., 2, 1] = p[..., 2], -p[..., 1], p[..., 0]
     return out
@@ -227,7 +227,8 @@ class TreeRecursions:
             Jw = _apply(j.J, w_i)
             f.append(j.m * a_i - _apply(j.H, dw_i) - _cross(w_i, _apply(j.H, w_i)))
             n.append(_apply(j.J, dw_i) + _cross(w_i, Jw) + _apply(j.H, a_i))
-        tau = np.zeros((count, self.n))
+        tau = np.zeros((count, self.n), dtype=np.result_type(Q, *(x for x in (V, A)
+                                                                  if x is not None)))
         for i in reversed(range(len(self._joints))):
             j = self._joints[i]
             if j.free:  # the wrench on the base, force then moment, in its axes

@@ -45,7 +45,7 @@ class SphericalModel:
 
 def wxyz_matrix(quaternion) -> np.ndarray:
     """The rotation (..., 3, 3) of quaternions (..., 4) in MuJoCo's order w, x, y, z, normalized."""
-    quaternion = np.asarray(quaternion, dtype=float)
+    quaternion = np.asarray(quaternion, dtype=np.result_type(quaternion, float))
     return quaternion_matrix(np.concatenate([quaternion[..., 1:4], quaternion[..., :1]], -1))
 
 

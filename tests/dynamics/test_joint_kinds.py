@@ -10,7 +10,7 @@ The ball (spherical) joint is read from MJCF (MuJoCo's ball joint: its quaternio
 angular velocity in the child's axes) and compared with Pinocchio's JointModelSpherical (the
 quaternion x y z w, the same velocity): q is reordered between the two. Its derivatives (the
 numpy reference's complex step along the turn, q (x) exp(dq), as Pinocchio's), C(q, v), A_g and
-J_dot v agree with Pinocchio's; the regressor is refused in one line naming the joint.
+J_dot v and the regressor agree with Pinocchio's.
 
 Pinocchio 4.1's computeRNEADerivatives and computeABADerivatives are wrong for
 JointModelUniversal (its d tau/dq disagrees with its own rnea's finite differences by O(1)), so
@@ -301,7 +301,7 @@ def test_derivatives_agree_with_pinocchio(case, backends, backend):
 def test_momentum_coriolis_and_regressor_agree_with_pinocchio(case, backends, backend):
     """The centre of mass, A_g, J_dot v, C(q, v) and the regressor Y (Pinocchio's C and Y
     of a universal joint from its two revolute joints, as its derivatives; a ball joint's
-    all but Y, against Pinocchio's JointModelSpherical)."""
+    against Pinocchio's JointModelSpherical)."""
     kind, _, model, data, body, (q, v, a, tau), (chain, chain_data) = case
     d = backends[backend]
     where = f"{kind} joint, {backend}"
@@ -315,11 +315,7 @@ def test_momentum_coriolis_and_regressor_agree_with_pinocchio(case, backends, ba
            f"{where}: J_dot v")
     _agree(d.coriolis_matrix(ours, v), pin.computeCoriolisMatrix(chain, chain_data, q, v),
            f"{where}: C")
-    if ball:  # the regressor: not yet, refused by name
-        with pytest.raises(lagrangian.LagrangianError, match="spherical"):
-            d.regressor(ours, v, a)
-        return
-    Y = d.regressor(q, v, a)
+    Y = d.regressor(ours, v, a)
     _agree(Y, pin.computeJointTorqueRegressor(chain, chain_data, q, v, a), f"{where}: Y")
     _agree(Y @ d.inertial_parameters(), tau, f"{where}: Y pi")
 

@@ -108,8 +108,6 @@ SPOILT = {"q": NAN_Q, "v": INF_V, "a": INF_A, "w": NAN_W}
 @pytest.mark.parametrize("name", list(FUNCTIONS))
 def test_a_state_not_finite_is_nan_in_its_whole_row_with_one_warning(tmp_path, backend,
                                                                       floating, name):
-    if floating and backend == "numpy" and name == "regressor":
-        pytest.skip("a floating base's regressor needs the compiler (refused in one line)")
     robot = _robot(tmp_path, floating, backend)
     call, inputs, axes = FUNCTIONS[name]
     x = _inputs(robot)

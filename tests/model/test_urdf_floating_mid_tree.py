@@ -173,7 +173,8 @@ def test_velocity_terms_and_the_manifold_match_pinocchio(robots):
 def test_the_derivatives_match_pinocchio(robots, key):
     """d tau/dq, d tau/dv (computeRNEADerivatives) and d a/dq, d a/dv, M^-1
     (computeABADerivatives), the free flyer's d/dq along its own tangent, q (x) exp(dq): the
-    numpy reference's complex step, the compiled derivatives having no such joint."""
+    numpy reference's complex step, the compiled derivatives having no such joint; and the
+    regressor Y (computeJointTorqueRegressor)."""
     ours, model, _ = robots[key]
     data = model.createData()
     iq, iv = _orders(ours, model)
@@ -189,6 +190,14 @@ def test_the_derivatives_match_pinocchio(robots, key):
         theirs = pin.computeABADerivatives(model, data, Q[k], V[k], A[k])
         for ours_, theirs_ in zip(forward, theirs, strict=True):
             np.testing.assert_allclose(ours_[k][np.ix_(iv, iv)], theirs_, atol=1e-9)
+        # the regressor: tau = Y pi, Pinocchio's parameters of each body in its own frame,
+        # its bodies' blocks matched to ours by joint name
+        bodies = [name.split("@")[1] for name in ours.parameter_names()[::10]]
+        blocks = np.concatenate([np.arange(10) + 10 * bodies.index(name)
+                                 for name in list(model.names)[1:]])
+        Y = pin.computeJointTorqueRegressor(model, data, Q[k], V[k], A[k])
+        np.testing.assert_allclose(ours.regressor(q[k], v[k], a[k])[np.ix_(iv, blocks)], Y,
+                                   atol=1e-9)
 
 
 def test_the_layout_names_and_the_symbolic_bodies(robots):
@@ -260,9 +269,7 @@ def test_the_engine_agrees_with_the_numpy_reference(robots, key, capsys):
 def test_engine_only_paths_refuse_in_one_line(robots):
     ours, _, path = robots["arm"]
     system = lagrangian.load(path)
-    q, v = np.r_[np.zeros(8), 1.0, 0.0], np.zeros(9)
     calls = {"kernel='unrolled'": lambda: system.dynamics(kernel="unrolled"),
-             "regressor": lambda: ours.regressor(q, v, v),
              "standalone C export": lambda: system.to_c("carrier"),
              "simulate": lambda: system.simulate(0.1)}
     try:

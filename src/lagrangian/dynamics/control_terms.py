@@ -20,7 +20,6 @@ from .regressor import (
     tree_parameters,
     tree_regressor,
 )
-from .tree.spherical import refuse_spherical
 
 
 class DerivativesKernel(NamedTuple):
@@ -42,7 +41,6 @@ class ControlTerms:
     def _regressor_of(self, parameters: Sequence[str] | None):
         tree = getattr(self, "tree", None)
         if tree is not None:
-            refuse_spherical(tree, "the regressor")
             if parameters is not None:
                 raise InputError("a robot's regressor is over its bodies' 10 inertial "
                                  "parameters each; parameters=[...] is for model files",
@@ -53,8 +51,10 @@ class ControlTerms:
                 compute, P = fast.checked_regressor, fast.P
                 return (lambda Q, V, A: compute(Q, V, A, P),
                         tree_parameter_names(tree), tree_parameters(tree))
-            g = self.parameters[tree.gravity_parameter]
-            return (lambda Q, V, A: tree_regressor(tree, g, Q, V, A),
+            from .recursive_numpy import NumpyBackend
+
+            recursions = NumpyBackend(tree, self.parameters, self.n, own_frames=True)
+            return (lambda Q, V, A: tree_regressor(recursions, Q, V, A),
                     tree_parameter_names(tree), tree_parameters(tree))
         if parameters is None:
             raise InputError("name the parameters the model's T and V are linear in: "

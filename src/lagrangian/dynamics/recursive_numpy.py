@@ -44,7 +44,8 @@ class NumpyBackend(TreeRecursions):
     kernel = "numpy"
     tables = None
 
-    def __init__(self, tree: KinematicTree, parameters: Mapping[str, float], nv: int):
+    def __init__(self, tree: KinematicTree, parameters: Mapping[str, float], nv: int,
+                 own_frames: bool = False):
         self.tree, self.n = tree, nv
         missing = [name for name in (tree.gravity_parameter, *tree.actuators)
                    if name is not None and name not in parameters]
@@ -59,7 +60,9 @@ class NumpyBackend(TreeRecursions):
         # the bodies as the engine reads them (tree/description.py): one description; a
         # floating base (a joint that description does not turn) and a free flyer below the
         # root (one the engine does not take: selection.py) from the tree itself
-        joints = (tree.joints if tree.floating_base or tree.free_joints
+        # own_frames: each body in its joint's own frame (the regressor's parameters are
+        # about it), not the description's canonical axes
+        joints = (tree.joints if own_frames or tree.floating_base or tree.free_joints
                   else joints_of(describe(tree, parameters)))
         self._joints = [_Joint(j, tree) for j in joints]
         self._widths = (tree.nq, nv, nv)

@@ -22,9 +22,7 @@ import sympy as sp
 
 from ..compile.lambdified import StateFunction
 from ..errors import InputError
-from ..kinds import JointKind
 from ..model.expressions import as_expression
-from .tree.joint_models import joint_model
 
 PARAMETERS_PER_BODY = ("m", "mc_x", "mc_y", "mc_z", "I_xx", "I_xy", "I_yy", "I_xz", "I_yz", "I_zz")
 # (row, column) of I for I_xx, I_xy, I_yy, I_xz, I_yz, I_zz: Pinocchio's order
@@ -37,13 +35,6 @@ def cross_matrix(x) -> np.ndarray:
     out[..., 0, 1], out[..., 0, 2], out[..., 1, 2] = -x[..., 2], x[..., 1], -x[..., 0]
     out[..., 1, 0], out[..., 2, 0], out[..., 2, 1] = x[..., 2], -x[..., 1], x[..., 0]
     return out
-
-
-def _cross(a, b):
-    # by components: np.cross's axis handling costs more than the product on (N, 3) batches
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def tree_parameters(tree) -> np.ndarray:
@@ -60,101 +51,53 @@ def tree_parameter_names(tree) -> tuple[str, ...]:
     return tuple(f"{p}@{joint.name}" for joint in tree.joints for p in PARAMETERS_PER_BODY)
 
 
-def tree_motion(tree, gravity: float, Q, V, A):
-    """The forward pass of Newton-Euler over flat batches (N, nq) and (N, nv), real or complex
-    (the complex step of derivatives.py): each body's placement (R, p) in its parent, motion
-    subspace (s_w, s_v) (None for a floating base's free flyer, whose S is 1), and angular
-    velocity w, angular acceleration dw and linear acceleration a of its origin (gravity
-    included: the ground accelerates up by g), body axes. A floating base reads q[:7], v[:6]
-    (free_flyer.py); the joints q[7 + c], v[6 + c]."""
-    count = len(Q)
-    up = -gravity * np.array(tree.gravity_direction, dtype=float)
-    placements, spaces, w, dw, acc = [], [], [], [], []
-    dtype = np.result_type(Q, V, A, float)
-    iq, iv = tree.base_nq, tree.base_nv
-    for joint in tree.joints:
-        model = joint_model(joint.kind)
-        if joint.kind == JointKind.FREE_FLYER:  # the base: its twist (v, w) in its own axes
-            R, p = model.placement_arrays(np.array(joint.rotation, dtype=float),
-                                          np.array(joint.translation, dtype=float), Q[:, :7])
-            placements.append((R, p))
-            spaces.append(None)
-            w.append(V[:, 3:6])
-            dw.append(A[:, 3:6])
-            # the origin's acceleration v_dot + w x v, and up by g
-            acc.append(np.einsum("nji,j->ni", R, up) + A[:, :3] + _cross(V[:, 3:6], V[:, :3]))
-            continue
-        u = np.array(joint.axis, dtype=float)
-        theta = joint.multiplier * Q[:, iq + joint.coordinate] + joint.offset
-        R, p = model.placement_arrays(np.array(joint.rotation, dtype=float),
-                                      np.array(joint.translation, dtype=float), u, theta,
-                                      joint.pitch)
-        R = np.broadcast_to(R, (count, 3, 3))
-        p = np.broadcast_to(p, (count, 3))
-        s_w, s_v = (None if s is None else np.array(s, dtype=float) for s in model.subspace(u, joint.pitch))
-        placements.append((R, p))
-        spaces.append((s_w, s_v))
-        RT = np.swapaxes(R, -1, -2)
-        if joint.parent < 0:  # the ground at rest, accelerating up by g
-            w_in = dw_in = np.zeros((count, 3), dtype=dtype)
-            a_i = np.einsum("nij,j->ni", RT, up)
-        else:
-            wl, dwl, al = w[joint.parent], dw[joint.parent], acc[joint.parent]
-            w_in = np.einsum("nij,nj->ni", RT, wl)
-            dw_in = np.einsum("nij,nj->ni", RT, dwl)
-            a_i = np.einsum("nij,nj->ni", RT, al + _cross(dwl, p) + _cross(wl, _cross(wl, p)))
-        rate = joint.multiplier * V[:, iv + joint.coordinate, None]
-        accel = joint.multiplier * A[:, iv + joint.coordinate, None]
-        w_i, dw_i = w_in, dw_in
-        if s_w is not None:
-            w_i = w_in + rate * s_w
-            dw_i = dw_in + _cross(w_in, rate * s_w) + accel * s_w
-        if s_v is not None:
-            a_i = a_i + 2.0 * _cross(w_i, rate * s_v) + accel * s_v
-        w.append(w_i)
-        dw.append(dw_i)
-        acc.append(a_i)
-    return placements, spaces, w, dw, acc
-
-
-def tree_regressor(tree, gravity: float, Q: np.ndarray, V: np.ndarray, A: np.ndarray
-                   ) -> np.ndarray:
-    """Y (N, nv, 10 * bodies) over flat batches Q (N, nq), V, A (N, nv): tau = Y pi. A floating
-    base's six rows are the wrench on the base in its axes (force, then moment), as
-    Pinocchio's rnea."""
+def tree_regressor(recursions, Q: np.ndarray, V: np.ndarray, A: np.ndarray) -> np.ndarray:
+    """Y (N, nv, 10 * bodies) over flat batches Q (N, nq), V, A (N, nv): tau = Y pi, from the
+    numpy reference's forward pass (recursive_numpy.NumpyBackend in the bodies' own frames):
+    each body's wrench per unit of its parameters carried to every joint from its own to the
+    root. A floating base's six rows are the wrench on the base in its axes (force, then
+    moment), as Pinocchio's rnea; a ball joint's three the moment on its body, a free flyer's
+    below the root six its wrench, in its body's axes."""
     count, nv = V.shape
-    joints = tree.joints
-    placements, spaces, w, dw, acc = tree_motion(tree, gravity, Q, V, A)
+    joints = recursions._joints
+    placements, w, dw, acc = recursions._motion(Q, V, A)
     Y = np.zeros((count, nv, 10 * len(joints)))
     if count <= 256:  # few states: every body's basis wrenches in one call (Python's overhead
         # is per call); many: body by body (arrays that stay in cache)
         forces, moments = (x.reshape(len(joints), count, 3, 10) for x in _basis_wrenches(
-            *(np.concatenate(x) for x in (w, dw, acc))))
-    shifts = [cross_matrix(p) for _, p in placements]  # [p]x of each body's origin
+            *(np.concatenate([np.broadcast_to(y, (count, 3)) for y in x])
+              for x in (w, dw, acc))))
     for i in range(len(joints)):
         if count <= 256:
             force, moment = forces[i], moments[i]
         else:
-            force, moment = _basis_wrenches(w[i], dw[i], acc[i])
+            force, moment = _basis_wrenches(*(np.broadcast_to(x[i], (count, 3))
+                                              for x in (w, dw, acc)))
+        columns = slice(10 * i, 10 * i + 10)
         k = i
         while k >= 0:  # the body's wrench reaches every joint from its own to the root
             joint = joints[k]
-            if spaces[k] is None:  # the free flyer: S = 1, the whole wrench (the root)
-                Y[:, 0:3, 10 * i:10 * i + 10] += force
-                Y[:, 3:6, 10 * i:10 * i + 10] += moment
+            if joint.free:  # the floating base: S = 1, the whole wrench (the root)
+                Y[:, 0:3, columns] += force
+                Y[:, 3:6, columns] += moment
                 break
-            s_w, s_v = spaces[k]
-            column = 0.0
-            if s_w is not None:
-                column = column + np.einsum("nij,i->nj", moment, s_w)
-            if s_v is not None:
-                column = column + np.einsum("nij,i->nj", force, s_v)
-            Y[:, tree.base_nv + joint.coordinate, 10 * i:10 * i + 10] += joint.multiplier * column
+            if joint.ball:
+                Y[:, joint.iv:joint.iv + 3, columns] += moment
+            elif joint.inner:
+                Y[:, joint.iv:joint.iv + 3, columns] += force
+                Y[:, joint.iv + 3:joint.iv + 6, columns] += moment
+            else:
+                column = 0.0
+                if joint.s_w is not None:
+                    column = column + np.einsum("nij,i->nj", moment, joint.s_w)
+                if joint.s_v is not None:
+                    column = column + np.einsum("nij,i->nj", force, joint.s_v)
+                Y[:, joint.iv, columns] += joint.multiplier * column
             if joint.parent < 0:
                 break
-            R = placements[k][0]
+            R, _, P = placements[k]
             force = R @ force
-            moment = R @ moment + shifts[k] @ force
+            moment = R @ moment + P @ force
             k = joint.parent
     return Y
 

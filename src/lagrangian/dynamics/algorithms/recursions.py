@@ -149,12 +149,14 @@ class TreeRecursions:
             placements.append((R, p, j.P0 if p is j.t0 else _skew_batch(p)))
         return placements
 
-    def _newton_euler(self, Q, V, A):
-        """tau (N, n) for q, q_dot, q_ddot, minus the actuator parameters (V, A None: zero)."""
+    def _motion(self, Q, V, A):
+        """Newton-Euler's forward pass: each body's placement (R, p, [p]x) in its parent, and
+        its angular velocity w, angular acceleration dw and origin's acceleration a (up by g:
+        the ground accelerates up, gravity's trick), body axes; V, A None: zero."""
         count = len(Q)
         placements = self._kinematics(Q)
         zero = np.zeros((count, 3))
-        w, dw, acc, f, n = [], [], [], [], []
+        w, dw, acc = [], [], []
         for i, j in enumerate(self._joints):
             R, p, P = placements[i]
             if j.free:  # the floating base: its twist (v, w) and its derivative, in its axes
@@ -164,9 +166,6 @@ class TreeRecursions:
                 acc.append(_apply_transpose(R, np.broadcast_to(self._up, (count, 3)))
                            + (0.0 if A is None else A[:, :3])
                            + (0.0 if V is None else _cross(V[:, 3:6], V[:, :3])))
-                f.append(j.m * acc[i] - _apply(j.H, dw[i]) - _cross(w[i], _apply(j.H, w[i])))
-                n.append(_apply(j.J, dw[i]) + _cross(w[i], _apply(j.J, w[i]))
-                         + _apply(j.H, acc[i]))
                 continue
             if j.parent < 0:  # the ground: at rest, accelerating up by g
                 w_in = dw_in = zero
@@ -188,45 +187,41 @@ class TreeRecursions:
                 if A is not None:
                     a_i = a_i + A[:, j.iv:j.iv + 3]
                     dw_i = dw_i + A[:, j.iv + 3:j.iv + 6]
-                w.append(w_i)
-                dw.append(dw_i)
-                acc.append(a_i)
-                f.append(j.m * a_i - _apply(j.H, dw_i) - _cross(w_i, _apply(j.H, w_i)))
-                n.append(_apply(j.J, dw_i) + _cross(w_i, _apply(j.J, w_i)) + _apply(j.H, a_i))
-                continue
-            if j.ball:  # w += w_rel, dw += w x w_rel + dw_rel (S = 1 on the angular rows)
+            elif j.ball:  # w += w_rel, dw += w x w_rel + dw_rel (S = 1 on the angular rows)
                 w_i, dw_i = w_in, dw_in
                 if V is not None:
                     w_i = w_in + V[:, j.iv:j.iv + 3]
                     dw_i = dw_in + _cross(w_in, V[:, j.iv:j.iv + 3])
                 if A is not None:
                     dw_i = dw_i + A[:, j.iv:j.iv + 3]
-                w.append(w_i)
-                dw.append(dw_i)
-                acc.append(a_i)
-                f.append(j.m * a_i - _apply(j.H, dw_i) - _cross(w_i, _apply(j.H, w_i)))
-                n.append(_apply(j.J, dw_i) + _cross(w_i, _apply(j.J, w_i)) + _apply(j.H, a_i))
-                continue
-            rate = None if V is None else j.multiplier * V[:, j.iv, None]
-            w_i, dw_i = w_in, dw_in
-            if rate is not None and j.s_w is not None:
-                w_i = w_in + rate * j.s_w
-                dw_i = dw_in + _cross(w_in, rate * j.s_w)
-            if rate is not None and j.s_v is not None:
-                a_i = a_i + 2.0 * _cross(w_i, rate * j.s_v)
-            if A is not None:
-                accel = j.multiplier * A[:, j.iv, None]
-                if j.s_w is not None:
-                    dw_i = dw_i + accel * j.s_w
-                if j.s_v is not None:
-                    a_i = a_i + accel * j.s_v
+            else:
+                rate = None if V is None else j.multiplier * V[:, j.iv, None]
+                w_i, dw_i = w_in, dw_in
+                if rate is not None and j.s_w is not None:
+                    w_i = w_in + rate * j.s_w
+                    dw_i = dw_in + _cross(w_in, rate * j.s_w)
+                if rate is not None and j.s_v is not None:
+                    a_i = a_i + 2.0 * _cross(w_i, rate * j.s_v)
+                if A is not None:
+                    accel = j.multiplier * A[:, j.iv, None]
+                    if j.s_w is not None:
+                        dw_i = dw_i + accel * j.s_w
+                    if j.s_v is not None:
+                        a_i = a_i + accel * j.s_v
             w.append(w_i)
             dw.append(dw_i)
             acc.append(a_i)
+        return placements, w, dw, acc
+
+    def _newton_euler(self, Q, V, A):
+        """tau (N, n) for q, q_dot, q_ddot, minus the actuator parameters (V, A None: zero)."""
+        count = len(Q)
+        placements, w, dw, acc = self._motion(Q, V, A)
+        f, n = [], []
+        for j, w_i, dw_i, a_i in zip(self._joints, w, dw, acc, strict=True):
             # about the body's origin: f = m a + dw x h + w x (w x h), n = J dw + w x J w + h x a
-            Jw = _apply(j.J, w_i)
             f.append(j.m * a_i - _apply(j.H, dw_i) - _cross(w_i, _apply(j.H, w_i)))
-            n.append(_apply(j.J, dw_i) + _cross(w_i, Jw) + _apply(j.H, a_i))
+            n.append(_apply(j.J, dw_i) + _cross(w_i, _apply(j.J, w_i)) + _apply(j.H, a_i))
         tau = np.zeros((count, self.n), dtype=np.result_type(Q, *(x for x in (V, A)
                                                                   if x is not None)))
         for i in reversed(range(len(self._joints))):

@@ -18,6 +18,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..model.answer import FREQUENCY_KEYS, MATRICES
+from ..model.answer_notation import module_notation_text
 from ..model.model import Model, multiplier_name
 from ..model.reader import check_known_keys
 from ..model.units import generalized_force_unit, parse_quantity
@@ -274,14 +275,16 @@ class _Reader:
         number with a unit (read_written reads it) or names no parameter."""
         quantity = _NUMBER.match(value) if isinstance(value, str) else None
         if not isinstance(value, str) or quantity and (
-                not quantity[4] or quantity[4][0] not in "*/^(+-"):
-            return None  # a number, with its unit where it has one (4.43 rad/s)
+                not quantity[4] or quantity[4][0] not in "*/^(+-" and quantity[4][0].isascii()):
+            return None  # a number, with its unit where it has one (4.43 rad/s); 2π reads on
         parameters = {p.symbol: p for p in self.model.parameters}
         try:
             expression = self.expression(value, field)
         except ModelError:
             return None  # a unit (4.43 rad/s) or a fault that read_written names
         symbols = expression.free_symbols
+        if not symbols and module_notation_text(value) is not None:
+            return Written(value, float(expression), None)  # √2, 2π: exact, as the module writes
         if not symbols or not symbols <= set(parameters):
             if symbols - set(parameters):
                 names = ", ".join(sorted(str(s) for s in symbols - set(parameters)))

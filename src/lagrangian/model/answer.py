@@ -21,7 +21,12 @@ from pathlib import Path
 import sympy as sp
 
 from ..errors import ModelError
-from .answer_notation import module_notation_text, prime_hint, primes_as_rates
+from .answer_notation import (
+    module_notation_text,
+    prime_hint,
+    primes_as_rates,
+    time_derivative_parts,
+)
 from .expressions import CONSTANTS, FUNCTIONS, parse_expression
 from .model import Model, multiplier_name
 from .reader import check_known_keys, load_toml, read_text_file
@@ -36,6 +41,7 @@ MECHANICS_TABLES = ("momenta", "conserved", "routhian", "hamiltonian")
 TABLES = ("energy", "generalized_forces", "equations", "multipliers", *FINAL_TABLES,
           *MECHANICS_TABLES, "coordinates")
 _FOREIGN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+_TIME_DERIVATIVE_NAME = "d_dt_of_"  # stands for a d/dt(...) cut out of an answer's text
 ENERGY_KEYS = ("T", "V", "D", "L")  # L: the Lagrangian, checked as T - V
 MULTIPLIER_KEYS = ("count", "names")
 
@@ -126,18 +132,25 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
     coordinates = [c.name for c in model.coordinates]
     foreign: dict[str, frozenset[sp.Symbol]] = {}
 
-    def expression(value: object, field: str, item: str) -> sp.Expr:
+    def expression(value: object, field: str, item: str,
+                   known: Mapping[str, sp.Expr] = names) -> sp.Expr:
         if not isinstance(value, str):
-            return parse_expression(value, names, field=field, source=source)
+            return parse_expression(value, known, field=field, source=source)
+        cut = time_derivative_parts(value, _TIME_DERIVATIVE_NAME)
+        if cut is not None:  # d/dt(m L² θ̇) + m g L sinθ, the module's Lagrange equation
+            value, parts = cut
+            known = {**known, **{name: _total_derivative(
+                expression(inner, field, item, known), model, field, source)
+                for name, inner in parts}}
         rewritten = module_notation_text(value)
         for k, text in enumerate([rewritten, value] if rewritten is not None else [value]):
             try:
-                extra = _foreign_names(text, names, field, source)
-                parsed = parse_expression(text, {**names, **extra}, field=field, source=source)
+                extra = _foreign_names(text, known, field, source)
+                parsed = parse_expression(text, {**known, **extra}, field=field, source=source)
             except ModelError as error:
                 if k == 0 and rewritten is not None:
                     continue  # the grammar's own message, of the text as written
-                raise _prime_or(error, value, names, field, source) from None
+                raise _prime_or(error, value, known, field, source) from None
             if extra:
                 foreign[item] = foreign.get(item, frozenset()) | set(extra.values())
             return parsed
@@ -215,6 +228,16 @@ def answer_from_mapping(data: Mapping, model: Model, *, source: str = "<answer>"
                          "[conserved], [routhian] or [hamiltonian]",
                          source=source)
     return answer
+
+
+def _total_derivative(expression: sp.Expr, model: Model, field: str, source: str) -> sp.Expr:
+    """d/dt of an expression in q, q_dot and t: sum dE/dq q_dot + dE/dq_dot q_ddot + dE/dt."""
+    if any(expression.has(c.acceleration) for c in model.coordinates):
+        raise ModelError("d/dt(...) of an acceleration is not read: write the equation with "
+                         "q_ddot at most", field=field, source=source)
+    return sp.expand(sum((expression.diff(c.symbol) * c.velocity
+                          + expression.diff(c.velocity) * c.acceleration
+                          for c in model.coordinates), expression.diff(model.time)))
 
 
 def answer_expression(value: object, names: Mapping[str, sp.Expr], field: str,

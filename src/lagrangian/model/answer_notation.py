@@ -5,7 +5,8 @@ spaces (or a middle dot), a function applied to a name without parentheses, √ 
 pass rewrites such text token by token (model/tokens.py reads the Unicode spellings) into the
 model grammar, inserting * and parentheses; nothing is evaluated. It is used for answers only:
 a model file keeps its explicit grammar. A prime (theta', θ') is refused with the spelling to
-use.
+use. The module's Lagrange equation, d/dt(m L² θ̇) + m g L sinθ = 0, is read with each d/dt(...)
+cut out (time_derivative_parts) and taken as the total time derivative of what it holds.
 """
 
 from __future__ import annotations
@@ -30,6 +31,13 @@ _GLUED_FUNCTION = re.compile(
 _GLUED_POWER = re.compile(r"([" + _SUPER + r"])(?=[^\W\d_" + _SUPER + r"])")
 _GLUED_FRACTION = re.compile(r"([" + _FRACTION + r"])(?=[^\s*/+\-)])")
 _ROOT = re.compile("\u221a")
+# a number glued to a Greek or other non-ASCII letter (2π, 2θ): the module's product, kept
+# together as one operand (sin 2θ is sin(2θ)) unless a power or more letters follow (2θ², 2πf)
+_GLUED_NUMBER = re.compile(r"(?<![\w.])(\d+(?:\.\d+)?)([^\W\d_\x00-\x7f][\u0300-\u036f]*)"
+                           r"(?![\w\u0300-\u036f" + _SUPER + r"])")
+_GLUED_NUMBER_BEFORE = re.compile(r"(?<![\w.])(\d+(?:\.\d+)?)(?=[^\W\d_\x00-\x7f])")
+# d/dt( opening a total time derivative, not part of a longer name (rad/dt)
+_TIME_DERIVATIVE = re.compile(r"(?<![\w.])d\s*/\s*dt\s*\(")
 _OPERAND_END = ("name", "number", ")")
 
 
@@ -71,6 +79,8 @@ def module_notation_text(text: str) -> str | None:
     spaced = _GLUED_POWER.sub(r"\1 ", spaced)
     spaced = _GLUED_FRACTION.sub(r"\1 ", spaced)
     spaced = _ROOT.sub(" sqrt ", spaced)
+    spaced = _GLUED_NUMBER.sub(r"(\1 \2)", spaced)
+    spaced = _GLUED_NUMBER_BEFORE.sub(r"\1 ", spaced)
     tokens = _safe_tokens(spaced)
     if not tokens:
         return None
@@ -79,6 +89,30 @@ def module_notation_text(text: str) -> str | None:
     changed = changed or spaced != text
     return "".join(value if kind != "name" else f" {value} " for kind, value in out) \
         if changed else None
+
+
+def time_derivative_parts(text: str, prefix: str) -> tuple[str, list[tuple[str, str]]] | None:
+    """``text`` with each outermost d/dt(...) replaced by a name ``prefix``1, ``prefix``2, ...,
+    and each name with the text inside its parentheses; None without a d/dt( or where its
+    parentheses do not close (the grammar's own message is then given)."""
+    parts: list[tuple[str, str]] = []
+    out, start = [], 0
+    for match in _TIME_DERIVATIVE.finditer(text):
+        if match.start() < start:
+            continue  # inside a d/dt already cut out: read with it
+        depth, end = 1, match.end()
+        while end < len(text) and depth:
+            depth += {"(": 1, ")": -1}.get(text[end], 0)
+            end += 1
+        if depth:
+            return None
+        name = f"{prefix}{len(parts) + 1}"
+        parts.append((name, text[match.end():end - 1]))
+        out += [text[start:match.start()], f" {name} "]
+        start = end
+    if not parts:
+        return None
+    return "".join(out) + text[start:], parts
 
 
 def _is_function(token: tuple[str, str]) -> bool:
@@ -159,4 +193,4 @@ def _join(out: list[tuple[str, str]], token: tuple[str, str]) -> bool:
     return False
 
 
-__all__ = ["module_notation_text", "prime_hint", "primes_as_rates"]
+__all__ = ["module_notation_text", "prime_hint", "primes_as_rates", "time_derivative_parts"]

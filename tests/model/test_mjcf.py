@@ -121,23 +121,31 @@ def mjcf_written_by_mujoco(urdf_path, tmp_path, strip_mimic: bool = False):
 
 @pytest.mark.parametrize("name", ["two_link_arm", "ur5", "solo12", "panda"])
 def test_mjcf_written_by_mujoco_from_a_urdf(name, tmp_path):
-    """MuJoCo reads the URDF and writes MJCF; that MJCF read by us and by MuJoCo agree to 1e-9,
-    and with our reading of the URDF to MuJoCo's printed precision (6 digits). The Panda's
-    mimic finger is made a joint of its own here (MuJoCo writes a mimic as a joint equality, read
-    back as the mimic: tests/model/test_mjcf_state.py)."""
+    """MuJoCo reads the URDF and writes MJCF; that MJCF read by us and by MuJoCo agree on M, the
+    bias, forward (mj_forward) and inverse dynamics (mj_inverse) to 1e-9, and with our reading
+    of the URDF to MuJoCo's printed precision (6 digits). The Panda's mimic finger is made a
+    joint of its own here (MuJoCo writes a mimic as a joint equality, read back as the mimic:
+    tests/model/test_mjcf_state.py)."""
     urdf = example_urdf(name)
     if urdf is None:
         pytest.skip(f"{name}: example-robot-data is not installed")
     path = mjcf_written_by_mujoco(urdf, tmp_path, strip_mimic=name == "panda")
     model = mujoco.MjModel.from_xml_path(str(path))
+    # the states run past the joints' ranges: MuJoCo's limit constraints off, as ours
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_LIMIT)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        ours = lagrangian.load(path).dynamics(backend="numpy")
+        system = lagrangian.load(path)
+    ours = system.dynamics(backend="numpy")
+    damped = system.dynamics(backend="numpy", actuators=True)  # the Panda's damping 0.3
     assert ours.nv == model.nv
     for q, v, tau in states(model.nq, 2):
-        M, bias, *_ = mujoco_terms(model, q, v, tau)
+        M, bias, qacc, inverse, _ = mujoco_terms(model, q, v, tau)
         assert np.allclose(ours.mass_matrix(q), M, rtol=0, atol=1e-9)
         assert np.allclose(ours.bias_forces(q, v), bias, rtol=0, atol=1e-9)
+        assert np.allclose(inverse, tau, rtol=0, atol=1e-9)  # MuJoCo's FD and ID consistent
+        assert np.allclose(damped.forward_dynamics(q, v, tau), qacc, rtol=0, atol=1e-9)
+        assert np.allclose(damped.inverse_dynamics(q, v, qacc), tau, rtol=0, atol=1e-9)
     if name == "two_link_arm":  # the same robot as URDF: MuJoCo printed its short numbers whole
         urdf_system = lagrangian.load(urdf).dynamics(backend="numpy")
         for q, v, _ in states(model.nq, 2):

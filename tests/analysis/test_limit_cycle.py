@@ -116,10 +116,10 @@ def heel_strike(x):
     return np.array([th2, th1, u1, u2])
 
 
-def goswami_step(x):
+def goswami_step(x, gamma=GAMMA):
     """The state just after the next heel strike and the time: th1 + th2 first falls below 0
     (the swing foot passes the stance leg's mirror image), then rises through it."""
-    def mirror(t, y):
+    def mirror(t, y, _gamma):
         return y[0] + y[1]
 
     mirror.terminal = True
@@ -127,7 +127,7 @@ def goswami_step(x):
     for direction in (-1, 1):
         mirror.direction = direction
         run = integrate.solve_ivp(goswami_rhs, (t0, t0 + 5), y0, method="DOP853", rtol=1e-12,
-                                  atol=1e-12, events=mirror, first_step=1e-6)
+                                  atol=1e-12, events=mirror, first_step=1e-6, args=(gamma,))
         t0, y0 = run.t_events[0][-1], run.y_events[0][-1]
     return heel_strike(y0), t0
 
@@ -145,17 +145,43 @@ def test_the_compass_gait_is_a_fixed_point_of_goswamis_step(gait):
     assert x[0] == pytest.approx(-x[1], abs=1e-12)  # on the heel strike's guard
 
 
-def test_the_compass_gaits_multipliers_agree_with_goswamis_map(gait):
-    """Finite differences of the independent map here (the library uses none)."""
-    x = np.array(list(gait.state.values()))
+def goswami_multipliers(x, gamma=GAMMA):
+    """Finite differences of the independent map here (the library uses none), less the
+    section's 0."""
     h = 1e-6
-    columns = [(goswami_step(x + h * np.eye(4)[i])[0] - goswami_step(x - h * np.eye(4)[i])[0])
-               / (2 * h) for i in range(4)]
+    columns = [(goswami_step(x + h * e, gamma)[0] - goswami_step(x - h * e, gamma)[0]) / (2 * h)
+               for e in np.eye(4)]
     eigenvalues = np.linalg.eigvals(np.array(columns).T)
-    nontrivial = sorted(eigenvalues[np.argsort(np.abs(eigenvalues))[1:]], key=lambda m: -abs(m))
-    for ours, theirs in zip(gait.multipliers, nontrivial, strict=True):
-        assert abs(ours - theirs) < 1e-5 or abs(ours - np.conj(theirs)) < 1e-5
-    assert gait.stable and len(gait.multipliers) == 3
+    return sorted(eigenvalues[np.argsort(np.abs(eigenvalues))[1:]], key=lambda m: -abs(m))
+
+
+def assert_same_multipliers(ours, theirs):
+    assert len(ours) == len(theirs) == 3
+    for mine in ours:
+        assert min(abs(mine - other) for other in theirs) < 1e-5
+
+
+def test_the_compass_gaits_multipliers_agree_with_goswamis_map(gait):
+    x = np.array(list(gait.state.values()))
+    assert_same_multipliers(gait.multipliers, goswami_multipliers(x))
+    assert gait.stable
+
+
+def test_the_compass_gait_at_a_slope_given_by_set(cli):
+    """`cycle compass_gait --set gamma=0.03`: the fixed point, period and multipliers of
+    Goswami's map at that slope (issue 41's must-show, the CLI as a user meets it)."""
+    import json
+
+    code, out, err = cli("cycle", "compass_gait", "--set", "gamma=0.03", "--json")
+    assert code == 0, err
+    document = json.loads(out)
+    x = np.array(list(document["state"].values()))
+    after, period = goswami_step(x, 0.03)
+    assert after == pytest.approx(x, abs=1e-7)
+    assert document["period"] == pytest.approx(period, abs=1e-8)
+    assert_same_multipliers([complex(re, im) for re, im in document["multipliers"]],
+                            goswami_multipliers(x, 0.03))
+    assert document["stable"] is True
 
 
 def test_a_driven_model_has_no_autonomous_cycle():

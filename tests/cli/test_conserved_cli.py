@@ -5,8 +5,10 @@ from __future__ import annotations
 import json
 
 import pytest
+import sympy
 
 from conserved_models import CENTRAL_WELL, SPHERICAL_PENDULUM
+from lagrangian.model.expressions import parse_expression
 
 
 @pytest.fixture(scope="module")
@@ -56,5 +58,18 @@ def test_derive_hamilton_prints_h_and_the_momenta(cli):
     assert document["q_dot"] == {"theta": "p_theta/(L**2*m)"}
     text = cli("derive", "pendulum", "--hamilton").out
     assert "H = " in text
+    # p_dot = -dH/dtheta = -m g L sin(theta), written out where it is short
+    assert "p_theta_dot = -dH/dtheta = -L*g*m*sin(theta)" in text
+    # the hoop: p_dot = m R^2 Omega^2 sin cos - m g R sin (the drive's centrifugal term)
+    hoop = cli("derive", "bead_on_hoop", "--hamilton", "--json").out
+    p_dot = json.loads(hoop)["p_dot"]["p_theta"]
+    m, R, g, Omega, theta = sympy.symbols("m R g Omega theta")
+    names = {"m": m, "R": R, "g": g, "Omega": Omega, "theta": theta}
+    assert sympy.simplify(parse_expression(p_dot, names) - (
+        m * R**2 * Omega**2 * sympy.sin(theta) * sympy.cos(theta) - m * g * R * sympy.sin(theta))) == 0
+    assert f"p_theta_dot = -dH/dtheta = {p_dot}" in cli("derive", "bead_on_hoop", "--hamilton").out
+    # too long for a line (the double pendulum's): named, and given in --json
+    assert "p_theta1_dot = -dH/dtheta1 (written out in --json)" in \
+        cli("derive", "double_pendulum", "--hamilton").out
     bad = cli("derive", "cartesian_pendulum", "--hamilton")
     assert bad.code == 2 and "unconstrained" in bad.err

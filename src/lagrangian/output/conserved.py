@@ -101,6 +101,9 @@ def routhian_document(reduced: Model) -> dict[str, Any]:
             "effective_potential": format_expression(reduced.potential_energy)}
 
 
+_WRITTEN_OPS = 40  # -dH/dq up to this many operations is written out in the text
+
+
 def hamiltonian_text(hamiltonian: Hamiltonian) -> str:
     """derive --hamilton: the momenta, H and Hamilton's equations."""
     model = hamiltonian.eom.model
@@ -115,7 +118,10 @@ def hamiltonian_text(hamiltonian: Hamiltonian) -> str:
     for q, p, Q in zip(model.q, hamiltonian.momenta, forces, strict=True):
         extra = "" if Q == 0 else f" + Q[{q}]"
         lines.append(f"  {q}_dot = {format_expression(sp.simplify(H.diff(p)))}")
-        lines.append(f"  {p}_dot = -dH/d{q}{extra}")
+        rate = -H.diff(q)  # written out where it reads at a glance; --json has it always
+        written = (f" = {format_expression(rate + Q)}" if sp.count_ops(rate) <= _WRITTEN_OPS
+                   else " (written out in --json)")
+        lines.append(f"  {p}_dot = -dH/d{q}{extra}{written}")
     return "\n".join(lines) + "\n"
 
 

@@ -26,6 +26,8 @@ def _quiet(cli, *args):
 @pytest.mark.parametrize(("args", "message"), [
     # m L^2 of L = 1e300 overflows: M is inf (was scipy's "array must not contain infs")
     (("modes", "pendulum", "--set", "L=1e300"), "error: the mass matrix M is not finite"),
+    # M, K finite, M^-1 K = g/L = 2e308 not (was overflow and NaN warnings, then a NaN residual)
+    (("modes", "pendulum", "--set", "g=1e308"), "error: the state matrix A = [0 I; -M^-1 K"),
     (("simulate", *CART, "--control", "lqr", "--inputs", "F", "--Q", "inf"),
      "error: --Q: entries must be finite numbers"),
     (("simulate", *CART, "--control", "lqr", "--inputs", "F", "--R", "nan"),

@@ -227,8 +227,13 @@ def linear_model_at(
                               "the linear model has no state-space form") from None
     columns = np.zeros((n, 0)) if input_columns is None else np.asarray(input_columns, float)
     Br = basis.T @ columns
-    A = state_matrix(-projector @ Kr, -projector @ Cr)
-    B = np.vstack([np.zeros((p, columns.shape[1])), projector @ Br])
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused just below
+        A = state_matrix(-projector @ Kr, -projector @ Cr)
+        B = np.vstack([np.zeros((p, columns.shape[1])), projector @ Br])
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(B))):
+        # M, C and K are finite, but M^-1 K may not be (g = 1e308 on a pendulum of m L^2 < 1)
+        raise DerivationError("the state matrix A = [0 I; -M^-1 K  -M^-1 C] (or B) is not "
+                              "finite at this equilibrium: M^-1 K or M^-1 C overflows")
     return LinearModel(
         equilibrium={name: float(v) for name, v in zip(names, q0, strict=True)},
         multipliers={c.name: float(v) for c, v in zip(model.constraints, multipliers,

@@ -8,7 +8,7 @@ import pytest
 from check_helpers import check_text, finding
 
 import lagrangian
-from conserved_models import SPHERICAL_PENDULUM
+from conserved_models import DAMPED_PAIR, PUSHED_PAIR, SPHERICAL_PENDULUM
 from lagrangian.errors import ModelError
 from lagrangian.model.answer import parse_answer
 
@@ -92,3 +92,21 @@ def test_bad_tables_name_the_field():
         check_text("pendulum", '[conserved]\ncyclic = ["psi"]\n')
     with pytest.raises(ModelError, match="hamiltonian.H"):
         check_text("pendulum", '[hamiltonian]\nH = 3\n')
+
+
+def test_total_momentum_claimed_where_a_load_breaks_it_says_which_load(tmp_path):
+    """m1 x1_dot + m2 x2_dot is the quantity of the translation xi = (1, 1): a dashpot on the
+    stretch does no work along it (still conserved), a push k on x1 does (Q . xi = k)."""
+    claim = '[conserved]\nquantities = ["m₁ ẋ₁ + m₂ ẋ₂"]\n'
+    for name, text in (("damped", DAMPED_PAIR), ("pushed", PUSHED_PAIR)):
+        (tmp_path / f"{name}.toml").write_text(text)
+    damped = _check(lagrangian.load(tmp_path / "damped.toml"), claim)
+    assert finding(damped, "conserved[1]").status == "correct"
+    pushed = finding(_check(lagrangian.load(tmp_path / "pushed.toml"), claim), "conserved[1]")
+    assert pushed.code == "momentum_not_conserved", pushed
+    assert "virtual work along it: Q . xi = k" in pushed.message
+    # the pair's x1 is in L through its spring: the terms named with their own signs
+    cyclic = finding(_check(lagrangian.load(tmp_path / "damped.toml"),
+                            '[conserved]\ncyclic = ["x1"]\n'), "cyclic[x1]")
+    assert cyclic.code == "not_cyclic" and "+ -" not in cyclic.message
+    assert "k*x1*x2 - k*l0*x1" in cyclic.message

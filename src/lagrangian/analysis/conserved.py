@@ -88,6 +88,7 @@ class NotConserved:
     name: str
     kind: ConservedKind
     reason: str
+    expression: sp.Expr | None = None  # a Noether candidate's xi . dL/dq_dot
 
 
 @dataclass(frozen=True)
@@ -144,8 +145,7 @@ def conserved_quantities(eom: EquationsOfMotion) -> ConservedQuantities:
         momentum_name = f"p_{name}"
         if coordinate in L.free_symbols and not _is_zero(L.diff(coordinate), model):
             terms = [t for t in sp.Add.make_args(L) if coordinate in t.free_symbols]
-            not_cyclic.append((name, " + ".join(format_expression(t) for t in terms[:4])
-                               + (" + ..." if len(terms) > 4 else "")))
+            not_cyclic.append((name, _sum_text(terms[:4]) + (" + ..." if len(terms) > 4 else "")))
             continue
         cyclic.append(i)
         generator = tuple(sp.S.One if j == i else sp.S.Zero for j in range(len(q)))
@@ -170,14 +170,28 @@ def conserved_quantities(eom: EquationsOfMotion) -> ConservedQuantities:
         for k, generator in enumerate(_affine_generators(L, eom, cyclic), start=1):
             name = f"J{k}"
             reason = _work_along(eom, generator)
-            if reason is not None:
-                broken.append(NotConserved(name, ConservedKind.NOETHER, reason))
-                continue
             expression = sp.factor_terms(sp.expand(sum(
                 (x * L.diff(v) for x, v in zip(generator, q_dot, strict=True)), sp.S.Zero)))
+            if reason is not None:
+                broken.append(NotConserved(name, ConservedKind.NOETHER, reason, expression))
+                continue
             quantities.append(ConservedQuantity(name, ConservedKind.NOETHER, expression,
                                                 generator, **common))
     return ConservedQuantities(tuple(quantities), tuple(broken), tuple(not_cyclic), note)
+
+
+def _sum_text(terms: Sequence[sp.Expr]) -> str:
+    """Terms in the order given, joined by their signs (a - b, not a + -b)."""
+    text = ""
+    for term in terms:
+        written = format_expression(term)
+        if not text:
+            text = written
+        elif written.startswith("-"):
+            text += f" - {written[1:]}"
+        else:
+            text += f" + {written}"
+    return text
 
 
 def _is_zero(expr: sp.Expr, model) -> bool:

@@ -238,6 +238,14 @@ class _Mechanics:
                                f"this is the momentum of {name}, which is cyclic, but "
                                f"{broken[0]}.", listed,
                                hint=f"Does a load do virtual work along {name}?")
+        for b in self.found.broken:  # a symmetry of L that a load breaks (a push on x1)
+            if b.expression is not None and not eq.zero(b.expression, points) and \
+                    eq.constant_in_state(F / b.expression, points):
+                return Finding(item, "wrong", "momentum_not_conserved",
+                               f"this is {fmt(b.expression)}, the quantity of a symmetry of L, "
+                               f"but {b.reason}.", listed,
+                               hint="Does a load do virtual work along the symmetry's "
+                                    "direction?")
         return Finding(item, "wrong", "not_conserved",
                        f"{fmt(F)} changes along the motion (dF/dt != 0 by the equations of "
                        "motion).", listed,

@@ -182,3 +182,17 @@ def test_control_law_codegen_section(cli, tmp_path, monkeypatch):
     assert tau == pytest.approx(-4.0 * 0.3, abs=1e-6)
     assert a == pytest.approx((tau - 9.81 * 0.5 * np.sin(0.3)) / 0.25, abs=1e-6)
     assert f"{tau:.6f} {a:.6f}" in main  # the printed figures in the page are these
+
+
+def test_computed_torque_on_ball_joints_section(capsys, tmp_path, monkeypatch, cli):
+    monkeypatch.chdir(tmp_path)  # the example writes wrist.xml where it runs
+    lines = _run("control-computed-torque-ball", capsys)
+    assert lines[0] == str(("shoulder_qw", "shoulder_qx", "shoulder_qy", "shoulder_qz",
+                            "elbow"))
+    assert lines[-1] == "True"
+    result = cli("simulate", "wrist.xml", "--t-end", "3", "--control", "computed-torque",
+                 "--about", "shoulder_qw=0.8,shoulder_qx=0.6", "--json")
+    assert result.code == 0, result.err
+    final = json.loads(result.out)["final_state"]
+    assert final["shoulder_qw"] == pytest.approx(0.8, abs=1e-8)
+    assert final["shoulder_qx"] == pytest.approx(0.6, abs=1e-8)

@@ -85,7 +85,8 @@ def simulate(
     system = load_system(model, set_, lock, gravity, payload, floating_base)
     tree = system.model.kinematic_tree
     # q and v differ (a floating base's numbers, a ball joint's quaternion): simulate judges
-    manifold = getattr(tree, "floating_base", False) or bool(getattr(tree, "spherical", ()))
+    manifold = getattr(tree, "floating_base", False) or bool(getattr(tree, "quaternion_joints",
+                                                                     ()))
     if not system.runs_on_tree:  # a tree's masses are checked as it is read; nothing derived
         warn_if_unphysical(system.equations_of_motion())
     end = parse_quantity(t_end, "s", "--t-end")
@@ -214,21 +215,23 @@ def simulate(
 def _refuse_on_manifold(tree, animate, control, along) -> None:
     """What a run whose q and v differ does not take yet, refused in one line before it: a
     floating base's drawing (the model's bodies hold no base; a ball is drawn by its Euler
-    hinges), and on a ball joint the controllers and the linearization along the run (both
-    built on q_dot = v)."""
+    hinges), and on a ball joint LQR and the linearization along the run (both built on
+    q_dot = v; computed torque takes the error on the manifold)."""
     from ..errors import InputError
 
-    balls = getattr(tree, "spherical", ())
+    joints = getattr(tree, "quaternion_joints", ())  # a ball, a free flyer below the root
     if animate is not None and getattr(tree, "floating_base", False):
         raise InputError("a floating base's run is not animated yet: --out and --plot are",
                          field="--animate")
     for flag, given, then in (
-            ("--control", control not in (None, "model"), "; in Python, give simulate a "
-             "controller (t, q, v) -> u of nv torques (a ball's: its moment, body axes)"),
+            ("--control", control == "lqr", "; --control computed-torque takes it, and in "
+             "Python simulate takes a controller (t, q, v) -> u of nv torques (a ball's: its "
+             "moment, body axes)"),
             ("--linearize-along", along, "")):
-        if given and balls:
-            raise InputError(f"the ball joint '{balls[0].name}' is not linearized yet (q_dot is "
-                             f"not v for its quaternion){then}", field=flag)
+        if given and joints:
+            kind = "ball" if joints[0].kind == "spherical" else "floating"
+            raise InputError(f"the {kind} joint '{joints[0].name}' is not linearized yet (q_dot "
+                             f"is not v for its quaternion){then}", field=flag)
 
 
 def _impact_options(system, max_impacts, settle) -> dict:

@@ -3,7 +3,10 @@ tau = M(q) (q_ddot_d + Kd (q_dot_d - q_dot) + Kp (q_d - q)) + C(q, q_dot) q_dot 
 
 On the model it was computed from, the error e = q_d - q then obeys e_ddot + Kd e_dot + Kp e = 0
 exactly: with Kp = w^2 I and Kd = 2 w I (critical damping) each joint's error is
-(e0 + (e0_dot + w e0) t) exp(-w t). Units SI (rad or m; tau in N m or N; gains 1/s^2, 1/s).
+(e0 + (e0_dot + w e0) t) exp(-w t). Where q and v differ in length (a ball joint, a free flyer
+below the root) the error is taken on the manifold, e = q_d (-) q (the dynamics' difference: q
+(+) e = q_d, a ball's turn in its body's axes), and the law holds to first order in e (the
+exponential map's Jacobian is 1 + O(e)). Units SI (rad or m; tau in N m or N; gains 1/s^2, 1/s).
 """
 
 from __future__ import annotations
@@ -28,17 +31,20 @@ class ComputedTorque:
     Kd: np.ndarray
     reference: Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
     inputs: tuple[str, ...] = ()  # generalized forces on every coordinate
+    # q and v differ in length (ball joints, free flyers below the root): e = q_d (-) q
+    manifold: bool = False
 
     @property
     def error_eigenvalues(self) -> np.ndarray:
         """The eigenvalues of the error dynamics [[0, I], [-Kp, -Kd]] (1/s)."""
-        n = len(self.coordinates)
+        n = len(self.Kp)
         return np.linalg.eigvals(np.block([[np.zeros((n, n)), np.eye(n)], [-self.Kp, -self.Kd]]))
 
     def __call__(self, t, q, q_dot) -> np.ndarray:
         q_d, v_d, a_d = self.reference(t)
         q, v = np.asarray(q, dtype=float), np.asarray(q_dot, dtype=float)
-        command = a_d + self.Kd @ (v_d - v) + self.Kp @ (q_d - q)
+        error = self.dynamics.difference(q, q_d) if self.manifold else q_d - q
+        command = a_d + self.Kd @ (v_d - v) + self.Kp @ error
         mass = self.dynamics.mass_matrix(q)
         return mass @ command + self.dynamics.bias_forces(q, v)
 
@@ -64,7 +70,17 @@ def computed_torque(system, q_des, Kp, Kd) -> ComputedTorque:
     if constraints:  # M q_ddot = tau - bias would ignore the constraint forces
         raise ModelError(f"computed torque needs a model without constraints (this one has "
                          f"{len(constraints)}: {', '.join(constraints)})", field="constraints")
-    if getattr(dynamics, "velocity_names", None) is not None:
+    velocities = getattr(dynamics, "velocity_names", None)
+    tree = getattr(dynamics, "tree", None)
+    if velocities is not None and not getattr(tree, "floating_base", False):
+        # a ball joint or a free flyer below the root: every velocity number driven, the
+        # error on the manifold
+        n = len(velocities)
+        Kp = square_matrix(Kp, n, "Kp", definite=True)
+        Kd = square_matrix(Kd, n, "Kd", definite=True)
+        return ComputedTorque(dynamics, tuple(velocities), Kp, Kd,
+                              _manifold_reference(q_des, dynamics, system), manifold=True)
+    if velocities is not None:
         # tau = M(q) q_ddot_d + b commands all nv forces, the base's wrench among them: a
         # floating base's simulation takes the joints' forces only (nothing pushes the base)
         raise ModelError("computed torque needs every coordinate actuated, and a floating "
@@ -111,4 +127,40 @@ def _reference(q_des, names: tuple[str, ...], system):
     if not np.all(np.isfinite(target)):
         raise InputError("the reference must be finite", field="q_des")
     zero = np.zeros(n)
+    return lambda t: (target, zero, zero)
+
+
+def _manifold_reference(q_des, dynamics, system):
+    """t -> (q_d (nq), q_dot_d (nv), q_ddot_d (nv)) for a tree whose q and v differ in length,
+    checked once at t = 0: a target by name (a ball's <ball>_qw..qz, the joints' as for a
+    fixed base; the rest at simulate's start), nq numbers, or a callable; unit quaternions."""
+    from ..simulation.tree_state import TreeState
+
+    nq, nv = len(dynamics.coordinates), len(dynamics.velocity_names)
+    if callable(q_des):
+        def reference(t):
+            value = q_des(t)
+            if not (isinstance(value, tuple | list) and len(value) == 3):
+                raise InputError("a reference callable must return (q_d, q_dot_d, q_ddot_d)",
+                                 field="q_des")
+            parts = tuple(np.asarray(x, dtype=float) for x in value)
+            if [x.shape for x in parts] != [(nq,), (nv,), (nv,)]:
+                raise InputError(f"a reference callable must return q_d of {nq} values and "
+                                 f"q_dot_d, q_ddot_d of {nv}, got shapes "
+                                 f"{[x.shape for x in parts]}", field="q_des")
+            return parts
+
+        dynamics.difference(reference(0.0)[0], reference(0.0)[0])  # its quaternions checked
+        return reference
+    if isinstance(q_des, Mapping):
+        _, target, _ = TreeState(dynamics, system.model).start(system.model, dict(q_des))
+    else:
+        target = np.asarray(q_des, dtype=float)
+        if target.shape != (nq,):
+            raise InputError(f"expected {nq} values ({', '.join(dynamics.coordinates)}), got "
+                             f"shape {target.shape}", field="q_des")
+    if not np.all(np.isfinite(target)):
+        raise InputError("the reference must be finite", field="q_des")
+    dynamics.difference(target, target)  # a quaternion off unit norm: one line naming it
+    zero = np.zeros(nv)
     return lambda t: (target, zero, zero)

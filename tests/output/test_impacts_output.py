@@ -1,10 +1,12 @@
 """Impacts shown: the text and JSON of a run's impacts, the cycle's words, the impacts marked
-on the time histories (output/impacts.py, output/plots.py)."""
+on the time histories and named on the animation's frames (output/impacts.py, output/plots.py,
+output/animation.py)."""
 
 from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 import lagrangian
@@ -42,3 +44,23 @@ def test_the_cycle_in_words():
     assert "a stable limit cycle through 'spoke'" in text and "0.5 (|0.5|)" in text
     document = cycle_document(cycle)
     assert document["multipliers"] == [[pytest.approx(0.5, abs=1e-8), 0.0]]
+
+
+def test_the_animation_names_each_impact_on_the_frames_after_it(run):
+    from lagrangian.output.animation import IMPACT_SHOWN_S, mechanism_animation
+
+    animation = mechanism_animation(run, fps=20)
+    label, times = animation.impact_label, animation.times
+    for record in run.impacts:
+        k = int(np.searchsorted(times, record.time))  # the first frame at or after it
+        animation.draw(k)
+        assert label.get_text() == "impact: floor"
+        later = int(np.searchsorted(times, record.time + IMPACT_SHOWN_S + 0.06))
+        if later < len(times) and all(not record.time < r.time <= times[later]
+                                      for r in run.impacts):
+            animation.draw(later)
+            assert label.get_text() == ""
+    animation.draw(0)  # falling from 1 m: the floor first struck at sqrt(2/g) = 0.45 s
+    assert label.get_text() == ""
+    assert mechanism_animation(lagrangian.load("double_pendulum").simulate(0.1, samples=5),
+                               fps=10).impact_label is None

@@ -136,14 +136,37 @@ def mechanism_animation(result: SimulationResult, *, fps: int = 25, max_frames: 
     panel = mechanism_panel(ax, geometry, q, v, times, view=view, trail=max(1, int(fps)),
                             title=plain_text(result.model_name), shift=shift)
     clock = _clock(ax)
+    struck, labels = _impact_labels(ax, result, times)
 
     def draw(k):
         clock.set_text(f"{times[k]:.2f}")
-        return [*panel.draw(k), clock]
+        if struck is None:
+            return [*panel.draw(k), clock]
+        struck.set_text(labels[k])
+        return [*panel.draw(k), clock, struck]
 
     animation = _animation(figure, draw, times, fps, html_dpi=None if size else HTML_DPI)
     animation.panels = (panel,)
+    animation.impact_label = struck
     return animation
+
+
+IMPACT_SHOWN_S = 0.15  # an impact's name stays this long on the frames after it (s)
+
+
+def _impact_labels(ax, result, times: np.ndarray):
+    """A run through impacts: a text in the corner and, per frame, "impact: <name>" on the
+    frames within IMPACT_SHOWN_S (or one frame's spacing) after one, else ""."""
+    records = getattr(result, "impacts", ())
+    if not records:
+        return None, None
+    at = np.array([record.time for record in records])
+    shown = max(IMPACT_SHOWN_S, float(np.max(np.diff(times)))) if len(times) > 1 \
+        else IMPACT_SHOWN_S
+    latest = np.searchsorted(at, times, side="right") - 1  # each frame's latest impact
+    labels = [f"impact: {records[i].name}" if i >= 0 and t - at[i] <= shown else ""
+              for i, t in zip(latest, times, strict=True)]
+    return ax.text(0.02, 0.89, "", transform=ax.transAxes, color="C3"), labels  # under the clock
 
 
 def mechanism_picture(model: Model, q=None, parameters=None, *, size: object = None,

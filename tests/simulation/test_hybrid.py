@@ -81,8 +81,9 @@ def test_the_cap_on_impacts(ball):
     capped = ball.simulate(5.0, samples=101, max_impacts=3)
     assert capped.status == "impact_limit" and len(capped.impacts) == 3
     assert "3 impacts" in capped.message
-    with pytest.raises(InputError, match="max_impacts"):
-        ball.simulate(1.0, max_impacts=-1)
+    for bad in (-1, 0):  # 0: the first impact would pass the cap
+        with pytest.raises(InputError, match="max_impacts must be a whole number >= 1"):
+            ball.simulate(1.0, max_impacts=bad)
 
 
 def test_a_stop_condition_is_refused_for_impacts(ball):

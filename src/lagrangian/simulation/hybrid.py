@@ -269,8 +269,9 @@ def simulate_through_impacts(
         if value not in (None, (), False, True):
             raise InputError(f"'{name}' is not available for a model with impacts",
                              field=name)
-    if isinstance(max_impacts, bool) or not isinstance(max_impacts, int) or max_impacts < 0:
-        raise InputError(f"max_impacts must be a whole number >= 0, got {max_impacts!r}",
+    # 0 would be a cap the first impact already passes (the run stops just after it)
+    if isinstance(max_impacts, bool) or not isinstance(max_impacts, int) or max_impacts < 1:
+        raise InputError(f"max_impacts must be a whole number >= 1, got {max_impacts!r}",
                          field="max_impacts")
     model = eom.model
     start = resolve_state(model, initial, field="initial", what="coordinate or velocity (or t)")

@@ -228,12 +228,14 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
             if isinstance(limits, bool | str) else None
         if start_beyond is None:
             raise InputError(f"limits is True, False or 'clamp', not {limits!r}", field="limits")
-        # q and v differ in length (a floating base, a ball joint): simulation/floating.py
-        manifold = self._floating or bool(getattr(self._model.kinematic_tree, "spherical", ()))
+        # q and v differ in length (a floating base, a ball joint, a free flyer below the
+        # root): simulation/floating.py
+        manifold = self._floating or bool(getattr(self._model.kinematic_tree,
+                                                  "quaternion_joints", ()))
         if start_beyond == "clamp" and manifold:
             raise InputError(("a floating base's" if self._floating else "a robot with a ball "
-                              "joint:") + " start is not clamped (yet): start it inside, "
-                             "or run with limits=False", field="limits")
+                              "or floating joint:") + " start is not clamped (yet): start it "
+                             "inside, or run with limits=False", field="limits")
         limits = limits is not False
         tree = self._recursive is not None  # the tree's recursions: nothing to derive
         if canonical is not True and canonical is not False:

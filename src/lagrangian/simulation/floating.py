@@ -3,7 +3,9 @@ floating base): y = [q, v (nv)] integrated on the manifold (simulation/tree_stat
 
 q_dot from v by the free flyer's kinematics (position rate R v_lin, quaternion rate
 1/2 q (x) (0, omega)), the base's quaternion renormalized after each accepted step and at each
-sample; each ball joint as q = c (x) exp(d) (q (+) d, MuJoCo's mj_integratePos), the solver
+sample; a free flyer below the root (a URDF floating joint between links) its position by
+R(quat) v_lin in its parent's joint frame, its quaternion as a ball's; each ball joint as
+q = c (x) exp(d) (q (+) d, MuJoCo's mj_integratePos), the solver
 stepping the turn d (3 numbers, rad) by d_dot = J_r(d)^-1 omega (omega in the body's axes)
 and moving the centre c to the ball when |d| passes tree_state.RECENTRE (restarting there with
 the step size it had), so a ball's quaternion is of norm 1 by construction; v_dot by the
@@ -95,11 +97,12 @@ def floating_stop_condition(text: str, dynamics, model) -> StopCondition:
     import sympy as sp
 
     state = TreeState(dynamics, model)
-    own = (*state.base_q, *state.base_v, *sorted(state.ball_q), *sorted(state.ball_v))
+    # a free flyer's x y z are the model's coordinates too: parsed as the model's
+    own = (*state.base_q, *state.base_v, *sorted(state.ball_q), *sorted(state.ball_v),
+           *sorted(state.free_q - set(state.free_model)), *sorted(state.free_v))
     stop = parse_stop_condition(text, model, names={name: sp.Symbol(name) for name in own})
     for symbol in sorted(stop.function.free_symbols, key=str):
-        name = str(symbol)
-        state.refuse_hinge(name.removesuffix("_dot"), "stop_when")
+        state.refuse_hinge(str(symbol), "stop_when")
     return stop
 
 
@@ -169,6 +172,8 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
         rate = np.empty(nq)
         if state.floating:
             base_rate(q, v, rate)
+        for _, iq, iv in state.free:  # x y z rate R v_lin (its quaternion's: the chart's)
+            base_rate(q[iq:iq + 7], v[iv:iv + 6], rate[iq:iq + 7])
         rate[q_of] = v[v_of]
         return np.concatenate([chart.rate(y[:nz], v, rate),
                                dynamics.forward_dynamics(q, v, tau)])

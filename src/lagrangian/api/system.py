@@ -211,7 +211,9 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         is the n joint torques or all n + 6 entries, the base's wrench first, and
         ``stop_when`` may name the base's numbers (base_z, base_vz, ...); a ball joint's
         quaternion and angular velocity are named <joint>_qw .. _qz and <joint>_wx .. _wz
-        (docs/bridges.md). A model with
+        (docs/bridges.md), a URDF floating joint between links' <joint>_x .. _qw (m, then
+        x y z w) and <joint>_vx .. _wz (m/s, rad/s, child axes) (docs/floating-base.md). A
+        model with
         [[impacts]] runs through them (``.impacts`` lists each; status 'accumulated' where they
         accumulate, 'settled' with ``settle=True``, 'impact_limit' at ``max_impacts``, default
         1000): docs/simulation.md. ``canonical=True`` integrates Hamilton's equations in

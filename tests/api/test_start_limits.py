@@ -106,3 +106,34 @@ def test_a_joint_on_its_limit_hides_no_crossing():
     assert run.status == lagrangian.RunStatus.LIMIT
     assert "joint 'panda_joint2' (panda_joint2) reached its position limit 1.7628" in run.message
     assert run.q[-1, 1] == pytest.approx(1.7628, abs=1e-6)
+
+
+# A slider resting on its lower limit 0 beside a 1 m pendulum hinged on the same base (their
+# motions independent): the pendulum's crossing is the one named.
+TWIN = """<?xml version="1.0"?>
+<robot name="twin">
+  <link name="base"/>
+  <link name="slide"><inertial><mass value="1"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+  <link name="bob"><inertial><origin xyz="0 0 -1"/><mass value="1"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+  <joint name="slider" type="prismatic"><parent link="base"/><child link="slide"/>
+    <axis xyz="1 0 0"/><limit lower="0" upper="1" effort="1" velocity="10"/></joint>
+  <joint name="hinge" type="revolute"><parent link="base"/><child link="bob"/>
+    <axis xyz="0 1 0"/><limit lower="-0.3" upper="0.6" effort="1" velocity="10"/></joint>
+</robot>
+"""
+
+
+def test_the_joint_that_crossed_is_named_not_one_resting_on_its_limit(tmp_path):
+    # the event's root leaves the hinge 1e-13 short of -0.3 or past it; the slider, exactly on
+    # 0, was named about half the time (from rest at 0.45 rad and at 0.35 rad, both were)
+    path = tmp_path / "twin.urdf"
+    path.write_text(TWIN)
+    robot = lagrangian.load(path)
+    for theta0 in (0.45, 0.35):
+        run = robot.simulate(3, initial={"hinge": theta0}, samples=11)
+        assert run.status == lagrangian.RunStatus.LIMIT
+        assert run.message.startswith("joint 'hinge' (hinge) reached its position limit -0.3")
+        assert run.q[-1, 0] == 0.0
+        assert run.t[-1] == pytest.approx(_time_between(9.81, theta0, -0.3, 200_001), rel=1e-3)

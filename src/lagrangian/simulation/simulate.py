@@ -440,10 +440,14 @@ def beyond_limits(limits: Sequence[JointLimit], q0: np.ndarray | None = None):
         low_margin = np.where(x0 <= lower, _ON_LIMIT * (1 + np.abs(lower)), 0.0)
         high_margin = np.where(x0 >= upper, _ON_LIMIT * (1 + np.abs(upper)), 0.0)
 
-    def beyond(q, v, t) -> float:
+    def distances(q) -> np.ndarray:
         x = np.asarray(q, dtype=float)[index]
-        return float(np.max(np.maximum(lower - x - low_margin, x - upper - high_margin)))
+        return np.maximum(lower - x - low_margin, x - upper - high_margin)
 
+    def beyond(q, v, t) -> float:
+        return float(np.max(distances(q)))
+
+    beyond.limits, beyond.distances = limits, distances  # at_limit names the one reached
     return beyond
 
 
@@ -455,7 +459,9 @@ def at_limit(run: LoopRun, limits, beyond, event, n: int) -> LoopRun:
     if event is not None and event(y[:n], y[n:], t) > h:
         return run
     x = y[:n]
-    reached = max(limits, key=lambda m: max(m.lower - x[m.coordinate], x[m.coordinate] - m.upper))
+    # the joint whose distance decided h, margins included: a joint resting on its limit (0 m
+    # away) was named in place of the one that crossed (-1e-13 away at the event's root)
+    reached = beyond.limits[int(np.argmax(beyond.distances(x)))]
     side = reached.lower if x[reached.coordinate] < 0.5 * (reached.lower + reached.upper) \
         else reached.upper
     return replace(run, status=RunStatus.LIMIT, message=(

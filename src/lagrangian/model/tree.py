@@ -261,7 +261,7 @@ def refuse_free_joints(tree: KinematicTree | None, what: str) -> None:
         raise ModelError(f"joint '{free[0].name}' is a floating joint below the root (a free "
                          f"flyer between two links), which {what} does not take yet (M, "
                          "inverse and forward dynamics and their derivatives, the energies, "
-                         "frames and Jacobians do)", field="joint")
+                         "frames, Jacobians and simulate do)", field="joint")
 
 
 _QUATERNION = (JointKind.SPHERICAL, JointKind.FREE_FLYER)

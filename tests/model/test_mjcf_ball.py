@@ -1,7 +1,7 @@
 """MJCF ball joints (model/mjcf_ball.py): the tree's spherical joint in MuJoCo's own layout, so
 qpos, qvel, qacc and qfrc move unchanged for a fixed base, and through model/mjcf_state.py's
-maps (only the free joint's numbers change) for a floating one; MuJoCo's mj_inverse and
-mj_forward reproduced to 1e-9; what a ball joint does not take yet refused in one line."""
+maps (only the free joint's numbers change) for a floating one; MuJoCo's mj_fullM, mj_inverse
+and mj_forward reproduced to 1e-9; what a ball joint does not take yet refused in one line."""
 
 from __future__ import annotations
 
@@ -79,6 +79,11 @@ def test_inverse_and_forward_dynamics_agree_with_mujoco(limb, backend):
         data.qpos[:], data.qvel[:], data.qacc[:] = qpos, qvel, qacc
         mujoco.mj_inverse(model, data)
         q, v, a = layout.from_mujoco(qpos, qvel, qacc)
+        # M = G^T M_mj G, G = d qvel / d v (the base's linear rows turned; the armature in both)
+        G = np.column_stack([layout.to_mujoco(q, e)[1] for e in np.eye(model.nv)])
+        M_mj = np.zeros((model.nv, model.nv))
+        mujoco.mj_fullM(model, data, M_mj)
+        np.testing.assert_allclose(d.mass_matrix(q), G.T @ M_mj @ G, rtol=0, atol=1e-9)
         tau = layout.force_from_mujoco(qpos, data.qfrc_inverse)
         np.testing.assert_allclose(d.inverse_dynamics(q, v, a), tau, rtol=0, atol=1e-9)
         data.qfrc_applied[:] = rng.uniform(-2.0, 2.0, model.nv)

@@ -8,9 +8,15 @@ from __future__ import annotations
 import sympy as sp
 
 from ..derivation.equations import EquationsOfMotion
-from ..derivation.intermediates import Intermediates, intermediates, is_large, with_entries
+from ..derivation.intermediates import (
+    LARGE_TREE_NODES,
+    Intermediates,
+    intermediates,
+    is_large,
+    with_entries,
+)
 from ..derivation.readable import readable, readable_matrix
-from ..model.expressions import format_expression
+from ..model.expressions import format_expression, tree_size
 
 
 class _Display:
@@ -79,7 +85,7 @@ def printed_expressions(eom: EquationsOfMotion) -> list[sp.Expr]:
 def _named(eom: EquationsOfMotion) -> Intermediates | None:
     """The intermediate quantities where the equations written out would be large, else None."""
     exprs = printed_expressions(eom)
-    if not is_large(exprs):
+    if not is_large(exprs) or _collapses(eom, exprs):
         return None
     model = eom.model
     taken = {p.name for p in model.parameters} | {str(s) for s in eom.multipliers}
@@ -92,6 +98,28 @@ def _named(eom: EquationsOfMotion) -> Intermediates | None:
                for j in range(i, M.cols) if M[i, j] != 0]
     entries += [(f"f_{name}", value) for name, value in zip(names, eom.forcing, strict=True)]
     return with_entries(named, entries, taken)
+
+
+# A large derivation on few coordinates whose readable T is this many times shorter is tried
+# in readable forms whole (a top built of particles: its rotation's products collapse by
+# sin^2 + cos^2 = 1, 22,000-55,000 nodes to 200 in 1-2 s); a spatial chain's T does not shrink
+# (its readable forms cost 40 s at 4 links), and neither does one past COLLAPSE_NODES.
+COLLAPSE_RATIO = 10
+COLLAPSE_COORDINATES = 3
+COLLAPSE_NODES = 3 * LARGE_TREE_NODES
+
+
+def _collapses(eom: EquationsOfMotion, exprs: list[sp.Expr]) -> bool:
+    """Whether the readable forms of large derived expressions are small: written out then."""
+    model = eom.model
+    if len(model.coordinates) > COLLAPSE_COORDINATES or is_large(exprs, COLLAPSE_NODES):
+        return False
+    rates = frozenset([*model.q_dot, *model.q_ddot, *eom.multipliers])
+    ranges = {c.symbol: tuple(c.range) for c in model.coordinates if c.range}
+    T = eom.kinetic_energy
+    if COLLAPSE_RATIO * tree_size(readable(T, rates, ranges)) > tree_size(T):
+        return False
+    return not is_large([readable(e, rates, ranges) for e in exprs])
 
 
 # LaTeX: the letters of the labels, set in another alphabet when the model has a symbol of

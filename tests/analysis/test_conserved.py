@@ -65,6 +65,20 @@ def test_spherical_pendulum_routhian_conical_frequency(models):
     assert modes.natural_frequencies[0] == pytest.approx(expected, rel=0, abs=1e-7)
 
 
+def test_the_routhian_steps_and_balances_as_the_full_pendulum(models):
+    """The reduced model at the start's p_phi swings theta as the full one does, and the
+    conical motion at theta0 = 0.6 rad (phi_dot^2 = g/(l cos theta0)) is its equilibrium."""
+    full, reduced = models["spherical"], models["spherical"].routhian("phi")
+    m, l, g, theta0 = 1.3, 0.8, 9.81, 0.6
+    assert reduced.parameters["p_phi"] == pytest.approx(m * l**2 * math.sin(theta0)**2 * 1.0)
+    a, b = full.simulate(1.0), reduced.simulate(1.0)
+    swing = np.interp(np.asarray(b["t"]), np.asarray(a["t"]), np.asarray(a["theta"]))
+    assert np.abs(swing - np.asarray(b["theta"])).max() < 1e-7
+    p_phi = m * l**2 * math.sin(theta0)**2 * math.sqrt(g / (l * math.cos(theta0)))
+    found = reduced.with_parameters(p_phi=p_phi).equilibria()
+    assert any(abs(e.coordinates["theta"] - theta0) < 1e-9 and e.stable for e in found), found
+
+
 def test_routhian_refuses_a_coordinate_that_is_not_cyclic(models):
     with pytest.raises(ModelError, match="'theta' is not cyclic: L depends on it through"):
         models["spherical"].routhian("theta")

@@ -103,9 +103,7 @@ def test_a_start_beyond_a_limit_is_refused_naming_the_joint(pendulum, cli, float
 
     robot = lagrangian.load(pendulum, floating_base=floating)
     with pytest.raises(InputError, match=r"joint 'hinge.1' \(hinge_1\) starts at 0\.7, above "
-                                         r"its position limit 0\.5 \(range -0\.3 to 0\.5\); "
-                                         r".*\(limits='clamp', --clamp-start\) .*"
-                                         r"\(limits=False, --ignore-limits\)"):
+                                         r"its position limit 0\.5 \(range -0\.3 to 0\.5\)"):
         robot.simulate(0.1, initial={"hinge_1": 0.7})
     if not floating:  # floating, the point mass on a massless base has a singular M
         assert robot.simulate(0.05, initial={"hinge_1": 0.7}, limits=False).status == "finished"

@@ -413,9 +413,8 @@ def check_start_within(limits: Sequence[JointLimit], q: np.ndarray, start: str =
         where = (f"joint '{limit.joint}' ({limit.name}) starts at {x:.6g}, {side} its position "
                  f"limit {bound:.6g} (range {limit.lower:.6g} to {limit.upper:.6g})")
         if start == "refuse":
-            raise InputError(f"{where}; start it inside, clamp it to the limit (limits='clamp', "
-                             "--clamp-start) or start anyway (limits=False, --ignore-limits)",
-                             field="initial")
+            raise InputError(f"{where}; start it inside, clamp it to the limit or run with the "
+                             "position limits ignored", field="initial")
         if start == "clamp":  # on the limit: the event sees it leave (beyond_limits)
             q[limit.coordinate] = bound
             notes.append(f"{where} {limit.unit}: clamped to the limit")

@@ -94,6 +94,25 @@ def test_a_tumbling_top_keeps_its_angular_momentum_and_energy(robots):
     assert np.max(np.abs(np.linalg.norm(run.q[:, iq:iq + 4], axis=1) - 1)) < 1e-14
 
 
+@pytest.mark.parametrize("key, start", [
+    ("arm", {"grip_wx": 2.0, "grip_vy": 0.5, "shoulder_dot": 1.0, "lid_dot": -2.0}),
+    ("pod", {"pod_joint_wz": 3.0, "pod_joint_vx": 0.4, "base_wy": 1.0, "fin_joint_dot": 2.0})])
+def test_an_unactuated_run_keeps_t_plus_v(robots, key, start):
+    """The box's parent and child both moving (the arm), or the pod on a floating hull: T + V
+    constant to the step control's tolerance over 2 s, |q| = 1 to rounding."""
+    system, _ = robots[key]
+    run = system.simulate(2.0, initial=start, rtol=1e-10, atol=1e-10, samples=101,
+                          limits=False)  # the hinges swing past their URDF limits
+    assert run.status == "finished"
+    energy = run.energy
+    assert np.ptp(run.kinetic_energy) > 0.1 * np.max(np.abs(run.kinetic_energy))  # it swaps
+    # relative to the largest T (the box falls): measured 2e-9 at rtol 1e-10
+    assert np.max(np.abs(energy - energy[0])) < 1e-8 * np.max(np.abs(run.kinetic_energy))
+    stem = "grip" if key == "arm" else "pod_joint"
+    iq = list(run.coordinates).index(f"{stem}_qx")
+    assert np.max(np.abs(np.linalg.norm(run.q[:, iq:iq + 4], axis=1) - 1)) < 1e-14
+
+
 def test_the_docs_crane_runs_and_its_hook_falls_at_g_while_the_crane_is_driven(
         tmp_path, monkeypatch, capsys):
     """docs/floating-base.md's crane block: its layout printed, and with slew and travel

@@ -20,6 +20,13 @@ def test_cycle_json_of_the_rimless_wheel_at_a_slope_given_by_set(cli):
     c = math.cos(2 * alpha)
     before = math.sqrt(4 * G * math.sin(alpha) * math.sin(0.1) / (1 - c * c))
     assert document["state"]["theta_dot"] == pytest.approx(c * before, rel=1e-8)
+    # McGeer's stance from gamma - alpha to gamma + alpha from the vertical, by energy
+    from scipy.integrate import quad
+
+    period = quad(lambda phi: 1 / math.sqrt((c * before) ** 2 + 2 * G * (
+        math.cos(0.1 - alpha) - math.cos(phi))), 0.1 - alpha, 0.1 + alpha,
+        epsabs=1e-13, epsrel=1e-13)[0]
+    assert document["period"] == pytest.approx(period, rel=1e-8)
     (re, im), = document["multipliers"]
     assert (re, im) == pytest.approx((c * c, 0.0), abs=1e-8)
     assert document["stable"] is True

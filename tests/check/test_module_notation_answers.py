@@ -139,6 +139,10 @@ def test_a_period_with_2_pi_glued_and_shapes_in_roots_as_the_module_writes_them(
     assert report.correct, report
     report = check_text("double_pendulum", '[mode_shapes]\nshapes = [[1, "√3"], [1, "−√2"]]\n')
     assert finding(report, "shape[1]").status == "wrong"
+    # in the model's parameters (l1 = l2 = 1 m): taken at their values, and said so
+    report = check_text("double_pendulum", '[mode_shapes]\nshapes = [[1, "√2 l₁/l₂"], [1, "−√2"]]\n')
+    assert "at the model's parameter values" in finding(report, "shape[1]").message
+    assert finding(report, "shape[1]").status == "correct"
     # a unit glued after a number is still a unit: 2 µs is 2e-6 s, not the period
     assert finding(check_text("ladder_spring_mass", '[frequencies]\nperiod = ["2 µs"]\n'),
                    "period[1]").code == "frequency_wrong"

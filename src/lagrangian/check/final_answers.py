@@ -280,6 +280,8 @@ class _FinalChecker:
         text = "(" + ", ".join(w.text for w in shape) + ")"
         expected = "(" + ", ".join(f"{x:.4g}" for x in ours) + ")"
         precision = ("to the precision you wrote" if any(w.step for w in shape)
+                     else "at the model's parameter values, as written in its parameters"
+                     if any(w.in_parameters for w in shape)
                      else "exactly (whole numbers and constants)")
         if ok:
             return Finding(f"shape[{i}]", "correct", None,

@@ -101,6 +101,23 @@ def test_spinning_hoop_lists_the_jacobi_integral_not_t_plus_v():
     assert all(sp.simplify(q.expression - energy) != 0 for q in found)
 
 
+def test_the_heavy_tops_quantities_print_as_goldsteins():
+    """Its T is built from body rates (psi in every term): h and p_phi are shown in their
+    readable forms, equal to Goldstein's (Sec. 5.7, I1 = A + m l^2 about the pivot, I3 = C)
+    and free of psi."""
+    top = lagrangian.load("heavy_top")
+    A, C, m, l, g, theta, wp, wt, ws = _symbols(top, "A", "C", "m", "l", "g", "theta",
+                                               "phi_dot", "theta_dot", "psi_dot")
+    I1, s, c = A + m * l**2, sp.sin(theta), sp.cos(theta)
+    found = top.conserved()
+    h, p_phi = found.named("h"), found.named("p_phi")
+    book_h = (I1 * (wt**2 + wp**2 * s**2) + C * (ws + wp * c) ** 2) / 2 + m * g * l * c
+    assert sp.simplify(h.expression - book_h) == 0 and h.equals_energy
+    assert sp.simplify(p_phi.expression - (I1 * wp * s**2 + C * c * (ws + wp * c))) == 0
+    assert top.symbol("psi") not in h.expression.free_symbols | p_phi.expression.free_symbols
+    assert sp.count_ops(h.expression) <= 1.3 * sp.count_ops(book_h)
+
+
 def test_kepler_conserves_m_r2_phi_dot(models):
     system = models["kepler"]
     m, r, phi_dot = _symbols(system, "m", "r", "phi_dot")

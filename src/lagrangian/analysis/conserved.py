@@ -19,6 +19,7 @@ import sympy as sp
 
 from ..compile.lambdified import numpy_function
 from ..derivation.equations import EquationsOfMotion
+from ..derivation.readable import readable
 from ..derivation.regularity import vanishes
 from ..errors import ModelError
 from ..kinds import InvariantKind
@@ -29,6 +30,8 @@ NOETHER_MAX_COORDINATES = 6
 _SAMPLES_PER_UNKNOWN = 3
 _SMALL_OPERATIONS = 400  # L expanded and its momenta tidied below this many operations
 _SIMPLIFY_NODES = 600  # identities confirmed by simplify below this tree size
+_SHOWN_NODES = 2000  # a quantity's readable form tried below this tree size
+_SHOWN_RATIO = 0.8  # and kept where it has at most this share of the operations
 
 
 class ConservedKind(StrEnum):
@@ -155,8 +158,8 @@ def conserved_quantities(eom: EquationsOfMotion) -> ConservedQuantities:
         if reason is not None:
             broken.append(NotConserved(momentum_name, ConservedKind.MOMENTUM, reason))
             continue
-        quantities.append(ConservedQuantity(momentum_name, ConservedKind.MOMENTUM, momentum,
-                                            generator, **common))
+        quantities.append(ConservedQuantity(momentum_name, ConservedKind.MOMENTUM,
+                                            _shown(momentum, model), generator, **common))
     jacobi = _jacobi(eom, common)
     if isinstance(jacobi, NotConserved):
         broken.append(jacobi)
@@ -175,9 +178,19 @@ def conserved_quantities(eom: EquationsOfMotion) -> ConservedQuantities:
             if reason is not None:
                 broken.append(NotConserved(name, ConservedKind.NOETHER, reason, expression))
                 continue
-            quantities.append(ConservedQuantity(name, ConservedKind.NOETHER, expression,
-                                                generator, **common))
+            quantities.append(ConservedQuantity(name, ConservedKind.NOETHER,
+                                                _shown(expression, model), generator, **common))
     return ConservedQuantities(tuple(quantities), tuple(broken), tuple(not_cyclic), note)
+
+
+def _shown(expression: sp.Expr, model) -> sp.Expr:
+    """The derivation's readable form of a small quantity (equal to it) where it is clearly
+    shorter: the heavy top's h as Goldstein's, with no psi (its T is written in body rates)."""
+    if tree_size(expression, _SHOWN_NODES) >= _SHOWN_NODES:
+        return expression
+    shown = readable(expression, frozenset(model.q_dot), {c.symbol: tuple(c.range)
+                                                           for c in model.coordinates if c.range})
+    return shown if sp.count_ops(shown) < _SHOWN_RATIO * sp.count_ops(expression) else expression
 
 
 def _sum_text(terms: Sequence[sp.Expr]) -> str:
@@ -238,8 +251,9 @@ def _jacobi(eom: EquationsOfMotion, common: dict) -> ConservedQuantity | NotCons
             eom.power.xreplace(_values(eom.model)), eom.model):
         T, V, h = eom.kinetic_energy, eom.potential_energy, eom.jacobi_integral
         equals = _is_zero(h - T - V, eom.model)
-        return ConservedQuantity("h", ConservedKind.JACOBI, T + V if equals else sp.expand(h),
-                                 (), equals_energy=equals, **common)
+        return ConservedQuantity("h", ConservedKind.JACOBI,
+                                 _shown(T + V if equals else sp.expand(h), eom.model), (),
+                                 equals_energy=equals, **common)
     if kind == InvariantKind.WORK_BALANCE:
         model = eom.model
         causes = []
@@ -255,7 +269,7 @@ def _jacobi(eom: EquationsOfMotion, common: dict) -> ConservedQuantity | NotCons
     equals = kind == InvariantKind.ENERGY
     expression = eom.kinetic_energy + eom.potential_energy if equals \
         else sp.expand(eom.jacobi_integral)
-    return ConservedQuantity("h", ConservedKind.JACOBI, expression, (),
+    return ConservedQuantity("h", ConservedKind.JACOBI, _shown(expression, eom.model), (),
                              equals_energy=equals, **common)
 
 

@@ -110,3 +110,19 @@ def test_total_momentum_claimed_where_a_load_breaks_it_says_which_load(tmp_path)
                             '[conserved]\ncyclic = ["x1"]\n'), "cyclic[x1]")
     assert cyclic.code == "not_cyclic" and "+ -" not in cyclic.message
     assert "k*x1*x2 - k*l0*x1" in cyclic.message
+
+
+def test_a_magnetic_fields_potential_is_named_not_a_drive():
+    """A charge in a uniform field B (V = -q v . A, A = B/2 (-y, x)): the force does no work,
+    so 1/2 m v^2 is conserved and T + V is not, for V's rates, not a drive; the canonical
+    angular momentum m (x y_dot - y x_dot) + q B (x^2 + y^2)/2 is conserved, the kinetic one
+    alone is not."""
+    claims = ["½ m (ẋ² + ẏ²) − q B/2 (x ẏ − y ẋ)", "½ m (ẋ² + ẏ²)",
+              "m (x ẏ − y ẋ) + ½ q B (x² + y²)", "m (x ẏ − y ẋ)"]
+    text = "[conserved]\nquantities = [" + ", ".join(f'"{c}"' for c in claims) + "]\n"
+    report = check_text("charged_particle", text)
+    energy = finding(report, "conserved[1]")
+    assert energy.code == "energy_not_conserved", energy
+    assert "velocity-dependent potential" in energy.message and "drive" not in energy.message
+    assert [finding(report, f"conserved[{k}]").status for k in (2, 3, 4)] == \
+        ["correct", "correct", "wrong"]

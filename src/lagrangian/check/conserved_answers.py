@@ -206,13 +206,23 @@ class _Mechanics:
                            "every motion.", None)
         return self.not_conserved(item, F)
 
+    def velocity_potential(self) -> bool:
+        """Whether V holds a rate and T has no term without one (no drive)."""
+        T, V, q_dot = self.eom.kinetic_energy, self.eom.potential_energy, self.model.q_dot
+        at_rest = T.xreplace({v: 0 for v in q_dot})
+        return any(V.has(v) for v in q_dot) and eq.zero(at_rest, self.points)
+
     def not_conserved(self, item: str, F: sp.Expr) -> Finding:
         eom, points = self.eom, self.points
         energy = eom.kinetic_energy + eom.potential_energy
         listed = "; ".join(f"{q.name} = {q.text}" for q in self.found) or "none"
         if not eq.zero(energy, points) and eq.constant_in_state(F / energy, points):
             kind = eom.invariant_kind
-            if kind == InvariantKind.JACOBI_INTEGRAL:
+            if kind == InvariantKind.JACOBI_INTEGRAL and self.velocity_potential():
+                # a magnetic field's V = -q v . A: its force does no work, h = T here
+                why = ("V depends on the rates (a velocity-dependent potential: the Jacobi "
+                       "integral h = q_dot . dL/dq_dot - L is conserved, not T + V)")
+            elif kind == InvariantKind.JACOBI_INTEGRAL:
                 why = ("the drive does work (T has terms without rates: the Jacobi integral "
                        "h = q_dot . dL/dq_dot - L is conserved, not T + V)")
             else:

@@ -3,8 +3,9 @@ hundred a surface in CI) and by this file's campaign (``python tests/fuzz/fuzz_t
 --inputs 100000``, a count per surface): [control] laws of model files (the reader), LQR
 options (Q and R as numbers, diagonals, matrices and the command line's text), class folders
 (hostile file names, links to the answer key, FIFOs, folders named *.toml), report options
-(--size, --fps, --t-end, --out) and codegen names (--name). Every surface runs in-process, in
-milliseconds an input: the CLI runs that compile are the older campaigns' (fuzz_seams.py).
+(--size, --fps, --t-end, --out), codegen names (--name), MJCF documents (parse_mjcf) and
+[[impacts]] tables (the model file's reader). Every surface runs in-process, in milliseconds an
+input: the CLI runs that compile are the older campaigns' (fuzz_seams.py).
 
 The contract: an answer, or the project's one-line error (a LagrangianError); never another
 exception, never numpy's RuntimeWarning, never a hang; and the surface's own promise (a C
@@ -22,7 +23,7 @@ from hypothesis import strategies as st
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from fuzz_inputs import HOSTILE_NUMBERS, LagrangianError, run_input  # noqa: E402
+from fuzz_inputs import HOSTILE_NUMBERS, LagrangianError, expressions, run_input  # noqa: E402
 from fuzz_seams import C_SEQUENCES, control_models, special_names  # noqa: E402
 
 SECRET = "KEY_SECRET_7f3a"  # in the answer key: no message may quote it
@@ -242,6 +243,122 @@ def codegen_names() -> st.SearchStrategy[str]:
                                                               "main", "int", "_x", "x-y"]))
 
 
+# -- MJCF documents -----------------------------------------------------------------------
+
+_LEG = """<mujoco model="NAME">
+  <option gravity="GRAVITY"/>
+  <worldbody>
+    <body name="trunk" pos="POS">
+      <freejoint name="root"/>
+      <inertial pos="0.01 0.02 -0.01" mass="MASS" fullinertia="INERTIA"/>
+      <body name="thigh" pos="0.2 0.1 0" euler="EULER">
+        <joint name="hip" type="KIND" axis="AXIS" range="RANGE"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="SIZE"/>
+        <body name="shin" pos="0 0 -0.3">
+          <joint name="JOINT" axis="1 1 0"/>
+          <geom type="GEOM" size="0.02 0.03 0.15" pos="0 0 -0.15"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+_SLOTS = {"NAME": "leg", "GRAVITY": "0 0 -9.81", "POS": "0 0 1", "MASS": "5",
+          "INERTIA": "0.1 0.2 0.25 0.01 -0.02 0.03", "EULER": "10 0 20", "KIND": "hinge",
+          "AXIS": "0 1 0", "RANGE": "-1 1", "SIZE": "0.03", "JOINT": "knee", "GEOM": "box"}
+
+
+@st.composite
+def mjcf_documents(draw) -> str:
+    """The floating leg of tests/mjcf_models.py with some of its values hostile: numbers
+    (1e308, nan, -1, 1e-400), the wrong count, text, joint and geom kinds, names; sometimes a
+    line dropped (an unclosed element, a body without mass)."""
+    numbers = st.sampled_from(HOSTILE_NUMBERS)
+    hostile = st.one_of(numbers, st.lists(numbers, min_size=0, max_size=7).map(" ".join),
+                        st.sampled_from(["", " ", "ball", "slide", "free", "cylinder", "mesh",
+                                         "root", "hip", "&amp;", "&lt;", "<", "\"", "]]>"]),
+                        special_names().map(lambda s: s.replace("\x00", "")))
+    values = {slot: draw(hostile) if draw(st.integers(0, 5)) == 5 else value
+              for slot, value in _SLOTS.items()}
+    text = _LEG
+    for slot, value in values.items():
+        text = text.replace(slot, value)
+    lines = text.splitlines()
+    if draw(st.booleans()) and draw(st.booleans()):
+        del lines[draw(st.integers(0, len(lines) - 1))]
+    return "\n".join(lines)
+
+
+def read_mjcf_document(text: str) -> None:
+    """parse_mjcf (a floating base): a robot model, or one line; an accepted model's masses
+    and inertias finite, its masses >= 0."""
+    import math
+
+    import sympy as sp
+
+    from lagrangian.model.mjcf import parse_mjcf
+
+    model = parse_mjcf(text, floating_base=True)
+    for body in model.rigid_bodies:
+        for value in (body.mass, *(x for row in body.inertia for x in row)):
+            number = sp.sympify(value)
+            if number.is_number and not math.isfinite(float(number)):
+                raise Broke(f"body {body.name!r} accepted with {value} in its inertia")
+        if sp.sympify(body.mass).is_number and float(body.mass) < 0:
+            raise Broke(f"body {body.name!r} accepted with mass {body.mass}")
+
+
+# -- [[impacts]] tables -------------------------------------------------------------------
+
+_BALL = {}
+
+
+@st.composite
+def impact_tables(draw) -> str:
+    """The bouncing ball's [[impacts]] with hostile guards, points, normals, restitutions,
+    tangential laws, releases and relabels (expressions, numbers, lists, tables, text)."""
+    import json
+
+    expressions_ = st.one_of(expressions(), st.sampled_from(HOSTILE_NUMBERS))
+    anything = st.one_of(expressions_.map(json.dumps), st.sampled_from(HOSTILE_NUMBERS),
+                         st.lists(expressions_, max_size=4).map(json.dumps),
+                         st.sampled_from(["true", "{}", "[]", '{ y = "y" }', '{ q = "y" }',
+                                          '"stick"', '"slip"', '"pivot"', '"ball"', '"floor"',
+                                          '"nowhere"', "[0, 1]", "[0, 0]", "[1e308, 1e308]",
+                                          '["nan", 1]', "[0, 1, 0]", '"e"', '"-e"', '"2"']))
+    keys = {"name": '"floor"', "guard": '"y"', "point": '"ball"', "normal": "[0, 1]",
+            "restitution": '"e"'}
+    for key in ("name", "guard", "point", "normal", "restitution", "tangential", "release",
+                "relabel", "bogus"):
+        if draw(st.integers(0, 5)) == 5:  # hypothesis leans to 0: the valid table first
+            keys[key] = draw(anything)
+        elif key in keys and draw(st.integers(0, 9)) == 9:
+            del keys[key]
+    if not _BALL:
+        from fuzz_inputs import EXAMPLE_TEXTS
+
+        _BALL["text"] = EXAMPLE_TEXTS["bouncing_ball"].split("[[impacts]]")[0]
+    table = "\n".join(f"{key} = {value}" for key, value in keys.items())
+    return f"{_BALL['text']}[[impacts]]\n{table}\n"
+
+
+def read_impacts(text: str) -> None:
+    """parse_model: the model with its impacts (a numeric normal of unit length), or one
+    line."""
+    import math
+
+    import sympy as sp
+
+    import lagrangian
+
+    model = lagrangian.parse_model(text)
+    for impact in model.impacts:
+        normal = [sp.sympify(c) for c in impact.normal]
+        if all(c.is_number for c in normal) and not math.isclose(
+                math.sqrt(sum(float(c) ** 2 for c in normal)), 1.0, rel_tol=1e-9):
+            raise Broke(f"impact {impact.name!r} accepted with normal {impact.normal}")
+
+
 # -- the surfaces ---------------------------------------------------------------------------
 
 def surfaces(folder: Path) -> dict[str, tuple[st.SearchStrategy, object]]:
@@ -262,6 +379,8 @@ def surfaces(folder: Path) -> dict[str, tuple[st.SearchStrategy, object]]:
         "report options (--size, --fps, --t-end, --out)": (
             report_options(), lambda options: check_report_options(options, folder)),
         "codegen names (--name)": (codegen_names(), codegen_name),
+        "MJCF documents (parse_mjcf)": (mjcf_documents(), read_mjcf_document),
+        "[[impacts]] tables (model file reader)": (impact_tables(), read_impacts),
     }
 
 

@@ -1,9 +1,10 @@
 """Fuzzing campaign for the seams of issue 39, CI budget: [control] laws through the model
 reader, LQR options (Q, R in Python and as --Q/--R text), class folders (answer_files: links,
-FIFOs, hostile names), report options and codegen names, a few hundred inputs a surface, all
-in-process. Each input: an answer or one line of the project's error, no numpy warning, the
-surface's own promise kept (fuzz_trust.py). The 10^5-per-surface campaign:
-``python tests/fuzz/fuzz_trust.py --inputs 100000``. Figures: docs/robustness.md.
+FIFOs, hostile names), report options, codegen names, MJCF documents and [[impacts]] tables, a
+few hundred inputs a surface, all in-process. Each input: an answer or one line of the
+project's error, no numpy warning, the surface's own promise kept (fuzz_trust.py). The
+10^5-per-surface campaign: ``python tests/fuzz/fuzz_trust.py --inputs 100000``. Figures:
+docs/robustness.md.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ CI_INPUTS = {
     "class folders (answer_files)": 200,
     "report options (--size, --fps, --t-end, --out)": 300,
     "codegen names (--name)": 200,
+    "MJCF documents (parse_mjcf)": 200,
+    "[[impacts]] tables (model file reader)": 200,
 }
 TALLY: dict[str, dict[str, int]] = {}
 # Defects this campaign found and whose fixes it keeps: none tolerated now (a link loop in a

@@ -73,3 +73,9 @@ def test_derive_hamilton_prints_h_and_the_momenta(cli):
         cli("derive", "double_pendulum", "--hamilton").out
     bad = cli("derive", "cartesian_pendulum", "--hamilton")
     assert bad.code == 2 and "unconstrained" in bad.err
+
+
+def test_conserved_on_a_robots_tree_is_refused_in_one_line(cli):
+    bad = cli("conserved", "two_link_arm")
+    assert bad.code == 2 and bad.err.count("\n") == 1
+    assert "conserved:" in bad.err and "kinematic tree (URDF, MJCF) is not searched" in bad.err

@@ -131,8 +131,9 @@ def conserved_quantities(eom: EquationsOfMotion) -> ConservedQuantities:
     """Every conserved quantity of the derived equations that the three searches find."""
     model = eom.model
     if model.kinematic_tree is not None:
-        raise ModelError("conserved quantities are found from a derived L; a robot's tree "
-                         "has none derived", field="conserved")
+        raise ModelError("conserved quantities are searched in a model file's L (energies, "
+                         "particles, bodies); a robot's kinematic tree (URDF, MJCF) is not "
+                         "searched", field="conserved")
     L = eom.lagrangian
     small = sp.count_ops(L) < _SMALL_OPERATIONS if tree_size(L, 4000) < 4000 else False
     L = sp.expand(L) if small else L  # a large L (the bicycle's) is only differentiated

@@ -36,7 +36,9 @@ MEANINGS = {
                           "`rate` (initial q_dot), `range = [low, high]` (searched by "
                           "equilibria; a printed abs() whose sign it fixes is dropped)",
     "parameters.<name>": "a number (SI), or this table (`value` converted to SI from `unit`); "
-                         "no value: symbolic only",
+                         "no value: symbolic only; `range = [low, high]` (inclusive, `inf` "
+                         "allowed) and `integer = true` (a count) bound every value given, "
+                         "the file's, `--set`'s, `with_parameters`' and a study's",
     "energy": "T, V, D as expressions, added to what the components contribute",
     "gravity": "`g` its magnitude (a number or a parameter), `direction` a vector (default "
                "[0, -1])",

@@ -113,15 +113,26 @@ class ModelBuilder(RigidBodiesMixin, ConstraintsMixin, SteadyMotionMixin, Contro
 
     def parameter(
         self, name: str, value: float | None = None, unit: str | None = None, *,
-        field: str | None = None,
+        field: str | None = None, range: Sequence[float] | None = None,  # noqa: A002
+        integer: bool = False,
     ) -> sp.Symbol:
-        """Declare a named constant (SI value, or None to keep it symbolic); returns its symbol."""
+        """Declare a named constant (SI value, or None to keep it symbolic), the values it may
+        take (``range`` [lower, upper] inclusive, SI; ``integer``: a count); returns its
+        symbol."""
         field = field or f"parameters.{name}"
         self._declare(name, field)
         symbol = sp.Symbol(name)
-        self._parameters.append(
-            Parameter(name, symbol, _optional_float(value, field, self.source), unit)
-        )
+        if not isinstance(integer, bool):
+            raise ModelError("integer is true or false", field=f"{field}.integer",
+                             source=self.source)
+        parameter = Parameter(name, symbol, _optional_float(value, field, self.source), unit,
+                              _closed_range(range, f"{field}.range", self.source), integer)
+        if parameter.value is not None:
+            try:
+                parameter.checked(parameter.value, field)
+            except ModelError as error:  # the file's own value: named with its source
+                raise ModelError(error.message, field=field, source=self.source) from None
+        self._parameters.append(parameter)
         self._names[name] = symbol
         return symbol
 
@@ -581,6 +592,24 @@ def _range(value, field: str, source: str | None) -> tuple[float, float] | None:
     if not lower < upper:
         raise ModelError("lower must be below upper", field=field, source=source)
     return (lower, upper)
+
+
+def _closed_range(value, field: str, source: str | None) -> tuple[float, float] | None:
+    """[lower, upper] with lower <= upper (either may be -inf or inf), or None."""
+    if value is None:
+        return None
+    if not isinstance(value, Sequence) or isinstance(value, str) or len(value) != 2:
+        raise ModelError("expected [lower, upper]", field=field, source=source)
+    bounds = []
+    for v in value:
+        if isinstance(v, bool) or not isinstance(v, int | float):
+            raise ModelError(f"a bound is a number, not {v!r}", field=field, source=source)
+        if math.isnan(v):
+            raise ModelError("a bound is a number, not nan", field=field, source=source)
+        bounds.append(float(v))
+    if not bounds[0] <= bounds[1]:
+        raise ModelError("lower must not be above upper", field=field, source=source)
+    return (bounds[0], bounds[1])
 
 
 __all__ = ["ModelBuilder", "multiplier_name"]

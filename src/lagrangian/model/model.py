@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 import sympy as sp
 
+from ..errors import ModelError
 from ..kinds import ConstraintKind
 from .checked import si_number, unknown_name
 from .vector import Vector
@@ -57,12 +58,27 @@ class Coordinate:
 
 @dataclass(frozen=True)
 class Parameter:
-    """A named constant; ``value`` in SI units, or None for a purely symbolic one."""
+    """A named constant; ``value`` in SI units, or None for a purely symbolic one; ``range``
+    (lower, upper), inclusive, and ``integer`` the values it may take (a count: a wheel's
+    spokes), checked wherever a value is given."""
 
     name: str
     symbol: sp.Symbol
     value: float | None = None
     unit: str | None = None
+    range: tuple[float, float] | None = None
+    integer: bool = False
+
+    def checked(self, value: float, field: str) -> float:
+        """``value`` if the parameter may take it, else a ModelError naming it and its range."""
+        if self.integer and value != int(value):
+            raise ModelError(f"'{self.name}' is a whole number (a count), not {value:g}",
+                             field=field)
+        if self.range is not None and not self.range[0] <= value <= self.range[1]:
+            lower, upper = self.range
+            raise ModelError(f"'{self.name}' = {value:g} is outside its range [{lower:g}, "
+                             f"{upper:g}]", field=field)
+        return value
 
 
 @dataclass(frozen=True)
@@ -259,6 +275,7 @@ class Model:
         for name in values:
             if name not in names:
                 raise unknown_name(name, names, "parameter", "parameters")
-        parameters = tuple(replace(p, value=si_number(p.name, values[p.name], "parameters"))
+        parameters = tuple(replace(p, value=p.checked(si_number(p.name, values[p.name],
+                                                                "parameters"), "parameters"))
                            if p.name in values else p for p in self.parameters)
         return replace(self, parameters=parameters)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import errno
 import functools
+import math
 import os
 import re
 import stat
@@ -35,7 +36,7 @@ COMPONENT_KEYS = {
                 {"restitution", "tangential", "release", "relabel"}),
 }
 COORDINATE_KEYS = {"unit", "initial", "rate", "range"}  # a coordinate given as a table
-PARAMETER_KEYS = {"value", "unit"}  # a parameter given as a table
+PARAMETER_KEYS = {"value", "unit", "range", "integer"}  # a parameter given as a table
 ENERGY_KEYS = {"T", "V", "D"}
 GRAVITY_KEYS = ({"g"}, {"direction"})
 STEADY_KEYS = ({"speed", "rates", "keep"}, {"about"})
@@ -227,7 +228,14 @@ def model_from_mapping(data: Mapping, *, source: str = "<model>") -> Model:
             value = spec.get("value")
             if value is not None and unit is not None:
                 value = to_si(value, unit, f"{field}.value", source)
-            builder.parameter(key, value, unit, field=field)
+            bounds = spec.get("range")
+            if bounds is not None and unit is not None and isinstance(bounds, list) \
+                    and all(isinstance(b, int | float) and not isinstance(b, bool)
+                            for b in bounds):
+                bounds = [b if isinstance(b, float) and math.isinf(b)
+                          else to_si(b, unit, f"{field}.range", source) for b in bounds]
+            builder.parameter(key, value, unit, field=field, range=bounds,
+                              integer=spec.get("integer", False))
         else:
             builder.parameter(key, spec, field=field)
 

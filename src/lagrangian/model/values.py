@@ -151,7 +151,8 @@ def resolve_parameters(
     values: list[float | None] = []
     for p in model.parameters:
         if p.name in overrides:
-            values.append(si_number(p.name, overrides[p.name], field))
+            values.append(p.checked(si_number(p.name, overrides[p.name], field),
+                                    f"{field}.{p.name}"))
         elif p.value is None and require:
             raise ModelError(f"parameter '{p.name}' has no value; give one",
                              field=f"{field}.{p.name}")

@@ -25,3 +25,24 @@ def leg(trunk_height: float = 0.0) -> str:
   </worldbody>
 </mujoco>
 """
+
+
+# a ball, then a hinge, then a ball, each body turned and offset, under tilted gravity
+BALL_HINGE_BALL = """<mujoco model="ball_hinge_chain">
+  <compiler angle="radian"/>
+  <option gravity="0.5 -1 -9.7"/>
+  <worldbody>
+    <body name="upper" pos="0.1 0 1" quat="0.9 0.1 0.3 0.2">
+      <joint name="shoulder" type="ball"/>
+      <inertial pos="0 0.03 -0.3" mass="2.0" diaginertia="0.05 0.04 0.02"/>
+      <body name="lower" pos="0 0.05 -0.6" euler="0.2 0.1 0">
+        <joint name="elbow" type="hinge" axis="0.3 1 0.1" pos="0 0 0.02"/>
+        <inertial pos="0.02 0 -0.25" quat="0.8 0.2 0.1 0.3" mass="1.1" diaginertia="0.03 0.02 0.01"/>
+        <body name="hand" pos="0 0 -0.5">
+          <joint name="wrist" type="ball" pos="0.01 0 0"/>
+          <inertial pos="0 0.01 -0.05" mass="0.4" diaginertia="0.002 0.003 0.001"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""

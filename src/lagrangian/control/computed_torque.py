@@ -99,18 +99,7 @@ def _reference(q_des, names: tuple[str, ...], system):
     """t -> (q_d, q_dot_d, q_ddot_d), each (n,), checked once at t = 0."""
     n = len(names)
     if callable(q_des):
-        def reference(t):
-            value = q_des(t)
-            if not (isinstance(value, tuple | list) and len(value) == 3):
-                raise InputError("a reference callable must return (q_d, q_dot_d, q_ddot_d)",
-                                 field="q_des")
-            parts = tuple(np.asarray(x, dtype=float) for x in value)
-            if any(x.shape != (n,) for x in parts):
-                raise InputError(f"a reference callable must return three arrays of {n} "
-                                 f"values ({', '.join(names)}), got shapes "
-                                 f"{[x.shape for x in parts]}", field="q_des")
-            return parts
-
+        reference = _called(q_des, (n, n, n), f"three arrays of {n} values ({', '.join(names)})")
         reference(0.0)
         return reference
     if isinstance(q_des, Mapping):
@@ -130,6 +119,23 @@ def _reference(q_des, names: tuple[str, ...], system):
     return lambda t: (target, zero, zero)
 
 
+def _called(q_des, widths: tuple[int, int, int], expected: str):
+    """A reference callable t -> (q_d, q_dot_d, q_ddot_d) whose answers are checked: three
+    arrays of the given widths, else one line saying what was expected."""
+    def reference(t):
+        value = q_des(t)
+        if not (isinstance(value, tuple | list) and len(value) == 3):
+            raise InputError("a reference callable must return (q_d, q_dot_d, q_ddot_d)",
+                             field="q_des")
+        parts = tuple(np.asarray(x, dtype=float) for x in value)
+        if [x.shape for x in parts] != [(w,) for w in widths]:
+            raise InputError(f"a reference callable must return {expected}, got shapes "
+                             f"{[x.shape for x in parts]}", field="q_des")
+        return parts
+
+    return reference
+
+
 def _manifold_reference(q_des, dynamics, system):
     """t -> (q_d (nq), q_dot_d (nv), q_ddot_d (nv)) for a tree whose q and v differ in length,
     checked once at t = 0: a target by name (a ball's <ball>_qw..qz, the joints' as for a
@@ -138,18 +144,8 @@ def _manifold_reference(q_des, dynamics, system):
 
     nq, nv = len(dynamics.coordinates), len(dynamics.velocity_names)
     if callable(q_des):
-        def reference(t):
-            value = q_des(t)
-            if not (isinstance(value, tuple | list) and len(value) == 3):
-                raise InputError("a reference callable must return (q_d, q_dot_d, q_ddot_d)",
-                                 field="q_des")
-            parts = tuple(np.asarray(x, dtype=float) for x in value)
-            if [x.shape for x in parts] != [(nq,), (nv,), (nv,)]:
-                raise InputError(f"a reference callable must return q_d of {nq} values and "
-                                 f"q_dot_d, q_ddot_d of {nv}, got shapes "
-                                 f"{[x.shape for x in parts]}", field="q_des")
-            return parts
-
+        reference = _called(q_des, (nq, nv, nv),
+                            f"q_d of {nq} values and q_dot_d, q_ddot_d of {nv}")
         dynamics.difference(reference(0.0)[0], reference(0.0)[0])  # its quaternions checked
         return reference
     if isinstance(q_des, Mapping):

@@ -87,3 +87,25 @@ def test_simulate_refuses_what_a_ball_does_not_take_in_one_line(cli, arm, argume
     code, out, err = cli("simulate", arm, "--t-end", "0.1", *arguments)
     assert code == 2 and out == "" and err.count("\n") == 1, err
     assert names in err
+
+
+def test_regressor_rows_are_the_velocities_and_y_pi_is_mujocos_inverse_dynamics(cli, arm):
+    """`regressor` on a ball robot: Y's rows are v's (the ball's three moments, the elbow's
+    torque), and tau = Y pi at a moving state equals MuJoCo's mj_rne (qfrc_bias + M qacc)."""
+    mujoco = pytest.importorskip("mujoco")
+    qpos = np.array([0.7, -0.1, 0.5, 0.2, -0.4])
+    qpos[:4] /= np.linalg.norm(qpos[:4])
+    qvel, qacc = np.array([0.3, -0.8, 1.5, 0.6]), np.array([1.0, 0.5, -0.2, 0.3])
+    text = [",".join(f"{x:.17g}" for x in x_) for x_ in (qpos, qvel, qacc)]
+    code, out, err = cli("regressor", arm, "--q", text[0], "--v", text[1], "--a", text[2],
+                         "--json")
+    assert code == 0, err
+    found = json.loads(out)
+    assert found["velocities"] == ["shoulder_wx", "shoulder_wy", "shoulder_wz", "elbow"]
+    model = mujoco.MjModel.from_xml_string(ARM)
+    data = mujoco.MjData(model)
+    data.qpos[:], data.qvel[:], data.qacc[:] = qpos, qvel, qacc
+    mujoco.mj_inverse(model, data)
+    np.testing.assert_allclose(found["tau"], data.qfrc_inverse, atol=1e-9)
+    code, out, err = cli("regressor", arm)  # the default state: the ball unturned, at rest
+    assert code == 0 and "Velocities (Y's rows): shoulder_wx" in out, err

@@ -11,7 +11,7 @@ import typer
 from ..errors import InputError
 from . import app
 from .common import FLOATING_HELP, GRAVITY_HELP, LOCK_HELP, load_system, print_json
-from .dynamics import _vector, base_layout
+from .dynamics import _start, _vector, base_layout
 
 
 @app.command()
@@ -37,11 +37,13 @@ def regressor(
     from ..output.regressor import regressor_document, regressor_text
 
     system = load_system(model, set_, lock, gravity, floating_base=floating_base)
-    start = resolve_state(system.model)
+    start = resolve_state(system.model)  # a ball joint's default: unturned (dynamics._start)
     names_q, names_v, base_q, base_v = base_layout(system)
     n = len(names_v)
-    qs = _vector(q, names_q, "--q", base_q + list(start.q))
-    vs = _vector(v, names_v, "--v", base_v + list(start.q_dot))
+    own = [c.name for c in system.model.coordinates]
+    qs = _vector(q, names_q, "--q", _start(names_q, base_q, dict(zip(own, start.q, strict=True))))
+    vs = _vector(v, names_v, "--v", _start(names_v, base_v,
+                                           dict(zip(own, start.q_dot, strict=True))))
     accelerations = _vector(a, names_v, "--a", [0.0] * n)
     names = None if parameters is None else [p.strip() for p in parameters.split(",")]
     f = system.dynamics()
@@ -54,7 +56,7 @@ def regressor(
             raise
         raise InputError(exc.message, field=f"--{exc.field}") from None
     document = regressor_document(names_q, f.parameter_names(names), values, np.asarray(Y),
-                                  found, velocities=names_v if base_q else None)
+                                  found, velocities=names_v if names_v != names_q else None)
     if json_:
         print_json(document)
     else:

@@ -11,8 +11,8 @@ def regressor_document(coordinates, names, values, Y, base=None,
                        velocities=None) -> dict[str, Any]:
     """coordinates, parameters (names and the model's values pi), the regressor Y (n x k
     nested lists, tau = Y pi), tau; with ``base`` its names, tolerance and combination
-    (beta = combination pi); a floating base's ``velocities``, the names of Y's rows and tau's
-    (``coordinates`` are q's). SI units."""
+    (beta = combination pi); ``velocities`` where q and v differ (a floating base, a ball
+    joint), the names of Y's rows and tau's (``coordinates`` are q's). SI units."""
     Y = np.asarray(Y, dtype=float)
     document: dict[str, Any] = {
         "coordinates": list(coordinates),

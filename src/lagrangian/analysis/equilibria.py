@@ -267,12 +267,16 @@ def _find_equilibria(functions: AtRestFunctions, t: float, stability) -> Equilib
         qi = _wrap(qi, periodic, low)
         if not _inside(qi, low, high, model, periodic):
             continue
-        if model.rigid_bodies and gimbal_lock(
-                model.rigid_bodies, {**values, **dict(zip(model.q, qi, strict=True))}, 1e-6):
+        chart_singular = getattr(functions, "chart_singular", None)  # a tree's Euler angles
+        if (chart_singular is not None and chart_singular(qi)) or (model.rigid_bodies and gimbal_lock(
+                model.rigid_bodies, {**values, **dict(zip(model.q, qi, strict=True))}, 1e-6)):
             if not any(_same(qi, other, periodic, low, high) for other in singular):
                 singular.append(qi)
             continue
-        if any(_same(qi, other, periodic, low, high) for other, _ in found):
+        same_configuration = getattr(functions, "same_configuration", None)
+        if any(_same(qi, other, periodic, low, high)
+               or (same_configuration is not None and same_configuration(qi, other))
+               for other, _ in found):
             continue
         found.append((qi, li))
     found.sort(key=lambda item: tuple(np.round(item[0], 9)))

@@ -26,7 +26,15 @@ class TreeAtRest:
     def __init__(self, dynamics):
         self.dynamics = dynamics
         self.model = dynamics.model
-        self.n, self.m = dynamics.n, 0
+        self.n, self.m = len(self.model.coordinates), 0
+        tree = dynamics.tree
+        # a ball joint or a free flyer below the root: the model's coordinates are its Euler
+        # angles (what derive shows), the tree's numbers a quaternion (tree/model_charts.py)
+        self._charts = None
+        if tree.quaternion_joints and not tree.floating_base:
+            from .tree.model_charts import ModelCharts
+
+            self._charts = ModelCharts(self.model, dynamics.velocity_names)
         self.parameter_names = tuple(p.name for p in self.model.parameters)
         self.parameters = dict(dynamics.parameters)
         self.search_parameters = tuple(range(len(self.parameter_names)))
@@ -39,6 +47,16 @@ class TreeAtRest:
         self.depends_on = frozenset(c.symbol for c, m in zip(self.model.coordinates, moving,
                                                              strict=True) if m)
 
+    def chart_singular(self, q: np.ndarray) -> bool:
+        """Whether q is at a gimbal lock of the Euler angles the model gives a ball joint or a
+        free flyer below the root (no stability is claimed there)."""
+        return self._charts is not None and self._charts.singular(q)
+
+    def same_configuration(self, first: np.ndarray, second: np.ndarray) -> bool:
+        """Whether two configurations place the tree alike (Euler angles cover a ball's turns
+        twice); False where the model's coordinates are the tree's own."""
+        return self._charts is not None and self._charts.same(first, second)
+
     def evaluate(self, q: np.ndarray, t: float = 0.0, parameters: np.ndarray | None = None
                  ) -> dict[str, np.ndarray]:
         """Every matrix at configurations q (..., n), at rest (t: no effect on a tree)."""
@@ -46,7 +64,19 @@ class TreeAtRest:
             raise ValueError("a tree's equations at rest are for its own parameter values")
         q = np.asarray(q, dtype=float)
         batch, n = q.shape[:-1], self.n
-        gravity = self.dynamics.gravity
+        gravity, mass = self.dynamics.gravity, self.dynamics.mass_matrix
+        if self._charts is not None:  # M_theta = E^T M E, g_theta = E^T g (virtual work)
+            charts = self._charts
+
+            def gravity(theta):
+                E = charts.rates(theta)
+                return np.einsum("...ji,...j->...i", E,
+                                 self.dynamics.gravity(charts.configuration(theta)))
+
+            def mass(theta):
+                E = charts.rates(theta)
+                M = self.dynamics.mass_matrix(charts.configuration(theta))
+                return np.swapaxes(E, -1, -2) @ M @ E
         # rows: +h, -h, +h/2, -h/2 along each coordinate (4 n states per configuration)
         eye = np.eye(n) * STEP
         shifts = np.concatenate([eye, -eye, eye / 2, -eye / 2])
@@ -55,7 +85,7 @@ class TreeAtRest:
         narrow = (g[..., 2 * n:3 * n, :] - g[..., 3 * n:, :]) / STEP
         stiffness = np.swapaxes((4 * narrow - wide) / 3, -1, -2)  # K_ij = dg_i/dq_j
         return {
-            "mass": self.dynamics.mass_matrix(q),
+            "mass": mass(q),
             "forcing": -gravity(q),
             "stiffness": stiffness,
             "damping": np.zeros(batch + (n, n)),

@@ -38,3 +38,17 @@ def test_a_ball_with_e_below_1_has_no_cycle_its_returns_shrink_by_e(ball):
     # the flights after the first two impacts: 2 v e / g and 2 v e^2 / g
     assert f"{2 * v * 0.8 / g:.4g} -> {2 * v * 0.8**2 / g:.4g} s" in str(caught.value)
     assert "\n" not in str(caught.value)
+
+
+def test_a_flow_whose_step_collapses_ends_the_search_in_one_line():
+    # g = 1e154: the wheel's time scale sqrt(L/g) is 1e-77 s, so DOP853 stepped 1e-78 s at a
+    # time toward the search's 20 s and never returned (minutes at full CPU); now the guards
+    # of the other loops end it after one window of 1000 steps, numpy's warnings held back
+    import warnings
+
+    wheel = lagrangian.load("rimless_wheel").with_parameters(g=1e154)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with pytest.raises(InputError, match="the step size collapsed: 1000 steps") as caught:
+            wheel.limit_cycle()
+    assert "\n" not in str(caught.value)

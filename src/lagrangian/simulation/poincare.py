@@ -20,6 +20,7 @@ import sympy as sp
 
 from ..compile.lambdified import StateFunction
 from ..errors import InputError
+from .guards import GuardedRhs, StepCollapse
 from .hybrid import CompiledImpact, kkt_system
 
 
@@ -134,23 +135,36 @@ class PoincareMap:
 
         n = self.flow.n
         z0 = np.concatenate([x, np.eye(2 * n).ravel()]) if jacobian else np.array(x, float)
-        fun = self.flow.rhs if jacobian else self.functions.rhs
-        solver = integrate.DOP853(fun, 0.0, z0, self.t_max, rtol=self.steps.rtol,
-                                  atol=self.steps.atol)
+        fun = GuardedRhs(self.flow.rhs if jacobian else self.functions.rhs, "DOP853", len(z0),
+                         0.0, self.t_max)
         event, offsets = self.guards.leaving(x[:n], x[n:], 0.0)
         armed = event(x[:n], x[n:], 0.0) < 0
-        while solver.status == "running":
-            solver.step()
-            if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
-                raise InputError(f"the flow failed at t = {solver.t:.6g} s before the next "
-                                 "impact", field=field)
-            y = solver.y
-            g = event(y[:n], y[n:2 * n], solver.t)
-            if armed and g >= 0:
-                dense = solver.dense_output()
-                t_hit = _crossing(event, dense, solver.t_old, solver.t, n)
-                return self._after(dense(t_hit), t_hit, jacobian, offsets, field)
-            armed = armed or g < 0
+        # scipy's overflow warnings held back: a flow that is not finite is refused below, and
+        # a step size that collapses (g = 1e154: steps of 1e-77 s toward t_max) ends the search
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            solver = integrate.DOP853(fun, 0.0, z0, self.t_max, rtol=self.steps.rtol,
+                                      atol=self.steps.atol)
+            while solver.status == "running":
+                try:
+                    solver.step()
+                    fun.accepted(solver.t)
+                except StepCollapse as stop:
+                    raise InputError(f"the flow failed before the next impact: {stop.message}",
+                                     field=field) from None
+                if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
+                    raise InputError(f"the flow failed at t = {solver.t:.6g} s before the next "
+                                     "impact", field=field)
+                y = solver.y
+                g = event(y[:n], y[n:2 * n], solver.t)
+                if armed and g >= 0:
+                    dense = solver.dense_output()
+                    t_hit = _crossing(event, dense, solver.t_old, solver.t, n)
+                    break
+                armed = armed or g < 0
+            else:
+                t_hit = None
+        if t_hit is not None:
+            return self._after(dense(t_hit), t_hit, jacobian, offsets, field)
         raise InputError(f"no impact within {self.t_max:g} s of the start (the motion comes to "
                          "rest or falls before its guard: no cycle through an impact from "
                          "there; try a guess nearer a cycle)", field=field)

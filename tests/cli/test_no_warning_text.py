@@ -79,3 +79,12 @@ def test_weights_of_text_or_below_double_range_are_one_line():
                            (2.2e-309, "its smallest eigenvalue 2.2e-309 is too small")):
             with pytest.raises(lagrangian.InputError, match=re.escape(message)):
                 lagrangian.lqr(upright, 1, R)
+
+
+def test_a_run_through_impacts_with_an_energy_past_double_range_is_quiet(cli):
+    # a ball started 1e308 m below its floor: V = m g y is -inf, T + V NaN, quietly (was
+    # numpy's 'invalid value encountered in subtract' around the run's lines); it falls freely
+    result = _quiet(cli, "simulate", "bouncing_ball", "--t-end", "0.5", "--initial", "y=-1e308",
+                    "--samples", "3")
+    assert result.code == 0, result.err
+    assert "y_dot = -4.905" in result.out  # -g t, g = 9.81 m/s^2

@@ -452,8 +452,9 @@ def _result(eom, functions, substitution, t, y, step_control, status, message, s
     model = eom.model
     n = functions.n
     q, q_dot = y[:, :n], y[:, n:]
-    energy = functions.energy(q, q_dot, t)
-    kinetic = energy - functions.energy(q, np.zeros_like(q_dot), t)
+    with np.errstate(over="ignore", invalid="ignore"):  # V of y = -1e308 is -inf: NaN, quietly
+        energy = functions.energy(q, q_dot, t)
+        kinetic = energy - functions.energy(q, np.zeros_like(q_dot), t)
     power_terms = StateFunction(model, eom.generalized_forces, substitution)
     power = np.einsum("ki,ki->k", power_terms(q, q_dot, t), q_dot)
     empty = np.zeros((len(t), 0))

@@ -7,9 +7,11 @@ from __future__ import annotations
 
 import re
 import warnings
+from pathlib import Path
 
 import pytest
 
+ARM = Path(__file__).resolve().parents[2] / "src/lagrangian/model/examples/two_link_arm.urdf"
 CART = ["cart_pendulum", "--t-end", "0.2", "--samples", "3", "--about", "theta=pi"]
 
 
@@ -28,6 +30,9 @@ def _quiet(cli, *args):
     (("modes", "pendulum", "--set", "L=1e300"), "error: the mass matrix M is not finite"),
     # M, K finite, M^-1 K = g/L = 2e308 not (was overflow and NaN warnings, then a NaN residual)
     (("modes", "pendulum", "--set", "g=1e308"), "error: the state matrix A = [0 I; -M^-1 K"),
+    # Y holds m a = inf (was printed, after numpy's overflow warning in tau = Y pi)
+    (("regressor", str(ARM), "--q", "0,0", "--v", "0,0", "--a", "1e308,1"),
+     "error: the regressor Y is not finite at this state"),
     (("simulate", *CART, "--control", "lqr", "--inputs", "F", "--Q", "inf"),
      "error: --Q: entries must be finite numbers"),
     (("simulate", *CART, "--control", "lqr", "--inputs", "F", "--R", "nan"),

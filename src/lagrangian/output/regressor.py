@@ -6,6 +6,8 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import DerivationError
+
 
 def regressor_document(coordinates, names, values, Y, base=None,
                        velocities=None) -> dict[str, Any]:
@@ -14,12 +16,18 @@ def regressor_document(coordinates, names, values, Y, base=None,
     (beta = combination pi); ``velocities`` where q and v differ (a floating base, a ball
     joint), the names of Y's rows and tau's (``coordinates`` are q's). SI units."""
     Y = np.asarray(Y, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused just below
+        tau = Y @ np.asarray(values, dtype=float)
+    for what, value in (("regressor Y", Y), ("torque tau = Y pi", tau)):
+        if not np.all(np.isfinite(value)):  # as the dynamics' own values (api/state_dynamics)
+            raise DerivationError(f"the {what} is not finite at this state (a number beyond "
+                                  "floating point: an acceleration of 1e308 times a mass)")
     document: dict[str, Any] = {
         "coordinates": list(coordinates),
         "parameters": list(names),
         "values": [float(x) for x in values],
         "regressor": Y.tolist(),
-        "tau": (Y @ np.asarray(values, dtype=float)).tolist(),
+        "tau": tau.tolist(),
     }
     if velocities is not None:
         document["velocities"] = list(velocities)

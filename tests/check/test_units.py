@@ -110,3 +110,17 @@ def test_geometry_in_bare_numbers_is_si_metres_but_a_forgotten_length_is_caught(
     wrong = check_model_units(lagrangian.parse_model(FORGOT_L % "-cos(theta)"))
     assert [i.item for i in wrong.issues] == ["particles[bob].position.y"]
     assert check_model_units(lagrangian.parse_model(FORGOT_L % "-L*cos(theta)")).consistent
+
+
+def test_a_long_exact_number_is_shown_in_three_figures():
+    # 1e-300*1e-300 is the exact 1/10^600: the warning printed its 600 digits, one line of 650
+    # characters; a number of 20 digits or fewer is shown as it is
+    import sympy as sp
+
+    from lagrangian.check.units import format_expression
+
+    theta = sp.Symbol("theta")
+    assert format_expression(theta**2 / sp.Integer(10)**600) == "1.00e-600*theta**2"
+    assert format_expression(theta**2 * sp.cos(sp.Integer(10)**24)) == "theta**2*cos(1.00e+24)"
+    assert format_expression(-sp.Integer(10)**30 * theta) == "-1.00e+30*theta"
+    assert format_expression(sp.Rational(1, 3) * theta) == "theta/3"

@@ -113,14 +113,24 @@ def test_geometry_in_bare_numbers_is_si_metres_but_a_forgotten_length_is_caught(
 
 
 def test_a_long_exact_number_is_shown_in_three_figures():
+    """In messages (units warnings, the [control] laws' line); the JSON keeps every digit."""
     # 1e-300*1e-300 is the exact 1/10^600: the warning printed its 600 digits, one line of 650
     # characters; a number of 20 digits or fewer is shown as it is
     import sympy as sp
 
-    from lagrangian.check.units import format_expression
+    from lagrangian.model.printing import shown_expression as format_expression
 
     theta = sp.Symbol("theta")
     assert format_expression(theta**2 / sp.Integer(10)**600) == "1.00e-600*theta**2"
     assert format_expression(theta**2 * sp.cos(sp.Integer(10)**24)) == "theta**2*cos(1.00e+24)"
     assert format_expression(-sp.Integer(10)**30 * theta) == "-1.00e+30*theta"
     assert format_expression(sp.Rational(1, 3) * theta) == "theta/3"
+    from lagrangian.output.control import law_summary, law_text
+
+    model = lagrangian.parse_model(
+        '[coordinates]\nx = { unit = "m", initial = 0, rate = 0 }\n'
+        '[parameters]\nm = { value = 1, unit = "kg" }\nF = { value = 0, unit = "N" }\n'
+        '[energy]\nT = "m*x_dot^2/2"\nV = "0"\n[generalized_forces]\nx = "F"\n'
+        '[control]\nF = "-1e-300*1e-300*x"\n')
+    assert law_text(model).endswith("F = -1.00e-600*x")
+    assert len(law_summary(model)["laws"]["F"]) > 600  # exact in the JSON

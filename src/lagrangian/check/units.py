@@ -15,22 +15,12 @@ from functools import singledispatch
 import sympy as sp
 
 from ..compile.exact import distinct_nodes
-from ..model.expressions import format_expression as _grammar_text
 from ..model.model import Body, Damper, Model, Particle, PointForce, Spring, Torque, multiplier_name
+from ..model.printing import shown_expression as format_expression  # messages only
 from ..model.rotations import Moment, RigidBody
 from ..model.units import UnitOutsideTable, generalized_force_unit, is_angle_unit, registry, si_dimension
 
 ENERGY = "J"
-
-
-def format_expression(expr: sp.Expr) -> str:
-    """A term as the grammar prints it, an exact number of over 20 digits shown to 3 figures
-    (1e-300*1e-300 in V was printed with its 600 digits in a units warning)."""
-    long = {a: sp.sign(a) * sp.Symbol(str(sp.Float(abs(a), 3)))
-            for a in sp.sympify(expr).atoms(sp.Rational) if len(str(abs(a))) > 20}
-    return _grammar_text(expr.xreplace(long) if long else expr)
-
-
 POWER = "W"
 
 

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from ..model.model import Model
-from ..model.printing import format_expression
+from ..model.printing import format_expression, shown_expression
 
 
 def controller_text(controller) -> str:
@@ -28,5 +28,5 @@ def law_summary(model: Model) -> dict:
 
 def law_text(model: Model) -> str:
     """One line: the laws of the model's [control] table, compiled with its equations."""
-    laws = "; ".join(f"{name} = {format_expression(law)}" for name, law in model.control)
+    laws = "; ".join(f"{name} = {shown_expression(law)}" for name, law in model.control)
     return f"controller: the model's [control] laws, compiled with its equations: {laws}"

@@ -171,12 +171,21 @@ def test_a_link_inside_the_folder_and_a_fifo_are_refused_too(klass):
     assert [r.verdict for r in by_glob] == [r.verdict for r in report]
 
 
-def test_a_file_named_explicitly_is_read_through_its_link(klass):
+def test_a_lone_file_is_read_through_its_link_a_class_named_file_by_file_is_not(klass, cli):
     import lagrangian
 
-    report = lagrangian.load(str(klass.parent / "model.toml")).check_many(
-        [klass / "key.toml", klass / "good.toml"])
-    assert [r.verdict for r in report] == ["correct", "correct"]
+    system = lagrangian.load(str(klass.parent / "model.toml"))
+    assert system.check(klass / "key.toml").passed  # one answer, named: read as named
+    # the shell's `class/*.toml` names each file: the link to the key is not graded 'correct',
+    # the link to the secrets not read (its API_TOKEN was echoed), a link to a folder not entered
+    (klass / "here.toml").symlink_to(klass)
+    named = sorted(klass.iterdir())
+    report = system.check_many(named)
+    verdicts = {r.file.rsplit("/", 1)[-1]: r.verdict for r in report}
+    assert verdicts == {"a\\nb.toml": "correct", "good.toml": "correct", "here.toml": "unreadable",
+                        "key.toml": "unreadable", "secret.toml": "unreadable"}
+    code, text, err = cli("check", str(klass.parent / "model.toml"), *map(str, named))
+    assert code == 2 and "API_TOKEN" not in text + err and text.count("symbolic link") == 3
 
 
 def test_the_class_outputs_never_show_a_refused_file_nor_forge_a_row(cli, klass, tmp_path):

@@ -159,7 +159,8 @@ def answer_files(named: Iterable[str | Path], *, exclude: Iterable[str | Path] =
     """(path, error) of every answer file named by a path, a glob or a folder (its *.toml,
     hidden files and ``exclude``, the model itself, left out), each once, in the order named.
     A name that gives no file is an entry with its error, and so is a file of a folder or a glob
-    that is not a regular file inside it (a symbolic link, a FIFO): refused, never read."""
+    that is not a regular file inside it (a symbolic link, a FIFO): refused, never read; of
+    several names (a class) each file named is held to that rule too, a lone one read as named."""
     return [(path, error) for path, error, _ in _entries(named, exclude)]
 
 
@@ -170,6 +171,10 @@ def _entries(named: Iterable[str | Path], exclude: Iterable[str | Path]
     excluded = {Path(p).resolve() for p in exclude if Path(p).exists()}
     entries: list[tuple[str, str | None, bool]] = []
     seen: set[Path] = set()
+    named = list(named)
+    # several names are a class, and the shell's `class/*.toml` names a folder's files one by
+    # one: each is held to the folder's rule (a student's link to the key graded 'correct')
+    strict = len(named) > 1
 
     def add(path: Path, found: bool) -> None:
         refusal = _refusal(path) if found else None
@@ -188,7 +193,7 @@ def _entries(named: Iterable[str | Path], exclude: Iterable[str | Path]
     for name in named:
         text = str(name)
         path = Path(text)
-        if path.is_dir():
+        if path.is_dir() and not (strict and path.is_symlink()):
             found = sorted(p for p in path.glob("*.toml") if not p.name.startswith("."))
             kept = [p for p in found if _resolved(p) not in excluded and not _directory(p)]
             if not kept:
@@ -197,7 +202,7 @@ def _entries(named: Iterable[str | Path], exclude: Iterable[str | Path]
             for p in kept:
                 add(p, True)
         elif path.exists() or path.is_symlink():
-            add(path, False)
+            add(path, strict)
         elif glob.has_magic(text):
             found = sorted(Path(p) for p in glob.glob(text) if not _directory(Path(p)))
             if not found:

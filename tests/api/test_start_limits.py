@@ -137,3 +137,26 @@ def test_the_joint_that_crossed_is_named_not_one_resting_on_its_limit(tmp_path):
         assert run.message.startswith("joint 'hinge' (hinge) reached its position limit -0.3")
         assert run.q[-1, 0] == 0.0
         assert run.t[-1] == pytest.approx(_time_between(9.81, theta0, -0.3, 200_001), rel=1e-3)
+
+
+def test_on_a_floating_base_too(tmp_path):
+    # the twin on a free 10 kg base: the slider rests on its limit 0 (it hid every crossing:
+    # the floating Panda, its finger at 0, ran joint 2 through 1.7628 to 2.02 rad), and a start
+    # beyond a limit run with limits=False says so in the result, as on a fixed base
+    path = tmp_path / "twin_floating.urdf"
+    # (the slider along y, the hinge's axis: the base's recoil in x and z, its turn about y,
+    # push it nowhere)
+    path.write_text(TWIN.replace('<link name="base"/>', '<link name="base"><inertial><mass '
+                                 'value="10"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" '
+                                 'izz="1"/></inertial></link>')
+                    .replace('<axis xyz="1 0 0"/>', '<axis xyz="0 1 0"/>'))
+    robot = lagrangian.load(path, floating_base=True)
+    run = robot.simulate(1.0, initial={"hinge": 0.0, "hinge_dot": -2.0}, samples=11)
+    assert run.status == lagrangian.RunStatus.LIMIT
+    assert run.message.startswith("joint 'hinge' (hinge) reached its position limit -0.3")
+    hinge = list(run.coordinates).index("hinge")
+    assert run.q[-1, hinge] == pytest.approx(-0.3, abs=1e-6)
+    run = robot.simulate(0.05, initial={"hinge": 0.7}, limits=False, samples=3)
+    assert run.q[0, hinge] == 0.7
+    assert run.message.endswith("starts at 0.7, above its position limit 0.6 (range -0.3 to "
+                                "0.6) rad: started there, the limits ignored")

@@ -125,9 +125,10 @@ def _stop_event(stop: StopCondition, state: TreeState, model, parameters):
     return event
 
 
-def _limit_event(limits, state: TreeState):
-    """The joints' position-limit event (simulate.beyond_limits) on the tree's layout."""
-    beyond = beyond_limits(limits)
+def _limit_event(limits, state: TreeState, q0):
+    """The joints' position-limit event (simulate.beyond_limits) on the tree's layout; a joint
+    that starts on its limit (the Panda's finger at 0) hides no other joint's crossing."""
+    beyond = beyond_limits(limits, state.joints_q(q0))
     return None if beyond is None else (
         lambda q, v, t: beyond(state.joints_q(q), state.joints_v(v), t)), beyond
 
@@ -150,7 +151,9 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
         stop = floating_stop_condition(stop, dynamics, model)
     joint_limits = urdf_limits(model, positions=limits)
     t0, q0, v0 = state.start(model, initial)
-    check_start_within(joint_limits, state.joints_q(q0))  # the limits are the model's
+    # the limits are the model's; run with them ignored, a start beyond one is said in the result
+    _, beyond_at_start = check_start_within(joint_limits if limits else urdf_limits(model),
+                                            state.joints_q(q0), "refuse" if limits else "ignore")
     if not (np.isfinite(t_end) and t_end > t0):
         raise InputError(f"the end time ({t_end} s) must be after the start time ({t0} s)",
                          field="t_end")
@@ -199,7 +202,7 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     guarded = GuardedRhs(rhs, step_control.method, len(y0), t0, t_end)
     solver = None  # built in the loop's try: its first step size calls the guarded rhs
     user = None if stop is None else _stop_event(stop, state, model, system.parameters)
-    limit, beyond = _limit_event(joint_limits, state)
+    limit, beyond = _limit_event(joint_limits, state, q0)
     event = user if limit is None else limit if user is None else (
         lambda q, v, t: max(user(q, v, t), limit(q, v, t)))
     samples, times = [np.concatenate([q0, v0])], [t0]
@@ -284,6 +287,8 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
                                     and m.upper is not None], beyond,
                            None if there is None else (lambda *_: there), state.n)
         status, message = decided.status, decided.message
+    if beyond_at_start:
+        message = f"{message}; warning: {beyond_at_start}"
     q, v = Y[:, :nq], Y[:, nq:]
     kinetic = dynamics.kinetic_energy(q, v)
     energy = kinetic + dynamics.potential_energy(q)

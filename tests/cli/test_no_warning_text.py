@@ -39,6 +39,9 @@ def _quiet(cli, *args):
      "error: --R: entries must be finite numbers"),
     (("simulate", *CART, "--control", "computed-torque", "--kp", "inf"),
      "error: --kp: entries must be finite numbers"),
+    # Kp (x_d - x) = 100 * 1e308 overflows (was numpy's warning before the refusal)
+    (("simulate", *CART[:-1], "x=1e308", "--control", "computed-torque"),
+     "error: --control: the controller returned a value that is not finite at t = 0 s"),
 ])
 def test_a_refusal_is_one_line_without_warnings(cli, args, message):
     result = _quiet(cli, *args)

@@ -43,10 +43,13 @@ class ComputedTorque:
     def __call__(self, t, q, q_dot) -> np.ndarray:
         q_d, v_d, a_d = self.reference(t)
         q, v = np.asarray(q, dtype=float), np.asarray(q_dot, dtype=float)
-        error = self.dynamics.difference(q, q_d) if self.manifold else q_d - q
-        command = a_d + self.Kd @ (v_d - v) + self.Kp @ error
-        mass = self.dynamics.mass_matrix(q)
-        return mass @ command + self.dynamics.bias_forces(q, v)
+        # a target of 1e308 m overflows Kp e: inf, quietly (the control loop refuses a command
+        # that is not finite in one line; numpy's warning printed around it)
+        with np.errstate(over="ignore", invalid="ignore"):
+            error = self.dynamics.difference(q, q_d) if self.manifold else q_d - q
+            command = a_d + self.Kd @ (v_d - v) + self.Kp @ error
+            mass = self.dynamics.mass_matrix(q)
+            return mass @ command + self.dynamics.bias_forces(q, v)
 
     def summary(self) -> dict:
         """JSON-ready: coordinates, gains, the error dynamics' eigenvalues (re, im)."""

@@ -49,7 +49,7 @@ def simulate(
     fps: Annotated[int | None, typer.Option("--fps", help=FPS_HELP + " Default 20.")] = None,
     stop_when: Annotated[str | None, typer.Option("--stop-when", help="Stop when a condition turns true, e.g. \"theta < 0\".")] = None,  # noqa: E501
     ignore_limits: Annotated[bool, typer.Option("--ignore-limits", help="URDF: run through the joints' position limits (by default a joint reaching one ends the run, status 'limit', and a start beyond one is refused); a start beyond one is warned.")] = False,  # noqa: E501
-    clamp_start: Annotated[bool, typer.Option("--clamp-start", help="URDF: a start beyond a joint's position limit starts at the limit (with a warning) instead of being refused.")] = False,  # noqa: E501
+    clamp_start: Annotated[bool, typer.Option("--clamp-start", help="URDF: a start beyond a joint's position or velocity limit starts at the limit (with a warning) instead of being refused.")] = False,  # noqa: E501
     control: Annotated[str | None, typer.Option("--control", help="Close the loop: lqr (about --about, inputs --inputs, weights --Q, --R), computed-torque (to the configuration --about, gains --kp, --kd), or model (the model file's own [control] laws, compiled with its equations).")] = None,  # noqa: E501
     about: Annotated[list[str], typer.Option("--about", help="--control: the equilibrium (lqr) or target (computed-torque), NAME=VALUE; others solved for or at their initial values.")] = [],  # noqa: B006,E501
     control_inputs: Annotated[list[str], typer.Option("--inputs", help="--control lqr: the loads, parameters or coordinates it drives (F); repeat, or separate by commas.")] = [],  # noqa: B006,E501

@@ -33,7 +33,14 @@ from .integration_loops import LoopRun, crossing_time, touch_inside
 from .invariants import cumulative_work
 from .options import SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
-from .simulate import at_limit, beyond_limits, check_start_within, exceeded_limits, urdf_limits
+from .simulate import (
+    at_limit,
+    beyond_limits,
+    check_start_rates,
+    check_start_within,
+    exceeded_limits,
+    urdf_limits,
+)
 from .tree_state import BallCharts, TreeState
 
 
@@ -152,8 +159,11 @@ def simulate_floating(system, t_end: float, initial, step_control: StepControl,
     joint_limits = urdf_limits(model, positions=limits)
     t0, q0, v0 = state.start(model, initial)
     # the limits are the model's; run with them ignored, a start beyond one is said in the result
-    _, beyond_at_start = check_start_within(joint_limits if limits else urdf_limits(model),
-                                            state.joints_q(q0), "refuse" if limits else "ignore")
+    every = joint_limits if limits else urdf_limits(model)
+    rule = "refuse" if limits else "ignore"
+    _, beyond_at_start = check_start_within(every, state.joints_q(q0), rule)
+    _, too_fast = check_start_rates(every, state.joints_v(v0), rule)
+    beyond_at_start = "; ".join(note for note in (beyond_at_start, too_fast) if note)
     if not (np.isfinite(t_end) and t_end > t0):
         raise InputError(f"the end time ({t_end} s) must be after the start time ({t0} s)",
                          field="t_end")

@@ -37,7 +37,8 @@ from .options import METHODS, SaveAt, StepControl
 from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["METHODS", "STATUS_MESSAGES", "JointLimit", "SaveAt", "SimulationResult", "StepControl",
-           "START_LIMITS", "StopCondition", "at_limit", "beyond_limits", "check_start_within",
+           "START_LIMITS", "StopCondition", "at_limit", "beyond_limits", "check_start_rates",
+           "check_start_within",
            "exceeded_limits", "model_law", "parse_stop_condition", "simulate", "urdf_limits"]
 
 DEFAULT_STEP_CONTROL = StepControl()  # DOP853, rtol = atol = 1e-9
@@ -76,9 +77,9 @@ def simulate(
     (t, q, q_dot) -> u adds generalized forces (or, with ``inputs``, B u: simulation/control.py)
     to the model's own, in the scipy loop; ``controller="model"`` closes the loop with the
     model's own [control] laws instead, compiled with the equations (simulation/control_law.py).
-    A start beyond a position limit (``start_limits``, default the position ``limits``) is
+    A start beyond a position or velocity limit (``start_limits``, default ``limits``) is
     refused, or with ``start_beyond`` "clamp" started at the limit, "ignore" where it is, each
-    noted in the result's message (check_start_within). A rate that makes the accelerations
+    noted in the result's message (check_start_within, check_start_rates). A rate that makes the accelerations
     overflow at the start is refused naming it; a step size that collapses ends the run as
     'failed', each within a bounded number of calls (simulation/guards.py). ``canonical``
     (the model's Hamiltonian, analysis/hamilton.py) integrates Hamilton's equations in (q, p)
@@ -127,8 +128,11 @@ def simulate(
     q0, v0, projected = start.q_array(), start.q_dot_array(), {}
     q0, beyond_at_start = check_start_within(positioned if start_limits is None else start_limits,
                                              q0, start_beyond)
+    v0, too_fast = check_start_rates(limits if start_limits is None else start_limits, v0,
+                                     start_beyond)
+    beyond_at_start = "; ".join(note for note in (beyond_at_start, too_fast) if note)
     if beyond_at_start:  # clamped (or ignored): the start as it was used
-        start = replace(start, q=tuple(float(x) for x in q0))
+        start = replace(start, q=tuple(float(x) for x in q0), q_dot=tuple(float(x) for x in v0))
     beyond = beyond_limits(limits, q0) if limits else None
     if drift is not None:
         q0, v0, projected = _project_start(drift, start)
@@ -421,6 +425,34 @@ def check_start_within(limits: Sequence[JointLimit], q: np.ndarray, start: str =
         else:
             notes.append(f"{where} {limit.unit}: started there, the limits ignored")
     return q, "; ".join(notes)
+
+
+def check_start_rates(limits: Sequence[JointLimit], v: np.ndarray, start: str = "refuse"
+                      ) -> tuple[np.ndarray, str]:
+    """A start faster than a joint's velocity limit (a URDF <limit velocity>): refused in one
+    line naming the joint, its rate and its limit (``start`` "refuse"), or started at the
+    limit's speed ("clamp") or as given ("ignore"), with a note for the result's message.
+    Returns (v, note)."""
+    if start not in START_LIMITS:
+        raise InputError(f"unknown start {start!r}: refuse, clamp or ignore", field="limits")
+    v, notes = np.array(v, dtype=float), []
+    for limit in limits:
+        if limit.velocity is None:
+            continue
+        rate = float(v[limit.coordinate])
+        if abs(rate) <= limit.velocity:
+            continue
+        where = (f"joint '{limit.joint}' ({limit.name}) starts at the rate {rate:.6g} "
+                 f"{limit.unit}/s, beyond its velocity limit {limit.velocity:.6g} {limit.unit}/s")
+        if start == "refuse":
+            raise InputError(f"{where}; start it slower, clamp it to the limit or run with the "
+                             "limits ignored", field="initial")
+        if start == "clamp":
+            v[limit.coordinate] = math.copysign(limit.velocity, rate)
+            notes.append(f"{where}: clamped to the limit")
+        else:
+            notes.append(f"{where}: started so, the limits ignored")
+    return v, "; ".join(notes)
 
 
 def beyond_limits(limits: Sequence[JointLimit], q0: np.ndarray | None = None):

@@ -206,6 +206,7 @@ _CLI_HOMES = {
     "course_document": ("check.course", "course_document"),
     "course_folder": ("check.course", "course_folder"),
     "state_dynamics": ("api.state_dynamics", "state_dynamics"),
+    "state_kinematics": ("api.state_dynamics", "state_kinematics"),
 }
 
 

@@ -33,6 +33,9 @@ def _quiet(cli, *args):
     # Y holds m a = inf (was printed, after numpy's overflow warning in tau = Y pi)
     (("regressor", str(ARM), "--q", "0,0", "--v", "0,0", "--a", "1e308,1"),
      "error: the regressor Y is not finite at this state"),
+    # J_dot q_dot goes as q_dot^2: 1e200 rad/s overflows (was -inf after numpy's warning)
+    (("kinematics", str(ARM), "--v", "1e200,1"),
+     "error: J_dot q_dot is not finite at this state"),
     (("simulate", *CART, "--control", "lqr", "--inputs", "F", "--Q", "inf"),
      "error: --Q: entries must be finite numbers"),
     (("simulate", *CART, "--control", "lqr", "--inputs", "F", "--R", "nan"),

@@ -79,3 +79,36 @@ def state_dynamics(dynamics, q: Sequence[float], v: Sequence[float], *,
                                   "(a number beyond floating point, or a state outside the "
                                   "model's domain)")
     return StateDynamics(values, constraints, undefined, tuple(lines))
+
+
+def state_kinematics(kinematics, q: Sequence[float], frame: str, reference: str,
+                     v: Sequence[float] | None = None, centroidal: bool = False
+                     ) -> dict[str, Any]:
+    """A frame's placement (4 x 4) and Jacobian (6 x nv), the centre of mass (m) and its
+    Jacobian, with ``v`` J_dot q_dot ([a; w_dot] at q_ddot = 0, m/s^2 and rad/s^2), with
+    ``centroidal`` A_g (and A_g q_dot, kg m/s and kg m^2/s). A value that is not finite (an
+    overflow: a rate of 1e200 rad/s squared) is a DerivationError naming it."""
+    import numpy as np
+
+    with np.errstate(over="ignore", invalid="ignore"):
+        values: dict[str, Any] = {
+            "q": q, "placement": kinematics.placement(q, frame),
+            "jacobian": kinematics.jacobian(q, frame, reference),
+            "center_of_mass": kinematics.center_of_mass(q),
+            "center_of_mass_jacobian": kinematics.center_of_mass_jacobian(q)}
+        if v is not None:
+            values["v"] = v
+            values["jacobian_dot_times_v"] = kinematics.jacobian_dot_times_v(q, v, frame,
+                                                                           reference)
+        if centroidal:
+            values["centroidal_momentum_matrix"] = kinematics.centroidal_momentum_matrix(q)
+            if v is not None:
+                values["centroidal_momentum"] = values["centroidal_momentum_matrix"] @ v
+    named = {"jacobian_dot_times_v": "J_dot q_dot", "centroidal_momentum": "A_g q_dot",
+             "centroidal_momentum_matrix": "the centroidal momentum matrix A_g"}
+    for key, value in values.items():
+        if not np.all(np.isfinite(np.asarray(value, dtype=float))):
+            raise DerivationError(f"{named.get(key, 'the ' + key.replace('_', ' '))} is not "
+                                  "finite at this state (a number beyond floating point)")
+    return values
+

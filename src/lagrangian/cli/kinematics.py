@@ -29,7 +29,7 @@ def kinematics(
     json_: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """A frame's placement (4 x 4) and Jacobian (6 x n), the centre of mass and its Jacobian."""
-    from .. import resolve_state
+    from .. import resolve_state, state_kinematics
     from ..output.kinematics import kinematics_document, kinematics_text
 
     system = load_system(model, set_, lock, floating_base=floating_base)
@@ -39,18 +39,8 @@ def kinematics(
                                                                   strict=True))))
     robot = system.dynamics().kinematics
     name = frame if frame is not None else robot.frames[-1]
-    values = {"q": qs, "placement": robot.placement(qs, name),
-              "jacobian": robot.jacobian(qs, name, reference),
-              "center_of_mass": robot.center_of_mass(qs),
-              "center_of_mass_jacobian": robot.center_of_mass_jacobian(qs)}
     vs = None if v is None else _vector(v, velocities, "--v", [])
-    if vs is not None:
-        values["v"] = vs
-        values["jacobian_dot_times_v"] = robot.jacobian_dot_times_v(qs, vs, name, reference)
-    if centroidal:
-        values["centroidal_momentum_matrix"] = robot.centroidal_momentum_matrix(qs)
-        if vs is not None:
-            values["centroidal_momentum"] = values["centroidal_momentum_matrix"] @ vs
+    values = state_kinematics(robot, qs, name, reference, vs, centroidal)
     velocities = velocities if velocities != names else None  # a floating base, a ball
     if json_:
         print_json(kinematics_document(names, name, reference, values, velocities))

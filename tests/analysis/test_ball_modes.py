@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import lagrangian
+from mjcf_models import BALL_HINGE_BALL
 
 M, D, G = 2.0, 0.4, 9.81
 I_CENTRE = (0.05, 0.08, 0.03)  # about the centre of mass, body axes (kg m^2)
@@ -48,3 +49,22 @@ def test_every_rest_found_has_its_centre_of_mass_on_the_vertical(bob):
         assert np.hypot(centre[0], centre[1]) < 1e-7, rest
         assert abs(abs(centre[2]) - D) < 1e-7
         assert rest.stable == (centre[2] < 0), rest
+
+
+def test_a_rest_found_on_a_family_is_taken_back_as_one(tmp_path):
+    """A rest that equilibria() lists is accepted by linearize as given: on the ball-and-hinge
+    arm's family of rests (the ball turning about the vertical through its pivot) Newton's
+    polish slides along the family, and the rest was refused as 'not an equilibrium' for a
+    residual of 1e-9. About it the turn is a zero mode, which the elbow alone cannot move: LQR
+    says so in one line."""
+    path = tmp_path / "chain.xml"
+    hand = BALL_HINGE_BALL[BALL_HINGE_BALL.index('        <body name="hand"'):
+                           BALL_HINGE_BALL.index('      </body>\n    </body>')]
+    path.write_text(BALL_HINGE_BALL.replace(hand, ""))  # a ball, then a hinge
+    chain = lagrangian.load(path)
+    rest = chain.equilibria()[0]
+    linear = chain.linearize(rest.coordinates, inputs=["elbow"])
+    assert all(abs(linear.equilibrium[name] - value) < 1e-12
+               for name, value in rest.coordinates.items())
+    with pytest.raises(lagrangian.InputError, match="not stabilizable"):
+        lagrangian.lqr(linear, 1.0, 1.0)

@@ -329,7 +329,10 @@ def resolve_equilibrium(
             q[i] = float(about[n])
     points = np.concatenate([q[None], starting_points(model, ~given)[1:]])
     points[:, given] = q[given]
-    scale = force_scale(functions, points, t)
+    # the forces' size over the search's own starting points too, so that a rest that
+    # find_equilibria returned (to its tolerance) is taken back as one
+    scale = max(force_scale(functions, points, t),
+                force_scale(functions, starting_points(model, np.ones(len(names), bool)), t))
     solver = _Solver(functions, t, scale)
     limit = np.where(periodic, 1.0, np.maximum(np.abs(high - low) / 4, 1e-12))
     everything = np.ones(len(names), bool)
@@ -355,6 +358,9 @@ def resolve_equilibrium(
         result = polished(q_start, lam_start)
         if result is not None:
             return result
+    if ok[0]:  # balanced as given, where polishing slides along a family of rests (a ball
+        # turning about the vertical: Newton's step is free along it)
+        return np.vectorize(_clean)(q1[0]), lam1[0]
     given_text = ", ".join(f"{n}={about[n]:.6g}" for n in names if n in about)
     hint = ""
     nearby = solver.solve(q[None], lam[None], np.ones(len(names), bool), limit)

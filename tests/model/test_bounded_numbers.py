@@ -50,7 +50,8 @@ def refusal(text) -> str:
          "0*infinity or similar)"),
         ("pi/0", "division by zero in 'pi/0'"),
         ("0^-1", "division by zero in '0^-1'"),
-        ("1e308*pi*theta", "the number 1e308 is too large (at most 1e300 in size)"),
+        ("1e308*pi*theta", "the number 1e308 is too large (every number must be below 1e300 "
+                           "in size)"),
         ("1e200*theta*1e200", "a number in '1e200*theta*1e200' is too large (beyond 1e300)"),
         ("10^299*100", "the product '10^299*100' is too large a number (beyond 1e300)"),
         # silently 0 before

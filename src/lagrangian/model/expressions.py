@@ -132,7 +132,8 @@ def _literal(text: str, fail) -> sp.Rational:
     size = len(digits) - 1 + power  # floor(log10 |x|)
     if size >= MAX_NUMBER_DIGITS:
         if exponent_text:
-            raise fail(f"the number {text} is too large (at most 1e{MAX_NUMBER_DIGITS} in size)")
+            raise fail(f"the number {text} is too large (every number must be below "
+                       f"1e{MAX_NUMBER_DIGITS} in size)")
         raise fail(f"the number has more than {MAX_NUMBER_DIGITS} digits")
     if size < -MAX_NUMBER_DIGITS:
         raise fail(f"the number {text} is too small (below 1e-{MAX_NUMBER_DIGITS}, it would be "

@@ -57,3 +57,26 @@ def test_the_wheel_takes_a_whole_number_of_spokes_and_refuses_the_rest(cli):
     cycle = wheel.with_parameters(spokes=8).limit_cycle()
     (multiplier,) = cycle.multipliers
     assert abs(multiplier) == pytest.approx(math.cos(2 * math.pi / 8) ** 2, abs=1e-8)
+
+
+def test_a_restitution_parameter_is_held_to_zero_one_where_it_is_given(tmp_path, cli):
+    """The parameter that is an impact's restitution: its file value refused naming the impact
+    (it was reported under --set, which the user never gave), --set and with_parameters by
+    its range [0, 1]; inside, the ball rebounds at e times its speed."""
+    from lagrangian.model.examples import example_text
+
+    text = example_text("bouncing_ball")
+    path = tmp_path / "ball.toml"
+    path.write_text(text.replace("e = 0.8", "e = -0.5"))
+    with pytest.raises(lagrangian.ModelError) as caught:
+        lagrangian.load(path)
+    assert "ball.toml: impacts[0].restitution: the restitution 'e' = -0.5" in str(caught.value)
+    result = cli("simulate", "bouncing_ball", "--t-end", "1", "--set", "e=1.5")
+    assert result.code == 2 and result.err.strip() == (
+        "error: --set: 'e' = 1.5 is outside its range [0, 1]")
+    ball = lagrangian.load("bouncing_ball")
+    with pytest.raises(lagrangian.ModelError, match=re.escape("outside its range [0, 1]")):
+        ball.with_parameters(e=-0.1)
+    run = ball.with_parameters(e=0.5).simulate(1.0)
+    (first, *_) = run.impacts
+    assert first.after["y_dot"] == pytest.approx(-0.5 * first.before["y_dot"], rel=1e-9)

@@ -11,6 +11,7 @@ The impact map itself is derived (derivation/impact_map.py), never written by th
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Self
@@ -71,6 +72,8 @@ class ImpactsMixin:
                               f"{field}.point")
         n = self._impact_normal(normal, f"{field}.normal")
         e = self._parameter_expression(restitution, f"{field}.restitution")
+        if isinstance(e, sp.Symbol):  # a parameter: every value it is given held to [0, 1]
+            self._restitution_parameter(e, f"{field}.restitution")
         if not e.free_symbols:
             value = float(e)
             if not 0 <= value <= 1:
@@ -93,6 +96,22 @@ class ImpactsMixin:
             self._impacts = []
         self._impacts.append(impact)
         return self
+
+    def _restitution_parameter(self, symbol: sp.Symbol, field: str) -> None:
+        """The parameter that is an impact's restitution takes values in [0, 1] only (its
+        range narrowed to that): its value in the file checked here, naming the impact, and
+        every later one (--set, with_parameters) by the parameter's range."""
+        from dataclasses import replace
+
+        for k, parameter in enumerate(self._parameters):
+            if parameter.symbol != symbol:
+                continue
+            low, high = parameter.range or (-math.inf, math.inf)
+            bounds = (max(low, 0.0), min(high, 1.0))
+            if parameter.value is not None and not bounds[0] <= parameter.value <= bounds[1]:
+                raise self._error(f"the restitution '{parameter.name}' = {parameter.value:g} "
+                                  "must be in [0, 1]", field)
+            self._parameters[k] = replace(parameter, range=bounds)
 
     def _impact_normal(self, normal: object, field: str) -> Vector:
         vector = self.vector(normal, field, velocities=False)

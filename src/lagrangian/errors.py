@@ -144,6 +144,11 @@ class ModelWarning(UserWarning):
     fixed to the root with an inertia that is not physical); one line, printed by the CLI."""
 
 
+class BackendWarning(RuntimeWarning):
+    """A compiler is there but the generated C failed to build: numpy runs instead (the same
+    numbers, slower); one line, printed by the CLI."""
+
+
 class DynamicsWarning(UserWarning):
     """Some states of a batch have no dynamics (an input not finite, or for forward dynamics a
     mass matrix that is not positive definite): their output rows are NaN, the others exact.

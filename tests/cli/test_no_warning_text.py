@@ -99,3 +99,27 @@ def test_a_run_through_impacts_with_an_energy_past_double_range_is_quiet(cli):
                     "--samples", "3")
     assert result.code == 0, result.err
     assert "y_dot = -4.905" in result.out  # -g t, g = 9.81 m/s^2
+
+
+def test_a_compiler_that_fails_is_one_warning_line(cli, tmp_path, monkeypatch):
+    """A compiler that is there but fails: numpy runs (the same pendulum), and the CLI says so
+    in one line `warning: C backend unavailable, ...` with the compiler's words, not Python's
+    file:line, the message over three lines and the source line."""
+    broken = tmp_path / "cc"
+    broken.write_text("#!/bin/sh\necho 'cc1: out of memory' >&2\nexit 1\n")
+    broken.chmod(0o755)
+    monkeypatch.setenv("CC", str(broken))
+    monkeypatch.setenv("LAGRANGIAN_CACHE", str(tmp_path / "cache"))
+    from lagrangian.model.examples import example_text
+
+    model = tmp_path / "pendulum.toml"  # its own equations: nothing compiled in this process
+    model.write_text(example_text("pendulum").replace("theta", "phi_cc"))
+    result = cli("simulate", str(model), "--t-end", "1", "--json")
+    assert result.code == 0, result.err
+    lines = result.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("warning: C backend unavailable, using numpy")
+    assert "cc1: out of memory" in lines[0]
+    import json
+
+    assert json.loads(result.out)["final_state"]["phi_cc"] == pytest.approx(-0.0910577687,
+                                                                           abs=1e-8)

@@ -89,13 +89,32 @@ def main(argv: list[str] | None = None) -> None:
     (unknown option, bad or missing value: typer's 6-line box before) and files that cannot be
     written. Everything printed passes through TerminalText: no control character from a
     model file reaches the terminal."""
+    import warnings
+
     streams = sys.stdout, sys.stderr
     reset_warnings()
     sys.stdout, sys.stderr = TerminalText(sys.stdout), TerminalText(sys.stderr)
+    shown = warnings.showwarning
+    warnings.showwarning = _one_line_warnings(shown)
     try:
         _run(argv)
     finally:
         sys.stdout, sys.stderr = streams
+        warnings.showwarning = shown
+
+
+def _one_line_warnings(shown):
+    """The library's own warnings (a backend that gave way to numpy, states without dynamics)
+    as one line `warning: ...` each, not Python's file:line and source; others as before."""
+    from ..errors import BackendWarning, DynamicsWarning, ModelWarning, one_line
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, BackendWarning | DynamicsWarning | ModelWarning):
+            typer.echo(f"warning: {one_line(str(message))}", err=True)
+        else:
+            shown(message, category, filename, lineno, file, line)
+
+    return show
 
 
 def _run(argv: list[str] | None) -> None:

@@ -372,7 +372,12 @@ def tell_numpy_fallback(exc: Exception, what_happens: str) -> None:
                    + ("unset CC or point it at gcc or clang" if "CC=" in str(exc)
                       else "install gcc or clang (or set CC)"))
     elif compiled_was_expected():
-        warnings.warn(f"C backend unavailable, using numpy: {exc}", RuntimeWarning, stacklevel=3)
+        from ..errors import BackendWarning
+
+        # the compiler's own words after the first line, joined: one line in the CLI
+        first, *rest = [line.strip() for line in str(exc).splitlines() if line.strip()] or [""]
+        warnings.warn(f"C backend unavailable, using numpy: {first} {'; '.join(rest)}".rstrip(),
+                      BackendWarning, stacklevel=3)
 
 
 def compiled_was_expected() -> bool:

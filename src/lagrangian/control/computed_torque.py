@@ -82,7 +82,7 @@ def computed_torque(system, q_des, Kp, Kd) -> ComputedTorque:
         Kp = square_matrix(Kp, n, "Kp", definite=True)
         Kd = square_matrix(Kd, n, "Kd", definite=True)
         return ComputedTorque(dynamics, tuple(velocities), Kp, Kd,
-                              _manifold_reference(q_des, dynamics, system), manifold=True)
+                              _reference(q_des, dynamics, system, manifold=True), manifold=True)
     if velocities is not None:
         # tau = M(q) q_ddot_d + b commands all nv forces, the base's wrench among them: a
         # floating base's simulation takes the joints' forces only (nothing pushes the base)
@@ -94,32 +94,45 @@ def computed_torque(system, q_des, Kp, Kd) -> ComputedTorque:
     n = len(names)
     Kp = square_matrix(Kp, n, "Kp", definite=True)
     Kd = square_matrix(Kd, n, "Kd", definite=True)
-    reference = _reference(q_des, names, system)
+    reference = _reference(q_des, dynamics, system)
     return ComputedTorque(dynamics, names, Kp, Kd, reference)
 
 
-def _reference(q_des, names: tuple[str, ...], system):
-    """t -> (q_d, q_dot_d, q_ddot_d), each (n,), checked once at t = 0."""
-    n = len(names)
+def _reference(q_des, dynamics, system, manifold: bool = False):
+    """t -> (q_d, q_dot_d, q_ddot_d), checked once at t = 0: a target by name, numbers in the
+    coordinates' order, or a callable. ``manifold`` (q and v differ in length: a ball joint, a
+    free flyer below the root): q_d of nq numbers with unit quaternions, the rates of nv, and
+    names as simulate's start takes them (a ball's <ball>_qw..qz)."""
+    names = tuple(dynamics.coordinates)
+    nq = len(names)
+    nv = len(dynamics.velocity_names) if manifold else nq
     if callable(q_des):
-        reference = _called(q_des, (n, n, n), f"three arrays of {n} values ({', '.join(names)})")
-        reference(0.0)
-        return reference
-    if isinstance(q_des, Mapping):
-        from ..model.values import resolve_state
-
-        start = resolve_state(system.model, dict(q_des), field="q_des", velocities=False,
-                              time=False)
-        target = np.asarray(start.q, dtype=float)
+        reference = _called(q_des, (nq, nv, nv), f"q_d of {nq} values and q_dot_d, q_ddot_d "
+                            f"of {nv}" if manifold else
+                            f"three arrays of {nq} values ({', '.join(names)})")
+        target = reference(0.0)[0]
     else:
-        target = np.asarray(q_des, dtype=float)
-        if target.shape != (n,):
-            raise InputError(f"expected {n} values ({', '.join(names)}), got shape "
-                             f"{target.shape}", field="q_des")
-    if not np.all(np.isfinite(target)):
-        raise InputError("the reference must be finite", field="q_des")
-    zero = np.zeros(n)
-    return lambda t: (target, zero, zero)
+        if isinstance(q_des, Mapping) and manifold:
+            from ..simulation.tree_state import TreeState
+
+            _, target, _ = TreeState(dynamics, system.model).start(system.model, dict(q_des))
+        elif isinstance(q_des, Mapping):
+            from ..model.values import resolve_state
+
+            target = np.asarray(resolve_state(system.model, dict(q_des), field="q_des",
+                                              velocities=False, time=False).q, dtype=float)
+        else:
+            target = np.asarray(q_des, dtype=float)
+            if target.shape != (nq,):
+                raise InputError(f"expected {nq} values ({', '.join(names)}), got shape "
+                                 f"{target.shape}", field="q_des")
+        if not np.all(np.isfinite(target)):
+            raise InputError("the reference must be finite", field="q_des")
+        zero = np.zeros(nv)
+        reference = lambda t: (target, zero, zero)  # noqa: E731
+    if manifold:
+        dynamics.difference(target, target)  # a quaternion off unit norm: one line naming it
+    return reference
 
 
 def _called(q_des, widths: tuple[int, int, int], expected: str):
@@ -139,27 +152,3 @@ def _called(q_des, widths: tuple[int, int, int], expected: str):
     return reference
 
 
-def _manifold_reference(q_des, dynamics, system):
-    """t -> (q_d (nq), q_dot_d (nv), q_ddot_d (nv)) for a tree whose q and v differ in length,
-    checked once at t = 0: a target by name (a ball's <ball>_qw..qz, the joints' as for a
-    fixed base; the rest at simulate's start), nq numbers, or a callable; unit quaternions."""
-    from ..simulation.tree_state import TreeState
-
-    nq, nv = len(dynamics.coordinates), len(dynamics.velocity_names)
-    if callable(q_des):
-        reference = _called(q_des, (nq, nv, nv),
-                            f"q_d of {nq} values and q_dot_d, q_ddot_d of {nv}")
-        dynamics.difference(reference(0.0)[0], reference(0.0)[0])  # its quaternions checked
-        return reference
-    if isinstance(q_des, Mapping):
-        _, target, _ = TreeState(dynamics, system.model).start(system.model, dict(q_des))
-    else:
-        target = np.asarray(q_des, dtype=float)
-        if target.shape != (nq,):
-            raise InputError(f"expected {nq} values ({', '.join(dynamics.coordinates)}), got "
-                             f"shape {target.shape}", field="q_des")
-    if not np.all(np.isfinite(target)):
-        raise InputError("the reference must be finite", field="q_des")
-    dynamics.difference(target, target)  # a quaternion off unit norm: one line naming it
-    zero = np.zeros(nv)
-    return lambda t: (target, zero, zero)

@@ -51,9 +51,12 @@ class ControlTerms:
                 compute, P = fast.checked_regressor, fast.P
                 return (lambda Q, V, A: compute(Q, V, A, P),
                         tree_parameter_names(tree), tree_parameters(tree))
-            from .recursive_numpy import NumpyBackend
+            recursions = self.__dict__.get("_regressor_recursions")
+            if recursions is None:  # once per dynamics: the bodies in their own joint frames
+                from .recursive_numpy import NumpyBackend
 
-            recursions = NumpyBackend(tree, self.parameters, self.n, own_frames=True)
+                recursions = NumpyBackend(tree, self.parameters, self.n, own_frames=True)
+                self.__dict__["_regressor_recursions"] = recursions
             return (lambda Q, V, A: tree_regressor(recursions, Q, V, A),
                     tree_parameter_names(tree), tree_parameters(tree))
         if parameters is None:

@@ -152,5 +152,5 @@ def shown_expression(expr: sp.Expr) -> str:
     """``format_expression`` for a message, an exact number of over 20 digits shown to 3
     figures (1/10^600 as 1.00e-600, not its 600 digits): display only, not read back."""
     long = {a: sp.sign(a) * sp.Symbol(str(sp.Float(abs(a), 3)))
-            for a in sp.sympify(expr).atoms(sp.Rational) if len(str(abs(a))) > 20}
+            for a in sp.sympify(expr).atoms(sp.Rational) if len(str(abs(a))) > 20}  # safe: sympy
     return format_expression(expr.xreplace(long) if long else expr)

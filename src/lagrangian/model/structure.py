@@ -85,8 +85,8 @@ def complex_values(expressions, values) -> list[complex]:
             result = _FUNCTIONS[type(x)](value(x.args[0]))
         elif not x.args:
             raise ValueError(f"no value for {x}")
-        else:  # safe: sympy objects (numbers put in), never text
-            result = complex(x.func(*(sp.sympify(value(a)) for a in x.args)).evalf())
+        else:  # a function of several arguments: sympy's own, at the numbers put in
+            result = complex(x.func(*(sp.sympify(value(a)) for a in x.args)).evalf())  # safe
         memo[id(x)] = (result, x)  # x held, so that its id is not reused meanwhile
         return result
 

@@ -41,7 +41,7 @@
 /* the mass matrix's scratch per body: its rotation and origin in the world, its composite
    inertia about the world's origin (m, h, J_O's six), its joint's s_w and s_v there */
 enum { TW_RW = TW_A, TW_OW = TW_RW + 9, TW_IC = TW_OW + 3, TW_SW = TW_IC + 10,
-       TW_SV = TW_SW + 3 };
+       TW_SV = TW_SW + 3, TW_COLS = TW_SV + 3 /* up to six columns (s_v, s_w): to 76 */ };
 
 /* TK_CORE_BEGIN */
 /* The recursions, emitted twice by compact_kernel.py: on one state (tk_*, TK_T double) and
@@ -196,29 +196,27 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
     }
 }
 
-/* a ball joint's columns of M and S_c . f (tree_kernel_forward.c) */
-static inline TK_T TK_FN(ball_dot)(const TK_T *w, int c, const TK_T *f);
-static void TK_FN(ball_columns)(const tk_tree *t, const TK_T *W, int i, TK_T *M);
-/* a free flyer's below the root six columns of M, and S_k^T f at an ancestor's six */
-static void TK_FN(flyer_columns)(const tk_tree *t, const TK_T *W, int i, TK_T *M);
-static inline void TK_FN(flyer_dots)(const TK_T *w, const TK_T *f, TK_T *e);
-
 /* M by the composite-rigid-body algorithm in world axes about the world's origin (row-major
    n x n): each body's inertia (mass m, first moment h, rotational inertia J_O) moved there once,
-   composites summed child into parent with no turning, then M[i][j] = S_j . (I_c(i) S_i) for
-   each joint j from body i to the root: one 6-vector dot a pair, where the bodies' own axes
-   turned the composite's wrench at every step of that walk. */
+   composites summed child into parent with no turning, and each joint's motion columns S there
+   (joint.h: one, a ball's three, a free flyer's six, the multiplier k in a mimic's); then
+   M[i][j] = S_j . (I_c(i) S_i) for each column j of body i's joint and of every joint from it
+   to the root: one 6-vector dot a pair, no joint kind asked again. */
 static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict W,
                         TK_T *restrict M)
 {
-    const int n = t->nv;
+    const int n = t->nv, nb = t->nb;
+    /* the tree's links as integers, read once: the walks below are chains of these loads */
+    int parent_of[nb], column_of[nb], count_of[nb];
     TK_FN(place)(t, q, W);
     for (int k = 0; k < n * n; k++) M[k] = TK_C(0.0);
-    for (int i = 0; i < t->nb; i++) {
+    for (int i = 0; i < nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
         TK_T *w = W + i * TW_STRIDE, *R = w + TW_R, *p = w + TW_P;
         TK_T *Rw = w + TW_RW, *o = w + TW_OW, *Ic = w + TW_IC;
         const int parent = (int)b[TK_PARENT];
+        parent_of[i] = parent;
+        column_of[i] = TK_FREE(b) ? 0 : t->bv + (int)b[TK_COORD];
         if (parent < 0) {  /* the ground's axes are the world's (a free flyer's pose too) */
             for (int r = 0; r < 9; r++) Rw[r] = R[r];
             for (int r = 0; r < 3; r++) o[r] = p[r];
@@ -246,105 +244,44 @@ static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict
             if (e < 3) v += m * oo + 2.0 * oh;
             Ic[4 + e] = v - m * o[x] * o[y] - o[x] * hr[y] - hr[x] * o[y];
         }
-        /* the joint's motion per unit rate at the world's origin: s_w = Rw e_z sw,
-           s_v = Rw e_z sv + o x s_w */
-        if (!TK_FREE(b) && !TK_BALL(b) && !TK_FLYER(b)) {
-            double sw, sv;
-            TK_T *Sw = w + TW_SW, *Sv = w + TW_SV, x[3];
-            tk_subspace(b, &sw, &sv);
-            for (int r = 0; r < 3; r++) { Sw[r] = sw * Rw[3 * r + 2]; Sv[r] = sv * Rw[3 * r + 2]; }
-            SP_CROSS(o, Sw, x);
-            for (int r = 0; r < 3; r++) Sv[r] += x[r];
-        }
+        /* the joint's motion columns at the world's origin (s_v, s_w), per unit rate */
+        TK_T *S = w + TW_COLS;
+        const int count = JT_FN(columns)(b, Rw, o, (TK_T (*)[6])S);
+        count_of[i] = count;
+        if (count == 1 && b[TK_MULT] != 1.0)  /* a mimic: q_i = k q_master + offset */
+            for (int r = 0; r < 6; r++) S[r] *= b[TK_MULT];
     }
-    for (int i = t->nb - 1; i > 0; i--) {  /* composites: children before their parents */
-        const int parent = (int)t->body[i * TK_STRIDE + TK_PARENT];
+    for (int i = nb - 1; i > 0; i--) {  /* composites: children before their parents */
+        const int parent = parent_of[i];
         if (parent < 0) continue;
         const TK_T *Ic = W + i * TW_STRIDE + TW_IC;
         TK_T *Icp = W + parent * TW_STRIDE + TW_IC;
         for (int k = 0; k < 10; k++) Icp[k] += Ic[k];
     }
-    for (int i = t->nb - 1; i >= 0; i--) {
-        const double *b = t->body + i * TK_STRIDE;
+    for (int i = nb - 1; i >= 0; i--) {
         const TK_T *w = W + i * TW_STRIDE, *Ic = w + TW_IC, *h = Ic + 1, *J = Ic + 4;
-        if (TK_FREE(b)) {  /* the base's six columns [R e_c; 0] and [o x R e_c; R e_c] */
-            TK_T S[6][6], F[6][6];
-            JT_FN(columns)(b, w + TW_RW, w + TW_OW, S);
-            for (int c = 0; c < 6; c++) {  /* F = Ic S: [m s_v + s_w x h; h x s_v + J_O s_w] */
-                const TK_T *sv = S[c], *sw = S[c] + 3;
-                TK_T x[3];
-                SP_CROSS(sw, h, x);
-                for (int r = 0; r < 3; r++) F[c][r] = Ic[0] * sv[r] + x[r];
-                SP_CROSS(h, sv, x);
-                F[c][3] = x[0] + J[0] * sw[0] + J[3] * sw[1] + J[4] * sw[2];
-                F[c][4] = x[1] + J[3] * sw[0] + J[1] * sw[1] + J[5] * sw[2];
-                F[c][5] = x[2] + J[4] * sw[0] + J[5] * sw[1] + J[2] * sw[2];
-            }
-            for (int c = 0; c < 6; c++)
-                for (int r = 0; r < 6; r++) {
-                    TK_T e = TK_C(0.0);
-                    for (int k = 0; k < 6; k++) e += S[r][k] * F[c][k];
-                    M[r * n + c] += e;
+        const TK_T *S = w + TW_COLS;
+        const int ci = column_of[i];
+        for (int c = 0; c < count_of[i]; c++) {
+            const TK_T *sv = S + 6 * c, *sw = sv + 3;
+            TK_T f[6], x[3];
+            SP_CROSS(sw, h, x);  /* F = Ic S: [m s_v + s_w x h; h x s_v + J_O s_w] */
+            for (int r = 0; r < 3; r++) f[r] = Ic[0] * sv[r] + x[r];
+            SP_CROSS(h, sv, x);
+            f[3] = x[0] + J[0] * sw[0] + J[3] * sw[1] + J[4] * sw[2];
+            f[4] = x[1] + J[3] * sw[0] + J[1] * sw[1] + J[5] * sw[2];
+            f[5] = x[2] + J[4] * sw[0] + J[5] * sw[1] + J[2] * sw[2];
+            for (int r = 0; r < count_of[i]; r++)  /* the joint's own block */
+                M[(ci + r) * n + ci + c] += SP_DOT(S + 6 * r, f) + SP_DOT(S + 6 * r + 3, f + 3);
+            for (int k = parent_of[i]; k >= 0; k = parent_of[k]) {  /* += : mimics share */
+                const TK_T *Sk = W + k * TW_STRIDE + TW_COLS;
+                const int ck = column_of[k];
+                for (int r = 0; r < count_of[k]; r++) {
+                    const TK_T e = SP_DOT(Sk + 6 * r, f) + SP_DOT(Sk + 6 * r + 3, f + 3);
+                    M[(ci + c) * n + ck + r] += e;
+                    M[(ck + r) * n + ci + c] += e;
                 }
-            continue;
-        }
-        if (TK_BALL(b)) {
-            TK_FN(ball_columns)(t, W, i, M);
-            continue;
-        }
-        if (TK_FLYER(b)) {
-            TK_FN(flyer_columns)(t, W, i, M);
-            continue;
-        }
-        const TK_T *Sw = w + TW_SW, *Sv = w + TW_SV;
-        TK_T f[6], x[3];
-        SP_CROSS(Sw, h, x);  /* I_c(i) S_i */
-        for (int r = 0; r < 3; r++) f[r] = Ic[0] * Sv[r] + x[r];
-        SP_CROSS(h, Sv, x);
-        f[3] = x[0] + J[0] * Sw[0] + J[3] * Sw[1] + J[4] * Sw[2];
-        f[4] = x[1] + J[3] * Sw[0] + J[1] * Sw[1] + J[5] * Sw[2];
-        f[5] = x[2] + J[4] * Sw[0] + J[5] * Sw[1] + J[2] * Sw[2];
-        const int ci = t->bv + (int)b[TK_COORD];
-        M[ci * n + ci] += SP_DOT(Sv, f) + SP_DOT(Sw, f + 3);
-        for (int k = (int)b[TK_PARENT]; k >= 0; k = (int)t->body[k * TK_STRIDE + TK_PARENT]) {
-            const double *bk = t->body + k * TK_STRIDE;
-            const TK_T *wk = W + k * TW_STRIDE;
-            if (TK_FREE(bk)) {  /* the base's six columns: S_base^T f */
-                const TK_T *Rw = wk + TW_RW, *o = wk + TW_OW;
-                for (int c = 0; c < 3; c++) {
-                    TK_T e[3] = {Rw[c], Rw[3 + c], Rw[6 + c]}, y[3];
-                    SP_CROSS(o, e, y);
-                    const TK_T lin = SP_DOT(e, f), ang = SP_DOT(y, f) + SP_DOT(e, f + 3);
-                    M[ci * n + c] += lin;  /* += : mimic joints share a column */
-                    M[c * n + ci] += lin;
-                    M[ci * n + 3 + c] += ang;
-                    M[(3 + c) * n + ci] += ang;
-                }
-                break;
             }
-            if (TK_BALL(bk)) {  /* the ball's three columns: S_ball^T f */
-                const int ck = t->bv + (int)bk[TK_COORD];
-                for (int c = 0; c < 3; c++) {
-                    const TK_T e = TK_FN(ball_dot)(wk, c, f);
-                    M[ci * n + ck + c] += e;
-                    M[(ck + c) * n + ci] += e;
-                }
-                continue;
-            }
-            if (TK_FLYER(bk)) {  /* a free flyer's six columns: S_k^T f */
-                const int ck = t->bv + (int)bk[TK_COORD];
-                TK_T e[6];
-                TK_FN(flyer_dots)(wk, f, e);
-                for (int c = 0; c < 6; c++) {
-                    M[ci * n + ck + c] += e[c];
-                    M[(ck + c) * n + ci] += e[c];
-                }
-                continue;
-            }
-            const TK_T e = SP_DOT(wk + TW_SV, f) + SP_DOT(wk + TW_SW, f + 3);
-            const int ck = t->bv + (int)bk[TK_COORD];
-            M[ci * n + ck] += e;
-            M[ck * n + ci] += e;
         }
     }
 }

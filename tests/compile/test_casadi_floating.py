@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import lagrangian
-from lagrangian.compile.casadi_tree import BASE_CONFIGURATION, BASE_VELOCITY
+from lagrangian.dynamics.tree.free_flyer import BASE_CONFIGURATION, BASE_VELOCITY
 from lagrangian.model.mjcf_state import mujoco_layout
 from lagrangian.model.urdf import example_urdf
 from lagrangian.simulation.floating import configuration_rate

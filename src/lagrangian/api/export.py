@@ -88,14 +88,15 @@ class ExportMethods:
         """CasADi Functions built node by node from the derived equations (SI units, x = [q;
         q_dot]): ``rhs(x, u)``, ``mass_matrix(q)``, ``forcing(q, q_dot, u)`` and, with
         constraints, ``constraints(q, q_dot)``; ``inputs`` name the entries of u as in
-        ``linearize(inputs=...)``. A robot read from URDF or MJCF gets them from its tree by
-        recursive Newton-Euler over casadi SX (nothing derived; inputs: coordinates or their
-        tau_<joint>). Needs the extra [casadi] (docs/bridges.md)."""
+        ``linearize(inputs=...)``. A robot read from URDF or MJCF gets them from its tree: the
+        numpy reference's recursions over casadi SX (nothing derived; every joint kind; inputs:
+        the joints' velocity numbers or their tau_<joint>). Needs the extra [casadi]
+        (docs/bridges.md)."""
         from ..compile.casadi_functions import casadi_functions
         from ..compile.functions import refuse_large_chain
 
         if self._model.source_names and self._model.kinematic_tree is not None:
-            from ..compile.casadi_tree import tree_casadi_functions
+            from ..dynamics.standalone.casadi_tree import tree_casadi_functions
 
             return tree_casadi_functions(self._model, inputs, parameters)
         refuse_large_chain(self.model)

@@ -25,7 +25,9 @@ _UNARY = {sp.sin: "sin", sp.cos: "cos", sp.tan: "tan", sp.exp: "exp", sp.log: "l
           sp.floor: "floor", sp.ceiling: "ceil"}
 
 
-def _casadi():
+def casadi_module():
+    """The casadi package, imported on first use (the extra [casadi]), refused in one line
+    where it is not installed."""
     require_extra("casadi", ["casadi"], "a CasADi bridge (to_casadi, optimize)")
     import casadi
 
@@ -37,7 +39,7 @@ def sympy_to_sx(exprs: Sequence[sp.Expr], env: Mapping[sp.Symbol, object]) -> li
 
     Shared sub-expressions are converted once; a node with no CasADi counterpart (an undefined
     function, a derivative left in the equations) is refused by name."""
-    ca = _casadi()
+    ca = casadi_module()
     exprs = [sp.sympify(e) for e in exprs]  # safe: sympy objects (derived), no text
     done: dict = {}
     for root in exprs:  # post-order: each node after its arguments, each node once
@@ -124,8 +126,9 @@ class CasadiFunctions:
     constraints. ``inputs`` name the entries of u (as ``linearize(inputs=...)``): a generalized
     force on a coordinate, or added to a load's parameter (as simulate's controller does).
     Equations with t explicit (``time_dependent``): each Function takes t (s) last.
-    A floating base's state is x = [q (nq = n + 7); v (nv = n + 6)] in our dynamics' layout
-    (``configuration``, ``velocities``: compile/casadi_tree.py), M nv x nv, f and tau nv."""
+    A robot whose q and v differ (a floating base, ball joints, a free flyer below the root)
+    has x = [q (nq); v (nv)] in our dynamics' layout, named by ``configuration`` and
+    ``velocities`` (dynamics/standalone/casadi_tree.py), M nv x nv, f and tau nv."""
 
     coordinates: tuple[str, ...]
     inputs: tuple[str, ...]
@@ -136,9 +139,12 @@ class CasadiFunctions:
     constraints: object | None
     # per input, the coordinate whose generalized force it is (its index), None for a load
     input_coordinates: tuple[int | None, ...] = ()
-    # a floating base's names of q and v (the base's numbers first); () on a fixed base
+    # the names of q and v where they differ (a floating base's numbers first, a quaternion's
+    # four); () where x = [q; q_dot] of the coordinates
     configuration: tuple[str, ...] = ()
     velocities: tuple[str, ...] = ()
+    # x starts with a floating base's seven and six numbers (base_x .. base_wz)
+    floating: bool = False
     # the equations hold t explicitly (a driven support, a force of time): each Function then
     # takes t (s) as its last argument, rhs(x, u, t), mass_matrix(q, t), ...
     time_dependent: bool = False
@@ -146,12 +152,13 @@ class CasadiFunctions:
     @property
     def floating_base(self) -> bool:
         """Whether x holds a floating base's seven and six numbers first."""
-        return bool(self.configuration)
+        return self.floating
 
     @property
     def states(self) -> tuple[str, ...]:
         """The names of x: the coordinates, then their velocities (``theta_dot``); a floating
-        base's numbers first in each (base_x .. base_qw, base_vx .. base_wz)."""
+        base's numbers first in each (base_x .. base_qw, base_vx .. base_wz), a ball's four
+        and three (shoulder_qw .. shoulder_qz, shoulder_wx .. shoulder_wz)."""
         if self.configuration:
             return self.configuration + self.velocities
         return self.coordinates + tuple(f"{c}_dot" for c in self.coordinates)
@@ -168,7 +175,7 @@ def casadi_functions(eom: EquationsOfMotion, inputs: Sequence[str] = (),
     """rhs, mass_matrix, forcing and constraints of ``eom`` as CasADi Functions; the named
     ``inputs`` (parameters, loads or coordinates: a generalized force on it) are the entries
     of u, the other parameters their model values overridden by ``parameters`` (SI)."""
-    ca = _casadi()
+    ca = casadi_module()
     model = eom.model
     inputs = tuple(inputs)
     if len(set(inputs)) != len(inputs):
@@ -249,4 +256,4 @@ def _uses(eom: EquationsOfMotion, symbols: set, forcing: bool = True) -> bool:
     return any(p.free_symbols & symbols for p in parts)
 
 
-__all__ = ["CasadiFunctions", "casadi_functions", "sympy_to_sx"]
+__all__ = ["CasadiFunctions", "casadi_functions", "casadi_module", "sympy_to_sx"]

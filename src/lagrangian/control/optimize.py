@@ -5,9 +5,9 @@ u(t) on [0, t_final], subject to x_dot = rhs(x, u) at the collocation points (tr
 Hermite-Simpson), x(0) = start, x(t_final) = goal where given, and bounds on u and x.
 
 A floating base's x = [q; v] holds its position, quaternion (x y z w) and body twist first, as
-our dynamics (compile/casadi_tree.py): its quaternion is collocated as the other numbers (its
-rate keeps |q| = 1 up to the scheme's error, and the base's R is that of q / |q|); it starts at
-the origin at rest, level, unless ``start`` names its numbers.
+our dynamics (dynamics/standalone/casadi_tree.py): its quaternion is collocated as the other
+numbers (its rate keeps |q| = 1 up to the scheme's error, and the base's R is that of q / |q|);
+it starts at the origin at rest, level, unless ``start`` names its numbers.
 """
 
 from __future__ import annotations

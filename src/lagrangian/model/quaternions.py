@@ -15,7 +15,8 @@ QUATERNION_TOLERANCE = 1e-6
 def quaternion_matrix(quaternion) -> np.ndarray:
     """The rotation (..., 3, 3) of quaternions (..., 4) in the order x, y, z, w, normalized."""
     quaternion = np.asarray(quaternion, dtype=np.result_type(quaternion, float))
-    if quaternion.dtype.kind == "c":  # the complex step: |q| analytic, sqrt(q . q), not |q|
+    # the complex step (|q| analytic, sqrt(q . q), not |q|) and symbolic entries (casadi SX)
+    if quaternion.dtype.kind in "cO":
         norm = np.sqrt((quaternion * quaternion).sum(axis=-1, keepdims=True))
     else:
         norm = np.linalg.norm(quaternion, axis=-1, keepdims=True)

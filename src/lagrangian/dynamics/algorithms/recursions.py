@@ -107,7 +107,7 @@ def _spatial_inertia(m, h, J, count: int) -> np.ndarray:
     f = m v - [h]x w, n = [h]x v + J w; (count, 6, 6)."""
     h = np.broadcast_to(h, (count, 3))
     H = _skew_batch(h)
-    out = np.zeros((count, 6, 6))
+    out = np.zeros((count, 6, 6), dtype=H.dtype)
     out[:, :3, :3] = m * np.eye(3) if np.ndim(m) == 0 else np.asarray(m)[:, None, None] * np.eye(3)
     out[:, :3, 3:] = -H
     out[:, 3:, :3] = H
@@ -252,7 +252,8 @@ class TreeRecursions:
         mass = [j.m for j in joints]
         h = [j.h for j in joints]
         J = [j.J for j in joints]
-        M = np.zeros((count, self.n, self.n))
+        # float, or the entries' own type (complex; casadi SX in an object array)
+        M = np.zeros((count, self.n, self.n), dtype=np.result_type(Q, float))
         for i in reversed(range(len(joints))):
             j = joints[i]
             if j.free:  # the floating base: the composite inertia itself, [[m, -[h]x], [[h]x, J]]

@@ -39,9 +39,9 @@
 #define JT_SINCOS TK_SINCOS
 
 /* the mass matrix's scratch per body: its rotation and origin in the world, its composite
-   inertia about the world's origin (m, h, J_O's six), its joint's s_w and s_v there */
-enum { TW_RW = TW_A, TW_OW = TW_RW + 9, TW_IC = TW_OW + 3, TW_SW = TW_IC + 10,
-       TW_SV = TW_SW + 3, TW_COLS = TW_SV + 3 /* up to six columns (s_v, s_w): to 76 */ };
+   inertia about the world's origin (m, h, J_O's six), its joint's columns (s_v, s_w) there: up
+   to six, to 70 (before TW_CS) */
+enum { TW_RW = TW_A, TW_OW = TW_RW + 9, TW_IC = TW_OW + 3, TW_COLS = TW_IC + 10 };
 
 /* TK_CORE_BEGIN */
 /* The recursions, emitted twice by compact_kernel.py: on one state (tk_*, TK_T double) and
@@ -74,11 +74,11 @@ static void TK_FN(place)(const tk_tree *t, const TK_T *restrict q, TK_T *restric
     }
 }
 
-/* Recursive Newton-Euler: tau = M a + C v + g - tau0 (v, a NULL: zero). */
-static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T *restrict v,
-                           const TK_T *restrict a, TK_T *restrict W, TK_T *restrict tau)
+/* Recursive Newton-Euler: tau = M a + C v + g - tau0 (v, a NULL: zero), the bodies placed
+   in W (TK_FN(place)) */
+static void TK_FN(inverse_placed)(const tk_tree *t, const TK_T *restrict v,
+                                  const TK_T *restrict a, TK_T *restrict W, TK_T *restrict tau)
 {
-    TK_FN(place)(t, q, W);
     for (int i = 0; i < t->bv; i++) tau[i] = TK_C(0.0);
     for (int i = 0; i < t->n; i++) tau[t->bv + i] = TK_C(-t->tau0[i]);
     for (int i = 0; i < t->nb; i++) {
@@ -196,19 +196,25 @@ static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T 
     }
 }
 
+static void TK_FN(inverse)(const tk_tree *t, const TK_T *restrict q, const TK_T *restrict v,
+                           const TK_T *restrict a, TK_T *restrict W, TK_T *restrict tau)
+{
+    TK_FN(place)(t, q, W);
+    TK_FN(inverse_placed)(t, v, a, W, tau);
+}
+
 /* M by the composite-rigid-body algorithm in world axes about the world's origin (row-major
    n x n): each body's inertia (mass m, first moment h, rotational inertia J_O) moved there once,
    composites summed child into parent with no turning, and each joint's motion columns S there
    (joint.h: one, a ball's three, a free flyer's six, the multiplier k in a mimic's); then
    M[i][j] = S_j . (I_c(i) S_i) for each column j of body i's joint and of every joint from it
-   to the root: one 6-vector dot a pair, no joint kind asked again. */
-static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict W,
-                        TK_T *restrict M)
+   to the root: one 6-vector dot a pair, no joint kind asked again. The bodies placed in W
+   (TK_FN(place)); the numbers there that RNEA reads (R, p, cos, sin) left as they are. */
+static void TK_FN(mass_placed)(const tk_tree *t, TK_T *restrict W, TK_T *restrict M)
 {
     const int n = t->nv, nb = t->nb;
     /* the tree's links as integers, read once: the walks below are chains of these loads */
     int parent_of[nb], column_of[nb], count_of[nb];
-    TK_FN(place)(t, q, W);
     for (int k = 0; k < n * n; k++) M[k] = TK_C(0.0);
     for (int i = 0; i < nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
@@ -284,6 +290,13 @@ static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict
             }
         }
     }
+}
+
+static void TK_FN(mass)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict W,
+                        TK_T *restrict M)
+{
+    TK_FN(place)(t, q, W);
+    TK_FN(mass_placed)(t, W, M);
 }
 
 /* T = 1/2 sum (m v.v + 2 v.(w x h) + w.J w) */

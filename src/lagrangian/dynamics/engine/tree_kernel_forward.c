@@ -232,8 +232,9 @@ static TK_MASK TK_FN(forward_cholesky)(const tk_tree *t, const TK_T *restrict q,
 {
     TK_MASK bad = TK_FINE;
     const int n = t->nv;
-    TK_FN(mass)(t, q, W, L);
-    TK_FN(inverse)(t, q, v, NULL, W, qdd);
+    TK_FN(place)(t, q, W);  /* once: the mass matrix leaves RNEA's placements as they are */
+    TK_FN(mass_placed)(t, W, L);
+    TK_FN(inverse_placed)(t, v, NULL, W, qdd);
     for (int i = 0; i < n; i++) qdd[i] = tau[i] - qdd[i];
     for (int j = 0; j < n; j++) {
         TK_T d = L[j * n + j];

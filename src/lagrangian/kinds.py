@@ -13,7 +13,9 @@ class JointKind(StrEnum):
     MuJoCo's, by a unit quaternion w x y z and the angular velocity in the child's axes), not
     at all (fixed) or freely in space (free_flyer: a URDF robot's floating base), or about and
     along its axis at once (helical: a screw, turning theta and sliding pitch * theta; the
-    Python tree builder's, model/robot_builder.py). A kinematic tree moves its bodies by the
+    Python tree builder's, model/robot_builder.py), or MuJoCo's free joint (free: three
+    prismatic joints along the world's axes and a ball, MuJoCo's qpos/qvel exactly; an MJCF
+    robot's, model/mjcf_free.py). A kinematic tree moves its bodies by the
     one-degree-of-freedom kinds, ball joints and free flyers (at its root, a floating base; or
     below it, a URDF floating joint between two links) (dynamics/tree/joint_models.py)."""
 
@@ -27,6 +29,11 @@ class JointKind(StrEnum):
     # a screw (Pinocchio's JointModelHelicalUnaligned): in a tree only, made by
     # lagrangian.RobotBuilder (URDF and model files have none)
     HELICAL = "helical"
+    # MuJoCo's free joint (MJCF <freejoint>) in MuJoCo's layout: q = [x y z (world), qw qx qy qz],
+    # v = [origin velocity in world axes, angular velocity in body axes]. Never a tree joint's
+    # kind: expanded when the tree is built into three prismatic joints along the world's axes
+    # and a spherical joint at their end, which every backend moves (model/mjcf_free.py)
+    FREE = "free"
 
 
 class ConstraintKind(StrEnum):

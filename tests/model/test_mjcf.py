@@ -157,8 +157,9 @@ def test_mjcf_written_by_mujoco_from_a_urdf(name, tmp_path):
 REFUSALS = [
     ('<body><joint type="ball" damping="1"/><geom size="0.1"/></body>',
      "damping on a ball joint is not supported"),
-    ('<body><freejoint/><geom size="0.1"/></body>', "a free joint is read only with "
-                                                      "floating_base=True"),
+    ('<body><joint/><geom size="0.1"/><body><freejoint/><geom size="0.1"/></body></body>',
+     "a free joint must be the only joint of a body at the top of the worldbody"),
+    ('<body><joint/><freejoint/><geom size="0.1"/></body>', "a free joint must be the only"),
     ('<body><joint ref="10"/><geom size="0.1"/></body>', "ref other than 0"),
     ('<body><joint stiffness="3"/><geom size="0.1"/></body>', "stiffness other than 0"),
     ('<body><joint type="spin"/><geom size="0.1"/></body>', "unknown joint type 'spin'"),

@@ -6,13 +6,14 @@ joint's anchor, several joints in one body chain through massless links), and re
 reader, so an MJCF robot enters the same engine. Each joint is a coordinate in MuJoCo's qpos
 order (depth first in document order) with MuJoCo's sign and zero, so a state moves between
 MuJoCo and us unchanged; a ball joint is the tree's spherical joint, its quaternion w x y z and
-angular velocity in the child's axes as MuJoCo's (model/mjcf_ball.py). A free joint is read only
-with ``floating_base`` (the tree's free flyer, in Pinocchio's layout: model/mjcf_state.py
-converts MuJoCo's). A joint equality with a linear polycoef is a mimic joint
-(model/mjcf_equality.py). A joint's damping, frictionloss and armature are kept
-(Model.source_dynamics, source_armature) for dynamics(actuators=True). What would change the
-dynamics and is not modelled (tendons, other equalities, actuators with dynamics, a joint's ref
-or stiffness, ...) is refused in one line naming the file, element and fault.
+angular velocity in the child's axes as MuJoCo's (model/mjcf_ball.py); a free joint is three
+slides along the world's axes and a ball, MuJoCo's layout exactly (model/mjcf_free.py), or with
+``floating_base`` the tree's free flyer (Pinocchio's layout: model/mjcf_state.py converts). A
+joint equality with a linear polycoef is a mimic joint (model/mjcf_equality.py). A joint's
+damping, frictionloss and armature are kept (Model.source_dynamics, source_armature) for
+dynamics(actuators=True). What would change the dynamics and is not modelled (tendons, other
+equalities, actuators with dynamics, a joint's ref or stiffness, ...) is refused in one line
+naming the file, element and fault.
 Units SI (MJCF's lengths in m, masses in kg; angles by the compiler, degrees by default).
 """
 
@@ -27,8 +28,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, did_you_mean, require_extra
+from ..kinds import JointKind
 from .mjcf_ball import ball_joint, with_ball_joints
 from .mjcf_equality import check_mimics, folded_losses, read_equalities
+from .mjcf_free import free_joint, with_free_joints
 from .mjcf_geometry import (
     DENSITY,
     axis_angle_matrix,
@@ -80,6 +83,11 @@ def parse_mjcf(text: str, *, source: str = "<mjcf>", lock: Mapping[str, float] |
     reader = _Reader(root, source)
     reader.floating = bool(floating_base)
     urdf = reader.urdf()
+    slides = {s: free for free, three in reader.slides.items() for s in three}
+    locked = [name for name in (lock or {}) if name in reader.slides or name in slides]
+    if locked:
+        raise ModelError(f"the free joint '{slides.get(locked[0], locked[0])}' cannot be "
+                         "locked (yet)", field=f"lock.{locked[0]}", source=source)
     locked = [name for name in (lock or {}) if name in reader.balls]
     if locked:
         raise ModelError(f"the ball joint '{locked[0]}' cannot be locked (yet)",
@@ -89,6 +97,7 @@ def parse_mjcf(text: str, *, source: str = "<mjcf>", lock: Mapping[str, float] |
     joints = len(reader.joint_names) + len(reader.balls)
     if reader.balls:  # the tree's ball joints in MuJoCo's layout (mjcf_ball.py)
         model = with_ball_joints(model, reader.balls, source)
+    model = with_free_joints(model, reader.slides)  # MuJoCo's layout (mjcf_free.py)
     coordinate = {joint: name for name, joint in model.source_names}  # locked: none
     model = replace(model, description=f"Robot '{model.name}' read from MJCF ({joints} joints, "
                                        f"{reader.bodies} bodies).",
@@ -151,10 +160,17 @@ class _Reader:
         self.elements: dict[str, object] = {}
         self.joint_names: list[str] = []
         self.balls: dict[str, tuple[str, str, str]] = {}  # a ball joint's three URDF hinges
-        self.floating = False  # floating_base asked for: a free joint is read (_free)
-        self.free: str | None = None  # the free joint's name, once read
+        self.floating = False  # floating_base asked for: a free joint is the free flyer
+        self.free: str | None = None  # that free joint's name, once read
+        # a free joint in MuJoCo's layout: its three slides (mjcf_free.py); its ball in balls
+        self.slides: dict[str, tuple[str, str, str]] = {}
         self.link_names: set[str] = {"world"}
         self.bodies = 0
+
+    def named(self, name: str) -> bool:
+        """Whether a joint (or a free joint's slide) of this name is read already."""
+        return name in self.joint_names or name in self.balls or any(
+            name in slides for slides in self.slides.values())
 
     def error(self, message: str, field: str | None = None) -> ModelError:
         return ModelError(message, field=field, source=self.source)
@@ -301,7 +317,7 @@ class _Reader:
                 raise self.error("the world body cannot have joints", f"worldbody.{child.tag}")
         if not self.joint_names and self.free is None and not self.balls:
             raise self.error("no hinge, slide or ball joint: nothing moves", "worldbody")
-        check_mimics(self, self.mimics, self.joint_names, self.free)
+        check_mimics(self, self.mimics, self.joint_names, {*self.slides, self.free} - {None})
         for name, (joint2, c0, c1) in self.mimics.items():
             ElementTree.SubElement(self.elements[name], "mimic", joint=joint2,
                                    multiplier=repr(float(c1)), offset=repr(float(c0)))
@@ -374,10 +390,11 @@ class _Reader:
         name = joint.get("name") or f"{body}_joint{k}" if joint.tag == "joint" else \
             joint.get("name") or f"{body}_free"
         field = f"{where}.joint '{name}'"
-        attrs = self.attrs(joint, childclass, field) if joint.tag == "joint" else {}
+        attrs = self.attrs(joint, childclass, field) if joint.tag == "joint" else \
+            dict(joint.attrib)
         kind = kind or attrs.get("type", "hinge")
-        if kind == "free":
-            return self._free(name, body, parent, current, field, attrs, only=len(
+        if kind == JointKind.FREE:
+            return free_joint(self, name, body, parent, field, attrs, only=len(
                 [c for c in _children(joint.getparent()) if c.tag in ("joint", "freejoint")]
             ) == 1)
         if kind == "ball":
@@ -395,7 +412,7 @@ class _Reader:
                 raise self.error(f"{key} other than 0 is not supported (yet)", f"{field}.{key}")
         if attrs.get("springdamper"):
             raise self.error("springdamper is not supported (yet)", f"{field}.springdamper")
-        if name in self.joint_names or name in self.balls:
+        if self.named(name):
             raise self.error(f"two joints are named '{name}'", field)
         self.joint_names.append(name)
         axis = self.vector(attrs, "axis", (0, 0, 1), field)
@@ -412,31 +429,6 @@ class _Reader:
                                                limit)
         self.losses[name] = (float(losses[0]), float(losses[1]), float(losses[2]))
         return link, (_transform(np.eye(3), -anchor) if kind == "hinge" else np.eye(4))
-
-    def _free(self, name: str, body: str, parent: str, current, field: str, attrs,
-              only: bool):
-        """A free joint, with floating_base: the tree's free flyer, in its own layout."""
-        if not self.floating:
-            raise self.error("a free joint is read only with floating_base=True (load(..., "
-                             "floating_base=True), --floating-base): the base's state then "
-                             "has Pinocchio's layout, q = [x, y, z, qx, qy, qz, qw] and v = "
-                             "[linear, angular velocity in body axes]; MuJoCo's (w first, "
-                             "linear velocity in world axes) is not a joint kind yet", field)
-        if parent != "world" or not only or self.free is not None:
-            raise self.error("a free joint must be the only joint of the one body at the top "
-                             "of the worldbody (the floating base)", field)
-        if self.joint_names:
-            raise self.error("the floating base must come first in the worldbody", field)
-        for key in ("damping", "frictionloss", "armature", "stiffness"):  # <joint type=free>
-            if self.numbers(attrs.get(key, "0"), 1, f"{field}.{key}")[0] != 0:
-                raise self.error(f"{key} on a free joint is not supported: the floating "
-                                 "base's six numbers have no actuator", f"{field}.{key}")
-        self.free = name
-        link = self._fresh_link(body)
-        # the free flyer's state is the body's placement: the file's pos and quat are only
-        # MuJoCo's default qpos0
-        self._urdf_joint(name, "floating", "world", link, np.eye(4))
-        return link, np.eye(4)
 
     def _limit(self, attrs, field: str, scale: float):
         limited = attrs.get("limited", "auto")

@@ -42,7 +42,7 @@ def ball_joint(reader, name: str, body: str, parent: str, current: np.ndarray, f
                                           and reader.autolimits and "range" in attrs):
         raise reader.error("a ball joint's range (a cone limit) is not supported (yet)",
                            f"{field}.range")
-    if name in reader.joint_names or name in reader.balls:
+    if reader.named(name):
         raise reader.error(f"two joints are named '{name}'", field)
     anchor = reader.vector(attrs, "pos", (0, 0, 0), field)
     hinges = tuple(f"{name}__{a}" for a in AXES)

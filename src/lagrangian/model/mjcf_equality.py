@@ -53,11 +53,12 @@ def read_equalities(reader) -> dict[str, Mimic]:
     return mimics
 
 
-def check_mimics(reader, mimics: dict[str, Mimic], joints, free: str | None) -> None:
-    """Every equality's joints among the document's hinge and slide joints, no cycle."""
+def check_mimics(reader, mimics: dict[str, Mimic], joints, free) -> None:
+    """Every equality's joints among the document's hinge and slide joints (``free``: the free
+    joints' names), no cycle."""
     for first, (second, *_) in mimics.items():
         for name in (first, second):
-            if name == free:
+            if name in free:
                 raise reader.error(f"the free joint '{name}' cannot be in a joint equality",
                                    f"equality.joint '{first}'")
             if name not in joints:

@@ -3,8 +3,10 @@
 MuJoCo's qpos holds every joint in document order, a free joint as x y z (m) and its quaternion
 w x y z; qvel a free joint's linear velocity in world axes (m/s) and its angular velocity in
 body axes (rad/s). A ball joint is the same in both: its quaternion w x y z in q, its body's
-angular velocity in its own axes in v (and its moment in tau), so its numbers are copied.
-Ours holds a free flyer as x y z and the quaternion x y z w, its velocity v
+angular velocity in its own axes in v (and its moment in tau), so its numbers are copied; so is
+a free joint read without floating_base (three slides and a ball, model/mjcf_free.py), its
+force the world force and the moment in body axes in both. With floating_base ours holds the
+free joint as the tree's free flyer, x y z and the quaternion x y z w, its velocity v
 = (R^T p_dot, w) all in body axes, and no entry for a mimic joint (an MJCF joint equality:
 q_mimic = k q_master + offset). With G = d qvel / d v (R on the base's linear rows, k on a
 mimic's), the maps are

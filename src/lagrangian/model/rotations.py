@@ -32,7 +32,8 @@ AXES: dict[str, Vector] = {
     "z": (sp.S.Zero, sp.S.Zero, sp.S.One),
 }
 # each compares equal to its word in a model file (a free flyer is a URDF robot's base only)
-JOINT_TYPES = tuple(k for k in JointKind if k not in (JointKind.FREE_FLYER, JointKind.HELICAL))
+JOINT_TYPES = tuple(k for k in JointKind
+                    if k not in (JointKind.FREE_FLYER, JointKind.HELICAL, JointKind.FREE))
 JOINT_KEYS = {  # the required and optional keys of each kind's table
     JointKind.REVOLUTE: ({"type", "axis", "angle"}, {"at"}),
     JointKind.PRISMATIC: ({"type", "axis", "distance"}, {"at"}),
@@ -40,6 +41,7 @@ JOINT_KEYS = {  # the required and optional keys of each kind's table
     JointKind.FIXED: ({"type"}, {"at", "rotation"}),
     JointKind.FREE_FLYER: ({"type"}, set()),  # refused by JOINT_TYPES before its keys are read
     JointKind.HELICAL: ({"type"}, set()),  # a tree builder's only (model/robot_builder.py): refused
+    JointKind.FREE: ({"type"}, set()),  # an MJCF robot's only (model/mjcf_free.py): refused
 }
 # Exact numbers up to this size (numerator and denominator) stay exact in a unit vector; others
 # are taken as floats: the exact length of (1e-290, 0, -1) cost 5-30 s of factoring.
@@ -358,7 +360,8 @@ class RotationReader:
     # one entry per JointKind (tests/model/test_component_tables.py checks none is missing)
     _JOINT_FRAMES = {JointKind.REVOLUTE: _revolute, JointKind.PRISMATIC: _prismatic,
                      JointKind.SPHERICAL: _turned, JointKind.FIXED: _turned,
-                     JointKind.FREE_FLYER: _free, JointKind.HELICAL: _free}
+                     JointKind.FREE_FLYER: _free, JointKind.HELICAL: _free,
+                     JointKind.FREE: _free}
 
     def inertia(self, value: object, field: str, values: Mapping[sp.Symbol, float]) -> Matrix3:
         """Principal [Ixx, Iyy, Izz] or a symmetric 3x3 tensor (kg m^2), about the centre of mass

@@ -17,7 +17,10 @@ by the configuration's first 7 numbers (position, quaternion x y z w) and the ve
 flyer below the root (a URDF floating joint between two links, coordinate c >= 0) moves its body
 in its parent by q[c:c+7] (x y z in the joint's frame, then qx qy qz qw: R = R_0 R(q),
 p = t_0 + R_0 (x, y, z)) and v's six numbers (linear then angular, the body's own axes), as
-Pinocchio's JointModelFreeFlyer anywhere in a tree. Fixed and locked
+Pinocchio's JointModelFreeFlyer anywhere in a tree. MuJoCo's free joint (JointKind.FREE) is no
+joint of its own here: three prismatic joints along the world's axes from the ground (massless
+bodies) and a spherical joint at their end, MuJoCo's qpos and qvel exactly (model/mjcf_free.py).
+Fixed and locked
 joints are folded into R_0, t_0 of the next joint down, and the links they carry into the
 inertia of the moving body above them. A body's inertia is (m, h = m c, J_O): mass (kg), first
 moment about its frame's origin (kg m) and inertia tensor about that origin (kg m^2), in its

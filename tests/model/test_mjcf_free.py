@@ -192,3 +192,48 @@ def test_a_free_joint_cannot_be_locked_and_floating_base_takes_one(tmp_path):
             lagrangian.load(path, lock=lock)
     with pytest.raises(ModelError, match="with floating_base the model has one free joint"):
         lagrangian.load(path, floating_base=True)
+
+
+def test_derivatives_and_integrate_are_mujocos_on_its_tangent(robot):
+    """d tau/dq and d tau/dv along MuJoCo's tangent (mj_integratePos: the position moved in
+    world axes, the quaternion by exp(w) in body axes) equal central differences of its
+    mj_inverse (rigid bodies: no armature or damping) to 1e-6; integrate is mj_integratePos."""
+    system, model, _ = robot
+    rigid = mujoco.MjModel.from_xml_string(ROBOT)
+    rigid.dof_armature[:] = 0.0
+    rigid.dof_damping[:] = 0.0
+    data = mujoco.MjData(rigid)
+    qpos, qvel, qacc = _state(rigid, np.random.default_rng(3))
+
+    def inverse(qp, qv):
+        data.qpos[:], data.qvel[:], data.qacc[:] = qp, qv, qacc
+        mujoco.mj_inverse(rigid, data)
+        return data.qfrc_inverse.copy()
+
+    h, nv = 1e-6, rigid.nv
+    by_q, by_v = np.zeros((nv, nv)), np.zeros((nv, nv))
+    for i, step in enumerate(np.eye(nv) * h):
+        moved = [qpos.copy(), qpos.copy()]
+        mujoco.mj_integratePos(rigid, moved[0], step, 1.0)
+        mujoco.mj_integratePos(rigid, moved[1], -step, 1.0)
+        by_q[:, i] = (inverse(moved[0], qvel) - inverse(moved[1], qvel)) / (2 * h)
+        by_v[:, i] = (inverse(qpos, qvel + step) - inverse(qpos, qvel - step)) / (2 * h)
+    d = system.dynamics(backend="numpy")
+    d_q, d_v = d.inverse_dynamics_derivatives(qpos, qvel, qacc)
+    np.testing.assert_allclose(d_q, by_q, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(d_v, by_v, rtol=0, atol=1e-6)
+    expected = qpos.copy()
+    mujoco.mj_integratePos(model, expected, qvel, 0.3)
+    np.testing.assert_allclose(d.integrate(qpos, qvel, 0.3), expected, rtol=0, atol=1e-12)
+
+
+def test_the_command_line_names_the_free_joint(tmp_path, cli):
+    path = tmp_path / "top.xml"
+    path.write_text("<mujoco><worldbody><body><freejoint name='top'/><geom size='0.1'/>"
+                    "</body></worldbody></mujoco>")
+    result = cli("dynamics", str(path), "--q", "0,0,1,0.5,0,0,0")
+    assert result.code == 2 and "free joint 'top' quaternion (q[3:7], w x y z) has norm 0.5" \
+        in result.err and len(result.err.strip().splitlines()) == 1
+    result = cli("codegen", str(path), "--out", str(tmp_path / "c"))
+    assert result.code == 2 and "free joint in MuJoCo's layout" in result.err \
+        and "--floating-base" in result.err and len(result.err.strip().splitlines()) == 1

@@ -92,7 +92,7 @@ def with_free_joints(model, slides: dict[str, tuple[str, str, str]]):
     hidden = {i for i, j in enumerate(tree.joints) if j.name in names}
     actuators = tuple(None if c in coordinates else a
                       for c, a in zip(tree.velocity_coordinates, tree.actuators, strict=True))
-    merged = replace(tree, actuators=actuators,
+    merged = replace(tree, actuators=actuators, mujoco_free=tuple(slides),
                      frames=tuple(f for f in tree.frames if f.body not in hidden))
     taus = {f"tau_{c}" for c in coordinates}
     return replace(model, kinematic_tree=merged,

@@ -180,6 +180,9 @@ class KinematicTree:
     # The model's own coordinates where they are not the tree's (an MJCF ball joint: three hinge
     # angles in the symbolic model, its quaternion here); () where they are the same.
     model_coordinates: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    # MJCF free joints in MuJoCo's layout (model/mjcf_free.py): the ball joints that end three
+    # world slides, named by the free joint, for the words of a refusal; not the dynamics'
+    mujoco_free: tuple[str, ...] = field(default=(), compare=False, repr=False)
 
     @property
     def velocity_coordinates(self) -> tuple[str, ...]:
@@ -247,6 +250,13 @@ def refuse_ball_joints(tree: KinematicTree | None, what: str) -> None:
     if balls:
         from ..errors import ModelError
 
+        if balls[0].name in tree.mujoco_free:
+            # one free joint can be the floating base instead, which more of the tools take
+            hint = ": load with floating_base=True (--floating-base) for the free flyer" \
+                if len(tree.mujoco_free) == 1 else ""
+            raise ModelError(f"joint '{balls[0].name}' is a free joint in MuJoCo's layout (three "
+                             f"slides and a ball joint), which {what} does not take yet{hint}",
+                             field="joint")
         raise ModelError(f"joint '{balls[0].name}' is a ball (spherical) joint, which {what} "
                          "does not take yet (M, inverse and forward dynamics and their "
                          "derivatives, the energies, frames and Jacobians do)",

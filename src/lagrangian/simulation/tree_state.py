@@ -44,6 +44,7 @@ class TreeState:
         self.balls = tuple((j.name, tree.base_nq + j.coordinate,
                             tree.base_nv + tree.velocity_index(j.coordinate))
                            for j in tree.spherical)
+        self.mujoco_free = tree.mujoco_free  # MJCF free joints: balls at the end of world slides
         self.base_q = self.q_names[:tree.base_nq]
         self.base_v = self.v_names[:tree.base_nv]
         self.ball_q = {n for name, iq, _ in self.balls for n in self.q_names[iq:iq + 4]}
@@ -200,7 +201,8 @@ class TreeState:
 
         if self.floating:
             check_quaternions(q[None], field=field)
-        quaternions = [("ball", name, iq) for name, iq, _ in self.balls] \
+        quaternions = [("free" if name in self.mujoco_free else "ball", name, iq)
+                       for name, iq, _ in self.balls] \
             + [("floating", name, iq + 3) for name, iq, _ in self.free]
         for kind, name, iq in quaternions:
             norm = float(np.linalg.norm(q[iq:iq + 4]))

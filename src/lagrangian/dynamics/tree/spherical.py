@@ -60,7 +60,9 @@ def quaternion_slices(tree) -> list[tuple[str, str, int, str]]:
     a ball joint's (w x y z) and a free flyer's below the root (x y z w, after x, y, z)."""
     free = [(j.name, "floating joint", tree.base_nq + j.coordinate + 3, "x y z w")
             for j in tree.free_joints]
-    return [(name, "ball joint", iq, "w x y z") for name, iq, _ in ball_slices(tree)] + free
+    free_joints = getattr(tree, "mujoco_free", ())  # MJCF free joints: a ball at world slides
+    return [(name, "free joint" if name in free_joints else "ball joint", iq, "w x y z")
+            for name, iq, _ in ball_slices(tree)] + free
 
 
 def check_tree_quaternions(tree, Q: np.ndarray, field: str = "q") -> None:

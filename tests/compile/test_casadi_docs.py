@@ -29,3 +29,22 @@ def test_the_floating_and_time_block(capsys):
     assert x_ddot[1] == pytest.approx(-g / L * np.sin(theta) + A * Omega ** 2 * np.cos(theta) / L,
                                       rel=1e-12)
     assert "base_qw" in capsys.readouterr().out
+
+
+def test_the_ball_joint_block(tmp_path, monkeypatch, capsys):
+    """The spherical pendulum (m = 2 kg, L = 0.5 m, I = 0.01 kg m^2 about its centre) tilted by
+    0.3 rad at rest: w_x' = -m g L sin(tilt) / (I + m L^2); a moment u about its own z turns it
+    at w_z' = u / I; the quaternion still at rest."""
+    monkeypatch.chdir(tmp_path)
+    (code,) = re.findall(r"```python\n(.*?)```", block("bridges-ball-casadi", "bridges.md"),
+                         re.S)
+    namespace: dict = {}
+    exec(code, namespace)  # noqa: S102 - our own documentation
+    m, g, L, I, tilt = 2.0, 9.81, 0.5, 0.01, 0.3
+    x_dot = namespace["x_dot"]
+    assert x_dot[4] == pytest.approx(-m * g * L * np.sin(tilt) / (I + m * L ** 2), rel=1e-12)
+    assert np.abs(np.r_[x_dot[:4], x_dot[5:]]).max() < 1e-12
+    state = [np.cos(tilt / 2), np.sin(tilt / 2), 0, 0, 0, 0, 0]
+    pushed = np.asarray(namespace["f"].rhs(state, [1.5])).ravel()
+    assert pushed[6] == pytest.approx(1.5 / I, rel=1e-12)
+    assert "pivot_wz" in capsys.readouterr().out

@@ -1,6 +1,7 @@
-"""A robot's CasADi functions from its kinematic tree (recursive Newton-Euler over casadi SX):
-M, the bias forces and the forward dynamics agree with our recursive dynamics and, for an MJCF
-robot, with MuJoCo; and a URDF arm's trajectory optimised on them replays in simulate."""
+"""A robot's CasADi functions from its kinematic tree (the numpy reference's recursions over
+casadi SX): M, the bias forces and the forward dynamics agree with our recursive dynamics (a
+variant too: mimic fingers, a lock, a payload, tilted gravity, a floating base) and, for an
+MJCF robot, with MuJoCo; and a URDF arm's trajectory optimised on them replays in simulate."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import pytest
 
 import lagrangian
 from lagrangian.errors import ModelError
+from lagrangian.model.urdf import example_urdf
 
 MJCF = """
 <mujoco model="arm">
@@ -101,3 +103,33 @@ def test_a_urdf_arm_optimised_and_replayed(arm):
     assert np.abs(run.q[:, 0] - result.states["shoulder"]).max() <= result.defects["replay"]
     with pytest.raises(ModelError, match="not a coordinate or actuator"):
         arm.to_casadi(inputs=["wrist"])
+
+
+def test_a_robot_variant_equals_our_engine():
+    """The Panda on a floating base, its fingers mimic, a wrist joint locked, a 1.5 kg payload
+    and gravity tilted: the tree's numbers, so CasADi's M, bias and forward dynamics equal the
+    compiled engine's (itself Pinocchio's: tests/dynamics)."""
+    if example_urdf("panda") is None:
+        pytest.skip("panda: example-robot-data is not installed")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        system = lagrangian.load("panda", lock={"panda_joint7": 0.3}, floating_base=True,
+                                 payload={"panda_hand": (1.5, (0.0, 0.02, 0.1))},
+                                 gravity=(1.0, -2.0, -9.5))
+    functions = system.to_casadi(inputs=["tau_panda_joint2"])
+    dynamics = system.dynamics()
+    nq, nv = dynamics.nq, dynamics.nv
+    assert functions.configuration == tuple(dynamics.coordinates)
+    rng = np.random.default_rng(5)
+    for _ in range(2):
+        q = np.r_[rng.normal(size=3), rng.normal(size=4), rng.uniform(-1, 1, nq - 7)]
+        q[3:7] /= np.linalg.norm(q[3:7])
+        v = rng.uniform(-1, 1, nv)
+        tau = np.zeros(nv)
+        tau[6 + list(dynamics.velocity_names[6:]).index("panda_joint2")] = 2.0
+        assert np.allclose(np.asarray(functions.mass_matrix(q)), dynamics.mass_matrix(q),
+                           rtol=0, atol=1e-9)
+        assert np.allclose(-np.asarray(functions.forcing(q, v, [0.0])).ravel(),
+                           dynamics.bias_forces(q, v), rtol=0, atol=1e-9)
+        x_dot = np.asarray(functions.rhs(np.r_[q, v], [2.0])).ravel()
+        assert np.allclose(x_dot[nq:], dynamics.forward_dynamics(q, v, tau), rtol=0, atol=1e-8)

@@ -108,3 +108,11 @@ def test_a_scaled_quaternion_turns_its_body_as_the_unit_one(chain):
     scaled[5:9] *= 1.5
     np.testing.assert_allclose(np.asarray(functions.mass_matrix(scaled)),
                                np.asarray(functions.mass_matrix(q)), rtol=0, atol=1e-12)
+
+
+def test_optimize_refuses_a_ball_joint_in_one_line(chain):
+    """Collocation does not name a ball's start and goal yet: one line naming the joint."""
+    system = chain[0]
+    with pytest.raises(lagrangian.ModelError, match="joint 'shoulder' is a ball") as info:
+        lagrangian.optimize(system, ["tau_elbow"], 1.0, 10)
+    assert "\n" not in str(info.value)

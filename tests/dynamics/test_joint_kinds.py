@@ -320,6 +320,27 @@ def test_momentum_coriolis_and_regressor_agree_with_pinocchio(case, backends, ba
     _agree(Y @ d.inertial_parameters(), tau, f"{where}: Y pi")
 
 
+def test_the_casadi_functions_agree_with_pinocchio(case):
+    """to_casadi (the numpy reference's recursions over casadi SX) on each kind: M = crba,
+    -f = nle with no input, and rhs's accelerations = aba under the joints' torques (the
+    inputs: every joint's velocity number; a floating base unforced)."""
+    casadi = pytest.importorskip("casadi")
+    kind, system, model, data, _, (q, v, _, tau), _ = case
+    where = f"{kind} joint, casadi"
+    names = list(system.model.kinematic_tree.velocity_coordinates)
+    functions = system.to_casadi(inputs=names)
+    assert isinstance(functions.rhs, casadi.Function)
+    base = model.nv - len(names)  # the floating base's six, unforced
+    forced = np.r_[np.zeros(base), tau[base:]]
+    M = pin.crba(model, data, q)
+    ours = _ours(kind, q)
+    _agree(np.asarray(functions.mass_matrix(ours)), np.triu(M) + np.triu(M, 1).T, f"{where}: M")
+    _agree(-np.asarray(functions.forcing(ours, v, np.zeros(len(names)))).ravel(),
+           pin.nle(model, data, q, v), f"{where}: bias")
+    x_dot = np.asarray(functions.rhs(np.r_[ours, v], tau[base:])).ravel()
+    _agree(x_dot[model.nq:], pin.aba(model, data, q, v, forced), f"{where}: FD")
+
+
 def test_a_batch_is_its_single_calls(case, backends):
     """The compiled engine's batches (vector lanes) on each kind: rows equal the single calls
     (M, ID, FD bit for bit; a frame's Jacobian and the derivatives to 1e-13), a NaN state's

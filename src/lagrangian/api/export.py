@@ -95,7 +95,9 @@ class ExportMethods:
         from ..compile.casadi_functions import casadi_functions
         from ..compile.functions import refuse_large_chain
 
-        if self._model.source_names and self._model.kinematic_tree is not None:
+        # a robot's tree (URDF, MJCF, RobotBuilder), also one whose joints have no source
+        # name of their own (an MJCF ball joint's quaternion): our dynamics' q and v
+        if self._model.kinematic_tree is not None:
             from ..dynamics.standalone.casadi_tree import tree_casadi_functions
 
             return tree_casadi_functions(self._model, inputs, parameters)

@@ -22,6 +22,7 @@ from ..errors import InputError, ModelError
 from ..model.checked import unknown_name
 from ..model.model import Model
 from ..model.quaternions import QUATERNION_TOLERANCE
+from ..model.tree import refuse_ball_joints
 from ..model.values import resolve_state
 from ..simulation.replay import replay
 
@@ -374,9 +375,12 @@ def _check_quaternion(values: dict[int, float], what: str, required: bool) -> No
 
 
 def check_model(model: Model) -> None:
-    """Refuse what collocation cannot take (nothing yet: kept for the API's call)."""
+    """Refuse what collocation cannot take: a quaternion below the root (a ball joint, a
+    floating joint between links), whose start and goal are not named yet (to_casadi's
+    functions take it)."""
     if not isinstance(model, Model):
         raise ModelError("optimize needs a model", field="optimize")
+    refuse_ball_joints(model.kinematic_tree, "optimize")
 
 
 __all__ = ["METHODS", "OBJECTIVES", "Trajectory", "check_model", "collocate"]

@@ -76,7 +76,8 @@ PAYLOAD_HELP = ("URDF: a point mass fixed to a link, LINK=MASS[@X,Y,Z] (kg; m in
                 "frame, default its origin); repeatable.")
 FLOATING_HELP = ("URDF: a free-flyer joint under the root link (a robot that walks or flies): q is "
                  "the base's x,y,z and quaternion qx,qy,qz,qw, then the joints; v the base's "
-                 "twist vx..wz in its own axes, then the joint rates.")
+                 "twist vx..wz in its own axes, then the joint rates. MJCF: the free joint as "
+                 "that base (without the flag, MuJoCo's own qpos and qvel).")
 GRAVITY_HELP = ("Gravity as a vector in world axes, GX,GY,GZ in m/s^2 (default: the model's; "
                 "a URDF's is 0,0,-9.81).")
 

@@ -73,7 +73,7 @@ def _link_settings(settings: list[str]) -> tuple[list[str], dict[str, float | st
 @app.command()
 def dynamics(
     model: Annotated[str, typer.Argument(help="Model file (TOML or URDF) or built-in example name.")],
-    q: Annotated[str | None, typer.Option("--q", help="Coordinates, comma-separated in the model's order (a ball joint: its quaternion w,x,y,z; default: the initial values, a ball unturned).")] = None,  # noqa: E501
+    q: Annotated[str | None, typer.Option("--q", help="Coordinates, comma-separated in the model's order (a ball joint: its quaternion w,x,y,z; an MJCF free joint: MuJoCo's x,y,z,qw,qx,qy,qz; default: the initial values, a ball unturned).")] = None,  # noqa: E501
     v: Annotated[str | None, typer.Option("--v", help="Velocities, comma-separated (default: the initial rates).")] = None,  # noqa: E501
     a: Annotated[str | None, typer.Option("--a", help="Accelerations: print the inverse dynamics tau.")] = None,  # noqa: E501
     tau: Annotated[str | None, typer.Option("--tau", help="Generalized forces on top of the model's loads: print the forward dynamics q_ddot.")] = None,  # noqa: E501

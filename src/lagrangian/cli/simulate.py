@@ -31,7 +31,7 @@ from .common import (
 def simulate(
     model: Annotated[str, typer.Argument(help="Model file (TOML) or built-in example name.")],
     t_end: Annotated[str, typer.Option("--t-end", help="End time (s, or with a unit: 500ms).")],
-    initial: Annotated[list[str], typer.Option("--initial", help="Initial value: NAME=VALUE (theta=30deg, theta_dot=0, t=0; a ball joint's quaternion shoulder_qw..shoulder_qz and angular velocity shoulder_wx..shoulder_wz; a URDF floating joint between links hook_x..hook_qw and hook_vx..hook_wz); default: the model's initial/rate; repeat, or separate by commas.")] = [],  # noqa: B006,E501
+    initial: Annotated[list[str], typer.Option("--initial", help="Initial value: NAME=VALUE (theta=30deg, theta_dot=0, t=0; a ball joint's quaternion shoulder_qw..shoulder_qz and angular velocity shoulder_wx..shoulder_wz; an MJCF free joint root_x..root_z, root_qw..root_qz, root_x_dot..root_z_dot (world axes) and root_wx..root_wz; a URDF floating joint between links hook_x..hook_qw and hook_vx..hook_wz); default: the model's initial/rate; repeat, or separate by commas.")] = [],  # noqa: B006,E501
     set_: Annotated[list[str], typer.Option("--set", help=SET_HELP)] = [],  # noqa: B006
     lock: Annotated[list[str], typer.Option("--lock", help=LOCK_HELP)] = [],  # noqa: B006
     gravity: Annotated[str | None, typer.Option("--gravity", help=GRAVITY_HELP)] = None,

@@ -1,8 +1,9 @@
 """A robot with ball joints in CasADi (the numpy reference's recursions over casadi SX): a ball,
 a hinge and a ball under tilted gravity. Its M, bias and accelerations agree with MuJoCo (whose
 qpos/qvel are ours: w x y z, the angular velocity in the child's axes) and with our forward
-dynamics; q_dot is d/dt of our manifold step q (+) v t at t = 0; casadi's Jacobian of rhs is a
-central difference of our forward dynamics. (A floating joint between links, and one on a
+dynamics; q_dot is d/dt of MuJoCo's and our step q (+) v t at t = 0; casadi's Jacobian of rhs is a
+central difference of our forward dynamics. An MJCF free joint (three slides and a ball) is
+MuJoCo's in M, qacc and mj_integratePos's rate. (A floating joint between links, and one on a
 floating base, are checked against Pinocchio in tests/model/test_urdf_floating_mid_tree.py.)"""
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import numpy as np
 import pytest
 
 import lagrangian
-from mjcf_models import BALL_HINGE_BALL
+from mjcf_models import BALL_HINGE_BALL, leg
 
 casadi = pytest.importorskip("casadi")
 mujoco = pytest.importorskip("mujoco")
@@ -69,7 +70,11 @@ def test_a_ball_chain_agrees_with_mujoco_and_our_dynamics(chain):
         a = dynamics.forward_dynamics(q, v, _torque(u))
         np.testing.assert_allclose(x_dot[9:], a, rtol=0,
                                    atol=1e-10 * max(1.0, np.abs(a).max()))
-        h = 1e-6  # q_dot: the rate of q exp(v t) (the integrator's step, mj_integratePos)
+        h = 1e-6  # q_dot: the rate of q exp(v t), MuJoCo's step and ours
+        ahead, behind = q.copy(), q.copy()
+        mujoco.mj_integratePos(model, ahead, v, h)
+        mujoco.mj_integratePos(model, behind, v, -h)
+        np.testing.assert_allclose(x_dot[:9], (ahead - behind) / (2 * h), rtol=0, atol=1e-8)
         rate = (dynamics.integrate(q, v, h) - dynamics.integrate(q, v, -h)) / (2 * h)
         np.testing.assert_allclose(x_dot[:9], rate, rtol=0, atol=1e-8)
 
@@ -108,6 +113,34 @@ def test_a_scaled_quaternion_turns_its_body_as_the_unit_one(chain):
     scaled[5:9] *= 1.5
     np.testing.assert_allclose(np.asarray(functions.mass_matrix(scaled)),
                                np.asarray(functions.mass_matrix(q)), rtol=0, atol=1e-12)
+
+
+def test_an_mjcf_free_joint_is_mujocos_in_casadi(tmp_path):
+    """A free joint in MuJoCo's layout (x y z, qw qx qy qz; the linear velocity in world axes,
+    the angular in the body's): M = mj_fullM, the accelerations = mj_forward's qacc, and
+    q_dot = d/dt of mj_integratePos(q, v, t) at t = 0 (central difference)."""
+    path = tmp_path / "leg.xml"
+    path.write_text(leg())
+    functions = lagrangian.load(path).to_casadi(inputs=["hip", "knee"])
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(6)
+    for _ in range(2):
+        q = np.r_[rng.normal(size=3), rng.normal(size=4), rng.uniform(-1, 1, 2)]
+        q[3:7] /= np.linalg.norm(q[3:7])
+        v, u = rng.uniform(-1, 1, 8), rng.uniform(-1, 1, 2)
+        data.qpos[:], data.qvel[:], data.qfrc_applied[:] = q, v, np.r_[np.zeros(6), u]
+        mujoco.mj_forward(model, data)
+        M = np.zeros((8, 8))
+        mujoco.mj_fullM(model, data, M)
+        np.testing.assert_allclose(np.asarray(functions.mass_matrix(q)), M, rtol=0, atol=1e-9)
+        x_dot = np.asarray(functions.rhs(np.r_[q, v], u)).ravel()
+        np.testing.assert_allclose(x_dot[9:], data.qacc, rtol=0, atol=1e-9)
+        h = 1e-6
+        ahead, behind = q.copy(), q.copy()
+        mujoco.mj_integratePos(model, ahead, v, h)
+        mujoco.mj_integratePos(model, behind, v, -h)
+        np.testing.assert_allclose(x_dot[:9], (ahead - behind) / (2 * h), rtol=0, atol=1e-8)
 
 
 def test_optimize_refuses_a_ball_joint_in_one_line(chain):

@@ -1,1 +1,2 @@
-"""Standalone C99 export: a model's dynamics, frames and control laws."""
+"""Exports of a robot's dynamics to other code: standalone C99 (its dynamics, frames and control
+laws) and CasADi Functions (casadi_tree.py: the numpy reference's recursions over casadi SX)."""

@@ -540,8 +540,9 @@ def load(path_or_example: str | Path, *, lock: Mapping[str, float] | None = None
     a text with its unit, "30deg", checked against the joint's kind and limit; ``payload``
     {link: mass, or (mass, (x, y, z))} fixes point masses (kg, m in the link's frame) to links,
     as an edited URDF would; ``floating_base`` frees its root link, nq = n + 7, nv = n + 6:
-    dynamics and kinematics only), a MuJoCo robot (MJCF, .xml: hinge and slide joints in
-    MuJoCo's qpos order, docs/bridges.md; ``lock`` and ``payload`` as for URDF), a built-in
+    dynamics and kinematics only), a MuJoCo robot (MJCF, .xml: hinge, slide, ball and free
+    joints in MuJoCo's qpos and qvel layout, docs/bridges.md; ``floating_base`` makes its one
+    free joint the free flyer instead; ``lock`` and ``payload`` as for URDF), a built-in
     example by name (see ``examples()``), or an installed example-robot-data robot by its
     short name ("panda", "ur5": ``example_robots()``; a built-in example of the same name comes
     first); ``gravity`` (g_x, g_y, g_z) in m/s^2 turns the model's gravity

@@ -9,7 +9,7 @@ from collections.abc import Iterable
 def closest_name(name: str, known: Iterable[str]) -> str | None:
     """The known name closest to ``name`` (difflib, ignoring case), or None when none is close.
     A name that differs only in case ('l' for 'L') is the closest of all."""
-    known = list(known)
+    name, known = str(name), [str(k) for k in known]  # a key of any type is named by its text
     same_but_case = [k for k in known if k.lower() == name.lower()]
     if same_but_case:
         return same_but_case[0]

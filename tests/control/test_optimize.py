@@ -141,6 +141,7 @@ def test_a_solve_cut_short_says_so(motor_pendulum):
 def test_bad_requests_are_refused_in_one_line(motor_pendulum, monkeypatch):
     cases = [
         (dict(goal={"phi": 1.0}), ModelError, "'phi' is not a state"),
+        (dict(start={3: 0.0}), ModelError, "'3' is not a state"),  # was an AttributeError
         (dict(bounds={"u": (5, -5)}), InputError, "above the upper bound"),
         (dict(bounds={"v": (0, 1)}), ModelError, "'v' is not a input or state"),
         (dict(method="euler"), InputError, "not one of trapezoidal, hermite-simpson"),

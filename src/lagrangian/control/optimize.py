@@ -290,7 +290,8 @@ def _horizon(t_final, nodes) -> tuple[float, int]:
 
 def _named(values: Mapping[str, float] | None, names: Sequence[str], what: str) -> dict[int, float]:
     out = {}
-    for name, value in dict(values or {}).items():
+    for key, value in dict(values or {}).items():
+        name = str(key)  # a coordinate's sympy symbol names its state as its text does
         if name not in names:
             raise unknown_name(name, list(names), "state", what)
         out[list(names).index(name)] = _number(value, f"{what} {name}")

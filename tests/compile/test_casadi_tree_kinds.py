@@ -141,11 +141,3 @@ def test_an_mjcf_free_joint_is_mujocos_in_casadi(tmp_path):
         mujoco.mj_integratePos(model, ahead, v, h)
         mujoco.mj_integratePos(model, behind, v, -h)
         np.testing.assert_allclose(x_dot[:9], (ahead - behind) / (2 * h), rtol=0, atol=1e-8)
-
-
-def test_optimize_refuses_a_ball_joint_in_one_line(chain):
-    """Collocation does not name a ball's start and goal yet: one line naming the joint."""
-    system = chain[0]
-    with pytest.raises(lagrangian.ModelError, match="joint 'shoulder' is a ball") as info:
-        lagrangian.optimize(system, ["tau_elbow"], 1.0, 10)
-    assert "\n" not in str(info.value)

@@ -21,8 +21,11 @@ def optimize(system: System, inputs: Sequence[str], t_final: float, nodes: int =
     unless ``bounds`` names the joint); direct collocation on ``nodes`` points,
     ``method`` "trapezoidal" or "hermite-simpson", solved by IPOPT through CasADi (extra
     [casadi]). A floating base's states are its position, quaternion and twist (base_x ..
-    base_wz) before the joints', the base at the origin, level and at rest unless ``start``
-    names them; a model with t in its equations is collocated at the nodes' times from t = 0.
+    base_wz) before the joints', a ball joint's its quaternion and angular velocity in its
+    body's axes (shoulder_qw .. shoulder_qz, shoulder_wx .. shoulder_wz; its moment inputs
+    shoulder_wx ..), named as simulate's start, each quaternion held unit at the nodes; the
+    base at the origin and level, each ball unturned, at rest unless ``start`` names them;
+    a model with t in its equations is collocated at the nodes' times from t = 0.
     Replay it with ``system.simulate(t_final, initial=trajectory.initial_state(),
     controller=trajectory.controller())``: docs/bridges.md."""
     if not isinstance(system, System):

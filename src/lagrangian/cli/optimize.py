@@ -17,8 +17,10 @@ from .common import (
     state_assignments,
 )
 
-TO_HELP = "The goal at t_final: STATE=VALUE (theta=pi, theta_dot=0); the other states are free."
-FROM_HELP = "The start: STATE=VALUE (default: the model's initial values)."
+TO_HELP = ("The goal at t_final: STATE=VALUE (theta=pi, theta_dot=0; a ball joint's "
+           "shoulder_qw..shoulder_qz and shoulder_wx..shoulder_wz); the other states are free.")
+FROM_HELP = ("The start: STATE=VALUE, named as simulate --initial (default: the model's initial "
+             "values; a ball joint unturned and at rest).")
 BOUND_HELP = ("NAME=LOWER:UPPER on an input or a state (u=-5:5, x=-1:1; leave a side empty "
               "for no bound: x=:1). A bound on a name that is not a state makes it an input.")
 INPUT_HELP = ("An input to optimise: a load, a parameter or a coordinate (a generalized force "
@@ -51,7 +53,10 @@ def optimize(
     goal = state_assignments(system, to, "--to")
     start = state_assignments(system, from_, "--from")
     states = {name for c in system.model.coordinates for name in (c.name, c.velocity.name)}
-    if floating_base:  # the base's numbers (base_x .. base_wz) are states too, judged by optimize
+    tree = system.model.kinematic_tree
+    if floating_base or getattr(tree, "quaternion_joints", ()):
+        # the base's numbers (base_x .. base_wz), a ball's (shoulder_qw .. shoulder_wz) are
+        # states too, judged by optimize
         dynamics = system.dynamics()
         states |= {*dynamics.coordinates, *dynamics.velocity_names}
     bounds = {}

@@ -4,10 +4,12 @@ minimise the effort J = integral of |u|^2 dt (u in the inputs' SI units) over x(
 u(t) on [0, t_final], subject to x_dot = rhs(x, u) at the collocation points (trapezoidal or
 Hermite-Simpson), x(0) = start, x(t_final) = goal where given, and bounds on u and x.
 
-A floating base's x = [q; v] holds its position, quaternion (x y z w) and body twist first, as
-our dynamics (dynamics/standalone/casadi_tree.py): its quaternion is collocated as the other
-numbers (its rate keeps |q| = 1 up to the scheme's error, and the base's R is that of q / |q|);
-it starts at the origin at rest, level, unless ``start`` names its numbers.
+A tree whose q and v differ (a floating base, a ball joint, a floating joint between links)
+is collocated in our dynamics' x = [q; v] (dynamics/standalone/casadi_tree.py): a base's
+position, quaternion (x y z w) and body twist first, a ball's quaternion (w x y z) and angular
+velocity in its body's axes; each quaternion is held on |q| = 1 at the nodes (optimize_tree.py)
+and the start is named as simulate's (the base at the origin, each ball unturned, at rest,
+unless ``start`` names their numbers).
 """
 
 from __future__ import annotations
@@ -21,10 +23,17 @@ from ..compile.casadi_functions import CasadiFunctions
 from ..errors import InputError, ModelError
 from ..model.checked import unknown_name
 from ..model.model import Model
-from ..model.quaternions import QUATERNION_TOLERANCE
-from ..model.tree import refuse_ball_joints
 from ..model.values import resolve_state
 from ..simulation.replay import replay
+from .optimize_tree import (
+    check_goal,
+    on_manifold,
+    project,
+    quaternions,
+    refuse_hinges,
+    tree_start,
+    unit_guess,
+)
 
 METHODS = ("trapezoidal", "hermite-simpson")
 OBJECTIVES = ("effort",)
@@ -145,10 +154,17 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
     if r == 0:
         raise InputError("name at least one input to optimise (a load, parameter or "
                          "coordinate: inputs=[...])", field="inputs")
-    first = _start(model, functions, start)
+    manifold = on_manifold(model)
+    rows = quaternions(model, functions) if manifold else []
+    if manifold:  # named as simulate's start; a ball's Euler hinge refused naming its own
+        refuse_hinges(model, functions, start, "start")
+        refuse_hinges(model, functions, goal, "goal")
+        _named(start, names, "start")
+        first = tree_start(model, functions, start), {}
+    else:
+        first = _start(model, functions, start)
     target = _named(goal, names, "goal")
-    if functions.floating_base:
-        _check_quaternion(target, "goal", required=False)
+    check_goal(target, rows)
     lower, upper = _bounds(bounds, names, functions.inputs)
 
     opti = ca.Opti()
@@ -160,14 +176,16 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
     F = f.map(nodes)(X, U, *timed)  # x_dot at every node
     defects = []
     if method == "trapezoidal":
-        defects.append(X[:, 1:] - X[:, :-1] - h / 2 * (F[:, :-1] + F[:, 1:]))
+        defects.append(project(ca, opti, X, X[:, 1:] - X[:, :-1] - h / 2 * (F[:, :-1] + F[:, 1:]),
+                               rows, target, nodes))
         cost = h / 2 * ca.sum2(ca.sum1(U[:, :-1] ** 2) + ca.sum1(U[:, 1:] ** 2))
         Um = None
     else:  # Hermite-Simpson, separated: midpoint states and inputs are variables
         Xm, Um = opti.variable(n2, nodes - 1), opti.variable(r, nodes - 1)
         Fm = f.map(nodes - 1)(Xm, Um, *((ca.DM(times[:, :-1] + h / 2),) if timed else ()))
         defects.append(Xm - (X[:, :-1] + X[:, 1:]) / 2 - h / 8 * (F[:, :-1] - F[:, 1:]))
-        defects.append(X[:, 1:] - X[:, :-1] - h / 6 * (F[:, :-1] + 4 * Fm + F[:, 1:]))
+        defects.append(project(ca, opti, X, X[:, 1:] - X[:, :-1]
+                               - h / 6 * (F[:, :-1] + 4 * Fm + F[:, 1:]), rows, target, nodes))
         cost = h / 6 * ca.sum2(ca.sum1(U[:, :-1] ** 2) + 4 * ca.sum1(Um ** 2)
                                + ca.sum1(U[:, 1:] ** 2))
         opti.set_initial(Um, 0.0)
@@ -197,7 +215,7 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
         for row in _rows(k, n2, (X, U), middle):
             opti.subject_to(row <= hi)
     opti.minimize(cost)
-    guess = _guess(fixed, free, target, n2, nodes)
+    guess = unit_guess(_guess(fixed, free, target, n2, nodes), rows)
     opti.set_initial(X, guess)
     opti.set_initial(U, 0.0)
     if method != "trapezoidal":
@@ -227,7 +245,8 @@ def collocate(functions: CasadiFunctions, model: Model, t_final: float, nodes: i
                  "replay": 0.0},
         iterations=int(stats.get("iter_count", 0)), midpoint_inputs=um,
         input_coordinates=functions.input_coordinates,
-        force_width=len(functions.coordinates))
+        force_width=len(functions.velocities) - 6 * functions.floating_base
+        if functions.velocities else len(functions.coordinates))
     trajectory.defects["replay"] = _replay_error(functions, trajectory, x)
     return trajectory
 
@@ -314,17 +333,6 @@ def _start(model: Model, functions: CasadiFunctions, start) -> tuple[dict[int, f
     with their guess (the model's initial values)."""
     names = functions.states
     given = _named(start, names, "start")
-    if functions.floating_base:  # the base at the origin, level and at rest unless given
-        base = {**dict(zip(functions.configuration[:7], (0.0,) * 6 + (1.0,), strict=True)),
-                **dict.fromkeys(functions.velocities[:6], 0.0)}
-        joints = {names[i]: v for i, v in given.items() if names[i] not in base}
-        state = resolve_state(model, joints, field="start")
-        base.update({names[i]: v for i, v in given.items() if names[i] in base})
-        values = [*(base[k] for k in functions.configuration[:7]), *map(float, state.q),
-                  *(base[k] for k in functions.velocities[:6]), *map(float, state.q_dot)]
-        every = dict(enumerate(values))
-        _check_quaternion(every, "start", required=True)
-        return every, {}
     state = resolve_state(model, {names[i]: v for i, v in given.items()}, field="start")
     values = [*map(float, state.q), *map(float, state.q_dot)]
     if functions.constraints is None or not given:  # the model's own start is consistent
@@ -365,23 +373,10 @@ def _guess(fixed, free, target, n2: int, nodes: int) -> np.ndarray:
     return begin[:, None] + (end - begin)[:, None] * s[None, :]
 
 
-def _check_quaternion(values: dict[int, float], what: str, required: bool) -> None:
-    """A floating base's quaternion (x entries 3..6) of unit norm where all four are given."""
-    if not required and not all(i in values for i in range(3, 7)):
-        return
-    norm = float(np.sqrt(sum(values[i] ** 2 for i in range(3, 7))))
-    if abs(norm - 1.0) > QUATERNION_TOLERANCE:
-        raise InputError(f"the base quaternion (base_qx, base_qy, base_qz, base_qw) has norm "
-                         f"{norm:.9g}: a unit quaternion is needed", field=what)
-
-
 def check_model(model: Model) -> None:
-    """Refuse what collocation cannot take: a quaternion below the root (a ball joint, a
-    floating joint between links), whose start and goal are not named yet (to_casadi's
-    functions take it)."""
+    """Refuse what collocation cannot take: anything but a model."""
     if not isinstance(model, Model):
         raise ModelError("optimize needs a model", field="optimize")
-    refuse_ball_joints(model.kinematic_tree, "optimize")
 
 
 __all__ = ["METHODS", "OBJECTIVES", "Trajectory", "check_model", "collocate"]

@@ -317,3 +317,79 @@ def test_a_branching_trees_factor_along_the_tree_gives_the_forward_derivatives(t
             central = (robot.forward_dynamics(q[state], v[state] + e, tau[state])
                        - robot.forward_dynamics(q[state], v[state] - e, tau[state])) / (2 * h)
             np.testing.assert_allclose(fv[state][:, k], central, rtol=0, atol=2e-6)
+
+
+# a free trunk with an arm on two ball joints (shoulder, wrist) about an elbow, and a leg: as
+# MuJoCo's free joint (three world slides and a ball) and, loaded with floating_base, on the
+# free flyer; the tree branches at the trunk (M factored along the tree)
+BALL_ARM = """<mujoco><worldbody><body name="trunk"><freejoint name="root"/>
+<geom type="box" size="0.2 0.1 0.05" mass="3"/>
+<body name="arm" pos="0.2 0 0"><joint name="shoulder" type="ball"/>
+<geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03" mass="0.7"/>
+<body name="fore" pos="0.3 0 0"><joint name="elbow" axis="0 1 0"/>
+<geom type="capsule" fromto="0 0 0 0.25 0 0" size="0.02" mass="0.4"/>
+<body name="hand" pos="0.25 0 0"><joint name="wrist" type="ball"/>
+<geom type="sphere" size="0.04" mass="0.2" pos="0.05 0.01 0"/></body></body></body>
+<body name="leg" pos="-0.2 0 0"><joint name="hip" axis="1 0 0"/>
+<geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03" mass="0.6"/></body>
+</body></worldbody></mujoco>"""
+
+
+@pytest.fixture(scope="module")
+def ball_arm(tmp_path_factory):
+    path = tmp_path_factory.mktemp("ball") / "arm.xml"
+    path.write_text(BALL_ARM)
+    return {floating: lagrangian.load(path, floating_base=floating) for floating in (False, True)}
+
+
+def _unit_states(dynamics, count, seed):
+    from lagrangian.dynamics.tree.spherical import quaternion_slices
+
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(-1, 1, (count, len(dynamics.coordinates)))
+    slices = [iq for _, _, iq, _ in quaternion_slices(dynamics.tree)]
+    for iq in slices + ([3] if dynamics.tree.floating_base else []):
+        q[:, iq:iq + 4] /= np.linalg.norm(q[:, iq:iq + 4], axis=1, keepdims=True)
+    return q, *rng.uniform(-1, 1, (2, count, dynamics.n))
+
+
+@needs_c
+@pytest.mark.parametrize("floating", [False, True])
+def test_ball_joints_compiled_derivatives_are_the_complex_steps(ball_arm, floating):
+    """A ball joint in the engine as its three columns (the turn of the body's axes x, y, z,
+    each moving the subtree from the ball's parent's motion): d tau/dq along q (x) exp(dq) and
+    d tau/dv equal the complex step through the numpy reference's Newton-Euler, and the forward
+    derivatives -M^-1 d tau and M^-1, on both layouts, a batch on the lanes."""
+    from lagrangian.dynamics.derivatives import tree_inverse_dynamics_derivatives
+    from lagrangian.dynamics.recursive_numpy import NumpyBackend
+
+    dynamics = ball_arm[floating].dynamics()
+    assert dynamics._derivatives_kernel() is not None  # the engine's, not the complex step
+    q, v, a = _unit_states(dynamics, 6, 3)
+    exact = tree_inverse_dynamics_derivatives(
+        NumpyBackend(dynamics.tree, dynamics.parameters, dynamics.n), q, v, a)
+    for ours, theirs in zip(dynamics.inverse_dynamics_derivatives(q, v, a), exact, strict=True):
+        np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-12 * np.abs(theirs).max())
+    fq, fv, inverse = dynamics.forward_dynamics_derivatives(q, v, a)
+    accelerations = dynamics.forward_dynamics(q, v, a)
+    dq, dv = tree_inverse_dynamics_derivatives(
+        NumpyBackend(dynamics.tree, dynamics.parameters, dynamics.n), q, v, accelerations)
+    np.testing.assert_allclose(inverse @ dynamics.mass_matrix(q), np.broadcast_to(
+        np.eye(dynamics.n), inverse.shape), rtol=0, atol=1e-10)
+    np.testing.assert_allclose(fq, -inverse @ dq, rtol=0, atol=1e-10 * np.abs(fq).max())
+    np.testing.assert_allclose(fv, -inverse @ dv, rtol=0, atol=1e-10 * np.abs(fv).max())
+
+
+@needs_c
+def test_ball_joints_compiled_derivatives_refuse_a_quaternion_off_unit_in_one_line(ball_arm):
+    dynamics = ball_arm[False].dynamics()
+    q, v, a = _unit_states(dynamics, 1, 4)
+    q[0, 7:11] *= 0.5  # the shoulder's w x y z (after the free joint's 7)
+    for call in (dynamics.inverse_dynamics_derivatives, dynamics.forward_dynamics_derivatives):
+        with pytest.raises(lagrangian.InputError, match="'shoulder'.*norm 0.5") as caught:
+            call(q[0], v[0], a[0])
+        assert "\n" not in str(caught.value)
+    q[0, 7] = np.nan  # a state not finite: its rows NaN, the warning counts it
+    with pytest.warns(lagrangian.DynamicsWarning, match="1 of 1 states"):
+        dq, _ = dynamics.inverse_dynamics_derivatives(q, v, a)
+    assert np.isnan(dq).all()

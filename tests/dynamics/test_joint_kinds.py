@@ -8,9 +8,10 @@ with no tree here, or with no branch in a kernel, fails under its own name.
 
 The ball (spherical) joint is read from MJCF (MuJoCo's ball joint: its quaternion w x y z, its
 angular velocity in the child's axes) and compared with Pinocchio's JointModelSpherical (the
-quaternion x y z w, the same velocity): q is reordered between the two. Its derivatives (the
-numpy reference's complex step along the turn, q (x) exp(dq), as Pinocchio's), C(q, v), A_g and
-J_dot v and the regressor agree with Pinocchio's.
+quaternion x y z w, the same velocity): q is reordered between the two. Its derivatives (along
+the turn, q (x) exp(dq), as Pinocchio's: the engine's analytic ones over the ball's three
+columns, the numpy reference's complex step), C(q, v), A_g and J_dot v and the regressor agree
+with Pinocchio's.
 
 Pinocchio 4.1's computeRNEADerivatives and computeABADerivatives are wrong for
 JointModelUniversal (its d tau/dq disagrees with its own rnea's finite differences by O(1)), so
@@ -284,6 +285,9 @@ def test_derivatives_agree_with_pinocchio(case, backends, backend):
     kind, system, _, _, _, (q, v, a, tau), (model, data) = case
     d = backends[backend]
     where = f"{kind} joint, {backend}"
+    # the engine's analytic derivatives on every kind (a ball's as its three columns), never
+    # the complex step the numpy backend takes
+    assert (d._derivatives_kernel() is not None) == (backend == "compiled"), where
     # a ball joint's d/dq along its turn in its body's axes (q (x) exp(dq)), as Pinocchio's
     mine = _ours(kind, q) if kind == JointKind.SPHERICAL else q
     dq, dv, _ = pin.computeRNEADerivatives(model, data, q, v, a)

@@ -47,7 +47,7 @@ class ControlTerms:
                                  field="parameters")
             # compiled C (derivatives_c.py) where a compiler works, else numpy
             fast = self._derivatives_kernel()
-            if fast is not None:
+            if fast is not None and fast.regressor is not None:
                 compute, P = fast.checked_regressor, fast.P
                 return (lambda Q, V, A: compute(Q, V, A, P),
                         tree_parameter_names(tree), tree_parameters(tree))
@@ -78,7 +78,7 @@ class ControlTerms:
         axes, force then moment (Pinocchio's layout). A model file: the named ``parameters``, in
         which T and V must be linear."""
         fast = self._derivatives_kernel() if parameters is None else None
-        if fast is not None:  # one C call; a bad input goes
+        if fast is not None and fast.regressor is not None:  # one C call; a bad input goes
             # the guarded way to be named
             try:
                 out = fast.regressor(q, v, a, fast.P)
@@ -120,8 +120,9 @@ class ControlTerms:
 
     def _derivatives_kernel(self):
         """The tree's compiled module's DerivativesKernel (derivatives_c.py), or None: a
-        compiled backend's tree of revolute and prismatic joints (a floating base too); the
-        numpy backend and a model file keep derivatives.py."""
+        compiled backend's tree of revolute, prismatic, helical and ball joints (a floating base
+        too); a free flyer below the root, the numpy backend and a model file keep
+        derivatives.py."""
         found = self.__dict__.get("_derivatives_c", False)
         if found is False:
             found = None
@@ -136,7 +137,8 @@ class ControlTerms:
                     if tree.floating_base:
                         from .tree.free_flyer import checking_quaternions
 
-                        checked = tuple(checking_quaternions(f) for f in checked)
+                        checked = tuple(f if f is None else checking_quaternions(f)
+                                        for f in checked)
                     found = DerivativesKernel(inverse, module.forward_derivatives, regressor,
                                               runtime_values(tree, self.parameters), *checked)
             self.__dict__["_derivatives_c"] = found

@@ -46,7 +46,10 @@ static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t na
     const npy_intp ni = PyArray_SIZE(table_i), nd = PyArray_SIZE(table_d);
     const int *h = (const int *)PyArray_DATA(table_i);
     tk_tree t;
-    if (ni < DK_HEADER || tk_open(PyArray_DATA(table_d), nd, &t) || t.balls) goto bad;
+    /* a ball joint only as its three columns (derivatives_c.py's description) */
+    if (ni < DK_HEADER || tk_open(PyArray_DATA(table_d), nd, &t) || (t.balls && tk_whole_balls(&t))
+        || t.flyers)
+        goto bad;
     const long nb = h[0], nj = h[1], ff = h[2], np = h[3], nnz = h[4];
     if (nb != t.nb || nj != t.n || ff != t.fb || np < nb || nnz < 0) goto bad;
     const long nv = nj + 6 * ff;
@@ -55,7 +58,7 @@ static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t na
     /* the block: the tree, D's copy, each body's multiplier, then I and each body's parent
        and coordinate */
     dk_tree *tree = malloc(sizeof(dk_tree) + ((size_t)nd + nb) * sizeof(double)
-                           + ((size_t)nint + 2 * nb) * sizeof(int));
+                           + ((size_t)nint + 5 * nb) * sizeof(int));
     if (!tree) {
         PyErr_NoMemory();
         goto done;
@@ -63,21 +66,51 @@ static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t na
     double *reals = (double *)(tree + 1);  /* the doubles first: aligned after the struct */
     double *mult = reals + nd;
     int *ints = (int *)(mult + nb), *parent = ints + nint, *coord = parent + nb;
+    int *motion = coord + nb, *end = motion + nb, *group = end + nb;
     memcpy(reals, PyArray_DATA(table_d), (size_t)nd * sizeof(double));
     memcpy(ints, h, (size_t)nint * sizeof(int));
-    *tree = (dk_tree){.nb = nb, .nj = nj, .ff = ff, .np = np, .nv = nv, .nq = nj + 7 * ff,
+    *tree = (dk_tree){.nb = nb, .nj = nj, .ff = ff, .np = np, .nv = nv, .nq = t.nq,
                       .qo = 7 * ff, .vo = 6 * ff, .ltdl = h[5] != 0, .once = h[6] != 0,
                       .sparse = h[7] != 0};
     tk_open(reals, nd, &tree->t);  /* the same numbers: checked above */
+    int columns_fine = 1;
     for (long i = 0; i < nb; i++) {
         const double *b = DK_BODY_OF(tree, i);
         parent[i] = (int)b[TK_PARENT];
         coord[i] = TK_FREE(b) ? 0 : (int)b[TK_COORD];
         mult[i] = b[TK_MULT];
+        /* a ball's columns: their motion from the ball's parent's, their ends at the last
+           column (the body), one group; any other record its own */
+        const int column = TK_BALL(b) ? (int)b[TK_COLUMN] : 0;
+        motion[i] = parent[i];
+        end[i] = i;
+        group[i] = column ? i : -1;
+        if (column > 1) {
+            const int p = parent[i];
+            const double *bp = p >= 0 ? DK_BODY_OF(tree, p) : NULL;
+            columns_fine &= p >= 0 && p < i && TK_BALL(bp) && (int)bp[TK_COLUMN] == column - 1
+                            && bp[TK_QCOORD] == b[TK_QCOORD] && (int)bp[TK_COORD] + 1 == coord[i];
+            if (!columns_fine) break;
+            motion[i] = motion[p];
+            group[i] = group[p];
+        }
+        if (column == 3)
+            for (long k = i; k >= 0 && group[k] == group[i]; k = parent[k]) end[k] = (int)i;
+    }
+    for (long i = 0; columns_fine && i < nb; i++) {  /* every ball ends in its third column */
+        const double *b = DK_BODY_OF(tree, i);
+        columns_fine &= !TK_BALL(b) || (int)DK_BODY_OF(tree, end[i])[TK_COLUMN] == 3;
+    }
+    if (!columns_fine) {
+        free(tree);
+        goto bad;
     }
     tree->parent = parent;
     tree->coord = coord;
     tree->mult = mult;
+    tree->motion = motion;
+    tree->end = end;
+    tree->group = group;
     const int *at = ints + DK_HEADER;
     tree->pair = (const int (*)[2])at; at += 2 * np;
     tree->row0 = at; at += nv + 1;
@@ -95,9 +128,9 @@ static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t na
         fine &= tree->row0[c] <= tree->row0[c + 1] && tree->lambda[c] >= -1
                 && tree->lambda[c] < c;
     for (long e = 0; e < nnz; e++) fine &= tree->rows[e] >= 0 && tree->rows[e] < nv;
-    /* a thread's work: 120 numbers a body, 3 a coordinate and four nv x nv matrices (dk4_carve,
+    /* a thread's work: 126 numbers a body, 3 a coordinate and four nv x nv matrices (dk4_carve,
        checked on a block of that size) */
-    tree->space = 120 * (size_t)nb + 3 * (size_t)nv + 4 * (size_t)nv * nv;
+    tree->space = 126 * (size_t)nb + 3 * (size_t)nv + 4 * (size_t)nv * nv;
     lg_v4 *probe = malloc(tree->space * sizeof(lg_v4));
     dk4_work w;
     fine &= probe && (size_t)(dk4_carve(tree, probe, &w) - probe) <= tree->space;
@@ -127,6 +160,29 @@ typedef struct {
     npy_intp *next;  /* the batch's first state not yet taken (shared), or NULL: k0 to k1 */
     int nomemory;    /* the thread's work block could not be had */
 } dk_job;
+
+/* Whether every finite state's ball-joint quaternions are unit within the tolerance; else 0 with
+   a ValueError, and the caller's guarded path names the joint, the state and its norm. */
+static int dk_unit_balls(const dk_tree *tree, const double *q, npy_intp states, npy_intp step)
+{
+    for (npy_intp k = 0; k < states; k++) {
+        const double *x = q + k * step;
+        int finite = 1;
+        for (int i = 0; i < tree->nq; i++) finite &= isfinite(x[i]) != 0;
+        if (!finite) continue;
+        for (int i = 0; i < tree->nb; i++) {
+            const double *b = DK_BODY_OF(tree, i);
+            if (!TK_BALL(b) || b[TK_COLUMN] != 1.0) continue;
+            const double *e = x + tree->qo + (int)b[TK_QCOORD];
+            const double norm = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
+            if (!(fabs(norm - 1.0) <= DK_QTOL)) {
+                PyErr_SetString(PyExc_ValueError, "q: a ball joint's quaternion is not unit");
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
 
 /* the numbers of input j: q nq (a floating base's 7 first), v, a and tau nv */
 static inline int dk_width(const dk_tree *tree, int j) { return j == 0 ? tree->nq : tree->nv; }
@@ -315,6 +371,9 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     }
     if (tree->ff && !lg_unit_quaternions((const double *)PyArray_DATA(in[0]),
                                          step[0] ? count : 1, step[0], tree->nq, DK_QTOL))
+        goto done;
+    if (tree->t.balls && !dk_unit_balls(tree, (const double *)PyArray_DATA(in[0]),
+                                        step[0] ? count : 1, step[0]))
         goto done;
     P = (PyArrayObject *)PyArray_FROMANY(args[3], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
     if (!P) goto done;

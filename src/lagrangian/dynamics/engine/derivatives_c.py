@@ -5,13 +5,14 @@ and the joint-torque regressor Y; a batch in one call on vector lanes and thread
 (derivatives_bindings.c). One compiled module for every tree (keyed by its C and this file,
 never a tree's numbers): the tree is given at run time as two tables, made once per dynamics
 object, and gravity, the actuator parameters tau_<joint> and the bodies' inertials as P
-(runtime_values). Revolute, prismatic and helical joints, a free flyer at the root; the complex step of
-derivatives.py is the fallback (and the check). Units SI.
+(runtime_values). Revolute, prismatic, helical and ball joints (a ball as its three columns:
+``description``), a free flyer at the root; the complex step of derivatives.py is the fallback
+(a free flyer below the root) and the check. Units SI.
 
 The tree reaches it as its description D (tree/description.py, the tree kernel's: each joint
 in canonical axes, placed by joint.h) and one table of its pattern (``tables``), nb bodies
 numbered parents first, nj joint coordinates, a floating base's six velocity coordinates first
-(nv = nj + 6 ff, nq = nj + 7 ff):
+(nv = nj + 6 ff, nq = nj + 7 ff, and one more per ball joint):
 
     I (int32): nb, nj, ff (1: body 0 a free flyer), np pairs, nnz pattern entries, ltdl (1:
     M factored along the tree), once (1: each coordinate one body's), sparse (1: the lanes'
@@ -31,9 +32,10 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ...kinds import JointKind
 from ...model.tree import KinematicTree
 from ..emit.tree_c import _SINCOS, _VECTOR
-from ..tree.description import HEADER, STRIDE, describe
+from ..tree.description import HEADER, IDENTITY, JOINT_CODES, STRIDE, describe
 from ..tree.free_flyer import QUATERNION_TOLERANCE
 from .headers import header_bytes, spliced
 
@@ -81,58 +83,107 @@ static inline int dk4_bits(dk4_mask mask)
 }"""
 
 
-def _pairs(tree: KinematicTree) -> list[tuple[int, int]]:
+# an expanded ball joint's record (joint.h's TK_COLUMN): 1, 2, 3 for its x, y, z column
+COLUMN = 57
+
+
+def description(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
+    """The tree's description D (describe) as this module reads it: each ball joint's one
+    record made three, one per column of its angular velocity in its own axes (x, y, z: a
+    chain of one-column records, the first placed as the ball, the next two at its pose; the
+    body's inertial on the last, which its children hang from), so that every record drives
+    one velocity number, as the kernel's pairs take them (derivatives_kernel.c: a ball's
+    columns move their subtree as a revolute joint's, from the ball's parent's motion)."""
+    D = describe(tree, parameters)
+    n, nb = int(D[1]), int(D[0])
+    records = D[HEADER + n:].reshape(nb, STRIDE)
+    balls = records[:, 1] == JOINT_CODES[JointKind.SPHERICAL]
+    if not balls.any():
+        return D
+    out, index = [], {}  # index: each old body's new one (a ball's: its last column's)
+    for i, record in enumerate(records):
+        parent = int(record[0])
+        record = record.copy()
+        record[0] = index[parent] if parent >= 0 else -1
+        if not balls[i]:
+            index[i] = len(out)
+            out.append(record)
+            continue
+        for column in (1, 2, 3):
+            r = record.copy()
+            r[COLUMN], r[2] = column, record[2] + column - 1
+            if column > 1:  # at the ball's pose: no turn, no offset of its own
+                r[0] = len(out) - 1
+                r[5:14], r[14:17], r[IDENTITY] = np.eye(3).ravel(), 0.0, 1.0
+            if column < 3:  # massless: the body's inertial is the last column's
+                r[20:33] = 0.0
+            out.append(r)
+        index[i] = len(out) - 1
+    D = np.concatenate([D[:HEADER + n], np.ravel(out)])
+    D[0] = len(out)
+    D.flags.writeable = False
+    return D
+
+
+def _bodies(D: np.ndarray) -> tuple[list[int], list[int], bool]:
+    """Each record's parent and velocity number (a floating base's body 0: -1), and whether
+    body 0 is a floating base."""
+    n, nb = int(D[1]), int(D[0])
+    records = D[HEADER + n:].reshape(nb, STRIDE)
+    floating = bool(D[6])
+    parents = [int(r[0]) for r in records]
+    coordinates = [-1 if floating and b == 0 else int(r[2]) for b, r in enumerate(records)]
+    return parents, coordinates, floating
+
+
+def _pairs(parents: list[int]) -> list[tuple[int, int]]:
     """(k, j) for every body k and each j on its path to the ground, k itself first."""
     out = []
-    for k in range(len(tree.joints)):
+    for k in range(len(parents)):
         j = k
         while j >= 0:
             out.append((k, j))
-            j = tree.joints[j].parent
+            j = parents[j]
     return out
 
 
-def _column_rows(tree: KinematicTree, pairs: list[tuple[int, int]]) -> list[list[int]]:
+def _column_rows(coordinates: list[int], floating: bool, n: int,
+                 pairs: list[tuple[int, int]]) -> list[list[int]]:
     """For each coordinate j, the coordinates k whose d tau_k/dq_j, d tau_k/dq_dot_j can be
     nonzero: the entries the kernel's pairs write (a path to the ground through both joints; a
     floating base's six with every coordinate), ascending."""
-    floating = bool(tree.floating_base)
     base = range(6) if floating else range(0)
 
-    def coordinates(body: int):
+    def of(body: int):
         if floating and body == 0:
             return base
-        return [6 * floating + tree.joints[body].coordinate]
+        return [6 * floating + coordinates[body]]
 
-    n = len(tree.coordinates) + 6 * floating
-    rows: list[set[int]] = [set() for _ in range(n)]
+    rows: list[set[int]] = [set() for _ in range(n + 6 * floating)]
     for k, j in pairs:
-        for a in coordinates(k):
-            for b in coordinates(j):
+        for a in of(k):
+            for b in of(j):
                 rows[b].add(a)
                 rows[a].add(b)
     return [sorted(r) for r in rows]
 
 
-def _coordinate_parents(tree: KinematicTree) -> list[int] | None:
+def _coordinate_parents(parents: list[int], coordinates: list[int], floating: bool,
+                        n: int) -> list[int] | None:
     """Each velocity coordinate's parent coordinate (-1 at a root; a floating base's six a chain
     under which its children hang), or None where the coordinates are not a tree numbered
     parents first, one body each (a mimic joint's coordinate moves two bodies)."""
-    floating = bool(tree.floating_base)
-    n = len(tree.coordinates) + 6 * floating
-    parents = [c - 1 for c in range(6)] if floating else []
-    parents += [None] * (n - len(parents))
-    for b, joint in enumerate(tree.joints):
+    out = [c - 1 for c in range(6)] if floating else []
+    out += [None] * n
+    for b, (p, coordinate) in enumerate(zip(parents, coordinates, strict=True)):
         if floating and b == 0:
             continue
-        c = 6 * floating + joint.coordinate
-        p = joint.parent
-        parent = -1 if p < 0 else 5 if floating and p == 0 \
-            else 6 * floating + tree.joints[p].coordinate
-        if parents[c] is not None or parent >= c:
+        c = 6 * floating + coordinate
+        parent = -1 if p < 0 else 5 if floating and p == 0 else 6 * floating + coordinates[p]
+        if out[c] is not None or parent >= c:
             return None
-        parents[c] = parent
-    return None if None in parents else parents
+        out[c] = parent
+    return None if None in out else out
 
 
 def factored_along_the_tree(tree: KinematicTree,
@@ -141,9 +192,10 @@ def factored_along_the_tree(tree: KinematicTree,
     L^T D L, no fill-in: derivatives_factor.c's ltdl_factor) rather than by a dense Cholesky: a
     tree that branches (two legs, or more), its coordinates one body's each, numbered parents
     first; else None. On a chain both do the same work and the dense loops are the simpler.
-    ``parents``: _coordinate_parents(tree), where the caller has it."""
+    ``parents``: the coordinates' parents (_coordinate_parents), where the caller has them."""
     if parents is None:
-        parents = _coordinate_parents(tree)
+        D = description(tree, {})
+        parents = _coordinate_parents(*_bodies(D), int(D[1]))
     if parents is None:
         return None
     children = [parents.count(c) for c in range(-1, len(parents))]
@@ -151,20 +203,23 @@ def factored_along_the_tree(tree: KinematicTree,
 
 
 def tables(tree: KinematicTree) -> np.ndarray:
-    """The tree's I (int32), laid out as this module's docstring says."""
-    nb, nj = len(tree.joints), len(tree.coordinates)
-    floating = int(bool(tree.floating_base))
+    """The tree's I (int32), laid out as this module's docstring says, over the records of
+    its description (``description``: a ball joint's three)."""
+    D = description(tree, {})
+    nb, nj = int(D[0]), int(D[1])
+    body_parents, coordinates, floating = _bodies(D)
     nv = nj + 6 * floating
-    pairs = _pairs(tree)
-    rows = _column_rows(tree, pairs)
+    pairs = _pairs(body_parents)
+    rows = _column_rows(coordinates, floating, nj, pairs)
     starts = np.cumsum([0] + [len(r) for r in rows])
     # on the lanes, the products -M^-1 d tau/dq, -M^-1 d tau/dq_dot skip the zero entries where
     # a quarter or more are zero (a floating base's legs: 36% fewer multiply-adds on Solo12); a
     # denser pattern (a serial arm: none) keeps the row by row loops
     sparse = starts[-1] <= 0.75 * nv ** 2
-    one_body = _coordinate_parents(tree)  # None where a coordinate moves two bodies (mimic)
+    # None where a coordinate moves two bodies (mimic)
+    one_body = _coordinate_parents(body_parents, coordinates, floating, nj)
     parents = factored_along_the_tree(tree, one_body)
-    header = [nb, nj, floating, len(pairs), int(starts[-1]), int(parents is not None),
+    header = [nb, nj, int(floating), len(pairs), int(starts[-1]), int(parents is not None),
               int(one_body is not None), int(sparse)]
     I = np.concatenate([
         header, np.ravel(np.array(pairs, dtype=int)), starts, [k for r in rows for k in r],
@@ -203,10 +258,8 @@ def kernel_source():
 
 
 def applies(tree: KinematicTree | None) -> bool:
-    """Whether the kernel takes this tree: revolute, prismatic and helical joints on a fixed
-    base or a floating one (a free flyer at the root), of any size."""
-    from ...kinds import JointKind
-
+    """Whether the kernel takes this tree: revolute, prismatic, helical and ball joints on a
+    fixed base or a floating one (a free flyer at the root), of any size."""
     if tree is None or not tree.joints:
         return False
     kinds = [j.kind for j in tree.joints]
@@ -214,7 +267,8 @@ def applies(tree: KinematicTree | None) -> bool:
         if kinds[0] != JointKind.FREE_FLYER:
             return False
         kinds = kinds[1:]
-    return all(k in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.HELICAL) for k in kinds)
+    return all(k in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.HELICAL,
+                      JointKind.SPHERICAL) for k in kinds)
 
 
 def engine():
@@ -232,11 +286,12 @@ def engine():
 
 
 class TreeDerivatives(NamedTuple):
-    """The engine's functions bound to one tree: each takes (Q, V, X, P)."""
+    """The engine's functions bound to one tree: each takes (Q, V, X, P); no regressor (None)
+    for a tree with a ball joint."""
 
     inverse_derivatives: partial
     forward_derivatives: partial
-    regressor: partial
+    regressor: partial | None
     module: object
 
 
@@ -248,10 +303,11 @@ def derivatives_module(tree: KinematicTree) -> TreeDerivatives | None:
     module = engine()
     if module is None:
         return None
-    handle = module.tree(describe(tree, {}), tables(tree))
+    handle = module.tree(description(tree, {}), tables(tree))
+    # a ball's three records are not its body's ten parameters: its regressor stays numpy's
+    regressor = None if tree.quaternion_joints else partial(module.regressor, handle)
     return TreeDerivatives(partial(module.inverse_derivatives, handle),
-                           partial(module.forward_derivatives, handle),
-                           partial(module.regressor, handle), module)
+                           partial(module.forward_derivatives, handle), regressor, module)
 
 
 def runtime_values(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
@@ -259,7 +315,7 @@ def runtime_values(tree: KinematicTree, parameters: Mapping[str, float]) -> np.n
     coordinate; 0 where none), then per body m (kg), h = m c (kg m, 3) and J_O (kg m^2, 9,
     about its origin)], read-only: the description's numbers (describe), each body's in its
     canonical axes, as the kernel places it."""
-    D = describe(tree, parameters)
+    D = description(tree, parameters)
     n, nb = int(D[1]), int(D[0])
     records = D[HEADER + n:].reshape(nb, STRIDE)
     P = np.concatenate([D[2:5], D[HEADER:HEADER + n], records[:, 20:33].ravel()])
@@ -267,5 +323,5 @@ def runtime_values(tree: KinematicTree, parameters: Mapping[str, float]) -> np.n
     return P
 
 
-__all__ = ["applies", "derivatives_module", "engine", "kernel_source", "runtime_values",
-           "tables"]
+__all__ = ["COLUMN", "applies", "derivatives_module", "description", "engine", "kernel_source",
+           "runtime_values", "tables"]

@@ -16,7 +16,13 @@
  *   row k above j (k a strict ancestor): S_k . (S_j x* F_j + Ic_j psi_j + Bc_j dv_j),
  * likewise for theta_dot, and M_kj = S_k . Ic_k S_j. B = [[0, -2[l]x], [0, A]] with l the
  * linear momentum and A = [w]x J_O - J_O [w]x - [v]x[c]x - [c]x[v]x - [n]x (n the angular
- * momentum about the origin, c = m x_G): 12 numbers, additive over a subtree. */
+ * momentum about the origin, c = m x_G): 12 numbers, additive over a subtree.
+ * A ball joint is three such columns (derivatives_c.py's description: one record each, the body
+ * on the last), the turns of its body about its own x, y, z: each moves the ball's subtree
+ * rigidly from the ball's parent's v_p, a_p (dv, psi as above with those), and between two
+ * columns of one ball both entries take the row-below form (each column turns with the
+ * others); d a/d theta_dot's own part is dv + v_b x S (v_b the ball's body's), 2 dv for a
+ * joint of one column. */
 
 #define DK_STR_(x) #x
 #define DK_STR(x) DK_STR_(x)
@@ -30,7 +36,7 @@
  * joint in canonical axes, placed by joint.h) and one table of its pattern (derivatives_c.py),
  * copied here once per tree by the bindings: nb bodies, nj joint coordinates, ff 1 on a
  * floating base (body 0 a free flyer, its 7 q and 6 v first: qo, vo), nv = nj + 6 ff velocity
- * coordinates, nq = nj + 7 ff; np ancestor pairs (k, j), j on k's path to the ground, k first;
+ * coordinates, nq = nj + 7 ff + a ball's one more; np ancestor pairs (k, j), j on k's path to the ground, k first;
  * per coordinate j the rows that d tau/d(q, q_dot)_j can have nonzero (rows[row0[j] ..
  * row0[j + 1]]), and its parent coordinate (lambda, for the factor along the tree). Per body,
  * read out of D once: its parent body, coordinate and multiplier. ``space``: the DK_T numbers
@@ -39,6 +45,10 @@ typedef struct {
     int nb, nj, ff, np, nv, nq, qo, vo, ltdl, once, sparse;
     tk_tree t;
     const int *parent, *coord, (*pair)[2], *row0, *rows, *lambda;
+    /* per record: whose motion its column's dv and psi are taken from (the parent's, a ball
+       column's the ball's parent's), the record of its body (a ball column's: the last), and
+       its ball (the first column's record; -1 for a record that is no ball's column) */
+    const int *motion, *end, *group;
     const double *mult;
     size_t space;
 } dk_tree;
@@ -101,6 +111,7 @@ static inline void DK_FN(iapply)(const DK_FN(inertia) *Y, const DK_T *x, DK_T *o
  * floating base's six columns here. */
 typedef struct {
     DK_T (*S)[6], (*dv)[6], (*psi)[6];
+    DK_T (*dvv)[6];               /* d a/d theta_dot's own part: 2 dv (a ball column's below) */
     DK_T (*F)[6];                 /* f_i, then the subtree's sum */
     DK_FN(inertia) *Y;            /* the body's, then the subtree's */
     DK_T (*L)[3], (*A)[9];        /* B's 12 numbers, the body's then the subtree's */
@@ -125,6 +136,7 @@ static DK_T *DK_FN(carve)(const dk_tree *tree, DK_T *at, DK_FN(work) *w)
     const size_t nb = tree->nb, nv = tree->nv;
 #define DK_TAKE(field, count) (w->field = (void *)at, at += (count))
     DK_TAKE(S, 6 * nb); DK_TAKE(dv, 6 * nb); DK_TAKE(psi, 6 * nb); DK_TAKE(F, 6 * nb);
+    DK_TAKE(dvv, 6 * nb);
     DK_TAKE(Y, 13 * nb); DK_TAKE(L, 3 * nb); DK_TAKE(A, 9 * nb); DK_TAKE(r1, 6 * nb);
     DK_TAKE(r2, 3 * nb); DK_TAKE(Phi, 6 * nb); DK_TAKE(Psi, 6 * nb); DK_TAKE(R, 9 * nb);
     DK_TAKE(o, 3 * nb); DK_TAKE(V, 6 * nb); DK_TAKE(Acc, 6 * nb); DK_TAKE(F0, 6 * nb);
@@ -169,26 +181,55 @@ static void DK_FN(kinematics)(const dk_tree *tree, const DK_T *q, const DK_T *qd
             continue;
         }
         const double *b = DK_BODY_OF(tree, i);
-        const int p = tree->parent[i];
-        DK_FN(jt_placed)(&tree->t, b, q, p < 0 ? NULL : R[p], p < 0 ? NULL : o[p], R[i], o[i]);
-        DK_FN(jt_columns)(b, R[i], o[i], (DK_T (*)[6])w->S[i]);  /* S (joint.h) */
+        const int p = tree->parent[i], mp = tree->motion[i];
+        const int column = tree->group[i] >= 0 ? (int)b[TK_COLUMN] : 0;
+        if (column > 1) {  /* a ball's second or third column: at the ball's pose */
+            for (int j = 0; j < 9; j++) R[i][j] = R[p][j];
+            for (int j = 0; j < 3; j++) o[i][j] = o[p][j];
+        } else {
+            DK_FN(jt_placed)(&tree->t, b, q, p < 0 ? NULL : R[p], p < 0 ? NULL : o[p], R[i],
+                             o[i]);
+        }
+        if (column > 0) {  /* its column c of [o x R e_c; R e_c] (joint.h's ball columns) */
+            DK_T e[3] = {R[i][column - 1], R[i][column + 2], R[i][column + 5]};
+            SP_CROSS(o[i], e, w->S[i]);
+            for (int j = 0; j < 3; j++) w->S[i][3 + j] = e[j];
+        } else {
+            DK_FN(jt_columns)(b, R[i], o[i], (DK_T (*)[6])w->S[i]);  /* S (joint.h) */
+        }
         const DK_T *S = w->S[i];
-        DK_T vp[6], ap[6];
+        /* the parent's motion, which the column adds to; and that its dv and psi are taken
+           from (a ball column's: the ball's parent's, the ball's columns one joint) */
+        DK_T vp[6], ap[6], vm[6], am[6];
         for (int j = 0; j < 6; j++) {
             vp[j] = p >= 0 ? V[p][j] : DK_C(0.0);
             ap[j] = p >= 0 ? Acc[p][j] : DK_C(j < 3 ? -g[j] : 0.0);
+            vm[j] = mp >= 0 ? V[mp][j] : DK_C(0.0);
+            am[j] = mp >= 0 ? Acc[mp][j] : DK_C(j < 3 ? -g[j] : 0.0);
         }
         DK_T rate = tree->mult[i] * qd[tree->vo + tree->coord[i]];
         DK_T accel = tree->mult[i] * qdd[tree->vo + tree->coord[i]];
         DK_T t[6];
-        DK_FN(mcross)(vp, S, w->dv[i]);
-        DK_FN(mcross)(ap, S, w->psi[i]);
-        DK_FN(mcross)(vp, w->dv[i], t);
+        DK_FN(mcross)(vm, S, w->dv[i]);
+        DK_FN(mcross)(am, S, w->psi[i]);
+        DK_FN(mcross)(vm, w->dv[i], t);
         for (int j = 0; j < 6; j++) {
             w->psi[i][j] += t[j];
             V[i][j] = vp[j] + S[j] * rate;
             Acc[i][j] = ap[j] + S[j] * accel + w->dv[i][j] * rate;
         }
+    }
+    /* d a/d theta_dot below the joint, its own part: 2 dv for a joint of one column; for a
+       ball's column dv + v_b x S (v_b the ball's body's velocity: the ball's other columns
+       turn with it) */
+    for (int i = 0; i < tree->nb; i++) {
+        if (tree->group[i] < 0) {
+            for (int j = 0; j < 6; j++) w->dvv[i][j] = 2.0 * w->dv[i][j];
+            continue;
+        }
+        DK_T t[6];
+        DK_FN(mcross)(V[tree->end[i]], w->S[i], t);
+        for (int j = 0; j < 6; j++) w->dvv[i][j] = w->dv[i][j] + t[j];
     }
 }
 
@@ -278,9 +319,9 @@ static void DK_FN(backward)(const dk_tree *tree, DK_FN(work) *w, DK_T *tau, int 
             DK_FN(iapply)(Y, w->psi[i], u);
             DK_FN(bapply)(w->L[i], w->A[i], w->dv[i], x);
             for (int j = 0; j < 6; j++) w->Phi[i][j] = t[j] + u[j] + x[j];
-            DK_FN(iapply)(Y, w->dv[i], u);
+            DK_FN(iapply)(Y, w->dvv[i], u);
             DK_FN(bapply)(w->L[i], w->A[i], S, x);
-            for (int j = 0; j < 6; j++) w->Psi[i][j] = 2.0 * u[j] + x[j];
+            for (int j = 0; j < 6; j++) w->Psi[i][j] = u[j] + x[j];
         }
         if (tree->ff && i == 0)  /* the base's columns, its subtree the whole tree */
             for (int c = 0; c < 6; c++) {
@@ -398,8 +439,13 @@ static inline __attribute__((always_inline)) void DK_FN(pairs)(const dk_tree *tr
         DK_ADD(dq[ck * n + cj],
                kk * (DK_FN(dot6)(r1, w->psi[j]) + SP_DOT(r2, w->dv[j] + 3)));
         DK_ADD(dv[ck * n + cj],
-               kk * (2.0 * DK_FN(dot6)(r1, w->dv[j]) + SP_DOT(r2, w->S[j] + 3)));
-        if (k != j) {
+               kk * (DK_FN(dot6)(r1, w->dvv[j]) + SP_DOT(r2, w->S[j] + 3)));
+        if (k != j && tree->group[k] >= 0 && tree->group[k] == tree->group[j]) {
+            /* two columns of one ball: j's turns with k's (the body's axes), as a row below */
+            DK_ADD(dq[cj * n + ck], kk * (DK_FN(dot6)(w->r1[j], w->psi[k])
+                                          + SP_DOT(w->r2[j], w->dv[k] + 3)));
+            DK_ADD(dv[cj * n + ck], kk * DK_FN(dot6)(w->S[j], w->Psi[k]));
+        } else if (k != j) {
             DK_ADD(dq[cj * n + ck], kk * DK_FN(dot6)(w->S[j], w->Phi[k]));
             DK_ADD(dv[cj * n + ck], kk * DK_FN(dot6)(w->S[j], w->Psi[k]));
         }
@@ -458,9 +504,13 @@ static int DK_FN(forward_derivatives)(const dk_tree *tree, DK_T *space, const DK
         const int p = tree->parent[i];
         const DK_T accel = ff && i == 0 ? DK_C(0.0) : tree->mult[i] * b[vo + tree->coord[i]];
         DK_T t[6], u[6];
-        if (p >= 0) {
-            DK_FN(mcross)(da[p], w.S[i], t);
-            for (int j = 0; j < 6; j++) { w.psi[i][j] += t[j]; da[i][j] = da[p][j]; }
+        if (p >= 0) {  /* psi from its motion's (a ball column's: the ball's parent's) */
+            const int mp = tree->motion[i];
+            if (mp >= 0) {
+                DK_FN(mcross)(da[mp], w.S[i], t);
+                for (int j = 0; j < 6; j++) w.psi[i][j] += t[j];
+            }
+            for (int j = 0; j < 6; j++) da[i][j] = da[p][j];
         } else {
             for (int j = 0; j < 6; j++) da[i][j] = DK_C(0.0);
         }

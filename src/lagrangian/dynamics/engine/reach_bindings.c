@@ -371,7 +371,10 @@ static int rk_model_from(PyObject *description, PyObject *ints, PyObject *floats
     if (!Fa) goto done;
     const npy_intp nD = PyArray_SIZE(Da), ni = PyArray_SIZE(Ia), nd = PyArray_SIZE(Fa);
     tk_tree t;
-    if (tk_open(PyArray_DATA(Da), nD, &t)) { fault = "D: not a tree description"; goto done; }
+    if (tk_open(PyArray_DATA(Da), nD, &t) || !tk_whole_balls(&t)) {
+        fault = "D: not a tree description";
+        goto done;
+    }
     const int *head = PyArray_DATA(Ia);
     if (ni < 3) { fault = "INTS: no header"; goto done; }
     const int nb = t.nb, n = t.n, fb = t.fb, nf = head[0];

@@ -184,7 +184,8 @@ static PyObject *tk_py_prepare(PyObject *self, PyObject *const *args, Py_ssize_t
     (void)self;
     PyArrayObject *D = nargs == 1 ? tk_array(args[0], 1, 1) : NULL;
     tk_tree tree;
-    if (!D || tk_open((const double *)PyArray_DATA(D), PyArray_SIZE(D), &tree)) {
+    if (!D || tk_open((const double *)PyArray_DATA(D), PyArray_SIZE(D), &tree)
+        || !tk_whole_balls(&tree)) {
         Py_XDECREF(D);
         PyErr_SetString(PyExc_TypeError, "tree: not a tree description (compact_kernel.py)");
         return NULL;

@@ -2,8 +2,8 @@
 buildModelFromUrdf reads it (JointModelFreeFlyer: q = x y z in the parent's joint frame, then
 qx qy qz qw; v = the child's linear then angular velocity relative to its parent, in its own
 axes). The oracle is Pinocchio at random states, compared by joint name, and the numpy
-reference; the compiled engine runs it (joint.h's kind 5), and every path that does not take it
-yet says so in one line naming the joint."""
+reference; the compiled engine runs it (joint.h's kind 5), and so do kernel="unrolled" and
+the C export (tests/dynamics/test_joint_kinds_export.py)."""
 
 from __future__ import annotations
 
@@ -318,18 +318,6 @@ def test_the_casadi_functions_match_pinocchio(robots, key):
         column = (forward(plus) - forward(minus)) / (2 * step)
         np.testing.assert_allclose(J[:, i], column, rtol=0,
                                    atol=1e-5 * max(1.0, np.abs(column).max()), err_msg=f"x[{i}]")
-
-
-def test_engine_only_paths_refuse_in_one_line(robots):
-    ours, _, path = robots["arm"]
-    system = lagrangian.load(path)
-    calls = {"kernel='unrolled'": lambda: system.dynamics(kernel="unrolled"),
-             "standalone C export": lambda: system.to_c("carrier")}
-    for what, call in calls.items():
-        with pytest.raises(lagrangian.ModelError) as info:
-            call()
-        text = str(info.value)
-        assert "\n" not in text and "joint 'grip' is a floating joint below the root" in text, what
 
 
 def test_bad_input_is_named_in_one_line(robots, tmp_path):

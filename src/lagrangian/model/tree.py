@@ -259,7 +259,8 @@ def refuse_ball_joints(tree: KinematicTree | None, what: str) -> None:
                              field="joint")
         raise ModelError(f"joint '{balls[0].name}' is a ball (spherical) joint, which {what} "
                          "does not take yet (M, inverse and forward dynamics and their "
-                         "derivatives, the energies, frames and Jacobians do)",
+                         "derivatives, the energies, frames and Jacobians, kernel='unrolled' "
+                         "and the C export do)",
                          field="joint")
     refuse_free_joints(tree, what)
 
@@ -274,7 +275,8 @@ def refuse_free_joints(tree: KinematicTree | None, what: str) -> None:
         raise ModelError(f"joint '{free[0].name}' is a floating joint below the root (a free "
                          f"flyer between two links), which {what} does not take yet (M, "
                          "inverse and forward dynamics and their derivatives, the energies, "
-                         "frames, Jacobians and simulate do)", field="joint")
+                         "frames, Jacobians, simulate, kernel='unrolled' and the C export do)",
+                         field="joint")
 
 
 _QUATERNION = (JointKind.SPHERICAL, JointKind.FREE_FLYER)

@@ -3,7 +3,9 @@ kinematics, Newton-Euler inverse dynamics, the composite-rigid-body mass matrix,
 (or Cholesky) forward dynamics and the energies (SI units).
 
 A floating base (a free flyer first, free_flyer.py) takes q and v with its 7 and 6 numbers
-first: the joints read q[7:] and v[6:] by their coordinate, the base its own (_free_*)."""
+first: the joints read q[7:] and v[6:] by their coordinate, the base its own (_free_*). A ball
+joint (4 numbers in q, 3 in v) or a free flyer below the root (7 and 6) reads its own q and v
+slices (tree_floating.several_*): q is nq wide, v, a and tau nv."""
 
 from __future__ import annotations
 
@@ -11,7 +13,15 @@ from ...kinds import JointKind
 from ...model.tree import KinematicTree
 from ..tree.joint_models import joint_model
 from .tree_emitter import Term, _Emitter, _Layout
-from .tree_floating import free_root_acceleration, free_root_motion
+from .tree_floating import (
+    free_root_acceleration,
+    free_root_motion,
+    quaternion_rotation,
+    several,
+    several_columns,
+    several_placement,
+    several_rates,
+)
 
 
 def _rotation(E: _Emitter, joint, c: Term, s: Term):
@@ -30,22 +40,28 @@ def _rotation(E: _Emitter, joint, c: Term, s: Term):
 
 
 def _free(joint) -> bool:
-    return joint.kind == JointKind.FREE_FLYER
+    """The floating base's free flyer (the root's, its numbers before the joints')."""
+    return joint.kind == JointKind.FREE_FLYER and joint.coordinate < 0
 
 
 def _free_placement(E: _Emitter, joint, q):
     """The floating base's R = R_0 R(quaternion) and p = t_0 + R_0 (x, y, z): the rotation of
     the quaternion made unit (2 / |q|^2 in place of 2)."""
-    x, y, z, w = q[3:7]
-    s = E.div(2.0, E.sum([E.mul(c, c) for c in (x, y, z, w)]))
-    xx, yy, zz = E.mul(x, x), E.mul(y, y), E.mul(z, z)
-    xy, xz, yz = E.mul(x, y), E.mul(x, z), E.mul(y, z)
-    wx, wy, wz = E.mul(w, x), E.mul(w, y), E.mul(w, z)
-    Rq = [[E.sub(1.0, E.mul(s, E.add(yy, zz))), E.mul(s, E.sub(xy, wz)), E.mul(s, E.add(xz, wy))],
-          [E.mul(s, E.add(xy, wz)), E.sub(1.0, E.mul(s, E.add(xx, zz))), E.mul(s, E.sub(yz, wx))],
-          [E.mul(s, E.sub(xz, wy)), E.mul(s, E.add(yz, wx)), E.sub(1.0, E.mul(s, E.add(xx, yy)))]]
     R0 = [list(row) for row in joint.rotation]
-    return E.matmul(R0, Rq), E.vadd(list(joint.translation), E.apply(R0, list(q[:3])))
+    return (E.matmul(R0, quaternion_rotation(E, *q[3:7])),
+            E.vadd(list(joint.translation), E.apply(R0, list(q[:3]))))
+
+
+def _starts(tree: KinematicTree) -> list[int]:
+    """Each joint's first number among the joints' own velocity numbers (v after the base)."""
+    return [tree.velocity_index(j.coordinate) if j.coordinate >= 0 else -1 for j in tree.joints]
+
+
+def _columns(joint, start: int):
+    """(S's column (s_w, s_v), its index in the joints' v, the rate's multiplier) of a joint."""
+    if several(joint):
+        return [(column, start + k, 1.0) for k, column in enumerate(several_columns(joint))]
+    return [(joint_model(joint.kind).subspace(joint.axis, joint.pitch), start, joint.multiplier)]
 
 
 def _kinematics(E: _Emitter, tree: KinematicTree, q):
@@ -55,6 +71,11 @@ def _kinematics(E: _Emitter, tree: KinematicTree, q):
     for joint in tree.joints:
         if _free(joint):
             placements.append(_free_placement(E, joint, base))
+            continue
+        if several(joint):
+            width = joint_model(joint.kind).nq
+            placements.append(several_placement(
+                E, joint, q[joint.coordinate:joint.coordinate + width]))
             continue
         theta = E.add(E.mul(q[joint.coordinate], joint.multiplier), joint.offset)
         placements.append(joint_model(joint.kind).placement_terms(E, joint, theta, _rotation))
@@ -88,6 +109,7 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
     up = [E.mul(g, -d) for d in tree.gravity_direction]  # the ground accelerates up by g
     w, dw, acc, f, n = [], [], [], [], []
     (vb, v), (ab, a) = (v[:tree.base_nv], v[tree.base_nv:]), (a[:tree.base_nv], a[tree.base_nv:])
+    starts = _starts(tree)
     for i, joint in enumerate(tree.joints):
         R, p = placements[i]
         if _free(joint):  # the base: its twist (v, w) and its derivative; origin v_dot + w x v
@@ -97,10 +119,21 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
             wl, dwl, al = [0.0] * 3, [0.0] * 3, up
         else:
             wl, dwl, al = w[joint.parent], dw[joint.parent], acc[joint.parent]
-        if not _free(joint):
+        if several(joint):  # S v = (ws, vs), S a = (aw, av), S constant in the child's axes
+            k, nv = starts[i], joint_model(joint.kind).nv
+            ws, vs = several_rates(E, joint, v[k:k + nv])
+            aw, av = several_rates(E, joint, a[k:k + nv])
+            w_in = E.apply_transpose(R, wl)
+            origin = E.vadd(al, E.vadd(E.cross(dwl, p), E.cross(wl, E.cross(wl, p))))
+            w_i = E.vadd(w_in, ws)
+            dw_i = E.vadd(E.apply_transpose(R, dwl), E.vadd(E.cross(w_in, ws), aw))
+            # the origin's: Coriolis 2 w_in x vs, and vs turned by ws in the child's axes
+            a_i = E.vadd(E.apply_transpose(R, origin),
+                         E.vadd(E.vadd(E.scale(2.0, E.cross(w_in, vs)), E.cross(ws, vs)), av))
+        elif not _free(joint):
             s_w, s_v = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
-            rate = E.mul(v[joint.coordinate], joint.multiplier)
-            accel = E.mul(a[joint.coordinate], joint.multiplier)
+            rate = E.mul(v[starts[i]], joint.multiplier)
+            accel = E.mul(a[starts[i]], joint.multiplier)
             w_in = E.apply_transpose(R, wl)
             dw_in = E.apply_transpose(R, dwl)
             origin = E.vadd(al, E.vadd(E.cross(dwl, p), E.cross(wl, E.cross(wl, p))))
@@ -121,26 +154,21 @@ def _inverse_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, a
         f.append(E.vadd(E.scale(m, a_i), E.vadd(E.cross(dw_i, h), E.cross(w_i, E.cross(w_i, h)))))
         n.append(E.vadd(E.vadd(E.apply(J, dw_i), E.cross(w_i, E.apply(J, w_i))),
                         E.cross(h, a_i)))
-    tau_full: list[Term] = [0.0] * len(tree.joints)
+    tau: list[Term] = [0.0] * (layout.n - tree.base_nv)
     base: list[Term] = []
     for i in reversed(range(len(tree.joints))):
         joint = tree.joints[i]
         if _free(joint):  # the wrench on the base, force then moment, in its axes
             base = f[i] + n[i]
             continue
-        tau_full[i] = _project(E, joint_model(joint.kind).subspace(joint.axis, joint.pitch),
-                               n[i], f[i])
+        for subspace, k, multiplier in _columns(joint, starts[i]):
+            tau[k] = E.add(tau[k], E.mul(_project(E, subspace, n[i], f[i]), multiplier))
         if joint.parent >= 0:
             R, p = placements[i]
             force = E.apply(R, f[i])
             f[joint.parent] = E.vadd(f[joint.parent], force)
             n[joint.parent] = E.vadd(n[joint.parent],
                                      E.vadd(E.apply(R, n[i]), E.cross(p, force)))
-    tau: list[Term] = [0.0] * (layout.n - tree.base_nv)
-    for i, joint in enumerate(tree.joints):
-        if not _free(joint):
-            tau[joint.coordinate] = E.add(tau[joint.coordinate],
-                                          E.mul(tau_full[i], joint.multiplier))
     return base + [E.sub(t, actuator) for t, actuator in zip(tau, layout.actuators, strict=True)]
 
 
@@ -151,7 +179,11 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
     mass = [j.mass for j in tree.joints]
     h = [list(j.first_moment) for j in tree.joints]
     J = [[list(r) for r in j.inertia] for j in tree.joints]
-    full, base, coupling, first = {}, {}, {}, tree.base_nv  # coupling: a joint's wrench on the base
+    entries, first, starts = {}, tree.base_nv, _starts(tree)
+
+    def add(r, c, x):  # M[first + r, first + c] (c < 0: the base's column first + c)
+        entries[first + r, first + c] = E.add(entries.get((first + r, first + c), 0.0), x)
+
     for i in reversed(range(nb)):
         joint = tree.joints[i]
         if _free(joint):  # the composite inertia of the whole robot, [[m, -[h]x], [[h]x, J]]
@@ -159,23 +191,33 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
             block = [[m, 0.0, 0.0], [0.0, m, 0.0], [0.0, 0.0, m],
                      [0.0, E.neg(hz), hy, J[i][0][0]], [hz, 0.0, E.neg(hx), J[i][1][0], J[i][1][1]],
                      [E.neg(hy), hx, 0.0, J[i][2][0], J[i][2][1], J[i][2][2]]]
-            base = {(r, c): x for r, row in enumerate(block) for c, x in enumerate(row)}
+            for r, row in enumerate(block):
+                for c, x in enumerate(row):
+                    entries[r, c] = E.add(entries.get((r, c), 0.0), x)
             continue
-        subspace = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
-        force, moment = _unit_rate_wrench(E, subspace, mass[i], h[i], J[i])
-        full[i, i] = _project(E, subspace, moment, force)
-        k = i
-        while tree.joints[k].parent >= 0:
-            R, p = placements[k]
-            force = E.apply(R, force)
-            moment = E.vadd(E.apply(R, moment), E.cross(p, force))
-            k = tree.joints[k].parent
-            ancestor = tree.joints[k]
-            if _free(ancestor):  # S = 1: the wrench itself, force then moment
-                coupling[i] = force + moment
-                continue
-            space = joint_model(ancestor.kind).subspace(ancestor.axis, ancestor.pitch)
-            full[i, k] = _project(E, space, moment, force)
+        own = _columns(joint, starts[i])
+        for subspace, ci, ki in own:  # one column of M per velocity number of the joint
+            force, moment = _unit_rate_wrench(E, subspace, mass[i], h[i], J[i])
+            for row, ri, kr in own:
+                if ri >= ci:
+                    add(ri, ci, E.mul(_project(E, row, moment, force), ki * kr))
+            k = i
+            while tree.joints[k].parent >= 0:
+                R, p = placements[k]
+                force = E.apply(R, force)
+                moment = E.vadd(E.apply(R, moment), E.cross(p, force))
+                k = tree.joints[k].parent
+                ancestor = tree.joints[k]
+                if _free(ancestor):  # S = 1: the wrench itself, force then moment
+                    for c, x in enumerate(force + moment):
+                        add(ci, c - first, E.mul(x, ki))
+                    continue
+                for space, ak, ka in _columns(ancestor, starts[k]):
+                    x = E.mul(_project(E, space, moment, force), ki * ka)
+                    if ci >= ak:
+                        add(ci, ak, x)
+                    if ak >= ci:  # both where a mimic joint shares its ancestor's coordinate
+                        add(ak, ci, x)
         parent = joint.parent
         if parent >= 0:  # the composite inertia of body i, moved into its parent's axes
             R, p = placements[i]
@@ -198,19 +240,6 @@ def _mass_matrix(E: _Emitter, tree: KinematicTree, layout: _Layout, q):
                     J[parent][r][c] = J[parent][c][r] = entry
             h[parent] = E.vadd(h[parent], E.vadd(hr, E.scale(mass[i], p)))
             mass[parent] = mass[parent] + mass[i]
-    entries = dict(base)
-    for (i, k), value in full.items():
-        a, b = tree.joints[i], tree.joints[k]
-        for (r, c, x) in ((a.coordinate, b.coordinate, value),) + (
-                ((b.coordinate, a.coordinate, value),) if i != k else ()):
-            if r >= c:
-                entries[first + r, first + c] = E.add(entries.get((first + r, first + c), 0.0),
-                                                      E.mul(x, a.multiplier * b.multiplier))
-    for i, wrench in coupling.items():  # rows of the joints, the base's six columns
-        joint = tree.joints[i]
-        for c, x in enumerate(wrench):
-            r = first + joint.coordinate
-            entries[r, c] = E.add(entries.get((r, c), 0.0), E.mul(x, joint.multiplier))
     return entries
 
 
@@ -218,6 +247,8 @@ def _articulated(tree: KinematicTree) -> bool:
     """Whether the articulated-body algorithm applies: each coordinate drives one joint, as
     its angle or distance (no mimic joint); a floating base's free flyer is the root's."""
     joints = [j for j in tree.joints if not _free(j)]
+    if any(several(j) for j in joints):  # a ball or a free flyer below the root: M = L L^T
+        return False
     used = [j.coordinate for j in joints]
     return len(set(used)) == len(used) and all(j.multiplier == 1.0 for j in joints)
 
@@ -367,6 +398,7 @@ def _velocities(E: _Emitter, tree: KinematicTree, q, v):
     placements = _kinematics(E, tree, q)
     w, vel = [], []
     base, v = v[:tree.base_nv], v[tree.base_nv:]
+    starts = _starts(tree)
     for i, joint in enumerate(tree.joints):
         R, p = placements[i]
         if _free(joint):  # the base's own twist
@@ -375,9 +407,15 @@ def _velocities(E: _Emitter, tree: KinematicTree, q, v):
             continue
         wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
                                                                  vel[joint.parent])
-        rate = E.mul(v[joint.coordinate], joint.multiplier)
         w_i = E.apply_transpose(R, wl)
         v_i = E.apply_transpose(R, E.vadd(vl, E.cross(wl, p)))
+        if several(joint):  # its own S v added, in its axes
+            k = starts[i]
+            ws, vs = several_rates(E, joint, v[k:k + joint_model(joint.kind).nv])
+            w.append(E.vadd(w_i, ws))
+            vel.append(E.vadd(v_i, vs))
+            continue
+        rate = E.mul(v[starts[i]], joint.multiplier)
         s_w, s_v = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
         if s_w is not None:
             w_i = E.vadd(w_i, E.scale(rate, s_w))

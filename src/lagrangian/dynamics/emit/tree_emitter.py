@@ -219,8 +219,8 @@ class _Layout:
             f"p[{index[tree.gravity_parameter]}]"
         self.actuators = [0.0 if name is None else f"p[{index[name]}]"
                           for name in tree.actuators]
-        self.n = len(tree.coordinates) + tree.base_nv  # v's numbers (q has base_nq before)
-        self.nq = len(tree.coordinates) + tree.base_nq
+        self.n = tree.nv  # v's numbers (3 per ball joint, 6 per free flyer)
+        self.nq = tree.nq  # q's (4 per ball joint, 7 per free flyer)
 
 
 def _cholesky_solve(E: _Emitter, mass: dict, rhs: list) -> list:

@@ -35,11 +35,8 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
     """The compiled module's C: the recursive functions, lg_parts/lg_energy/lg_residual for
     template.c (simulation, accelerations), and batched bindings for each function."""
     from ...compile.codegen import TEMPLATE, GeneratedSource
-    from ...model.tree import refuse_ball_joints
 
-    refuse_ball_joints(tree, "the unrolled per-tree module (kernel='unrolled')")
-
-    n = len(tree.coordinates) + tree.base_nv  # v's numbers; q's are RT_NQ (a floating base)
+    n = tree.nv  # v's numbers; q's are RT_NQ (a floating base's, ball joints' quaternions)
     # vector variants (LG_LANES states at once) for batches up to VECTOR_LIMIT coordinates; a
     # long chain's code is big enough that compiling it twice costs minutes, so there the batch
     # runs the scalar functions; a floating base's forward dynamics (the articulated-body
@@ -51,7 +48,7 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
         f"/* lagrangian: recursive dynamics of a tree of {len(tree.joints)} bodies, {n} "
         "coordinates */",
         f"#define LG_N {n}",
-        f"#define RT_NQ {n + tree.base_nq - tree.base_nv}",
+        f"#define RT_NQ {tree.nq}",
         "#define LG_M 0",
         f"#define RT_FLOATING {int(tree.floating_base)}",
         f"#define RT_QUATERNION_TOLERANCE {QUATERNION_TOLERANCE!r}",

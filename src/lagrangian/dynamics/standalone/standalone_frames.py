@@ -6,14 +6,31 @@ Pinocchio's), ``<P>_frame_jacobian_dot_times_v(q, v, frame, reference, out)`` (t
 acceleration at a = 0), ``<P>_center_of_mass(q, c)`` with its Jacobian and the centroidal
 momentum matrix ``<P>_centroidal_momentum_matrix(q, Ag)`` (6 x N, as Pinocchio's ccrba), the
 frames by index in ``<P>_frame_names``: frames.py's and centroidal.py's formulas over the
-tree's numbers written as static tables, a floating base's free flyer as body 0.
+tree's numbers written as static tables, a floating base's free flyer as body 0. A ball joint
+(q w x y z, v the child's angular velocity in its axes) and a free flyer below the root (q x y z
+qx qy qz qw, v its twist in its axes, linear then angular) place their body by their quaternion
+and give three or six columns, the numpy reference's (dynamics/algorithms/frames.py).
 """
 
 from __future__ import annotations
 
 from ...compile.codegen import c_comment_text, c_table
+from ...kinds import JointKind
 from ...model.tree import KinematicTree
 from ..tree.joint_models import joint_model
+
+
+def _kind(joint) -> int:
+    """fr_kind: 0 a joint of one number, 1 a ball joint, 2 a free flyer (the base's or below)."""
+    return {JointKind.SPHERICAL: 1, JointKind.FREE_FLYER: 2}.get(joint.kind, 0)
+
+
+def _first(tree: KinematicTree, joint) -> tuple[int, int]:
+    """The joint's first number in the full q and in the full v."""
+    if joint.coordinate < 0:  # the floating base: q[0:7], v[0:6]
+        return 0, 0
+    return (tree.base_nq + joint.coordinate,
+            tree.base_nv + tree.velocity_index(joint.coordinate))
 
 
 def c_string(text: str) -> str:
@@ -64,7 +81,9 @@ def frame_functions(P: str, tree: KinematicTree) -> str:
     names = ", ".join(c_string(f.name) for f in frames) or '""'
     tables = "\n".join([
         c_table("fr_parent", "int", [j.parent for j in joints]),
-        c_table("fr_coord", "int", [j.coordinate for j in joints]),
+        c_table("fr_kind", "int", [_kind(j) for j in joints]),
+        c_table("fr_iq", "int", [_first(tree, j)[0] for j in joints]),
+        c_table("fr_iv", "int", [_first(tree, j)[1] for j in joints]),
         c_table("fr_turns", "int", [getattr(m, "turns", False) for m in models]),
         c_table("fr_slides", "int", [getattr(m, "slides", False) for m in models]),
         # the slide per unit th: 1 prismatic, the pitch (m/rad) helical (turns and slides)
@@ -86,10 +105,7 @@ def frame_functions(P: str, tree: KinematicTree) -> str:
     return f"""
 /* -- frames: placements and Jacobians (standalone_frames.py) -- */
 #define FR_NB {len(joints)}
-#define FR_FB {int(tree.floating_base)}
-#define FR_BQ (FR_FB ? 7 : 0)
-#define FR_BV (FR_FB ? 6 : 0)
-#define FR_NV (FR_BV + {len(tree.coordinates)})
+#define FR_NV {tree.nv}
 {tables}
 
 const char *const {P}_frame_names[{P.upper()}_NF] = {{{names}}};
@@ -121,18 +137,24 @@ static void fr_bodies(const double *q, double (*R)[9], double (*o)[3])
         const double *u = fr_u[i];
         for (int j = 0; j < 9; j++) Rj[j] = (j % 4 == 0) ? 1.0 : 0.0;
         for (int j = 0; j < 3; j++) pl[j] = fr_t0[i][j];
-        if (FR_FB && i == 0) {{  /* the free flyer: position, unit quaternion x y z w */
-            double x = q[3], y = q[4], z = q[5], w = q[6];
+        if (fr_kind[i]) {{  /* a unit quaternion: a free flyer's x y z w after its position,
+                               a ball joint's w x y z */
+            const double *e = q + fr_iq[i];
+            const int flyer = fr_kind[i] == 2;
+            double x = flyer ? e[3] : e[1], y = flyer ? e[4] : e[2], z = flyer ? e[5] : e[3],
+                   w = flyer ? e[6] : e[0];
             double k = 1.0 / (x * x + y * y + z * z + w * w);
             Rj[0] = 1 - 2 * k * (y * y + z * z); Rj[1] = 2 * k * (x * y - z * w);
             Rj[2] = 2 * k * (x * z + y * w); Rj[3] = 2 * k * (x * y + z * w);
             Rj[4] = 1 - 2 * k * (x * x + z * z); Rj[5] = 2 * k * (y * z - x * w);
             Rj[6] = 2 * k * (x * z - y * w); Rj[7] = 2 * k * (y * z + x * w);
             Rj[8] = 1 - 2 * k * (x * x + y * y);
-            fr_apply(fr_R0[i], q, d);
-            for (int j = 0; j < 3; j++) pl[j] += d[j];
+            if (flyer) {{
+                fr_apply(fr_R0[i], e, d);
+                for (int j = 0; j < 3; j++) pl[j] += d[j];
+            }}
         }} else {{
-            double th = fr_mult[i] * q[FR_BQ + fr_coord[i]] + fr_off[i];
+            double th = fr_mult[i] * q[fr_iq[i]] + fr_off[i];
             if (fr_turns[i]) {{  /* Rot(u, th) = u u^T + cos th (1 - u u^T) + sin th [u]x */
                 double c = cos(th), s = sin(th);
                 double S[9] = {{0.0, -u[2], u[1], u[2], 0.0, -u[0], -u[1], u[0], 0.0}};
@@ -194,6 +216,39 @@ static void fr_column(double *J, int c, const double *v, const double *w, double
     }}
 }}
 
+/* joint i's world columns at the origin, [v; w] each (a free flyer's six: its body's axes,
+   linear then angular; a ball joint's three angular; else one, its multiplier in), and the first
+   velocity number; returns the count */
+static int fr_columns(int i, double (*R)[9], double (*o)[3], double (*S)[6], int *first)
+{{
+    if (fr_kind[i]) {{
+        const int flyer = fr_kind[i] == 2, turns = flyer ? 3 : 0;
+        for (int c = 0; c < 3; c++) {{
+            double e[3] = {{R[i][c], R[i][3 + c], R[i][6 + c]}}, v[3];
+            fr_cross(o[i], e, v);
+            for (int j = 0; j < 3; j++) {{
+                if (flyer) {{ S[c][j] = e[j]; S[c][3 + j] = 0.0; }}
+                S[turns + c][j] = v[j]; S[turns + c][3 + j] = e[j];
+            }}
+        }}
+        *first = fr_iv[i];
+        return flyer ? 6 : 3;
+    }}
+    double v[3] = {{0.0, 0.0, 0.0}}, w[3] = {{0.0, 0.0, 0.0}};
+    if (fr_turns[i]) {{
+        fr_apply(R[i], fr_u[i], w);
+        fr_cross(o[i], w, v);
+    }}
+    if (fr_slides[i]) {{
+        double d[3];
+        fr_apply(R[i], fr_u[i], d);
+        for (int j = 0; j < 3; j++) v[j] += fr_lead[i] * d[j];
+    }}
+    for (int j = 0; j < 3; j++) {{ S[0][j] = fr_mult[i] * v[j]; S[0][3 + j] = fr_mult[i] * w[j]; }}
+    *first = fr_iv[i];
+    return 1;
+}}
+
 void {P}_frame_jacobian(const double *q, int frame, int reference, double *J)
 {{
     double R[FR_NB][9], o[FR_NB][3], Rf[9], p[3];
@@ -203,27 +258,9 @@ void {P}_frame_jacobian(const double *q, int frame, int reference, double *J)
     fr_bodies(q, R, o);
     fr_frame(frame, R, o, Rf, p);
     for (int i = b; i >= 0; i = fr_parent[i]) {{  /* world columns: velocity at the origin */
-        double v[3], w[3], zero[3] = {{0.0, 0.0, 0.0}};
-        if (FR_FB && i == 0) {{
-            for (int c = 0; c < 3; c++) {{
-                double e[3] = {{R[0][c], R[0][3 + c], R[0][6 + c]}};
-                fr_column(J, c, e, zero, 1.0);
-                fr_cross(o[0], e, v);
-                fr_column(J, 3 + c, v, e, 1.0);
-            }}
-            continue;
-        }}
-        for (int j = 0; j < 3; j++) v[j] = w[j] = 0.0;
-        if (fr_turns[i]) {{
-            fr_apply(R[i], fr_u[i], w);
-            fr_cross(o[i], w, v);
-        }}
-        if (fr_slides[i]) {{
-            double d[3];
-            fr_apply(R[i], fr_u[i], d);
-            for (int j = 0; j < 3; j++) v[j] += fr_lead[i] * d[j];
-        }}
-        fr_column(J, FR_BV + fr_coord[i], v, w, fr_mult[i]);
+        double S[6][6];
+        int first, count = fr_columns(i, R, o, S, &first);
+        for (int c = 0; c < count; c++) fr_column(J, first + c, S[c], S[c] + 3, 1.0);
     }}
     if (reference == 0) return;
     for (int c = 0; c < FR_NV; c++) {{  /* at the frame's origin: v(p) = v(0) + w x p */
@@ -238,37 +275,6 @@ void {P}_frame_jacobian(const double *q, int frame, int reference, double *J)
             }}
         }}
     }}
-}}
-
-/* joint i's world columns at the origin, [v; w] each (a free flyer's six, else one, its
-   multiplier in), and the first velocity number; returns the count */
-static int fr_columns(int i, double (*R)[9], double (*o)[3], double (*S)[6], int *first)
-{{
-    if (FR_FB && i == 0) {{
-        for (int c = 0; c < 3; c++) {{
-            double e[3] = {{R[0][c], R[0][3 + c], R[0][6 + c]}}, v[3];
-            fr_cross(o[0], e, v);
-            for (int j = 0; j < 3; j++) {{
-                S[c][j] = e[j]; S[c][3 + j] = 0.0;
-                S[3 + c][j] = v[j]; S[3 + c][3 + j] = e[j];
-            }}
-        }}
-        *first = 0;
-        return 6;
-    }}
-    double v[3] = {{0.0, 0.0, 0.0}}, w[3] = {{0.0, 0.0, 0.0}};
-    if (fr_turns[i]) {{
-        fr_apply(R[i], fr_u[i], w);
-        fr_cross(o[i], w, v);
-    }}
-    if (fr_slides[i]) {{
-        double d[3];
-        fr_apply(R[i], fr_u[i], d);
-        for (int j = 0; j < 3; j++) v[j] += fr_lead[i] * d[j];
-    }}
-    for (int j = 0; j < 3; j++) {{ S[0][j] = fr_mult[i] * v[j]; S[0][3 + j] = fr_mult[i] * w[j]; }}
-    *first = FR_BV + fr_coord[i];
-    return 1;
 }}
 
 void {P}_frame_jacobian_dot_times_v(const double *q, const double *v, int frame, int reference,

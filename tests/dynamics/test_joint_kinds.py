@@ -20,6 +20,8 @@ as two RevoluteUnaligned joints (its rnea and aba shown equal to JointModelUnive
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -369,6 +371,67 @@ def test_a_batch_is_its_single_calls(case, backends):
                 assert np.array_equal(batch[i], single), (kind, k, i)
             else:
                 _agree(batch[i], single, f"{kind}: batch {k}, row {i}")
+
+
+@pytest.mark.parametrize("case", [JointKind.SPHERICAL], indirect=True, ids=str)
+def test_the_generated_code_takes_the_ball_joint(case, tmp_path):
+    """The per-tree generated code on the ball joint: kernel="unrolled" (a batch on vector
+    lanes, and a single call) and the standalone C export (-std=c99 -pedantic -Werror) give
+    Pinocchio's M, bias, g, ID, FD, T and V, the export the frame's placement and Jacobians
+    too, to 1e-10 (test_joint_kinds_export.py: an MJCF free joint, a URDF floating joint
+    between links, every export function against the numpy reference)."""
+    import ctypes
+
+    from tests.dynamics.test_joint_kinds_export import _export
+
+    kind, system, model, data, body, (pq, v, a, tau), _ = case
+    q = _ours(kind, pq)
+    M = pin.crba(model, data, pq)
+    expected = {"M": np.triu(M) + np.triu(M, 1).T, "b": pin.nle(model, data, pq, v),
+                "g": pin.computeGeneralizedGravity(model, data, pq), "ID": tau, "FD": a,
+                "T": pin.computeKineticEnergy(model, data, pq, v),
+                "V": pin.computePotentialEnergy(model, data, pq)}
+
+    def seven(d, x, y, z, t):
+        return {"M": d.mass_matrix(x), "b": d.bias_forces(x, y), "g": d.gravity(x),
+                "ID": d.inverse_dynamics(x, y, z), "FD": d.forward_dynamics(x, y, t),
+                "T": d.kinetic_energy(x, y), "V": d.potential_energy(x)}
+
+    d = system.dynamics(kernel="unrolled")
+    assert d.kernel == "unrolled"
+    batch = seven(d, *(np.repeat(np.asarray(x)[None], 5, axis=0) for x in (q, v, a, tau)))
+    for what, single in seven(d, q, v, a, tau).items():
+        _agree(single, expected[what], f"ball joint, unrolled: {what}")
+        for row in batch[what]:
+            _agree(row, expected[what], f"ball joint, unrolled batch: {what}")
+    c, P, code = _export(system, tmp_path, "-O0")
+
+    def at(x):
+        return np.ascontiguousarray(x, dtype=float).ctypes.data_as(ctypes.c_void_p)
+
+    count = int(re.search(rf"#define {P.upper()}_NP (\d+)", code.header).group(1))
+    p = at(np.ctypeslib.as_array((ctypes.c_double * count).in_dll(c, f"{P}_parameters")))
+    n = model.nv
+    M, out, T = np.zeros((n, n)), np.zeros(n), np.zeros((4, 4))
+    getattr(c, f"{P}_mass_matrix")(at(q), p, at(M))
+    _agree(M, expected["M"], "ball joint, export: M")
+    for name, args, what in (("bias_forces", (q, v), "b"), ("gravity", (q,), "g"),
+                             ("inverse_dynamics", (q, v, a), "ID"),
+                             ("forward_dynamics", (q, v, tau), "FD")):
+        getattr(c, f"{P}_{name}")(*map(at, args), p, at(out))
+        _agree(out, expected[what], f"ball joint, export: {what}")
+    for name, args, what in (("kinetic_energy", (q, v), "T"), ("potential_energy", (q,), "V")):
+        function = getattr(c, f"{P}_{name}")
+        function.restype = ctypes.c_double
+        _agree(function(*map(at, args), p), expected[what], f"ball joint, export: {what}")
+    names = [x.decode() for x in (ctypes.c_char_p * len(d.frames)).in_dll(c, f"{P}_frame_names")]
+    pin.computeJointJacobians(model, data, pq)
+    getattr(c, f"{P}_frame_placement")(at(q), names.index("c"), at(T))
+    _agree(T, data.oMi[body].homogeneous, "ball joint, export: placement")
+    for r, reference in enumerate((pin.WORLD, pin.LOCAL, pin.LOCAL_WORLD_ALIGNED)):
+        J = np.zeros((6, n))
+        getattr(c, f"{P}_frame_jacobian")(at(q), names.index("c"), r, at(J))
+        _agree(J, pin.getJointJacobian(model, data, body, reference), f"ball joint, export: J {r}")
 
 
 def test_every_kind_has_a_code_and_a_tree():

@@ -9,7 +9,8 @@ kernel="unrolled"), compiled with -std=c99 -pedantic -Werror:
   (q x y z qx qy qz qw, v the child's twist in its axes), also on a floating base: the unrolled
   kernel's seven functions and every function of the export (frames, J_dot v, the centre of
   mass, A_g) against the numpy reference (algorithms/recursions.py) at random unit quaternions
-  to 1e-10. One unrolled module (but on a floating base) and one export per robot."""
+  to 1e-10 (kernel="unrolled" on the ball-hinge-ball chain: test_joint_kinds.py, against
+  Pinocchio). One unrolled module per tree shape, one export per robot."""
 
 from __future__ import annotations
 
@@ -126,9 +127,9 @@ def _seven(d, Q, V, A):
             "T": d.kinetic_energy(Q, V), "V": d.potential_energy(Q)}
 
 
-# the unrolled module compiles per tree (3-5 s each): the three shapes, not the base's variant
-@pytest.mark.parametrize("quaternion_robot", ["ball_hinge_ball", "mjcf_free", "urdf_floating"],
-                         indirect=True)
+# the unrolled module compiles per tree (3-5 s each): one per shape (a ball-hinge-ball chain:
+# test_joint_kinds.py's against Pinocchio), not the floating base's variant
+@pytest.mark.parametrize("quaternion_robot", ["mjcf_free", "urdf_floating"], indirect=True)
 def test_the_unrolled_kernel_takes_ball_and_free_joints(quaternion_robot):
     """kernel="unrolled" on nq-wide q and nv-wide v: its batches (vector lanes) and single
     calls equal the numpy reference to 1e-10; a quaternion off unit norm is refused in one line

@@ -120,6 +120,9 @@ class LinearModel(SecondOrderForm):
     # model's own: trim - nominal holds the state.
     trim: dict[str, float] = field(default_factory=dict)
     nominal_inputs: dict[str, float] = field(default_factory=dict)
+    # a robot with ball joints: the Euler charts that read a run's quaternion state into z
+    # (control/lqr_charts.TreeCharts, set by System.linearize), for LQR's controller
+    charts: object | None = field(default=None, repr=False, compare=False)
 
     @property
     def constrained(self) -> bool:

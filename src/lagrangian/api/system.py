@@ -421,15 +421,24 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         if inputs:  # the inputs' values that hold ``about`` solved for (its trim)
             from ..analysis.trim import trimmed_linear_model
 
-            return trimmed_linear_model(functions, about, inputs, lambda values: AtRestFunctions(
-                self.equations_of_motion(), values))
+            return self._charted(trimmed_linear_model(
+                functions, about, inputs,
+                lambda values: AtRestFunctions(self.equations_of_motion(), values)))
         import numpy as np
 
         from ..analysis.equilibria import resolve_equilibrium
 
         with np.errstate(over="ignore", invalid="ignore"):  # judged by linear_model_at's check
             q, multipliers = resolve_equilibrium(functions, about)
-        return linear_model_at(functions, q, multipliers)
+        return self._charted(linear_model_at(functions, q, multipliers))
+
+    def _charted(self, linear: LinearModel) -> LinearModel:
+        """The linear model with the Euler charts that read a run's ball joints into its
+        coordinates (control/lqr_charts.py), where the tree has a ball joint."""
+        from ..control.lqr_charts import tree_charts
+
+        charts = tree_charts(self)
+        return linear if charts is None else replace(linear, charts=charts)
 
     def modes(self, about: Mapping[str, float] | None = None, *,
               steady: Mapping[str, float] | None = None,

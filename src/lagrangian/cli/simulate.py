@@ -51,8 +51,8 @@ def simulate(
     ignore_limits: Annotated[bool, typer.Option("--ignore-limits", help="URDF: run through the joints' position limits (by default a joint reaching one ends the run, status 'limit', and a start beyond one is refused); a start beyond one is warned.")] = False,  # noqa: E501
     clamp_start: Annotated[bool, typer.Option("--clamp-start", help="URDF: a start beyond a joint's position or velocity limit starts at the limit (with a warning) instead of being refused.")] = False,  # noqa: E501
     control: Annotated[str | None, typer.Option("--control", help="Close the loop: lqr (about --about, inputs --inputs, weights --Q, --R), computed-torque (to the configuration --about, gains --kp, --kd), or model (the model file's own [control] laws, compiled with its equations).")] = None,  # noqa: E501
-    about: Annotated[list[str], typer.Option("--about", help="--control: the equilibrium (lqr) or target (computed-torque), NAME=VALUE; others solved for or at their initial values.")] = [],  # noqa: B006,E501
-    control_inputs: Annotated[list[str], typer.Option("--inputs", help="--control lqr: the loads, parameters or coordinates it drives (F); repeat, or separate by commas.")] = [],  # noqa: B006,E501
+    about: Annotated[list[str], typer.Option("--about", help="--control: the equilibrium (lqr) or target (computed-torque), NAME=VALUE; others solved for or at their initial values. LQR on a ball joint takes its Euler angles shoulder__x, __y, __z (R = Rx Ry Rz, as modes), computed torque its quaternion shoulder_qw..shoulder_qz.")] = [],  # noqa: B006,E501
+    control_inputs: Annotated[list[str], typer.Option("--inputs", help="--control lqr: the loads, parameters or coordinates it drives (F; a ball joint's moments about its Euler hinges shoulder__x, __y, __z); repeat, or separate by commas.")] = [],  # noqa: B006,E501
     q_weight: Annotated[str, typer.Option("--Q", help="--control lqr: state weight, a number or the diagonal (x then x_dot), comma-separated.")] = "1",  # noqa: E501
     r_weight: Annotated[str, typer.Option("--R", help="--control lqr: input weight, a number or the diagonal.")] = "1",  # noqa: E501
     kp: Annotated[str, typer.Option("--kp", help="--control computed-torque: position gain (1/s^2), a number or the diagonal.")] = "100",  # noqa: E501
@@ -215,23 +215,20 @@ def simulate(
 def _refuse_on_manifold(tree, animate, control, along) -> None:
     """What a run whose q and v differ does not take yet, refused in one line before it: a
     floating base's drawing (the model's bodies hold no base; a ball is drawn by its Euler
-    hinges), and on a ball joint LQR and the linearization along the run (both built on
-    q_dot = v; computed torque takes the error on the manifold)."""
+    hinges), and on a ball joint the linearization along the run (built on q_dot = v; LQR
+    reads the run in the Euler angles of its linear model, computed torque takes the error
+    on the manifold)."""
     from ..errors import InputError
 
     joints = getattr(tree, "quaternion_joints", ())  # a ball, a free flyer below the root
     if animate is not None and getattr(tree, "floating_base", False):
         raise InputError("a floating base's run is not animated yet: --out and --plot are",
                          field="--animate")
-    for flag, given, then in (
-            ("--control", control == "lqr", "; --control computed-torque takes it, and in "
-             "Python simulate takes a controller (t, q, v) -> u of nv torques (a ball's: its "
-             "moment, body axes)"),
-            ("--linearize-along", along, "")):
-        if given and joints:
-            kind = "ball" if joints[0].kind == "spherical" else "floating"
-            raise InputError(f"the {kind} joint '{joints[0].name}' is not linearized yet (q_dot "
-                             f"is not v for its quaternion){then}", field=flag)
+    if along and joints:
+        kind = "ball" if joints[0].kind == "spherical" else "floating"
+        raise InputError(f"the {kind} joint '{joints[0].name}' is not linearized along a run "
+                         "yet (q_dot is not v for its quaternion); --control lqr linearizes "
+                         "about a rest, in its Euler angles", field="--linearize-along")
 
 
 def _impact_options(system, max_impacts, settle) -> dict:

@@ -2,7 +2,9 @@
 u = -K x minimizes int (x^T Q x + u^T R u) dt, K = R^-1 B^T S with S from the continuous
 algebraic Riccati equation A^T S + S A - S B R^-1 B^T S + Q = 0 (scipy's solver).
 
-x = [z - z0; z_dot] in the linear model's coordinates z about its equilibrium z0 (SI units).
+x = [z - z0; z_dot] in the linear model's coordinates z about its equilibrium z0 (SI units). On a
+robot with ball joints z are the model's Euler angles and the run's state is read into them
+(lqr_charts.py).
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 from ..analysis.linearization import LinearModel
 from ..errors import InputError
 from .gains import square_matrix
+from .lqr_charts import TreeCharts
 
 # A mode counts as unstable (needs the inputs) when its real part is above -this x |A|.
 _MARGINAL = 1e-9
@@ -41,6 +44,11 @@ class LQR:
     # to the model's own values to reach them (trim - nominal; 0 where the model's hold it)
     trim: dict[str, float] = field(default_factory=dict)
     _offset: np.ndarray | None = None
+    # a robot with ball joints: its Euler charts (lqr_charts.py), the inputs' generalized
+    # forces B_q (n x r) and the whole equilibrium in the model's coordinates
+    _charts: TreeCharts | None = None
+    _forces: np.ndarray | None = None
+    _about: np.ndarray | None = None
 
     @property
     def gain(self) -> np.ndarray:
@@ -58,16 +66,31 @@ class LQR:
         return values[np.lexsort((values.imag, -values.real))]
 
     def state(self, q, q_dot) -> np.ndarray:
-        """x = [z - z0; z_dot] from the model's q and q_dot, shape (..., 2p)."""
+        """x = [z - z0; z_dot] from the model's q and q_dot, shape (..., 2p); on a robot with
+        ball joints also from the run's (a ball's quaternion and angular velocity: the Euler
+        angles nearest the equilibrium and their rates)."""
         q, v = np.asarray(q, dtype=float), np.asarray(q_dot, dtype=float)
+        if self._on_tree(q):
+            q, v, _ = self._charts.model_state(q, v, self._about)
         return np.concatenate([q[..., self._positions] - self._origin,
                                v[..., self._positions]], axis=-1)
 
     def __call__(self, t, q, q_dot) -> np.ndarray:
         """u = u* - K x on top of the model's own input values, u* what holds the equilibrium
-        (trim - nominal; the inputs' units: N, N m, or the parameter's)."""
+        (trim - nominal; the inputs' units: N, N m, or the parameter's). Given the run's state
+        of a robot with ball joints, the tree's nv generalized forces E^-T B_q u instead (a
+        ball's moment in its body's axes, N m), as simulate takes them."""
+        if self._on_tree(np.asarray(q)):
+            theta, rates, E = self._charts.model_state(q, q_dot, self._about)
+            x = np.concatenate([theta[self._positions] - self._origin, rates[self._positions]])
+            u = -(self.K @ x) if self._offset is None else self._offset - self.K @ x
+            return self._charts.torques(E, self._forces @ u)
         u = -(self.K @ self.state(q, q_dot))
         return u if self._offset is None else self._offset + u
+
+    def _on_tree(self, q: np.ndarray) -> bool:
+        """Whether q is the tree's (quaternions) rather than the model's Euler angles."""
+        return self._charts is not None and q.shape[-1] == self._charts.nq
 
     def summary(self) -> dict:
         """JSON-ready: inputs, states, K, closed-loop eigenvalues (re, im)."""
@@ -99,6 +122,9 @@ def lqr(linear_model: LinearModel, Q, R) -> LQR:
     if model.steady or model.state_constraints.size:
         raise InputError("lqr needs a linear model about an equilibrium, not a steady motion",
                          field="linear_model")
+    charts = getattr(model, "charts", None)  # a robot with ball joints: lqr_charts.py
+    if charts is not None:
+        charts.check_inputs(model.inputs)
     A, B = np.asarray(model.A, dtype=float), np.asarray(model.B, dtype=float)
     size, width = A.shape[0], B.shape[1]
     if width == 0:
@@ -134,7 +160,9 @@ def lqr(linear_model: LinearModel, Q, R) -> LQR:
     return LQR(K=K, S=S, Q=Q, R=R, A=A, B=B, inputs=tuple(model.inputs),
                state_names=tuple(model.state_names), equilibrium=dict(model.equilibrium),
                _positions=positions, _origin=origin, trim=trim,
-               _offset=offset if offset is not None and np.any(offset) else None)
+               _offset=offset if offset is not None and np.any(offset) else None,
+               _charts=charts, _forces=None if charts is None else model.input_matrix,
+               _about=None if charts is None else np.array([model.equilibrium[c] for c in names]))
 
 
 def _require_stabilizable(A: np.ndarray, B: np.ndarray, inputs) -> None:

@@ -33,6 +33,25 @@ def _quaternion_wxyz(R: np.ndarray) -> np.ndarray:
     return np.concatenate([xyzw[..., 3:], xyzw[..., :3]], axis=-1)
 
 
+def _wrap(angle: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """angle plus whole turns, within a half turn of centre (rad)."""
+    return centre + (angle - centre + np.pi) % (2 * np.pi) - np.pi
+
+
+def _nearest(triple: np.ndarray, near: np.ndarray) -> np.ndarray:
+    """Of an Euler triple (..., 3) (outer, middle, inner) and its twin (outer + pi, pi -
+    middle, inner + pi), the one nearest ``near`` (3), outer and inner wrapped to it."""
+    one = triple.copy()
+    two = np.stack([triple[..., 0] + np.pi, np.pi - triple[..., 1], triple[..., 2] + np.pi], -1)
+    choices = []
+    for branch in (one, two):
+        branch[..., [0, 2]] = _wrap(branch[..., [0, 2]], near[[0, 2]])
+        branch[..., 1] = _wrap(branch[..., 1], near[1])
+        choices.append(branch)
+    closer = (np.abs(choices[1] - near).sum(-1) < np.abs(choices[0] - near).sum(-1))[..., None]
+    return np.where(closer, choices[1], choices[0])
+
+
 class ModelCharts:
     """Theta (the model's coordinates) -> the tree's q and E(theta) (v = E theta_dot)."""
 
@@ -76,6 +95,29 @@ class ModelCharts:
             wxyz = _quaternion_wxyz(R)
             q[..., iq + 3:iq + 7] = np.concatenate([wxyz[..., 1:], wxyz[..., :1]], axis=-1)
         return q
+
+    def angles(self, q: np.ndarray, near: np.ndarray) -> np.ndarray:
+        """The model's coordinates theta (..., n) of the tree's q (..., nq), each Euler triple
+        on the branch nearest ``near`` (n; (a, b, c) and (a + pi, pi - b, c + pi) turn alike,
+        a and c taken within a half turn of near's): configuration's inverse."""
+        from ...model.quaternions import quaternion_matrix
+
+        q, near = np.asarray(q, dtype=float), np.asarray(near, dtype=float)
+        theta = np.zeros(q.shape[:-1] + (self.n,))
+        for k, iq, _ in self.hinges:
+            theta[..., k] = q[..., iq]
+        for indices, iq, _ in self.balls:  # R = Rx(a) Ry(b) Rz(c), quaternion w x y z
+            R = quaternion_matrix(np.concatenate([q[..., iq + 1:iq + 4], q[..., iq:iq + 1]], -1))
+            b = np.arcsin(np.clip(R[..., 0, 2], -1.0, 1.0))
+            a, c = np.arctan2(-R[..., 1, 2], R[..., 2, 2]), np.arctan2(-R[..., 0, 1], R[..., 0, 0])
+            theta[..., indices] = _nearest(np.stack([a, b, c], -1), near[indices])
+        for indices, iq, _ in self.free:  # R = Rz(yaw) Ry(pitch) Rx(roll), x y z w
+            theta[..., indices[:3]] = q[..., iq:iq + 3]
+            R = quaternion_matrix(q[..., iq + 3:iq + 7])
+            pitch = -np.arcsin(np.clip(R[..., 2, 0], -1.0, 1.0))
+            roll, yaw = np.arctan2(R[..., 2, 1], R[..., 2, 2]), np.arctan2(R[..., 1, 0], R[..., 0, 0])
+            theta[..., indices[3:]] = _nearest(np.stack([roll, pitch, yaw], -1), near[indices[3:]])
+        return theta
 
     def singular(self, theta: np.ndarray, tolerance: float = 1e-6) -> bool:
         """Whether theta is at a singularity of an Euler chart (gimbal lock: cos b = 0 for a

@@ -172,9 +172,10 @@ def test_velocity_terms_and_the_manifold_match_pinocchio(robots):
 def test_the_derivatives_match_pinocchio(robots, key):
     """d tau/dq, d tau/dv (computeRNEADerivatives) and d a/dq, d a/dv, M^-1
     (computeABADerivatives), the free flyer's d/dq along its own tangent, q (x) exp(dq): the
-    numpy reference's complex step, the compiled derivatives having no such joint; and the
-    regressor Y (computeJointTorqueRegressor)."""
+    engine's analytic ones over the flyer's six columns; and the regressor Y
+    (computeJointTorqueRegressor)."""
     ours, model, _ = robots[key]
+    assert ours._derivatives_kernel() is not None  # the engine's, not the complex step
     data = model.createData()
     iq, iv = _orders(ours, model)
     Q, V, A = _states(model, 2, seed=5)

@@ -46,9 +46,10 @@ static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t na
     const npy_intp ni = PyArray_SIZE(table_i), nd = PyArray_SIZE(table_d);
     const int *h = (const int *)PyArray_DATA(table_i);
     tk_tree t;
-    /* a ball joint only as its three columns (derivatives_c.py's description) */
-    if (ni < DK_HEADER || tk_open(PyArray_DATA(table_d), nd, &t) || (t.balls && tk_whole_balls(&t))
-        || t.flyers)
+    /* a ball joint or a free flyer below the root only as its columns (derivatives_c.py's
+       description) */
+    if (ni < DK_HEADER || tk_open(PyArray_DATA(table_d), nd, &t)
+        || ((t.balls || t.flyers) && tk_whole_balls(&t)))
         goto bad;
     const long nb = h[0], nj = h[1], ff = h[2], np = h[3], nnz = h[4];
     if (nb != t.nb || nj != t.n || ff != t.fb || np < nb || nnz < 0) goto bad;
@@ -79,27 +80,29 @@ static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t na
         parent[i] = (int)b[TK_PARENT];
         coord[i] = TK_FREE(b) ? 0 : (int)b[TK_COORD];
         mult[i] = b[TK_MULT];
-        /* a ball's columns: their motion from the ball's parent's, their ends at the last
-           column (the body), one group; any other record its own */
-        const int column = TK_BALL(b) ? (int)b[TK_COLUMN] : 0;
+        /* a ball's or a flyer's columns: their motion from the joint's parent's, their ends
+           at the last column (the body), one group; any other record its own */
+        const int column = TK_BALL(b) || TK_FLYER(b) ? (int)b[TK_COLUMN] : 0;
         motion[i] = parent[i];
         end[i] = i;
         group[i] = column ? i : -1;
         if (column > 1) {
             const int p = parent[i];
             const double *bp = p >= 0 ? DK_BODY_OF(tree, p) : NULL;
-            columns_fine &= p >= 0 && p < i && TK_BALL(bp) && (int)bp[TK_COLUMN] == column - 1
+            columns_fine &= p >= 0 && p < i && bp[TK_KIND] == b[TK_KIND]
+                            && (int)bp[TK_COLUMN] == column - 1
                             && bp[TK_QCOORD] == b[TK_QCOORD] && (int)bp[TK_COORD] + 1 == coord[i];
             if (!columns_fine) break;
             motion[i] = motion[p];
             group[i] = group[p];
         }
-        if (column == 3)
+        if (column == (TK_BALL(b) ? 3 : 6))  /* the last: the body */
             for (long k = i; k >= 0 && group[k] == group[i]; k = parent[k]) end[k] = (int)i;
     }
-    for (long i = 0; columns_fine && i < nb; i++) {  /* every ball ends in its third column */
+    for (long i = 0; columns_fine && i < nb; i++) {  /* every such joint ends in its last */
         const double *b = DK_BODY_OF(tree, i);
-        columns_fine &= !TK_BALL(b) || (int)DK_BODY_OF(tree, end[i])[TK_COLUMN] == 3;
+        if (TK_BALL(b) || TK_FLYER(b))
+            columns_fine &= (int)DK_BODY_OF(tree, end[i])[TK_COLUMN] == (TK_BALL(b) ? 3 : 6);
     }
     if (!columns_fine) {
         free(tree);
@@ -172,11 +175,11 @@ static int dk_unit_balls(const dk_tree *tree, const double *q, npy_intp states, 
         if (!finite) continue;
         for (int i = 0; i < tree->nb; i++) {
             const double *b = DK_BODY_OF(tree, i);
-            if (!TK_BALL(b) || b[TK_COLUMN] != 1.0) continue;
-            const double *e = x + tree->qo + (int)b[TK_QCOORD];
+            if (!(TK_BALL(b) || TK_FLYER(b)) || b[TK_COLUMN] != 1.0) continue;
+            const double *e = x + tree->qo + (int)b[TK_QCOORD] + (TK_FLYER(b) ? 3 : 0);
             const double norm = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
             if (!(fabs(norm - 1.0) <= DK_QTOL)) {
-                PyErr_SetString(PyExc_ValueError, "q: a ball joint's quaternion is not unit");
+                PyErr_SetString(PyExc_ValueError, "q: a joint's quaternion is not unit");
                 return 0;
             }
         }
@@ -372,8 +375,9 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     if (tree->ff && !lg_unit_quaternions((const double *)PyArray_DATA(in[0]),
                                          step[0] ? count : 1, step[0], tree->nq, DK_QTOL))
         goto done;
-    if (tree->t.balls && !dk_unit_balls(tree, (const double *)PyArray_DATA(in[0]),
-                                        step[0] ? count : 1, step[0]))
+    if ((tree->t.balls || tree->t.flyers)
+        && !dk_unit_balls(tree, (const double *)PyArray_DATA(in[0]), step[0] ? count : 1,
+                          step[0]))
         goto done;
     P = (PyArrayObject *)PyArray_FROMANY(args[3], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
     if (!P) goto done;

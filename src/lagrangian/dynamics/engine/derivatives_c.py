@@ -5,14 +5,14 @@ and the joint-torque regressor Y; a batch in one call on vector lanes and thread
 (derivatives_bindings.c). One compiled module for every tree (keyed by its C and this file,
 never a tree's numbers): the tree is given at run time as two tables, made once per dynamics
 object, and gravity, the actuator parameters tau_<joint> and the bodies' inertials as P
-(runtime_values). Revolute, prismatic, helical and ball joints (a ball as its three columns:
-``description``), a free flyer at the root; the complex step of derivatives.py is the fallback
-(a free flyer below the root) and the check. Units SI.
+(runtime_values). Revolute, prismatic, helical and ball joints and free flyers (at the root, or
+below it: a ball or a flyer below the root as one record per column, ``description``); the
+complex step of derivatives.py is the fallback (no compiler) and the check. Units SI.
 
 The tree reaches it as its description D (tree/description.py, the tree kernel's: each joint
 in canonical axes, placed by joint.h) and one table of its pattern (``tables``), nb bodies
 numbered parents first, nj joint coordinates, a floating base's six velocity coordinates first
-(nv = nj + 6 ff, nq = nj + 7 ff, and one more per ball joint):
+(nv = nj + 6 ff, nq = nj + 7 ff, and one more per ball joint or free flyer below the root):
 
     I (int32): nb, nj, ff (1: body 0 a free flyer), np pairs, nnz pattern entries, ltdl (1:
     M factored along the tree), once (1: each coordinate one body's), sparse (1: the lanes'
@@ -35,7 +35,7 @@ import numpy as np
 from ...kinds import JointKind
 from ...model.tree import KinematicTree
 from ..emit.tree_c import _SINCOS, _VECTOR
-from ..tree.description import HEADER, IDENTITY, JOINT_CODES, STRIDE, describe
+from ..tree.description import FLYER, HEADER, IDENTITY, JOINT_CODES, STRIDE, describe
 from ..tree.free_flyer import QUATERNION_TOLERANCE
 from .headers import header_bytes, spliced
 
@@ -83,39 +83,43 @@ static inline int dk4_bits(dk4_mask mask)
 }"""
 
 
-# an expanded ball joint's record (joint.h's TK_COLUMN): 1, 2, 3 for its x, y, z column
+# a record of a joint of several columns made one per column (joint.h's TK_COLUMN): 1, 2, 3 a
+# ball's x, y, z; 1 to 6 a free flyer below the root's (its twist in its own axes: linear x, y,
+# z, then angular)
 COLUMN = 57
 
 
 def description(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
-    """The tree's description D (describe) as this module reads it: each ball joint's one
-    record made three, one per column of its angular velocity in its own axes (x, y, z: a
-    chain of one-column records, the first placed as the ball, the next two at its pose; the
-    body's inertial on the last, which its children hang from), so that every record drives
-    one velocity number, as the kernel's pairs take them (derivatives_kernel.c: a ball's
-    columns move their subtree as a revolute joint's, from the ball's parent's motion)."""
+    """The tree's description D (describe) as this module reads it: each ball joint's and each
+    free flyer below the root's one record made one per column of its body's twist in its own
+    axes (a chain of one-column records, the first placed as the joint, the others at its pose;
+    the body's inertial on the last, which its children hang from), so that every record drives
+    one velocity number, as the kernel's pairs take them (derivatives_kernel.c: each column
+    moves the subtree rigidly, from the joint's parent's motion)."""
     D = describe(tree, parameters)
     n, nb = int(D[1]), int(D[0])
     records = D[HEADER + n:].reshape(nb, STRIDE)
-    balls = records[:, 1] == JOINT_CODES[JointKind.SPHERICAL]
-    if not balls.any():
+    columns = np.where(records[:, 1] == JOINT_CODES[JointKind.SPHERICAL], 3,
+                       np.where(records[:, 1] == FLYER, 6, 1))
+    if (columns == 1).all():
         return D
-    out, index = [], {}  # index: each old body's new one (a ball's: its last column's)
+    out, index = [], {}  # index: each old body's new one (a split joint's: its last column's)
     for i, record in enumerate(records):
         parent = int(record[0])
         record = record.copy()
         record[0] = index[parent] if parent >= 0 else -1
-        if not balls[i]:
+        if columns[i] == 1:
             index[i] = len(out)
             out.append(record)
             continue
-        for column in (1, 2, 3):
+        last = int(columns[i])
+        for column in range(1, last + 1):
             r = record.copy()
             r[COLUMN], r[2] = column, record[2] + column - 1
-            if column > 1:  # at the ball's pose: no turn, no offset of its own
+            if column > 1:  # at the joint's pose: no turn, no offset of its own
                 r[0] = len(out) - 1
                 r[5:14], r[14:17], r[IDENTITY] = np.eye(3).ravel(), 0.0, 1.0
-            if column < 3:  # massless: the body's inertial is the last column's
+            if column < last:  # massless: the body's inertial is the last column's
                 r[20:33] = 0.0
             out.append(r)
         index[i] = len(out) - 1
@@ -258,17 +262,15 @@ def kernel_source():
 
 
 def applies(tree: KinematicTree | None) -> bool:
-    """Whether the kernel takes this tree: revolute, prismatic, helical and ball joints on a
-    fixed base or a floating one (a free flyer at the root), of any size."""
+    """Whether the kernel takes this tree: revolute, prismatic, helical and ball joints and free
+    flyers (at the root: a floating base; or below it), of any size."""
     if tree is None or not tree.joints:
         return False
     kinds = [j.kind for j in tree.joints]
-    if tree.floating_base:
-        if kinds[0] != JointKind.FREE_FLYER:
-            return False
-        kinds = kinds[1:]
+    if tree.floating_base and kinds[0] != JointKind.FREE_FLYER:
+        return False
     return all(k in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.HELICAL,
-                      JointKind.SPHERICAL) for k in kinds)
+                      JointKind.SPHERICAL, JointKind.FREE_FLYER) for k in kinds)
 
 
 def engine():

@@ -17,12 +17,13 @@
  * likewise for theta_dot, and M_kj = S_k . Ic_k S_j. B = [[0, -2[l]x], [0, A]] with l the
  * linear momentum and A = [w]x J_O - J_O [w]x - [v]x[c]x - [c]x[v]x - [n]x (n the angular
  * momentum about the origin, c = m x_G): 12 numbers, additive over a subtree.
- * A ball joint is three such columns (derivatives_c.py's description: one record each, the body
- * on the last), the turns of its body about its own x, y, z: each moves the ball's subtree
- * rigidly from the ball's parent's v_p, a_p (dv, psi as above with those), and between two
- * columns of one ball both entries take the row-below form (each column turns with the
- * others); d a/d theta_dot's own part is dv + v_b x S (v_b the ball's body's), 2 dv for a
- * joint of one column. */
+ * A ball joint is three such columns, a free flyer below the root six (derivatives_c.py's
+ * description: one record each, the body on the last), its body's twists in its own axes (a
+ * ball's turns about its x, y, z; a flyer's slides along them, then those turns): each moves
+ * the joint's subtree rigidly from the joint's parent's v_p, a_p (dv, psi as above with
+ * those), and between two columns of one joint both entries take the row-below form (each
+ * column moves with the others, fixed in the body); d a/d theta_dot's own part is
+ * dv + v_b x S (v_b the joint's body's), 2 dv for a joint of one column. */
 
 #define DK_STR_(x) #x
 #define DK_STR(x) DK_STR_(x)
@@ -183,17 +184,17 @@ static void DK_FN(kinematics)(const dk_tree *tree, const DK_T *q, const DK_T *qd
         const double *b = DK_BODY_OF(tree, i);
         const int p = tree->parent[i], mp = tree->motion[i];
         const int column = tree->group[i] >= 0 ? (int)b[TK_COLUMN] : 0;
-        if (column > 1) {  /* a ball's second or third column: at the ball's pose */
+        if (column > 1) {  /* a ball's or a flyer's later column: at the joint's pose */
             for (int j = 0; j < 9; j++) R[i][j] = R[p][j];
             for (int j = 0; j < 3; j++) o[i][j] = o[p][j];
         } else {
             DK_FN(jt_placed)(&tree->t, b, q, p < 0 ? NULL : R[p], p < 0 ? NULL : o[p], R[i],
                              o[i]);
         }
-        if (column > 0) {  /* its column c of [o x R e_c; R e_c] (joint.h's ball columns) */
-            DK_T e[3] = {R[i][column - 1], R[i][column + 2], R[i][column + 5]};
-            SP_CROSS(o[i], e, w->S[i]);
-            for (int j = 0; j < 3; j++) w->S[i][3 + j] = e[j];
+        if (column > 0) {  /* the joint's column of its twist in its body's axes (joint.h) */
+            DK_T all[6][6];
+            DK_FN(jt_columns)(b, R[i], o[i], all);
+            for (int j = 0; j < 6; j++) w->S[i][j] = all[column - 1][j];
         } else {
             DK_FN(jt_columns)(b, R[i], o[i], (DK_T (*)[6])w->S[i]);  /* S (joint.h) */
         }

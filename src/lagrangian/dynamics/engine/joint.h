@@ -43,8 +43,9 @@
 #define TK_ROWSIGN 44   /* 3: that entry, +-1 */
 #define TK_AXES 47      /* 9: A, the canonical axes -> the body's own (its link's), row-major */
 #define TK_IDENTITY 56  /* 1 where R0 is exactly the identity */
-#define TK_COLUMN 57    /* a ball joint's record made three (derivatives_c.py's description): 1,
-                           2, 3 its x, y, z column, one velocity number each; 0 a whole ball */
+#define TK_COLUMN 57    /* a ball's or a free flyer below the root's record made one per column
+                           (derivatives_c.py's description): 1, 2, ... the column, one velocity
+                           number each; 0 the whole joint */
 #define TK_LEAD 61      /* the slide along u per unit theta: 1 prismatic, pitch (m/rad) helical */
 #define TK_TURNS(b) ((b)[TK_KIND] == 0.0 || (b)[TK_KIND] == 3.0)
 #define TK_SLIDES(b) ((b)[TK_KIND] == 1.0 || (b)[TK_KIND] == 3.0)
@@ -82,7 +83,7 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
         if (TK_BALL(b) && b[TK_COLUMN] <= 1.0) t->balls++;  /* a ball's columns: one ball */
-        if (TK_FLYER(b)) t->flyers++;
+        if (TK_FLYER(b) && b[TK_COLUMN] <= 1.0) t->flyers++;
     }
     t->nq = t->bq + t->n + t->balls + t->flyers;
     t->nv = t->bv + t->n;
@@ -101,7 +102,10 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
                   && b[TK_QCOORD] + 4 <= t->nq - t->bq))
                 return -1;
         } else if (TK_FLYER(b)) {
-            if (!(b[TK_COORD] >= 0 && b[TK_COORD] + 6 <= t->n && b[TK_QCOORD] >= 0
+            const double column = b[TK_COLUMN];  /* a whole flyer's six numbers, or one */
+            if (!(column >= 0.0 && column <= 6.0 && column == (int)column)
+                || !(b[TK_COORD] >= 0 && b[TK_COORD] + (column > 0.0 ? 7.0 - column : 6.0) <= t->n
+                     && b[TK_QCOORD] >= 0
                   && b[TK_QCOORD] + 7 <= t->nq - t->bq))
                 return -1;
         } else if (!(b[TK_COORD] >= 0 && b[TK_COORD] < t->n)
@@ -113,13 +117,14 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
     return 0;
 }
 
-/* Whether every ball joint of t is one record (TK_COLUMN 0): the algorithms that take a ball as a
-   whole (all but the derivatives kernel, which takes it as its three columns) */
+/* Whether every ball joint and free flyer below the root of t is one record (TK_COLUMN 0): the
+   algorithms that take them whole (all but the derivatives kernel, which takes their columns) */
 static int tk_whole_balls(const tk_tree *t)
 {
-    for (int i = 0; i < t->nb; i++)
-        if (TK_BALL(t->body + i * TK_STRIDE) && t->body[i * TK_STRIDE + TK_COLUMN] != 0.0)
-            return 0;
+    for (int i = 0; i < t->nb; i++) {
+        const double *b = t->body + i * TK_STRIDE;
+        if ((TK_BALL(b) || TK_FLYER(b)) && b[TK_COLUMN] != 0.0) return 0;
+    }
     return 1;
 }
 

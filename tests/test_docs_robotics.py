@@ -99,3 +99,20 @@ def test_the_cpp_controller(cli, tmp_path, monkeypatch):
     assert [float(x) for x in out.split()] == pytest.approx(
         [2.54 + 1.2 * c, 0.34 + 0.6 * c, 0.34 + 0.6 * c, 0.34], abs=1e-4)
     assert "3.5931 0.8665" in source
+
+
+def test_the_ball_joint_export(cli, tmp_path, monkeypatch, capsys):
+    """The ball-joint block: the C export's header has q 4 and v 3 numbers, and the unrolled
+    kernel holds a 2 kg bob 0.5 m below its ball turned 0.4 rad about x by m g d sin(0.4)
+    about x; M's entry about x is I + m d^2; its codegen command writes the C."""
+    monkeypatch.chdir(tmp_path)
+    code = re.findall(r"```python\n(.*?)```", section("robotics-ball-export"), re.S)[0]
+    exec(compile(code, "robotics-ball-export", "exec"), {})
+    sizes, gravity, inertia = capsys.readouterr().out.strip().splitlines()
+    assert sizes == "[['SPHERICAL_PENDULUM_N', '3'], ['SPHERICAL_PENDULUM_NQ', '4']]"
+    moment = [float(x) for x in gravity.strip("[]").split()]
+    assert moment == pytest.approx([2.0 * 9.81 * 0.5 * math.sin(0.4), 0.0, 0.0], abs=1e-8)
+    assert float(inertia) == pytest.approx(0.01 + 2.0 * 0.5**2, abs=1e-8)
+    (codegen,) = commands("robotics-ball-export")
+    assert cli(*codegen).code == 0
+    assert "#define SPHERICAL_PENDULUM_NQ 4" in Path("gen/spherical_pendulum.h").read_text()

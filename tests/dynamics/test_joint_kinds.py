@@ -11,7 +11,8 @@ angular velocity in the child's axes) and compared with Pinocchio's JointModelSp
 quaternion x y z w, the same velocity): q is reordered between the two. Its derivatives (along
 the turn, q (x) exp(dq), as Pinocchio's: the engine's analytic ones over the ball's three
 columns, the numpy reference's complex step), C(q, v), A_g and J_dot v and the regressor agree
-with Pinocchio's.
+with Pinocchio's, and so does the per-tree generated code (kernel="unrolled" and the standalone
+C export; the free joints and the other kinds' export: test_joint_kinds_export.py).
 
 Pinocchio 4.1's computeRNEADerivatives and computeABADerivatives are wrong for
 JointModelUniversal (its d tau/dq disagrees with its own rnea's finite differences by O(1)), so

@@ -10,15 +10,15 @@ numbers (zeros and ones folded away, common terms shared):
 - inverse dynamics by recursive Newton-Euler: tau = M(q) a + C(q, q_dot) q_dot + g(q);
 - the mass matrix by the composite-rigid-body algorithm;
 - forward dynamics by the articulated-body algorithm, O(n), or M = L L^T, whichever takes
-  fewer operations (Cholesky only with mimic joints);
+  fewer operations (Cholesky only with mimic joints, ball joints or free flyers below the root);
 - sin and cos of each joint angle once, by inline kernels (fdlibm's polynomials after a
   three-part reduction by pi/2, libm beyond |x| = 1e5): a libm call costs as much as the rest
   of the mass matrix of a 7-joint arm;
 - kinetic energy 1/2 sum (m v.v + 2 v.(w x h) + w.J_O w), potential energy m g height.
 
 A floating base (free_flyer.py) takes q of nq = n + 7 numbers and v, a, tau of nv = n + 6 (the
-module's RT_NQ and LG_N); its quaternion's norm is checked before the C call, the C uses its
-unit rotation.
+module's RT_NQ and LG_N), and a ball joint 4 in q and 3 in v (a free flyer below the root 7
+and 6); every quaternion's norm is checked before the C call, the C uses its unit rotation.
 
 Units SI. Gravity g (a runtime parameter) along the tree's direction; each coordinate's actuator
 parameter tau_<joint> acts as a load, as in the symbolic equations (b = C q_dot + g - tau_p).

@@ -106,10 +106,10 @@ JOINT_MODELS: dict[JointKind, JointModel | FreeFlyerModel | SphericalModel] = {
     # a screw: Rot(u, theta) and pitch * theta along u (S = (u, pitch u), pitch in m/rad)
     JointKind.HELICAL: JointModel(JointKind.HELICAL, turns=True, slides=True, pitched=True),
     # a floating base at a tree's root (numpy and the engine), or a URDF floating joint below it
-    # (numpy only: selection.py chooses it, the engine-only paths refuse it by name)
+    # (numpy, the engine and the generated code: emit/tree_floating.py's several_*)
     JointKind.FREE_FLYER: FreeFlyerModel(),
     # a ball joint (MuJoCo's): a quaternion w x y z, the angular velocity in the body's axes
-    # (spherical.py); M, ID, FD and the energies in numpy and the compact engine only
+    # (spherical.py); numpy, the engine and the generated code (emit/tree_floating.py)
     JointKind.SPHERICAL: SphericalModel(),
 }
 

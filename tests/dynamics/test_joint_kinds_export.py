@@ -132,19 +132,22 @@ def _seven(d, Q, V, A):
 @pytest.mark.parametrize("quaternion_robot", ["mjcf_free", "urdf_floating"], indirect=True)
 def test_the_unrolled_kernel_takes_ball_and_free_joints(quaternion_robot):
     """kernel="unrolled" on nq-wide q and nv-wide v: its batches (vector lanes) and single
-    calls equal the numpy reference to 1e-10; a quaternion off unit norm is refused in one line
-    naming its joint."""
+    calls equal the numpy reference to 1e-10, and each other bit for bit; a quaternion off unit
+    norm is refused in one line naming its joint."""
     key, system, reference, _ = quaternion_robot
     d = system.dynamics(kernel="unrolled")
     assert d.kernel == "unrolled" and d.module is not None, key
     tree = system.model.kinematic_tree
     Q, V, A = _states(tree, 9, seed=3)
     expected = _seven(reference, Q, V, A)
-    for what, batch in _seven(d, Q, V, A).items():
-        _agree(batch, expected[what], f"{key}: unrolled {what} (batch)")
+    batch = _seven(d, Q, V, A)
+    for what, rows in batch.items():
+        _agree(rows, expected[what], f"{key}: unrolled {what} (batch)")
     for i in (0, 8):
         for what, single in _seven(d, Q[i], V[i], A[i]).items():
             _agree(single, expected[what][i], f"{key}: unrolled {what} (state {i})")
+            # the vector lanes' row is the scalar call's, bit for bit (no fused operations)
+            assert np.array_equal(single, batch[what][i]), (key, what, i)
     name, what, iq, _ = quaternion_slices(tree)[-1]
     bad = Q[0].copy()
     bad[iq:iq + 4] *= 0.5

@@ -5,7 +5,8 @@ quaternion kept on |q| = 1 at the nodes by a multiplier mu along q in its defect
 
     q_{k+1} - q_k - h/2 (q_dot_k + q_dot_{k+1}) - mu_k q_{k+1} = 0,  |q_{k+1}|^2 = 1,
 
-the projection of the scheme's step back onto the sphere (mu is of the scheme's order h^3).
+the projection of the scheme's step back onto the sphere (mu is of the scheme's order h^3;
+|mu| <= 1/2 keeps out the other root, mu near 2, where q_{k+1} is the step's opposite).
 """
 
 from __future__ import annotations
@@ -102,6 +103,10 @@ def project(ca, opti, X, defect, rows, target, nodes: int):
         return defect
     mu = opti.variable(len(rows), nodes - 1)
     opti.set_initial(mu, 0.0)
+    # (1 - mu) q_{k+1} = the step: mu near 0 is the step scaled back onto the sphere; near 2
+    # it is the step turned to -q_{k+1}, the same rotation with the rate's sign flipped, a
+    # branch that is no solution of the dynamics (the optimizer would use it): kept out
+    opti.subject_to(opti.bounded(-0.5, ca.vec(mu), 0.5))
     shift = [ca.DM.zeros(1, nodes - 1)] * X.shape[0]
     for j, (_, indices) in enumerate(rows):
         for i in indices:

@@ -84,28 +84,7 @@ def compiled_backend(tree: KinematicTree, parameters: Mapping[str, float], names
     # (docs/robotics.md; with them Solo12's g differed in the last bit in 162 of 400 states)
     module = compiled.load_keyed(tree_key(tree, names), lambda: module_source(tree, names),
                                  native=True, exact=True)
-    backend = CompiledBackend("unrolled", module, values)
-    if tree.quaternion_joints:  # the module checks the base's quaternion alone
-        for name in RECURSIONS:
-            setattr(backend, name, _quaternions_checked(getattr(module, name), tree))
-    return backend
-
-
-def _quaternions_checked(function, tree: KinematicTree):
-    """``function(q, ...)`` answering NotImplemented where q is not a float array of the tree's
-    width or a ball joint's or free flyer's quaternion is off unit norm (the front then names
-    the joint and the state, or uses a near-unit one normalized)."""
-    from .tree.spherical import ball_quaternions_unit
-
-    nq = tree.nq
-
-    def checked(q, *rest):
-        if (q.__class__ is not np.ndarray or q.dtype != np.float64 or q.ndim == 0
-                or q.shape[-1] != nq or not ball_quaternions_unit(tree, q.reshape(-1, nq))):
-            return NotImplemented
-        return function(q, *rest)
-
-    return checked
+    return CompiledBackend("unrolled", module, values)
 
 
 class _CompactKernel:

@@ -12,11 +12,44 @@ from ...model.tree import KinematicTree
 from ..emit.tree_c import dynamics_functions
 from ..emit.tree_emitter import VECTOR_LIMIT
 from ..tree.free_flyer import QUATERNION_TOLERANCE
+from ..tree.spherical import quaternion_slices
 
 # The Python bindings of the batched functions (threads over states, vector lanes): real C.
 # batch_threads.c first: the thread count the three compiled modules' batches share
-_BINDINGS = "\n" + "\n".join(Path(__file__).with_name(name).read_text(encoding="utf-8")
-                             for name in ("batch_threads.c", "tree_bindings.c"))
+_THREADS, _BINDINGS = ("\n" + Path(__file__).with_name(name).read_text(encoding="utf-8")
+                       for name in ("batch_threads.c", "tree_bindings.c"))
+
+
+def _quaternion_check(starts: list[int], floating: bool) -> str:
+    """C that widens tree_bindings.c's check of the base quaternion (batch_threads.c's
+    lg_unit_quaternions, under RT_FLOATING) to every quaternion in q: the base's and each ball
+    joint's or free flyer's at ``starts``; a state not finite is its row's NaN, not an error."""
+    return f"""
+/* each finite state's quaternions q[s..s+3], s in rt_quaternions (ball joints, free flyers
+   below the root), of unit norm to ``tolerance``, and the base's (lg_unit_quaternions); else 0
+   with a ValueError, and the front names the joint, the state and the norm */
+static const int rt_quaternions[{len(starts)}] = {{{", ".join(map(str, starts))}}};
+static int rt_unit_quaternions(const double *q, npy_intp states, npy_intp step, int nq,
+                               double tolerance)
+{{
+    if ({int(floating)} && !lg_unit_quaternions(q, states, step, nq, tolerance)) return 0;
+    for (npy_intp k = 0; k < states; k++) {{
+        const double *x = q + k * step;
+        int finite = 1;
+        for (int i = 0; i < nq; i++) finite &= isfinite(x[i]) != 0;
+        for (int j = 0; finite && j < {len(starts)}; j++) {{
+            const double *e = x + rt_quaternions[j];
+            const double norm = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
+            if (!(fabs(norm - 1.0) <= tolerance)) {{
+                PyErr_SetString(PyExc_ValueError, "q: a joint's quaternion is not unit");
+                return 0;
+            }}
+        }}
+    }}
+    return 1;
+}}
+#define lg_unit_quaternions rt_unit_quaternions
+"""
 
 _DECLARE = "\n".join(
     f"static PyObject *rt_py_{name}(PyObject *, PyObject *const *, Py_ssize_t);"
@@ -37,6 +70,7 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
     from ...compile.codegen import TEMPLATE, GeneratedSource
 
     n = tree.nv  # v's numbers; q's are RT_NQ (a floating base's, ball joints' quaternions)
+    starts = [iq for *_, iq, _ in quaternion_slices(tree)]  # ball joints', free flyers' below
     # vector variants (LG_LANES states at once) for batches up to VECTOR_LIMIT coordinates; a
     # long chain's code is big enough that compiling it twice costs minutes, so there the batch
     # runs the scalar functions; a floating base's forward dynamics (the articulated-body
@@ -50,7 +84,8 @@ def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
         f"#define LG_N {n}",
         f"#define RT_NQ {tree.nq}",
         "#define LG_M 0",
-        f"#define RT_FLOATING {int(tree.floating_base)}",
+        # the check of the quaternions in q before the C call: the base's, or every one's
+        f"#define RT_FLOATING {int(tree.floating_base or bool(starts))}",
         f"#define RT_QUATERNION_TOLERANCE {QUATERNION_TOLERANCE!r}",
         f"#define LG_NP {len(parameters)}",
         "#define PY_SSIZE_T_CLEAN",
@@ -89,6 +124,8 @@ static void lg_residual(const double *restrict q, const double *restrict v, doub
         "#define RT_VECTOR_FORWARD " + ("1" if "rt4_forward_dynamics" in functions else "0"),
         "#define RT_VECTOR " + ("1" if "rt4_mass_matrix" in functions else "0"),
         TEMPLATE.read_text(),
+        _THREADS,
+        _quaternion_check(starts, tree.floating_base) if starts else "",
         _BINDINGS,
     ])
     return GeneratedSource(source=source, parameters=parameters, n=n, m=0)

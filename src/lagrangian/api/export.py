@@ -57,7 +57,9 @@ class ExportMethods:
         C q_dot + g, g(q), inverse and forward dynamics and the energies (SI units);
         ``prefix`` names the functions (default: from the model's name), ``parameters`` override
         the model's values compiled in as defaults; a [control] table's laws as <prefix>_control
-        and <prefix>_control_forces. Write it with ``lagrangian.output.files.write_c(code, dir)``."""
+        and <prefix>_control_forces; a robot's frames, and its ball and free joints (q of
+        <PREFIX>_NQ numbers, v of <PREFIX>_N). Write it with
+        ``lagrangian.output.files.write_c(code, dir)``."""
         from ..compile.codegen import CodegenError
         from ..dynamics.standalone.standalone import c_prefix, standalone_for
         from ..simulation.control import input_columns  # B of a [control] table's inputs

@@ -29,8 +29,9 @@ def codegen(
 ) -> None:
     """Write M(q), bias C q_dot + g, gravity, inverse and forward dynamics and the energies as
     standalone C (no Python, no allocation, libm only) for embedding in a controller; a URDF
-    robot's frames too (placements, Jacobians, J_dot v, centre of mass); a model file's
-    [control] laws as <name>_control and <name>_control_forces."""
+    or MJCF robot's frames too (placements, Jacobians, J_dot v, centre of mass), its ball and
+    free joints with q of <NAME>_NQ numbers and v of <NAME>_N; a model file's [control] laws as
+    <name>_control and <name>_control_forces."""
     if lang.lower() not in LANGUAGES:
         raise InputError(f"unknown language {lang!r}: use c", field="--lang")
     directory = Path(out)

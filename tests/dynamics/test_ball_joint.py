@@ -285,8 +285,9 @@ def test_what_has_no_ball_joint_yet_refuses_it_by_name(chain):
 def test_compiled_frames_agree_with_the_numpy_reference(request, robot):
     """The compiled reach module (joint.h's ball branch) on a tree with ball joints: every
     frame's placement and Jacobian in the three references, the centre of mass and its
-    Jacobian against the numpy reference (frames.py), to 1e-12; a NaN state's row NaN. What
-    has no ball branch for (J_dot v, A_g, wrenches) the front takes from the numpy walks."""
+    Jacobian, and (the ball as its body's three columns, each fixed in the body: S_dot = V x S)
+    J_dot v, A_g, C(q, v) and the wrenches' one Newton-Euler pass against the numpy reference
+    (frames.py, centroidal.py, coriolis_tree.py, wrenches.py), to 1e-12; a NaN state's row NaN."""
     _, dynamics, _ = request.getfixturevalue(robot)
     ours, reference = dynamics["compiled"], dynamics["numpy"]
     kernel = ours._reach_kernel()
@@ -308,6 +309,22 @@ def test_compiled_frames_agree_with_the_numpy_reference(request, robot):
                                rtol=0, atol=1e-12)
     np.testing.assert_allclose(kernel.center_of_mass_jacobian(Q),
                                reference.center_of_mass_jacobian(Q), rtol=0, atol=1e-12)
+    V = rng.uniform(-1.0, 1.0, (4, ours.nv))
+    for frame in ours.frames:  # compiled, not the numpy walks the front used to fall back on
+        for ref in ("world", "local", "local_world_aligned"):
+            np.testing.assert_allclose(kernel.drift(Q, V, frame, ref),
+                                       reference.jacobian_dot_times_v(Q, V, frame, ref),
+                                       rtol=0, atol=1e-12)
+    np.testing.assert_allclose(kernel.centroidal(Q), reference.centroidal_momentum_matrix(Q),
+                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(kernel.coriolis(Q, V), reference.coriolis_matrix(Q, V),
+                               rtol=0, atol=1e-12)
+    one_pass = kernel.fused_inverse(ours)
+    assert one_pass, "the wrenches' one pass checked equal and taken"
+    wrench = {ours.frames[-1]: rng.uniform(-2.0, 2.0, (4, 6))}
+    np.testing.assert_allclose(one_pass(Q, V, V, wrench),
+                               reference.inverse_dynamics(Q, V, V, f_ext=wrench),
+                               rtol=0, atol=1e-11)
     Q[2, -1] = np.nan
     J, bad = kernel.jacobian(Q, ours.frames[-1], "world")
     assert bad == 1 and np.isnan(J[2]).all() and not np.isnan(J[[0, 1, 3]]).any()

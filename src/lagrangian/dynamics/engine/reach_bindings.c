@@ -58,15 +58,6 @@ static int rk_unit_quaternions(const rk_model *md, PyArrayObject *Q)
     return 1;
 }
 
-/* 1 where the tree has no ball joint, else ValueError: what needs a joint of one number or
- * a free flyer (J_dot v, A_g, C(q, v), wrenches, inverse dynamics: numpy's refuse a ball) */
-static int rk_no_balls(const rk_model *md, const char *what)
-{
-    if (!md->t.balls) return 1;
-    PyErr_Format(PyExc_ValueError, "%s: a ball joint (not in the reach module)", what);
-    return 0;
-}
-
 static PyObject *rk_output(PyArrayObject *like, int tail0, int tail1)
 {
     npy_intp dims[NPY_MAXDIMS];
@@ -133,7 +124,6 @@ static PyObject *rk_py_drift(PyObject *self, PyObject *const *args, Py_ssize_t n
 {
     const rk_model *md = RK_MD(self);
     if (nargs != 4) { PyErr_SetString(PyExc_TypeError, "drift(Q, V, frame, reference)"); return NULL; }
-    if (!rk_no_balls(md, "drift")) return NULL;
     const int f = rk_frame_named(md, ((rk_tree *)self)->index, args[2]);
     if (f < 0) return NULL;
     const int ref = rk_reference_named(args[3]);
@@ -201,7 +191,6 @@ static PyObject *rk_py_jacobian(PyObject *self, PyObject *const *args, Py_ssize_
     static PyObject *rk_py_##name(PyObject *self, PyObject *const *args, Py_ssize_t nargs)    \
     {                                                                                          \
         if (nargs != 1) { PyErr_SetString(PyExc_TypeError, #name "(Q)"); return NULL; }       \
-        if (kind == RK_CENTROIDAL && !rk_no_balls(RK_MD(self), #name)) return NULL;            \
         return rk_of_q(self, args[0], kind, 0, 0, tail0, tail1);                               \
     }
 RK_OF_Q(com, RK_COM, 3, 0)
@@ -214,7 +203,6 @@ static PyObject *rk_py_wrench(PyObject *self, PyObject *const *args, Py_ssize_t 
 {
     const rk_model *md = RK_MD(self);
     if (nargs != 5) { PyErr_SetString(PyExc_TypeError, "wrench(Q, frame, W, OUT, sign)"); return NULL; }
-    if (!rk_no_balls(md, "wrench")) return NULL;
     int f = (int)PyLong_AsLong(args[1]);
     double sign = PyFloat_AsDouble(args[4]);
     if (PyErr_Occurred()) return NULL;
@@ -250,7 +238,6 @@ static PyObject *rk_py_coriolis(PyObject *self, PyObject *const *args, Py_ssize_
 {
     const rk_model *md = RK_MD(self);
     if (nargs != 2) { PyErr_SetString(PyExc_TypeError, "coriolis(Q, V)"); return NULL; }
-    if (!rk_no_balls(md, "coriolis")) return NULL;
     PyArrayObject *Q = rk_input(args[0], md->nq, "q");
     if (!Q) return NULL;
     if (!rk_unit_quaternions(md, Q)) { Py_DECREF(Q); return NULL; }
@@ -276,7 +263,6 @@ static PyObject *rk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t
 {
     const rk_model *md = RK_MD(self);
     PyObject *index = ((rk_tree *)self)->index;
-    if (!rk_no_balls(md, "inverse")) return NULL;
     if (nargs != 5 || !PyDict_Check(args[4])) {
         PyErr_SetString(PyExc_TypeError, "inverse(UP, Q, V, A, F_EXT)");
         return NULL;
@@ -412,6 +398,7 @@ static int rk_model_from(PyObject *description, PyObject *ints, PyObject *floats
         mult[i] = b[TK_MULT];
         if (TK_FREE(b)) quat[nquat++] = 3;  /* x y z w after the origin */
         else if (TK_BALL(b)) quat[nquat++] = t.bq + (int)b[TK_QCOORD];  /* w x y z */
+        else if (TK_FLYER(b)) quat[nquat++] = t.bq + (int)b[TK_QCOORD] + 3;  /* x y z w */
         m[i] = b[TK_MASS];
         for (int j = 0; j < 3; j++) h[3 * i + j] = b[TK_H + j];
         for (int j = 0; j < 9; j++) J[9 * i + j] = b[TK_J + j];

@@ -34,6 +34,7 @@ from ...model.tree import KinematicTree
 from ..emit.tree_c import _SINCOS, _VECTOR
 from ..tree.description import canonical_frame, describe
 from ..tree.free_flyer import QUATERNION_TOLERANCE
+from ..tree.spherical import quaternion_slices
 from .headers import header_bytes, spliced
 
 # the walks, frames and the centre of mass, C(q, v), inverse dynamics with wrenches, then the
@@ -70,9 +71,10 @@ def _coriolis_zeros(tree: KinematicTree) -> tuple[bool, list[int]]:
     base = 6 if free else 0
     nv = tree.nv
     # each body's velocity numbers: the base's six, a ball's three, else one
+    many = {JointKind.SPHERICAL: 3, JointKind.FREE_FLYER: 6}  # a flyer's below the root
     columns = [list(range(6)) if free and i == 0 else
                [base + tree.velocity_index(j.coordinate) + c
-                for c in range(3 if j.kind == JointKind.SPHERICAL else 1)]
+                for c in range(many.get(JointKind(j.kind), 1))]
                for i, j in enumerate(tree.joints)]
     coordinates = [j.coordinate for j in tree.joints[int(free):]]
     shared = len(set(coordinates)) < len(coordinates)
@@ -146,13 +148,12 @@ def engine():
 
 def reach_module(tree: KinematicTree):
     """The compiled module for this tree (the same for every tree: ``engine``), or None where
-    no compiler works or a joint is one the kernel does not know. A ball joint's tree has its
-    placements, Jacobians and centre of mass here; its J_dot v, A_g, C(q, v) and wrenches are
-    refused by the module (ValueError), and numpy's walks name the fault in one line."""
+    no compiler works or a joint is one the kernel does not know. A ball joint and a free flyer
+    below the root are their body's columns (three, six) in every function."""
     from ..tree.joint_models import ONE_DOF
 
-    free = tree.floating_base  # a free flyer: body 0 only (RK_FREE)
-    if any(j.kind not in ONE_DOF and j.kind != JointKind.SPHERICAL
+    free = tree.floating_base  # a free flyer: body 0 (RK_FREE), or below the root
+    if any(j.kind not in ONE_DOF and j.kind not in (JointKind.SPHERICAL, JointKind.FREE_FLYER)
            for j in tree.joints[int(free):]):
         return None  # a joint the kernel does not know: numpy's walks refuse it in one line
     return engine()
@@ -180,11 +181,13 @@ class ReachKernel:
         self.centroidal = compiled.centroidal if massive else None
         self.center_of_mass = compiled.com if massive else None
         self.center_of_mass_jacobian = compiled.com_jacobian if massive else None
-        # a floating base's C by Pinocchio's factorization; a fixed base's is M's Christoffel
-        # symbols (joint_space.py), which the same factorization gives: None until
-        # checked_coriolis has compared the two, then the compiled function or False
-        self.coriolis = compiled.coriolis if tree.floating_base else None
-        self.fixed_coriolis = None if not tree.floating_base else False
+        # C by Pinocchio's factorization where v is not q's rate (a floating base, a ball, a free
+        # flyer below the root); else C is M's Christoffel symbols (joint_space.py), which the
+        # same factorization gives: None until checked_coriolis has compared the two, then the
+        # compiled function or False
+        manifold = tree.floating_base or bool(tree.quaternion_joints)
+        self.coriolis = compiled.coriolis if manifold else None
+        self.fixed_coriolis = None if not manifold else False
         self.tree = tree
         # inverse dynamics less wrenches in one pass (q, v, a, f_ext) -> tau: None until
         # fused_inverse has asked, then the compiled function or False
@@ -226,6 +229,8 @@ class ReachKernel:
         q = rng.uniform(-1.0, 1.0, (3, len(dynamics.coordinates)))
         if tree.floating_base:
             q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=-1, keepdims=True)
+        for _, _, at, _ in quaternion_slices(tree):  # each ball's and flyer's below the root
+            q[:, at:at + 4] /= np.linalg.norm(q[:, at:at + 4], axis=-1, keepdims=True)
         v, a = rng.uniform(-1.0, 1.0, (2, 3, dynamics.n))
         wrenches = {f.name: rng.uniform(-5.0, 5.0, (3, 6)) for f in tree.frames if f.body >= 0}
         wrenches = dict(list(wrenches.items())[-1:])  # the last moving frame's

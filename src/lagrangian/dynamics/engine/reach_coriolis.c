@@ -17,28 +17,38 @@ static inline void RK_FN(motion_cross)(const RK_T *V, const RK_T *s, RK_T *out)
 }
 
 /* a body's workspace: its world column S and its rate V x S, V, and (summed over the subtree
- * going up) its inertia m, h, J and B's l, A; a free flyer's six columns apart (S0, dS0), so
- * that eight lanes' workspace of a quadruped stays within a core's first-level cache (with six
- * columns a body, Solo12's was 85 kB) */
+ * going up) its inertia m, h, J and B's l, A; a free flyer's six columns apart (S0, dS0), and
+ * a ball's three or a flyer's below the root six in a pool after the bodies (pool: where,
+ * else -1), so that eight lanes' workspace of a quadruped stays within a core's first-level
+ * cache (with six columns a body, Solo12's was 85 kB) */
 typedef struct {
     RK_T S[6], dS[6], V[6], h[3], J[9], l[3], A[9];
     double m;
-    int columns, first;
+    int columns, first, pool;
 } RK_FN(cbody);
 
 typedef struct {
     RK_T S0[6][6], dS0[6][6];
-    RK_FN(cbody) b[];  /* nb of them */
+    RK_FN(cbody) b[];  /* nb of them, then the pool's columns and their rates */
 } RK_FN(cwork);
 
 static size_t RK_FN(cwork_size)(const rk_model *md)
 {
-    return sizeof(RK_FN(cwork)) + (size_t)md->nb * sizeof(RK_FN(cbody));
+    const size_t pooled = 3 * (size_t)md->t.balls + 6 * (size_t)md->t.flyers;
+    return sizeof(RK_FN(cwork)) + (size_t)md->nb * sizeof(RK_FN(cbody))
+           + 2 * pooled * 6 * sizeof(RK_T);
 }
 
-/* body i's columns and their rates, (RK_T (*)[6]): the free flyer's six or the joint's one */
-#define RK_COLUMNS(w, i) (RK_FREE(i) ? (w)->S0 : (RK_T (*)[6])(w)->b[i].S)
-#define RK_RATES(w, i) (RK_FREE(i) ? (w)->dS0 : (RK_T (*)[6])(w)->b[i].dS)
+/* body i's columns and their rates, (RK_T (*)[6]): the free flyer's six, a ball's or a flyer's
+   in the pool, or the joint's one */
+#define RK_POOL(w, md) ((RK_T (*)[6])((w)->b + (md)->nb))
+#define RK_COLUMNS(w, i)                                                                    \
+    (RK_FREE(i) ? (w)->S0                                                                   \
+     : (w)->b[i].pool >= 0 ? RK_POOL(w, md) + (w)->b[i].pool : (RK_T (*)[6])(w)->b[i].S)
+#define RK_RATES(w, i)                                                                      \
+    (RK_FREE(i) ? (w)->dS0                                                                  \
+     : (w)->b[i].pool >= 0 ? RK_POOL(w, md) + (w)->b[i].pool + (w)->b[i].columns            \
+                           : (RK_T (*)[6])(w)->b[i].dS)
 
 /* I x = [m x_v - h x x_w; h x x_v + J x_w] */
 static inline void RK_FN(inertia_times)(const RK_FN(cbody) *b, const RK_T *x, RK_T *out)
@@ -63,13 +73,24 @@ static void RK_FN(coriolis)(const rk_model *md, RK_FN(work) *space, const RK_T *
         for (int j = 0; j < md->nczero; j++) C[md->czero[j]] = RK_C(0.0);
     else  /* a mimic joint's coordinate is another joint's too: its entries add up */
         for (int j = 0; j < md->nv * md->nv; j++) C[j] = RK_C(0.0);
+    int pooled = 0;  /* the pool's columns taken so far */
     for (int i = 0; i < md->nb; i++) {
         RK_FN(cbody) *bi = body + i;
-        RK_T (*S)[6] = RK_COLUMNS(work, i), (*dS)[6] = RK_RATES(work, i);
         int p = md->parent[i];
+        bi->pool = -1;
+        if (RK_MANY(md, i)) {  /* its columns (and then their rates) in the pool */
+            double mult;
+            bi->pool = pooled;
+            bi->columns = RK_FN(columns)(md, i, R, o, RK_POOL(work, md) + pooled, &bi->first,
+                                         &mult);
+            pooled += 2 * bi->columns;
+        }
+        RK_T (*S)[6] = RK_COLUMNS(work, i), (*dS)[6] = RK_RATES(work, i);
         if (RK_FREE(i)) {
             RK_FREE_COLUMNS(md, R[0], o[0], S);
             bi->columns = 6, bi->first = 0;
+        } else if (RK_MANY(md, i)) {
+            /* set above */
         } else {
             RK_SUBSPACE(md, i, R, o, S[0]);
             for (int j = 0; j < 6; j++) S[0][j] *= md->mult[i];

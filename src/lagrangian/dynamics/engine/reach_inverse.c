@@ -45,6 +45,24 @@ static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *re
                     A[0][j] += base[c][j] * qdd[c];
                 }
             }
+        } else if (RK_MANY(md, i)) {  /* a ball's three columns, a flyer's six */
+            RK_T columns_[6][6], c[6];
+            int first;
+            double mult;
+            const int columns = RK_FN(columns)(md, i, R, o, columns_, &first, &mult);
+            for (int j = 0; j < 6; j++) {
+                V[i][j] = p < 0 ? RK_C(0.0) : V[p][j];
+                A[i][j] = p < 0 ? RK_C(j < 3 ? up[j] : 0.0) : A[p][j];
+            }
+            for (int col = 0; col < columns; col++)
+                for (int j = 0; j < 6; j++) {
+                    V[i][j] += columns_[col][j] * qd[first + col];
+                    A[i][j] += columns_[col][j] * qdd[first + col];
+                }
+            for (int col = 0; col < columns; col++) {  /* each fixed in the body: V x S */
+                RK_FN(motion_cross)(V[i], columns_[col], c);
+                for (int j = 0; j < 6; j++) A[i][j] += c[j] * qd[first + col];
+            }
         } else {
             const RK_T rate = md->mult[i] * qd[md->bv + md->coord[i]];
             const RK_T accel = md->mult[i] * qdd[md->bv + md->coord[i]];
@@ -95,6 +113,16 @@ static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *re
                 RK_T t = RK_C(0.0);
                 for (int j = 0; j < 6; j++) t += base[c][j] * F[0][j];
                 tau[c] = t;
+            }
+        } else if (RK_MANY(md, i)) {
+            RK_T columns_[6][6];
+            int first;
+            double mult;
+            const int columns = RK_FN(columns)(md, i, R, o, columns_, &first, &mult);
+            for (int col = 0; col < columns; col++) {
+                RK_T t = RK_C(0.0);
+                for (int j = 0; j < 6; j++) t += columns_[col][j] * F[i][j];
+                tau[first + col] += t;
             }
         } else {
             RK_T t = RK_C(0.0);

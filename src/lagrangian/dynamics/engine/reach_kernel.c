@@ -147,11 +147,16 @@ static int RK_FN(path)(const rk_model *md, const RK_T *q, int b, int *path, RK_T
 #define RK_SUBSPACE(md, i, R, o, S) \
     ((void)RK_FN(jt_columns)(RK_BODY(i), (R)[i], (o)[i], (RK_T (*)[6])(S)))
 
+/* whether body i's joint (not the floating base) has several columns: a ball, a free flyer
+   below the root */
+#define RK_MANY(md, i) (TK_BALL(RK_BODY(i)) || TK_FLYER(RK_BODY(i)))
+
 /* a free flyer's six columns at the world's origin, world axes (S = 1 in the base's axes) */
 #define RK_FREE_COLUMNS(md, R, o, S) ((void)RK_FN(jt_columns)(RK_BODY(0), (R), (o), (S)))
 
 /* a joint's columns at the world's origin, world axes (joint.h), and the first coordinate
- * they fill: a free flyer's six, a ball's three, else one (times the joint's multiplier) */
+ * they fill: a free flyer's six (at the root or below it), a ball's three, else one (times the
+ * joint's multiplier) */
 static inline __attribute__((always_inline)) int RK_FN(columns)(const rk_model *md, int i,
                                                                 RK_T (*R)[9], RK_T (*o)[3],
                                                                 RK_T (*F)[6], int *first,
@@ -159,7 +164,7 @@ static inline __attribute__((always_inline)) int RK_FN(columns)(const rk_model *
 {
     const double *b = RK_BODY(i);
     *first = RK_FREE(i) ? 0 : md->bv + md->coord[i];
-    *mult = TK_FREE(b) || TK_BALL(b) ? 1.0 : md->mult[i];
+    *mult = TK_FREE(b) || TK_BALL(b) || TK_FLYER(b) ? 1.0 : md->mult[i];
     return RK_FN(jt_columns)(b, R[i], o[i], F);
 }
 
@@ -211,20 +216,28 @@ static void RK_FN(drift)(const rk_model *md, RK_FN(work) *work, const RK_T *q, c
             }
             continue;
         }
-        RK_T S[6], c[6], rate = md->mult[i] * qd[md->bv + md->coord[i]];
-        int p = md->parent[i];
-        RK_SUBSPACE(md, i, R, o, S);
+        /* V = V_p + sum S theta_dot, A = A_p + sum (V x S) theta_dot: each column fixed in
+           its body (a ball's three, a flyer's six) moves with it */
+        RK_T F[6][6];
+        int first, p = md->parent[i];
+        double mult;
+        const int columns = RK_FN(columns)(md, i, R, o, F, &first, &mult);
         for (int j = 0; j < 6; j++) {
-            V[i][j] = (p < 0 ? RK_C(0.0) : V[p][j]) + S[j] * rate;
+            V[i][j] = p < 0 ? RK_C(0.0) : V[p][j];
             A[i][j] = p < 0 ? RK_C(0.0) : A[p][j];
         }
-        /* [v; w] x [s_v; s_w] = [w x s_v + v x s_w; w x s_w] */
-        RK_T t1[3], t2[3];
-        SP_CROSS(V[i] + 3, S, t1);
-        SP_CROSS(V[i], S + 3, t2);
-        SP_CROSS(V[i] + 3, S + 3, c + 3);
-        for (int j = 0; j < 3; j++) c[j] = t1[j] + t2[j];
-        for (int j = 0; j < 6; j++) A[i][j] += c[j] * rate;
+        for (int col = 0; col < columns; col++)
+            for (int j = 0; j < 6; j++) V[i][j] += F[col][j] * (mult * qd[first + col]);
+        for (int col = 0; col < columns; col++) {
+            /* [v; w] x [s_v; s_w] = [w x s_v + v x s_w; w x s_w] */
+            const RK_T *S = F[col], rate = mult * qd[first + col];
+            RK_T c[6], t1[3], t2[3];
+            SP_CROSS(V[i] + 3, S, t1);
+            SP_CROSS(V[i], S + 3, t2);
+            SP_CROSS(V[i] + 3, S + 3, c + 3);
+            for (int j = 0; j < 3; j++) c[j] = t1[j] + t2[j];
+            for (int j = 0; j < 6; j++) A[i][j] += c[j] * rate;
+        }
     }
     RK_T Rf[9], p[3], pd[3], pdd[3], t[3];
     RK_FN(frame)(md, f, R, o, Rf, p);
@@ -263,7 +276,6 @@ static void RK_FN(wrench)(const rk_model *md, RK_FN(work) *work, const RK_T *q, 
     SP_CROSS(p, w, m);
     for (int j = 0; j < 3; j++) m[j] += w[3 + j];
     for (int i = b; i >= 0; i = md->parent[i]) {
-        RK_T S[6];
         if (RK_FREE(i)) {  /* R^T f and R^T (m_O - o x f) */
             RK_T t[3], n[3];
             SP_CROSS(o[0], w, t);
@@ -272,9 +284,15 @@ static void RK_FN(wrench)(const rk_model *md, RK_FN(work) *work, const RK_T *q, 
             SP_APPLY_T(R[0], n, out + 3);
             continue;
         }
-        RK_SUBSPACE(md, i, R, o, S);
-        out[md->bv + md->coord[i]] += md->mult[i] * (S[0] * w[0] + S[1] * w[1] + S[2] * w[2]
-                                                  + S[3] * m[0] + S[4] * m[1] + S[5] * m[2]);
+        RK_T F[6][6];
+        int first;
+        double mult;
+        const int columns = RK_FN(columns)(md, i, R, o, F, &first, &mult);
+        for (int col = 0; col < columns; col++) {
+            const RK_T *S = F[col];
+            out[first + col] += mult * (S[0] * w[0] + S[1] * w[1] + S[2] * w[2]
+                                        + S[3] * m[0] + S[4] * m[1] + S[5] * m[2]);
+        }
     }
 }
 

@@ -116,8 +116,46 @@ def test_the_command_line_balances_the_body(top, cli):
     assert all(re < 0 for re, _ in document["control"]["closed_loop_eigenvalues"])
     for arguments, names in ((("--inputs", "g"), "not 'g'"),
                              (("--inputs", "pivot__x", "--Q", "x"), "Q"),
+                             (("--inputs", "pivot__x", "--about", "pivot_qw=1"),
+                              "for the joint 'pivot' pivot__x, pivot__y, pivot__z"),
                              (("--inputs", ",".join(HINGES), "--linearize-along"),
                               "not linearized along a run")):
         bad = cli("simulate", path, "--t-end", "1", "--control", "lqr", *arguments)
         assert bad.code == 2 and len(bad.err.strip().splitlines()) == 1, bad.err
         assert names in bad.err
+
+
+HELD = """<robot name="held"><link name="hull"/>
+<link name="pod"><inertial><origin xyz="0.1 -0.05 -0.2"/><mass value="0.8"/>
+<inertia ixx="0.004" ixy="0" ixz="0" iyy="0.005" iyz="0" izz="0.006"/></inertial></link>
+<link name="fin"><inertial><origin xyz="0.1 0 0"/><mass value="0.3"/>
+<inertia ixx="0.001" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.002"/></inertial></link>
+<joint name="hook" type="floating"><parent link="hull"/><child link="pod"/></joint>
+<joint name="fin" type="continuous"><parent link="hull"/><child link="fin"/>
+<origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint></robot>"""
+
+
+def test_a_body_held_on_a_floating_joint_between_links(tmp_path):
+    """LQR on a URDF floating joint between links (its model coordinates x y z roll pitch yaw):
+    at rest the trim is the pod's weight held at its joint, a force (0, 0, m g) and the moment
+    c x (0, 0, m g) of its centre of mass c; from a push the regulator brings it back."""
+    pytest.importorskip("yourdfpy")
+    path = tmp_path / "held.urdf"
+    path.write_text(HELD)
+    system = lagrangian.load(path)
+    names = [c.name for c in system.model.coordinates]
+    linear = system.linearize(dict.fromkeys(names, 0.0), inputs=names)
+    weight, centre = 0.8 * G, np.array([0.1, -0.05, -0.2])
+    trim = [linear.trim[f"hook_{a}"] for a in ("x", "y", "z", "roll", "pitch", "yaw")]
+    np.testing.assert_allclose(trim, np.r_[0, 0, weight, np.cross(centre, [0, 0, weight])],
+                               atol=1e-9)
+    regulator = lagrangian.lqr(linear, 1.0, 1.0)
+    assert np.all(regulator.closed_loop_eigenvalues.real < 0)
+    dynamics = system.dynamics()
+    pushed = regulator._charts.charts.configuration(np.array([0.05, -0.02, 0.01, 0.1, -0.05,
+                                                              0.08, 0.1]))
+    run = system.simulate(6.0, initial=dict(zip(dynamics.coordinates, pushed, strict=True)),
+                          controller=regulator, rtol=1e-8, atol=1e-10, samples=7)
+    assert run.completed
+    back = regulator.state(np.asarray(run.q)[-1], np.asarray(run.q_dot)[-1])
+    assert np.abs(back).max() < 1e-3

@@ -403,6 +403,9 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         """
         from ..analysis.linearization import linear_model_at, symbolic_linear_model
         from ..compile.at_rest import AtRestFunctions
+        from ..control.lqr_charts import refuse_state_names
+
+        refuse_state_names(self, about)  # a ball's quaternion: its Euler angles, by name
 
         if steady:
             from ..analysis.steady import steady_linear_model

@@ -65,4 +65,23 @@ def tree_charts(system) -> TreeCharts | None:
                       (*(c.name for c in model.coordinates), *actuators))
 
 
-__all__ = ["TreeCharts", "tree_charts"]
+def refuse_state_names(system, about) -> None:
+    """One line for a run's number (a ball's shoulder_qw, its shoulder_wx) named where the
+    model's coordinates are wanted (linearize's and modes' ``about``), naming the joint's."""
+    tree = system.model.kinematic_tree
+    if not about or tree is None or not tree.quaternion_joints:
+        return
+    dynamics = system.dynamics()
+    model = [c.name for c in system.model.coordinates]
+    run = set(dynamics.coordinates) | set(dynamics.velocity_names)
+    for key in map(str, dict(about)):
+        if key in run and key not in model:
+            joint = key.rsplit("_", 1)[0]
+            own = [c for c in model if c.startswith(f"{joint}_")]
+            raise InputError(f"'{key}' is a number of the run's state; a linear model takes "
+                             f"the model's coordinates, for the joint '{joint}' "
+                             f"{', '.join(own)} (a ball's Euler angles, R = Rx Ry Rz, rad; a "
+                             "floating joint's x y z, roll pitch yaw)", field="about")
+
+
+__all__ = ["TreeCharts", "refuse_state_names", "tree_charts"]

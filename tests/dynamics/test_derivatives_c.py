@@ -393,3 +393,19 @@ def test_ball_joints_compiled_derivatives_refuse_a_quaternion_off_unit_in_one_li
     with pytest.warns(lagrangian.DynamicsWarning, match="1 of 1 states"):
         dq, _ = dynamics.inverse_dynamics_derivatives(q, v, a)
     assert np.isnan(dq).all()
+
+
+@needs_c
+@pytest.mark.parametrize("floating", [False, True])
+def test_ball_joints_compiled_regressor_gives_tau(ball_arm, floating):
+    """The compiled regressor over the tree's own bodies (a ball's first two records, massless,
+    left out): Y pi = tau, and Y the numpy walks' own, ten columns a body."""
+    dynamics = ball_arm[floating].dynamics()
+    q, v, a = _unit_states(dynamics, 4, 6)
+    fast = dynamics._derivatives_kernel()
+    Y = fast.regressor(q, v, a, fast.P)
+    np.testing.assert_allclose(Y @ dynamics.inertial_parameters(),
+                               dynamics.inverse_dynamics(q, v, a), rtol=0, atol=1e-12)
+    reference = ball_arm[floating].dynamics(backend="numpy").regressor(q, v, a)
+    np.testing.assert_allclose(Y, reference, rtol=0, atol=1e-12)
+    assert Y.shape[-1] == 10 * len(dynamics.tree.joints)

@@ -47,7 +47,7 @@ class ControlTerms:
                                  field="parameters")
             # compiled C (derivatives_c.py) where a compiler works, else numpy
             fast = self._derivatives_kernel()
-            if fast is not None and fast.regressor is not None:
+            if fast is not None:
                 compute, P = fast.checked_regressor, fast.P
                 return (lambda Q, V, A: compute(Q, V, A, P),
                         tree_parameter_names(tree), tree_parameters(tree))
@@ -78,7 +78,7 @@ class ControlTerms:
         axes, force then moment (Pinocchio's layout). A model file: the named ``parameters``, in
         which T and V must be linear."""
         fast = self._derivatives_kernel() if parameters is None else None
-        if fast is not None and fast.regressor is not None:  # one C call; a bad input goes
+        if fast is not None:  # one C call; a bad input goes
             # the guarded way to be named
             try:
                 out = fast.regressor(q, v, a, fast.P)
@@ -137,8 +137,7 @@ class ControlTerms:
                     if tree.floating_base:
                         from .tree.free_flyer import checking_quaternions
 
-                        checked = tuple(f if f is None else checking_quaternions(f)
-                                        for f in checked)
+                        checked = tuple(checking_quaternions(f) for f in checked)
                     found = DerivativesKernel(inverse, module.forward_derivatives, regressor,
                                               runtime_values(tree, self.parameters), *checked)
             self.__dict__["_derivatives_c"] = found

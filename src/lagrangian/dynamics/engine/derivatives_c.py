@@ -288,12 +288,11 @@ def engine():
 
 
 class TreeDerivatives(NamedTuple):
-    """The engine's functions bound to one tree: each takes (Q, V, X, P); no regressor (None)
-    for a tree with a ball joint."""
+    """The engine's functions bound to one tree: each takes (Q, V, X, P)."""
 
     inverse_derivatives: partial
     forward_derivatives: partial
-    regressor: partial | None
+    regressor: partial
     module: object
 
 
@@ -305,11 +304,32 @@ def derivatives_module(tree: KinematicTree) -> TreeDerivatives | None:
     module = engine()
     if module is None:
         return None
-    handle = module.tree(description(tree, {}), tables(tree))
-    # a ball's three records are not its body's ten parameters: its regressor stays numpy's
-    regressor = None if tree.quaternion_joints else partial(module.regressor, handle)
+    D = description(tree, {})
+    handle = module.tree(D, tables(tree))
+    regressor = partial(module.regressor, handle)
+    if tree.quaternion_joints:  # a split joint's first records are massless: not the tree's
+        regressor = partial(_bodies_columns, regressor, _real_columns(D))
     return TreeDerivatives(partial(module.inverse_derivatives, handle),
                            partial(module.forward_derivatives, handle), regressor, module)
+
+
+def _real_columns(D: np.ndarray) -> np.ndarray:
+    """The regressor's columns of the tree's own bodies among the description's records: each
+    record's ten but those of a split joint's records before its last (massless, frameless)."""
+    n, nb = int(D[1]), int(D[0])
+    records = D[HEADER + n:].reshape(nb, STRIDE)
+    last = np.where(records[:, 1] == JOINT_CODES[JointKind.SPHERICAL], 3,
+                    np.where(records[:, 1] == FLYER, 6, 0))
+    real = (records[:, COLUMN] == 0) | (records[:, COLUMN] == last)
+    return (10 * np.flatnonzero(real)[:, None] + np.arange(10)).ravel()
+
+
+def _bodies_columns(regressor, columns: np.ndarray, Q, V, A, P):
+    """The regressor's Y over the tree's bodies (``columns``), its NaN-row count kept."""
+    out = regressor(Q, V, A, P)
+    if out.__class__ is tuple:
+        return out[0][..., columns], out[1]
+    return out[..., columns]
 
 
 def runtime_values(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:

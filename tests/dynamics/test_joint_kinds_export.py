@@ -4,7 +4,8 @@ kernel="unrolled"), compiled with -std=c99 -pedantic -Werror:
 - a helical joint and a universal one (two revolute joints): M, ID, FD, T, V, a frame's
   placement and its Jacobians against Pinocchio's JointModelHelicalUnaligned and
   JointModelUniversal to 1e-10;
-- ball joints (MuJoCo's: q w x y z, v the child's angular velocity in its axes), MJCF free joints
+- ball joints (MuJoCo's: q w x y z, v the child's angular velocity in its axes; a chain of nine,
+  its forward dynamics the articulated-body algorithm), MJCF free joints
   in MuJoCo's layout (three world slides and a ball) and URDF floating joints between links
   (q x y z qx qy qz qw, v the child's twist in its axes), also on a floating base: the unrolled
   kernel's seven functions and every function of the export (frames, J_dot v, the centre of
@@ -94,7 +95,20 @@ def test_the_standalone_c_moves_helical_and_universal_joints(tmp_path):
 # (file name, text, floating_base): ball joints; free joints in MuJoCo's layout with a ball wrist
 # and hinges; a floating joint between links with a moving parent and child; one below a
 # floating base
-QUATERNION_ROBOTS = {"ball_hinge_ball": ("chain.xml", BALL_HINGE_BALL, False),
+def _ball_chain(count: int) -> str:
+    """``count`` bodies on ball joints, each 0.3 m below the last, turned and off-centre: nv =
+    3 count past 24, so the export's forward dynamics is the articulated-body algorithm."""
+    body = ""
+    for k in reversed(range(count)):
+        body = (f'<body name="b{k}" pos="0.02 0.01 -0.3" euler="0.{k} 0.2 -0.1">'
+                f'<joint name="s{k}" type="ball"/><inertial pos="0.01 -0.02 -0.15" '
+                f'mass="{1 + 0.1 * k:.1f}" diaginertia="0.02 0.03 0.01"/>{body}</body>')
+    return (f'<mujoco model="ball_chain"><compiler angle="radian"/><worldbody>{body}'
+            "</worldbody></mujoco>")
+
+
+QUATERNION_ROBOTS = {"ball_chain": ("balls.xml", _ball_chain(9), False),
+                     "ball_hinge_ball": ("chain.xml", BALL_HINGE_BALL, False),
                      "mjcf_free": ("two_free.xml", MJCF_FREE, False),
                      "urdf_floating": ("arm.urdf", ARM, False),
                      "urdf_floating_on_a_base": ("pod.urdf", POD, True)}
@@ -166,6 +180,8 @@ def test_the_c_export_takes_ball_and_free_joints(quaternion_robot):
     tree = system.model.kinematic_tree
     nq, nv = tree.nq, tree.nv
     assert f"#define {P.upper()}_N {nv}\n#define {P.upper()}_NQ {nq}\n" in code.header, key
+    if key == "ball_chain":  # O(n): the balls' 3 x 3 D = S^T IA S (emit/tree_floating.py)
+        assert "forward dynamics: the articulated-body algorithm" in code.source
     import re
 
     count = int(re.search(rf"#define {P.upper()}_NP (\d+)", code.header).group(1))

@@ -18,6 +18,8 @@ from .tree_floating import (
     free_root_motion,
     quaternion_rotation,
     several,
+    several_acceleration,
+    several_articulated,
     several_columns,
     several_placement,
     several_rates,
@@ -247,8 +249,6 @@ def _articulated(tree: KinematicTree) -> bool:
     """Whether the articulated-body algorithm applies: each coordinate drives one joint, as
     its angle or distance (no mimic joint); a floating base's free flyer is the root's."""
     joints = [j for j in tree.joints if not _free(j)]
-    if any(several(j) for j in joints):  # a ball or a free flyer below the root: M = L L^T
-        return False
     used = [j.coordinate for j in joints]
     return len(set(used)) == len(used) and all(j.multiplier == 1.0 for j in joints)
 
@@ -258,10 +258,12 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
     actuator parameters), O(n). Spatial vectors in body axes about the body's origin: motion
     (w, v), force (n, f); inertia blocks [[A, B], [B^T, C]] with n = A w + B v, f = B^T w + C v.
     A floating base (the root, S = 1) is solved by its 6 x 6 articulated inertia
-    (tree_floating.py); its 6 numbers come first in v, tau and q_ddot."""
+    (tree_floating.py); its 6 numbers come first in v, tau and q_ddot. A ball joint or a free
+    flyer below the root (S of 3 or 6 columns, constant in its body's axes) by its 3 x 3 or
+    6 x 6 D = S^T IA S (tree_floating.several_articulated)."""
     placements = _kinematics(E, tree, q)
     nb = len(tree.joints)
-    first = tree.base_nv
+    first, starts = tree.base_nv, _starts(tree)
     base_v, base_tau, v, tau = v[:first], tau[:first], v[first:], tau[first:]
     w, vel, c, A, B, C, pn, pf = [], [], [], [], [], [], [], []
     for i, joint in enumerate(tree.joints):
@@ -270,9 +272,17 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
         if _free(joint):  # the base's own twist; S = 1 is constant, so no bias motion
             w_i, v_i = free_root_motion(base_v)
             c.append((zero, zero))
+        elif several(joint):  # v_i = X v_parent + S v_j, c = v_i x S v_j (S constant)
+            k = starts[i]
+            ws, vs = several_rates(E, joint, v[k:k + joint_model(joint.kind).nv])
+            wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
+                                                                     vel[joint.parent])
+            w_i = E.vadd(E.apply_transpose(R, wl), ws)
+            v_i = E.vadd(E.apply_transpose(R, E.vadd(vl, E.cross(wl, p))), vs)
+            c.append((E.cross(w_i, ws), E.vadd(E.cross(w_i, vs), E.cross(v_i, ws))))
         else:
             s_w, s_v = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
-            rate = v[joint.coordinate]
+            rate = v[starts[i]]
             wl, vl = ([0.0] * 3, [0.0] * 3) if joint.parent < 0 else (w[joint.parent],
                                                                      vel[joint.parent])
             w_i = E.apply_transpose(R, wl)
@@ -304,6 +314,16 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
         joint = tree.joints[i]
         if _free(joint):  # the root: solved in the forward pass below
             continue
+        if several(joint):
+            k = starts[i]
+            efforts = [E.add(tau[k + a], layout.actuators[k + a])
+                       for a in range(joint_model(joint.kind).nv)]
+            (U[i], D[i], uu[i]), (Aa, Ba, Ca, an, af) = several_articulated(
+                E, joint, A[i], B[i], C[i], pn[i], pf[i], c[i], efforts)
+            if joint.parent < 0:
+                continue
+            _into_parent(E, placements[i], joint.parent, A, B, C, pn, pf, Aa, Ba, Ca, an, af)
+            continue
         s_w, s_v = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
         zero = [0.0] * 3
         # U = IA S: Un = A s_w + B s_v, Uf = B^T s_w + C s_v
@@ -314,12 +334,11 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
         drive_n, drive_f = s_w or zero, s_v or zero
         U[i] = (Un, Uf)
         D[i] = E.add(E.dot(drive_n, Un), E.dot(drive_f, Uf))
-        effort = E.add(tau[joint.coordinate], layout.actuators[joint.coordinate])
+        effort = E.add(tau[starts[i]], layout.actuators[starts[i]])
         uu[i] = E.sub(effort, E.add(E.dot(drive_n, pn[i]), E.dot(drive_f, pf[i])))
         parent = joint.parent
         if parent < 0:
             continue
-        R, p = placements[i]
         inv = E.div(1.0, D[i])
         Uns, Ufs = E.scale(inv, Un), E.scale(inv, Uf)
         # Ia = IA - U U^T / D, pa = pA + Ia c + U u / D
@@ -330,28 +349,7 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
         Bt = [[Ba[k][r] for k in range(3)] for r in range(3)]
         an = E.vadd(pn[i], E.vadd(E.vadd(E.apply(Aa, cw), E.apply(Ba, cv)), E.scale(uu[i], Uns)))
         af = E.vadd(pf[i], E.vadd(E.vadd(E.apply(Bt, cw), E.apply(Ca, cv)), E.scale(uu[i], Ufs)))
-        # into the parent: rotate (R X R^T), then move the reference point by p
-        Ar, Br, Cr = _sandwich(E, R, Aa, True), _sandwich(E, R, Ba, False), _sandwich(E, R, Ca, True)
-        P = [[0.0, E.neg(p[2]), p[1]], [p[2], 0.0, E.neg(p[0])], [E.neg(p[1]), p[0], 0.0]]
-        K = E.matmul(P, Cr)  # [p]x C
-        PBt = E.matmul(P, [[Br[k][r] for k in range(3)] for r in range(3)])  # [p]x B^T
-        KP = E.matmul(K, P)
-        for r in range(3):
-            for k in range(r, 3):
-                # A_P = A + [p]x B^T + ([p]x B^T)^T - [p]x C [p]x
-                entry = E.add(Ar[r][k], E.sub(E.add(PBt[r][k], PBt[k][r]), KP[r][k]))
-                A[parent][r][k] = E.add(A[parent][r][k], entry)
-                if k != r:
-                    A[parent][k][r] = A[parent][r][k]
-                C[parent][r][k] = E.add(C[parent][r][k], Cr[r][k])
-                if k != r:
-                    C[parent][k][r] = C[parent][r][k]
-        for r in range(3):
-            for k in range(3):  # B_P = B + [p]x C
-                B[parent][r][k] = E.add(B[parent][r][k], E.add(Br[r][k], K[r][k]))
-        force = E.apply(R, af)
-        pf[parent] = E.vadd(pf[parent], force)
-        pn[parent] = E.vadd(pn[parent], E.vadd(E.apply(R, an), E.cross(p, force)))
+        _into_parent(E, placements[i], parent, A, B, C, pn, pf, Aa, Ba, Ca, an, af)
     up = [E.mul(layout.gravity, -d) for d in tree.gravity_direction]
     acc_w, acc_v = [None] * nb, [None] * nb
     qdd: list[Term] = [0.0] * layout.n
@@ -368,9 +366,13 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
         cw, cv = c[i]
         aw = E.vadd(E.apply_transpose(R, aw_l), cw)
         av = E.vadd(E.apply_transpose(R, E.vadd(av_l, E.cross(aw_l, p))), cv)
+        if several(joint):
+            x, acc_w[i], acc_v[i] = several_acceleration(E, joint, (U[i], D[i], uu[i]), aw, av)
+            qdd[first + starts[i]:first + starts[i] + len(x)] = x
+            continue
         Un, Uf = U[i]
         x = E.div(E.sub(uu[i], E.add(E.dot(Un, aw), E.dot(Uf, av))), D[i])
-        qdd[first + joint.coordinate] = x
+        qdd[first + starts[i]] = x
         s_w, s_v = joint_model(joint.kind).subspace(joint.axis, joint.pitch)
         if s_w is not None:
             aw = E.vadd(aw, E.scale(x, s_w))
@@ -378,6 +380,33 @@ def _forward_dynamics(E: _Emitter, tree: KinematicTree, layout: _Layout, q, v, t
             av = E.vadd(av, E.scale(x, s_v))
         acc_w[i], acc_v[i] = aw, av
     return qdd
+
+
+def _into_parent(E: _Emitter, placement, parent: int, A, B, C, pn, pf, Aa, Ba, Ca, an, af):
+    """Add a body's articulated inertia (Aa, Ba, Ca) and bias force (an, af) to its parent's:
+    rotated into the parent's axes (R X R^T), then the reference point moved by p."""
+    R, p = placement
+    Ar, Br, Cr = _sandwich(E, R, Aa, True), _sandwich(E, R, Ba, False), _sandwich(E, R, Ca, True)
+    P = [[0.0, E.neg(p[2]), p[1]], [p[2], 0.0, E.neg(p[0])], [E.neg(p[1]), p[0], 0.0]]
+    K = E.matmul(P, Cr)  # [p]x C
+    PBt = E.matmul(P, [[Br[k][r] for k in range(3)] for r in range(3)])  # [p]x B^T
+    KP = E.matmul(K, P)
+    for r in range(3):
+        for k in range(r, 3):
+            # A_P = A + [p]x B^T + ([p]x B^T)^T - [p]x C [p]x
+            entry = E.add(Ar[r][k], E.sub(E.add(PBt[r][k], PBt[k][r]), KP[r][k]))
+            A[parent][r][k] = E.add(A[parent][r][k], entry)
+            if k != r:
+                A[parent][k][r] = A[parent][r][k]
+            C[parent][r][k] = E.add(C[parent][r][k], Cr[r][k])
+            if k != r:
+                C[parent][k][r] = C[parent][r][k]
+    for r in range(3):
+        for k in range(3):  # B_P = B + [p]x C
+            B[parent][r][k] = E.add(B[parent][r][k], E.add(Br[r][k], K[r][k]))
+    force = E.apply(R, af)
+    pf[parent] = E.vadd(pf[parent], force)
+    pn[parent] = E.vadd(pn[parent], E.vadd(E.apply(R, an), E.cross(p, force)))
 
 
 def _sandwich(E: _Emitter, R, X, symmetric: bool):

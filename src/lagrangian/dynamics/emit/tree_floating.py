@@ -91,3 +91,61 @@ def several_rates(E: _Emitter, joint, rates) -> tuple[list[Term], list[Term]]:
         if s_v is not None:
             v = E.vadd(v, E.scale(rate, s_v))
     return w, v
+
+
+def _columns_times(E: _Emitter, A, B, C, s_w, s_v):
+    """U = IA S for one column: (A s_w + B s_v, B^T s_w + C s_v)."""
+    zero: list[Term] = [0.0] * 3
+    return (E.vadd(zero if s_w is None else E.apply(A, s_w), zero if s_v is None else E.apply(B, s_v)),
+            E.vadd(zero if s_w is None else E.apply_transpose(B, s_w),
+                   zero if s_v is None else E.apply(C, s_v)))
+
+
+def _along(E: _Emitter, s_w, s_v, n, f) -> Term:
+    """S_a^T (n, f) for one column."""
+    return E.add(0.0 if s_w is None else E.dot(s_w, n), 0.0 if s_v is None else E.dot(s_v, f))
+
+
+def several_articulated(E: _Emitter, joint, A, B, C, pn, pf, c, efforts):
+    """The articulated-body step of a joint of several columns (k = 3 or 6): U = IA S,
+    D = S^T U (k x k, its lower triangle), u = tau - S^T pA, and what the parent takes:
+    Ia = IA - U D^-1 U^T and pa = pA + Ia c + U D^-1 u (D^-1 by straight-line Cholesky, its
+    factor shared by value numbering). Gives ((U, D, u), (Aa, Ba, Ca, an, af))."""
+    columns = several_columns(joint)
+    U = [_columns_times(E, A, B, C, s_w, s_v) for s_w, s_v in columns]
+    D = {(r, k): _along(E, *columns[r], *U[k]) for r in range(len(columns)) for k in range(r + 1)}
+    u = [E.sub(effort, _along(E, s_w, s_v, pn, pf))
+         for effort, (s_w, s_v) in zip(efforts, columns, strict=True)]
+    count = len(columns)
+    inverse = [_cholesky_solve(E, D, [1.0 if r == k else 0.0 for r in range(count)])
+               for k in range(count)]  # D^-1's columns (= rows: D is symmetric)
+    # W_a = sum_b (D^-1)_ab U_b, so U D^-1 U^T = sum_a U_a W_a^T and U D^-1 u = sum_a u_a W_a
+    W = [tuple([E.sum(E.mul(inverse[a][b], U[b][part][r]) for b in range(count))
+                for r in range(3)] for part in (0, 1)) for a in range(count)]
+
+    def less(X, left, right):
+        return [[E.sub(X[r][k], E.sum(E.mul(U[a][left][r], W[a][right][k]) for a in range(count)))
+                 for k in range(3)] for r in range(3)]
+
+    Aa, Ba, Ca = less(A, 0, 0), less(B, 0, 1), less(C, 1, 1)
+    cw, cv = c
+    Bt = [[Ba[k][r] for k in range(3)] for r in range(3)]
+    an = E.vadd(E.vadd(pn, E.vadd(E.apply(Aa, cw), E.apply(Ba, cv))),
+                [E.sum(E.mul(u[a], W[a][0][r]) for a in range(count)) for r in range(3)])
+    af = E.vadd(E.vadd(pf, E.vadd(E.apply(Bt, cw), E.apply(Ca, cv))),
+                [E.sum(E.mul(u[a], W[a][1][r]) for a in range(count)) for r in range(3)])
+    return (U, D, u), (Aa, Ba, Ca, an, af)
+
+
+def several_acceleration(E: _Emitter, joint, solved, aw, av):
+    """q_ddot of the joint's numbers, D^-1 (u - U^T a'), and its body's spatial acceleration
+    a' + S q_ddot, from a' = (aw, av), its parent's moved into its axes with the bias c."""
+    U, D, u = solved
+    rhs = [E.sub(u_a, E.add(E.dot(Un, aw), E.dot(Uf, av))) for u_a, (Un, Uf) in zip(u, U, strict=True)]
+    x = _cholesky_solve(E, D, rhs)
+    for x_a, (s_w, s_v) in zip(x, several_columns(joint), strict=True):
+        if s_w is not None:
+            aw = E.vadd(aw, E.scale(x_a, s_w))
+        if s_v is not None:
+            av = E.vadd(av, E.scale(x_a, s_v))
+    return x, aw, av

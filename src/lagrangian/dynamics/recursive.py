@@ -10,7 +10,8 @@ numbers (zeros and ones folded away, common terms shared):
 - inverse dynamics by recursive Newton-Euler: tau = M(q) a + C(q, q_dot) q_dot + g(q);
 - the mass matrix by the composite-rigid-body algorithm;
 - forward dynamics by the articulated-body algorithm, O(n), or M = L L^T, whichever takes
-  fewer operations (Cholesky only with mimic joints, ball joints or free flyers below the root);
+  fewer operations (Cholesky only with mimic joints; a ball joint's or a free flyer's D = S^T IA S
+  3 x 3 or 6 x 6);
 - sin and cos of each joint angle once, by inline kernels (fdlibm's polynomials after a
   three-part reduction by pi/2, libm beyond |x| = 1e5): a libm call costs as much as the rest
   of the mass matrix of a 7-joint arm;

@@ -82,6 +82,11 @@ def test_forces_units_on_values(cli):
         (("forces", "pendulum", "--at", "theta=0.5m"),
          "error: --at theta: '0.5m' is not in units compatible with 'rad'"),
         (("forces", "pendulum", "--at", "theta"), "error: --at: expected NAME=VALUE, got 'theta'"),
+        # a name given twice: one of the two would be dropped without a word
+        (("forces", "pendulum", "--at", "theta=0.1,theta=0.2"),
+         "error: --at: 'theta' is given twice ('0.1', then '0.2'): give it once"),
+        (("dynamics", "pendulum", "--set", "m=1", "--set", "m=2"),
+         "error: --set: 'm' is given twice ('1', then '2'): give it once"),
         (("forces", "pendulum", "--set", "q=1"),
          "error: --set: 'q' is not a parameter of this model; expected one of: m, L, g"),
         (("forces", "pendulum", "--at", "theta=abc"),

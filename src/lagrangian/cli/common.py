@@ -227,14 +227,19 @@ def payloads(settings: Iterable[str]) -> dict[str, tuple[float, tuple[float, ...
 
 
 def assignments(settings: Iterable[str], option: str) -> list[tuple[str, str]]:
-    """NAME=VALUE options as (name, value text) pairs."""
-    pairs = []
+    """NAME=VALUE options as (name, value text) pairs; a name given twice is refused (one of
+    the two would be dropped without a word)."""
+    pairs: dict[str, str] = {}
     for setting in settings:
         name, sep, value = setting.partition("=")
-        if not sep or not name.strip() or not value.strip():
+        name, value = name.strip(), value.strip()
+        if not sep or not name or not value:
             raise InputError(f"expected NAME=VALUE, got {setting!r}", field=option)
-        pairs.append((name.strip(), value.strip()))
-    return pairs
+        if name in pairs:
+            raise InputError(f"{name!r} is given twice ({pairs[name]!r}, then {value!r}): give "
+                             f"it once", field=option)
+        pairs[name] = value
+    return list(pairs.items())
 
 
 def warn_if_unphysical(eom: EquationsOfMotion) -> None:

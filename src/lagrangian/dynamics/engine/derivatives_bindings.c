@@ -164,29 +164,6 @@ typedef struct {
     int nomemory;    /* the thread's work block could not be had */
 } dk_job;
 
-/* Whether every finite state's ball-joint quaternions are unit within the tolerance; else 0 with
-   a ValueError, and the caller's guarded path names the joint, the state and its norm. */
-static int dk_unit_balls(const dk_tree *tree, const double *q, npy_intp states, npy_intp step)
-{
-    for (npy_intp k = 0; k < states; k++) {
-        const double *x = q + k * step;
-        int finite = 1;
-        for (int i = 0; i < tree->nq; i++) finite &= isfinite(x[i]) != 0;
-        if (!finite) continue;
-        for (int i = 0; i < tree->nb; i++) {
-            const double *b = DK_BODY_OF(tree, i);
-            if (!(TK_BALL(b) || TK_FLYER(b)) || b[TK_COLUMN] != 1.0) continue;
-            const double *e = x + tree->qo + (int)b[TK_QCOORD] + (TK_FLYER(b) ? 3 : 0);
-            const double norm = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
-            if (!(fabs(norm - 1.0) <= DK_QTOL)) {
-                PyErr_SetString(PyExc_ValueError, "q: a joint's quaternion is not unit");
-                return 0;
-            }
-        }
-    }
-    return 1;
-}
-
 /* the numbers of input j: q nq (a floating base's 7 first), v, a and tau nv */
 static inline int dk_width(const dk_tree *tree, int j) { return j == 0 ? tree->nq : tree->nv; }
 
@@ -376,9 +353,11 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
                                          step[0] ? count : 1, step[0], tree->nq, DK_QTOL))
         goto done;
     if ((tree->t.balls || tree->t.flyers)
-        && !dk_unit_balls(tree, (const double *)PyArray_DATA(in[0]), step[0] ? count : 1,
-                          step[0]))
+        && !tk_unit_balls(&tree->t, (const double *)PyArray_DATA(in[0]), step[0] ? count : 1,
+                          step[0])) {
+        PyErr_SetString(PyExc_ValueError, "q: a joint's quaternion is not unit");
         goto done;
+    }
     P = (PyArrayObject *)PyArray_FROMANY(args[3], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
     if (!P) goto done;
     if (PyArray_SIZE(P) != 3 + tree->nj + 13 * tree->nb) {

@@ -128,6 +128,28 @@ static int tk_whole_balls(const tk_tree *t)
     return 1;
 }
 
+/* Whether every finite state's ball-joint and below-the-root flyer quaternions are unit within
+   the tolerance (``states`` states of q, ``step`` apart; a split joint's on its first record),
+   else 0 and the front names the joint, the state and its norm (tree/spherical.py). */
+static int tk_unit_balls(const tk_tree *t, const double *q, Py_ssize_t states, Py_ssize_t step)
+{
+    for (Py_ssize_t k = 0; k < states; k++) {
+        const double *x = q + k * step;
+        int finite = 1;
+        for (int i = 0; i < t->nq; i++) finite &= isfinite(x[i]) != 0;
+        if (!finite) continue;
+        for (int i = 0; i < t->nb; i++) {
+            const double *b = t->body + i * TK_STRIDE;
+            if (!(TK_BALL(b) || TK_FLYER(b)) || b[TK_COLUMN] > 1.0) continue;
+            /* a ball's w x y z, a flyer's x y z w after its x, y, z */
+            const double *e = x + t->bq + (int)b[TK_QCOORD] + (TK_FLYER(b) ? 3 : 0);
+            const double norm = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
+            if (!(fabs(norm - 1.0) <= t->qtol)) return 0;
+        }
+    }
+    return 1;
+}
+
 /* S = ((0, 0, s_w), (0, 0, s_v)) per unit rate of q (the multiplier k included), about the
    joint's z, of a joint of one number (not a free flyer's, not a ball's): the tree's numbers
    alone. */

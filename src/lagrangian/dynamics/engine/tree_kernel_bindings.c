@@ -211,27 +211,6 @@ static PyObject *tk_py_prepare(PyObject *self, PyObject *const *args, Py_ssize_t
     return capsule;
 }
 
-/* Whether every finite state's ball-joint quaternions are unit within the tolerance (else the
-   front names the joint, the state and its norm: tree/spherical.py). */
-static int tk_unit_balls(const tk_tree *t, const double *q, npy_intp states, npy_intp step)
-{
-    for (npy_intp k = 0; k < states; k++) {
-        const double *x = q + k * step;
-        int finite = 1;
-        for (int i = 0; i < t->nq; i++) finite &= isfinite(x[i]) != 0;
-        if (!finite) continue;
-        for (int i = 0; i < t->nb; i++) {
-            const double *b = t->body + i * TK_STRIDE;
-            if (!TK_BALL(b) && !TK_FLYER(b)) continue;
-            /* a ball's w x y z, a flyer's x y z w after its x, y, z */
-            const double *e = x + t->bq + (int)b[TK_QCOORD] + (TK_FLYER(b) ? 3 : 0);
-            const double norm = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
-            if (!(fabs(norm - 1.0) <= t->qtol)) return 0;
-        }
-    }
-    return 1;
-}
-
 static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int kind)
 {
     PyArrayObject *in[3] = {NULL, NULL, NULL};

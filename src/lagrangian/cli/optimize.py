@@ -24,7 +24,8 @@ FROM_HELP = ("The start: STATE=VALUE, named as simulate --initial (default: the 
 BOUND_HELP = ("NAME=LOWER:UPPER on an input or a state (u=-5:5, x=-1:1; leave a side empty "
               "for no bound: x=:1). A bound on a name that is not a state makes it an input.")
 INPUT_HELP = ("An input to optimise: a load, a parameter or a coordinate (a generalized force "
-              "on it), as in linearize. Default: the --bound names that are not states.")
+              "on it; a ball joint's moment shoulder_wx ..), as in linearize; repeat, or "
+              "separate by commas. Default: the --bound names that are not states.")
 METHOD_HELP = "trapezoidal or hermite-simpson."
 
 
@@ -68,7 +69,8 @@ def optimize(
         bounds[name] = tuple(None if not side.strip() else
                              lagrangian.parse_quantity(side.strip(), None, f"--bound {name}")
                              for side in (lower, upper))
-    inputs = list(input_) or [name for name in bounds if name not in states]
+    named = [name.strip() for text in input_ for name in text.split(",") if name.strip()]
+    inputs = named or [name for name in bounds if name not in states]
     trajectory = lagrangian.optimize(system, inputs, t_final, nodes, start=start or None,
                                      goal=goal, bounds=bounds, method=method)
     if json_:

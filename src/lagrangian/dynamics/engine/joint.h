@@ -87,7 +87,6 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
     }
     t->nq = t->bq + t->n + t->balls + t->flyers;
     t->nv = t->bv + t->n;
-    if (t->balls || t->flyers) t->mimic = 1;  /* forward dynamics by Cholesky of M */
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
         if (!(b[TK_PARENT] >= -1 && b[TK_PARENT] < i))

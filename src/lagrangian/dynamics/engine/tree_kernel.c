@@ -43,6 +43,12 @@
    to six, to 70 (before TW_CS) */
 enum { TW_RW = TW_A, TW_OW = TW_RW + 9, TW_IC = TW_OW + 3, TW_COLS = TW_IC + 10 };
 
+/* the articulated-body algorithm's scratch per body after R, p: V 6, C 6, A 6, IA 36, PA 6, U 6,
+   D, u; a ball's or a flyer's below the root D^-1 (its factor), u and U in its IA's place once
+   its parent has its share (the backward pass reads a body's IA no more) */
+enum { TA_V = TW_A, TA_C = TA_V + 6, TA_A = TA_C + 6, TA_IA = TA_A + 6, TA_PA = TA_IA + 36,
+       TA_U = TA_PA + 6, TA_D = TA_U + 6, TA_UU = TA_D + 1 };
+
 /* TK_CORE_BEGIN */
 /* The recursions, emitted twice by compact_kernel.py: on one state (tk_*, TK_T double) and
    on LG_LANES states at once (tk4_*, TK_T lg_v4). TK_FN(name) names a function, TK_C(x) a

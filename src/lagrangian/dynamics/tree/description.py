@@ -6,9 +6,8 @@ The description ``D`` (float64, contiguous), built by ``describe``:
 
     D[0] nb bodies, D[1] n the joints' velocity numbers (their coordinates, but 3 for a ball
     joint's 4 configuration numbers), D[2:5] the gravity vector g * direction (world
-    axes, m/s^2), D[5] 1 where a coordinate drives more or fewer than one body (mimic joints)
-    or the tree has a ball joint: forward dynamics by Cholesky of M instead of the
-    articulated-body algorithm, D[6] 1 for a
+    axes, m/s^2), D[5] 1 where a coordinate drives more than one body (mimic joints): forward
+    dynamics by Cholesky of M instead of the articulated-body algorithm, D[6] 1 for a
     floating base (body 0 on a free flyer: q of n + 7 numbers, v of n + 6, free_flyer.py's
     layout), D[7] the quaternion-norm tolerance (free_flyer.QUATERNION_TOLERANCE);
     D[8:8+n] the actuator parameters tau_<joint> (N m or N), acting as loads, one per velocity
@@ -105,8 +104,8 @@ def describe(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray
     D = np.zeros(HEADER + n + nb * STRIDE)
     D[0], D[1] = nb, n
     D[2:5] = float(parameters.get(tree.gravity_parameter, 0.0)) * np.array(tree.gravity_direction)
-    drives = np.bincount([j.coordinate for j in tree.joints if j.coordinate >= 0], minlength=n)
-    D[5] = float(not np.all(drives == 1) or bool(tree.quaternion_joints))
+    coordinates = [j.coordinate for j in tree.joints if j.coordinate >= 0]
+    D[5] = float(len(set(coordinates)) < len(coordinates))  # a mimic joint's shared coordinate
     D[6], D[7] = float(tree.floating_base), QUATERNION_TOLERANCE
     D[HEADER:HEADER + n] = [float(parameters.get(a, 0.0)) for a in tree.actuators]  # None: 0
     frames = [canonical_frame(j) for j in tree.joints]

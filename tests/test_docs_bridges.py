@@ -88,3 +88,19 @@ def test_opty_block_prints_the_cart_poles_equations(capsys):
     equations = namespace["equations"]
     assert [str(x) for x in equations.states] == ["x(t)", "theta(t)", "x_dot(t)", "theta_dot(t)"]
     assert "r_push(t)" in capsys.readouterr().out
+
+
+def test_optimize_ball_block_turns_the_body_by_the_closed_form(tmp_path, monkeypatch, capsys,
+                                                                cli):
+    """Rest to rest by THETA about a principal axis in T: cost 12 I^2 THETA^2 / T^3."""
+    monkeypatch.chdir(tmp_path)  # the example writes body.xml where it runs
+    namespace: dict = {}
+    exec(python_of("bridges-ball-optimize"), namespace)  # noqa: S102 - our own documentation
+    best = namespace["best"]
+    assert best.converged
+    assert best.cost == pytest.approx(12 * 0.4**2 * 1.2**2 / 1.5**3, rel=1e-4)
+    assert capsys.readouterr().out.strip().splitlines()[-1] == "True"
+    (as_json,) = commands("bridges-ball-optimize")
+    result = cli(*as_json)
+    assert result.code == 0, result.err
+    assert json.loads(result.out)["cost"] == pytest.approx(best.cost, rel=1e-5)

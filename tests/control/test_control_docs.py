@@ -196,3 +196,13 @@ def test_computed_torque_on_ball_joints_section(capsys, tmp_path, monkeypatch, c
     final = json.loads(result.out)["final_state"]
     assert final["shoulder_qw"] == pytest.approx(0.8, abs=1e-8)
     assert final["shoulder_qx"] == pytest.approx(0.6, abs=1e-8)
+
+
+def test_lqr_on_a_ball_joint_section(capsys, tmp_path, monkeypatch, cli):
+    monkeypatch.chdir(tmp_path)  # the example writes top.xml where it runs
+    lines = _run("control-ball-lqr", capsys)
+    assert float(lines[0]) < -0.5 and lines[-1] == "True"
+    result = cli(*_command("control-ball-lqr"))
+    assert result.code == 0, result.err
+    final = json.loads(result.out)["final_state"]
+    assert np.hypot(final["pivot_qx"], final["pivot_qy"]) < 1e-3  # upright: sin(tilt / 2)

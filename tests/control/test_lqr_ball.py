@@ -159,3 +159,12 @@ def test_a_body_held_on_a_floating_joint_between_links(tmp_path):
     assert run.completed
     back = regulator.state(np.asarray(run.q)[-1], np.asarray(run.q_dot)[-1])
     assert np.abs(back).max() < 1e-3
+
+
+def test_the_linearization_along_a_run_refuses_a_ball_in_one_line(top):
+    """A(t) along a run is built on q_dot = v: a ball's quaternion is refused by name."""
+    _, system, _ = top
+    run = system.simulate(0.1, samples=3)
+    with pytest.raises(InputError, match="joint 'pivot' is not linearized along a run") as info:
+        system.linearize_along(run)
+    assert "\n" not in str(info.value)

@@ -51,6 +51,7 @@ def linearize_along(dynamics, simulation, inputs=None,
     ``simulation``'s samples; ``inputs`` names the coordinates whose generalized forces are u
     (default all)."""
     names = tuple(dynamics.coordinates)
+    _refuse_quaternions(dynamics)
     if tuple(simulation.coordinates) != names:
         raise InputError("the simulation is not of this system (its coordinates are "
                          f"{', '.join(simulation.coordinates)})", field="simulation")
@@ -81,3 +82,18 @@ def linearize_along(dynamics, simulation, inputs=None,
         dynamics, TrajectoryLinearization(t, A, B, (), inputs), q, v, t, independent)
     return TrajectoryLinearization(t, A, B, (*kept, *(f"{c}_dot" for c in kept)), inputs,
                                    dependent)
+
+
+def _refuse_quaternions(dynamics) -> None:
+    """One line for a tree whose q and v differ (a ball joint, a floating joint or base): A(t)
+    here is built on q_dot = v."""
+    tree = getattr(getattr(dynamics, "model", None), "kinematic_tree", None)
+    joints = getattr(tree, "quaternion_joints", ()) or ()
+    if tree is None or not (joints or tree.floating_base):
+        return
+    if not joints:
+        raise InputError("a floating base is not linearized along a run yet (q_dot is not v "
+                         "for its quaternion)", field="simulation")
+    raise InputError(f"the joint '{joints[0].name}' is not linearized along a run yet (q_dot is "
+                     "not v for its quaternion); linearize and lqr take it about a rest, in "
+                     "its Euler angles", field="simulation")

@@ -400,6 +400,9 @@ class System(CheckMethods, ControlMethods, StudyMethods, ConservationMethods, Im
         parameters kept as symbols. ``steady`` linearizes about a steady motion instead: cyclic
         coordinates turning at constant rates, e.g.
         ``steady={"psi_dot": 10}`` (rad/s), the rest at ``about`` (the others solved for).
+        A robot with a ball joint (or a floating joint between links) is linearized in the
+        model's Euler angles (``shoulder__x``, ``__y``, ``__z``, R = Rx Ry Rz), and ``lqr`` of
+        it reads a run's quaternion state into them: docs/control.md.
         """
         from ..analysis.linearization import linear_model_at, symbolic_linear_model
         from ..compile.at_rest import AtRestFunctions

@@ -112,7 +112,9 @@ def lqr(linear_model: LinearModel, Q, R) -> LQR:
     """The LQR about ``linear_model`` (System.linearize(about, inputs=[...]) or a modal
     analysis' ``linear_model``): weights Q on x = [z - z0; z_dot] (number, diagonal or
     matrix, positive semidefinite) and R on u (positive definite). Refused in one line when
-    (A, B) is not stabilizable or Q leaves an unstable mode unweighted."""
+    (A, B) is not stabilizable or Q leaves an unstable mode unweighted. On a robot with ball
+    joints z are the model's Euler angles and the inputs generalized forces there (its
+    coordinates, actuators), the controller taking the run's quaternion state."""
     import scipy.linalg
 
     model = getattr(linear_model, "linear_model", linear_model)  # a ModalAnalysis too

@@ -20,7 +20,15 @@ from sympy.printing.c import C99CodePrinter
 from ..derivation.equations import EquationsOfMotion
 from .exact import distinct_nodes, machine_numbers
 
-TEMPLATE = Path(__file__).with_name("template.c")
+# the numerics appended after the generated functions: the solve and DOP853, the ensembles,
+# then the Python bindings (one text: template_text)
+TEMPLATES = tuple(Path(__file__).with_name(name) for name in
+                  ("template.c", "template_ensemble.c", "template_bindings.c"))
+
+
+def template_text() -> str:
+    """The numerics template's C, its three parts in order."""
+    return "\n".join(path.read_text(encoding="utf-8") for path in TEMPLATES)
 
 # x**2 .. x**4 as products: pow() is a library call at -O2 without fast-math.
 _EXPAND_POW = create_expand_pow_optimization(4)
@@ -409,5 +417,5 @@ def generate(eom: EquationsOfMotion, vector: bool = False) -> GeneratedSource:
         names = sorted({type(e).__name__ if not isinstance(e, sp.Basic) else str(e.func)
                         for e in unsupported})
         raise CodegenError(f"no C translation for {', '.join(names)}")
-    source = "\n".join(body) + "\n" + TEMPLATE.read_text()
+    source = "\n".join(body) + "\n" + template_text()
     return GeneratedSource(source=source, parameters=parameters, n=n, m=m)

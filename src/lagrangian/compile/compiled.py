@@ -361,10 +361,11 @@ def load(generated: GeneratedSource) -> ModuleType:
 
 @lru_cache(maxsize=1)
 def _generator_key() -> str:
-    """The code generator itself (codegen.py, template.c): a new generator is a new module."""
+    """The code generator itself (codegen.py, the template's three parts): a new generator is a
+    new module."""
     here = Path(__file__).parent
-    return hashlib.sha256(b"".join((here / f).read_bytes() for f in ("codegen.py", "template.c"))
-                          ).hexdigest()
+    names = ("codegen.py", "template.c", "template_ensemble.c", "template_bindings.c")
+    return hashlib.sha256(b"".join((here / f).read_bytes() for f in names)).hexdigest()
 
 
 def keyed_module_name(key: str, native: bool = False, exact: bool = False) -> str:

@@ -42,7 +42,7 @@ def relative_drift(change: np.ndarray, initial: float, others=(), *,
 def energy_drift(energy: np.ndarray, kinetic: np.ndarray | None = None) -> float:
     """max |E - E0| / |E0| of a run's energy samples (relative to the largest T where E0 = 0).
     The one definition: SimulationResult.energy_drift and the compiled ensembles' summary
-    (compile/template.c lg_summary, tested against this) agree with it."""
+    (compile/template_ensemble.c lg_summary, tested against this) agree with it."""
     return relative_drift(energy - energy[0], energy[0], () if kinetic is None else (kinetic,))
 
 

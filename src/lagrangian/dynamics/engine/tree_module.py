@@ -67,7 +67,7 @@ _METHODS = " ".join(
 def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
     """The compiled module's C: the recursive functions, lg_parts/lg_energy/lg_residual for
     template.c (simulation, accelerations), and batched bindings for each function."""
-    from ...compile.codegen import TEMPLATE, GeneratedSource
+    from ...compile.codegen import GeneratedSource, template_text
 
     n = tree.nv  # v's numbers; q's are RT_NQ (a floating base's, ball joints' quaternions)
     starts = [iq for *_, iq, _ in quaternion_slices(tree)]  # ball joints', free flyers' below
@@ -123,7 +123,7 @@ static void lg_residual(const double *restrict q, const double *restrict v, doub
         f"#define LG_EXTRA_METHODS {_METHODS}",
         "#define RT_VECTOR_FORWARD " + ("1" if "rt4_forward_dynamics" in functions else "0"),
         "#define RT_VECTOR " + ("1" if "rt4_mass_matrix" in functions else "0"),
-        TEMPLATE.read_text(),
+        template_text(),
         _THREADS,
         _quaternion_check(starts, tree.floating_base) if starts else "",
         _BINDINGS,
@@ -133,12 +133,16 @@ static void lg_residual(const double *restrict q, const double *restrict v, doub
 
 @lru_cache(maxsize=1)
 def _generator_key() -> str:
-    """The tree generator itself: a change to any of its files is a new module."""
+    """The tree generator itself: a change to any of its files, or to the numerics template its
+    module carries (compile/template*.c), is a new module."""
+    from ...compile.codegen import TEMPLATES
+
     here = Path(__file__).parents[1]  # dynamics/: the generator spans emit/, tree/, engine/
     files = ("emit/tree_emitter.py", "emit/tree_algorithms.py", "emit/tree_floating.py",
              "tree/joint_models.py", "emit/tree_c.py", "engine/tree_module.py",
              "engine/batch_threads.c", "engine/tree_bindings.c")
-    return hashlib.sha256(b"".join((here / f).read_bytes() for f in files)).hexdigest()
+    return hashlib.sha256(b"".join((here / f).read_bytes() for f in files)
+                          + b"".join(path.read_bytes() for path in TEMPLATES)).hexdigest()
 
 
 def tree_key(tree: KinematicTree, parameters: tuple[str, ...]) -> str:

@@ -8,11 +8,14 @@ Q_theta . dtheta = tau . E dtheta), so a ball's moment in its body's axes (N m).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..dynamics.tree.model_charts import ModelCharts
 from ..errors import InputError
+
+if TYPE_CHECKING:  # loaded where a tree has a ball (tree_charts): linearize's path stays small
+    from ..dynamics.tree.model_charts import ModelCharts
 
 
 @dataclass(frozen=True)
@@ -60,6 +63,8 @@ def tree_charts(system) -> TreeCharts | None:
     if tree is None or tree.floating_base or not tree.quaternion_joints \
             or not system.runs_on_tree:
         return None
+    from ..dynamics.tree.model_charts import ModelCharts
+
     actuators = tuple(a for a in tree.actuators if a)
     return TreeCharts(ModelCharts(model, system.dynamics().velocity_names),
                       (*(c.name for c in model.coordinates), *actuators))

@@ -38,9 +38,10 @@ if TYPE_CHECKING:  # the names below, for type checkers and readers; loaded on f
     from ..simulation.events import StopCondition
     from ..simulation.options import SaveAt, StepControl
     from .layout import StateLayout, state_layout
+    from .loading import load
     from .modes import ModalAnalysis
     from .simulation import Simulation
-    from .system import System, SystemBuilder, load
+    from .system import System, SystemBuilder
 
     SimulationResult = Simulation
 
@@ -106,7 +107,7 @@ _HOMES = {
     "Simulation": (".simulation", "Simulation"),
     "System": (".system", "System"),
     "SystemBuilder": (".system", "SystemBuilder"),
-    "load": (".system", "load"),
+    "load": (".loading", "load"),
     "SimulationResult": (".simulation", "Simulation"),
 }
 

@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import InputError, ModelError, did_you_mean_or_list
 from .joint_space import Dynamics, solve_positive
 from .tree.free_flyer import BASE_VELOCITY
+from .tree_terms import TreeTerms
 
 
 def actuator_values(model, armature: Mapping[str, float] | None,
@@ -56,7 +57,7 @@ def actuator_values(model, armature: Mapping[str, float] | None,
     return values
 
 
-class ActuatedDynamics(Dynamics):
+class ActuatedDynamics(TreeTerms, Dynamics):
     """A robot's dynamics with its actuators: armature on M's diagonal, viscous damping and
     Coulomb friction in the bias (module docstring); frames and the rest from the rigid body's
     dynamics underneath (``rigid``)."""

@@ -5,60 +5,19 @@ mixed into joint_space.Dynamics (every path, a URDF tree's and a model file's)."
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from functools import partial
-from typing import NamedTuple
 
 import numpy as np
 
 from ..errors import InputError
-from .regressor import (
-    BASE_TOLERANCE,
-    BaseParameters,
-    ModelRegressor,
-    tree_parameter_names,
-    tree_parameters,
-    tree_regressor,
-)
-
-
-class DerivativesKernel(NamedTuple):
-    """A tree's compiled derivatives (derivatives_c.py): each function takes (Q, V, X, P); the
-    C refuses a base quaternion of the wrong norm with a ValueError, the checked ones name the
-    state and the norm in one line first (the guarded way)."""
-
-    inverse: Callable
-    forward: Callable
-    regressor: Callable
-    P: np.ndarray
-    checked_inverse: Callable
-    checked_regressor: Callable
+from .regressor import BASE_TOLERANCE, BaseParameters, ModelRegressor
 
 
 class ControlTerms:
     """Regressor and parameters (a mixin of joint_space.Dynamics; SI units)."""
 
     def _regressor_of(self, parameters: Sequence[str] | None):
-        tree = getattr(self, "tree", None)
-        if tree is not None:
-            if parameters is not None:
-                raise InputError("a robot's regressor is over its bodies' 10 inertial "
-                                 "parameters each; parameters=[...] is for model files",
-                                 field="parameters")
-            # compiled C (derivatives_c.py) where a compiler works, else numpy
-            fast = self._derivatives_kernel()
-            if fast is not None:
-                compute, P = fast.checked_regressor, fast.P
-                return (lambda Q, V, A: compute(Q, V, A, P),
-                        tree_parameter_names(tree), tree_parameters(tree))
-            recursions = self.__dict__.get("_regressor_recursions")
-            if recursions is None:  # once per dynamics: the bodies in their own joint frames
-                from .recursive_numpy import NumpyBackend
-
-                recursions = NumpyBackend(tree, self.parameters, self.n, own_frames=True)
-                self.__dict__["_regressor_recursions"] = recursions
-            return (lambda Q, V, A: tree_regressor(recursions, Q, V, A),
-                    tree_parameter_names(tree), tree_parameters(tree))
         if parameters is None:
             raise InputError("name the parameters the model's T and V are linear in: "
                              "regressor(q, v, a, parameters=[...])", field="parameters")
@@ -77,15 +36,6 @@ class ControlTerms:
         quaternion, v and a of nv) has nv rows, the first six the wrench on the base in its own
         axes, force then moment (Pinocchio's layout). A model file: the named ``parameters``, in
         which T and V must be linear."""
-        fast = self._derivatives_kernel() if parameters is None else None
-        if fast is not None:  # one C call; a bad input goes
-            # the guarded way to be named
-            try:
-                out = fast.regressor(q, v, a, fast.P)
-            except (ValueError, TypeError):
-                pass
-            else:
-                return out if out.__class__ is not tuple else _reported(out)[0]
         compute, names, _ = self._regressor_of(parameters)
         return self._guarded(compute, (q, v, a), ("q", "v", "a"), (self.n, len(names)))
 
@@ -108,70 +58,32 @@ class ControlTerms:
         count = states if states is not None else max(20 * len(names) // max(self.n, 1), 20)
         rng = np.random.default_rng(seed)
         q = rng.uniform(-np.pi, np.pi, (count, self.nq))
-        if getattr(getattr(self, "tree", None), "floating_base", False):
-            q[:, :3] = rng.uniform(-1.0, 1.0, (count, 3))
-            quaternion = rng.normal(size=(count, 4))  # uniform on the unit sphere
-            q[:, 3:7] = quaternion / np.linalg.norm(quaternion, axis=-1, keepdims=True)
+        self._place_bases(q, rng)
         v, a = rng.uniform(-1.0, 1.0, (2, count, self.n))
         stacked = np.asarray(compute(q, v, a)).reshape(count * self.n, len(names))
         return BaseParameters(names, stacked, tolerance)
 
     # -- derivatives (derivatives_c.py, derivatives.py) -------------------------------------------
 
-    def _derivatives_kernel(self):
-        """The tree's compiled module's DerivativesKernel (derivatives_c.py), or None: a
-        compiled backend's tree of revolute, prismatic, helical and ball joints (a floating base
-        too); a free flyer below the root, the numpy backend and a model file keep
-        derivatives.py."""
-        found = self.__dict__.get("_derivatives_c", False)
-        if found is False:
-            found = None
-            tree = getattr(self, "tree", None)
-            if tree is not None and getattr(self, "module", None) is not None:
-                from .engine.derivatives_c import applies, derivatives_module, runtime_values
-
-                module = derivatives_module(tree) if applies(tree) else None
-                if module is not None:
-                    inverse, regressor = module.inverse_derivatives, module.regressor
-                    checked = (inverse, regressor)
-                    if tree.floating_base:
-                        from .tree.free_flyer import checking_quaternions
-
-                        checked = tuple(checking_quaternions(f) for f in checked)
-                    found = DerivativesKernel(inverse, module.forward_derivatives, regressor,
-                                              runtime_values(tree, self.parameters), *checked)
-            self.__dict__["_derivatives_c"] = found
-        return found
+    def _place_bases(self, q, rng) -> None:
+        """Put random floating-base states into q (count, nq) in place: a model file has none
+        (tree_terms.py)."""
 
     def _inverse_derivatives(self):
         found = self.__dict__.get("_derivatives")
         if found is None:
-            tree = getattr(self, "tree", None)
-            fast = self._derivatives_kernel()
-            if fast is not None:
-                inverse, P = fast.checked_inverse, fast.P
-
-                def found(Q, V, A):
-                    return inverse(Q, V, A, P)[:2]
-            elif tree is not None:  # the numpy reference's Newton-Euler, by the complex step
-                from .derivatives import tree_inverse_dynamics_derivatives
-                from .recursive_numpy import NumpyBackend
-
-                recursions = getattr(self, "recursions", None)
-                if not isinstance(recursions, NumpyBackend):
-                    recursions = NumpyBackend(tree, self.parameters, self.n)
-
-                def found(Q, V, A):
-                    return tree_inverse_dynamics_derivatives(recursions, Q, V, A)
-            else:
-                from .derivatives import ModelDerivatives
-
-                if self._equations is None:
-                    raise InputError("this dynamics object was built without its equations",
-                                     field="q")
-                found = ModelDerivatives(self._equations(), dict(self.functions.parameters))
-            self.__dict__["_derivatives"] = found
+            found = self.__dict__["_derivatives"] = self._derivatives_source()
         return found
+
+    def _derivatives_source(self):
+        """(Q, V, A) -> (d tau/dq, d tau/dq_dot): a model file's from its derived M and f
+        (derivatives.py; a URDF tree's: tree_terms.py)."""
+        from .derivatives import ModelDerivatives
+
+        if self._equations is None:
+            raise InputError("this dynamics object was built without its equations",
+                             field="q")
+        return ModelDerivatives(self._equations(), dict(self.functions.parameters))
 
     def inverse_dynamics_derivatives(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
         """(d tau/dq, d tau/dq_dot) of tau = M(q) q_ddot + C q_dot + g, (..., n, n) each (row
@@ -180,17 +92,9 @@ class ControlTerms:
         the complex step through the numpy reference's Newton-Euler, along every joint's
         tangent (ball joints and free flyers too), exact to rounding; a model file's from its
         derived M and f."""
-        fast = self._derivatives_kernel()
-        if fast is not None:  # one C call; a bad input goes the guarded way to be named
-            try:
-                out = fast.inverse(q, v, a, fast.P)
-            except (ValueError, TypeError):
-                pass
-            else:
-                return out if len(out) == 2 else _reported(out)
         compute = self._inverse_derivatives()
         n = self.n
-        # partial, not a lambda: a closure would slow the compiled path above on every call
+        # partial, not a lambda: a closure pays for its cells on every call
         both = self._guarded(partial(_side_by_side, compute), (q, v, a), ("q", "v", "a"),
                              (n, 2 * n))
         return both[..., :n], both[..., n:]
@@ -200,14 +104,6 @@ class ControlTerms:
         """(d q_ddot/dq, d q_ddot/dq_dot, d q_ddot/d tau), (..., n, n) each, as Pinocchio's
         computeABADerivatives: -M^-1 d tau/dq and -M^-1 d tau/dq_dot at q_ddot = FD(q, q_dot,
         tau), and M^-1."""
-        fast = self._derivatives_kernel()
-        if fast is not None:
-            try:
-                out = fast.forward(q, v, tau, fast.P)
-            except (ValueError, TypeError):
-                pass
-            else:
-                return out if len(out) == 3 else _reported(out)
         n = self.n
         # forward dynamics' rule: one warning for the three, a state's three rows NaN together
         # (an input not finite, or M not positive definite), as the C's
@@ -244,13 +140,3 @@ def _inverses(mass: np.ndarray) -> np.ndarray:
             except np.linalg.LinAlgError:
                 pass
     return out.reshape(mass.shape)
-
-
-def _reported(out: tuple) -> tuple:
-    """The C's (outputs..., count of NaN rows): one DynamicsWarning at the user's call, and the
-    outputs."""
-    from .tree.numbers import warn_undefined
-
-    first = out[0]
-    warn_undefined(out[-1], int(np.prod(first.shape[:-2], dtype=np.int64)), stacklevel=4)
-    return out[:-1]

@@ -32,7 +32,6 @@ import numpy as np
 from ..compile.functions import NumericSystem
 from ..derivation.equations import EquationsOfMotion
 from ..errors import DerivationError, DynamicsWarning, InputError, ModelError
-from .algorithms.frames import TreeKinematics, tree_kinematics
 from .control_terms import ControlTerms
 from .tree.numbers import (
     batch_shape,
@@ -154,45 +153,41 @@ class Dynamics(ControlTerms):
         flat = [np.broadcast_to(x, batch + x.shape[-1:]).reshape(total, x.shape[-1])
                 for x in arrays]
         if self.velocity_names is not None and fields[0] == "q":  # a floating base's quaternion
-            tree = getattr(self, "tree", None)
-            if tree is not None and tree.quaternion_joints:  # and the ball joints' (tree/spherical.py)
-                from .tree.spherical import check_tree_quaternions
-
-                check_tree_quaternions(tree, flat[0])
-            else:
-                from .tree.free_flyer import check_quaternions
-
-                check_quaternions(flat[0])
+            self._check_quaternions(flat[0])
         out, good = over_finite_rows(compute, flat, tail, forward)
         bad = total - int(good.sum())
         if bad:
             warn_undefined(bad, total)
         return out.reshape(batch + tail)
 
+    def _check_quaternions(self, flat) -> None:
+        """Refuse q's quaternions of the wrong norm in one line (flat (N, nq)): a model file
+        has none (a floating base's are checked by its own class: tree_frames.py)."""
+
     # -- frames, Jacobians and the centre of mass (a URDF robot's tree: frames.py) --------------
 
     @property
-    def kinematics(self) -> TreeKinematics | ModelKinematics:
+    def kinematics(self) -> ModelKinematics:
         """Placements, frame Jacobians and the centre of mass of the robot's kinematic tree
         (refused in one line for a model without one)."""
-        found = self.__dict__.get("_tree_kinematics")
+        found = self.__dict__.get("_kinematics")
         if found is None:
-            found = self.__dict__["_tree_kinematics"] = self._frames_source()
+            found = self.__dict__["_kinematics"] = self._frames_source()
         return found
 
     def _frames_source(self):
-        """A URDF tree's frames (frames.py), else a model file's points and bodies from its own
-        expressions (model_frames.py), at this object's parameter values."""
-        tree = getattr(self, "tree", None)
+        """A model file's points and bodies from its own expressions (model_frames.py), at this
+        object's parameter values; refused in one line for a model without them."""
         model = getattr(self, "model", None)
-        if (tree is None or not tree.frames) and model is not None \
-                and model.kinematic_tree is None and (model.particles or model.bodies
-                                                      or model.rigid_bodies):
-            from .model_frames import ModelKinematics
+        from .model_frames import ModelKinematics, model_frames_apply
+
+        if model is not None and model_frames_apply(model):
 
             values = getattr(self, "parameters", None) or self.functions.parameters
             return ModelKinematics(model, values)
-        return tree_kinematics(tree)
+        raise InputError("frames, Jacobians and the centre of mass are those of a URDF "
+                         "robot's kinematic tree or a model file's particles and bodies; this "
+                         "model has neither (energies alone name no point)", field="frame")
 
     @property
     def frames(self) -> tuple[str, ...]:
@@ -204,123 +199,37 @@ class Dynamics(ControlTerms):
 
     def placement(self, q, frame: str) -> np.ndarray:
         """The frame's 4 x 4 placement in the world (rotation and origin in m), (..., 4, 4)."""
-        fast = self._reach
-        if fast is None:
-            fast = self._reach_kernel()
-        if fast:
-            try:
-                out = fast.placement(q, frame)
-            except (KeyError, ValueError, TypeError):
-                pass  # numpy below names the fault in one line
-            else:
-                return out if out.__class__ is not tuple else reported_rows(out, 2)
         return undefined_rows(self.kinematics.placement, (q, frame), (q,), 2)
 
     def jacobian(self, q, frame: str, reference: str = "local_world_aligned") -> np.ndarray:
         """The frame's 6 x n Jacobian, linear rows first, (..., 6, n); ``reference`` "world",
         "local" or "local_world_aligned" as Pinocchio's ReferenceFrame."""
-        fast = self._reach
-        if fast is None:
-            fast = self._reach_kernel()
-        if fast:
-            try:
-                out = fast.jacobian(q, frame, reference)
-            except (KeyError, ValueError, TypeError):
-                pass  # numpy below names the fault in one line
-            else:
-                return out if out.__class__ is not tuple else reported_rows(out, 2)
         return undefined_rows(self.kinematics.jacobian, (q, frame, reference), (q,), 2)
 
     def center_of_mass(self, q) -> np.ndarray:
         """The moving bodies' centre of mass in the world (m), (..., 3)."""
-        fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast:
-            try:  # None without moving mass: TypeError, then numpy's one-line refusal
-                out = fast.center_of_mass(q)
-                return out if out.__class__ is not tuple else reported_rows(out, 1)
-            except (ValueError, TypeError):
-                pass
         return undefined_rows(self.kinematics.center_of_mass, (q,), (q,), 1)
 
     def center_of_mass_jacobian(self, q) -> np.ndarray:
         """J_c with c_dot = J_c q_dot, (..., 3, n)."""
-        fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast:
-            try:
-                out = fast.center_of_mass_jacobian(q)
-                return out if out.__class__ is not tuple else reported_rows(out, 2)
-            except (ValueError, TypeError):
-                pass
         return undefined_rows(self.kinematics.center_of_mass_jacobian, (q,), (q,), 2)
 
     def jacobian_dot_times_v(self, q, v, frame: str,
                              reference: str = "local_world_aligned") -> np.ndarray:
         """J_dot q_dot: the frame's classical acceleration at q_ddot = 0 (m/s^2, rad/s^2),
         (..., 6), as Pinocchio's getFrameClassicalAcceleration with a = 0."""
-        fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast:
-            try:
-                out = fast.drift(q, v, frame, reference)
-                return out if out.__class__ is not tuple else reported_rows(out, 1)
-            except (KeyError, ValueError, TypeError):
-                pass  # numpy below broadcasts, or names the fault in one line
         return undefined_rows(self.kinematics.jacobian_dot_times_v, (q, v, frame, reference),
                               (q, v), 1)
 
     def centroidal_momentum_matrix(self, q) -> np.ndarray:
         """A_g with h_g = A_g q_dot (linear, then angular momentum about the centre of mass,
         world axes), (..., 6, n), as Pinocchio's ccrba."""
-        fast = self._reach
-        if fast is None:
-            fast = self._reach_kernel()
-        if fast:
-            try:  # None without moving mass: TypeError, then below
-                out = fast.centroidal(q)
-                return out if out.__class__ is not tuple else reported_rows(out, 2)
-            except (ValueError, TypeError):
-                pass
         return undefined_rows(self.kinematics.centroidal_momentum_matrix, (q,), (q,), 2)
-
-    # the compiled kernel of the functions above (reach_c.py): None until asked, then
-    # the kernel, or False (not the C backend, or no compiler)
-    _reach = None
-
-    def _reach_kernel(self):
-        self._reach = False
-        if getattr(self, "backend", None) in ("recursive", "compact"):  # compiled C backends
-            from .engine.reach_c import ReachKernel, reach_module
-
-            module = reach_module(self.tree)
-            if module is not None:
-                self._reach = ReachKernel(module, self.tree, self.kinematics.mass() > 0)
-        return self._reach
 
     def _with_wrenches(self, q, v, x, f_ext, forward: bool) -> np.ndarray:
         """Inverse or forward dynamics with wrenches at frames: tau_ext = sum J^T w
-        (wrenches.py) taken from tau, or added to it; in compiled C where it can be."""
-        fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast:
-            try:
-                if forward:  # a state not finite leaves NaN in tau, and forward dynamics warns
-                    tau = np.array(x, dtype=float)  # our own copy, added to in place
-                    fast.add_wrenches(q, f_ext, tau, 1.0)
-                    return self.forward_dynamics(q, v, tau)
-                one_pass = fast.inverse if fast.inverse is not None else fast.fused_inverse(self)
-                # one Newton-Euler pass (reach_inverse.c, on vector lanes over a batch) for a
-                # floating base or a few states; over many states of a fixed base the tree
-                # module's unrolled ID and then J^T w are the faster (measured: benchmarks.md)
-                if one_pass and (self.velocity_names is not None or q.__class__ is not np.ndarray
-                                 or q.ndim < 2 or len(q) <= 64):
-                    out = one_pass(q, v, x, f_ext)
-                    return out if out.__class__ is not tuple else reported_rows(out, 1, 5)
-                with warnings.catch_warnings():  # counted once, with the wrenches' states
-                    warnings.simplefilter("ignore", DynamicsWarning)
-                    tau = self.inverse_dynamics(q, v, x)
-                # the count of rows NaN after the last wrench (made NaN whole): the batch's
-                bad = fast.add_wrenches(q, f_ext, tau, -1.0)
-                return reported_rows((tau, bad) if bad else tau, 1, 5)
-            except (KeyError, ValueError, TypeError, AttributeError):
-                pass  # numpy below broadcasts, or names the fault in one line
+        (wrenches.py) taken from tau, or added to it (in compiled C where it can be:
+        tree_frames.py)."""
         inputs = (q, v, x, *f_ext.values()) if isinstance(f_ext, Mapping) else (q, v, x)
         return undefined_rows(self._wrenches_numpy, (q, v, x, f_ext, forward), inputs, 1, 5)
 
@@ -344,18 +253,12 @@ class Dynamics(ControlTerms):
         batch = batch_shape((q, v), ("q", "v"))
         Q = np.broadcast_to(q, batch + q.shape[-1:]).reshape(-1, q.shape[-1])
         V = np.broadcast_to(v, batch + v.shape[-1:]).reshape(-1, v.shape[-1])
-        if self.velocity_names is None:
-            return (Q + V).reshape(batch + q.shape[-1:])
-        tree = getattr(self, "tree", None)
-        if tree is not None and tree.quaternion_joints:  # each ball turned by exp(w dt) (spherical.py)
-            from .tree.spherical import check_tree_quaternions, integrate_tree
+        return self._integrate_rows(Q, V).reshape(batch + q.shape[-1:])
 
-            check_tree_quaternions(tree, Q)
-            return integrate_tree(tree, Q, V).reshape(batch + q.shape[-1:])
-        from .tree.free_flyer import check_quaternions, integrate
-
-        check_quaternions(Q)
-        return integrate(Q, V).reshape(batch + q.shape[-1:])
+    def _integrate_rows(self, Q, V) -> np.ndarray:
+        """Q + V over rows (N, n): a model file's coordinates are flat (quaternions:
+        tree_frames.py)."""
+        return Q + V
 
     def difference(self, q0, q1) -> np.ndarray:
         """v with q0 (+) v = q1 (integrate's inverse for dt = 1), (..., nv)."""
@@ -363,20 +266,11 @@ class Dynamics(ControlTerms):
         batch = batch_shape((q0, q1), ("q0", "q1"))
         Q0, Q1 = (np.broadcast_to(x, batch + x.shape[-1:]).reshape(-1, x.shape[-1])
                   for x in (q0, q1))
-        if self.velocity_names is None:
-            return (Q1 - Q0).reshape(batch + (self.n,))
-        tree = getattr(self, "tree", None)
-        if tree is not None and tree.quaternion_joints:
-            from .tree.spherical import check_tree_quaternions, difference_tree
+        return self._difference_rows(Q0, Q1).reshape(batch + (self.n,))
 
-            check_tree_quaternions(tree, Q0, "q0")
-            check_tree_quaternions(tree, Q1, "q1")
-            return difference_tree(tree, Q0, Q1).reshape(batch + (self.n,))
-        from .tree.free_flyer import check_quaternions, difference
-
-        check_quaternions(Q0)
-        check_quaternions(Q1)
-        return difference(Q0, Q1).reshape(batch + (self.n,))
+    def _difference_rows(self, Q0, Q1) -> np.ndarray:
+        """Q1 - Q0 over rows (N, n) (quaternions: tree_frames.py)."""
+        return Q1 - Q0
 
     def coriolis_matrix(self, q, v) -> np.ndarray:
         """C(q, q_dot) of the Coriolis and centrifugal terms, C q_dot = bias - g, with
@@ -389,35 +283,7 @@ class Dynamics(ControlTerms):
 
         A floating base's twist is not the rate of its coordinates: there C is the tree's
         spatial factorization (coriolis_tree.py), M_dot - 2C skew along q (+) v dt, (..., nv, nv)."""
-        if self.velocity_names is not None:  # quasi-velocities: Pinocchio's factorization
-            fast = self._reach if self._reach is not None else self._reach_kernel()
-            if fast and fast.coriolis is not None:  # compiled (reach_kernel.c)
-                try:
-                    out = fast.coriolis(q, v)
-                    return out if out.__class__ is not tuple else reported_rows(out, 2)
-                except (ValueError, TypeError):
-                    pass  # numpy below broadcasts, or names the fault in one line
-            from .algorithms.coriolis_tree import coriolis_matrix
-
-            # partial, not a lambda: a closure over self would slow the compiled path above
-            return self._guarded(partial(coriolis_matrix, self.kinematics), (q, v),
-                                 ("q", "v"), (self.n, self.n))
-        if not self._velocity_terms_are_christoffel():
-            raise DerivationError(
-                "C(q, q_dot) is the matrix of the Coriolis and centrifugal terms of M; this "
-                "model's velocity terms are not only those (a damper, a velocity-dependent load, "
-                "a moving support, or M changing with t): use bias_forces(q, q_dot)")
-        fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast:  # a fixed tree's C by the same factorization, compiled, where checked equal
-            compiled = fast.fixed_coriolis
-            if compiled is None:
-                compiled = fast.checked_coriolis(self)
-            if compiled:
-                try:
-                    out = compiled(q, v)
-                    return out if out.__class__ is not tuple else reported_rows(out, 2)
-                except (ValueError, TypeError):
-                    pass  # numpy below broadcasts, or names the fault in one line
+        self._require_christoffel()
         return self._guarded(self._christoffel_coriolis, (q, v), ("q", "v"), (self.n, self.n))
 
     def _christoffel_coriolis(self, q, v) -> np.ndarray:
@@ -433,6 +299,14 @@ class Dynamics(ControlTerms):
             self._christoffel = (self._equations is not None
                                  and velocity_terms_are_christoffel(self._equations()))
         return self._christoffel
+
+    def _require_christoffel(self) -> None:
+        """Refuse C in one line where the velocity terms are not only M's."""
+        if not self._velocity_terms_are_christoffel():
+            raise DerivationError(
+                "C(q, q_dot) is the matrix of the Coriolis and centrifugal terms of M; this "
+                "model's velocity terms are not only those (a damper, a velocity-dependent load, "
+                "a moving support, or M changing with t): use bias_forces(q, q_dot)")
 
     def mass_matrix(self, q) -> np.ndarray:
         """M(q), shape (..., n, n) (kg, kg m or kg m^2 per entry)."""

@@ -279,4 +279,11 @@ class ModelKinematics:
         return StateFunction(self.model, exprs), parts
 
 
-__all__ = ["ModelKinematics"]
+def model_frames_apply(model: Model) -> bool:
+    """Whether the model's frames are its own points and bodies: a model file's, not a URDF
+    robot's (whose frames are its tree's, frames.py)."""
+    return model.kinematic_tree is None and bool(model.particles or model.bodies
+                                                 or model.rigid_bodies)
+
+
+__all__ = ["ModelKinematics", "model_frames_apply"]

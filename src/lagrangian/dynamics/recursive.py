@@ -44,11 +44,12 @@ from .recursive_numpy import NumpyBackend, floating_refusal
 from .tree.applicable import TREE_PATH_BODIES, applicable_tree
 from .tree.numbers import batch_shape
 from .tree.spherical import check_tree_quaternions, quaternion_slices, refuse_spherical, unit_ball_quaternions
+from .tree_terms import TreeTerms
 
 BACKENDS = {"compact": "recursive", "unrolled": "recursive", "numpy": "recursive-numpy"}
 
 
-class TreeDynamics(Dynamics):
+class TreeDynamics(TreeTerms, Dynamics):
     """A tree's recursive dynamics over one backend, batched over leading axes (SI units).
 
     Every input is (..., n) (or (n,), broadcast against the others); outputs keep the batch

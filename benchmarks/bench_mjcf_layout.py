@@ -15,24 +15,13 @@ columns alternate in this process. MuJoCo's mj_forward on the same state is prin
 from __future__ import annotations
 
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
+from bench_engine import best
 from bench_variants import robots
 
 import lagrangian
-
-
-def best(call, calls: int = 200, runs: int = 7) -> float:
-    """Microseconds per call, the best of ``runs`` runs of ``calls`` calls."""
-    fastest = float("inf")
-    for _ in range(runs):
-        start = time.perf_counter()
-        for _ in range(calls):
-            call()
-        fastest = min(fastest, (time.perf_counter() - start) / calls)
-    return fastest * 1e6
 
 
 def solo_on_a_free_joint(folder: Path) -> Path:
@@ -90,7 +79,7 @@ def main() -> None:
     }
     names = list(layouts)
     print(f"Solo12 on an MJCF free joint, nv {model.nv} (us per call; mj_forward "
-          f"{best(lambda: mujoco.mj_forward(model, data)):.2f} us)")
+          f"{1e6 * best(lambda: mujoco.mj_forward(model, data), 200, 7):.2f} us)")
     print(f"{'':18s}" + "".join(f"{name:>18s}" for name in names) + "   MuJoCo's / flyer")
     data.qpos[:], data.qvel[:] = q, v
     for label, call in calls.items():
@@ -98,7 +87,7 @@ def main() -> None:
         for name in names:
             d, (x, y) = layouts[name], states[name]
             call(d, x, y)  # warm: built, cached, checked
-            times[name] = best(lambda d=d, x=x, y=y, call=call: call(d, x, y))
+            times[name] = 1e6 * best(lambda d=d, x=x, y=y, call=call: call(d, x, y), 200, 7)
         print(f"{label:18s}" + "".join(f"{times[name]:18.2f}" for name in names)
               + f"{times[names[0]] / times[names[1]]:14.2f}")
 

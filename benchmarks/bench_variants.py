@@ -8,7 +8,8 @@ One fresh process with an empty cache (LAGRANGIAN_CACHE in a temporary folder): 
 runs first (the engine's one-time builds, reported apart), then each variant in turn, timed
 from its load (its tables included) to its last answer. ``--kernel auto`` (the same as
 ``compact``) is what a user gets: every function on the one engine; ``--kernel unrolled`` puts
-M, ID and FD on each tree's own unrolled module (compiled per tree). Needs the bench extra (pin, example-robot-data) for the URDFs.
+M, ID and FD on each tree's own unrolled module (compiled per tree). Needs the bench extra
+(pin, example-robot-data) for the URDFs.
 """
 
 from __future__ import annotations

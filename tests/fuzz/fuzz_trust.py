@@ -290,15 +290,59 @@ def mjcf_documents(draw) -> str:
 
 
 def read_mjcf_document(text: str) -> None:
-    """parse_mjcf (a floating base): a robot model, or one line; an accepted model's masses
-    and inertias finite, its masses >= 0."""
+    """parse_mjcf in both layouts (MuJoCo's own, a free joint its three world slides and a
+    ball; and the floating base): a robot model, or one line; an accepted model's masses and
+    inertias finite, its masses >= 0."""
+    from lagrangian.model.mjcf import parse_mjcf
+
+    for floating_base in (False, True):
+        try:
+            model = parse_mjcf(text, floating_base=floating_base)
+        except LagrangianError:
+            if floating_base:
+                raise
+            continue  # refused in MuJoCo's layout (its one line): the floating base's below
+        _check_bodies(model)
+        if not floating_base:
+            _through_the_engine(model)
+
+
+def _through_the_engine(model) -> None:
+    """An accepted MJCF robot in MuJoCo's layout through the compiled engine at a random state
+    (unit quaternions): M symmetric, and M, ID, FD and its derivatives finite, or the row NaN
+    with the library's own DynamicsWarning (a massless branch: M not positive definite)."""
+    import numpy as np
+
+    from lagrangian import DynamicsWarning, System
+    from lagrangian.dynamics.tree.spherical import quaternion_slices
+
+    system = System(model)
+    if not system.runs_on_tree:
+        return
+    d = system.dynamics()
+    rng = np.random.default_rng(len(d.coordinates))
+    q = rng.uniform(-1.0, 1.0, len(d.coordinates))
+    for _, _, at, _ in quaternion_slices(d.tree):
+        q[at:at + 4] /= np.linalg.norm(q[at:at + 4])
+    v, tau = rng.uniform(-1.0, 1.0, (2, d.n))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynamicsWarning)  # the library's own: a NaN row
+        M = d.mass_matrix(q)
+        if not (np.isfinite(M).all() and np.array_equal(M, M.T)):
+            raise Broke(f"M not finite and symmetric: {M}")
+        if not np.isfinite(d.inverse_dynamics(q, v, tau)).all():
+            raise Broke("inverse dynamics not finite")
+        a = d.forward_dynamics(q, v, tau)
+        derivatives = d.forward_dynamics_derivatives(q, v, tau)
+    if np.isfinite(a).all() != all(np.isfinite(x).all() for x in derivatives):
+        raise Broke("forward dynamics and its derivatives disagree on being defined")
+
+
+def _check_bodies(model) -> None:
     import math
 
     import sympy as sp
 
-    from lagrangian.model.mjcf import parse_mjcf
-
-    model = parse_mjcf(text, floating_base=True)
     for body in model.rigid_bodies:
         for value in (body.mass, *(x for row in body.inertia for x in row)):
             number = sp.sympify(value)

@@ -283,8 +283,11 @@ static void TK_FN(mass_placed)(const tk_tree *t, TK_T *restrict W, TK_T *restric
             f[3] = x[0] + J[0] * sw[0] + J[3] * sw[1] + J[4] * sw[2];
             f[4] = x[1] + J[3] * sw[0] + J[1] * sw[1] + J[5] * sw[2];
             f[5] = x[2] + J[4] * sw[0] + J[5] * sw[1] + J[2] * sw[2];
-            for (int r = 0; r < count_of[i]; r++)  /* the joint's own block */
-                M[(ci + r) * n + ci + c] += SP_DOT(S + 6 * r, f) + SP_DOT(S + 6 * r + 3, f + 3);
+            for (int r = c; r < count_of[i]; r++) {  /* the joint's own block, mirrored: */
+                const TK_T e = SP_DOT(S + 6 * r, f) + SP_DOT(S + 6 * r + 3, f + 3);
+                M[(ci + r) * n + ci + c] += e;  /* M symmetric bit for bit */
+                if (r != c) M[(ci + c) * n + ci + r] += e;
+            }
             for (int k = parent_of[i]; k >= 0; k = parent_of[k]) {  /* += : mimics share */
                 const TK_T *Sk = W + k * TW_STRIDE + TW_COLS;
                 const int ck = column_of[k];

@@ -89,6 +89,13 @@ static inline int dk4_bits(dk4_mask mask)
 COLUMN = 57
 
 
+def _columns_of(records: np.ndarray) -> np.ndarray:
+    """Each record's joint's velocity numbers: a ball's 3, a free flyer's below the root 6,
+    else 1."""
+    kinds = records[:, 1]
+    return np.where(kinds == JOINT_CODES[JointKind.SPHERICAL], 3, np.where(kinds == FLYER, 6, 1))
+
+
 def description(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:
     """The tree's description D (describe) as this module reads it: each ball joint's and each
     free flyer below the root's one record made one per column of its body's twist in its own
@@ -99,8 +106,7 @@ def description(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndar
     D = describe(tree, parameters)
     n, nb = int(D[1]), int(D[0])
     records = D[HEADER + n:].reshape(nb, STRIDE)
-    columns = np.where(records[:, 1] == JOINT_CODES[JointKind.SPHERICAL], 3,
-                       np.where(records[:, 1] == FLYER, 6, 1))
+    columns = _columns_of(records)
     if (columns == 1).all():
         return D
     out, index = [], {}  # index: each old body's new one (a split joint's: its last column's)
@@ -318,9 +324,8 @@ def _real_columns(D: np.ndarray) -> np.ndarray:
     record's ten but those of a split joint's records before its last (massless, frameless)."""
     n, nb = int(D[1]), int(D[0])
     records = D[HEADER + n:].reshape(nb, STRIDE)
-    last = np.where(records[:, 1] == JOINT_CODES[JointKind.SPHERICAL], 3,
-                    np.where(records[:, 1] == FLYER, 6, 0))
-    real = (records[:, COLUMN] == 0) | (records[:, COLUMN] == last)
+    # a whole record (column 0), or a split joint's last column: its body's
+    real = (records[:, COLUMN] == 0) | (records[:, COLUMN] == _columns_of(records))
     return (10 * np.flatnonzero(real)[:, None] + np.arange(10)).ravel()
 
 

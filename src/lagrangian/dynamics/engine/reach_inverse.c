@@ -45,10 +45,11 @@ static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *re
                     A[0][j] += base[c][j] * qdd[c];
                 }
             }
-        } else if (RK_MANY(md, i)) {  /* a ball's three columns, a flyer's six */
-            RK_T columns_[6][6], c[6];
+        } else {  /* its columns (one; a ball's three, a flyer's six), each fixed in the body */
+            RK_T (*columns_)[6] = (RK_T (*)[6])S[i], many[6][6], c[6];
             int first;
             double mult;
+            if (RK_MANY(md, i)) columns_ = many;  /* more than S[i]'s one: recomputed below */
             const int columns = RK_FN(columns)(md, i, R, o, columns_, &first, &mult);
             for (int j = 0; j < 6; j++) {
                 V[i][j] = p < 0 ? RK_C(0.0) : V[p][j];
@@ -56,24 +57,13 @@ static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *re
             }
             for (int col = 0; col < columns; col++)
                 for (int j = 0; j < 6; j++) {
-                    V[i][j] += columns_[col][j] * qd[first + col];
-                    A[i][j] += columns_[col][j] * qdd[first + col];
+                    V[i][j] += columns_[col][j] * (mult * qd[first + col]);
+                    A[i][j] += columns_[col][j] * (mult * qdd[first + col]);
                 }
-            for (int col = 0; col < columns; col++) {  /* each fixed in the body: V x S */
+            for (int col = 0; col < columns; col++) {  /* d/dt S = V x S: S moves with its body */
                 RK_FN(motion_cross)(V[i], columns_[col], c);
-                for (int j = 0; j < 6; j++) A[i][j] += c[j] * qd[first + col];
+                for (int j = 0; j < 6; j++) A[i][j] += c[j] * (mult * qd[first + col]);
             }
-        } else {
-            const RK_T rate = md->mult[i] * qd[md->bv + md->coord[i]];
-            const RK_T accel = md->mult[i] * qdd[md->bv + md->coord[i]];
-            RK_T c[6];
-            RK_SUBSPACE(md, i, R, o, S[i]);
-            for (int j = 0; j < 6; j++) {
-                V[i][j] = (p < 0 ? RK_C(0.0) : V[p][j]) + S[i][j] * rate;
-                A[i][j] = (p < 0 ? RK_C(j < 3 ? up[j] : 0.0) : A[p][j]) + S[i][j] * accel;
-            }
-            RK_FN(motion_cross)(V[i], S[i], c);  /* d/dt S = V x S: S moves with its body */
-            for (int j = 0; j < 6; j++) A[i][j] += c[j] * rate;
         }
         /* f = I A + V x* (I V) about the body's own origin o (its inertia without lever
          * arms: motions there [v + w x o; w]), V x* [f; n] = [w x f; w x n + v x f], then
@@ -114,20 +104,20 @@ static void RK_FN(inverse)(const rk_model *md, RK_FN(work) *work, const RK_T *re
                 for (int j = 0; j < 6; j++) t += base[c][j] * F[0][j];
                 tau[c] = t;
             }
-        } else if (RK_MANY(md, i)) {
-            RK_T columns_[6][6];
-            int first;
-            double mult;
-            const int columns = RK_FN(columns)(md, i, R, o, columns_, &first, &mult);
+        } else {
+            RK_T (*columns_)[6] = (RK_T (*)[6])S[i], many[6][6];
+            int first, columns = 1;
+            double mult = md->mult[i];
+            first = md->bv + md->coord[i];
+            if (RK_MANY(md, i)) {
+                columns_ = many;
+                columns = RK_FN(columns)(md, i, R, o, columns_, &first, &mult);
+            }
             for (int col = 0; col < columns; col++) {
                 RK_T t = RK_C(0.0);
                 for (int j = 0; j < 6; j++) t += columns_[col][j] * F[i][j];
-                tau[first + col] += t;
+                tau[first + col] += mult * t;
             }
-        } else {
-            RK_T t = RK_C(0.0);
-            for (int j = 0; j < 6; j++) t += S[i][j] * F[i][j];
-            tau[md->bv + md->coord[i]] += md->mult[i] * t;
         }
         const int p = md->parent[i];
         if (p >= 0)

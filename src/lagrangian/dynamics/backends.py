@@ -55,6 +55,14 @@ class CompiledBackend:
         for name in RECURSIONS:  # the module's own functions: no Python between
             setattr(self, name, getattr(module, name))
 
+    def bound(self, name: str, fallback, report):
+        """The module's recursion ``name`` bound to the tables: called with the inputs alone,
+        fallback(*inputs) where it answers NotImplemented, report((out, count)) where it has
+        NaN rows (bound_call.c); None where the module has no such binding."""
+        make = getattr(self.module, "bound", None)
+        return None if make is None else make(getattr(self.module, name), self.tables,
+                                               fallback, report)
+
     def numeric_kernel(self, n: int):
         """NumericSystem's kernel over this module (simulation)."""
         if self.kernel == "unrolled":

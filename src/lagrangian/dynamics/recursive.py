@@ -31,6 +31,7 @@ taken before any code is generated).
 from __future__ import annotations
 
 from collections.abc import Mapping
+from functools import partial
 
 import numpy as np
 
@@ -38,7 +39,7 @@ from ..model.model import Model
 from ..model.tree import KinematicTree
 from ..model.values import resolve_parameters
 from .algorithms.recursions import _positive_definite
-from .backends import TreeBackend, compiled_backend
+from .backends import CompiledBackend, TreeBackend, compiled_backend
 from .joint_space import Dynamics, reported_rows
 from .recursive_numpy import NumpyBackend, floating_refusal
 from .tree.applicable import TREE_PATH_BODIES, applicable_tree
@@ -47,6 +48,9 @@ from .tree.spherical import check_tree_quaternions, quaternion_slices, refuse_sp
 from .tree_terms import TreeTerms
 
 BACKENDS = {"compact": "recursive", "unrolled": "recursive", "numpy": "recursive-numpy"}
+# each recursion's axes of one state's output
+_TAILS = {"mass_matrix": 2, "bias_forces": 1, "gravity": 1, "inverse_dynamics": 1,
+          "forward_dynamics": 1, "kinetic_energy": 0, "potential_energy": 0}
 
 
 class TreeDynamics(TreeTerms, Dynamics):
@@ -87,6 +91,14 @@ class TreeDynamics(TreeTerms, Dynamics):
         self._inverse, self._forward = b.inverse_dynamics, b.forward_dynamics
         self._kinetic, self._potential = b.kinetic_energy, b.potential_energy
         self._P = b.tables
+        if isinstance(b, CompiledBackend) and type(self) is TreeDynamics:
+            # each recursion's method the module's call itself, its tables bound: no Python
+            # frame in front of the kernel; the class's method (checks, shapes) its fallback
+            for name, tail in _TAILS.items():
+                bound = b.bound(name, getattr(self, name), partial(reported_rows, tail=tail,
+                                                                   stacklevel=3))
+                if bound is not None:
+                    setattr(self, name, bound)
 
     @property
     def module(self):

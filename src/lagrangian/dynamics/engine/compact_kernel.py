@@ -24,7 +24,7 @@ from .headers import HEADERS, spliced
 # modules, then the batched Python bindings (one translation unit)
 _SOURCES = tuple(Path(__file__).with_name(name)
                  for name in ("tree_kernel.c", "tree_kernel_forward.c", "batch_threads.c",
-                              "tree_kernel_bindings.c"))
+                              "bound_call.c", "tree_kernel_bindings.c"))
 
 
 # the recursions' core (tree_kernel.c from TK_CORE_BEGIN, then tree_kernel_forward.c) twice:
@@ -65,12 +65,13 @@ typedef long long lg_i4 __attribute__((vector_size(sizeof(lg_v4))));
 def _source() -> str:
     from ..emit.tree_c import _SINCOS, _VECTOR
 
-    first, forward, threads, bindings = (path.read_text(encoding="utf-8") for path in _SOURCES)
+    first, forward, threads, bound, bindings = (path.read_text(encoding="utf-8")
+                                                for path in _SOURCES)
     head, core = first.split("/* TK_CORE_BEGIN */")
     before, after = head.split("/* TK_SINCOS */")
     core = "\n".join([core, forward])
     return spliced("\n".join([before, _SINCOS, _VECTOR, after, _SCALAR, core, _LANES, core,
-                               threads, bindings]))
+                               threads, bound, bindings]))
 
 
 @lru_cache(maxsize=1)

@@ -329,6 +329,7 @@ static PyMethodDef tk_methods[] = {
     TK_METHOD(kinetic_energy, "(Q, V, D) -> T"),
     TK_METHOD(potential_energy, "(Q, D) -> V"),
     TK_METHOD(prepare, "(D) -> the tree prepared for the functions above (checked once)"),
+    LG_BOUND_METHOD,
     {NULL, NULL, 0, NULL},
 };
 

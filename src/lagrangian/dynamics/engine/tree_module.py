@@ -16,8 +16,9 @@ from ..tree.spherical import quaternion_slices
 
 # The Python bindings of the batched functions (threads over states, vector lanes): real C.
 # batch_threads.c first: the thread count the three compiled modules' batches share
-_THREADS, _BINDINGS = ("\n" + Path(__file__).with_name(name).read_text(encoding="utf-8")
-                       for name in ("batch_threads.c", "tree_bindings.c"))
+# bound_call.c: each recursion bound to its tables as TreeDynamics's method
+_THREADS, _BOUND, _BINDINGS = ("\n" + Path(__file__).with_name(name).read_text(encoding="utf-8")
+                               for name in ("batch_threads.c", "bound_call.c", "tree_bindings.c"))
 
 
 def _quaternion_check(starts: list[int], floating: bool) -> str:
@@ -54,14 +55,18 @@ static int rt_unit_quaternions(const double *q, npy_intp states, npy_intp step, 
 _DECLARE = "\n".join(
     f"static PyObject *rt_py_{name}(PyObject *, PyObject *const *, Py_ssize_t);"
     for name in ("mass_matrix", "bias_forces", "gravity", "inverse_dynamics", "forward_dynamics",
-                 "kinetic_energy", "potential_energy"))
+                 "kinetic_energy", "potential_energy")) + (
+    "\nstatic PyObject *lg_py_bound(PyObject *, PyObject *const *, Py_ssize_t);")
 
 _METHODS = " ".join(
     f'{{"{name}", (PyCFunction)(void (*)(void))rt_py_{name}, METH_FASTCALL, "{doc}"}},'
     for name, doc in (("mass_matrix", "(Q, P) -> M"), ("bias_forces", "(Q, V, P) -> b"),
                       ("gravity", "(Q, P) -> g"), ("inverse_dynamics", "(Q, V, A, P) -> tau"),
                       ("forward_dynamics", "(Q, V, TAU, P) -> q_ddot"),
-                      ("kinetic_energy", "(Q, V, P) -> T"), ("potential_energy", "(Q, P) -> V")))
+                      ("kinetic_energy", "(Q, V, P) -> T"), ("potential_energy", "(Q, P) -> V"))
+) + ' {"bound", (PyCFunction)(void (*)(void))lg_py_bound, METH_FASTCALL, "(function, P, fallback, ' \
+    'report) -> function(*inputs, P)"},'
+
 
 
 def module_source(tree: KinematicTree, parameters: tuple[str, ...]):
@@ -125,6 +130,7 @@ static void lg_residual(const double *restrict q, const double *restrict v, doub
         "#define RT_VECTOR " + ("1" if "rt4_mass_matrix" in functions else "0"),
         template_text(),
         _THREADS,
+        _BOUND,
         _quaternion_check(starts, tree.floating_base) if starts else "",
         _BINDINGS,
     ])
@@ -140,7 +146,7 @@ def _generator_key() -> str:
     here = Path(__file__).parents[1]  # dynamics/: the generator spans emit/, tree/, engine/
     files = ("emit/tree_emitter.py", "emit/tree_algorithms.py", "emit/tree_floating.py",
              "tree/joint_models.py", "emit/tree_c.py", "engine/tree_module.py",
-             "engine/batch_threads.c", "engine/tree_bindings.c")
+             "engine/batch_threads.c", "engine/bound_call.c", "engine/tree_bindings.c")
     return hashlib.sha256(b"".join((here / f).read_bytes() for f in files)
                           + b"".join(path.read_bytes() for path in TEMPLATES)).hexdigest()
 

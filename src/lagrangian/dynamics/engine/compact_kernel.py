@@ -29,7 +29,8 @@ _SOURCES = tuple(Path(__file__).with_name(name)
 
 # the recursions' core (tree_kernel.c from TK_CORE_BEGIN, then tree_kernel_forward.c) twice:
 # on one state, then on LG_LANES states at once
-_SCALAR = """#define TK_T double
+_SCALAR = """#define TK_SCALAR 1
+#define TK_T double
 #define TK_FN(name) tk_##name
 #define TK_C(x) (x)
 #define TK_SINCOS lg_sincos_inline
@@ -39,7 +40,8 @@ _SCALAR = """#define TK_T double
 #define TK_NOT_POSITIVE(d) (!((d) > 0.0))
 #define TK_NOT_FINITE(x) (!isfinite(x))
 #define TK_GIVE_UP(bad) do { if (bad) return bad; } while (0)"""
-_LANES = """#undef TK_T
+_LANES = """#undef TK_SCALAR
+#undef TK_T
 #undef TK_FN
 #undef TK_C
 #undef TK_SINCOS
@@ -50,6 +52,7 @@ _LANES = """#undef TK_T
 #undef TK_NOT_FINITE
 #undef TK_GIVE_UP
 typedef long long lg_i4 __attribute__((vector_size(sizeof(lg_v4))));
+#define TK_SCALAR 0
 #define TK_T lg_v4
 #define TK_FN(name) tk4_##name
 #define TK_C(x) LG_V4(x)

@@ -177,14 +177,23 @@ static inline void JT_FN(turned)(const double *R0, JT_T x, JT_T y, JT_T z, JT_T 
                              + R0[3 * r + 2] * E[6 + col];
 }
 
+/* theta = k q[c] + offset of body b's joint of one number at the configuration q */
+static inline __attribute__((always_inline)) JT_T JT_FN(angle)(const tk_tree *t, const double *b,
+                                                               const JT_T *restrict q)
+{
+    return b[TK_MULT] * q[t->bq + (int)b[TK_QCOORD]] + b[TK_OFFSET];
+}
+
 /* Body b's R (body -> parent axes) and p (its origin in the parent) at the configuration q
    (the whole state's, the base's numbers first), and theta's cos, sin (1, 0 for a joint that
-   does not turn about z). */
-static inline __attribute__((always_inline)) void JT_FN(place)(const tk_tree *t,
-                                                               const double *b,
-                                                               const JT_T *restrict q,
-                                                               JT_T *R, JT_T *p, JT_T *cos_,
-                                                               JT_T *sin_)
+   does not turn about z); ``given`` (a constant): a turning joint's cos, sin already in
+   *cos_, *sin_ (computed with the other joints' on the vector unit). */
+static inline __attribute__((always_inline)) void JT_FN(place_sines)(const tk_tree *t,
+                                                                     const double *b,
+                                                                     const JT_T *restrict q,
+                                                                     JT_T *R, JT_T *p,
+                                                                     JT_T *cos_, JT_T *sin_,
+                                                                     const int given)
 {
     const double *R0 = b + TK_R0;
     if (TK_FREE(b) || TK_FLYER(b)) {  /* R0 R(quaternion x y z w, normalized), t0 + R0 x */
@@ -211,14 +220,19 @@ static inline __attribute__((always_inline)) void JT_FN(place)(const tk_tree *t,
         *sin_ = JT_C(0.0);
         return;
     }
-    const JT_T theta = b[TK_MULT] * q[t->bq + (int)b[TK_QCOORD]] + b[TK_OFFSET];
+    const JT_T theta = JT_FN(angle)(t, b, q);
     if (TK_TURNS(b)) {
         /* sine and cosine written out here: a libm call cost as much as the rest of an
            arm's mass matrix */
         JT_T sn, cs;
-        JT_SINCOS(theta, &sn, &cs);
-        *cos_ = cs;
-        *sin_ = sn;
+        if (given) {
+            cs = *cos_;
+            sn = *sin_;
+        } else {
+            JT_SINCOS(theta, &sn, &cs);
+            *cos_ = cs;
+            *sin_ = sn;
+        }
         if (b[TK_PERMUTED] != 0.0) {  /* row r of R0 Rot(z) is +-row PERM[r] of Rot(z) */
             for (int r = 0; r < 3; r++) {
                 const int k = (int)b[TK_PERM + r];
@@ -245,6 +259,15 @@ static inline __attribute__((always_inline)) void JT_FN(place)(const tk_tree *t,
         const JT_T slide = b[TK_KIND] == 1.0 ? theta : b[TK_LEAD] * theta;
         for (int r = 0; r < 3; r++) p[r] += R0[3 * r + 2] * slide;
     }
+}
+
+static inline __attribute__((always_inline)) void JT_FN(place)(const tk_tree *t,
+                                                               const double *b,
+                                                               const JT_T *restrict q,
+                                                               JT_T *R, JT_T *p, JT_T *cos_,
+                                                               JT_T *sin_)
+{
+    JT_FN(place_sines)(t, b, q, R, p, cos_, sin_, 0);
 }
 
 /* Body b's rotation Rw (body -> world) and origin ow in the world from its parent's (Rp, op)

@@ -74,10 +74,35 @@ static inline void TK_FN(sandwich)(const TK_T *R, const TK_T *A, TK_T *out)  /* 
 /* Each body's R and p for the configuration q (into the scratch W), and theta's cos, sin. */
 static void TK_FN(place)(const tk_tree *t, const TK_T *restrict q, TK_T *restrict W)
 {
+#if TK_SCALAR
+    /* on one state: every turning joint's theta first, then their sines and cosines LG_LANES
+       at a time on the vector unit (the lanes' own function: the same numbers bit for bit) */
+    const int nb = t->nb, chunks = (nb + LG_LANES - 1) / LG_LANES;
+    lg_v4 theta[chunks], sine, cosine;
+    for (int k = 0; k < chunks; k++) theta[k] = LG_V4(0.0);
+    for (int i = 0; i < nb; i++) {
+        const double *b = t->body + i * TK_STRIDE;
+        if (TK_TURNS(b)) theta[i / LG_LANES][i % LG_LANES] = JT_FN(angle)(t, b, q);
+    }
+    for (int k = 0; k < chunks; k++) {
+        lg_vsincos_inline(theta[k], &sine, &cosine);
+        for (int l = 0; l < LG_LANES && k * LG_LANES + l < nb; l++) {
+            TK_T *w = W + (k * LG_LANES + l) * TW_STRIDE;
+            w[TW_CS] = cosine[l];
+            w[TW_SN] = sine[l];
+        }
+    }
+    for (int i = 0; i < nb; i++) {
+        TK_T *w = W + i * TW_STRIDE;
+        JT_FN(place_sines)(t, t->body + i * TK_STRIDE, q, w + TW_R, w + TW_P, w + TW_CS,
+                           w + TW_SN, 1);
+    }
+#else
     for (int i = 0; i < t->nb; i++) {
         TK_T *w = W + i * TW_STRIDE;
         JT_FN(place)(t, t->body + i * TK_STRIDE, q, w + TW_R, w + TW_P, w + TW_CS, w + TW_SN);
     }
+#endif
 }
 
 /* Recursive Newton-Euler: tau = M a + C v + g - tau0 (v, a NULL: zero), the bodies placed
@@ -236,8 +261,7 @@ static void TK_FN(mass_placed)(const tk_tree *t, TK_T *restrict W, TK_T *restric
             const TK_T *Rp = W + parent * TW_STRIDE + TW_RW, *op = W + parent * TW_STRIDE + TW_OW;
             JT_FN(world)(b, Rp, op, R, p, w[TW_CS], w[TW_SN], Rw, o);
         }
-        /* Ic = (m, h_O = R h + m o, J_O = R J R^T + m (|o|^2 1 - o o^T) + 2 (o.Rh) 1 - o (Rh)^T
-           - (Rh) o^T), J_O as xx yy zz xy xz yz */
+        /* Ic = (m, h_O, J_O about the world's origin), J_O as xx yy zz xy xz yz */
         const double m = b[TK_MASS];
         TK_T hr[3], RJ[9];
         SP_APPLY(Rw, b + TK_H, hr);
@@ -245,16 +269,18 @@ static void TK_FN(mass_placed)(const tk_tree *t, TK_T *restrict W, TK_T *restric
             for (int col = 0; col < 3; col++)
                 RJ[3 * r + col] = Rw[3 * r] * b[TK_J + col] + Rw[3 * r + 1] * b[TK_J + 3 + col]
                                   + Rw[3 * r + 2] * b[TK_J + 6 + col];
-        const TK_T oo = SP_DOT(o, o), oh = SP_DOT(o, hr);
         static const int ra[6] = {0, 1, 2, 0, 0, 1}, rc[6] = {0, 1, 2, 1, 2, 2};
+        TK_T *hO = Ic + 1;  /* h_O = R h + m o, then m (|o|^2 1 - o o^T) + 2 (o.Rh) 1 - o (Rh)^T
+                               - (Rh) o^T = (o.h_O + o.Rh) 1 - o h_O^T - (Rh) o^T */
         Ic[0] = TK_C(m);
-        for (int r = 0; r < 3; r++) Ic[1 + r] = hr[r] + m * o[r];
+        for (int r = 0; r < 3; r++) hO[r] = hr[r] + m * o[r];
+        const TK_T diagonal = SP_DOT(o, hO) + SP_DOT(o, hr);
         for (int e = 0; e < 6; e++) {
             const int x = ra[e], y = rc[e];
             TK_T v = RJ[3 * x] * Rw[3 * y] + RJ[3 * x + 1] * Rw[3 * y + 1]
                      + RJ[3 * x + 2] * Rw[3 * y + 2];
-            if (e < 3) v += m * oo + 2.0 * oh;
-            Ic[4 + e] = v - m * o[x] * o[y] - o[x] * hr[y] - hr[x] * o[y];
+            if (e < 3) v += diagonal;
+            Ic[4 + e] = v - o[x] * hO[y] - hr[x] * o[y];
         }
         /* the joint's motion columns at the world's origin (s_v, s_w), per unit rate */
         TK_T *S = w + TW_COLS;
@@ -263,18 +289,15 @@ static void TK_FN(mass_placed)(const tk_tree *t, TK_T *restrict W, TK_T *restric
         if (count == 1 && b[TK_MULT] != 1.0)  /* a mimic: q_i = k q_master + offset */
             for (int r = 0; r < 6; r++) S[r] *= b[TK_MULT];
     }
-    for (int i = nb - 1; i > 0; i--) {  /* composites: children before their parents */
-        const int parent = parent_of[i];
-        if (parent < 0) continue;
-        const TK_T *Ic = W + i * TW_STRIDE + TW_IC;
-        TK_T *Icp = W + parent * TW_STRIDE + TW_IC;
-        for (int k = 0; k < 10; k++) Icp[k] += Ic[k];
-    }
-    for (int i = nb - 1; i >= 0; i--) {
-        const TK_T *w = W + i * TW_STRIDE, *Ic = w + TW_IC, *h = Ic + 1, *J = Ic + 4;
+    for (int i = nb - 1; i >= 0; i--) {  /* children before their parents */
+        TK_T *w = W + i * TW_STRIDE, *Ic = w + TW_IC, *h = Ic + 1, *J = Ic + 4;
         const TK_T *S = w + TW_COLS;
-        const int ci = column_of[i];
-        for (int c = 0; c < count_of[i]; c++) {
+        const int ci = column_of[i], count = count_of[i], parent = parent_of[i];
+        if (parent >= 0) {  /* its composite is whole: into its parent's */
+            TK_T *Icp = W + parent * TW_STRIDE + TW_IC;
+            for (int k = 0; k < 10; k++) Icp[k] += Ic[k];
+        }
+        for (int c = 0; c < count; c++) {
             const TK_T *sv = S + 6 * c, *sw = sv + 3;
             TK_T f[6], x[3];
             SP_CROSS(sw, h, x);  /* F = Ic S: [m s_v + s_w x h; h x s_v + J_O s_w] */
@@ -283,18 +306,25 @@ static void TK_FN(mass_placed)(const tk_tree *t, TK_T *restrict W, TK_T *restric
             f[3] = x[0] + J[0] * sw[0] + J[3] * sw[1] + J[4] * sw[2];
             f[4] = x[1] + J[3] * sw[0] + J[1] * sw[1] + J[5] * sw[2];
             f[5] = x[2] + J[4] * sw[0] + J[5] * sw[1] + J[2] * sw[2];
-            for (int r = c; r < count_of[i]; r++) {  /* the joint's own block, mirrored: */
+            for (int r = c; r < count; r++) {  /* the joint's own block, mirrored: */
                 const TK_T e = SP_DOT(S + 6 * r, f) + SP_DOT(S + 6 * r + 3, f + 3);
                 M[(ci + r) * n + ci + c] += e;  /* M symmetric bit for bit */
                 if (r != c) M[(ci + c) * n + ci + r] += e;
             }
-            for (int k = parent_of[i]; k >= 0; k = parent_of[k]) {  /* += : mimics share */
+            TK_T *row = M + (ci + c) * n, *column = M + ci + c;
+            for (int k = parent; k >= 0; k = parent_of[k]) {  /* += : mimics share */
                 const TK_T *Sk = W + k * TW_STRIDE + TW_COLS;
                 const int ck = column_of[k];
+                if (count_of[k] == 1) {
+                    const TK_T e = SP_DOT(Sk, f) + SP_DOT(Sk + 3, f + 3);
+                    row[ck] += e;
+                    column[ck * n] += e;
+                    continue;
+                }
                 for (int r = 0; r < count_of[k]; r++) {
                     const TK_T e = SP_DOT(Sk + 6 * r, f) + SP_DOT(Sk + 6 * r + 3, f + 3);
-                    M[(ci + c) * n + ck + r] += e;
-                    M[(ck + r) * n + ci + c] += e;
+                    row[ck + r] += e;
+                    column[(ck + r) * n] += e;
                 }
             }
         }

@@ -211,6 +211,43 @@ static PyObject *tk_py_prepare(PyObject *self, PyObject *const *args, Py_ssize_t
     return capsule;
 }
 
+/* One state, its inputs float64 vectors of their widths (tk_batch checked): the scalar
+   function on it, its scratch on the stack; the quaternions checked as in a batch (else
+   NotImplemented: the front names the joint); an input not finite, or no finite answer, gives
+   (NaN output, 1) as a batch does. */
+#define TK_ONE_SCRATCH 4096  /* numbers: 32 bodies and 25 velocities */
+static int tk_one_fits(const tk_tree *t)
+{
+    return (size_t)t->nb * TW_STRIDE + (size_t)t->nv * t->nv <= TK_ONE_SCRATCH;
+}
+
+static PyObject *tk_single(const tk_tree *t, PyObject *const *args, int nin, int kind)
+{
+    const double *a[3] = {NULL, NULL, NULL};
+    int fine = 1;
+    for (int i = 0; i < nin; i++) {
+        a[i] = (const double *)PyArray_DATA((PyArrayObject *)args[i]);
+        fine &= tk_finite(a[i], i == 0 ? t->nq : t->nv);
+    }
+    if (fine && ((t->fb && !lg_unit_quaternions(a[0], 1, t->nq, t->nq, t->qtol))
+                 || ((t->balls || t->flyers) && !tk_unit_balls(t, a[0], 1, t->nq)))) {
+        PyErr_Clear();  /* the front names the state and its norm */
+        Py_RETURN_NOTIMPLEMENTED;
+    }
+    const int n = t->nv;
+    npy_intp dims[2] = {n, n};
+    const int nd = kind == TK_MASSM ? 2 : (kind == TK_KINETIC || kind == TK_POTENTIAL) ? 0 : 1;
+    const int size = kind == TK_MASSM ? n * n : nd == 0 ? 1 : n;
+    double W[TK_ONE_SCRATCH];
+    PyObject *out = PyArray_SimpleNew(nd, dims, NPY_DOUBLE);
+    if (!out) return NULL;
+    double *y = (double *)PyArray_DATA((PyArrayObject *)out);
+    if (fine) fine = tk_one(t, kind, a, W, W + (size_t)t->nb * TW_STRIDE, y) == 0;
+    if (fine) return out;
+    for (int i = 0; i < size; i++) y[i] = NAN;
+    return Py_BuildValue("(Nn)", out, (Py_ssize_t)1);
+}
+
 static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int kind)
 {
     PyArrayObject *in[3] = {NULL, NULL, NULL};
@@ -228,6 +265,18 @@ static PyObject *tk_batch(PyObject *const *args, Py_ssize_t nargs, int nin, int 
     if (!prepared) return NULL;  /* another capsule: its name's error */
     const tk_tree tree = prepared->tree;
     const int n = tree.nv;  /* q is nq wide (a floating base's quaternion), the rest nv */
+    if (tk_one_fits(&tree)) {  /* one state, each input a vector of its width: straight */
+        int one = 1;           /* to the scalar function, no batch set up */
+        for (int i = 0; i < nin && one; i++) {
+            PyObject *x = args[i];
+            one = PyArray_CheckExact(x) && PyArray_NDIM((PyArrayObject *)x) == 1
+                  && PyArray_TYPE((PyArrayObject *)x) == NPY_DOUBLE
+                  && PyArray_DIMS((PyArrayObject *)x)[0] == (i == 0 ? tree.nq : n)
+                  && PyArray_IS_C_CONTIGUOUS((PyArrayObject *)x)
+                  && PyArray_ISALIGNED((PyArrayObject *)x);
+        }
+        if (one) return tk_single(&tree, args, nin, kind);
+    }
 #define TK_WIDTH(i) ((i) == 0 ? tree.nq : n)
     int base = 0;
     for (int i = 0; i < nin; i++) {

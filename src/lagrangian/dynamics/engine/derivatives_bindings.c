@@ -73,7 +73,7 @@ static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t na
     *tree = (dk_tree){.nb = nb, .nj = nj, .ff = ff, .np = np, .nv = nv, .nq = t.nq,
                       .qo = 7 * ff, .vo = 6 * ff, .ltdl = h[5] != 0, .once = h[6] != 0,
                       .sparse = h[7] != 0};
-    tk_open(reals, nd, &tree->t);  /* the same numbers: checked above */
+    tk_open_marked(reals, nd, &tree->t);  /* the same numbers: checked above */
     int columns_fine = 1;
     for (long i = 0; i < nb; i++) {
         const double *b = DK_BODY_OF(tree, i);

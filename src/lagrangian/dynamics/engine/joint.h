@@ -47,11 +47,30 @@
                            (derivatives_c.py's description): 1, 2, ... the column, one velocity
                            number each; 0 the whole joint */
 #define TK_LEAD 61      /* the slide along u per unit theta: 1 prismatic, pitch (m/rad) helical */
-#define TK_TURNS(b) ((b)[TK_KIND] == 0.0 || (b)[TK_KIND] == 3.0)
-#define TK_SLIDES(b) ((b)[TK_KIND] == 1.0 || (b)[TK_KIND] == 3.0)
-#define TK_FREE(b) ((b)[TK_KIND] == 2.0)
-#define TK_BALL(b) ((b)[TK_KIND] == 4.0)
-#define TK_FLYER(b) ((b)[TK_KIND] == 5.0)
+#define TK_FLAGS 62     /* a module's own copy only (tk_open_marked): the record's kind and
+                           whether R0 is a signed permutation, as an int64's bits */
+/* the kinds as the description gives them: what checks a description (tk_open) reads */
+#define TK_KIND_TURNS(b) ((b)[TK_KIND] == 0.0 || (b)[TK_KIND] == 3.0)
+#define TK_KIND_SLIDES(b) ((b)[TK_KIND] == 1.0 || (b)[TK_KIND] == 3.0)
+#define TK_KIND_FREE(b) ((b)[TK_KIND] == 2.0)
+#define TK_KIND_BALL(b) ((b)[TK_KIND] == 4.0)
+#define TK_KIND_FLYER(b) ((b)[TK_KIND] == 5.0)
+/* the same, and R0's form, as one integer's bits in a module's marked copy: what the
+   algorithms read (a kind test each a double comparison or two, a tenth of a call's time) */
+enum { TK_F_TURNS = 1, TK_F_SLIDES = 2, TK_F_FREE = 4, TK_F_BALL = 8, TK_F_FLYER = 16,
+       TK_F_PERMUTED = 32 };
+static inline long long tk_flags(const double *b)
+{
+    long long flags;
+    memcpy(&flags, b + TK_FLAGS, sizeof flags);
+    return flags;
+}
+#define TK_TURNS(b) (tk_flags(b) & TK_F_TURNS)
+#define TK_SLIDES(b) (tk_flags(b) & TK_F_SLIDES)
+#define TK_FREE(b) (tk_flags(b) & TK_F_FREE)
+#define TK_BALL(b) (tk_flags(b) & TK_F_BALL)
+#define TK_FLYER(b) (tk_flags(b) & TK_F_FLYER)
+#define TK_IS_PERMUTED(b) (tk_flags(b) & TK_F_PERMUTED)
 
 typedef struct {
     int nb, n, mimic, fb, bq, bv, nq, nv;  /* bq, bv: the base's numbers before the joints' */
@@ -82,8 +101,8 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
     t->balls = t->flyers = 0;
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
-        if (TK_BALL(b) && b[TK_COLUMN] <= 1.0) t->balls++;  /* a ball's columns: one ball */
-        if (TK_FLYER(b) && b[TK_COLUMN] <= 1.0) t->flyers++;
+        if (TK_KIND_BALL(b) && b[TK_COLUMN] <= 1.0) t->balls++;  /* a ball's columns: one ball */
+        if (TK_KIND_FLYER(b) && b[TK_COLUMN] <= 1.0) t->flyers++;
     }
     t->nq = t->bq + t->n + t->balls + t->flyers;
     t->nv = t->bv + t->n;
@@ -92,15 +111,15 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
         if (!(b[TK_PARENT] >= -1 && b[TK_PARENT] < i))
             return -1;
         if (t->fb && i == 0) {  /* the free flyer, and only it, on the ground */
-            if (!TK_FREE(b) || b[TK_PARENT] != -1) return -1;
-        } else if (TK_BALL(b)) {
+            if (!TK_KIND_FREE(b) || b[TK_PARENT] != -1) return -1;
+        } else if (TK_KIND_BALL(b)) {
             const double column = b[TK_COLUMN];  /* a whole ball's three numbers, or one */
             if (!(column == 0.0 || column == 1.0 || column == 2.0 || column == 3.0)
                 || !(b[TK_COORD] >= 0 && b[TK_COORD] + (column > 0.0 ? 4.0 - column : 3.0) <= t->n
                      && b[TK_QCOORD] >= 0
                   && b[TK_QCOORD] + 4 <= t->nq - t->bq))
                 return -1;
-        } else if (TK_FLYER(b)) {
+        } else if (TK_KIND_FLYER(b)) {
             const double column = b[TK_COLUMN];  /* a whole flyer's six numbers, or one */
             if (!(column >= 0.0 && column <= 6.0 && column == (int)column)
                 || !(b[TK_COORD] >= 0 && b[TK_COORD] + (column > 0.0 ? 7.0 - column : 6.0) <= t->n
@@ -109,9 +128,26 @@ static int tk_open(const double *d, Py_ssize_t size, tk_tree *t)
                 return -1;
         } else if (!(b[TK_COORD] >= 0 && b[TK_COORD] < t->n)
                    || !(b[TK_QCOORD] >= 0 && b[TK_QCOORD] < t->nq - t->bq)
-                   || !(TK_TURNS(b) || TK_SLIDES(b))) {
+                   || !(TK_KIND_TURNS(b) || TK_KIND_SLIDES(b))) {
             return -1;
         }
+    }
+    return 0;
+}
+
+/* tk_open on a module's own copy d of a description it has checked (tk_open), each record's
+   kind marked first in its TK_FLAGS (the algorithms' reads) */
+static int tk_open_marked(double *d, Py_ssize_t size, tk_tree *t)
+{
+    if (tk_open(d, size, t)) return -1;
+    for (int i = 0; i < t->nb; i++) {
+        double *b = d + TK_HEADER + t->n + (size_t)i * TK_STRIDE;
+        long long flags = (TK_KIND_TURNS(b) ? TK_F_TURNS : 0)
+                          | (TK_KIND_SLIDES(b) ? TK_F_SLIDES : 0)
+                          | (TK_KIND_FREE(b) ? TK_F_FREE : 0) | (TK_KIND_BALL(b) ? TK_F_BALL : 0)
+                          | (TK_KIND_FLYER(b) ? TK_F_FLYER : 0)
+                          | (b[TK_PERMUTED] != 0.0 ? TK_F_PERMUTED : 0);
+        memcpy(b + TK_FLAGS, &flags, sizeof flags);
     }
     return 0;
 }
@@ -122,7 +158,7 @@ static int tk_whole_balls(const tk_tree *t)
 {
     for (int i = 0; i < t->nb; i++) {
         const double *b = t->body + i * TK_STRIDE;
-        if ((TK_BALL(b) || TK_FLYER(b)) && b[TK_COLUMN] != 0.0) return 0;
+        if ((TK_KIND_BALL(b) || TK_KIND_FLYER(b)) && b[TK_COLUMN] != 0.0) return 0;
     }
     return 1;
 }
@@ -139,9 +175,9 @@ static int tk_unit_balls(const tk_tree *t, const double *q, Py_ssize_t states, P
         if (!finite) continue;
         for (int i = 0; i < t->nb; i++) {
             const double *b = t->body + i * TK_STRIDE;
-            if (!(TK_BALL(b) || TK_FLYER(b)) || b[TK_COLUMN] > 1.0) continue;
+            if (!(TK_KIND_BALL(b) || TK_KIND_FLYER(b)) || b[TK_COLUMN] > 1.0) continue;
             /* a ball's w x y z, a flyer's x y z w after its x, y, z */
-            const double *e = x + t->bq + (int)b[TK_QCOORD] + (TK_FLYER(b) ? 3 : 0);
+            const double *e = x + t->bq + (int)b[TK_QCOORD] + (TK_KIND_FLYER(b) ? 3 : 0);
             const double norm = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
             if (!(fabs(norm - 1.0) <= t->qtol)) return 0;
         }
@@ -233,7 +269,7 @@ static inline __attribute__((always_inline)) void JT_FN(place_sines)(const tk_tr
             *cos_ = cs;
             *sin_ = sn;
         }
-        if (b[TK_PERMUTED] != 0.0) {  /* row r of R0 Rot(z) is +-row PERM[r] of Rot(z) */
+        if (TK_IS_PERMUTED(b)) {  /* row r of R0 Rot(z) is +-row PERM[r] of Rot(z) */
             for (int r = 0; r < 3; r++) {
                 const int k = (int)b[TK_PERM + r];
                 const double e = b[TK_SIGN + r];
@@ -256,7 +292,7 @@ static inline __attribute__((always_inline)) void JT_FN(place_sines)(const tk_tr
     }
     for (int r = 0; r < 3; r++) p[r] = JT_C(b[TK_T0 + r]);
     if (TK_SLIDES(b)) {  /* along R0 e_z by lead theta (a prismatic joint's lead 1) */
-        const JT_T slide = b[TK_KIND] == 1.0 ? theta : b[TK_LEAD] * theta;
+        const JT_T slide = TK_TURNS(b) ? b[TK_LEAD] * theta : theta;
         for (int r = 0; r < 3; r++) p[r] += R0[3 * r + 2] * slide;
     }
 }
@@ -280,7 +316,7 @@ static inline __attribute__((always_inline)) void JT_FN(world)(const double *b, 
                                                                JT_T *restrict ow)
 {
     JT_T d[3];
-    if (b[TK_PERMUTED] != 0.0 && !TK_BALL(b) && !TK_FREE(b)) {
+    if (TK_IS_PERMUTED(b) && !TK_BALL(b) && !TK_FREE(b)) {
         const int r0 = (int)b[TK_ROW], r1 = (int)b[TK_ROW + 1], r2 = (int)b[TK_ROW + 2];
         const double e0 = b[TK_ROWSIGN], e1 = b[TK_ROWSIGN + 1], e2 = b[TK_ROWSIGN + 2];
         if (TK_TURNS(b)) {  /* the signs exact: (e cos) x = cos (e x) bit for bit */
@@ -324,7 +360,7 @@ static inline __attribute__((always_inline)) void JT_FN(placed)(const tk_tree *t
         JT_FN(place)(t, b, q, Rw, ow, &cs, &sn);
         return;
     }
-    if (b[TK_PERMUTED] != 0.0 && !TK_BALL(b) && !TK_FREE(b)) {
+    if (TK_IS_PERMUTED(b) && !TK_BALL(b) && !TK_FREE(b)) {
         const JT_T theta = b[TK_MULT] * q[t->bq + (int)b[TK_QCOORD]] + b[TK_OFFSET];
         JT_T p[3];
         cs = JT_C(1.0);
@@ -332,7 +368,7 @@ static inline __attribute__((always_inline)) void JT_FN(placed)(const tk_tree *t
         if (TK_TURNS(b)) JT_SINCOS(theta, &sn, &cs);
         for (int r = 0; r < 3; r++) p[r] = JT_C(b[TK_T0 + r]);
         if (TK_SLIDES(b)) {  /* as JT_FN(place) */
-            const JT_T slide = b[TK_KIND] == 1.0 ? theta : b[TK_LEAD] * theta;
+            const JT_T slide = TK_TURNS(b) ? b[TK_LEAD] * theta : theta;
             for (int r = 0; r < 3; r++) p[r] += b[TK_R0 + 3 * r + 2] * slide;
         }
         JT_FN(world)(b, Rp, op, NULL, p, cs, sn, Rw, ow);

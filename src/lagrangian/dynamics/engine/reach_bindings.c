@@ -380,7 +380,7 @@ static int rk_model_from(PyObject *description, PyObject *ints, PyObject *floats
     if (!d) { PyErr_NoMemory(); goto done; }
     *tables = d;
     memcpy(d, PyArray_DATA(Da), (size_t)nD * sizeof(double));
-    tk_open(d, nD, &t);  /* the same numbers: checked above */
+    tk_open_marked(d, nD, &t);  /* the same numbers: checked above */
     double *fr = d + nD, *per = fr + nd;
     int *a = (int *)(d + doubles);
     memcpy(fr, PyArray_DATA(Fa), (size_t)nd * sizeof(double));

@@ -201,7 +201,7 @@ static PyObject *tk_py_prepare(PyObject *self, PyObject *const *args, Py_ssize_t
     }
     memcpy(numbers, PyArray_DATA(D), (size_t)size * sizeof(double));
     Py_DECREF(D);
-    tk_open(numbers, size, &p->tree);  /* the same numbers: checked above */
+    tk_open_marked(numbers, size, &p->tree);  /* the same numbers: checked above */
     p->numbers = numbers;
     PyObject *capsule = PyCapsule_New(p, TK_CAPSULE, tk_release);
     if (!capsule) {

@@ -25,7 +25,8 @@ The description ``D`` (float64, contiguous), built by ``describe``:
       own body axes, row-major: what a result per the link's own inertial turns by)  56 1 where R0
       is exactly the identity (a free flyer's or a ball's turn then needs no product)  57:61 spare
       61 the lead: the slide along u per unit theta (1 prismatic, the pitch in m/rad
-      helical, 0 revolute)  62:64 spare.
+      helical, 0 revolute)  62 the engine's own: a module's copy marks the kind there
+      (joint.h's TK_FLAGS)  63 spare.
       A free flyer (code 2, body 0 only) reads R0, t0 and the inertia alone; one below the
       root (code 5, FLYER: a URDF floating joint between two links) reads R0, t0, the inertia
       and its q (x y z qx qy qz qw) and v (linear, angular) offsets; a helical joint

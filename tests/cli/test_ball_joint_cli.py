@@ -81,7 +81,6 @@ def test_a_symmetric_arm_spins_about_the_vertical_at_its_start_rate(cli, arm, tm
 @pytest.mark.parametrize("arguments, names", [
     (("--initial", "shoulder__x=0.2"), "'shoulder__x' is an Euler angle of the ball joint"),
     (("--initial", "shoulder_qw=0.5"), "ball joint 'shoulder' quaternion"),
-    (("--linearize-along",), "the ball joint 'shoulder' is not linearized along a run"),
     (("--control", "lqr", "--inputs", "g"), "LQR drives its coordinates or actuators"),
 ])
 def test_simulate_refuses_what_a_ball_does_not_take_in_one_line(cli, arm, arguments, names):

@@ -87,6 +87,12 @@ def test_along_section(cli):
     assert A[0, 1, 0] == pytest.approx(-9.81 / 0.5 * np.cos(1.0), rel=1e-9)  # -g/L cos theta
 
 
+def test_along_section_takes_a_ball_in_its_tangent(capsys):
+    names, shape = _run("control-along", capsys)
+    assert names.startswith("('delta_shoulder_wx', 'delta_shoulder_wy', 'delta_shoulder_wz'")
+    assert shape == "(6, 8, 8)"
+
+
 def test_regressor_section(capsys, cli):
     count, error = _run("control-regressor", capsys)[-1].split()
     assert int(count) >= 2 and float(error) < 0.05

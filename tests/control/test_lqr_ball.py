@@ -117,9 +117,7 @@ def test_the_command_line_balances_the_body(top, cli):
     for arguments, names in ((("--inputs", "g"), "not 'g'"),
                              (("--inputs", "pivot__x", "--Q", "x"), "Q"),
                              (("--inputs", "pivot__x", "--about", "pivot_qw=1"),
-                              "for the joint 'pivot' pivot__x, pivot__y, pivot__z"),
-                             (("--inputs", ",".join(HINGES), "--linearize-along"),
-                              "not linearized along a run")):
+                              "for the joint 'pivot' pivot__x, pivot__y, pivot__z")):
         bad = cli("simulate", path, "--t-end", "1", "--control", "lqr", *arguments)
         assert bad.code == 2 and len(bad.err.strip().splitlines()) == 1, bad.err
         assert names in bad.err
@@ -161,10 +159,21 @@ def test_a_body_held_on_a_floating_joint_between_links(tmp_path):
     assert np.abs(back).max() < 1e-3
 
 
-def test_the_linearization_along_a_run_refuses_a_ball_in_one_line(top):
-    """A(t) along a run is built on q_dot = v: a ball's quaternion is refused by name."""
-    _, system, _ = top
-    run = system.simulate(0.1, samples=3)
-    with pytest.raises(InputError, match="joint 'pivot' is not linearized along a run") as info:
-        system.linearize_along(run)
-    assert "\n" not in str(info.value)
+def test_the_linearization_along_a_balanced_run_is_in_the_balls_tangent(top):
+    """A(t) along the regulated run, x = [dq; v] with q = q_run (+) dq: the ball's tangent
+    drifts by d(dq)/dt = dw - w(t) x dq (A's q-q block -[w(t)]x), dq_dot = dv (I), and u acts
+    on the ball's three moments (control/along.py; the transition test:
+    test_linearize_along_manifold.py)."""
+    _, system, regulator = top
+    start = _start(None, [0.1, -0.05, 0.0])
+    run = system.simulate(0.5, initial=start, controller=regulator, samples=6)
+    along = system.linearize_along(run)
+    w = np.asarray(run.q_dot)[:, :3]
+    cross = np.zeros((6, 3, 3))  # [w]x y = w x y
+    cross[:, 0, 1], cross[:, 0, 2], cross[:, 1, 2] = -w[:, 2], w[:, 1], -w[:, 0]
+    cross -= np.swapaxes(cross, 1, 2)
+    np.testing.assert_array_equal(along.A[:, :3, :3], -cross)
+    n = system.dynamics().nv
+    np.testing.assert_allclose(along.A[:, :n, n:], np.broadcast_to(np.eye(n), (6, n, n)))
+    assert along.state_names[:3] == ("delta_pivot_wx", "delta_pivot_wy", "delta_pivot_wz")
+    assert along.inputs == ("pivot_wx", "pivot_wy", "pivot_wz") and along.B.shape == (6, 2 * n, 3)

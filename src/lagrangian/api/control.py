@@ -26,7 +26,9 @@ class ControlMethods:
         eigenvalues, Phi_ddot = 0), as the run's own right-hand side does; ``independent`` (its
         n - m independent coordinates, or "auto" for the best conditioned along the run) gives
         A(t), B(t) on the constraint manifold instead, in x = [q_i; q_i_dot] (holonomic
-        constraints; the others follow from Phi = 0 and Phi_dot = 0)."""
+        constraints; the others follow from Phi = 0 and Phi_dot = 0). A tree whose q holds
+        quaternions (a ball joint, a free flyer, a floating base) in the tangent: x = [dq; v]
+        with q = q_run (+) dq, the states delta_<velocity> and u on each velocity number."""
         from ..control.along import linearize_along
 
         return linearize_along(self._dynamics_in_time(), simulation, inputs, independent)

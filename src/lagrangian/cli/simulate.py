@@ -111,7 +111,7 @@ def simulate(
         from ..output.plots import check_plot_path
 
         check_plot_path(plot)
-    _refuse_on_manifold(tree, animate, control, along)
+    _refuse_on_manifold(tree, animate)
     if animate is not None:
         check_animation_path(animate)
         check_animatable(system.model)
@@ -212,23 +212,15 @@ def simulate(
         raise SystemExit(130)
 
 
-def _refuse_on_manifold(tree, animate, control, along) -> None:
+def _refuse_on_manifold(tree, animate) -> None:
     """What a run whose q and v differ does not take yet, refused in one line before it: a
     floating base's drawing (the model's bodies hold no base; a ball is drawn by its Euler
-    hinges), and on a ball joint the linearization along the run (built on q_dot = v; LQR
-    reads the run in the Euler angles of its linear model, computed torque takes the error
-    on the manifold)."""
+    hinges)."""
     from ..errors import InputError
 
-    joints = getattr(tree, "quaternion_joints", ())  # a ball, a free flyer below the root
     if animate is not None and getattr(tree, "floating_base", False):
         raise InputError("a floating base's run is not animated yet: --out and --plot are",
                          field="--animate")
-    if along and joints:
-        kind = "ball" if joints[0].kind == "spherical" else "floating"
-        raise InputError(f"the {kind} joint '{joints[0].name}' is not linearized along a run "
-                         "yet (q_dot is not v for its quaternion); --control lqr linearizes "
-                         "about a rest, in its Euler angles", field="--linearize-along")
 
 
 def _impact_options(system, max_impacts, settle) -> dict:

@@ -1,7 +1,8 @@
 """Linearization along a trajectory: x_dot = A(t) x + B(t) u about a run's saved samples, x =
 [q; q_dot], from the derivatives of forward dynamics (dynamics/derivatives.py; a constrained
 model's dynamics/constrained.py) at each sample,
-with the controller's generalized forces of that run held in place (SI units)."""
+with the controller's generalized forces of that run held in place (SI units). A tree whose q
+holds quaternions (ball joints, free flyers) in its tangent: x = [dq; v], q = q_run (+) dq."""
 
 from __future__ import annotations
 
@@ -51,29 +52,43 @@ def linearize_along(dynamics, simulation, inputs=None,
     ``simulation``'s samples; ``inputs`` names the coordinates whose generalized forces are u
     (default all)."""
     names = tuple(dynamics.coordinates)
-    _refuse_quaternions(dynamics)
     if tuple(simulation.coordinates) != names:
         raise InputError("the simulation is not of this system (its coordinates are "
                          f"{', '.join(simulation.coordinates)})", field="simulation")
-    inputs = names if inputs is None else tuple(inputs)
-    unknown = [name for name in inputs if name not in names]
+    tree = getattr(getattr(dynamics, "model", None), "kinematic_tree", None)
+    manifold = tree is not None and bool(tree.floating_base or tree.quaternion_joints)
+    if manifold and independent is not None:
+        raise InputError("a tree has no constraints to reduce by: leave independent out",
+                         field="independent")
+    # the velocity numbers: q's own where q_dot = v; a ball's angular velocity, a free flyer's
+    # twist where q holds a quaternion (the generalized forces u act on them)
+    velocities = tuple(dynamics.velocity_names) if manifold else names
+    inputs = velocities if inputs is None else tuple(inputs)
+    unknown = [name for name in inputs if name not in velocities]
     if unknown:
         raise InputError(f"'{unknown[0]}' is not a coordinate (inputs along a run are the "
-                         f"generalized forces on: {', '.join(names)})", field="inputs")
+                         f"generalized forces on: {', '.join(velocities)})", field="inputs")
     q, v = np.asarray(simulation.q, dtype=float), np.asarray(simulation.q_dot, dtype=float)
     forces = simulation.control_forces
-    tau = np.zeros_like(q) if forces is None else np.asarray(forces, dtype=float)
+    tau = np.zeros_like(v) if forces is None else np.asarray(forces, dtype=float)
     t = np.asarray(simulation.t, dtype=float)
     # dynamics/constrained.py's at each sample's time (moving constraints, explicit t)
     timed = {"t": t} if getattr(dynamics, "timed", False) else {}
     by_position, by_velocity, by_force = dynamics.forward_dynamics_derivatives(q, v, tau, **timed)
-    count, n = q.shape
+    count, n = v.shape
     A = np.zeros((count, 2 * n, 2 * n))
     A[:, :n, n:] = np.eye(n)
     A[:, n:, :n], A[:, n:, n:] = by_position, by_velocity
-    columns = [names.index(name) for name in inputs]
+    if manifold:  # the tangent's own drift: q = q_run (+) dq moves dq by -ad(v_run) dq
+        _tangent_drift(tree, v, A[:, :n, :n])
+    columns = [velocities.index(name) for name in inputs]
     B = np.zeros((count, 2 * n, len(columns)))
     B[:, n:, :] = by_force[:, :, columns]
+    if manifold:
+        turned = _turned_numbers(tree)
+        states = (*(f"delta_{c}" if i in turned else c for i, c in enumerate(velocities)),
+                  *simulation.rate_names)
+        return TrajectoryLinearization(t, A, B, states, inputs)
     if independent is None:
         return TrajectoryLinearization(t, A, B, (*names, *(f"{c}_dot" for c in names)), inputs)
     from .manifold import reduce_to_manifold
@@ -84,16 +99,41 @@ def linearize_along(dynamics, simulation, inputs=None,
                                    dependent)
 
 
-def _refuse_quaternions(dynamics) -> None:
-    """One line for a tree whose q and v differ (a ball joint, a floating joint or base): A(t)
-    here is built on q_dot = v."""
-    tree = getattr(getattr(dynamics, "model", None), "kinematic_tree", None)
-    joints = getattr(tree, "quaternion_joints", ()) or ()
-    if tree is None or not (joints or tree.floating_base):
-        return
-    if not joints:
-        raise InputError("a floating base is not linearized along a run yet (q_dot is not v "
-                         "for its quaternion)", field="simulation")
-    raise InputError(f"the joint '{joints[0].name}' is not linearized along a run yet (q_dot is "
-                     "not v for its quaternion); linearize and lqr take it about a rest, in "
-                     "its Euler angles", field="simulation")
+def _flyers(tree) -> list[int]:
+    """Where each free flyer's twist (linear, then angular, in its own axes) starts in v: the
+    floating base's, then each one below the root."""
+    return ([0] if tree.floating_base else []) + [
+        tree.base_nv + tree.velocity_index(j.coordinate) for j in tree.free_joints]
+
+
+def _turned_numbers(tree) -> set[int]:
+    """The velocity numbers whose configuration is on a manifold (a ball's three, a free
+    flyer's six): their state in x is the tangent dq, named delta_<velocity>."""
+    from ..dynamics.tree.spherical import ball_slices
+
+    balls = {iv + k for _, _, iv in ball_slices(tree) for k in range(3)}
+    return balls | {iv + k for iv in _flyers(tree) for k in range(6)}
+
+
+def _cross(w: np.ndarray) -> np.ndarray:
+    """[w]x of each row of w (N, 3): (N, 3, 3)."""
+    out = np.zeros((len(w), 3, 3))
+    out[:, 0, 1], out[:, 0, 2], out[:, 1, 2] = -w[:, 2], w[:, 1], -w[:, 0]
+    out[:, 1, 0], out[:, 2, 0], out[:, 2, 1] = w[:, 2], -w[:, 1], w[:, 0]
+    return out
+
+
+def _tangent_drift(tree, v: np.ndarray, block: np.ndarray) -> None:
+    """d(dq)/dt = dv - ad(v) dq, into ``block`` (N, n, n) (the q-q block of A): the right
+    perturbation q (+) dq of the derivatives (Pinocchio's dIntegrate: R = R_run exp([dq]x) for
+    a ball, d(dq)/dt = dw - w x dq; a free flyer's twist (v_lin, w): -[[w]x, [v_lin]x; 0, [w]x]),
+    zero for a number with q_dot = v."""
+    from ..dynamics.tree.spherical import ball_slices
+
+    for _, _, iv in ball_slices(tree):
+        block[:, iv:iv + 3, iv:iv + 3] = -_cross(v[:, iv:iv + 3])
+    for iv in _flyers(tree):
+        linear, angular = _cross(v[:, iv:iv + 3]), _cross(v[:, iv + 3:iv + 6])
+        block[:, iv:iv + 3, iv:iv + 3] = -angular
+        block[:, iv:iv + 3, iv + 3:iv + 6] = -linear
+        block[:, iv + 3:iv + 6, iv + 3:iv + 6] = -angular

@@ -108,6 +108,8 @@ static PyObject *dk_py_tree(PyObject *self, PyObject *const *args, Py_ssize_t na
         free(tree);
         goto bad;
     }
+    tree->bodies = 0;
+    for (long i = 0; i < nb; i++) tree->bodies += end[i] == i;
     tree->parent = parent;
     tree->coord = coord;
     tree->mult = mult;
@@ -182,7 +184,7 @@ enum { DK_INVERSE, DK_FORWARD, DK_REGRESSOR };
 /* the numbers of one output of one state */
 static inline size_t dk_size(const dk_tree *tree, int kind)
 {
-    return (size_t)tree->nv * (kind == DK_REGRESSOR ? 10 * (size_t)tree->nb : (size_t)tree->nv);
+    return (size_t)tree->nv * (kind == DK_REGRESSOR ? 10 * (size_t)tree->bodies : (size_t)tree->nv);
 }
 
 /* States k0 to k1 of the job: LG_LANES at a time through the dk4_ functions (out: their
@@ -273,7 +275,7 @@ static void *dk_run(void *argument)
     dk_job *job = (dk_job *)argument;
     const dk_tree *tree = job->tree;
     /* one block: the work, then, with LG_LANES states or more, the lanes' outputs (a
-       regressor's are nv x 10 nb vectors) and inputs; one state's work in doubles alone */
+       regressor's are nv x 10 bodies vectors) and inputs; one state's work in doubles alone */
     const int lanes = job->k1 - job->k0 >= LG_LANES;
     const size_t outputs = 3 * dk_size(tree, DK_FORWARD) > dk_size(tree, DK_REGRESSOR)
                            ? 3 * dk_size(tree, DK_FORWARD) : dk_size(tree, DK_REGRESSOR);
@@ -367,12 +369,12 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     }
     /* the outputs as views of one block (nout, ..., nv, nv): one allocation (two large ones
        of a size freed and asked again each call cost glibc a trim and fresh pages); the
-       regressor's (..., nv, 10 nb) */
+       regressor's (..., nv, 10 bodies) */
     npy_intp dims[NPY_MAXDIMS];
     dims[0] = nout;
     memcpy(dims + 1, PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp));
     dims[nd] = tree->nv;
-    dims[nd + 1] = kind == DK_REGRESSOR ? 10 * tree->nb : tree->nv;
+    dims[nd + 1] = kind == DK_REGRESSOR ? 10 * tree->bodies : tree->nv;
     block = lg_output(nd + 2, dims);
     if (!block) goto done;
     for (int o = 0; o < nout; o++) {

@@ -312,29 +312,9 @@ def derivatives_module(tree: KinematicTree) -> TreeDerivatives | None:
         return None
     D = description(tree, {})
     handle = module.tree(D, tables(tree))
-    regressor = partial(module.regressor, handle)
-    if tree.quaternion_joints:  # a split joint's first records are massless: not the tree's
-        regressor = partial(_bodies_columns, regressor, _real_columns(D))
+    regressor = partial(module.regressor, handle)  # the tree's bodies' columns alone
     return TreeDerivatives(partial(module.inverse_derivatives, handle),
                            partial(module.forward_derivatives, handle), regressor, module)
-
-
-def _real_columns(D: np.ndarray) -> np.ndarray:
-    """The regressor's columns of the tree's own bodies among the description's records: each
-    record's ten but those of a split joint's records before its last (massless, frameless)."""
-    n, nb = int(D[1]), int(D[0])
-    records = D[HEADER + n:].reshape(nb, STRIDE)
-    # a whole record (column 0), or a split joint's last column: its body's
-    real = (records[:, COLUMN] == 0) | (records[:, COLUMN] == _columns_of(records))
-    return (10 * np.flatnonzero(real)[:, None] + np.arange(10)).ravel()
-
-
-def _bodies_columns(regressor, columns: np.ndarray, Q, V, A, P):
-    """The regressor's Y over the tree's bodies (``columns``), its NaN-row count kept."""
-    out = regressor(Q, V, A, P)
-    if out.__class__ is tuple:
-        return out[0][..., columns], out[1]
-    return out[..., columns]
 
 
 def runtime_values(tree: KinematicTree, parameters: Mapping[str, float]) -> np.ndarray:

@@ -44,6 +44,7 @@
  * of one state's work (a lane group's on the lanes: carve). */
 typedef struct {
     int nb, nj, ff, np, nv, nq, qo, vo, ltdl, once, sparse;
+    int bodies;  /* the records that are a body's (end[i] == i): the regressor's ten columns */
     tk_tree t;
     const int *parent, *coord, (*pair)[2], *row0, *rows, *lambda;
     /* per record: whose motion its column's dv and psi are taken from (the parent's, a ball

@@ -22,8 +22,9 @@ static inline void DK_FN(regressor_column)(const DK_T *S, double mult, const DK_
     for (int p = 0; p < 6; p++) row[4 + p] += mult * SP_DOT(sw, Nj[p]);
 }
 
-/* Y (nv x 10 nb, row-major) with tau = Y pi, pi = [m, m c, I_xx, I_xy, I_yy, I_xz, I_yz,
- * I_zz] per body about its origin in its link's own axes (Pinocchio's order): body i's wrench
+/* Y (nv x 10 bodies, row-major) with tau = Y pi, pi = [m, m c, I_xx, I_xy, I_yy, I_xz, I_yz,
+ * I_zz] per body about its origin in its link's own axes (Pinocchio's order; a ball's or a
+ * flyer's records before its last are massless and frameless, no body's: none): body i's wrench
  * at its origin per parameter, from its angular velocity w, angular acceleration dw and its
  * origin's acceleration ac (gravity in), in its axes: m [ac; 0], h [(dw x + w x w x) h; h x ac],
  * J [0; J dw + w x J w]; each paired with S_k of every joint k at or above it, in its axes. */
@@ -33,9 +34,11 @@ static void DK_FN(regressor)(const dk_tree *tree, DK_T *space, const DK_T *q, co
     DK_FN(work) w;
     DK_FN(carve)(tree, space, &w);
     DK_FN(kinematics)(tree, q, qd, qdd, g, &w);
-    const int nb = tree->nb, width = 10 * nb;
+    const int nb = tree->nb, width = 10 * tree->bodies;
     for (int j = 0; j < tree->nv * width; j++) Y[j] = DK_C(0.0);
-    for (int i = 0; i < nb; i++) {
+    for (int i = 0, body = -1; i < nb; i++) {
+        if (tree->end[i] != i) continue;  /* a split joint's column before its last */
+        body++;
         const DK_T *o = w.o[i], *V = w.V[i], *Acc = w.Acc[i];
         /* the link's own axes, whose inertial pi is: R = R_c A^T, R_c the body's canonical
            axes (D's) and A (D's TK_AXES) the canonical axes in the link's */
@@ -81,9 +84,10 @@ static void DK_FN(regressor)(const dk_tree *tree, DK_T *space, const DK_T *q, co
         }
         for (int kk = i; kk >= tree->ff; kk = tree->parent[kk])
             DK_FN(regressor_column)(w.S[kk], tree->mult[kk], R, o, al, Fh, Nh, Nj,
-                                    Y + (tree->vo + tree->coord[kk]) * width + 10 * i);
+                                    Y + (tree->vo + tree->coord[kk]) * width + 10 * body);
         /* a floating base's rows 0..5, the wrench on it in its axes: every body hangs from it */
         for (int c = 0; c < 6 * tree->ff; c++)
-            DK_FN(regressor_column)(w.ffS[c], 1.0, R, o, al, Fh, Nh, Nj, Y + c * width + 10 * i);
+            DK_FN(regressor_column)(w.ffS[c], 1.0, R, o, al, Fh, Nh, Nj,
+                                    Y + c * width + 10 * body);
     }
 }

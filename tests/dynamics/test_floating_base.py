@@ -269,6 +269,9 @@ def test_bad_input_is_refused_in_one_line(tmp_path):
         lagrangian.load("pendulum", floating_base=True)
     with pytest.raises(lagrangian.ModelError, match="no equations in its joint coordinates"):
         system.equations_of_motion()
+    for at_rest in (system.equilibria, system.linearize):  # one line, not a width's fault
+        with pytest.raises(lagrangian.ModelError, match="no rest in its joint coordinates"):
+            at_rest()
     with pytest.raises(lagrangian.ModelError, match="unknown name 'kneee'"):  # the stop's names
         system.simulate(0.1, stop_when="kneee > 1")
     bad = tmp_path / "bad.urdf"

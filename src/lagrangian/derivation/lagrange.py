@@ -127,9 +127,9 @@ def derive(model: Model, *, check: bool = True,
     tree = model.kinematic_tree
     if tree is not None and tree.floating_base:  # its base moves by a quaternion, not by q
         raise ModelError("a floating-base robot has no equations in its joint coordinates "
-                         "(derive, simulate, modes and the other symbolic commands need them): "
-                         "use dynamics(), its kinematics and integrate(q, v, dt), or load it "
-                         "with a fixed base")
+                         "(derive and the other symbolic commands need them): use dynamics(), "
+                         "its kinematics, simulate and integrate(q, v, dt), or load it with a "
+                         "fixed base")
     refuse_deep_chain(model)
     q, q_dot, t = model.q, model.q_dot, model.time
     n = len(q)

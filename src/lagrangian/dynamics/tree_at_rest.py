@@ -24,14 +24,20 @@ class TreeAtRest:
     static_names: tuple[str, ...] = ()
 
     def __init__(self, dynamics):
+        tree = dynamics.tree
+        if tree.floating_base:  # the model's coordinates are the joints': a base has no rest
+            from ..errors import ModelError
+
+            raise ModelError("a floating-base robot has no rest in its joint coordinates "
+                             "(equilibria, linearize, modes and lqr take a fixed base): load it "
+                             "with a fixed base, or linearize a run with linearize_along")
         self.dynamics = dynamics
         self.model = dynamics.model
         self.n, self.m = len(self.model.coordinates), 0
-        tree = dynamics.tree
         # a ball joint or a free flyer below the root: the model's coordinates are its Euler
         # angles (what derive shows), the tree's numbers a quaternion (tree/model_charts.py)
         self._charts = None
-        if tree.quaternion_joints and not tree.floating_base:
+        if tree.quaternion_joints:
             from .tree.model_charts import ModelCharts
 
             self._charts = ModelCharts(self.model, dynamics.velocity_names)

@@ -14,6 +14,7 @@ prefix that is an identifier, a linked file never read, a name printed on one li
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
 import warnings
@@ -403,6 +404,107 @@ def read_impacts(text: str) -> None:
             raise Broke(f"impact {impact.name!r} accepted with normal {impact.normal}")
 
 
+_ENGINE_ROBOTS = {  # MJCF text, floating_base: a ball and MuJoCo's free joint, a free flyer
+    "free joint, ball": ("FREE", False), "free flyer base": ("FREE", True),
+    "ball, hinge, ball": ("CHAIN", False)}
+
+
+@functools.cache
+def _engine_robot(name: str):
+    """The robot's compiled dynamics, built once a process (tests/mjcf_models.py's chain)."""
+    import tempfile
+
+    import lagrangian
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from mjcf_models import BALL_HINGE_BALL
+
+    which, floating = _ENGINE_ROBOTS[name]
+    text = BALL_HINGE_BALL if which == "CHAIN" else BALL_HINGE_BALL.replace(
+        '<joint name="shoulder" type="ball"/>', '<freejoint name="root"/>')
+    path = Path(tempfile.mkdtemp(prefix="fuzz-engine-")) / "robot.xml"
+    path.write_text(text)
+    return lagrangian.load(path, floating_base=floating).dynamics()
+
+
+@st.composite
+def engine_calls(draw):
+    """(robot, function, inputs): one state's q, v, a of hostile numbers (NaN, inf, 1e308, a
+    quaternion off unit norm or scaled by 1 + 1e-12), as float64 vectors, strided views,
+    read-only arrays, float32, int or a list, now and then a number short or long."""
+    import numpy as np
+
+    robot = draw(st.sampled_from(sorted(_ENGINE_ROBOTS)))
+    function = draw(st.sampled_from(["mass_matrix", "inverse_dynamics", "forward_dynamics",
+                                     "bias_forces", "gravity", "kinetic_energy",
+                                     "potential_energy"]))
+    d = _engine_robot(robot)
+    count = {"mass_matrix": 1, "gravity": 1, "potential_energy": 1, "bias_forces": 2,
+             "kinetic_energy": 2}.get(function, 3)
+    numbers = st.one_of(st.floats(-3.0, 3.0), st.sampled_from(
+        [0.0, -0.0, 1e308, -1e308, 1e-308, float("nan"), float("inf"), float("-inf")]))
+    inputs = []
+    for k in range(count):
+        width = d.nq if k == 0 else d.nv
+        width += draw(st.sampled_from([0] * 12 + [-1, 1]))
+        x = np.array(draw(st.lists(numbers, min_size=max(width, 0), max_size=max(width, 0))))
+        if k == 0 and width == d.nq and draw(st.booleans()):  # its quaternions unit (or nearly)
+            from lagrangian.dynamics.tree.spherical import quaternion_slices
+
+            at = [s for *_, s, _ in quaternion_slices(d.tree)] + ([3] if d.tree.floating_base
+                                                                  else [])
+            with np.errstate(all="ignore"):
+                for i in at:
+                    x[i:i + 4] /= np.linalg.norm(x[i:i + 4]) / draw(st.sampled_from(
+                        [1.0, 1.0 + 1e-12, 1.0 + 1e-6, 1.5]))
+        layout = draw(st.sampled_from(["vector", "vector", "strided", "read-only", "float32",
+                                       "int", "list"]))
+        if layout == "strided":
+            x = np.repeat(x, 2)[::2]
+        elif layout == "read-only":
+            x.flags.writeable = False
+        elif layout == "float32":
+            with np.errstate(over="ignore"):  # 1e308 is inf in float32
+                x = x.astype(np.float32)
+        elif layout == "int":
+            with np.errstate(all="ignore"):
+                x = np.nan_to_num(x, posinf=9, neginf=-9).astype(np.int64)
+        elif layout == "list":
+            x = x.tolist()
+        inputs.append(x)
+    return robot, function, tuple(inputs)
+
+
+def call_engine(drawn) -> None:
+    """One state through the compiled front (its own path, engine/tree_kernel_bindings.c's
+    tk_single) and the same state as a batch of one (the batch path): the same refusal, or the
+    same numbers bit for bit (NaN where either has them), the same DynamicsWarning count."""
+    import numpy as np
+
+    from lagrangian import DynamicsWarning
+
+    robot, function, inputs = drawn
+    call = getattr(_engine_robot(robot), function)
+    outcomes = []
+    for shaped in (inputs, tuple(np.asarray(x)[None] for x in inputs)):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", DynamicsWarning)
+            try:
+                out = np.asarray(call(*shaped))
+            except LagrangianError as exc:
+                outcomes.append(("refused", str(exc)))
+                continue
+        outcomes.append(("answer", out, sum(isinstance(w.message, DynamicsWarning)
+                                             for w in caught)))
+    (alone, batch) = outcomes
+    if alone[0] != batch[0]:
+        raise Broke(f"one state {alone[0]}, its batch of one {batch[0]}: {alone[1]!s:.200}")
+    if alone[0] == "refused":
+        raise LagrangianError(alone[1])  # the one line, counted as the surface's refusal
+    if alone[2] != batch[2] or not np.array_equal(alone[1], batch[1][0], equal_nan=True):
+        raise Broke(f"one state's {function} is not its batch of one's row")
+
+
 # -- the surfaces ---------------------------------------------------------------------------
 
 def surfaces(folder: Path) -> dict[str, tuple[st.SearchStrategy, object]]:
@@ -425,6 +527,7 @@ def surfaces(folder: Path) -> dict[str, tuple[st.SearchStrategy, object]]:
         "codegen names (--name)": (codegen_names(), codegen_name),
         "MJCF documents (parse_mjcf)": (mjcf_documents(), read_mjcf_document),
         "[[impacts]] tables (model file reader)": (impact_tables(), read_impacts),
+        "engine calls (one state, a batch of one)": (engine_calls(), call_engine),
     }
 
 

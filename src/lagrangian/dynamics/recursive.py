@@ -221,7 +221,8 @@ def _unit_quaternions(q) -> np.ndarray:
     Q = np.asarray(q, dtype=float)
     flat = Q.reshape(-1, Q.shape[-1])
     check_quaternions(flat)
-    norms = np.sqrt((flat[:, 3:7] ** 2).sum(axis=-1))
+    with np.errstate(over="ignore", invalid="ignore"):  # a state beyond 1e154: its NaN row
+        norms = np.sqrt((flat[:, 3:7] ** 2).sum(axis=-1))
     edge = np.isfinite(flat).all(axis=-1) & ~(np.abs(norms - 1.0) <= QUATERNION_TOLERANCE)
     if not edge.any():
         return Q

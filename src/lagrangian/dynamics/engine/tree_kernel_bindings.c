@@ -229,8 +229,9 @@ static PyObject *tk_single(const tk_tree *t, PyObject *const *args, int nin, int
         a[i] = (const double *)PyArray_DATA((PyArrayObject *)args[i]);
         fine &= tk_finite(a[i], i == 0 ? t->nq : t->nv);
     }
-    if (fine && ((t->fb && !lg_unit_quaternions(a[0], 1, t->nq, t->nq, t->qtol))
-                 || ((t->balls || t->flyers) && !tk_unit_balls(t, a[0], 1, t->nq)))) {
+    /* a finite q's quaternions, whatever v and a hold (as a batch checks them) */
+    if (((t->fb && !lg_unit_quaternions(a[0], 1, t->nq, t->nq, t->qtol))
+         || ((t->balls || t->flyers) && !tk_unit_balls(t, a[0], 1, t->nq)))) {
         PyErr_Clear();  /* the front names the state and its norm */
         Py_RETURN_NOTIMPLEMENTED;
     }

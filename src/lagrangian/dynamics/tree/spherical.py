@@ -91,7 +91,8 @@ def unit_ball_quaternions(tree, Q: np.ndarray) -> np.ndarray:
     made unit (as the base's, recursive._unit_quaternions): a unit one keeps its bits."""
     out = Q
     for _, _, iq, _ in quaternion_slices(tree):
-        norms = np.sqrt((out[:, iq:iq + 4] ** 2).sum(axis=-1))
+        with np.errstate(over="ignore", invalid="ignore"):  # a state beyond 1e154: its NaN row
+            norms = np.sqrt((out[:, iq:iq + 4] ** 2).sum(axis=-1))
         edge = np.isfinite(out).all(axis=-1) & ~(np.abs(norms - 1.0) <= QUATERNION_TOLERANCE)
         if edge.any():
             out = out.copy() if out is Q else out

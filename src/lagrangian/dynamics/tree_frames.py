@@ -58,12 +58,9 @@ class TreeFrames:
         fast = self._reach
         if fast is None:
             fast = self._reach_kernel()
-        if fast:
-            try:
-                out = fast.placement(q, frame)
-            except (KeyError, ValueError, TypeError):
-                pass  # numpy below names the fault in one line
-            else:
+        if fast:  # NotImplemented: numpy below names the fault in one line
+            out = fast.placement(q, frame)
+            if out is not NotImplemented:
                 return out if out.__class__ is not tuple else reported_rows(out, 2)
         return undefined_rows(self.kinematics.placement, (q, frame), (q,), 2)
 
@@ -73,35 +70,28 @@ class TreeFrames:
         fast = self._reach
         if fast is None:
             fast = self._reach_kernel()
-        if fast:
-            try:
-                out = fast.jacobian(q, frame, reference)
-            except (KeyError, ValueError, TypeError):
-                pass  # numpy below names the fault in one line
-            else:
+        if fast:  # NotImplemented: numpy below names the fault in one line
+            out = fast.jacobian(q, frame, reference)
+            if out is not NotImplemented:
                 return out if out.__class__ is not tuple else reported_rows(out, 2)
         return undefined_rows(self.kinematics.jacobian, (q, frame, reference), (q,), 2)
 
     def center_of_mass(self, q) -> np.ndarray:
         """The moving bodies' centre of mass in the world (m), (..., 3)."""
         fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast:
-            try:  # None without moving mass: TypeError, then numpy's one-line refusal
-                out = fast.center_of_mass(q)
+        if fast and fast.center_of_mass is not None:  # None: no moving mass (numpy refuses)
+            out = fast.center_of_mass(q)
+            if out is not NotImplemented:
                 return out if out.__class__ is not tuple else reported_rows(out, 1)
-            except (ValueError, TypeError):
-                pass
         return undefined_rows(self.kinematics.center_of_mass, (q,), (q,), 1)
 
     def center_of_mass_jacobian(self, q) -> np.ndarray:
         """J_c with c_dot = J_c q_dot, (..., 3, n)."""
         fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast:
-            try:
-                out = fast.center_of_mass_jacobian(q)
+        if fast and fast.center_of_mass_jacobian is not None:
+            out = fast.center_of_mass_jacobian(q)
+            if out is not NotImplemented:
                 return out if out.__class__ is not tuple else reported_rows(out, 2)
-            except (ValueError, TypeError):
-                pass
         return undefined_rows(self.kinematics.center_of_mass_jacobian, (q,), (q,), 2)
 
     def jacobian_dot_times_v(self, q, v, frame: str,
@@ -109,12 +99,10 @@ class TreeFrames:
         """J_dot q_dot: the frame's classical acceleration at q_ddot = 0 (m/s^2, rad/s^2),
         (..., 6), as Pinocchio's getFrameClassicalAcceleration with a = 0."""
         fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast:
-            try:
-                out = fast.drift(q, v, frame, reference)
+        if fast:  # NotImplemented: numpy below broadcasts, or names the fault in one line
+            out = fast.drift(q, v, frame, reference)
+            if out is not NotImplemented:
                 return out if out.__class__ is not tuple else reported_rows(out, 1)
-            except (KeyError, ValueError, TypeError):
-                pass  # numpy below broadcasts, or names the fault in one line
         return undefined_rows(self.kinematics.jacobian_dot_times_v, (q, v, frame, reference),
                               (q, v), 1)
 
@@ -124,12 +112,10 @@ class TreeFrames:
         fast = self._reach
         if fast is None:
             fast = self._reach_kernel()
-        if fast:
-            try:  # None without moving mass: TypeError, then below
-                out = fast.centroidal(q)
+        if fast and fast.centroidal is not None:  # None: no moving mass (numpy refuses)
+            out = fast.centroidal(q)
+            if out is not NotImplemented:
                 return out if out.__class__ is not tuple else reported_rows(out, 2)
-            except (ValueError, TypeError):
-                pass
         return undefined_rows(self.kinematics.centroidal_momentum_matrix, (q,), (q,), 2)
 
     # the compiled kernel of the functions above (reach_c.py): None until asked, then
@@ -214,11 +200,9 @@ class TreeFrames:
         if self.velocity_names is not None:  # quasi-velocities: Pinocchio's factorization
             fast = self._reach if self._reach is not None else self._reach_kernel()
             if fast and fast.coriolis is not None:  # compiled (reach_kernel.c)
-                try:
-                    out = fast.coriolis(q, v)
+                out = fast.coriolis(q, v)  # NotImplemented: numpy below names the fault
+                if out is not NotImplemented:
                     return out if out.__class__ is not tuple else reported_rows(out, 2)
-                except (ValueError, TypeError):
-                    pass  # numpy below broadcasts, or names the fault in one line
             from .algorithms.coriolis_tree import coriolis_matrix
 
             # partial, not a lambda: a closure over self would slow the compiled path above
@@ -231,11 +215,9 @@ class TreeFrames:
             if compiled is None:
                 compiled = fast.checked_coriolis(self)
             if compiled:
-                try:
-                    out = compiled(q, v)
+                out = compiled(q, v)  # NotImplemented: numpy below names the fault
+                if out is not NotImplemented:
                     return out if out.__class__ is not tuple else reported_rows(out, 2)
-                except (ValueError, TypeError):
-                    pass  # numpy below broadcasts, or names the fault in one line
         return self._guarded(self._christoffel_coriolis, (q, v), ("q", "v"), (self.n, self.n))
 
     coriolis_matrix.__doc__ = Dynamics.coriolis_matrix.__doc__

@@ -19,9 +19,10 @@ from .tree_frames import TreeFrames
 
 
 class DerivativesKernel(NamedTuple):
-    """A tree's compiled derivatives (derivatives_c.py): each function takes (Q, V, X, P); the
-    C refuses a base quaternion of the wrong norm with a ValueError, the checked ones name the
-    state and the norm in one line first (the guarded way)."""
+    """A tree's compiled derivatives (derivatives_c.py): each function takes (Q, V, X, P) and
+    answers NotImplemented for inputs it does not take (widths, batch shapes, a quaternion off
+    unit norm); the checked ones name the state and the norm in one line first (the guarded
+    way)."""
 
     inverse: Callable
     forward: Callable
@@ -59,13 +60,9 @@ class TreeTerms(TreeFrames):
 
     def regressor(self, q, v, a, parameters: Sequence[str] | None = None) -> np.ndarray:
         fast = self._derivatives_kernel() if parameters is None else None
-        if fast is not None:  # one C call; a bad input goes
-            # the guarded way to be named
-            try:
-                out = fast.regressor(q, v, a, fast.P)
-            except (ValueError, TypeError):
-                pass
-            else:
+        if fast is not None:  # one C call; NotImplemented: the guarded way names the fault
+            out = fast.regressor(q, v, a, fast.P)
+            if out is not NotImplemented:
                 return out if out.__class__ is not tuple else _reported(out)[0]
         compute, names, _ = self._regressor_of(parameters)  # as the base's: one frame deep
         return self._guarded(compute, (q, v, a), ("q", "v", "a"), (self.n, len(names)))
@@ -135,12 +132,9 @@ class TreeTerms(TreeFrames):
 
     def inverse_dynamics_derivatives(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
         fast = self._derivatives_kernel()
-        if fast is not None:  # one C call; a bad input goes the guarded way to be named
-            try:
-                out = fast.inverse(q, v, a, fast.P)
-            except (ValueError, TypeError):
-                pass
-            else:
+        if fast is not None:  # one C call; NotImplemented: the guarded way names the fault
+            out = fast.inverse(q, v, a, fast.P)
+            if out is not NotImplemented:
                 return out if len(out) == 2 else _reported(out)
         compute = self._inverse_derivatives()  # as the base's, one frame deep for the warning
         n = self.n
@@ -154,12 +148,9 @@ class TreeTerms(TreeFrames):
     def forward_dynamics_derivatives(self, q, v, tau) -> tuple[np.ndarray, np.ndarray,
                                                                np.ndarray]:
         fast = self._derivatives_kernel()
-        if fast is not None:
-            try:
-                out = fast.forward(q, v, tau, fast.P)
-            except (ValueError, TypeError):
-                pass
-            else:
+        if fast is not None:  # as inverse_dynamics_derivatives
+            out = fast.forward(q, v, tau, fast.P)
+            if out is not NotImplemented:
                 return out if len(out) == 3 else _reported(out)
         n = self.n
         # forward dynamics' rule: one warning for the three, a state's three rows NaN together

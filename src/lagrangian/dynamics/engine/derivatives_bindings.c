@@ -6,7 +6,8 @@
  * the functions take (tree, Q, V, X, P) with Q, V, X (..., nq / nv) float64 (or (nq,), shared
  * by the batch), P = [g (3), tau_<joint> (nj), 13 per body]; outputs (..., nv, nv) each, as a
  * tuple, with the count of NaN rows appended where a state's inputs are not all finite (or,
- * forward, its M is not positive definite). A batch runs on threads taking DK_CHUNK states at a
+ * forward, its M is not positive definite); NotImplemented for inputs of other widths, batch
+ * shapes or quaternions off unit norm (the front checks and names them). A batch runs on threads taking DK_CHUNK states at a
  * time, each thread's work in one heap block (any tree's size, off the threads' stacks). */
 
 #define DK_PTHREADS LG_PTHREADS  /* batch_threads.c, above this text */
@@ -311,7 +312,6 @@ static int dk_threads(npy_intp count) { return lg_threads(count, DK_THREAD_STATE
 
 static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
 {
-    const char *names[3] = {"q", "v", kind == DK_FORWARD ? "tau" : "a"};
     PyArrayObject *in[3] = {NULL, NULL, NULL}, *P = NULL;
     PyObject *out[3] = {NULL, NULL, NULL}, *block = NULL, *result = NULL;
     npy_intp step[3] = {0, 0, 0};
@@ -326,13 +326,9 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
     int base = 0;
     for (int i = 0; i < 3; i++) {
         in[i] = (PyArrayObject *)PyArray_FROMANY(args[i], NPY_DOUBLE, 0, 0, NPY_ARRAY_CARRAY_RO);
-        if (!in[i]) goto done;
+        if (!in[i]) goto front;
         int nd = PyArray_NDIM(in[i]);
-        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != dk_width(tree, i)) {
-            PyErr_Format(PyExc_ValueError, "%s: expected %d values along the last axis",
-                         names[i], dk_width(tree, i));
-            goto done;
-        }
+        if (nd == 0 || PyArray_DIMS(in[i])[nd - 1] != dk_width(tree, i)) goto front;
         if (PyArray_SIZE(in[i]) / dk_width(tree, i)
             > PyArray_SIZE(in[base]) / dk_width(tree, base))
             base = i;
@@ -345,21 +341,17 @@ static PyObject *dk_batch(PyObject *const *args, Py_ssize_t nargs, int kind)
             continue;
         }
         if (PyArray_NDIM(in[i]) != nd
-            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp))) {
-            PyErr_SetString(PyExc_ValueError, "the batch shapes of the inputs differ");
-            goto done;
-        }
+            || memcmp(PyArray_DIMS(in[i]), PyArray_DIMS(in[base]), (nd - 1) * sizeof(npy_intp)))
+            goto front;
         step[i] = dk_width(tree, i);
     }
     if (tree->ff && !lg_unit_quaternions((const double *)PyArray_DATA(in[0]),
                                          step[0] ? count : 1, step[0], tree->nq, DK_QTOL))
-        goto done;
+        goto front;
     if ((tree->t.balls || tree->t.flyers)
         && !tk_unit_balls(&tree->t, (const double *)PyArray_DATA(in[0]), step[0] ? count : 1,
-                          step[0])) {
-        PyErr_SetString(PyExc_ValueError, "q: a joint's quaternion is not unit");
-        goto done;
-    }
+                          step[0]))
+        goto front;
     P = (PyArrayObject *)PyArray_FROMANY(args[3], NPY_DOUBLE, 1, 1, NPY_ARRAY_CARRAY_RO);
     if (!P) goto done;
     if (PyArray_SIZE(P) != 3 + tree->nj + 13 * tree->nb) {
@@ -430,6 +422,11 @@ done:
     Py_XDECREF(block);
     Py_XDECREF(P);
     return result;
+front:  /* inputs this call does not take (numbers, widths, batch shapes, quaternions): the
+           Python front checks them and names the fault (tree_terms.py); no error is read */
+    PyErr_Clear();
+    for (int i = 0; i < 3; i++) Py_XDECREF(in[i]);
+    Py_RETURN_NOTIMPLEMENTED;
 }
 
 static PyObject *dk_py_inverse(PyObject *self, PyObject *const *args, Py_ssize_t nargs)

@@ -162,7 +162,8 @@ def reach_module(tree: KinematicTree):
 class ReachKernel:
     """The compiled functions with frames by name; inputs of one batch shape (..., n). Each
     returns its output, or (output, count of NaN rows) where a state's inputs are not all
-    finite (its whole row NaN: reach_bindings.c)."""
+    finite (its whole row NaN: reach_bindings.c); the frame functions NotImplemented for inputs
+    they do not take (the front names the fault). The wrench functions still raise."""
 
     def __init__(self, module, tree: KinematicTree, massive: bool):
         self.module = module
@@ -203,12 +204,12 @@ class ReachKernel:
         self.fixed_coriolis = False
         rng = np.random.default_rng(0)
         q, v = rng.uniform(-1.0, 1.0, (2, 3, dynamics.n))
-        try:
-            ours = np.asarray(self.compiled.coriolis(q, v), dtype=float)
-            with np.errstate(all="ignore"):
-                christoffel = np.asarray(dynamics._christoffel_coriolis(q, v), dtype=float)
-        except (ValueError, TypeError):
+        ours = self.compiled.coriolis(q, v)
+        if ours is NotImplemented:  # inputs it does not take (not these): numpy's C stays
             return False
+        ours = np.asarray(ours, dtype=float)
+        with np.errstate(all="ignore"):
+            christoffel = np.asarray(dynamics._christoffel_coriolis(q, v), dtype=float)
         scale = 1.0 + np.abs(christoffel).max()
         if np.abs(ours - christoffel).max() <= 1e-9 * scale:
             self.fixed_coriolis = self.compiled.coriolis

@@ -106,6 +106,22 @@ def test_two_link_textbook_mass_matrix(tmp_path):
                                rtol=1e-13)
 
 
+def test_a_state_beyond_1e154_overflows_without_numpys_warning(tmp_path):
+    """Spong's arm on the numpy recursions at rates of 1e300 rad/s: the bias forces overflow
+    to inf as the compiled engine's do, forward dynamics' row is NaN with the one
+    DynamicsWarning, M (which no rate enters) stays finite; no RuntimeWarning."""
+    import warnings
+
+    f = arm(tmp_path, URDF.TWO_LINK).dynamics(backend="numpy")
+    q, v = np.array([0.3, 0.5]), np.array([1e300, -1e300])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert not np.isfinite(f.bias_forces(q, v)).all()
+        with pytest.warns(lagrangian.DynamicsWarning, match="1 of 1 states"):
+            assert np.isnan(f.forward_dynamics(q, v, np.zeros(2))).all()
+        assert np.isfinite(f.mass_matrix(q)).all()
+
+
 @pytest.mark.parametrize("lock", [{"grip": 0.01}, {"grip": 0.01, "wrist": -0.3}])
 def test_laws_of_the_numpy_recursions(tmp_path, lock):
     f = arm(tmp_path, RECURSIVE.TREE, lock).dynamics(backend="numpy")

@@ -51,13 +51,16 @@ def over_finite_rows(compute, flat, tail: tuple[int, ...], forward: bool = False
     good = np.ones(total, dtype=bool)
     for x in flat:
         good &= np.isfinite(x).all(axis=-1)
-    if good.all():
-        out = np.asarray(compute(*flat), dtype=float).reshape((total,) + tail)
-    else:
-        out = np.full((total,) + tail, np.nan)
-        if good.any():
-            out[good] = np.asarray(compute(*(x[good] for x in flat)),
-                                   dtype=float).reshape((-1,) + tail)
+    # a finite state beyond 1e154 overflows to inf as the compiled engine's does, without
+    # numpy's RuntimeWarning (forward dynamics then counts its row)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        if good.all():
+            out = np.asarray(compute(*flat), dtype=float).reshape((total,) + tail)
+        else:
+            out = np.full((total,) + tail, np.nan)
+            if good.any():
+                out[good] = np.asarray(compute(*(x[good] for x in flat)),
+                                       dtype=float).reshape((-1,) + tail)
     if forward:
         good &= np.isfinite(out.reshape(total, -1)).all(axis=-1)
         out[~good] = np.nan

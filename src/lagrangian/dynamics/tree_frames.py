@@ -136,12 +136,15 @@ class TreeFrames:
         """Inverse or forward dynamics with wrenches at frames: tau_ext = sum J^T w
         (wrenches.py) taken from tau, or added to it; in compiled C where it can be."""
         fast = self._reach if self._reach is not None else self._reach_kernel()
-        if fast:
-            try:
-                if forward:  # a state not finite leaves NaN in tau, and forward dynamics warns
+        # the compiled way where it takes the inputs (NotImplemented: the numpy way below
+        # broadcasts, or names the fault in one line)
+        if fast and isinstance(f_ext, Mapping):
+            if forward:  # a state not finite leaves NaN in tau, and forward dynamics warns
+                if x.__class__ is np.ndarray and x.dtype.kind in "fiu":
                     tau = np.array(x, dtype=float)  # our own copy, added to in place
-                    fast.add_wrenches(q, f_ext, tau, 1.0)
-                    return self.forward_dynamics(q, v, tau)
+                    if fast.add_wrenches(q, f_ext, tau, 1.0) is not NotImplemented:
+                        return self.forward_dynamics(q, v, tau)
+            else:
                 one_pass = fast.inverse if fast.inverse is not None else fast.fused_inverse(self)
                 # one Newton-Euler pass (reach_inverse.c, on vector lanes over a batch) for a
                 # floating base or a few states; over many states of a fixed base the tree
@@ -149,15 +152,16 @@ class TreeFrames:
                 if one_pass and (self.velocity_names is not None or q.__class__ is not np.ndarray
                                  or q.ndim < 2 or len(q) <= 64):
                     out = one_pass(q, v, x, f_ext)
-                    return out if out.__class__ is not tuple else reported_rows(out, 1, 5)
-                with warnings.catch_warnings():  # counted once, with the wrenches' states
-                    warnings.simplefilter("ignore", DynamicsWarning)
-                    tau = self.inverse_dynamics(q, v, x)
-                # the count of rows NaN after the last wrench (made NaN whole): the batch's
-                bad = fast.add_wrenches(q, f_ext, tau, -1.0)
-                return reported_rows((tau, bad) if bad else tau, 1, 5)
-            except (KeyError, ValueError, TypeError, AttributeError):
-                pass  # numpy below broadcasts, or names the fault in one line
+                    if out is not NotImplemented:
+                        return out if out.__class__ is not tuple else reported_rows(out, 1, 5)
+                else:
+                    with warnings.catch_warnings():  # counted once, with the wrenches' states
+                        warnings.simplefilter("ignore", DynamicsWarning)
+                        tau = np.array(self.inverse_dynamics(q, v, x), dtype=float)
+                    # the count of rows NaN after the last wrench (made NaN whole): the batch's
+                    bad = fast.add_wrenches(q, f_ext, tau, -1.0)
+                    if bad is not NotImplemented:
+                        return reported_rows((tau, bad) if bad else tau, 1, 5)
         inputs = (q, v, x, *f_ext.values()) if isinstance(f_ext, Mapping) else (q, v, x)
         return undefined_rows(self._wrenches_numpy, (q, v, x, f_ext, forward), inputs, 1, 5)
 

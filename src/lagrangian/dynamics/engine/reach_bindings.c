@@ -308,7 +308,7 @@ done:
     return rk_result(out, bad);
 }
 
-/* A frame function's NULL for inputs it does not take (the checks above raise: a width, a
+/* A method's NULL for inputs it does not take (the checks above raise: a width, a
    batch shape, a quaternion off unit norm, a frame or a reference not the tree's):
    NotImplemented instead, the fault cleared, and the Python front (tree_frames.py) checks the
    inputs and names the fault in one line; no error is read there. Memory errors stay. */
@@ -328,6 +328,8 @@ RK_FRONTED(centroidal)
 RK_FRONTED(coriolis)
 RK_FRONTED(com)
 RK_FRONTED(com_jacobian)
+RK_FRONTED(wrench)
+RK_FRONTED(inverse)
 
 #define RK_FAST(name) (PyCFunction)(void (*)(void))rk_py_##name, METH_FASTCALL
 #define RK_FRONT(name) (PyCFunction)(void (*)(void))rk_fronted_##name, METH_FASTCALL
@@ -336,9 +338,9 @@ static PyMethodDef rk_tree_methods[] = {
     {"jacobian", RK_FRONT(jacobian), "(Q, frame, reference) -> 6 x nv, or (6 x nv, NaN rows)"},
     {"drift", RK_FRONT(drift), "(Q, V, frame, reference) -> [a; w_dot], or ([a; w_dot], NaN rows)"},
     {"centroidal", RK_FRONT(centroidal), "(Q) -> A_g, or (A_g, NaN rows)"},
-    {"wrench", RK_FAST(wrench), "(Q, frame, W, OUT, sign): OUT += sign J^T w; -> NaN rows"},
+    {"wrench", RK_FRONT(wrench), "(Q, frame, W, OUT, sign): OUT += sign J^T w; -> NaN rows"},
     {"coriolis", RK_FRONT(coriolis), "(Q, V) -> C(q, v), or (C(q, v), NaN rows)"},
-    {"inverse", RK_FAST(inverse), "(UP, Q, V, A, F_EXT) -> tau, or (tau, NaN rows)"},
+    {"inverse", RK_FRONT(inverse), "(UP, Q, V, A, F_EXT) -> tau, or (tau, NaN rows)"},
     {"com", RK_FRONT(com), "(Q) -> c, or (c, NaN rows)"},
     {"com_jacobian", RK_FRONT(com_jacobian), "(Q) -> J_c, or (J_c, NaN rows)"},
     {NULL, NULL, 0, NULL},

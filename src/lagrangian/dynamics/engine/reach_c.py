@@ -235,25 +235,30 @@ class ReachKernel:
         v, a = rng.uniform(-1.0, 1.0, (2, 3, dynamics.n))
         wrenches = {f.name: rng.uniform(-5.0, 5.0, (3, 6)) for f in tree.frames if f.body >= 0}
         wrenches = dict(list(wrenches.items())[-1:])  # the last moving frame's
-        try:
-            fused = one_pass(q, v, a, wrenches)  # finite states: the output alone
-            apart = np.array(dynamics.inverse_dynamics(q, v, a), dtype=float)
-            self.add_wrenches(q, wrenches, apart, -1.0)
-        except (ValueError, TypeError, KeyError):
+        fused = one_pass(q, v, a, wrenches)  # finite states: the output alone
+        apart = np.array(dynamics.inverse_dynamics(q, v, a), dtype=float)
+        if fused is NotImplemented or self.add_wrenches(q, wrenches, apart, -1.0) \
+                is NotImplemented:  # a tree these do not take: the two calls stay
             self.inverse = False
             return False
         scale = 1.0 + np.abs(apart).max()
         self.inverse = one_pass if np.abs(fused - apart).max() <= 1e-9 * scale else False
         return self.inverse
 
-    def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float) -> int:
+    def add_wrenches(self, q, wrenches, out: np.ndarray, sign: float):
         """out += sign sum J^T w over the frames, in place (out: q's batch, nv wide), the rows of
         states not finite (q, a wrench, or out's row already) made NaN whole; their count.
-        ValueError or KeyError where the inputs are not plain or a base quaternion is off (the
-        numpy path then names the fault)."""
+        NotImplemented where a frame is not the tree's or the inputs are not plain or a
+        quaternion is off (out then partly added to: the caller's own copy; the numpy path
+        names the fault)."""
         wrench, bad = self.compiled.wrench, None
         for name, w in wrenches.items():
-            bad = wrench(q, self.frame_index[name], w, out, sign)  # the last counts them all
+            index = self.frame_index.get(name) if isinstance(name, str) else None
+            if index is None:
+                return NotImplemented
+            bad = wrench(q, index, w, out, sign)  # the last counts them all
+            if bad is NotImplemented:
+                return NotImplemented
         if bad is None:  # no wrench: the rows NaN already (the caller's dynamics')
             bad = int(np.isnan(out).reshape(-1, out.shape[-1]).any(axis=-1).sum())
         return bad

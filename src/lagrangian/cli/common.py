@@ -57,6 +57,7 @@ FLAG_OF_FIELD = {
     "controller": "--control",
     "linear_model": "--control",
     "inputs": "--inputs",
+    "independent": "--independent",
     "Q": "--Q",
     "R": "--R",
     "Kp": "--kp",

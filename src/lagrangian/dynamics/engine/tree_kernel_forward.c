@@ -386,10 +386,9 @@ TK_SHORT_LOOPS static TK_MASK TK_FN(forward_cholesky)(const tk_tree *t, const TK
     TK_FN(mass_placed)(t, W, L);
     TK_FN(inverse_placed)(t, v, NULL, W, qdd);
     for (int i = 0; i < n; i++) qdd[i] = tau[i] - qdd[i];
-    /* M = L D L^T, L unit lower, by columns from the left, each column's update of the rest
-       at once (right-looking): one reciprocal a column, no square root, and the solves by
-       columns too, so that the chain from one unknown to the next is one product and one
-       difference (the dot-product forms' chains of sums were a sixth of the Panda's FD) */
+    /* M = L D L^T, L unit lower, column by column, each one's update of the rest at once and
+       of L y = x with it: one reciprocal a column and no square root (the roots and divisions
+       on the factor's chain were a fifteenth of the Panda's forward dynamics) */
     TK_T inverse[n], column[n];
     for (int j = 0; j < n; j++) {
         const TK_T d = L[j * n + j];
@@ -398,15 +397,15 @@ TK_SHORT_LOOPS static TK_MASK TK_FN(forward_cholesky)(const tk_tree *t, const TK
         inverse[j] = 1.0 / d;
         for (int i = j + 1; i < n; i++) {
             column[i] = L[i * n + j];  /* l_ij d_j */
-            L[i * n + j] = column[i] * inverse[j];
+            const TK_T l = column[i] * inverse[j];
+            L[i * n + j] = l;
+            qdd[i] -= l * qdd[j];  /* y_j is whole: every column before it is done */
         }
         for (int i = j + 1; i < n; i++) {
             const TK_T l = L[i * n + j];
             for (int k = j + 1; k <= i; k++) L[i * n + k] -= l * column[k];
         }
     }
-    for (int i = 0; i < n; i++)  /* L y = x */
-        for (int k = i + 1; k < n; k++) qdd[k] -= L[k * n + i] * qdd[i];
     for (int i = 0; i < n; i++) qdd[i] *= inverse[i];
     for (int i = n - 1; i >= 0; i--)  /* L^T x = D^-1 y */
         for (int k = 0; k < i; k++) qdd[k] -= L[i * n + k] * qdd[i];

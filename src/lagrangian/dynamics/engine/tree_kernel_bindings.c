@@ -20,6 +20,19 @@ typedef struct {
     int failed;
 } tk_job;
 
+/* Forward dynamics by M's factor, M = L D L^T with the bias from one RNEA, rather than the
+   articulated-body algorithm: where mimic joints drive several bodies from one coordinate, and
+   on a fixed base of one-number joints up to TK_FACTOR_MOST of them, where it is the faster
+   (measured on the engine, ns: UR5 574 against 682, the locked Panda 662 against 820, a
+   12-joint chain 1273 against 1416; even at 16 joints, ABA ahead from 24 and on Solo12's
+   floating base: docs/benchmarks.md). Chosen by the tree alone: a batch's lanes and its single
+   calls take the same one. */
+#define TK_FACTOR_MOST 12
+static inline int tk_by_factor(const tk_tree *t)
+{
+    return t->mimic || (!t->fb && !t->balls && !t->flyers && t->nv <= TK_FACTOR_MOST);
+}
+
 /* One state on the scalar functions into y (size numbers); 0 where it is defined. */
 static int tk_one(const tk_tree *t, int kind, const double **a, double *W, double *L,
                   double *y)
@@ -30,7 +43,7 @@ static int tk_one(const tk_tree *t, int kind, const double **a, double *W, doubl
     case TK_GRAVITY: tk_inverse(t, a[0], NULL, NULL, W, y); return 0;
     case TK_INVERSE: tk_inverse(t, a[0], a[1], a[2], W, y); return 0;
     case TK_FORWARD:
-        return t->mimic ? tk_forward_cholesky(t, a[0], a[1], a[2], W, L, y)
+        return tk_by_factor(t) ? tk_forward_cholesky(t, a[0], a[1], a[2], W, L, y)
                         : tk_forward_aba(t, a[0], a[1], a[2], W, y);
     case TK_KINETIC: y[0] = tk_kinetic(t, a[0], a[1], W); return 0;
     default: y[0] = tk_potential(t, a[0], W); return 0;
@@ -48,7 +61,7 @@ static lg_i4 tk_lanes(const tk_tree *t, int kind, const lg_v4 **a, lg_v4 *W, lg_
     case TK_GRAVITY: tk4_inverse(t, a[0], NULL, NULL, W, Y); return fine;
     case TK_INVERSE: tk4_inverse(t, a[0], a[1], a[2], W, Y); return fine;
     case TK_FORWARD:
-        return t->mimic ? tk4_forward_cholesky(t, a[0], a[1], a[2], W, L, Y)
+        return tk_by_factor(t) ? tk4_forward_cholesky(t, a[0], a[1], a[2], W, L, Y)
                         : tk4_forward_aba(t, a[0], a[1], a[2], W, Y);
     case TK_KINETIC: Y[0] = tk4_kinetic(t, a[0], a[1], W); return fine;
     default: Y[0] = tk4_potential(t, a[0], W); return fine;

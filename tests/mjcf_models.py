@@ -46,3 +46,7 @@ BALL_HINGE_BALL = """<mujoco model="ball_hinge_chain">
     </body>
   </worldbody>
 </mujoco>"""
+
+# the chain on MuJoCo's free joint instead of its shoulder (a ball wrist below)
+FREE_HINGE_BALL = BALL_HINGE_BALL.replace('<joint name="shoulder" type="ball"/>',
+                                          '<freejoint name="root"/>')

@@ -17,15 +17,14 @@ from tests.model.test_urdf_floating_mid_tree import ARM
 
 import lagrangian
 from lagrangian.dynamics.tree.spherical import ball_slices
-from mjcf_models import BALL_HINGE_BALL
+from mjcf_models import BALL_HINGE_BALL, FREE_HINGE_BALL
 
 pytest.importorskip("yourdfpy")
 
-FREE = BALL_HINGE_BALL.replace('<joint name="shoulder" type="ball"/>', '<freejoint name="root"/>')
 CASES = {  # file text, suffix, floating_base
     "ball, hinge, ball": (BALL_HINGE_BALL, "xml", False),
-    "MuJoCo's free joint": (FREE, "xml", False),
-    "free flyer base": (FREE, "xml", True),
+    "MuJoCo's free joint": (FREE_HINGE_BALL, "xml", False),
+    "free flyer base": (FREE_HINGE_BALL, "xml", True),
     "floating joint between links": (ARM, "urdf", False),
 }
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import lagrangian
-from mjcf_models import BALL_HINGE_BALL
+from mjcf_models import BALL_HINGE_BALL, FREE_HINGE_BALL
 
 mujoco = pytest.importorskip("mujoco")
 pytest.importorskip("yourdfpy")
@@ -57,7 +57,7 @@ BODIES = """<mujoco model="joints_in_one_body">
 
 
 # the chain on a free flyer instead of its shoulder: a floating base with a ball wrist
-FLOATING = CHAIN.replace('<joint name="shoulder" type="ball"/>', '<freejoint name="root"/>')
+FLOATING = FREE_HINGE_BALL
 
 
 def _load(tmp_path_factory, text, name, **options):

@@ -417,11 +417,10 @@ def _engine_robot(name: str):
     import lagrangian
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from mjcf_models import BALL_HINGE_BALL
+    from mjcf_models import BALL_HINGE_BALL, FREE_HINGE_BALL
 
     which, floating = _ENGINE_ROBOTS[name]
-    text = BALL_HINGE_BALL if which == "CHAIN" else BALL_HINGE_BALL.replace(
-        '<joint name="shoulder" type="ball"/>', '<freejoint name="root"/>')
+    text = BALL_HINGE_BALL if which == "CHAIN" else FREE_HINGE_BALL
     path = Path(tempfile.mkdtemp(prefix="fuzz-engine-")) / "robot.xml"
     path.write_text(text)
     return lagrangian.load(path, floating_base=floating).dynamics()

@@ -115,25 +115,18 @@ def _turned_numbers(tree) -> set[int]:
     return balls | {iv + k for iv in _flyers(tree) for k in range(6)}
 
 
-def _cross(w: np.ndarray) -> np.ndarray:
-    """[w]x of each row of w (N, 3): (N, 3, 3)."""
-    out = np.zeros((len(w), 3, 3))
-    out[:, 0, 1], out[:, 0, 2], out[:, 1, 2] = -w[:, 2], w[:, 1], -w[:, 0]
-    out[:, 1, 0], out[:, 2, 0], out[:, 2, 1] = w[:, 2], -w[:, 1], w[:, 0]
-    return out
-
-
 def _tangent_drift(tree, v: np.ndarray, block: np.ndarray) -> None:
     """d(dq)/dt = dv - ad(v) dq, into ``block`` (N, n, n) (the q-q block of A): the right
     perturbation q (+) dq of the derivatives (Pinocchio's dIntegrate: R = R_run exp([dq]x) for
     a ball, d(dq)/dt = dw - w x dq; a free flyer's twist (v_lin, w): -[[w]x, [v_lin]x; 0, [w]x]),
     zero for a number with q_dot = v."""
+    from ..dynamics.regressor import cross_matrix
     from ..dynamics.tree.spherical import ball_slices
 
     for _, _, iv in ball_slices(tree):
-        block[:, iv:iv + 3, iv:iv + 3] = -_cross(v[:, iv:iv + 3])
+        block[:, iv:iv + 3, iv:iv + 3] = -cross_matrix(v[:, iv:iv + 3])
     for iv in _flyers(tree):
-        linear, angular = _cross(v[:, iv:iv + 3]), _cross(v[:, iv + 3:iv + 6])
+        linear, angular = cross_matrix(v[:, iv:iv + 3]), cross_matrix(v[:, iv + 3:iv + 6])
         block[:, iv:iv + 3, iv:iv + 3] = -angular
         block[:, iv:iv + 3, iv + 3:iv + 6] = -linear
         block[:, iv + 3:iv + 6, iv + 3:iv + 6] = -angular
